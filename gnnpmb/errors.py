@@ -1,0 +1,15 @@
+"""User-facing errors: the CLI prints ``str(error)`` as one line and exits non-zero, without a traceback."""
+
+from __future__ import annotations
+
+
+class GnnpmbError(Exception):
+    """Base of every error caused by the user's input (paths, files, names); the message says how to fix it."""
+
+
+class DataError(GnnpmbError):
+    """A dataset, scene or detection file that cannot be used."""
+
+
+class UnknownNameError(GnnpmbError):
+    """An unknown tracker, class, scene or preset name."""

@@ -1,0 +1,301 @@
+"""Introspection events: the contract between trackers and the viewer.
+
+Every tracker emits these, per class and per frame, to an ``EventSink``. The viewer (``viz``) reads only these
+events and ``gnnpmb.types``, never a tracker's internals. Events carry ids, indices and arrays, not tracker objects.
+Costly payloads (covariances, cost matrices) are built only when ``sink.enabled`` is true, so running without a
+sink costs next to nothing.
+
+Array shapes: K tracks (or Bernoullis / Gaussian components), M measurements of the class this frame.
+Measurements are named by their *source index* into the frame's full detection list (``FrameDetections.boxes``).
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from gnnpmb.types import TrackEstimate
+
+
+class AxisKind(enum.Enum):
+    """What a row or column of a cost or marginal matrix stands for."""
+
+    TRACK = "track"  # an existing track / Bernoulli, ref = track id
+    MEASUREMENT = "meas"  # a detection, ref = source index
+    NEW_TRACK = "new"  # "measurement starts a new track (or is clutter)", ref = source index
+    MISSED = "missed"  # "track not detected", ref = track id
+
+
+@dataclass(frozen=True, slots=True)
+class AxisLabel:
+    kind: AxisKind
+    ref: int
+
+    def __str__(self) -> str:
+        return f"{self.kind.value} {self.ref}"
+
+
+class PruneReason(enum.Enum):
+    LOW_EXISTENCE = "existence below pruning threshold"
+    NOT_IN_ANY_HYPOTHESIS = "absent from every kept global hypothesis"
+    MERGED = "merged into another component"
+    LOW_WEIGHT = "mixture weight below pruning threshold"
+    CAPPED = "over the component cap"
+    TRACK_LOGIC = "deleted by track logic"
+
+
+class TrackLogicAction(enum.Enum):
+    TENTATIVE = "tentative"
+    CONFIRMED = "confirmed"
+    DELETED = "deleted"
+
+
+@dataclass(frozen=True, slots=True)
+class FrameStarted:
+    """Emitted by the pipeline before any tracker event of a keyframe."""
+
+    tracker: str
+    frame_index: int
+    sample_token: str
+    timestamp_us: int
+    dt_s: float
+
+
+@dataclass(frozen=True, slots=True)
+class Predicted:
+    """Prior of every track after the motion model (Kalman predict, existence times P_S).
+
+    track_ids: (K,); mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); existence: (K,) (1 for trackers without one).
+    """
+
+    class_name: str
+    track_ids: np.ndarray
+    mean: np.ndarray
+    cov: np.ndarray
+    existence: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class Gated:
+    """Ellipsoidal gating: measurement j is in track k's gate iff (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < threshold.
+
+    track_ids: (K,); meas_indices: (M,) source indices; inside: (K, M) bool; center_xy: (K, 2) predicted
+    measurement H m_k; innovation_cov: (K, 2, 2) S_k; threshold: squared Mahalanobis gate (chi-square value).
+    """
+
+    class_name: str
+    track_ids: np.ndarray
+    meas_indices: np.ndarray
+    inside: np.ndarray
+    center_xy: np.ndarray
+    innovation_cov: np.ndarray
+    threshold: float
+
+
+@dataclass(frozen=True, slots=True)
+class CostMatrix:
+    """An assignment cost matrix with the meaning of every row and column.
+
+    cost: (R, C) float, +inf where an assignment is impossible (outside the gate). For the PMB family rows are
+    measurements and columns are [existing tracks | one new-track column per measurement]; entries are negative
+    log-likelihood ratios against the track being missed (paper eq. for the PMB update).
+    hypothesis: index of the global hypothesis the matrix belongs to (0 for single-hypothesis trackers).
+    """
+
+    class_name: str
+    cost: np.ndarray
+    rows: tuple[AxisLabel, ...]
+    cols: tuple[AxisLabel, ...]
+    hypothesis: int = 0
+    description: str = "negative log-likelihood ratio"
+
+
+@dataclass(frozen=True, slots=True)
+class Assignment:
+    """The chosen association: pairs of (row, col) labels from the cost matrix and the total cost.
+
+    missed_track_ids: tracks associated with no measurement this frame.
+    """
+
+    class_name: str
+    pairs: tuple[tuple[AxisLabel, AxisLabel], ...]
+    total_cost: float
+    missed_track_ids: tuple[int, ...]
+    hypothesis: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class Born:
+    """New tracks (Bernoullis) created from measurements.
+
+    track_ids: (B,); meas_indices: (B,) source index of the creating measurement; mean: (B, 4);
+    existence: (B,) initial existence probability.
+    """
+
+    class_name: str
+    track_ids: np.ndarray
+    meas_indices: np.ndarray
+    mean: np.ndarray
+    existence: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class Posterior:
+    """Every track after the update: mean (K, 4), cov (K, 4, 4), existence (K,) in [0, 1]."""
+
+    class_name: str
+    track_ids: np.ndarray
+    mean: np.ndarray
+    cov: np.ndarray
+    existence: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class Pruned:
+    """A track or component removed: why, and the existence (or weight) it last had."""
+
+    class_name: str
+    track_id: int
+    reason: PruneReason
+    last_existence: float
+
+
+@dataclass(frozen=True, slots=True)
+class Extracted:
+    """The tracker's output for the frame (state extraction)."""
+
+    class_name: str
+    estimates: tuple[TrackEstimate, ...]
+    threshold: float
+
+
+@dataclass(frozen=True, slots=True)
+class GlobalHypotheses:
+    """PMBM global hypotheses after the update: log_weights (H,) normalised (logsumexp = 0), sorted descending;
+    members[h] the track ids present in hypothesis h; local[h] the single-target hypothesis key of each member."""
+
+    class_name: str
+    log_weights: np.ndarray
+    members: tuple[tuple[int, ...], ...]
+    local: tuple[tuple[int, ...], ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Marginals:
+    """Marginal association probabilities (TO-PMB, JPDA): probs (R, C), rows sum to 1 over their columns.
+
+    method: "lbp" (loopy belief propagation), "exact" (enumeration) or similar; iterations used.
+    """
+
+    class_name: str
+    probs: np.ndarray
+    rows: tuple[AxisLabel, ...]
+    cols: tuple[AxisLabel, ...]
+    method: str
+    iterations: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class Merged:
+    """Components merged into one (moment matching): into_id absorbed from_ids with weights (coalescence shows here)."""
+
+    class_name: str
+    into_id: int
+    from_ids: tuple[int, ...]
+    weights: tuple[float, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Cardinality:
+    """CPHD cardinality distribution: pmf[n] = P(n targets), n = 0..len(pmf)-1."""
+
+    class_name: str
+    pmf: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class IntensityWeights:
+    """GM-PHD / CPHD intensity: component labels (K,) and weights (K,) after update and pruning."""
+
+    class_name: str
+    labels: np.ndarray
+    weights: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class TrackLogic:
+    """An M/N track-logic transition (GNN, JPDA): hits in the last `window` frames."""
+
+    class_name: str
+    track_id: int
+    action: TrackLogicAction
+    hits: int
+    window: int
+
+
+Event = (
+    FrameStarted
+    | Predicted
+    | Gated
+    | CostMatrix
+    | Assignment
+    | Born
+    | Posterior
+    | Pruned
+    | Extracted
+    | GlobalHypotheses
+    | Marginals
+    | Merged
+    | Cardinality
+    | IntensityWeights
+    | TrackLogic
+)
+
+
+@runtime_checkable
+class EventSink(Protocol):
+    """Receives events. Trackers build costly payloads only when ``enabled`` is true."""
+
+    enabled: bool
+
+    def emit(self, event: Event) -> None: ...
+
+
+class NullSink:
+    """Discards everything; trackers skip building payloads."""
+
+    enabled = False
+
+    def emit(self, event: Event) -> None:
+        return None
+
+
+class ListSink:
+    """Keeps every event in order (tests, batch analysis)."""
+
+    enabled = True
+
+    def __init__(self) -> None:
+        self.events: list[Event] = []
+
+    def emit(self, event: Event) -> None:
+        self.events.append(event)
+
+    def of_type(self, kind: type) -> list:
+        return [e for e in self.events if isinstance(e, kind)]
+
+
+class TeeSink:
+    """Forwards every event to several sinks; enabled if any of them is."""
+
+    def __init__(self, *sinks: EventSink) -> None:
+        self.sinks = sinks
+        self.enabled = any(s.enabled for s in sinks)
+
+    def emit(self, event: Event) -> None:
+        for s in self.sinks:
+            if s.enabled:
+                s.emit(event)

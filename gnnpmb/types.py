@@ -1,0 +1,156 @@
+"""Plain data shared by data loading, trackers, evaluation and the viewer.
+
+Conventions: every position is in the nuScenes *global* frame unless a name says otherwise; sizes follow the
+devkit's (width, length, height) order; quaternions are (w, x, y, z) like the devkit. Arrays are struct-of-arrays
+so a tracker can vectorise over all boxes of a class.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+TRACKING_CLASSES: tuple[str, ...] = ("bicycle", "bus", "car", "motorcycle", "pedestrian", "trailer", "truck")
+"""The seven nuScenes tracking classes, in the devkit's (alphabetical) order."""
+
+STATE_DIM = 4
+"""Tracker state [x, y, vx, vy] (metres, metres per second, global frame)."""
+MEAS_DIM = 2
+"""Measurement [x, y]: the BEV centre of a detection box."""
+
+
+@dataclass(frozen=True, slots=True)
+class Boxes:
+    """N 3D boxes in the global frame (detections or ground truth), struct-of-arrays.
+
+    translation_m: (N, 3) box centres; size_wlh_m: (N, 3); quat_wxyz: (N, 4); velocity_mps: (N, 2) BEV velocity;
+    score: (N,) detection score in [0, 1] (1 for ground truth); class_name: (N,) tracking class names;
+    instance_id: (N,) ground-truth instance token (empty strings for detections).
+    """
+
+    translation_m: np.ndarray
+    size_wlh_m: np.ndarray
+    quat_wxyz: np.ndarray
+    velocity_mps: np.ndarray
+    score: np.ndarray
+    class_name: np.ndarray
+    instance_id: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.translation_m.shape[0])
+
+    @property
+    def xy(self) -> np.ndarray:
+        """(N, 2) BEV centres: the tracker's measurements."""
+        return self.translation_m[:, :2]
+
+    def subset(self, index: np.ndarray) -> Boxes:
+        """Boxes selected by an integer or boolean index."""
+        return Boxes(
+            translation_m=self.translation_m[index],
+            size_wlh_m=self.size_wlh_m[index],
+            quat_wxyz=self.quat_wxyz[index],
+            velocity_mps=self.velocity_mps[index],
+            score=self.score[index],
+            class_name=self.class_name[index],
+            instance_id=self.instance_id[index],
+        )
+
+    @staticmethod
+    def empty() -> Boxes:
+        return Boxes(
+            translation_m=np.zeros((0, 3)),
+            size_wlh_m=np.zeros((0, 3)),
+            quat_wxyz=np.zeros((0, 4)),
+            velocity_mps=np.zeros((0, 2)),
+            score=np.zeros(0),
+            class_name=np.zeros(0, dtype=object),
+            instance_id=np.zeros(0, dtype=object),
+        )
+
+    @staticmethod
+    def concatenate(parts: list[Boxes]) -> Boxes:
+        parts = [p for p in parts if len(p)]
+        if not parts:
+            return Boxes.empty()
+        return Boxes(
+            translation_m=np.concatenate([p.translation_m for p in parts]),
+            size_wlh_m=np.concatenate([p.size_wlh_m for p in parts]),
+            quat_wxyz=np.concatenate([p.quat_wxyz for p in parts]),
+            velocity_mps=np.concatenate([p.velocity_mps for p in parts]),
+            score=np.concatenate([p.score for p in parts]),
+            class_name=np.concatenate([p.class_name for p in parts]),
+            instance_id=np.concatenate([p.instance_id for p in parts]),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Measurements:
+    """The detections of one class in one frame, as a tracker sees them.
+
+    boxes: the kept detection boxes of this class (M boxes); source_index: (M,) index of each into the frame's full
+    detection list (``FrameDetections.boxes``), so events name measurements the viewer can find again.
+    """
+
+    boxes: Boxes
+    source_index: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.boxes)
+
+    @property
+    def z(self) -> np.ndarray:
+        """(M, 2) measurement vectors [x, y]."""
+        return self.boxes.xy
+
+
+@dataclass(frozen=True, slots=True)
+class FrameDetections:
+    """All detections of one keyframe and what preprocessing did to them.
+
+    boxes: every detection in the input (all classes); kept: (N,) bool, passed score threshold and NMS;
+    below_threshold: (N,) bool; suppressed_by_nms: (N,) bool.
+    """
+
+    boxes: Boxes
+    kept: np.ndarray
+    below_threshold: np.ndarray
+    suppressed_by_nms: np.ndarray
+
+    def measurements(self, class_name: str) -> Measurements:
+        idx = np.flatnonzero(self.kept & (self.boxes.class_name == class_name))
+        return Measurements(boxes=self.boxes.subset(idx), source_index=idx)
+
+
+@dataclass(frozen=True, slots=True)
+class TrackEstimate:
+    """One extracted track: the tracker's output box for one frame.
+
+    x, y, vx, vy are filtered; z, size and rotation come from the last associated detection (paper sec. V-B).
+    score is the tracking score written to the submission (the associated detection's score);
+    existence is the Bernoulli existence probability (1 for trackers without one); meas_index is the source index
+    of the detection associated this frame, or -1 when the track was not detected.
+    """
+
+    track_id: int
+    class_name: str
+    translation_m: tuple[float, float, float]
+    size_wlh_m: tuple[float, float, float]
+    quat_wxyz: tuple[float, float, float, float]
+    velocity_mps: tuple[float, float]
+    score: float
+    existence: float
+    meas_index: int = -1
+
+
+@dataclass(slots=True)
+class IdAllocator:
+    """Hands out track ids that are unique across classes, deterministically (1, 2, 3, ...)."""
+
+    next_id: int = 1
+
+    def allocate(self) -> int:
+        track_id = self.next_id
+        self.next_id += 1
+        return track_id
