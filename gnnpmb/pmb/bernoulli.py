@@ -1,0 +1,114 @@
+"""Multi-Bernoulli components: K potential targets, each existing with probability r and Gaussian state.
+
+A Bernoulli density f(X) = 1 - r if X is empty, r N(x; m, P) if X = {x} (Williams 2015; García-Fernández,
+Williams, Granström & Svensson 2018, sec. II). Besides the filtered [x, y, vx, vy], each Bernoulli carries the
+box fields of the last detection associated with it (z, size, rotation) and that detection's score, which is
+both the tracking score and the P_D used when the track is missed (paper sec. V-B).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from gnnpmb.kalman import MotionModel, predict
+
+
+@dataclass(frozen=True, slots=True)
+class Bernoullis:
+    """K Bernoulli components, struct-of-arrays.
+
+    track_id: (K,) int, the track label (metadata, kept through updates);
+    local_key: (K,) int64, identifies the single-target hypothesis (equal keys = identical component; PMBM);
+    existence: (K,) r in [0, 1]; mean: (K, 4); cov: (K, 4, 4);
+    score: (K,) last associated detection score; z_m: (K,); size_wlh_m: (K, 3); quat_wxyz: (K, 4);
+    meas_index: (K,) source index of the detection associated in the latest update, -1 if missed.
+    """
+
+    track_id: np.ndarray
+    local_key: np.ndarray
+    existence: np.ndarray
+    mean: np.ndarray
+    cov: np.ndarray
+    score: np.ndarray
+    z_m: np.ndarray
+    size_wlh_m: np.ndarray
+    quat_wxyz: np.ndarray
+    meas_index: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.track_id.shape[0])
+
+    @staticmethod
+    def empty() -> Bernoullis:
+        return Bernoullis(
+            track_id=np.zeros(0, dtype=np.int64),
+            local_key=np.zeros(0, dtype=np.int64),
+            existence=np.zeros(0),
+            mean=np.zeros((0, 4)),
+            cov=np.zeros((0, 4, 4)),
+            score=np.zeros(0),
+            z_m=np.zeros(0),
+            size_wlh_m=np.zeros((0, 3)),
+            quat_wxyz=np.zeros((0, 4)),
+            meas_index=np.zeros(0, dtype=np.int64),
+        )
+
+    def subset(self, index: np.ndarray) -> Bernoullis:
+        return Bernoullis(
+            track_id=self.track_id[index],
+            local_key=self.local_key[index],
+            existence=self.existence[index],
+            mean=self.mean[index],
+            cov=self.cov[index],
+            score=self.score[index],
+            z_m=self.z_m[index],
+            size_wlh_m=self.size_wlh_m[index],
+            quat_wxyz=self.quat_wxyz[index],
+            meas_index=self.meas_index[index],
+        )
+
+    @staticmethod
+    def concatenate(parts: list[Bernoullis]) -> Bernoullis:
+        parts = [p for p in parts if len(p)]
+        if not parts:
+            return Bernoullis.empty()
+        if len(parts) == 1:
+            return parts[0]
+        return Bernoullis(
+            track_id=np.concatenate([p.track_id for p in parts]),
+            local_key=np.concatenate([p.local_key for p in parts]),
+            existence=np.concatenate([p.existence for p in parts]),
+            mean=np.concatenate([p.mean for p in parts]),
+            cov=np.concatenate([p.cov for p in parts]),
+            score=np.concatenate([p.score for p in parts]),
+            z_m=np.concatenate([p.z_m for p in parts]),
+            size_wlh_m=np.concatenate([p.size_wlh_m for p in parts]),
+            quat_wxyz=np.concatenate([p.quat_wxyz for p in parts]),
+            meas_index=np.concatenate([p.meas_index for p in parts]),
+        )
+
+
+def predict_bernoullis(b: Bernoullis, model: MotionModel, p_survive: float) -> Bernoullis:
+    """Prediction: r' = P_S r, (m', P') = Kalman predict (García-Fernández et al. 2018, eq. 8-9)."""
+    if not len(b):
+        return b
+    mean, cov = predict(b.mean, b.cov, model)
+    return replace(
+        b,
+        existence=p_survive * b.existence,
+        mean=mean,
+        cov=cov,
+        meas_index=np.full(len(b), -1, dtype=np.int64),
+    )
+
+
+def missed_update(existence: np.ndarray, p_detect: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Misdetection hypothesis of each Bernoulli (García-Fernández et al. 2018, eq. 12):
+    weight l_0 = 1 - r P_D, posterior existence r' = r (1 - P_D) / l_0; the state is unchanged.
+
+    Returns (log l_0 (K,), r' (K,)).
+    """
+    l0 = 1.0 - existence * p_detect
+    return np.log(l0), existence * (1.0 - p_detect) / l0

@@ -1,0 +1,284 @@
+"""The shared Poisson multi-Bernoulli (mixture) core: predict, gate, cost, *strategy*, update, prune, extract.
+
+GNN-PMB, PMBM and TO-PMB differ only in how the strategy manages data-association hypotheses (paper sec. III-IV):
+``strategy.BestAssignment`` keeps the single best global hypothesis (GNN-PMB), ``pmbm.KBest`` keeps up to N_h
+(PMBM, Murty), ``topmb.Marginals`` merges every local hypothesis by its marginal probability (TO-PMB, LBP).
+Everything else in a frame is this module, per class:
+
+1. predict every hypothesis' Bernoullis (``bernoulli.predict_bernoullis``);
+2. birth intensity at this frame's detections and new-track hypotheses (``poisson``);
+3. per hypothesis: gate and local hypothesis likelihoods, cost matrix (``cost``);
+4. the strategy turns prior hypotheses + local hypotheses into posterior hypotheses;
+5. prune Bernoullis with r below the threshold, and tracks absent from every hypothesis;
+6. extract tracks with r >= the extraction threshold from the most likely hypothesis (paper Table II).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from gnnpmb.config import TrackerConfig
+from gnnpmb.events import (
+    AxisLabel,
+    Born,
+    CostMatrix,
+    EventSink,
+    Extracted,
+    Gated,
+    Posterior,
+    Predicted,
+    Pruned,
+    PruneReason,
+)
+from gnnpmb.kalman import cv_model
+from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
+from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
+from gnnpmb.pmb.poisson import measurement_birth, new_track_hypotheses
+from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
+
+
+@dataclass(frozen=True, slots=True)
+class GlobalHypothesis:
+    """One global data-association hypothesis: its log weight and the Bernoullis it contains."""
+
+    log_weight: float
+    bernoullis: Bernoullis
+
+
+_MASK63 = np.uint64((1 << 63) - 1)
+
+
+def combine_keys(parent: np.ndarray, outcome: np.ndarray) -> np.ndarray:
+    """Deterministic 63-bit key of a child single-target hypothesis from its parent key and outcome
+    (0 = missed, j + 1 = detected by local measurement j; new tracks use a negative parent). SplitMix64 finaliser."""
+    with np.errstate(over="ignore"):
+        x = parent.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15) + outcome.astype(np.uint64)
+        x ^= x >> np.uint64(30)
+        x *= np.uint64(0xBF58476D1CE4E5B9)
+        x ^= x >> np.uint64(27)
+        x *= np.uint64(0x94D049BB133111EB)
+        x ^= x >> np.uint64(31)
+    return (x & _MASK63).astype(np.int64)
+
+
+@dataclass(slots=True)
+class UpdateContext:
+    """What a strategy needs besides the hypotheses: the class, the sink, and lazily allocated birth ids.
+
+    ``birth_id(j)`` gives the track id of the Bernoulli started by local measurement j; the same j always gets the
+    same id within a frame (so every hypothesis agrees), and ids are allocated in the order first asked for.
+    """
+
+    class_name: str
+    sink: EventSink
+    ids: IdAllocator
+    frame_serial: int
+    _birth_ids: dict[int, int] = field(default_factory=dict)
+
+    def birth_id(self, j: int) -> int:
+        if j not in self._birth_ids:
+            self._birth_ids[j] = self.ids.allocate()
+        return self._birth_ids[j]
+
+    @property
+    def born_ids(self) -> dict[int, int]:
+        """Local measurement index -> track id of the births allocated this frame."""
+        return dict(self._birth_ids)
+
+
+class HypothesisStrategy(Protocol):
+    """Data-association hypothesis management: the only thing that differs across GNN-PMB, PMBM and TO-PMB."""
+
+    name: str
+
+    def update(
+        self, priors: list[GlobalHypothesis], locals_: list[LocalHypotheses], ctx: UpdateContext
+    ) -> list[GlobalHypothesis]:
+        """Posterior hypotheses, sorted by decreasing weight, log weights normalised (logsumexp = 0)."""
+        ...
+
+
+def posterior_from_assignment(local: LocalHypotheses, col_of_row: np.ndarray, ctx: UpdateContext) -> Bernoullis:
+    """Bernoullis of the posterior hypothesis that follows one assignment of measurements to columns
+    (``cost.LocalHypotheses.cost_matrix``): detected tracks get r = 1 and the Kalman update, missed tracks the
+    misdetection update, measurements on their new-track column start a Bernoulli (module ``cost`` docstring)."""
+    prior, meas = local.prior, local.meas
+    k, m = local.n_tracks, local.n_meas
+    meas_of_track = np.full(k, -1, dtype=np.int64)
+    on_track = col_of_row < k
+    meas_of_track[col_of_row[on_track]] = np.flatnonzero(on_track)
+    det_k = np.flatnonzero(meas_of_track >= 0)
+    det_j = meas_of_track[det_k]
+
+    existence = local.miss_existence.copy()
+    existence[det_k] = 1.0
+    mean = prior.mean.copy()
+    mean[det_k] = detected_means(local, det_k, det_j)
+    cov = prior.cov.copy()
+    cov[det_k] = local.inn.cov_post[det_k]
+    boxes = meas.boxes
+    score, z_m = prior.score.copy(), prior.z_m.copy()
+    size, quat = prior.size_wlh_m.copy(), prior.quat_wxyz.copy()
+    score[det_k] = boxes.score[det_j]
+    z_m[det_k] = boxes.translation_m[det_j, 2]
+    size[det_k] = boxes.size_wlh_m[det_j]
+    quat[det_k] = boxes.quat_wxyz[det_j]
+    meas_index = np.full(k, -1, dtype=np.int64)
+    meas_index[det_k] = meas.source_index[det_j]
+    tracks = Bernoullis(
+        track_id=prior.track_id,
+        local_key=combine_keys(prior.local_key, meas_of_track + 1),
+        existence=existence,
+        mean=mean,
+        cov=cov,
+        score=score,
+        z_m=z_m,
+        size_wlh_m=size,
+        quat_wxyz=quat,
+        meas_index=meas_index,
+    )
+    new_j = np.flatnonzero(col_of_row == k + np.arange(m))
+    return Bernoullis.concatenate([tracks, new_bernoullis(local, new_j, ctx)])
+
+
+def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext) -> Bernoullis:
+    """The Bernoullis started by local measurements ``new_j`` (existence r_j from ``poisson``)."""
+    if len(new_j) == 0:
+        return Bernoullis.empty()
+    boxes, new = local.meas.boxes, local.new
+    return Bernoullis(
+        track_id=np.array([ctx.birth_id(int(j)) for j in new_j], dtype=np.int64),
+        local_key=combine_keys(np.full(len(new_j), -ctx.frame_serial), new_j + 1),
+        existence=new.existence[new_j],
+        mean=new.mean[new_j],
+        cov=new.cov[new_j],
+        score=boxes.score[new_j],
+        z_m=boxes.translation_m[new_j, 2],
+        size_wlh_m=boxes.size_wlh_m[new_j],
+        quat_wxyz=boxes.quat_wxyz[new_j],
+        meas_index=local.meas.source_index[new_j],
+    )
+
+
+def assignment_pairs(
+    local: LocalHypotheses, col_of_row: np.ndarray
+) -> tuple[tuple[tuple[AxisLabel, AxisLabel], ...], tuple[int, ...]]:
+    """(row label, column label) of every assigned measurement, and the ids of tracks left undetected."""
+    rows, cols = local.row_labels(), local.col_labels()
+    pairs = tuple((rows[j], cols[int(c)]) for j, c in enumerate(col_of_row))
+    detected = set(int(c) for c in col_of_row if c < local.n_tracks)
+    missed = tuple(int(t) for i, t in enumerate(local.prior.track_id) if i not in detected)
+    return pairs, missed
+
+
+def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
+    """Track id -> its largest existence probability over the hypotheses."""
+    out: dict[int, float] = {}
+    for h in hypotheses:
+        for t, r in zip(h.bernoullis.track_id.tolist(), h.bernoullis.existence.tolist(), strict=True):
+            out[t] = max(r, out.get(t, 0.0))
+    return out
+
+
+class PmbCore:
+    """One class's PMB / PMBM filter; ``strategy`` decides the hypothesis management (module docstring)."""
+
+    def __init__(self, class_name: str, config: TrackerConfig, strategy: HypothesisStrategy, ids: IdAllocator):
+        self.class_name = class_name
+        self.config = config
+        self.params = config.pmb
+        self.class_params = config.for_class(class_name)
+        self.strategy = strategy
+        self.ids = ids
+        self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty())]
+        self.frame_serial = 0
+
+    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
+        """Process one frame of this class's measurements; returns the extracted tracks."""
+        p = self.params
+        self.frame_serial += 1
+        model = cv_model(dt_s, self.class_params)
+        priors = [
+            GlobalHypothesis(h.log_weight, predict_bernoullis(h.bernoullis, model, p.p_survive))
+            for h in self.hypotheses
+        ]
+        new = new_track_hypotheses(measurement_birth(meas, p), meas, model.R, p.clutter_intensity)
+        locals_ = [local_hypotheses(h.bernoullis, meas, new, model.R, p.gate_chi2) for h in priors]
+        if sink.enabled:
+            self._emit_prior(locals_[0], sink)
+        ctx = UpdateContext(self.class_name, sink, self.ids, self.frame_serial)
+        posteriors = self.strategy.update(priors, locals_, ctx)
+        self.hypotheses = self._prune(priors, posteriors, ctx, sink)
+        best = self.hypotheses[0].bernoullis
+        estimates = self._extract(best)
+        if sink.enabled:
+            self._emit_posterior(best, ctx, estimates, sink)
+        return estimates
+
+    def _prune(
+        self, priors: list[GlobalHypothesis], posteriors: list[GlobalHypothesis], ctx: UpdateContext, sink: EventSink
+    ) -> list[GlobalHypothesis]:
+        """Drop Bernoullis with r < threshold from every hypothesis; report tracks that vanished from all."""
+        threshold = self.params.prune_existence
+        kept = [
+            GlobalHypothesis(h.log_weight, h.bernoullis.subset(h.bernoullis.existence >= threshold))
+            for h in posteriors
+        ]
+        if sink.enabled:
+            posterior_r = _max_existence(posteriors)
+            prior_r = _max_existence(priors)
+            alive = {t for h in kept for t in h.bernoullis.track_id.tolist()}
+            for t in sorted((set(posterior_r) | set(prior_r)) - alive):
+                if t in posterior_r:
+                    sink.emit(Pruned(self.class_name, t, PruneReason.LOW_EXISTENCE, posterior_r[t]))
+                else:
+                    sink.emit(Pruned(self.class_name, t, PruneReason.NOT_IN_ANY_HYPOTHESIS, prior_r[t]))
+        return kept
+
+    def _extract(self, b: Bernoullis) -> list[TrackEstimate]:
+        sel = np.flatnonzero(b.existence >= self.params.extraction_threshold)
+        return [
+            TrackEstimate(
+                track_id=int(b.track_id[i]),
+                class_name=self.class_name,
+                translation_m=(float(b.mean[i, 0]), float(b.mean[i, 1]), float(b.z_m[i])),
+                size_wlh_m=tuple(float(v) for v in b.size_wlh_m[i]),
+                quat_wxyz=tuple(float(v) for v in b.quat_wxyz[i]),
+                velocity_mps=(float(b.mean[i, 2]), float(b.mean[i, 3])),
+                score=float(b.score[i]),
+                existence=float(b.existence[i]),
+                meas_index=int(b.meas_index[i]),
+            )
+            for i in sel
+        ]
+
+    def _emit_prior(self, local: LocalHypotheses, sink: EventSink) -> None:
+        prior = local.prior
+        sink.emit(Predicted(self.class_name, prior.track_id, prior.mean, prior.cov, prior.existence))
+        sink.emit(
+            Gated(
+                self.class_name,
+                track_ids=prior.track_id,
+                meas_indices=local.meas.source_index,
+                inside=local.inside,
+                center_xy=local.inn.z_pred,
+                innovation_cov=local.inn.S,
+                threshold=self.params.gate_chi2,
+            )
+        )
+        sink.emit(CostMatrix(self.class_name, local.cost_matrix(), local.row_labels(), local.col_labels()))
+
+    def _emit_posterior(
+        self, best: Bernoullis, ctx: UpdateContext, estimates: list[TrackEstimate], sink: EventSink
+    ) -> None:
+        born = set(ctx.born_ids.values())
+        sel = np.flatnonzero(np.isin(best.track_id, list(born)))
+        if len(sel):
+            sink.emit(
+                Born(self.class_name, best.track_id[sel], best.meas_index[sel], best.mean[sel], best.existence[sel])
+            )
+        sink.emit(Posterior(self.class_name, best.track_id, best.mean, best.cov, best.existence))
+        sink.emit(Extracted(self.class_name, tuple(estimates), self.params.extraction_threshold))

@@ -1,0 +1,108 @@
+"""Tracker names (the ``--tracker`` values) and how each is built, one instance per class.
+
+Every tracker is a ``ClassTracker``: ``step(measurements, dt_s, sink) -> list[TrackEstimate]``. The PMB family
+shares ``pmb.core.PmbCore`` and differs only in the hypothesis strategy (paper sec. III-IV).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Protocol
+
+from gnnpmb.config import TrackerConfig
+from gnnpmb.errors import UnknownNameError
+from gnnpmb.events import EventSink
+from gnnpmb.types import TRACKING_CLASSES, IdAllocator, Measurements, TrackEstimate
+
+
+class ClassTracker(Protocol):
+    """A single-class multi-object tracker."""
+
+    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]: ...
+
+
+def _gnnpmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    from gnnpmb.pmb.core import PmbCore
+    from gnnpmb.pmb.strategy import BestAssignment
+
+    return PmbCore(class_name, config, BestAssignment(), ids)
+
+
+def _pmbm(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    from gnnpmb.pmb.core import PmbCore
+    from gnnpmb.pmb.pmbm import KBest
+
+    return PmbCore(class_name, config, KBest(config.pmbm), ids)
+
+
+def _topmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    from gnnpmb.pmb.core import PmbCore
+    from gnnpmb.pmb.topmb import Marginals
+
+    return PmbCore(class_name, config, Marginals(config.lbp), ids)
+
+
+def _phd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    from gnnpmb.phd.gmphd import GmPhdTracker
+
+    return GmPhdTracker(class_name, config, ids)
+
+
+def _cphd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    from gnnpmb.phd.cphd import CphdTracker
+
+    return CphdTracker(class_name, config, ids)
+
+
+def _jpda(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    from gnnpmb.vector.jpda import JpdaTracker
+
+    return JpdaTracker(class_name, config, ids)
+
+
+def _gnn(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    from gnnpmb.vector.gnn import GnnTracker
+
+    return GnnTracker(class_name, config, ids)
+
+
+_FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassTracker]] = {
+    "gnnpmb": _gnnpmb,
+    "pmbm": _pmbm,
+    "topmb": _topmb,
+    "phd": _phd,
+    "cphd": _cphd,
+    "jpda": _jpda,
+    "gnn": _gnn,
+}
+
+TRACKER_NAMES: tuple[str, ...] = tuple(_FACTORIES)
+
+TRACKER_DESCRIPTIONS: dict[str, str] = {
+    "gnnpmb": "GNN-PMB: PMB keeping the single best global hypothesis (Hungarian)",
+    "pmbm": "PMBM: up to N_h global hypotheses from Murty's k-best assignments",
+    "topmb": "TO-PMB: track-oriented PMB, marginals by loopy belief propagation",
+    "phd": "GM-PHD: Gaussian-mixture probability hypothesis density filter",
+    "cphd": "GM-CPHD: cardinalised PHD filter",
+    "jpda": "JPDA: joint probabilistic data association with M/N track logic",
+    "gnn": "GNN: global nearest neighbour Kalman trackers with M/N track logic",
+}
+
+
+def check_tracker(name: str) -> str:
+    if name not in _FACTORIES:
+        raise UnknownNameError(f"unknown tracker '{name}'; choose one of: {', '.join(TRACKER_NAMES)}")
+    return name
+
+
+def check_classes(names: list[str]) -> list[str]:
+    bad = [n for n in names if n not in TRACKING_CLASSES]
+    if bad:
+        raise UnknownNameError(f"unknown class '{bad[0]}'; choose from: {', '.join(TRACKING_CLASSES)}")
+    if not names:
+        raise UnknownNameError(f"no classes given; choose from: {', '.join(TRACKING_CLASSES)}")
+    return names
+
+
+def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    return _FACTORIES[check_tracker(name)](class_name, config, ids)
