@@ -2,9 +2,8 @@
 
 State m = [x, y, vx, vy]; measurement z = H m = [x, y]. Motion x_k = F x_{k-1} + w, w ~ N(0, Q) with
 F = [[I, dt I], [0, I]] and Q = diag(q_x, q_y, q_x, q_y) (paper sec. V-B, the authors' per-class values).
-Update: S = H P H^T + R, K = P H^T S^-1, m+ = m + K (z - H m), P+ = (I - K H) P (I - K H)^T + K R K^T
-(Joseph form, keeps P symmetric positive-definite). References: Bar-Shalom, Li & Kirubarajan, "Estimation with
-Applications to Tracking and Navigation", 2001, ch. 5.
+Update: S = H P H^T + R, K = P H^T S^-1, m+ = m + K (z - H m), P+ = P - K S K^T (symmetrised).
+References: Bar-Shalom, Li & Kirubarajan, "Estimation with Applications to Tracking and Navigation", 2001, ch. 5.
 """
 
 from __future__ import annotations
@@ -64,18 +63,27 @@ class Innovation:
 
 
 def innovation(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:
-    """S, S^-1, gain and posterior covariance for (K, 4) means and (K, 4, 4) covariances."""
+    """S, S^-1, gain and posterior covariance for (K, 4) means and (K, 4, 4) covariances.
+
+    S is 2 x 2, so its inverse and determinant are written out (much faster than batched LAPACK calls for the
+    few tracks of one class). P+ = P - K S K^T, symmetrised; it equals the Joseph form for the optimal gain.
+    """
     z_pred = mean[:, :2]
     PHt = cov[:, :, :2]  # P H^T, (K, 4, 2)
-    S = symmetrize(cov[:, :2, :2] + R)
-    S_inv = symmetrize(np.linalg.inv(S))
-    sign, log_det = np.linalg.slogdet(S)
-    if np.any(sign <= 0):
+    S = cov[:, :2, :2] + R
+    s00, s11 = S[:, 0, 0], S[:, 1, 1]
+    s01 = 0.5 * (S[:, 0, 1] + S[:, 1, 0])
+    det = s00 * s11 - s01 * s01
+    if np.any(det <= 0) or np.any(s00 <= 0):
         raise FloatingPointError("innovation covariance is not positive-definite")
+    S = np.empty_like(S)
+    S[:, 0, 0], S[:, 1, 1], S[:, 0, 1], S[:, 1, 0] = s00, s11, s01, s01
+    S_inv = np.empty_like(S)
+    S_inv[:, 0, 0], S_inv[:, 1, 1] = s11 / det, s00 / det
+    S_inv[:, 0, 1] = S_inv[:, 1, 0] = -s01 / det
     gain = PHt @ S_inv
-    IKH = np.eye(4) - gain @ H
-    cov_post = symmetrize(IKH @ cov @ np.swapaxes(IKH, -1, -2) + gain @ R @ np.swapaxes(gain, -1, -2))
-    return Innovation(z_pred=z_pred, S=S, S_inv=S_inv, log_det_S=log_det, gain=gain, cov_post=cov_post)
+    cov_post = symmetrize(cov - gain @ np.swapaxes(PHt, -1, -2))
+    return Innovation(z_pred=z_pred, S=S, S_inv=S_inv, log_det_S=np.log(det), gain=gain, cov_post=cov_post)
 
 
 def residuals(inn: Innovation, z: np.ndarray) -> np.ndarray:

@@ -11,6 +11,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from gnnpmb.config import TrackerConfig
 from gnnpmb.data.preprocess import preprocess
 from gnnpmb.data.scene import Keyframe, SceneData
@@ -52,7 +54,9 @@ def get_detections(scene: SceneData, detections_file: Path | None, detector: str
     if scene.synthetic:
         from gnnpmb.data.demo import CLUTTER_HOTSPOTS
 
-        hotspots = [(h.xy_global, h.radius_m) for h in CLUTTER_HOTSPOTS if h.scene_name == scene.name]
+        hotspots = [
+            (np.asarray(h.xy_global), h.radius_m, h.frames) for h in CLUTTER_HOTSPOTS if h.scene_name == scene.name
+        ]
     return simulate_detections(scene, detector, seed=seed, hotspots=hotspots)
 
 

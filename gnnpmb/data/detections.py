@@ -1,0 +1,246 @@
+"""nuScenes detection submission files: the JSON that CenterPoint, Megvii and PointPillars publish.
+
+Layout: ``{"meta": {...}, "results": {sample_token: [box, ...]}}``, each box
+``{"sample_token", "translation": [x, y, z], "size": [w, l, h], "rotation": [w, x, y, z],
+"velocity": [vx, vy], "detection_name", "detection_score", "attribute_name"}`` in the global frame. The loader
+needs the geometry, ``detection_name`` and ``detection_score``; it does not require ``attribute_name`` or the
+per-box ``sample_token``. A NaN velocity (allowed by the devkit for detectors without velocity) means unknown
+and becomes 0. Only the 7 tracking classes are kept (barrier, traffic_cone and construction_vehicle
+boxes are dropped).
+
+Result files of the full val split are 100-400 MB, so a file is parsed once per process and kept as compact
+arrays per sample, keyed by (path, inode, mtime, size): loading another scene from the same file is instant,
+and a rewritten file is parsed again. A malformed box is reported only when a sample that contains it is
+requested.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections import OrderedDict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gnnpmb.errors import DataError
+from gnnpmb.types import TRACKING_CLASSES, Boxes
+
+DETECTION_CLASSES: tuple[str, ...] = (
+    "barrier",
+    "bicycle",
+    "bus",
+    "car",
+    "construction_vehicle",
+    "motorcycle",
+    "pedestrian",
+    "traffic_cone",
+    "trailer",
+    "truck",
+)
+"""The ten nuScenes detection classes; all but barrier, traffic_cone and construction_vehicle are tracked."""
+
+_VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
+    ("translation", 3),
+    ("size", 3),
+    ("rotation", 4),
+    ("velocity", 2),
+)
+_CACHE_FILES = 2
+"""Parsed files kept in memory (each full-val file takes a few hundred MB as arrays)."""
+
+
+@dataclass(frozen=True, slots=True)
+class _ParsedFile:
+    """One parsed detection file: tracking-class boxes per sample, or the sample's first problem."""
+
+    boxes: dict[str, Boxes]
+    problems: dict[str, str]
+
+
+_cache: OrderedDict[tuple[str, int, int, int], _ParsedFile] = OrderedDict()
+
+
+def _as_floats(value: Any) -> np.ndarray | None:
+    """``value`` as a float array the way the fast path converts it, or None if it cannot be."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return None
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _box_problem(entry: Any) -> str | None:
+    """What is wrong with one box entry, or None."""
+    if not isinstance(entry, dict):
+        return f"is a {type(entry).__name__}, not an object"
+    for name, length in _VECTOR_FIELDS:
+        if name not in entry:
+            return f"has no '{name}' field"
+        value = _as_floats(entry[name])
+        if value is None or value.shape != (length,):
+            return f"field '{name}' must be a list of {length} numbers, got {_short(entry[name])}"
+        if name != "velocity" and not np.isfinite(value).all():
+            return f"field '{name}' has a NaN or infinite value: {_short(entry[name])}"
+    if "detection_name" not in entry:
+        return "has no 'detection_name' field"
+    if entry["detection_name"] not in DETECTION_CLASSES:
+        return f"has detection_name {entry['detection_name']!r}, not a nuScenes detection class"
+    if "detection_score" not in entry:
+        return "has no 'detection_score' field"
+    score = _as_floats(entry["detection_score"])
+    if score is None or score.shape != () or not np.isfinite(score):
+        return f"field 'detection_score' must be a finite number, got {_short(entry['detection_score'])}"
+    if not 0.0 <= float(score) <= 1.0:
+        return f"field 'detection_score' must lie in [0, 1], got {float(score)}"
+    return None
+
+
+def _diagnose(token: str, entries: Any) -> str:
+    """One-line description of the first malformed box of a sample."""
+    if not isinstance(entries, list):
+        return f"results entry of sample {token} is a {type(entries).__name__}, not a list of boxes"
+    for k, entry in enumerate(entries):
+        problem = _box_problem(entry)
+        if problem is not None:
+            return f"box {k} of sample {token} {problem}"
+    return f"the boxes of sample {token} could not be read"
+
+
+def _convert_sample(token: str, entries: Any) -> Boxes | str:
+    """The tracking-class boxes of one sample's entries, or a problem description (checked fully only on the
+    slow path, when the fast vectorised conversion finds something wrong)."""
+    if not isinstance(entries, list):
+        return _diagnose(token, entries)
+    if not entries:
+        return Boxes.empty()
+    n = len(entries)
+    try:
+        names = np.array([e["detection_name"] for e in entries], dtype=object)
+        score = np.array([e["detection_score"] for e in entries], dtype=float)
+        arrays = {name: np.array([e[name] for e in entries], dtype=float) for name, _ in _VECTOR_FIELDS}
+    except (KeyError, TypeError, ValueError):
+        return _diagnose(token, entries)
+    fine = (
+        all(arrays[name].shape == (n, length) for name, length in _VECTOR_FIELDS)
+        and score.shape == (n,)
+        and all(np.isfinite(a).all() for name, a in arrays.items() if name != "velocity")
+        and np.isfinite(score).all()
+        and ((score >= 0.0) & (score <= 1.0)).all()
+        and np.isin(names.astype(str), DETECTION_CLASSES).all()
+    )
+    if not fine:
+        return _diagnose(token, entries)
+    keep = np.flatnonzero(np.isin(names.astype(str), TRACKING_CLASSES))
+    return Boxes(
+        translation_m=arrays["translation"][keep],
+        size_wlh_m=arrays["size"][keep],
+        quat_wxyz=arrays["rotation"][keep],
+        velocity_mps=np.nan_to_num(arrays["velocity"][keep], nan=0.0, posinf=0.0, neginf=0.0),
+        score=score[keep],
+        class_name=names[keep],
+        instance_id=np.full(keep.size, "", dtype=object),
+    )
+
+
+def _parse(path: Path) -> _ParsedFile:
+    try:
+        data = json.loads(path.read_bytes())
+    except json.JSONDecodeError as exc:
+        raise DataError(
+            f"detections file {path} is not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno} "
+            f"(character {exc.pos}); is it truncated? Download or generate it again"
+        ) from None
+    except UnicodeDecodeError as exc:
+        raise DataError(
+            f"detections file {path} is not UTF-8 JSON text (bad byte at position {exc.start}); "
+            "pass a nuScenes detection results .json file"
+        ) from None
+    if not isinstance(data, dict) or "results" not in data:
+        raise DataError(
+            f"detections file {path} has no 'results' object; "
+            "expected a nuScenes detection submission {'meta': ..., 'results': {sample_token: [boxes]}}"
+        )
+    results = data["results"]
+    if not isinstance(results, dict):
+        raise DataError(
+            f"'results' in detections file {path} is a {type(results).__name__}, "
+            "not an object keyed by sample token"
+        )
+    boxes: dict[str, Boxes] = {}
+    problems: dict[str, str] = {}
+    for token in list(results):
+        converted = _convert_sample(token, results.pop(token))
+        if isinstance(converted, Boxes):
+            boxes[token] = converted
+        else:
+            problems[token] = converted
+    return _ParsedFile(boxes=boxes, problems=problems)
+
+
+def _parsed(path: Path) -> _ParsedFile:
+    """The parsed file, from the in-process cache when the file has not changed."""
+    try:
+        st = path.stat()
+    except FileNotFoundError:
+        raise DataError(
+            f"detections file not found: {path}; check the path (or use a simulated detector preset)"
+        ) from None
+    if not path.is_file():
+        raise DataError(f"detections path {path} is not a file; pass a nuScenes detection results .json file")
+    key = (str(path.resolve()), st.st_ino, st.st_mtime_ns, st.st_size)
+    if key in _cache:
+        _cache.move_to_end(key)
+        return _cache[key]
+    parsed = _parse(path)
+    _cache[key] = parsed
+    while len(_cache) > _CACHE_FILES:
+        _cache.popitem(last=False)
+    return parsed
+
+
+def load_detection_file(
+    path: Path, sample_tokens: Sequence[str], scene_name: str | None = None
+) -> dict[str, Boxes]:
+    """Tracking-class detection boxes of exactly ``sample_tokens`` (in that order) from a submission file.
+
+    scene_name only makes error messages clearer. Raises ``DataError`` when the file is missing or malformed,
+    a requested sample has a malformed box, or some requested samples have no entry (an empty list is fine).
+    """
+    path = Path(path)
+    parsed = _parsed(path)
+    missing = [t for t in sample_tokens if t not in parsed.boxes and t not in parsed.problems]
+    if missing:
+        where = f"the {len(sample_tokens)} " + (
+            f"samples of {scene_name}" if scene_name else "requested samples"
+        )
+        raise DataError(
+            f"detections file {path.name} has no boxes entry for {len(missing)} of {where} "
+            f"(first missing: {missing[0]}); is it for another split or version?"
+        )
+    for token in sample_tokens:
+        if token in parsed.problems:
+            raise DataError(f"detections file {path.name}: {parsed.problems[token]}")
+    return {token: parsed.boxes[token] for token in sample_tokens}
+
+
+def write_detection_file(path: Path, submission: dict[str, Any]) -> None:
+    """Write a detection submission as JSON, atomically (temporary file in the same folder, then rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(json.dumps(submission, allow_nan=False, separators=(",", ":")))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -1,0 +1,75 @@
+"""Detection preprocessing before tracking (paper sec. V-B): score threshold, then per-class 3D-IoU NMS.
+
+1. Boxes with ``score < score_threshold`` are dropped (``below_threshold``).
+2. Among the remaining boxes of each class, greedy non-maximum suppression: visit boxes from the highest
+   score down (equal scores: lower input index first, so the result is deterministic); keep a box unless a box
+   kept before it overlaps it with 3D IoU ``> nms_iou_3d`` (``suppressed_by_nms``). Boxes of different classes
+   never suppress each other.
+
+Boxes whose class is not among the tracked ``classes`` are simply not kept: neither ``below_threshold`` nor
+``suppressed_by_nms`` is set for them, so the viewer can tell "not tracked" apart from "filtered out".
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from gnnpmb.config import PreprocessParams
+from gnnpmb.data.boxes3d import iou_3d, overlap_candidates, yaw_from_quat_wxyz
+from gnnpmb.types import Boxes, FrameDetections
+
+
+def nms_3d(boxes: Boxes, iou_threshold: float) -> np.ndarray:
+    """(N,) bool mask of the boxes greedy per-class NMS keeps, suppressing at 3D IoU > ``iou_threshold``."""
+    n = len(boxes)
+    keep = np.ones(n, dtype=bool)
+    if n < 2:
+        return keep
+    t, size = boxes.translation_m, boxes.size_wlh_m
+    i, j = overlap_candidates(t, size, group=boxes.class_name)
+    if i.size == 0:
+        return keep
+    yaw = yaw_from_quat_wxyz(boxes.quat_wxyz)
+    iou = iou_3d(t[i], size[i], yaw[i], t[j], size[j], yaw[j])
+    over = iou > iou_threshold
+    i, j = i[over], j[over]
+    if i.size == 0:
+        return keep
+    # Rank by score descending, then by index; each overlapping pair is directed from better to worse rank.
+    order = np.lexsort((np.arange(n), -boxes.score))
+    rank = np.empty(n, dtype=np.int64)
+    rank[order] = np.arange(n)
+    better = np.where(rank[i] < rank[j], i, j)
+    worse = np.where(rank[i] < rank[j], j, i)
+    by_better = np.argsort(rank[better], kind="stable")
+    better, worse = better[by_better], worse[by_better]
+    # A box's own suppression is final before its pairs are visited: pairs are in order of the better rank.
+    suppressed = np.zeros(n, dtype=bool)
+    for b, w in zip(better.tolist(), worse.tolist(), strict=True):
+        if not suppressed[b]:
+            suppressed[w] = True
+    return ~suppressed
+
+
+def preprocess(
+    boxes: Boxes, params: PreprocessParams, classes: Sequence[str] | None = None
+) -> FrameDetections:
+    """Apply the score threshold and per-class 3D NMS to one frame's N detections.
+
+    classes: the tracked classes; ``None`` tracks every class present. Boxes of other classes are not kept and
+    have neither flag set. Returns the input boxes unchanged with ``kept``, ``below_threshold`` and
+    ``suppressed_by_nms`` (N,) masks.
+    """
+    n = len(boxes)
+    if classes is None:
+        tracked = np.ones(n, dtype=bool)
+    else:
+        tracked = np.isin(boxes.class_name.astype(str), np.asarray(list(classes), dtype=str))
+    below = tracked & (boxes.score < params.score_threshold)
+    candidates = np.flatnonzero(tracked & ~below)
+    suppressed = np.zeros(n, dtype=bool)
+    suppressed[candidates] = ~nms_3d(boxes.subset(candidates), params.nms_iou_3d)
+    kept = tracked & ~below & ~suppressed
+    return FrameDetections(boxes=boxes, kept=kept, below_threshold=below, suppressed_by_nms=suppressed)

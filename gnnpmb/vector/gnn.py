@@ -1,0 +1,115 @@
+"""GNN: global nearest neighbour Kalman tracking with M/N track logic (Blackman & Popoli 1999, ch. 6).
+
+Each frame the single most likely assignment of measurements to tracks is chosen. With a constant detection
+probability P_D and a Poisson clutter intensity kappa, the likelihood of an assignment in which pairs (j, k)
+are associated, the other tracks are missed and the other measurements are clutter (or new objects) is
+
+    prod_(j,k) P_D N(z_j; H m_k, S_k)  *  prod_(missed k) (1 - P_D)  *  prod_(unassigned j) kappa.
+
+Dividing by the assignment with no pairs, prod_k (1 - P_D) prod_j kappa, leaves a product over the pairs
+only, so the best assignment minimises the sum of the pair costs
+
+    C[j, k] = -log [ P_D N(z_j; H m_k, S_k) / ((1 - P_D) kappa) ]     (+inf outside the gate)
+
+over an (M, K + M) matrix augmented with one dummy column per measurement, C[j, K + j] = 0 ("measurement j
+is not assigned to any track": it starts a tentative track; the other dummy entries are +inf). A pair is
+only taken when its likelihood ratio exceeds 1, so leaving a track missed is always possible. Assigned tracks
+get the Kalman update with their measurement; missed tracks keep their prediction. Everything else
+(prediction, gate, births, track logic, output) is ``tracks.VectorTracker``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gnnpmb.assign.hungarian import solve
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, EventSink
+from gnnpmb.kalman import Innovation, log_likelihood
+from gnnpmb.types import Measurements
+from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
+
+COST_DESCRIPTION = "-log[P_D N(z; Hm, S) / ((1 - P_D) kappa)]; new-track column 0 = unassigned"
+
+
+def pair_costs(
+    log_lik: np.ndarray, inside: np.ndarray, p_detect: float, clutter_intensity: float
+) -> np.ndarray:
+    """(M, K) costs C[j, k] (module docstring) from (K, M) log N(z_j; H m_k, S_k) and gate; +inf outside."""
+    offset = np.log(p_detect) - np.log1p(-p_detect) - np.log(clutter_intensity)
+    return np.where(inside, -(log_lik + offset), np.inf).T
+
+
+def best_assignment(cost: np.ndarray) -> tuple[np.ndarray, float]:
+    """Optimal assignment for (M, K) pair costs augmented with the zero-cost dummy columns.
+
+    Returns (track_of_meas (M,) int, -1 = unassigned; total cost). Only rows and columns with a finite pair
+    enter the Hungarian solve, which keeps it small when most measurements are far from every track.
+    """
+    m, _ = cost.shape
+    track_of_meas = np.full(m, -1, dtype=np.int64)
+    finite = np.isfinite(cost)
+    rows, cols = np.flatnonzero(finite.any(axis=1)), np.flatnonzero(finite.any(axis=0))
+    if len(rows) == 0:
+        return track_of_meas, 0.0
+    r, c = len(rows), len(cols)
+    sub = np.full((r, c + r), np.inf)
+    sub[:, :c] = cost[np.ix_(rows, cols)]
+    sub[np.arange(r), c + np.arange(r)] = 0.0
+    col_of_row, total = solve(sub)
+    on_track = col_of_row < c
+    track_of_meas[rows[on_track]] = cols[col_of_row[on_track]]
+    return track_of_meas, total
+
+
+class GnnTracker(VectorTracker):
+    """One class's GNN tracker (module docstring); ``step`` is ``tracks.VectorTracker.step``."""
+
+    def _associate(
+        self,
+        prior: VectorTracks,
+        inn: Innovation,
+        d2: np.ndarray,
+        inside: np.ndarray,
+        meas: Measurements,
+        sink: EventSink,
+    ) -> Association:
+        k, m = inside.shape
+        cost = pair_costs(log_likelihood(inn, d2), inside, self.params.p_detect, self.clutter_intensity)
+        track_of_meas, total = best_assignment(cost)
+        det_j = np.flatnonzero(track_of_meas >= 0)
+        det_k = track_of_meas[det_j]
+        mean, cov = prior.mean.copy(), prior.cov.copy()
+        if len(det_j):
+            nu = meas.z[det_j] - inn.z_pred[det_k]
+            mean[det_k] += np.einsum("pij,pj->pi", inn.gain[det_k], nu)
+            cov[det_k] = inn.cov_post[det_k]
+        meas_of_track = np.full(k, -1, dtype=np.int64)
+        meas_of_track[det_k] = det_j
+        if sink.enabled:
+            self._emit_assignment(prior, meas, cost, track_of_meas, meas_of_track, total, sink)
+        return Association(mean=mean, cov=cov, meas_of_track=meas_of_track, birth=track_of_meas < 0)
+
+    def _emit_assignment(
+        self,
+        prior: VectorTracks,
+        meas: Measurements,
+        cost: np.ndarray,
+        track_of_meas: np.ndarray,
+        meas_of_track: np.ndarray,
+        total: float,
+        sink: EventSink,
+    ) -> None:
+        m, k = cost.shape
+        full = np.full((m, k + m), np.inf)
+        full[:, :k] = cost
+        full[np.arange(m), k + np.arange(m)] = 0.0
+        rows = tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
+        track_cols = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
+        new_cols = tuple(AxisLabel(AxisKind.NEW_TRACK, int(i)) for i in meas.source_index)
+        cols = track_cols + new_cols
+        sink.emit(CostMatrix(self.class_name, full, rows, cols, description=COST_DESCRIPTION))
+        pairs = tuple(
+            (rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist())
+        )
+        missed = tuple(int(t) for t in prior.track_id[meas_of_track < 0])
+        sink.emit(Assignment(self.class_name, pairs, total, missed))

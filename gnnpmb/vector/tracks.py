@@ -1,0 +1,268 @@
+"""The vector track set and the frame loop shared by the vector-type trackers (GNN, JPDA).
+
+A vector-type tracker keeps a fixed list of Kalman tracks, each with an M/N track-logic state, instead of a
+random-finite-set density (Blackman & Popoli 1999, ch. 6; Bar-Shalom, Daum & Huang 2009). Per class and frame:
+
+1. Kalman predict every track (``gnnpmb.kalman``, per-class Q and R);
+2. ellipsoidal gate: d^2_kj = (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < G (``[pmb] gate_chi2``);
+3. data association and state update: the only part that differs (``gnn.GnnTracker``: the single best
+   assignment; ``jpda.JpdaTracker``: marginal association probabilities and the PDA update);
+4. measurements left unassociated start tentative tracks: mean [z_j, v_j] with the detector's velocity v_j,
+   covariance the Kalman update of diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j (``[pmb] birth_pos_std_m``,
+   ``birth_vel_std_mps``), i.e. about R in position;
+5. M/N track logic (``track_logic``) confirms and deletes tracks;
+6. output: the *confirmed* tracks associated with a detection this frame. Coasting tracks (missed, not yet
+   deleted) are kept and predicted but not output: a coasted box drifts from the truth and the nuScenes metric
+   counts it as a false positive, while the same object's next detection resumes the track under its old id.
+
+Output boxes carry the filtered x, y, vx, vy and the associated detection's z, size, rotation and score;
+existence is 1 (vector trackers have no existence probability).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from gnnpmb.config import TrackerConfig
+from gnnpmb.events import Born, EventSink, Extracted, Gated, Posterior, Predicted, Pruned, PruneReason
+from gnnpmb.gating import gate
+from gnnpmb.kalman import Innovation, MotionModel, cv_model, innovation, mahalanobis2, predict
+from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
+from gnnpmb.vector.track_logic import LogicState, advance, emit_transitions
+
+
+@dataclass(frozen=True, slots=True)
+class VectorTracks:
+    """K tracks of one class, struct-of-arrays.
+
+    track_id: (K,) int64; mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); score: (K,) score of the last
+    associated detection; z_m: (K,), size_wlh_m: (K, 3), quat_wxyz: (K, 4) box fields of that detection;
+    meas_index: (K,) source index of the detection associated in the latest frame, -1 if missed; logic: M/N
+    state.
+    """
+
+    track_id: np.ndarray
+    mean: np.ndarray
+    cov: np.ndarray
+    score: np.ndarray
+    z_m: np.ndarray
+    size_wlh_m: np.ndarray
+    quat_wxyz: np.ndarray
+    meas_index: np.ndarray
+    logic: LogicState
+
+    def __len__(self) -> int:
+        return int(self.track_id.shape[0])
+
+    @staticmethod
+    def empty() -> VectorTracks:
+        return VectorTracks(
+            track_id=np.zeros(0, dtype=np.int64),
+            mean=np.zeros((0, 4)),
+            cov=np.zeros((0, 4, 4)),
+            score=np.zeros(0),
+            z_m=np.zeros(0),
+            size_wlh_m=np.zeros((0, 3)),
+            quat_wxyz=np.zeros((0, 4)),
+            meas_index=np.zeros(0, dtype=np.int64),
+            logic=LogicState.empty(),
+        )
+
+    def subset(self, index: np.ndarray) -> VectorTracks:
+        return VectorTracks(
+            track_id=self.track_id[index],
+            mean=self.mean[index],
+            cov=self.cov[index],
+            score=self.score[index],
+            z_m=self.z_m[index],
+            size_wlh_m=self.size_wlh_m[index],
+            quat_wxyz=self.quat_wxyz[index],
+            meas_index=self.meas_index[index],
+            logic=self.logic.subset(index),
+        )
+
+    @staticmethod
+    def concatenate(a: VectorTracks, b: VectorTracks) -> VectorTracks:
+        if not len(b):
+            return a
+        if not len(a):
+            return b
+        return VectorTracks(
+            track_id=np.concatenate([a.track_id, b.track_id]),
+            mean=np.concatenate([a.mean, b.mean]),
+            cov=np.concatenate([a.cov, b.cov]),
+            score=np.concatenate([a.score, b.score]),
+            z_m=np.concatenate([a.z_m, b.z_m]),
+            size_wlh_m=np.concatenate([a.size_wlh_m, b.size_wlh_m]),
+            quat_wxyz=np.concatenate([a.quat_wxyz, b.quat_wxyz]),
+            meas_index=np.concatenate([a.meas_index, b.meas_index]),
+            logic=LogicState.concatenate([a.logic, b.logic]),
+        )
+
+    def predicted(self, model: MotionModel) -> VectorTracks:
+        """Kalman prediction m' = F m, P' = F P F^T + Q; no detection associated yet."""
+        if not len(self):
+            return self
+        mean, cov = predict(self.mean, self.cov, model)
+        return replace(self, mean=mean, cov=cov, meas_index=np.full(len(self), -1, dtype=np.int64))
+
+    def updated(self, assoc: Association, meas: Measurements) -> VectorTracks:
+        """Posterior state from ``assoc``; tracks with a hit take the box fields of their detection."""
+        k = np.flatnonzero(assoc.meas_of_track >= 0)
+        j = assoc.meas_of_track[k]
+        boxes = meas.boxes
+        score, z_m = self.score.copy(), self.z_m.copy()
+        size, quat, meas_index = self.size_wlh_m.copy(), self.quat_wxyz.copy(), self.meas_index.copy()
+        score[k] = boxes.score[j]
+        z_m[k] = boxes.translation_m[j, 2]
+        size[k] = boxes.size_wlh_m[j]
+        quat[k] = boxes.quat_wxyz[j]
+        meas_index[k] = meas.source_index[j]
+        return replace(
+            self,
+            mean=assoc.mean,
+            cov=assoc.cov,
+            score=score,
+            z_m=z_m,
+            size_wlh_m=size,
+            quat_wxyz=quat,
+            meas_index=meas_index,
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Association:
+    """What a data-association step decides for K prior tracks and M measurements.
+
+    mean: (K, 4), cov: (K, 4, 4) posterior states; meas_of_track: (K,) local index of the detection each track
+    is associated with (a *hit*: the track takes its box fields), -1 for a miss; birth: (M,) bool, the
+    measurements that start tentative tracks.
+    """
+
+    mean: np.ndarray
+    cov: np.ndarray
+    meas_of_track: np.ndarray
+    birth: np.ndarray
+
+
+class VectorTracker(ABC):
+    """One class's vector-type tracker; subclasses implement ``_associate`` (module docstring, step 3)."""
+
+    def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
+        self.class_name = class_name
+        self.params = config.vector
+        self.class_params = config.for_class(class_name)
+        self.gate_chi2 = config.pmb.gate_chi2
+        self.clutter_intensity = config.pmb.clutter_intensity
+        self.lbp = config.lbp
+        self.ids = ids
+        self.tracks = VectorTracks.empty()
+        var = np.array([config.pmb.birth_pos_std_m**2] * 2 + [config.pmb.birth_vel_std_mps**2] * 2)
+        R = cv_model(0.0, self.class_params).R
+        self._birth_cov = innovation(np.zeros((1, 4)), np.diag(var)[None], R).cov_post[0]
+
+    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
+        """Process one frame of this class's measurements; returns the confirmed tracks hit this frame."""
+        model = cv_model(dt_s, self.class_params)
+        prior = self.tracks.predicted(model)
+        k, m = len(prior), len(meas)
+        inn = innovation(prior.mean, prior.cov, model.R) if k else _empty_innovation()
+        d2 = mahalanobis2(inn, meas.z) if k and m else np.zeros((k, m))
+        inside = gate(d2, self.gate_chi2)
+        if sink.enabled:
+            self._emit_prior(prior, inn, inside, meas, sink)
+        assoc = self._associate(prior, inn, d2, inside, meas, sink)
+        logic = advance(prior.logic, assoc.meas_of_track >= 0, self.params)
+        posterior = replace(prior.updated(assoc, meas), logic=logic.state)
+        born = self._born(meas, np.flatnonzero(assoc.birth))
+        self.tracks = VectorTracks.concatenate(posterior.subset(~logic.deleted), born)
+        estimates = self._extract(self.tracks)
+        if sink.enabled:
+            if len(born):
+                ones = np.ones(len(born))
+                sink.emit(Born(self.class_name, born.track_id, born.meas_index, born.mean, ones))
+            emit_transitions(self.class_name, prior.track_id, logic, born.track_id, self.params, sink)
+            for t in prior.track_id[logic.deleted].tolist():
+                sink.emit(Pruned(self.class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
+            t = self.tracks
+            sink.emit(Posterior(self.class_name, t.track_id, t.mean, t.cov, np.ones(len(t))))
+            sink.emit(Extracted(self.class_name, tuple(estimates), 1.0))
+        return estimates
+
+    @abstractmethod
+    def _associate(
+        self,
+        prior: VectorTracks,
+        inn: Innovation,
+        d2: np.ndarray,
+        inside: np.ndarray,
+        meas: Measurements,
+        sink: EventSink,
+    ) -> Association:
+        """Data association and state update of the K prior tracks with the M measurements; d2 and inside are
+        (K, M) squared Mahalanobis distances and gate. Emits the association's own events."""
+
+    def _born(self, meas: Measurements, new_j: np.ndarray) -> VectorTracks:
+        """Tentative tracks started by local measurements ``new_j``, ids allocated in measurement order."""
+        b = len(new_j)
+        if b == 0:
+            return VectorTracks.empty()
+        boxes = meas.boxes
+        return VectorTracks(
+            track_id=np.array([self.ids.allocate() for _ in range(b)], dtype=np.int64),
+            mean=np.concatenate([meas.z[new_j], boxes.velocity_mps[new_j]], axis=1),
+            cov=np.broadcast_to(self._birth_cov, (b, 4, 4)).copy(),
+            score=boxes.score[new_j],
+            z_m=boxes.translation_m[new_j, 2],
+            size_wlh_m=boxes.size_wlh_m[new_j],
+            quat_wxyz=boxes.quat_wxyz[new_j],
+            meas_index=meas.source_index[new_j],
+            logic=LogicState.born(b, self.params),
+        )
+
+    def _extract(self, t: VectorTracks) -> list[TrackEstimate]:
+        sel = np.flatnonzero(t.logic.confirmed & (t.meas_index >= 0))
+        return [
+            TrackEstimate(
+                track_id=int(t.track_id[i]),
+                class_name=self.class_name,
+                translation_m=(float(t.mean[i, 0]), float(t.mean[i, 1]), float(t.z_m[i])),
+                size_wlh_m=tuple(float(v) for v in t.size_wlh_m[i]),
+                quat_wxyz=tuple(float(v) for v in t.quat_wxyz[i]),
+                velocity_mps=(float(t.mean[i, 2]), float(t.mean[i, 3])),
+                score=float(t.score[i]),
+                existence=1.0,
+                meas_index=int(t.meas_index[i]),
+            )
+            for i in sel.tolist()
+        ]
+
+    def _emit_prior(
+        self, prior: VectorTracks, inn: Innovation, inside: np.ndarray, meas: Measurements, sink: EventSink
+    ) -> None:
+        sink.emit(Predicted(self.class_name, prior.track_id, prior.mean, prior.cov, np.ones(len(prior))))
+        sink.emit(
+            Gated(
+                self.class_name,
+                track_ids=prior.track_id,
+                meas_indices=meas.source_index,
+                inside=inside,
+                center_xy=inn.z_pred,
+                innovation_cov=inn.S,
+                threshold=self.gate_chi2,
+            )
+        )
+
+
+def _empty_innovation() -> Innovation:
+    return Innovation(
+        z_pred=np.zeros((0, 2)),
+        S=np.zeros((0, 2, 2)),
+        S_inv=np.zeros((0, 2, 2)),
+        log_det_S=np.zeros(0),
+        gain=np.zeros((0, 4, 2)),
+        cov_post=np.zeros((0, 4, 4)),
+    )

@@ -1,0 +1,155 @@
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+
+from gnnpmb.data.detections import load_detection_file, write_detection_file
+from gnnpmb.errors import DataError
+
+
+def box(token: str, name: str = "car", score: float = 0.8, x: float = 1.0) -> dict:
+    return {
+        "sample_token": token,
+        "translation": [x, 2.0, 0.9],
+        "size": [1.9, 4.5, 1.6],
+        "rotation": [math.cos(0.2), 0.0, 0.0, math.sin(0.2)],
+        "velocity": [3.0, -1.0],
+        "detection_name": name,
+        "detection_score": score,
+        "attribute_name": "vehicle.moving",
+    }
+
+
+def submission(results: dict) -> dict:
+    return {"meta": {"use_camera": False, "use_lidar": True}, "results": results}
+
+
+@pytest.fixture
+def det_file(tmp_path):
+    results = {
+        "s0": [box("s0"), box("s0", "barrier", 0.9), box("s0", "pedestrian", 0.3, x=5.0)],
+        "s1": [],
+        "s2": [box("s2", "traffic_cone"), box("s2", "construction_vehicle"), box("s2", "truck", 0.1)],
+        "other": [box("other", "bus")],
+    }
+    path = tmp_path / "dets.json"
+    write_detection_file(path, submission(results))
+    return path
+
+
+def test_loads_requested_samples_and_tracking_classes(det_file):
+    out = load_detection_file(det_file, ["s2", "s0", "s1"])
+    assert list(out) == ["s2", "s0", "s1"]
+    s0 = out["s0"]
+    assert list(s0.class_name) == ["car", "pedestrian"]
+    np.testing.assert_allclose(s0.translation_m, [[1.0, 2.0, 0.9], [5.0, 2.0, 0.9]])
+    np.testing.assert_allclose(s0.size_wlh_m[0], [1.9, 4.5, 1.6])
+    np.testing.assert_allclose(s0.quat_wxyz[0], [math.cos(0.2), 0, 0, math.sin(0.2)])
+    np.testing.assert_allclose(s0.velocity_mps[0], [3.0, -1.0])
+    np.testing.assert_allclose(s0.score, [0.8, 0.3])
+    assert list(s0.instance_id) == ["", ""]
+    assert len(out["s1"]) == 0 and out["s1"].translation_m.shape == (0, 3)
+    assert list(out["s2"].class_name) == ["truck"]
+
+
+def test_parsed_once_and_reparsed_when_rewritten(det_file):
+    first = load_detection_file(det_file, ["s0"])
+    again = load_detection_file(det_file, ["s0", "s1"])
+    assert again["s0"] is first["s0"]
+    write_detection_file(det_file, submission({"s0": [box("s0", "bicycle", 0.5)]}))
+    fresh = load_detection_file(det_file, ["s0"])
+    assert list(fresh["s0"].class_name) == ["bicycle"]
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(DataError, match="detections file not found"):
+        load_detection_file(tmp_path / "nope.json", ["s0"])
+
+
+def test_truncated_json_says_where(tmp_path):
+    path = tmp_path / "cut.json"
+    text = json.dumps(submission({"s0": [box("s0")] * 3}), indent=1)
+    path.write_text(text[: len(text) // 2])
+    with pytest.raises(DataError, match=r"not valid JSON: .* at line \d+, column \d+ .*truncated") as info:
+        load_detection_file(path, ["s0"])
+    assert "\n" not in str(info.value)
+
+
+def test_not_a_submission(tmp_path):
+    path = tmp_path / "x.json"
+    path.write_text(json.dumps({"meta": {}}))
+    with pytest.raises(DataError, match="no 'results' object"):
+        load_detection_file(path, ["s0"])
+    path.write_text(json.dumps({"results": [1, 2]}))
+    with pytest.raises(DataError, match="not an object keyed by sample token"):
+        load_detection_file(path, ["s0"])
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda b: b.pop("size"), "box 1 of sample s0 has no 'size' field"),
+        (
+            lambda b: b.update(rotation=[1.0, 0.0, 0.0]),
+            "box 1 of sample s0 field 'rotation' must be a list of 4",
+        ),
+        (
+            lambda b: b.update(translation=[1.0, float("inf"), 0.0]),
+            "field 'translation' has a NaN or infinite",
+        ),
+        (lambda b: b.update(translation=[1.0, "a", 0.0]), "field 'translation' must be a list of 3 numbers"),
+        (lambda b: b.pop("detection_score"), "box 1 of sample s0 has no 'detection_score' field"),
+        (lambda b: b.update(detection_score=1.5), "'detection_score' must lie in \\[0, 1\\]"),
+        (lambda b: b.update(detection_name="cat"), "detection_name 'cat', not a nuScenes detection class"),
+    ],
+)
+def test_malformed_box_names_sample_and_field(tmp_path, change, message):
+    bad = box("s0")
+    change(bad)
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(submission({"s0": [box("s0"), bad], "s1": []})))
+    with pytest.raises(DataError, match=message):
+        load_detection_file(path, ["s1", "s0"])
+    # A sample that is not requested may be malformed.
+    assert len(load_detection_file(path, ["s1"])["s1"]) == 0
+
+
+def test_nan_velocity_means_unknown_and_becomes_zero(tmp_path):
+    path = tmp_path / "nan_velocity.json"
+    raw = submission({"s0": [box("s0"), box("s0")]})
+    raw["results"]["s0"][0]["velocity"] = [float("nan"), float("nan")]
+    path.write_text(json.dumps(raw))
+    boxes = load_detection_file(path, ["s0"])["s0"]
+    assert boxes.velocity_mps[0].tolist() == [0.0, 0.0]
+    assert np.isfinite(boxes.velocity_mps).all()
+
+
+def test_sample_entry_not_a_list(tmp_path):
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(submission({"s0": {"boxes": []}})))
+    with pytest.raises(DataError, match="results entry of sample s0 is a dict, not a list of boxes"):
+        load_detection_file(path, ["s0"])
+
+
+def test_missing_samples_are_counted(det_file):
+    tokens = ["s0", "x1", "x2", "s1"]
+    with pytest.raises(DataError) as info:
+        load_detection_file(det_file, tokens, scene_name="scene-0103")
+    text = str(info.value)
+    assert "no boxes entry for 2 of the 4 samples of scene-0103" in text
+    assert "first missing: x1" in text and "another split or version" in text
+    with pytest.raises(DataError, match="no boxes entry for 1 of the 1 requested samples"):
+        load_detection_file(det_file, ["zzz"])
+
+
+def test_write_is_atomic_and_leaves_no_temp_files(tmp_path):
+    path = tmp_path / "sub" / "dets.json"
+    write_detection_file(path, submission({"s0": [box("s0")]}))
+    before = path.read_bytes()
+    with pytest.raises(ValueError):
+        write_detection_file(path, submission({"s0": [box("s0", score=float("nan"))]}))
+    assert path.read_bytes() == before
+    assert os.listdir(path.parent) == ["dets.json"]
+    assert json.loads(before)["results"]["s0"][0]["detection_name"] == "car"
