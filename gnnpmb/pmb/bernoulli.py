@@ -108,7 +108,8 @@ def missed_update(existence: np.ndarray, p_detect: np.ndarray) -> tuple[np.ndarr
     """Misdetection hypothesis of each Bernoulli (García-Fernández et al. 2018, eq. 12):
     weight l_0 = 1 - r P_D, posterior existence r' = r (1 - P_D) / l_0; the state is unchanged.
 
-    Returns (log l_0 (K,), r' (K,)).
+    Returns (log l_0 (K,), r' (K,)). P_D is kept below 1 so that a certain track scored 1.0 can still be missed.
     """
+    p_detect = np.minimum(p_detect, 1.0 - 1e-9)
     l0 = 1.0 - existence * p_detect
     return np.log(l0), existence * (1.0 - p_detect) / l0

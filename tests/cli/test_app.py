@@ -1,0 +1,210 @@
+"""``gnnpmb-viz`` end to end on the synthetic demo, and its one-line errors."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from cli.app import app, parse_classes, parse_frames
+from cli.errors import run_app
+from gnnpmb.errors import GnnpmbError, UnknownNameError
+from tests.viz.rrd import at_frame, read_rows
+from viz import paths
+
+SCENE = "scene-0103"
+N_FRAMES = 40
+SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
+
+
+def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    """Run the app in-process: (exit code, stdout, stderr)."""
+    try:
+        run_app(app, argv)
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture(scope="module")
+def full_run(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """scene-0103 with gnnpmb (all defaults) saved to an .rrd; returns the file and stdout."""
+    out = tmp_path_factory.mktemp("e2e") / "x.rrd"
+    stdout = io.StringIO()
+    with contextlib.redirect_stdout(stdout):
+        run_app(app, [SCENE, "--dataroot", str(demo_dataroot), "--save", str(out), "--no-progress"])
+    return out, stdout.getvalue().strip()
+
+
+@pytest.fixture(scope="module")
+def rows(full_run: tuple[Path, str]) -> dict:
+    return read_rows(full_run[0])
+
+
+def test_summary_line(full_run: tuple[Path, str]) -> None:
+    out, summary = full_run
+    assert summary.startswith(f"{SCENE}: {N_FRAMES} frames, gnnpmb ")
+    assert "ms/frame" in summary and summary.endswith(f"saved {out}")
+    assert sorted(p.name for p in out.parent.iterdir()) == ["x.rrd"]
+
+
+def test_sensors_and_ground_truth_on_every_frame(rows: dict) -> None:
+    lidar = [r for r in rows[paths.LIDAR] if not r["static"]]
+    assert [r["frame"] for r in lidar] == list(range(N_FRAMES))
+    assert all(r["Points3D:positions.len"] > 1000 for r in lidar)
+    assert [r["frame"] for r in rows[paths.EGO]] == list(range(N_FRAMES))
+    gt = [r for r in rows[paths.GT] if not r["static"]]
+    assert len(gt) == N_FRAMES and sum(len(r["Boxes3D:centers"]) for r in gt) > N_FRAMES
+    kept = rows[paths.DETECTIONS_KEPT]
+    assert len(kept) == N_FRAMES and sum(len(r["Boxes3D:centers"]) for r in kept) > N_FRAMES
+    assert paths.DETECTIONS_SUPPRESSED in rows
+
+
+def test_tracks_costs_existence_and_events(rows: dict) -> None:
+    car_tracks = rows[paths.tracks("gnnpmb", "car")]
+    boxes = [r for r in car_tracks if "Boxes3D:centers" in r]
+    assert boxes and max(r["frame"] for r in boxes) >= N_FRAMES - 5
+    assert all(label.split()[1] == "car" for r in boxes for label in r["Boxes3D:labels"])
+    cost = rows[paths.cost_matrix("gnnpmb", "car")]
+    assert at_frame(cost, 0) and at_frame(cost, N_FRAMES - 1)
+    assert cost[0]["Tensor:data"][0]["names"][0] == "meas"
+    assert paths.cost_axes("gnnpmb", "car") in rows
+    existence = [p for p in rows if p.startswith(paths.existence_root("gnnpmb") + "/car/")]
+    assert len(existence) >= 5
+    events = rows[paths.events("gnnpmb", "car")]
+    assert {r["frame"] for r in events} >= {0, N_FRAMES - 1}
+    texts = [t for r in events for t in r["TextLog:text"]]
+    assert any(t.startswith("born track") for t in texts)
+    assert any(t.startswith("h0 assignment") for t in texts)
+
+
+def test_installed_script_with_a_detections_file_and_frame_range(demo_dataroot: Path, tmp_path: Path) -> None:
+    """A real process through the console script: --detections (GT boxes as a submission), --frames, --classes."""
+    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+
+    location = resolve_dataroot(demo_dataroot, None)
+    scene = load_scene(open_nuscenes(location), location, SCENE)
+    results = {}
+    for k in scene.keyframes:
+        g = k.gt
+        results[k.sample_token] = [
+            {
+                "sample_token": k.sample_token,
+                "translation": g.translation_m[i].tolist(),
+                "size": g.size_wlh_m[i].tolist(),
+                "rotation": g.quat_wxyz[i].tolist(),
+                "velocity": g.velocity_mps[i].tolist(),
+                "detection_name": str(g.class_name[i]),
+                "detection_score": 0.8,
+                "attribute_name": "",
+            }
+            for i in range(len(g))
+        ]
+    dets = tmp_path / "dets.json"
+    dets.write_text(json.dumps({"meta": {"use_lidar": True}, "results": results}))
+    out = tmp_path / "sub.rrd"
+    argv = [SCENE, "--dataroot", str(demo_dataroot), "--detections", str(dets), "--frames", "2:6"]
+    proc = subprocess.run(
+        [str(SCRIPT), *argv, "--classes", "car,pedestrian", "--save", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "NO_COLOR": "1"},
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().startswith(f"{SCENE}: 4 frames, gnnpmb ")
+    assert "4/4" in proc.stderr  # the progress bar counted the frames
+    rows = read_rows(out)
+    assert [r["frame"] for r in rows[paths.EGO]] == [2, 3, 4, 5]
+    assert {r["frame"] for r in rows[paths.cost_matrix("gnnpmb", "car")]} <= {2, 3, 4, 5}
+    assert not any(p.startswith(paths.tracks("gnnpmb", "bus")) for p in rows)
+    kept = at_frame(rows[paths.DETECTIONS_KEPT], 3)[0]
+    assert kept["Boxes3D:labels"] and set(kept["Boxes3D:labels"]) == {"0.80"}
+
+
+def _truncated_submission(path: Path) -> None:
+    text = json.dumps({"meta": {}, "results": {"tok": [{"translation": [1.0, 2.0, 3.0], "size": [1, 2, 3]}]}})
+    path.write_text(text[: len(text) // 2])
+
+
+def _malformed_submission(path: Path) -> None:
+    path.write_text(json.dumps({"meta": {}, "results": [1, 2, 3]}))
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["scene-9999"], "unknown scene 'scene-9999'; available: scene-0103, scene-0916"),
+        ([SCENE, "--tracker", "kalman"], "unknown tracker 'kalman'; choose one of: gnnpmb, pmbm"),
+        ([SCENE, "--classes", "car,tree"], "unknown class 'tree'; choose from: bicycle"),
+        ([SCENE, "--detector", "yolo"], "unknown detector preset 'yolo'"),
+        ([SCENE, "--frames", "abc"], "bad --frames 'abc': use START:END"),
+        ([SCENE, "--frames", "5:2"], "END must be greater than START"),
+        ([SCENE, "--frames", "30:50"], "--frames 30:50 is outside scene-0103, which has keyframes 0 to 39"),
+        ([SCENE, "--frames", ":0"], "--frames 0:0 selects no keyframes"),
+        ([SCENE, "--params", "missing.toml"], "parameter file not found"),
+        ([SCENE, "--detections", "TRUNCATED"], "detections file"),
+        ([SCENE, "--detections", "MALFORMED"], "detections file"),
+        ([SCENE, "--detections", "missing.json"], "missing.json"),
+    ],
+)
+def test_bad_input_is_one_line_and_leaves_no_recording(
+    argv: list[str], expected: str, demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    _truncated_submission(tmp_path / "truncated.json")
+    _malformed_submission(tmp_path / "malformed.json")
+    argv = [
+        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(a, a)
+        for a in argv
+    ]
+    out = tmp_path / "out" / "x.rrd"
+    out.parent.mkdir()
+    code, stdout, stderr = run([*argv, "--dataroot", str(demo_dataroot), "--save", str(out)], capsys)
+    assert code == 2
+    assert stderr.count("\n") == 1 and stderr.startswith("error: ") and expected in stderr
+    assert "Traceback" not in stderr and stdout == ""
+    assert list(out.parent.iterdir()) == []
+
+
+def test_missing_dataroot_and_bad_save_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run([SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys)
+    assert code == 2 and "does not exist" in err and err.count("\n") == 1
+    code, _, err = run([SCENE, "--save", str(tmp_path / "no" / "x.rrd")], capsys)
+    assert code == 2 and "does not exist; create it first" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_real_process_prints_no_traceback(tmp_path: Path) -> None:
+    proc = subprocess.run(
+        [str(SCRIPT), SCENE, "--tracker", "nope", "--save", str(tmp_path / "x.rrd")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [
+        "error: unknown tracker 'nope'; choose one of: gnnpmb, pmbm, topmb, phd, cphd, jpda, gnn"
+    ]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_parse_frames_and_classes() -> None:
+    assert parse_frames(None) == (None, None)
+    assert parse_frames("3:10") == (3, 10)
+    assert parse_frames(":7") == (None, 7)
+    assert parse_frames("4:") == (4, None)
+    for bad in ["3", "a:b", "-1:4", "1:2:3", "4:4"]:
+        with pytest.raises(GnnpmbError, match="--frames"):
+            parse_frames(bad)
+    assert parse_classes(None)[0] == "bicycle" and len(parse_classes(None)) == 7
+    assert parse_classes(" car, bus ,car") == ("car", "bus")
+    with pytest.raises(UnknownNameError):
+        parse_classes(",")

@@ -1,0 +1,39 @@
+from __future__ import annotations
+
+import numpy as np
+
+from gnnpmb.types import TRACKING_CLASSES
+from viz.colors import CLASS_COLORS, CLASS_IDS, annotation_context, class_colors, class_ids, track_color, track_colors
+
+
+def test_every_class_has_a_distinct_id_and_colour() -> None:
+    assert set(CLASS_IDS) == set(CLASS_COLORS) == set(TRACKING_CLASSES)
+    assert sorted(CLASS_IDS.values()) == list(range(1, 8))
+    assert len(set(CLASS_COLORS.values())) == 7
+    np.testing.assert_array_equal(class_ids(np.array(["car", "bus", "tree"], dtype=object)), [3, 2, 0])
+    rgba = class_colors(np.array(["car", "tree"], dtype=object), alpha=70)
+    np.testing.assert_array_equal(rgba, [[0, 130, 200, 70], [128, 128, 128, 70]])
+
+
+def test_annotation_context_lists_the_seven_classes() -> None:
+    batch = annotation_context().context.as_arrow_array().to_pylist()[0]
+    infos = [c["class_description"]["info"] for c in batch]
+    assert sorted((i["id"], i["label"]) for i in infos) == sorted((i, n) for n, i in CLASS_IDS.items())
+    car = next(i for i in infos if i["label"] == "car")
+    assert car["color"] == (0 << 24) | (130 << 16) | (200 << 8) | 255
+
+
+def test_track_colours_are_a_pure_function_of_the_id() -> None:
+    ids = np.arange(1, 200)
+    a = track_colors(ids)
+    np.testing.assert_array_equal(a, track_colors(ids))
+    np.testing.assert_array_equal(track_colors(ids[::-1]), a[::-1])
+    assert track_color(42) == tuple(int(v) for v in a[41])
+    assert a.dtype == np.uint8 and a.shape == (199, 3)
+
+
+def test_consecutive_ids_are_well_separated() -> None:
+    a = track_colors(np.arange(1, 500)).astype(float)
+    gap = np.linalg.norm(np.diff(a, axis=0), axis=1)
+    assert gap.min() > 60.0
+    assert len({tuple(c) for c in a[:50].astype(int)}) == 50

@@ -1,0 +1,43 @@
+from __future__ import annotations
+
+import pytest
+
+from viz import paths
+
+
+def test_spatial_entities_follow_the_transform_tree() -> None:
+    assert paths.EGO == "world/ego_vehicle"
+    assert paths.LIDAR == "world/ego_vehicle/LIDAR_TOP"
+    assert paths.DETECTIONS_KEPT == "world/detections/kept"
+    assert paths.DETECTIONS_SUPPRESSED == "world/detections/suppressed"
+    assert paths.tracks("gnnpmb", "car") == "world/trackers/gnnpmb/tracks/car"
+    assert paths.gates("pmbm", "bus") == "world/trackers/pmbm/gates/bus"
+    assert paths.failures_world("gnn", "id_switch") == "world/trackers/gnn/failures/id_switch"
+
+
+def test_non_spatial_entities_live_under_the_tracker() -> None:
+    assert paths.cost_matrix("gnnpmb", "car") == "trackers/gnnpmb/cost/car"
+    assert paths.cost_matrix("pmbm", "car", hypothesis=2) == "trackers/pmbm/cost_hypotheses/car/2"
+    assert paths.existence("gnnpmb", "car", 17) == "trackers/gnnpmb/existence/car/17"
+    assert paths.events("jpda", "truck") == "trackers/jpda/events/truck"
+    assert paths.cardinality_pmf("cphd", "car").startswith(paths.cardinality_pmf_root("cphd") + "/")
+    assert paths.intensity_total("phd", "car").startswith(paths.intensity_total_root("phd") + "/")
+
+
+def test_every_tracker_entity_sits_in_its_own_subtree() -> None:
+    """Two trackers never share an entity, so both fit in one recording."""
+    makers = [
+        paths.tracks, paths.predicted, paths.gates, paths.cost_matrix, paths.cost_axes, paths.events, paths.marginals,
+        paths.cardinality_pmf, paths.cardinality_mean, paths.intensity_weights, paths.intensity_total,
+    ]  # fmt: skip
+    a = {m("gnnpmb", "car") for m in makers}
+    b = {m("pmbm", "car") for m in makers}
+    assert len(a) == len(makers) and not a & b
+    for p in a:
+        assert p.startswith((paths.tracker_world("gnnpmb") + "/", paths.tracker_root("gnnpmb") + "/"))
+
+
+@pytest.mark.parametrize("bad", ["", "a/b", " car"])
+def test_bad_segments_are_rejected(bad: str) -> None:
+    with pytest.raises(ValueError, match="segment"):
+        paths.tracks("gnnpmb", bad)

@@ -1,0 +1,87 @@
+"""Fixed class colours (an AnnotationContext at ``/``) and stable, well-separated per-track colours."""
+
+from __future__ import annotations
+
+import numpy as np
+import rerun as rr
+
+from gnnpmb.types import TRACKING_CLASSES
+
+CLASS_COLORS: dict[str, tuple[int, int, int]] = {
+    "bicycle": (230, 25, 75),
+    "bus": (255, 225, 25),
+    "car": (0, 130, 200),
+    "motorcycle": (245, 130, 48),
+    "pedestrian": (60, 180, 75),
+    "trailer": (145, 30, 180),
+    "truck": (70, 240, 240),
+}
+"""One colour per tracking class, fixed so every recording looks the same."""
+
+CLASS_IDS: dict[str, int] = {name: i + 1 for i, name in enumerate(TRACKING_CLASSES)}
+"""Rerun class ids 1..7 in the devkit's class order (0 is left for 'unknown')."""
+
+_GOLDEN = 0.6180339887498949
+_SATURATION = np.array([0.85, 0.6, 0.95])
+_VALUE = np.array([0.95, 0.8, 0.65])
+
+
+def class_ids(class_names: np.ndarray) -> np.ndarray:
+    """(N,) uint16 class ids of (N,) class names; 0 for names outside the tracking classes."""
+    names = np.asarray(class_names, dtype=object)
+    out = np.zeros(names.shape[0], dtype=np.uint16)
+    for name, cid in CLASS_IDS.items():
+        out[names == name] = cid
+    return out
+
+
+def class_colors(class_names: np.ndarray, alpha: int = 255) -> np.ndarray:
+    """(N, 4) uint8 RGBA class colours of (N,) class names (grey for unknown names); alpha < 255 dims them."""
+    names = np.asarray(class_names, dtype=object)
+    out = np.full((names.shape[0], 4), 128, dtype=np.uint8)
+    for name, rgb in CLASS_COLORS.items():
+        out[names == name, :3] = rgb
+    out[:, 3] = alpha
+    return out
+
+
+def annotation_context() -> rr.AnnotationContext:
+    """Class id -> label and colour for every tracking class; log it static at ``/``."""
+    return rr.AnnotationContext(
+        [
+            rr.ClassDescription(info=rr.AnnotationInfo(id=cid, label=name, color=CLASS_COLORS[name]))
+            for name, cid in CLASS_IDS.items()
+        ]
+    )
+
+
+def track_colors(track_ids: np.ndarray) -> np.ndarray:
+    """(N, 3) uint8 RGB colours of (N,) track ids, a pure function of the id.
+
+    Hue steps by the golden ratio per id (consecutive ids land far apart on the colour wheel); saturation and
+    value cycle over three levels so ids with nearby hues still differ in brightness.
+    """
+    ids = np.asarray(track_ids, dtype=np.int64).reshape(-1)
+    h = np.mod(ids * _GOLDEN, 1.0)
+    s = _SATURATION[np.mod(ids, 3)]
+    v = _VALUE[np.mod(ids // 3, 3)]
+    return (_hsv_to_rgb(h, s, v) * 255.0 + 0.5).astype(np.uint8)
+
+
+def pack_rgba(colors: np.ndarray, alpha: int = 255) -> np.ndarray:
+    """(N, 3) RGB or (N, 4) RGBA uint8 -> (N,) uint32 0xRRGGBBAA, the layout Rerun stores (cheapest to log)."""
+    c = np.asarray(colors, dtype=np.uint32).reshape(-1, colors.shape[-1])
+    a = c[:, 3] if c.shape[1] == 4 else np.uint32(alpha)
+    return (c[:, 0] << 24) | (c[:, 1] << 16) | (c[:, 2] << 8) | a
+
+
+def track_color(track_id: int) -> tuple[int, int, int]:
+    """RGB colour of one track id (see ``track_colors``)."""
+    r, g, b = track_colors(np.array([track_id]))[0]
+    return int(r), int(g), int(b)
+
+
+def _hsv_to_rgb(h: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """(N, 3) RGB in [0, 1] from (N,) hue, saturation, value in [0, 1] (standard hexcone model)."""
+    k = np.mod(np.array([5.0, 3.0, 1.0])[None, :] + h[:, None] * 6.0, 6.0)
+    return v[:, None] - v[:, None] * s[:, None] * np.clip(np.minimum(k, 4.0 - k), 0.0, 1.0)
