@@ -47,7 +47,7 @@ def get_detections(scene: SceneData, detections_file: Path | None, detector: str
     if detections_file is not None:
         from gnnpmb.data.detections import load_detection_file
 
-        return load_detection_file(detections_file, scene.sample_tokens)
+        return load_detection_file(detections_file, scene.sample_tokens, scene.name)
     from gnnpmb.data.simdet import simulate_detections
 
     hotspots: list = []

@@ -1,0 +1,279 @@
+"""``gnnpmb``: batch tracking into a nuScenes submission, the official evaluation, and the failure finder.
+
+Commands: ``track`` (every scene of a split -> tracking submission .json), ``eval`` (the devkit's TrackingEval
+on a submission, with our own table), ``failures`` (one scene: which frames and ids the metrics blame) and
+``demo-data`` (write the synthetic demo dataset). User mistakes end with one line on stderr and exit code 2.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import defaultdict
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from cli.errors import entry_point
+from gnnpmb.errors import GnnpmbError
+from gnnpmb.registry import TRACKER_NAMES
+
+if TYPE_CHECKING:
+    from gnnpmb.eval.failures import FailureReport
+
+DEFAULT_DETECTOR = "centerpoint"
+DEFAULT_TRACKER = "gnnpmb"
+_TABLE_WIDTH = 160
+"""Console width when stdout is not a terminal (pipes, tests), so tables are not squeezed to 80 columns."""
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    help="Batch tracking on nuScenes splits, the official tracking evaluation, and the failure finder.",
+)
+
+DatarootOption = Annotated[
+    Path | None, typer.Option(help="nuScenes dataroot (default: $NUSCENES_DATAROOT, else the built-in demo).")
+]
+VersionOption = Annotated[str | None, typer.Option(help="Dataset version folder, e.g. v1.0-mini.")]
+SplitOption = Annotated[
+    str | None,
+    typer.Option(help="Split: mini_val, val, ... or one in <version>/splits.json (default: from --version)."),
+]
+DetectionsOption = Annotated[
+    Path | None, typer.Option(help="nuScenes detection results .json (instead of a simulated detector).")
+]
+DetectorOption = Annotated[
+    str | None,
+    typer.Option(
+        help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR})."
+    ),
+]
+TrackerOption = Annotated[str, typer.Option("--tracker", "-t", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")]
+SeedOption = Annotated[int, typer.Option(help="Seed of the simulated detector.")]
+ParamsOption = Annotated[
+    Path | None, typer.Option(help="Tracker parameter file (.toml) overriding the paper's.")
+]
+
+
+def _stdout() -> Console:
+    console = Console()
+    return console if console.is_terminal else Console(width=_TABLE_WIDTH)
+
+
+def default_split(version: str) -> str:
+    """The evaluation split of a version: mini_val for *mini, test for *test, else val."""
+    if version.endswith("mini"):
+        return "mini_val"
+    if version.endswith("test"):
+        return "test"
+    return "val"
+
+
+def _detector(detections: Path | None, detector: str | None) -> str:
+    """The simulated detector preset to use (checked), refusing --detections together with --detector."""
+    from gnnpmb.data.simdet import get_preset
+
+    if detections is not None and detector is not None:
+        raise GnnpmbError("pass either --detections FILE or --detector PRESET, not both")
+    name = detector or DEFAULT_DETECTOR
+    get_preset(name)
+    return name
+
+
+@app.command()
+def track(
+    out: Annotated[Path, typer.Option(help="Where to write the tracking submission (.json).")],
+    dataroot: DatarootOption = None,
+    version: VersionOption = None,
+    split: SplitOption = None,
+    detections: DetectionsOption = None,
+    detector: DetectorOption = None,
+    tracker: TrackerOption = DEFAULT_TRACKER,
+    seed: SeedOption = 0,
+    params: ParamsOption = None,
+    progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
+) -> None:
+    """Track every scene of a split (all 7 classes) and write a nuScenes tracking submission."""
+    from gnnpmb.config import load_config
+    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot, split_scenes
+    from gnnpmb.eval.nuscenes_eval import check_split_version, split_sample_tokens
+    from gnnpmb.eval.submission import build_submission, run_results, write_submission
+    from gnnpmb.pipeline import get_detections, run_tracker
+    from gnnpmb.registry import check_tracker
+
+    check_tracker(tracker)
+    preset = _detector(detections, detector)
+    config = load_config(params)
+    if detections is not None and not detections.is_file():
+        raise GnnpmbError(f"detections file not found: {detections}")
+    location = resolve_dataroot(dataroot, version)
+    split = split or default_split(location.version)
+    check_split_version(split, location.version)
+    scene_names = split_scenes(split, location)
+    if not scene_names:
+        raise GnnpmbError(f"split {split} has no scenes in {location.dataroot / location.version}")
+    nusc = open_nuscenes(location)
+    tokens = split_sample_tokens(nusc, scene_names)
+
+    parts = []
+    n_frames = n_boxes = 0
+    step_s = 0.0
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        disable=not progress,
+        transient=True,
+    ) as bar:
+        scenes_task = bar.add_task("scenes", total=len(scene_names))
+        frames_task = bar.add_task("frames", total=None)
+        for name in scene_names:
+            scene = load_scene(nusc, location, name)
+            bar.update(frames_task, description=f"{name} frames", total=len(scene.keyframes), completed=0)
+            scene_detections = get_detections(scene, detections, preset, seed)
+            run = run_tracker(
+                scene, scene_detections, tracker, config, on_frame=lambda: bar.advance(frames_task)
+            )
+            results = run_results(run)
+            parts.append(results)
+            n_frames += len(run.frames)
+            n_boxes += sum(len(boxes) for boxes in results.values())
+            step_s += sum(f.step_time_s for f in run.frames)
+            bar.advance(scenes_task)
+    write_submission(out, build_submission(parts, tokens))
+    ms = 1e3 * step_s / max(n_frames, 1)
+    typer.echo(
+        f"{tracker}: {len(scene_names)} scenes of {split}, {n_frames} frames, {n_boxes} boxes, "
+        f"{ms:.1f} ms/frame -> {out}"
+    )
+
+
+@app.command("eval")
+def evaluate(
+    results: Annotated[Path, typer.Argument(help="Tracking submission .json (e.g. from 'gnnpmb track').")],
+    dataroot: DatarootOption = None,
+    version: VersionOption = None,
+    split: SplitOption = None,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            help="Folder for the devkit's metrics files (default: <results>_eval/ next to the file)."
+        ),
+    ] = None,
+) -> None:
+    """Score a tracking submission with the official nuScenes evaluation (tracking_nips_2019)."""
+    from gnnpmb.data.nuscenes import resolve_dataroot
+    from gnnpmb.eval.nuscenes_eval import TABLE_METRICS, evaluate_submission, format_metric
+
+    location = resolve_dataroot(dataroot, version)
+    split = split or default_split(location.version)
+    start = time.perf_counter()
+    scores = evaluate_submission(results, location, split, out)
+    table = Table(title=f"{results.name} on {split} ({location.version})")
+    table.add_column("class")
+    for metric in TABLE_METRICS:
+        table.add_column(metric.upper(), justify="right")
+    for class_name, metrics in scores.per_class.items():
+        table.add_row(class_name, *(format_metric(m, metrics[m]) for m in TABLE_METRICS))
+    table.add_section()
+    table.add_row("overall", *(format_metric(m, scores.overall[m]) for m in TABLE_METRICS), style="bold")
+    console = _stdout()
+    console.print(table)
+    console.print(
+        f"AMOTA {scores.overall['amota']:.3f}; evaluated in {time.perf_counter() - start:.1f} s; "
+        f"metrics in {scores.summary_path}",
+        highlight=False,
+        soft_wrap=True,
+    )
+
+
+@app.command()
+def failures(
+    scene: Annotated[str, typer.Argument(help="Scene name, e.g. scene-0103.")],
+    tracker: TrackerOption = DEFAULT_TRACKER,
+    dataroot: DatarootOption = None,
+    version: VersionOption = None,
+    detections: DetectionsOption = None,
+    detector: DetectorOption = None,
+    seed: SeedOption = 0,
+    params: ParamsOption = None,
+    json_out: Annotated[
+        Path | None, typer.Option("--json", help="Also write the report as JSON here.")
+    ] = None,
+) -> None:
+    """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
+    coalescence and cascading identity theft (scored with the devkit's own matching)."""
+    from gnnpmb.config import load_config
+    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.eval.failures import find_failures
+    from gnnpmb.eval.submission import run_results, write_json
+    from gnnpmb.pipeline import get_detections, run_tracker
+    from gnnpmb.registry import check_tracker
+
+    check_tracker(tracker)
+    preset = _detector(detections, detector)
+    config = load_config(params)
+    location = resolve_dataroot(dataroot, version)
+    nusc = open_nuscenes(location)
+    scene_data = load_scene(nusc, location, scene)
+    run = run_tracker(scene_data, get_detections(scene_data, detections, preset, seed), tracker, config)
+    report = find_failures(nusc, scene, run_results(run), tracker)
+    if json_out is not None:
+        write_json(json_out, report.to_json())
+    print_report(report, _stdout())
+    if json_out is not None:
+        typer.echo(f"report -> {json_out}")
+
+
+def print_report(report: FailureReport, console: Console) -> None:
+    """The failure report as two tables: per class at its best-MOTA threshold, then failures per frame."""
+    from gnnpmb.eval.failures import FailureKind
+    from gnnpmb.eval.nuscenes_eval import format_metric
+
+    classes = Table(
+        title=f"{report.tracker} on {report.scene_name}: devkit counts at the best-MOTA threshold"
+    )
+    for name in ("class", "threshold", "MOTA", "TP", "FP", "FN", "IDS", "FRAG"):
+        classes.add_column(name, justify="left" if name == "class" else "right")
+    for c in report.classes:
+        threshold = "all" if c.threshold is None else f"{c.threshold:.3f}"
+        counts = (format_metric(m, getattr(c, m)) for m in ("tp", "fp", "fn", "ids", "frag"))
+        classes.add_row(c.class_name, threshold, format_metric("mota", c.mota), *counts)
+    console.print(classes)
+
+    grouped: dict[tuple[int, FailureKind], list[str]] = defaultdict(list)
+    for f in report.failures:
+        grouped[(f.frame_index, f.kind)].append(f.describe())
+    rows = Table(title="failures per frame")
+    rows.add_column("frame", justify="right")
+    rows.add_column("kind")
+    rows.add_column("what (GT ids shortened to 6 characters)")
+    for (frame, kind), texts in grouped.items():
+        rows.add_row(str(frame), kind.value, "; ".join(texts))
+    console.print(rows)
+    totals = ", ".join(f"{len(report.of_kind(k))} {k.value}" for k in FailureKind)
+    console.print(f"{report.scene_name}, {report.tracker}: {totals}", highlight=False, soft_wrap=True)
+
+
+@app.command("demo-data")
+def demo_data(
+    out: Annotated[
+        Path, typer.Option(help="Folder to write the demo dataroot into (new, empty or an old demo).")
+    ],
+    seed: Annotated[int, typer.Option(help="Seed of the LiDAR noise.")] = 0,
+) -> None:
+    """Write the synthetic nuScenes-format demo dataset (v1.0-mini, scenes scene-0103 and scene-0916)."""
+    from gnnpmb.data.demo import generate_demo_dataset
+
+    path = generate_demo_dataset(out, seed=seed)
+    typer.echo(f"demo dataset (v1.0-mini, seed {seed}) -> {path}")
+
+
+main = entry_point(app)

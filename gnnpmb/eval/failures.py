@@ -1,0 +1,499 @@
+"""The failure finder: the frames and ids the official metrics blame, and two failure patterns of the paper.
+
+One scene of a tracking submission is prepared exactly as ``TrackingEval`` prepares it (the devkit's loaders:
+class ranges, boxes without points, bike racks, track-averaged scores, interpolation inside tracks). Per
+class, the devkit's ``TrackingEvaluation.accumulate`` picks the recall threshold with the best MOTA, as the
+official MOTA, IDS, FP and FN do; the frames are then fed again through the devkit's own accumulator
+(``MOTAccumulatorCustom.update``: CLEAR-MOT matching, Bernardin & Stiefelhagen 2008, with a 2 m centre
+distance) at that threshold, so every reported event is one the official counts include. The devkit merges its
+per-scene accumulators with renamed ids, hence this replay, which keeps the real ids and frames.
+
+Kinds (one ``Failure`` per event):
+
+* ``id_switch``: a SWITCH event; gt_ids = (object,), track_ids = (old track, new track).
+* ``fragmentation``: an object tracked before and after this frame becomes missed here (the devkit's FRAG);
+  track_ids = (the track it had,).
+* ``false_track``: an FP event (a track box matched to no object); track_ids = (track,).
+* ``miss``: a MISS event (an object no track box covers); gt_ids = (object,).
+* ``coalescence`` (paper sec. I and V-C): one track stands for several close objects of one class: an object
+  is missed while a track matched to another object whose centre is < ``coalescence_radius_m`` away lies
+  within the match distance of it as well; gt_ids = (matched object, missed objects...), track_ids = (track,).
+* ``identity_theft`` (cascading identity theft, paper sec. V-C): a track born on false detections (its first
+  frames are FPs) takes over a real object that another track held, causing the object's ID switch;
+  gt_ids = (object,), track_ids = (thief, victim). The victim, left without its object, may steal the next
+  object in turn: a cascade (``generation`` 2, 3, ...).
+"""
+
+from __future__ import annotations
+
+import enum
+import json
+from collections import defaultdict
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from gnnpmb.errors import DataError
+from gnnpmb.eval.nuscenes_eval import quiet_devkit, scene_sample_tokens, tracking_config
+
+if TYPE_CHECKING:
+    from nuscenes import NuScenes
+    from nuscenes.eval.common.data_classes import EvalBoxes
+    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingConfig
+
+COALESCENCE_RADIUS_M = 2.0
+"""Objects with BEV centres closer than this may be covered by one track (the devkit's match distance)."""
+
+_NOT_EVENTS = frozenset({"RAW", "ASCEND", "TRANSFER", "MIGRATE"})
+"""Bookkeeping rows of the accumulator; the metrics count only MATCH, SWITCH, MISS and FP ("noraw")."""
+
+
+class FailureKind(enum.Enum):
+    ID_SWITCH = "id_switch"
+    FRAGMENTATION = "fragmentation"
+    FALSE_TRACK = "false_track"
+    MISS = "miss"
+    COALESCENCE = "coalescence"
+    IDENTITY_THEFT = "identity_theft"
+
+
+def short_id(object_id: str) -> str:
+    """A short, still distinctive form of an id for tables and labels (first 6 characters of long tokens)."""
+    return object_id if len(object_id) <= 8 else object_id[:6]
+
+
+@dataclass(frozen=True, slots=True)
+class FailureBox:
+    """A box involved in a failure, as the evaluation saw it (ground truth or track, possibly interpolated).
+
+    role: "gt" or "track" plus what it did (e.g. "missed gt", "old track"); object_id: instance token or
+    tracking id; translation_m (3,), size_wlh_m (3,), quat_wxyz (4,) in the global frame.
+    """
+
+    role: str
+    object_id: str
+    translation_m: tuple[float, float, float]
+    size_wlh_m: tuple[float, float, float]
+    quat_wxyz: tuple[float, float, float, float]
+
+    @property
+    def is_gt(self) -> bool:
+        return self.role.endswith("gt")
+
+
+@dataclass(frozen=True, slots=True)
+class Failure:
+    """One failure event at one keyframe (``frame_index`` into the scene's keyframes); see the module
+    docstring for what gt_ids and track_ids hold per kind. generation counts cascade steps of identity theft
+    (else 0)."""
+
+    kind: FailureKind
+    frame_index: int
+    sample_token: str
+    class_name: str
+    gt_ids: tuple[str, ...]
+    track_ids: tuple[str, ...]
+    boxes: tuple[FailureBox, ...]
+    generation: int = 0
+
+    def describe(self) -> str:
+        """One readable line naming the ids."""
+        gt = ", ".join(f"GT {short_id(g)}" for g in self.gt_ids)
+        tracks = [f"track {t}" for t in self.track_ids]
+        match self.kind:
+            case FailureKind.ID_SWITCH:
+                return f"{self.class_name} {gt}: {tracks[0]} -> {tracks[1]}"
+            case FailureKind.FRAGMENTATION:
+                return f"{self.class_name} {gt} lost by {tracks[0]}"
+            case FailureKind.FALSE_TRACK:
+                return f"{self.class_name} {tracks[0]}"
+            case FailureKind.MISS:
+                return f"{self.class_name} {gt}"
+            case FailureKind.COALESCENCE:
+                missed = ", ".join(f"GT {short_id(g)}" for g in self.gt_ids[1:])
+                return (
+                    f"{self.class_name} {tracks[0]} covers GT {short_id(self.gt_ids[0])} and missed {missed}"
+                )
+            case FailureKind.IDENTITY_THEFT:
+                cascade = f" (cascade step {self.generation})" if self.generation > 1 else ""
+                return f"{self.class_name} {tracks[0]} took {gt} from {tracks[1]}{cascade}"
+        raise AssertionError(self.kind)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "kind": self.kind.value,
+            "frame_index": self.frame_index,
+            "sample_token": self.sample_token,
+            "class_name": self.class_name,
+            "gt_ids": list(self.gt_ids),
+            "track_ids": list(self.track_ids),
+            "generation": self.generation,
+            "description": self.describe(),
+            "boxes": [
+                {
+                    "role": b.role,
+                    "id": b.object_id,
+                    "translation": list(b.translation_m),
+                    "size": list(b.size_wlh_m),
+                    "rotation": list(b.quat_wxyz),
+                }
+                for b in self.boxes
+            ],
+        }
+
+
+@dataclass(frozen=True, slots=True)
+class ClassEvaluation:
+    """The devkit's numbers for one class at the best-MOTA recall threshold (score threshold None: no recall
+    level was reached, every box counts). tp, fp, fn, ids, frag are the devkit's own counts (NaN if
+    unknown)."""
+
+    class_name: str
+    threshold: float | None
+    mota: float
+    tp: float
+    fp: float
+    fn: float
+    ids: float
+    frag: float
+
+
+@dataclass(frozen=True, slots=True)
+class FailureReport:
+    """Every failure of one tracker on one scene; sample_tokens (F,) in keyframe order; classes: the evaluated
+    classes (those with ground truth in the scene after the devkit's filters)."""
+
+    scene_name: str
+    tracker: str
+    sample_tokens: tuple[str, ...]
+    classes: tuple[ClassEvaluation, ...]
+    failures: tuple[Failure, ...]
+    coalescence_radius_m: float = COALESCENCE_RADIUS_M
+
+    def of_kind(self, kind: FailureKind) -> list[Failure]:
+        return [f for f in self.failures if f.kind is kind]
+
+    def counts(self, kind: FailureKind) -> np.ndarray:
+        """(F,) number of failures of ``kind`` per keyframe."""
+        out = np.zeros(len(self.sample_tokens), dtype=np.int64)
+        for f in self.of_kind(kind):
+            out[f.frame_index] += 1
+        return out
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "scene": self.scene_name,
+            "tracker": self.tracker,
+            "sample_tokens": list(self.sample_tokens),
+            "coalescence_radius_m": self.coalescence_radius_m,
+            "classes": [
+                {
+                    "class_name": c.class_name,
+                    "threshold": c.threshold,
+                    **{k: _json_number(getattr(c, k)) for k in ("mota", "tp", "fp", "fn", "ids", "frag")},
+                }
+                for c in self.classes
+            ],
+            "totals": {kind.value: len(self.of_kind(kind)) for kind in FailureKind},
+            "failures": [f.to_json() for f in self.failures],
+        }
+
+
+def _json_number(value: float) -> float | None:
+    return None if np.isnan(value) else float(value)
+
+
+def _box(role: str, box: TrackingBox) -> FailureBox:
+    return FailureBox(
+        role=role,
+        object_id=str(box.tracking_id),
+        translation_m=tuple(float(v) for v in box.translation),
+        size_wlh_m=tuple(float(v) for v in box.size),
+        quat_wxyz=tuple(float(v) for v in box.rotation),
+    )
+
+
+def _split_with_scene(nusc: NuScenes, scene_name: str) -> str:
+    """A split that holds ``scene_name`` (the devkit's ``create_tracks`` keeps only samples of a split)."""
+    from nuscenes.utils.splits import create_splits_scenes
+
+    splits = create_splits_scenes()
+    custom = Path(nusc.dataroot) / nusc.version / "splits.json"
+    if custom.is_file():
+        try:
+            splits.update(json.loads(custom.read_text(encoding="utf-8")))
+        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            raise DataError(f"custom split file {custom} is not valid JSON ({type(exc).__name__})") from None
+    for name, scenes in sorted(splits.items(), key=lambda kv: len(kv[1])):
+        if scene_name in scenes:
+            return name
+    raise DataError(
+        f"scene {scene_name} is in no nuScenes split, so the devkit cannot evaluate it; list it in "
+        f'{custom} as a custom split (e.g. {{"my_split": ["{scene_name}"]}})'
+    )
+
+
+def _prepared(nusc: NuScenes, boxes: EvalBoxes, cfg: TrackingConfig) -> EvalBoxes:
+    """The devkit's box preparation: ego distances, then its class-range, point-count and bike-rack filter."""
+    from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes
+
+    boxes = add_center_dist(nusc, boxes)
+    if any(boxes.boxes[t] for t in boxes.sample_tokens):  # the filter asserts at least one box exists
+        boxes = filter_eval_boxes(nusc, boxes, cfg.class_range, verbose=False)
+    return boxes
+
+
+@dataclass(slots=True)
+class _Frame:
+    """One keyframe the accumulator saw for one class."""
+
+    frame_index: int
+    gt: dict[str, TrackingBox]
+    pred: dict[str, TrackingBox]
+    events: list[tuple[str, str | None, str | None]] = field(default_factory=list)
+
+
+def _accumulate(
+    scene_gt: Mapping[int, list[TrackingBox]],
+    scene_pred: Mapping[int, list[TrackingBox]],
+    class_name: str,
+    threshold: float | None,
+    dist_th_tp: float,
+    frame_of_timestamp: Mapping[int, int],
+) -> list[_Frame]:
+    """Per-frame MATCH/SWITCH/MISS/FP events of one class at one score threshold (the devkit's accumulator).
+
+    Frames are fed exactly as ``TrackingEvaluation.accumulate_threshold`` feeds them: class filter, score
+    threshold on the track-averaged score, BEV centre distances, pairs at >= dist_th_tp forbidden, frames with
+    neither ground truth nor tracks skipped.
+    """
+    from nuscenes.eval.tracking.mot import MOTAccumulatorCustom
+    from sklearn.metrics.pairwise import euclidean_distances
+
+    acc = MOTAccumulatorCustom()
+    frames: list[_Frame] = []
+    for timestamp in scene_gt:
+        gt = [b for b in scene_gt[timestamp] if b.tracking_name == class_name]
+        every_pred = [b for b in scene_pred.get(timestamp, []) if b.tracking_name == class_name]
+        pred = every_pred if threshold is None else [b for b in every_pred if b.tracking_score >= threshold]
+        if not gt and not pred:
+            continue
+        if not gt or not pred:
+            distances = np.ones((0, 0))
+        else:
+            distances = euclidean_distances(
+                np.array([b.translation[:2] for b in gt]), np.array([b.translation[:2] for b in pred])
+            )
+        distances[distances >= dist_th_tp] = np.nan
+        acc.update([b.tracking_id for b in gt], [b.tracking_id for b in pred], distances, frameid=len(frames))
+        frames.append(
+            _Frame(
+                frame_of_timestamp[timestamp],
+                {str(b.tracking_id): b for b in gt},
+                {str(b.tracking_id): b for b in every_pred},
+            )
+        )
+    events = acc.events
+    types = events["Type"].astype(str).to_numpy()
+    keep = ~np.isin(types, list(_NOT_EVENTS))
+    frame_ids = events.index.get_level_values(0).to_numpy()[keep]
+    oids = events["OId"].to_numpy()[keep]
+    hids = events["HId"].to_numpy()[keep]
+    for frame_id, kind, oid, hid in zip(frame_ids, types[keep], oids, hids, strict=True):
+        frames[int(frame_id)].events.append(
+            (kind, None if _missing(oid) else str(oid), None if _missing(hid) else str(hid))
+        )
+    return frames
+
+
+def _missing(value: Any) -> bool:
+    return value is None or (isinstance(value, float) and np.isnan(value))
+
+
+def _bev_distance(a: TrackingBox, b: TrackingBox) -> float:
+    return float(np.hypot(a.translation[0] - b.translation[0], a.translation[1] - b.translation[1]))
+
+
+def _class_failures(
+    frames: Sequence[_Frame],
+    class_name: str,
+    tokens: Sequence[str],
+    dist_th_tp: float,
+    coalescence_radius_m: float,
+) -> list[Failure]:
+    """Derive every failure of one class from its per-frame events (see the module docstring)."""
+    out: list[Failure] = []
+
+    def add(kind: FailureKind, fr: _Frame, gt_ids, track_ids, boxes, generation: int = 0) -> None:
+        out.append(
+            Failure(
+                kind,
+                fr.frame_index,
+                tokens[fr.frame_index],
+                class_name,
+                tuple(gt_ids),
+                tuple(track_ids),
+                tuple(boxes),
+                generation,
+            )
+        )
+
+    last_track: dict[str, str] = {}  # object -> track it was last matched to (the accumulator's memory)
+    history: dict[str, list[tuple[_Frame, bool]]] = defaultdict(list)  # object -> (frame, missed) in order
+    seen_tracks: set[str] = set()
+    # Tracks that may steal an identity: born false (generation 1, lost nothing) or robbed by a thief
+    # (the thief's generation + 1, and the object it lost: taking that one back is no theft).
+    candidates: dict[str, tuple[int, str | None]] = {}
+    for fr in frames:
+        matched = {o: h for kind, o, h in fr.events if kind in ("MATCH", "SWITCH")}
+        switches = [(o, h) for kind, o, h in fr.events if kind == "SWITCH"]
+        for kind, o, h in fr.events:
+            if kind == "SWITCH":
+                old = last_track[o]
+                boxes = [_box("gt", fr.gt[o]), _box("new track", fr.pred[h])]
+                if old in fr.pred:
+                    boxes.append(_box("old track", fr.pred[old]))
+                add(FailureKind.ID_SWITCH, fr, [o], [old, h], boxes)
+            elif kind == "MISS":
+                add(FailureKind.MISS, fr, [o], [], [_box("missed gt", fr.gt[o])])
+            elif kind == "FP":
+                add(FailureKind.FALSE_TRACK, fr, [], [h], [_box("false track", fr.pred[h])])
+            if o is not None:
+                history[o].append((fr, kind == "MISS"))
+
+        # Cascading identity theft: a switch whose new track is a candidate; its victim becomes one (same
+        # frame included, so a chain of thefts within one frame is followed).
+        stolen: set[str] = set()
+        changed = True
+        while changed:
+            changed = False
+            for o, h in switches:
+                if o in stolen or h not in candidates or candidates[h][1] == o:
+                    continue
+                victim = last_track[o]
+                generation = candidates[h][0]
+                boxes = [_box("gt", fr.gt[o]), _box("thief track", fr.pred[h])]
+                if victim in fr.pred:
+                    boxes.append(_box("victim track", fr.pred[victim]))
+                add(FailureKind.IDENTITY_THEFT, fr, [o], [h, victim], boxes, generation)
+                stolen.add(o)
+                candidates.setdefault(victim, (generation + 1, o))
+                changed = True
+        for h in matched.values():
+            candidates.pop(h, None)
+        for kind, _o, h in fr.events:
+            if kind == "FP" and h not in seen_tracks:
+                candidates[h] = (1, None)
+        seen_tracks.update(h for _kind, _o, h in fr.events if h is not None)
+
+        # Coalescence: a missed object next to an object whose track also lies within match distance of it.
+        covered: dict[str, list[str]] = defaultdict(list)
+        for kind, o, _h in fr.events:
+            if kind != "MISS":
+                continue
+            near = [
+                (_bev_distance(fr.gt[o], fr.gt[b]), b)
+                for b, h in matched.items()
+                if _bev_distance(fr.gt[o], fr.gt[b]) < coalescence_radius_m
+                and _bev_distance(fr.gt[o], fr.pred[h]) < dist_th_tp
+            ]
+            if near:
+                covered[min(near)[1]].append(o)
+        for b, missed in covered.items():
+            h = matched[b]
+            boxes = [_box("track", fr.pred[h]), _box("matched gt", fr.gt[b])]
+            boxes += [_box("missed gt", fr.gt[o]) for o in missed]
+            add(FailureKind.COALESCENCE, fr, [b, *missed], [h], boxes)
+        last_track.update(matched)
+
+    # Fragmentation (the devkit's FRAG): tracked -> missed transitions inside an object's tracked span.
+    for o, steps in history.items():
+        tracked = [i for i, (_fr, missed) in enumerate(steps) if not missed]
+        if not tracked:
+            continue
+        track_of = None
+        for i in range(tracked[0], tracked[-1] + 1):
+            fr, missed = steps[i]
+            if missed and not steps[i - 1][1]:
+                add(FailureKind.FRAGMENTATION, fr, [o], [track_of], [_box("missed gt", fr.gt[o])])
+            if not missed:
+                track_of = next(h for kind, oo, h in fr.events if oo == o and kind != "MISS")
+    return out
+
+
+def find_failures(
+    nusc: NuScenes,
+    scene_name: str,
+    results: Mapping[str, Sequence[Mapping[str, Any]]],
+    tracker: str,
+    coalescence_radius_m: float = COALESCENCE_RADIUS_M,
+) -> FailureReport:
+    """Evaluate one scene of a tracking submission with the devkit and list its failures.
+
+    results: submission boxes keyed by sample token (``submission.run_results``); samples of the scene without
+    an entry count as empty. Failures are sorted by frame, then kind, class and ids.
+    """
+    from nuscenes.eval.common.data_classes import EvalBoxes
+    from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
+    from nuscenes.eval.tracking.algo import TrackingEvaluation
+    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetricData
+    from nuscenes.eval.tracking.loaders import create_tracks
+
+    tokens = scene_sample_tokens(nusc, scene_name)
+    frame_of_timestamp = {nusc.get("sample", t)["timestamp"]: i for i, t in enumerate(tokens)}
+    split = _split_with_scene(nusc, scene_name)
+    cfg = tracking_config()
+    with quiet_devkit():
+        try:
+            pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in tokens}, TrackingBox)
+        except (AssertionError, KeyError, TypeError, ValueError) as exc:
+            raise DataError(
+                f"the tracking results of {scene_name} are not valid submission boxes: {exc}"
+            ) from None
+        gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
+        tracks_gt = create_tracks(_prepared(nusc, gt, cfg), nusc, split, gt=True)
+        tracks_pred = create_tracks(_prepared(nusc, pred, cfg), nusc, split, gt=False)
+        scene_token = nusc.get("sample", tokens[0])["scene_token"]
+        classes: list[ClassEvaluation] = []
+        failures: list[Failure] = []
+        for class_name in cfg.class_names:
+            evaluation = TrackingEvaluation(
+                tracks_gt,
+                tracks_pred,
+                class_name,
+                cfg.dist_fcn_callable,
+                cfg.dist_th_tp,
+                cfg.min_recall,
+                num_thresholds=TrackingMetricData.nelem,
+                metric_worst=cfg.metric_worst,
+                verbose=False,
+            )
+            md = evaluation.accumulate()
+            if np.all(np.isnan(md.mota)):
+                continue  # no ground truth of this class: the devkit does not score it
+            best = int(np.nanargmax(md.mota))
+            threshold = None if np.isnan(md.confidence[best]) else float(md.confidence[best])
+            classes.append(
+                ClassEvaluation(
+                    class_name,
+                    threshold,
+                    *(float(md.get_metric(m)[best]) for m in ("mota", "tp", "fp", "fn", "ids", "frag")),
+                )
+            )
+            frames = _accumulate(
+                tracks_gt[scene_token],
+                tracks_pred[scene_token],
+                class_name,
+                threshold,
+                cfg.dist_th_tp,
+                frame_of_timestamp,
+            )
+            failures += _class_failures(frames, class_name, tokens, cfg.dist_th_tp, coalescence_radius_m)
+    kind_order = {kind: i for i, kind in enumerate(FailureKind)}
+    failures.sort(key=lambda f: (f.frame_index, kind_order[f.kind], f.class_name, f.gt_ids, f.track_ids))
+    return FailureReport(
+        scene_name, tracker, tuple(tokens), tuple(classes), tuple(failures), coalescence_radius_m
+    )

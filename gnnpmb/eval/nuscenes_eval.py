@@ -1,0 +1,221 @@
+"""The official nuScenes tracking evaluation (the devkit's ``TrackingEval``), made quiet and safe.
+
+Scores are the devkit's own: config ``tracking_nips_2019`` (2 m centre-distance matching, 40 recall
+thresholds, class ranges 50 m for vehicles and 40 m for pedestrians and two-wheelers). AMOTA/AMOTP average
+over the recall thresholds; MOTA, MOTP, MT, ML, TP, FP, FN, IDS and FRAG are read at the threshold with the
+best MOTA (Weng et al. 2020, "AB3DMOT"; Caesar et al. 2020, "nuScenes"). This module checks the submission
+first (``check_submission``) so a bad file fails with one clear line instead of an assert inside the devkit,
+silences the devkit's printing, and writes its output files (``metrics_summary.json``,
+``metrics_details.json``) atomically.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import os
+import shutil
+import tempfile
+import warnings
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from gnnpmb.errors import DataError
+from gnnpmb.eval.submission import check_submission, read_submission
+
+if TYPE_CHECKING:
+    from nuscenes import NuScenes
+    from nuscenes.eval.tracking.data_classes import TrackingConfig
+
+    from gnnpmb.data.nuscenes import DatasetLocation
+
+EVAL_CONFIG = "tracking_nips_2019"
+"""The devkit config every score here is computed with."""
+
+TABLE_METRICS: tuple[str, ...] = (
+    "amota",
+    "amotp",
+    "mota",
+    "motp",
+    "recall",
+    "mt",
+    "ml",
+    "tp",
+    "fp",
+    "fn",
+    "ids",
+    "frag",
+)
+"""The metrics shown in the results table, as named in the devkit's ``metrics_summary.json``."""
+
+COUNT_METRICS = frozenset({"mt", "ml", "tp", "fp", "fn", "ids", "frag"})
+"""Metrics that are counts (summed over classes in the overall row); the others are averaged."""
+
+DEVKIT_FILES = ("metrics_summary.json", "metrics_details.json")
+
+_SPLIT_VERSION_SUFFIX = {
+    "train": "trainval",
+    "val": "trainval",
+    "train_detect": "trainval",
+    "train_track": "trainval",
+    "mini_train": "mini",
+    "mini_val": "mini",
+    "test": "test",
+}
+
+
+@contextlib.contextmanager
+def quiet_devkit() -> Iterator[None]:
+    """Silence the devkit: its prints (stdout), tqdm bars and pandas/motmetrics warnings (stderr)."""
+    with (
+        contextlib.redirect_stdout(io.StringIO()),
+        contextlib.redirect_stderr(io.StringIO()),
+        warnings.catch_warnings(),
+    ):
+        warnings.simplefilter("ignore")
+        yield
+
+
+def tracking_config() -> TrackingConfig:
+    """The official ``tracking_nips_2019`` config. Creating it also registers the devkit's tracking class
+    names, which ``TrackingBox`` checks against."""
+    from nuscenes.eval.common.config import config_factory
+
+    return config_factory(EVAL_CONFIG)
+
+
+def check_split_version(split: str, version: str) -> None:
+    """The devkit evaluates mini splits only on a ``*mini`` version, train/val on ``*trainval``, test on
+    ``*test``; custom splits (``splits.json``) on any version."""
+    suffix = _SPLIT_VERSION_SUFFIX.get(split)
+    if suffix is not None and not version.endswith(suffix):
+        raise DataError(
+            f"split {split} cannot be evaluated on dataset version {version}; use a version ending in "
+            f"'{suffix}' (e.g. v1.0-{suffix}) or a split of {version}"
+        )
+
+
+def scene_sample_tokens(nusc: NuScenes, scene_name: str) -> list[str]:
+    """The sample tokens of one scene in time order (following the devkit's ``next`` links)."""
+    for scene in nusc.scene:
+        if scene["name"] == scene_name:
+            tokens = []
+            token = scene["first_sample_token"]
+            while token:
+                tokens.append(token)
+                token = nusc.get("sample", token)["next"]
+            return tokens
+    raise DataError(f"scene {scene_name} is not in dataset {nusc.version} at {nusc.dataroot}")
+
+
+def split_sample_tokens(nusc: NuScenes, scene_names: Sequence[str]) -> list[str]:
+    """Every sample token of the given scenes, scene by scene in time order."""
+    tokens: list[str] = []
+    for name in scene_names:
+        tokens.extend(scene_sample_tokens(nusc, name))
+    return tokens
+
+
+def default_eval_dir(results_path: Path) -> Path:
+    """Where ``gnnpmb eval`` writes the devkit's files by default: ``<stem>_eval/`` next to the results."""
+    results_path = Path(results_path)
+    return results_path.with_name(f"{results_path.stem}_eval")
+
+
+@dataclass(frozen=True, slots=True)
+class TrackingScores:
+    """The devkit's metrics: per_class[class][metric] and overall[metric] (NaN where a class has no ground
+    truth), with the evaluation time and where ``metrics_summary.json`` was written."""
+
+    per_class: dict[str, dict[str, float]]
+    overall: dict[str, float]
+    eval_time_s: float
+    summary_path: Path
+
+    @staticmethod
+    def from_summary(summary: dict[str, Any], summary_path: Path) -> TrackingScores:
+        """Read the devkit's ``metrics_summary.json`` content."""
+        label_metrics: dict[str, dict[str, float]] = summary["label_metrics"]
+        classes = sorted(next(iter(label_metrics.values())))
+        per_class = {c: {m: float(label_metrics[m][c]) for m in label_metrics} for c in classes}
+        overall = {m: float(summary[m]) for m in label_metrics}
+        return TrackingScores(per_class, overall, float(summary["eval_time"]), summary_path)
+
+
+def run_tracking_eval(
+    results_path: Path, dataroot: Path, version: str, split: str, out_dir: Path
+) -> TrackingScores:
+    """Run ``TrackingEval`` quietly (no curves) and move its files into ``out_dir`` atomically.
+
+    The devkit writes into a temporary folder beside ``out_dir``; each file then replaces its old version with
+    ``os.replace``, so a failed run leaves ``out_dir`` as it was. Check the submission first
+    (``check_submission``): the devkit's own checks are bare asserts, turned into ``DataError`` here.
+    """
+    from nuscenes.eval.tracking.evaluate import TrackingEval
+
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    try:
+        with quiet_devkit():
+            cfg = tracking_config()
+            try:
+                evaluation = TrackingEval(
+                    config=cfg,
+                    result_path=str(results_path),
+                    eval_set=split,
+                    output_dir=str(tmp),
+                    nusc_version=version,
+                    nusc_dataroot=str(dataroot),
+                    verbose=False,
+                )
+                summary = evaluation.main(render_curves=False)
+            except (AssertionError, ValueError, KeyError) as exc:
+                raise DataError(
+                    f"the nuScenes evaluation rejected {Path(results_path).name}: {exc}"
+                ) from None
+        out_dir.mkdir(parents=True, exist_ok=True)
+        for name in DEVKIT_FILES:
+            os.replace(tmp / name, out_dir / name)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return TrackingScores.from_summary(summary, out_dir / DEVKIT_FILES[0])
+
+
+def evaluate_submission(
+    results_path: Path, location: DatasetLocation, split: str, out_dir: Path | None = None
+) -> TrackingScores:
+    """Check ``results_path`` against ``split`` of the dataset at ``location``, then score it with the
+    official evaluation; the devkit's files go to ``out_dir`` (default ``default_eval_dir(results_path)``)."""
+    from gnnpmb.data.nuscenes import open_nuscenes, split_scenes
+
+    results_path = Path(results_path)
+    check_split_version(split, location.version)
+    data = read_submission(results_path)  # a broken file fails before the devkit's slow import
+    scene_names = split_scenes(split, location)
+    if not scene_names:
+        raise DataError(
+            f"split {split} has no scenes in {location.dataroot / location.version}; pick another split"
+        )
+    nusc = open_nuscenes(location)
+    check_submission(
+        data,
+        results_path.name,
+        split,
+        split_sample_tokens(nusc, scene_names),
+        {s["token"] for s in nusc.sample},
+    )
+    del data
+    return run_tracking_eval(
+        results_path, location.dataroot, location.version, split, out_dir or default_eval_dir(results_path)
+    )
+
+
+def format_metric(metric: str, value: float) -> str:
+    """A metric as the devkit prints it: 3 decimals for ratios and distances, integers for counts."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    return f"{int(round(value))}" if metric in COUNT_METRICS else f"{value:.3f}"

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# The README's test command: installs what the suite needs (uv; Chromium for the browser check when running as
+# root with apt-get), then runs pytest. Extra arguments go to pytest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+if command -v uv >/dev/null 2>&1; then
+    UV=(uv)
+else
+    python3 -m pip install --quiet --disable-pip-version-check uv
+    UV=(python3 -m uv)
+fi
+if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+    if ! command -v chromium >/dev/null 2>&1; then
+        echo "installing Chromium for the browser check (apt-get)" >&2
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
+    fi
+    # Chromium can be installed here, so the browser check must run rather than skip.
+    export GNNPMB_REQUIRE_BROWSER="${GNNPMB_REQUIRE_BROWSER:-1}"
+fi
+exec "${UV[@]}" run pytest "$@"

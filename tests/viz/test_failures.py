@@ -1,0 +1,116 @@
+"""Failure markers in a saved recording: boxes only at their frame, labels naming ids, counts, text lines."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rerun as rr
+
+from gnnpmb.data.scene import SceneData
+from gnnpmb.eval.failures import ClassEvaluation, Failure, FailureBox, FailureKind, FailureReport
+from tests.viz.rrd import at_frame, latest_at, read_rows
+from viz import paths
+from viz.failures import KIND_COLORS, MARKER_MARGIN_M, MARKER_SCALE, failure_log, log_failures
+
+T = "gnnpmb"
+GT_ID = "a1b2c3d4e5f6"
+
+
+def fbox(role: str, object_id: str, x: float) -> FailureBox:
+    return FailureBox(role, object_id, (x, 2.0, 1.0), (2.0, 4.0, 1.5), (1.0, 0.0, 0.0, 0.0))
+
+
+def report_for(scene: SceneData) -> FailureReport:
+    tokens = scene.sample_tokens
+    switch = Failure(
+        FailureKind.ID_SWITCH,
+        1,
+        tokens[1],
+        "car",
+        (GT_ID,),
+        ("4", "9"),
+        (fbox("gt", GT_ID, 11.0), fbox("new track", "9", 11.2), fbox("old track", "4", 14.0)),
+    )
+    misses = [
+        Failure(FailureKind.MISS, 0, tokens[0], "car", (GT_ID,), (), (fbox("missed gt", GT_ID, 10.0),)),
+        Failure(FailureKind.MISS, 0, tokens[0], "pedestrian", ("p9",), (), (fbox("missed gt", "p9", 5.0),)),
+        Failure(FailureKind.MISS, 2, tokens[2], "pedestrian", ("p9",), (), (fbox("missed gt", "p9", 5.0),)),
+    ]
+    theft = Failure(
+        FailureKind.IDENTITY_THEFT,
+        1,
+        tokens[1],
+        "car",
+        (GT_ID,),
+        ("9", "4"),
+        (fbox("gt", GT_ID, 11.0), fbox("thief track", "9", 11.2)),
+        generation=1,
+    )
+    classes = (ClassEvaluation("car", 0.5, 0.5, 1.0, 0.0, 1.0, 1.0, 0.0),)
+    return FailureReport(scene.name, T, tokens, classes, (misses[0], misses[1], switch, theft, misses[2]))
+
+
+def test_failures_are_logged_per_kind_and_frame(saved_stream, tiny_scene) -> None:
+    stream, path = saved_stream
+    scene, _ = tiny_scene
+    log_failures(stream, T, report_for(scene), scene)
+    stream.disconnect()
+    rows = read_rows(path)
+
+    switch_rows = rows[paths.failures_world(T, "id_switch")]
+    assert [len(r.get("Boxes3D:centers") or []) for r in switch_rows] == [0, 3, 0]
+    frame1 = at_frame(switch_rows, 1)[0]
+    assert frame1["Boxes3D:labels"] == [
+        "ID switch: gt a1b2c3",
+        "ID switch: new track 9",
+        "ID switch: old track 4",
+    ]
+    np.testing.assert_allclose(frame1["Boxes3D:centers"][2], [14.0, 2.0, 1.0])
+    half = 0.5 * (np.array([4.0, 2.0, 1.5]) * MARKER_SCALE + MARKER_MARGIN_M)  # wlh -> box x, y, z extents
+    np.testing.assert_allclose(frame1["Boxes3D:half_sizes"][0], half, rtol=1e-6)
+    r, g, b = KIND_COLORS[FailureKind.ID_SWITCH]
+    assert set(frame1["Boxes3D:colors"]) == {(r << 24) | (g << 16) | (b << 8) | 255}
+    assert not latest_at(switch_rows, 2, "Boxes3D:centers")
+
+    miss_rows = rows[paths.failures_world(T, "miss")]
+    assert [r["Boxes3D:labels"] for r in miss_rows] == [
+        ["miss: missed gt a1b2c3", "miss: missed gt p9"],
+        [],
+        ["miss: missed gt p9"],
+    ]
+
+    counts = {
+        kind: [r["Scalars:scalars"][0] for r in rows[paths.failure_count(T, kind.value)] if not r["static"]]
+        for kind in FailureKind
+    }
+    assert counts[FailureKind.MISS] == [2.0, 0.0, 1.0]
+    assert counts[FailureKind.ID_SWITCH] == [0.0, 1.0, 0.0]
+    assert counts[FailureKind.COALESCENCE] == [0.0, 0.0, 0.0]
+    assert paths.failures_world(T, "coalescence") not in rows
+    static = [r for r in rows[paths.failure_count(T, "identity_theft")] if r["static"]]
+    assert static[0]["SeriesLines:names"] == ["identity theft"]
+
+    log_rows = rows[failure_log(T)]
+    lines = [(r["frame"], r["TextLog:text"][0], r["TextLog:level"][0]) for r in log_rows]
+    assert lines == [
+        (0, "miss: car GT a1b2c3", "INFO"),
+        (0, "miss: pedestrian GT p9", "INFO"),
+        (1, "ID switch: car GT a1b2c3: track 4 -> track 9", "WARN"),
+        (1, "identity theft: car track 9 took GT a1b2c3 from track 4", "ERROR"),
+        (2, "miss: pedestrian GT p9", "INFO"),
+    ]
+    timestamps = [r["timestamp"] for r in log_rows]
+    assert timestamps[2] == np.datetime64(scene.keyframes[1].timestamp_us, "us")
+
+
+def test_report_of_another_scene_is_refused(tmp_path: Path, tiny_scene) -> None:
+    scene, _ = tiny_scene
+    report = report_for(scene)
+    other = FailureReport("scene-other", T, ("x", "y", "z"), report.classes, ())
+    stream = rr.RecordingStream("gnnpmb-viz-test-refuse")
+    stream.save(tmp_path / "refused.rrd")
+    with pytest.raises(ValueError, match="not for the samples of scene-test"):
+        log_failures(stream, T, other, scene)
+    stream.disconnect()

@@ -1,0 +1,141 @@
+"""Tracking failures (``gnnpmb.eval.failures``) as markers in a Rerun recording, to scrub straight to them.
+
+Per failure kind and tracker: the involved ground-truth and track boxes at the failure's frame, drawn a little
+larger than the objects in the kind's colour with labels naming the ids (``world/trackers/<tracker>/failures/
+<kind>``), and a per-frame count series (``trackers/<tracker>/failures/<kind>``). Every failure is also a line
+of one TextLog per tracker (``failure_log``). Everything is sent column-wise: a handful of calls per tracker
+however many failures there are.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import rerun as rr
+
+from gnnpmb.data.scene import SceneData
+from gnnpmb.eval.failures import Failure, FailureBox, FailureKind, FailureReport, short_id
+from viz import paths
+from viz.geometry import quat_wxyz_to_xyzw, size_wlh_to_xyz
+
+KIND_COLORS: dict[FailureKind, tuple[int, int, int]] = {
+    FailureKind.ID_SWITCH: (255, 0, 255),
+    FailureKind.FRAGMENTATION: (255, 160, 0),
+    FailureKind.FALSE_TRACK: (255, 0, 0),
+    FailureKind.MISS: (255, 255, 255),
+    FailureKind.COALESCENCE: (0, 255, 140),
+    FailureKind.IDENTITY_THEFT: (255, 255, 0),
+}
+"""One colour per failure kind, bright so the markers stand out from the class-coloured boxes."""
+
+KIND_LABELS: dict[FailureKind, str] = {
+    FailureKind.ID_SWITCH: "ID switch",
+    FailureKind.FRAGMENTATION: "fragmentation",
+    FailureKind.FALSE_TRACK: "false track",
+    FailureKind.MISS: "miss",
+    FailureKind.COALESCENCE: "coalescence",
+    FailureKind.IDENTITY_THEFT: "identity theft",
+}
+
+KIND_LEVELS: dict[FailureKind, str] = {
+    FailureKind.ID_SWITCH: "WARN",
+    FailureKind.FRAGMENTATION: "WARN",
+    FailureKind.FALSE_TRACK: "INFO",
+    FailureKind.MISS: "INFO",
+    FailureKind.COALESCENCE: "WARN",
+    FailureKind.IDENTITY_THEFT: "ERROR",
+}
+"""TextLog levels: the paper's failure patterns stand out, plain misses and false tracks stay quiet."""
+
+MARKER_SCALE = 1.1
+MARKER_MARGIN_M = 0.3
+"""A marker box is the object's box times MARKER_SCALE plus MARKER_MARGIN_M: it encloses the drawn object."""
+MARKER_LINE_RADIUS_M = 0.08
+
+
+def failure_log(tracker: str) -> str:
+    """TextLog of every failure of one tracker (``trackers/<tracker>/failure_log``).
+
+    Not in ``viz/paths.py`` yet; kept beside the failure counts (``paths.failure_count``) but outside their
+    ``failures/`` folder, so a time-series view of ``failures/**`` holds only the counts.
+    """
+    return f"{paths.tracker_root(tracker)}/failure_log"
+
+
+def _label(kind: FailureKind, box: FailureBox) -> str:
+    name = short_id(box.object_id) if box.is_gt else box.object_id
+    return f"{KIND_LABELS[kind]}: {box.role} {name}"
+
+
+def _frame_boxes(failures: list[Failure], n_frames: int) -> tuple[list[FailureBox], list[str], np.ndarray]:
+    """The distinct boxes per frame (a box in several failures of one kind and frame is drawn once), their
+    labels and (F,) boxes per frame."""
+    boxes: list[FailureBox] = []
+    labels: list[str] = []
+    lengths = np.zeros(n_frames, dtype=np.int64)
+    seen: set[tuple[int, str, str]] = set()
+    for failure in sorted(failures, key=lambda f: f.frame_index):
+        for box in failure.boxes:
+            key = (failure.frame_index, box.role, box.object_id)
+            if key in seen:
+                continue
+            seen.add(key)
+            boxes.append(box)
+            labels.append(_label(failure.kind, box))
+            lengths[failure.frame_index] += 1
+    return boxes, labels, lengths
+
+
+def log_failures(stream: rr.RecordingStream, tracker: str, report: FailureReport, scene: SceneData) -> None:
+    """Log ``report`` (failures of ``tracker`` on ``scene``) on the frame and timestamp timelines.
+
+    Boxes of a kind show only at their frame (other frames get an empty batch); the count series has a value
+    at every keyframe (0 when nothing failed).
+    """
+    if tuple(report.sample_tokens) != tuple(scene.sample_tokens):
+        raise ValueError(
+            f"the failure report is for {report.scene_name}, not for the samples of {scene.name}"
+        )
+    n = len(scene.keyframes)
+    frames = np.arange(n, dtype=np.int64)
+    stamps = np.array([k.timestamp_us for k in scene.keyframes], dtype="datetime64[us]")
+
+    def indexes(at: np.ndarray) -> list[rr.TimeColumn]:
+        return [rr.TimeColumn("frame", sequence=frames[at]), rr.TimeColumn("timestamp", timestamp=stamps[at])]
+
+    every_frame = np.arange(n)
+    for kind in FailureKind:
+        failures = report.of_kind(kind)
+        color = KIND_COLORS[kind]
+        count_path = paths.failure_count(tracker, kind.value)
+        stream.log(count_path, rr.SeriesLines(names=KIND_LABELS[kind], colors=[color]), static=True)
+        stream.send_columns(
+            count_path,
+            indexes=indexes(every_frame),
+            columns=rr.Scalars.columns(scalars=report.counts(kind).astype(np.float64)),
+        )
+        if not failures:
+            continue
+        boxes, labels, lengths = _frame_boxes(failures, n)
+        sizes = size_wlh_to_xyz(np.array([b.size_wlh_m for b in boxes], dtype=np.float64))
+        stream.send_columns(
+            paths.failures_world(tracker, kind.value),
+            indexes=indexes(every_frame),
+            columns=rr.Boxes3D.columns(
+                centers=np.array([b.translation_m for b in boxes], dtype=np.float64),
+                half_sizes=0.5 * (sizes * MARKER_SCALE + MARKER_MARGIN_M),
+                quaternions=quat_wxyz_to_xyzw(np.array([b.quat_wxyz for b in boxes], dtype=np.float64)),
+                colors=np.tile(np.array(color, dtype=np.uint8), (len(boxes), 1)),
+                radii=np.full(len(boxes), MARKER_LINE_RADIUS_M, dtype=np.float32),
+                labels=labels,
+            ).partition(lengths),
+        )
+    if report.failures:
+        at = np.array([f.frame_index for f in report.failures], dtype=np.int64)
+        stream.send_columns(
+            failure_log(tracker),
+            indexes=indexes(at),
+            columns=rr.TextLog.columns(
+                text=[f"{KIND_LABELS[f.kind]}: {f.describe()}" for f in report.failures],
+                level=[KIND_LEVELS[f.kind] for f in report.failures],
+            ),
+        )
