@@ -3,7 +3,9 @@
 Per frame and class it shows predicted means, gate ellipses, the cost matrix (a heat map plus a markdown table
 naming every row and column), the extracted tracks and, for the trackers that have them, PMBM hypothesis
 weights, TO-PMB/JPDA marginals, the CPHD cardinality and PHD intensity weights. Births, prunings, assignments,
-track-logic transitions and merges go to a text log. Per-track existence probabilities become time series.
+track-logic transitions and merges go to a text log. Per-track existence probabilities become time series:
+under ``existence/`` for Bernoullis that were output as tracks at least once, under ``candidates/`` for those
+that never were (the many short-lived births on clutter), so the default plot stays readable.
 
 Cheap logging: per-frame entities are logged directly; text-log lines are buffered for the frame and sent as one
 column chunk per class; time series are kept in memory and sent column-wise by ``finish()`` (one chunk per
@@ -157,6 +159,8 @@ class TrackerLogger:
         self._texts: dict[str, tuple[list[str], list[str]]] = {}
         self._series: dict[str, _Series] = {}
         self._track_z: dict[int, float] = {}
+        self._existence_paths: dict[str, tuple[str, int]] = {}  # series path -> (class, track id)
+        self._extracted_ids: set[int] = set()
         self._handlers: dict[type, Callable] = {
             FrameStarted: self._on_frame_started,
             Predicted: self._on_predicted,
@@ -189,6 +193,8 @@ class TrackerLogger:
             self._close_frame()
             self._frame = -1
         for path, series in self._series.items():
+            if path in self._existence_paths and self._existence_paths[path][1] not in self._extracted_ids:
+                path = paths.candidate_existence(self.tracker, *self._existence_paths[path])
             if series.color is None:
                 self.stream.log(path, rr.SeriesLines(names=series.name), static=True)
             else:
@@ -202,6 +208,7 @@ class TrackerLogger:
                 columns=rr.Scalars.columns(scalars=np.asarray(series.values, dtype=np.float64)),
             )
         self._series.clear()
+        self._existence_paths.clear()
 
     # Frame bookkeeping.
     def _on_frame_started(self, event: FrameStarted) -> None:
@@ -297,6 +304,7 @@ class TrackerLogger:
     def _on_extracted(self, event: Extracted) -> None:
         for e in event.estimates:
             self._track_z[e.track_id] = float(e.translation_m[2])
+            self._extracted_ids.add(e.track_id)
         if not event.estimates:
             return
         boxes = estimate_boxes(event.estimates)
@@ -395,6 +403,7 @@ class TrackerLogger:
             path = paths.existence(self.tracker, event.class_name, t)
             if path not in self._series:
                 self._series[path] = _Series(f"{t} {event.class_name}", track_color(t))
+                self._existence_paths[path] = (event.class_name, t)
             self._sample(path, r)
 
     def _on_hypotheses(self, event: GlobalHypotheses) -> None:

@@ -81,6 +81,16 @@ def existence(tracker: str, class_name: str, track_id: int) -> str:
     return f"{existence_root(tracker)}/{_name(class_name)}/{int(track_id)}"
 
 
+def candidates_root(tracker: str) -> str:
+    return f"{tracker_root(tracker)}/candidates"
+
+
+def candidate_existence(tracker: str, class_name: str, track_id: int) -> str:
+    """Scalars: the existence probability over time of a Bernoulli that was never output as a track (a candidate
+    that stayed below the extraction threshold); kept apart so the default existence plot shows real tracks."""
+    return f"{candidates_root(tracker)}/{_name(class_name)}/{int(track_id)}"
+
+
 def events_root(tracker: str) -> str:
     return f"{tracker_root(tracker)}/events"
 
