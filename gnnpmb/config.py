@@ -61,48 +61,119 @@ class PmbParams:
     birth_pos_std_m: float = 15.0
     birth_vel_std_mps: float = 1.0
     prune_existence: float = 1e-6
-    poisson_prune_weight: float = 1e-3
     extraction_threshold: float = 0.9
 
 
 @dataclass(frozen=True, slots=True)
 class PmbmParams:
-    """PMBM hypothesis management: at most n_hypotheses global hypotheses, drop those below hypothesis_prune
-    (normalised weight)."""
+    """PMBM hypothesis management (``gnnpmb.pmb.pmbm``; García-Fernández et al. 2018, sec. V).
+
+    n_hypotheses: N_h, the most global hypotheses kept; prior hypothesis h of weight w_h gets its
+    ceil(N_h w_h) best assignments (Murty). Default N_h = 100; N_h = 1 is exactly GNN-PMB.
+    hypothesis_prune: global hypotheses whose normalised weight falls below it are dropped (the most likely one
+    always stays).
+    """
 
     n_hypotheses: int = 100
     hypothesis_prune: float = 1e-4
 
+    def __post_init__(self) -> None:
+        if self.n_hypotheses < 1:
+            raise ConfigError(f"[pmbm] n_hypotheses must be at least 1, got {self.n_hypotheses}")
+        if not 0.0 <= self.hypothesis_prune < 1.0:
+            raise ConfigError(f"[pmbm] hypothesis_prune must be in [0, 1), got {self.hypothesis_prune}")
+
 
 @dataclass(frozen=True, slots=True)
 class LbpParams:
-    """Loopy belief propagation for marginal association probabilities (TO-PMB, JPDA)."""
+    """Loopy belief propagation for marginal association probabilities (TO-PMB, JPDA; ``gnnpmb.assign.lbp``,
+    Williams & Lau 2014).
+
+    max_iterations: at most this many message-passing rounds (>= 1); tolerance: stop once no marginal
+    probability changes by more than this between two rounds (> 0). On the demo scenes TO-PMB's LBP stops after
+    2 rounds (median; 8 at most), so the cap is a safeguard rather than a speed setting.
+    """
 
     max_iterations: int = 100
     tolerance: float = 1e-7
 
+    def __post_init__(self) -> None:
+        if self.max_iterations < 1:
+            raise ConfigError(f"[lbp] max_iterations must be at least 1, got {self.max_iterations}")
+        if not self.tolerance > 0.0:
+            raise ConfigError(f"[lbp] tolerance must be > 0, got {self.tolerance}")
+
 
 @dataclass(frozen=True, slots=True)
 class PhdParams:
-    """GM-PHD / GM-CPHD mixture management (Vo & Ma 2006; Vo, Vo & Cantoni 2007)."""
+    """GM-PHD / GM-CPHD filters (``gnnpmb.phd``; Vo & Ma 2006; Vo, Vo & Cantoni 2007).
+
+    p_detect: detection probability P_D in (0, 1] of a persistent component (a measurement-driven birth component
+    is detected by construction). prune_weight: components lighter than this are dropped (Vo & Ma Table II, T).
+    merge_threshold: components within this squared Mahalanobis distance (4-D state) of a heavier one are merged
+    into it (U). max_components: at most this many components are kept per class (J_max). extraction_weight: the
+    PHD filter reports every component at least this heavy, round(w) times (Table III). max_cardinality: hard
+    upper bound of the CPHD cardinality support per class; below it the support follows the previous posterior
+    plus the birth count, so most frames use far fewer terms (median 7, at most 21 on the demo scenes); the CPHD
+    reports at most this many tracks per class. Survival, gate, clutter intensity and birth come from ``[pmb]``
+    so every tracker of the study sees the same models. T, U, J_max and the 0.5 extraction weight are Vo & Ma's.
+    """
 
     p_detect: float = 0.9
     prune_weight: float = 1e-5
     merge_threshold: float = 4.0
     max_components: int = 100
     extraction_weight: float = 0.5
-    max_cardinality: int = 60
+    max_cardinality: int = 100
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.p_detect <= 1.0:
+            raise ConfigError(f"[phd] p_detect must be in (0, 1], got {self.p_detect}")
+        if not self.prune_weight >= 0.0:
+            raise ConfigError(f"[phd] prune_weight must be >= 0, got {self.prune_weight}")
+        if not self.merge_threshold >= 0.0:
+            raise ConfigError(f"[phd] merge_threshold must be >= 0, got {self.merge_threshold}")
+        if self.max_components < 1:
+            raise ConfigError(f"[phd] max_components must be at least 1, got {self.max_components}")
+        if not self.extraction_weight > 0.0:
+            raise ConfigError(f"[phd] extraction_weight must be > 0, got {self.extraction_weight}")
+        if self.max_cardinality < 1:
+            raise ConfigError(f"[phd] max_cardinality must be at least 1, got {self.max_cardinality}")
 
 
 @dataclass(frozen=True, slots=True)
 class VectorParams:
-    """Vector-type trackers (GNN, JPDA): M/N confirmation, deletion after `delete_misses` consecutive misses."""
+    """Vector-type trackers (GNN, JPDA; ``gnnpmb.vector``).
+
+    p_detect: constant detection probability P_D in (0, 1) of the association likelihoods (Blackman & Popoli
+    1999, ch. 6; Bar-Shalom, Daum & Huang 2009). confirm_m / confirm_n: a tentative track is confirmed once it
+    has confirm_m hits within its first confirm_n frames (the birth frame counts as a hit) and deleted as soon
+    as it can no longer get there. delete_misses: a confirmed track is deleted after this many consecutive
+    misses. exact_cluster_max: JPDA enumerates a gated cluster exactly when it has at most this many tracks
+    (and at most ``vector.jpda.EXACT_ASSOCIATION_BUDGET`` joint events), otherwise it uses loopy belief
+    propagation (``[lbp]``). The gate, clutter intensity kappa and
+    the initial covariance of a new track come from ``[pmb]`` (gate_chi2, clutter_intensity, birth_pos_std_m,
+    birth_vel_std_mps), so every tracker of the study sees the same gate and clutter model.
+    """
 
     p_detect: float = 0.9
     confirm_m: int = 2
     confirm_n: int = 3
     delete_misses: int = 3
     exact_cluster_max: int = 8
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.p_detect < 1.0:
+            raise ConfigError(f"[vector] p_detect must be strictly between 0 and 1, got {self.p_detect}")
+        if not 1 <= self.confirm_m <= self.confirm_n <= 62:
+            raise ConfigError(
+                f"[vector] need 1 <= confirm_m <= confirm_n <= 62, got confirm_m = {self.confirm_m}, "
+                f"confirm_n = {self.confirm_n}"
+            )
+        if self.delete_misses < 1:
+            raise ConfigError(f"[vector] delete_misses must be at least 1, got {self.delete_misses}")
+        if self.exact_cluster_max < 1:
+            raise ConfigError(f"[vector] exact_cluster_max must be at least 1, got {self.exact_cluster_max}")
 
 
 @dataclass(frozen=True, slots=True)

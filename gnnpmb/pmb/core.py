@@ -15,8 +15,9 @@ Everything else in a frame is this module, per class:
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Protocol, overload
 
 import numpy as np
 
@@ -33,10 +34,10 @@ from gnnpmb.events import (
     Pruned,
     PruneReason,
 )
-from gnnpmb.kalman import cv_model
+from gnnpmb.kalman import MotionModel, cv_model
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
-from gnnpmb.pmb.poisson import measurement_birth, new_track_hypotheses
+from gnnpmb.pmb.poisson import NewTrackHypotheses, measurement_birth, new_track_hypotheses
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -70,12 +71,15 @@ class UpdateContext:
 
     ``birth_id(j)`` gives the track id of the Bernoulli started by local measurement j; the same j always gets the
     same id within a frame (so every hypothesis agrees), and ids are allocated in the order first asked for.
+    ``prune_existence``: the core drops Bernoullis with r below it right after the strategy (so a strategy can
+    tell which hypotheses will become identical).
     """
 
     class_name: str
     sink: EventSink
     ids: IdAllocator
     frame_serial: int
+    prune_existence: float = 0.0
     _birth_ids: dict[int, int] = field(default_factory=dict)
 
     def birth_id(self, j: int) -> int:
@@ -89,13 +93,40 @@ class UpdateContext:
         return dict(self._birth_ids)
 
 
+class HypothesisLocals(Sequence[LocalHypotheses]):
+    """The local hypotheses of every prior global hypothesis, cut on first use from those of ``union``, the
+    set of all their distinct Bernoullis: hypothesis h holds the union's Bernoullis ``members[h]``."""
+
+    def __init__(self, union: LocalHypotheses, members: list[np.ndarray]):
+        self.union = union
+        self.members = members
+        self._cut: dict[int, LocalHypotheses] = {}
+
+    def __len__(self) -> int:
+        return len(self.members)
+
+    @overload
+    def __getitem__(self, h: int) -> LocalHypotheses: ...
+
+    @overload
+    def __getitem__(self, h: slice) -> list[LocalHypotheses]: ...
+
+    def __getitem__(self, h: int | slice) -> LocalHypotheses | list[LocalHypotheses]:
+        if isinstance(h, slice):
+            return [self[i] for i in range(len(self))[h]]
+        h = range(len(self))[h]
+        if h not in self._cut:
+            self._cut[h] = self.union.subset(self.members[h])
+        return self._cut[h]
+
+
 class HypothesisStrategy(Protocol):
     """Data-association hypothesis management: the only thing that differs across GNN-PMB, PMBM and TO-PMB."""
 
     name: str
 
     def update(
-        self, priors: list[GlobalHypothesis], locals_: list[LocalHypotheses], ctx: UpdateContext
+        self, priors: list[GlobalHypothesis], locals_: Sequence[LocalHypotheses], ctx: UpdateContext
     ) -> list[GlobalHypothesis]:
         """Posterior hypotheses, sorted by decreasing weight, log weights normalised (logsumexp = 0)."""
         ...
@@ -105,32 +136,71 @@ def posterior_from_assignment(local: LocalHypotheses, col_of_row: np.ndarray, ct
     """Bernoullis of the posterior hypothesis that follows one assignment of measurements to columns
     (``cost.LocalHypotheses.cost_matrix``): detected tracks get r = 1 and the Kalman update, missed tracks the
     misdetection update, measurements on their new-track column start a Bernoulli (module ``cost`` docstring)."""
-    prior, meas = local.prior, local.meas
-    k, m = local.n_tracks, local.n_meas
-    meas_of_track = np.full(k, -1, dtype=np.int64)
-    on_track = col_of_row < k
-    meas_of_track[col_of_row[on_track]] = np.flatnonzero(on_track)
-    det_k = np.flatnonzero(meas_of_track >= 0)
-    det_j = meas_of_track[det_k]
+    k = local.n_tracks
+    tracks = updated_bernoullis(local, np.arange(k), meas_of_track(k, col_of_row) + 1)
+    new_j = np.flatnonzero(col_of_row == k + np.arange(local.n_meas))
+    return Bernoullis.concatenate([tracks, new_bernoullis(local, new_j, ctx)])
 
-    existence = local.miss_existence.copy()
-    existence[det_k] = 1.0
-    mean = prior.mean.copy()
-    mean[det_k] = detected_means(local, det_k, det_j)
-    cov = prior.cov.copy()
-    cov[det_k] = local.inn.cov_post[det_k]
-    boxes = meas.boxes
-    score, z_m = prior.score.copy(), prior.z_m.copy()
-    size, quat = prior.size_wlh_m.copy(), prior.quat_wxyz.copy()
-    score[det_k] = boxes.score[det_j]
-    z_m[det_k] = boxes.translation_m[det_j, 2]
-    size[det_k] = boxes.size_wlh_m[det_j]
-    quat[det_k] = boxes.quat_wxyz[det_j]
-    meas_index = np.full(k, -1, dtype=np.int64)
-    meas_index[det_k] = meas.source_index[det_j]
-    tracks = Bernoullis(
-        track_id=prior.track_id,
-        local_key=combine_keys(prior.local_key, meas_of_track + 1),
+
+def posteriors_from_assignments(
+    union: LocalHypotheses, members: list[np.ndarray], assignments: list[np.ndarray], ctx: UpdateContext
+) -> list[Bernoullis]:
+    """``posterior_from_assignment`` for many hypotheses at once (PMBM): hypothesis i holds the Bernoullis
+    ``members[i]`` of ``union`` and assigns measurements by ``assignments[i]`` (M,), given as columns of the
+    union's cost matrix (u < U: union Bernoulli u, U + j: new track of measurement j). Each distinct
+    (Bernoulli, outcome) is updated once; the Bernoullis keep the order of ``members[i]``, births follow in
+    measurement order, and birth ids are allocated hypothesis by hypothesis, all as calling
+    ``posterior_from_assignment`` on each hypothesis' own local hypotheses in turn would."""
+    n_union, m = union.n_tracks, union.n_meas
+    codes, births = [], []
+    for index, col_of_row in zip(members, assignments, strict=True):
+        codes.append(index * (m + 1) + meas_of_track(n_union, col_of_row)[index] + 1)
+        births.append(np.flatnonzero(col_of_row == n_union + np.arange(m)))
+        for j in births[-1].tolist():
+            ctx.birth_id(j)
+    distinct, inverse = np.unique(np.concatenate(codes), return_inverse=True)
+    tracks = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1))
+    born = np.unique(np.concatenate(births))
+    every = Bernoullis.concatenate([tracks, new_bernoullis(union, born, ctx)])
+    bounds = np.cumsum([0] + [len(c) for c in codes])
+    return [
+        every.subset(np.concatenate([inverse[start:stop], len(tracks) + np.searchsorted(born, new_j)]))
+        for start, stop, new_j in zip(bounds[:-1], bounds[1:], births, strict=True)
+    ]
+
+
+def meas_of_track(n_tracks: int, col_of_row: np.ndarray) -> np.ndarray:
+    """(K,) the measurement an assignment (M,) gives each of the K track columns, -1 if none."""
+    out = np.full(n_tracks, -1, dtype=np.int64)
+    on_track = col_of_row < n_tracks
+    out[col_of_row[on_track]] = np.flatnonzero(on_track)
+    return out
+
+
+def updated_bernoullis(local: LocalHypotheses, rows: np.ndarray, outcome: np.ndarray) -> Bernoullis:
+    """Prior Bernoullis ``rows`` of ``local`` after the single-target hypotheses ``outcome`` (0 = missed: the
+    misdetection update; j + 1 = detected by local measurement j: r = 1 and the Kalman update, box fields and
+    score from the detection). The local key becomes ``combine_keys(parent key, outcome)``."""
+    prior, boxes = local.prior, local.meas.boxes
+    det = np.flatnonzero(outcome > 0)
+    det_k, det_j = rows[det], outcome[det] - 1
+    existence = local.miss_existence[rows]
+    existence[det] = 1.0
+    mean = prior.mean[rows]
+    mean[det] = detected_means(local, det_k, det_j)
+    cov = prior.cov[rows]
+    cov[det] = local.inn.cov_post[det_k]
+    score, z_m = prior.score[rows], prior.z_m[rows]
+    size, quat = prior.size_wlh_m[rows], prior.quat_wxyz[rows]
+    score[det] = boxes.score[det_j]
+    z_m[det] = boxes.translation_m[det_j, 2]
+    size[det] = boxes.size_wlh_m[det_j]
+    quat[det] = boxes.quat_wxyz[det_j]
+    meas_index = np.full(len(rows), -1, dtype=np.int64)
+    meas_index[det] = local.meas.source_index[det_j]
+    return Bernoullis(
+        track_id=prior.track_id[rows],
+        local_key=combine_keys(prior.local_key[rows], outcome),
         existence=existence,
         mean=mean,
         cov=cov,
@@ -140,8 +210,6 @@ def posterior_from_assignment(local: LocalHypotheses, col_of_row: np.ndarray, ct
         quat_wxyz=quat,
         meas_index=meas_index,
     )
-    new_j = np.flatnonzero(col_of_row == k + np.arange(m))
-    return Bernoullis.concatenate([tracks, new_bernoullis(local, new_j, ctx)])
 
 
 def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext) -> Bernoullis:
@@ -176,11 +244,11 @@ def assignment_pairs(
 
 def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
     """Track id -> its largest existence probability over the hypotheses."""
-    out: dict[int, float] = {}
-    for h in hypotheses:
-        for t, r in zip(h.bernoullis.track_id.tolist(), h.bernoullis.existence.tolist(), strict=True):
-            out[t] = max(r, out.get(t, 0.0))
-    return out
+    ids = np.concatenate([h.bernoullis.track_id for h in hypotheses])
+    ids, inverse = np.unique(ids, return_inverse=True)
+    largest = np.zeros(len(ids))
+    np.maximum.at(largest, inverse, np.concatenate([h.bernoullis.existence for h in hypotheses]))
+    return dict(zip(ids.tolist(), largest.tolist(), strict=True))
 
 
 class PmbCore:
@@ -201,15 +269,11 @@ class PmbCore:
         p = self.params
         self.frame_serial += 1
         model = cv_model(dt_s, self.class_params)
-        priors = [
-            GlobalHypothesis(h.log_weight, predict_bernoullis(h.bernoullis, model, p.p_survive))
-            for h in self.hypotheses
-        ]
         new = new_track_hypotheses(measurement_birth(meas, p), meas, model.R, p.clutter_intensity)
-        locals_ = [local_hypotheses(h.bernoullis, meas, new, model.R, p.gate_chi2) for h in priors]
+        priors, locals_ = self._predict_and_localise(meas, model, new)
         if sink.enabled:
             self._emit_prior(locals_[0], sink)
-        ctx = UpdateContext(self.class_name, sink, self.ids, self.frame_serial)
+        ctx = UpdateContext(self.class_name, sink, self.ids, self.frame_serial, p.prune_existence)
         posteriors = self.strategy.update(priors, locals_, ctx)
         self.hypotheses = self._prune(priors, posteriors, ctx, sink)
         best = self.hypotheses[0].bernoullis
@@ -218,19 +282,45 @@ class PmbCore:
             self._emit_posterior(best, ctx, estimates, sink)
         return estimates
 
+    def _predict_and_localise(
+        self, meas: Measurements, model: MotionModel, new: NewTrackHypotheses
+    ) -> tuple[list[GlobalHypothesis], Sequence[LocalHypotheses]]:
+        """Predicted prior hypotheses and their local hypotheses. Global hypotheses share most Bernoullis
+        (equal ``local_key`` = identical component), so with several hypotheses every distinct Bernoulli is
+        predicted and gated once and each hypothesis takes its rows when asked (``HypothesisLocals``; PMBM,
+        García-Fernández et al. 2018, sec. V)."""
+        p = self.params
+        if len(self.hypotheses) == 1:
+            h = self.hypotheses[0]
+            prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
+            local = local_hypotheses(prior, meas, new, model.R, p.gate_chi2)
+            return [GlobalHypothesis(h.log_weight, prior)], [local]
+        every = Bernoullis.concatenate([h.bernoullis for h in self.hypotheses])
+        _, first, inverse = np.unique(every.local_key, return_index=True, return_inverse=True)
+        union_prior = predict_bernoullis(every.subset(first), model, p.p_survive)
+        union_local = local_hypotheses(union_prior, meas, new, model.R, p.gate_chi2)
+        bounds = np.cumsum([0] + [len(h.bernoullis) for h in self.hypotheses])
+        members = [inverse[start:stop] for start, stop in zip(bounds[:-1], bounds[1:], strict=True)]
+        priors = [
+            GlobalHypothesis(h.log_weight, union_prior.subset(index))
+            for h, index in zip(self.hypotheses, members, strict=True)
+        ]
+        return priors, HypothesisLocals(union_local, members)
+
     def _prune(
         self, priors: list[GlobalHypothesis], posteriors: list[GlobalHypothesis], ctx: UpdateContext, sink: EventSink
     ) -> list[GlobalHypothesis]:
         """Drop Bernoullis with r < threshold from every hypothesis; report tracks that vanished from all."""
         threshold = self.params.prune_existence
         kept = [
-            GlobalHypothesis(h.log_weight, h.bernoullis.subset(h.bernoullis.existence >= threshold))
+            h if h.bernoullis.existence.min(initial=1.0) >= threshold
+            else GlobalHypothesis(h.log_weight, h.bernoullis.subset(h.bernoullis.existence >= threshold))
             for h in posteriors
         ]
         if sink.enabled:
             posterior_r = _max_existence(posteriors)
             prior_r = _max_existence(priors)
-            alive = {t for h in kept for t in h.bernoullis.track_id.tolist()}
+            alive = set(np.concatenate([h.bernoullis.track_id for h in kept]).tolist())
             for t in sorted((set(posterior_r) | set(prior_r)) - alive):
                 if t in posterior_r:
                     sink.emit(Pruned(self.class_name, t, PruneReason.LOW_EXISTENCE, posterior_r[t]))

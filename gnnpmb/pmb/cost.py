@@ -66,6 +66,21 @@ class LocalHypotheses:
         """sum_k log l_k0: the log weight of the hypothesis before subtracting the assignment cost."""
         return float(self.miss_log_lik.sum())
 
+    def subset(self, index: np.ndarray) -> LocalHypotheses:
+        """The local hypotheses of the prior Bernoullis ``index`` (an integer array; same measurements and
+        new-track hypotheses)."""
+        return LocalHypotheses(
+            prior=self.prior.subset(index),
+            meas=self.meas,
+            inn=_subset_innovation(self.inn, index),
+            d2=self.d2[index],
+            inside=self.inside[index],
+            miss_log_lik=self.miss_log_lik[index],
+            miss_existence=self.miss_existence[index],
+            det_log_lik=self.det_log_lik[index],
+            new=self.new,
+        )
+
     def row_labels(self) -> tuple[AxisLabel, ...]:
         return tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in self.meas.source_index)
 
@@ -118,15 +133,17 @@ def detected_means(local: LocalHypotheses, track_index: np.ndarray, meas_index: 
     """(P, 4) Kalman-updated means for P (track, measurement) pairs given as local row/column indices."""
     if len(track_index) == 0:
         return np.zeros((0, 4))
-    sub = Innovation(
-        z_pred=local.inn.z_pred[track_index],
-        S=local.inn.S[track_index],
-        S_inv=local.inn.S_inv[track_index],
-        log_det_S=local.inn.log_det_S[track_index],
-        gain=local.inn.gain[track_index],
-        cov_post=local.inn.cov_post[track_index],
+    nu = local.meas.z[meas_index] - local.inn.z_pred[track_index]
+    return local.prior.mean[track_index] + np.einsum("pij,pj->pi", local.inn.gain[track_index], nu)
+
+
+def _subset_innovation(inn: Innovation, index: np.ndarray) -> Innovation:
+    return Innovation(
+        z_pred=inn.z_pred[index],
+        S=inn.S[index],
+        S_inv=inn.S_inv[index],
+        log_det_S=inn.log_det_S[index],
+        gain=inn.gain[index],
+        cov_post=inn.cov_post[index],
     )
-    z = local.meas.z[meas_index]
-    nu = z - sub.z_pred
-    return local.prior.mean[track_index] + np.einsum("pij,pj->pi", sub.gain, nu)
 

@@ -1,0 +1,397 @@
+"""The k best 2D assignments by Murty's partitioning, on independent blocks of the cost matrix.
+
+An assignment maps every row of an (R, C) cost matrix, R <= C, to a distinct column; +inf marks a forbidden
+pair. Murty (1968), "An algorithm for ranking all the assignments in order of increasing cost", Operations
+Research 16(3): the solution space minus the best solution a of a subproblem splits into disjoint subproblems
+P_q, q = p .. R-1 (rows < p already pinned): rows < q keep their columns in a, row q may not take a(q). Each
+subproblem's best solution is found with scipy's Hungarian / Jonker-Volgenant solver and kept in a priority
+queue; the next best solution overall is the queue's minimum.
+
+Speed-ups in the spirit of Miller, Stone & Cox (1997), "Optimizing Murty's ranked assignment method", IEEE
+T-AES 33(3): rows pinned by the partition and their columns are removed from the subproblem, a subproblem
+whose constrained row has no allowed column is skipped unsolved, a single free row is solved by argmin, and
+solutions are ranked lazily, only as deep as asked. Above all, gating makes tracking matrices block diagonal:
+rows and columns joined by finite entries form independent blocks (``blocks``), an assignment is one solution
+per block and its cost the sum, so the ranked assignments are the smallest sums over per-block rankings
+(``Product``, a lazy heap over index tuples). A block is ranked by ``Murty``, or, when its candidate
+assignments are few, by listing them all at once (``Enumerated``). ``Ranking`` objects can be shared between
+problems that contain the same block (PMBM global hypotheses share most of theirs, ``pmb.pmbm``).
+
+A ranking may be limited to assignments costing at most ``max_increase`` more than the best one (PMBM drops
+such hypotheses anyway). Then an entry (i, j) is forbidden before splitting into blocks, which keeps blocks
+small, when a lower bound on the cost of any assignment using it already exceeds that: c_ij + sum_{i' != i}
+min_j' c_i'j', or the best cost + c_ij - c_ip for a column p that only row i may use
+(``forbid_beyond_private``).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from typing import Protocol
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
+
+ENUMERATION_LIMIT = 1024
+"""A block whose rows' allowed-column counts multiply to at most this is ranked by listing its candidate
+assignments at once (a few vectorised steps) instead of by Murty's method."""
+
+
+class Ranking(Protocol):
+    """Assignments of one problem in increasing cost, computed on demand."""
+
+    def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        """The index-th cheapest assignment (col_of_row, cost), or None if there are fewer. Do not modify."""
+        ...
+
+
+def k_best(cost: np.ndarray, k: int, max_increase: float = math.inf) -> list[tuple[np.ndarray, float]]:
+    """The k lowest-cost assignments of an (R, C) cost matrix (R <= C, +inf forbidden), cheapest first.
+
+    Returns up to k pairs (col_of_row (R,) int64, total cost); fewer when fewer feasible assignments exist (or
+    cost at most ``max_increase`` more than the best), none when no assignment avoids the forbidden entries
+    (or R > C). Equal-cost assignments come in a deterministic order. The first is exactly
+    ``hungarian.solve(cost)`` (its restriction to every block is optimal there), so a k-best user with k = 1
+    behaves like the single-best user.
+    """
+    cost = np.asarray(cost, dtype=float)
+    if cost.ndim != 2:
+        raise ValueError(f"cost must be a 2D matrix, got shape {cost.shape}")
+    if np.isnan(cost).any() or np.isneginf(cost).any():
+        raise ValueError("cost may contain finite values and +inf only")
+    n_rows, n_cols = cost.shape
+    if k <= 0 or n_rows > n_cols:
+        return []
+    try:
+        first, first_total = solve(cost)
+    except InfeasibleAssignment:
+        return []
+    out = [(first, first_total)]
+    if k == 1 or n_rows == 0:
+        return out
+    ranking = rank(cost, first, max_increase)
+    arange = np.arange(n_rows)
+    for index in range(1, k):
+        found = ranking.solution(index)
+        if found is None:
+            break
+        out.append((found[0].copy(), float(cost[arange, found[0]].sum())))
+    return out
+
+
+def rank(cost: np.ndarray, first: np.ndarray | None = None, max_increase: float = math.inf) -> Ranking:
+    """Lazy ranking of the assignments of ``cost`` (R <= C rows, +inf forbidden) that cost at most
+    ``max_increase`` more than the best, split into blocks unless small.
+
+    ``first``: a best assignment to start from (else found here). Raises ``InfeasibleAssignment`` when no
+    assignment exists.
+    """
+    n_rows = cost.shape[0]
+    if n_rows == 0:
+        return Product(np.zeros(0, dtype=np.int64), [], max_increase)
+    if _candidates(cost) <= ENUMERATION_LIMIT:
+        return block_ranking(cost, first, max_increase)
+    if max_increase < math.inf:
+        if first is None:
+            first, _ = solve(cost)
+        cost = _forbid_hopeless(forbid_beyond_private(cost, max_increase), first, max_increase)
+        if _candidates(cost) <= ENUMERATION_LIMIT:
+            return block_ranking(cost, first, max_increase)
+    parts = []
+    base = np.empty(n_rows, dtype=np.int64)
+    for rows, cols in blocks(cost):
+        root = None
+        if first is not None:
+            local_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
+            local_of_col[cols] = np.arange(len(cols))
+            root = local_of_col[first[rows]]
+        ranking = block_ranking(cost[np.ix_(rows, cols)], root, max_increase)
+        base[rows] = cols[ranking.solution(0)[0]]
+        parts.append((rows, cols, ranking))
+    return Product(base, parts, max_increase)
+
+
+def block_ranking(
+    cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf
+) -> Ranking:
+    """Ranking of one block (not split): a sorted row for a single row, enumeration when small, else Murty;
+    only assignments at most ``max_increase`` costlier than the best. ``root``: a best assignment to rank
+    first (else found here). Raises ``InfeasibleAssignment``."""
+    n_rows = cost.shape[0]
+    if n_rows == 1:
+        if not np.isfinite(cost[0]).any():
+            raise InfeasibleAssignment("the only row has no allowed column")
+        return SingleRow(cost[0], int(np.argmin(cost[0]) if root is None else root[0]), max_increase)
+    if _candidates(cost) <= ENUMERATION_LIMIT:
+        return Enumerated(cost, root, max_increase)
+    return Murty(cost, solve(cost)[0] if root is None else root, max_increase)
+
+
+def _candidates(cost: np.ndarray) -> float:
+    """Product over rows of the number of allowed columns: an upper bound on the number of assignments."""
+    return float(np.prod(np.count_nonzero(cost < np.inf, axis=1), dtype=float))
+
+
+def forbid_beyond_private(
+    cost: np.ndarray, max_increase: float, usable: np.ndarray | None = None
+) -> np.ndarray:
+    """``cost`` with +inf at every (i, j) with c_ij > c_ip + ``max_increase`` for a column p that only row i
+    may use (a private column, like a PMB new-track column). Moving row i to p keeps any assignment feasible,
+    so one using (i, j) costs more than ``max_increase`` above the best; the best assignment keeps its
+    entries. ``usable``: (C,) bool, the columns that may serve as p (for matrices that later lose columns:
+    only those that stay), default all."""
+    finite = cost < np.inf
+    private = finite & (np.count_nonzero(finite, axis=0) == 1)
+    if usable is not None:
+        private &= usable
+    private_min = np.where(private, cost, np.inf).min(axis=1)
+    return np.where(cost <= (private_min + max_increase)[:, None], cost, np.inf)
+
+
+def _forbid_hopeless(cost: np.ndarray, best: np.ndarray, max_increase: float) -> np.ndarray:
+    """``cost`` with +inf at every (i, j) that no assignment within ``max_increase`` of the best one
+    (``best``) can use: c_ij + sum_{i' != i} min_j' c_i'j' > cost(best) + max_increase. The best assignment
+    stays."""
+    row_min = cost.min(axis=1)
+    allowed = float(cost[np.arange(cost.shape[0]), best].sum()) + max_increase - (row_min.sum() - row_min)
+    return np.where(cost <= allowed[:, None], cost, np.inf)
+
+
+def blocks(cost: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(rows, cols) of every connected block of finite entries of ``cost`` (bipartite components with at least
+    one row), ordered by their first row; columns without a finite entry belong to no block.
+
+    Union-find over the finite entries by hooking the larger root under the smaller and pointer jumping, so a
+    block's label is its smallest row index.
+    """
+    n_rows, n_cols = cost.shape
+    if n_rows == 0:
+        return []
+    a, c = np.divmod(np.flatnonzero(cost < np.inf), n_cols)  # np.nonzero is slow on 2D arrays
+    b = n_rows + c
+    label = np.arange(n_rows + n_cols)
+    while True:
+        la, lb = label[a], label[b]
+        differ = la != lb
+        if not differ.any():
+            break
+        np.minimum.at(label, np.maximum(la[differ], lb[differ]), np.minimum(la[differ], lb[differ]))
+        jumped = label[label]
+        while (jumped != label).any():
+            label, jumped = jumped, jumped[jumped]
+    row_label, col_label = label[:n_rows], label[n_rows:]
+    row_order = np.argsort(row_label, kind="stable")
+    col_order = np.argsort(col_label, kind="stable")
+    row_sorted, col_sorted = row_label[row_order], col_label[col_order]
+    row_starts = np.flatnonzero(np.diff(row_sorted, prepend=-1))
+    names = row_sorted[row_starts]
+    row_stops = [*row_starts[1:].tolist(), n_rows]
+    col_starts = np.searchsorted(col_sorted, names, side="left").tolist()
+    col_stops = np.searchsorted(col_sorted, names, side="right").tolist()
+    return [
+        (row_order[i:j], col_order[k:m])
+        for i, j, k, m in zip(row_starts.tolist(), row_stops, col_starts, col_stops, strict=True)
+    ]
+
+
+class SingleRow:
+    """Ranking of a one-row problem: its finite entries, ``root`` first, then by cost (stable)."""
+
+    def __init__(self, cost_row: np.ndarray, root: int, max_increase: float = math.inf):
+        order = np.argsort(cost_row, kind="stable")
+        keep = (
+            (cost_row[order] < np.inf) & (cost_row[order] <= cost_row[root] + max_increase) & (order != root)
+        )
+        self._cols = np.concatenate([[root], order[keep]]).astype(np.int64)
+        self._costs = cost_row[self._cols]
+
+    def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        if index >= len(self._cols):
+            return None
+        return self._cols[index : index + 1], float(self._costs[index])
+
+
+class Enumerated:
+    """Ranking of a small block by listing every assignment: rows' allowed columns are combined row by row,
+    dropping combinations that reuse a column, then sorted by cost (stable); ``root``, if given, comes
+    first."""
+
+    def __init__(self, cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf):
+        n_rows = cost.shape[0]
+        combos = np.zeros((1, 0), dtype=np.int64)
+        for i in range(n_rows):
+            allowed = np.flatnonzero(cost[i] < np.inf)
+            grown = np.column_stack([np.repeat(combos, len(allowed), axis=0), np.tile(allowed, len(combos))])
+            combos = grown[(grown[:, :i] != grown[:, i : i + 1]).all(axis=1)]
+        if len(combos) == 0:
+            raise InfeasibleAssignment("no assignment avoids the forbidden entries")
+        costs = cost[np.arange(n_rows), combos].sum(axis=1)
+        order = np.argsort(costs, kind="stable")
+        if root is not None:
+            at = np.flatnonzero((combos[order] == root).all(axis=1))[0]
+            order = np.concatenate([order[at : at + 1], order[:at], order[at + 1 :]])
+        order = order[costs[order] <= costs[order[0]] + max_increase]
+        self._combos = combos[order]
+        self._costs = costs[order]
+
+    def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        if index >= len(self._combos):
+            return None
+        return self._combos[index], float(self._costs[index])
+
+
+class Murty:
+    """Ranking of one (r, c) block by Murty's partitioning (module docstring); ``root`` is a best assignment.
+
+    A queued subproblem is (cost, serial, best solution, p, barred): rows < p pinned to the solution's
+    columns, row p may not take the columns in ``barred``; ``serial`` makes equal costs pop first in, first
+    out. The latest solution is partitioned only when a further one is asked for; subproblems costing more
+    than the root plus ``max_increase`` are not queued.
+    """
+
+    def __init__(self, cost: np.ndarray, root: np.ndarray, max_increase: float = math.inf):
+        self.cost = cost
+        self._arange = np.arange(cost.shape[0])
+        self.solutions: list[tuple[np.ndarray, float]] = [(root, self._total(root))]
+        self._limit = self.solutions[0][1] + max_increase
+        self._queue: list[tuple[float, int, np.ndarray, int, tuple[int, ...]]] = []
+        self._serial = 0
+        self._unexpanded: tuple[np.ndarray, int, tuple[int, ...]] | None = (root, 0, ())
+
+    def _total(self, cols: np.ndarray) -> float:
+        return float(self.cost[self._arange, cols].sum())
+
+    def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        while len(self.solutions) <= index:
+            if self._unexpanded is not None:
+                self._expand(*self._unexpanded)
+                self._unexpanded = None
+            if not self._queue:
+                return None
+            total, _, sol, pinned, barred = heapq.heappop(self._queue)
+            self.solutions.append((sol, total))
+            self._unexpanded = (sol, pinned, barred)
+        return self.solutions[index]
+
+    def _expand(self, sol: np.ndarray, pinned: int, barred: tuple[int, ...]) -> None:
+        """Queue the best solution of every subproblem P_q, q = pinned .. r-1, that partitions the rest of the
+        subproblem (pinned, barred) whose best is ``sol``."""
+        cost = self.cost
+        n_rows = cost.shape[0]
+        free = np.ones(cost.shape[1], dtype=bool)
+        free[sol[:pinned]] = False
+        for q in range(pinned, n_rows):
+            row_barred = (*barred, int(sol[q])) if q == pinned else (int(sol[q]),)
+            row = np.where(free, cost[q], np.inf)
+            row[list(row_barred)] = np.inf
+            if np.isfinite(row).any():
+                self._push_child(sol, q, row, free, row_barred)
+            free[sol[q]] = False
+
+    def _push_child(
+        self, sol: np.ndarray, q: int, row: np.ndarray, free: np.ndarray, barred: tuple[int, ...]
+    ) -> None:
+        """Solve P_q: rows < q keep ``sol``, row q costs ``row`` (barred and taken columns at +inf), later
+        rows use the free columns; queue its best solution if one exists within the limit."""
+        child = sol.copy()
+        if q == len(sol) - 1:
+            child[q] = int(np.argmin(row))
+        else:
+            sub_cols = np.flatnonzero(free)
+            sub = self.cost[q:, sub_cols]
+            sub[0] = row[sub_cols]
+            try:
+                _, picked = linear_sum_assignment(sub)
+            except ValueError:
+                return
+            child[q:] = sub_cols[picked]
+        total = self._total(child)
+        if total <= self._limit and total < np.inf:
+            heapq.heappush(self._queue, (total, self._serial, child, q, barred))
+            self._serial += 1
+
+
+class Product:
+    """Ranking of a problem made of independent parts (disjoint rows and columns): the smallest sums of one
+    solution per part, up to ``max_increase`` above the best.
+
+    base: (R,) the best assignment (every part's solution 0 on its rows; not modified); parts: (rows, cols,
+    ranking) with the part's rows in the problem and its local-to-problem column map.
+
+    Index tuples t (solution index per part) are ranked with a heap. Parts with a second solution are sorted
+    by d_q = cost(1) - cost(0); with q the last nonzero position of t, its successors are t + e_q, t + e_(q+1)
+    and, if t_q = 1, t - e_q + e_(q+1). Every tuple then has exactly one parent and costs no less than it (a
+    part's costs never decrease and d is sorted), so at most three heap entries are pushed per solution.
+    """
+
+    def __init__(
+        self,
+        base: np.ndarray,
+        parts: list[tuple[np.ndarray, np.ndarray, Ranking]],
+        max_increase: float = math.inf,
+    ):
+        self.base = base
+        self.parts = parts
+        total = float(sum(ranking.solution(0)[1] for _, _, ranking in parts))
+        self._limit = total + max_increase
+        self._varying: list[tuple[np.ndarray, np.ndarray, Ranking]] = []
+        self._found: list[tuple[tuple[int, ...], float]] = [((), total)]
+        self._solutions: dict[int, tuple[np.ndarray, float]] = {0: (base, total)}
+        self._heap: list[tuple[float, int, tuple[int, ...], int]] = []
+        self._serial = 0
+        self._unexpanded: tuple[tuple[int, ...], float, int] | None = ((), total, -1)
+
+    def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        while len(self._found) <= index:
+            if self._unexpanded is not None:
+                self._push_successors(*self._unexpanded)
+                self._unexpanded = None
+            if not self._heap:
+                return None
+            total, _, choice, last = heapq.heappop(self._heap)
+            self._found.append((choice, total))
+            self._unexpanded = (choice, total, last)
+        if index not in self._solutions:
+            choice, total = self._found[index]
+            cols = self.base.copy()
+            for (rows, part_cols, ranking), i in zip(self._varying, choice, strict=True):
+                if i:
+                    cols[rows] = part_cols[ranking.solution(i)[0]]
+            self._solutions[index] = (cols, total)
+        return self._solutions[index]
+
+    def _cost(self, q: int, i: int) -> float:
+        return self._varying[q][2].solution(i)[1]
+
+    def _push(self, total: float, choice: tuple[int, ...], last: int) -> None:
+        if total <= self._limit:
+            heapq.heappush(self._heap, (total, self._serial, choice, last))
+            self._serial += 1
+
+    def _push_successors(self, choice: tuple[int, ...], total: float, last: int) -> None:
+        if last < 0:
+            steps = []
+            for n, (_, _, ranking) in enumerate(self.parts):
+                second = ranking.solution(1)
+                if second is not None:
+                    steps.append((second[1] - ranking.solution(0)[1], n))
+            steps.sort()
+            self._varying = [self.parts[n] for _, n in steps]
+            if steps:
+                self._push(total + steps[0][0], (1,) + (0,) * (len(steps) - 1), 0)
+            return
+        i = choice[last]
+        further = self._varying[last][2].solution(i + 1)
+        if further is not None:
+            self._push(
+                total + further[1] - self._cost(last, i), (*choice[:last], i + 1, *choice[last + 1 :]), last
+            )
+        if last + 1 < len(self._varying):
+            step = self._cost(last + 1, 1) - self._cost(last + 1, 0)
+            self._push(total + step, (*choice[: last + 1], 1, *choice[last + 2 :]), last + 1)
+            if i == 1:
+                undo = self._cost(last, 1) - self._cost(last, 0)
+                self._push(total - undo + step, (*choice[:last], 0, 1, *choice[last + 2 :]), last + 1)

@@ -1,0 +1,305 @@
+"""PMBM hypothesis management: keep up to N_h global hypotheses, each expanded by Murty's k best assignments.
+
+García-Fernández, Williams, Granström & Svensson (2018), "Poisson multi-Bernoulli mixture filter: direct
+derivation and implementation", IEEE T-AES 54(4), sec. IV-V; the GNN-PMB paper (Liu et al., T-IV 2023),
+sec. III. Prior global hypothesis h with normalised weight w_h and cost matrix C_h (``cost.LocalHypotheses``)
+has children a = the H_h = ceil(N_h w_h) best assignments of C_h (``assign.murty``), with
+
+    log w_{h,a} = log w_h + sum_k log l_k0 - C_h(a)        (up to normalisation),
+
+since an assignment's likelihood is the product of its local hypothesis likelihoods. Children that will hold
+the same Bernoullis (same multiset of local keys after the core's existence pruning) are merged by adding
+weights; then the weights are normalised, sorted (ties keep parent, then rank order), children below
+``hypothesis_prune`` dropped, at most N_h kept and renormalised. With N_h = 1 this is exactly GNN-PMB
+(``strategy.BestAssignment``).
+
+Of a parent's H_h best assignments only those costing at most -log(hypothesis_prune) more than its best are
+enumerated: the parent's best child alone outweighs such a child by more than 1 / hypothesis_prune, so its
+normalised weight is below the threshold whatever the other children (it could matter only by merging).
+
+Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
+whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
+ranked once (``murty.rank``) and shared by all hypotheses that contain it (``murty.Product``). Posteriors are
+built once per distinct (Bernoulli, outcome) (``core.posteriors_from_assignments``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import logsumexp
+
+from gnnpmb.assign.hungarian import InfeasibleAssignment
+from gnnpmb.assign.murty import Product, Ranking, blocks, forbid_beyond_private, k_best, rank
+from gnnpmb.config import PmbmParams
+from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses
+from gnnpmb.pmb.core import (
+    GlobalHypothesis,
+    HypothesisLocals,
+    UpdateContext,
+    assignment_pairs,
+    posteriors_from_assignments,
+)
+from gnnpmb.pmb.cost import LocalHypotheses
+
+COST_MATRIX_EVENTS = 3
+"""Cost matrices are emitted for the first COST_MATRIX_EVENTS prior hypotheses only (the core emits that of
+hypothesis 0, the strategy the others), to keep recordings small."""
+
+
+@dataclass(frozen=True, slots=True)
+class _Child:
+    """One posterior hypothesis candidate: its unnormalised log weight, parent index, assignment (M,) as
+    columns of the union's cost matrix (``SharedRanking``) and the assignment's cost."""
+
+    log_weight: float
+    parent: int
+    col_of_row: np.ndarray
+    total_cost: float
+
+
+def hypothesis_budget(n_hypotheses: int, log_weight: float) -> int:
+    """H_h = ceil(N_h w_h) >= 1 children for a prior hypothesis of normalised log weight ``log_weight``
+    (a relative 1e-9 slack keeps N_h w_h = 2 + rounding error at 2)."""
+    return max(1, math.ceil(n_hypotheses * math.exp(log_weight) * (1.0 - 1e-9)))
+
+
+class KBest:
+    """PMBM: at most ``params.n_hypotheses`` global hypotheses from Murty's k best assignments."""
+
+    name = "k-best"
+
+    def __init__(self, params: PmbmParams):
+        self.params = params
+        self._log_prune = math.log(params.hypothesis_prune) if params.hypothesis_prune > 0 else -math.inf
+        self._max_increase = -self._log_prune
+
+    def update(
+        self, priors: list[GlobalHypothesis], locals_: Sequence[LocalHypotheses], ctx: UpdateContext
+    ) -> list[GlobalHypothesis]:
+        prior_log_w = np.array([h.log_weight for h in priors])
+        prior_log_w = prior_log_w - logsumexp(prior_log_w)
+        budgets = [hypothesis_budget(self.params.n_hypotheses, lw) for lw in prior_log_w]
+        if ctx.sink.enabled:
+            for h in range(1, min(COST_MATRIX_EVENTS, len(locals_))):
+                local = locals_[h]
+                cost = local.cost_matrix()
+                ctx.sink.emit(
+                    CostMatrix(ctx.class_name, cost, local.row_labels(), local.col_labels(), hypothesis=h)
+                )
+        union, members = _union_of(locals_)
+        if len(locals_) == 1:
+            ranked = [k_best(locals_[0].cost_matrix(), budgets[0], self._max_increase)]
+        else:
+            ranked = SharedRanking(union, members, self._max_increase).k_best(budgets)
+        children: list[_Child] = []
+        for h, assignments in enumerate(ranked):
+            base = float(prior_log_w[h]) + float(union.miss_log_lik[members[h]].sum())  # sum_k log l_k0
+            children.extend(_Child(base - total, h, col_of_row, total) for col_of_row, total in assignments)
+        kept, log_w = self._select(_merge_identical(children, union, members, ctx))
+        bernoullis = posteriors_from_assignments(
+            union, [members[c.parent] for c in kept], [c.col_of_row for c in kept], ctx
+        )
+        posteriors = [GlobalHypothesis(float(lw), b) for lw, b in zip(log_w, bernoullis, strict=True)]
+        if ctx.sink.enabled:
+            best = kept[0]
+            own = _own_columns(best.col_of_row, members[best.parent], union.n_tracks)
+            _emit(best.total_cost, own, locals_[best.parent], posteriors, ctx)
+        return posteriors
+
+    def _select(self, children: list[_Child]) -> tuple[list[_Child], np.ndarray]:
+        """Normalise, sort descending (stable), drop below ``hypothesis_prune`` (the best always stays), cap
+        to N_h, renormalise. Returns the kept children and their normalised log weights."""
+        log_w = np.array([c.log_weight for c in children])
+        log_w = log_w - logsumexp(log_w)
+        order = np.argsort(-log_w, kind="stable")
+        keep = order[log_w[order] >= self._log_prune]
+        keep = (keep if len(keep) else order[:1])[: self.params.n_hypotheses]
+        kept_log_w = log_w[keep] - logsumexp(log_w[keep])
+        return [children[i] for i in keep], kept_log_w
+
+
+def _own_columns(col_of_row: np.ndarray, index: np.ndarray, n_union: int) -> np.ndarray:
+    """An assignment in union columns (M,) as columns of the cost matrix of the hypothesis holding
+    ``index``."""
+    column = np.full(n_union + len(col_of_row), -1, dtype=np.int64)
+    column[index] = np.arange(len(index))
+    column[n_union:] = len(index) + np.arange(len(col_of_row))
+    return column[col_of_row]
+
+
+def _union_of(locals_: Sequence[LocalHypotheses]) -> tuple[LocalHypotheses, list[np.ndarray]]:
+    """The local hypotheses of every Bernoulli of every hypothesis, and each hypothesis' rows of it."""
+    if isinstance(locals_, HypothesisLocals):
+        return locals_.union, locals_.members
+    if len(locals_) == 1:
+        return locals_[0], [np.arange(locals_[0].n_tracks)]
+    raise ValueError(
+        "PMBM needs the local hypotheses of several global hypotheses as HypothesisLocals (PmbCore)"
+    )
+
+
+class SharedRanking:
+    """Rankings of the cost matrices of hypotheses cut from one union of Bernoullis.
+
+    Column u < U of the union matrix (M, U + M) is union Bernoulli u, column U + j the new-track column of
+    measurement j; hypothesis h holds the Bernoullis ``members[h]``, so its matrix is the union's without the
+    absent Bernoullis' columns. Entries that cannot be in any assignment within ``max_increase`` of the best
+    are forbidden first, by columns private to one row and present in every hypothesis, like the new-track
+    columns (``murty.forbid_beyond_private``). Each gated block of the union matrix is then ranked once per
+    distinct set of its Bernoullis present (``murty.rank``), and a hypothesis' ranking is the
+    ``murty.Product`` of its blocks.
+    """
+
+    def __init__(self, union: LocalHypotheses, members: list[np.ndarray], max_increase: float):
+        self.n_union = union.n_tracks
+        self.n_meas = union.n_meas
+        self.members = members
+        self.max_increase = max_increase
+        cost = union.cost_matrix()
+        has_column = np.ones((len(members), cost.shape[1]), dtype=bool)
+        has_column[:, : self.n_union] = False
+        for h, index in enumerate(members):
+            has_column[h, index] = True
+        cost = forbid_beyond_private(cost, max_increase, usable=has_column.all(axis=0))
+        self.common: list[tuple[np.ndarray, np.ndarray, Ranking | None]] = []
+        self.varying: list[tuple[list[tuple[np.ndarray, np.ndarray, Ranking | None]], np.ndarray]] = []
+        for rows, cols in blocks(cost):
+            present = has_column[:, cols]
+            if (present == present[0]).all():
+                self.common.append(_part(cost, rows, cols, present[0], max_increase))
+                continue
+            _, first, pattern = np.unique(
+                np.packbits(present, axis=1), axis=0, return_index=True, return_inverse=True
+            )
+            parts = [_part(cost, rows, cols, present[h], max_increase) for h in first.tolist()]
+            self.varying.append((parts, pattern.ravel()))
+        self.common_base = np.zeros(self.n_meas, dtype=np.int64)
+        self.common_ok = all(ranking is not None for _, _, ranking in self.common)
+        if self.common_ok:
+            for rows, cols, ranking in self.common:
+                self.common_base[rows] = cols[ranking.solution(0)[0]]
+
+    def k_best(self, budgets: list[int]) -> list[list[tuple[np.ndarray, float]]]:
+        """The budgets[h] best assignments (col_of_row as union columns, cost) of every hypothesis."""
+        return [self._hypothesis(h, k) for h, k in enumerate(budgets)]
+
+    def _hypothesis(self, h: int, k: int) -> list[tuple[np.ndarray, float]]:
+        parts = self.common + [options[pattern[h]] for options, pattern in self.varying]
+        if not self.common_ok or any(ranking is None for _, _, ranking in parts[len(self.common) :]):
+            return []
+        base = self.common_base.copy()
+        for rows, cols, ranking in parts[len(self.common) :]:
+            base[rows] = cols[ranking.solution(0)[0]]
+        product = Product(base, parts, self.max_increase)
+        out = []
+        for i in range(k):
+            found = product.solution(i)
+            if found is None:
+                break
+            out.append(found)
+        return out
+
+
+def _part(
+    cost: np.ndarray, rows: np.ndarray, cols: np.ndarray, present: np.ndarray, max_increase: float
+) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
+    """(rows, columns, ranking) of a block of the union matrix with only its ``present`` columns, ranked up to
+    ``max_increase`` above its best; the ranking is None if that sub-problem has no assignment."""
+    sub_cols = cols[present]
+    try:
+        return rows, sub_cols, rank(cost[np.ix_(rows, sub_cols)], max_increase=max_increase)
+    except InfeasibleAssignment:
+        return rows, sub_cols, None
+
+
+def _merge_identical(
+    children: list[_Child], union: LocalHypotheses, members: list[np.ndarray], ctx: UpdateContext
+) -> list[_Child]:
+    """Children that hold the same Bernoullis once those below ``ctx.prune_existence`` are dropped, merged
+    into the first of them (log weights added with logaddexp); order of first appearance is kept.
+
+    Without pruning no two children are identical (their parents differ in some Bernoulli, whose descendant
+    they keep; siblings differ in some measurement's fate), so signatures are only computed when a child can
+    lose a Bernoulli to pruning: a missed one below the threshold, or a birth below it.
+    """
+    threshold = ctx.prune_existence
+    low_miss = union.miss_existence < threshold
+    low_birth = union.new.existence < threshold
+    if len(children) == 1 or not (low_miss.any() or low_birth.any()):
+        return children
+    signatures = _signatures(
+        np.stack([c.col_of_row for c in children]),
+        np.array([c.parent for c in children]),
+        members,
+        low_miss,
+        low_birth,
+    )
+    first_of: dict[bytes, int] = {}
+    merged: list[_Child] = []
+    for child, signature in zip(children, signatures, strict=True):
+        at = first_of.get(signature)
+        if at is None:
+            first_of[signature] = len(merged)
+            merged.append(child)
+        else:
+            into = merged[at]
+            merged[at] = _Child(
+                float(np.logaddexp(into.log_weight, child.log_weight)),
+                into.parent,
+                into.col_of_row,
+                into.total_cost,
+            )
+    return merged
+
+
+def _signatures(
+    assignments: np.ndarray,
+    parents: np.ndarray,
+    members: list[np.ndarray],
+    low_miss: np.ndarray,
+    low_birth: np.ndarray,
+) -> list[bytes]:
+    """One signature per child: its assignment (M,) in union columns, its parent holding union Bernoullis
+    ``members[parent]``. Per union Bernoulli: 0 when absent or pruned, 1 when missed, j + 2 when detected by
+    measurement j; then the births that survive pruning. Equal signatures = equal Bernoulli sets after
+    pruning."""
+    n_meas = assignments.shape[1]
+    n_union = len(low_miss)
+    present = np.zeros((len(members), n_union), dtype=bool)
+    for h, index in enumerate(members):
+        present[h, index] = True
+    state = (present[parents] & ~low_miss).astype(np.int32)
+    child, row = np.divmod(np.flatnonzero(assignments < n_union), n_meas)
+    state[child, assignments[child, row]] = row + 2
+    births = np.packbits((assignments == n_union + np.arange(n_meas)) & ~low_birth, axis=1)
+    return [a.tobytes() + b.tobytes() for a, b in zip(state, births, strict=True)]
+
+
+def _emit(
+    total_cost: float,
+    col_of_row: np.ndarray,
+    local: LocalHypotheses,
+    posteriors: list[GlobalHypothesis],
+    ctx: UpdateContext,
+) -> None:
+    """The best child's ``Assignment`` (``col_of_row`` over its parent's ``local`` columns) and the
+    ``GlobalHypotheses`` as the core will keep them (after pruning)."""
+    pairs, missed = assignment_pairs(local, col_of_row)
+    ctx.sink.emit(Assignment(ctx.class_name, pairs, total_cost, missed, hypothesis=0))
+    alive = [h.bernoullis.existence >= ctx.prune_existence for h in posteriors]
+    ctx.sink.emit(
+        GlobalHypotheses(
+            ctx.class_name,
+            log_weights=np.array([h.log_weight for h in posteriors]),
+            members=tuple(
+                tuple(h.bernoullis.track_id[a].tolist()) for h, a in zip(posteriors, alive, strict=True)
+            ),
+            local=tuple(
+                tuple(h.bernoullis.local_key[a].tolist()) for h, a in zip(posteriors, alive, strict=True)
+            ),
+        )
+    )
