@@ -15,6 +15,7 @@ frame, so a class without tracks shows no boxes.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -79,6 +80,23 @@ def cost_heat(cost: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
         hi = lo + 1.0
     sentinel = lo - 0.25 * (hi - lo)
     return np.where(finite, heat, sentinel).astype(np.float32), (sentinel, hi)
+
+
+def compact_cost(event: CostMatrix) -> CostMatrix:
+    """The matrix without columns in which every entry is impossible (tracks with no measurement in their gate:
+    with many candidate Bernoullis most columns are), so the heat map shows what the solver chose between; the
+    markdown table still names every column. The description says how many were hidden."""
+    cost = np.asarray(event.cost)
+    keep = np.isfinite(cost).any(axis=0)
+    if keep.all():
+        return event
+    hidden = int((~keep).sum())
+    return dataclasses.replace(
+        event,
+        cost=cost[:, keep],
+        cols=tuple(c for c, k in zip(event.cols, keep.tolist(), strict=True) if k),
+        description=f"{event.description} ({hidden} columns with no possible assignment hidden)",
+    )
 
 
 def axis_dim_name(labels: Sequence[AxisLabel]) -> str:
@@ -327,10 +345,11 @@ class TrackerLogger:
         cost = np.asarray(event.cost)
         if cost.ndim != 2 or cost.size == 0:
             return
-        heat, value_range = cost_heat(cost)
+        shown = compact_cost(event)
+        heat, value_range = cost_heat(np.asarray(shown.cost))
         self._show(
             paths.cost_matrix(self.tracker, event.class_name, event.hypothesis),
-            rr.Tensor(heat, dim_names=[axis_dim_name(event.rows), axis_dim_name(event.cols)], value_range=value_range),
+            rr.Tensor(heat, dim_names=[axis_dim_name(shown.rows), axis_dim_name(shown.cols)], value_range=value_range),
         )
         if event.hypothesis == 0:
             self._show(

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -142,7 +143,9 @@ def test_cost_matrix_heat_map_and_table(logged: tuple[dict, Path]) -> None:
     heat = np.array(tensor["buffer"]).reshape(2, 2)
     assert heat[0, 1] == pytest.approx(1.0) and heat[1, 0] == pytest.approx(2.0)
     assert heat[0, 0] == heat[1, 1] == pytest.approx(lo) and lo < 1.0 and hi == pytest.approx(2.0)
+    # Frame 1: track 2 has no measurement in its gate, so its all-impossible column is left out of the heat map.
     assert at_frame(rows, 1)[0]["Tensor:data"][0]["names"] == ["meas", "track|new"]
+    assert at_frame(rows, 1)[0]["Tensor:data"][0]["shape"] == [1, 2]
     assert latest_at(rows, 2, "Tensor:data") is None
     table = at_frame(logged[0][paths.cost_axes(T, "car")], 1)[0]["TextDocument:text"][0]
     assert "| **meas 0** | -4.00 | - | 0.00 |" in table
@@ -255,3 +258,26 @@ def test_two_trackers_share_one_recording_without_touching_each_other(saved_stre
         assert latest_at(rows[paths.tracks(name, "car")], 1, "Boxes3D:centers")[0][0] == pytest.approx(x)
         assert len([r for r in rows[paths.existence(name, "car", 1)] if not r["static"]]) == 2
         assert paths.predicted(name, "car") not in rows
+
+
+def test_cost_heat_map_hides_columns_with_no_possible_assignment() -> None:
+    from gnnpmb.events import AxisKind, AxisLabel, CostMatrix
+    from viz.logger import compact_cost
+
+    inf = np.inf
+    event = CostMatrix(
+        "car",
+        np.array([[1.0, inf, 2.0, inf], [inf, inf, inf, 3.0]]),
+        (AxisLabel(AxisKind.MEASUREMENT, 0), AxisLabel(AxisKind.MEASUREMENT, 1)),
+        (
+            AxisLabel(AxisKind.TRACK, 5),
+            AxisLabel(AxisKind.TRACK, 6),
+            AxisLabel(AxisKind.NEW_TRACK, 0),
+            AxisLabel(AxisKind.NEW_TRACK, 1),
+        ),
+    )
+    out = compact_cost(event)
+    assert [str(c) for c in out.cols] == ["track 5", "new 0", "new 1"]
+    assert out.cost.shape == (2, 3) and "1 columns" in out.description
+    full = dataclasses.replace(event, cost=np.ones((2, 4)))
+    assert compact_cost(full) is full
