@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.config import ClassParams
+from gnnpmb.soa import StructOfArrays
 
 H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
 """Measurement matrix: picks the BEV position."""
@@ -47,7 +48,7 @@ def predict(mean: np.ndarray, cov: np.ndarray, model: MotionModel) -> tuple[np.n
 
 
 @dataclass(frozen=True, slots=True)
-class Innovation:
+class Innovation(StructOfArrays):
     """Per-track quantities of the update, shared by gating, likelihoods and the update itself.
 
     z_pred: (K, 2) H m; S: (K, 2, 2); S_inv: (K, 2, 2); log_det_S: (K,); gain: (K, 4, 2); cov_post: (K, 4, 4)
@@ -60,6 +61,17 @@ class Innovation:
     log_det_S: np.ndarray
     gain: np.ndarray
     cov_post: np.ndarray
+
+    @staticmethod
+    def empty() -> Innovation:
+        return Innovation(
+            z_pred=np.zeros((0, 2)),
+            S=np.zeros((0, 2, 2)),
+            S_inv=np.zeros((0, 2, 2)),
+            log_det_S=np.zeros(0),
+            gain=np.zeros((0, 4, 2)),
+            cov_post=np.zeros((0, 4, 4)),
+        )
 
 
 def innovation(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gnnpmb.soa import StructOfArrays
+
 TRACKING_CLASSES: tuple[str, ...] = ("bicycle", "bus", "car", "motorcycle", "pedestrian", "trailer", "truck")
 """The seven nuScenes tracking classes, in the devkit's (alphabetical) order."""
 
@@ -21,7 +23,7 @@ MEAS_DIM = 2
 
 
 @dataclass(frozen=True, slots=True)
-class Boxes:
+class Boxes(StructOfArrays):
     """N 3D boxes in the global frame (detections or ground truth), struct-of-arrays.
 
     translation_m: (N, 3) box centres; size_wlh_m: (N, 3); quat_wxyz: (N, 4); velocity_mps: (N, 2) BEV velocity;
@@ -45,18 +47,6 @@ class Boxes:
         """(N, 2) BEV centres: the tracker's measurements."""
         return self.translation_m[:, :2]
 
-    def subset(self, index: np.ndarray) -> Boxes:
-        """Boxes selected by an integer or boolean index."""
-        return Boxes(
-            translation_m=self.translation_m[index],
-            size_wlh_m=self.size_wlh_m[index],
-            quat_wxyz=self.quat_wxyz[index],
-            velocity_mps=self.velocity_mps[index],
-            score=self.score[index],
-            class_name=self.class_name[index],
-            instance_id=self.instance_id[index],
-        )
-
     @staticmethod
     def empty() -> Boxes:
         return Boxes(
@@ -67,21 +57,6 @@ class Boxes:
             score=np.zeros(0),
             class_name=np.zeros(0, dtype=object),
             instance_id=np.zeros(0, dtype=object),
-        )
-
-    @staticmethod
-    def concatenate(parts: list[Boxes]) -> Boxes:
-        parts = [p for p in parts if len(p)]
-        if not parts:
-            return Boxes.empty()
-        return Boxes(
-            translation_m=np.concatenate([p.translation_m for p in parts]),
-            size_wlh_m=np.concatenate([p.size_wlh_m for p in parts]),
-            quat_wxyz=np.concatenate([p.quat_wxyz for p in parts]),
-            velocity_mps=np.concatenate([p.velocity_mps for p in parts]),
-            score=np.concatenate([p.score for p in parts]),
-            class_name=np.concatenate([p.class_name for p in parts]),
-            instance_id=np.concatenate([p.instance_id for p in parts]),
         )
 
 

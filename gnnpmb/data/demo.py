@@ -495,7 +495,7 @@ def _annotated_span(distance_m: np.ndarray) -> np.ndarray:
     return span
 
 
-_TABLE_NAMES = (
+TABLE_NAMES: tuple[str, ...] = (
     "category",
     "attribute",
     "visibility",
@@ -510,6 +510,7 @@ _TABLE_NAMES = (
     "sample_annotation",
     "map",
 )
+"""The tables ``nuscenes.NuScenes`` 1.2.0 loads (``<dataroot>/<version>/<table>.json``)."""
 
 
 def _link(rows: list[dict]) -> None:
@@ -666,7 +667,7 @@ def _write_dataset(dataroot: Path, seed: int) -> None:
     (dataroot / DEMO_VERSION).mkdir(parents=True)
     (dataroot / "samples" / "LIDAR_TOP").mkdir(parents=True)
     (dataroot / "maps").mkdir()
-    tables: dict[str, list[dict]] = {name: [] for name in _TABLE_NAMES}
+    tables: dict[str, list[dict]] = {name: [] for name in TABLE_NAMES}
     for name, description in CATEGORIES:
         tables["category"].append({"token": token("category", name), "name": name, "description": description})
     for name, description in ATTRIBUTES:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gnnpmb.data.demo import DEMO_VERSION, SYNTHETIC_MARKER, ensure_demo_dataset
+from gnnpmb.data.demo import DEMO_VERSION, SYNTHETIC_MARKER, TABLE_NAMES, ensure_demo_dataset
 from gnnpmb.data.scene import Keyframe, Pose, SceneData
 from gnnpmb.errors import DataError, UnknownNameError
 from gnnpmb.types import Boxes
@@ -26,22 +26,6 @@ if TYPE_CHECKING:
 
 DATAROOT_ENV = "NUSCENES_DATAROOT"
 LIDAR_CHANNEL = "LIDAR_TOP"
-TABLE_NAMES: tuple[str, ...] = (
-    "category",
-    "attribute",
-    "visibility",
-    "instance",
-    "sensor",
-    "calibrated_sensor",
-    "ego_pose",
-    "log",
-    "scene",
-    "sample",
-    "sample_data",
-    "sample_annotation",
-    "map",
-)
-"""The tables ``nuscenes.NuScenes`` 1.2.0 loads (``<dataroot>/<version>/<table>.json``)."""
 _POINT_BYTES = 5 * 4
 _FIX_HINT = "pass --dataroot pointing at the folder that contains v1.0-mini/ (or another v1.0-* folder)"
 

@@ -149,11 +149,11 @@ def gate_components(
     """Innovations, gate and log-likelihoods of every (component, measurement) pair (module docstring, 3)."""
     k, m = len(persistent), len(meas)
     mix = GaussianMixture.concatenate([persistent, births])
-    inn = innovation(mix.mean, mix.cov, R) if len(mix) else _empty_innovation()
+    inn = innovation(mix.mean, mix.cov, R)
     z = meas.z
     log_lik = np.full((k + m, m), -np.inf)
     if k and m:
-        inn_p = _innovation_rows(inn, slice(0, k))
+        inn_p = inn.subset(slice(0, k))
         d2 = mahalanobis2(inn_p, z)
         inside = gate(d2, gate_chi2)
         log_lik[:k] = np.where(inside, log_likelihood(inn_p, d2), -np.inf)
@@ -172,26 +172,6 @@ def gate_components(
     )
 
 
-def _innovation_rows(inn: Innovation, rows: slice | np.ndarray) -> Innovation:
-    return Innovation(
-        z_pred=inn.z_pred[rows],
-        S=inn.S[rows],
-        S_inv=inn.S_inv[rows],
-        log_det_S=inn.log_det_S[rows],
-        gain=inn.gain[rows],
-        cov_post=inn.cov_post[rows],
-    )
-
-
-def _empty_innovation() -> Innovation:
-    return Innovation(
-        z_pred=np.zeros((0, 2)),
-        S=np.zeros((0, 2, 2)),
-        S_inv=np.zeros((0, 2, 2)),
-        log_det_S=np.zeros(0),
-        gain=np.zeros((0, 4, 2)),
-        cov_post=np.zeros((0, 4, 4)),
-    )
 
 
 def phd_update(

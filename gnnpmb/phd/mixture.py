@@ -28,10 +28,11 @@ import numpy as np
 
 from gnnpmb.events import PruneReason
 from gnnpmb.kalman import symmetrize
+from gnnpmb.soa import StructOfArrays
 
 
 @dataclass(frozen=True, slots=True)
-class GaussianMixture:
+class GaussianMixture(StructOfArrays):
     """K labelled Gaussian components, struct-of-arrays.
 
     weight: (K,) w_i >= 0; mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); label: (K,) int64 track label (< 0 =
@@ -65,39 +66,6 @@ class GaussianMixture:
             size_wlh_m=np.zeros((0, 3)),
             quat_wxyz=np.zeros((0, 4)),
             meas_index=np.zeros(0, dtype=np.int64),
-        )
-
-    def subset(self, index: np.ndarray) -> GaussianMixture:
-        """Components selected by an integer or boolean index (in that order)."""
-        return GaussianMixture(
-            weight=self.weight[index],
-            mean=self.mean[index],
-            cov=self.cov[index],
-            label=self.label[index],
-            score=self.score[index],
-            z_m=self.z_m[index],
-            size_wlh_m=self.size_wlh_m[index],
-            quat_wxyz=self.quat_wxyz[index],
-            meas_index=self.meas_index[index],
-        )
-
-    @staticmethod
-    def concatenate(parts: list[GaussianMixture]) -> GaussianMixture:
-        parts = [p for p in parts if len(p)]
-        if not parts:
-            return GaussianMixture.empty()
-        if len(parts) == 1:
-            return parts[0]
-        return GaussianMixture(
-            weight=np.concatenate([p.weight for p in parts]),
-            mean=np.concatenate([p.mean for p in parts]),
-            cov=np.concatenate([p.cov for p in parts]),
-            label=np.concatenate([p.label for p in parts]),
-            score=np.concatenate([p.score for p in parts]),
-            z_m=np.concatenate([p.z_m for p in parts]),
-            size_wlh_m=np.concatenate([p.size_wlh_m for p in parts]),
-            quat_wxyz=np.concatenate([p.quat_wxyz for p in parts]),
-            meas_index=np.concatenate([p.meas_index for p in parts]),
         )
 
 

@@ -13,10 +13,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gnnpmb.kalman import MotionModel, predict
+from gnnpmb.soa import StructOfArrays
 
 
 @dataclass(frozen=True, slots=True)
-class Bernoullis:
+class Bernoullis(StructOfArrays):
     """K Bernoulli components, struct-of-arrays.
 
     track_id: (K,) int, the track label (metadata, kept through updates);
@@ -37,9 +38,6 @@ class Bernoullis:
     quat_wxyz: np.ndarray
     meas_index: np.ndarray
 
-    def __len__(self) -> int:
-        return int(self.track_id.shape[0])
-
     @staticmethod
     def empty() -> Bernoullis:
         return Bernoullis(
@@ -53,40 +51,6 @@ class Bernoullis:
             size_wlh_m=np.zeros((0, 3)),
             quat_wxyz=np.zeros((0, 4)),
             meas_index=np.zeros(0, dtype=np.int64),
-        )
-
-    def subset(self, index: np.ndarray) -> Bernoullis:
-        return Bernoullis(
-            track_id=self.track_id[index],
-            local_key=self.local_key[index],
-            existence=self.existence[index],
-            mean=self.mean[index],
-            cov=self.cov[index],
-            score=self.score[index],
-            z_m=self.z_m[index],
-            size_wlh_m=self.size_wlh_m[index],
-            quat_wxyz=self.quat_wxyz[index],
-            meas_index=self.meas_index[index],
-        )
-
-    @staticmethod
-    def concatenate(parts: list[Bernoullis]) -> Bernoullis:
-        parts = [p for p in parts if len(p)]
-        if not parts:
-            return Bernoullis.empty()
-        if len(parts) == 1:
-            return parts[0]
-        return Bernoullis(
-            track_id=np.concatenate([p.track_id for p in parts]),
-            local_key=np.concatenate([p.local_key for p in parts]),
-            existence=np.concatenate([p.existence for p in parts]),
-            mean=np.concatenate([p.mean for p in parts]),
-            cov=np.concatenate([p.cov for p in parts]),
-            score=np.concatenate([p.score for p in parts]),
-            z_m=np.concatenate([p.z_m for p in parts]),
-            size_wlh_m=np.concatenate([p.size_wlh_m for p in parts]),
-            quat_wxyz=np.concatenate([p.quat_wxyz for p in parts]),
-            meas_index=np.concatenate([p.meas_index for p in parts]),
         )
 
 

@@ -72,7 +72,7 @@ class LocalHypotheses:
         return LocalHypotheses(
             prior=self.prior.subset(index),
             meas=self.meas,
-            inn=_subset_innovation(self.inn, index),
+            inn=self.inn.subset(index),
             d2=self.d2[index],
             inside=self.inside[index],
             miss_log_lik=self.miss_log_lik[index],
@@ -94,7 +94,7 @@ def local_hypotheses(
 ) -> LocalHypotheses:
     """Gate every (track, measurement) pair and compute the local hypothesis likelihoods (module docstring)."""
     k, m = len(prior), len(meas)
-    inn = innovation(prior.mean, prior.cov, R) if k else _empty_innovation()
+    inn = innovation(prior.mean, prior.cov, R)
     d2 = mahalanobis2(inn, meas.z) if k and m else np.zeros((k, m))
     inside = gate(d2, gate_chi2)
     miss_log_lik, miss_existence = missed_update(prior.existence, prior.score)
@@ -118,16 +118,6 @@ def local_hypotheses(
     )
 
 
-def _empty_innovation() -> Innovation:
-    return Innovation(
-        z_pred=np.zeros((0, 2)),
-        S=np.zeros((0, 2, 2)),
-        S_inv=np.zeros((0, 2, 2)),
-        log_det_S=np.zeros(0),
-        gain=np.zeros((0, 4, 2)),
-        cov_post=np.zeros((0, 4, 4)),
-    )
-
 
 def detected_means(local: LocalHypotheses, track_index: np.ndarray, meas_index: np.ndarray) -> np.ndarray:
     """(P, 4) Kalman-updated means for P (track, measurement) pairs given as local row/column indices."""
@@ -136,14 +126,4 @@ def detected_means(local: LocalHypotheses, track_index: np.ndarray, meas_index: 
     nu = local.meas.z[meas_index] - local.inn.z_pred[track_index]
     return local.prior.mean[track_index] + np.einsum("pij,pj->pi", local.inn.gain[track_index], nu)
 
-
-def _subset_innovation(inn: Innovation, index: np.ndarray) -> Innovation:
-    return Innovation(
-        z_pred=inn.z_pred[index],
-        S=inn.S[index],
-        S_inv=inn.S_inv[index],
-        log_det_S=inn.log_det_S[index],
-        gain=inn.gain[index],
-        cov_post=inn.cov_post[index],
-    )
 

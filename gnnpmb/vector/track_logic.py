@@ -21,12 +21,13 @@ import numpy as np
 
 from gnnpmb.config import VectorParams
 from gnnpmb.events import EventSink, TrackLogic, TrackLogicAction
+from gnnpmb.soa import StructOfArrays
 
 _HISTORY_MASK = np.int64((1 << 62) - 1)
 
 
 @dataclass(frozen=True, slots=True)
-class LogicState:
+class LogicState(StructOfArrays):
     """Track-logic state of K tracks.
 
     confirmed: (K,) bool; history: (K,) int64 hit bits, bit 0 = the latest frame; age: (K,) int64 frames since
@@ -58,18 +59,6 @@ class LogicState:
             history=np.zeros(0, dtype=np.int64),
             age=np.zeros(0, dtype=np.int64),
             misses=np.zeros(0, dtype=np.int64),
-        )
-
-    def subset(self, index: np.ndarray) -> LogicState:
-        return LogicState(self.confirmed[index], self.history[index], self.age[index], self.misses[index])
-
-    @staticmethod
-    def concatenate(parts: list[LogicState]) -> LogicState:
-        return LogicState(
-            confirmed=np.concatenate([p.confirmed for p in parts]),
-            history=np.concatenate([p.history for p in parts]),
-            age=np.concatenate([p.age for p in parts]),
-            misses=np.concatenate([p.misses for p in parts]),
         )
 
     def hits(self, window: int) -> np.ndarray:

@@ -30,12 +30,13 @@ from gnnpmb.config import TrackerConfig
 from gnnpmb.events import Born, EventSink, Extracted, Gated, Posterior, Predicted, Pruned, PruneReason
 from gnnpmb.gating import gate
 from gnnpmb.kalman import Innovation, MotionModel, cv_model, innovation, mahalanobis2, predict
+from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 from gnnpmb.vector.track_logic import LogicState, advance, emit_transitions
 
 
 @dataclass(frozen=True, slots=True)
-class VectorTracks:
+class VectorTracks(StructOfArrays):
     """K tracks of one class, struct-of-arrays.
 
     track_id: (K,) int64; mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); score: (K,) score of the last
@@ -69,37 +70,6 @@ class VectorTracks:
             quat_wxyz=np.zeros((0, 4)),
             meas_index=np.zeros(0, dtype=np.int64),
             logic=LogicState.empty(),
-        )
-
-    def subset(self, index: np.ndarray) -> VectorTracks:
-        return VectorTracks(
-            track_id=self.track_id[index],
-            mean=self.mean[index],
-            cov=self.cov[index],
-            score=self.score[index],
-            z_m=self.z_m[index],
-            size_wlh_m=self.size_wlh_m[index],
-            quat_wxyz=self.quat_wxyz[index],
-            meas_index=self.meas_index[index],
-            logic=self.logic.subset(index),
-        )
-
-    @staticmethod
-    def concatenate(a: VectorTracks, b: VectorTracks) -> VectorTracks:
-        if not len(b):
-            return a
-        if not len(a):
-            return b
-        return VectorTracks(
-            track_id=np.concatenate([a.track_id, b.track_id]),
-            mean=np.concatenate([a.mean, b.mean]),
-            cov=np.concatenate([a.cov, b.cov]),
-            score=np.concatenate([a.score, b.score]),
-            z_m=np.concatenate([a.z_m, b.z_m]),
-            size_wlh_m=np.concatenate([a.size_wlh_m, b.size_wlh_m]),
-            quat_wxyz=np.concatenate([a.quat_wxyz, b.quat_wxyz]),
-            meas_index=np.concatenate([a.meas_index, b.meas_index]),
-            logic=LogicState.concatenate([a.logic, b.logic]),
         )
 
     def predicted(self, model: MotionModel) -> VectorTracks:
@@ -169,7 +139,7 @@ class VectorTracker(ABC):
         model = cv_model(dt_s, self.class_params)
         prior = self.tracks.predicted(model)
         k, m = len(prior), len(meas)
-        inn = innovation(prior.mean, prior.cov, model.R) if k else _empty_innovation()
+        inn = innovation(prior.mean, prior.cov, model.R)
         d2 = mahalanobis2(inn, meas.z) if k and m else np.zeros((k, m))
         inside = gate(d2, self.gate_chi2)
         if sink.enabled:
@@ -178,7 +148,7 @@ class VectorTracker(ABC):
         logic = advance(prior.logic, assoc.meas_of_track >= 0, self.params)
         posterior = replace(prior.updated(assoc, meas), logic=logic.state)
         born = self._born(meas, np.flatnonzero(assoc.birth))
-        self.tracks = VectorTracks.concatenate(posterior.subset(~logic.deleted), born)
+        self.tracks = VectorTracks.concatenate([posterior.subset(~logic.deleted), born])
         estimates = self._extract(self.tracks)
         if sink.enabled:
             if len(born):
@@ -256,13 +226,3 @@ class VectorTracker(ABC):
             )
         )
 
-
-def _empty_innovation() -> Innovation:
-    return Innovation(
-        z_pred=np.zeros((0, 2)),
-        S=np.zeros((0, 2, 2)),
-        S_inv=np.zeros((0, 2, 2)),
-        log_det_S=np.zeros(0),
-        gain=np.zeros((0, 4, 2)),
-        cov_post=np.zeros((0, 4, 4)),
-    )
