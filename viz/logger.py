@@ -149,7 +149,8 @@ class TrackerLogger:
 
     gate_z_m: height at which gates and predicted means of tracks with no known box height are drawn (global z;
     nuScenes ego poses have z = 0). gate_points: vertices per gate ellipse. log_predicted: draw the predicted
-    means. Call ``finish()`` after the last frame: it sends the time series (existence, hypothesis weights, ...),
+    means. gate_min_existence: gates are drawn for tracks whose predicted existence reaches it. Call
+    ``finish()`` after the last frame: it sends the time series (existence, hypothesis weights, ...),
     which therefore appear in a live viewer at the end of the run.
     """
 
@@ -163,6 +164,7 @@ class TrackerLogger:
         gate_z_m: float = 0.0,
         gate_points: int = 32,
         log_predicted: bool = True,
+        gate_min_existence: float = 0.1,
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
         self.stream = stream
@@ -170,6 +172,8 @@ class TrackerLogger:
         self.gate_z_m = gate_z_m
         self.gate_points = gate_points
         self.log_predicted = log_predicted
+        self.gate_min_existence = gate_min_existence
+        self._prior_existence: dict[str, tuple[np.ndarray, np.ndarray]] = {}  # class -> (ids, existence)
         self._frame = -1  # current keyframe index; -1 before the first FrameStarted
         self._timestamp_us = 0
         self._live: set[str] = set()
@@ -284,6 +288,7 @@ class TrackerLogger:
     # Spatial events.
     def _on_predicted(self, event: Predicted) -> None:
         ids = np.asarray(event.track_ids)
+        self._prior_existence[event.class_name] = (ids, np.asarray(event.existence, dtype=np.float64))
         if ids.size == 0 or not self.log_predicted:
             return
         self._show(
@@ -302,11 +307,13 @@ class TrackerLogger:
 
     def _on_gated(self, event: Gated) -> None:
         ids = np.asarray(event.track_ids)
-        if ids.size == 0:
+        drawn = self._gate_worthy(event.class_name, ids)
+        if not drawn.any():
             return
+        ids = ids[drawn]
         outline = ellipse_outline(
-            np.asarray(event.center_xy, dtype=np.float64),
-            np.asarray(event.innovation_cov, dtype=np.float64),
+            np.asarray(event.center_xy, dtype=np.float64)[drawn],
+            np.asarray(event.innovation_cov, dtype=np.float64)[drawn],
             event.threshold,
             self.gate_points,
         )
@@ -318,6 +325,15 @@ class TrackerLogger:
                 radii=GATE_LINE_RADIUS_M,
             ),
         )
+
+    def _gate_worthy(self, class_name: str, ids: np.ndarray) -> np.ndarray:
+        """(K,) bool: draw the gate of tracks whose predicted existence (from this frame's ``Predicted``) is at
+        least ``gate_min_existence``; the many candidate Bernoullis born on clutter would hide everything else."""
+        known_ids, existence = self._prior_existence.get(class_name, (np.zeros(0, dtype=np.int64), np.zeros(0)))
+        if known_ids.size == 0:
+            return np.ones(ids.size, dtype=bool)
+        lookup = dict(zip(known_ids.tolist(), existence.tolist(), strict=True))
+        return np.array([lookup.get(t, 1.0) >= self.gate_min_existence for t in ids.tolist()], dtype=bool)
 
     def _on_extracted(self, event: Extracted) -> None:
         for e in event.estimates:

@@ -281,3 +281,16 @@ def test_cost_heat_map_hides_columns_with_no_possible_assignment() -> None:
     assert out.cost.shape == (2, 3) and "1 columns" in out.description
     full = dataclasses.replace(event, cost=np.ones((2, 4)))
     assert compact_cost(full) is full
+
+
+def test_gates_of_unlikely_candidates_are_not_drawn(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
+    stream, path = saved_stream
+    logger = TrackerLogger(stream, T, gate_min_existence=0.5)
+    for event in scripted_events():
+        logger.emit(event)
+    logger.finish()
+    stream.disconnect()
+    strips = latest_at(read_rows(path)[paths.gates(T, "car")], 1, "LineStrips3D:strips")
+    assert len(strips) == 1  # track 1 (prior r = 0.68) only; track 2 (r = 0.28) is below 0.5
+    np.testing.assert_allclose(np.hypot(np.array(strips[0])[:, 0] - 10.0, np.array(strips[0])[:, 1] - 2.0),
+                               np.sqrt(40.0), rtol=1e-6)
