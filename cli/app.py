@@ -1,43 +1,78 @@
 """``gnnpmb-viz``: track one nuScenes scene and watch every step of the tracker(s) in Rerun.
 
+``gnnpmb-viz SCENE [--tracker A --tracker B ...]`` runs every tracker on the same preprocessed detections and
+logs them into one recording: one 3D view per tracker side by side, the comparison of the trackers (where they
+disagree, judged against the ground truth), each tracker's failures found with the devkit's matching, and the
+provenance of the run (command line, versions, parameters, inputs and their hashes, digests of the tracks).
+``gnnpmb-viz reproduce FILE.rrd`` reads that provenance back, re-runs the trackers on the same inputs and says
+whether the tracks are identical. Typer cannot mix a positional SCENE with a subcommand, so ``main``
+dispatches on the first argument being ``reproduce``.
+
 Everything the user typed is checked before a recording is opened (names, --frames, files, the dataset), so a
 mistake costs one line on stderr and leaves no ``.rrd`` behind.
 """
 
 from __future__ import annotations
 
+import contextvars
+import functools
 import re
-from collections.abc import Sequence
+import sys
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 import typer
 
-from cli.errors import entry_point
-from gnnpmb.config import TrackerConfig, load_config
+from cli.errors import run_app
+from gnnpmb.config import TrackerConfig, config_from_dict, load_config
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError, GnnpmbError
+from gnnpmb.provenance import DetectionsSource, Provenance, TrackDigest, track_digest
 from gnnpmb.registry import TRACKER_NAMES, check_classes, check_tracker
 from gnnpmb.types import TRACKING_CLASSES, Boxes, FrameDetections
 
+if TYPE_CHECKING:
+    import rerun as rr
+
+    from gnnpmb.compare import Comparison
+    from gnnpmb.data.nuscenes import DatasetLocation
+    from gnnpmb.pipeline import TrackingRun
+
+PROG = "gnnpmb-viz"
 DEFAULT_TRACKER = "gnnpmb"
 DEFAULT_DETECTOR = "centerpoint"
+EXIT_DIFFERENT = 1
 _FRAMES_RE = re.compile(r"^\s*(\d*)\s*:\s*(\d*)\s*$")
+_COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar(
+    "command_line", default=None
+)
+"""The command line ``main`` was given, recorded in the provenance (else ``sys.argv`` is used)."""
 
 app = typer.Typer(
     add_completion=False,
     help="Track a nuScenes scene and inspect every step of the tracker(s) in the Rerun viewer.",
     pretty_exceptions_enable=False,
 )
+reproduce_app = typer.Typer(
+    add_completion=False,
+    help="Re-run the trackers of a recording saved by gnnpmb-viz and check its tracks.",
+    pretty_exceptions_enable=False,
+)
 
 
 @dataclass(frozen=True, slots=True)
 class ViewRequest:
-    """Everything one ``gnnpmb-viz`` run needs, checked: no recording is opened before this exists."""
+    """Everything one ``gnnpmb-viz`` run needs, checked: no recording is opened before this exists.
+
+    source: where the detections came from, with their hash; seed: the simulated detector's seed;
+    argv: the command line, for the provenance.
+    """
 
     scene: SceneData
+    location: DatasetLocation
     trackers: tuple[str, ...]
     classes: tuple[str, ...]
     frame_range: range
@@ -45,6 +80,20 @@ class ViewRequest:
     detections: dict[str, Boxes]
     frame_detections: list[FrameDetections]
     save: Path | None
+    source: DetectionsSource
+    seed: int
+    argv: tuple[str, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class ViewResult:
+    """What ``run_view`` did: mean tracker ms per frame and track digest per tracker, the comparison (None
+    with one tracker) and notices for the user (e.g. failures skipped)."""
+
+    ms_per_frame: dict[str, float]
+    digests: dict[str, TrackDigest]
+    comparison: Comparison | None
+    notices: tuple[str, ...]
 
 
 def parse_frames(text: str | None) -> tuple[int | None, int | None]:
@@ -69,7 +118,8 @@ def frame_range_of(bounds: tuple[int | None, int | None], scene: SceneData) -> r
         raise DataError(f"{scene.name} has no keyframes")
     if start >= n or end > n:
         raise GnnpmbError(
-            f"--frames {start}:{end} is outside {scene.name}, which has keyframes 0 to {n - 1} (use END <= {n})"
+            f"--frames {start}:{end} is outside {scene.name}, which has keyframes 0 to {n - 1} "
+            f"(use END <= {n})"
         )
     if end <= start:
         raise GnnpmbError(f"--frames {start}:{end} selects no keyframes; END must be greater than START")
@@ -84,18 +134,40 @@ def parse_classes(text: str | None) -> tuple[str, ...]:
     return tuple(dict.fromkeys(check_classes(names)))
 
 
+def detections_source(
+    scene: SceneData, detections: dict[str, Boxes], detections_file: Path | None, detector: str, seed: int
+) -> DetectionsSource:
+    """Where ``detections`` came from, with the SHA-256 of the file, or of the simulated boxes."""
+    from gnnpmb.provenance import boxes_sha256, file_sha256
+
+    if detections_file is not None:
+        path = Path(detections_file).expanduser().absolute()
+        return DetectionsSource("file", file_sha256(path), path=str(path))
+    return DetectionsSource(
+        "simulated", boxes_sha256(detections, scene.sample_tokens), preset=detector, seed=int(seed)
+    )
+
+
+def command_line() -> tuple[str, ...]:
+    """The command line of this run: what ``main`` was given, else this process's arguments."""
+    given = _COMMAND_LINE.get()
+    return given if given is not None else (PROG, *sys.argv[1:])
+
+
 def prepare(
     scene_name: str,
     trackers: Sequence[str],
-    dataroot: Path | None,
-    version: str | None,
-    detections_file: Path | None,
-    detector: str,
-    seed: int,
-    params: Path | None,
-    classes: str | None,
-    frames: str | None,
-    save: Path | None,
+    *,
+    dataroot: Path | None = None,
+    version: str | None = None,
+    detections_file: Path | None = None,
+    detector: str = DEFAULT_DETECTOR,
+    seed: int = 0,
+    params: Path | None = None,
+    classes: str | None = None,
+    frames: str | None = None,
+    save: Path | None = None,
+    argv: Sequence[str] = (),
 ) -> ViewRequest:
     """Check every argument and load the scene and detections; raises GnnpmbError with a one-line message."""
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
@@ -113,19 +185,178 @@ def prepare(
     scene = load_scene(open_nuscenes(location), location, scene_name)
     frame_range = frame_range_of(bounds, scene)
     detections = get_detections(scene, detections_file, detector, seed)
+    source = detections_source(scene, detections, detections_file, detector, seed)
     frame_detections = preprocess_frames(scene, detections, config, class_names)
-    return ViewRequest(scene, names, class_names, frame_range, config, detections, frame_detections, target)
+    return ViewRequest(
+        scene,
+        location,
+        names,
+        class_names,
+        frame_range,
+        config,
+        detections,
+        frame_detections,
+        target,
+        source,
+        int(seed),
+        tuple(argv),
+    )
 
 
-def run_view(request: ViewRequest, *, progress: bool = True) -> dict[str, float]:
-    """Log the scene and run every tracker into one recording; returns mean tracker ms per frame by tracker."""
+def prepare_reproduction(
+    provenance: Provenance,
+    *,
+    dataroot: Path | None = None,
+    detections_file: Path | None = None,
+    save: Path | None = None,
+    argv: Sequence[str] = (),
+) -> ViewRequest:
+    """The request that re-runs a recorded run: same dataset (checked by scene token), same detections
+    (checked by hash), parameters, classes, frames and trackers. dataroot / detections_file replace the
+    recorded paths (e.g. on another machine). Raises a DataError naming the input that is missing or
+    changed."""
+    from gnnpmb.data.nuscenes import check_dataroot, load_scene, open_nuscenes
+    from gnnpmb.pipeline import get_detections, preprocess_frames
+    from viz.recording import check_save_path
+
+    p = provenance
+    target = check_save_path(save) if save is not None else None
+    root = Path(dataroot) if dataroot is not None else Path(p.dataroot)
+    if not root.exists():
+        raise DataError(f"the recorded dataroot {root} does not exist; pass --dataroot DIR with a copy of it")
+    location = check_dataroot(root, p.version, "--dataroot" if dataroot is not None else "the recording")
+    scene = load_scene(open_nuscenes(location), location, p.scene_name)
+    if scene.token != p.scene_token:
+        raise DataError(
+            f"{p.scene_name} in {location.dataroot} has token {scene.token}, the recorded one "
+            f"{p.scene_token}: not the same dataset"
+        )
+    config = config_from_dict(p.config)
+    classes = tuple(check_classes(list(p.classes)))
+    trackers = tuple(check_tracker(t) for t in p.trackers)
+    frame_range = frame_range_of((p.frame_start, p.frame_end), scene)
+    recorded = p.detections
+    if recorded.kind == "file":
+        path = Path(detections_file) if detections_file is not None else Path(str(recorded.path))
+        if not path.is_file():
+            raise DataError(f"the recorded detections file {path} is missing; pass --detections FILE.json")
+        source = detections_source(scene, {}, path, DEFAULT_DETECTOR, p.seed)
+        if source.sha256 != recorded.sha256:
+            raise DataError(
+                f"detections file {path} has changed since the recording (sha256 {source.sha256[:12]}, "
+                f"recorded {recorded.sha256[:12]})"
+            )
+        detections = get_detections(scene, path, DEFAULT_DETECTOR, p.seed)
+    else:
+        preset = str(recorded.preset)
+        seed = int(recorded.seed if recorded.seed is not None else p.seed)
+        detections = get_detections(scene, None, preset, seed)
+        source = detections_source(scene, detections, None, preset, seed)
+        if source.sha256 != recorded.sha256:
+            raise DataError(
+                f"the simulated {preset} detector (seed {seed}) now gives other detections than when "
+                f"recorded (sha256 {source.sha256[:12]}, recorded {recorded.sha256[:12]})"
+            )
+    frame_detections = preprocess_frames(scene, detections, config, classes)
+    return ViewRequest(
+        scene,
+        location,
+        trackers,
+        classes,
+        frame_range,
+        config,
+        detections,
+        frame_detections,
+        target,
+        source,
+        p.seed,
+        tuple(argv),
+    )
+
+
+def recording_name(request: ViewRequest) -> str:
+    """E.g. "scene-0103 · gnnpmb vs pmbm · synthetic demo"."""
+    data = "synthetic demo" if request.scene.synthetic else f"nuScenes {request.location.version}"
+    return f"{request.scene.name} · {' vs '.join(request.trackers)} · {data}"
+
+
+def provenance_of(request: ViewRequest, digests: dict[str, TrackDigest]) -> Provenance:
+    """The provenance of a run of ``request`` whose tracks have ``digests``."""
+    from gnnpmb.provenance import package_versions
+
+    return Provenance(
+        argv=request.argv,
+        versions=package_versions(),
+        config=request.config.as_dict(),
+        dataroot=str(request.location.dataroot),
+        version=request.location.version,
+        synthetic=request.scene.synthetic,
+        scene_name=request.scene.name,
+        scene_token=request.scene.token,
+        detections=request.source,
+        seed=request.seed,
+        frame_start=request.frame_range.start,
+        frame_end=request.frame_range.stop,
+        classes=request.classes,
+        trackers=request.trackers,
+        track_digests=digests,
+    )
+
+
+def run_digest(run: TrackingRun) -> TrackDigest:
+    """The track digest of one tracker run."""
+    return track_digest([f.keyframe.index for f in run.frames], [f.estimates for f in run.frames])
+
+
+def compare_runs(runs: Sequence[TrackingRun]) -> Comparison:
+    """Per-frame disagreements between tracker runs over the same keyframes (``gnnpmb.compare``)."""
+    from gnnpmb.compare import compare_trackers
+
+    frames = runs[0].frames
+    return compare_trackers(
+        [f.keyframe.gt for f in frames],
+        {run.tracker: [f.estimates for f in run.frames] for run in runs},
+        frame_indices=[f.keyframe.index for f in frames],
+    )
+
+
+def log_failures_of(
+    stream: rr.RecordingStream, request: ViewRequest, runs: Sequence[TrackingRun], on_done: Callable[[], None]
+) -> list[str]:
+    """Find each run's failures with the devkit's matching and log them (``viz.failures``), limited to the
+    tracked keyframes. Returns notices: a scene without ground truth, or one the devkit cannot evaluate, is
+    skipped."""
+    from gnnpmb.data.nuscenes import open_nuscenes
+    from gnnpmb.eval.failures import find_failures
+    from gnnpmb.eval.submission import run_results
+    from viz.failures import log_failures
+
+    scene = request.scene
+    if not any(len(k.gt) for k in scene.keyframes):
+        return [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
+    nusc = open_nuscenes(request.location)
+    for run in runs:
+        try:
+            report = find_failures(nusc, scene.name, run_results(run), run.tracker)
+        except DataError as exc:
+            return [f"failure markers skipped: {exc}"]
+        log_failures(stream, run.tracker, report, scene, request.frame_range)
+        on_done()
+    return []
+
+
+def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = True) -> ViewResult:
+    """Log the scene, run every tracker into one recording (sharing the preprocessed detections), compare them
+    and log failures and provenance."""
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from gnnpmb.data.nuscenes import load_lidar_points
     from gnnpmb.pipeline import run_tracker
     from viz.blueprint import default_blueprint
+    from viz.compare import log_comparison
     from viz.logger import TrackerLogger
+    from viz.provenance import log_provenance
     from viz.recording import recording
     from viz.scene import log_scene
 
@@ -141,9 +372,10 @@ def run_view(request: ViewRequest, *, progress: bool = True) -> dict[str, float]
         console=Console(stderr=True),
         disable=not progress,
     )
-    ms_per_frame: dict[str, float] = {}
-    name = f"{scene.name} {'+'.join(request.trackers)}"
-    with recording(name, request.save, blueprint) as stream, bar:
+    runs: list[TrackingRun] = []
+    notices: list[str] = []
+    comparison = None
+    with recording(recording_name(request), request.save, blueprint) as stream, bar:
         sensors = bar.add_task(f"{scene.name} sensors", total=n)
         log_scene(
             stream,
@@ -156,69 +388,232 @@ def run_view(request: ViewRequest, *, progress: bool = True) -> dict[str, float]
         for tracker in request.trackers:
             task = bar.add_task(f"{scene.name} {tracker}", total=n)
             logger = TrackerLogger(stream, tracker, gate_z_m=gate_z_m)
-            run = run_tracker(
-                scene,
+            runs.append(
+                run_tracker(
+                    scene,
+                    request.detections,
+                    tracker,
+                    request.config,
+                    sink=logger,
+                    classes=request.classes,
+                    frame_range=frame_range,
+                    on_frame=lambda task=task: bar.advance(task),
+                    frame_detections=request.frame_detections,
+                )
+            )
+            logger.finish()
+        if len(runs) > 1:
+            comparison = compare_runs(runs)
+            log_comparison(stream, comparison, scene)
+        if failures:
+            task = bar.add_task(f"{scene.name} failures", total=len(runs))
+            notices += log_failures_of(stream, request, runs, lambda: bar.advance(task))
+        digests = {run.tracker: run_digest(run) for run in runs}
+        log_provenance(stream, provenance_of(request, digests))
+    ms = {run.tracker: 1000.0 * float(np.mean([f.step_time_s for f in run.frames])) for run in runs}
+    return ViewResult(ms, digests, comparison, tuple(notices))
+
+
+def rerun_digests(request: ViewRequest) -> dict[str, TrackDigest]:
+    """Run every tracker of ``request`` without logging; their track digests."""
+    from gnnpmb.pipeline import run_tracker
+
+    return {
+        tracker: run_digest(
+            run_tracker(
+                request.scene,
                 request.detections,
                 tracker,
                 request.config,
-                sink=logger,
                 classes=request.classes,
-                frame_range=frame_range,
-                on_frame=lambda task=task: bar.advance(task),
+                frame_range=request.frame_range,
                 frame_detections=request.frame_detections,
             )
-            logger.finish()
-            ms_per_frame[tracker] = 1000.0 * float(np.mean([f.step_time_s for f in run.frames]))
-    return ms_per_frame
+        )
+        for tracker in request.trackers
+    }
 
 
-@app.command()
+def digest_report(recorded: dict[str, TrackDigest], now: dict[str, TrackDigest]) -> tuple[list[str], bool]:
+    """One line per tracker ("identical" or its first differing keyframe) and whether all are identical."""
+    lines, same = [], True
+    for tracker, digest in now.items():
+        before = recorded.get(tracker)
+        if before is None:
+            lines.append(f"{tracker}: no recorded track digest to compare with")
+            same = False
+            continue
+        first = before.first_difference(digest)
+        if first is None:
+            lines.append(f"{tracker}: identical ({len(digest.frames)} frames)")
+        else:
+            lines.append(
+                f"{tracker}: DIFFERENT from keyframe {first} on "
+                f"({before.differing_frames(digest)} of {len(digest.frames)} frames differ)"
+            )
+            same = False
+    return lines, same
+
+
+def _version_notes(recorded: dict[str, str]) -> list[str]:
+    from gnnpmb.provenance import package_versions
+
+    now = package_versions(tuple(recorded))
+    return [f"note: recorded with {k} {v}, now {now[k]}" for k, v in recorded.items() if now.get(k) != v]
+
+
+VIEW_HELP = (
+    "Track SCENE and stream the recording to a Rerun viewer (or save it with --save).\n\n"
+    "With several --tracker options every tracker runs on the same detections; the viewer shows them side by "
+    "side with where they disagree.\n\n"
+    f"To re-run the trackers of a saved recording and check that its tracks are identical: {PROG} reproduce "
+    f"FILE.rrd (see {PROG} reproduce --help)."
+)
+REPRODUCE_HELP = (
+    "Re-run the trackers of FILE.rrd (saved by gnnpmb-viz SCENE --save FILE.rrd) on the same inputs, checked "
+    "by hash, and report per tracker whether the tracks are identical or the first keyframe where they "
+    "differ.\n\n"
+    "Exit code 0: all identical; 1: some differ; 2: an input is missing or changed."
+)
+
+
+@app.command(help=VIEW_HELP)
 def view(
     scene: Annotated[str, typer.Argument(help="Scene name, e.g. scene-0103.")],
     tracker: Annotated[
         list[str] | None,
         typer.Option(
-            "--tracker", "-t", metavar="NAME", help=f"Tracker to run; repeat for several ({', '.join(TRACKER_NAMES)})."
+            "--tracker",
+            "-t",
+            metavar="NAME",
+            help=f"Tracker to run; repeat to compare several side by side ({', '.join(TRACKER_NAMES)}).",
         ),
     ] = None,
     dataroot: Annotated[
         Path | None,
-        typer.Option(metavar="DIR", help="nuScenes dataroot (default: $NUSCENES_DATAROOT, else the built-in demo)."),
+        typer.Option(
+            metavar="DIR", help="nuScenes dataroot (default: $NUSCENES_DATAROOT, else the built-in demo)."
+        ),
     ] = None,
-    version: Annotated[str | None, typer.Option(metavar="V", help="Dataset version folder, e.g. v1.0-mini.")] = None,
+    version: Annotated[
+        str | None, typer.Option(metavar="V", help="Dataset version folder, e.g. v1.0-mini.")
+    ] = None,
     detections: Annotated[
         Path | None,
-        typer.Option(metavar="FILE.json", help="nuScenes detection results .json (default: a simulated detector)."),
+        typer.Option(
+            metavar="FILE.json", help="nuScenes detection results .json (default: a simulated detector)."
+        ),
     ] = None,
     detector: Annotated[
-        str, typer.Option(metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars.")
+        str,
+        typer.Option(
+            metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars."
+        ),
     ] = DEFAULT_DETECTOR,
     seed: Annotated[int, typer.Option(metavar="N", help="Seed of the simulated detector.")] = 0,
     params: Annotated[
-        Path | None, typer.Option(metavar="FILE.toml", help="Tracker parameter file (.toml) overriding the paper's.")
+        Path | None,
+        typer.Option(metavar="FILE.toml", help="Tracker parameter file (.toml) overriding the paper's."),
     ] = None,
     classes: Annotated[
         str | None,
         typer.Option(
-            metavar="CLASS,...", help=f"Comma-separated classes to track (default all: {','.join(TRACKING_CLASSES)})."
+            metavar="CLASS,...",
+            help=f"Comma-separated classes to track (default all: {','.join(TRACKING_CLASSES)}).",
         ),
     ] = None,
     frames: Annotated[
         str | None, typer.Option(metavar="START:END", help="Keyframes START:END (END exclusive), e.g. 0:20.")
     ] = None,
     save: Annotated[
-        Path | None, typer.Option(metavar="OUT.rrd", help="Write the recording to this .rrd instead of a viewer.")
+        Path | None,
+        typer.Option(metavar="OUT.rrd", help="Write the recording to this .rrd instead of a viewer."),
     ] = None,
+    failures: Annotated[
+        bool,
+        typer.Option(help="Find and mark each tracker's failures with the devkit's matching (needs GT)."),
+    ] = True,
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
 ) -> None:
-    """Track SCENE and stream the recording to a Rerun viewer (or save it with --save)."""
+    """Track SCENE into one recording and show or save it (``VIEW_HELP``)."""
     request = prepare(
-        scene, tracker or [], dataroot, version, detections, detector, seed, params, classes, frames, save
+        scene,
+        tracker or [],
+        dataroot=dataroot,
+        version=version,
+        detections_file=detections,
+        detector=detector,
+        seed=seed,
+        params=params,
+        classes=classes,
+        frames=frames,
+        save=save,
+        argv=command_line(),
     )
-    ms = run_view(request, progress=progress)
-    timing = ", ".join(f"{name} {value:.1f} ms/frame" for name, value in ms.items())
+    result = run_view(request, progress=progress, failures=failures)
+    for notice in result.notices:
+        typer.echo(f"note: {notice}", err=True)
+    timing = ", ".join(f"{name} {value:.1f} ms/frame" for name, value in result.ms_per_frame.items())
+    compared = ""
+    if result.comparison is not None:
+        compared = f"; {len(result.comparison.disagreements)} disagreements"
     output = f"saved {request.save}" if request.save is not None else "streamed to the Rerun viewer"
-    typer.echo(f"{request.scene.name}: {len(request.frame_range)} frames, {timing}; {output}")
+    typer.echo(f"{request.scene.name}: {len(request.frame_range)} frames, {timing}{compared}; {output}")
 
 
-main = entry_point(app)
+@reproduce_app.command(help=REPRODUCE_HELP)
+def reproduce(
+    recording_file: Annotated[
+        Path,
+        typer.Argument(metavar="FILE.rrd", help="A recording saved by gnnpmb-viz SCENE --save FILE.rrd."),
+    ],
+    dataroot: Annotated[
+        Path | None,
+        typer.Option(metavar="DIR", help="Use this dataroot instead of the recorded one (a copy)."),
+    ] = None,
+    detections: Annotated[
+        Path | None,
+        typer.Option(
+            metavar="FILE.json", help="Use this detections file instead of the recorded path (a copy)."
+        ),
+    ] = None,
+    save: Annotated[
+        Path | None, typer.Option(metavar="OUT.rrd", help="Also write the re-run as a new recording.")
+    ] = None,
+    progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr (with --save).")] = True,
+) -> None:
+    """Re-run a recording's trackers and compare their track digests (``REPRODUCE_HELP``)."""
+    from viz.provenance import read_provenance
+
+    provenance = read_provenance(recording_file)
+    request = prepare_reproduction(
+        provenance, dataroot=dataroot, detections_file=detections, save=save, argv=command_line()
+    )
+    for note in _version_notes(provenance.versions):
+        typer.echo(note, err=True)
+    typer.echo(
+        f"{provenance.scene_name} ({provenance.data_source}), keyframes {provenance.frame_start}:"
+        f"{provenance.frame_end}, detections: {request.source.describe()} (same as recorded)"
+    )
+    digests = run_view(request, progress=progress).digests if save is not None else rerun_digests(request)
+    lines, same = digest_report(provenance.track_digests, digests)
+    for line in lines:
+        typer.echo(line)
+    if save is not None:
+        typer.echo(f"saved {request.save}")
+    if not same:
+        raise typer.Exit(EXIT_DIFFERENT)
+
+
+def main(argv: Sequence[str] | None = None) -> None:
+    """The ``gnnpmb-viz`` console script: ``reproduce ...`` goes to the reproduce command, anything else to
+    the viewer command (typer cannot have a positional SCENE beside a subcommand)."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    token = _COMMAND_LINE.set((PROG, *args))
+    try:
+        if args and args[0] == "reproduce":
+            run_app(functools.partial(reproduce_app, prog_name=f"{PROG} reproduce"), args[1:])
+        else:
+            run_app(functools.partial(app, prog_name=PROG), args)
+    finally:
+        _COMMAND_LINE.reset(token)

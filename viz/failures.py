@@ -85,11 +85,18 @@ def _frame_boxes(failures: list[Failure], n_frames: int) -> tuple[list[FailureBo
     return boxes, labels, lengths
 
 
-def log_failures(stream: rr.RecordingStream, tracker: str, report: FailureReport, scene: SceneData) -> None:
+def log_failures(
+    stream: rr.RecordingStream,
+    tracker: str,
+    report: FailureReport,
+    scene: SceneData,
+    frame_range: range | None = None,
+) -> None:
     """Log ``report`` (failures of ``tracker`` on ``scene``) on the frame and timestamp timelines.
 
     Boxes of a kind show only at their frame (other frames get an empty batch); the count series has a value
-    at every keyframe (0 when nothing failed).
+    at every keyframe of ``frame_range`` (default: the whole scene; 0 when nothing failed). Failures outside the
+    range are left out.
     """
     if tuple(report.sample_tokens) != tuple(scene.sample_tokens):
         raise ValueError(
@@ -102,16 +109,17 @@ def log_failures(stream: rr.RecordingStream, tracker: str, report: FailureReport
     def indexes(at: np.ndarray) -> list[rr.TimeColumn]:
         return [rr.TimeColumn("frame", sequence=frames[at]), rr.TimeColumn("timestamp", timestamp=stamps[at])]
 
-    every_frame = np.arange(n)
+    every_frame = np.arange(n) if frame_range is None else np.array(frame_range, dtype=np.int64)
+    in_range = set(every_frame.tolist())
     for kind in FailureKind:
-        failures = report.of_kind(kind)
+        failures = [f for f in report.of_kind(kind) if f.frame_index in in_range]
         color = KIND_COLORS[kind]
         count_path = paths.failure_count(tracker, kind.value)
         stream.log(count_path, rr.SeriesLines(names=KIND_LABELS[kind], colors=[color]), static=True)
         stream.send_columns(
             count_path,
             indexes=indexes(every_frame),
-            columns=rr.Scalars.columns(scalars=report.counts(kind).astype(np.float64)),
+            columns=rr.Scalars.columns(scalars=report.counts(kind).astype(np.float64)[every_frame]),
         )
         if not failures:
             continue
@@ -127,15 +135,16 @@ def log_failures(stream: rr.RecordingStream, tracker: str, report: FailureReport
                 colors=np.tile(np.array(color, dtype=np.uint8), (len(boxes), 1)),
                 radii=np.full(len(boxes), MARKER_LINE_RADIUS_M, dtype=np.float32),
                 labels=labels,
-            ).partition(lengths),
+            ).partition(lengths[every_frame]),
         )
-    if report.failures:
-        at = np.array([f.frame_index for f in report.failures], dtype=np.int64)
+    logged = [f for f in report.failures if f.frame_index in in_range]
+    if logged:
+        at = np.array([f.frame_index for f in logged], dtype=np.int64)
         stream.send_columns(
             failure_log(tracker),
             indexes=indexes(at),
             columns=rr.TextLog.columns(
-                text=[f"{KIND_LABELS[f.kind]}: {f.describe()}" for f in report.failures],
-                level=[KIND_LEVELS[f.kind] for f in report.failures],
+                text=[f"{KIND_LABELS[f.kind]}: {f.describe()}" for f in logged],
+                level=[KIND_LEVELS[f.kind] for f in logged],
             ),
         )

@@ -12,11 +12,14 @@ from pathlib import Path
 
 import pytest
 
-from cli.app import app, parse_classes, parse_frames
-from cli.errors import run_app
-from gnnpmb.errors import GnnpmbError, UnknownNameError
+from cli.app import log_failures_of, main, parse_classes, parse_frames, prepare
+from gnnpmb.config import TrackerConfig
+from gnnpmb.errors import DataError, GnnpmbError, UnknownNameError
+from gnnpmb.pipeline import run_tracker
+from gnnpmb.provenance import PACKAGES
 from tests.viz.rrd import at_frame, read_rows
 from viz import paths
+from viz.provenance import PROPERTY_ENTITY, read_provenance
 
 SCENE = "scene-0103"
 N_FRAMES = 40
@@ -26,7 +29,7 @@ SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
 def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
     """Run the app in-process: (exit code, stdout, stderr)."""
     try:
-        run_app(app, argv)
+        main(argv)
         code = 0
     except SystemExit as exc:
         code = int(exc.code or 0)
@@ -40,7 +43,7 @@ def full_run(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> t
     out = tmp_path_factory.mktemp("e2e") / "x.rrd"
     stdout = io.StringIO()
     with contextlib.redirect_stdout(stdout):
-        run_app(app, [SCENE, "--dataroot", str(demo_dataroot), "--save", str(out), "--no-progress"])
+        main([SCENE, "--dataroot", str(demo_dataroot), "--save", str(out), "--no-progress"])
     return out, stdout.getvalue().strip()
 
 
@@ -86,8 +89,61 @@ def test_tracks_costs_existence_and_events(rows: dict) -> None:
     assert any(t.startswith("h0 assignment") for t in texts)
 
 
+def test_failure_markers_of_the_tracker(rows: dict) -> None:
+    misses = [r for r in rows[paths.failure_count("gnnpmb", "miss")] if not r["static"]]
+    assert [r["frame"] for r in misses] == list(range(N_FRAMES))
+    assert sum(r["Scalars:scalars"][0] for r in misses) > 0
+    assert paths.failures_world("gnnpmb", "miss") in rows
+    assert not any(p.startswith("comparison/") for p in rows)  # one tracker: nothing to compare
+
+
+def test_recording_name_and_provenance(full_run: tuple[Path, str], demo_dataroot: Path, rows: dict) -> None:
+    out, _ = full_run
+    info = [r for r in rows["__properties"] if "RecordingInfo:name" in r]
+    assert info[0]["RecordingInfo:name"] == [f"{SCENE} · gnnpmb · synthetic demo"]
+    p = read_provenance(out)
+    assert p.argv == (
+        "gnnpmb-viz",
+        SCENE,
+        "--dataroot",
+        str(demo_dataroot),
+        "--save",
+        str(out),
+        "--no-progress",
+    )
+    assert set(p.versions) == set(PACKAGES) and p.versions["rerun-sdk"].startswith("0.41")
+    assert p.config == TrackerConfig().as_dict()
+    assert p.dataroot == str(demo_dataroot.resolve()) and p.version == "v1.0-mini" and p.synthetic
+    assert p.scene_name == SCENE and len(p.scene_token) == 32
+    assert (p.detections.kind, p.detections.preset, p.detections.seed) == ("simulated", "centerpoint", 0)
+    assert len(p.detections.sha256) == 64 and p.seed == 0
+    assert (p.frame_start, p.frame_end, p.trackers) == (0, N_FRAMES, ("gnnpmb",))
+    assert len(p.classes) == 7
+    digest = p.track_digests["gnnpmb"]
+    assert digest.frame_indices == tuple(range(N_FRAMES)) and len(set(digest.frames)) > N_FRAMES // 2
+    readable = rows[PROPERTY_ENTITY.lstrip("/")][0]
+    assert readable["command"] == [
+        f"gnnpmb-viz {SCENE} --dataroot {demo_dataroot} --save {out} --no-progress"
+    ]
+    assert readable["frames"] == [f"0:{N_FRAMES}"] and readable["seed"] == ["0"]
+    assert readable["track_digests"] == [f"gnnpmb {digest.overall[:16]}"]
+
+
+def test_reproduce_reports_identical_tracks(
+    full_run: tuple[Path, str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out, err = run(["reproduce", str(full_run[0])], capsys)
+    assert (code, err) == (0, "")
+    lines = out.strip().splitlines()
+    assert lines[0].startswith(
+        f"{SCENE} (synthetic demo), keyframes 0:{N_FRAMES}, detections: simulated centerpoint"
+    )
+    assert lines[1:] == [f"gnnpmb: identical ({N_FRAMES} frames)"]
+
+
 def test_installed_script_with_a_detections_file_and_frame_range(demo_dataroot: Path, tmp_path: Path) -> None:
-    """A real process through the console script: --detections (GT boxes as a submission), --frames, --classes."""
+    """A real process through the console script: --detections (GT boxes as a submission), --frames,
+    --classes."""
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
 
     location = resolve_dataroot(demo_dataroot, None)
@@ -162,7 +218,9 @@ def test_bad_input_is_one_line_and_leaves_no_recording(
     _truncated_submission(tmp_path / "truncated.json")
     _malformed_submission(tmp_path / "malformed.json")
     argv = [
-        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(a, a)
+        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(
+            a, a
+        )
         for a in argv
     ]
     out = tmp_path / "out" / "x.rrd"
@@ -175,7 +233,9 @@ def test_bad_input_is_one_line_and_leaves_no_recording(
 
 
 def test_missing_dataroot_and_bad_save_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run([SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys)
+    code, _, err = run(
+        [SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys
+    )
     assert code == 2 and "does not exist" in err and err.count("\n") == 1
     code, _, err = run([SCENE, "--save", str(tmp_path / "no" / "x.rrd")], capsys)
     assert code == 2 and "does not exist; create it first" in err
@@ -208,3 +268,36 @@ def test_parse_frames_and_classes() -> None:
     assert parse_classes(" car, bus ,car") == ("car", "bus")
     with pytest.raises(UnknownNameError):
         parse_classes(",")
+
+
+def test_failures_are_skipped_with_a_notice_without_ground_truth(
+    demo_dataroot: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import dataclasses
+
+    from gnnpmb.eval import failures
+    from gnnpmb.types import Boxes
+
+    request = prepare(SCENE, ["gnn"], dataroot=demo_dataroot, frames="0:3")
+    unannotated = dataclasses.replace(
+        request.scene,
+        keyframes=tuple(dataclasses.replace(k, gt=Boxes.empty()) for k in request.scene.keyframes),
+    )
+    calls: list[None] = []
+    notices = log_failures_of(
+        None, dataclasses.replace(request, scene=unannotated), [], lambda: calls.append(None)
+    )
+    assert notices == [f"{SCENE} has no ground-truth boxes (no annotations): failure markers skipped"]
+
+    def not_in_a_split(*_args, **_kwargs):
+        raise DataError(f"scene {SCENE} is in no nuScenes split, so the devkit cannot evaluate it")
+
+    monkeypatch.setattr(failures, "find_failures", not_in_a_split)
+    runs = [
+        run_tracker(request.scene, request.detections, "gnn", request.config, frame_range=request.frame_range)
+    ]
+    notices = log_failures_of(None, request, runs, lambda: calls.append(None))
+    assert notices == [
+        f"failure markers skipped: scene {SCENE} is in no nuScenes split, so the devkit cannot evaluate it"
+    ]
+    assert calls == []

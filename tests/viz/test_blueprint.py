@@ -6,8 +6,9 @@ import pytest
 import rerun.blueprint as rrb
 from rerun.chunk import RrdReader
 
-from viz import paths
-from viz.blueprint import default_blueprint
+from viz import compare, paths
+from viz.blueprint import EYE_POSITION_M, EYE_TARGET_M, default_blueprint, failures_root
+from viz.failures import failure_log
 from viz.recording import close_recording, open_recording
 
 
@@ -20,16 +21,31 @@ def views(node) -> list:
     return [v for child in node.contents for v in views(child)]
 
 
+def stored_views(path: Path) -> dict[str, tuple[str, str]]:
+    """View name -> (class identifier, origin) of the default blueprint saved in an ``.rrd``."""
+    reader = RrdReader(path)
+    (blueprint,) = reader.blueprints()
+    out = {}
+    for chunk in reader.stream(store=blueprint):
+        for row in chunk.to_record_batch().to_pylist():
+            if row.get("ViewBlueprint:display_name"):
+                out[row["ViewBlueprint:display_name"][0]] = (
+                    row["ViewBlueprint:class_identifier"][0],
+                    row["ViewBlueprint:space_origin"][0],
+                )
+    return out
+
+
 def test_one_3d_view_per_tracker_showing_only_its_own_tracks() -> None:
     all_views = views(default_blueprint(["gnnpmb", "pmbm"], ["car", "bus"]))
     spatial = [v for v in all_views if isinstance(v, rrb.Spatial3DView)]
     assert [v.name for v in spatial] == ["gnnpmb 3D", "pmbm 3D"]
     for v, name in zip(spatial, ["gnnpmb", "pmbm"], strict=True):
-        assert v.origin == paths.WORLD
+        assert v.origin == paths.EGO  # the camera follows the ego vehicle
         assert v.contents == ["+ world/**", "- world/trackers/**", f"+ world/trackers/{name}/**"]
 
 
-def test_cost_existence_and_log_views_per_tracker() -> None:
+def test_cost_existence_failure_and_log_views_per_tracker() -> None:
     all_views = views(default_blueprint(["gnnpmb", "pmbm"], ["car", "bus"]))
     origins = {(type(v).__name__, v.origin) for v in all_views}
     for t in ["gnnpmb", "pmbm"]:
@@ -37,9 +53,28 @@ def test_cost_existence_and_log_views_per_tracker() -> None:
             assert ("TensorView", paths.cost_matrix(t, c)) in origins
             assert ("TextDocumentView", paths.cost_axes(t, c)) in origins
         assert ("TimeSeriesView", paths.existence_root(t)) in origins
+        assert ("TimeSeriesView", paths.candidates_root(t)) in origins
+        assert ("TimeSeriesView", failures_root(t)) in origins
         assert ("TextLogView", paths.events_root(t)) in origins
+        assert ("TextLogView", failure_log(t)) in origins
+    assert failures_root("pmbm") == paths.failure_count("pmbm", "miss").rsplit("/", 1)[0]
     assert ("TimeSeriesView", paths.hypotheses_root("pmbm")) in origins
     assert ("TimeSeriesView", paths.hypotheses_root("gnnpmb")) not in origins
+
+
+def test_comparison_panel_only_with_several_trackers() -> None:
+    def origins(trackers: list[str]) -> set[tuple[str, str]]:
+        return {(type(v).__name__, v.origin) for v in views(default_blueprint(trackers, ["car"]))}
+
+    several = origins(["gnnpmb", "jpda", "gnn"])
+    assert ("TimeSeriesView", compare.counts_root()) in several
+    assert ("TextLogView", compare.log_path()) in several
+    single = origins(["gnnpmb"])
+    assert ("TimeSeriesView", compare.counts_root()) not in single
+    assert ("TextLogView", compare.log_path()) not in single
+    assert ("Spatial3DView", paths.EGO) in single
+    assert compare.markers_path(compare.DisagreementKind.ID_CHANGE).startswith(f"{paths.WORLD}/")
+    assert not compare.markers_path(compare.DisagreementKind.ID_CHANGE).startswith(paths.WORLD_TRACKERS)
 
 
 def test_tracker_specific_views() -> None:
@@ -55,4 +90,17 @@ def test_blueprint_is_accepted_in_strict_mode_and_saved(tmp_path: Path, strict: 
     out = tmp_path / "bp.rrd"
     stream = open_recording("bp", out, default_blueprint(["gnnpmb", "jpda", "phd"], ["car"]), strict=True)
     close_recording(stream, out)
-    assert len(RrdReader(out).blueprints()) == 1
+    stored = stored_views(out)
+    assert stored["gnnpmb 3D"] == ("3D", paths.EGO) and stored["phd 3D"] == ("3D", paths.EGO)
+    assert stored["disagreements"] == ("TextLog", compare.log_path())
+    assert stored["disagreements per frame"] == ("TimeSeries", compare.counts_root())
+    assert stored["jpda failures per frame"] == ("TimeSeries", failures_root("jpda"))
+    eyes = [
+        row
+        for chunk in RrdReader(out).stream(store=RrdReader(out).blueprints()[0])
+        for row in chunk.to_record_batch().to_pylist()
+        if row.get("EyeControls3D:position")
+    ]
+    assert len(eyes) == 3
+    assert eyes[0]["EyeControls3D:position"] == [list(EYE_POSITION_M)]
+    assert eyes[0]["EyeControls3D:look_target"] == [list(EYE_TARGET_M)]

@@ -114,3 +114,17 @@ def test_report_of_another_scene_is_refused(tmp_path: Path, tiny_scene) -> None:
     with pytest.raises(ValueError, match="not for the samples of scene-test"):
         log_failures(stream, T, other, scene)
     stream.disconnect()
+
+
+def test_frame_range_limits_markers_counts_and_log(saved_stream, tiny_scene) -> None:
+    stream, path = saved_stream
+    scene, _ = tiny_scene
+    log_failures(stream, T, report_for(scene), scene, frame_range=range(1, 2))
+    stream.disconnect()
+    rows = read_rows(path)
+    misses = [r for r in rows[paths.failure_count(T, "miss")] if not r["static"]]
+    assert [r["frame"] for r in misses] == [1] and misses[0]["Scalars:scalars"] == [0.0]
+    assert paths.failures_world(T, "miss") not in rows  # both misses lie outside the range
+    switches = [r for r in rows[paths.failures_world(T, "id_switch")] if not r["static"]]
+    assert [r["frame"] for r in switches] == [1]
+    assert {r["frame"] for r in rows[failure_log(T)] if not r["static"]} == {1}

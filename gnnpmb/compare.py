@@ -1,0 +1,301 @@
+"""Where two or more trackers disagree, frame by frame, judged against the ground truth.
+
+Per tracker and keyframe, the estimates are matched to the ground-truth boxes with the nuScenes tracking
+criterion: BEV centre distance below ``MATCH_DISTANCE_M`` (2 m, ``dist_th_tp`` of ``tracking_nips_2019``),
+same class, one-to-one, the pairing found by the Hungarian method (most pairs, then least summed distance).
+Then, for every pair of trackers (A, B), in either role:
+
+* ``missed_by_one``: a GT object A's estimates cover and B's do not.
+* ``id_change``: a GT object both cover, where A now gives it another id than the last time A covered it while
+  B gives it the same id as the last time B covered it (one tracker switched, the other kept its id).
+* ``only_in_one``: an estimate of A matched to no GT object with no estimate of B of its class closer than
+  ``MATCH_DISTANCE_M`` (a track only A reports).
+
+Objects both trackers miss, and switches both trackers make, are agreements and not listed. Frames must be
+given in time order (``id_change`` remembers each tracker's last id per object across frames).
+"""
+
+from __future__ import annotations
+
+import enum
+import itertools
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from gnnpmb.types import Boxes, TrackEstimate
+
+MATCH_DISTANCE_M = 2.0
+"""The devkit's centre-distance threshold for a true positive (a pair at or above it never matches)."""
+_FORBIDDEN = 1e9
+"""Cost of an impossible pair: larger than any sum of real distances, so the most possible pairs come
+first."""
+
+
+class DisagreementKind(enum.Enum):
+    MISSED_BY_ONE = "missed_by_one"
+    ID_CHANGE = "id_change"
+    ONLY_IN_ONE = "only_in_one"
+
+
+@dataclass(frozen=True, slots=True)
+class Disagreement:
+    """One disagreement at one keyframe (``frame_index`` into the scene's keyframes).
+
+    tracker: the tracker that covers the object (``missed_by_one``), switched its id (``id_change``) or
+    reports the lone track (``only_in_one``); other: the tracker that misses it, kept its id, or has nothing
+    there. gt_id: the GT instance ("" for ``only_in_one``). track_ids: ``missed_by_one`` (tracker's track,),
+    ``id_change`` (tracker's previous id, its new id, other's id), ``only_in_one`` (tracker's track,).
+    translation_m (3,), size_wlh_m (3,), quat_wxyz (4,): the GT box, or the lone track's box (global frame).
+    """
+
+    kind: DisagreementKind
+    frame_index: int
+    class_name: str
+    tracker: str
+    other: str
+    gt_id: str
+    track_ids: tuple[int, ...]
+    translation_m: tuple[float, float, float]
+    size_wlh_m: tuple[float, float, float]
+    quat_wxyz: tuple[float, float, float, float]
+
+    def describe(self) -> str:
+        """One readable line naming trackers and ids."""
+        gt = f"{self.class_name} GT {short_gt_id(self.gt_id)}"
+        match self.kind:
+            case DisagreementKind.MISSED_BY_ONE:
+                return f"{gt}: tracked by {self.tracker} (track {self.track_ids[0]}), missed by {self.other}"
+            case DisagreementKind.ID_CHANGE:
+                old, new, kept = self.track_ids
+                return f"{gt}: {self.tracker} switched track {old} -> {new}, {self.other} kept track {kept}"
+            case DisagreementKind.ONLY_IN_ONE:
+                return (
+                    f"{self.class_name} track {self.track_ids[0]} of {self.tracker} matches no GT; "
+                    f"{self.other} has no {self.class_name} track there"
+                )
+        raise AssertionError(self.kind)
+
+
+@dataclass(frozen=True, slots=True)
+class Comparison:
+    """Every disagreement between ``trackers`` over the keyframes ``frame_indices`` (time order), sorted by
+    frame, kind, class, tracker and ids."""
+
+    trackers: tuple[str, ...]
+    frame_indices: tuple[int, ...]
+    disagreements: tuple[Disagreement, ...]
+
+    def of_kind(self, kind: DisagreementKind) -> list[Disagreement]:
+        return [d for d in self.disagreements if d.kind is kind]
+
+    def counts(self, kind: DisagreementKind) -> np.ndarray:
+        """(F,) number of disagreements of ``kind`` at each of the F keyframes ``frame_indices``."""
+        position = {f: i for i, f in enumerate(self.frame_indices)}
+        out = np.zeros(len(self.frame_indices), dtype=np.int64)
+        for d in self.of_kind(kind):
+            out[position[d.frame_index]] += 1
+        return out
+
+    def totals(self) -> dict[DisagreementKind, int]:
+        return {kind: len(self.of_kind(kind)) for kind in DisagreementKind}
+
+
+def short_gt_id(gt_id: str) -> str:
+    """First 6 characters of a long instance token (as the viewer labels GT boxes)."""
+    return gt_id if len(gt_id) <= 8 else gt_id[:6]
+
+
+def match_to_gt(
+    gt_xy: np.ndarray,
+    gt_class: np.ndarray,
+    track_xy: np.ndarray,
+    track_class: np.ndarray,
+    max_dist_m: float = MATCH_DISTANCE_M,
+) -> np.ndarray:
+    """(G,) index of the track matched to each GT object, -1 if none.
+
+    gt_xy (G, 2), gt_class (G,), track_xy (K, 2), track_class (K,). A pair is possible when the classes are
+    equal and the BEV centre distance is < max_dist_m; the Hungarian method picks the one-to-one pairing with
+    the most possible pairs and, among those, the least summed distance.
+    """
+    n_gt, n_tracks = len(gt_class), len(track_class)
+    out = np.full(n_gt, -1, dtype=np.int64)
+    if n_gt == 0 or n_tracks == 0:
+        return out
+    dist = np.linalg.norm(
+        np.asarray(gt_xy, float)[:, None, :] - np.asarray(track_xy, float)[None, :, :], axis=2
+    )
+    ok = (np.asarray(gt_class, dtype=object)[:, None] == np.asarray(track_class, dtype=object)[None, :]) & (
+        dist < max_dist_m
+    )
+    if not ok.any():
+        return out
+    rows, cols = linear_sum_assignment(np.where(ok, dist, _FORBIDDEN))
+    keep = ok[rows, cols]
+    out[rows[keep]] = cols[keep]
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class _Frame:
+    """One tracker's estimates of one frame as arrays: xy (K, 2), class (K,), ids (K,), and the match
+    gt_track (G,) (track index per GT object, -1 if none)."""
+
+    estimates: Sequence[TrackEstimate]
+    xy: np.ndarray
+    classes: np.ndarray
+    ids: np.ndarray
+    gt_track: np.ndarray
+
+
+def _frame(estimates: Sequence[TrackEstimate], gt: Boxes, max_dist_m: float) -> _Frame:
+    k = len(estimates)
+    xy = np.array([e.translation_m[:2] for e in estimates], dtype=np.float64).reshape(k, 2)
+    classes = np.array([e.class_name for e in estimates], dtype=object)
+    ids = np.array([e.track_id for e in estimates], dtype=np.int64)
+    return _Frame(estimates, xy, classes, ids, match_to_gt(gt.xy, gt.class_name, xy, classes, max_dist_m))
+
+
+def _gt_box(gt: Boxes, g: int) -> tuple[tuple[float, float, float], ...]:
+    return (
+        tuple(float(v) for v in gt.translation_m[g]),
+        tuple(float(v) for v in gt.size_wlh_m[g]),
+        tuple(float(v) for v in gt.quat_wxyz[g]),
+    )
+
+
+def compare_trackers(
+    gt: Sequence[Boxes],
+    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
+    frame_indices: Sequence[int] | None = None,
+    max_dist_m: float = MATCH_DISTANCE_M,
+) -> Comparison:
+    """Disagreements between the trackers of ``estimates`` (tracker -> per-frame estimates, in time order)
+    over frames whose ground truth is ``gt`` (per frame; ``instance_id`` names the objects). frame_indices:
+    the keyframe index of each frame (default 0, 1, ...). See the module docstring for the kinds."""
+    names = tuple(estimates)
+    if len(names) < 2:
+        raise ValueError(f"comparing needs at least two trackers, got {len(names)}")
+    indices = tuple(range(len(gt))) if frame_indices is None else tuple(int(i) for i in frame_indices)
+    for name in names:
+        if len(estimates[name]) != len(gt):
+            raise ValueError(
+                f"{name} has {len(estimates[name])} frames of estimates for {len(gt)} frames of GT"
+            )
+    if len(indices) != len(gt):
+        raise ValueError(f"got {len(indices)} frame indices for {len(gt)} frames")
+    last_id: dict[str, dict[str, int]] = {name: {} for name in names}
+    out: list[Disagreement] = []
+    for frame_index, gt_boxes, per_tracker in zip(
+        indices, gt, zip(*(estimates[n] for n in names), strict=True), strict=True
+    ):
+        frames = {n: _frame(e, gt_boxes, max_dist_m) for n, e in zip(names, per_tracker, strict=True)}
+        gt_ids = [str(i) for i in gt_boxes.instance_id]
+        for a, b in itertools.combinations(names, 2):
+            out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, a, b)
+            out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, b, a)
+            out += _id_changes(frame_index, gt_boxes, gt_ids, frames, last_id, a, b)
+            out += _only_in_one(frame_index, frames, a, b, max_dist_m)
+            out += _only_in_one(frame_index, frames, b, a, max_dist_m)
+        for n, fr in frames.items():
+            for g in np.flatnonzero(fr.gt_track >= 0).tolist():
+                last_id[n][gt_ids[g]] = int(fr.ids[fr.gt_track[g]])
+    kind_order = {kind: i for i, kind in enumerate(DisagreementKind)}
+    out.sort(
+        key=lambda d: (
+            d.frame_index,
+            kind_order[d.kind],
+            d.class_name,
+            d.tracker,
+            d.other,
+            d.gt_id,
+            d.track_ids,
+        )
+    )
+    return Comparison(names, indices, tuple(out))
+
+
+def _missed_by_one(
+    frame_index: int, gt: Boxes, gt_ids: list[str], frames: Mapping[str, _Frame], a: str, b: str
+) -> list[Disagreement]:
+    fa, fb = frames[a], frames[b]
+    return [
+        Disagreement(
+            DisagreementKind.MISSED_BY_ONE,
+            frame_index,
+            str(gt.class_name[g]),
+            a,
+            b,
+            gt_ids[g],
+            (int(fa.ids[fa.gt_track[g]]),),
+            *_gt_box(gt, g),
+        )
+        for g in np.flatnonzero((fa.gt_track >= 0) & (fb.gt_track < 0)).tolist()
+    ]
+
+
+def _id_changes(
+    frame_index: int,
+    gt: Boxes,
+    gt_ids: list[str],
+    frames: Mapping[str, _Frame],
+    last_id: Mapping[str, Mapping[str, int]],
+    a: str,
+    b: str,
+) -> list[Disagreement]:
+    out = []
+    fa, fb = frames[a], frames[b]
+    for g in np.flatnonzero((fa.gt_track >= 0) & (fb.gt_track >= 0)).tolist():
+        now = {a: int(fa.ids[fa.gt_track[g]]), b: int(fb.ids[fb.gt_track[g]])}
+        before = {n: last_id[n].get(gt_ids[g]) for n in (a, b)}
+        switched = {n: before[n] is not None and before[n] != now[n] for n in (a, b)}
+        kept = {n: before[n] is not None and before[n] == now[n] for n in (a, b)}
+        for x, y in ((a, b), (b, a)):
+            if switched[x] and kept[y]:
+                out.append(
+                    Disagreement(
+                        DisagreementKind.ID_CHANGE,
+                        frame_index,
+                        str(gt.class_name[g]),
+                        x,
+                        y,
+                        gt_ids[g],
+                        (int(before[x]), now[x], now[y]),
+                        *_gt_box(gt, g),
+                    )
+                )
+    return out
+
+
+def _only_in_one(
+    frame_index: int, frames: Mapping[str, _Frame], a: str, b: str, max_dist_m: float
+) -> list[Disagreement]:
+    fa, fb = frames[a], frames[b]
+    unmatched = np.ones(len(fa.ids), dtype=bool)
+    unmatched[fa.gt_track[fa.gt_track >= 0]] = False
+    lone = np.flatnonzero(unmatched)
+    if lone.size and len(fb.ids):
+        dist = np.linalg.norm(fa.xy[lone, None, :] - fb.xy[None, :, :], axis=2)
+        near = ((dist < max_dist_m) & (fa.classes[lone, None] == fb.classes[None, :])).any(axis=1)
+        lone = lone[~near]
+    out = []
+    for k in lone.tolist():
+        e = fa.estimates[k]
+        out.append(
+            Disagreement(
+                DisagreementKind.ONLY_IN_ONE,
+                frame_index,
+                e.class_name,
+                a,
+                b,
+                "",
+                (e.track_id,),
+                tuple(float(v) for v in e.translation_m),
+                tuple(float(v) for v in e.size_wlh_m),
+                tuple(float(v) for v in e.quat_wxyz),
+            )
+        )
+    return out

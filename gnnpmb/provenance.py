@@ -1,0 +1,296 @@
+"""Provenance of a recording: everything needed to re-run its trackers and check that they give the same
+tracks.
+
+A ``Provenance`` holds the command line, package versions, the full tracker parameters, the dataset (dataroot,
+version, synthetic or real, scene name and token), where the detections came from with a content hash, the
+seed, frame range and classes, and per tracker a digest of its output tracks. ``to_json``/``from_json`` give a
+canonical JSON form (sorted keys) that ``viz.provenance`` stores in the recording.
+
+Track digest (``track_digest``), stable across runs and machines for equal outputs:
+
+* an estimate is one text line ``"<track_id> <class> <x> <y> <z> <w> <l> <h> <qw> <qx> <qy> <qz> <vx> <vy>
+  <score> <existence> <meas_index>"`` with lengths, sizes and velocities at 4 decimals (0.1 mm, 0.1 mm/s) and
+  quaternion, score and existence at 6 decimals (negative zero written as zero), so float noise far below what
+  a viewer shows does not count as a difference;
+* a frame's digest is the SHA-256 (hex) of its lines sorted by track id, joined by newlines (an empty frame
+  hashes the empty string);
+* the overall digest is the SHA-256 of the lines ``"<keyframe index> <frame digest>"`` joined by newlines.
+
+Detections hash (``detections_sha256``): a detection file is hashed byte for byte (``file_sha256``); simulated
+detections are hashed from the generated boxes (``boxes_sha256``), stored next to the preset and seed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from gnnpmb.errors import DataError
+from gnnpmb.types import Boxes, TrackEstimate
+
+FORMAT_VERSION = 1
+"""Bumped when the stored layout or the digest definition changes."""
+PACKAGES: tuple[str, ...] = ("gnnpmb-viz", "rerun-sdk", "nuscenes-devkit", "numpy")
+"""Distributions whose versions a recording records."""
+_CHUNK_BYTES = 1 << 20
+
+
+def package_versions(packages: Sequence[str] = PACKAGES) -> dict[str, str]:
+    """Installed version of each distribution ("not installed" if missing)."""
+    out = {}
+    for name in packages:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+def file_sha256(path: Path) -> str:
+    """SHA-256 (hex) of a file's bytes, read in 1 MiB blocks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        while block := f.read(_CHUNK_BYTES):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def boxes_sha256(detections: Mapping[str, Boxes], sample_tokens: Sequence[str]) -> str:
+    """SHA-256 (hex) of the detections of ``sample_tokens`` (in that order): per sample its token, box count,
+    then the float arrays as little-endian float64 bytes and the class names (a sample without detections
+    counts as empty)."""
+    digest = hashlib.sha256()
+    for token in sample_tokens:
+        boxes = detections.get(token, Boxes.empty())
+        digest.update(f"{token} {len(boxes)}\n".encode())
+        for array in (
+            boxes.translation_m,
+            boxes.size_wlh_m,
+            boxes.quat_wxyz,
+            boxes.velocity_mps,
+            boxes.score,
+        ):
+            digest.update(np.ascontiguousarray(array, dtype="<f8").tobytes())
+        digest.update("\n".join(str(c) for c in boxes.class_name).encode())
+    return digest.hexdigest()
+
+
+def _fixed(values: np.ndarray, decimals: int) -> list[str]:
+    rounded = np.round(np.asarray(values, dtype=np.float64), decimals) + 0.0  # -0.0 + 0.0 == +0.0
+    return [f"{v:.{decimals}f}" for v in rounded.tolist()]
+
+
+def estimate_line(e: TrackEstimate) -> str:
+    """The canonical text line of one estimate (see the module docstring)."""
+    parts = [str(e.track_id), e.class_name]
+    parts += _fixed(np.array([*e.translation_m, *e.size_wlh_m]), 4)
+    parts += _fixed(np.array(e.quat_wxyz), 6)
+    parts += _fixed(np.array(e.velocity_mps), 4)
+    parts += _fixed(np.array([e.score, e.existence]), 6)
+    parts.append(str(e.meas_index))
+    return " ".join(parts)
+
+
+def frame_digest(estimates: Sequence[TrackEstimate]) -> str:
+    """SHA-256 (hex) of one frame's estimates: their lines sorted by track id, joined by newlines."""
+    lines = [estimate_line(e) for e in sorted(estimates, key=lambda e: (e.track_id, e.class_name))]
+    return hashlib.sha256("\n".join(lines).encode()).hexdigest()
+
+
+@dataclass(frozen=True, slots=True)
+class TrackDigest:
+    """Digest of one tracker's output: ``frames`` (F,) per-frame digests of the keyframes ``frame_indices``,
+    ``overall`` over all of them."""
+
+    overall: str
+    frame_indices: tuple[int, ...]
+    frames: tuple[str, ...]
+
+    def first_difference(self, other: TrackDigest) -> int | None:
+        """Keyframe index of the first frame whose digest differs from ``other`` (frames present in only one
+        count as different); None if the outputs are identical."""
+        if self.overall == other.overall and self.frame_indices == other.frame_indices:
+            return None
+        mine = dict(zip(self.frame_indices, self.frames, strict=True))
+        theirs = dict(zip(other.frame_indices, other.frames, strict=True))
+        for index in sorted(set(mine) | set(theirs)):
+            if mine.get(index) != theirs.get(index):
+                return index
+        return None
+
+    def differing_frames(self, other: TrackDigest) -> int:
+        """Number of keyframes whose digests differ (or that only one of the two has)."""
+        mine = dict(zip(self.frame_indices, self.frames, strict=True))
+        theirs = dict(zip(other.frame_indices, other.frames, strict=True))
+        return sum(mine.get(i) != theirs.get(i) for i in set(mine) | set(theirs))
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "overall": self.overall,
+            "frame_indices": list(self.frame_indices),
+            "frames": list(self.frames),
+        }
+
+    @staticmethod
+    def from_json(data: Mapping[str, Any]) -> TrackDigest:
+        return TrackDigest(
+            str(data["overall"]),
+            tuple(int(i) for i in data["frame_indices"]),
+            tuple(map(str, data["frames"])),
+        )
+
+
+def track_digest(frame_indices: Sequence[int], frames: Sequence[Sequence[TrackEstimate]]) -> TrackDigest:
+    """The digest of a tracker's estimates ``frames`` at keyframes ``frame_indices`` (see the module
+    docstring)."""
+    if len(frame_indices) != len(frames):
+        raise ValueError(f"got {len(frame_indices)} frame indices for {len(frames)} frames of estimates")
+    per_frame = tuple(frame_digest(f) for f in frames)
+    indices = tuple(int(i) for i in frame_indices)
+    text = "\n".join(f"{i} {d}" for i, d in zip(indices, per_frame, strict=True))
+    return TrackDigest(hashlib.sha256(text.encode()).hexdigest(), indices, per_frame)
+
+
+@dataclass(frozen=True, slots=True)
+class DetectionsSource:
+    """Where the detections came from: ``kind`` "file" (``path``) or "simulated" (``preset``, ``seed``), and
+    the SHA-256 of the file bytes or of the generated boxes."""
+
+    kind: str
+    sha256: str
+    path: str | None = None
+    preset: str | None = None
+    seed: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("file", "simulated"):
+            raise ValueError(f"unknown detections kind {self.kind!r}")
+
+    def describe(self) -> str:
+        if self.kind == "file":
+            return f"file {self.path} (sha256 {self.sha256[:12]})"
+        return f"simulated {self.preset} detector, seed {self.seed} (sha256 {self.sha256[:12]})"
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "kind": self.kind,
+            "sha256": self.sha256,
+            "path": self.path,
+            "preset": self.preset,
+            "seed": self.seed,
+        }
+
+    @staticmethod
+    def from_json(data: Mapping[str, Any]) -> DetectionsSource:
+        seed = data.get("seed")
+        return DetectionsSource(
+            str(data["kind"]),
+            str(data["sha256"]),
+            data.get("path"),
+            data.get("preset"),
+            None if seed is None else int(seed),
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Provenance:
+    """Everything a recording was made from (see the module docstring). frame_start/frame_end: the keyframes
+    ``range(frame_start, frame_end)``; config: ``TrackerConfig.as_dict()``; track_digests: tracker ->
+    digest."""
+
+    argv: tuple[str, ...]
+    versions: dict[str, str]
+    config: dict[str, Any]
+    dataroot: str
+    version: str
+    synthetic: bool
+    scene_name: str
+    scene_token: str
+    detections: DetectionsSource
+    seed: int
+    frame_start: int
+    frame_end: int
+    classes: tuple[str, ...]
+    trackers: tuple[str, ...]
+    track_digests: dict[str, TrackDigest] = field(default_factory=dict)
+    format_version: int = FORMAT_VERSION
+
+    @property
+    def frame_range(self) -> range:
+        return range(self.frame_start, self.frame_end)
+
+    @property
+    def data_source(self) -> str:
+        """ "synthetic demo" or "nuScenes <version>"."""
+        return "synthetic demo" if self.synthetic else f"nuScenes {self.version}"
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "format_version": self.format_version,
+            "argv": list(self.argv),
+            "versions": dict(self.versions),
+            "config": self.config,
+            "dataroot": self.dataroot,
+            "version": self.version,
+            "synthetic": self.synthetic,
+            "scene_name": self.scene_name,
+            "scene_token": self.scene_token,
+            "detections": self.detections.to_json(),
+            "seed": self.seed,
+            "frame_start": self.frame_start,
+            "frame_end": self.frame_end,
+            "classes": list(self.classes),
+            "trackers": list(self.trackers),
+            "track_digests": {name: d.to_json() for name, d in self.track_digests.items()},
+        }
+
+    def dumps(self) -> str:
+        """Canonical JSON text (sorted keys, no spaces)."""
+        return json.dumps(self.to_json(), sort_keys=True, separators=(",", ":"))
+
+    @staticmethod
+    def from_json(data: Mapping[str, Any]) -> Provenance:
+        """Parse ``to_json`` output; a DataError names what is missing or malformed."""
+        if not isinstance(data, Mapping):
+            raise DataError("the stored provenance is not a JSON object")
+        version = data.get("format_version")
+        if version != FORMAT_VERSION:
+            raise DataError(
+                f"the stored provenance has format version {version}; this gnnpmb-viz reads version "
+                f"{FORMAT_VERSION} (re-record with this version)"
+            )
+        try:
+            return Provenance(
+                argv=tuple(map(str, data["argv"])),
+                versions={str(k): str(v) for k, v in data["versions"].items()},
+                config=dict(data["config"]),
+                dataroot=str(data["dataroot"]),
+                version=str(data["version"]),
+                synthetic=bool(data["synthetic"]),
+                scene_name=str(data["scene_name"]),
+                scene_token=str(data["scene_token"]),
+                detections=DetectionsSource.from_json(data["detections"]),
+                seed=int(data["seed"]),
+                frame_start=int(data["frame_start"]),
+                frame_end=int(data["frame_end"]),
+                classes=tuple(map(str, data["classes"])),
+                trackers=tuple(map(str, data["trackers"])),
+                track_digests={str(k): TrackDigest.from_json(v) for k, v in data["track_digests"].items()},
+            )
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise DataError(f"the stored provenance is malformed ({type(exc).__name__}: {exc})") from None
+
+    @staticmethod
+    def loads(text: str) -> Provenance:
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise DataError(f"the stored provenance is not valid JSON ({exc})") from None
+        return Provenance.from_json(data)

@@ -1,0 +1,128 @@
+"""Disagreements between trackers on hand-made estimates and ground truth: exactly the expected ones."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gnnpmb.compare import MATCH_DISTANCE_M, Comparison, DisagreementKind, compare_trackers, match_to_gt
+from gnnpmb.types import Boxes, TrackEstimate
+
+MISSED, ID_CHANGE, ONLY = (
+    DisagreementKind.MISSED_BY_ONE,
+    DisagreementKind.ID_CHANGE,
+    DisagreementKind.ONLY_IN_ONE,
+)
+
+
+def gt_boxes(objects: list[tuple[str, str, float, float]]) -> Boxes:
+    """GT boxes from (instance id, class, x, y)."""
+    n = len(objects)
+    return Boxes(
+        translation_m=np.array([[x, y, 1.0] for _, _, x, y in objects], dtype=float).reshape(n, 3),
+        size_wlh_m=np.tile([2.0, 4.5, 1.6], (n, 1)),
+        quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)),
+        velocity_mps=np.zeros((n, 2)),
+        score=np.ones(n),
+        class_name=np.array([c for _, c, _, _ in objects], dtype=object),
+        instance_id=np.array([i for i, _, _, _ in objects], dtype=object),
+    )
+
+
+def est(track_id: int, class_name: str, x: float, y: float) -> TrackEstimate:
+    return TrackEstimate(
+        track_id, class_name, (x, y, 1.0), (2.0, 4.5, 1.6), (1.0, 0.0, 0.0, 0.0), (0.0, 0.0), 0.9, 1.0
+    )
+
+
+GT = gt_boxes([("g1-token-0001", "car", 0.0, 0.0), ("g2", "car", 10.0, 0.0), ("p1", "pedestrian", 20.0, 5.0)])
+
+A_FRAMES = [
+    [est(1, "car", 0.5, 0.0), est(2, "car", 10.3, 0.0), est(3, "car", 30.0, 30.0)],
+    [est(5, "car", 0.2, 0.0), est(2, "car", 10.2, 0.0), est(6, "pedestrian", 50.0, 50.0)],
+    [est(5, "car", 0.0, 0.0), est(7, "car", 10.0, 0.0), est(8, "car", 20.0, 5.0)],
+]
+"""Tracker A: covers g1 (switching 1 -> 5 in frame 1) and g2 (switching 2 -> 7 in frame 2), never p1 (its car
+8 sits on the pedestrian: wrong class); false tracks 3 (B has one there too), 6 (B's track there is a car) and
+8."""
+B_FRAMES = [
+    [est(11, "car", 0.0, 0.4), est(12, "pedestrian", 20.2, 5.0), est(13, "car", 30.5, 30.0)],
+    [
+        est(11, "car", 0.1, 0.0),
+        est(14, "car", 10.0, 0.5),
+        est(12, "pedestrian", 20.0, 5.0),
+        est(15, "car", 50.5, 50.0),
+    ],
+    [est(11, "car", 0.0, 0.0), est(16, "car", 10.0, 0.0), est(12, "pedestrian", 20.0, 5.0)],
+]
+"""Tracker B: keeps id 11 on g1, misses g2 in frame 0, then covers it (14, switching to 16 in frame 2 like A),
+and covers p1 with 12 throughout."""
+
+
+def summary(comparison: Comparison) -> list[tuple]:
+    return [
+        (d.frame_index, d.kind, d.class_name, d.tracker, d.other, d.gt_id, d.track_ids)
+        for d in comparison.disagreements
+    ]
+
+
+def test_hand_made_disagreements_are_exactly_the_expected_ones() -> None:
+    comparison = compare_trackers([GT] * 3, {"A": A_FRAMES, "B": B_FRAMES}, frame_indices=[4, 5, 6])
+    assert summary(comparison) == [
+        (4, MISSED, "car", "A", "B", "g2", (2,)),
+        (4, MISSED, "pedestrian", "B", "A", "p1", (12,)),
+        (5, MISSED, "pedestrian", "B", "A", "p1", (12,)),
+        (5, ID_CHANGE, "car", "A", "B", "g1-token-0001", (1, 5, 11)),
+        (5, ONLY, "car", "B", "A", "", (15,)),
+        (5, ONLY, "pedestrian", "A", "B", "", (6,)),
+        (6, MISSED, "pedestrian", "B", "A", "p1", (12,)),
+        (6, ONLY, "car", "A", "B", "", (8,)),
+    ]
+    assert comparison.trackers == ("A", "B") and comparison.frame_indices == (4, 5, 6)
+    assert comparison.counts(MISSED).tolist() == [2, 1, 1]
+    assert comparison.counts(ID_CHANGE).tolist() == [0, 1, 0]
+    assert comparison.counts(ONLY).tolist() == [0, 2, 1]
+    assert comparison.totals() == {MISSED: 4, ID_CHANGE: 1, ONLY: 3}
+
+
+def test_disagreement_boxes_and_descriptions() -> None:
+    comparison = compare_trackers([GT] * 3, {"A": A_FRAMES, "B": B_FRAMES})
+    switch = comparison.of_kind(ID_CHANGE)[0]
+    assert switch.translation_m == (0.0, 0.0, 1.0) and switch.size_wlh_m == (2.0, 4.5, 1.6)
+    assert switch.describe() == "car GT g1-tok: A switched track 1 -> 5, B kept track 11"
+    lone = comparison.of_kind(ONLY)[-1]
+    assert lone.translation_m == (20.0, 5.0, 1.0)
+    assert lone.describe() == "car track 8 of A matches no GT; B has no car track there"
+    missed = comparison.of_kind(MISSED)[0]
+    assert missed.describe() == "car GT g2: tracked by A (track 2), missed by B"
+
+
+def test_identical_trackers_agree_and_three_trackers_compare_pairwise() -> None:
+    assert compare_trackers([GT] * 3, {"A": A_FRAMES, "A2": A_FRAMES}).disagreements == ()
+    only_g1 = [[est(21, "car", 0.0, 0.0)]] * 3
+    both_cover = [[est(31, "car", 0.1, 0.0), est(32, "pedestrian", 20.0, 5.0)]] * 3
+    comparison = compare_trackers([GT] * 3, {"A": only_g1, "B": only_g1, "C": both_cover})
+    assert [(d.frame_index, d.tracker, d.other, d.gt_id) for d in comparison.disagreements] == [
+        (f, "C", other, "p1") for f in range(3) for other in ("A", "B")
+    ]
+
+
+def test_hungarian_matching_beats_greedy_and_respects_threshold_and_class() -> None:
+    gt_xy = np.array([[0.0, 0.0], [2.5, 0.0]])
+    cars = np.array(["car", "car"], dtype=object)
+    # Greedy (closest pair first) would give track 0 to GT 0 and leave GT 1 and track 1 unmatched.
+    tracks = np.array([[1.2, 0.0], [-0.5, 1.85]])
+    assert match_to_gt(gt_xy, cars, tracks, cars).tolist() == [1, 0]
+    at_threshold = np.array([[MATCH_DISTANCE_M, 0.0]])
+    assert match_to_gt(gt_xy[:1], cars[:1], at_threshold, cars[:1]).tolist() == [-1]
+    assert match_to_gt(gt_xy[:1], cars[:1], at_threshold - [1e-9, 0.0], cars[:1]).tolist() == [0]
+    peds = np.array(["pedestrian"], dtype=object)
+    assert match_to_gt(gt_xy[:1], cars[:1], np.zeros((1, 2)), peds).tolist() == [-1]
+    assert match_to_gt(np.zeros((0, 2)), cars[:0], tracks, cars).tolist() == []
+
+
+def test_bad_input() -> None:
+    with pytest.raises(ValueError, match="at least two trackers"):
+        compare_trackers([GT], {"A": A_FRAMES[:1]})
+    with pytest.raises(ValueError, match="B has 2 frames"):
+        compare_trackers([GT] * 3, {"A": A_FRAMES, "B": B_FRAMES[:2]})

@@ -1,0 +1,461 @@
+"""A real-browser check of a saved recording: serve it with Rerun's web viewer, open it in headless Chromium
+and screenshot it once the 3D views show the scene.
+
+``rerun FILE.rrd --serve-web`` hosts the web viewer over HTTP and the recording over gRPC (both bound to
+127.0.0.1, on free ports). Chromium runs headless with WebGL2 on SwiftShader (no GPU) and a fresh profile; it
+is driven over the DevTools protocol (``websocket-client``): set the viewport, navigate, then take
+``Page.captureScreenshot`` every few seconds until the 3D-view regions hold many varied, non-background pixels
+(LiDAR points, coloured boxes), all data has streamed in (the viewer's backlog readout is gone) and the page
+has stopped changing, rather than the loading page. Both servers run in their own process groups and are
+killed (group-wide) on every exit path.
+
+By hand: ``uv run python -m viz.webcheck FILE.rrd --out shot.png [--views 2]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import base64
+import contextlib
+import io
+import itertools
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.parse
+import urllib.request
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_FLAGS: tuple[str, ...] = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+    "--disable-sync",
+    "--disable-quic",
+    "--hide-scrollbars",
+    "--mute-audio",
+)
+"""Headless Chromium that renders WebGL2 on SwiftShader and talks to nothing but localhost."""
+
+DEFAULT_VIEWPORT = (1600, 900)
+BACKGROUND_TOLERANCE = 12
+"""A pixel is background when each channel is within this of the region's most common colour."""
+SATURATION_MIN = 60
+"""A pixel is coloured (a box, gate or label) when its channels spread by more than this; the LiDAR points,
+grid and background are greys."""
+MIN_FOREGROUND_FRACTION = 0.02
+MIN_DISTINCT_COLORS = 200
+MIN_COLORED_FRACTION = 0.001
+MAX_CHANGED_FRACTION = 0.002
+SETTLED_SHOTS = 2
+"""The page has settled when this many consecutive shots have rendered views, no ingestion backlog
+(``backlog_region``) and fewer than MAX_CHANGED_FRACTION of all pixels changed since the shot before."""
+STATUS_X = (235, 500)
+STATUS_Y = (6, 30)
+"""Pixel span of the top bar (Rerun 0.41 web viewer) right of the renderer badge, where the viewer shows its
+ingestion backlog ("123.4 s latency") while data is still streaming in; blank once everything has arrived.
+The data may take minutes to arrive on SwiftShader, and the 3D views can stay unchanged for over half a
+minute meanwhile, so an unchanged page alone does not mean it is complete."""
+"""A rendered 3D view (LiDAR points, class- and track-coloured boxes, gates, labels) beats all three by far:
+measured 18-20 % foreground, 2,000-10,000 colours and 1.3-1.9 % coloured pixels per view on the demo scene.
+The loading page and an empty view are a uniform background with a grid, a logo or a few lines of text (under
+40 colours); LiDAR alone, before the boxes have streamed in, has no coloured pixels."""
+
+
+class WebCheckError(RuntimeError):
+    """The browser check could not run (a server did not start, the page never rendered)."""
+
+
+@dataclass(frozen=True, slots=True)
+class RegionStats:
+    """Pixels of one screenshot region (x0, y0, x1, y1): the fraction that differs from the region's
+    background colour, the number of distinct colours among them, and the fraction of coloured (non-grey)
+    pixels."""
+
+    box: tuple[int, int, int, int]
+    foreground_fraction: float
+    distinct_colors: int
+    colored_fraction: float
+
+    @property
+    def rendered(self) -> bool:
+        return (
+            self.foreground_fraction >= MIN_FOREGROUND_FRACTION
+            and self.distinct_colors >= MIN_DISTINCT_COLORS
+            and self.colored_fraction >= MIN_COLORED_FRACTION
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class WebCheckResult:
+    """Outcome of ``check_recording``: the screenshot written; whether every 3D-view region looked rendered
+    and the page had settled; seconds from navigation to the first shot with rendered views and to the settled
+    shot (None if never); shots taken; total wall time; the last shot's region stats."""
+
+    screenshot: Path
+    rendered: bool
+    seconds_to_render: float | None
+    seconds_to_settle: float | None
+    shots: int
+    total_s: float
+    regions: tuple[RegionStats, ...]
+    process_groups: tuple[int, ...]
+
+    def describe(self) -> str:
+        parts = ", ".join(
+            f"{r.foreground_fraction:.1%} foreground, {r.distinct_colors} colours, "
+            f"{r.colored_fraction:.2%} coloured"
+            for r in self.regions
+        )
+        if self.rendered:
+            when = (
+                f"rendered after {self.seconds_to_render:.1f} s, settled after {self.seconds_to_settle:.1f} s"
+            )
+        else:
+            when = "NOT rendered"
+        return (
+            f"{when} ({self.shots} shots, {self.total_s:.1f} s in all); 3D views: {parts}; {self.screenshot}"
+        )
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that nothing listens on right now."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def rerun_executable() -> Path:
+    """The ``rerun`` CLI installed next to this Python interpreter (the venv's)."""
+    exe = Path(sys.executable).parent / "rerun"
+    if not exe.is_file():
+        raise WebCheckError(f"the rerun CLI is not installed next to {sys.executable}")
+    return exe
+
+
+@contextlib.contextmanager
+def process_group(argv: Sequence[str], log_path: Path) -> Iterator[subprocess.Popen[bytes]]:
+    """Run ``argv`` in a new session (its own process group), output to ``log_path``; on exit SIGTERM the
+    whole group, then SIGKILL whatever is left after 5 s, and reap the leader."""
+    with open(log_path, "wb") as log:
+        proc = subprocess.Popen(
+            list(argv), stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True
+        )
+    try:
+        yield proc
+    finally:
+        _kill_group(proc)
+
+
+def _kill_group(proc: subprocess.Popen[bytes]) -> None:
+    """SIGTERM the process group led by ``proc``, SIGKILL it if anything is still running 5 s later, and reap
+    the leader."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, sig)
+        deadline = time.monotonic() + 5.0
+        while group_members(proc.pid) and time.monotonic() < deadline:
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                proc.wait(timeout=0.1)
+        if not group_members(proc.pid):
+            break
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        proc.wait(timeout=5.0)
+
+
+def group_members(pgid: int) -> list[int]:
+    """Pids of the running (not zombie) processes in process group ``pgid``, from ``/proc``."""
+    members = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue  # the process ended while we looked
+        state, pgrp = fields[0], int(fields[2])
+        if pgrp == pgid and state not in ("Z", "X"):
+            members.append(int(stat.parent.name))
+    return members
+
+
+def _wait_for_http(url: str, timeout_s: float, proc: subprocess.Popen[bytes], what: str, log: Path) -> bytes:
+    """GET ``url`` until it answers (returns the body); fail early if ``proc`` died."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            with urllib.request.urlopen(url, timeout=2.0) as response:
+                return response.read()
+        except (urllib.error.URLError, ConnectionError, TimeoutError, OSError):
+            pass
+        if proc.poll() is not None:
+            raise WebCheckError(f"{what} exited with code {proc.returncode}; see {log}")
+        if time.monotonic() > deadline:
+            raise WebCheckError(f"{what} did not answer at {url} within {timeout_s:.0f} s; see {log}")
+        time.sleep(0.25)
+
+
+class DevTools:
+    """A minimal Chrome DevTools protocol client over one page's websocket: ``call`` sends a command and waits
+    for its reply (events in between are ignored)."""
+
+    def __init__(self, ws_url: str, timeout_s: float = 60.0) -> None:
+        import websocket
+
+        self._ws = websocket.create_connection(ws_url, timeout=timeout_s, suppress_origin=True)
+        self._ids = itertools.count(1)
+
+    def call(self, method: str, **params: Any) -> dict[str, Any]:
+        msg_id = next(self._ids)
+        self._ws.send(json.dumps({"id": msg_id, "method": method, "params": params}))
+        while True:
+            reply = json.loads(self._ws.recv())
+            if reply.get("id") != msg_id:
+                continue
+            if "error" in reply:
+                raise WebCheckError(
+                    f"DevTools {method} failed: {reply['error'].get('message', reply['error'])}"
+                )
+            return reply.get("result", {})
+
+    def close(self) -> None:
+        self._ws.close()
+
+
+def view_regions(width: int, height: int, n_views: int) -> list[tuple[int, int, int, int]]:
+    """(x0, y0, x1, y1) pixel boxes well inside each of the ``n_views`` side-by-side 3D views of the default
+    blueprint (``viz.blueprint``): they span the left three fifths of the window, above the bottom panels;
+    each box keeps clear of view borders, titles and the top bar."""
+    left, right = 0.0, 0.6 * width
+    top, bottom = 0.10 * height, 0.50 * height
+    step = (right - left) / n_views
+    boxes = []
+    for i in range(n_views):
+        x0 = left + i * step
+        boxes.append((int(x0 + 0.1 * step), int(top), int(x0 + 0.9 * step), int(bottom)))
+    return boxes
+
+
+def region_stats(image: np.ndarray, box: tuple[int, int, int, int]) -> RegionStats:
+    """Foreground fraction, distinct colours and coloured fraction of an (H, W, 3) uint8 image inside ``box``;
+    the background is the region's most common colour."""
+    x0, y0, x1, y1 = box
+    pixels = np.ascontiguousarray(image[y0:y1, x0:x1, :3]).reshape(-1, 3)
+    if pixels.size == 0:
+        return RegionStats(box, 0.0, 0, 0.0)
+    packed = (pixels[:, 0].astype(np.uint32) << 16) | (pixels[:, 1].astype(np.uint32) << 8) | pixels[:, 2]
+    colors, counts = np.unique(packed, return_counts=True)
+    mode = colors[np.argmax(counts)]
+    background = np.array([(mode >> 16) & 255, (mode >> 8) & 255, mode & 255], dtype=np.int16)
+    foreground = np.any(np.abs(pixels.astype(np.int16) - background) > BACKGROUND_TOLERANCE, axis=1)
+    distinct = int(np.unique(packed[foreground]).size)
+    spread = pixels.max(axis=1).astype(np.int16) - pixels.min(axis=1)
+    return RegionStats(box, float(foreground.mean()), distinct, float(np.mean(spread > SATURATION_MIN)))
+
+
+def changed_fraction(before: np.ndarray | None, after: np.ndarray) -> float:
+    """Fraction of pixels of two (H, W, 3) shots that differ by more than BACKGROUND_TOLERANCE in some channel
+    (1 when there is no earlier shot or the sizes differ)."""
+    if before is None or before.shape != after.shape:
+        return 1.0
+    diff = np.abs(before.astype(np.int16) - after.astype(np.int16)).max(axis=2)
+    return float(np.mean(diff > BACKGROUND_TOLERANCE))
+
+
+def backlog_region(width: int) -> tuple[int, int, int, int]:
+    """(x0, y0, x1, y1) of the top-bar text where the viewer reports its ingestion backlog (left of the
+    centred command search box)."""
+    return STATUS_X[0], STATUS_Y[0], min(STATUS_X[1], width // 2 - 220), STATUS_Y[1]
+
+
+def backlog_shown(image: np.ndarray) -> bool:
+    """Whether the viewer's top bar shows an ingestion backlog (text in ``backlog_region``)."""
+    return region_stats(image, backlog_region(image.shape[1])).foreground_fraction > 0.005
+
+
+def decode_png(data: bytes) -> np.ndarray:
+    """(H, W, 3) uint8 RGB pixels of a PNG."""
+    from PIL import Image
+
+    with Image.open(io.BytesIO(data)) as img:
+        return np.asarray(img.convert("RGB"))
+
+
+def _page_websocket(debug_port: int, proc: subprocess.Popen[bytes], log: Path, timeout_s: float) -> str:
+    deadline = time.monotonic() + timeout_s
+    while True:
+        body = _wait_for_http(f"http://127.0.0.1:{debug_port}/json/list", timeout_s, proc, "chromium", log)
+        pages = [t for t in json.loads(body) if t.get("type") == "page" and t.get("webSocketDebuggerUrl")]
+        if pages:
+            return str(pages[0]["webSocketDebuggerUrl"])
+        if time.monotonic() > deadline:
+            raise WebCheckError(f"chromium opened no page within {timeout_s:.0f} s; see {log}")
+        time.sleep(0.25)
+
+
+def check_recording(
+    rrd: Path,
+    out: Path,
+    *,
+    n_views: int = 2,
+    viewport: tuple[int, int] = DEFAULT_VIEWPORT,
+    timeout_s: float = 420.0,
+    poll_s: float = 4.0,
+    chromium: Path = CHROMIUM,
+    work_dir: Path | None = None,
+) -> WebCheckResult:
+    """Serve ``rrd`` with Rerun's web viewer, open it in headless Chromium and write a PNG screenshot to
+    ``out``.
+
+    Screenshots are taken every ``poll_s`` seconds after navigation until every one of the ``n_views`` 3D-view
+    regions (``view_regions``) looks rendered and the page has settled (SETTLED_SHOTS shots in a row without
+    an ingestion backlog and nearly unchanged), or ``timeout_s`` passes; ``out`` holds the last shot either
+    way (so a failure can be looked at). Server logs and the browser profile go to ``work_dir`` (a temp dir
+    if None). Raises WebCheckError when a server does not start.
+    """
+    rrd, out = Path(rrd).absolute(), Path(out).absolute()
+    if not rrd.is_file():
+        raise WebCheckError(f"recording {rrd} does not exist")
+    if not chromium.is_file():
+        raise WebCheckError(f"chromium is not installed at {chromium}")
+    width, height = viewport
+    start = time.monotonic()
+    with contextlib.ExitStack() as stack:
+        work = (
+            Path(work_dir)
+            if work_dir is not None
+            else Path(stack.enter_context(tempfile.TemporaryDirectory()))
+        )
+        work.mkdir(parents=True, exist_ok=True)
+        web_port, grpc_port, debug_port = free_port(), free_port(), free_port()
+        serve_log, browser_log = work / "rerun-serve.log", work / "chromium.log"
+        server = stack.enter_context(
+            process_group(
+                [
+                    str(rerun_executable()),
+                    str(rrd),
+                    "--serve-web",
+                    "--web-viewer-port",
+                    str(web_port),
+                    "--port",
+                    str(grpc_port),
+                    "--bind",
+                    "127.0.0.1",
+                ],
+                serve_log,
+            )
+        )
+        _wait_for_http(f"http://127.0.0.1:{web_port}/", 60.0, server, "rerun --serve-web", serve_log)
+        profile = work / "chromium-profile"
+        browser = stack.enter_context(
+            process_group(
+                [
+                    str(chromium),
+                    *CHROMIUM_FLAGS,
+                    f"--remote-debugging-port={debug_port}",
+                    f"--user-data-dir={profile}",
+                    f"--window-size={width},{height}",
+                    "about:blank",
+                ],
+                browser_log,
+            )
+        )
+        devtools = DevTools(_page_websocket(debug_port, browser, browser_log, 60.0))
+        stack.callback(devtools.close)
+        devtools.call(
+            "Emulation.setDeviceMetricsOverride",
+            width=width,
+            height=height,
+            deviceScaleFactor=1,
+            mobile=False,
+        )
+        grpc_url = f"rerun+http://127.0.0.1:{grpc_port}/proxy"
+        url = f"http://127.0.0.1:{web_port}/?url={urllib.parse.quote(grpc_url, safe='')}"
+        devtools.call("Page.navigate", url=url)
+        navigated = time.monotonic()
+        boxes = view_regions(width, height, n_views)
+        shots, settled = 0, 0
+        first_rendered: float | None = None
+        stats: tuple[RegionStats, ...] = ()
+        previous: np.ndarray | None = None
+        while True:
+            time.sleep(poll_s)
+            png = base64.b64decode(devtools.call("Page.captureScreenshot", format="png")["data"])
+            shots += 1
+            _write_atomic(out, png)
+            image = decode_png(png)
+            stats = tuple(region_stats(image, b) for b in boxes)
+            changed = changed_fraction(previous, image)
+            previous = image
+            elapsed = time.monotonic() - navigated
+            if all(s.rendered for s in stats):
+                first_rendered = elapsed if first_rendered is None else first_rendered
+                quiet = changed <= MAX_CHANGED_FRACTION and not backlog_shown(image)
+                settled = settled + 1 if quiet else 0
+            else:
+                first_rendered, settled = None, 0
+            if settled >= SETTLED_SHOTS or elapsed > timeout_s:
+                break
+            if server.poll() is not None:
+                raise WebCheckError(
+                    f"rerun --serve-web exited with code {server.returncode}; see {serve_log}"
+                )
+    done = settled >= SETTLED_SHOTS
+    return WebCheckResult(
+        out,
+        done,
+        first_rendered if done else None,
+        elapsed if done else None,
+        shots,
+        time.monotonic() - start,
+        stats,
+        (server.pid, browser.pid),
+    )
+
+
+def _write_atomic(path: Path, data: bytes) -> None:
+    tmp = path.with_name(f".{path.name}.partial")
+    tmp.write_bytes(data)
+    os.replace(tmp, path)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m viz.webcheck",
+        description="Open a saved .rrd in Rerun's web viewer in headless Chromium; screenshot its 3D views.",
+    )
+    parser.add_argument("rrd", type=Path, help="the recording (.rrd)")
+    parser.add_argument("--out", type=Path, default=Path("webcheck.png"), help="screenshot to write (PNG)")
+    parser.add_argument("--views", type=int, default=2, help="number of side-by-side 3D views to check")
+    parser.add_argument(
+        "--timeout", type=float, default=420.0, help="seconds to wait for the scene to render"
+    )
+    parser.add_argument("--width", type=int, default=DEFAULT_VIEWPORT[0])
+    parser.add_argument("--height", type=int, default=DEFAULT_VIEWPORT[1])
+    args = parser.parse_args(argv)
+    try:
+        result = check_recording(
+            args.rrd, args.out, n_views=args.views, viewport=(args.width, args.height), timeout_s=args.timeout
+        )
+    except WebCheckError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(result.describe())
+    return 0 if result.rendered else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
