@@ -15,7 +15,7 @@ import rerun as rr
 from gnnpmb.compare import Comparison, Disagreement, DisagreementKind, short_gt_id
 from gnnpmb.data.scene import SceneData
 from viz import paths
-from viz.geometry import quat_wxyz_to_xyzw, size_wlh_to_xyz
+from viz.markers import send_counts, send_marker_boxes, send_text_lines, time_indexes
 
 COMPARISON = "comparison"
 KIND_COLORS: dict[DisagreementKind, tuple[int, int, int]] = {
@@ -95,45 +95,33 @@ def log_comparison(stream: rr.RecordingStream, comparison: Comparison, scene: Sc
     """Log ``comparison`` (over keyframes of ``scene``) on the frame and timestamp timelines: per kind a count
     at every compared frame and marker boxes (an empty batch at frames without any), plus the text log."""
     frames = np.asarray(comparison.frame_indices, dtype=np.int64)
-    stamps = np.array([scene.keyframes[i].timestamp_us for i in frames.tolist()], dtype="datetime64[us]")
-
-    def indexes(at: np.ndarray) -> list[rr.TimeColumn]:
-        return [rr.TimeColumn("frame", sequence=frames[at]), rr.TimeColumn("timestamp", timestamp=stamps[at])]
-
+    indexes = time_indexes(frames, np.array([scene.keyframes[i].timestamp_us for i in frames.tolist()]))
     every = np.arange(frames.size)
     for kind in DisagreementKind:
         color = KIND_COLORS[kind]
-        stream.log(count_path(kind), rr.SeriesLines(names=KIND_LABELS[kind], colors=[color]), static=True)
-        stream.send_columns(
-            count_path(kind),
-            indexes=indexes(every),
-            columns=rr.Scalars.columns(scalars=comparison.counts(kind).astype(np.float64)),
-        )
+        send_counts(stream, count_path(kind), KIND_LABELS[kind], color, indexes(every), comparison.counts(kind))
         found = comparison.of_kind(kind)
         if not found:
             continue
         boxes, labels, lengths = _markers(found, comparison.frame_indices)
-        sizes = size_wlh_to_xyz(np.array([b.size_wlh_m for b in boxes], dtype=np.float64))
-        stream.send_columns(
+        send_marker_boxes(
+            stream,
             markers_path(kind),
-            indexes=indexes(every),
-            columns=rr.Boxes3D.columns(
-                centers=np.array([b.translation_m for b in boxes], dtype=np.float64),
-                half_sizes=0.5 * (sizes * MARKER_SCALE + MARKER_MARGIN_M),
-                quaternions=quat_wxyz_to_xyzw(np.array([b.quat_wxyz for b in boxes], dtype=np.float64)),
-                colors=np.tile(np.array(color, dtype=np.uint8), (len(boxes), 1)),
-                radii=np.full(len(boxes), MARKER_LINE_RADIUS_M, dtype=np.float32),
-                labels=labels,
-            ).partition(lengths),
+            indexes(every),
+            boxes,
+            labels,
+            lengths,
+            color=color,
+            scale=MARKER_SCALE,
+            margin_m=MARKER_MARGIN_M,
+            line_radius_m=MARKER_LINE_RADIUS_M,
         )
     if comparison.disagreements:
         position = {f: i for i, f in enumerate(comparison.frame_indices)}
-        at = np.array([position[d.frame_index] for d in comparison.disagreements], dtype=np.int64)
-        stream.send_columns(
+        send_text_lines(
+            stream,
             log_path(),
-            indexes=indexes(at),
-            columns=rr.TextLog.columns(
-                text=[f"{KIND_LABELS[d.kind]}: {d.describe()}" for d in comparison.disagreements],
-                level=[KIND_LEVELS[d.kind] for d in comparison.disagreements],
-            ),
+            indexes(np.array([position[d.frame_index] for d in comparison.disagreements], dtype=np.int64)),
+            [f"{KIND_LABELS[d.kind]}: {d.describe()}" for d in comparison.disagreements],
+            [KIND_LEVELS[d.kind] for d in comparison.disagreements],
         )

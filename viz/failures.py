@@ -15,7 +15,7 @@ import rerun as rr
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import Failure, FailureBox, FailureKind, FailureReport, short_id
 from viz import paths
-from viz.geometry import quat_wxyz_to_xyzw, size_wlh_to_xyz
+from viz.markers import send_counts, send_marker_boxes, send_text_lines, time_indexes
 
 KIND_COLORS: dict[FailureKind, tuple[int, int, int]] = {
     FailureKind.ID_SWITCH: (255, 0, 255),
@@ -103,48 +103,41 @@ def log_failures(
             f"the failure report is for {report.scene_name}, not for the samples of {scene.name}"
         )
     n = len(scene.keyframes)
-    frames = np.arange(n, dtype=np.int64)
-    stamps = np.array([k.timestamp_us for k in scene.keyframes], dtype="datetime64[us]")
-
-    def indexes(at: np.ndarray) -> list[rr.TimeColumn]:
-        return [rr.TimeColumn("frame", sequence=frames[at]), rr.TimeColumn("timestamp", timestamp=stamps[at])]
-
+    indexes = time_indexes(np.arange(n, dtype=np.int64), np.array([k.timestamp_us for k in scene.keyframes]))
     every_frame = np.arange(n) if frame_range is None else np.array(frame_range, dtype=np.int64)
     in_range = set(every_frame.tolist())
     for kind in FailureKind:
-        failures = [f for f in report.of_kind(kind) if f.frame_index in in_range]
         color = KIND_COLORS[kind]
-        count_path = paths.failure_count(tracker, kind.value)
-        stream.log(count_path, rr.SeriesLines(names=KIND_LABELS[kind], colors=[color]), static=True)
-        stream.send_columns(
-            count_path,
-            indexes=indexes(every_frame),
-            columns=rr.Scalars.columns(scalars=report.counts(kind).astype(np.float64)[every_frame]),
+        send_counts(
+            stream,
+            paths.failure_count(tracker, kind.value),
+            KIND_LABELS[kind],
+            color,
+            indexes(every_frame),
+            report.counts(kind)[every_frame],
         )
+        failures = [f for f in report.of_kind(kind) if f.frame_index in in_range]
         if not failures:
             continue
         boxes, labels, lengths = _frame_boxes(failures, n)
-        sizes = size_wlh_to_xyz(np.array([b.size_wlh_m for b in boxes], dtype=np.float64))
-        stream.send_columns(
+        send_marker_boxes(
+            stream,
             paths.failures_world(tracker, kind.value),
-            indexes=indexes(every_frame),
-            columns=rr.Boxes3D.columns(
-                centers=np.array([b.translation_m for b in boxes], dtype=np.float64),
-                half_sizes=0.5 * (sizes * MARKER_SCALE + MARKER_MARGIN_M),
-                quaternions=quat_wxyz_to_xyzw(np.array([b.quat_wxyz for b in boxes], dtype=np.float64)),
-                colors=np.tile(np.array(color, dtype=np.uint8), (len(boxes), 1)),
-                radii=np.full(len(boxes), MARKER_LINE_RADIUS_M, dtype=np.float32),
-                labels=labels,
-            ).partition(lengths[every_frame]),
+            indexes(every_frame),
+            boxes,
+            labels,
+            lengths[every_frame],
+            color=color,
+            scale=MARKER_SCALE,
+            margin_m=MARKER_MARGIN_M,
+            line_radius_m=MARKER_LINE_RADIUS_M,
         )
     logged = [f for f in report.failures if f.frame_index in in_range]
     if logged:
-        at = np.array([f.frame_index for f in logged], dtype=np.int64)
-        stream.send_columns(
+        send_text_lines(
+            stream,
             failure_log(tracker),
-            indexes=indexes(at),
-            columns=rr.TextLog.columns(
-                text=[f"{KIND_LABELS[f.kind]}: {f.describe()}" for f in logged],
-                level=[KIND_LEVELS[f.kind] for f in logged],
-            ),
+            indexes(np.array([f.frame_index for f in logged], dtype=np.int64)),
+            [f"{KIND_LABELS[f.kind]}: {f.describe()}" for f in logged],
+            [KIND_LEVELS[f.kind] for f in logged],
         )
