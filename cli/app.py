@@ -27,6 +27,7 @@ import numpy as np
 import typer
 
 from cli.errors import run_app
+from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
 from gnnpmb.config import TrackerConfig, config_from_dict, load_config
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError, GnnpmbError
@@ -489,32 +490,17 @@ def view(
             help=f"Tracker to run; repeat to compare several side by side ({', '.join(TRACKER_NAMES)}).",
         ),
     ] = None,
-    dataroot: Annotated[
-        Path | None,
-        typer.Option(
-            metavar="DIR", help="nuScenes dataroot (default: $NUSCENES_DATAROOT, else the built-in demo)."
-        ),
-    ] = None,
-    version: Annotated[
-        str | None, typer.Option(metavar="V", help="Dataset version folder, e.g. v1.0-mini.")
-    ] = None,
-    detections: Annotated[
-        Path | None,
-        typer.Option(
-            metavar="FILE.json", help="nuScenes detection results .json (default: a simulated detector)."
-        ),
-    ] = None,
+    dataroot: DatarootOption = None,
+    version: VersionOption = None,
+    detections: DetectionsOption = None,
     detector: Annotated[
         str,
         typer.Option(
             metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars."
         ),
     ] = DEFAULT_DETECTOR,
-    seed: Annotated[int, typer.Option(metavar="N", help="Seed of the simulated detector.")] = 0,
-    params: Annotated[
-        Path | None,
-        typer.Option(metavar="FILE.toml", help="Tracker parameter file (.toml) overriding the paper's."),
-    ] = None,
+    seed: SeedOption = 0,
+    params: ParamsOption = None,
     classes: Annotated[
         str | None,
         typer.Option(

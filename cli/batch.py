@@ -18,6 +18,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from cli.errors import entry_point
+from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.registry import TRACKER_NAMES
 
@@ -36,16 +37,9 @@ app = typer.Typer(
     help="Batch tracking on nuScenes splits, the official tracking evaluation, and the failure finder.",
 )
 
-DatarootOption = Annotated[
-    Path | None, typer.Option(help="nuScenes dataroot (default: $NUSCENES_DATAROOT, else the built-in demo).")
-]
-VersionOption = Annotated[str | None, typer.Option(help="Dataset version folder, e.g. v1.0-mini.")]
 SplitOption = Annotated[
     str | None,
     typer.Option(help="Split: mini_val, val, ... or one in <version>/splits.json (default: from --version)."),
-]
-DetectionsOption = Annotated[
-    Path | None, typer.Option(help="nuScenes detection results .json (instead of a simulated detector).")
 ]
 DetectorOption = Annotated[
     str | None,
@@ -54,10 +48,6 @@ DetectorOption = Annotated[
     ),
 ]
 TrackerOption = Annotated[str, typer.Option("--tracker", "-t", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")]
-SeedOption = Annotated[int, typer.Option(help="Seed of the simulated detector.")]
-ParamsOption = Annotated[
-    Path | None, typer.Option(help="Tracker parameter file (.toml) overriding the paper's.")
-]
 
 
 def _stdout() -> Console:
