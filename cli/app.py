@@ -36,10 +36,10 @@ from gnnpmb.registry import TRACKER_NAMES, check_classes, check_tracker
 from gnnpmb.types import TRACKING_CLASSES, Boxes, FrameDetections
 
 if TYPE_CHECKING:
-    import rerun as rr
-
     from gnnpmb.compare import Comparison
     from gnnpmb.data.nuscenes import DatasetLocation
+    from gnnpmb.eval.failures import FailureReport
+    from gnnpmb.focus import FocusTarget
     from gnnpmb.pipeline import TrackingRun
 
 PROG = "gnnpmb-viz"
@@ -47,9 +47,7 @@ DEFAULT_TRACKER = "gnnpmb"
 DEFAULT_DETECTOR = "centerpoint"
 EXIT_DIFFERENT = 1
 _FRAMES_RE = re.compile(r"^\s*(\d*)\s*:\s*(\d*)\s*$")
-_COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar(
-    "command_line", default=None
-)
+_COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar("command_line", default=None)
 """The command line ``main`` was given, recorded in the provenance (else ``sys.argv`` is used)."""
 
 app = typer.Typer(
@@ -84,6 +82,7 @@ class ViewRequest:
     source: DetectionsSource
     seed: int
     argv: tuple[str, ...]
+    focus: str | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -95,6 +94,7 @@ class ViewResult:
     digests: dict[str, TrackDigest]
     comparison: Comparison | None
     notices: tuple[str, ...]
+    focus: FocusTarget | None = None
 
 
 def parse_frames(text: str | None) -> tuple[int | None, int | None]:
@@ -119,8 +119,7 @@ def frame_range_of(bounds: tuple[int | None, int | None], scene: SceneData) -> r
         raise DataError(f"{scene.name} has no keyframes")
     if start >= n or end > n:
         raise GnnpmbError(
-            f"--frames {start}:{end} is outside {scene.name}, which has keyframes 0 to {n - 1} "
-            f"(use END <= {n})"
+            f"--frames {start}:{end} is outside {scene.name}, which has keyframes 0 to {n - 1} (use END <= {n})"
         )
     if end <= start:
         raise GnnpmbError(f"--frames {start}:{end} selects no keyframes; END must be greater than START")
@@ -144,9 +143,7 @@ def detections_source(
     if detections_file is not None:
         path = Path(detections_file).expanduser().absolute()
         return DetectionsSource("file", file_sha256(path), path=str(path))
-    return DetectionsSource(
-        "simulated", boxes_sha256(detections, scene.sample_tokens), preset=detector, seed=int(seed)
-    )
+    return DetectionsSource("simulated", boxes_sha256(detections, scene.sample_tokens), preset=detector, seed=int(seed))
 
 
 def command_line() -> tuple[str, ...]:
@@ -169,6 +166,7 @@ def prepare(
     frames: str | None = None,
     save: Path | None = None,
     argv: Sequence[str] = (),
+    focus: str | None = None,
 ) -> ViewRequest:
     """Check every argument and load the scene and detections; raises GnnpmbError with a one-line message."""
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
@@ -177,6 +175,10 @@ def prepare(
     from viz.recording import check_save_path
 
     names = tuple(dict.fromkeys(check_tracker(t) for t in (trackers or [DEFAULT_TRACKER])))
+    if focus is not None:
+        from gnnpmb.focus import parse_focus
+
+        parse_focus(focus)
     get_preset(detector)
     class_names = parse_classes(classes)
     bounds = parse_frames(frames)
@@ -201,6 +203,7 @@ def prepare(
         source,
         int(seed),
         tuple(argv),
+        focus,
     )
 
 
@@ -275,10 +278,13 @@ def prepare_reproduction(
     )
 
 
-def recording_name(request: ViewRequest) -> str:
-    """E.g. "scene-0103 · gnnpmb vs pmbm · synthetic demo"."""
+def recording_name(request: ViewRequest, focus: FocusTarget | None = None) -> str:
+    """E.g. "scene-0103 · gnnpmb vs pmbm · synthetic demo", with "· focus id_switch:1" for a focus."""
     data = "synthetic demo" if request.scene.synthetic else f"nuScenes {request.location.version}"
-    return f"{request.scene.name} · {' vs '.join(request.trackers)} · {data}"
+    name = f"{request.scene.name} · {' vs '.join(request.trackers)} · {data}"
+    if focus is not None:
+        name += f" · focus {focus.failure_id or request.focus}"
+    return name
 
 
 def provenance_of(request: ViewRequest, digests: dict[str, TrackDigest]) -> Provenance:
@@ -321,34 +327,48 @@ def compare_runs(runs: Sequence[TrackingRun]) -> Comparison:
     )
 
 
-def log_failures_of(
-    stream: rr.RecordingStream, request: ViewRequest, runs: Sequence[TrackingRun], on_done: Callable[[], None]
-) -> list[str]:
-    """Find each run's failures with the devkit's matching and log them (``viz.failures``), limited to the
-    tracked keyframes. Returns notices: a scene without ground truth, or one the devkit cannot evaluate, is
-    skipped."""
+def find_reports(
+    request: ViewRequest, runs: Sequence[TrackingRun], on_done: Callable[[], None] = lambda: None
+) -> tuple[dict[str, FailureReport], list[str]]:
+    """Each run's failures found with the devkit's matching, and notices: a scene without ground truth, or one
+    the devkit cannot evaluate, gives no reports."""
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.failures import find_failures
     from gnnpmb.eval.submission import run_results
-    from viz.failures import log_failures
 
     scene = request.scene
     if not any(len(k.gt) for k in scene.keyframes):
-        return [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
+        return {}, [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
     nusc = open_nuscenes(request.location)
+    reports = {}
     for run in runs:
         try:
-            report = find_failures(nusc, scene.name, run_results(run), run.tracker)
+            reports[run.tracker] = find_failures(nusc, scene.name, run_results(run), run.tracker)
         except DataError as exc:
-            return [f"failure markers skipped: {exc}"]
-        log_failures(stream, run.tracker, report, scene, request.frame_range)
+            return {}, [f"failure markers skipped: {exc}"]
         on_done()
-    return []
+    return reports, []
+
+
+def resolve_request_focus(request: ViewRequest) -> tuple[FocusTarget, dict[str, FailureReport], list[str]]:
+    """Run the trackers without logging, find their failures and resolve ``request.focus``; returns the focus,
+    the failure reports and notices. Raises GnnpmbError (one line) when the focus names nothing in this run."""
+    from gnnpmb.focus import resolve_focus
+
+    if request.focus is None:
+        raise ValueError("the request has no focus")
+    runs = rerun_runs(request)
+    reports, notices = find_reports(request, runs)
+    if not reports and not request.focus.startswith("track:"):
+        raise GnnpmbError(f"--focus {request.focus} needs ground truth: {'; '.join(notices)}")
+    estimates = {run.tracker: [f.estimates for f in run.frames] for run in runs}
+    return resolve_focus(request.focus, request.scene, reports, estimates, request.frame_range), reports, notices
 
 
 def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = True) -> ViewResult:
     """Log the scene, run every tracker into one recording (sharing the preprocessed detections), compare them
-    and log failures and provenance."""
+    and log failures and provenance. With ``request.focus`` the trackers first run without logging to find the
+    focus (``resolve_request_focus``); the recording then holds the keyframes around it and opens on it."""
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -356,15 +376,23 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
     from gnnpmb.pipeline import run_tracker
     from viz.blueprint import default_blueprint
     from viz.compare import log_comparison
+    from viz.failures import log_failures
+    from viz.focus import log_focus
     from viz.logger import TrackerLogger
     from viz.provenance import log_provenance
     from viz.recording import recording
     from viz.scene import log_scene
+    from viz.timeline import PLAIN_CLOCK, Clock
 
     scene, frame_range = request.scene, request.frame_range
-    n = len(frame_range)
+    focus, reports, notices = None, {}, []
+    if request.focus is not None:  # the logged runs below give the same tracks (deterministic): reuse the reports
+        focus, reports, notices = resolve_request_focus(request)
+    shown = focus.window(frame_range) if focus is not None else frame_range
+    clock = Clock(focus_end=focus.frame_index) if focus is not None else PLAIN_CLOCK
+    n = len(shown)
     gate_z_m = float(np.median([k.ego_pose.translation_m[2] for k in scene.keyframes]))
-    blueprint = default_blueprint(request.trackers, request.classes)
+    blueprint = default_blueprint(request.trackers, request.classes, focus)
     bar = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
@@ -374,21 +402,29 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
         disable=not progress,
     )
     runs: list[TrackingRun] = []
-    notices: list[str] = []
+    loggers: dict[str, TrackerLogger] = {}
     comparison = None
-    with recording(recording_name(request), request.save, blueprint) as stream, bar:
+    with recording(recording_name(request, focus), request.save, blueprint) as stream, bar:
         sensors = bar.add_task(f"{scene.name} sensors", total=n)
         log_scene(
             stream,
             scene,
-            [request.frame_detections[i] for i in frame_range],
-            frame_range,
+            [request.frame_detections[i] for i in shown],
+            shown,
             points_loader=load_lidar_points,
             on_frame=lambda: bar.advance(sensors),
+            clock=clock,
         )
         for tracker in request.trackers:
-            task = bar.add_task(f"{scene.name} {tracker}", total=n)
-            logger = TrackerLogger(stream, tracker, gate_z_m=gate_z_m)
+            task = bar.add_task(f"{scene.name} {tracker}", total=len(frame_range))
+            logger = loggers[tracker] = TrackerLogger(
+                stream,
+                tracker,
+                gate_z_m=gate_z_m,
+                clock=clock,
+                log_frames=shown if focus is not None else None,
+                focus_tracks=set(focus.track_ids.get(tracker, ())) if focus is not None else None,
+            )
             runs.append(
                 run_tracker(
                     scene,
@@ -405,34 +441,42 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
             logger.finish()
         if len(runs) > 1:
             comparison = compare_runs(runs)
-            log_comparison(stream, comparison, scene)
-        if failures:
+            log_comparison(stream, comparison.within(shown), scene, clock)
+        if failures and focus is None:
             task = bar.add_task(f"{scene.name} failures", total=len(runs))
-            notices += log_failures_of(stream, request, runs, lambda: bar.advance(task))
+            reports, notices = find_reports(request, runs, lambda: bar.advance(task))
+        if failures or focus is not None:
+            for name, report in reports.items():
+                log_failures(stream, name, report, scene, shown, clock, show_labels=focus is None)
+        if focus is not None:
+            log_focus(stream, focus, scene, runs, loggers, clock, shown)
         digests = {run.tracker: run_digest(run) for run in runs}
         log_provenance(stream, provenance_of(request, digests))
     ms = {run.tracker: 1000.0 * float(np.mean([f.step_time_s for f in run.frames])) for run in runs}
-    return ViewResult(ms, digests, comparison, tuple(notices))
+    return ViewResult(ms, digests, comparison, tuple(notices), focus)
+
+
+def rerun_runs(request: ViewRequest) -> list[TrackingRun]:
+    """Run every tracker of ``request`` without logging."""
+    from gnnpmb.pipeline import run_tracker
+
+    return [
+        run_tracker(
+            request.scene,
+            request.detections,
+            tracker,
+            request.config,
+            classes=request.classes,
+            frame_range=request.frame_range,
+            frame_detections=request.frame_detections,
+        )
+        for tracker in request.trackers
+    ]
 
 
 def rerun_digests(request: ViewRequest) -> dict[str, TrackDigest]:
     """Run every tracker of ``request`` without logging; their track digests."""
-    from gnnpmb.pipeline import run_tracker
-
-    return {
-        tracker: run_digest(
-            run_tracker(
-                request.scene,
-                request.detections,
-                tracker,
-                request.config,
-                classes=request.classes,
-                frame_range=request.frame_range,
-                frame_detections=request.frame_detections,
-            )
-        )
-        for tracker in request.trackers
-    }
+    return {run.tracker: run_digest(run) for run in rerun_runs(request)}
 
 
 def digest_report(recorded: dict[str, TrackDigest], now: dict[str, TrackDigest]) -> tuple[list[str], bool]:
@@ -495,9 +539,7 @@ def view(
     detections: DetectionsOption = None,
     detector: Annotated[
         str,
-        typer.Option(
-            metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars."
-        ),
+        typer.Option(metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars."),
     ] = DEFAULT_DETECTOR,
     seed: SeedOption = 0,
     params: ParamsOption = None,
@@ -519,6 +561,14 @@ def view(
         bool,
         typer.Option(help="Find and mark each tracker's failures with the devkit's matching (needs GT)."),
     ] = True,
+    focus: Annotated[
+        str | None,
+        typer.Option(
+            metavar="ID",
+            help="Open on a failure: an id from 'gnnpmb failures' (e.g. id_switch:1), track:ID or gt:TOKEN. "
+            "The recording holds the frames around it and opens at it, looking at the place.",
+        ),
+    ] = None,
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
 ) -> None:
     """Track SCENE into one recording and show or save it (``VIEW_HELP``)."""
@@ -535,8 +585,11 @@ def view(
         frames=frames,
         save=save,
         argv=command_line(),
+        focus=focus,
     )
     result = run_view(request, progress=progress, failures=failures)
+    if result.focus is not None:
+        typer.echo(f"focus: {result.focus.title}")
     for notice in result.notices:
         typer.echo(f"note: {notice}", err=True)
     timing = ", ".join(f"{name} {value:.1f} ms/frame" for name, value in result.ms_per_frame.items())
@@ -559,9 +612,7 @@ def reproduce(
     ] = None,
     detections: Annotated[
         Path | None,
-        typer.Option(
-            metavar="FILE.json", help="Use this detections file instead of the recorded path (a copy)."
-        ),
+        typer.Option(metavar="FILE.json", help="Use this detections file instead of the recorded path (a copy)."),
     ] = None,
     save: Annotated[
         Path | None, typer.Option(metavar="OUT.rrd", help="Also write the re-run as a new recording.")

@@ -238,18 +238,23 @@ def print_report(report: FailureReport, console: Console) -> None:
         classes.add_row(c.class_name, threshold, format_metric("mota", c.mota), *counts)
     console.print(classes)
 
-    grouped: dict[tuple[int, FailureKind], list[str]] = defaultdict(list)
-    for f in report.failures:
-        grouped[(f.frame_index, f.kind)].append(f.describe())
-    rows = Table(title="failures per frame")
+    grouped: dict[tuple[int, FailureKind], list[tuple[str, str]]] = defaultdict(list)
+    for failure_id, f in zip(report.ids(), report.failures, strict=True):
+        grouped[(f.frame_index, f.kind)].append((failure_id, f.describe()))
+    rows = Table(title="failures per frame (open one: gnnpmb-viz SCENE --tracker T --focus ID)")
     rows.add_column("frame", justify="right")
-    rows.add_column("kind")
+    rows.add_column("id")
     rows.add_column("what (GT ids shortened to 6 characters)")
-    for (frame, kind), texts in grouped.items():
-        rows.add_row(str(frame), kind.value, "; ".join(texts))
+    for (frame, _kind), entries in grouped.items():
+        rows.add_row(str(frame), _id_span([i for i, _ in entries]), "; ".join(text for _, text in entries))
     console.print(rows)
     totals = ", ".join(f"{len(report.of_kind(k))} {k.value}" for k in FailureKind)
     console.print(f"{report.scene_name}, {report.tracker}: {totals}", highlight=False, soft_wrap=True)
+
+
+def _id_span(ids: list[str]) -> str:
+    """``miss:3`` or ``miss:3-7`` for the ids of one kind in one frame (numbered consecutively)."""
+    return ids[0] if len(ids) == 1 else f"{ids[0]}-{ids[-1].split(':')[1]}"
 
 
 @app.command("demo-data")

@@ -102,6 +102,14 @@ class Comparison:
     def totals(self) -> dict[DisagreementKind, int]:
         return {kind: len(self.of_kind(kind)) for kind in DisagreementKind}
 
+    def within(self, frames: range) -> Comparison:
+        """The comparison restricted to the keyframes in ``frames``."""
+        return Comparison(
+            self.trackers,
+            tuple(f for f in self.frame_indices if f in frames),
+            tuple(d for d in self.disagreements if d.frame_index in frames),
+        )
+
 
 def short_gt_id(gt_id: str) -> str:
     """First 6 characters of a long instance token (as the viewer labels GT boxes)."""

@@ -65,6 +65,20 @@ class FrameStarted:
 
 
 @dataclass(frozen=True, slots=True)
+class MeasurementsReceived:
+    """The kept detections of one class that the tracker receives this frame, emitted before its other events.
+
+    meas_indices: (M,) source indices (the ids every other event uses); xyz_m: (M, 3) box centres (global);
+    score: (M,) detection scores. The viewer draws association lines to these positions.
+    """
+
+    class_name: str
+    meas_indices: np.ndarray
+    xyz_m: np.ndarray
+    score: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
 class Predicted:
     """Prior of every track after the motion model (Kalman predict, existence times P_S).
 
@@ -238,6 +252,7 @@ class TrackLogic:
 
 Event = (
     FrameStarted
+    | MeasurementsReceived
     | Predicted
     | Gated
     | CostMatrix

@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.events import EventSink
+from gnnpmb.events import EventSink, MeasurementsReceived
 from gnnpmb.registry import check_classes, check_tracker, make_class_tracker
 from gnnpmb.types import TRACKING_CLASSES, FrameDetections, IdAllocator, TrackEstimate
 
@@ -26,5 +26,10 @@ class MultiClassTracker:
     def step(self, frame: FrameDetections, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
         estimates: list[TrackEstimate] = []
         for class_name, tracker in self.trackers.items():
-            estimates.extend(tracker.step(frame.measurements(class_name), dt_s, sink))
+            meas = frame.measurements(class_name)
+            if sink.enabled:
+                sink.emit(
+                    MeasurementsReceived(class_name, meas.source_index, meas.boxes.translation_m, meas.boxes.score)
+                )
+            estimates.extend(tracker.step(meas, dt_s, sink))
         return estimates

@@ -1,24 +1,32 @@
 """The default viewer layout, built in code.
 
-One tracker: its 3D view on the left (shared LiDAR, ground truth and detections plus its own tracks, gates,
-predictions and failure markers); on the right its panel: cost matrices (one tab per class, heat map over its
-labelled table), series (existence, candidates, failures per frame, tracker-specific plots) and logs (events,
-failures).
+Per tracker a bird's-eye view (top-down, following the ego car, no LiDAR by default) and a perspective 3D view,
+each showing the shared scene (ground truth, detections, comparison markers) and only that tracker's entities:
+its tracks (one entity per track, with trails), association lines, gates and failure markers; candidate
+Bernoullis and suppressed detections are hidden by default (one click in the blueprint tree brings them back).
+Beside them the tracker's panel: the decision view (why each detection went where it did: a document and a
+labelled cost grid), the story log (INFO and up by default), per-track series and tracker-specific plots.
 
-Several trackers (a comparison): one 3D view per tracker side by side on the same timeline, each showing the
-shared scene, the comparison markers (``world/comparison``) and only that tracker's own entities; below them
-the comparison panel (disagreements per frame and each tracker's failures per frame as tabs, beside the
-disagreement log); on the right one tab per tracker with its panel.
+Several trackers: their views side by side above the comparison panel; their panels as tabs on the right.
+
+A *focus* layout (``gnnpmb.focus.FocusTarget``, ``gnnpmb-viz --focus``) opens at the failure: the time panel
+uses the ``focus`` timeline, which ends at the failure frame, so the viewer (following the newest data) shows
+that frame on opening (the ``frame`` timeline still holds the frames after it); the cameras look at the place
+from above and from the side, and the series views show only the involved tracks.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import rerun.blueprint as rrb
 
 from viz import compare, paths
 from viz.failures import failure_log
+
+if TYPE_CHECKING:
+    from gnnpmb.focus import FocusTarget
 
 _EXTRA_PLOTS: dict[str, tuple[str, ...]] = {
     "pmbm": ("hypotheses",),
@@ -29,12 +37,27 @@ _EXTRA_PLOTS: dict[str, tuple[str, ...]] = {
 }
 """Which tracker-specific plots each tracker fills (the names of ``TRACKER_NAMES``)."""
 
-
 EYE_POSITION_M = (-18.0, -14.0, 22.0)
 EYE_TARGET_M = (10.0, 0.0, 0.0)
-"""Default camera of the 3D views in the ego frame (x forward, z up): behind, left of and above the car,
-looking at a point 10 m ahead. The views' origin is the ego vehicle, so the camera follows the car through the
-scene."""
+"""Default camera of the perspective views in the ego frame (x forward, z up): behind, left of and above the car,
+looking at a point 10 m ahead. The views' origin is the ego vehicle, so the camera follows the car."""
+BEV_EYE_POSITION_M = (12.0, 0.0, 80.0)
+BEV_TARGET_M = (12.0, 0.0, 0.0)
+"""Bird's-eye camera in the ego frame: straight down on a point 12 m ahead, forward pointing up the screen."""
+FOCUS_HEIGHT_M: dict[str, float] = {"pedestrian": 16.0, "bicycle": 18.0, "motorcycle": 18.0, "car": 28.0}
+"""Height of the bird's-eye camera above a focused place by class (small objects closer); 40 m otherwise."""
+STORY_COLUMNS = rrb.TextLogColumns(
+    text_log_columns=[
+        rrb.components.TextLogColumn(kind="LogLevel", visible=True),
+        rrb.components.TextLogColumn(kind="Body", visible=True),
+        rrb.components.TextLogColumn(kind="EntityPath", visible=False),
+    ]
+)
+"""Story and failure logs show level and text (the class is in the line; the entity path only takes room)."""
+FOCUS_TIMELINE = "focus"
+"""Timeline of focus recordings: the frame index, logged only up to the failure frame (see module docstring)."""
+STORY_LEVELS = ("INFO", "WARN", "ERROR", "CRITICAL")
+"""Levels the story log shows by default (DEBUG: per-frame summaries and candidates, one click away)."""
 
 
 def failures_root(tracker: str) -> str:
@@ -42,20 +65,60 @@ def failures_root(tracker: str) -> str:
     return f"{paths.tracker_root(tracker)}/failures"
 
 
-def spatial_view(tracker: str) -> rrb.Spatial3DView:
-    """3D view of everything under ``world`` except the other trackers' entities, seen from the ego vehicle's
-    frame (``EYE_POSITION_M``)."""
+def focus_doc() -> str:
+    """TextDocument describing the focused failure (static)."""
+    return "focus/summary"
+
+
+def focus_world() -> str:
+    """Boxes3D highlighting the involved ground truth, tracks and detections at each frame."""
+    return f"{paths.WORLD}/focus"
+
+
+def _contents(tracker: str) -> list[str]:
+    return ["+ world/**", "- world/trackers/**", f"+ {paths.tracker_world(tracker)}/**"]
+
+
+def _hidden(tracker: str, *, lidar: bool) -> dict[str, rrb.EntityBehavior]:
+    hidden = [paths.tracker_world(tracker) + "/candidates", paths.DETECTIONS_SUPPRESSED]
+    if lidar:
+        hidden.append(paths.LIDAR)
+    return {p: rrb.EntityBehavior(visible=False) for p in hidden}
+
+
+def spatial_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3DView:
+    """Perspective 3D view of the scene and this tracker's entities (not the other trackers')."""
+    if focus is None:
+        origin, eye = paths.EGO, rrb.EyeControls3D(position=EYE_POSITION_M, look_target=EYE_TARGET_M, eye_up=(0, 0, 1))
+    else:
+        x, y = focus.center_xy_m
+        origin = paths.WORLD
+        eye = rrb.EyeControls3D(position=(x - 14.0, y - 14.0, 16.0), look_target=(x, y, 0.0), eye_up=(0, 0, 1))
     return rrb.Spatial3DView(
-        origin=paths.EGO,
-        contents=[
-            f"+ {paths.WORLD}/**",
-            f"- {paths.WORLD_TRACKERS}/**",
-            f"+ {paths.tracker_world(tracker)}/**",
-        ],
+        origin=origin,
+        contents=_contents(tracker),
         name=f"{tracker} 3D",
-        eye_controls=rrb.EyeControls3D(
-            position=EYE_POSITION_M, look_target=EYE_TARGET_M, eye_up=(0.0, 0.0, 1.0)
-        ),
+        eye_controls=eye,
+        overrides=_hidden(tracker, lidar=False),
+    )
+
+
+def bev_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3DView:
+    """Top-down view without LiDAR: tracks, trails, association lines, gates, detections, ground truth."""
+    if focus is None:
+        origin = paths.EGO
+        eye = rrb.EyeControls3D(position=BEV_EYE_POSITION_M, look_target=BEV_TARGET_M, eye_up=(1, 0, 0))
+    else:
+        x, y = focus.center_xy_m
+        origin = paths.WORLD
+        height = FOCUS_HEIGHT_M.get(focus.class_name, 40.0)
+        eye = rrb.EyeControls3D(position=(x, y, height), look_target=(x, y, 0.0), eye_up=(0, 1, 0))
+    return rrb.Spatial3DView(
+        origin=origin,
+        contents=_contents(tracker),
+        name=f"{tracker} bird's-eye",
+        eye_controls=eye,
+        overrides=_hidden(tracker, lidar=True),
     )
 
 
@@ -68,29 +131,11 @@ def _matrix_view(origin: str, name: str) -> rrb.TensorView:
     )
 
 
-def cost_views(tracker: str, classes: Sequence[str]) -> rrb.Tabs:
-    """One tab per class: the cost heat map above its row/column table."""
-    return rrb.Tabs(
-        *[
-            rrb.Vertical(
-                _matrix_view(paths.cost_matrix(tracker, c), f"{tracker} cost {c}"),
-                rrb.TextDocumentView(origin=paths.cost_axes(tracker, c), name=f"{tracker} cost table {c}"),
-                row_shares=[3, 2],
-                name=c,
-            )
-            for c in classes
-        ],
-        name=f"{tracker} cost matrices",
-    )
-
-
 def _extra_views(tracker: str, classes: Sequence[str]) -> list[rrb.View | rrb.Container]:
     views: list[rrb.View | rrb.Container] = []
     for kind in _EXTRA_PLOTS.get(tracker, ()):
         if kind == "hypotheses":
-            views.append(
-                rrb.TimeSeriesView(origin=paths.hypotheses_root(tracker), name=f"{tracker} hypothesis log w")
-            )
+            views.append(rrb.TimeSeriesView(origin=paths.hypotheses_root(tracker), name=f"{tracker} hypothesis log w"))
         elif kind == "marginals":
             views.append(
                 rrb.Tabs(
@@ -123,25 +168,77 @@ def failure_counts_view(tracker: str) -> rrb.TimeSeriesView:
     return rrb.TimeSeriesView(origin=failures_root(tracker), name=f"{tracker} failures per frame")
 
 
-def tracker_panel(tracker: str, classes: Sequence[str]) -> rrb.Vertical:
-    """Cost matrices, series (existence of tracks and of never-extracted candidates, failure counts and
-    tracker-specific plots as tabs) and logs (events, failures as tabs) of one tracker."""
+def _series_contents(root: str, focus: FocusTarget | None, tracker: str) -> list[str] | str:
+    if focus is None or not focus.track_ids.get(tracker):
+        return "$origin/**"
+    return [f"+ {root}/{focus.class_name}/{t}" for t in focus.track_ids[tracker]]
+
+
+def track_series_views(tracker: str, focus: FocusTarget | None = None) -> list[rrb.TimeSeriesView]:
+    """Existence, normalised innovation and chosen cost per track; only the involved tracks when focused."""
+    legend = rrb.PlotLegend(visible=focus is not None)
+    return [
+        rrb.TimeSeriesView(
+            origin=root,
+            contents=_series_contents(root, focus, tracker),
+            name=f"{tracker} {what}",
+            plot_legend=legend,
+        )
+        for root, what in (
+            (paths.existence_root(tracker), "existence"),
+            (paths.nis_root(tracker), "NIS (innovation²/S)"),
+            (paths.chosen_cost_root(tracker), "chosen cost"),
+        )
+    ]
+
+
+def story_view(tracker: str, focus: FocusTarget | None = None) -> rrb.TextLogView:
+    origin = paths.events_root(tracker) if focus is None else paths.events(tracker, focus.class_name)
+    return rrb.TextLogView(
+        origin=origin,
+        name=f"{tracker} story",
+        rows=rrb.TextLogRows(filter_by_log_level=list(STORY_LEVELS)),
+        columns=STORY_COLUMNS,
+    )
+
+
+def decision_views(tracker: str) -> rrb.Horizontal:
+    """The decision document beside the labelled cost grid (rows m<idx>, columns track ids and "new")."""
+    return rrb.Horizontal(
+        rrb.TextDocumentView(origin=paths.decisions(tracker), name=f"{tracker} decisions"),
+        rrb.Spatial2DView(origin=paths.decision_matrix(tracker), name=f"{tracker} cost grid"),
+        column_shares=[3, 2],
+        name=f"{tracker} decisions",
+    )
+
+
+def tracker_panel(tracker: str, classes: Sequence[str], focus: FocusTarget | None = None) -> rrb.Vertical:
+    """Decision view, story and failure logs, and series (per-track, candidates, failures, extra plots); with a
+    focus the summary of the failure comes first and the decision document goes to a tab beside the story."""
     series = rrb.Tabs(
-        rrb.TimeSeriesView(origin=paths.existence_root(tracker), name=f"{tracker} existence"),
+        *track_series_views(tracker, focus),
         rrb.TimeSeriesView(origin=paths.candidates_root(tracker), name=f"{tracker} candidates"),
         failure_counts_view(tracker),
         *_extra_views(tracker, classes),
     )
     logs = rrb.Tabs(
-        rrb.TextLogView(origin=paths.events_root(tracker), name=f"{tracker} events"),
-        rrb.TextLogView(origin=failure_log(tracker), name=f"{tracker} failures"),
+        story_view(tracker, focus),
+        rrb.TextLogView(origin=failure_log(tracker), name=f"{tracker} failures", columns=STORY_COLUMNS),
     )
-    return rrb.Vertical(cost_views(tracker, classes), series, logs, row_shares=[5, 3, 2], name=tracker)
+    if focus is not None:
+        logs = rrb.Tabs(
+            story_view(tracker, focus),
+            rrb.TextDocumentView(origin=paths.decisions(tracker), name=f"{tracker} decisions"),
+            rrb.Spatial2DView(origin=paths.decision_matrix(tracker), name=f"{tracker} cost grid"),
+            rrb.TextLogView(origin=failure_log(tracker), name=f"{tracker} failures", columns=STORY_COLUMNS),
+        )
+        summary = rrb.TextDocumentView(origin=focus_doc(), name="focus")
+        return rrb.Vertical(summary, logs, series, row_shares=[6, 3, 2], name=tracker)
+    return rrb.Vertical(decision_views(tracker), logs, series, row_shares=[5, 3, 2], name=tracker)
 
 
 def comparison_panel(trackers: Sequence[str]) -> rrb.Horizontal:
-    """Disagreements per frame (and each tracker's failures per frame) as tabs, beside the disagreement
-    log."""
+    """Disagreements per frame (and each tracker's failures per frame) as tabs, beside the disagreement log."""
     counts = rrb.Tabs(
         rrb.TimeSeriesView(origin=compare.counts_root(), name="disagreements per frame"),
         *[failure_counts_view(t) for t in trackers],
@@ -150,23 +247,31 @@ def comparison_panel(trackers: Sequence[str]) -> rrb.Horizontal:
     return rrb.Horizontal(counts, log, column_shares=[2, 3], name="comparison")
 
 
-def default_blueprint(trackers: Sequence[str], classes: Sequence[str]) -> rrb.Blueprint:
-    """The layout for a recording of ``trackers`` (one or more, side by side) over ``classes``."""
+def _tracker_views(tracker: str, focus: FocusTarget | None) -> rrb.Container:
+    return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[3, 2])
+
+
+def default_blueprint(
+    trackers: Sequence[str], classes: Sequence[str], focus: FocusTarget | None = None
+) -> rrb.Blueprint:
+    """The layout for a recording of ``trackers`` (one or more, side by side) over ``classes``; with ``focus``
+    the layout opens at and looks at the failure."""
     if not trackers:
         raise ValueError("default_blueprint needs at least one tracker")
-    panels = [tracker_panel(t, classes) for t in trackers]
+    panels = [tracker_panel(t, classes, focus) for t in trackers]
+    scene = rrb.Horizontal(*[_tracker_views(t, focus) for t in trackers])
     if len(trackers) == 1:
-        layout = rrb.Horizontal(spatial_view(trackers[0]), panels[0], column_shares=[3, 2])
+        layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:
-        left = rrb.Vertical(
-            rrb.Horizontal(*[spatial_view(t) for t in trackers]),
-            comparison_panel(trackers),
-            row_shares=[3, 1],
-        )
+        left = rrb.Vertical(scene, comparison_panel(trackers), row_shares=[4, 1])
         layout = rrb.Horizontal(left, rrb.Tabs(*panels), column_shares=[3, 2])
+    if focus is None:
+        time_panel = rrb.TimePanel(state="collapsed", timeline="frame", play_state="paused")
+    else:
+        time_panel = rrb.TimePanel(state="collapsed", timeline=FOCUS_TIMELINE, play_state="following")
     return rrb.Blueprint(
         layout,
-        rrb.TimePanel(state="expanded", timeline="frame"),
+        time_panel,
         rrb.SelectionPanel(state="collapsed"),
         rrb.BlueprintPanel(state="collapsed"),
     )

@@ -22,6 +22,10 @@ CLASS_IDS: dict[str, int] = {name: i + 1 for i, name in enumerate(TRACKING_CLASS
 """Rerun class ids 1..7 in the devkit's class order (0 is left for 'unknown')."""
 
 _GOLDEN = 0.6180339887498949
+TRACK_HUE_BANDS: tuple[tuple[float, float], ...] = ((75.0 / 360, 140.0 / 360), (205.0 / 360, 250.0 / 360))
+"""Hues (fractions of the colour wheel) track colours may take: greens and blues. The rest of the wheel is
+reserved for markers (failures: reds, oranges, yellows, magentas; comparisons: cyans and violets), so no track is
+ever drawn in a marker's colour."""
 _SATURATION = np.array([0.85, 0.6, 0.95])
 _VALUE = np.array([0.95, 0.8, 0.65])
 
@@ -58,11 +62,12 @@ def annotation_context() -> rr.AnnotationContext:
 def track_colors(track_ids: np.ndarray) -> np.ndarray:
     """(N, 3) uint8 RGB colours of (N,) track ids, a pure function of the id.
 
-    Hue steps by the golden ratio per id (consecutive ids land far apart on the colour wheel); saturation and
-    value cycle over three levels so ids with nearby hues still differ in brightness.
+    Hue steps by the golden ratio per id (consecutive ids land far apart) and is mapped onto the allowed
+    ``TRACK_HUE_BANDS``; saturation and value cycle over three levels so ids with nearby hues still differ in
+    brightness.
     """
     ids = np.asarray(track_ids, dtype=np.int64).reshape(-1)
-    h = np.mod(ids * _GOLDEN, 1.0)
+    h = _band_hue(np.mod(ids * _GOLDEN, 1.0))
     s = _SATURATION[np.mod(ids, 3)]
     v = _VALUE[np.mod(ids // 3, 3)]
     return (_hsv_to_rgb(h, s, v) * 255.0 + 0.5).astype(np.uint8)
@@ -79,6 +84,25 @@ def track_color(track_id: int) -> tuple[int, int, int]:
     """RGB colour of one track id (see ``track_colors``)."""
     r, g, b = track_colors(np.array([track_id]))[0]
     return int(r), int(g), int(b)
+
+
+def _band_hue(u: np.ndarray) -> np.ndarray:
+    """(N,) hues in ``TRACK_HUE_BANDS`` from (N,) uniform values in [0, 1): the bands laid end to end."""
+    widths = np.array([b - a for a, b in TRACK_HUE_BANDS])
+    edges = np.concatenate([[0.0], np.cumsum(widths) / widths.sum()])
+    band = np.clip(np.searchsorted(edges, u, side="right") - 1, 0, len(widths) - 1)
+    starts = np.array([a for a, _ in TRACK_HUE_BANDS])
+    return starts[band] + (u - edges[band]) * widths.sum()
+
+
+def hue_of(rgb: np.ndarray) -> np.ndarray:
+    """(N,) hue in [0, 1) of (N, 3) RGB colours (0-255); 0 for greys."""
+    c = np.asarray(rgb, dtype=np.float64).reshape(-1, 3) / 255.0
+    mx, mn = c.max(axis=1), c.min(axis=1)
+    d = np.where(mx > mn, mx - mn, 1.0)
+    r, g, b = c.T
+    h = np.where(mx == r, np.mod((g - b) / d, 6.0), np.where(mx == g, (b - r) / d + 2.0, (r - g) / d + 4.0))
+    return np.where(mx > mn, h / 6.0, 0.0)
 
 
 def _hsv_to_rgb(h: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -15,7 +15,8 @@ import rerun as rr
 from gnnpmb.compare import Comparison, Disagreement, DisagreementKind, short_gt_id
 from gnnpmb.data.scene import SceneData
 from viz import paths
-from viz.markers import send_counts, send_marker_boxes, send_text_lines, time_indexes
+from viz.markers import send_counts, send_marker_boxes, send_text_lines
+from viz.timeline import PLAIN_CLOCK, Clock
 
 COMPARISON = "comparison"
 KIND_COLORS: dict[DisagreementKind, tuple[int, int, int]] = {
@@ -91,23 +92,26 @@ def _markers(
     return [boxes[k] for k in keys], ["; ".join(labels[k]) for k in keys], lengths
 
 
-def log_comparison(stream: rr.RecordingStream, comparison: Comparison, scene: SceneData) -> None:
-    """Log ``comparison`` (over keyframes of ``scene``) on the frame and timestamp timelines: per kind a count
-    at every compared frame and marker boxes (an empty batch at frames without any), plus the text log."""
+def log_comparison(
+    stream: rr.RecordingStream, comparison: Comparison, scene: SceneData, clock: Clock = PLAIN_CLOCK
+) -> None:
+    """Log ``comparison`` (over keyframes of ``scene``) on the recording's timelines (``clock``): per kind a
+    count at every compared frame and marker boxes (an empty batch at frames without any), plus the text log."""
     frames = np.asarray(comparison.frame_indices, dtype=np.int64)
-    indexes = time_indexes(frames, np.array([scene.keyframes[i].timestamp_us for i in frames.tolist()]))
-    every = np.arange(frames.size)
+    stamps = np.array([scene.keyframes[i].timestamp_us for i in frames.tolist()], dtype=np.int64)
     for kind in DisagreementKind:
         color = KIND_COLORS[kind]
-        send_counts(stream, count_path(kind), KIND_LABELS[kind], color, indexes(every), comparison.counts(kind))
+        send_counts(stream, clock, count_path(kind), KIND_LABELS[kind], color, frames, stamps, comparison.counts(kind))
         found = comparison.of_kind(kind)
         if not found:
             continue
         boxes, labels, lengths = _markers(found, comparison.frame_indices)
         send_marker_boxes(
             stream,
+            clock,
             markers_path(kind),
-            indexes(every),
+            frames,
+            stamps,
             boxes,
             labels,
             lengths,
@@ -117,11 +121,13 @@ def log_comparison(stream: rr.RecordingStream, comparison: Comparison, scene: Sc
             line_radius_m=MARKER_LINE_RADIUS_M,
         )
     if comparison.disagreements:
-        position = {f: i for i, f in enumerate(comparison.frame_indices)}
+        at = np.array([d.frame_index for d in comparison.disagreements], dtype=np.int64)
         send_text_lines(
             stream,
+            clock,
             log_path(),
-            indexes(np.array([position[d.frame_index] for d in comparison.disagreements], dtype=np.int64)),
+            at,
+            np.array([scene.keyframes[i].timestamp_us for i in at.tolist()], dtype=np.int64),
             [f"{KIND_LABELS[d.kind]}: {d.describe()}" for d in comparison.disagreements],
             [KIND_LEVELS[d.kind] for d in comparison.disagreements],
         )

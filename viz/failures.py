@@ -15,17 +15,19 @@ import rerun as rr
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import Failure, FailureBox, FailureKind, FailureReport, short_id
 from viz import paths
-from viz.markers import send_counts, send_marker_boxes, send_text_lines, time_indexes
+from viz.markers import send_counts, send_marker_boxes, send_text_lines
+from viz.timeline import PLAIN_CLOCK, Clock
 
 KIND_COLORS: dict[FailureKind, tuple[int, int, int]] = {
     FailureKind.ID_SWITCH: (255, 0, 255),
     FailureKind.FRAGMENTATION: (255, 160, 0),
     FailureKind.FALSE_TRACK: (255, 0, 0),
-    FailureKind.MISS: (255, 255, 255),
+    FailureKind.MISS: (150, 150, 150),
     FailureKind.COALESCENCE: (0, 255, 140),
     FailureKind.IDENTITY_THEFT: (255, 255, 0),
 }
-"""One colour per failure kind, bright so the markers stand out from the class-coloured boxes."""
+"""One colour per failure kind, outside the hues tracks may take (``viz.colors.TRACK_HUE_BANDS``); "miss", the
+most frequent kind, is a mid grey that shows on the dark and the light theme alike."""
 
 KIND_LABELS: dict[FailureKind, str] = {
     FailureKind.ID_SWITCH: "ID switch",
@@ -91,29 +93,33 @@ def log_failures(
     report: FailureReport,
     scene: SceneData,
     frame_range: range | None = None,
+    clock: Clock = PLAIN_CLOCK,
+    *,
+    show_labels: bool = True,
 ) -> None:
-    """Log ``report`` (failures of ``tracker`` on ``scene``) on the frame and timestamp timelines.
+    """Log ``report`` (failures of ``tracker`` on ``scene``) on the recording's timelines (``clock``).
 
+    show_labels: show the marker labels (a focus recording labels the involved objects itself); misses never do.
     Boxes of a kind show only at their frame (other frames get an empty batch); the count series has a value
     at every keyframe of ``frame_range`` (default: the whole scene; 0 when nothing failed). Failures outside the
     range are left out.
     """
     if tuple(report.sample_tokens) != tuple(scene.sample_tokens):
-        raise ValueError(
-            f"the failure report is for {report.scene_name}, not for the samples of {scene.name}"
-        )
+        raise ValueError(f"the failure report is for {report.scene_name}, not for the samples of {scene.name}")
     n = len(scene.keyframes)
-    indexes = time_indexes(np.arange(n, dtype=np.int64), np.array([k.timestamp_us for k in scene.keyframes]))
+    stamps = np.array([k.timestamp_us for k in scene.keyframes], dtype=np.int64)
     every_frame = np.arange(n) if frame_range is None else np.array(frame_range, dtype=np.int64)
     in_range = set(every_frame.tolist())
     for kind in FailureKind:
         color = KIND_COLORS[kind]
         send_counts(
             stream,
+            clock,
             paths.failure_count(tracker, kind.value),
             KIND_LABELS[kind],
             color,
-            indexes(every_frame),
+            every_frame,
+            stamps[every_frame],
             report.counts(kind)[every_frame],
         )
         failures = [f for f in report.of_kind(kind) if f.frame_index in in_range]
@@ -122,8 +128,10 @@ def log_failures(
         boxes, labels, lengths = _frame_boxes(failures, n)
         send_marker_boxes(
             stream,
+            clock,
             paths.failures_world(tracker, kind.value),
-            indexes(every_frame),
+            every_frame,
+            stamps[every_frame],
             boxes,
             labels,
             lengths[every_frame],
@@ -131,13 +139,18 @@ def log_failures(
             scale=MARKER_SCALE,
             margin_m=MARKER_MARGIN_M,
             line_radius_m=MARKER_LINE_RADIUS_M,
+            show_labels=show_labels and kind is not FailureKind.MISS,
         )
+    ids = dict(zip(map(id, report.failures), report.ids(), strict=True))
     logged = [f for f in report.failures if f.frame_index in in_range]
     if logged:
+        at = np.array([f.frame_index for f in logged], dtype=np.int64)
         send_text_lines(
             stream,
+            clock,
             failure_log(tracker),
-            indexes(np.array([f.frame_index for f in logged], dtype=np.int64)),
-            [f"{KIND_LABELS[f.kind]}: {f.describe()}" for f in logged],
+            at,
+            stamps[at],
+            [f"[{ids[id(f)]}] {KIND_LABELS[f.kind]}: {f.describe()}" for f in logged],
             [KIND_LEVELS[f.kind] for f in logged],
         )

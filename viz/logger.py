@@ -1,22 +1,29 @@
-"""``TrackerLogger``: an ``EventSink`` that draws one tracker's introspection events in Rerun.
+"""``TrackerLogger``: an ``EventSink`` that draws one tracker's introspection events in Rerun so a failure can be
+explained from the picture.
 
-Per frame and class it shows predicted means, gate ellipses, the cost matrix (a heat map plus a markdown table
-naming every row and column), the extracted tracks and, for the trackers that have them, PMBM hypothesis
-weights, TO-PMB/JPDA marginals, the CPHD cardinality and PHD intensity weights. Births, prunings, assignments,
-track-logic transitions and merges go to a text log. Per-track existence probabilities become time series:
-under ``existence/`` for Bernoullis that were output as tracks at least once, under ``candidates/`` for those
-that never were (the many short-lived births on clutter), so the default plot stays readable.
+Per frame and class, from the events alone:
 
-Cheap logging: per-frame entities are logged directly; text-log lines are buffered for the frame and sent as one
-column chunk per class; time series are kept in memory and sent column-wise by ``finish()`` (one chunk per
-series instead of one per point). An entity drawn in one frame and not redrawn in the next is cleared at the next
-frame, so a class without tracks shows no boxes.
+* **which detection went to which track**: a line from each track's predicted position to the detection it was
+  given, in the track's colour (``associations``); pairs inside a gate that the solver did not choose as dimmed
+  lines (``gated_pairs``); detections are named ``m<idx>`` everywhere (labels, lines, tables, log);
+* **why**: the decision view (``viz.decisions``): per conflict the chosen pair, its cost, the best alternative
+  and the margin, as a document and as a labelled cost grid with the chosen cells outlined;
+* **what happened before**: one entity per extracted track (``tracks/<class>/<id>``: its box and a trail of its
+  last ``TRAIL_FRAMES`` positions), per-track series (existence, normalised innovation, chosen cost) and a story
+  log per class: confirmed, missed, no longer reported, pruned at INFO/WARN; candidates' births and prunings
+  aggregated into one DEBUG line per class and frame; close calls at INFO.
+
+Candidate Bernoullis (predicted existence below ``gate_min_existence``, the many births on clutter) get no gate,
+no box and no own series: their predicted means go to one hidden-by-default entity per class and their number to
+one series per class. Time series are collected and sent column-wise by ``finish()`` (one chunk per series).
+Events of one class are buffered and drawn when the frame closes, so every view of a frame is consistent.
 """
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Callable, Sequence
+import math
+from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,7 +31,7 @@ import rerun as rr
 
 from gnnpmb.events import (
     Assignment,
-    AxisLabel,
+    AxisKind,
     Born,
     Cardinality,
     CostMatrix,
@@ -35,6 +42,7 @@ from gnnpmb.events import (
     GlobalHypotheses,
     IntensityWeights,
     Marginals,
+    MeasurementsReceived,
     Merged,
     Posterior,
     Predicted,
@@ -42,95 +50,44 @@ from gnnpmb.events import (
     TrackLogic,
     TrackLogicAction,
 )
+from gnnpmb.explain import Decisions, explain
 from gnnpmb.gating import ellipse_outline
+from gnnpmb.types import TrackEstimate
 from viz import paths
 from viz.colors import class_ids, pack_rgba, track_color, track_colors
+from viz.decisions import (
+    CLOSE_CALL_MARGIN,
+    column_name,
+    cost_colors,
+    decision_grid,
+    decisions_markdown,
+    meas_name,
+)
 from viz.geometry import estimate_boxes, lift_xy
-from viz.scene import set_frame_time
+from viz.timeline import PLAIN_CLOCK, Clock
 
 TRACK_LINE_RADIUS_M = 0.06
+TRAIL_RADIUS_M = 0.05
+TRAIL_FRAMES = 10
+"""A track's trail shows its positions over the last this many frames."""
+ASSOCIATION_RADIUS_M = 0.07
+GATED_PAIR_RADIUS_M = 0.025
+GATED_PAIR_ALPHA = 90
 GATE_LINE_RADIUS_M = 0.03
 PREDICTED_POINT_RADIUS_M = 0.25
-MAX_TABLE_CELLS = 600
-"""Cost matrices with more cells than this are listed row by row (finite entries only) instead of as a table."""
+CANDIDATE_POINT_RADIUS_M = 0.12
 MAX_HYPOTHESIS_SERIES = 10
 """Log weights are plotted for the best this many PMBM global hypotheses."""
+CHOSEN_CELL_COLOR = (255, 210, 0)
+TEXT_FLUSH_FRAMES = 10
+"""Story lines are sent column-wise every this many frames (and at the end): a live viewer sees them within
+seconds, and a recording holds a few chunks per class instead of one per frame."""
 
 _LEVEL_BY_ACTION = {
     TrackLogicAction.TENTATIVE: "DEBUG",
     TrackLogicAction.CONFIRMED: "INFO",
     TrackLogicAction.DELETED: "WARN",
 }
-
-
-def cost_heat(cost: np.ndarray) -> tuple[np.ndarray, tuple[float, float]]:
-    """Heat map of an (R, C) cost matrix for a Tensor view: (R, C) float32 heat and its value range.
-
-    heat = -cost (the log-likelihood ratio for the PMB family: brighter = more likely). Impossible entries
-    (+inf cost, NaN) get a sentinel a quarter of the finite span below the lowest finite heat, and the value range
-    starts at the sentinel, so gated-out cells are the darkest colour and never squash the colour map.
-    """
-    heat = -np.asarray(cost, dtype=np.float64)
-    finite = np.isfinite(heat)
-    if finite.any():
-        lo, hi = float(heat[finite].min()), float(heat[finite].max())
-    else:
-        lo, hi = 0.0, 1.0
-    if hi <= lo:
-        hi = lo + 1.0
-    sentinel = lo - 0.25 * (hi - lo)
-    return np.where(finite, heat, sentinel).astype(np.float32), (sentinel, hi)
-
-
-def compact_cost(event: CostMatrix) -> CostMatrix:
-    """The matrix without columns in which every entry is impossible (tracks with no measurement in their gate:
-    with many candidate Bernoullis most columns are), so the heat map shows what the solver chose between; the
-    markdown table still names every column. The description says how many were hidden."""
-    cost = np.asarray(event.cost)
-    keep = np.isfinite(cost).any(axis=0)
-    if keep.all():
-        return event
-    hidden = int((~keep).sum())
-    return dataclasses.replace(
-        event,
-        cost=cost[:, keep],
-        cols=tuple(c for c, k in zip(event.cols, keep.tolist(), strict=True) if k),
-        description=f"{event.description} ({hidden} columns with no possible assignment hidden)",
-    )
-
-
-def axis_dim_name(labels: Sequence[AxisLabel]) -> str:
-    """Name of a matrix dimension from the kinds of its labels, e.g. "meas" or "track|new"."""
-    kinds = dict.fromkeys(label.kind.value for label in labels)
-    return "|".join(kinds) or "empty"
-
-
-def cost_markdown(event: CostMatrix) -> str:
-    """Markdown naming every row and column of a cost matrix with its values.
-
-    Up to MAX_TABLE_CELLS cells: a full table ("-" = impossible). Larger matrices (gating makes them sparse): one
-    line per row listing only its finite entries.
-    """
-    cost = np.asarray(event.cost, dtype=np.float64)
-    head = (
-        f"**{event.class_name}**, hypothesis {event.hypothesis}: {event.description}; "
-        f"{cost.shape[0]} rows x {cost.shape[1]} columns. The heat map shows -cost; darkest = impossible.\n\n"
-    )
-    cols = [str(c) for c in event.cols]
-    finite = np.isfinite(cost)
-    if cost.size <= MAX_TABLE_CELLS:
-        shown = np.where(finite, cost, np.nan)
-        lines = ["| | " + " | ".join(cols) + " |", "|---" * (len(cols) + 1) + "|"]
-        for label, row in zip(event.rows, shown.tolist(), strict=True):
-            cells = " | ".join(map("{:.2f}".format, row)).replace("nan", "-")
-            lines.append(f"| **{label}** | {cells} |")
-        return head + "\n".join(lines) + "\n"
-    lines = []
-    for label, row, ok in zip(event.rows, cost, finite, strict=True):
-        idx = np.flatnonzero(ok)
-        entries = ", ".join(f"{cols[j]} {v:.2f}" for j, v in zip(idx.tolist(), row[idx].tolist(), strict=True))
-        lines.append(f"- **{label}**: {entries or 'nothing possible'}")
-    return head + "\n".join(lines) + "\n"
 
 
 @dataclass(slots=True)
@@ -144,14 +101,47 @@ class _Series:
     values: list[float] = field(default_factory=list)
 
 
+@dataclass(frozen=True, slots=True)
+class TrackStep:
+    """One focused track at one frame: predicted existence and BEV position, the detections inside its gate with
+    their NIS, the detection it was given (-1: none), its existence after the update (NaN if gone) and
+    whether it was reported."""
+
+    prior_existence: float
+    predicted_xy_m: tuple[float, float]
+    gated: tuple[tuple[int, float], ...]
+    given: int
+    posterior_existence: float
+    reported: bool
+
+
+@dataclass(slots=True)
+class _ClassFrame:
+    """The events of one class in the current frame, drawn together when the frame closes."""
+
+    meas: MeasurementsReceived | None = None
+    predicted: Predicted | None = None
+    gated: Gated | None = None
+    cost: CostMatrix | None = None
+    assignment: Assignment | None = None
+    born: list[Born] = field(default_factory=list)
+    pruned: list[Pruned] = field(default_factory=list)
+    merged: list[Merged] = field(default_factory=list)
+    logic: list[TrackLogic] = field(default_factory=list)
+    posterior: Posterior | None = None
+    extracted: Extracted | None = None
+
+
 class TrackerLogger:
     """An ``EventSink`` logging one tracker's events to ``stream`` under that tracker's entity paths.
 
-    gate_z_m: height at which gates and predicted means of tracks with no known box height are drawn (global z;
-    nuScenes ego poses have z = 0). gate_points: vertices per gate ellipse. log_predicted: draw the predicted
-    means. gate_min_existence: gates are drawn for tracks whose predicted existence reaches it. Call
-    ``finish()`` after the last frame: it sends the time series (existence, hypothesis weights, ...),
-    which therefore appear in a live viewer at the end of the run.
+    gate_z_m: height at which gates, lines and predicted means of tracks with no known box height are drawn
+    (global z). gate_points: vertices per gate ellipse. log_predicted: draw the predicted means.
+    gate_min_existence: tracks whose predicted existence reaches it are drawn (gate, prediction, gated pairs);
+    the others are candidates. clock: the timelines rows go on (``viz.timeline``). log_frames: draw and log
+    only these keyframes (None: all); the others still feed the tracks' history (trails, series, story state).
+    focus_tracks: their conflicts come first in the decision view. Call ``finish()`` after the last frame: it
+    sends the time series.
     """
 
     enabled = True
@@ -165,6 +155,9 @@ class TrackerLogger:
         gate_points: int = 32,
         log_predicted: bool = True,
         gate_min_existence: float = 0.1,
+        clock: Clock = PLAIN_CLOCK,
+        log_frames: range | None = None,
+        focus_tracks: set[int] | None = None,
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
         self.stream = stream
@@ -173,33 +166,53 @@ class TrackerLogger:
         self.gate_points = gate_points
         self.log_predicted = log_predicted
         self.gate_min_existence = gate_min_existence
-        self._prior_existence: dict[str, tuple[np.ndarray, np.ndarray]] = {}  # class -> (ids, existence)
+        self.clock = clock
+        self.log_frames = log_frames
+        self.focus_tracks = focus_tracks
+        self._drawing = True
+        self.decisions: dict[int, list[Decisions]] = {}
+        """Frame index -> the decisions of every class (kept for the focus view and tests)."""
+        self.track_steps: dict[int, dict[int, TrackStep]] = {}
+        """Focused track id -> frame -> its ``TrackStep`` (only for ``focus_tracks``)."""
+        self.story: list[tuple[int, str, str, str]] = []
+        """Every story line logged: (frame, class, text, level)."""
         self._frame = -1  # current keyframe index; -1 before the first FrameStarted
         self._timestamp_us = 0
         self._live: set[str] = set()
         self._touched: set[str] = set()
-        self._texts: dict[str, tuple[list[str], list[str]]] = {}
+        self._classes: dict[str, _ClassFrame] = {}
+        self._texts: dict[str, tuple[list[int], list[int], list[str], list[str]]] = {}
+        self._frames_since_text_flush = 0
         self._series: dict[str, _Series] = {}
+        self._multi: dict[str, tuple[list[str], list[int], list[int], list[np.ndarray]]] = {}
         self._track_z: dict[int, float] = {}
-        self._existence_paths: dict[str, tuple[str, int]] = {}  # series path -> (class, track id)
-        self._extracted_ids: set[int] = set()
+        self._trails: dict[int, deque[tuple[float, float, float]]] = {}
+        self._reported: set[int] = set()  # tracks extracted in the previous frame
+        self._extracted_ids: set[int] = set()  # tracks extracted at least once
+        self._track_series: dict[str, tuple[str, int]] = {}  # series path -> (class, track id)
         self._handlers: dict[type, Callable] = {
             FrameStarted: self._on_frame_started,
-            Predicted: self._on_predicted,
-            Gated: self._on_gated,
+            MeasurementsReceived: self._store("meas"),
+            Predicted: self._store("predicted"),
+            Gated: self._store("gated"),
             CostMatrix: self._on_cost,
             Assignment: self._on_assignment,
-            Born: self._on_born,
-            Posterior: self._on_posterior,
-            Pruned: self._on_pruned,
-            Extracted: self._on_extracted,
+            Born: self._append("born"),
+            Posterior: self._store("posterior"),
+            Pruned: self._append("pruned"),
+            Extracted: self._store("extracted"),
             GlobalHypotheses: self._on_hypotheses,
             Marginals: self._on_marginals,
-            Merged: self._on_merged,
+            Merged: self._append("merged"),
             Cardinality: self._on_cardinality,
             IntensityWeights: self._on_intensity,
-            TrackLogic: self._on_track_logic,
+            TrackLogic: self._append("logic"),
         }
+
+    @property
+    def reported_ever(self) -> set[int]:
+        """Ids of the tracks output at least once so far (the others are candidates)."""
+        return self._extracted_ids
 
     def emit(self, event: Event) -> None:
         handler = self._handlers.get(type(event))
@@ -214,23 +227,58 @@ class TrackerLogger:
         if self._frame >= 0:
             self._close_frame()
             self._frame = -1
+        self._flush_texts()
         for path, series in self._series.items():
-            if path in self._existence_paths and self._existence_paths[path][1] not in self._extracted_ids:
-                path = paths.candidate_existence(self.tracker, *self._existence_paths[path])
-            if series.color is None:
-                self.stream.log(path, rr.SeriesLines(names=series.name), static=True)
-            else:
-                self.stream.log(path, rr.SeriesLines(names=series.name, colors=[series.color]), static=True)
-            self.stream.send_columns(
+            owner = self._track_series.get(path)
+            if owner is not None and owner[1] not in self._extracted_ids:
+                continue  # a candidate's series: only the per-class candidate count is kept
+            colors = None if series.color is None else [series.color]
+            self.stream.log(path, rr.SeriesLines(names=series.name, colors=colors), static=True)
+            values = np.asarray(series.values, dtype=np.float64)
+            self.clock.send(
+                self.stream,
                 path,
-                indexes=[
-                    rr.TimeColumn("frame", sequence=series.frames),
-                    rr.TimeColumn("timestamp", timestamp=np.array(series.timestamps_us, dtype="datetime64[us]")),
-                ],
-                columns=rr.Scalars.columns(scalars=np.asarray(series.values, dtype=np.float64)),
+                np.asarray(series.frames),
+                np.asarray(series.timestamps_us),
+                lambda rows, values=values: rr.Scalars.columns(scalars=values[rows]),
+            )
+        for path, (names, frames, stamps, values) in self._multi.items():
+            self.stream.log(path, rr.SeriesLines(names=names), static=True)
+            stacked = np.stack(values)
+            self.clock.send(
+                self.stream,
+                path,
+                np.asarray(frames),
+                np.asarray(stamps),
+                lambda rows, stacked=stacked: rr.Scalars.columns(scalars=stacked[rows]),
             )
         self._series.clear()
-        self._existence_paths.clear()
+        self._track_series.clear()
+        self._multi.clear()
+
+    # Event intake.
+    def _store(self, name: str) -> Callable[[Event], None]:
+        def handler(event: Event) -> None:
+            setattr(self._class_frame(event.class_name), name, event)
+
+        return handler
+
+    def _append(self, name: str) -> Callable[[Event], None]:
+        def handler(event: Event) -> None:
+            getattr(self._class_frame(event.class_name), name).append(event)
+
+        return handler
+
+    def _class_frame(self, class_name: str) -> _ClassFrame:
+        return self._classes.setdefault(class_name, _ClassFrame())
+
+    def _on_cost(self, event: CostMatrix) -> None:
+        if event.hypothesis == 0:
+            self._class_frame(event.class_name).cost = event
+
+    def _on_assignment(self, event: Assignment) -> None:
+        if event.hypothesis == 0:
+            self._class_frame(event.class_name).assignment = event
 
     # Frame bookkeeping.
     def _on_frame_started(self, event: FrameStarted) -> None:
@@ -238,42 +286,80 @@ class TrackerLogger:
             self._close_frame()
         self._frame = event.frame_index
         self._timestamp_us = event.timestamp_us
-        set_frame_time(self.stream, event.frame_index, event.timestamp_us)
+        self._drawing = self.log_frames is None or event.frame_index in self.log_frames
+        self.clock.set(self.stream, event.frame_index, event.timestamp_us)
 
     def _close_frame(self) -> None:
-        """Send the frame's text lines; clear entities drawn last frame but not this one."""
-        set_frame_time(self.stream, self._frame, self._timestamp_us)
-        for path, (texts, levels) in self._texts.items():
-            n = len(texts)
-            self.stream.send_columns(
-                path,
-                indexes=[
-                    rr.TimeColumn("frame", sequence=np.full(n, self._frame, dtype=np.int64)),
-                    rr.TimeColumn("timestamp", timestamp=np.full(n, self._timestamp_us, dtype="datetime64[us]")),
-                ],
-                columns=rr.TextLog.columns(text=texts, level=levels),
-            )
-        self._texts.clear()
-        for path in sorted(self._live - self._touched):
-            self.stream.log(path, rr.Clear(recursive=False))
-        self._live = self._touched
+        """Draw the frame's classes, the decision view and the story lines; clear what was drawn last frame but
+        not in this one."""
+        self.clock.set(self.stream, self._frame, self._timestamp_us)
+        reported: set[int] = set()
+        decisions: list[Decisions] = []
+        matrices: dict[str, CostMatrix] = {}
+        fallbacks: list[CostMatrix] = []
+        for class_name, cf in self._classes.items():
+            reported |= self._draw_class(class_name, cf)
+            if self._drawing and cf.cost is not None and cf.assignment is not None:
+                d = explain(cf.cost, cf.assignment)
+                if d is None:
+                    fallbacks.append(cf.cost)
+                else:
+                    decisions.append(d)
+                    matrices[class_name] = cf.cost
+                    self._story_close_calls(d)
+        self._reported = reported
+        self._classes = {}
+        if decisions or fallbacks:
+            self.decisions[self._frame] = decisions
+            self._draw_decisions(decisions, matrices, fallbacks)
+        self._frames_since_text_flush += 1
+        if self._frames_since_text_flush >= TEXT_FLUSH_FRAMES:
+            self._flush_texts()
+        if self._drawing:
+            for path in sorted(self._live - self._touched):
+                self.stream.log(path, rr.Clear(recursive=False))
+            self._live = self._touched
         self._touched = set()
 
-    def _show(self, path: str, archetype: rr.AsComponents) -> None:
-        self.stream.log(path, archetype)
+    def _flush_texts(self) -> None:
+        for path, (frames, stamps, texts, levels) in self._texts.items():
+            self.clock.send(
+                self.stream,
+                path,
+                np.asarray(frames),
+                np.asarray(stamps),
+                lambda rows, texts=texts, levels=levels: rr.TextLog.columns(
+                    text=[texts[i] for i in rows], level=[levels[i] for i in rows]
+                ),
+            )
+        self._texts.clear()
+        self._frames_since_text_flush = 0
+
+    def _show(self, path: str, *archetypes: rr.AsComponents) -> None:
+        if not self._drawing:
+            return
+        for archetype in archetypes:
+            self.stream.log(path, archetype)
         self._touched.add(path)
 
     def _text(self, class_name: str, text: str, level: str) -> None:
-        texts, levels = self._texts.setdefault(paths.events(self.tracker, class_name), ([], []))
+        if not self._drawing:
+            return
+        self.story.append((self._frame, class_name, text, level))
+        frames, stamps, texts, levels = self._texts.setdefault(paths.events(self.tracker, class_name), ([], [], [], []))
+        frames.append(self._frame)
+        stamps.append(self._timestamp_us)
         texts.append(text)
         levels.append(level)
 
-    def _sample(self, path: str, value: float, name: str = "") -> None:
-        """Append one point to a time series at the current frame (a repeat in the same frame replaces it).
-        A new series is named ``name`` (or the entity's last path part) and coloured by the viewer."""
+    def _sample(self, path: str, value: float, name: str = "", color: tuple[int, int, int] | None = None) -> None:
+        """Append one point to a time series at the current frame (a repeat in the same frame replaces it);
+        nothing after the last of ``log_frames``."""
+        if self.log_frames is not None and self._frame >= self.log_frames.stop:
+            return
         series = self._series.get(path)
         if series is None:
-            series = self._series[path] = _Series(name or path.rsplit("/", 1)[-1], None)
+            series = self._series[path] = _Series(name or path.rsplit("/", 1)[-1], color)
         if series.frames and series.frames[-1] == self._frame:
             series.values[-1] = float(value)
             return
@@ -281,169 +367,406 @@ class TrackerLogger:
         series.timestamps_us.append(self._timestamp_us)
         series.values.append(float(value))
 
+    def _track_sample(self, path: str, class_name: str, track_id: int, value: float, what: str) -> None:
+        self._track_series.setdefault(path, (class_name, track_id))
+        self._sample(path, value, f"{track_id} {class_name} {what}", track_color(track_id))
+
     def _z_of(self, track_ids: np.ndarray) -> np.ndarray:
         """(K,) last known box height of each track, gate_z_m for tracks never extracted."""
         return np.array([self._track_z.get(int(t), self.gate_z_m) for t in track_ids], dtype=np.float64)
 
-    # Spatial events.
-    def _on_predicted(self, event: Predicted) -> None:
-        ids = np.asarray(event.track_ids)
-        self._prior_existence[event.class_name] = (ids, np.asarray(event.existence, dtype=np.float64))
-        if ids.size == 0 or not self.log_predicted:
-            return
-        self._show(
-            paths.predicted(self.tracker, event.class_name),
-            rr.Points3D(
-                lift_xy(np.asarray(event.mean)[:, :2], self._z_of(ids)),
-                colors=pack_rgba(track_colors(ids)),
-                radii=PREDICTED_POINT_RADIUS_M,
-                labels=[
-                    f"{t} prior r={r:.2f}"
-                    for t, r in zip(ids.tolist(), np.asarray(event.existence).tolist(), strict=True)
-                ],
-                show_labels=False,
-            ),
-        )
-
-    def _on_gated(self, event: Gated) -> None:
-        ids = np.asarray(event.track_ids)
-        drawn = self._gate_worthy(event.class_name, ids)
-        if not drawn.any():
-            return
-        ids = ids[drawn]
-        outline = ellipse_outline(
-            np.asarray(event.center_xy, dtype=np.float64)[drawn],
-            np.asarray(event.innovation_cov, dtype=np.float64)[drawn],
-            event.threshold,
-            self.gate_points,
-        )
-        self._show(
-            paths.gates(self.tracker, event.class_name),
-            rr.LineStrips3D(
-                lift_xy(outline, self._z_of(ids)[:, None]),
-                colors=pack_rgba(track_colors(ids)),
-                radii=GATE_LINE_RADIUS_M,
-            ),
-        )
-
-    def _gate_worthy(self, class_name: str, ids: np.ndarray) -> np.ndarray:
-        """(K,) bool: draw the gate of tracks whose predicted existence (from this frame's ``Predicted``) is at
-        least ``gate_min_existence``; the many candidate Bernoullis born on clutter would hide everything else."""
-        known_ids, existence = self._prior_existence.get(class_name, (np.zeros(0, dtype=np.int64), np.zeros(0)))
-        if known_ids.size == 0:
-            return np.ones(ids.size, dtype=bool)
-        lookup = dict(zip(known_ids.tolist(), existence.tolist(), strict=True))
-        return np.array([lookup.get(t, 1.0) >= self.gate_min_existence for t in ids.tolist()], dtype=bool)
-
-    def _on_extracted(self, event: Extracted) -> None:
-        for e in event.estimates:
+    # One class, one frame.
+    def _draw_class(self, class_name: str, cf: _ClassFrame) -> set[int]:
+        """Draw one class's frame; returns the ids of its extracted tracks."""
+        estimates = cf.extracted.estimates if cf.extracted is not None else ()
+        for e in estimates:
             self._track_z[e.track_id] = float(e.translation_m[2])
-            self._extracted_ids.add(e.track_id)
-        if not event.estimates:
-            return
-        boxes = estimate_boxes(event.estimates)
-        ids = np.array([e.track_id for e in event.estimates], dtype=np.int64)
-        self._show(
-            paths.tracks(self.tracker, event.class_name),
-            rr.Boxes3D(
-                centers=boxes.centers_m,
-                sizes=boxes.sizes_xyz_m,
-                quaternions=boxes.quat_xyzw,
-                colors=pack_rgba(track_colors(ids)),
-                class_ids=class_ids(np.array([e.class_name for e in event.estimates], dtype=object)),
-                labels=[f"{e.track_id} {e.class_name} r={e.existence:.2f}" for e in event.estimates],
-                radii=TRACK_LINE_RADIUS_M,
-            ),
-        )
+        worthy = self._draw_prior(class_name, cf)
+        self._draw_associations(class_name, cf, worthy)
+        self._record_posterior(class_name, cf)
+        if self.focus_tracks:
+            self._record_steps(cf, estimates)
+        self._story(class_name, cf, estimates)
+        self._draw_tracks(class_name, estimates)
+        return {e.track_id for e in estimates}
 
-    # Matrices.
-    def _on_cost(self, event: CostMatrix) -> None:
-        cost = np.asarray(event.cost)
-        if cost.ndim != 2 or cost.size == 0:
-            return
-        shown = compact_cost(event)
-        heat, value_range = cost_heat(np.asarray(shown.cost))
-        self._show(
-            paths.cost_matrix(self.tracker, event.class_name, event.hypothesis),
-            rr.Tensor(heat, dim_names=[axis_dim_name(shown.rows), axis_dim_name(shown.cols)], value_range=value_range),
-        )
-        if event.hypothesis == 0:
+    def _draw_prior(self, class_name: str, cf: _ClassFrame) -> dict[int, int]:
+        """Predicted means (tracks vs candidates) and gates; returns track id -> row of the tracks worth a gate."""
+        if cf.predicted is None:
+            return {}
+        ids = np.asarray(cf.predicted.track_ids, dtype=np.int64)
+        existence = np.asarray(cf.predicted.existence, dtype=np.float64)
+        focused = np.isin(ids, list(self.focus_tracks or ()))
+        worthy = (existence >= self.gate_min_existence) | focused
+        xy = np.asarray(cf.predicted.mean, dtype=np.float64).reshape(-1, 4)[:, :2]
+        if self.log_predicted:
+            for path, sel in (
+                (paths.predicted(self.tracker, class_name), np.flatnonzero(worthy & ~focused)),
+                (paths.predicted_focus(self.tracker, class_name), np.flatnonzero(focused)),
+            ):
+                if sel.size == 0:
+                    continue
+                self._show(
+                    path,
+                    rr.Points3D(
+                        lift_xy(xy[sel], self._z_of(ids[sel])),
+                        colors=pack_rgba(track_colors(ids[sel])),
+                        radii=PREDICTED_POINT_RADIUS_M,
+                        labels=[f"{t} predicted, r={r:.2f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
+                        show_labels=path != paths.predicted(self.tracker, class_name),
+                    ),
+                )
+        if (~worthy).any():
+            sel = np.flatnonzero(~worthy)
             self._show(
-                paths.cost_axes(self.tracker, event.class_name),
-                rr.TextDocument(cost_markdown(event), media_type="text/markdown"),
+                paths.candidates_world(self.tracker, class_name),
+                rr.Points3D(
+                    lift_xy(xy[sel], self.gate_z_m),
+                    colors=[(160, 160, 160)],
+                    radii=CANDIDATE_POINT_RADIUS_M,
+                    labels=[f"candidate {t}, r={r:.3f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
+                    show_labels=False,
+                ),
+            )
+        self._sample(
+            paths.candidate_count(self.tracker, class_name), float((~worthy).sum()), f"{class_name} candidates"
+        )
+        gated = cf.gated
+        if gated is not None:
+            gids = np.asarray(gated.track_ids, dtype=np.int64)
+            lookup = dict(zip(ids.tolist(), worthy.tolist(), strict=True))  # focused tracks count as worthy
+            drawn = np.array([lookup.get(int(t), True) for t in gids], dtype=bool)
+            if drawn.any():
+                outline = ellipse_outline(
+                    np.asarray(gated.center_xy, dtype=np.float64)[drawn],
+                    np.asarray(gated.innovation_cov, dtype=np.float64)[drawn],
+                    gated.threshold,
+                    self.gate_points,
+                )
+                self._show(
+                    paths.gates(self.tracker, class_name),
+                    rr.LineStrips3D(
+                        lift_xy(outline, self._z_of(gids[drawn])[:, None]),
+                        colors=pack_rgba(track_colors(gids[drawn])),
+                        radii=GATE_LINE_RADIUS_M,
+                    ),
+                )
+            return {int(t): k for k, (t, d) in enumerate(zip(gids.tolist(), drawn.tolist(), strict=True)) if d}
+        return {int(t): k for k, t in enumerate(ids.tolist()) if worthy[k]}
+
+    def _draw_associations(self, class_name: str, cf: _ClassFrame, worthy: dict[int, int]) -> None:
+        """Chosen (track, detection) lines in the track's colour, gated-but-rejected ones dimmed; per-track NIS
+        and chosen-cost samples."""
+        if cf.meas is None or cf.predicted is None or cf.assignment is None:
+            return
+        pos = {int(m): k for k, m in enumerate(np.asarray(cf.meas.meas_indices).tolist())}
+        xyz = np.asarray(cf.meas.xyz_m, dtype=np.float64).reshape(-1, 3)
+        pred_ids = np.asarray(cf.predicted.track_ids, dtype=np.int64)
+        pred_xy = {int(t): m[:2] for t, m in zip(pred_ids, np.asarray(cf.predicted.mean).reshape(-1, 4), strict=True)}
+        costs = self._pair_costs(cf.cost)
+        strips, colors, labels = [], [], []
+        chosen: set[tuple[int, int]] = set()
+        for row, col in cf.assignment.pairs:
+            if col.kind is not AxisKind.TRACK or row.ref not in pos or col.ref not in pred_xy:
+                continue
+            m, t = int(row.ref), int(col.ref)
+            chosen.add((t, m))
+            z = xyz[pos[m], 2]
+            strips.append([(*pred_xy[t], z), tuple(xyz[pos[m]])])
+            colors.append(track_color(t))
+            cost = costs.get((m, t), math.nan)
+            labels.append(f"{meas_name(m)} → {t} (cost {cost:.2f})")
+            self._track_sample(paths.chosen_cost(self.tracker, class_name, t), class_name, t, cost, "chosen cost")
+            nis = self._nis(cf.gated, t, xyz[pos[m], :2])
+            if nis is not None:
+                self._track_sample(paths.nis(self.tracker, class_name, t), class_name, t, nis, "NIS")
+        if strips:
+            self._show(
+                paths.associations(self.tracker, class_name),
+                rr.LineStrips3D(strips, colors=colors, radii=ASSOCIATION_RADIUS_M, labels=labels, show_labels=False),
+            )
+        gated = cf.gated
+        if gated is None:
+            return
+        inside = np.asarray(gated.inside, dtype=bool)
+        gids = np.asarray(gated.track_ids, dtype=np.int64).tolist()
+        gmeas = np.asarray(gated.meas_indices, dtype=np.int64).tolist()
+        rejected, rcolors, rlabels = [], [], []
+        for k, j in zip(*np.nonzero(inside), strict=True):
+            t, m = gids[k], gmeas[j]
+            if t not in worthy or (t, m) in chosen or m not in pos:
+                continue
+            rejected.append([(*pred_xy[t], xyz[pos[m], 2]), tuple(xyz[pos[m]])])
+            rcolors.append((*track_color(t), GATED_PAIR_ALPHA))
+            rlabels.append(f"{meas_name(m)} in gate of {t}, not chosen (cost {costs.get((m, t), math.nan):.2f})")
+        if rejected:
+            self._show(
+                paths.gated_pairs(self.tracker, class_name),
+                rr.LineStrips3D(rejected, colors=rcolors, radii=GATED_PAIR_RADIUS_M, labels=rlabels, show_labels=False),
             )
 
+    @staticmethod
+    def _pair_costs(matrix: CostMatrix | None) -> dict[tuple[int, int], float]:
+        """(meas index, track id) -> cost of every finite track entry of the matrix."""
+        if matrix is None:
+            return {}
+        cost = np.asarray(matrix.cost, dtype=np.float64)
+        out = {}
+        track_cols = [(j, c.ref) for j, c in enumerate(matrix.cols) if c.kind is AxisKind.TRACK]
+        for i, r in enumerate(matrix.rows):
+            for j, t in track_cols:
+                if math.isfinite(cost[i, j]):
+                    out[(int(r.ref), int(t))] = float(cost[i, j])
+        return out
+
+    @staticmethod
+    def _nis(gated: Gated | None, track_id: int, z: np.ndarray) -> float | None:
+        """(z - H m)^T S^-1 (z - H m) of detection z for a track, from its gate (None if not gated)."""
+        if gated is None:
+            return None
+        hit = np.flatnonzero(np.asarray(gated.track_ids) == track_id)
+        if hit.size == 0:
+            return None
+        k = int(hit[0])
+        nu = z - np.asarray(gated.center_xy[k], dtype=np.float64)
+        return float(nu @ np.linalg.solve(np.asarray(gated.innovation_cov[k], dtype=np.float64), nu))
+
+    def _record_posterior(self, class_name: str, cf: _ClassFrame) -> None:
+        """Existence samples and trail points of the Bernoullis worth following (r >= gate_min_existence or
+        already reported); candidates only count."""
+        post = cf.posterior
+        if post is None:
+            return
+        ids = np.asarray(post.track_ids, dtype=np.int64)
+        existence = np.asarray(post.existence, dtype=np.float64)
+        mean = np.asarray(post.mean, dtype=np.float64).reshape(-1, 4)
+        follow = np.flatnonzero((existence >= self.gate_min_existence) | np.isin(ids, list(self._extracted_ids)))
+        for k in follow.tolist():
+            t = int(ids[k])
+            self._track_sample(paths.existence(self.tracker, class_name, t), class_name, t, existence[k], "existence")
+            trail = self._trails.setdefault(t, deque(maxlen=TRAIL_FRAMES))
+            trail.append((float(mean[k, 0]), float(mean[k, 1]), self._track_z.get(t, self.gate_z_m)))
+
+    def _record_steps(self, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
+        """The frame's ``TrackStep`` of every focused track this class predicted."""
+        if cf.predicted is None:
+            return
+        ids = np.asarray(cf.predicted.track_ids, dtype=np.int64).tolist()
+        mean = np.asarray(cf.predicted.mean, dtype=np.float64).reshape(-1, 4)
+        prior_r = np.asarray(cf.predicted.existence, dtype=np.float64)
+        post = {}
+        if cf.posterior is not None:
+            post = dict(
+                zip(
+                    np.asarray(cf.posterior.track_ids).tolist(),
+                    np.asarray(cf.posterior.existence).tolist(),
+                    strict=True,
+                )
+            )
+        given = {}
+        if cf.assignment is not None:
+            given = {int(c.ref): int(r.ref) for r, c in cf.assignment.pairs if c.kind is AxisKind.TRACK}
+        reported = {e.track_id for e in estimates}
+        meas_xy = {}
+        if cf.meas is not None:
+            xyz = np.asarray(cf.meas.xyz_m, dtype=np.float64).reshape(-1, 3)
+            meas_xy = {int(m): xyz[k, :2] for k, m in enumerate(np.asarray(cf.meas.meas_indices).tolist())}
+        for k, t in enumerate(ids):
+            if t not in self.focus_tracks:
+                continue
+            gated: list[tuple[int, float]] = []
+            if cf.gated is not None:
+                g = np.flatnonzero(np.asarray(cf.gated.track_ids) == t)
+                if g.size:
+                    inside = np.asarray(cf.gated.inside, dtype=bool)[g[0]]
+                    for j in np.flatnonzero(inside).tolist():
+                        m = int(np.asarray(cf.gated.meas_indices)[j])
+                        nis = self._nis(cf.gated, t, meas_xy[m]) if m in meas_xy else math.nan
+                        gated.append((m, float(nis) if nis is not None else math.nan))
+            self.track_steps.setdefault(t, {})[self._frame] = TrackStep(
+                float(prior_r[k]),
+                (float(mean[k, 0]), float(mean[k, 1])),
+                tuple(gated),
+                given.get(t, -1),
+                float(post.get(t, math.nan)),
+                t in reported,
+            )
+
+    def _draw_tracks(self, class_name: str, estimates: tuple[TrackEstimate, ...]) -> None:
+        if not estimates:
+            return
+        boxes = estimate_boxes(estimates)
+        cids = class_ids(np.array([e.class_name for e in estimates], dtype=object))
+        for k, e in enumerate(estimates):
+            self._extracted_ids.add(e.track_id)
+            color = track_color(e.track_id)
+            trail = list(self._trails.get(e.track_id, ()))
+            parts: list[rr.AsComponents] = [
+                rr.Boxes3D(
+                    centers=boxes.centers_m[k : k + 1],
+                    sizes=boxes.sizes_xyz_m[k : k + 1],
+                    quaternions=boxes.quat_xyzw[k : k + 1],
+                    colors=[color],
+                    class_ids=cids[k : k + 1],
+                    labels=[str(e.track_id)],
+                    radii=TRACK_LINE_RADIUS_M,
+                )
+            ]
+            if len(trail) >= 2:
+                parts.append(rr.LineStrips3D([trail], colors=[color], radii=TRAIL_RADIUS_M))
+            self._show(paths.track(self.tracker, class_name, e.track_id), *parts)
+
+    # The story log.
+    def _story(self, class_name: str, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
+        now = {e.track_id: e for e in estimates}
+        known = self._extracted_ids
+        for t, e in now.items():
+            via = f"from {meas_name(e.meas_index)}" if e.meas_index >= 0 else "without a detection"
+            if t not in known:
+                self._text(class_name, f"track {t} confirmed (r={e.existence:.2f}, {via})", "INFO")
+            elif e.meas_index < 0:
+                self._text(class_name, f"track {t} missed this frame, still reported (r={e.existence:.2f})", "INFO")
+        posterior_r: dict[int, float] = {}
+        if cf.posterior is not None:
+            posterior_r = dict(
+                zip(
+                    np.asarray(cf.posterior.track_ids).tolist(),
+                    np.asarray(cf.posterior.existence).tolist(),
+                    strict=True,
+                )
+            )
+        pruned_ids = {p.track_id for p in cf.pruned}
+        for t in sorted(self._reported - set(now) - pruned_ids):
+            if t in posterior_r:
+                self._text(
+                    class_name, f"track {t} no longer reported (r={posterior_r[t]:.2f} fell below extraction)", "WARN"
+                )
+        candidates_pruned = 0
+        for p in cf.pruned:
+            if p.track_id in known:
+                self._text(
+                    class_name, f"track {p.track_id} ended: {p.reason.value} (last r={p.last_existence:.3g})", "WARN"
+                )
+            else:
+                candidates_pruned += 1
+            self._trails.pop(p.track_id, None)
+        born = [(int(t), int(m)) for b in cf.born for t, m in zip(b.track_ids, b.meas_indices, strict=True)]
+        if born or candidates_pruned:
+            names = ", ".join(meas_name(m) for _, m in born[:12]) + (" …" if len(born) > 12 else "")
+            self._text(
+                class_name,
+                f"{len(born)} new candidates{' from ' + names if born else ''}; {candidates_pruned} candidates pruned",
+                "DEBUG",
+            )
+        for m in cf.merged:
+            if m.into_id in known or any(f in known for f in m.from_ids):
+                weights = ", ".join(f"{w:.3g}" for w in m.weights)
+                ids = ", ".join(str(i) for i in m.from_ids)
+                self._text(class_name, f"merged {ids} into track {m.into_id} (weights {weights})", "INFO")
+        for ev in cf.logic:
+            if ev.action is not TrackLogicAction.DELETED:
+                continue  # tentative is a candidate's birth; confirmation shows as "confirmed" above
+            self._text(
+                class_name,
+                f"track {ev.track_id} {ev.action.value} ({ev.hits}/{ev.window} hits)",
+                _LEVEL_BY_ACTION[ev.action],
+            )
+        if cf.assignment is not None and cf.meas is not None:
+            to_tracks = sum(1 for _, c in cf.assignment.pairs if c.kind is AxisKind.TRACK)
+            shown_missed = [t for t in cf.assignment.missed_track_ids if t in known]
+            self._text(
+                class_name,
+                f"{len(cf.meas.meas_indices)} detections: {to_tracks} updated tracks, "
+                f"{len(cf.assignment.pairs) - to_tracks} new or clutter; reported tracks missed: "
+                f"{', '.join(map(str, shown_missed)) or 'none'}",
+                "DEBUG",
+            )
+
+    def _story_close_calls(self, d: Decisions) -> None:
+        """Close calls that involve a reported track (between candidates they are routine)."""
+        for conflict in d.conflicts:
+            for c in conflict.choices:
+                reported = {
+                    label.ref
+                    for label in (c.chosen, c.alternative)
+                    if label is not None and label.kind is AxisKind.TRACK
+                } & self._extracted_ids
+                if c.margin < CLOSE_CALL_MARGIN and c.alternative is not None and reported:
+                    self._text(
+                        d.class_name,
+                        f"close call: {meas_name(c.meas.ref)} → {column_name(c.chosen)} (cost {c.chosen_cost:.2f}) "
+                        f"over {column_name(c.alternative)} ({c.alternative_cost:.2f}), margin {c.margin:.2f}",
+                        "INFO",
+                    )
+
+    # The decision view.
+    def _draw_decisions(
+        self, decisions: list[Decisions], matrices: dict[str, CostMatrix], fallbacks: list[CostMatrix]
+    ) -> None:
+        doc = decisions_markdown(
+            self.tracker,
+            self._frame,
+            decisions,
+            fallbacks,
+            focus_tracks=self.focus_tracks,
+            reported=self._extracted_ids,
+        )
+        self._show(paths.decisions(self.tracker), rr.TextDocument(doc, media_type="text/markdown"))
+        grid = decision_grid(decisions, matrices, reported=self._extracted_ids, focus_tracks=self.focus_tracks)
+        root = paths.decision_matrix(self.tracker)
+        if grid.costs.size:
+            self._show(
+                f"{root}/cells",
+                rr.Boxes2D(
+                    centers=grid.centers,
+                    sizes=np.full((grid.costs.size, 2), 0.94),
+                    colors=cost_colors(grid.costs),
+                    labels=grid.labels,
+                    show_labels=True,
+                    draw_order=1.0,
+                ),
+            )
+            sel = np.flatnonzero(grid.chosen)
+            if sel.size:
+                self._show(
+                    f"{root}/chosen",
+                    rr.Boxes2D(
+                        centers=grid.centers[sel],
+                        sizes=np.full((sel.size, 2), 0.94),
+                        colors=[CHOSEN_CELL_COLOR],
+                        radii=0.05,
+                        draw_order=2.0,
+                    ),
+                )
+            self._show(
+                f"{root}/axes",
+                rr.Points2D(grid.axis_positions, radii=0.01, labels=grid.axis_labels, show_labels=True),
+            )
+
+    # Tracker-specific plots.
     def _on_marginals(self, event: Marginals) -> None:
         probs = np.asarray(event.probs, dtype=np.float32)
         if probs.ndim != 2 or probs.size == 0:
             return
+        kinds = "|".join(dict.fromkeys(label.kind.value for label in event.rows)) or "empty"
+        col_kinds = "|".join(dict.fromkeys(label.kind.value for label in event.cols)) or "empty"
         self._show(
             paths.marginals(self.tracker, event.class_name),
-            rr.Tensor(probs, dim_names=[axis_dim_name(event.rows), axis_dim_name(event.cols)], value_range=(0.0, 1.0)),
+            rr.Tensor(probs, dim_names=[kinds, col_kinds], value_range=(0.0, 1.0)),
         )
-        self._text(
-            event.class_name,
-            f"marginals {probs.shape[0]}x{probs.shape[1]} by {event.method}, {event.iterations} iterations",
-            "DEBUG",
-        )
-
-    # Text events.
-    def _on_assignment(self, event: Assignment) -> None:
-        pairs = ", ".join(f"{r}->{c}" for r, c in event.pairs) or "none"
-        missed = ", ".join(str(t) for t in event.missed_track_ids) or "none"
-        self._text(
-            event.class_name,
-            f"h{event.hypothesis} assignment, cost {event.total_cost:.3f}: {pairs}; missed tracks: {missed}",
-            "DEBUG",
-        )
-
-    def _on_born(self, event: Born) -> None:
-        mean = np.asarray(event.mean)
-        for t, m, xy, r in zip(
-            np.asarray(event.track_ids).tolist(),
-            np.asarray(event.meas_indices).tolist(),
-            mean.reshape(-1, 4)[:, :2].tolist(),
-            np.asarray(event.existence).tolist(),
-            strict=True,
-        ):
-            self._text(
-                event.class_name, f"born track {t} from meas {m} at ({xy[0]:.1f}, {xy[1]:.1f}) r={r:.3f}", "INFO"
-            )
-
-    def _on_pruned(self, event: Pruned) -> None:
-        self._text(
-            event.class_name,
-            f"pruned track {event.track_id}: {event.reason.value} (last {event.last_existence:.3g})",
-            "WARN",
-        )
-
-    def _on_merged(self, event: Merged) -> None:
-        weights = ", ".join(f"{w:.3g}" for w in event.weights)
-        self._text(
-            event.class_name,
-            f"merged {', '.join(str(i) for i in event.from_ids)} into {event.into_id} (weights {weights})",
-            "DEBUG",
-        )
-
-    def _on_track_logic(self, event: TrackLogic) -> None:
-        self._text(
-            event.class_name,
-            f"track {event.track_id} {event.action.value} ({event.hits}/{event.window} hits)",
-            _LEVEL_BY_ACTION[event.action],
-        )
-
-    # Series and charts.
-    def _on_posterior(self, event: Posterior) -> None:
-        for t, r in zip(np.asarray(event.track_ids).tolist(), np.asarray(event.existence).tolist(), strict=True):
-            path = paths.existence(self.tracker, event.class_name, t)
-            if path not in self._series:
-                self._series[path] = _Series(f"{t} {event.class_name}", track_color(t))
-                self._existence_paths[path] = (event.class_name, t)
-            self._sample(path, r)
 
     def _on_hypotheses(self, event: GlobalHypotheses) -> None:
-        for rank, w in enumerate(np.asarray(event.log_weights)[:MAX_HYPOTHESIS_SERIES].tolist()):
-            self._sample(paths.hypothesis_weight(self.tracker, event.class_name, rank), w, f"h{rank}")
+        """Log weights of the best MAX_HYPOTHESIS_SERIES hypotheses as one multi-line series per class (NaN
+        where fewer are kept), each line named by class and rank."""
+        w = np.full(MAX_HYPOTHESIS_SERIES, np.nan)
+        top = np.asarray(event.log_weights, dtype=np.float64)[:MAX_HYPOTHESIS_SERIES]
+        w[: top.size] = top
+        path = paths.hypothesis_weights(self.tracker, event.class_name)
+        series = self._multi.setdefault(path, ([f"{event.class_name} h{r}" for r in range(w.size)], [], [], []))
+        names, frames, stamps, values = series
+        frames.append(self._frame)
+        stamps.append(self._timestamp_us)
+        values.append(w)
 
     def _on_cardinality(self, event: Cardinality) -> None:
         pmf = np.asarray(event.pmf, dtype=np.float64)

@@ -36,13 +36,41 @@ def tracker_world(tracker: str) -> str:
 
 
 def tracks(tracker: str, class_name: str) -> str:
-    """Boxes3D of the extracted tracks of one class."""
+    """Parent of the extracted tracks of one class (one entity per track, ``track``)."""
     return f"{tracker_world(tracker)}/tracks/{_name(class_name)}"
 
 
+def track(tracker: str, class_name: str, track_id: int) -> str:
+    """One extracted track: its Boxes3D (while it is reported) and its trail (LineStrips3D of recent
+    positions); one entity per track, so a click selects it and hover names it."""
+    return f"{tracks(tracker, class_name)}/{int(track_id)}"
+
+
 def predicted(tracker: str, class_name: str) -> str:
-    """Points3D of the predicted track means (prior) of one class."""
+    """Points3D of the predicted means (prior) of the tracks of one class worth a gate (not candidates)."""
     return f"{tracker_world(tracker)}/predicted/{_name(class_name)}"
+
+
+def predicted_focus(tracker: str, class_name: str) -> str:
+    """Points3D of the predicted means of the focused tracks of a focus recording, labelled."""
+    return f"{predicted(tracker, class_name)}/focus"
+
+
+def candidates_world(tracker: str, class_name: str) -> str:
+    """Points3D of the predicted means of candidate Bernoullis (low existence, e.g. born on clutter); hidden by
+    default in the views, one click away."""
+    return f"{tracker_world(tracker)}/candidates/{_name(class_name)}"
+
+
+def associations(tracker: str, class_name: str) -> str:
+    """LineStrips3D: one line per chosen (track, detection) pair, from the track's predicted position to the
+    detection, in the track's colour."""
+    return f"{tracker_world(tracker)}/associations/{_name(class_name)}"
+
+
+def gated_pairs(tracker: str, class_name: str) -> str:
+    """LineStrips3D: dimmed lines for (track, detection) pairs inside the gate that the solver did not choose."""
+    return f"{tracker_world(tracker)}/gated_pairs/{_name(class_name)}"
 
 
 def gates(tracker: str, class_name: str) -> str:
@@ -60,16 +88,14 @@ def tracker_root(tracker: str) -> str:
     return f"{TRACKERS}/{_name(tracker)}"
 
 
-def cost_matrix(tracker: str, class_name: str, hypothesis: int = 0) -> str:
-    """Tensor of the assignment cost of one class; hypothesis 0 (the best) has the short path."""
-    if hypothesis == 0:
-        return f"{tracker_root(tracker)}/cost/{_name(class_name)}"
-    return f"{tracker_root(tracker)}/cost_hypotheses/{_name(class_name)}/{int(hypothesis)}"
+def decisions(tracker: str) -> str:
+    """TextDocument: the frame's conflicts per class, chosen pairs, best alternatives and margins."""
+    return f"{tracker_root(tracker)}/decisions"
 
 
-def cost_axes(tracker: str, class_name: str) -> str:
-    """TextDocument naming the rows and columns of the cost matrix of hypothesis 0, with its values."""
-    return f"{tracker_root(tracker)}/cost_axes/{_name(class_name)}"
+def decision_matrix(tracker: str) -> str:
+    """2D: the conflicts' cost cells (Boxes2D labelled with their cost), row and column labels, chosen cells."""
+    return f"{tracker_root(tracker)}/decision_matrix"
 
 
 def existence_root(tracker: str) -> str:
@@ -81,14 +107,32 @@ def existence(tracker: str, class_name: str, track_id: int) -> str:
     return f"{existence_root(tracker)}/{_name(class_name)}/{int(track_id)}"
 
 
+def nis_root(tracker: str) -> str:
+    return f"{tracker_root(tracker)}/nis"
+
+
+def nis(tracker: str, class_name: str, track_id: int) -> str:
+    """Scalars: normalised innovation squared (z - H m)^T S^-1 (z - H m) of the detection a track was given."""
+    return f"{nis_root(tracker)}/{_name(class_name)}/{int(track_id)}"
+
+
+def chosen_cost_root(tracker: str) -> str:
+    return f"{tracker_root(tracker)}/chosen_cost"
+
+
+def chosen_cost(tracker: str, class_name: str, track_id: int) -> str:
+    """Scalars: the assignment cost of the pair chosen for a track (lower = more likely)."""
+    return f"{chosen_cost_root(tracker)}/{_name(class_name)}/{int(track_id)}"
+
+
 def candidates_root(tracker: str) -> str:
     return f"{tracker_root(tracker)}/candidates"
 
 
-def candidate_existence(tracker: str, class_name: str, track_id: int) -> str:
-    """Scalars: the existence probability over time of a Bernoulli that was never output as a track (a candidate
-    that stayed below the extraction threshold); kept apart so the default existence plot shows real tracks."""
-    return f"{candidates_root(tracker)}/{_name(class_name)}/{int(track_id)}"
+def candidate_count(tracker: str, class_name: str) -> str:
+    """Scalars: how many candidate Bernoullis (never output as tracks) a class holds per frame; their
+    individual series would be thousands of short lines (and chunks)."""
+    return f"{candidates_root(tracker)}/{_name(class_name)}"
 
 
 def events_root(tracker: str) -> str:
@@ -104,9 +148,9 @@ def hypotheses_root(tracker: str) -> str:
     return f"{tracker_root(tracker)}/hypotheses"
 
 
-def hypothesis_weight(tracker: str, class_name: str, rank: int) -> str:
-    """Scalars: log weight of the rank-th best PMBM global hypothesis."""
-    return f"{hypotheses_root(tracker)}/{_name(class_name)}/{int(rank)}"
+def hypothesis_weights(tracker: str, class_name: str) -> str:
+    """Scalars: log weights of the best PMBM global hypotheses of one class, one line per rank (h0, h1, ...)."""
+    return f"{hypotheses_root(tracker)}/{_name(class_name)}"
 
 
 def marginals(tracker: str, class_name: str) -> str:

@@ -1,8 +1,9 @@
 """Logging a scene to Rerun: ego poses, LiDAR sweeps, ground truth and detections, one keyframe at a time.
 
-Every keyframe is logged on two timelines: ``frame`` (sequence = keyframe index in the scene) and ``timestamp``
-(the keyframe's LiDAR time). Boxes are in the nuScenes global frame (under ``world``); the LiDAR points stay in
-the sensor frame under ``world/ego_vehicle/LIDAR_TOP`` and Rerun places them with the logged transforms.
+Every keyframe is logged on the timelines of ``viz.timeline.Clock``: ``frame`` (keyframe index) and ``timestamp``
+(the keyframe's LiDAR time), plus ``focus`` in focus recordings. Boxes are in the nuScenes global frame (under
+``world``); the LiDAR points stay in the sensor frame under ``world/ego_vehicle/LIDAR_TOP`` and Rerun places them
+with the logged transforms.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from viz import paths
 from viz.colors import annotation_context, class_colors, class_ids
 from viz.geometry import quat_wxyz_to_xyzw, rerun_boxes
 from viz.pointcloud import DEFAULT_MAX_POINTS, DEFAULT_VOXEL_M, intensity_colors, prepare_sweep
+from viz.timeline import PLAIN_CLOCK, Clock
 
 PointsLoader = Callable[[Keyframe], np.ndarray]
 """Returns a keyframe's LiDAR sweep as (N, >=4) [x, y, z, intensity, ...] in the sensor frame."""
@@ -28,12 +30,6 @@ SUPPRESSED_ALPHA = 70
 EGO_BODY_CENTER_M = (1.4, 0.0, 0.8)
 """Body box of the nuScenes ego car (Renault Zoe) in the ego frame, whose origin is the rear axle centre."""
 EGO_BODY_SIZE_XYZ_M = (4.1, 1.73, 1.56)
-
-
-def set_frame_time(stream: rr.RecordingStream, frame_index: int, timestamp_us: int) -> None:
-    """Point the stream's ``frame`` and ``timestamp`` timelines at one keyframe."""
-    stream.set_time("frame", sequence=int(frame_index))
-    stream.set_time("timestamp", timestamp=np.datetime64(int(timestamp_us), "us"))
 
 
 def log_static_context(stream: rr.RecordingStream) -> None:
@@ -52,8 +48,9 @@ def log_scene(
     max_points: int = DEFAULT_MAX_POINTS,
     voxel_m: float = DEFAULT_VOXEL_M,
     on_frame: Callable[[], None] | None = None,
+    clock: Clock = PLAIN_CLOCK,
 ) -> None:
-    """Log the keyframes ``frame_range`` (default: all) of ``scene``.
+    """Log the keyframes ``frame_range`` (default: all) of ``scene`` on the timelines of ``clock``.
 
     frame_detections: one entry per logged keyframe, in order (``[f.detections for f in run.frames]``).
     points_loader: reads a keyframe's sweep; without one no LiDAR is logged. Sweeps above max_points are
@@ -78,7 +75,15 @@ def log_scene(
         )
     for i, detections in zip(indices, frame_detections, strict=True):
         keyframe = scene.keyframes[i]
-        log_keyframe(stream, keyframe, detections, points_loader=points_loader, max_points=max_points, voxel_m=voxel_m)
+        log_keyframe(
+            stream,
+            keyframe,
+            detections,
+            points_loader=points_loader,
+            max_points=max_points,
+            voxel_m=voxel_m,
+            clock=clock,
+        )
         if on_frame is not None:
             on_frame()
 
@@ -91,22 +96,24 @@ def log_keyframe(
     points_loader: PointsLoader | None = None,
     max_points: int = DEFAULT_MAX_POINTS,
     voxel_m: float = DEFAULT_VOXEL_M,
+    clock: Clock = PLAIN_CLOCK,
 ) -> None:
     """Ego pose, LiDAR sweep, ground truth and detections of one keyframe, at that keyframe's time."""
-    set_frame_time(stream, keyframe.index, keyframe.timestamp_us)
+    clock.set(stream, keyframe.index, keyframe.timestamp_us)
     pose = keyframe.ego_pose
     stream.log(paths.EGO, rr.Transform3D(translation=pose.translation_m, quaternion=quat_wxyz_to_xyzw(pose.quat_wxyz)))
     if points_loader is not None:
         sweep = prepare_sweep(points_loader(keyframe), max_points=max_points, voxel_m=voxel_m)
         stream.log(paths.LIDAR, rr.Points3D(sweep[:, :3], colors=intensity_colors(sweep[:, 3])))
     stream.log(paths.GT, _gt_boxes(keyframe.gt))
-    kept = np.asarray(detections.kept, dtype=bool)
-    stream.log(paths.DETECTIONS_KEPT, _detection_boxes(detections.boxes.subset(np.flatnonzero(kept))))
-    dropped = np.flatnonzero(~kept)
+    kept = np.flatnonzero(np.asarray(detections.kept, dtype=bool))
+    stream.log(paths.DETECTIONS_KEPT, _detection_boxes(detections.boxes.subset(kept), kept))
+    dropped = np.flatnonzero(~np.asarray(detections.kept, dtype=bool))
     stream.log(
         paths.DETECTIONS_SUPPRESSED,
         _detection_boxes(
             detections.boxes.subset(dropped),
+            dropped,
             reasons=np.where(np.asarray(detections.suppressed_by_nms)[dropped], "nms", "low"),
         ),
     )
@@ -131,15 +138,21 @@ def _gt_boxes(gt: Boxes) -> rr.Boxes3D:
     )
 
 
-def _detection_boxes(boxes: Boxes, reasons: np.ndarray | None = None) -> rr.Boxes3D:
-    """Kept detections in class colours; dropped ones (with reasons "nms"/"low" score) dimmed."""
+def detection_label(source_index: int, score: float) -> str:
+    """``m<idx> <score>``: the detection's name in every view, event and log line, and its score."""
+    return f"m{int(source_index)} {float(score):.2f}"
+
+
+def _detection_boxes(boxes: Boxes, source_index: np.ndarray, reasons: np.ndarray | None = None) -> rr.Boxes3D:
+    """Kept detections in class colours labelled ``m<idx> <score>``; dropped ones (reasons "nms"/"low" score)
+    dimmed."""
     b = rerun_boxes(boxes)
     scores = np.asarray(boxes.score, dtype=np.float64)
+    labels = [detection_label(i, s) for i, s in zip(np.asarray(source_index).tolist(), scores, strict=True)]
     if reasons is None:
-        labels = [f"{s:.2f}" for s in scores]
         colors = None
     else:
-        labels = [f"{s:.2f} {r}" for s, r in zip(scores, reasons, strict=True)]
+        labels = [f"{label} {r}" for label, r in zip(labels, reasons, strict=True)]
         colors = class_colors(boxes.class_name, alpha=SUPPRESSED_ALPHA)
     return rr.Boxes3D(
         centers=b.centers_m,

@@ -176,6 +176,20 @@ class FailureReport:
     def of_kind(self, kind: FailureKind) -> list[Failure]:
         return [f for f in self.failures if f.kind is kind]
 
+    def ids(self) -> list[str]:
+        """A stable id per failure, in order: ``<kind>:<n>`` numbering each kind from 1 by frame (e.g.
+        ``id_switch:2``); ``gnnpmb failures`` prints them and ``gnnpmb-viz --focus`` takes them."""
+        seen: dict[FailureKind, int] = {}
+        out = []
+        for f in self.failures:
+            seen[f.kind] = seen.get(f.kind, 0) + 1
+            out.append(f"{f.kind.value}:{seen[f.kind]}")
+        return out
+
+    def by_id(self, failure_id: str) -> Failure | None:
+        """The failure with ``failure_id`` (see ``ids``), None if there is none."""
+        return dict(zip(self.ids(), self.failures, strict=True)).get(failure_id)
+
     def counts(self, kind: FailureKind) -> np.ndarray:
         """(F,) number of failures of ``kind`` per keyframe."""
         out = np.zeros(len(self.sample_tokens), dtype=np.int64)
@@ -344,6 +358,7 @@ def _class_failures(
     last_track: dict[str, str] = {}  # object -> track it was last matched to (the accumulator's memory)
     history: dict[str, list[tuple[_Frame, bool]]] = defaultdict(list)  # object -> (frame, missed) in order
     seen_tracks: set[str] = set()
+    last_seen: dict[str, TrackingBox] = {}  # track -> its latest box
     # Tracks that may steal an identity: born false (generation 1, lost nothing) or robbed by a thief
     # (the thief's generation + 1, and the object it lost: taking that one back is no theft).
     candidates: dict[str, tuple[int, str | None]] = {}
@@ -356,6 +371,8 @@ def _class_failures(
                 boxes = [_box("gt", fr.gt[o]), _box("new track", fr.pred[h])]
                 if old in fr.pred:
                     boxes.append(_box("old track", fr.pred[old]))
+                elif old in last_seen:  # the lost track where it was last reported
+                    boxes.append(_box("old track", last_seen[old]))
                 add(FailureKind.ID_SWITCH, fr, [o], [old, h], boxes)
             elif kind == "MISS":
                 add(FailureKind.MISS, fr, [o], [], [_box("missed gt", fr.gt[o])])
@@ -408,6 +425,7 @@ def _class_failures(
             boxes += [_box("missed gt", fr.gt[o]) for o in missed]
             add(FailureKind.COALESCENCE, fr, [b, *missed], [h], boxes)
         last_track.update(matched)
+        last_seen.update(fr.pred)
 
     # Fragmentation (the devkit's FRAG): tracked -> missed transitions inside an object's tracked span.
     for o, steps in history.items():

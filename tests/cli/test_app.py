@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from cli.app import log_failures_of, main, parse_classes, parse_frames, prepare
+from cli.app import find_reports, main, parse_classes, parse_frames, prepare
 from gnnpmb.config import TrackerConfig
 from gnnpmb.errors import DataError, GnnpmbError, UnknownNameError
 from gnnpmb.pipeline import run_tracker
@@ -71,22 +71,26 @@ def test_sensors_and_ground_truth_on_every_frame(rows: dict) -> None:
     assert paths.DETECTIONS_SUPPRESSED in rows
 
 
-def test_tracks_costs_existence_and_events(rows: dict) -> None:
-    car_tracks = rows[paths.tracks("gnnpmb", "car")]
-    boxes = [r for r in car_tracks if "Boxes3D:centers" in r]
-    assert boxes and max(r["frame"] for r in boxes) >= N_FRAMES - 5
-    assert all(label.split()[1] == "car" for r in boxes for label in r["Boxes3D:labels"])
-    cost = rows[paths.cost_matrix("gnnpmb", "car")]
-    assert at_frame(cost, 0) and at_frame(cost, N_FRAMES - 1)
-    assert cost[0]["Tensor:data"][0]["names"][0] == "meas"
-    assert paths.cost_axes("gnnpmb", "car") in rows
+def test_tracks_decisions_existence_and_story(rows: dict) -> None:
+    car_tracks = [p for p in rows if p.startswith(paths.tracks("gnnpmb", "car") + "/")]
+    assert len(car_tracks) >= 5  # one entity per reported track
+    boxes = [r for p in car_tracks for r in rows[p] if "Boxes3D:centers" in r]
+    assert max(r["frame"] for r in boxes) >= N_FRAMES - 5
+    assert all(
+        r["Boxes3D:labels"] == [p.rsplit("/", 1)[1]] for p in car_tracks for r in rows[p] if "Boxes3D:labels" in r
+    )
+    docs = rows[paths.decisions("gnnpmb")]
+    assert at_frame(docs, 0) and at_frame(docs, N_FRAMES - 1)
+    assert any("| detection | chosen | cost | next best | cost | margin |" in r["TextDocument:text"][0] for r in docs)
+    lines = [r for r in rows[paths.associations("gnnpmb", "car")] if "LineStrips3D:labels" in r]
+    assert lines and all(" → " in label for r in lines for label in r["LineStrips3D:labels"])
     existence = [p for p in rows if p.startswith(paths.existence_root("gnnpmb") + "/car/")]
     assert len(existence) >= 5
     events = rows[paths.events("gnnpmb", "car")]
     assert {r["frame"] for r in events} >= {0, N_FRAMES - 1}
     texts = [t for r in events for t in r["TextLog:text"]]
-    assert any(t.startswith("born track") for t in texts)
-    assert any(t.startswith("h0 assignment") for t in texts)
+    assert any(t.startswith("track ") and " confirmed " in t for t in texts)
+    assert any("new candidates" in t for t in texts)
 
 
 def test_failure_markers_of_the_tracker(rows: dict) -> None:
@@ -122,22 +126,16 @@ def test_recording_name_and_provenance(full_run: tuple[Path, str], demo_dataroot
     digest = p.track_digests["gnnpmb"]
     assert digest.frame_indices == tuple(range(N_FRAMES)) and len(set(digest.frames)) > N_FRAMES // 2
     readable = rows[PROPERTY_ENTITY.lstrip("/")][0]
-    assert readable["command"] == [
-        f"gnnpmb-viz {SCENE} --dataroot {demo_dataroot} --save {out} --no-progress"
-    ]
+    assert readable["command"] == [f"gnnpmb-viz {SCENE} --dataroot {demo_dataroot} --save {out} --no-progress"]
     assert readable["frames"] == [f"0:{N_FRAMES}"] and readable["seed"] == ["0"]
     assert readable["track_digests"] == [f"gnnpmb {digest.overall[:16]}"]
 
 
-def test_reproduce_reports_identical_tracks(
-    full_run: tuple[Path, str], capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_reproduce_reports_identical_tracks(full_run: tuple[Path, str], capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run(["reproduce", str(full_run[0])], capsys)
     assert (code, err) == (0, "")
     lines = out.strip().splitlines()
-    assert lines[0].startswith(
-        f"{SCENE} (synthetic demo), keyframes 0:{N_FRAMES}, detections: simulated centerpoint"
-    )
+    assert lines[0].startswith(f"{SCENE} (synthetic demo), keyframes 0:{N_FRAMES}, detections: simulated centerpoint")
     assert lines[1:] == [f"gnnpmb: identical ({N_FRAMES} frames)"]
 
 
@@ -180,10 +178,12 @@ def test_installed_script_with_a_detections_file_and_frame_range(demo_dataroot: 
     assert "4/4" in proc.stderr  # the progress bar counted the frames
     rows = read_rows(out)
     assert [r["frame"] for r in rows[paths.EGO]] == [2, 3, 4, 5]
-    assert {r["frame"] for r in rows[paths.cost_matrix("gnnpmb", "car")]} <= {2, 3, 4, 5}
+    assert {r["frame"] for r in rows[paths.decisions("gnnpmb")]} <= {2, 3, 4, 5}
     assert not any(p.startswith(paths.tracks("gnnpmb", "bus")) for p in rows)
     kept = at_frame(rows[paths.DETECTIONS_KEPT], 3)[0]
-    assert kept["Boxes3D:labels"] and set(kept["Boxes3D:labels"]) == {"0.80"}
+    assert kept["Boxes3D:labels"] and all(
+        label.startswith("m") and label.endswith(" 0.80") for label in kept["Boxes3D:labels"]
+    )
 
 
 def _truncated_submission(path: Path) -> None:
@@ -218,9 +218,7 @@ def test_bad_input_is_one_line_and_leaves_no_recording(
     _truncated_submission(tmp_path / "truncated.json")
     _malformed_submission(tmp_path / "malformed.json")
     argv = [
-        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(
-            a, a
-        )
+        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(a, a)
         for a in argv
     ]
     out = tmp_path / "out" / "x.rrd"
@@ -233,9 +231,7 @@ def test_bad_input_is_one_line_and_leaves_no_recording(
 
 
 def test_missing_dataroot_and_bad_save_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run(
-        [SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys
-    )
+    code, _, err = run([SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys)
     assert code == 2 and "does not exist" in err and err.count("\n") == 1
     code, _, err = run([SCENE, "--save", str(tmp_path / "no" / "x.rrd")], capsys)
     assert code == 2 and "does not exist; create it first" in err
@@ -284,19 +280,17 @@ def test_failures_are_skipped_with_a_notice_without_ground_truth(
         keyframes=tuple(dataclasses.replace(k, gt=Boxes.empty()) for k in request.scene.keyframes),
     )
     calls: list[None] = []
-    notices = log_failures_of(
-        None, dataclasses.replace(request, scene=unannotated), [], lambda: calls.append(None)
-    )
+    reports, notices = find_reports(dataclasses.replace(request, scene=unannotated), [], lambda: calls.append(None))
+    assert reports == {}
     assert notices == [f"{SCENE} has no ground-truth boxes (no annotations): failure markers skipped"]
 
     def not_in_a_split(*_args, **_kwargs):
         raise DataError(f"scene {SCENE} is in no nuScenes split, so the devkit cannot evaluate it")
 
     monkeypatch.setattr(failures, "find_failures", not_in_a_split)
-    runs = [
-        run_tracker(request.scene, request.detections, "gnn", request.config, frame_range=request.frame_range)
-    ]
-    notices = log_failures_of(None, request, runs, lambda: calls.append(None))
+    runs = [run_tracker(request.scene, request.detections, "gnn", request.config, frame_range=request.frame_range)]
+    reports, notices = find_reports(request, runs, lambda: calls.append(None))
+    assert reports == {}
     assert notices == [
         f"failure markers skipped: scene {SCENE} is in no nuScenes split, so the devkit cannot evaluate it"
     ]

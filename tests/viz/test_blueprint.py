@@ -36,23 +36,35 @@ def stored_views(path: Path) -> dict[str, tuple[str, str]]:
     return out
 
 
-def test_one_3d_view_per_tracker_showing_only_its_own_tracks() -> None:
+def test_a_birds_eye_and_a_perspective_view_per_tracker_showing_only_its_own_tracks() -> None:
     all_views = views(default_blueprint(["gnnpmb", "pmbm"], ["car", "bus"]))
     spatial = [v for v in all_views if isinstance(v, rrb.Spatial3DView)]
-    assert [v.name for v in spatial] == ["gnnpmb 3D", "pmbm 3D"]
-    for v, name in zip(spatial, ["gnnpmb", "pmbm"], strict=True):
+    assert [v.name for v in spatial] == ["gnnpmb bird's-eye", "gnnpmb 3D", "pmbm bird's-eye", "pmbm 3D"]
+    for v, name in zip(spatial, ["gnnpmb", "gnnpmb", "pmbm", "pmbm"], strict=True):
         assert v.origin == paths.EGO  # the camera follows the ego vehicle
         assert v.contents == ["+ world/**", "- world/trackers/**", f"+ world/trackers/{name}/**"]
 
 
-def test_cost_existence_failure_and_log_views_per_tracker() -> None:
+def hidden(view: rrb.Spatial3DView) -> set[str]:
+    """Entities a view hides by default (one click away in its blueprint tree)."""
+    return {p for p, behavior in view.visualizer_overrides.items() if "visible=[False]" in repr(behavior)}
+
+
+def test_birds_eye_hides_lidar_candidates_and_suppressed_detections_by_default() -> None:
+    bev, persp = [v for v in views(default_blueprint(["gnnpmb"], ["car"])) if isinstance(v, rrb.Spatial3DView)]
+    assert hidden(bev) == {paths.LIDAR, "world/trackers/gnnpmb/candidates", paths.DETECTIONS_SUPPRESSED}
+    assert hidden(persp) == {"world/trackers/gnnpmb/candidates", paths.DETECTIONS_SUPPRESSED}
+
+
+def test_decision_story_existence_failure_and_log_views_per_tracker() -> None:
     all_views = views(default_blueprint(["gnnpmb", "pmbm"], ["car", "bus"]))
     origins = {(type(v).__name__, v.origin) for v in all_views}
     for t in ["gnnpmb", "pmbm"]:
-        for c in ["car", "bus"]:
-            assert ("TensorView", paths.cost_matrix(t, c)) in origins
-            assert ("TextDocumentView", paths.cost_axes(t, c)) in origins
+        assert ("TextDocumentView", paths.decisions(t)) in origins
+        assert ("Spatial2DView", paths.decision_matrix(t)) in origins
         assert ("TimeSeriesView", paths.existence_root(t)) in origins
+        assert ("TimeSeriesView", paths.nis_root(t)) in origins
+        assert ("TimeSeriesView", paths.chosen_cost_root(t)) in origins
         assert ("TimeSeriesView", paths.candidates_root(t)) in origins
         assert ("TimeSeriesView", failures_root(t)) in origins
         assert ("TextLogView", paths.events_root(t)) in origins
@@ -91,7 +103,7 @@ def test_blueprint_is_accepted_in_strict_mode_and_saved(tmp_path: Path, strict: 
     stream = open_recording("bp", out, default_blueprint(["gnnpmb", "jpda", "phd"], ["car"]), strict=True)
     close_recording(stream, out)
     stored = stored_views(out)
-    assert stored["gnnpmb 3D"] == ("3D", paths.EGO) and stored["phd 3D"] == ("3D", paths.EGO)
+    assert stored["gnnpmb 3D"] == ("3D", paths.EGO) and stored["phd bird's-eye"] == ("3D", paths.EGO)
     assert stored["disagreements"] == ("TextLog", compare.log_path())
     assert stored["disagreements per frame"] == ("TimeSeries", compare.counts_root())
     assert stored["jpda failures per frame"] == ("TimeSeries", failures_root("jpda"))
@@ -101,6 +113,13 @@ def test_blueprint_is_accepted_in_strict_mode_and_saved(tmp_path: Path, strict: 
         for row in chunk.to_record_batch().to_pylist()
         if row.get("EyeControls3D:position")
     ]
-    assert len(eyes) == 3
-    assert eyes[0]["EyeControls3D:position"] == [list(EYE_POSITION_M)]
-    assert eyes[0]["EyeControls3D:look_target"] == [list(EYE_TARGET_M)]
+    assert len(eyes) == 6
+    assert [list(EYE_POSITION_M)] in [e["EyeControls3D:position"] for e in eyes]
+    assert [list(EYE_TARGET_M)] in [e["EyeControls3D:look_target"] for e in eyes]
+    panel = [
+        row
+        for chunk in RrdReader(out).stream(store=RrdReader(out).blueprints()[0])
+        for row in chunk.to_record_batch().to_pylist()
+        if row.get("TimePanelBlueprint:timeline")
+    ]
+    assert panel[0]["TimePanelBlueprint:timeline"] == ["frame"]  # paused: opens at the first frame

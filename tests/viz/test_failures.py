@@ -74,7 +74,8 @@ def test_failures_are_logged_per_kind_and_frame(saved_stream, tiny_scene) -> Non
     assert set(frame1["Boxes3D:colors"]) == {(r << 24) | (g << 16) | (b << 8) | 255}
     assert not latest_at(switch_rows, 2, "Boxes3D:centers")
 
-    miss_rows = rows[paths.failures_world(T, "miss")]
+    miss_rows = [r for r in rows[paths.failures_world(T, "miss")] if not r["static"]]
+    assert [r for r in rows[paths.failures_world(T, "miss")] if r["static"]][0]["Boxes3D:show_labels"] == [False]
     assert [r["Boxes3D:labels"] for r in miss_rows] == [
         ["miss: missed gt a1b2c3", "miss: missed gt p9"],
         [],
@@ -95,11 +96,11 @@ def test_failures_are_logged_per_kind_and_frame(saved_stream, tiny_scene) -> Non
     log_rows = rows[failure_log(T)]
     lines = [(r["frame"], r["TextLog:text"][0], r["TextLog:level"][0]) for r in log_rows]
     assert lines == [
-        (0, "miss: car GT a1b2c3", "INFO"),
-        (0, "miss: pedestrian GT p9", "INFO"),
-        (1, "ID switch: car GT a1b2c3: track 4 -> track 9", "WARN"),
-        (1, "identity theft: car track 9 took GT a1b2c3 from track 4", "ERROR"),
-        (2, "miss: pedestrian GT p9", "INFO"),
+        (0, "[miss:1] miss: car GT a1b2c3", "INFO"),  # the ids gnnpmb failures prints and --focus takes
+        (0, "[miss:2] miss: pedestrian GT p9", "INFO"),
+        (1, "[id_switch:1] ID switch: car GT a1b2c3: track 4 -> track 9", "WARN"),
+        (1, "[identity_theft:1] identity theft: car track 9 took GT a1b2c3 from track 4", "ERROR"),
+        (2, "[miss:3] miss: pedestrian GT p9", "INFO"),
     ]
     timestamps = [r["timestamp"] for r in log_rows]
     assert timestamps[2] == np.datetime64(scene.keyframes[1].timestamp_us, "us")

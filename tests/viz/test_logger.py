@@ -1,6 +1,7 @@
+"""The event logger read back from a saved recording: what a user sees per entity and frame."""
+
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,7 @@ from gnnpmb.events import (
     IntensityWeights,
     ListSink,
     Marginals,
+    MeasurementsReceived,
     Merged,
     Posterior,
     Predicted,
@@ -33,15 +35,19 @@ from gnnpmb.events import (
 from gnnpmb.types import TrackEstimate
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
-from viz.colors import track_colors
-from viz.logger import TrackerLogger, axis_dim_name, cost_heat, cost_markdown
+from viz.colors import pack_rgba, track_colors
+from viz.logger import TrackerLogger
+from viz.timeline import Clock
 
 T = "gnnpmb"
 T0_US = 1_533_151_603_547_590
+INF = np.inf
 
 
-def est(track_id: int, x: float, r: float, class_name: str = "car") -> TrackEstimate:
-    return TrackEstimate(track_id, class_name, (x, 2.0, 0.9), (2.0, 4.5, 1.6), (1.0, 0.0, 0.0, 0.0), (1.0, 0.0), 0.9, r)
+def est(track_id: int, x: float, r: float, meas_index: int = -1, class_name: str = "car") -> TrackEstimate:
+    return TrackEstimate(
+        track_id, class_name, (x, 2.0, 0.9), (2.0, 4.5, 1.6), (1.0, 0.0, 0.0, 0.0), (1.0, 0.0), 0.9, r, meas_index
+    )
 
 
 def meas(j: int) -> AxisLabel:
@@ -56,31 +62,58 @@ def new(j: int) -> AxisLabel:
     return AxisLabel(AxisKind.NEW_TRACK, j)
 
 
-def frame(i: int) -> FrameStarted:
-    return FrameStarted(T, i, f"s{i}", T0_US + 500_000 * i, 0.0 if i == 0 else 0.5)
+def frame(i: int, tracker: str = T) -> FrameStarted:
+    return FrameStarted(tracker, i, f"s{i}", T0_US + 500_000 * i, 0.0 if i == 0 else 0.5)
+
+
+def received(xs: list[float]) -> MeasurementsReceived:
+    n = len(xs)
+    return MeasurementsReceived(
+        "car", np.arange(n), np.array([[x, 2.0, 1.0] for x in xs]).reshape(n, 3), np.full(n, 0.8)
+    )
 
 
 def scripted_events() -> list:
-    """Frame 0: two cars born. Frame 1: both predicted and gated, track 2 pruned, track 1 extracted; a bus
-    class with nothing. Frame 2: no car tracks at all. Plus one event of every other kind."""
+    """Frame 0: m0 and m1 start tracks 1 (r 0.97, reported) and 2 (r 0.4, a candidate).
+    Frame 1: both predicted; m0 (x 10.5) is in both gates, m1 (x 11) in track 1's; the solver gives m0 to track 1
+    (cost -5) over track 2 (-4) and m1 to track 2 (-4.5; m1 alone would rather go to track 1 at -5, but the swap
+    totals -9 against -9.5: margin 0.5) -- a close call.
+    Track 2 then drops to 1e-7 and is pruned; track 1 is reported. The bus class has nothing.
+    Frame 2: nothing; track 1 is pruned. Plus one event of every tracker-specific kind."""
     cov = np.tile(np.diag([1.0, 1.0, 2.0, 2.0]), (2, 1, 1))
     mean2 = np.array([[10.0, 2.0, 1.0, 0.0], [20.0, 5.0, 0.0, 0.0]])
     return [
         frame(0),
+        received([10.0, 20.0]),
         Predicted("car", np.zeros(0, int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0)),
-        CostMatrix("car", np.array([[np.inf, -1.0], [-2.0, np.inf]]), (meas(0), meas(1)), (new(1), new(0))),
+        CostMatrix("car", np.array([[-1.0, INF], [INF, -2.0]]), (meas(0), meas(1)), (new(0), new(1))),
         Assignment("car", ((meas(0), new(0)), (meas(1), new(1))), -3.0, ()),
         Born("car", np.array([1, 2]), np.array([0, 1]), mean2, np.array([0.97, 0.4])),
         Posterior("car", np.array([1, 2]), mean2, cov, np.array([0.97, 0.4])),
-        Extracted("car", (est(1, 10.0, 0.97),), 0.9),
-        TrackLogic("car", 1, TrackLogicAction.CONFIRMED, 3, 4),
+        Extracted("car", (est(1, 10.0, 0.97, 0),), 0.9),
+        TrackLogic("car", 1, TrackLogicAction.DELETED, 0, 4),
         frame(1),
+        received([10.5, 11.0]),
         Predicted("car", np.array([1, 2]), mean2, cov, np.array([0.68, 0.28])),
-        Gated("car", np.array([1, 2]), np.array([0]), np.array([[True], [False]]), mean2[:, :2], cov[:, :2, :2], 40.0),
-        CostMatrix("car", np.array([[-4.0, np.inf, 0.0]]), (meas(0),), (track(1), track(2), new(0))),
+        Gated(
+            "car",
+            np.array([1, 2]),
+            np.array([0, 1]),
+            np.array([[True, True], [True, False]]),
+            mean2[:, :2],
+            cov[:, :2, :2],
+            40.0,
+        ),
+        CostMatrix(
+            "car",
+            np.array([[-5.0, -4.0, 1.0, INF], [-5.0, -4.5, INF, 1.0]]),
+            (meas(0), meas(1)),
+            (track(1), track(2), new(0), new(1)),
+        ),
+        Assignment("car", ((meas(0), track(1)), (meas(1), track(2))), -9.5, ()),
         Posterior("car", np.array([1, 2]), mean2, cov, np.array([0.99, 1e-7])),
         Pruned("car", 2, PruneReason.LOW_EXISTENCE, 1e-7),
-        Extracted("car", (est(1, 11.0, 0.99),), 0.9),
+        Extracted("car", (est(1, 11.0, 0.99, 0),), 0.9),
         Extracted("bus", (), 0.9),
         GlobalHypotheses("car", np.array([-0.1, -2.4]), ((1,), (1, 2)), ((0,), (0, 1))),
         Marginals("car", np.array([[0.8, 0.2]]), (meas(0),), (track(1), new(0)), "lbp", 7),
@@ -88,100 +121,148 @@ def scripted_events() -> list:
         Cardinality("car", np.array([0.1, 0.6, 0.3])),
         IntensityWeights("car", np.array([1, 3]), np.array([0.8, 0.3])),
         frame(2),
-        Extracted("car", (), 0.9),
         Posterior("car", np.zeros(0, int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0)),
+        Pruned("car", 1, PruneReason.LOW_EXISTENCE, 0.05),
+        Extracted("car", (), 0.9),
     ]
+
+
+def log_all(stream: rr.RecordingStream, events: list, **kwargs) -> TrackerLogger:
+    logger = TrackerLogger(stream, T, **kwargs)
+    for event in events:
+        logger.emit(event)
+    logger.finish()
+    logger.finish()
+    return logger
 
 
 @pytest.fixture
 def logged(saved_stream: tuple[rr.RecordingStream, Path]) -> tuple[dict, Path]:
     stream, path = saved_stream
-    logger = TrackerLogger(stream, T)
-    for event in scripted_events():
-        logger.emit(event)
-    logger.finish()
-    logger.finish()
+    log_all(stream, scripted_events())
     stream.disconnect()
     return read_rows(path), path
 
 
-def test_tracks_are_boxes_with_id_colours_and_labels_and_vanish_without_tracks(logged: tuple[dict, Path]) -> None:
-    rows = logged[0][paths.tracks(T, "car")]
+def lines(rows: list[dict], frame_index: int) -> list[tuple[str, str]]:
+    return [
+        (t, lv)
+        for r in at_frame(rows, frame_index)
+        for t, lv in zip(r["TextLog:text"], r["TextLog:level"], strict=True)
+    ]
+
+
+def test_each_track_is_one_entity_with_its_box_id_label_and_trail(logged: tuple[dict, Path]) -> None:
+    rows = logged[0][paths.track(T, "car", 1)]
     first = at_frame(rows, 0)[0]
-    assert first["Boxes3D:labels"] == ["1 car r=0.97"]
+    assert first["Boxes3D:labels"] == ["1"]
     np.testing.assert_allclose(first["Boxes3D:centers"], [[10.0, 2.0, 0.9]], rtol=1e-6)
     # devkit wlh (2.0, 4.5, 1.6) -> half extents along the box's x, y, z
     np.testing.assert_allclose(first["Boxes3D:half_sizes"], [[2.25, 1.0, 0.8]], rtol=1e-6)
-    r, g, b = track_colors(np.array([1]))[0]
-    assert first["Boxes3D:colors"] == [(int(r) << 24) | (int(g) << 16) | (int(b) << 8) | 255]
+    assert first["Boxes3D:colors"] == [int(pack_rgba(track_colors(np.array([1])))[0])]
     np.testing.assert_allclose(latest_at(rows, 1, "Boxes3D:centers"), [[11.0, 2.0, 0.9]], rtol=1e-6)
-    assert latest_at(rows, 2, "Boxes3D:centers") is None
-    assert paths.tracks(T, "bus") not in logged[0]  # never had tracks: nothing to draw or clear
+    trail = latest_at(rows, 1, "LineStrips3D:strips")
+    np.testing.assert_allclose(np.array(trail[0])[:, :2], [[10.0, 2.0], [10.0, 2.0]])  # posterior means, frames 0-1
+    assert latest_at(rows, 2, "Boxes3D:centers") is None  # cleared when no longer reported
+    assert paths.track(T, "car", 2) not in logged[0]  # a candidate never gets a box
+    assert not any(p.startswith(paths.tracks(T, "bus")) for p in logged[0])
 
 
-def test_gates_are_closed_ellipses_cleared_when_not_redrawn(logged: tuple[dict, Path]) -> None:
-    rows = logged[0][paths.gates(T, "car")]
-    strips = latest_at(rows, 1, "LineStrips3D:strips")
-    assert len(strips) == 2
+def test_an_association_line_for_every_assigned_pair_and_dim_lines_for_gated_rejects(
+    logged: tuple[dict, Path],
+) -> None:
+    rows = logged[0]
+    chosen = at_frame(rows[paths.associations(T, "car")], 1)[0]
+    strips = [np.array(s) for s in chosen["LineStrips3D:strips"]]
+    assert len(strips) == 2  # m0 -> 1 and m1 -> 2: every assigned (detection, track) pair
+    np.testing.assert_allclose(strips[0], [[10.0, 2.0, 1.0], [10.5, 2.0, 1.0]])  # prediction of 1 -> m0
+    np.testing.assert_allclose(strips[1], [[20.0, 5.0, 1.0], [11.0, 2.0, 1.0]])
+    assert chosen["LineStrips3D:labels"] == ["m0 → 1 (cost -5.00)", "m1 → 2 (cost -4.50)"]
+    assert chosen["LineStrips3D:colors"] == [int(c) for c in pack_rgba(track_colors(np.array([1, 2])))]
+    rejected = at_frame(rows[paths.gated_pairs(T, "car")], 1)[0]
+    assert rejected["LineStrips3D:labels"] == [
+        "m1 in gate of 1, not chosen (cost -5.00)",
+        "m0 in gate of 2, not chosen (cost -4.00)",
+    ]
+    assert all(c & 0xFF == 90 for c in rejected["LineStrips3D:colors"])  # dimmed
+    assert latest_at(rows[paths.associations(T, "car")], 2, "LineStrips3D:strips") is None
+
+
+def test_gates_and_predictions_only_for_tracks_worth_it(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
+    stream, path = saved_stream
+    log_all(stream, scripted_events(), gate_min_existence=0.5)
+    stream.disconnect()
+    rows = read_rows(path)
+    strips = latest_at(rows[paths.gates(T, "car")], 1, "LineStrips3D:strips")
+    assert len(strips) == 1  # track 1 (prior r = 0.68) only; track 2 (r = 0.28) is a candidate
     outline = np.array(strips[0])
     assert outline.shape == (33, 3)
     np.testing.assert_allclose(outline[0], outline[-1], atol=1e-9)
-    # cov[:2, :2] = I and threshold 40: a circle of radius sqrt(40) around (10, 2), drawn at the track's box height.
     np.testing.assert_allclose(np.hypot(outline[:, 0] - 10.0, outline[:, 1] - 2.0), np.sqrt(40.0), rtol=1e-6)
-    np.testing.assert_allclose(outline[:, 2], 0.9, rtol=1e-6)
-    np.testing.assert_allclose(np.array(strips[1])[:, 2], 0.0)  # track 2 was never extracted: gate_z_m
-    assert latest_at(rows, 2, "LineStrips3D:strips") is None
-    assert latest_at(logged[0][paths.predicted(T, "car")], 1, "Points3D:positions.len") == 2
+    np.testing.assert_allclose(outline[:, 2], 0.9, rtol=1e-6)  # at the track's box height
+    assert latest_at(rows[paths.gates(T, "car")], 2, "LineStrips3D:strips") is None
+    assert latest_at(rows[paths.predicted(T, "car")], 1, "Points3D:positions.len") == 1
+    assert latest_at(rows[paths.candidates_world(T, "car")], 1, "Points3D:positions.len") == 1
 
 
-def test_cost_matrix_heat_map_and_table(logged: tuple[dict, Path]) -> None:
-    rows = logged[0][paths.cost_matrix(T, "car")]
-    tensor = at_frame(rows, 0)[0]["Tensor:data"][0]
-    assert tensor["shape"] == [2, 2]
-    assert tensor["names"] == ["meas", "new"]
-    lo, hi = at_frame(rows, 0)[0]["Tensor:value_range"][0]
-    heat = np.array(tensor["buffer"]).reshape(2, 2)
-    assert heat[0, 1] == pytest.approx(1.0) and heat[1, 0] == pytest.approx(2.0)
-    assert heat[0, 0] == heat[1, 1] == pytest.approx(lo) and lo < 1.0 and hi == pytest.approx(2.0)
-    # Frame 1: track 2 has no measurement in its gate, so its all-impossible column is left out of the heat map.
-    assert at_frame(rows, 1)[0]["Tensor:data"][0]["names"] == ["meas", "track|new"]
-    assert at_frame(rows, 1)[0]["Tensor:data"][0]["shape"] == [1, 2]
-    assert latest_at(rows, 2, "Tensor:data") is None
-    table = at_frame(logged[0][paths.cost_axes(T, "car")], 1)[0]["TextDocument:text"][0]
-    assert "| **meas 0** | -4.00 | - | 0.00 |" in table
-    assert "track 2" in table
+def test_decision_view_names_the_choice_the_alternative_and_the_margin(logged: tuple[dict, Path]) -> None:
+    rows = logged[0]
+    doc = at_frame(rows[paths.decisions(T)], 1)[0]["TextDocument:text"][0]
+    assert "tracks 1 (+1 candidate) · detections m0, m1 — closest margin 0.50 **close call**" in doc
+    assert "| m0 | **track 1** | -5.00 | track 2 | -4.00 | 0.50 |" in doc
+    assert "| m1 | **track 2** | -4.50 | track 1 | -5.00 | 0.50 |" in doc
+    grid = rows[f"{paths.decision_matrix(T)}/cells"]
+    cells = at_frame(grid, 1)[0]
+    # Columns: track 1, track 2 (a candidate, but given m1), new; rows m0, m1; finite cells only.
+    assert cells["Boxes2D:labels"] == ["-5.0", "-4.0", "1.0", "-5.0", "-4.5", "1.0"]
+    chosen = at_frame(rows[f"{paths.decision_matrix(T)}/chosen"], 1)[0]
+    np.testing.assert_allclose(chosen["Boxes2D:centers"], [[0.5, 0.5], [1.5, 1.5]])
+    axes = at_frame(rows[f"{paths.decision_matrix(T)}/axes"], 1)[0]["Points2D:labels"]
+    assert axes == ["car, margin 0.50", "1", "2", "new", "m0", "m1"]
+    frame0 = at_frame(rows[paths.decisions(T)], 0)[0]["TextDocument:text"][0]
+    assert "2 detections outside every gate (new track or clutter): m0, m1" in frame0
 
 
-def test_event_log_levels_and_texts(logged: tuple[dict, Path]) -> None:
+def test_story_log_tells_each_reported_track_and_aggregates_candidates(logged: tuple[dict, Path]) -> None:
     rows = logged[0][paths.events(T, "car")]
-    frame0 = [(t, lv) for r in at_frame(rows, 0) for t, lv in zip(r["TextLog:text"], r["TextLog:level"], strict=True)]
-    assert ("born track 1 from meas 0 at (10.0, 2.0) r=0.970", "INFO") in frame0
-    assert ("track 1 confirmed (3/4 hits)", "INFO") in frame0
-    assert any(t.startswith("h0 assignment, cost -3.000: meas 0->new 0") and lv == "DEBUG" for t, lv in frame0)
-    frame1 = [(t, lv) for r in at_frame(rows, 1) for t, lv in zip(r["TextLog:text"], r["TextLog:level"], strict=True)]
-    assert ("pruned track 2: existence below pruning threshold (last 1e-07)", "WARN") in frame1
-    assert any(t.startswith("merged 1, 3 into 1") for t, _ in frame1)
-    assert any(t.startswith("marginals 1x2 by lbp, 7 iterations") for t, _ in frame1)
+    frame0 = lines(rows, 0)
+    assert ("track 1 confirmed (r=0.97, from m0)", "INFO") in frame0
+    assert ("2 new candidates from m0, m1; 0 candidates pruned", "DEBUG") in frame0
+    assert ("track 1 deleted (0/4 hits)", "WARN") in frame0
+    frame1 = lines(rows, 1)
+    assert ("close call: m1 → track 2 (cost -4.50) over track 1 (-5.00), margin 0.50", "INFO") in frame1
+    assert ("0 new candidates; 1 candidates pruned", "DEBUG") in frame1
+    assert ("merged 1, 3 into track 1 (weights 0.7, 0.3)", "INFO") in frame1
+    assert any(t.startswith("2 detections: 2 updated tracks, 0 new or clutter") for t, _ in frame1)
+    assert ("track 1 ended: existence below pruning threshold (last r=0.05)", "WARN") in lines(rows, 2)
+    assert max(len(t) for r in rows if "TextLog:text" in r for t in r["TextLog:text"]) < 200
 
 
-def test_existence_series_are_sent_column_wise_one_chunk_per_track(logged: tuple[dict, Path]) -> None:
+def test_series_per_reported_track_one_chunk_each_and_candidates_counted(logged: tuple[dict, Path]) -> None:
     rows, path = logged
     series = rows[paths.existence(T, "car", 1)]
     temporal = [r for r in series if not r["static"]]
     assert [r["frame"] for r in temporal] == [0, 1]
     assert [r["Scalars:scalars"][0] for r in temporal] == pytest.approx([0.97, 0.99])
-    assert [r for r in series if r["static"]][0]["SeriesLines:names"] == ["1 car"]
+    assert [r for r in series if r["static"]][0]["SeriesLines:names"] == ["1 car existence"]
     chunks = [c for c in RrdReader(path).store().stream() if c.entity_path == "/" + paths.existence(T, "car", 1)]
     assert len([c for c in chunks if not c.is_static]) == 1
-    # Track 2 is never extracted: its series is a candidate's, kept out of the default existence plot.
-    assert paths.existence(T, "car", 2) not in rows
-    assert [r["frame"] for r in rows[paths.candidate_existence(T, "car", 2)] if not r["static"]] == [0, 1]
+    nis = [r["Scalars:scalars"][0] for r in rows[paths.nis(T, "car", 1)] if not r["static"]]
+    assert nis == pytest.approx([0.25])  # m0 at 0.5 m from the prediction, S = I
+    cost = [r["Scalars:scalars"][0] for r in rows[paths.chosen_cost(T, "car", 1)] if not r["static"]]
+    assert cost == pytest.approx([-5.0])
+    # Track 2 was never reported: no series of its own, only the per-class candidate count.
+    assert paths.existence(T, "car", 2) not in rows and paths.nis(T, "car", 2) not in rows
+    counts = [r["Scalars:scalars"][0] for r in rows[paths.candidate_count(T, "car")] if not r["static"]]
+    assert counts == [0.0, 0.0]  # at frame 1 both tracks were drawn (default gate_min_existence 0.1)
 
 
 def test_tracker_specific_plots(logged: tuple[dict, Path]) -> None:
     rows = logged[0]
-    weights = [r["Scalars:scalars"][0] for r in rows[paths.hypothesis_weight(T, "car", 1)] if not r["static"]]
-    assert weights == pytest.approx([-2.4])
+    weights = [r["Scalars:scalars"] for r in rows[paths.hypothesis_weights(T, "car")] if not r["static"]]
+    assert weights[0][:2] == pytest.approx([-0.1, -2.4]) and np.isnan(weights[0][2:]).all()
+    names = [r for r in rows[paths.hypothesis_weights(T, "car")] if r["static"]][0]["SeriesLines:names"]
+    assert names[:2] == ["car h0", "car h1"]
     marg = at_frame(rows[paths.marginals(T, "car")], 1)[0]
     assert marg["Tensor:data"][0]["buffer"] == pytest.approx([0.8, 0.2])
     assert marg["Tensor:value_range"][0] == [0.0, 1.0]
@@ -192,6 +273,24 @@ def test_tracker_specific_plots(logged: tuple[dict, Path]) -> None:
     assert mean == pytest.approx([1.2])
     total = [r["Scalars:scalars"][0] for r in rows[paths.intensity_total(T, "car")] if not r["static"]]
     assert total == pytest.approx([1.1])
+
+
+def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
+    stream, path = saved_stream
+    logger = log_all(stream, scripted_events(), clock=Clock(focus_end=1), log_frames=range(1, 3), focus_tracks={2})
+    stream.disconnect()
+    rows = read_rows(path)
+    assert not at_frame(rows[paths.track(T, "car", 1)], 0)  # frame 0 is outside the recorded window
+    assert at_frame(rows[paths.track(T, "car", 1)], 1)[0]["Boxes3D:labels"] == ["1"]
+    assert [r["frame"] for r in rows[paths.existence(T, "car", 1)] if not r["static"]] == [0, 1]  # history
+    assert [r.get("focus") for r in rows[paths.existence(T, "car", 1)] if not r["static"]] == [0, 1]
+    assert {r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 1)} == {1}
+    assert [r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 2)] == [None]  # past the focus
+    step = logger.track_steps[2][1]
+    assert (step.prior_existence, step.given, step.reported) == (pytest.approx(0.28), 1, False)
+    assert [m for m, _ in step.gated] == [0]
+    labels = at_frame(rows[paths.predicted_focus(T, "car")], 1)[0]
+    assert labels["Points3D:labels"] == ["2 predicted, r=0.28"] and labels["Points3D:show_labels"] == [True]
 
 
 def test_events_outside_a_frame_and_unknown_events_are_rejected(saved_stream) -> None:
@@ -212,42 +311,13 @@ def test_logger_is_a_sink_usable_in_a_tee() -> None:
     assert TeeSink(ListSink(), TrackerLogger(rr.RecordingStream("y"), T)).enabled
 
 
-def test_cost_heat_sentinel_sits_below_every_finite_value() -> None:
-    heat, (lo, hi) = cost_heat(np.array([[1.0, np.inf], [np.nan, 3.0]]))
-    assert heat.dtype == np.float32
-    assert hi == pytest.approx(-1.0) and heat[1, 1] == pytest.approx(-3.0)
-    assert heat[0, 1] == heat[1, 0] == pytest.approx(lo) and lo < -3.0
-    all_inf, (lo2, hi2) = cost_heat(np.full((2, 2), np.inf))
-    assert np.all(all_inf == lo2) and lo2 < hi2
-    single, (lo3, hi3) = cost_heat(np.array([[2.0]]))
-    assert lo3 < single[0, 0] <= hi3
-
-
-def test_axis_names_and_large_table() -> None:
-    assert axis_dim_name((track(1), track(2), new(0))) == "track|new"
-    assert axis_dim_name(()) == "empty"
-    cost = np.full((30, 60), np.inf)
-    cost[np.arange(30), 30 + np.arange(30)] = 0.5
-    cost[3, 7] = -1.25
-    big = CostMatrix(
-        "car",
-        cost,
-        tuple(meas(j) for j in range(30)),
-        tuple([track(t) for t in range(30)] + [new(j) for j in range(30)]),
-    )
-    text = cost_markdown(big)
-    assert "|" not in text
-    assert "- **meas 3**: track 7 -1.25, new 3 0.50\n" in text
-    assert "- **meas 4**: new 4 0.50\n" in text
-
-
 def test_two_trackers_share_one_recording_without_touching_each_other(saved_stream) -> None:
     stream, path = saved_stream
     for name, x in [("gnnpmb", 10.0), ("pmbm", 50.0)]:
         logger = TrackerLogger(stream, name, log_predicted=False)
         for event in scripted_events():
             if isinstance(event, FrameStarted):
-                event = FrameStarted(name, event.frame_index, event.sample_token, event.timestamp_us, event.dt_s)
+                event = frame(event.frame_index, name)
             elif isinstance(event, Extracted) and event.estimates:
                 event = Extracted("car", (est(1, x, 0.97),), 0.9)
             logger.emit(event)
@@ -255,42 +325,6 @@ def test_two_trackers_share_one_recording_without_touching_each_other(saved_stre
     stream.disconnect()
     rows = read_rows(path)
     for name, x in [("gnnpmb", 10.0), ("pmbm", 50.0)]:
-        assert latest_at(rows[paths.tracks(name, "car")], 1, "Boxes3D:centers")[0][0] == pytest.approx(x)
+        assert latest_at(rows[paths.track(name, "car", 1)], 1, "Boxes3D:centers")[0][0] == pytest.approx(x)
         assert len([r for r in rows[paths.existence(name, "car", 1)] if not r["static"]]) == 2
         assert paths.predicted(name, "car") not in rows
-
-
-def test_cost_heat_map_hides_columns_with_no_possible_assignment() -> None:
-    from gnnpmb.events import AxisKind, AxisLabel, CostMatrix
-    from viz.logger import compact_cost
-
-    inf = np.inf
-    event = CostMatrix(
-        "car",
-        np.array([[1.0, inf, 2.0, inf], [inf, inf, inf, 3.0]]),
-        (AxisLabel(AxisKind.MEASUREMENT, 0), AxisLabel(AxisKind.MEASUREMENT, 1)),
-        (
-            AxisLabel(AxisKind.TRACK, 5),
-            AxisLabel(AxisKind.TRACK, 6),
-            AxisLabel(AxisKind.NEW_TRACK, 0),
-            AxisLabel(AxisKind.NEW_TRACK, 1),
-        ),
-    )
-    out = compact_cost(event)
-    assert [str(c) for c in out.cols] == ["track 5", "new 0", "new 1"]
-    assert out.cost.shape == (2, 3) and "1 columns" in out.description
-    full = dataclasses.replace(event, cost=np.ones((2, 4)))
-    assert compact_cost(full) is full
-
-
-def test_gates_of_unlikely_candidates_are_not_drawn(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
-    stream, path = saved_stream
-    logger = TrackerLogger(stream, T, gate_min_existence=0.5)
-    for event in scripted_events():
-        logger.emit(event)
-    logger.finish()
-    stream.disconnect()
-    strips = latest_at(read_rows(path)[paths.gates(T, "car")], 1, "LineStrips3D:strips")
-    assert len(strips) == 1  # track 1 (prior r = 0.68) only; track 2 (r = 0.28) is below 0.5
-    np.testing.assert_allclose(np.hypot(np.array(strips[0])[:, 0] - 10.0, np.array(strips[0])[:, 1] - 2.0),
-                               np.sqrt(40.0), rtol=1e-6)

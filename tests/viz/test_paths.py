@@ -11,13 +11,17 @@ def test_spatial_entities_follow_the_transform_tree() -> None:
     assert paths.DETECTIONS_KEPT == "world/detections/kept"
     assert paths.DETECTIONS_SUPPRESSED == "world/detections/suppressed"
     assert paths.tracks("gnnpmb", "car") == "world/trackers/gnnpmb/tracks/car"
+    assert paths.track("gnnpmb", "car", 802) == "world/trackers/gnnpmb/tracks/car/802"
+    assert paths.associations("gnnpmb", "car") == "world/trackers/gnnpmb/associations/car"
+    assert paths.candidates_world("gnnpmb", "car") == "world/trackers/gnnpmb/candidates/car"
     assert paths.gates("pmbm", "bus") == "world/trackers/pmbm/gates/bus"
     assert paths.failures_world("gnn", "id_switch") == "world/trackers/gnn/failures/id_switch"
 
 
 def test_non_spatial_entities_live_under_the_tracker() -> None:
-    assert paths.cost_matrix("gnnpmb", "car") == "trackers/gnnpmb/cost/car"
-    assert paths.cost_matrix("pmbm", "car", hypothesis=2) == "trackers/pmbm/cost_hypotheses/car/2"
+    assert paths.decisions("gnnpmb") == "trackers/gnnpmb/decisions"
+    assert paths.nis("gnnpmb", "car", 17) == "trackers/gnnpmb/nis/car/17"
+    assert paths.hypothesis_weights("pmbm", "car") == "trackers/pmbm/hypotheses/car"
     assert paths.existence("gnnpmb", "car", 17) == "trackers/gnnpmb/existence/car/17"
     assert paths.events("jpda", "truck") == "trackers/jpda/events/truck"
     assert paths.cardinality_pmf("cphd", "car").startswith(paths.cardinality_pmf_root("cphd") + "/")
@@ -27,7 +31,8 @@ def test_non_spatial_entities_live_under_the_tracker() -> None:
 def test_every_tracker_entity_sits_in_its_own_subtree() -> None:
     """Two trackers never share an entity, so both fit in one recording."""
     makers = [
-        paths.tracks, paths.predicted, paths.gates, paths.cost_matrix, paths.cost_axes, paths.events, paths.marginals,
+        paths.tracks, paths.predicted, paths.gates, paths.associations, paths.gated_pairs, paths.candidates_world,
+        paths.events, paths.marginals, paths.candidate_count, paths.hypothesis_weights,
         paths.cardinality_pmf, paths.cardinality_mean, paths.intensity_weights, paths.intensity_total,
     ]  # fmt: skip
     a = {m("gnnpmb", "car") for m in makers}

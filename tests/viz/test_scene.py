@@ -51,10 +51,10 @@ def test_gt_boxes_with_class_ids_and_short_labels(scene_rows: dict) -> None:
 
 def test_detections_kept_and_dimmed_suppressed(scene_rows: dict) -> None:
     kept = at_frame(scene_rows[paths.DETECTIONS_KEPT], 1)[0]
-    assert kept["Boxes3D:labels"] == ["0.90"] and kept["Boxes3D:class_ids"] == [3]
+    assert kept["Boxes3D:labels"] == ["m0 0.90"] and kept["Boxes3D:class_ids"] == [3]  # m<source index> <score>
     np.testing.assert_allclose(kept["Boxes3D:centers"], [[11.2, 2.1, 1.0]], rtol=1e-6)
     dropped = at_frame(scene_rows[paths.DETECTIONS_SUPPRESSED], 1)[0]
-    assert dropped["Boxes3D:labels"] == ["0.50 nms", "0.05 low"]
+    assert dropped["Boxes3D:labels"] == ["m1 0.50 nms", "m2 0.05 low"]
     assert [c & 0xFF for c in dropped["Boxes3D:colors"]] == [70, 70]
 
 

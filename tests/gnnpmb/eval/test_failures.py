@@ -100,7 +100,10 @@ def test_deliberate_id_switch_is_reported_at_its_frame_with_the_ids(nusc, scene:
     assert (switch.frame_index, switch.class_name) == (k, class_name)
     assert switch.sample_token == scene.keyframes[k].sample_token
     assert switch.gt_ids == (instance,) and switch.track_ids == (instance, "switched")
-    assert {b.role for b in switch.boxes} == {"gt", "new track"}
+    # The lost track's box is where it was last reported (frame k - 1), so the marker shows both tracks.
+    assert [b.role for b in switch.boxes] == ["gt", "new track", "old track"]
+    last = next(b for b in results[scene.keyframes[k - 1].sample_token] if b["tracking_id"] == instance)
+    np.testing.assert_allclose(switch.boxes[2].translation_m, last["translation"], atol=1e-6)
     devkit = {c.class_name: c for c in report.classes}[class_name]
     assert devkit.ids == 1 and devkit.mota < 1.0
 

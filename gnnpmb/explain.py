@@ -1,0 +1,199 @@
+"""Why the solver chose an association: conflicts, chosen pairs, best alternatives and margins.
+
+Works on the events alone (``CostMatrix`` + ``Assignment`` of one class and frame), for every tracker whose
+matrix has the shared layout: rows are measurements, columns are existing tracks followed by one new-track
+column per measurement; every row is assigned to exactly one column, a track column at most once, and a track
+whose column is unused is missed (cost 0, the reference the PMB costs are relative to).
+
+A *conflict* is a connected group of tracks and measurements linked through *competitive* pairs: a pair links
+when its cost is at most ``LINK_SLACK`` above the measurement's own new-track cost. A pair costlier than that
+never appears in an assignment within ``LINK_SLACK`` of the best one (swapping that measurement to its own,
+always free, new-track column is cheaper by more than the slack), so the conflicts are exact for every decision
+closer than the slack, and stay small even when wide gates of low-existence candidates overlap everything.
+For every chosen pair the *margin* is how much the best assignment of the conflict gets worse when that pair is
+forbidden (re-solved with the Hungarian algorithm), capped at ``LINK_SLACK``: a margin near 0 is a close call,
+the usual cause of an ID switch.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix
+
+LINK_SLACK = 5.0
+"""Pairs costlier than the measurement's new-track cost plus this do not link a conflict; margins are capped at
+it (in cost units: nats for the PMB family)."""
+
+
+@dataclass(frozen=True, slots=True)
+class PairChoice:
+    """One measurement's decision: the chosen column and its cost; the row's cheapest other column
+    (None if it had no other) and its cost; margin = best total without this pair minus the chosen total
+    (inf when no other assignment is possible)."""
+
+    meas: AxisLabel
+    chosen: AxisLabel
+    chosen_cost: float
+    alternative: AxisLabel | None
+    alternative_cost: float
+    margin: float
+
+
+@dataclass(frozen=True, slots=True)
+class Conflict:
+    """Tracks and measurements linked through their gates, with the decisions taken inside.
+
+    track_ids / meas_indices: the members; choices: one per measurement (in row order); missed_track_ids:
+    member tracks given no measurement; total_cost: the chosen assignment's cost over the conflict.
+    """
+
+    class_name: str
+    track_ids: tuple[int, ...]
+    meas_indices: tuple[int, ...]
+    choices: tuple[PairChoice, ...]
+    missed_track_ids: tuple[int, ...]
+    total_cost: float
+
+    @property
+    def closest_margin(self) -> float:
+        """The smallest margin of any choice (inf for a conflict without alternatives)."""
+        return min((c.margin for c in self.choices), default=math.inf)
+
+    def involves(self, track_ids: set[int] = frozenset(), meas_indices: set[int] = frozenset()) -> bool:
+        return bool(track_ids & set(self.track_ids)) or bool(meas_indices & set(self.meas_indices))
+
+
+@dataclass(frozen=True, slots=True)
+class Decisions:
+    """The conflicts of one class and frame (those with at least one track), closest call first, and the
+    measurements that could only start a new track (no track's gate held them)."""
+
+    class_name: str
+    conflicts: tuple[Conflict, ...]
+    births_only: tuple[int, ...]
+    description: str
+
+
+def _competitive(cost: np.ndarray, n_tracks: int) -> np.ndarray:
+    """(R, C) bool: finite entries, track columns only where within LINK_SLACK of the row's new-track cost."""
+    finite = np.isfinite(cost)
+    if cost.shape[0] == 0:
+        return finite
+    birth = cost[np.arange(cost.shape[0]), n_tracks + np.arange(cost.shape[0])]
+    tracks = finite[:, :n_tracks] & (cost[:, :n_tracks] <= birth[:, None] + LINK_SLACK)
+    return np.concatenate([tracks, finite[:, n_tracks:]], axis=1)
+
+
+def _components(finite: np.ndarray, n_tracks: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Connected components of the bipartite gate graph: (rows, track columns) per component with at least
+    one track and one measurement.
+
+    finite: (R, C) bool; only the first n_tracks columns link rows (new-track columns belong to one row)."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n_rows = finite.shape[0]
+    link = finite[:, :n_tracks]
+    r, c = np.nonzero(link)
+    graph = csr_matrix((np.ones(r.size), (r, n_rows + c)), shape=(n_rows + n_tracks, n_rows + n_tracks))
+    _, label = connected_components(graph, directed=False)
+    out = []
+    for comp in np.unique(label):
+        rows = np.flatnonzero(label[:n_rows] == comp)
+        cols = np.flatnonzero(label[n_rows:] == comp)
+        if cols.size and rows.size:
+            out.append((rows, cols))
+    return out
+
+
+def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
+    """The decisions behind ``assignment`` on ``matrix`` (same class, hypothesis and frame).
+
+    Returns None when the matrix does not have the shared layout or the assignment names a column the matrix
+    does not have (e.g. a PMBM child of a prior hypothesis other than the matrix's).
+    """
+    cost = np.asarray(matrix.cost, dtype=np.float64)
+    n_rows = cost.shape[0] if cost.ndim == 2 else 0
+    track_cols = [i for i, c in enumerate(matrix.cols) if c.kind is AxisKind.TRACK]
+    n_tracks = len(track_cols)
+    if (
+        cost.ndim != 2
+        or track_cols != list(range(n_tracks))
+        or any(r.kind is not AxisKind.MEASUREMENT for r in matrix.rows)
+        or any(c.kind is not AxisKind.NEW_TRACK for c in matrix.cols[n_tracks:])
+    ):
+        return None
+    row_of = {label: i for i, label in enumerate(matrix.rows)}
+    col_of = {label: j for j, label in enumerate(matrix.cols)}
+    chosen = np.full(n_rows, -1, dtype=np.int64)
+    for row_label, col_label in assignment.pairs:
+        if row_label not in row_of or col_label not in col_of:
+            return None
+        chosen[row_of[row_label]] = col_of[col_label]
+    if n_rows and (chosen < 0).any():
+        return None
+    if cost.shape[1] != n_tracks + n_rows:
+        return None
+    finite = _competitive(cost, n_tracks)
+    finite[np.arange(n_rows), chosen] = np.isfinite(cost[np.arange(n_rows), chosen])  # whatever was chosen links
+    conflicts = []
+    in_conflict = np.zeros(n_rows, dtype=bool)
+    for rows, tcols in _components(finite, n_tracks):
+        in_conflict[rows] = True
+        conflicts.append(_conflict(matrix, np.where(finite, cost, np.inf), chosen, rows, tcols, n_tracks))
+    conflicts.sort(key=lambda c: (c.closest_margin, c.track_ids))
+    births = tuple(int(matrix.rows[i].ref) for i in np.flatnonzero(~in_conflict))
+    return Decisions(matrix.class_name, tuple(conflicts), births, matrix.description)
+
+
+def _conflict(
+    matrix: CostMatrix, cost: np.ndarray, chosen: np.ndarray, rows: np.ndarray, tcols: np.ndarray, n_tracks: int
+) -> Conflict:
+    """Decisions of one component: its sub-matrix is [its track columns | its rows' new-track columns]."""
+    cols = np.concatenate([tcols, n_tracks + rows])
+    sub = cost[np.ix_(rows, cols)]
+    position = {int(c): k for k, c in enumerate(cols)}
+    chosen_sub = np.array([position.get(int(chosen[r]), -1) for r in rows])
+    total = float(sub[np.arange(rows.size), chosen_sub].sum()) if rows.size else 0.0
+    choices = []
+    for i, r in enumerate(rows):
+        j = chosen_sub[i]
+        others = np.where(np.arange(cols.size) == j, np.inf, sub[i])
+        k = int(np.argmin(others)) if others.size else -1
+        has_alt = k >= 0 and np.isfinite(others[k])
+        choices.append(
+            PairChoice(
+                meas=matrix.rows[r],
+                chosen=matrix.cols[cols[j]],
+                chosen_cost=float(sub[i, j]),
+                alternative=matrix.cols[cols[k]] if has_alt else None,
+                alternative_cost=float(others[k]) if has_alt else math.inf,
+                margin=_margin(sub, i, j, total),
+            )
+        )
+    used = {int(cols[j]) for j in chosen_sub if cols[j] < n_tracks}
+    missed = tuple(int(matrix.cols[c].ref) for c in tcols if int(c) not in used)
+    return Conflict(
+        matrix.class_name,
+        tuple(int(matrix.cols[c].ref) for c in tcols),
+        tuple(int(matrix.rows[r].ref) for r in rows),
+        tuple(choices),
+        missed,
+        total,
+    )
+
+
+def _margin(sub: np.ndarray, i: int, j: int, total: float) -> float:
+    """Best total of ``sub`` with entry (i, j) forbidden, minus ``total`` (inf if then infeasible)."""
+    forbidden = sub.copy()
+    forbidden[i, j] = np.inf
+    try:
+        _, best = solve(forbidden)
+    except InfeasibleAssignment:
+        return math.inf
+    return min(max(best - total, 0.0), LINK_SLACK)

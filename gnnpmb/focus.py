@@ -1,0 +1,237 @@
+"""Failure focus: from what the user names (``--focus``) to the frame, place, class and ids a bug-report
+recording opens on.
+
+Accepted forms:
+
+* a failure id printed by ``gnnpmb failures`` (``id_switch:1``, ``coalescence:2``, ...), looked up in the failures
+  of the first tracker;
+* ``track:ID``: the first failure (ID switch, identity theft, coalescence, fragmentation, false track) that involves
+  that track in any tracker's failures, else the last frame the track was reported;
+* ``gt:TOKEN`` (a prefix of a ground-truth instance token is enough): the first failure involving that object,
+  misses last, else the first frame it is visible.
+
+The involved tracks of the other trackers are those reported within ``NEAR_M`` of the involved objects at the
+focus frame, so a comparison recording highlights what each tracker did at the same place.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from gnnpmb.data.scene import SceneData
+from gnnpmb.errors import GnnpmbError
+from gnnpmb.eval.failures import Failure, FailureKind, FailureReport, short_id
+from gnnpmb.types import TrackEstimate
+
+FRAMES_BEFORE = 8
+FRAMES_AFTER = 4
+"""A focus recording holds the keyframes from FRAMES_BEFORE before the focus frame to FRAMES_AFTER after it."""
+NEAR_M = 2.0
+"""Tracks of other trackers within this BEV distance of an involved object are involved too (the devkit's match
+distance)."""
+_SPEC = re.compile(r"^(?P<kind>[a-z_]+):(?P<ref>\S+)$")
+_KIND_ORDER = (
+    FailureKind.IDENTITY_THEFT,
+    FailureKind.ID_SWITCH,
+    FailureKind.COALESCENCE,
+    FailureKind.FRAGMENTATION,
+    FailureKind.FALSE_TRACK,
+    FailureKind.MISS,
+)
+
+
+@dataclass(frozen=True, slots=True)
+class FocusTarget:
+    """What a focus recording opens on.
+
+    title: the failure in words; frame_index: the keyframe shown on opening; center_xy_m: global BEV centre of
+    the place; class_name; track_ids: involved track ids per tracker; gt_ids: involved instance tokens;
+    failure_id: the id ``gnnpmb failures`` prints (None when the focus is not a failure).
+    """
+
+    title: str
+    frame_index: int
+    center_xy_m: tuple[float, float]
+    class_name: str
+    track_ids: dict[str, tuple[int, ...]]
+    gt_ids: tuple[str, ...]
+    failure_id: str | None = None
+
+    def window(self, frames: range) -> range:
+        """The keyframes of a focus recording, within ``frames``."""
+        start = max(frames.start, self.frame_index - FRAMES_BEFORE)
+        return range(start, min(frames.stop, self.frame_index + FRAMES_AFTER + 1))
+
+
+def parse_focus(spec: str) -> tuple[str, str]:
+    """``kind:ref`` -> (kind, ref), checked; raises GnnpmbError naming the accepted forms."""
+    match = _SPEC.match(spec.strip())
+    kinds = {k.value for k in FailureKind}
+    if match is None or (match["kind"] not in kinds | {"track", "gt"}):
+        raise GnnpmbError(
+            f"bad --focus '{spec}': use track:ID, gt:TOKEN or a failure id such as id_switch:1 "
+            f"(gnnpmb failures SCENE --tracker T lists them)"
+        )
+    if match["kind"] == "track" and not match["ref"].isdigit():
+        raise GnnpmbError(f"bad --focus '{spec}': track:ID takes a track number, e.g. track:802")
+    return match["kind"], match["ref"]
+
+
+def resolve_focus(
+    spec: str,
+    scene: SceneData,
+    reports: Mapping[str, FailureReport],
+    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
+    frames: range,
+) -> FocusTarget:
+    """The focus named by ``spec`` on ``scene``.
+
+    reports: each tracker's failures (trackers in command-line order); estimates[tracker][k]: its tracks at
+    keyframe ``frames[k]``. Raises GnnpmbError (one line saying how to find a valid id) when nothing matches.
+    """
+    kind, ref = parse_focus(spec)
+    trackers = list(reports)
+    if kind == "track":
+        return _track_focus(int(ref), scene, reports, estimates, frames)
+    if kind == "gt":
+        return _gt_focus(ref, scene, reports, estimates, frames)
+    first = trackers[0]
+    failure = reports[first].by_id(spec.strip())
+    if failure is None or failure.frame_index not in frames:
+        ids = [i for i in reports[first].ids() if i.startswith(kind + ":")]
+        known = f"it has {ids[0]} to {ids[-1]}" if ids else f"it has no {kind.replace('_', ' ')}"
+        raise GnnpmbError(
+            f"--focus {spec}: no such failure of {first} on {scene.name} in the tracked frames ({known}); "
+            f"gnnpmb failures {scene.name} --tracker {first} lists them"
+        )
+    return _from_failure(failure, first, spec.strip(), scene, estimates, frames)
+
+
+def _from_failure(
+    failure: Failure,
+    tracker: str,
+    failure_id: str | None,
+    scene: SceneData,
+    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
+    frames: range,
+) -> FocusTarget:
+    centers = np.array([b.translation_m[:2] for b in failure.boxes], dtype=np.float64).reshape(-1, 2)
+    gt_centers = np.array([b.translation_m[:2] for b in failure.boxes if b.is_gt], dtype=np.float64).reshape(-1, 2)
+    center = centers.mean(axis=0) if len(centers) else _ego_xy(scene, failure.frame_index)
+    ids: dict[str, tuple[int, ...]] = {}
+    for name, per_frame in estimates.items():
+        own = {int(t) for t in failure.track_ids} if name == tracker else set()
+        near = _tracks_near(per_frame[failure.frame_index - frames.start], failure.class_name, gt_centers)
+        ids[name] = tuple(sorted(own | near))
+    label = failure_id or failure.kind.value
+    return FocusTarget(
+        title=f"{label} at frame {failure.frame_index} ({tracker}): {failure.describe()}",
+        frame_index=failure.frame_index,
+        center_xy_m=(float(center[0]), float(center[1])),
+        class_name=failure.class_name,
+        track_ids=ids,
+        gt_ids=failure.gt_ids,
+        failure_id=failure_id,
+    )
+
+
+def _first_failure(reports: Mapping[str, FailureReport], involved, frames: range) -> tuple[Failure, str, str] | None:
+    """The first failure satisfying ``involved``, by kind priority then frame: (failure, tracker, id)."""
+    found = [
+        (_KIND_ORDER.index(f.kind), f.frame_index, name, fid, f)
+        for name, report in reports.items()
+        for fid, f in zip(report.ids(), report.failures, strict=True)
+        if f.frame_index in frames and involved(f)
+    ]
+    if not found:
+        return None
+    _, _, name, fid, failure = min(found, key=lambda x: x[:2])
+    return failure, name, fid
+
+
+def _track_focus(
+    track_id: int,
+    scene: SceneData,
+    reports: Mapping[str, FailureReport],
+    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
+    frames: range,
+) -> FocusTarget:
+    hit = _first_failure(reports, lambda f: str(track_id) in f.track_ids, frames)
+    if hit is not None:
+        failure, tracker, fid = hit
+        return _from_failure(failure, tracker, fid, scene, estimates, frames)
+    for name, per_frame in estimates.items():
+        seen = [(k, e) for k, est in enumerate(per_frame) for e in est if e.track_id == track_id]
+        if seen:
+            k, e = seen[-1]
+            return FocusTarget(
+                title=f"track {track_id} ({name}, {e.class_name}), last reported at frame {frames[k]}",
+                frame_index=frames[k],
+                center_xy_m=(float(e.translation_m[0]), float(e.translation_m[1])),
+                class_name=e.class_name,
+                track_ids={n: (track_id,) if n == name else () for n in estimates},
+                gt_ids=(),
+            )
+    raise GnnpmbError(
+        f"--focus track:{track_id}: no tracker reported a track {track_id} on {scene.name} in the tracked frames"
+    )
+
+
+def _gt_focus(
+    prefix: str,
+    scene: SceneData,
+    reports: Mapping[str, FailureReport],
+    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
+    frames: range,
+) -> FocusTarget:
+    tokens = sorted({str(t) for i in frames for t in scene.keyframes[i].gt.instance_id if str(t).startswith(prefix)})
+    if not tokens:
+        raise GnnpmbError(f"--focus gt:{prefix}: no ground-truth object of {scene.name} has an id starting so")
+    if len(tokens) > 1:
+        shown = ", ".join(short_id(t) for t in tokens[:5])
+        raise GnnpmbError(f"--focus gt:{prefix} is ambiguous ({shown}...); give more characters of the id")
+    token = tokens[0]
+    hit = _first_failure(reports, lambda f: token in f.gt_ids, frames)
+    if hit is not None:
+        failure, tracker, fid = hit
+        return _from_failure(failure, tracker, fid, scene, estimates, frames)
+    for i in frames:
+        gt = scene.keyframes[i].gt
+        rows = np.flatnonzero(gt.instance_id == token)
+        if rows.size:
+            xy = gt.translation_m[rows[0], :2]
+            class_name = str(gt.class_name[rows[0]])
+            near = {
+                name: tuple(sorted(_tracks_near(per_frame[i - frames.start], class_name, xy[None, :])))
+                for name, per_frame in estimates.items()
+            }
+            return FocusTarget(
+                title=f"GT {short_id(token)} ({class_name}) first visible at frame {i}, no failure",
+                frame_index=i,
+                center_xy_m=(float(xy[0]), float(xy[1])),
+                class_name=class_name,
+                track_ids=near,
+                gt_ids=(token,),
+            )
+    raise AssertionError("token found above")
+
+
+def _tracks_near(estimates: Sequence[TrackEstimate], class_name: str, centers_xy: np.ndarray) -> set[int]:
+    if centers_xy.size == 0:
+        return set()
+    out = set()
+    for e in estimates:
+        if e.class_name != class_name:
+            continue
+        d = np.hypot(centers_xy[:, 0] - e.translation_m[0], centers_xy[:, 1] - e.translation_m[1])
+        if d.min() < NEAR_M:
+            out.add(e.track_id)
+    return out
+
+
+def _ego_xy(scene: SceneData, frame_index: int) -> np.ndarray:
+    return np.asarray(scene.keyframes[frame_index].ego_pose.translation_m[:2], dtype=np.float64)

@@ -1,0 +1,132 @@
+"""``gnnpmb-viz --focus``: a small recording that opens at a failure, looking at it, with the failure explained."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from rerun.chunk import RrdReader
+
+from cli.app import find_reports, main, prepare, rerun_runs
+from tests.viz.rrd import read_rows
+from viz import paths
+from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world
+
+SCENE = "scene-0916"
+SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
+ARGS = ["--detector", "pointpillars"]
+
+
+@pytest.fixture(scope="module")
+def failures_and_runs(demo_dataroot: Path):
+    """The first tracker's failures on the scene (the ids ``gnnpmb failures`` prints) and the runs."""
+    request = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars")
+    runs = rerun_runs(request)
+    reports, _ = find_reports(request, runs)
+    return reports["gnnpmb"], runs
+
+
+def blueprint_rows(path: Path) -> list[tuple[str, dict]]:
+    reader = RrdReader(path)
+    (blueprint,) = reader.blueprints()
+    return [(c.entity_path, row) for c in reader.stream(store=blueprint) for row in c.to_record_batch().to_pylist()]
+
+
+def record(demo_dataroot: Path, tmp_path: Path, focus: str, trackers: tuple[str, ...] = ("gnnpmb",)) -> tuple:
+    out = tmp_path / "focus.rrd"
+    stdout = io.StringIO()
+    argv = [SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out), "--no-progress"]
+    for t in trackers:
+        argv += ["--tracker", t]
+    with contextlib.redirect_stdout(stdout):
+        main(argv)
+    return out, stdout.getvalue()
+
+
+def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
+    demo_dataroot: Path, tmp_path: Path, failures_and_runs
+) -> None:
+    report, _ = failures_and_runs
+    ids = report.ids()
+    pick = next(i for i in ids if not i.startswith("miss:"))
+    failure = report.by_id(pick)
+    out, stdout = record(demo_dataroot, tmp_path, pick)
+    assert f"focus: {pick} at frame {failure.frame_index} (gnnpmb): {failure.describe()}" in stdout
+    rows = read_rows(out)
+    # Only the frames around the failure are recorded; the focus timeline ends at the failure frame.
+    frames = sorted({r["frame"] for r in rows[paths.EGO]})
+    assert frames == list(range(max(0, failure.frame_index - 8), min(40, failure.frame_index + 5)))
+    focus_times = [r["focus"] for r in rows[paths.EGO] if r.get("focus") is not None]
+    assert max(focus_times) == failure.frame_index
+    # The blueprint shows the focus timeline, following the newest data: the viewer opens at the failure.
+    bp = blueprint_rows(out)
+    panel = {k: v for _, r in bp for k, v in r.items() if k.startswith("TimePanelBlueprint:")}
+    assert panel["TimePanelBlueprint:timeline"] == [FOCUS_TIMELINE]
+    eyes = [r for path, r in bp if path.endswith("EyeControls3D")]
+    center = np.mean([b.translation_m[:2] for b in failure.boxes], axis=0)
+    assert len(eyes) == 2  # bird's-eye and perspective, both looking at the place
+    for eye in eyes:
+        np.testing.assert_allclose(eye["EyeControls3D:look_target"][0][:2], center, atol=1e-3)
+    top = next(e for e in eyes if e["EyeControls3D:eye_up"] == [[0.0, 1.0, 0.0]])
+    np.testing.assert_allclose(top["EyeControls3D:position"][0][:2], center, atol=1e-3)  # straight down
+    # The summary names the failure and tells each involved track's frames; the objects are highlighted.
+    summary = rows[focus_doc()][0]["TextDocument:text"][0]
+    assert summary.startswith(f"# {pick} at frame {failure.frame_index}")
+    for t in failure.track_ids:
+        assert f"Track {t}, frame by frame:" in summary
+    highlighted = [r for r in rows[focus_world()] if r.get("frame") == failure.frame_index]
+    labels = highlighted[0]["Boxes3D:labels"]
+    assert any(label.startswith("GT ") for label in labels)
+
+
+def test_focus_on_a_track_and_on_a_ground_truth_prefix(demo_dataroot: Path, tmp_path: Path, failures_and_runs) -> None:
+    report, _ = failures_and_runs
+    failure = next(f for f in report.failures if f.track_ids and f.gt_ids)
+    out, stdout = record(demo_dataroot, tmp_path, f"track:{failure.track_ids[0]}")
+    assert "focus: " in stdout and f"track {failure.track_ids[0]}" in stdout
+    out2, stdout2 = record(demo_dataroot, tmp_path, f"gt:{failure.gt_ids[0][:8]}")
+    assert "focus: " in stdout2
+    summary = read_rows(out2)[focus_doc()][0]["TextDocument:text"][0]
+    assert f"GT {failure.gt_ids[0][:6]}" in summary
+
+
+def test_focus_in_a_comparison_highlights_each_trackers_tracks(
+    demo_dataroot: Path, tmp_path: Path, failures_and_runs
+) -> None:
+    report, _ = failures_and_runs
+    pick = next(i for i in report.ids() if not i.startswith("miss:"))
+    out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", "gnn"))
+    rows = read_rows(out)
+    summary = rows[focus_doc()][0]["TextDocument:text"][0]
+    assert "## gnnpmb" in summary and "## gnn" in summary
+    assert paths.tracker_world("gnnpmb") + "/focus" in rows
+
+
+@pytest.mark.parametrize(
+    ("focus", "message"),
+    [
+        ("switch", "bad --focus 'switch': use track:ID, gt:TOKEN or a failure id such as id_switch:1"),
+        ("track:abc", "bad --focus 'track:abc': track:ID takes a track number"),
+        ("id_switch:999", "--focus id_switch:999: no such failure of gnnpmb on scene-0916"),
+        ("gt:zzzz", "--focus gt:zzzz: no ground-truth object of scene-0916 has an id starting so"),
+    ],
+)
+def test_bad_focus_is_one_line_and_exit_2(demo_dataroot: Path, tmp_path: Path, focus: str, message: str) -> None:
+    out = tmp_path / "x.rrd"
+    proc = subprocess.run(
+        [str(SCRIPT), SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={"PATH": "/usr/bin:/bin", "NO_COLOR": "1", "HOME": str(tmp_path)},
+    )
+    assert proc.returncode == 2, proc.stderr
+    errors = [line for line in proc.stderr.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and message in errors[0], proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir() if p.suffix == ".rrd") == []

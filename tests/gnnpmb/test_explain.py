@@ -1,0 +1,108 @@
+"""Decisions behind an assignment: conflicts, alternatives and margins on hand-computed matrices."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix
+from gnnpmb.explain import LINK_SLACK, explain
+
+INF = math.inf
+
+
+def meas(i: int) -> AxisLabel:
+    return AxisLabel(AxisKind.MEASUREMENT, i)
+
+
+def track(t: int) -> AxisLabel:
+    return AxisLabel(AxisKind.TRACK, t)
+
+
+def new(i: int) -> AxisLabel:
+    return AxisLabel(AxisKind.NEW_TRACK, i)
+
+
+def staged() -> tuple[CostMatrix, Assignment]:
+    """Tracks 7, 8 both gate detections m3 and m5; m9 is outside every gate; track 10 gates nothing.
+
+    Chosen: m3 -> 7 (-5) and m5 -> 8 (-4), total -9; the swap m3 -> 8, m5 -> 7 costs -8.5: margin 0.5.
+    """
+    cost = np.array(
+        [
+            [-5.0, -4.0, INF, 1.0, INF, INF],
+            [-4.5, -4.0, INF, INF, 1.0, INF],
+            [INF, INF, INF, INF, INF, 2.0],
+        ]
+    )
+    rows = (meas(3), meas(5), meas(9))
+    cols = (track(7), track(8), track(10), new(3), new(5), new(9))
+    matrix = CostMatrix("car", cost, rows, cols)
+    assignment = Assignment("car", ((meas(3), track(7)), (meas(5), track(8)), (meas(9), new(9))), -7.0, (10,))
+    return matrix, assignment
+
+
+def test_conflict_choices_alternatives_and_margins_by_hand() -> None:
+    matrix, assignment = staged()
+    d = explain(matrix, assignment)
+    assert d is not None
+    assert d.births_only == (9,)
+    (conflict,) = d.conflicts  # track 10 gates nothing: not a conflict
+    assert conflict.track_ids == (7, 8)
+    assert conflict.meas_indices == (3, 5)
+    assert conflict.total_cost == pytest.approx(-9.0)
+    assert conflict.missed_track_ids == ()
+    first, second = conflict.choices
+    assert (first.meas, first.chosen, first.chosen_cost) == (meas(3), track(7), -5.0)
+    assert (first.alternative, first.alternative_cost) == (track(8), -4.0)
+    assert first.margin == pytest.approx(0.5)
+    assert (second.meas, second.chosen, second.alternative, second.alternative_cost) == (
+        meas(5),
+        track(8),
+        track(7),
+        -4.5,
+    )
+    assert second.margin == pytest.approx(0.5)
+    assert conflict.closest_margin == pytest.approx(0.5)
+
+
+def test_a_missed_track_and_a_birth_inside_a_conflict() -> None:
+    """m3 gates track 7 (cost 2, worse than starting a new track at 1): the solver leaves 7 missed."""
+    cost = np.array([[2.0, 1.0]])
+    matrix = CostMatrix("car", cost, (meas(3),), (track(7), new(3)))
+    d = explain(matrix, Assignment("car", ((meas(3), new(3)),), 1.0, (7,)))
+    assert d is not None
+    (conflict,) = d.conflicts
+    assert conflict.missed_track_ids == (7,)
+    (choice,) = conflict.choices
+    assert (choice.chosen, choice.alternative, choice.margin) == (new(3), track(7), pytest.approx(1.0))
+
+
+def test_conflicts_are_sorted_closest_call_first() -> None:
+    cost = np.array([[-1.0, INF, 5.0, INF], [INF, -1.0, INF, -0.8]])
+    matrix = CostMatrix("car", cost, (meas(0), meas(1)), (track(1), track(2), new(0), new(1)))
+    d = explain(matrix, Assignment("car", ((meas(0), track(1)), (meas(1), track(2))), -2.0, ()))
+    assert d is not None
+    assert [c.track_ids for c in d.conflicts] == [(2,), (1,)]
+    # Track 1's margin is 6 by hand; margins are capped at LINK_SLACK (5).
+    assert [c.closest_margin for c in d.conflicts] == [pytest.approx(0.2), pytest.approx(LINK_SLACK)]
+
+
+def test_pairs_far_costlier_than_a_new_track_do_not_link_conflicts() -> None:
+    """Track 2 gates both detections but explains m1 10 nats worse than a new track would: two conflicts."""
+    cost = np.array([[-1.0, 0.5, 1.0, INF], [INF, 11.0, INF, 1.0]])
+    matrix = CostMatrix("car", cost, (meas(0), meas(1)), (track(1), track(2), new(0), new(1)))
+    d = explain(matrix, Assignment("car", ((meas(0), track(1)), (meas(1), new(1))), 0.0, (2,)))
+    assert d is not None
+    assert sorted(c.meas_indices for c in d.conflicts) == [(0,)]
+    assert d.births_only == (1,)
+
+
+def test_other_layouts_and_unknown_columns_are_not_explained() -> None:
+    matrix, assignment = staged()
+    other = Assignment("car", ((meas(3), track(99)),), 0.0, ())
+    assert explain(matrix, other) is None
+    transposed = CostMatrix("car", matrix.cost.T, matrix.cols, matrix.rows)
+    assert explain(transposed, assignment) is None

@@ -1,0 +1,242 @@
+"""The decision view: why the solver chose each association this frame (``gnnpmb.explain``), as text and as a
+labelled cost grid.
+
+``decisions_markdown`` lists, per class, each conflict (tracks and detections linked through gates), closest call
+first: for every detection the chosen column and its cost, the best alternative and its cost, and the margin
+(how much worse the best assignment gets without that pair). ``decision_grid`` lays the same conflicts out as a
+2D cost grid: one block per class, rows = detections (``m<idx>``), columns = tracks and one "new" column (each
+detection's own birth/clutter cost), each cell labelled with its cost and the chosen cells outlined, so the grid
+and the table show exactly the same columns.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from gnnpmb.events import AxisKind, AxisLabel, CostMatrix
+from gnnpmb.explain import Conflict, Decisions
+
+CLOSE_CALL_MARGIN = 1.0
+"""A choice whose margin (in cost units, nats for the PMB family) is below this is flagged as a close call."""
+MAX_CONFLICTS_PER_CLASS = 6
+"""The decision document lists at most this many conflicts per class (closest calls first)."""
+MAX_TABLE_CELLS = 400
+
+
+def meas_name(ref: int) -> str:
+    """How every view names detection ``ref`` (its source index): ``m<ref>``."""
+    return f"m{int(ref)}"
+
+
+def column_name(label: AxisLabel) -> str:
+    """``track 802``, ``new`` (start a track / clutter) or ``missed``."""
+    match label.kind:
+        case AxisKind.TRACK:
+            return f"track {label.ref}"
+        case AxisKind.NEW_TRACK:
+            return "new"
+        case AxisKind.MISSED:
+            return f"missed {label.ref}"
+        case AxisKind.MEASUREMENT:
+            return meas_name(label.ref)
+    raise AssertionError(label.kind)
+
+
+def _fmt(value: float) -> str:
+    return "–" if not math.isfinite(value) else f"{value:.2f}"
+
+
+def _ids(track_ids: tuple[int, ...], reported: set[int] | None) -> str:
+    """Track ids, the reported ones by number and the candidates (never reported) counted."""
+    if reported is None:
+        return ", ".join(str(t) for t in track_ids) or "none"
+    shown = [str(t) for t in track_ids if t in reported]
+    hidden = len(track_ids) - len(shown)
+    text = ", ".join(shown) or "no reported track"
+    return text + (f" (+{hidden} candidate{'s' if hidden > 1 else ''})" if hidden else "")
+
+
+def conflict_markdown(conflict: Conflict, reported: set[int] | None = None) -> str:
+    """One conflict as a heading line and a table (one row per detection). reported: tracks named by id (the
+    others, candidates never reported, are counted); None names all."""
+    tracks = _ids(conflict.track_ids, reported)
+    meas = ", ".join(meas_name(m) for m in conflict.meas_indices)
+    margin = conflict.closest_margin
+    flag = " **close call**" if margin < CLOSE_CALL_MARGIN else ""
+    lines = [
+        f"tracks {tracks} · detections {meas} — closest margin {_fmt(margin)}{flag}",
+        "",
+        "| detection | chosen | cost | next best | cost | margin |",
+        "|---|---|---|---|---|---|",
+    ]
+    for c in conflict.choices:
+        alt = column_name(c.alternative) if c.alternative is not None else "none"
+        lines.append(
+            f"| {meas_name(c.meas.ref)} | **{column_name(c.chosen)}** | {_fmt(c.chosen_cost)} | {alt} | "
+            f"{_fmt(c.alternative_cost)} | {_fmt(c.margin)} |"
+        )
+    if conflict.missed_track_ids:
+        lines.append("")
+        lines.append(f"missed (no detection, cost 0): {_ids(conflict.missed_track_ids, reported)}")
+    return "\n".join(lines) + "\n"
+
+
+def decisions_markdown(
+    tracker: str,
+    frame_index: int,
+    decisions: Sequence[Decisions],
+    fallbacks: Sequence[CostMatrix] = (),
+    *,
+    focus_tracks: set[int] | None = None,
+    reported: set[int] | None = None,
+) -> str:
+    """The frame's decision document: classes with conflicts (closest call first), then matrices that do not
+    have the shared layout as plain tables. focus_tracks: list the conflicts involving these tracks first;
+    reported: see ``conflict_markdown``."""
+    head = [
+        f"## {tracker} · frame {frame_index}: why each detection went where it did",
+        "",
+        "cost = −log likelihood ratio against *the track was missed* (lower = more likely; "
+        "**new** = the detection starts a track or is clutter). "
+        "margin = how much worse the best assignment gets without that pair (small = close call).",
+        "",
+    ]
+    body: list[str] = []
+    ordered = sorted(decisions, key=lambda d: min((c.closest_margin for c in d.conflicts), default=math.inf))
+    for d in ordered:
+        conflicts = list(d.conflicts)
+        if focus_tracks:
+            conflicts.sort(key=lambda c: not c.involves(focus_tracks))
+        if not conflicts and not d.births_only:
+            continue
+        body.append(f"### {d.class_name}")
+        if d.births_only:
+            body.append(
+                f"{len(d.births_only)} detections outside every gate (new track or clutter): "
+                + ", ".join(meas_name(m) for m in d.births_only)
+            )
+            body.append("")
+        for c in conflicts[:MAX_CONFLICTS_PER_CLASS]:
+            body.append(conflict_markdown(c, reported))
+        if len(conflicts) > MAX_CONFLICTS_PER_CLASS:
+            body.append(f"… {len(conflicts) - MAX_CONFLICTS_PER_CLASS} more conflicts with larger margins\n")
+    for m in fallbacks:
+        body.append(f"### {m.class_name} ({m.description})")
+        body.append(_plain_table(m))
+    if not body:
+        body.append("No detections and no tracks to decide about in this frame.")
+    return "\n".join(head + body) + "\n"
+
+
+def _plain_table(matrix: CostMatrix) -> str:
+    """A matrix without the shared layout, without its all-impossible columns; row per line when large."""
+    cost = np.asarray(matrix.cost, dtype=np.float64)
+    keep = np.flatnonzero(np.isfinite(cost).any(axis=0)) if cost.size else np.zeros(0, dtype=np.int64)
+    cols = [column_name(matrix.cols[j]) for j in keep]
+    rows = [column_name(r) for r in matrix.rows]
+    if cost.size == 0:
+        return "(empty)\n"
+    if len(rows) * len(cols) <= MAX_TABLE_CELLS:
+        lines = ["| | " + " | ".join(cols) + " |", "|---" * (len(cols) + 1) + "|"]
+        for name, row in zip(rows, cost[:, keep], strict=True):
+            lines.append(f"| **{name}** | " + " | ".join(_fmt(v) for v in row) + " |")
+        return "\n".join(lines) + "\n"
+    out = []
+    for name, row in zip(rows, cost[:, keep], strict=True):
+        ok = np.isfinite(row)
+        entries = ", ".join(f"{c} {_fmt(v)}" for c, v, o in zip(cols, row, ok, strict=True) if o)
+        out.append(f"- **{name}**: {entries or 'nothing possible'}")
+    return "\n".join(out) + "\n"
+
+
+@dataclass(frozen=True, slots=True)
+class Grid:
+    """A 2D cost grid: cells (N) with centres (N, 2), cost (N,), labels; chosen (N,) bool; axis labels at
+    positions (L, 2). One unit per cell; y grows downward (rows), blocks of classes stacked."""
+
+    centers: np.ndarray
+    costs: np.ndarray
+    labels: list[str]
+    chosen: np.ndarray
+    axis_positions: np.ndarray
+    axis_labels: list[str]
+
+
+def decision_grid(
+    decisions: Sequence[Decisions],
+    matrices: dict[str, CostMatrix],
+    max_blocks: int = 4,
+    reported: set[int] | None = None,
+    focus_tracks: set[int] | None = None,
+) -> Grid:
+    """Lay the conflicts out as stacked blocks, closest call first (at most ``max_blocks``): per block the rows
+    are its detections, the columns its tracks then "new" (each detection's own birth/clutter cost). reported:
+    only these tracks, and candidates a detection was given, get a column (None: every track). Conflicts
+    involving ``focus_tracks`` come first."""
+    centers: list[tuple[float, float]] = []
+    costs: list[float] = []
+    labels: list[str] = []
+    chosen: list[bool] = []
+    axis_pos: list[tuple[float, float]] = []
+    axis_lab: list[str] = []
+    blocks = sorted(
+        ((c, d.class_name) for d in decisions for c in d.conflicts[:MAX_CONFLICTS_PER_CLASS]),
+        key=lambda b: (not b[0].involves(focus_tracks or set()), b[0].closest_margin),
+    )[:max_blocks]
+    y0 = 0.0
+    for conflict, class_name in blocks:
+        m = matrices[class_name]
+        cost = np.asarray(m.cost, dtype=np.float64)
+        row_of = {label.ref: i for i, label in enumerate(m.rows)}
+        col_of = {label: j for j, label in enumerate(m.cols)}
+        picked = {(c.meas.ref, c.chosen) for c in conflict.choices}
+        given = {c.chosen.ref for c in conflict.choices if c.chosen.kind is AxisKind.TRACK}
+        track_ids = [t for t in conflict.track_ids if reported is None or t in reported or t in given]
+        axis_pos.append((-0.6, y0 - 1.1))
+        axis_lab.append(f"{class_name}, margin {_fmt(conflict.closest_margin)}")
+        for k, t in enumerate(track_ids):
+            axis_pos.append((k + 0.5, y0 - 0.35))
+            axis_lab.append(str(t))
+        axis_pos.append((len(track_ids) + 0.5, y0 - 0.35))
+        axis_lab.append("new")
+        for i, ref in enumerate(conflict.meas_indices):
+            y = y0 + i + 0.5
+            axis_pos.append((-0.6, y))
+            axis_lab.append(meas_name(ref))
+            r = row_of[ref]
+            cells = [(k, AxisLabel(AxisKind.TRACK, t)) for k, t in enumerate(track_ids)]
+            cells.append((len(track_ids), AxisLabel(AxisKind.NEW_TRACK, ref)))
+            for k, label in cells:
+                v = cost[r, col_of[label]]
+                if not math.isfinite(v):
+                    continue
+                centers.append((k + 0.5, y))
+                costs.append(float(v))
+                labels.append(f"{v:.1f}")
+                chosen.append((ref, label) in picked)
+        y0 += len(conflict.meas_indices) + 2.2
+    return Grid(
+        np.array(centers, dtype=np.float64).reshape(-1, 2),
+        np.array(costs, dtype=np.float64),
+        labels,
+        np.array(chosen, dtype=bool),
+        np.array(axis_pos, dtype=np.float64).reshape(-1, 2),
+        axis_lab,
+    )
+
+
+def cost_colors(costs: np.ndarray) -> np.ndarray:
+    """(N, 4) uint8 colours of costs: more likely (lower cost) = brighter blue, less likely = darker; a fixed
+    map over [-10, +10] so colours mean the same thing in every frame."""
+    t = np.clip((np.asarray(costs, dtype=np.float64) + 10.0) / 20.0, 0.0, 1.0)[:, None]
+    likely = np.array([60.0, 150.0, 255.0])
+    unlikely = np.array([70.0, 50.0, 60.0])
+    rgb = (1.0 - t) * likely + t * unlikely
+    out = np.empty((t.shape[0], 4), dtype=np.uint8)
+    out[:, :3] = rgb.round().astype(np.uint8)
+    out[:, 3] = 255
+    return out

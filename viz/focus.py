@@ -1,0 +1,183 @@
+"""The focus overlay of a bug-report recording (``gnnpmb-viz --focus``): what went wrong, where, and the story.
+
+* ``focus/summary`` (static TextDocument): the failure in words, the involved ids, what each tracker decided
+  about them at the focus frame (the conflict tables of the decision view) and the story lines of the involved
+  tracks, so the document alone explains the failure;
+* ``world/focus``: the involved ground-truth objects and the detections the involved tracks were given, drawn
+  slightly enlarged in their class colours with their labels shown (``GT 8bccf2``, ``m10 0.83``);
+* ``world/trackers/<tracker>/focus``: that tracker's involved tracks, enlarged, in their colours (their own
+  boxes carry the id labels).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import rerun as rr
+
+from gnnpmb.data.scene import SceneData
+from gnnpmb.eval.failures import short_id
+from gnnpmb.focus import FocusTarget
+from gnnpmb.pipeline import TrackingRun
+from viz import paths
+from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world
+from viz.colors import class_ids, track_colors
+from viz.decisions import conflict_markdown
+from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
+from viz.logger import TrackerLogger
+from viz.scene import detection_label
+from viz.timeline import Clock
+
+SCALE = 1.15
+MARGIN_M = 0.25
+LINE_RADIUS_M = 0.12
+MAX_STORY_LINES = 40
+
+
+def tracker_focus(tracker: str) -> str:
+    """Boxes3D of one tracker's involved tracks (only in that tracker's views)."""
+    return f"{paths.tracker_world(tracker)}/focus"
+
+
+def _mentions(text: str, track_ids: set[int]) -> bool:
+    numbers = {int(n) for n in re.findall(r"(?:track |→ )(\d+)", text)}
+    return bool(numbers & track_ids)
+
+
+def focus_markdown(focus: FocusTarget, loggers: Mapping[str, TrackerLogger], shown: range) -> str:
+    """The summary document: the failure, the ids, each tracker's decisions about them, their story."""
+    lines = [
+        f"# {focus.title}",
+        "",
+        f"Opened at frame **{focus.frame_index}** on the `{FOCUS_TIMELINE}` timeline, which ends there; choose the "
+        f"`frame` timeline in the time panel to step past it. Recorded frames: {shown.start}–{shown.stop - 1}.",
+        "",
+    ]
+    involved = [f"GT {short_id(g)}" for g in focus.gt_ids]
+    involved += [f"{t}: tracks {', '.join(map(str, ids))}" for t, ids in focus.track_ids.items() if ids]
+    lines += [f"**Involved** ({focus.class_name}): " + (" · ".join(involved) or "nothing else"), ""]
+    for tracker, logger in loggers.items():
+        ids = set(focus.track_ids.get(tracker, ()))
+        lines.append(f"## {tracker}")
+        lines += _steps_markdown(logger, sorted(ids), shown, focus.frame_index)
+        decided = [
+            c
+            for d in logger.decisions.get(focus.frame_index, [])
+            if d.class_name == focus.class_name
+            for c in d.conflicts
+            if c.involves(ids)
+        ]
+        if decided:
+            lines.append(f"Decisions at frame {focus.frame_index} about the involved tracks:")
+            lines.append("")
+            lines += [conflict_markdown(c, logger.reported_ever) for c in decided]
+        else:
+            lines.append(f"No conflict involved these tracks at frame {focus.frame_index} (nothing in their gates).")
+            lines.append("")
+        story = [
+            (f, text)
+            for f, class_name, text, _level in logger.story
+            if class_name == focus.class_name and f <= focus.frame_index and _mentions(text, ids)
+        ]
+        if story:
+            lines.append("Story of the involved tracks:")
+            lines.append("")
+            lines += [f"- frame {f}: {text}" for f, text in story[-MAX_STORY_LINES:]]
+            lines.append("")
+    return "\n".join(lines) + "\n"
+
+
+def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, last: int) -> list[str]:
+    """Per involved track, a table of its frames up to ``last``: existence before and after the update, the
+    detections in its gate (with NIS) and the one it was given, and whether it was reported."""
+    out: list[str] = []
+    for t in track_ids:
+        steps = {f: s for f, s in logger.track_steps.get(t, {}).items() if shown.start <= f <= last}
+        if not steps:
+            continue
+        out += [
+            f"Track {t}, frame by frame:",
+            "",
+            "| frame | r predicted | in gate (NIS) | given | r after | reported |",
+            "|---|---|---|---|---|---|",
+        ]
+        for f in sorted(steps):
+            s = steps[f]
+            gated = ", ".join(f"m{m} ({nis:.1f})" for m, nis in s.gated) or "nothing"
+            given = f"m{s.given}" if s.given >= 0 else "—"
+            after = "pruned" if s.posterior_existence != s.posterior_existence else f"{s.posterior_existence:.2f}"
+            out.append(
+                f"| {f} | {s.prior_existence:.2f} | {gated} | {given} | {after} | {'yes' if s.reported else 'no'} |"
+            )
+        out.append("")
+    return out
+
+
+def log_focus(
+    stream: rr.RecordingStream,
+    focus: FocusTarget,
+    scene: SceneData,
+    runs: Sequence[TrackingRun],
+    loggers: Mapping[str, TrackerLogger],
+    clock: Clock,
+    shown: range,
+) -> None:
+    """The summary document and, at every keyframe of ``shown``, the highlighted objects."""
+    stream.log(
+        focus_doc(), rr.TextDocument(focus_markdown(focus, loggers, shown), media_type="text/markdown"), static=True
+    )
+    frames = {run.tracker: {f.keyframe.index: f for f in run.frames} for run in runs}
+    gt_ids = set(focus.gt_ids)
+    for i in shown:
+        keyframe = scene.keyframes[i]
+        clock.set(stream, i, keyframe.timestamp_us)
+        gt = keyframe.gt
+        rows = np.flatnonzero(np.isin(gt.instance_id.astype(str), list(gt_ids))) if len(gt) else np.zeros(0, int)
+        centers = [gt.translation_m[rows]]
+        sizes = [size_wlh_to_xyz(gt.size_wlh_m[rows])]
+        quats = [quat_wxyz_to_xyzw(gt.quat_wxyz[rows])]
+        names = [gt.class_name[rows]]
+        labels = [f"GT {short_id(str(t))}" for t in gt.instance_id[rows]]
+        meas: set[int] = set()
+        detections = None
+        for tracker, ids in focus.track_ids.items():
+            frame = frames[tracker].get(i)
+            if frame is None:
+                continue
+            chosen = [e for e in frame.estimates if e.track_id in ids]
+            boxes = estimate_boxes(chosen)
+            stream.log(
+                tracker_focus(tracker),
+                rr.Boxes3D(
+                    centers=boxes.centers_m,
+                    half_sizes=0.5 * (boxes.sizes_xyz_m * SCALE + MARGIN_M),
+                    quaternions=boxes.quat_xyzw,
+                    colors=track_colors(np.array([e.track_id for e in chosen], dtype=np.int64)),
+                    radii=LINE_RADIUS_M,
+                ),
+            )
+            meas |= {e.meas_index for e in chosen if e.meas_index >= 0}
+            detections = frame.detections.boxes
+        if meas and detections is not None:
+            given = sorted(meas)
+            det = detections.subset(np.array(given, dtype=np.int64))
+            centers.append(det.translation_m)
+            sizes.append(size_wlh_to_xyz(det.size_wlh_m))
+            quats.append(quat_wxyz_to_xyzw(det.quat_wxyz))
+            names.append(det.class_name)
+            labels += [detection_label(m, s) for m, s in zip(given, det.score, strict=True)]
+        size = np.concatenate(sizes).reshape(-1, 3)
+        stream.log(
+            focus_world(),
+            rr.Boxes3D(
+                centers=np.concatenate(centers).reshape(-1, 3),
+                half_sizes=0.5 * (size * SCALE + MARGIN_M),
+                quaternions=np.concatenate(quats).reshape(-1, 4),
+                class_ids=class_ids(np.concatenate(names)),
+                labels=labels,
+                radii=LINE_RADIUS_M,
+                show_labels=True,
+            ),
+        )
