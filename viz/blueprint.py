@@ -243,7 +243,7 @@ def comparison_panel(trackers: Sequence[str]) -> rrb.Horizontal:
         rrb.TimeSeriesView(origin=compare.counts_root(), name="disagreements per frame"),
         *[failure_counts_view(t) for t in trackers],
     )
-    log = rrb.TextLogView(origin=compare.log_path(), name="disagreements")
+    log = rrb.TextLogView(origin=compare.log_path(), name="disagreements", columns=STORY_COLUMNS)
     return rrb.Horizontal(counts, log, column_shares=[2, 3], name="comparison")
 
 

@@ -34,6 +34,9 @@ SCALE = 1.15
 MARGIN_M = 0.25
 LINE_RADIUS_M = 0.12
 MAX_STORY_LINES = 40
+NEAR_DETECTION_M = 2.0
+"""A detection or track within this BEV distance of a ground-truth object is "on" it (the devkit's match
+distance)."""
 
 
 def tracker_focus(tracker: str) -> str:
@@ -46,8 +49,15 @@ def _mentions(text: str, track_ids: set[int]) -> bool:
     return bool(numbers & track_ids)
 
 
-def focus_markdown(focus: FocusTarget, loggers: Mapping[str, TrackerLogger], shown: range) -> str:
-    """The summary document: the failure, the ids, each tracker's decisions about them, their story."""
+def focus_markdown(
+    focus: FocusTarget,
+    loggers: Mapping[str, TrackerLogger],
+    shown: range,
+    scene: SceneData,
+    runs: Mapping[str, TrackingRun],
+) -> str:
+    """The summary document: the failure, the ids; per tracker a diagnosis line per involved track, the involved
+    objects' and tracks' frames, its decisions about them and their story."""
     lines = [
         f"# {focus.title}",
         "",
@@ -61,6 +71,11 @@ def focus_markdown(focus: FocusTarget, loggers: Mapping[str, TrackerLogger], sho
     for tracker, logger in loggers.items():
         ids = set(focus.track_ids.get(tracker, ()))
         lines.append(f"## {tracker}")
+        lines += [f"- {line}" for line in _diagnosis(logger, sorted(ids), shown, focus.frame_index)]
+        lines.append("")
+        run = runs.get(tracker)
+        if run is not None:
+            lines += _gt_markdown(focus, scene, run, logger, shown)
         lines += _steps_markdown(logger, sorted(ids), shown, focus.frame_index)
         decided = [
             c
@@ -87,6 +102,99 @@ def focus_markdown(focus: FocusTarget, loggers: Mapping[str, TrackerLogger], sho
             lines += [f"- frame {f}: {text}" for f, text in story[-MAX_STORY_LINES:]]
             lines.append("")
     return "\n".join(lines) + "\n"
+
+
+def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: int) -> list[str]:
+    """One sentence per involved track summarising its table: when it last got a detection, the frames since
+    with nothing in its gate or with detections it was not given, and its existence then and at ``last``."""
+    out = []
+    for t in track_ids:
+        steps = {f: s for f, s in logger.track_steps.get(t, {}).items() if shown.start <= f <= last}
+        if not steps:
+            continue
+        frames = sorted(steps)
+        given = [f for f in frames if steps[f].given >= 0]
+        since = [f for f in frames if not given or f > given[-1]]
+        empty = [f for f in since if not steps[f].gated]
+        passed = [f for f in since if steps[f].gated]
+        parts = []
+        if given:
+            parts.append(f"last given a detection at frame {given[-1]} (m{steps[given[-1]].given})")
+        else:
+            parts.append(f"given no detection in frames {frames[0]}-{frames[-1]}")
+        if empty:
+            parts.append(f"nothing in its gate at frame{'s' if len(empty) > 1 else ''} {_frames(empty)}")
+        if passed:
+            parts.append(
+                f"detections in its gate but given elsewhere at frame{'s' if len(passed) > 1 else ''} {_frames(passed)}"
+            )
+        first, final = steps[frames[0]], steps[frames[-1]]
+        after = (
+            "pruned" if final.posterior_existence != final.posterior_existence else f"{final.posterior_existence:.2f}"
+        )
+        parts.append(f"existence {first.prior_existence:.2f} at frame {frames[0]} -> {after} at frame {frames[-1]}")
+        parts.append("reported" if final.reported else "not reported")
+        out.append(f"**track {t}**: " + "; ".join(parts) + ".")
+    return out
+
+
+def _frames(frames: list[int]) -> str:
+    return ", ".join(str(f) for f in frames)
+
+
+def _gt_markdown(
+    focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: TrackerLogger, shown: range
+) -> list[str]:
+    """Per involved ground-truth object, frame by frame up to the focus frame: the nearest detection of its class
+    (distance, score), where the tracker sent it, and the tracks reported on the object."""
+    out: list[str] = []
+    by_frame = {f.keyframe.index: f for f in run.frames}
+    for gt_id in focus.gt_ids:
+        rows = []
+        seen, detected, sent = 0, 0, []
+        for i in range(shown.start, focus.frame_index + 1):
+            gt = scene.keyframes[i].gt
+            hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
+            frame = by_frame.get(i)
+            if hit.size == 0 or frame is None:
+                continue
+            xy = gt.translation_m[hit[0], :2]
+            boxes = frame.detections.boxes
+            mine = np.flatnonzero(np.asarray(frame.detections.kept) & (boxes.class_name == focus.class_name))
+            nearest = "none"
+            went = "—"
+            if mine.size:
+                d = np.hypot(*(boxes.translation_m[mine, :2] - xy).T)
+                k = int(np.argmin(d))
+                if d[k] < NEAR_DETECTION_M:
+                    m = int(mine[k])
+                    nearest = f"m{m} at {d[k]:.1f} m (score {boxes.score[m]:.2f})"
+                    went = logger.given.get(i, {}).get(m, "—")
+            covering = [
+                str(e.track_id)
+                for e in frame.estimates
+                if e.class_name == focus.class_name
+                and np.hypot(e.translation_m[0] - xy[0], e.translation_m[1] - xy[1]) < NEAR_DETECTION_M
+            ]
+            rows.append(f"| {i} | {nearest} | {went} | {', '.join(covering) or 'none'} |")
+            seen += 1
+            detected += nearest != "none"
+            sent += [went] if nearest != "none" else []
+        if rows:
+            news = sent.count("new")
+            out += [
+                f"**GT {short_id(gt_id)}**: a detection within {NEAR_DETECTION_M:.0f} m in {detected} of its {seen} "
+                f"frames up to {focus.frame_index}; {news} of them started a new track, the others went to "
+                f"{', '.join(sorted({w for w in sent if w not in ('new', '—')})) or 'no track'}.",
+                "",
+                f"GT {short_id(gt_id)}, frame by frame:",
+                "",
+                "| frame | nearest detection | sent to | reported tracks on it |",
+                "|---|---|---|---|",
+                *rows,
+                "",
+            ]
+    return out
 
 
 def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, last: int) -> list[str]:
@@ -126,7 +234,11 @@ def log_focus(
 ) -> None:
     """The summary document and, at every keyframe of ``shown``, the highlighted objects."""
     stream.log(
-        focus_doc(), rr.TextDocument(focus_markdown(focus, loggers, shown), media_type="text/markdown"), static=True
+        focus_doc(),
+        rr.TextDocument(
+            focus_markdown(focus, loggers, shown, scene, {run.tracker: run for run in runs}), media_type="text/markdown"
+        ),
+        static=True,
     )
     frames = {run.tracker: {f.keyframe.index: f for f in run.frames} for run in runs}
     gt_ids = set(focus.gt_ids)

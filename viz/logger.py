@@ -172,6 +172,8 @@ class TrackerLogger:
         self._drawing = True
         self.decisions: dict[int, list[Decisions]] = {}
         """Frame index -> the decisions of every class (kept for the focus view and tests)."""
+        self.given: dict[int, dict[int, str]] = {}
+        """Frame -> detection index -> where it went ("track 12", "new"), for the focus tracks' class only."""
         self.track_steps: dict[int, dict[int, TrackStep]] = {}
         """Focused track id -> frame -> its ``TrackStep`` (only for ``focus_tracks``)."""
         self.story: list[tuple[int, str, str, str]] = []
@@ -567,6 +569,8 @@ class TrackerLogger:
         if cf.assignment is not None:
             given = {int(c.ref): int(r.ref) for r, c in cf.assignment.pairs if c.kind is AxisKind.TRACK}
         reported = {e.track_id for e in estimates}
+        if cf.assignment is not None and any(t in self.focus_tracks for t in ids):
+            self.given[self._frame] = {int(r.ref): column_name(c) for r, c in cf.assignment.pairs}
         meas_xy = {}
         if cf.meas is not None:
             xyz = np.asarray(cf.meas.xyz_m, dtype=np.float64).reshape(-1, 3)

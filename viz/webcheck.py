@@ -1,13 +1,15 @@
 """A real-browser check of a saved recording: serve it with Rerun's web viewer, open it in headless Chromium
-and screenshot it once the 3D views show the scene.
+and screenshot it once the viewer has taken in the whole recording and the 3D views show the scene.
 
 ``rerun FILE.rrd --serve-web`` hosts the web viewer over HTTP and the recording over gRPC (both bound to
 127.0.0.1, on free ports). Chromium runs headless with WebGL2 on SwiftShader (no GPU) and a fresh profile; it
-is driven over the DevTools protocol (``websocket-client``): set the viewport, navigate, then take
-``Page.captureScreenshot`` every few seconds until the 3D-view regions hold many varied, non-background pixels
-(LiDAR points, coloured boxes), all data has streamed in (the viewer's backlog readout is gone) and the page
-has stopped changing, rather than the loading page. Both servers run in their own process groups and are
-killed (group-wide) on every exit path.
+is driven over the DevTools protocol (``websocket-client``): set the viewport, navigate, then poll every few
+seconds. Ready means, in this order: the viewer's own state (``WebHandle.viewer_state()``, read with
+``read_viewer_state``) shows the recording open with every view of its blueprint and every timeline of the file
+loaded to its last time; the viewer's ingestion-backlog readout is gone; and the 3D-view regions hold many
+varied, non-background pixels (LiDAR points, coloured boxes) in two shots in a row. Pixels alone are not
+enough: panels can still be empty while the 3D views look finished. Both servers run in their own process
+groups and are killed (group-wide) on every exit path.
 
 By hand: ``uv run python -m viz.webcheck FILE.rrd --out shot.png [--views 2]``.
 """
@@ -52,7 +54,7 @@ CHROMIUM_FLAGS: tuple[str, ...] = (
 )
 """Headless Chromium that renders WebGL2 on SwiftShader and talks to nothing but localhost."""
 
-DEFAULT_VIEWPORT = (1600, 900)
+DEFAULT_VIEWPORT = (1920, 1080)
 BACKGROUND_TOLERANCE = 12
 """A pixel is background when each channel is within this of the region's most common colour."""
 SATURATION_MIN = 60
@@ -61,10 +63,9 @@ grid and background are greys."""
 MIN_FOREGROUND_FRACTION = 0.02
 MIN_DISTINCT_COLORS = 200
 MIN_COLORED_FRACTION = 0.001
-MAX_CHANGED_FRACTION = 0.002
 SETTLED_SHOTS = 2
-"""The page has settled when this many consecutive shots have rendered views, no ingestion backlog
-(``backlog_region``) and fewer than MAX_CHANGED_FRACTION of all pixels changed since the shot before."""
+"""Ready: this many consecutive shots after the viewer's state showed everything loaded, with rendered views and
+no ingestion backlog (``backlog_region``)."""
 STATUS_X = (235, 500)
 STATUS_Y = (6, 30)
 """Pixel span of the top bar (Rerun 0.41 web viewer) right of the renderer badge, where the viewer shows its
@@ -75,6 +76,131 @@ minute meanwhile, so an unchanged page alone does not mean it is complete."""
 measured 18-20 % foreground, 2,000-10,000 colours and 1.3-1.9 % coloured pixels per view on the demo scene.
 The loading page and an empty view are a uniform background with a grid, a logo or a few lines of text (under
 40 colours); LiDAR alone, before the boxes have streamed in, has no coloured pixels."""
+
+
+VIEWER_STATE_JS = (
+    "(() => { const h = window._handle; if (!h || !h.viewer_state) return null;"
+    " const s = h.viewer_state(); let b = ''; for (const x of s) b += String.fromCharCode(x); return btoa(b); })()"
+)
+"""The web viewer's state (Rerun 0.41 ``WebHandle.viewer_state``: protobuf bytes), base64 over DevTools."""
+
+
+def _varint(buf: bytes, i: int) -> tuple[int, int]:
+    value, shift = 0, 0
+    while True:
+        byte = buf[i]
+        i += 1
+        value |= (byte & 0x7F) << shift
+        shift += 7
+        if byte < 0x80:
+            return value, i
+
+
+def protobuf_fields(buf: bytes) -> list[tuple[int, int | bytes]]:
+    """(field number, value) of one protobuf message: varints as int, length-delimited fields as bytes
+    (fixed-width fields as their raw bytes). Raises ValueError on bytes that are not a message."""
+    out: list[tuple[int, int | bytes]] = []
+    i = 0
+    while i < len(buf):
+        key, i = _varint(buf, i)
+        field, wire = key >> 3, key & 7
+        if wire == 0:
+            value, i = _varint(buf, i)
+            out.append((field, value))
+        elif wire == 2:
+            size, i = _varint(buf, i)
+            out.append((field, buf[i : i + size]))
+            i += size
+        elif wire in (1, 5):
+            width = 8 if wire == 1 else 4
+            out.append((field, buf[i : i + width]))
+            i += width
+        else:
+            raise ValueError(f"protobuf wire type {wire} at byte {i}")
+    if i != len(buf):
+        raise ValueError("truncated protobuf message")
+    return out
+
+
+@dataclass(frozen=True, slots=True)
+class ViewerState:
+    """What the web viewer says it holds: the open recording ("Recording:<app>:<id>"), the names of the views
+    it shows, and per timeline the last time it has data for."""
+
+    recording: str | None
+    views: frozenset[str]
+    timeline_max: dict[str, int]
+
+
+def read_viewer_state(buf: bytes) -> ViewerState:
+    """Decode ``viewer_state()`` bytes (Rerun 0.41, read on this machine): field 3 is the open recording (1: its
+    name; 2: its timelines, each 1: {1: name}, 3: {1: min, 2: max} of the data loaded so far); field 5 lists the
+    views (3: display name)."""
+    recording, views, maxima = None, set(), {}
+    for field, value in protobuf_fields(buf):
+        if field == 3 and isinstance(value, bytes):
+            for sub, sub_value in protobuf_fields(value):
+                if sub == 1 and isinstance(sub_value, bytes):
+                    recording = sub_value.decode("utf-8", "replace")
+                elif sub == 2 and isinstance(sub_value, bytes):
+                    name, top = None, None
+                    for key, item in protobuf_fields(sub_value):
+                        if key == 1 and isinstance(item, bytes):
+                            name = dict(protobuf_fields(item)).get(1, b"").decode()
+                        elif key == 3 and isinstance(item, bytes):
+                            top = dict(protobuf_fields(item)).get(2)
+                    if name is not None and isinstance(top, int):
+                        maxima[name] = top
+        elif field == 5 and isinstance(value, bytes):
+            name = dict(protobuf_fields(value)).get(3)
+            if isinstance(name, bytes):
+                views.add(name.decode("utf-8", "replace"))
+    return ViewerState(recording, frozenset(views), maxima)
+
+
+@dataclass(frozen=True, slots=True)
+class Expected:
+    """What a viewer that has taken in ``rrd`` must show: its recording, the views of its default blueprint and
+    the last time of each sequence timeline."""
+
+    recording: str
+    views: frozenset[str]
+    timeline_max: dict[str, int]
+
+    def met_by(self, state: ViewerState) -> bool:
+        return (
+            state.recording == self.recording
+            and self.views <= state.views
+            and all(state.timeline_max.get(k) == v for k, v in self.timeline_max.items())
+        )
+
+
+def expected_state(rrd: Path) -> Expected:
+    """The recording id, the blueprint's view names and the sequence timelines' last values of ``rrd``."""
+    from rerun.chunk import RrdReader
+
+    reader = RrdReader(rrd)
+    (entry,) = reader.recordings()
+    views: set[str] = set()
+    for blueprint in reader.blueprints():
+        for chunk in reader.stream(store=blueprint):
+            for row in (
+                chunk.to_record_batch()
+                .select([n for n in chunk.to_record_batch().schema.names if n == "ViewBlueprint:display_name"])
+                .to_pylist()
+            ):
+                if row.get("ViewBlueprint:display_name"):
+                    views.add(row["ViewBlueprint:display_name"][0])
+    maxima: dict[str, int] = {}
+    for chunk in reader.store().stream():
+        if chunk.is_static:
+            continue
+        batch = chunk.to_record_batch()
+        for name in ("frame", "focus"):
+            if name in batch.schema.names and batch.num_rows:
+                top = max(v for v in batch.column(name).to_pylist() if v is not None)
+                maxima[name] = max(maxima.get(name, top), top)
+    return Expected(f"Recording:{entry.application_id}:{entry.recording_id}", frozenset(views), maxima)
 
 
 class WebCheckError(RuntimeError):
@@ -103,34 +229,36 @@ class RegionStats:
 
 @dataclass(frozen=True, slots=True)
 class WebCheckResult:
-    """Outcome of ``check_recording``: the screenshot written; whether every 3D-view region looked rendered
-    and the page had settled; seconds from navigation to the first shot with rendered views and to the settled
-    shot (None if never); shots taken; total wall time; the last shot's region stats."""
+    """Outcome of ``check_recording``: the screenshot written; whether it is ready (the viewer's state shows
+    everything loaded, no backlog, every 3D-view region rendered); seconds from navigation until the viewer's
+    state showed everything loaded, to the first shot with rendered views and to the ready shot (None if
+    never); shots taken; total wall time; the last shot's region stats; the server and browser process
+    groups; the viewer's last state."""
 
     screenshot: Path
     rendered: bool
+    seconds_to_load: float | None
     seconds_to_render: float | None
     seconds_to_settle: float | None
     shots: int
     total_s: float
     regions: tuple[RegionStats, ...]
     process_groups: tuple[int, ...]
+    state: ViewerState
 
     def describe(self) -> str:
         parts = ", ".join(
-            f"{r.foreground_fraction:.1%} foreground, {r.distinct_colors} colours, "
-            f"{r.colored_fraction:.2%} coloured"
+            f"{r.foreground_fraction:.1%} foreground, {r.distinct_colors} colours, {r.colored_fraction:.2%} coloured"
             for r in self.regions
         )
         if self.rendered:
             when = (
-                f"rendered after {self.seconds_to_render:.1f} s, settled after {self.seconds_to_settle:.1f} s"
+                f"loaded (viewer state) after {self.seconds_to_load:.1f} s, rendered after "
+                f"{self.seconds_to_render:.1f} s, ready after {self.seconds_to_settle:.1f} s"
             )
         else:
-            when = "NOT rendered"
-        return (
-            f"{when} ({self.shots} shots, {self.total_s:.1f} s in all); 3D views: {parts}; {self.screenshot}"
-        )
+            when = f"NOT ready (loaded: {self.seconds_to_load})"
+        return f"{when} ({self.shots} shots, {self.total_s:.1f} s in all); 3D views: {parts}; {self.screenshot}"
 
 
 def free_port() -> int:
@@ -226,9 +354,7 @@ class DevTools:
             if reply.get("id") != msg_id:
                 continue
             if "error" in reply:
-                raise WebCheckError(
-                    f"DevTools {method} failed: {reply['error'].get('message', reply['error'])}"
-                )
+                raise WebCheckError(f"DevTools {method} failed: {reply['error'].get('message', reply['error'])}")
             return reply.get("result", {})
 
     def close(self) -> None:
@@ -236,11 +362,11 @@ class DevTools:
 
 
 def view_regions(width: int, height: int, n_views: int) -> list[tuple[int, int, int, int]]:
-    """(x0, y0, x1, y1) pixel boxes well inside each of the ``n_views`` side-by-side 3D views of the default
-    blueprint (``viz.blueprint``): they span the left three fifths of the window, above the bottom panels;
-    each box keeps clear of view borders, titles and the top bar."""
+    """(x0, y0, x1, y1) pixel boxes well inside the bird's-eye view of each of the ``n_views`` trackers side by
+    side in the default blueprint (``viz.blueprint``): they span the left three fifths of the window, in the
+    top part of each tracker's column; each box keeps clear of view borders, titles and the top bar."""
     left, right = 0.0, 0.6 * width
-    top, bottom = 0.10 * height, 0.50 * height
+    top, bottom = 0.08 * height, 0.40 * height
     step = (right - left) / n_views
     boxes = []
     for i in range(n_views):
@@ -264,15 +390,6 @@ def region_stats(image: np.ndarray, box: tuple[int, int, int, int]) -> RegionSta
     distinct = int(np.unique(packed[foreground]).size)
     spread = pixels.max(axis=1).astype(np.int16) - pixels.min(axis=1)
     return RegionStats(box, float(foreground.mean()), distinct, float(np.mean(spread > SATURATION_MIN)))
-
-
-def changed_fraction(before: np.ndarray | None, after: np.ndarray) -> float:
-    """Fraction of pixels of two (H, W, 3) shots that differ by more than BACKGROUND_TOLERANCE in some channel
-    (1 when there is no earlier shot or the sizes differ)."""
-    if before is None or before.shape != after.shape:
-        return 1.0
-    diff = np.abs(before.astype(np.int16) - after.astype(np.int16)).max(axis=2)
-    return float(np.mean(diff > BACKGROUND_TOLERANCE))
 
 
 def backlog_region(width: int) -> tuple[int, int, int, int]:
@@ -329,16 +446,13 @@ def check_recording(
     rrd, out = Path(rrd).absolute(), Path(out).absolute()
     if not rrd.is_file():
         raise WebCheckError(f"recording {rrd} does not exist")
+    expected = expected_state(rrd)
     if not chromium.is_file():
         raise WebCheckError(f"chromium is not installed at {chromium}")
     width, height = viewport
     start = time.monotonic()
     with contextlib.ExitStack() as stack:
-        work = (
-            Path(work_dir)
-            if work_dir is not None
-            else Path(stack.enter_context(tempfile.TemporaryDirectory()))
-        )
+        work = Path(work_dir) if work_dir is not None else Path(stack.enter_context(tempfile.TemporaryDirectory()))
         work.mkdir(parents=True, exist_ok=True)
         web_port, grpc_port, debug_port = free_port(), free_port(), free_port()
         serve_log, browser_log = work / "rerun-serve.log", work / "chromium.log"
@@ -389,40 +503,44 @@ def check_recording(
         boxes = view_regions(width, height, n_views)
         shots, settled = 0, 0
         first_rendered: float | None = None
+        loaded: float | None = None
         stats: tuple[RegionStats, ...] = ()
-        previous: np.ndarray | None = None
+        state = ViewerState(None, frozenset(), {})
         while True:
             time.sleep(poll_s)
+            elapsed = time.monotonic() - navigated
+            raw = devtools.call("Runtime.evaluate", expression=VIEWER_STATE_JS, returnByValue=True)
+            value = raw.get("result", {}).get("value")
+            if value:
+                state = read_viewer_state(base64.b64decode(value))
+                if loaded is None and expected.met_by(state):
+                    loaded = elapsed
             png = base64.b64decode(devtools.call("Page.captureScreenshot", format="png")["data"])
             shots += 1
             _write_atomic(out, png)
             image = decode_png(png)
             stats = tuple(region_stats(image, b) for b in boxes)
-            changed = changed_fraction(previous, image)
-            previous = image
-            elapsed = time.monotonic() - navigated
             if all(s.rendered for s in stats):
                 first_rendered = elapsed if first_rendered is None else first_rendered
-                quiet = changed <= MAX_CHANGED_FRACTION and not backlog_shown(image)
-                settled = settled + 1 if quiet else 0
+                settled = settled + 1 if loaded is not None and not backlog_shown(image) else 0
             else:
                 first_rendered, settled = None, 0
             if settled >= SETTLED_SHOTS or elapsed > timeout_s:
                 break
             if server.poll() is not None:
-                raise WebCheckError(
-                    f"rerun --serve-web exited with code {server.returncode}; see {serve_log}"
-                )
+                raise WebCheckError(f"rerun --serve-web exited with code {server.returncode}; see {serve_log}")
     done = settled >= SETTLED_SHOTS
     return WebCheckResult(
         out,
         done,
+        loaded,
         first_rendered if done else None,
         elapsed if done else None,
         shots,
         time.monotonic() - start,
         stats,
         (server.pid, browser.pid),
+        state,
     )
 
 
@@ -440,9 +558,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("rrd", type=Path, help="the recording (.rrd)")
     parser.add_argument("--out", type=Path, default=Path("webcheck.png"), help="screenshot to write (PNG)")
     parser.add_argument("--views", type=int, default=2, help="number of side-by-side 3D views to check")
-    parser.add_argument(
-        "--timeout", type=float, default=420.0, help="seconds to wait for the scene to render"
-    )
+    parser.add_argument("--timeout", type=float, default=420.0, help="seconds to wait for the scene to render")
     parser.add_argument("--width", type=int, default=DEFAULT_VIEWPORT[0])
     parser.add_argument("--height", type=int, default=DEFAULT_VIEWPORT[1])
     args = parser.parse_args(argv)
