@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.events import AxisKind, AxisLabel, CostMatrix
+from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, GlobalHypotheses
 from gnnpmb.explain import Conflict, Decisions
 
 CLOSE_CALL_MARGIN = 1.0
@@ -25,6 +25,8 @@ CLOSE_CALL_MARGIN = 1.0
 MAX_CONFLICTS_PER_CLASS = 6
 """The decision document lists at most this many conflicts per class (closest calls first)."""
 MAX_TABLE_CELLS = 400
+MAX_HYPOTHESES_LISTED = 5
+"""The decision document lists the best this many PMBM global hypotheses per class."""
 
 
 def meas_name(ref: int) -> str:
@@ -56,8 +58,10 @@ def _ids(track_ids: tuple[int, ...], reported: set[int] | None) -> str:
         return ", ".join(str(t) for t in track_ids) or "none"
     shown = [str(t) for t in track_ids if t in reported]
     hidden = len(track_ids) - len(shown)
-    text = ", ".join(shown) or "no reported track"
-    return text + (f" (+{hidden} candidate{'s' if hidden > 1 else ''})" if hidden else "")
+    counted = f"{hidden} candidate{'s' if hidden > 1 else ''}"
+    if not shown:
+        return counted if hidden else "none"
+    return ", ".join(shown) + (f" (+{counted})" if hidden else "")
 
 
 def conflict_markdown(conflict: Conflict, reported: set[int] | None = None) -> str:
@@ -93,10 +97,12 @@ def decisions_markdown(
     *,
     focus_tracks: set[int] | None = None,
     reported: set[int] | None = None,
+    hypotheses: Sequence[GlobalHypotheses] = (),
 ) -> str:
     """The frame's decision document: classes with conflicts (closest call first), then matrices that do not
     have the shared layout as plain tables. focus_tracks: list the conflicts involving these tracks first;
-    reported: see ``conflict_markdown``."""
+    reported: see ``conflict_markdown``; hypotheses: PMBM global hypotheses listed per class (when more than one
+    is kept)."""
     head = [
         f"## {tracker} · frame {frame_index}: why each detection went where it did",
         "",
@@ -127,9 +133,44 @@ def decisions_markdown(
     for m in fallbacks:
         body.append(f"### {m.class_name} ({m.description})")
         body.append(_plain_table(m))
+    body += [hypotheses_markdown(event, reported) for event in hypotheses if len(event.members) > 1]
     if not body:
         body.append("No detections and no tracks to decide about in this frame.")
     return "\n".join(head + body) + "\n"
+
+
+def hypotheses_markdown(event: GlobalHypotheses, reported: set[int] | None = None) -> str:
+    """The kept PMBM global hypotheses of one class: probability, and what tells each apart from the best one
+    (tracks only it holds, tracks only the best holds, tracks it explains with another association history)."""
+    weights = np.exp(np.asarray(event.log_weights, dtype=np.float64))
+    n = len(event.members)
+    lines = [
+        f"### {event.class_name}: {n} global hypotheses kept",
+        "",
+        "| hypothesis | probability | differs from h0 by |",
+        "|---|---|---|",
+    ]
+    best = dict(zip(event.members[0], event.local[0], strict=True)) if n else {}
+    for h in range(min(n, MAX_HYPOTHESES_LISTED)):
+        mine = dict(zip(event.members[h], event.local[h], strict=True))
+        if h == 0:
+            diff = "(the best, shown in the views)"
+        else:
+            added = sorted(set(mine) - set(best))
+            dropped = sorted(set(best) - set(mine))
+            other = sorted(t for t in set(mine) & set(best) if mine[t] != best[t])
+            parts = []
+            if other:
+                parts.append("other association for " + _ids(tuple(other), reported))
+            if added:
+                parts.append("also " + _ids(tuple(added), reported))
+            if dropped:
+                parts.append("without " + _ids(tuple(dropped), reported))
+            diff = "; ".join(parts) or "nothing visible (same tracks, same associations)"
+        lines.append(f"| h{h} | {weights[h]:.3f} | {diff} |")
+    if n > MAX_HYPOTHESES_LISTED:
+        lines.append(f"| … | {weights[MAX_HYPOTHESES_LISTED:].sum():.3f} | {n - MAX_HYPOTHESES_LISTED} more |")
+    return "\n".join(lines) + "\n"
 
 
 def _plain_table(matrix: CostMatrix) -> str:

@@ -130,6 +130,7 @@ class _ClassFrame:
     logic: list[TrackLogic] = field(default_factory=list)
     posterior: Posterior | None = None
     extracted: Extracted | None = None
+    hypotheses: GlobalHypotheses | None = None
 
 
 class TrackerLogger:
@@ -299,6 +300,7 @@ class TrackerLogger:
         decisions: list[Decisions] = []
         matrices: dict[str, CostMatrix] = {}
         fallbacks: list[CostMatrix] = []
+        hypotheses = [cf.hypotheses for cf in self._classes.values() if cf.hypotheses is not None]
         for class_name, cf in self._classes.items():
             reported |= self._draw_class(class_name, cf)
             if self._drawing and cf.cost is not None and cf.assignment is not None:
@@ -313,7 +315,7 @@ class TrackerLogger:
         self._classes = {}
         if decisions or fallbacks:
             self.decisions[self._frame] = decisions
-            self._draw_decisions(decisions, matrices, fallbacks)
+            self._draw_decisions(decisions, matrices, fallbacks, hypotheses)
         self._frames_since_text_flush += 1
         if self._frames_since_text_flush >= TEXT_FLUSH_FRAMES:
             self._flush_texts()
@@ -705,7 +707,11 @@ class TrackerLogger:
 
     # The decision view.
     def _draw_decisions(
-        self, decisions: list[Decisions], matrices: dict[str, CostMatrix], fallbacks: list[CostMatrix]
+        self,
+        decisions: list[Decisions],
+        matrices: dict[str, CostMatrix],
+        fallbacks: list[CostMatrix],
+        hypotheses: list[GlobalHypotheses],
     ) -> None:
         doc = decisions_markdown(
             self.tracker,
@@ -714,6 +720,7 @@ class TrackerLogger:
             fallbacks,
             focus_tracks=self.focus_tracks,
             reported=self._extracted_ids,
+            hypotheses=hypotheses,
         )
         self._show(paths.decisions(self.tracker), rr.TextDocument(doc, media_type="text/markdown"))
         grid = decision_grid(decisions, matrices, reported=self._extracted_ids, focus_tracks=self.focus_tracks)
@@ -760,8 +767,9 @@ class TrackerLogger:
         )
 
     def _on_hypotheses(self, event: GlobalHypotheses) -> None:
-        """Log weights of the best MAX_HYPOTHESIS_SERIES hypotheses as one multi-line series per class (NaN
-        where fewer are kept), each line named by class and rank."""
+        """Kept for the decision document; log weights of the best MAX_HYPOTHESIS_SERIES hypotheses as one
+        multi-line series per class (NaN where fewer are kept), each line named by class and rank."""
+        self._class_frame(event.class_name).hypotheses = event
         w = np.full(MAX_HYPOTHESIS_SERIES, np.nan)
         top = np.asarray(event.log_weights, dtype=np.float64)[:MAX_HYPOTHESIS_SERIES]
         w[: top.size] = top

@@ -328,3 +328,19 @@ def test_two_trackers_share_one_recording_without_touching_each_other(saved_stre
         assert latest_at(rows[paths.track(name, "car", 1)], 1, "Boxes3D:centers")[0][0] == pytest.approx(x)
         assert len([r for r in rows[paths.existence(name, "car", 1)] if not r["static"]]) == 2
         assert paths.predicted(name, "car") not in rows
+
+
+def test_pmbm_hypotheses_are_listed_with_what_tells_them_apart(saved_stream) -> None:
+    stream, path = saved_stream
+    events = scripted_events()
+    at = next(i for i, e in enumerate(events) if isinstance(e, GlobalHypotheses))
+    events[at] = GlobalHypotheses(
+        "car", np.log(np.array([0.6, 0.3, 0.1])), ((1, 2), (1, 2), (1,)), ((0, 0), (0, 5), (0,))
+    )
+    log_all(stream, events)
+    stream.disconnect()
+    doc = at_frame(read_rows(path)[paths.decisions(T)], 1)[0]["TextDocument:text"][0]
+    assert "### car: 3 global hypotheses kept" in doc
+    assert "| h0 | 0.600 | (the best, shown in the views) |" in doc
+    assert "| h1 | 0.300 | other association for 1 candidate |" in doc
+    assert "| h2 | 0.100 | without 1 candidate |" in doc
