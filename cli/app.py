@@ -378,7 +378,7 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
     from viz.compare import log_comparison
     from viz.failures import log_failures
     from viz.focus import log_focus
-    from viz.logger import TrackerLogger
+    from viz.logger import FLUSH_FRAMES, TrackerLogger
     from viz.provenance import log_provenance
     from viz.recording import recording
     from viz.scene import log_scene
@@ -424,6 +424,7 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
                 clock=clock,
                 log_frames=shown if focus is not None else None,
                 focus_tracks=set(focus.track_ids.get(tracker, ())) if focus is not None else None,
+                flush_frames=None if request.save is not None else FLUSH_FRAMES,
             )
             runs.append(
                 run_tracker(

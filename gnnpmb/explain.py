@@ -93,21 +93,25 @@ def _components(finite: np.ndarray, n_tracks: int) -> list[tuple[np.ndarray, np.
     """Connected components of the bipartite gate graph: (rows, track columns) per component with at least
     one track and one measurement.
 
-    finite: (R, C) bool; only the first n_tracks columns link rows (new-track columns belong to one row)."""
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    n_rows = finite.shape[0]
+    finite: (R, C) bool; only the first n_tracks columns link rows (new-track columns belong to one row).
+    Min-label propagation (each row starts as its own label; rows and columns take the smallest label they are
+    linked to until nothing changes): vectorised, and cheaper than a sparse-graph call on these small matrices.
+    """
     link = finite[:, :n_tracks]
-    r, c = np.nonzero(link)
-    graph = csr_matrix((np.ones(r.size), (r, n_rows + c)), shape=(n_rows + n_tracks, n_rows + n_tracks))
-    _, label = connected_components(graph, directed=False)
+    n_rows = link.shape[0]
+    if n_rows == 0 or n_tracks == 0:
+        return []
+    none = n_rows  # larger than every row label
+    row_label = np.arange(n_rows)
+    while True:
+        col_label = np.where(link, row_label[:, None], none).min(axis=0)
+        new = np.minimum(row_label, np.where(link, col_label[None, :], none).min(axis=1))
+        if np.array_equal(new, row_label):
+            break
+        row_label = new
     out = []
-    for comp in np.unique(label):
-        rows = np.flatnonzero(label[:n_rows] == comp)
-        cols = np.flatnonzero(label[n_rows:] == comp)
-        if cols.size and rows.size:
-            out.append((rows, cols))
+    for label in np.unique(col_label[col_label < none]):
+        out.append((np.flatnonzero(row_label == label), np.flatnonzero(col_label == label)))
     return out
 
 

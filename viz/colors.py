@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import rerun as rr
 
@@ -73,6 +75,22 @@ def track_colors(track_ids: np.ndarray) -> np.ndarray:
     return (_hsv_to_rgb(h, s, v) * 255.0 + 0.5).astype(np.uint8)
 
 
+_PACKED: list[np.ndarray] = [np.zeros(0, dtype=np.uint32)]
+"""Packed colours of track ids 0..N-1, grown on demand (``packed_track_colors``)."""
+
+
+def packed_track_colors(track_ids: np.ndarray, alpha: int = 255) -> np.ndarray:
+    """(N,) uint32 0xRRGGBBAA track colours of (N,) non-negative ids: ``pack_rgba(track_colors(ids))`` from a
+    table that grows with the largest id seen (the logger asks for the same ids every frame)."""
+    ids = np.asarray(track_ids, dtype=np.int64).reshape(-1)
+    table = _PACKED[0]
+    if ids.size and ids.max() >= table.size:
+        size = max(int(ids.max()) + 1, 2 * table.size, 1024)
+        _PACKED[0] = table = pack_rgba(track_colors(np.arange(size)))
+    packed = table[ids]
+    return packed if alpha == 255 else (packed & np.uint32(0xFFFFFF00)) | np.uint32(alpha)
+
+
 def pack_rgba(colors: np.ndarray, alpha: int = 255) -> np.ndarray:
     """(N, 3) RGB or (N, 4) RGBA uint8 -> (N,) uint32 0xRRGGBBAA, the layout Rerun stores (cheapest to log)."""
     c = np.asarray(colors, dtype=np.uint32).reshape(-1, colors.shape[-1])
@@ -80,6 +98,7 @@ def pack_rgba(colors: np.ndarray, alpha: int = 255) -> np.ndarray:
     return (c[:, 0] << 24) | (c[:, 1] << 16) | (c[:, 2] << 8) | a
 
 
+@functools.lru_cache(maxsize=4096)
 def track_color(track_id: int) -> tuple[int, int, int]:
     """RGB colour of one track id (see ``track_colors``)."""
     r, g, b = track_colors(np.array([track_id]))[0]

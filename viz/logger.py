@@ -54,7 +54,7 @@ from gnnpmb.explain import Decisions, explain
 from gnnpmb.gating import ellipse_outline
 from gnnpmb.types import TrackEstimate
 from viz import paths
-from viz.colors import class_ids, pack_rgba, track_color, track_colors
+from viz.colors import class_ids, pack_rgba, packed_track_colors, track_color
 from viz.decisions import (
     CLOSE_CALL_MARGIN,
     column_name,
@@ -64,6 +64,7 @@ from viz.decisions import (
     meas_name,
 )
 from viz.geometry import estimate_boxes, lift_xy
+from viz.rows import RowBuffer
 from viz.timeline import PLAIN_CLOCK, Clock
 
 TRACK_LINE_RADIUS_M = 0.06
@@ -78,10 +79,12 @@ PREDICTED_POINT_RADIUS_M = 0.25
 CANDIDATE_POINT_RADIUS_M = 0.12
 MAX_HYPOTHESIS_SERIES = 10
 """Log weights are plotted for the best this many PMBM global hypotheses."""
-CHOSEN_CELL_COLOR = (255, 210, 0)
-TEXT_FLUSH_FRAMES = 10
-"""Story lines are sent column-wise every this many frames (and at the end): a live viewer sees them within
-seconds, and a recording holds a few chunks per class instead of one per frame."""
+CHOSEN_CELL_RGBA = int(pack_rgba(np.array([[255, 210, 0]], dtype=np.uint8))[0])
+FLUSH_FRAMES = 10
+"""Default cadence: story lines and spatial rows are sent column-wise every this many frames (and at the end),
+so a live viewer sees them within seconds; a saved recording passes ``flush_frames=None`` (only at the end: one
+chunk per entity)."""
+CANDIDATE_COLOR = int(pack_rgba(np.array([[160, 160, 160]], dtype=np.uint8))[0])
 
 _LEVEL_BY_ACTION = {
     TrackLogicAction.TENTATIVE: "DEBUG",
@@ -141,8 +144,9 @@ class TrackerLogger:
     gate_min_existence: tracks whose predicted existence reaches it are drawn (gate, prediction, gated pairs);
     the others are candidates. clock: the timelines rows go on (``viz.timeline``). log_frames: draw and log
     only these keyframes (None: all); the others still feed the tracks' history (trails, series, story state).
-    focus_tracks: their conflicts come first in the decision view. Call ``finish()`` after the last frame: it
-    sends the time series.
+    focus_tracks: their conflicts come first in the decision view. flush_frames: send buffered rows every this
+    many frames (None: only at the end). Call ``finish()`` after the last frame: it sends what is buffered and
+    the time series.
     """
 
     enabled = True
@@ -159,6 +163,7 @@ class TrackerLogger:
         clock: Clock = PLAIN_CLOCK,
         log_frames: range | None = None,
         focus_tracks: set[int] | None = None,
+        flush_frames: int | None = FLUSH_FRAMES,
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
         self.stream = stream
@@ -170,6 +175,9 @@ class TrackerLogger:
         self.clock = clock
         self.log_frames = log_frames
         self.focus_tracks = focus_tracks
+        self.flush_frames = flush_frames
+        self._rows = RowBuffer(stream, clock)
+        self._buffered: set[str] = set()
         self._drawing = True
         self.decisions: dict[int, list[Decisions]] = {}
         """Frame index -> the decisions of every class (kept for the focus view and tests)."""
@@ -231,6 +239,7 @@ class TrackerLogger:
             self._close_frame()
             self._frame = -1
         self._flush_texts()
+        self._rows.flush()
         for path, series in self._series.items():
             owner = self._track_series.get(path)
             if owner is not None and owner[1] not in self._extracted_ids:
@@ -316,14 +325,18 @@ class TrackerLogger:
         if decisions or fallbacks:
             self.decisions[self._frame] = decisions
             self._draw_decisions(decisions, matrices, fallbacks, hypotheses)
-        self._frames_since_text_flush += 1
-        if self._frames_since_text_flush >= TEXT_FLUSH_FRAMES:
-            self._flush_texts()
         if self._drawing:
             for path in sorted(self._live - self._touched):
-                self.stream.log(path, rr.Clear(recursive=False))
+                if path in self._buffered:
+                    self._rows.clear(path, self._frame, self._timestamp_us)
+                else:
+                    self.stream.log(path, rr.Clear(recursive=False))
             self._live = self._touched
         self._touched = set()
+        self._frames_since_text_flush += 1
+        if self.flush_frames is not None and self._frames_since_text_flush >= self.flush_frames:
+            self._flush_texts()
+            self._rows.flush()
 
     def _flush_texts(self) -> None:
         for path, (frames, stamps, texts, levels) in self._texts.items():
@@ -344,6 +357,14 @@ class TrackerLogger:
             return
         for archetype in archetypes:
             self.stream.log(path, archetype)
+        self._touched.add(path)
+
+    def _put(self, path: str, archetype: type, n: int, static: dict | None = None, **fields) -> None:
+        """A buffered row of ``n`` instances on ``path`` (see ``viz.rows``)."""
+        if not self._drawing:
+            return
+        self._rows.put(path, archetype, self._frame, self._timestamp_us, n, static, **fields)
+        self._buffered.add(path)
         self._touched.add(path)
 
     def _text(self, class_name: str, text: str, level: str) -> None:
@@ -410,27 +431,27 @@ class TrackerLogger:
             ):
                 if sel.size == 0:
                     continue
-                self._show(
+                self._put(
                     path,
-                    rr.Points3D(
-                        lift_xy(xy[sel], self._z_of(ids[sel])),
-                        colors=pack_rgba(track_colors(ids[sel])),
-                        radii=PREDICTED_POINT_RADIUS_M,
-                        labels=[f"{t} predicted, r={r:.2f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
-                        show_labels=path != paths.predicted(self.tracker, class_name),
-                    ),
+                    rr.Points3D,
+                    sel.size,
+                    static={"show_labels": path != paths.predicted(self.tracker, class_name)},
+                    positions=lift_xy(xy[sel], self._z_of(ids[sel])),
+                    colors=packed_track_colors(ids[sel]),
+                    radii=np.full(sel.size, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
+                    labels=[f"{t} predicted, r={r:.2f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
                 )
         if (~worthy).any():
             sel = np.flatnonzero(~worthy)
-            self._show(
+            self._put(
                 paths.candidates_world(self.tracker, class_name),
-                rr.Points3D(
-                    lift_xy(xy[sel], self.gate_z_m),
-                    colors=[(160, 160, 160)],
-                    radii=CANDIDATE_POINT_RADIUS_M,
-                    labels=[f"candidate {t}, r={r:.3f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
-                    show_labels=False,
-                ),
+                rr.Points3D,
+                sel.size,
+                static={"show_labels": False},
+                positions=lift_xy(xy[sel], self.gate_z_m),
+                colors=np.full(sel.size, CANDIDATE_COLOR, dtype=np.uint32),
+                radii=np.full(sel.size, CANDIDATE_POINT_RADIUS_M, dtype=np.float32),
+                labels=[f"candidate {t}, r={r:.3f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
             )
         self._sample(
             paths.candidate_count(self.tracker, class_name), float((~worthy).sum()), f"{class_name} candidates"
@@ -447,13 +468,14 @@ class TrackerLogger:
                     gated.threshold,
                     self.gate_points,
                 )
-                self._show(
+                n = int(drawn.sum())
+                self._put(
                     paths.gates(self.tracker, class_name),
-                    rr.LineStrips3D(
-                        lift_xy(outline, self._z_of(gids[drawn])[:, None]),
-                        colors=pack_rgba(track_colors(gids[drawn])),
-                        radii=GATE_LINE_RADIUS_M,
-                    ),
+                    rr.LineStrips3D,
+                    n,
+                    strips=list(lift_xy(outline, self._z_of(gids[drawn])[:, None])),
+                    colors=packed_track_colors(gids[drawn]),
+                    radii=np.full(n, GATE_LINE_RADIUS_M, dtype=np.float32),
                 )
             return {int(t): k for k, (t, d) in enumerate(zip(gids.tolist(), drawn.tolist(), strict=True)) if d}
         return {int(t): k for k, t in enumerate(ids.tolist()) if worthy[k]}
@@ -468,7 +490,7 @@ class TrackerLogger:
         pred_ids = np.asarray(cf.predicted.track_ids, dtype=np.int64)
         pred_xy = {int(t): m[:2] for t, m in zip(pred_ids, np.asarray(cf.predicted.mean).reshape(-1, 4), strict=True)}
         costs = self._pair_costs(cf.cost)
-        strips, colors, labels = [], [], []
+        strips, owners, labels = [], [], []
         chosen: set[tuple[int, int]] = set()
         for row, col in cf.assignment.pairs:
             if col.kind is not AxisKind.TRACK or row.ref not in pos or col.ref not in pred_xy:
@@ -477,7 +499,7 @@ class TrackerLogger:
             chosen.add((t, m))
             z = xyz[pos[m], 2]
             strips.append([(*pred_xy[t], z), tuple(xyz[pos[m]])])
-            colors.append(track_color(t))
+            owners.append(t)
             cost = costs.get((m, t), math.nan)
             labels.append(f"{meas_name(m)} → {t} (cost {cost:.2f})")
             self._track_sample(paths.chosen_cost(self.tracker, class_name, t), class_name, t, cost, "chosen cost")
@@ -485,9 +507,15 @@ class TrackerLogger:
             if nis is not None:
                 self._track_sample(paths.nis(self.tracker, class_name, t), class_name, t, nis, "NIS")
         if strips:
-            self._show(
+            self._put(
                 paths.associations(self.tracker, class_name),
-                rr.LineStrips3D(strips, colors=colors, radii=ASSOCIATION_RADIUS_M, labels=labels, show_labels=False),
+                rr.LineStrips3D,
+                len(strips),
+                static={"show_labels": False},
+                strips=strips,
+                colors=packed_track_colors(np.array(owners, dtype=np.int64)),
+                radii=np.full(len(strips), ASSOCIATION_RADIUS_M, dtype=np.float32),
+                labels=labels,
             )
         gated = cf.gated
         if gated is None:
@@ -495,18 +523,24 @@ class TrackerLogger:
         inside = np.asarray(gated.inside, dtype=bool)
         gids = np.asarray(gated.track_ids, dtype=np.int64).tolist()
         gmeas = np.asarray(gated.meas_indices, dtype=np.int64).tolist()
-        rejected, rcolors, rlabels = [], [], []
+        rejected, rowners, rlabels = [], [], []
         for k, j in zip(*np.nonzero(inside), strict=True):
             t, m = gids[k], gmeas[j]
             if t not in worthy or (t, m) in chosen or m not in pos:
                 continue
             rejected.append([(*pred_xy[t], xyz[pos[m], 2]), tuple(xyz[pos[m]])])
-            rcolors.append((*track_color(t), GATED_PAIR_ALPHA))
+            rowners.append(t)
             rlabels.append(f"{meas_name(m)} in gate of {t}, not chosen (cost {costs.get((m, t), math.nan):.2f})")
         if rejected:
-            self._show(
+            self._put(
                 paths.gated_pairs(self.tracker, class_name),
-                rr.LineStrips3D(rejected, colors=rcolors, radii=GATED_PAIR_RADIUS_M, labels=rlabels, show_labels=False),
+                rr.LineStrips3D,
+                len(rejected),
+                static={"show_labels": False},
+                strips=rejected,
+                colors=packed_track_colors(np.array(rowners, dtype=np.int64), alpha=GATED_PAIR_ALPHA),
+                radii=np.full(len(rejected), GATED_PAIR_RADIUS_M, dtype=np.float32),
+                labels=rlabels,
             )
 
     @staticmethod
@@ -515,13 +549,14 @@ class TrackerLogger:
         if matrix is None:
             return {}
         cost = np.asarray(matrix.cost, dtype=np.float64)
-        out = {}
-        track_cols = [(j, c.ref) for j, c in enumerate(matrix.cols) if c.kind is AxisKind.TRACK]
-        for i, r in enumerate(matrix.rows):
-            for j, t in track_cols:
-                if math.isfinite(cost[i, j]):
-                    out[(int(r.ref), int(t))] = float(cost[i, j])
-        return out
+        cols = [j for j, c in enumerate(matrix.cols) if c.kind is AxisKind.TRACK]
+        if not cols or cost.size == 0:
+            return {}
+        sub = cost[:, cols]
+        rows, ks = np.nonzero(np.isfinite(sub))
+        meas = [int(matrix.rows[i].ref) for i in rows.tolist()]
+        tracks = [int(matrix.cols[cols[k]].ref) for k in ks.tolist()]
+        return dict(zip(zip(meas, tracks, strict=True), sub[rows, ks].tolist(), strict=True))
 
     @staticmethod
     def _nis(gated: Gated | None, track_id: int, z: np.ndarray) -> float | None:
@@ -602,25 +637,34 @@ class TrackerLogger:
         if not estimates:
             return
         boxes = estimate_boxes(estimates)
+        ids = np.array([e.track_id for e in estimates], dtype=np.int64)
         cids = class_ids(np.array([e.class_name for e in estimates], dtype=object))
+        colors = packed_track_colors(ids)
         for k, e in enumerate(estimates):
             self._extracted_ids.add(e.track_id)
-            color = track_color(e.track_id)
+            path = paths.track(self.tracker, class_name, e.track_id)
+            self._put(
+                path,
+                rr.Boxes3D,
+                1,
+                centers=boxes.centers_m[k : k + 1],
+                half_sizes=0.5 * boxes.sizes_xyz_m[k : k + 1],
+                quaternions=boxes.quat_xyzw[k : k + 1],
+                colors=colors[k : k + 1],
+                class_ids=cids[k : k + 1],
+                labels=[str(e.track_id)],
+                radii=np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32),
+            )
             trail = list(self._trails.get(e.track_id, ()))
-            parts: list[rr.AsComponents] = [
-                rr.Boxes3D(
-                    centers=boxes.centers_m[k : k + 1],
-                    sizes=boxes.sizes_xyz_m[k : k + 1],
-                    quaternions=boxes.quat_xyzw[k : k + 1],
-                    colors=[color],
-                    class_ids=cids[k : k + 1],
-                    labels=[str(e.track_id)],
-                    radii=TRACK_LINE_RADIUS_M,
-                )
-            ]
             if len(trail) >= 2:
-                parts.append(rr.LineStrips3D([trail], colors=[color], radii=TRAIL_RADIUS_M))
-            self._show(paths.track(self.tracker, class_name, e.track_id), *parts)
+                self._put(
+                    path,
+                    rr.LineStrips3D,
+                    1,
+                    strips=[np.array(trail)],
+                    colors=colors[k : k + 1],
+                    radii=np.full(1, TRAIL_RADIUS_M, dtype=np.float32),
+                )
 
     # The story log.
     def _story(self, class_name: str, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
@@ -726,32 +770,38 @@ class TrackerLogger:
         grid = decision_grid(decisions, matrices, reported=self._extracted_ids, focus_tracks=self.focus_tracks)
         root = paths.decision_matrix(self.tracker)
         if grid.costs.size:
-            self._show(
+            n = grid.costs.size
+            self._put(
                 f"{root}/cells",
-                rr.Boxes2D(
-                    centers=grid.centers,
-                    sizes=np.full((grid.costs.size, 2), 0.94),
-                    colors=cost_colors(grid.costs),
-                    labels=grid.labels,
-                    show_labels=True,
-                    draw_order=1.0,
-                ),
+                rr.Boxes2D,
+                n,
+                static={"show_labels": True, "draw_order": 1.0},
+                centers=grid.centers,
+                half_sizes=np.full((n, 2), 0.47),
+                colors=pack_rgba(cost_colors(grid.costs)),
+                labels=grid.labels,
             )
             sel = np.flatnonzero(grid.chosen)
             if sel.size:
-                self._show(
+                self._put(
                     f"{root}/chosen",
-                    rr.Boxes2D(
-                        centers=grid.centers[sel],
-                        sizes=np.full((sel.size, 2), 0.94),
-                        colors=[CHOSEN_CELL_COLOR],
-                        radii=0.05,
-                        draw_order=2.0,
-                    ),
+                    rr.Boxes2D,
+                    sel.size,
+                    static={"draw_order": 2.0},
+                    centers=grid.centers[sel],
+                    half_sizes=np.full((sel.size, 2), 0.47),
+                    colors=np.full(sel.size, CHOSEN_CELL_RGBA, dtype=np.uint32),
+                    radii=np.full(sel.size, 0.05, dtype=np.float32),
                 )
-            self._show(
+            k = len(grid.axis_labels)
+            self._put(
                 f"{root}/axes",
-                rr.Points2D(grid.axis_positions, radii=0.01, labels=grid.axis_labels, show_labels=True),
+                rr.Points2D,
+                k,
+                static={"show_labels": True},
+                positions=grid.axis_positions,
+                radii=np.full(k, 0.01, dtype=np.float32),
+                labels=grid.axis_labels,
             )
 
     # Tracker-specific plots.

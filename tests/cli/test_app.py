@@ -77,8 +77,8 @@ def test_tracks_decisions_existence_and_story(rows: dict) -> None:
     boxes = [r for p in car_tracks for r in rows[p] if "Boxes3D:centers" in r]
     assert max(r["frame"] for r in boxes) >= N_FRAMES - 5
     assert all(
-        r["Boxes3D:labels"] == [p.rsplit("/", 1)[1]] for p in car_tracks for r in rows[p] if "Boxes3D:labels" in r
-    )
+        r["Boxes3D:labels"] in ([p.rsplit("/", 1)[1]], []) for p in car_tracks for r in rows[p] if "Boxes3D:labels" in r
+    )  # its id while reported, an empty batch once it is not
     docs = rows[paths.decisions("gnnpmb")]
     assert at_frame(docs, 0) and at_frame(docs, N_FRAMES - 1)
     assert any("| detection | chosen | cost | next best | cost | margin |" in r["TextDocument:text"][0] for r in docs)

@@ -163,7 +163,7 @@ def test_each_track_is_one_entity_with_its_box_id_label_and_trail(logged: tuple[
     np.testing.assert_allclose(latest_at(rows, 1, "Boxes3D:centers"), [[11.0, 2.0, 0.9]], rtol=1e-6)
     trail = latest_at(rows, 1, "LineStrips3D:strips")
     np.testing.assert_allclose(np.array(trail[0])[:, :2], [[10.0, 2.0], [10.0, 2.0]])  # posterior means, frames 0-1
-    assert latest_at(rows, 2, "Boxes3D:centers") is None  # cleared when no longer reported
+    assert not latest_at(rows, 2, "Boxes3D:centers")  # cleared when no longer reported
     assert paths.track(T, "car", 2) not in logged[0]  # a candidate never gets a box
     assert not any(p.startswith(paths.tracks(T, "bus")) for p in logged[0])
 
@@ -185,7 +185,7 @@ def test_an_association_line_for_every_assigned_pair_and_dim_lines_for_gated_rej
         "m0 in gate of 2, not chosen (cost -4.00)",
     ]
     assert all(c & 0xFF == 90 for c in rejected["LineStrips3D:colors"])  # dimmed
-    assert latest_at(rows[paths.associations(T, "car")], 2, "LineStrips3D:strips") is None
+    assert not latest_at(rows[paths.associations(T, "car")], 2, "LineStrips3D:strips")
 
 
 def test_gates_and_predictions_only_for_tracks_worth_it(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
@@ -200,7 +200,7 @@ def test_gates_and_predictions_only_for_tracks_worth_it(saved_stream: tuple[rr.R
     np.testing.assert_allclose(outline[0], outline[-1], atol=1e-9)
     np.testing.assert_allclose(np.hypot(outline[:, 0] - 10.0, outline[:, 1] - 2.0), np.sqrt(40.0), rtol=1e-6)
     np.testing.assert_allclose(outline[:, 2], 0.9, rtol=1e-6)  # at the track's box height
-    assert latest_at(rows[paths.gates(T, "car")], 2, "LineStrips3D:strips") is None
+    assert not latest_at(rows[paths.gates(T, "car")], 2, "LineStrips3D:strips")
     assert latest_at(rows[paths.predicted(T, "car")], 1, "Points3D:positions.len") == 1
     assert latest_at(rows[paths.candidates_world(T, "car")], 1, "Points3D:positions.len") == 1
 
@@ -285,12 +285,13 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     assert [r["frame"] for r in rows[paths.existence(T, "car", 1)] if not r["static"]] == [0, 1]  # history
     assert [r.get("focus") for r in rows[paths.existence(T, "car", 1)] if not r["static"]] == [0, 1]
     assert {r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 1)} == {1}
-    assert [r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 2)] == [None]  # past the focus
+    assert {r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 2)} == {None}  # past the focus
     step = logger.track_steps[2][1]
     assert (step.prior_existence, step.given, step.reported) == (pytest.approx(0.28), 1, False)
     assert [m for m, _ in step.gated] == [0]
-    labels = at_frame(rows[paths.predicted_focus(T, "car")], 1)[0]
-    assert labels["Points3D:labels"] == ["2 predicted, r=0.28"] and labels["Points3D:show_labels"] == [True]
+    focused = rows[paths.predicted_focus(T, "car")]
+    assert at_frame(focused, 1)[0]["Points3D:labels"] == ["2 predicted, r=0.28"]
+    assert [r for r in focused if r["static"]][0]["Points3D:show_labels"] == [True]
 
 
 def test_events_outside_a_frame_and_unknown_events_are_rejected(saved_stream) -> None:
