@@ -169,9 +169,10 @@ def failure_counts_view(tracker: str) -> rrb.TimeSeriesView:
 
 
 def _series_contents(root: str, focus: FocusTarget | None, tracker: str) -> list[str] | str:
+    """Every series, or with a focus the involved tracks' (and their class's extraction threshold)."""
     if focus is None or not focus.track_ids.get(tracker):
         return "$origin/**"
-    return [f"+ {root}/{focus.class_name}/{t}" for t in focus.track_ids[tracker]]
+    return [f"+ {root}/{focus.class_name}/{t}" for t in (*focus.track_ids[tracker], "threshold")]
 
 
 def track_series_views(tracker: str, focus: FocusTarget | None = None) -> list[rrb.TimeSeriesView]:

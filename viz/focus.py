@@ -34,6 +34,15 @@ SCALE = 1.15
 MARGIN_M = 0.25
 LINE_RADIUS_M = 0.12
 MAX_STORY_LINES = 40
+TABLE_FRAMES = 6
+"""The frame tables show the focus frame and the TABLE_FRAMES frames before it."""
+LEGEND = (
+    "How to read the views: thin boxes in class colours are detections (`m<idx> <score>`), translucent boxes "
+    "are ground truth, boxes labelled with a number are tracks (trail: their last positions); circles are gates; "
+    "a solid line joins a track's prediction to the detection it was given, a faint one a detection inside its "
+    "gate that it was not given; enlarged boxes mark failures (magenta ID switch, orange fragmentation, red false "
+    "track, green coalescence, yellow identity theft, grey miss) and the involved objects carry their labels."
+)
 NEAR_DETECTION_M = 2.0
 """A detection or track within this BEV distance of a ground-truth object is "on" it (the devkit's match
 distance)."""
@@ -63,6 +72,8 @@ def focus_markdown(
         "",
         f"Opened at frame **{focus.frame_index}** on the `{FOCUS_TIMELINE}` timeline, which ends there; choose the "
         f"`frame` timeline in the time panel to step past it. Recorded frames: {shown.start}–{shown.stop - 1}.",
+        "",
+        LEGEND,
         "",
     ]
     involved = [f"GT {short_id(g)}" for g in focus.gt_ids]
@@ -138,6 +149,12 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
     return out
 
 
+def _after(step) -> float:
+    """Existence after the update (0 when the track was pruned that frame)."""
+    r = step.posterior_existence
+    return 0.0 if r != r else r
+
+
 def _frames(frames: list[int]) -> str:
     return ", ".join(str(f) for f in frames)
 
@@ -152,7 +169,7 @@ def _gt_markdown(
     for gt_id in focus.gt_ids:
         rows = []
         seen, detected, sent = 0, 0, []
-        for i in range(shown.start, focus.frame_index + 1):
+        for i in range(max(shown.start, focus.frame_index - TABLE_FRAMES), focus.frame_index + 1):
             gt = scene.keyframes[i].gt
             hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
             frame = by_frame.get(i)
@@ -202,13 +219,15 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
     detections in its gate (with NIS) and the one it was given, and whether it was reported."""
     out: list[str] = []
     for t in track_ids:
-        steps = {f: s for f, s in logger.track_steps.get(t, {}).items() if shown.start <= f <= last}
+        steps = {
+            f: s for f, s in logger.track_steps.get(t, {}).items() if max(shown.start, last - TABLE_FRAMES) <= f <= last
+        }
         if not steps:
             continue
         out += [
             f"Track {t}, frame by frame:",
             "",
-            "| frame | r predicted | in gate (NIS) | given | r after | reported |",
+            "| frame | r before update | in gate (NIS) | given | r after | reported |",
             "|---|---|---|---|---|---|",
         ]
         for f in sorted(steps):

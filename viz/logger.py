@@ -80,6 +80,7 @@ CANDIDATE_POINT_RADIUS_M = 0.12
 MAX_HYPOTHESIS_SERIES = 10
 """Log weights are plotted for the best this many PMBM global hypotheses."""
 CHOSEN_CELL_RGBA = int(pack_rgba(np.array([[255, 210, 0]], dtype=np.uint8))[0])
+THRESHOLD_COLOR = (150, 150, 150)
 FLUSH_FRAMES = 10
 """Default cadence: story lines and spatial rows are sent column-wise every this many frames (and at the end),
 so a live viewer sees them within seconds; a saved recording passes ``flush_frames=None`` (only at the end: one
@@ -404,6 +405,13 @@ class TrackerLogger:
     def _draw_class(self, class_name: str, cf: _ClassFrame) -> set[int]:
         """Draw one class's frame; returns the ids of its extracted tracks."""
         estimates = cf.extracted.estimates if cf.extracted is not None else ()
+        if cf.extracted is not None and cf.posterior is not None:
+            self._sample(
+                paths.extraction_threshold(self.tracker, class_name),
+                cf.extracted.threshold,
+                f"{class_name} extraction threshold",
+                THRESHOLD_COLOR,
+            )
         for e in estimates:
             self._track_z[e.track_id] = float(e.translation_m[2])
         worthy = self._draw_prior(class_name, cf)
@@ -439,7 +447,7 @@ class TrackerLogger:
                     positions=lift_xy(xy[sel], self._z_of(ids[sel])),
                     colors=packed_track_colors(ids[sel]),
                     radii=np.full(sel.size, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
-                    labels=[f"{t} predicted, r={r:.2f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
+                    labels=[f"{t} predicted r={r:.2f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
                 )
         if (~worthy).any():
             sel = np.flatnonzero(~worthy)

@@ -107,6 +107,11 @@ def existence(tracker: str, class_name: str, track_id: int) -> str:
     return f"{existence_root(tracker)}/{_name(class_name)}/{int(track_id)}"
 
 
+def extraction_threshold(tracker: str, class_name: str) -> str:
+    """Scalars: the existence a Bernoulli of this class needs to be reported, drawn beside the existence lines."""
+    return f"{existence_root(tracker)}/{_name(class_name)}/threshold"
+
+
 def nis_root(tracker: str) -> str:
     return f"{tracker_root(tracker)}/nis"
 

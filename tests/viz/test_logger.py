@@ -290,7 +290,7 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     assert (step.prior_existence, step.given, step.reported) == (pytest.approx(0.28), 1, False)
     assert [m for m, _ in step.gated] == [0]
     focused = rows[paths.predicted_focus(T, "car")]
-    assert at_frame(focused, 1)[0]["Points3D:labels"] == ["2 predicted, r=0.28"]
+    assert at_frame(focused, 1)[0]["Points3D:labels"] == ["2 predicted r=0.28"]
     assert [r for r in focused if r["static"]][0]["Points3D:show_labels"] == [True]
 
 
