@@ -17,6 +17,7 @@ trials finish in.
 from __future__ import annotations
 
 import math
+import os
 import re
 import shutil
 import tempfile
@@ -235,6 +236,28 @@ def _ray_trainable(config: dict[str, Any], context: _TrialContext) -> None:
     tune.report({"score": row["amota"] if row["amota"] is not None else 0.0, **metrics})
 
 
+def _reporter(listener: Callable[[Any, Mapping[str, Any]], None]) -> Any:
+    """A Ray Tune callback passing each trial's result to ``listener`` in the driver. Tune pickles its
+    callbacks into the experiment state; the listener (progress bar, locks) is left out of that copy."""
+    from ray import tune
+
+    class Reporter(tune.Callback):
+        def __init__(self, listener: Callable[[Any, Mapping[str, Any]], None]) -> None:
+            self.listener: Callable[[Any, Mapping[str, Any]], None] | None = listener
+
+        def __getstate__(self) -> dict[str, Any]:
+            return {}
+
+        def __setstate__(self, state: dict[str, Any]) -> None:
+            self.listener = None
+
+        def on_trial_result(self, iteration: int, trials: list, trial: Any, result: dict, **info: Any) -> None:
+            if self.listener is not None:
+                self.listener(trial, result)
+
+    return Reporter(listener)
+
+
 def _search_on_ray(
     dims: Sequence[SearchDim],
     trials: int,
@@ -243,9 +266,14 @@ def _search_on_ray(
     run: Execution,
     on_trial: Callable[[Trial], None],
 ) -> tuple[list[Trial], bool]:
+    import optuna
+
+    os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
+    os.environ.setdefault("TUNE_DISABLE_AUTO_CALLBACK_LOGGERS", "1")
     from ray import tune
     from ray.tune.search.optuna import OptunaSearch
 
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
     done: list[Trial] = []
 
     def to_row(metrics: Mapping[str, Any]) -> dict[str, Any]:
@@ -258,10 +286,9 @@ def _search_on_ray(
             or k.endswith("_time_s")
         }
 
-    class Reporter(tune.Callback):
-        def on_trial_result(self, iteration: int, trials: list, trial: Any, result: dict, **info: Any) -> None:
-            done.append(Trial(_assignment(dims, trial.config), to_row(result)))
-            on_trial(done[-1])
+    def listen(trial: Any, result: Mapping[str, Any]) -> None:
+        done.append(Trial(_assignment(dims, trial.config), to_row(result)))
+        on_trial(done[-1])
 
     storage = Path(tempfile.mkdtemp(prefix="gnnpmb-tune-"))
     try:
@@ -272,7 +299,9 @@ def _search_on_ray(
                 num_samples=trials,
                 max_concurrent_trials=run.workers,
             ),
-            run_config=tune.RunConfig(storage_path=str(storage), name="gnnpmb-tune", verbose=0, callbacks=[Reporter()]),
+            run_config=tune.RunConfig(
+                storage_path=str(storage), name="gnnpmb-tune", verbose=0, callbacks=[_reporter(listen)]
+            ),
         )
         try:
             grid = tuner.fit()
