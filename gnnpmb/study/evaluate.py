@@ -48,6 +48,17 @@ def _number(value: float, count: bool = False) -> float | int | None:
     return int(round(value)) if count else float(value)
 
 
+def _empty_row(track_s: float, wall_s: float) -> dict[str, Any]:
+    """The row of a configuration that tracked nothing: the devkit refuses an empty submission, and with no
+    output every recall threshold is unreached, so AMOTA is 0 and TP = FP = IDS = FRAG = 0; the other metrics
+    need the evaluation's ground-truth count and stay empty."""
+    row: dict[str, Any] = dict.fromkeys(OVERALL_METRICS)
+    row.update({"amota": 0.0, "tp": 0, "fp": 0, "ids": 0, "frag": 0})
+    row.update({class_column(c): None for c in TRACKING_CLASSES})
+    row.update({"track_time_s": round(track_s, 3), "eval_time_s": 0.0, "wall_time_s": round(wall_s, 3)})
+    return row
+
+
 def score_config(job: ConfigJob) -> dict[str, Any]:
     """Track and score one configuration: the overall metrics, AMOTA per class, and the times spent (s)."""
     from gnnpmb.eval.nuscenes_eval import run_tracking_eval
@@ -56,6 +67,8 @@ def score_config(job: ConfigJob) -> dict[str, Any]:
     start = time.perf_counter()
     parts = [track_scene(job.data, name, job.tracker, job.config).results for name in job.data.scene_names]
     track_s = time.perf_counter() - start
+    if not any(boxes for part in parts for boxes in part.values()):
+        return _empty_row(track_s, time.perf_counter() - start)
     scratch = Path(tempfile.mkdtemp(prefix="gnnpmb-study-"))
     try:
         results_path = scratch / "results.json"

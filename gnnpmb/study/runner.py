@@ -15,6 +15,7 @@ import os
 import socket
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any, TypeVar
 
 from gnnpmb.errors import GnnpmbError
@@ -24,6 +25,18 @@ R = TypeVar("R")
 
 ADDRESS_ENV = "RAY_ADDRESS"
 CONNECT_TIMEOUT_S = 5.0
+_UV_HOOK_ENV = "RAY_ENABLE_UV_RUN_RUNTIME_ENV"
+
+
+def import_ray() -> ModuleType:
+    """``import ray`` with Ray's ``uv run`` hook off (unless the user set it): under ``uv run`` that hook copies
+    the working directory (virtual environment included) to every worker and starts each worker through
+    ``uv run``, which took minutes here; workers use the driver's Python (locally) or the one that ran
+    ``ray start`` (on a cluster) instead."""
+    os.environ.setdefault(_UV_HOOK_ENV, "0")
+    import ray
+
+    return ray
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,7 +86,7 @@ def check_address(address: str) -> None:
 def ray_session(run: Execution) -> Iterator[None]:
     """A Ray connection for the duration of the block: reuse one that is already up (tests), else start a
     local instance with ``run.workers`` CPUs or join ``run.address``; shut down only what was started here."""
-    import ray
+    ray = import_ray()
 
     if ray.is_initialized():
         yield
@@ -114,8 +127,7 @@ def run_tasks(fn: Callable[[T], R], items: Sequence[T], run: Execution) -> Itera
         for i, item in enumerate(items):
             yield i, fn(item)
         return
-    import ray
-
+    ray = import_ray()
     remote = ray.remote(num_cpus=1, max_retries=0)(fn)
     pending: dict[Any, int] = {}
     queue = list(enumerate(items))

@@ -40,7 +40,7 @@ from gnnpmb.study.grid import (
     toml_paths,
 )
 from gnnpmb.study.results import write_text
-from gnnpmb.study.runner import Execution
+from gnnpmb.study.runner import Execution, import_ray
 from gnnpmb.types import TRACKING_CLASSES
 
 DEFAULT_CLASS_SPACE: dict[str, tuple[float, float, bool]] = {
@@ -268,6 +268,7 @@ def _search_on_ray(
 ) -> tuple[list[Trial], bool]:
     import optuna
 
+    import_ray()
     os.environ.setdefault("RAY_AIR_NEW_OUTPUT", "0")
     os.environ.setdefault("TUNE_DISABLE_AUTO_CALLBACK_LOGGERS", "1")
     from ray import tune

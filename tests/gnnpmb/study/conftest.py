@@ -81,8 +81,9 @@ def ray_local() -> Iterator[None]:
     """One local Ray instance (2 CPUs) for a test module; the commands reuse it instead of starting their own."""
     import logging
 
-    import ray
+    from gnnpmb.study.runner import import_ray
 
+    ray = import_ray()
     ray.init(num_cpus=2, include_dashboard=False, logging_level=logging.ERROR, log_to_driver=False)
     try:
         yield
