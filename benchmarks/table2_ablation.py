@@ -10,9 +10,11 @@ Usage: uv run python benchmarks/table2_ablation.py [--split mini_train] [--track
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from gnnpmb.data.nuscenes import resolve_dataroot, split_scenes
+from gnnpmb.eval.nuscenes_eval import format_metric
 from gnnpmb.study.cache import CACHE_FOLDER, ResultCache
 from gnnpmb.study.data import resolve_study_data
 from gnnpmb.study.grid import parse_param
@@ -29,6 +31,7 @@ ABLATION = (
     "pmb.extraction_threshold=0.5,0.6,0.7,0.8,0.9,0.95",
 )
 """The five Table II parameters and the values tried (the paper's defaults 0.1, 0.1, 0.1, 15, 0.9 included)."""
+COLUMNS = ("amota", "amotp", "mota", "ids", "fp", "fn")
 
 
 def main() -> None:
@@ -61,16 +64,14 @@ def main() -> None:
     plot_ablation(args.figure, plan.keys, rows, plan.base_values, title)
 
     print(f"{len(rows)} configurations ({outcome.from_cache} from cache) on {split}; figure -> {args.figure}")
-    print("| parameter | value | AMOTA | AMOTP | MOTA | IDS | FP | FN |")
+    print("| parameter | value | AMOTA | AMOTP | MOTA | IDS | FP | FN |  (- = nothing tracked, not scored)")
     print("|---|---|---|---|---|---|---|---|")
     for row in rows:
         varied = [k for k in plan.keys if row[k] is not None]
         key = varied[0] if varied else "(paper defaults)"
         value = row[key] if varied else ""
-        print(
-            f"| {key} | {value} | {row['amota']:.3f} | {row['amotp']:.3f} | {row['mota']:.3f} | {row['ids']} | "
-            f"{row['fp']} | {row['fn']} |"
-        )
+        cells = [format_metric(m, math.nan if row[m] is None else row[m]) for m in COLUMNS]
+        print(f"| {key} | {value} | {' | '.join(cells)} |")
 
 
 if __name__ == "__main__":

@@ -128,15 +128,22 @@ def inputs_fingerprint(data: StudyData) -> str:
     return hashlib.sha256(json.dumps(blob, sort_keys=True).encode()).hexdigest()
 
 
+_SCORING_STUDY_FILES = frozenset({"study/data.py", "study/evaluate.py"})
+
+
 def code_version() -> str:
     """SHA-256 of the ``gnnpmb`` package's source files and the versions of the packages that score the runs,
-    so a change of tracker code or of the evaluation invalidates cached results."""
+    so a change of tracker code or of the evaluation invalidates cached results. Of ``gnnpmb/study`` only the
+    files that produce scores count (editing plots or the runner keeps the cache)."""
     import gnnpmb
     from gnnpmb.provenance import package_versions
 
     root = Path(gnnpmb.__file__).parent
     digest = hashlib.sha256()
     for path in sorted(root.rglob("*")):
+        relative = path.relative_to(root).as_posix()
+        if relative.startswith("study/") and relative not in _SCORING_STUDY_FILES:
+            continue
         if path.suffix in (".py", ".toml") and path.is_file():
             digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes() + b"\0")
     digest.update(json.dumps(package_versions(("nuscenes-devkit", "motmetrics", "numpy")), sort_keys=True).encode())

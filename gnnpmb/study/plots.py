@@ -50,6 +50,12 @@ def series(
         return sorted(points.items(), key=lambda p: str(p[0]))
 
 
+def _scale_x(ax: Any, values: Sequence[float]) -> None:
+    """A logarithmic x axis when every value is positive and they span more than two decades."""
+    if values and min(values) > 0 and max(values) / min(values) > _LOG_SPAN:
+        ax.set_xscale("log")
+
+
 def _numeric(values: Sequence[Any]) -> bool:
     return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
 
@@ -104,9 +110,7 @@ def plot_sweep(
         if overall:
             ax.plot(xs(overall), [s for _, s in overall], marker="s", color="black", linewidth=2.5, label="overall")
         if numeric:
-            positive = [v for v in values if v > 0]
-            if len(positive) == len(values) and positive and max(positive) / min(positive) > _LOG_SPAN:
-                ax.set_xscale("log")
+            _scale_x(ax, values)
             if base_values.get(key) is not None:
                 ax.axvline(base_values[key], color="grey", linestyle=":", linewidth=1)
         else:
@@ -149,6 +153,7 @@ def plot_ablation(
         ax.plot(
             [v for v, _ in overall], [s for _, s in overall], marker="s", color="black", linewidth=2.5, label="overall"
         )
+        _scale_x(ax, [v for v, _ in overall])
         if base_values.get(key) is not None:
             ax.axvline(base_values[key], color="grey", linestyle=":", linewidth=1)
         ax.set_xlabel(key)
