@@ -121,7 +121,8 @@ def track(
         from gnnpmb.study.data import StudyData
         from gnnpmb.study.track import track_scenes
 
-        data = StudyData(location, split, tuple(scene_names), tuple(tokens), detections, preset, seed)
+        detections_path = None if detections is None else detections.resolve()  # workers may run elsewhere
+        data = StudyData(location, split, tuple(scene_names), tuple(tokens), detections_path, preset, seed)
         runs = track_scenes(data, tracker, config, run)
         parts = [r.results for r in runs]
         n_frames = sum(r.n_frames for r in runs)

@@ -111,33 +111,38 @@ def test_overlapping_keys_and_unreachable_cluster_are_one_line_errors(
 def test_tune_writes_a_params_file_that_track_accepts(
     tiny_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    params = tmp_path / "tuned.toml"
-    code, stdout, stderr = run(
-        [
-            "tune",
-            "--dataroot",
-            str(tiny_dataroot),
-            "--split",
-            "mini_val",
-            "--classes",
-            "car",
-            "--trials",
-            "2",
-            "--workers",
-            "1",
-            "--no-progress",
-            "--out",
-            str(params),
-        ],
-        capsys,
-    )
-    assert code == 0, stderr
-    assert "tune: 2 trials on mini_val" in stdout and "best per class" in stdout
-    text = params.read_text()
+    texts = []
+    for name in ("tuned.toml", "again.toml"):
+        params = tmp_path / name
+        code, stdout, stderr = run(
+            [
+                "tune",
+                "--dataroot",
+                str(tiny_dataroot),
+                "--split",
+                "mini_val",
+                "--classes",
+                "car",
+                "--trials",
+                "2",
+                "--workers",
+                "1",
+                "--no-progress",
+                "--out",
+                str(params),
+            ],
+            capsys,
+        )
+        assert code == 0, stderr
+        assert "tune: 2 trials on mini_val" in stdout and "best per class" in stdout
+        texts.append(params.read_text())
+    text = texts[0]
+    assert texts[1] == text  # one worker: deterministic for a seed
     assert "# search space: car.q_x in [0.005, 2] log" in text
     assert "# trials: 2 of 2 (Optuna TPE sampler, seed 0, in process)" in text
     assert set(tomllib.loads(text)) == {"classes"}
     assert set(tomllib.loads(text)["classes"]["car"]) == {"q_x", "q_y", "r_x", "r_y"}
+    params = tmp_path / "tuned.toml"
     assert load_config(params).classes["car"].q_x == tomllib.loads(text)["classes"]["car"]["q_x"]
     out = tmp_path / "results.json"
     code, _, stderr = run(
@@ -145,6 +150,24 @@ def test_tune_writes_a_params_file_that_track_accepts(
         capsys,
     )
     assert code == 0, stderr
+
+
+def test_tune_refuses_a_bad_space_before_any_work(
+    tiny_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "t.toml"
+    base = ["tune", "--dataroot", str(tiny_dataroot), "--split", "mini_val", "--workers", "1", "--out", str(out)]
+    for extra, message in (
+        (["--space", "car.q_x=1:0.1"], "need LOW < HIGH"),
+        (["--space", "car.nope=0.1:1"], "unknown parameter 'nope'"),
+        (["--classes", "boat"], "unknown class boat"),
+        (["--trials", "0"], "--trials must be at least 1"),
+    ):
+        code, _, stderr = run([*base, *extra], capsys)
+        assert code == 2 and stderr.startswith("error: ") and message in stderr, stderr
+    code, _, stderr = run(["tune", "--dataroot", str(tiny_dataroot), "--out", str(out)], capsys)
+    assert code == 2 and "split mini_train has no scenes" in stderr
+    assert not out.exists()
 
 
 def test_sweep_and_track_on_two_ray_workers_equal_one_worker(
