@@ -126,12 +126,12 @@ def register(app: typer.Typer) -> None:
     def sweep(
         out: Annotated[Path, typer.Option(metavar="DIR", help="Folder for results.csv/.json, plots and the cache.")],
         param: Annotated[
-            list[str],
+            list[str] | None,
             typer.Option(
                 metavar="KEY=V1,V2",
                 help="A swept key and its values (repeatable): pmb.gate_chi2=20,40, car.q_x=0.1,0.2, *.r_x=0.05,0.1.",
             ),
-        ],
+        ] = None,
         tracker: TrackerOption = DEFAULT_TRACKER,
         dataroot: DatarootOption = None,
         version: VersionOption = None,
@@ -164,7 +164,7 @@ def register(app: typer.Typer) -> None:
         check_tracker(tracker)
         check_out_dir(out)
         preset = _detector(detections, detector)
-        swept = [parse_param(p) for p in param]
+        swept = [parse_param(p) for p in param or []]
         base = base_params(params)
         run = execution(workers, address)
         location = resolve_dataroot(dataroot, version)
@@ -234,7 +234,10 @@ def register(app: typer.Typer) -> None:
         ] = None,
         dataroot: DatarootOption = None,
         version: VersionOption = None,
-        split: SplitOption = None,
+        split: Annotated[
+            str | None,
+            typer.Option(help="Split to tune on (default: mini_train for *mini versions, else train)."),
+        ] = None,
         detections: DetectionsOption = None,
         detector: DetectorOption = None,
         seed: Annotated[int, typer.Option(metavar="N", help="Seed of the simulated detector and the sampler.")] = 0,

@@ -100,6 +100,8 @@ def test_overlapping_keys_and_unreachable_cluster_are_one_line_errors(
     tiny_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     base = ["sweep", "--dataroot", str(tiny_dataroot), "--out", str(tmp_path / "s")]
+    code, _, stderr = run(base, capsys)
+    assert code == 2 and stderr == "error: empty grid: give at least one --param KEY=V1,V2,...\n"
     code, _, stderr = run([*base, "--param", "car.q_x=0.1", "--param", "*.q_x=0.2"], capsys)
     assert code == 2 and "both set classes.car.q_x" in stderr
     code, _, stderr = run([*base, "--param", "pmb.gate_chi2=20", "--address", "127.0.0.1:1"], capsys)
