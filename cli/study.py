@@ -26,7 +26,7 @@ WorkersOption = Annotated[
     int | None,
     typer.Option(
         metavar="N",
-        help="Parallel tasks (default: the CPU count); 1 runs in this process without Ray.",
+        help="Parallel tasks (default: the CPU count; on a cluster, all its CPUs); 1 runs in this process without Ray.",
     ),
 ]
 AddressOption = Annotated[
@@ -311,12 +311,12 @@ def _provenance(
 
     versions = package_versions(("gnnpmb-viz", "nuscenes-devkit", "ray", "optuna", "numpy"))
     detections = f"file {data.detections}" if data.detections else f"simulated preset {data.detector}, seed {seed}"
+    where = "in process" if not run.uses_ray else f"Ray Tune, {run.workers or 'all cluster CPUs'} concurrent"
     per_class = ", ".join(f"{c} {_metric(result.final_row[class_column(c)])}" for c in TRACKING_CLASSES)
     return [
         f"gnnpmb tune: per-class parameters for tracker {tracker}; pass this file with --params",
         "search space: " + "; ".join(d.describe() for d in dims),
-        f"trials: {len(result.trials)} of {trials} (Optuna TPE sampler, seed {seed}, "
-        f"{'in process' if not run.uses_ray else f'Ray Tune, {run.workers} concurrent'})",
+        f"trials: {len(result.trials)} of {trials} (Optuna TPE sampler, seed {seed}, {where})",
         "choice: per class, the values of the trial with that class's highest AMOTA",
         f"data: {data.location.dataroot} {data.location.version}, split {data.split} "
         f"({', '.join(data.scene_names)}); detections: {detections}",

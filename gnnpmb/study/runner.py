@@ -41,25 +41,29 @@ def import_ray() -> ModuleType:
 
 @dataclass(frozen=True, slots=True)
 class Execution:
-    """How to run: ``workers`` parallel tasks (1 = in this process, no Ray) and an optional cluster address."""
+    """How to run: ``workers`` parallel tasks (1 = in this process, no Ray) and an optional cluster address.
 
-    workers: int
+    workers None (only with an address): no cap of our own, Ray fills the cluster's CPUs.
+    """
+
+    workers: int | None
     address: str | None = None
 
     @property
     def uses_ray(self) -> bool:
-        return self.workers > 1 or self.address is not None
+        return self.address is not None or (self.workers or 0) > 1
 
 
 def execution(workers: int | None, address: str | None) -> Execution:
-    """Check ``--workers`` / ``--address`` (falling back to ``RAY_ADDRESS``); default workers: the CPU count."""
+    """Check ``--workers`` / ``--address`` (falling back to ``RAY_ADDRESS``). Default workers: the CPU count
+    locally, no cap on a cluster."""
     address = address or os.environ.get(ADDRESS_ENV) or None
     if workers is not None and workers < 1:
         raise GnnpmbError(f"--workers must be at least 1, got {workers}")
-    if workers is None:
-        workers = os.cpu_count() or 1
     if address is not None:
         check_address(address)
+    elif workers is None:
+        workers = os.cpu_count() or 1
     return Execution(workers=workers, address=address)
 
 
@@ -129,12 +133,13 @@ def run_tasks(fn: Callable[[T], R], items: Sequence[T], run: Execution) -> Itera
         return
     ray = import_ray()
     remote = ray.remote(num_cpus=1, max_retries=0)(fn)
+    cap = run.workers or len(items)
     pending: dict[Any, int] = {}
     queue = list(enumerate(items))
     queue.reverse()
     try:
         while queue or pending:
-            while queue and len(pending) < run.workers:
+            while queue and len(pending) < cap:
                 i, item = queue.pop()
                 pending[remote.remote(item)] = i
             done, _ = ray.wait(list(pending), num_returns=1)
