@@ -44,3 +44,14 @@ def test_one_at_a_time_plan_starts_with_the_base(tiny_dataroot: Path) -> None:
     assert plan.base_values == {"pmb.birth_weight": 0.1, "preprocess.nms_iou_3d": 0.1}
     with pytest.raises(Exception, match="unknown parameter"):
         plan_sweep("gnnpmb", data, {}, [parse_param("pmb.nope=1")], True)
+
+
+def test_a_configuration_that_tracks_nothing_scores_zero_without_the_devkit(tiny_dataroot: Path) -> None:
+    from gnnpmb.study.evaluate import ConfigJob, score_config
+    from gnnpmb.study.grid import build_config, config_toml
+
+    data = resolve_study_data(resolve_dataroot(tiny_dataroot, None), "mini_val", None, "centerpoint", 0)
+    assignment = (("pmb.birth_weight", 1e-6),)
+    row = score_config(ConfigJob(0, assignment, build_config(config_toml({}, assignment)), "gnnpmb", data))
+    assert row["amota"] == 0.0 and row["tp"] == 0 and row["fp"] == 0 and row["eval_time_s"] == 0.0
+    assert row["mota"] is None and row["amota_car"] is None
