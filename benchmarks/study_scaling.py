@@ -9,12 +9,16 @@ measured evaluation time divided by the scene count, so it also spreads the devk
 reloads the dataset tables for every evaluation) over the scenes; on trainval that table load is much larger
 and is not measured here.
 
+Ray starts its workers at nice 15; on a machine shared with other jobs, ``RAY_worker_niceness=0`` in the
+environment measures them at normal priority.
+
 Usage: uv run python benchmarks/study_scaling.py [--configs 4] [--workers 2] [--nodes 1,2,4,8] [--cores-per-node 2]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import tempfile
 import time
@@ -50,6 +54,7 @@ def main() -> None:
     parser.add_argument("--detector", default="centerpoint")
     args = parser.parse_args()
 
+    load = os.getloadavg()[0]
     location = resolve_dataroot(None, None)
     data = resolve_study_data(location, "mini_val", None, args.detector, 0)
     values = ",".join(f"{0.05 * (i + 1):.2f}" for i in range(args.configs))
@@ -59,7 +64,7 @@ def main() -> None:
     print(f"{args.configs} configurations of gnnpmb on demo mini_val ({n_scenes} scenes, {n_frames} keyframes)")
 
     serial_s, _, rows = measure(plan, Execution(workers=1))
-    parallel_s, parallel_sweep_s, _ = measure(plan, Execution(workers=args.workers))
+    parallel_s, parallel_sweep_s, parallel_rows = measure(plan, Execution(workers=args.workers))
     eval_share = sum(r["eval_time_s"] for r in rows) / sum(r["wall_time_s"] for r in rows)
     track_scene_s = statistics.median(r["track_time_s"] for r in rows) / n_scenes
     eval_scene_s = statistics.median(r["eval_time_s"] for r in rows) / n_scenes
@@ -68,6 +73,12 @@ def main() -> None:
         f"{args.workers} Ray workers: {parallel_s:.1f} s with Ray start-up ({60 * args.configs / parallel_s:.1f} "
         f"configurations/min), {parallel_sweep_s:.1f} s after start-up ({60 * args.configs / parallel_sweep_s:.1f}"
         " configurations/min)"
+    )
+    print(
+        "median wall time of one configuration: "
+        f"{statistics.median(r['wall_time_s'] for r in rows):.1f} s in process, "
+        f"{statistics.median(r['wall_time_s'] for r in parallel_rows):.1f} s in a Ray worker "
+        f"(load average before the runs: {load:.1f} on {os.cpu_count()} CPUs)"
     )
     print(f"evaluation share of a configuration's time: {100 * eval_share:.0f} %")
     print(
