@@ -19,6 +19,7 @@ from rich.table import Table
 
 from cli.errors import entry_point
 from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
+from cli.study import AddressOption, register
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.registry import TRACKER_NAMES
 
@@ -87,6 +88,10 @@ def track(
     seed: SeedOption = 0,
     params: ParamsOption = None,
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
+    workers: Annotated[
+        int, typer.Option(metavar="N", help="Scenes tracked in parallel on Ray; 1 (default) runs in this process.")
+    ] = 1,
+    address: AddressOption = None,
 ) -> None:
     """Track every scene of a split (all 7 classes) and write a nuScenes tracking submission."""
     from gnnpmb.config import load_config
@@ -95,10 +100,12 @@ def track(
     from gnnpmb.eval.submission import build_submission, run_results, write_submission
     from gnnpmb.pipeline import get_detections, run_tracker
     from gnnpmb.registry import check_tracker
+    from gnnpmb.study.runner import execution
 
     check_tracker(tracker)
     preset = _detector(detections, detector)
     config = load_config(params)
+    run = execution(workers, address)
     if detections is not None and not detections.is_file():
         raise GnnpmbError(f"detections file not found: {detections}")
     location = resolve_dataroot(dataroot, version)
@@ -110,33 +117,45 @@ def track(
     nusc = open_nuscenes(location)
     tokens = split_sample_tokens(nusc, scene_names)
 
-    parts = []
-    n_frames = n_boxes = 0
-    step_s = 0.0
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=Console(stderr=True),
-        disable=not progress,
-        transient=True,
-    ) as bar:
-        scenes_task = bar.add_task("scenes", total=len(scene_names))
-        frames_task = bar.add_task("frames", total=None)
-        for name in scene_names:
-            scene = load_scene(nusc, location, name)
-            bar.update(frames_task, description=f"{name} frames", total=len(scene.keyframes), completed=0)
-            scene_detections = get_detections(scene, detections, preset, seed)
-            run = run_tracker(
-                scene, scene_detections, tracker, config, on_frame=lambda: bar.advance(frames_task)
-            )
-            results = run_results(run)
-            parts.append(results)
-            n_frames += len(run.frames)
-            n_boxes += sum(len(boxes) for boxes in results.values())
-            step_s += sum(f.step_time_s for f in run.frames)
-            bar.advance(scenes_task)
+    if run.uses_ray:
+        from gnnpmb.study.data import StudyData
+        from gnnpmb.study.track import track_scenes
+
+        detections_path = None if detections is None else detections.resolve()  # workers may run elsewhere
+        data = StudyData(location, split, tuple(scene_names), tuple(tokens), detections_path, preset, seed)
+        runs = track_scenes(data, tracker, config, run)
+        parts = [r.results for r in runs]
+        n_frames = sum(r.n_frames for r in runs)
+        n_boxes = sum(len(boxes) for r in runs for boxes in r.results.values())
+        step_s = sum(r.step_time_s for r in runs)
+    else:
+        parts = []
+        n_frames = n_boxes = 0
+        step_s = 0.0
+        with Progress(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=Console(stderr=True),
+            disable=not progress,
+            transient=True,
+        ) as bar:
+            scenes_task = bar.add_task("scenes", total=len(scene_names))
+            frames_task = bar.add_task("frames", total=None)
+            for name in scene_names:
+                scene = load_scene(nusc, location, name)
+                bar.update(frames_task, description=f"{name} frames", total=len(scene.keyframes), completed=0)
+                scene_detections = get_detections(scene, detections, preset, seed)
+                scene_run = run_tracker(
+                    scene, scene_detections, tracker, config, on_frame=lambda: bar.advance(frames_task)
+                )
+                results = run_results(scene_run)
+                parts.append(results)
+                n_frames += len(scene_run.frames)
+                n_boxes += sum(len(boxes) for boxes in results.values())
+                step_s += sum(f.step_time_s for f in scene_run.frames)
+                bar.advance(scenes_task)
     write_submission(out, build_submission(parts, tokens))
     ms = 1e3 * step_s / max(n_frames, 1)
     typer.echo(
@@ -271,4 +290,5 @@ def demo_data(
     typer.echo(f"demo dataset (v1.0-mini, seed {seed}) -> {path}")
 
 
+register(app)
 main = entry_point(app)

@@ -1,0 +1,344 @@
+"""``gnnpmb sweep`` and ``gnnpmb tune``: parameter studies scored with the official evaluation, on Ray.
+
+Registered on the ``gnnpmb`` app by ``cli.batch`` (``register``); the work is in ``gnnpmb.study``. No
+``from __future__ import annotations`` here: typer must evaluate the option annotations inside ``register``.
+"""
+
+import sys
+import tomllib
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
+from gnnpmb.errors import GnnpmbError
+
+if TYPE_CHECKING:
+    from gnnpmb.study.data import StudyData
+    from gnnpmb.study.runner import Execution
+    from gnnpmb.study.tune import SearchDim, TuneResult
+
+WorkersOption = Annotated[
+    int | None,
+    typer.Option(
+        metavar="N",
+        help="Parallel tasks (default: the CPU count; on a cluster, all its CPUs); 1 runs in this process without Ray.",
+    ),
+]
+AddressOption = Annotated[
+    str | None,
+    typer.Option(
+        metavar="ADDR",
+        help="Join the Ray cluster at HOST:PORT (default: $RAY_ADDRESS, else a local Ray instance).",
+    ),
+]
+ProgressOption = Annotated[bool, typer.Option(help="Show a progress bar on stderr.")]
+
+
+def base_params(params: Path | None) -> dict[str, Any]:
+    """The ``--params`` file as a TOML dict (checked by the config loader first); empty without one."""
+    from gnnpmb.config import load_config
+
+    if params is None:
+        return {}
+    load_config(params)
+    return tomllib.loads(params.read_text(encoding="utf-8"))
+
+
+def train_split(version: str) -> str:
+    """The split parameters are tuned on by default: mini_train for *mini versions, else train."""
+    return "mini_train" if version.endswith("mini") else "train"
+
+
+def check_out_dir(out: Path) -> None:
+    """A sweep's output folder must be a folder (new or existing)."""
+    if out.exists() and not out.is_dir():
+        raise GnnpmbError(f"--out {out} is a file; give a folder for the sweep's results")
+
+
+def check_out_file(out: Path) -> None:
+    """The tuned parameter file must be a file path in a folder."""
+    if out.is_dir():
+        raise GnnpmbError(f"--out {out} is a folder; give a file name such as tuned.toml")
+
+
+def _progress(enabled: bool, total: int, what: str) -> Progress:
+    bar = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        disable=not enabled,
+        transient=True,
+    )
+    bar.add_task(f"{what}, best AMOTA -", total=total)
+    return bar
+
+
+def _best_label(what: str, best: float | None) -> str:
+    return f"{what}, best AMOTA {'-' if best is None else f'{best:.3f}'}"
+
+
+def _metric(value: Any, digits: int = 3) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float) and not value.is_integer():
+        return f"{value:.{digits}f}"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def _value(value: Any) -> str:
+    """A swept value in the table (``base`` where the key kept its base value)."""
+    if value is None:
+        return "base"
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def best_table(rows: list[dict[str, Any]], keys: tuple[str, ...], title: str) -> Table:
+    """The best rows as a rich table: configuration, swept values, official metrics, wall time."""
+    from gnnpmb.study.evaluate import OVERALL_METRICS
+
+    table = Table(title=title)
+    table.add_column("config", justify="right")
+    for key in keys:
+        table.add_column(key, justify="right")
+    for metric in OVERALL_METRICS:
+        table.add_column(metric.upper(), justify="right")
+    table.add_column("wall s", justify="right")
+    for row in rows:
+        values = [_value(row[k]) for k in keys]
+        table.add_row(
+            str(row["config"]), *values, *(_metric(row[m]) for m in OVERALL_METRICS), f"{row['wall_time_s']:.1f}"
+        )
+    return table
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``sweep`` and ``tune`` to the ``gnnpmb`` app (its shared option types come from ``cli.batch``)."""
+    from cli.batch import DEFAULT_TRACKER, DetectorOption, SplitOption, TrackerOption
+
+    @app.command()
+    def sweep(
+        out: Annotated[Path, typer.Option(metavar="DIR", help="Folder for results.csv/.json, plots and the cache.")],
+        param: Annotated[
+            list[str] | None,
+            typer.Option(
+                metavar="KEY=V1,V2",
+                help="A swept key and its values (repeatable): pmb.gate_chi2=20,40, car.q_x=0.1,0.2, *.r_x=0.05,0.1.",
+            ),
+        ] = None,
+        tracker: TrackerOption = DEFAULT_TRACKER,
+        dataroot: DatarootOption = None,
+        version: VersionOption = None,
+        split: SplitOption = None,
+        detections: DetectionsOption = None,
+        detector: DetectorOption = None,
+        seed: SeedOption = 0,
+        params: ParamsOption = None,
+        one_at_a_time: Annotated[
+            bool,
+            typer.Option(help="Vary one key at a time around the base parameters (Table II style), not the grid."),
+        ] = False,
+        workers: WorkersOption = None,
+        address: AddressOption = None,
+        top: Annotated[int, typer.Option(metavar="N", help="Rows in the table of best configurations.")] = 10,
+        progress: ProgressOption = True,
+    ) -> None:
+        """Score every configuration of a parameter grid with the official evaluation (cached, resumable)."""
+        from cli.batch import _detector, _stdout, default_split
+        from gnnpmb.data.nuscenes import resolve_dataroot
+        from gnnpmb.registry import check_tracker
+        from gnnpmb.study.cache import CACHE_FOLDER, ResultCache
+        from gnnpmb.study.data import resolve_study_data
+        from gnnpmb.study.grid import parse_param
+        from gnnpmb.study.plots import plot_sweep
+        from gnnpmb.study.results import best_amota, best_rows, write_results
+        from gnnpmb.study.runner import execution, session
+        from gnnpmb.study.sweep import plan_sweep, run_sweep
+
+        check_tracker(tracker)
+        check_out_dir(out)
+        preset = _detector(detections, detector)
+        swept = [parse_param(p) for p in param or []]
+        base = base_params(params)
+        run = execution(workers, address)
+        location = resolve_dataroot(dataroot, version)
+        data = resolve_study_data(location, split or default_split(location.version), detections, preset, seed)
+        plan = plan_sweep(tracker, data, base, swept, one_at_a_time)
+        n = len(plan.assignments)
+        rows_seen: list[dict[str, Any]] = []
+        with _progress(progress, n, "configurations") as bar:
+
+            def on_row(row: dict[str, Any], from_cache: bool) -> None:
+                rows_seen.append(row)
+                task = bar.task_ids[0]
+                bar.update(task, advance=1, description=_best_label("configurations", best_amota(rows_seen)))
+
+            with session(run):
+                outcome = run_sweep(plan, ResultCache(out / CACHE_FOLDER), run, on_row)
+        meta = {
+            "tracker": tracker,
+            "dataroot": str(data.location.dataroot),
+            "version": data.location.version,
+            "split": data.split,
+            "scenes": list(data.scene_names),
+            "detections": str(data.detections) if data.detections else None,
+            "detector": None if data.detections else data.detector,
+            "seed": seed,
+            "params": str(params) if params else None,
+            "keys": list(plan.keys),
+            "one_at_a_time": plan.one_at_a_time,
+            "base_values": plan.base_values,
+            "configurations": n,
+        }
+        rows = outcome.rows
+        if rows:
+            write_results(out, plan.keys, rows, meta)
+            title = f"{tracker} on {data.split} ({len(data.scene_names)} scenes, {meta['detector'] or 'file'})"
+            plot_sweep(out, plan.keys, rows, plan.base_values, plan.one_at_a_time, title)
+            console = _stdout()
+            console.print(best_table(best_rows(rows, top), plan.keys, f"best of {len(rows)} configurations"))
+        ran = len(rows) - outcome.from_cache
+        best = best_amota(rows)
+        typer.echo(
+            f"sweep: {len(rows)} of {n} configurations ({outcome.from_cache} from cache, {ran} run), "
+            f"best AMOTA {'-' if best is None else f'{best:.3f}'} -> {out}"
+        )
+        if outcome.interrupted:
+            print(
+                f"interrupted: {n - len(rows)} configurations left; run the same command again to resume",
+                file=sys.stderr,
+            )
+            raise typer.Exit(130)
+
+    @app.command()
+    def tune(
+        out: Annotated[Path, typer.Option(metavar="FILE.toml", help="Where to write the best parameters.")],
+        tracker: TrackerOption = DEFAULT_TRACKER,
+        trials: Annotated[int, typer.Option(metavar="N", help="Number of trials.")] = 20,
+        classes: Annotated[
+            str | None,
+            typer.Option(metavar="a,b", help="Classes whose per-class parameters are searched (default: all 7)."),
+        ] = None,
+        space: Annotated[
+            list[str] | None,
+            typer.Option(
+                metavar="KEY=LOW:HIGH[:log]",
+                help="Searched key and range (repeatable); replaces the default per-class space.",
+            ),
+        ] = None,
+        dataroot: DatarootOption = None,
+        version: VersionOption = None,
+        split: Annotated[
+            str | None,
+            typer.Option(help="Split to tune on (default: mini_train for *mini versions, else train)."),
+        ] = None,
+        detections: DetectionsOption = None,
+        detector: DetectorOption = None,
+        seed: Annotated[int, typer.Option(metavar="N", help="Seed of the simulated detector and the sampler.")] = 0,
+        params: ParamsOption = None,
+        workers: WorkersOption = None,
+        address: AddressOption = None,
+        progress: ProgressOption = True,
+    ) -> None:
+        """Search per-class parameters (Optuna TPE on Ray Tune) and write the best as a --params TOML."""
+        from cli.batch import _detector, _stdout
+        from gnnpmb.data.nuscenes import resolve_dataroot
+        from gnnpmb.registry import check_tracker
+        from gnnpmb.study.data import resolve_study_data
+        from gnnpmb.study.grid import config_toml
+        from gnnpmb.study.runner import execution, session
+        from gnnpmb.study.tune import check_space, default_space, parse_space, run_tune, write_params
+        from gnnpmb.types import TRACKING_CLASSES
+
+        check_tracker(tracker)
+        check_out_file(out)
+        preset = _detector(detections, detector)
+        base = base_params(params)
+        class_names = TRACKING_CLASSES if classes is None else tuple(c.strip() for c in classes.split(",") if c)
+        unknown = [c for c in class_names if c not in TRACKING_CLASSES]
+        if unknown or not class_names:
+            raise GnnpmbError(f"unknown class {', '.join(unknown) or '(none)'}; known: {', '.join(TRACKING_CLASSES)}")
+        dims = [parse_space(s) for s in space] if space else default_space(class_names, base)
+        check_space(dims, base)
+        if trials < 1:
+            raise GnnpmbError(f"--trials must be at least 1, got {trials}")
+        run = execution(workers, address)
+        location = resolve_dataroot(dataroot, version)
+        data = resolve_study_data(location, split or train_split(location.version), detections, preset, seed)
+        seen: list[float] = []
+        with _progress(progress, trials, "trials") as bar:
+
+            def on_trial(trial: Any) -> None:
+                if trial.row.get("amota") is not None:
+                    seen.append(trial.row["amota"])
+                bar.update(bar.task_ids[0], advance=1, description=_best_label("trials", max(seen, default=None)))
+
+            with session(run):
+                result = run_tune(tracker, data, base, dims, trials, seed, run, on_trial)
+        final = result.final_row
+        header = _provenance(tracker, data, dims, trials, seed, run, result, params)
+        write_params(out, config_toml(base, result.best), header)
+        _print_tune(_stdout(), result, class_names, dims)
+        typer.echo(
+            f"tune: {len(result.trials)} trials on {data.split}, combined AMOTA {_metric(final['amota'])} -> {out}"
+        )
+        if result.interrupted:
+            print("interrupted: wrote the best of the finished trials", file=sys.stderr)
+            raise typer.Exit(130)
+
+
+def _provenance(
+    tracker: str,
+    data: "StudyData",
+    dims: "list[SearchDim]",
+    trials: int,
+    seed: int,
+    run: "Execution",
+    result: "TuneResult",
+    params: Path | None,
+) -> list[str]:
+    """Comment header of a tuned parameter file: search space, trials, data, versions, scores."""
+    from gnnpmb.provenance import package_versions
+    from gnnpmb.study.data import code_version
+    from gnnpmb.study.evaluate import class_column
+    from gnnpmb.types import TRACKING_CLASSES
+
+    versions = package_versions(("gnnpmb-viz", "nuscenes-devkit", "ray", "optuna", "numpy"))
+    detections = f"file {data.detections}" if data.detections else f"simulated preset {data.detector}, seed {seed}"
+    where = "in process" if not run.uses_ray else f"Ray Tune, {run.workers or 'all cluster CPUs'} concurrent"
+    per_class = ", ".join(f"{c} {_metric(result.final_row[class_column(c)])}" for c in TRACKING_CLASSES)
+    return [
+        f"gnnpmb tune: per-class parameters for tracker {tracker}; pass this file with --params",
+        "search space: " + "; ".join(d.describe() for d in dims),
+        f"trials: {len(result.trials)} of {trials} (Optuna TPE sampler, seed {seed}, {where})",
+        "choice: per class, the values of the trial with that class's highest AMOTA",
+        f"data: {data.location.dataroot} {data.location.version}, split {data.split} "
+        f"({', '.join(data.scene_names)}); detections: {detections}",
+        f"base parameters: {params or 'paper defaults'}",
+        f"combined on {data.split}: AMOTA {_metric(result.final_row['amota'])}; per class: {per_class}",
+        "versions: " + ", ".join(f"{k} {v}" for k, v in versions.items()) + f"; code {code_version()[:12]}",
+        "score it on held-out data: gnnpmb track --params THIS.toml ... then gnnpmb eval",
+    ]
+
+
+def _print_tune(console: Console, result: "TuneResult", class_names: tuple[str, ...], dims: "list[SearchDim]") -> None:
+    """Per class: the best AMOTA seen in a trial, the combined evaluation's AMOTA, and the chosen values."""
+    from gnnpmb.study.evaluate import class_column
+    from gnnpmb.study.tune import class_of
+
+    chosen = dict(result.best)
+    table = Table(title="best per class")
+    for name in ("class", "best trial AMOTA", "combined AMOTA", "values"):
+        table.add_column(name, justify="left" if name in ("class", "values") else "right")
+    for c in class_names:
+        column = class_column(c)
+        scores = [t.row[column] for t in result.trials if t.row.get(column) is not None]
+        values = ", ".join(f"{d.key.split('.', 1)[1]}={chosen[d.key]:.4g}" for d in dims if class_of(d.key) == c)
+        table.add_row(c, _metric(max(scores, default=None)), _metric(result.final_row[column]), values or "-")
+    console.print(table)

@@ -1,0 +1,90 @@
+"""Score one configuration: track every scene of the split, then one official evaluation (the devkit's
+``TrackingEval`` through ``gnnpmb.eval.nuscenes_eval``), which gives the overall and the per-class metrics.
+
+Runs wherever the task lands (this process or a Ray worker); the submission and the devkit's files go to a
+temporary folder on that machine and are removed afterwards.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from gnnpmb.config import TrackerConfig
+from gnnpmb.study.data import StudyData, track_scene
+from gnnpmb.study.grid import Assignment
+from gnnpmb.types import TRACKING_CLASSES
+
+OVERALL_METRICS: tuple[str, ...] = ("amota", "amotp", "mota", "ids", "frag", "tp", "fp", "fn")
+"""Overall metrics kept per configuration (the devkit's names)."""
+COUNTS = frozenset({"ids", "frag", "tp", "fp", "fn"})
+
+
+@dataclass(frozen=True, slots=True)
+class ConfigJob:
+    """One configuration to score: its index in the study, its values, and the config built from them."""
+
+    index: int
+    assignment: Assignment
+    config: TrackerConfig
+    tracker: str
+    data: StudyData
+
+
+def class_column(class_name: str) -> str:
+    """Column of a class's AMOTA in the results (``amota_car``)."""
+    return f"amota_{class_name}"
+
+
+def _number(value: float, count: bool = False) -> float | int | None:
+    """A metric for JSON/CSV: None where the devkit gives NaN (a class without ground truth); counts as int."""
+    if value is None or math.isnan(value):
+        return None
+    return int(round(value)) if count else float(value)
+
+
+def _empty_row(track_s: float, wall_s: float) -> dict[str, Any]:
+    """The row of a configuration that tracked nothing: the devkit refuses an empty submission, and with no
+    output every recall threshold is unreached, so AMOTA is 0 and TP = FP = IDS = FRAG = 0; the other metrics
+    need the evaluation's ground-truth count and stay empty."""
+    row: dict[str, Any] = dict.fromkeys(OVERALL_METRICS)
+    row.update({"amota": 0.0, "tp": 0, "fp": 0, "ids": 0, "frag": 0})
+    row.update({class_column(c): None for c in TRACKING_CLASSES})
+    row.update({"track_time_s": round(track_s, 3), "eval_time_s": 0.0, "wall_time_s": round(wall_s, 3)})
+    return row
+
+
+def score_config(job: ConfigJob) -> dict[str, Any]:
+    """Track and score one configuration: the overall metrics, AMOTA per class, and the times spent (s)."""
+    from gnnpmb.eval.nuscenes_eval import run_tracking_eval
+    from gnnpmb.eval.submission import build_submission, write_submission
+
+    start = time.perf_counter()
+    parts = [track_scene(job.data, name, job.tracker, job.config).results for name in job.data.scene_names]
+    track_s = time.perf_counter() - start
+    if not any(boxes for part in parts for boxes in part.values()):
+        return _empty_row(track_s, time.perf_counter() - start)
+    scratch = Path(tempfile.mkdtemp(prefix="gnnpmb-study-"))
+    try:
+        results_path = scratch / "results.json"
+        write_submission(results_path, build_submission(parts, job.data.sample_tokens))
+        eval_start = time.perf_counter()
+        scores = run_tracking_eval(
+            results_path, job.data.location.dataroot, job.data.location.version, job.data.split, scratch / "eval"
+        )
+        eval_s = time.perf_counter() - eval_start
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+    row: dict[str, Any] = {m: _number(scores.overall[m], m in COUNTS) for m in OVERALL_METRICS}
+    for class_name in TRACKING_CLASSES:
+        metrics = scores.per_class.get(class_name)
+        row[class_column(class_name)] = None if metrics is None else _number(metrics["amota"])
+    row["track_time_s"] = round(track_s, 3)
+    row["eval_time_s"] = round(eval_s, 3)
+    row["wall_time_s"] = round(time.perf_counter() - start, 3)
+    return row

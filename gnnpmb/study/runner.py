@@ -1,0 +1,155 @@
+"""Where study tasks run: in this process (one worker, no Ray, for debugging) or as Ray tasks.
+
+Ray runs locally by default (``ray.init(num_cpus=workers)``, no dashboard, quiet logs); with an address (or
+``RAY_ADDRESS``) it joins an existing cluster, and ``workers`` caps how many tasks are in flight. An address
+that does not accept a TCP connection within ``CONNECT_TIMEOUT_S`` is refused before Ray is asked (Ray itself
+retries an unreachable GCS for minutes). Results are yielded as tasks finish; Ctrl-C cancels the tasks still
+running and re-raises, so the caller keeps whatever already finished.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import socket
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any, TypeVar
+
+from gnnpmb.errors import GnnpmbError
+
+T = TypeVar("T")
+R = TypeVar("R")
+
+ADDRESS_ENV = "RAY_ADDRESS"
+CONNECT_TIMEOUT_S = 5.0
+_UV_HOOK_ENV = "RAY_ENABLE_UV_RUN_RUNTIME_ENV"
+
+
+def import_ray() -> ModuleType:
+    """``import ray`` with Ray's ``uv run`` hook off (unless the user set it): under ``uv run`` that hook copies
+    the working directory (virtual environment included) to every worker and starts each worker through
+    ``uv run``, which took minutes here; workers use the driver's Python (locally) or the one that ran
+    ``ray start`` (on a cluster) instead."""
+    os.environ.setdefault(_UV_HOOK_ENV, "0")
+    import ray
+
+    return ray
+
+
+@dataclass(frozen=True, slots=True)
+class Execution:
+    """How to run: ``workers`` parallel tasks (1 = in this process, no Ray) and an optional cluster address.
+
+    workers None (only with an address): no cap of our own, Ray fills the cluster's CPUs.
+    """
+
+    workers: int | None
+    address: str | None = None
+
+    @property
+    def uses_ray(self) -> bool:
+        return self.address is not None or (self.workers or 0) > 1
+
+
+def execution(workers: int | None, address: str | None) -> Execution:
+    """Check ``--workers`` / ``--address`` (falling back to ``RAY_ADDRESS``). Default workers: the CPU count
+    locally, no cap on a cluster."""
+    address = address or os.environ.get(ADDRESS_ENV) or None
+    if workers is not None and workers < 1:
+        raise GnnpmbError(f"--workers must be at least 1, got {workers}")
+    if address is not None:
+        check_address(address)
+    elif workers is None:
+        workers = os.cpu_count() or 1
+    return Execution(workers=workers, address=address)
+
+
+def check_address(address: str) -> None:
+    """Refuse a cluster address whose head does not answer (``host:port``, ``ray://host:port``; ``auto`` and
+    ``local`` are left to Ray)."""
+    if address in ("auto", "local"):
+        return
+    hostport = address.removeprefix("ray://")
+    host, sep, port = hostport.rpartition(":")
+    if not sep or not port.isdigit() or not host:
+        raise GnnpmbError(f"Ray address '{address}' must look like HOST:PORT (e.g. 10.0.0.1:6379)")
+    try:
+        with socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S):
+            pass
+    except OSError as exc:
+        raise GnnpmbError(
+            f"cannot reach the Ray cluster at {address} ({exc.strerror or type(exc).__name__}); start it with "
+            "'ray start --head' on the head node, or drop --address / RAY_ADDRESS to run locally"
+        ) from None
+
+
+@contextlib.contextmanager
+def ray_session(run: Execution) -> Iterator[None]:
+    """A Ray connection for the duration of the block: reuse one that is already up (tests), else start a
+    local instance with ``run.workers`` CPUs or join ``run.address``; shut down only what was started here."""
+    ray = import_ray()
+
+    if ray.is_initialized():
+        yield
+        return
+    quiet = {"include_dashboard": False, "logging_level": logging.ERROR, "log_to_driver": False}
+    if run.address is None:
+        ray.init(num_cpus=run.workers, **quiet)
+    else:
+        try:
+            ray.init(address=run.address, **quiet)
+        except (ConnectionError, RuntimeError) as exc:
+            raise GnnpmbError(f"cannot join the Ray cluster at {run.address}: {str(exc).splitlines()[0]}") from None
+    try:
+        yield
+    finally:
+        ray.shutdown()
+
+
+def session(run: Execution) -> contextlib.AbstractContextManager[None]:
+    """``ray_session(run)`` when the run uses Ray, else nothing to set up."""
+    return ray_session(run) if run.uses_ray else contextlib.nullcontext()
+
+
+def _unwrap(exc: BaseException) -> BaseException:
+    """The user's error inside a failed Ray task (so it still prints as one line)."""
+    cause = getattr(exc, "cause", None)
+    return cause if isinstance(cause, GnnpmbError) else exc
+
+
+def run_tasks(fn: Callable[[T], R], items: Sequence[T], run: Execution) -> Iterator[tuple[int, R]]:
+    """``(index, fn(item))`` for every item, in finishing order; in this process when ``run.workers == 1``
+    without an address, else as Ray tasks with at most ``run.workers`` in flight (one CPU each).
+
+    Must be iterated inside ``ray_session(run)`` when ``run.uses_ray``. Closing the iterator early (or Ctrl-C)
+    cancels the tasks still running.
+    """
+    if not run.uses_ray:
+        for i, item in enumerate(items):
+            yield i, fn(item)
+        return
+    ray = import_ray()
+    remote = ray.remote(num_cpus=1, max_retries=0)(fn)
+    cap = run.workers or len(items)
+    pending: dict[Any, int] = {}
+    queue = list(enumerate(items))
+    queue.reverse()
+    try:
+        while queue or pending:
+            while queue and len(pending) < cap:
+                i, item = queue.pop()
+                pending[remote.remote(item)] = i
+            done, _ = ray.wait(list(pending), num_returns=1)
+            ref = done[0]
+            i = pending.pop(ref)
+            try:
+                result = ray.get(ref)
+            except ray.exceptions.RayTaskError as exc:
+                raise _unwrap(exc) from None
+            yield i, result
+    finally:
+        for ref in pending:
+            ray.cancel(ref, force=True)
