@@ -123,6 +123,18 @@ def test_comparison_counts_log_and_markers(rows: dict, expected: Comparison) -> 
     assert logged == [(d.frame_index, f"{compare.KIND_LABELS[d.kind]}: {d.describe()}") for d in expected.disagreements]
 
 
+def test_few_chunks_one_per_entity_not_per_bernoulli_or_frame(saved: tuple[Path, str], rows: dict) -> None:
+    """The web viewer's load time grows with the number of chunks: a saved recording sends each entity's rows
+    in one chunk (LiDAR split by size), and candidate Bernoullis get no entities of their own."""
+    from rerun.chunk import RrdReader
+
+    chunks = list(RrdReader(saved[0]).store().stream())
+    entities = {c.entity_path for c in chunks}
+    assert len(chunks) <= 1500
+    assert len(chunks) <= 2 * len(entities) + 20  # static + temporal part per entity, a few split
+    assert not any("/candidates/" in p and p.rsplit("/", 1)[1].isdigit() for p in rows)
+
+
 def test_comparison_blueprint_is_stored(saved: tuple[Path, str]) -> None:
     stored = stored_views(saved[0])
     assert stored["gnnpmb 3D"] == ("3D", paths.EGO) and stored["gnn 3D"] == ("3D", paths.EGO)
