@@ -338,7 +338,7 @@ class PmbCore:
                 size_wlh_m=tuple(float(v) for v in b.size_wlh_m[i]),
                 quat_wxyz=tuple(float(v) for v in b.quat_wxyz[i]),
                 velocity_mps=(float(b.mean[i, 2]), float(b.mean[i, 3])),
-                score=float(b.score[i]),
+                score=float(b.score[i] * b.existence[i]),
                 existence=float(b.existence[i]),
                 meas_index=int(b.meas_index[i]),
             )
