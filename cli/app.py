@@ -47,9 +47,7 @@ DEFAULT_TRACKER = "gnnpmb"
 DEFAULT_DETECTOR = "centerpoint"
 EXIT_DIFFERENT = 1
 _FRAMES_RE = re.compile(r"^\s*(\d*)\s*:\s*(\d*)\s*$")
-_COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar(
-    "command_line", default=None
-)
+_COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar("command_line", default=None)
 """The command line ``main`` was given, recorded in the provenance (else ``sys.argv`` is used)."""
 
 app = typer.Typer(
@@ -119,8 +117,7 @@ def frame_range_of(bounds: tuple[int | None, int | None], scene: SceneData) -> r
         raise DataError(f"{scene.name} has no keyframes")
     if start >= n or end > n:
         raise GnnpmbError(
-            f"--frames {start}:{end} is outside {scene.name}, which has keyframes 0 to {n - 1} "
-            f"(use END <= {n})"
+            f"--frames {start}:{end} is outside {scene.name}, which has keyframes 0 to {n - 1} (use END <= {n})"
         )
     if end <= start:
         raise GnnpmbError(f"--frames {start}:{end} selects no keyframes; END must be greater than START")
@@ -144,9 +141,7 @@ def detections_source(
     if detections_file is not None:
         path = Path(detections_file).expanduser().absolute()
         return DetectionsSource("file", file_sha256(path), path=str(path))
-    return DetectionsSource(
-        "simulated", boxes_sha256(detections, scene.sample_tokens), preset=detector, seed=int(seed)
-    )
+    return DetectionsSource("simulated", boxes_sha256(detections, scene.sample_tokens), preset=detector, seed=int(seed))
 
 
 def command_line() -> tuple[str, ...]:
@@ -182,7 +177,7 @@ def prepare(
     bounds = parse_frames(frames)
     config = load_config(params)
     target = check_save_path(save) if save is not None else None
-    location = resolve_dataroot(dataroot, version)
+    location = resolve_dataroot(dataroot, version, (scene_name,))
     scene = load_scene(open_nuscenes(location), location, scene_name)
     frame_range = frame_range_of(bounds, scene)
     detections = get_detections(scene, detections_file, detector, seed)
@@ -495,9 +490,7 @@ def view(
     detections: DetectionsOption = None,
     detector: Annotated[
         str,
-        typer.Option(
-            metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars."
-        ),
+        typer.Option(metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars."),
     ] = DEFAULT_DETECTOR,
     seed: SeedOption = 0,
     params: ParamsOption = None,
@@ -559,9 +552,7 @@ def reproduce(
     ] = None,
     detections: Annotated[
         Path | None,
-        typer.Option(
-            metavar="FILE.json", help="Use this detections file instead of the recorded path (a copy)."
-        ),
+        typer.Option(metavar="FILE.json", help="Use this detections file instead of the recorded path (a copy)."),
     ] = None,
     save: Annotated[
         Path | None, typer.Option(metavar="OUT.rrd", help="Also write the re-run as a new recording.")
