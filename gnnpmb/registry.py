@@ -113,4 +113,5 @@ def check_classes(names: list[str]) -> list[str]:
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
-    return _FACTORIES[check_tracker(name)](class_name, config, ids)
+    """Tracker ``name`` for class ``class_name``; it sees ``config`` with that class's overrides applied."""
+    return _FACTORIES[check_tracker(name)](class_name, config.resolved(class_name), ids)

@@ -212,7 +212,6 @@ def test_dense_frame_runs_and_stays_a_distribution():
     assert len(est) == int(np.argmax(pmf)) <= CFG.phd.max_cardinality
 
 
-def test_cphd_rejects_zero_clutter():
-    cfg = CFG.replace(pmb=dataclasses.replace(CFG.pmb, clutter_intensity=0.0))
+def test_zero_clutter_is_rejected_before_the_cphd_sees_it():
     with pytest.raises(ConfigError, match="clutter_intensity"):
-        CphdTracker("car", cfg, IdAllocator())
+        CphdTracker("car", CFG.replace(pmb=dataclasses.replace(CFG.pmb, clutter_intensity=0.0)), IdAllocator())
