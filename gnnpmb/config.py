@@ -96,6 +96,9 @@ RULES: dict[str, Range] = {
     "classes.r_x": _POSITIVE,
     "classes.r_y": _POSITIVE,
     "classes.match_distance_m": _POSITIVE,
+    "classes.r_vx": _POSITIVE,
+    "classes.r_vy": _POSITIVE,
+    "pmb.measure_velocity": Range(0.0, 1.0, True, True),
 }
 """Allowed range of every parameter, by ``section.key`` (``classes.key`` for the per-class models). Covariance
 entries: Q may be 0 (no process noise), R must be > 0 (a zero R makes a perfect sensor and a singular S)."""
@@ -119,13 +122,16 @@ def validate_section(params: Any, section: str) -> None:
 @dataclass(frozen=True, slots=True)
 class ClassParams:
     """Per-class models: process noise Q = diag(q_x, q_y, q_x, q_y), measurement noise R = diag(r_x, r_y), and
-    the greedy tracker's matching distance (``gnnpmb.greedy``; CenterPoint's per-class values)."""
+    the greedy tracker's matching distance (``gnnpmb.greedy``; CenterPoint's per-class values), and the velocity
+    measurement noise r_vx, r_vy ((m/s)^2) used only by the opt-in ``[pmb] measure_velocity = 1`` variant."""
 
     q_x: float
     q_y: float
     r_x: float
     r_y: float
     match_distance_m: float = 4.0
+    r_vx: float = 0.5
+    r_vy: float = 0.5
 
     def __post_init__(self) -> None:
         validate_section(self, "classes")
@@ -167,6 +173,7 @@ class PmbParams:
     birth_vel_std_mps: float = 1.0
     prune_existence: float = 1e-6
     extraction_threshold: float = 0.9
+    measure_velocity: int = 0
 
     def __post_init__(self) -> None:
         validate_section(self, "pmb")
