@@ -10,6 +10,7 @@ from gnnpmb.config import (
     dump_config,
     get_param,
     load_config,
+    paper_config,
     with_params,
 )
 
@@ -111,7 +112,7 @@ def test_per_class_overrides_fall_back_to_the_section_values(tmp_path):
 def test_dotted_names_get_and_set_parameters():
     cfg = with_params(TrackerConfig(), {"pmb.gate_chi2": 30, "classes.car.birth_weight": 0.2})
     assert get_param(cfg, "pmb.gate_chi2") == 30.0 and get_param(cfg, "classes.car.birth_weight") == 0.2
-    assert get_param(cfg, "classes.bus.birth_weight") == 0.1 and get_param(cfg, "classes.car.q_x") == 0.1589
+    assert get_param(cfg, "classes.bus.birth_weight") == 0.3 and get_param(cfg, "classes.car.q_x") == 0.1589
     cfg = with_params(cfg, {"classes.car.vector.p_detect": 0.7})
     assert get_param(cfg, "classes.car.vector.p_detect") == 0.7
     with pytest.raises(ConfigError, match="unknown parameter"):
@@ -129,3 +130,8 @@ def test_every_tracker_of_a_class_sees_its_overrides():
     assert make_class_tracker("gnnpmb", "car", cfg, IdAllocator()).params.gate_chi2 == 40.0
     assert make_class_tracker("gnn", "pedestrian", cfg, IdAllocator()).gate_chi2 == 9.0
     assert make_class_tracker("greedy", "pedestrian", cfg, IdAllocator()).max_age == 5
+
+
+def test_paper_parameter_file_is_the_paper_config():
+    assert load_config(DEFAULT_FILE.parent / "params" / "paper.toml") == paper_config()
+    assert paper_config().pmb.p_survive == 0.7 and paper_config().pmb.extraction_threshold == 0.9

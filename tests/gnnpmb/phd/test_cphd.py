@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from gnnpmb.config import ConfigError, TrackerConfig
+from gnnpmb.config import ConfigError, paper_config
 from gnnpmb.events import Cardinality, Extracted, ListSink, NullSink
 from gnnpmb.phd.cphd import (
     CphdTracker,
@@ -24,7 +24,7 @@ from gnnpmb.phd.gmphd import phd_update
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
-CFG = TrackerConfig()
+CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 
 
 def brute_esf(x: np.ndarray, order: int) -> np.ndarray:
