@@ -184,7 +184,7 @@ def prepare(
     bounds = parse_frames(frames)
     config = load_config(params)
     target = check_save_path(save) if save is not None else None
-    location = resolve_dataroot(dataroot, version)
+    location = resolve_dataroot(dataroot, version, (scene_name,))
     scene = load_scene(open_nuscenes(location), location, scene_name)
     frame_range = frame_range_of(bounds, scene)
     detections = get_detections(scene, detections_file, detector, seed)

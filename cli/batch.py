@@ -44,9 +44,7 @@ SplitOption = Annotated[
 ]
 DetectorOption = Annotated[
     str | None,
-    typer.Option(
-        help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR})."
-    ),
+    typer.Option(help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR})."),
 ]
 TrackerOption = Annotated[str, typer.Option("--tracker", "-t", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")]
 
@@ -108,7 +106,7 @@ def track(
     run = execution(workers, address)
     if detections is not None and not detections.is_file():
         raise GnnpmbError(f"detections file not found: {detections}")
-    location = resolve_dataroot(dataroot, version)
+    location = resolve_dataroot(dataroot, version, (split,) if split else ())
     split = split or default_split(location.version)
     check_split_version(split, location.version)
     scene_names = split_scenes(split, location)
@@ -172,16 +170,14 @@ def evaluate(
     split: SplitOption = None,
     out: Annotated[
         Path | None,
-        typer.Option(
-            help="Folder for the devkit's metrics files (default: <results>_eval/ next to the file)."
-        ),
+        typer.Option(help="Folder for the devkit's metrics files (default: <results>_eval/ next to the file)."),
     ] = None,
 ) -> None:
     """Score a tracking submission with the official nuScenes evaluation (tracking_nips_2019)."""
     from gnnpmb.data.nuscenes import resolve_dataroot
     from gnnpmb.eval.nuscenes_eval import TABLE_METRICS, evaluate_submission, format_metric
 
-    location = resolve_dataroot(dataroot, version)
+    location = resolve_dataroot(dataroot, version, (split,) if split else ())
     split = split or default_split(location.version)
     start = time.perf_counter()
     scores = evaluate_submission(results, location, split, out)
@@ -213,9 +209,7 @@ def failures(
     detector: DetectorOption = None,
     seed: SeedOption = 0,
     params: ParamsOption = None,
-    json_out: Annotated[
-        Path | None, typer.Option("--json", help="Also write the report as JSON here.")
-    ] = None,
+    json_out: Annotated[Path | None, typer.Option("--json", help="Also write the report as JSON here.")] = None,
 ) -> None:
     """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
     coalescence and cascading identity theft (scored with the devkit's own matching)."""
@@ -229,7 +223,7 @@ def failures(
     check_tracker(tracker)
     preset = _detector(detections, detector)
     config = load_config(params)
-    location = resolve_dataroot(dataroot, version)
+    location = resolve_dataroot(dataroot, version, (scene,))
     nusc = open_nuscenes(location)
     scene_data = load_scene(nusc, location, scene)
     run = run_tracker(scene_data, get_detections(scene_data, detections, preset, seed), tracker, config)
@@ -246,9 +240,7 @@ def print_report(report: FailureReport, console: Console) -> None:
     from gnnpmb.eval.failures import FailureKind
     from gnnpmb.eval.nuscenes_eval import format_metric
 
-    classes = Table(
-        title=f"{report.tracker} on {report.scene_name}: devkit counts at the best-MOTA threshold"
-    )
+    classes = Table(title=f"{report.tracker} on {report.scene_name}: devkit counts at the best-MOTA threshold")
     for name in ("class", "threshold", "MOTA", "TP", "FP", "FN", "IDS", "FRAG"):
         classes.add_column(name, justify="left" if name == "class" else "right")
     for c in report.classes:
@@ -278,16 +270,22 @@ def _id_span(ids: list[str]) -> str:
 
 @app.command("demo-data")
 def demo_data(
-    out: Annotated[
-        Path, typer.Option(help="Folder to write the demo dataroot into (new, empty or an old demo).")
-    ],
+    out: Annotated[Path, typer.Option(help="Folder to write the demo dataroot into (new, empty or an old demo).")],
     seed: Annotated[int, typer.Option(help="Seed of the LiDAR noise.")] = 0,
+    scenes: Annotated[
+        str,
+        typer.Option(help="Comma-separated scene names, or mini_val, mini_train or all (default mini_val)."),
+    ] = "mini_val",
 ) -> None:
-    """Write the synthetic nuScenes-format demo dataset (v1.0-mini, scenes scene-0103 and scene-0916)."""
-    from gnnpmb.data.demo import generate_demo_dataset
+    """Write the synthetic nuScenes-format demo dataset (v1.0-mini; the mini_val scenes scene-0103 and
+    scene-0916 by default, the eight generated mini_train scenes on request)."""
+    from gnnpmb.data.demo import DEMO_SCENES, generate_demo_dataset
+    from gnnpmb.data.demo_train import TRAIN_SCENES
 
-    path = generate_demo_dataset(out, seed=seed)
-    typer.echo(f"demo dataset (v1.0-mini, seed {seed}) -> {path}")
+    groups = {"mini_val": DEMO_SCENES, "mini_train": TRAIN_SCENES, "all": DEMO_SCENES + TRAIN_SCENES}
+    names = tuple(n for part in scenes.split(",") if part.strip() for n in groups.get(part.strip(), (part.strip(),)))
+    path = generate_demo_dataset(out, seed=seed, scenes=names)
+    typer.echo(f"demo dataset (v1.0-mini, seed {seed}, {len(set(names))} scenes) -> {path}")
 
 
 register(app)

@@ -1,14 +1,27 @@
 """Tracker parameters: the paper's values as defaults, overridable from one TOML file.
 
 Defaults follow Liu et al., "GNN-PMB", IEEE T-IV 2023, sec. V-B and Table II, and the per-class noise of the
-authors' public code (see ``gnnpmb/default_params.toml``, which is the editable copy of these values).
-A parameter file may set any subset; unknown keys are an error so typos do not go unnoticed.
+authors' public code (see ``gnnpmb/default_params.toml``, which is the editable copy of these values), except
+three ``[pmb]`` values chosen on the demo mini_train split (``PmbParams``); ``gnnpmb/params/paper.toml`` restores
+the paper's.
+A parameter file may set any subset; unknown keys are an error so typos do not go unnoticed, and every value is
+checked against its allowed range (``RULES``; the error names the key, the value and the range).
+
+Per-class parameters: ``[classes.<class>]`` holds the class's own models (``ClassParams``: Q, R, the greedy
+matching distance) and may override any key of the shared sections for that class only, e.g.
+``[classes.pedestrian] birth_weight = 0.05``; a key that two sections share (``p_detect`` of ``[phd]`` and
+``[vector]``) goes into a sub-table, ``[classes.car.vector] p_detect = 0.8``. Every tracker of a class sees the
+shared section values with its class's overrides applied (``TrackerConfig.resolved``). The canonical name of a
+parameter is its dotted path: ``pmb.gate_chi2``, ``classes.car.birth_weight``, ``classes.car.vector.p_detect``
+(``get_param``, ``with_params``).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,24 +35,121 @@ class ConfigError(GnnpmbError):
 
 
 @dataclass(frozen=True, slots=True)
+class Range:
+    """Allowed values of one parameter: lo < v (or <= if ``lo_closed``) and v < hi (or <= if ``hi_closed``)."""
+
+    lo: float
+    hi: float
+    lo_closed: bool
+    hi_closed: bool
+
+    def contains(self, value: float) -> bool:
+        if not math.isfinite(value):
+            return False
+        above = value >= self.lo if self.lo_closed else value > self.lo
+        below = value <= self.hi if self.hi_closed else value < self.hi
+        return above and below
+
+    def __str__(self) -> str:
+        if self.hi == math.inf:
+            return f">= {self.lo:g}" if self.lo_closed else f"> {self.lo:g}"
+        return f"in {'[' if self.lo_closed else '('}{self.lo:g}, {self.hi:g}{']' if self.hi_closed else ')'}"
+
+
+_INF = math.inf
+_PROB = Range(0.0, 1.0, True, True)
+_POSITIVE = Range(0.0, _INF, False, False)
+_NON_NEGATIVE = Range(0.0, _INF, True, False)
+
+
+def _at_least(n: int) -> Range:
+    return Range(float(n), _INF, True, False)
+
+
+RULES: dict[str, Range] = {
+    "preprocess.score_threshold": _PROB,
+    "preprocess.nms_iou_3d": _PROB,
+    "pmb.p_survive": Range(0.0, 1.0, False, True),
+    "pmb.clutter_intensity": _POSITIVE,
+    "pmb.gate_chi2": _POSITIVE,
+    "pmb.birth_weight": _POSITIVE,
+    "pmb.birth_pos_std_m": _POSITIVE,
+    "pmb.birth_vel_std_mps": _POSITIVE,
+    "pmb.prune_existence": Range(0.0, 1.0, True, False),
+    "pmb.extraction_threshold": _PROB,
+    "pmbm.n_hypotheses": _at_least(1),
+    "pmbm.hypothesis_prune": Range(0.0, 1.0, True, False),
+    "lbp.max_iterations": _at_least(1),
+    "lbp.tolerance": _POSITIVE,
+    "phd.p_detect": Range(0.0, 1.0, False, True),
+    "phd.prune_weight": _NON_NEGATIVE,
+    "phd.merge_threshold": _NON_NEGATIVE,
+    "phd.max_components": _at_least(1),
+    "phd.extraction_weight": _POSITIVE,
+    "phd.max_cardinality": _at_least(1),
+    "vector.p_detect": Range(0.0, 1.0, False, False),
+    "vector.confirm_m": Range(1.0, 62.0, True, True),
+    "vector.confirm_n": Range(1.0, 62.0, True, True),
+    "vector.delete_misses": _at_least(1),
+    "vector.exact_cluster_max": _at_least(1),
+    "greedy.max_age": _at_least(1),
+    "classes.q_x": _NON_NEGATIVE,
+    "classes.q_y": _NON_NEGATIVE,
+    "classes.r_x": _POSITIVE,
+    "classes.r_y": _POSITIVE,
+    "classes.match_distance_m": _POSITIVE,
+    "classes.r_vx": _POSITIVE,
+    "classes.r_vy": _POSITIVE,
+    "pmb.measure_velocity": Range(0.0, 1.0, True, True),
+}
+"""Allowed range of every parameter, by ``section.key`` (``classes.key`` for the per-class models). Covariance
+entries: Q may be 0 (no process noise), R must be > 0 (a zero R makes a perfect sensor and a singular S)."""
+
+
+def check_value(section: str, key: str, value: float, where: str) -> None:
+    """Raise a ``ConfigError`` naming ``where`` (e.g. ``[pmb]`` or ``[classes.car]``), the key, the value and
+    the allowed range if ``value`` is outside ``RULES[section.key]``."""
+    rule = RULES[f"{section}.{key}"]
+    if not rule.contains(float(value)):
+        raise ConfigError(f"{where} {key} must be {rule}, got {value!r}")
+
+
+def validate_section(params: Any, section: str) -> None:
+    """Check every field of a section dataclass against ``RULES`` (called by its ``__post_init__``)."""
+    where = f"[{section}]"
+    for f in dataclasses.fields(params):
+        check_value(section, f.name, getattr(params, f.name), where)
+
+
+@dataclass(frozen=True, slots=True)
 class ClassParams:
-    """Per-class noise: process noise Q = diag(q_x, q_y, q_x, q_y), measurement noise R = diag(r_x, r_y)."""
+    """Per-class models: process noise Q = diag(q_x, q_y, q_x, q_y), measurement noise R = diag(r_x, r_y), and
+    the greedy tracker's matching distance (``gnnpmb.greedy``; CenterPoint's per-class values), and the velocity
+    measurement noise r_vx, r_vy ((m/s)^2) used only by the opt-in ``[pmb] measure_velocity = 1`` variant."""
 
     q_x: float
     q_y: float
     r_x: float
     r_y: float
+    match_distance_m: float = 4.0
+    r_vx: float = 0.5
+    r_vy: float = 0.5
+
+    def __post_init__(self) -> None:
+        validate_section(self, "classes")
 
 
 PAPER_CLASS_PARAMS: dict[str, ClassParams] = {
-    "car": ClassParams(0.1589, 0.1249, 0.0890, 0.0941),
-    "truck": ClassParams(0.0945, 0.0946, 0.1486, 0.1445),
-    "bus": ClassParams(0.1177, 0.0885, 0.1755, 0.1382),
-    "trailer": ClassParams(0.0420, 0.0369, 0.2323, 0.2223),
-    "pedestrian": ClassParams(0.0335, 0.0247, 0.0386, 0.0377),
-    "bicycle": ClassParams(0.0199, 0.0137, 0.0539, 0.0504),
-    "motorcycle": ClassParams(0.0324, 0.0387, 0.0405, 0.0399),
+    "car": ClassParams(0.1589, 0.1249, 0.0890, 0.0941, 4.0),
+    "truck": ClassParams(0.0945, 0.0946, 0.1486, 0.1445, 4.0),
+    "bus": ClassParams(0.1177, 0.0885, 0.1755, 0.1382, 5.5),
+    "trailer": ClassParams(0.0420, 0.0369, 0.2323, 0.2223, 3.0),
+    "pedestrian": ClassParams(0.0335, 0.0247, 0.0386, 0.0377, 1.0),
+    "bicycle": ClassParams(0.0199, 0.0137, 0.0539, 0.0504, 3.0),
+    "motorcycle": ClassParams(0.0324, 0.0387, 0.0405, 0.0399, 13.0),
 }
+"""Q and R: the authors' GNN-PMB code; match_distance_m: CenterPoint's ``NUSCENE_CLS_VELOCITY_ERROR`` (Yin et al.
+2021, ``det3d/.../pub_tracker.py``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -49,19 +159,42 @@ class PreprocessParams:
     score_threshold: float = 0.1
     nms_iou_3d: float = 0.1
 
+    def __post_init__(self) -> None:
+        validate_section(self, "preprocess")
+
 
 @dataclass(frozen=True, slots=True)
 class PmbParams:
-    """Shared by the Poisson multi-Bernoulli family (GNN-PMB, PMBM, TO-PMB)."""
+    """Shared by the Poisson multi-Bernoulli family (GNN-PMB, PMBM, TO-PMB); survival, gate, clutter and birth
+    also by the PHD and vector trackers.
 
-    p_survive: float = 0.7
+    The paper's values (sec. V-B, Table II) are kept in ``gnnpmb/params/paper.toml``; three defaults differ, chosen
+    on the demo ``mini_train`` split only (``benchmarks/tune_mini_train.py``) after the failure finder showed why
+    the paper's values lose recall and identities:
+
+    - extraction_threshold 0.01 (paper 0.9): every Bernoulli with r >= 0.01 is output with tracking score = its
+      detection score x r. With 0.9 a new object is reported only from its second detection (a new Bernoulli
+      starts at r ~ 0.065 s with the paper's birth model) and a missed track not at all. AMOTA sweeps the score
+      threshold, so low-r boxes scored s r rank below every confident track and only add recall.
+    - p_survive 0.95 (paper 0.7 per 0.5 s keyframe, a mean lifetime of 1.7 s): with 0.7 a track occluded for a
+      few frames decays so far that its object comes back under a new id.
+    - birth_weight 0.3 (paper 0.1): the prior rate of new objects per detection; a larger one makes a detection's
+      first Bernoulli more likely (r_new = w s N / (c + w s N)), so a new object's first box is scored higher.
+    measure_velocity: 1 = measure [x, y, vx, vy] (opt-in variant, ``kalman``), 0 = the paper's [x, y].
+    """
+
+    p_survive: float = 0.95
     clutter_intensity: float = 1e-3
     gate_chi2: float = 40.0
-    birth_weight: float = 0.1
+    birth_weight: float = 0.3
     birth_pos_std_m: float = 15.0
     birth_vel_std_mps: float = 1.0
     prune_existence: float = 1e-6
-    extraction_threshold: float = 0.9
+    extraction_threshold: float = 0.01
+    measure_velocity: int = 0
+
+    def __post_init__(self) -> None:
+        validate_section(self, "pmb")
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,10 +211,7 @@ class PmbmParams:
     hypothesis_prune: float = 1e-4
 
     def __post_init__(self) -> None:
-        if self.n_hypotheses < 1:
-            raise ConfigError(f"[pmbm] n_hypotheses must be at least 1, got {self.n_hypotheses}")
-        if not 0.0 <= self.hypothesis_prune < 1.0:
-            raise ConfigError(f"[pmbm] hypothesis_prune must be in [0, 1), got {self.hypothesis_prune}")
+        validate_section(self, "pmbm")
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,10 +228,7 @@ class LbpParams:
     tolerance: float = 1e-7
 
     def __post_init__(self) -> None:
-        if self.max_iterations < 1:
-            raise ConfigError(f"[lbp] max_iterations must be at least 1, got {self.max_iterations}")
-        if not self.tolerance > 0.0:
-            raise ConfigError(f"[lbp] tolerance must be > 0, got {self.tolerance}")
+        validate_section(self, "lbp")
 
 
 @dataclass(frozen=True, slots=True)
@@ -127,18 +254,7 @@ class PhdParams:
     max_cardinality: int = 100
 
     def __post_init__(self) -> None:
-        if not 0.0 < self.p_detect <= 1.0:
-            raise ConfigError(f"[phd] p_detect must be in (0, 1], got {self.p_detect}")
-        if not self.prune_weight >= 0.0:
-            raise ConfigError(f"[phd] prune_weight must be >= 0, got {self.prune_weight}")
-        if not self.merge_threshold >= 0.0:
-            raise ConfigError(f"[phd] merge_threshold must be >= 0, got {self.merge_threshold}")
-        if self.max_components < 1:
-            raise ConfigError(f"[phd] max_components must be at least 1, got {self.max_components}")
-        if not self.extraction_weight > 0.0:
-            raise ConfigError(f"[phd] extraction_weight must be > 0, got {self.extraction_weight}")
-        if self.max_cardinality < 1:
-            raise ConfigError(f"[phd] max_cardinality must be at least 1, got {self.max_cardinality}")
+        validate_section(self, "phd")
 
 
 @dataclass(frozen=True, slots=True)
@@ -163,22 +279,36 @@ class VectorParams:
     exact_cluster_max: int = 8
 
     def __post_init__(self) -> None:
-        if not 0.0 < self.p_detect < 1.0:
-            raise ConfigError(f"[vector] p_detect must be strictly between 0 and 1, got {self.p_detect}")
-        if not 1 <= self.confirm_m <= self.confirm_n <= 62:
+        validate_section(self, "vector")
+        if self.confirm_m > self.confirm_n:
             raise ConfigError(
-                f"[vector] need 1 <= confirm_m <= confirm_n <= 62, got confirm_m = {self.confirm_m}, "
-                f"confirm_n = {self.confirm_n}"
+                f"[vector] need confirm_m <= confirm_n, got confirm_m = {self.confirm_m}, confirm_n = {self.confirm_n}"
             )
-        if self.delete_misses < 1:
-            raise ConfigError(f"[vector] delete_misses must be at least 1, got {self.delete_misses}")
-        if self.exact_cluster_max < 1:
-            raise ConfigError(f"[vector] exact_cluster_max must be at least 1, got {self.exact_cluster_max}")
+
+
+@dataclass(frozen=True, slots=True)
+class GreedyParams:
+    """The greedy closest-pair baseline (``gnnpmb.greedy``; CenterPoint, Yin et al. 2021).
+
+    max_age: a track missed this many frames in a row is deleted (CenterPoint's nuScenes setting: 3).
+    """
+
+    max_age: int = 3
+
+    def __post_init__(self) -> None:
+        validate_section(self, "greedy")
+
+
+PAPER_PMB = PmbParams(p_survive=0.7, birth_weight=0.1, extraction_threshold=0.9)
+"""The paper's ``[pmb]`` values (sec. V-B, Table II), where the defaults differ (``gnnpmb/params/paper.toml``)."""
+
+Overrides = dict[str, dict[str, dict[str, float]]]
+"""Per-class overrides of shared-section keys: class name -> section -> key -> value."""
 
 
 @dataclass(frozen=True, slots=True)
 class TrackerConfig:
-    """Everything a tracker needs; one instance for all classes."""
+    """Everything a tracker needs; one instance for all classes (``resolved`` gives one class's view)."""
 
     classes: dict[str, ClassParams] = field(default_factory=lambda: dict(PAPER_CLASS_PARAMS))
     preprocess: PreprocessParams = PreprocessParams()
@@ -187,6 +317,8 @@ class TrackerConfig:
     lbp: LbpParams = LbpParams()
     phd: PhdParams = PhdParams()
     vector: VectorParams = VectorParams()
+    greedy: GreedyParams = GreedyParams()
+    class_overrides: Overrides = field(default_factory=dict)
 
     def for_class(self, class_name: str) -> ClassParams:
         return self.classes[class_name]
@@ -194,45 +326,112 @@ class TrackerConfig:
     def replace(self, **changes: Any) -> TrackerConfig:
         return dataclasses.replace(self, **changes)
 
+    def resolved(self, class_name: str) -> TrackerConfig:
+        """This config as class ``class_name`` sees it: every shared section with the class's overrides applied
+        (no overrides left, so a tracker just reads ``config.pmb`` and so on)."""
+        own = self.class_overrides.get(class_name)
+        if not own:
+            return self if not self.class_overrides else self.replace(class_overrides={})
+        changes: dict[str, Any] = {s: dataclasses.replace(getattr(self, s), **v) for s, v in own.items()}
+        return self.replace(class_overrides={}, **changes)
+
+    def preprocess_by_class(self) -> dict[str, PreprocessParams]:
+        """Class name -> the preprocessing parameters of that class."""
+        return {name: self.resolved(name).preprocess for name in TRACKING_CLASSES}
+
     def as_dict(self) -> dict[str, Any]:
-        """Plain nested dict (for provenance and TOML output)."""
-        return {
-            "preprocess": dataclasses.asdict(self.preprocess),
-            "pmb": dataclasses.asdict(self.pmb),
-            "pmbm": dataclasses.asdict(self.pmbm),
-            "lbp": dataclasses.asdict(self.lbp),
-            "phd": dataclasses.asdict(self.phd),
-            "vector": dataclasses.asdict(self.vector),
-            "classes": {name: dataclasses.asdict(p) for name, p in self.classes.items()},
-        }
+        """Plain nested dict in the TOML layout (for provenance and TOML output; ``config_from_dict`` reads it)."""
+        out: dict[str, Any] = {name: dataclasses.asdict(getattr(self, name)) for name in _SECTIONS}
+        classes: dict[str, Any] = {}
+        for name, p in self.classes.items():
+            entry: dict[str, Any] = dataclasses.asdict(p)
+            for section, values in self.class_overrides.get(name, {}).items():
+                for key, value in values.items():
+                    if len(_SECTIONS_OF_KEY[key]) == 1:
+                        entry[key] = value
+                    else:
+                        entry.setdefault(section, {})[key] = value
+            classes[name] = entry
+        out["classes"] = classes
+        return out
 
 
-_SECTIONS = {
+def paper_config() -> TrackerConfig:
+    """The defaults with the paper's own ``[pmb]`` values: GNN-PMB exactly as published."""
+    return TrackerConfig(pmb=PAPER_PMB)
+
+
+_SECTIONS: dict[str, type] = {
     "preprocess": PreprocessParams,
     "pmb": PmbParams,
     "pmbm": PmbmParams,
     "lbp": LbpParams,
     "phd": PhdParams,
     "vector": VectorParams,
+    "greedy": GreedyParams,
 }
 
+_SECTIONS_OF_KEY: dict[str, tuple[str, ...]] = {}
+for _section, _kind in _SECTIONS.items():
+    for _f in dataclasses.fields(_kind):
+        _SECTIONS_OF_KEY[_f.name] = (*_SECTIONS_OF_KEY.get(_f.name, ()), _section)
 
-def _typed_section(kind: type, values: dict[str, Any], where: str, base: Any) -> Any:
+
+def _typed_value(kind: type, key: str, value: Any, where: str) -> float | int:
+    """``value`` as the type of field ``key`` of ``kind`` (int or float), or a ``ConfigError``."""
     known = {f.name: f for f in dataclasses.fields(kind)}
+    if key not in known:
+        raise ConfigError(f"{where}: unknown parameter '{key}' (known: {', '.join(sorted(known))})")
+    want = int if known[key].type in ("int", int) else float
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ConfigError(f"{where} {key}: expected a number, got {value!r}")
+    if want is int and not float(value).is_integer():
+        raise ConfigError(f"{where} {key}: expected an integer, got {value!r}")
+    return want(value)
+
+
+def _typed_section(kind: type, section: str, values: Any, where: str, base: Any) -> Any:
+    if not isinstance(values, dict):
+        raise ConfigError(f"{where} must be a table of parameters, got {values!r}")
     changes = {}
     for key, value in values.items():
-        if key not in known:
-            raise ConfigError(f"{where}: unknown parameter '{key}' (known: {', '.join(sorted(known))})")
-        want = int if known[key].type in ("int", int) else float
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ConfigError(f"{where}.{key}: expected a number, got {value!r}")
-        if want is int and not float(value).is_integer():
-            raise ConfigError(f"{where}.{key}: expected an integer, got {value!r}")
-        changes[key] = want(value)
+        changes[key] = _typed_value(kind, key, value, where)
+        check_value(section, key, changes[key], where)
     return dataclasses.replace(base, **changes)
 
 
-def config_from_dict(data: dict[str, Any], base: TrackerConfig | None = None) -> TrackerConfig:
+def _class_table(name: str, values: Any, params: ClassParams, overrides: dict[str, dict[str, float]]) -> ClassParams:
+    """Read ``[classes.<name>]``: own models into a new ``ClassParams``, shared-section keys into ``overrides``."""
+    where = f"[classes.{name}]"
+    if not isinstance(values, dict):
+        raise ConfigError(f"{where} must be a table of parameters, got {values!r}")
+    own = {f.name for f in dataclasses.fields(ClassParams)}
+    model = {k: v for k, v in values.items() if k in own}
+    for key, value in values.items():
+        if key in own:
+            continue
+        if key in _SECTIONS and isinstance(value, dict):
+            for sub_key, sub_value in value.items():
+                typed = _typed_value(_SECTIONS[key], sub_key, sub_value, f"[classes.{name}.{key}]")
+                check_value(key, sub_key, typed, f"[classes.{name}.{key}]")
+                overrides.setdefault(key, {})[sub_key] = typed
+            continue
+        sections = _SECTIONS_OF_KEY.get(key, ())
+        if not sections:
+            known = sorted(own | set(_SECTIONS_OF_KEY))
+            raise ConfigError(f"{where}: unknown parameter '{key}' (known: {', '.join(known)})")
+        if len(sections) > 1:
+            raise ConfigError(
+                f"{where}: '{key}' is a parameter of several sections ({', '.join(sections)}); set it in a "
+                f"sub-table such as [classes.{name}.{sections[0]}]"
+            )
+        typed = _typed_value(_SECTIONS[sections[0]], key, value, where)
+        check_value(sections[0], key, typed, where)
+        overrides.setdefault(sections[0], {})[key] = typed
+    return _typed_section(ClassParams, "classes", model, where, params)
+
+
+def config_from_dict(data: Mapping[str, Any], base: TrackerConfig | None = None) -> TrackerConfig:
     """Apply a nested dict of overrides (the TOML layout) to ``base`` (paper defaults if None)."""
     cfg = base or TrackerConfig()
     changes: dict[str, Any] = {}
@@ -241,31 +440,82 @@ def config_from_dict(data: dict[str, Any], base: TrackerConfig | None = None) ->
             if not isinstance(values, dict):
                 raise ConfigError("[classes] must be a table of per-class tables")
             classes = dict(cfg.classes)
+            overrides = {c: {s: dict(v) for s, v in o.items()} for c, o in cfg.class_overrides.items()}
             for name, cvalues in values.items():
                 if name not in TRACKING_CLASSES:
                     raise ConfigError(f"[classes.{name}]: unknown class (known: {', '.join(TRACKING_CLASSES)})")
-                classes[name] = _typed_section(ClassParams, cvalues, f"[classes.{name}]", classes[name])
+                own = overrides.setdefault(name, {})
+                classes[name] = _class_table(name, cvalues, classes[name], own)
+                if not own:
+                    del overrides[name]
             changes["classes"] = classes
+            changes["class_overrides"] = overrides
         elif key in _SECTIONS:
             if not isinstance(values, dict):
                 raise ConfigError(f"[{key}] must be a table")
-            changes[key] = _typed_section(_SECTIONS[key], values, f"[{key}]", getattr(cfg, key))
+            changes[key] = _typed_section(_SECTIONS[key], key, values, f"[{key}]", getattr(cfg, key))
         else:
             raise ConfigError(f"unknown section [{key}] (known: classes, {', '.join(_SECTIONS)})")
-    return cfg.replace(**changes)
+    out = cfg.replace(**changes)
+    for name in out.class_overrides:
+        out.resolved(name)  # cross-field checks (e.g. confirm_m <= confirm_n) of every class's view
+    return out
+
+
+def _nest(dotted: str, value: Any) -> dict[str, Any]:
+    parts = dotted.split(".")
+    if len(parts) < 2 or not all(parts):
+        raise ConfigError(f"'{dotted}' is not a parameter name; use section.key or classes.<class>.key")
+    out: dict[str, Any] = {parts[-1]: value}
+    for part in reversed(parts[:-1]):
+        out = {part: out}
+    return out
+
+
+def with_params(cfg: TrackerConfig, values: Mapping[str, Any]) -> TrackerConfig:
+    """``cfg`` with parameters set by dotted name, e.g. ``{"pmb.gate_chi2": 30, "classes.car.birth_weight": 0.2}``."""
+    for dotted, value in values.items():
+        cfg = config_from_dict(_nest(dotted, value), cfg)
+    return cfg
+
+
+def get_param(cfg: TrackerConfig, dotted: str) -> float | int:
+    """The value of the parameter with dotted name ``dotted`` (per-class names resolve through the fall-back)."""
+    parts = dotted.split(".")
+    if parts[0] == "classes" and len(parts) in (3, 4):
+        name, key = parts[1], parts[-1]
+        if name not in cfg.classes:
+            raise ConfigError(f"unknown class in '{dotted}' (known: {', '.join(TRACKING_CLASSES)})")
+        if len(parts) == 3 and hasattr(cfg.classes[name], key):
+            return getattr(cfg.classes[name], key)
+        sections = (parts[2],) if len(parts) == 4 else _SECTIONS_OF_KEY.get(key, ())
+        if len(sections) == 1 and sections[0] in _SECTIONS and hasattr(getattr(cfg, sections[0]), key):
+            return getattr(getattr(cfg.resolved(name), sections[0]), key)
+    elif len(parts) == 2 and parts[0] in _SECTIONS and hasattr(getattr(cfg, parts[0]), parts[1]):
+        return getattr(getattr(cfg, parts[0]), parts[1])
+    raise ConfigError(f"unknown parameter '{dotted}'")
 
 
 def load_config(path: Path | None) -> TrackerConfig:
     """Paper defaults, overridden by the TOML file at ``path`` if given."""
     if path is None:
         return TrackerConfig()
+    path = Path(path)
+    if path.is_dir():
+        raise ConfigError(f"parameter file {path} is a folder; pass a .toml file")
     try:
-        data = tomllib.loads(Path(path).read_text())
+        data = tomllib.loads(path.read_text())
     except FileNotFoundError as exc:
         raise ConfigError(f"parameter file not found: {path}") from exc
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(f"parameter file {path} is not valid TOML: {exc}") from exc
+    except OSError as exc:
+        raise ConfigError(f"cannot read parameter file {path}: {exc.strerror or exc}") from exc
     return config_from_dict(data)
+
+
+def _toml_value(value: Any) -> str:
+    return repr(value)
 
 
 def dump_config(cfg: TrackerConfig) -> str:
@@ -274,10 +524,15 @@ def dump_config(cfg: TrackerConfig) -> str:
     d = cfg.as_dict()
     for section in _SECTIONS:
         out.append(f"[{section}]")
-        out.extend(f"{k} = {v!r}" for k, v in d[section].items())
+        out.extend(f"{k} = {_toml_value(v)}" for k, v in d[section].items())
         out.append("")
     for name, values in d["classes"].items():
         out.append(f"[classes.{name}]")
-        out.extend(f"{k} = {v!r}" for k, v in values.items())
+        out.extend(f"{k} = {_toml_value(v)}" for k, v in values.items() if not isinstance(v, dict))
         out.append("")
+        for section, sub in values.items():
+            if isinstance(sub, dict):
+                out.append(f"[classes.{name}.{section}]")
+                out.extend(f"{k} = {_toml_value(v)}" for k, v in sub.items())
+                out.append("")
     return "\n".join(out)

@@ -1,7 +1,8 @@
 """Linear Kalman filter for the constant-velocity model, vectorised over K tracks.
 
-State m = [x, y, vx, vy]; measurement z = H m = [x, y]. Motion x_k = F x_{k-1} + w, w ~ N(0, Q) with
-F = [[I, dt I], [0, I]] and Q = diag(q_x, q_y, q_x, q_y) (paper sec. V-B, the authors' per-class values).
+State m = [x, y, vx, vy]; measurement z = H m = [x, y] (D = 2), or [x, y, vx, vy] (D = 4, H = I) for the opt-in
+variant that also measures the detector's velocity (``[pmb] measure_velocity = 1``).
+Motion x_k = F x_{k-1} + w, w ~ N(0, Q), F = [[I, dt I], [0, I]], Q = diag(q_x, q_y, q_x, q_y) (paper sec. V-B).
 Update: S = H P H^T + R, K = P H^T S^-1, m+ = m + K (z - H m), P+ = P - K S K^T (symmetrised).
 References: Bar-Shalom, Li & Kirubarajan, "Estimation with Applications to Tracking and Navigation", 2001, ch. 5.
 """
@@ -28,12 +29,13 @@ class MotionModel:
     R: np.ndarray
 
 
-def cv_model(dt_s: float, params: ClassParams) -> MotionModel:
+def cv_model(dt_s: float, params: ClassParams, measure_velocity: bool = False) -> MotionModel:
+    """F, Q and R (2 x 2 diag(r_x, r_y), or 4 x 4 diag(r_x, r_y, r_vx, r_vy) when ``measure_velocity``)."""
     F = np.eye(4)
     F[0, 2] = F[1, 3] = dt_s
     Q = np.diag([params.q_x, params.q_y, params.q_x, params.q_y])
-    R = np.diag([params.r_x, params.r_y])
-    return MotionModel(F=F, Q=Q, R=R)
+    r = [params.r_x, params.r_y] + ([params.r_vx, params.r_vy] if measure_velocity else [])
+    return MotionModel(F=F, Q=Q, R=np.diag(r))
 
 
 def symmetrize(P: np.ndarray) -> np.ndarray:
@@ -51,7 +53,7 @@ def predict(mean: np.ndarray, cov: np.ndarray, model: MotionModel) -> tuple[np.n
 class Innovation(StructOfArrays):
     """Per-track quantities of the update, shared by gating, likelihoods and the update itself.
 
-    z_pred: (K, 2) H m; S: (K, 2, 2); S_inv: (K, 2, 2); log_det_S: (K,); gain: (K, 4, 2); cov_post: (K, 4, 4)
+    z_pred: (K, D) H m; S: (K, D, D); S_inv: (K, D, D); log_det_S: (K,); gain: (K, 4, D); cov_post: (K, 4, 4)
     (the posterior covariance does not depend on the measurement value).
     """
 
@@ -77,9 +79,12 @@ class Innovation(StructOfArrays):
 def innovation(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:
     """S, S^-1, gain and posterior covariance for (K, 4) means and (K, 4, 4) covariances.
 
-    S is 2 x 2, so its inverse and determinant are written out (much faster than batched LAPACK calls for the
-    few tracks of one class). P+ = P - K S K^T, symmetrised; it equals the Joseph form for the optimal gain.
+    The measurement dimension D is R's (2 or 4; H picks the first D state entries). For D = 2, S's inverse and
+    determinant are written out (much faster than batched LAPACK calls for the few tracks of one class).
+    P+ = P - K S K^T, symmetrised; it equals the Joseph form for the optimal gain.
     """
+    if R.shape[0] != 2:
+        return _innovation_general(mean, cov, R)
     z_pred = mean[:, :2]
     PHt = cov[:, :, :2]  # P H^T, (K, 4, 2)
     S = cov[:, :2, :2] + R
@@ -98,6 +103,20 @@ def innovation(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:
     return Innovation(z_pred=z_pred, S=S, S_inv=S_inv, log_det_S=np.log(det), gain=gain, cov_post=cov_post)
 
 
+def _innovation_general(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:
+    """``innovation`` for a D-dimensional measurement of the first D state entries, by batched LAPACK."""
+    d = R.shape[0]
+    PHt = cov[:, :, :d]
+    S = symmetrize(cov[:, :d, :d] + R)
+    sign, log_det = np.linalg.slogdet(S) if len(S) else (np.ones(0), np.zeros(0))
+    if np.any(sign <= 0):
+        raise FloatingPointError("innovation covariance is not positive-definite")
+    S_inv = symmetrize(np.linalg.inv(S)) if len(S) else np.zeros((0, d, d))
+    gain = PHt @ S_inv
+    cov_post = symmetrize(cov - gain @ np.swapaxes(PHt, -1, -2))
+    return Innovation(z_pred=mean[:, :d], S=S, S_inv=S_inv, log_det_S=log_det, gain=gain, cov_post=cov_post)
+
+
 def residuals(inn: Innovation, z: np.ndarray) -> np.ndarray:
     """(K, M, 2) innovations z_j - H m_k."""
     return z[None, :, :] - inn.z_pred[:, None, :]
@@ -110,8 +129,9 @@ def mahalanobis2(inn: Innovation, z: np.ndarray) -> np.ndarray:
 
 
 def log_likelihood(inn: Innovation, d2: np.ndarray) -> np.ndarray:
-    """(K, M) log N(z_j; H m_k, S_k) from squared Mahalanobis distances."""
-    return -0.5 * (d2 + inn.log_det_S[:, None] + 2.0 * np.log(2.0 * np.pi))
+    """(K, M) log N(z_j; H m_k, S_k) from squared Mahalanobis distances (D-dimensional z)."""
+    d = inn.z_pred.shape[1]
+    return -0.5 * (d2 + inn.log_det_S[:, None] + d * np.log(2.0 * np.pi))
 
 
 def updated_means(mean: np.ndarray, inn: Innovation, z: np.ndarray) -> np.ndarray:

@@ -69,7 +69,8 @@ def preprocess_frames(
         raise DataError(
             f"detections are missing for {len(missing)} of the {len(scene.keyframes)} samples of {scene.name}"
         )
-    return [preprocess(detections[k.sample_token], config.preprocess, classes) for k in scene.keyframes]
+    params = config.preprocess_by_class()
+    return [preprocess(detections[k.sample_token], params, classes) for k in scene.keyframes]
 
 
 def run_tracker(

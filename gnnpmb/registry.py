@@ -66,6 +66,12 @@ def _gnn(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTrack
     return GnnTracker(class_name, config, ids)
 
 
+def _greedy(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+    from gnnpmb.greedy import GreedyTracker
+
+    return GreedyTracker(class_name, config, ids)
+
+
 _FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassTracker]] = {
     "gnnpmb": _gnnpmb,
     "pmbm": _pmbm,
@@ -74,6 +80,7 @@ _FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassTracker]]
     "cphd": _cphd,
     "jpda": _jpda,
     "gnn": _gnn,
+    "greedy": _greedy,
 }
 
 TRACKER_NAMES: tuple[str, ...] = tuple(_FACTORIES)
@@ -86,6 +93,7 @@ TRACKER_DESCRIPTIONS: dict[str, str] = {
     "cphd": "GM-CPHD: cardinalised PHD filter",
     "jpda": "JPDA: joint probabilistic data association with M/N track logic",
     "gnn": "GNN: global nearest neighbour Kalman trackers with M/N track logic",
+    "greedy": "greedy: CenterPoint's closest-pair matching of velocity-projected detection centres",
 }
 
 
@@ -105,4 +113,5 @@ def check_classes(names: list[str]) -> list[str]:
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
-    return _FACTORIES[check_tracker(name)](class_name, config, ids)
+    """Tracker ``name`` for class ``class_name``; it sees ``config`` with that class's overrides applied."""
+    return _FACTORIES[check_tracker(name)](class_name, config.resolved(class_name), ids)

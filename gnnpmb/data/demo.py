@@ -52,15 +52,16 @@ from pathlib import Path
 
 import numpy as np
 
+from gnnpmb.data.demo_spec import SYNTHETIC_MARKER, Motion, ObjectSpec, SceneSpec, Segment
+from gnnpmb.data.demo_train import LAYOUT_SEEDS, TRAIN_SCENES, train_scene
 from gnnpmb.data.raycast import LidarSpec, SceneBoxes, cast_scan
 from gnnpmb.errors import DataError
 
 DEMO_VERSION = "v1.0-mini"
 DEMO_SCENES: tuple[str, ...] = ("scene-0103", "scene-0916")
 DEMO_SEED = 0
-GENERATOR_VERSION = 1
+GENERATOR_VERSION = 2
 """Bump when the generated data changes, so cached copies (``demo-v<N>``) are regenerated."""
-SYNTHETIC_MARKER = "SYNTHETIC gnnpmb-viz demo"
 """Every demo scene description starts with this."""
 MARKER_FILE = "gnnpmb-demo.json"
 CACHE_ENV = "GNNPMB_CACHE_DIR"
@@ -87,58 +88,6 @@ class ClutterHotspot:
     xy_global: tuple[float, float]
     radius_m: float
     frames: tuple[int, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class Segment:
-    """A piece of motion: constant longitudinal acceleration and turn rate for ``duration_s``."""
-
-    duration_s: float
-    accel_mps2: float = 0.0
-    yaw_rate_rps: float = 0.0
-
-
-@dataclass(frozen=True, slots=True)
-class Motion:
-    """Start pose and speed in road coordinates, then segments; after the last one speed and heading stay."""
-
-    s_m: float
-    d_m: float
-    heading_rad: float
-    speed_mps: float
-    segments: tuple[Segment, ...] = ()
-
-
-@dataclass(frozen=True, slots=True)
-class ObjectSpec:
-    """One annotated object: a unique ``name`` (seeds its tokens), nuScenes category, size (w, l, h) and motion."""
-
-    name: str
-    category: str
-    size_wlh_m: tuple[float, float, float]
-    motion: Motion
-    intensity: float
-
-
-@dataclass(frozen=True, slots=True)
-class SceneSpec:
-    """A scene's road placement (origin (2,) global metres, heading rad), ego motion and objects."""
-
-    name: str
-    description: str
-    location: str
-    start_us: int
-    road_origin_m: tuple[float, float]
-    road_heading_rad: float
-    ego: Motion
-    objects: tuple[ObjectSpec, ...]
-
-    def to_global(self, s_m: np.ndarray, d_m: np.ndarray) -> np.ndarray:
-        """(..., 2) global x, y of road coordinates."""
-        c, s = math.cos(self.road_heading_rad), math.sin(self.road_heading_rad)
-        x = self.road_origin_m[0] + c * s_m - s * d_m
-        y = self.road_origin_m[1] + s * s_m + c * d_m
-        return np.stack([x, y], axis=-1)
 
 
 CATEGORIES: tuple[tuple[str, str], ...] = (
@@ -439,6 +388,33 @@ def scene_trajectories(spec: SceneSpec) -> Trajectories:
     )
 
 
+def _train_hotspots() -> tuple[ClutterHotspot, ...]:
+    """The roadworks zones of the generated ``mini_train`` scenes, active in every keyframe."""
+    out = []
+    for name in TRAIN_SCENES:
+        spec, roadworks = train_scene(name)
+        if roadworks is None:
+            continue
+        centre = spec.to_global(np.array(roadworks.centre_sd_m[0]), np.array(roadworks.centre_sd_m[1]))
+        out.append(
+            ClutterHotspot(
+                scene_name=name,
+                xy_global=(round(float(centre[0]), 3), round(float(centre[1]), 3)),
+                radius_m=roadworks.radius_m,
+                frames=tuple(range(KEYFRAMES_PER_SCENE)),
+            )
+        )
+    return tuple(out)
+
+
+def scene_spec(name: str) -> SceneSpec:
+    """The layout of demo scene ``name``: a hand-built ``mini_val`` scene or a generated ``mini_train`` one."""
+    for spec in SCENES:
+        if spec.name == name:
+            return spec
+    return train_scene(name)[0]
+
+
 def _clutter_hotspots() -> tuple[ClutterHotspot, ...]:
     spec = next(s for s in SCENES if s.name == "scene-0916")
     traj = scene_trajectories(spec)
@@ -455,8 +431,9 @@ def _clutter_hotspots() -> tuple[ClutterHotspot, ...]:
     )
 
 
-CLUTTER_HOTSPOTS: tuple[ClutterHotspot, ...] = _clutter_hotspots()
-"""Where and when the demo's bus passes the roadworks of scene-0916 (see the module docstring)."""
+CLUTTER_HOTSPOTS: tuple[ClutterHotspot, ...] = _clutter_hotspots() + _train_hotspots()
+"""Where and when the demo's bus passes the roadworks of scene-0916 (see the module docstring), and the roadworks
+of the generated train scenes (``demo_train``)."""
 
 
 def _yaw_quat_wxyz(yaw_rad: float) -> list[float]:
@@ -662,8 +639,15 @@ def _empty_mask_png() -> bytes:
     return buffer.getvalue()
 
 
-def _write_dataset(dataroot: Path, seed: int) -> None:
-    """Write the whole demo into the (empty) folder ``dataroot``."""
+def _scene_seeds(seed: int, names: tuple[str, ...]) -> list[np.random.SeedSequence]:
+    """LiDAR-noise seed of each scene: the val scenes keep their original streams, a train scene gets its own."""
+    val = dict(zip(DEMO_SCENES, np.random.SeedSequence(seed).spawn(len(DEMO_SCENES)), strict=True))
+    return [val[n] if n in val else np.random.SeedSequence([seed, LAYOUT_SEEDS[n]]) for n in names]
+
+
+def _write_dataset(dataroot: Path, seed: int, names: tuple[str, ...] = DEMO_SCENES) -> None:
+    """Write the demo scenes ``names`` into the (empty) folder ``dataroot``."""
+    specs = [scene_spec(n) for n in names]
     (dataroot / DEMO_VERSION).mkdir(parents=True)
     (dataroot / "samples" / "LIDAR_TOP").mkdir(parents=True)
     (dataroot / "maps").mkdir()
@@ -682,38 +666,58 @@ def _write_dataset(dataroot: Path, seed: int) -> None:
             },
         )
     tables["sensor"].append({"token": token("sensor", "LIDAR_TOP"), "channel": "LIDAR_TOP", "modality": "lidar"})
-    seeds = np.random.SeedSequence(seed).spawn(len(SCENES))
-    for spec, scene_seed in zip(SCENES, seeds, strict=True):
+    for spec, scene_seed in zip(specs, _scene_seeds(seed, names), strict=True):
         _write_scene(spec, tables, dataroot, np.random.default_rng(scene_seed))
 
     mask = _empty_mask_png()
-    for location in sorted({s.location for s in SCENES}):
+    for location in sorted({s.location for s in specs}):
         map_token = token("map", location)
         filename = f"maps/{map_token}.png"
         (dataroot / filename).write_bytes(mask)
-        logs = [token("log", s.name) for s in SCENES if s.location == location]
+        logs = [token("log", s.name) for s in specs if s.location == location]
         tables["map"].append(
             {"token": map_token, "log_tokens": logs, "category": "semantic_prior", "filename": filename}
         )
     for name, rows in tables.items():
         (dataroot / DEMO_VERSION / f"{name}.json").write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8")
-    marker = {"generator": "gnnpmb-viz demo", "generator_version": GENERATOR_VERSION, "seed": seed}
+    marker = {
+        "generator": "gnnpmb-viz demo",
+        "generator_version": GENERATOR_VERSION,
+        "seed": seed,
+        "scenes": list(names),
+    }
     (dataroot / MARKER_FILE).write_text(json.dumps(marker, indent=1) + "\n", encoding="utf-8")
 
 
-def is_demo_dataroot(path: Path, seed: int | None = None) -> bool:
-    """Whether ``path`` holds a complete demo of the current generator version (and of ``seed`` if given)."""
+def is_demo_dataroot(path: Path, seed: int | None = None, scenes: tuple[str, ...] = ()) -> bool:
+    """Whether ``path`` holds a complete demo of the current generator version (and of ``seed`` if given, with at
+    least the scenes ``scenes``)."""
     try:
         marker = json.loads((path / MARKER_FILE).read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return False
     if not isinstance(marker, dict) or marker.get("generator_version") != GENERATOR_VERSION:
         return False
+    if not set(scenes) <= set(marker.get("scenes", ())):
+        return False
     return seed is None or marker.get("seed") == seed
 
 
-def generate_demo_dataset(out_dir: Path, seed: int = DEMO_SEED) -> Path:
-    """Write the demo into ``out_dir`` (the dataroot) and return it.
+def check_demo_scenes(names: tuple[str, ...]) -> tuple[str, ...]:
+    """``names`` if every one is a demo scene (the ten ``v1.0-mini`` names), else a ``DataError`` naming the first
+    unknown one."""
+    known = DEMO_SCENES + TRAIN_SCENES
+    for n in names:
+        if n not in known:
+            raise DataError(f"unknown demo scene '{n}'; the demo has: {', '.join(sorted(known))}")
+    if not names:
+        raise DataError(f"no demo scenes given; the demo has: {', '.join(sorted(known))}")
+    return tuple(n for n in sorted(known) if n in names)
+
+
+def generate_demo_dataset(out_dir: Path, seed: int = DEMO_SEED, scenes: tuple[str, ...] = DEMO_SCENES) -> Path:
+    """Write the demo scenes ``scenes`` (default: the two mini_val ones) into ``out_dir`` (the dataroot) and
+    return it.
 
     The data is built in a sibling temp folder and renamed into place, so a reader never sees half a dataset.
     ``out_dir`` may be missing, empty or an earlier demo; anything else is refused with a ``DataError``.
@@ -730,7 +734,7 @@ def generate_demo_dataset(out_dir: Path, seed: int = DEMO_SEED) -> Path:
     out_dir.parent.mkdir(parents=True, exist_ok=True)
     build = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.build-", dir=out_dir.parent))
     try:
-        _write_dataset(build / "data", seed)
+        _write_dataset(build / "data", seed, check_demo_scenes(tuple(scenes)))
         if out_dir.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old-", dir=out_dir.parent))
             os.replace(out_dir, old / "data")
@@ -743,26 +747,35 @@ def generate_demo_dataset(out_dir: Path, seed: int = DEMO_SEED) -> Path:
     return out_dir
 
 
-def demo_cache_dir() -> Path:
+def demo_cache_dir(full: bool = False) -> Path:
     """Where ``ensure_demo_dataset`` keeps the demo: ``$GNNPMB_CACHE_DIR`` or the user cache dir of gnnpmb-viz,
-    in a ``demo-v<GENERATOR_VERSION>`` subfolder."""
+    in a ``demo-v<GENERATOR_VERSION>`` subfolder (the two mini_val scenes) or ``demo-v<GENERATOR_VERSION>-all``
+    (all ten scenes, when ``full``)."""
     root = os.environ.get(CACHE_ENV)
     if not root:
         import platformdirs
 
         root = platformdirs.user_cache_dir("gnnpmb-viz")
-    return Path(root).expanduser() / f"demo-v{GENERATOR_VERSION}"
+    return Path(root).expanduser() / f"demo-v{GENERATOR_VERSION}{'-all' if full else ''}"
 
 
-def ensure_demo_dataset() -> Path:
-    """The dataroot of the cached demo (seed ``DEMO_SEED``), generated on first use."""
-    dataroot = demo_cache_dir()
-    if is_demo_dataroot(dataroot, DEMO_SEED):
+TRAIN_NEEDS = ("mini_train", "train")
+"""Split names that need the generated train scenes."""
+
+
+def ensure_demo_dataset(needs: tuple[str, ...] = ()) -> Path:
+    """The dataroot of the cached demo (seed ``DEMO_SEED``), generated on first use. ``needs``: split or scene
+    names about to be used; only when one of them is a train split or scene are the eight train scenes
+    generated too (a separate cached dataroot), so the default val demo stays quick to build."""
+    full = any(n in TRAIN_NEEDS or n in TRAIN_SCENES for n in needs)
+    scenes = DEMO_SCENES + TRAIN_SCENES if full else DEMO_SCENES
+    dataroot = demo_cache_dir(full)
+    if is_demo_dataroot(dataroot, DEMO_SEED, scenes):
         return dataroot
     try:
-        return generate_demo_dataset(dataroot, DEMO_SEED)
+        return generate_demo_dataset(dataroot, DEMO_SEED, scenes)
     except OSError as exc:
-        if is_demo_dataroot(dataroot, DEMO_SEED):
+        if is_demo_dataroot(dataroot, DEMO_SEED, scenes):
             return dataroot
         raise DataError(
             f"cannot create the demo dataset in {dataroot}: {exc.strerror or exc}; set {CACHE_ENV} to a writable folder"

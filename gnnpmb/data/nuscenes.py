@@ -97,8 +97,9 @@ def check_dataroot(dataroot: Path, version: str | None, source: str = "--dataroo
     return DatasetLocation(dataroot=dataroot, version=version, synthetic=synthetic)
 
 
-def resolve_dataroot(dataroot: Path | None, version: str | None) -> DatasetLocation:
-    """The dataset to use: ``dataroot`` if given, else ``$NUSCENES_DATAROOT``, else the synthetic demo."""
+def resolve_dataroot(dataroot: Path | None, version: str | None, needs: tuple[str, ...] = ()) -> DatasetLocation:
+    """The dataset to use: ``dataroot`` if given, else ``$NUSCENES_DATAROOT``, else the synthetic demo (with the
+    generated train scenes when ``needs``, split or scene names, asks for them)."""
     if dataroot is not None:
         return check_dataroot(Path(dataroot), version, "--dataroot")
     from_env = os.environ.get(DATAROOT_ENV)
@@ -109,7 +110,7 @@ def resolve_dataroot(dataroot: Path | None, version: str | None) -> DatasetLocat
             f"the built-in demo dataset only has version {DEMO_VERSION}, not {version}; pass --dataroot (or set "
             f"{DATAROOT_ENV}) for real nuScenes data"
         )
-    return check_dataroot(ensure_demo_dataset(), DEMO_VERSION, "the built-in demo")
+    return check_dataroot(ensure_demo_dataset(needs), DEMO_VERSION, "the built-in demo")
 
 
 _OPENED: dict[tuple[Path, str], NuScenes] = {}

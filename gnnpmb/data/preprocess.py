@@ -6,13 +6,15 @@
    kept before it overlaps it with 3D IoU ``> nms_iou_3d`` (``suppressed_by_nms``). Boxes of different classes
    never suppress each other.
 
+Both thresholds may differ per class (``TrackerConfig.preprocess_by_class``).
+
 Boxes whose class is not among the tracked ``classes`` are simply not kept: neither ``below_threshold`` nor
 ``suppressed_by_nms`` is set for them, so the viewer can tell "not tracked" apart from "filtered out".
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -21,8 +23,9 @@ from gnnpmb.data.boxes3d import iou_3d, overlap_candidates, yaw_from_quat_wxyz
 from gnnpmb.types import Boxes, FrameDetections
 
 
-def nms_3d(boxes: Boxes, iou_threshold: float) -> np.ndarray:
-    """(N,) bool mask of the boxes greedy per-class NMS keeps, suppressing at 3D IoU > ``iou_threshold``."""
+def nms_3d(boxes: Boxes, iou_threshold: float | np.ndarray) -> np.ndarray:
+    """(N,) bool mask of the boxes greedy per-class NMS keeps, suppressing at 3D IoU > ``iou_threshold`` (a
+    number, or (N,) per box: boxes of one class share it)."""
     n = len(boxes)
     keep = np.ones(n, dtype=bool)
     if n < 2:
@@ -33,7 +36,7 @@ def nms_3d(boxes: Boxes, iou_threshold: float) -> np.ndarray:
         return keep
     yaw = yaw_from_quat_wxyz(boxes.quat_wxyz)
     iou = iou_3d(t[i], size[i], yaw[i], t[j], size[j], yaw[j])
-    over = iou > iou_threshold
+    over = iou > np.broadcast_to(np.asarray(iou_threshold, dtype=float), (n,))[i]
     i, j = i[over], j[over]
     if i.size == 0:
         return keep
@@ -53,11 +56,23 @@ def nms_3d(boxes: Boxes, iou_threshold: float) -> np.ndarray:
     return ~suppressed
 
 
+def _per_box(boxes: Boxes, params: PreprocessParams | Mapping[str, PreprocessParams], key: str) -> np.ndarray:
+    """(N,) the value of ``key`` for each box's class."""
+    if isinstance(params, PreprocessParams):
+        return np.full(len(boxes), getattr(params, key), dtype=float)
+    default = getattr(PreprocessParams(), key)
+    values = {name: getattr(p, key) for name, p in params.items()}
+    return np.array([values.get(str(c), default) for c in boxes.class_name], dtype=float)
+
+
 def preprocess(
-    boxes: Boxes, params: PreprocessParams, classes: Sequence[str] | None = None
+    boxes: Boxes,
+    params: PreprocessParams | Mapping[str, PreprocessParams],
+    classes: Sequence[str] | None = None,
 ) -> FrameDetections:
     """Apply the score threshold and per-class 3D NMS to one frame's N detections.
 
+    params: one set for every class, or class name -> parameters.
     classes: the tracked classes; ``None`` tracks every class present. Boxes of other classes are not kept and
     have neither flag set. Returns the input boxes unchanged with ``kept``, ``below_threshold`` and
     ``suppressed_by_nms`` (N,) masks.
@@ -67,9 +82,10 @@ def preprocess(
         tracked = np.ones(n, dtype=bool)
     else:
         tracked = np.isin(boxes.class_name.astype(str), np.asarray(list(classes), dtype=str))
-    below = tracked & (boxes.score < params.score_threshold)
+    below = tracked & (boxes.score < _per_box(boxes, params, "score_threshold"))
     candidates = np.flatnonzero(tracked & ~below)
     suppressed = np.zeros(n, dtype=bool)
-    suppressed[candidates] = ~nms_3d(boxes.subset(candidates), params.nms_iou_3d)
+    iou_threshold = _per_box(boxes, params, "nms_iou_3d")[candidates]
+    suppressed[candidates] = ~nms_3d(boxes.subset(candidates), iou_threshold)
     kept = tracked & ~below & ~suppressed
     return FrameDetections(boxes=boxes, kept=kept, below_threshold=below, suppressed_by_nms=suppressed)

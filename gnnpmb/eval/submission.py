@@ -126,7 +126,9 @@ def build_submission(
 ) -> dict[str, Any]:
     """A submission of per-scene results with an entry (maybe empty) for every token in ``sample_tokens``.
 
-    Raises ``DataError`` if a part holds a sample outside ``sample_tokens``.
+    A sample with more than ``MAX_BOXES_PER_SAMPLE`` boxes (the evaluation's limit) keeps its highest-scoring
+    ones (ties: earlier first), as the nuScenes submission rules ask. Raises ``DataError`` if a part holds a
+    sample outside ``sample_tokens``.
     """
     results: dict[str, list[dict[str, Any]]] = {token: [] for token in sample_tokens}
     for part in parts:
@@ -135,7 +137,10 @@ def build_submission(
                 raise DataError(
                     f"tracked sample {token} is not one of the samples the submission is built for"
                 )
-            results[token] = list(boxes)
+            kept = list(boxes)
+            if len(kept) > MAX_BOXES_PER_SAMPLE:
+                kept = sorted(kept, key=lambda b: -float(b["tracking_score"]))[:MAX_BOXES_PER_SAMPLE]
+            results[token] = kept
     return {"meta": dict(SUBMISSION_META), "results": results}
 
 

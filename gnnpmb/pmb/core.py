@@ -251,6 +251,16 @@ def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
     return dict(zip(ids.tolist(), largest.tolist(), strict=True))
 
 
+@dataclass(frozen=True, slots=True)
+class VelocityMeasurements(Measurements):
+    """Measurements whose vector is z = [x, y, vx, vy]: the BEV centre and the detector's velocity (M, 4), for the
+    opt-in ``[pmb] measure_velocity = 1`` variant (measurement matrix H = I, R = diag(r_x, r_y, r_vx, r_vy))."""
+
+    @property
+    def z(self) -> np.ndarray:
+        return np.concatenate([self.boxes.xy, self.boxes.velocity_mps], axis=1)
+
+
 class PmbCore:
     """One class's PMB / PMBM filter; ``strategy`` decides the hypothesis management (module docstring)."""
 
@@ -268,7 +278,9 @@ class PmbCore:
         """Process one frame of this class's measurements; returns the extracted tracks."""
         p = self.params
         self.frame_serial += 1
-        model = cv_model(dt_s, self.class_params)
+        model = cv_model(dt_s, self.class_params, p.measure_velocity == 1)
+        if p.measure_velocity == 1:
+            meas = VelocityMeasurements(meas.boxes, meas.source_index)
         new = new_track_hypotheses(measurement_birth(meas, p), meas, model.R, p.clutter_intensity)
         priors, locals_ = self._predict_and_localise(meas, model, new)
         if sink.enabled:
@@ -313,7 +325,8 @@ class PmbCore:
         """Drop Bernoullis with r < threshold from every hypothesis; report tracks that vanished from all."""
         threshold = self.params.prune_existence
         kept = [
-            h if h.bernoullis.existence.min(initial=1.0) >= threshold
+            h
+            if h.bernoullis.existence.min(initial=1.0) >= threshold
             else GlobalHypothesis(h.log_weight, h.bernoullis.subset(h.bernoullis.existence >= threshold))
             for h in posteriors
         ]
@@ -338,7 +351,7 @@ class PmbCore:
                 size_wlh_m=tuple(float(v) for v in b.size_wlh_m[i]),
                 quat_wxyz=tuple(float(v) for v in b.quat_wxyz[i]),
                 velocity_mps=(float(b.mean[i, 2]), float(b.mean[i, 3])),
-                score=float(b.score[i]),
+                score=float(b.score[i] * b.existence[i]),
                 existence=float(b.existence[i]),
                 meas_index=int(b.meas_index[i]),
             )
@@ -354,8 +367,8 @@ class PmbCore:
                 track_ids=prior.track_id,
                 meas_indices=local.meas.source_index,
                 inside=local.inside,
-                center_xy=local.inn.z_pred,
-                innovation_cov=local.inn.S,
+                center_xy=local.inn.z_pred[:, :2],
+                innovation_cov=local.inn.S[:, :2, :2],
                 threshold=self.params.gate_chi2,
             )
         )

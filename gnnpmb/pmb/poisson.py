@@ -35,7 +35,7 @@ class BirthIntensity:
 def measurement_birth(meas: Measurements, params: PmbParams) -> BirthIntensity:
     """One birth component per measurement at [z_j, v_j] with weight w_b."""
     m = len(meas)
-    mean = np.concatenate([meas.z, meas.boxes.velocity_mps], axis=1) if m else np.zeros((0, 4))
+    mean = np.concatenate([meas.boxes.xy, meas.boxes.velocity_mps], axis=1) if m else np.zeros((0, 4))
     var = np.array([params.birth_pos_std_m**2] * 2 + [params.birth_vel_std_mps**2] * 2)
     cov = np.broadcast_to(np.diag(var), (m, 4, 4)).copy()
     return BirthIntensity(weight=np.full(m, params.birth_weight), mean=mean, cov=cov)
@@ -59,12 +59,10 @@ def new_track_hypotheses(
     if m == 0:
         return NewTrackHypotheses(np.zeros(0), np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4, 4)))
     inn = innovation(birth.mean, birth.cov, R)
-    nu = meas.z - inn.z_pred  # (M, 2)
+    nu = meas.z - inn.z_pred  # (M, D)
     d2 = np.einsum("mi,mij,mj->m", nu, inn.S_inv, nu)
-    log_n = -0.5 * (d2 + inn.log_det_S + 2.0 * np.log(2.0 * np.pi))
+    log_n = -0.5 * (d2 + inn.log_det_S + nu.shape[1] * np.log(2.0 * np.pi))
     birth_term = birth.weight * meas.boxes.score * np.exp(log_n)
     total = clutter_intensity + birth_term
     mean = birth.mean + np.einsum("mij,mj->mi", inn.gain, nu)
-    return NewTrackHypotheses(
-        log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=inn.cov_post
-    )
+    return NewTrackHypotheses(log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=inn.cov_post)

@@ -54,9 +54,7 @@ def tracked(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> tu
 
 @pytest.fixture(scope="module")
 def evaluated(tracked: tuple[Path, str], demo_dataroot: Path) -> str:
-    code, stdout = run_quiet(
-        ["eval", str(tracked[0]), "--dataroot", str(demo_dataroot), "--split", "mini_val"]
-    )
+    code, stdout = run_quiet(["eval", str(tracked[0]), "--dataroot", str(demo_dataroot), "--split", "mini_val"])
     assert code == 0
     return stdout
 
@@ -77,14 +75,10 @@ def test_track_writes_a_submission_for_every_sample_of_the_split(tracked: tuple[
     assert sorted(p.name for p in path.parent.iterdir()) == ["results.json"]
 
 
-def test_track_is_deterministic(
-    tracked: tuple[Path, str], demo_dataroot: Path, tmp_path: Path, capsys
-) -> None:
+def test_track_is_deterministic(tracked: tuple[Path, str], demo_dataroot: Path, tmp_path: Path, capsys) -> None:
     again = tmp_path / "again.json"
     argv = ["track", "--dataroot", str(demo_dataroot), "--version", "v1.0-mini", "--split", "mini_val"]
-    code, _, _ = run(
-        [*argv, "--detector", "centerpoint", "--seed", "0", "--out", str(again), "--no-progress"], capsys
-    )
+    code, _, _ = run([*argv, "--detector", "centerpoint", "--seed", "0", "--out", str(again), "--no-progress"], capsys)
     assert code == 0
     assert again.read_bytes() == tracked[0].read_bytes()
 
@@ -112,9 +106,7 @@ def test_failures_lists_frames_and_writes_json(demo_dataroot: Path, tmp_path: Pa
     report = json.loads(report_path.read_text())
     assert report["scene"] == "scene-0916" and len(report["sample_tokens"]) == 40
     totals = report["totals"]
-    assert (
-        f"scene-0916, gnnpmb: {totals['id_switch']} id_switch, {totals['fragmentation']} fragmentation" in out
-    )
+    assert f"scene-0916, gnnpmb: {totals['id_switch']} id_switch, {totals['fragmentation']} fragmentation" in out
     assert "failures per frame" in out and "best-MOTA threshold" in out
     assert sum(totals.values()) == len(report["failures"]) > 0
     for c in report["classes"]:
@@ -127,14 +119,22 @@ def test_failures_lists_frames_and_writes_json(demo_dataroot: Path, tmp_path: Pa
 def test_demo_data_calls_the_generator(monkeypatch, tmp_path: Path, capsys) -> None:
     calls = []
 
-    def fake(out: Path, seed: int) -> Path:
-        calls.append((out, seed))
+    def fake(out: Path, seed: int, scenes: tuple[str, ...]) -> Path:
+        calls.append((out, seed, scenes))
         return out
 
     monkeypatch.setattr("gnnpmb.data.demo.generate_demo_dataset", fake)
     code, out, _ = run(["demo-data", "--out", str(tmp_path / "demo"), "--seed", "7"], capsys)
-    assert code == 0 and calls == [(tmp_path / "demo", 7)]
-    assert out == f"demo dataset (v1.0-mini, seed 7) -> {tmp_path / 'demo'}\n"
+    assert code == 0 and calls == [(tmp_path / "demo", 7, ("scene-0103", "scene-0916"))]
+    assert out == f"demo dataset (v1.0-mini, seed 7, 2 scenes) -> {tmp_path / 'demo'}\n"
+    code, out, _ = run(["demo-data", "--out", str(tmp_path / "d2"), "--scenes", "mini_train,scene-0103"], capsys)
+    assert code == 0 and len(calls[-1][2]) == 9 and calls[-1][2][-1] == "scene-0103"
+
+
+def test_demo_data_refuses_an_unknown_scene(tmp_path: Path, capsys) -> None:
+    code, _, err = run(["demo-data", "--out", str(tmp_path / "demo"), "--scenes", "scene-0104"], capsys)
+    assert code == 2 and "unknown demo scene 'scene-0104'" in _one_error_line(err)
+    assert not (tmp_path / "demo").exists()
 
 
 def _one_error_line(err: str) -> str:
@@ -166,9 +166,7 @@ def test_track_errors_write_nothing(demo_dataroot: Path, tmp_path: Path, capsys)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dets.json"]
 
 
-def test_eval_errors_are_one_line(
-    demo_dataroot: Path, tracked: tuple[Path, str], tmp_path: Path, capsys
-) -> None:
+def test_eval_errors_are_one_line(demo_dataroot: Path, tracked: tuple[Path, str], tmp_path: Path, capsys) -> None:
     good = json.loads(tracked[0].read_text())
     tokens = list(good["results"])
     missing = {"meta": good["meta"], "results": {t: good["results"][t] for t in tokens[40:]}}

@@ -3,7 +3,16 @@ from pathlib import Path
 import pytest
 
 import gnnpmb
-from gnnpmb.config import PAPER_CLASS_PARAMS, ConfigError, TrackerConfig, dump_config, load_config
+from gnnpmb.config import (
+    PAPER_CLASS_PARAMS,
+    ConfigError,
+    TrackerConfig,
+    dump_config,
+    get_param,
+    load_config,
+    paper_config,
+    with_params,
+)
 
 DEFAULT_FILE = Path(gnnpmb.__file__).parent / "default_params.toml"
 
@@ -48,3 +57,81 @@ def test_bad_parameter_files_name_the_problem(tmp_path, text, message):
 def test_missing_parameter_file(tmp_path):
     with pytest.raises(ConfigError, match="not found"):
         load_config(tmp_path / "nope.toml")
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[classes]\ncar = 5\n", r"\[classes.car\] must be a table"),
+        ("[classes.car]\nq_x = -0.1\n", r"\[classes.car\] q_x must be >= 0, got -0.1"),
+        ("[classes.car]\nr_y = 0\n", r"\[classes.car\] r_y must be > 0, got 0.0"),
+        ("[pmb]\np_survive = 1.5\n", r"\[pmb\] p_survive must be in \(0, 1\], got 1.5"),
+        ("[pmb]\ngate_chi2 = nan\n", r"\[pmb\] gate_chi2 must be > 0, got nan"),
+        ("[pmb]\ngate_chi2 = -4\n", r"\[pmb\] gate_chi2 must be > 0, got -4.0"),
+        ("[pmb]\nextraction_threshold = 1.2\n", r"extraction_threshold must be in \[0, 1\], got 1.2"),
+        ("[pmb]\nbirth_weight = 0\n", r"birth_weight must be > 0, got 0.0"),
+        ("[preprocess]\nscore_threshold = -0.1\n", r"\[preprocess\] score_threshold must be in \[0, 1\]"),
+        ("[classes.pedestrian]\nbirth_weight = -1\n", r"\[classes.pedestrian\] birth_weight must be > 0, got -1"),
+        ("[classes.car]\np_detect = 0.8\n", r"several sections \(phd, vector\); set it in a sub-table"),
+        ("[classes.car.vector]\np_detect = 1.0\n", r"\[classes.car.vector\] p_detect must be in \(0, 1\)"),
+        ("[classes.car]\nbirth_wieght = 1\n", "unknown parameter 'birth_wieght'"),
+        ("[classes.car.vector]\nconfirm_m = 5\n", "confirm_m <= confirm_n"),
+        ("[greedy]\nmax_age = 0\n", r"\[greedy\] max_age must be >= 1, got 0"),
+    ],
+)
+def test_every_value_is_range_checked_and_the_error_names_key_value_and_range(tmp_path, text, message):
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=message):
+        load_config(path)
+
+
+def test_a_folder_as_parameter_file_is_a_config_error(tmp_path):
+    with pytest.raises(ConfigError, match="is a folder"):
+        load_config(tmp_path)
+
+
+def test_per_class_overrides_fall_back_to_the_section_values(tmp_path):
+    path = tmp_path / "p.toml"
+    path.write_text(
+        "[pmb]\nbirth_weight = 0.2\n[classes.pedestrian]\nbirth_weight = 0.05\nscore_threshold = 0.3\n"
+        "[classes.car.vector]\np_detect = 0.8\n"
+    )
+    cfg = load_config(path)
+    ped, car, bus = cfg.resolved("pedestrian"), cfg.resolved("car"), cfg.resolved("bus")
+    assert ped.pmb.birth_weight == 0.05 and car.pmb.birth_weight == 0.2 and bus.pmb.birth_weight == 0.2
+    assert ped.preprocess.score_threshold == 0.3 and car.preprocess.score_threshold == 0.1
+    assert car.vector.p_detect == 0.8 and ped.vector.p_detect == 0.9 and car.phd.p_detect == 0.9
+    assert cfg.preprocess_by_class()["pedestrian"].score_threshold == 0.3
+    assert ped.class_overrides == {} and ped.classes == cfg.classes
+    again = tmp_path / "again.toml"
+    again.write_text(dump_config(cfg))
+    assert load_config(again) == cfg
+
+
+def test_dotted_names_get_and_set_parameters():
+    cfg = with_params(TrackerConfig(), {"pmb.gate_chi2": 30, "classes.car.birth_weight": 0.2})
+    assert get_param(cfg, "pmb.gate_chi2") == 30.0 and get_param(cfg, "classes.car.birth_weight") == 0.2
+    assert get_param(cfg, "classes.bus.birth_weight") == 0.3 and get_param(cfg, "classes.car.q_x") == 0.1589
+    cfg = with_params(cfg, {"classes.car.vector.p_detect": 0.7})
+    assert get_param(cfg, "classes.car.vector.p_detect") == 0.7
+    with pytest.raises(ConfigError, match="unknown parameter"):
+        get_param(cfg, "pmb.nope")
+    with pytest.raises(ConfigError, match="not a parameter name"):
+        with_params(cfg, {"gate_chi2": 3})
+
+
+def test_every_tracker_of_a_class_sees_its_overrides():
+    from gnnpmb.registry import make_class_tracker
+    from gnnpmb.types import IdAllocator
+
+    cfg = with_params(TrackerConfig(), {"classes.pedestrian.gate_chi2": 9.0, "classes.pedestrian.max_age": 5})
+    assert make_class_tracker("gnnpmb", "pedestrian", cfg, IdAllocator()).params.gate_chi2 == 9.0
+    assert make_class_tracker("gnnpmb", "car", cfg, IdAllocator()).params.gate_chi2 == 40.0
+    assert make_class_tracker("gnn", "pedestrian", cfg, IdAllocator()).gate_chi2 == 9.0
+    assert make_class_tracker("greedy", "pedestrian", cfg, IdAllocator()).max_age == 5
+
+
+def test_paper_parameter_file_is_the_paper_config():
+    assert load_config(DEFAULT_FILE.parent / "params" / "paper.toml") == paper_config()
+    assert paper_config().pmb.p_survive == 0.7 and paper_config().pmb.extraction_threshold == 0.9

@@ -254,7 +254,7 @@ def test_failure_situations_are_present(nusc: NuScenes, demo_dataroot: Path) -> 
     assert closest < 1.5
 
     # The bus passes within a few metres of the clutter hotspot during the hotspot's frames.
-    (hotspot,) = CLUTTER_HOTSPOTS
+    (hotspot,) = [h for h in CLUTTER_HOTSPOTS if h.scene_name in DEMO_SCENES]
     assert hotspot.scene_name in DEMO_SCENES and len(hotspot.frames) >= 3
     bus = next(
         t for t in tracks[hotspot.scene_name].values() if next(iter(t.values()))["category_name"] == "vehicle.bus.rigid"
@@ -311,9 +311,12 @@ def test_ensure_demo_dataset_generates_once_into_the_cache(
 
     (expected / demo.MARKER_FILE).unlink()  # an incomplete or foreign-looking cache is rebuilt
     calls: list[Path] = []
-    monkeypatch.setattr(demo, "generate_demo_dataset", lambda out, seed: calls.append(out) or out)
+    monkeypatch.setattr(demo, "generate_demo_dataset", lambda out, seed, scenes: calls.append(out) or out)
     ensure_demo_dataset()
     assert calls == [expected]
+    ensure_demo_dataset(("mini_val", "scene-0103"))  # val needs alone never build the train scenes
+    ensure_demo_dataset(("mini_train",))
+    assert calls == [expected, expected, expected.with_name(expected.name + "-all")]
 
 
 def _submission(nusc: NuScenes, fresh_ids: bool) -> dict:

@@ -113,6 +113,15 @@ def test_build_submission_fills_every_sample_and_refuses_strangers() -> None:
         build_submission([{"other0": []}], SPLIT)
 
 
+def test_build_submission_keeps_the_500_best_scored_boxes_of_a_sample() -> None:
+    boxes = [box("s1", track_id=str(i), tracking_score=(i % 7) / 10) for i in range(503)]
+    kept = build_submission([{"s1": boxes}], SPLIT)["results"]["s1"]
+    assert len(kept) == 500
+    dropped = {b["tracking_id"] for b in boxes} - {b["tracking_id"] for b in kept}
+    assert all(float(next(b for b in boxes if b["tracking_id"] == t)["tracking_score"]) == 0.0 for t in dropped)
+    assert [b["tracking_id"] for b in build_submission([{"s1": boxes[:3]}], SPLIT)["results"]["s1"]] == ["0", "1", "2"]
+
+
 def test_valid_submission_passes() -> None:
     stats = check_submission(submission(), "results.json", "mini_val", SPLIT, set(DATASET))
     assert (stats.samples, stats.boxes) == (3, 3)

@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from gnnpmb.config import ConfigError, TrackerConfig
+from gnnpmb.config import ConfigError, paper_config
 from gnnpmb.events import Cardinality, Extracted, ListSink, NullSink
 from gnnpmb.phd.cphd import (
     CphdTracker,
@@ -24,7 +24,7 @@ from gnnpmb.phd.gmphd import phd_update
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
-CFG = TrackerConfig()
+CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 
 
 def brute_esf(x: np.ndarray, order: int) -> np.ndarray:
@@ -212,7 +212,6 @@ def test_dense_frame_runs_and_stays_a_distribution():
     assert len(est) == int(np.argmax(pmf)) <= CFG.phd.max_cardinality
 
 
-def test_cphd_rejects_zero_clutter():
-    cfg = CFG.replace(pmb=dataclasses.replace(CFG.pmb, clutter_intensity=0.0))
+def test_zero_clutter_is_rejected_before_the_cphd_sees_it():
     with pytest.raises(ConfigError, match="clutter_intensity"):
-        CphdTracker("car", cfg, IdAllocator())
+        CphdTracker("car", CFG.replace(pmb=dataclasses.replace(CFG.pmb, clutter_intensity=0.0)), IdAllocator())

@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from gnnpmb.config import ConfigError, PhdParams, TrackerConfig
+from gnnpmb.config import ConfigError, PhdParams, TrackerConfig, paper_config
 from gnnpmb.events import (
     Born,
     Extracted,
@@ -26,7 +26,7 @@ from gnnpmb.phd.mixture import GaussianMixture
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
-CFG = TrackerConfig()
+CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 P = CFG.pmb
 PD = CFG.phd.p_detect
 CAR = CFG.for_class("car")

@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gnnpmb.config import TrackerConfig
+from gnnpmb.config import TrackerConfig, paper_config
 from gnnpmb.events import Assignment, AxisKind, Born, CostMatrix, Gated, ListSink, NullSink, Pruned
 from gnnpmb.pmb.core import PmbCore
 from gnnpmb.pmb.strategy import BestAssignment
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
-CFG = TrackerConfig()
+CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 P = CFG.pmb
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
@@ -48,6 +48,15 @@ def test_first_detection_starts_bernoulli_with_hand_computed_existence():
     np.testing.assert_allclose(b.mean[0], mean, atol=1e-12)
     np.testing.assert_allclose(b.cov[0], cov, atol=1e-9)
     assert r < P.extraction_threshold and est == []
+
+
+def test_with_the_defaults_a_new_bernoulli_is_reported_at_once_scored_score_times_existence():
+    defaults = TrackerConfig()
+    core = PmbCore("car", defaults, BestAssignment(), IdAllocator())
+    est = core.step(make_measurements([(1.0, 2.0)], 0.9), 0.0, NullSink())
+    r = core.hypotheses[0].bernoullis.existence[0]
+    assert defaults.pmb.extraction_threshold <= r < 0.9 and [e.track_id for e in est] == [1]
+    assert est[0].score == pytest.approx(0.9 * r, rel=1e-12) and est[0].existence == pytest.approx(r, rel=1e-12)
 
 
 def test_second_detection_kalman_update_and_existence_one():

@@ -4,6 +4,7 @@ reference."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -12,7 +13,7 @@ from scipy.special import logsumexp
 
 from gnnpmb.assign import murty
 from gnnpmb.assign.murty import k_best
-from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig
+from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig, paper_config
 from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses, ListSink, NullSink, Pruned, PruneReason
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext, posterior_from_assignment
@@ -21,7 +22,7 @@ from gnnpmb.pmb.strategy import BestAssignment
 from gnnpmb.types import IdAllocator, Measurements
 from tests.gnnpmb.pmb.helpers import make_measurements
 
-CFG = TrackerConfig()
+CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 P = CFG.pmb
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
@@ -157,7 +158,7 @@ def test_hypotheses_identical_after_pruning_are_merged():
     """With prune_existence 0.2 the 'missed + new' hypothesis is empty after the ambiguous frame, and after an
     empty frame the other one (its track missed, r = 0.19) is empty too: the two merge into one of weight
     1."""
-    config = CFG.replace(pmb=PmbParams(prune_existence=0.2))
+    config = CFG.replace(pmb=dataclasses.replace(CFG.pmb, prune_existence=0.2))
     core = core_with_track(KBest(config.pmbm), config)
     core.step(make_measurements([(2.2, 0.0)], 0.9), 0.5, NullSink())
     assert len(core.hypotheses) == 2 and len(core.hypotheses[1].bernoullis) == 0

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gnnpmb.assign.exact_marginals import exact_marginals_log
-from gnnpmb.config import TrackerConfig
+from gnnpmb.config import TrackerConfig, paper_config
 from gnnpmb.events import Assignment, AxisKind, ListSink, Marginals, Merged, NullSink, Posterior
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext
@@ -17,7 +17,7 @@ from gnnpmb.pmb.topmb import Marginals as TopmbMarginals
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
-CFG = TrackerConfig()
+CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 P = CFG.pmb
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])

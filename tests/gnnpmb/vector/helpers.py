@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from gnnpmb.config import TrackerConfig
+from gnnpmb.config import paper_config
 
-CFG = TrackerConfig()
+CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 V, P = CFG.vector, CFG.pmb
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
