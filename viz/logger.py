@@ -10,7 +10,7 @@ Per frame and class, from the events alone:
   and the margin, as a document and as a labelled cost grid with the chosen cells outlined;
 * **what happened before**: one entity per extracted track (``tracks/<class>/<id>``: its box and a trail of its
   last ``TRAIL_FRAMES`` positions), per-track series (existence, normalised innovation, chosen cost) and a story
-  log per class: confirmed, missed, no longer reported, pruned at INFO/WARN; candidates' births and prunings
+  log per class: confirmed, missed, no longer shown, ended at INFO/WARN; candidates' births and prunings
   aggregated into one DEBUG line per class and frame; close calls at INFO.
 
 Candidate Bernoullis (predicted existence below ``gate_min_existence``, the many births on clutter) get no gate,
@@ -81,6 +81,10 @@ MAX_HYPOTHESIS_SERIES = 10
 """Log weights are plotted for the best this many PMBM global hypotheses."""
 CHOSEN_CELL_RGBA = int(pack_rgba(np.array([[255, 210, 0]], dtype=np.uint8))[0])
 THRESHOLD_COLOR = (150, 150, 150)
+SHOW_MIN_EXISTENCE = 0.5
+"""Extracted tracks are drawn as tracks (own entity, box, trail, story, series) from this existence on. The
+submission may hold far less likely Bernoullis (a low extraction threshold with score = detection score x
+existence helps AMOTA); drawing them all would bury the picture (and the viewer in chunks)."""
 FLUSH_FRAMES = 10
 """Default cadence: story lines and spatial rows are sent column-wise every this many frames (and at the end),
 so a live viewer sees them within seconds; a saved recording passes ``flush_frames=None`` (only at the end: one
@@ -143,7 +147,8 @@ class TrackerLogger:
     gate_z_m: height at which gates, lines and predicted means of tracks with no known box height are drawn
     (global z). gate_points: vertices per gate ellipse. log_predicted: draw the predicted means.
     gate_min_existence: tracks whose predicted existence reaches it are drawn (gate, prediction, gated pairs);
-    the others are candidates. clock: the timelines rows go on (``viz.timeline``). log_frames: draw and log
+    the others are candidates. show_min_existence: extracted tracks below it are not drawn as tracks (focused
+    tracks always are). clock: the timelines rows go on (``viz.timeline``). log_frames: draw and log
     only these keyframes (None: all); the others still feed the tracks' history (trails, series, story state).
     focus_tracks: their conflicts come first in the decision view. flush_frames: send buffered rows every this
     many frames (None: only at the end). Call ``finish()`` after the last frame: it sends what is buffered and
@@ -161,6 +166,7 @@ class TrackerLogger:
         gate_points: int = 32,
         log_predicted: bool = True,
         gate_min_existence: float = 0.1,
+        show_min_existence: float = SHOW_MIN_EXISTENCE,
         clock: Clock = PLAIN_CLOCK,
         log_frames: range | None = None,
         focus_tracks: set[int] | None = None,
@@ -173,6 +179,7 @@ class TrackerLogger:
         self.gate_points = gate_points
         self.log_predicted = log_predicted
         self.gate_min_existence = gate_min_existence
+        self.show_min_existence = show_min_existence
         self.clock = clock
         self.log_frames = log_frames
         self.focus_tracks = focus_tracks
@@ -404,12 +411,17 @@ class TrackerLogger:
     # One class, one frame.
     def _draw_class(self, class_name: str, cf: _ClassFrame) -> set[int]:
         """Draw one class's frame; returns the ids of its extracted tracks."""
-        estimates = cf.extracted.estimates if cf.extracted is not None else ()
+        focus = self.focus_tracks or set()
+        estimates = tuple(
+            e
+            for e in (cf.extracted.estimates if cf.extracted is not None else ())
+            if e.existence >= self.show_min_existence or e.track_id in focus
+        )
         if cf.extracted is not None and cf.posterior is not None:
             self._sample(
                 paths.extraction_threshold(self.tracker, class_name),
-                cf.extracted.threshold,
-                f"{class_name} extraction threshold",
+                max(cf.extracted.threshold, self.show_min_existence),
+                f"{class_name} shown as a track above",
                 THRESHOLD_COLOR,
             )
         for e in estimates:
@@ -694,10 +706,11 @@ class TrackerLogger:
                 )
             )
         pruned_ids = {p.track_id for p in cf.pruned}
+        limit = max(cf.extracted.threshold if cf.extracted is not None else 0.0, self.show_min_existence)
         for t in sorted(self._reported - set(now) - pruned_ids):
             if t in posterior_r:
                 self._text(
-                    class_name, f"track {t} no longer reported (r={posterior_r[t]:.2f} fell below extraction)", "WARN"
+                    class_name, f"track {t} no longer shown (r={posterior_r[t]:.2f} fell below {limit:.2f})", "WARN"
                 )
         candidates_pruned = 0
         for p in cf.pruned:
