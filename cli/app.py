@@ -316,13 +316,18 @@ def run_digest(run: TrackingRun) -> TrackDigest:
 
 
 def compare_runs(runs: Sequence[TrackingRun]) -> Comparison:
-    """Per-frame disagreements between tracker runs over the same keyframes (``gnnpmb.compare``)."""
+    """Per-frame disagreements between tracker runs over the same keyframes (``gnnpmb.compare``), between the
+    tracks the viewer draws (existence at least ``viz.logger.SHOW_MIN_EXISTENCE``)."""
     from gnnpmb.compare import compare_trackers
+    from viz.logger import SHOW_MIN_EXISTENCE
 
     frames = runs[0].frames
     return compare_trackers(
         [f.keyframe.gt for f in frames],
-        {run.tracker: [f.estimates for f in run.frames] for run in runs},
+        {
+            run.tracker: [tuple(e for e in f.estimates if e.existence >= SHOW_MIN_EXISTENCE) for f in run.frames]
+            for run in runs
+        },
         frame_indices=[f.keyframe.index for f in frames],
     )
 
