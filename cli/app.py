@@ -9,7 +9,8 @@ whether the tracks are identical. Typer cannot mix a positional SCENE with a sub
 dispatches on the first argument being ``reproduce``.
 
 Everything the user typed is checked before a recording is opened (names, --frames, files, the dataset), so a
-mistake costs one line on stderr and leaves no ``.rrd`` behind.
+mistake costs one line on stderr and leaves no ``.rrd`` behind. Without ``--save`` or ``--serve`` the run needs
+a display for the spawned viewer; without one it stops at once with a hint instead of hanging.
 """
 
 from __future__ import annotations
@@ -26,8 +27,10 @@ from typing import TYPE_CHECKING, Annotated
 import numpy as np
 import typer
 
-from cli.errors import run_app
-from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
+from cli.errors import check_version_flag, run_app
+from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
+from cli.outputs import check_output_file
+from cli.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, ServeTarget, check_display, check_serve_ports
 from gnnpmb.config import TrackerConfig, config_from_dict, load_config
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError, GnnpmbError
@@ -47,11 +50,10 @@ DEFAULT_TRACKER = "gnnpmb"
 DEFAULT_DETECTOR = "centerpoint"
 EXIT_DIFFERENT = 1
 _FRAMES_RE = re.compile(r"^\s*(\d*)\s*:\s*(\d*)\s*$")
-_COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar(
-    "command_line", default=None
-)
+_COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar("command_line", default=None)
 """The command line ``main`` was given, recorded in the provenance (else ``sys.argv`` is used)."""
 
+tidy_help()
 app = typer.Typer(
     add_completion=False,
     help="Track a nuScenes scene and inspect every step of the tracker(s) in the Rerun viewer.",
@@ -69,7 +71,7 @@ class ViewRequest:
     """Everything one ``gnnpmb-viz`` run needs, checked: no recording is opened before this exists.
 
     source: where the detections came from, with their hash; seed: the simulated detector's seed;
-    argv: the command line, for the provenance.
+    argv: the command line, for the provenance; serve: the ports of the web viewer (None: save or spawn).
     """
 
     scene: SceneData
@@ -84,6 +86,7 @@ class ViewRequest:
     source: DetectionsSource
     seed: int
     argv: tuple[str, ...]
+    serve: ServeTarget | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -119,8 +122,7 @@ def frame_range_of(bounds: tuple[int | None, int | None], scene: SceneData) -> r
         raise DataError(f"{scene.name} has no keyframes")
     if start >= n or end > n:
         raise GnnpmbError(
-            f"--frames {start}:{end} is outside {scene.name}, which has keyframes 0 to {n - 1} "
-            f"(use END <= {n})"
+            f"--frames {start}:{end} is outside {scene.name}, which has keyframes 0 to {n - 1} (use END <= {n})"
         )
     if end <= start:
         raise GnnpmbError(f"--frames {start}:{end} selects no keyframes; END must be greater than START")
@@ -144,9 +146,7 @@ def detections_source(
     if detections_file is not None:
         path = Path(detections_file).expanduser().absolute()
         return DetectionsSource("file", file_sha256(path), path=str(path))
-    return DetectionsSource(
-        "simulated", boxes_sha256(detections, scene.sample_tokens), preset=detector, seed=int(seed)
-    )
+    return DetectionsSource("simulated", boxes_sha256(detections, scene.sample_tokens), preset=detector, seed=int(seed))
 
 
 def command_line() -> tuple[str, ...]:
@@ -162,26 +162,40 @@ def prepare(
     dataroot: Path | None = None,
     version: str | None = None,
     detections_file: Path | None = None,
-    detector: str = DEFAULT_DETECTOR,
+    detector: str | None = None,
     seed: int = 0,
     params: Path | None = None,
     classes: str | None = None,
     frames: str | None = None,
     save: Path | None = None,
+    serve: ServeTarget | None = None,
     argv: Sequence[str] = (),
 ) -> ViewRequest:
-    """Check every argument and load the scene and detections; raises GnnpmbError with a one-line message."""
+    """Check every argument and load the scene and detections; raises GnnpmbError with a one-line message.
+
+    The cheap checks (names, --frames, output path, ports, the --detections file) run before the dataset is
+    loaded. detector None means the default preset; it cannot be combined with ``detections_file``.
+    """
+    from gnnpmb.data.detections import check_detection_file
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
     from gnnpmb.data.simdet import get_preset
     from gnnpmb.pipeline import get_detections, preprocess_frames
-    from viz.recording import check_save_path
 
+    if detections_file is not None and detector is not None:
+        raise GnnpmbError("pass either --detections FILE.json or --detector PRESET, not both")
+    if save is not None and serve is not None:
+        raise GnnpmbError("pass either --save OUT.rrd or --serve, not both")
+    detector = detector or DEFAULT_DETECTOR
     names = tuple(dict.fromkeys(check_tracker(t) for t in (trackers or [DEFAULT_TRACKER])))
     get_preset(detector)
     class_names = parse_classes(classes)
     bounds = parse_frames(frames)
     config = load_config(params)
-    target = check_save_path(save) if save is not None else None
+    target = check_output_file(save, "--save", ".rrd") if save is not None else None
+    if serve is not None:
+        check_serve_ports(serve)
+    if detections_file is not None:
+        check_detection_file(detections_file)
     location = resolve_dataroot(dataroot, version)
     scene = load_scene(open_nuscenes(location), location, scene_name)
     frame_range = frame_range_of(bounds, scene)
@@ -201,6 +215,7 @@ def prepare(
         source,
         int(seed),
         tuple(argv),
+        serve,
     )
 
 
@@ -218,10 +233,9 @@ def prepare_reproduction(
     changed."""
     from gnnpmb.data.nuscenes import check_dataroot, load_scene, open_nuscenes
     from gnnpmb.pipeline import get_detections, preprocess_frames
-    from viz.recording import check_save_path
 
     p = provenance
-    target = check_save_path(save) if save is not None else None
+    target = check_output_file(save, "--save", ".rrd") if save is not None else None
     root = Path(dataroot) if dataroot is not None else Path(p.dataroot)
     if not root.exists():
         raise DataError(f"the recorded dataroot {root} does not exist; pass --dataroot DIR with a copy of it")
@@ -376,7 +390,13 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
     runs: list[TrackingRun] = []
     notices: list[str] = []
     comparison = None
-    with recording(recording_name(request), request.save, blueprint) as stream, bar:
+    if request.serve is not None:
+        from cli.serve import serving
+
+        opened = serving(recording_name(request), request.serve, blueprint)
+    else:
+        opened = recording(recording_name(request), request.save, blueprint)
+    with opened as stream, bar:
         sensors = bar.add_task(f"{scene.name} sensors", total=n)
         log_scene(
             stream,
@@ -480,7 +500,7 @@ REPRODUCE_HELP = (
 
 @app.command(help=VIEW_HELP)
 def view(
-    scene: Annotated[str, typer.Argument(help="Scene name, e.g. scene-0103.")],
+    scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
     tracker: Annotated[
         list[str] | None,
         typer.Option(
@@ -494,11 +514,12 @@ def view(
     version: VersionOption = None,
     detections: DetectionsOption = None,
     detector: Annotated[
-        str,
+        str | None,
         typer.Option(
-            metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars."
+            metavar="PRESET",
+            help=f"Simulated detector preset: centerpoint, megvii or pointpillars (default {DEFAULT_DETECTOR}).",
         ),
-    ] = DEFAULT_DETECTOR,
+    ] = None,
     seed: SeedOption = 0,
     params: ParamsOption = None,
     classes: Annotated[
@@ -515,6 +536,20 @@ def view(
         Path | None,
         typer.Option(metavar="OUT.rrd", help="Write the recording to this .rrd instead of a viewer."),
     ] = None,
+    serve: Annotated[
+        bool,
+        typer.Option(
+            "--serve",
+            help="Serve the web viewer on localhost and print its URL (for a remote machine or no display); "
+            "Ctrl-C stops it.",
+        ),
+    ] = False,
+    web_port: Annotated[
+        int, typer.Option(metavar="PORT", help="HTTP port of the web viewer (with --serve).")
+    ] = DEFAULT_WEB_PORT,
+    grpc_port: Annotated[
+        int, typer.Option(metavar="PORT", help="gRPC port the web viewer reads the data from (with --serve).")
+    ] = DEFAULT_GRPC_PORT,
     failures: Annotated[
         bool,
         typer.Option(help="Find and mark each tracker's failures with the devkit's matching (needs GT)."),
@@ -522,6 +557,8 @@ def view(
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
 ) -> None:
     """Track SCENE into one recording and show or save it (``VIEW_HELP``)."""
+    if save is None and not serve:
+        check_display()
     request = prepare(
         scene,
         tracker or [],
@@ -534,6 +571,7 @@ def view(
         classes=classes,
         frames=frames,
         save=save,
+        serve=ServeTarget(web_port, grpc_port) if serve else None,
         argv=command_line(),
     )
     result = run_view(request, progress=progress, failures=failures)
@@ -544,7 +582,13 @@ def view(
     if result.comparison is not None:
         compared = f"; {len(result.comparison.disagreements)} disagreements"
     output = f"saved {request.save}" if request.save is not None else "streamed to the Rerun viewer"
+    if request.serve is not None:
+        output = f"served at {request.serve.url}"
     typer.echo(f"{request.scene.name}: {len(request.frame_range)} frames, {timing}{compared}; {output}")
+    if request.serve is not None:
+        from cli.serve import wait_for_ctrl_c
+
+        wait_for_ctrl_c(request.serve)
 
 
 @reproduce_app.command(help=REPRODUCE_HELP)
@@ -559,9 +603,7 @@ def reproduce(
     ] = None,
     detections: Annotated[
         Path | None,
-        typer.Option(
-            metavar="FILE.json", help="Use this detections file instead of the recorded path (a copy)."
-        ),
+        typer.Option(metavar="FILE.json", help="Use this detections file instead of the recorded path (a copy)."),
     ] = None,
     save: Annotated[
         Path | None, typer.Option(metavar="OUT.rrd", help="Also write the re-run as a new recording.")
@@ -595,6 +637,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     """The ``gnnpmb-viz`` console script: ``reproduce ...`` goes to the reproduce command, anything else to
     the viewer command (typer cannot have a positional SCENE beside a subcommand)."""
     args = list(sys.argv[1:] if argv is None else argv)
+    check_version_flag(args, PROG)
     token = _COMMAND_LINE.set((PROG, *args))
     try:
         if args and args[0] == "reproduce":

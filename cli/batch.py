@@ -18,7 +18,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from cli.errors import entry_point
-from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
+from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
+from cli.outputs import check_output_dir, check_output_file
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.registry import TRACKER_NAMES
 
@@ -32,22 +33,29 @@ _TABLE_WIDTH = 160
 
 app = typer.Typer(
     add_completion=False,
-    no_args_is_help=True,
     pretty_exceptions_enable=False,
     help="Batch tracking on nuScenes splits, the official tracking evaluation, and the failure finder.",
 )
 
+tidy_help()
+
 SplitOption = Annotated[
     str | None,
-    typer.Option(help="Split: mini_val, val, ... or one in <version>/splits.json (default: from --version)."),
+    typer.Option(
+        metavar="NAME",
+        help="Split: mini_val, val, ... or one in <version>/splits.json (default: from --nuscenes-version).",
+    ),
 ]
 DetectorOption = Annotated[
     str | None,
     typer.Option(
-        help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR})."
+        metavar="PRESET",
+        help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR}).",
     ),
 ]
-TrackerOption = Annotated[str, typer.Option("--tracker", "-t", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")]
+TrackerOption = Annotated[
+    str, typer.Option("--tracker", "-t", metavar="NAME", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")
+]
 
 
 def _stdout() -> Console:
@@ -75,9 +83,17 @@ def _detector(detections: Path | None, detector: str | None) -> str:
     return name
 
 
+def _check_detections(detections: Path | None) -> None:
+    """Read a --detections file before any dataset is loaded, so a bad file fails in a second."""
+    if detections is not None:
+        from gnnpmb.data.detections import check_detection_file
+
+        check_detection_file(detections)
+
+
 @app.command()
 def track(
-    out: Annotated[Path, typer.Option(help="Where to write the tracking submission (.json).")],
+    out: Annotated[Path, typer.Option(metavar="FILE.json", help="Where to write the tracking submission (.json).")],
     dataroot: DatarootOption = None,
     version: VersionOption = None,
     split: SplitOption = None,
@@ -96,11 +112,11 @@ def track(
     from gnnpmb.pipeline import get_detections, run_tracker
     from gnnpmb.registry import check_tracker
 
+    target = check_output_file(out, "--out")
     check_tracker(tracker)
     preset = _detector(detections, detector)
     config = load_config(params)
-    if detections is not None and not detections.is_file():
-        raise GnnpmbError(f"detections file not found: {detections}")
+    _check_detections(detections)
     location = resolve_dataroot(dataroot, version)
     split = split or default_split(location.version)
     check_split_version(split, location.version)
@@ -128,17 +144,21 @@ def track(
             scene = load_scene(nusc, location, name)
             bar.update(frames_task, description=f"{name} frames", total=len(scene.keyframes), completed=0)
             scene_detections = get_detections(scene, detections, preset, seed)
-            run = run_tracker(
-                scene, scene_detections, tracker, config, on_frame=lambda: bar.advance(frames_task)
-            )
+            run = run_tracker(scene, scene_detections, tracker, config, on_frame=lambda: bar.advance(frames_task))
             results = run_results(run)
             parts.append(results)
             n_frames += len(run.frames)
             n_boxes += sum(len(boxes) for boxes in results.values())
             step_s += sum(f.step_time_s for f in run.frames)
             bar.advance(scenes_task)
-    write_submission(out, build_submission(parts, tokens))
+    write_submission(target, build_submission(parts, tokens))
     ms = 1e3 * step_s / max(n_frames, 1)
+    if n_boxes == 0:
+        typer.echo(
+            "note: no tracks were output; 'gnnpmb eval' cannot score an empty submission (check the detections "
+            "and score_threshold)",
+            err=True,
+        )
     typer.echo(
         f"{tracker}: {len(scene_names)} scenes of {split}, {n_frames} frames, {n_boxes} boxes, "
         f"{ms:.1f} ms/frame -> {out}"
@@ -147,21 +167,26 @@ def track(
 
 @app.command("eval")
 def evaluate(
-    results: Annotated[Path, typer.Argument(help="Tracking submission .json (e.g. from 'gnnpmb track').")],
+    results: Annotated[
+        Path, typer.Argument(metavar="RESULTS.json", help="Tracking submission .json (e.g. from 'gnnpmb track').")
+    ],
     dataroot: DatarootOption = None,
     version: VersionOption = None,
     split: SplitOption = None,
     out: Annotated[
         Path | None,
         typer.Option(
-            help="Folder for the devkit's metrics files (default: <results>_eval/ next to the file)."
+            metavar="DIR", help="Folder for the devkit's metrics files (default: <results>_eval/ next to the file)."
         ),
     ] = None,
 ) -> None:
     """Score a tracking submission with the official nuScenes evaluation (tracking_nips_2019)."""
     from gnnpmb.data.nuscenes import resolve_dataroot
-    from gnnpmb.eval.nuscenes_eval import TABLE_METRICS, evaluate_submission, format_metric
+    from gnnpmb.eval.nuscenes_eval import TABLE_METRICS, default_eval_dir, evaluate_submission, format_metric
+    from gnnpmb.eval.submission import check_results_file
 
+    check_results_file(results)
+    out = check_output_dir(out if out is not None else default_eval_dir(results), "--out")
     location = resolve_dataroot(dataroot, version)
     split = split or default_split(location.version)
     start = time.perf_counter()
@@ -186,7 +211,7 @@ def evaluate(
 
 @app.command()
 def failures(
-    scene: Annotated[str, typer.Argument(help="Scene name, e.g. scene-0103.")],
+    scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
     tracker: TrackerOption = DEFAULT_TRACKER,
     dataroot: DatarootOption = None,
     version: VersionOption = None,
@@ -195,7 +220,7 @@ def failures(
     seed: SeedOption = 0,
     params: ParamsOption = None,
     json_out: Annotated[
-        Path | None, typer.Option("--json", help="Also write the report as JSON here.")
+        Path | None, typer.Option("--json", metavar="FILE.json", help="Also write the report as JSON here.")
     ] = None,
 ) -> None:
     """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
@@ -207,16 +232,18 @@ def failures(
     from gnnpmb.pipeline import get_detections, run_tracker
     from gnnpmb.registry import check_tracker
 
+    json_target = check_output_file(json_out, "--json") if json_out is not None else None
     check_tracker(tracker)
     preset = _detector(detections, detector)
     config = load_config(params)
+    _check_detections(detections)
     location = resolve_dataroot(dataroot, version)
     nusc = open_nuscenes(location)
     scene_data = load_scene(nusc, location, scene)
     run = run_tracker(scene_data, get_detections(scene_data, detections, preset, seed), tracker, config)
     report = find_failures(nusc, scene, run_results(run), tracker)
-    if json_out is not None:
-        write_json(json_out, report.to_json())
+    if json_target is not None:
+        write_json(json_target, report.to_json())
     print_report(report, _stdout())
     if json_out is not None:
         typer.echo(f"report -> {json_out}")
@@ -227,9 +254,7 @@ def print_report(report: FailureReport, console: Console) -> None:
     from gnnpmb.eval.failures import FailureKind
     from gnnpmb.eval.nuscenes_eval import format_metric
 
-    classes = Table(
-        title=f"{report.tracker} on {report.scene_name}: devkit counts at the best-MOTA threshold"
-    )
+    classes = Table(title=f"{report.tracker} on {report.scene_name}: devkit counts at the best-MOTA threshold")
     for name in ("class", "threshold", "MOTA", "TP", "FP", "FN", "IDS", "FRAG"):
         classes.add_column(name, justify="left" if name == "class" else "right")
     for c in report.classes:
@@ -255,15 +280,16 @@ def print_report(report: FailureReport, console: Console) -> None:
 @app.command("demo-data")
 def demo_data(
     out: Annotated[
-        Path, typer.Option(help="Folder to write the demo dataroot into (new, empty or an old demo).")
+        Path,
+        typer.Option(metavar="DIR", help="Folder to write the demo dataroot into (new, empty or an old demo)."),
     ],
-    seed: Annotated[int, typer.Option(help="Seed of the LiDAR noise.")] = 0,
+    seed: Annotated[int, typer.Option(metavar="N", help="Seed of the LiDAR noise.")] = 0,
 ) -> None:
     """Write the synthetic nuScenes-format demo dataset (v1.0-mini, scenes scene-0103 and scene-0916)."""
     from gnnpmb.data.demo import generate_demo_dataset
 
-    path = generate_demo_dataset(out, seed=seed)
+    path = generate_demo_dataset(check_output_dir(out, "--out"), seed=seed)
     typer.echo(f"demo dataset (v1.0-mini, seed {seed}) -> {path}")
 
 
-main = entry_point(app)
+main = entry_point(app, "gnnpmb")

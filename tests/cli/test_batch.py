@@ -81,7 +81,7 @@ def test_track_is_deterministic(
     tracked: tuple[Path, str], demo_dataroot: Path, tmp_path: Path, capsys
 ) -> None:
     again = tmp_path / "again.json"
-    argv = ["track", "--dataroot", str(demo_dataroot), "--version", "v1.0-mini", "--split", "mini_val"]
+    argv = ["track", "--dataroot", str(demo_dataroot), "--nuscenes-version", "v1.0-mini", "--split", "mini_val"]
     code, _, _ = run(
         [*argv, "--detector", "centerpoint", "--seed", "0", "--out", str(again), "--no-progress"], capsys
     )
