@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextvars
 import functools
+import os
 import re
 import sys
 from collections.abc import Callable, Sequence
@@ -24,26 +25,26 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
 
-from cli.errors import check_version_flag, run_app
+from cli.errors import check_version_flag, exit_now_on_failure, run_app
 from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
 from cli.outputs import check_output_file
 from cli.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, ServeTarget, check_display, check_serve_ports
-from gnnpmb.config import TrackerConfig, config_from_dict, load_config
-from gnnpmb.data.scene import SceneData
+from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.errors import DataError, GnnpmbError
-from gnnpmb.provenance import DetectionsSource, Provenance, TrackDigest, track_digest
 from gnnpmb.registry import TRACKER_NAMES, check_classes, check_tracker
-from gnnpmb.types import TRACKING_CLASSES, Boxes, FrameDetections
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # numpy, the devkit and rerun load only on the paths that use them (fast --help)
     import rerun as rr
 
     from gnnpmb.compare import Comparison
+    from gnnpmb.config import TrackerConfig
     from gnnpmb.data.nuscenes import DatasetLocation
+    from gnnpmb.data.scene import SceneData
     from gnnpmb.pipeline import TrackingRun
+    from gnnpmb.provenance import DetectionsSource, Provenance, TrackDigest
+    from gnnpmb.types import Boxes, FrameDetections
 
 PROG = "gnnpmb-viz"
 DEFAULT_TRACKER = "gnnpmb"
@@ -56,11 +57,13 @@ _COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.Cont
 tidy_help()
 app = typer.Typer(
     add_completion=False,
+    rich_markup_mode=None,
     help="Track a nuScenes scene and inspect every step of the tracker(s) in the Rerun viewer.",
     pretty_exceptions_enable=False,
 )
 reproduce_app = typer.Typer(
     add_completion=False,
+    rich_markup_mode=None,
     help="Re-run the trackers of a recording saved by gnnpmb-viz and check its tracks.",
     pretty_exceptions_enable=False,
 )
@@ -141,7 +144,7 @@ def detections_source(
     scene: SceneData, detections: dict[str, Boxes], detections_file: Path | None, detector: str, seed: int
 ) -> DetectionsSource:
     """Where ``detections`` came from, with the SHA-256 of the file, or of the simulated boxes."""
-    from gnnpmb.provenance import boxes_sha256, file_sha256
+    from gnnpmb.provenance import DetectionsSource, boxes_sha256, file_sha256
 
     if detections_file is not None:
         path = Path(detections_file).expanduser().absolute()
@@ -176,6 +179,7 @@ def prepare(
     The cheap checks (names, --frames, output path, ports, the --detections file) run before the dataset is
     loaded. detector None means the default preset; it cannot be combined with ``detections_file``.
     """
+    from gnnpmb.config import load_config
     from gnnpmb.data.detections import check_detection_file
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
     from gnnpmb.data.simdet import get_preset
@@ -231,6 +235,7 @@ def prepare_reproduction(
     (checked by hash), parameters, classes, frames and trackers. dataroot / detections_file replace the
     recorded paths (e.g. on another machine). Raises a DataError naming the input that is missing or
     changed."""
+    from gnnpmb.config import config_from_dict
     from gnnpmb.data.nuscenes import check_dataroot, load_scene, open_nuscenes
     from gnnpmb.pipeline import get_detections, preprocess_frames
 
@@ -297,7 +302,7 @@ def recording_name(request: ViewRequest) -> str:
 
 def provenance_of(request: ViewRequest, digests: dict[str, TrackDigest]) -> Provenance:
     """The provenance of a run of ``request`` whose tracks have ``digests``."""
-    from gnnpmb.provenance import package_versions
+    from gnnpmb.provenance import Provenance, package_versions
 
     return Provenance(
         argv=request.argv,
@@ -320,6 +325,8 @@ def provenance_of(request: ViewRequest, digests: dict[str, TrackDigest]) -> Prov
 
 def run_digest(run: TrackingRun) -> TrackDigest:
     """The track digest of one tracker run."""
+    from gnnpmb.provenance import track_digest
+
     return track_digest([f.keyframe.index for f in run.frames], [f.estimates for f in run.frames])
 
 
@@ -363,6 +370,7 @@ def log_failures_of(
 def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = True) -> ViewResult:
     """Log the scene, run every tracker into one recording (sharing the preprocessed detections), compare them
     and log failures and provenance."""
+    import numpy as np
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -526,7 +534,7 @@ def view(
         str | None,
         typer.Option(
             metavar="CLASS,...",
-            help=f"Comma-separated classes to track (default all: {','.join(TRACKING_CLASSES)}).",
+            help=f"Comma-separated classes to track (default all: {', '.join(TRACKING_CLASSES)}).",
         ),
     ] = None,
     frames: Annotated[
@@ -635,9 +643,18 @@ def reproduce(
 
 def main(argv: Sequence[str] | None = None) -> None:
     """The ``gnnpmb-viz`` console script: ``reproduce ...`` goes to the reproduce command, anything else to
-    the viewer command (typer cannot have a positional SCENE beside a subcommand)."""
-    args = list(sys.argv[1:] if argv is None else argv)
+    the viewer command (typer cannot have a positional SCENE beside a subcommand). As the script (``argv``
+    None) a failed run exits at once (``cli.errors.exit_now_on_failure``)."""
+    if argv is None:
+        exit_now_on_failure(lambda: _main(sys.argv[1:]))
+    else:
+        _main(list(argv))
+
+
+def _main(args: list[str]) -> None:
+    """``main`` on the arguments after the program name."""
     check_version_flag(args, PROG)
+    os.environ.setdefault("RUST_LOG", "off")  # Rerun's own log lines; our errors say what went wrong
     token = _COMMAND_LINE.set((PROG, *args))
     try:
         if args and args[0] == "reproduce":

@@ -13,9 +13,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-from rich.table import Table
 
 from cli.errors import entry_point
 from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
@@ -23,7 +20,9 @@ from cli.outputs import check_output_dir, check_output_file
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.registry import TRACKER_NAMES
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # rich, numpy and the devkit load only on the paths that use them (fast --help)
+    from rich.console import Console
+
     from gnnpmb.eval.failures import FailureReport
 
 DEFAULT_DETECTOR = "centerpoint"
@@ -33,6 +32,7 @@ _TABLE_WIDTH = 160
 
 app = typer.Typer(
     add_completion=False,
+    rich_markup_mode=None,
     pretty_exceptions_enable=False,
     help="Batch tracking on nuScenes splits, the official tracking evaluation, and the failure finder.",
 )
@@ -59,6 +59,8 @@ TrackerOption = Annotated[
 
 
 def _stdout() -> Console:
+    from rich.console import Console
+
     console = Console()
     return console if console.is_terminal else Console(width=_TABLE_WIDTH)
 
@@ -91,7 +93,7 @@ def _check_detections(detections: Path | None) -> None:
         check_detection_file(detections)
 
 
-@app.command()
+@app.command(short_help="Track a split into a nuScenes tracking submission.")
 def track(
     out: Annotated[Path, typer.Option(metavar="FILE.json", help="Where to write the tracking submission (.json).")],
     dataroot: DatarootOption = None,
@@ -105,6 +107,9 @@ def track(
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
 ) -> None:
     """Track every scene of a split (all 7 classes) and write a nuScenes tracking submission."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
     from gnnpmb.config import load_config
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot, split_scenes
     from gnnpmb.eval.nuscenes_eval import check_split_version, split_sample_tokens
@@ -165,7 +170,7 @@ def track(
     )
 
 
-@app.command("eval")
+@app.command("eval", short_help="Score a submission with the official evaluation.")
 def evaluate(
     results: Annotated[
         Path, typer.Argument(metavar="RESULTS.json", help="Tracking submission .json (e.g. from 'gnnpmb track').")
@@ -181,6 +186,8 @@ def evaluate(
     ] = None,
 ) -> None:
     """Score a tracking submission with the official nuScenes evaluation (tracking_nips_2019)."""
+    from rich.table import Table
+
     from gnnpmb.data.nuscenes import resolve_dataroot
     from gnnpmb.eval.nuscenes_eval import TABLE_METRICS, default_eval_dir, evaluate_submission, format_metric
     from gnnpmb.eval.submission import check_results_file
@@ -209,7 +216,7 @@ def evaluate(
     )
 
 
-@app.command()
+@app.command(short_help="List one scene's tracking failures per frame.")
 def failures(
     scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
     tracker: TrackerOption = DEFAULT_TRACKER,
@@ -251,6 +258,8 @@ def failures(
 
 def print_report(report: FailureReport, console: Console) -> None:
     """The failure report as two tables: per class at its best-MOTA threshold, then failures per frame."""
+    from rich.table import Table
+
     from gnnpmb.eval.failures import FailureKind
     from gnnpmb.eval.nuscenes_eval import format_metric
 
@@ -277,7 +286,7 @@ def print_report(report: FailureReport, console: Console) -> None:
     console.print(f"{report.scene_name}, {report.tracker}: {totals}", highlight=False, soft_wrap=True)
 
 
-@app.command("demo-data")
+@app.command("demo-data", short_help="Write the synthetic demo dataset.")
 def demo_data(
     out: Annotated[
         Path,

@@ -8,10 +8,10 @@ its own bundled copy of click (``typer._click``), whose exceptions are not ``cli
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 from collections.abc import Callable, Sequence
-from importlib import metadata
 
 import typer
 
@@ -43,6 +43,8 @@ def _click_exception_types() -> tuple[type[Exception], ...]:
 
 def program_version() -> str:
     """The installed version of this program (the ``gnnpmb-viz`` distribution)."""
+    from importlib import metadata
+
     try:
         return metadata.version(DIST_NAME)
     except metadata.PackageNotFoundError:
@@ -95,7 +97,6 @@ def os_error_line(exc: OSError) -> str:
 def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
     """Run a typer app (or a partial of one); user mistakes end the process with one ``error:`` line and exit
     code 2, Ctrl-C exits 130 quietly, a closed stdout pipe exits quietly."""
-    click_errors = _click_exception_types()
     try:
         code = app(args=argv, standalone_mode=False)
     except GnnpmbError as exc:
@@ -111,9 +112,10 @@ def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
         _quiet_broken_pipe()
     except OSError as exc:
         _fail(os_error_line(exc))
-    except click_errors as exc:
-        code_of = getattr(exc, "exit_code", EXIT_USER_ERROR)
-        if code_of == 0:
+    except Exception as exc:
+        if not isinstance(exc, _click_exception_types()):
+            raise
+        if getattr(exc, "exit_code", EXIT_USER_ERROR) == 0:
             sys.exit(0)
         _fail(usage_line(exc))
     if isinstance(code, int) and code:
@@ -132,11 +134,27 @@ def _fail(message: str) -> None:
     sys.exit(EXIT_USER_ERROR)
 
 
+def exit_now_on_failure(run: Callable[[], None]) -> None:
+    """Run a console script's body; a failed run (SystemExit with a non-zero code) ends the process at once,
+    after flushing stdout and stderr, skipping interpreter shutdown: Rerun's exit hook can wait forever on a
+    recording whose file writer died (disk full). Every output was already finished or removed."""
+    try:
+        run()
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        if code == 0:
+            raise
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(OSError, ValueError):
+                stream.flush()
+        os._exit(code)
+
+
 def entry_point(app: typer.Typer, prog: str) -> Callable[[], None]:
     """A console-script ``main`` for ``app`` answering ``--version`` itself."""
 
     def main() -> None:
         check_version_flag(sys.argv[1:], prog)
-        run_app(app)
+        exit_now_on_failure(lambda: run_app(app))
 
     return main

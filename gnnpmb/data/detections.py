@@ -156,12 +156,13 @@ def _convert_sample(token: str, entries: Any) -> Boxes | str:
     n = len(entries)
     try:
         names = np.array([e["detection_name"] for e in entries], dtype=object)
-        raw_score = np.array([e["detection_score"] for e in entries])
+        scores = [e["detection_score"] for e in entries]
+        raw_score = np.array(scores)
         raw = {name: np.array([e[name] for e in entries]) for name, _ in _VECTOR_FIELDS if name != "velocity"}
         velocity = np.array([e["velocity"] for e in entries], dtype=float)
     except (KeyError, TypeError, ValueError):
         return _diagnose(token, entries)
-    if raw_score.dtype.kind not in "if" or any(a.dtype.kind not in "if" for a in raw.values()):
+    if not all(type(v) in (int, float) for v in scores) or any(a.dtype.kind not in "if" for a in raw.values()):
         return _diagnose(token, entries)
     score = raw_score.astype(float)
     arrays = {name: a.astype(float) for name, a in raw.items()} | {"velocity": velocity}

@@ -154,6 +154,9 @@ def write_json(path: Path, data: Any) -> None:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             json.dump(data, f, allow_nan=False, separators=(",", ":"))
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise DataError(f"cannot write {path}: {exc.strerror or exc}; free space or write elsewhere") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

@@ -66,9 +66,7 @@ def cluttered_sequence(seed: int, n_frames: int = 12) -> list[Measurements]:
         xy = xy[rng.random(len(xy)) > 0.15]
         clutter = rng.uniform(-2.0, 8.0, size=(int(rng.integers(0, 3)), 2))
         points = np.concatenate([xy, clutter])
-        frames.append(
-            make_measurements([tuple(p) for p in points], list(rng.uniform(0.3, 0.95, len(points))))
-        )
+        frames.append(make_measurements([tuple(p) for p in points], list(rng.uniform(0.3, 0.95, len(points)))))
     return frames
 
 
@@ -148,9 +146,7 @@ def test_a_hypothesis_gnnpmb_discards_wins_later():
     assert x_pmbm[1] == pytest.approx(0.0, abs=0.05) and x_gnnpmb[1] > 2.0
     (new_pmbm,) = set(x_pmbm) - {1}
     (new_gnnpmb,) = set(x_gnnpmb) - {1}
-    assert x_pmbm[new_pmbm] == pytest.approx(2.2, abs=0.05) and x_gnnpmb[new_gnnpmb] == pytest.approx(
-        0.0, abs=0.05
-    )
+    assert x_pmbm[new_pmbm] == pytest.approx(2.2, abs=0.05) and x_gnnpmb[new_gnnpmb] == pytest.approx(0.0, abs=0.05)
 
 
 def test_hypotheses_identical_after_pruning_are_merged():
@@ -204,9 +200,7 @@ class PlainKBest:
         keep = keep if len(keep) else order[:1]
         kept_w = w[keep] - logsumexp(w[keep])
         return [
-            GlobalHypothesis(
-                float(lw), posterior_from_assignment(locals_[children[i][1]], children[i][2], ctx)
-            )
+            GlobalHypothesis(float(lw), posterior_from_assignment(locals_[children[i][1]], children[i][2], ctx))
             for i, lw in zip(keep, kept_w, strict=True)
         ]
 
