@@ -179,25 +179,26 @@ def prepare(
     The cheap checks (names, --frames, output path, ports, the --detections file) run before the dataset is
     loaded. detector None means the default preset; it cannot be combined with ``detections_file``.
     """
-    from gnnpmb.config import load_config
-    from gnnpmb.data.detections import check_detection_file
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
-    from gnnpmb.data.simdet import get_preset
-    from gnnpmb.pipeline import get_detections, preprocess_frames
-
     if detections_file is not None and detector is not None:
         raise GnnpmbError("pass either --detections FILE.json or --detector PRESET, not both")
     if save is not None and serve is not None:
         raise GnnpmbError("pass either --save OUT.rrd or --serve, not both")
     detector = detector or DEFAULT_DETECTOR
     names = tuple(dict.fromkeys(check_tracker(t) for t in (trackers or [DEFAULT_TRACKER])))
-    get_preset(detector)
     class_names = parse_classes(classes)
     bounds = parse_frames(frames)
-    config = load_config(params)
     target = check_output_file(save, "--save", ".rrd") if save is not None else None
     if serve is not None:
         check_serve_ports(serve)
+
+    from gnnpmb.config import load_config
+    from gnnpmb.data.detections import check_detection_file
+    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.data.simdet import get_preset
+    from gnnpmb.pipeline import get_detections, preprocess_frames
+
+    get_preset(detector)
+    config = load_config(params)
     if detections_file is not None:
         check_detection_file(detections_file)
     location = resolve_dataroot(dataroot, version)

@@ -76,10 +76,10 @@ def default_split(version: str) -> str:
 
 def _detector(detections: Path | None, detector: str | None) -> str:
     """The simulated detector preset to use (checked), refusing --detections together with --detector."""
-    from gnnpmb.data.simdet import get_preset
-
     if detections is not None and detector is not None:
         raise GnnpmbError("pass either --detections FILE or --detector PRESET, not both")
+    from gnnpmb.data.simdet import get_preset
+
     name = detector or DEFAULT_DETECTOR
     get_preset(name)
     return name
@@ -107,6 +107,12 @@ def track(
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
 ) -> None:
     """Track every scene of a split (all 7 classes) and write a nuScenes tracking submission."""
+    from gnnpmb.registry import check_tracker
+
+    target = check_output_file(out, "--out")
+    check_tracker(tracker)
+    preset = _detector(detections, detector)
+
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -115,11 +121,7 @@ def track(
     from gnnpmb.eval.nuscenes_eval import check_split_version, split_sample_tokens
     from gnnpmb.eval.submission import build_submission, run_results, write_submission
     from gnnpmb.pipeline import get_detections, run_tracker
-    from gnnpmb.registry import check_tracker
 
-    target = check_output_file(out, "--out")
-    check_tracker(tracker)
-    preset = _detector(detections, detector)
     config = load_config(params)
     _check_detections(detections)
     location = resolve_dataroot(dataroot, version)
@@ -232,15 +234,17 @@ def failures(
 ) -> None:
     """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
     coalescence and cascading identity theft (scored with the devkit's own matching)."""
+    from gnnpmb.registry import check_tracker
+
+    json_target = check_output_file(json_out, "--json") if json_out is not None else None
+    check_tracker(tracker)
+
     from gnnpmb.config import load_config
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
     from gnnpmb.eval.failures import find_failures
     from gnnpmb.eval.submission import run_results, write_json
     from gnnpmb.pipeline import get_detections, run_tracker
-    from gnnpmb.registry import check_tracker
 
-    json_target = check_output_file(json_out, "--json") if json_out is not None else None
-    check_tracker(tracker)
     preset = _detector(detections, detector)
     config = load_config(params)
     _check_detections(detections)

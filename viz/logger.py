@@ -26,6 +26,7 @@ from gnnpmb.events import (
     Assignment,
     AxisLabel,
     Born,
+    BudgetReached,
     Cardinality,
     CostMatrix,
     Event,
@@ -199,6 +200,7 @@ class TrackerLogger:
             Cardinality: self._on_cardinality,
             IntensityWeights: self._on_intensity,
             TrackLogic: self._on_track_logic,
+            BudgetReached: self._on_budget,
         }
 
     def emit(self, event: Event) -> None:
@@ -409,6 +411,13 @@ class TrackerLogger:
             self._text(
                 event.class_name, f"born track {t} from meas {m} at ({xy[0]:.1f}, {xy[1]:.1f}) r={r:.3f}", "INFO"
             )
+
+    def _on_budget(self, event: BudgetReached) -> None:
+        self._text(
+            event.class_name,
+            f"budget {event.budget} = {event.limit} reached (this frame needed {event.needed}); work was cut",
+            "WARN",
+        )
 
     def _on_pruned(self, event: Pruned) -> None:
         self._text(
