@@ -67,9 +67,7 @@ class Marginals:
         """The single posterior PMB hypothesis (weight 1) from the single prior hypothesis ``locals_[0]``."""
         local = locals_[0]
         log_ratio = local.det_log_lik - local.miss_log_lik[:, None]
-        marg = lbp_marginals_log(
-            log_ratio, local.new.log_likelihood, self.params.max_iterations, self.params.tolerance
-        )
+        marg = lbp_marginals_log(log_ratio, local.new.log_likelihood, self.params.max_iterations, self.params.tolerance)
         tracks, components = merged_bernoullis(local, marg)
         r_new = marg.p_new * local.new.existence
         new_j = np.flatnonzero((r_new > 0.0) & (r_new >= ctx.prune_existence))
@@ -155,9 +153,7 @@ def _emit(local: LocalHypotheses, marg: AssociationMarginals, comp: Components, 
     meas, prior = local.meas, local.prior
     k, m = local.n_tracks, local.n_meas
     rows = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
-    cols = (AxisLabel(AxisKind.MISSED, -1),) + tuple(
-        AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index
-    )
+    cols = (AxisLabel(AxisKind.MISSED, -1),) + tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
     ctx.sink.emit(MarginalsEvent(ctx.class_name, marg.p_track, rows, cols, marg.method, marg.iterations))
 
     significant = comp.detected >= MERGE_REPORT_WEIGHT
