@@ -32,7 +32,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gnnpmb.assign.lbp import lbp_marginals_log
+from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.assign.marginals import AssociationMarginals
 from gnnpmb.config import LbpParams
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, Merged, Pruned, PruneReason
@@ -80,7 +80,7 @@ class Marginals:
     ) -> list[GlobalHypothesis]:
         """The single posterior PMB hypothesis (weight 1) from the single prior hypothesis ``locals_[0]``."""
         local = locals_[0]
-        log_ratio = _most_likely_per_row(local.det_log_lik - local.miss_log_lik[:, None], MAX_GATED_PER_TRACK)
+        log_ratio = keep_most_likely(local.det_log_lik - local.miss_log_lik[:, None], MAX_GATED_PER_TRACK)
         marg = lbp_marginals_log(log_ratio, local.new.log_likelihood, self.params.max_iterations, self.params.tolerance)
         tracks, components = merged_bernoullis(local, marg)
         r_new = marg.p_new * local.new.existence
@@ -90,16 +90,6 @@ class Marginals:
         if ctx.sink.enabled:
             _emit(local, marg, components, ctx)
         return [GlobalHypothesis(0.0, _capped(Bernoullis.concatenate([tracks, births]), self.max_bernoullis, ctx))]
-
-
-def _most_likely_per_row(log_ratio: np.ndarray, limit: int) -> np.ndarray:
-    """(K, M) log ratios with all but each row's ``limit`` largest finite entries set to -inf (not gated)."""
-    if log_ratio.shape[1] <= limit or (np.isfinite(log_ratio).sum(axis=1) <= limit).all():
-        return log_ratio
-    cut = -np.partition(-log_ratio, limit - 1, axis=1)[:, limit - 1 : limit]  # each row's limit-th largest
-    out = log_ratio.copy()
-    out[log_ratio < cut] = -np.inf
-    return out
 
 
 def _capped(bernoullis: Bernoullis, limit: int, ctx: UpdateContext) -> Bernoullis:
