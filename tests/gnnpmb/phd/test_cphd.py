@@ -210,3 +210,17 @@ def test_cphd_rejects_zero_clutter():
     cfg = CFG.replace(pmb=dataclasses.replace(CFG.pmb, clutter_intensity=0.0))
     with pytest.raises(ConfigError, match="clutter_intensity"):
         CphdTracker("car", cfg, IdAllocator())
+
+
+def test_leave_one_out_contraction_equals_the_expanded_sum():
+    from gnnpmb.phd.cphd import _contract_leave_one_out, _esf_tables
+    from gnnpmb.phd.gmphd import log_sum_exp
+
+    rng = np.random.default_rng(4)
+    for m, order in [(1, 3), (6, 4), (30, 50)]:
+        log_x = rng.normal(5.0, 3.0, size=m)
+        log_x[::4] = -np.inf  # gated-out measurements
+        log_gamma = rng.normal(0.0, 20.0, size=order + 1)
+        pre, _ = _esf_tables(log_x, order)
+        expanded = log_sum_exp(log_esf_leave_one_out(log_x, order) + log_gamma[None, :], axis=1)
+        np.testing.assert_allclose(_contract_leave_one_out(pre, log_x, log_gamma), expanded, rtol=1e-12, atol=1e-9)

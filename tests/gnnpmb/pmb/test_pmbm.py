@@ -309,3 +309,26 @@ def test_shared_ranking_equals_k_best_of_every_hypothesis(max_increase, enumerat
             for cols, total in ranked:  # columns of the union matrix, only the hypothesis' own
                 assert total == pytest.approx(cost[np.arange(n_meas), cols].sum(), abs=1e-9)
                 assert np.isin(cols[cols < n_union], index).all()
+
+
+def test_budget_gives_a_large_block_only_its_best_assignment_and_says_so():
+    from gnnpmb.events import BudgetReached, ListSink
+
+    unbounded = PmbCore("car", CFG, KBest(CFG.pmbm), IdAllocator())
+    budgeted = PmbCore("car", CFG, KBest(CFG.pmbm, murty_block_rows=1, crowd_hypotheses=1), IdAllocator())
+    frames = cluttered_sequence(seed=2, n_frames=6)
+    sink = ListSink()
+    for meas in frames:
+        unbounded.step(meas, 0.5, NullSink())
+        budgeted.step(meas, 0.5, sink)
+    reached = sink.of_type(BudgetReached)
+    assert reached and all(e.limit == 1 and e.needed > 1 for e in reached)
+    # with every block over budget and one hypothesis expanded, each frame keeps a single global hypothesis
+    assert len(budgeted.hypotheses) == 1 < len(unbounded.hypotheses)
+
+
+def test_budget_not_reached_changes_nothing():
+    a = PmbCore("car", CFG, KBest(CFG.pmbm), IdAllocator())
+    b = PmbCore("car", CFG, KBest(CFG.pmbm, murty_block_rows=10**6, crowd_hypotheses=10**6), IdAllocator())
+    for meas in cluttered_sequence(seed=3, n_frames=10):
+        assert a.step(meas, 0.5, NullSink()) == b.step(meas, 0.5, NullSink())
