@@ -112,6 +112,7 @@ def serving(name: str, target: ServeTarget, blueprint: rrb.BlueprintLike | None)
 
 def wait_for_ctrl_c(target: ServeTarget) -> None:
     """Keep serving the finished recording until Ctrl-C, then stop the servers."""
+    sys.stdout.flush()
     print(f"serving {target.url} (Ctrl-C to stop)", file=sys.stderr, flush=True)
     try:
         while True:
