@@ -9,13 +9,15 @@ whether the tracks are identical. Typer cannot mix a positional SCENE with a sub
 dispatches on the first argument being ``reproduce``.
 
 Everything the user typed is checked before a recording is opened (names, --frames, files, the dataset), so a
-mistake costs one line on stderr and leaves no ``.rrd`` behind.
+mistake costs one line on stderr and leaves no ``.rrd`` behind. Without ``--save`` or ``--serve`` the run needs
+a display for the spawned viewer; without one it stops at once with a hint instead of hanging.
 """
 
 from __future__ import annotations
 
 import contextvars
 import functools
+import os
 import re
 import sys
 from collections.abc import Callable, Sequence
@@ -23,24 +25,26 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
-import numpy as np
 import typer
 
-from cli.errors import run_app
-from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
-from gnnpmb.config import TrackerConfig, config_from_dict, load_config
-from gnnpmb.data.scene import SceneData
+from cli.errors import check_version_flag, exit_now_on_failure, run_app
+from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
+from cli.outputs import check_output_file
+from cli.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, ServeTarget, check_display, check_serve_ports
+from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.errors import DataError, GnnpmbError
-from gnnpmb.provenance import DetectionsSource, Provenance, TrackDigest, track_digest
 from gnnpmb.registry import TRACKER_NAMES, check_classes, check_tracker
-from gnnpmb.types import TRACKING_CLASSES, Boxes, FrameDetections
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # numpy, the devkit and rerun load only on the paths that use them (fast --help)
     from gnnpmb.compare import Comparison
+    from gnnpmb.config import TrackerConfig
     from gnnpmb.data.nuscenes import DatasetLocation
+    from gnnpmb.data.scene import SceneData
     from gnnpmb.eval.failures import FailureReport
     from gnnpmb.focus import FocusTarget
     from gnnpmb.pipeline import TrackingRun
+    from gnnpmb.provenance import DetectionsSource, Provenance, TrackDigest
+    from gnnpmb.types import Boxes, FrameDetections
 
 PROG = "gnnpmb-viz"
 DEFAULT_TRACKER = "gnnpmb"
@@ -50,13 +54,16 @@ _FRAMES_RE = re.compile(r"^\s*(\d*)\s*:\s*(\d*)\s*$")
 _COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar("command_line", default=None)
 """The command line ``main`` was given, recorded in the provenance (else ``sys.argv`` is used)."""
 
+tidy_help()
 app = typer.Typer(
     add_completion=False,
+    rich_markup_mode=None,
     help="Track a nuScenes scene and inspect every step of the tracker(s) in the Rerun viewer.",
     pretty_exceptions_enable=False,
 )
 reproduce_app = typer.Typer(
     add_completion=False,
+    rich_markup_mode=None,
     help="Re-run the trackers of a recording saved by gnnpmb-viz and check its tracks.",
     pretty_exceptions_enable=False,
 )
@@ -67,7 +74,7 @@ class ViewRequest:
     """Everything one ``gnnpmb-viz`` run needs, checked: no recording is opened before this exists.
 
     source: where the detections came from, with their hash; seed: the simulated detector's seed;
-    argv: the command line, for the provenance.
+    argv: the command line, for the provenance; serve: the ports of the web viewer (None: save or spawn).
     """
 
     scene: SceneData
@@ -83,6 +90,7 @@ class ViewRequest:
     seed: int
     argv: tuple[str, ...]
     focus: str | None = None
+    serve: ServeTarget | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,7 +146,7 @@ def detections_source(
     scene: SceneData, detections: dict[str, Boxes], detections_file: Path | None, detector: str, seed: int
 ) -> DetectionsSource:
     """Where ``detections`` came from, with the SHA-256 of the file, or of the simulated boxes."""
-    from gnnpmb.provenance import boxes_sha256, file_sha256
+    from gnnpmb.provenance import DetectionsSource, boxes_sha256, file_sha256
 
     if detections_file is not None:
         path = Path(detections_file).expanduser().absolute()
@@ -159,31 +167,47 @@ def prepare(
     dataroot: Path | None = None,
     version: str | None = None,
     detections_file: Path | None = None,
-    detector: str = DEFAULT_DETECTOR,
+    detector: str | None = None,
     seed: int = 0,
     params: Path | None = None,
     classes: str | None = None,
     frames: str | None = None,
     save: Path | None = None,
+    serve: ServeTarget | None = None,
     argv: Sequence[str] = (),
     focus: str | None = None,
 ) -> ViewRequest:
-    """Check every argument and load the scene and detections; raises GnnpmbError with a one-line message."""
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
-    from gnnpmb.data.simdet import get_preset
-    from gnnpmb.pipeline import get_detections, preprocess_frames
-    from viz.recording import check_save_path
+    """Check every argument and load the scene and detections; raises GnnpmbError with a one-line message.
 
+    The cheap checks (names, --frames, output path, ports, the --detections file) run before the dataset is
+    loaded. detector None means the default preset; it cannot be combined with ``detections_file``.
+    """
+    if detections_file is not None and detector is not None:
+        raise GnnpmbError("pass either --detections FILE.json or --detector PRESET, not both")
+    if save is not None and serve is not None:
+        raise GnnpmbError("pass either --save OUT.rrd or --serve, not both")
+    detector = detector or DEFAULT_DETECTOR
     names = tuple(dict.fromkeys(check_tracker(t) for t in (trackers or [DEFAULT_TRACKER])))
+    class_names = parse_classes(classes)
+    bounds = parse_frames(frames)
+    target = check_output_file(save, "--save", ".rrd") if save is not None else None
+    if serve is not None:
+        check_serve_ports(serve)
     if focus is not None:
         from gnnpmb.focus import parse_focus
 
         parse_focus(focus)
+
+    from gnnpmb.config import load_config
+    from gnnpmb.data.detections import check_detection_file
+    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.data.simdet import get_preset
+    from gnnpmb.pipeline import get_detections, preprocess_frames
+
     get_preset(detector)
-    class_names = parse_classes(classes)
-    bounds = parse_frames(frames)
     config = load_config(params)
-    target = check_save_path(save) if save is not None else None
+    if detections_file is not None:
+        check_detection_file(detections_file)
     location = resolve_dataroot(dataroot, version, (scene_name,))
     scene = load_scene(open_nuscenes(location), location, scene_name)
     frame_range = frame_range_of(bounds, scene)
@@ -203,7 +227,8 @@ def prepare(
         source,
         int(seed),
         tuple(argv),
-        focus,
+        focus=focus,
+        serve=serve,
     )
 
 
@@ -219,12 +244,12 @@ def prepare_reproduction(
     (checked by hash), parameters, classes, frames and trackers. dataroot / detections_file replace the
     recorded paths (e.g. on another machine). Raises a DataError naming the input that is missing or
     changed."""
+    from gnnpmb.config import config_from_dict
     from gnnpmb.data.nuscenes import check_dataroot, load_scene, open_nuscenes
     from gnnpmb.pipeline import get_detections, preprocess_frames
-    from viz.recording import check_save_path
 
     p = provenance
-    target = check_save_path(save) if save is not None else None
+    target = check_output_file(save, "--save", ".rrd") if save is not None else None
     root = Path(dataroot) if dataroot is not None else Path(p.dataroot)
     if not root.exists():
         raise DataError(f"the recorded dataroot {root} does not exist; pass --dataroot DIR with a copy of it")
@@ -289,7 +314,7 @@ def recording_name(request: ViewRequest, focus: FocusTarget | None = None) -> st
 
 def provenance_of(request: ViewRequest, digests: dict[str, TrackDigest]) -> Provenance:
     """The provenance of a run of ``request`` whose tracks have ``digests``."""
-    from gnnpmb.provenance import package_versions
+    from gnnpmb.provenance import Provenance, package_versions
 
     return Provenance(
         argv=request.argv,
@@ -312,6 +337,8 @@ def provenance_of(request: ViewRequest, digests: dict[str, TrackDigest]) -> Prov
 
 def run_digest(run: TrackingRun) -> TrackDigest:
     """The track digest of one tracker run."""
+    from gnnpmb.provenance import track_digest
+
     return track_digest([f.keyframe.index for f in run.frames], [f.estimates for f in run.frames])
 
 
@@ -374,6 +401,7 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
     """Log the scene, run every tracker into one recording (sharing the preprocessed detections), compare them
     and log failures and provenance. With ``request.focus`` the trackers first run without logging to find the
     focus (``resolve_request_focus``); the recording then holds the keyframes around it and opens on it."""
+    import numpy as np
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -409,7 +437,13 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
     runs: list[TrackingRun] = []
     loggers: dict[str, TrackerLogger] = {}
     comparison = None
-    with recording(recording_name(request, focus), request.save, blueprint) as stream, bar:
+    if request.serve is not None:
+        from cli.serve import serving
+
+        opened = serving(recording_name(request, focus), request.serve, blueprint)
+    else:
+        opened = recording(recording_name(request, focus), request.save, blueprint)
+    with opened as stream, bar:
         sensors = bar.add_task(f"{scene.name} sensors", total=n)
         log_scene(
             stream,
@@ -530,7 +564,7 @@ REPRODUCE_HELP = (
 
 @app.command(help=VIEW_HELP)
 def view(
-    scene: Annotated[str, typer.Argument(help="Scene name, e.g. scene-0103.")],
+    scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
     tracker: Annotated[
         list[str] | None,
         typer.Option(
@@ -544,16 +578,19 @@ def view(
     version: VersionOption = None,
     detections: DetectionsOption = None,
     detector: Annotated[
-        str,
-        typer.Option(metavar="PRESET", help="Simulated detector preset: centerpoint, megvii or pointpillars."),
-    ] = DEFAULT_DETECTOR,
+        str | None,
+        typer.Option(
+            metavar="PRESET",
+            help=f"Simulated detector preset: centerpoint, megvii or pointpillars (default {DEFAULT_DETECTOR}).",
+        ),
+    ] = None,
     seed: SeedOption = 0,
     params: ParamsOption = None,
     classes: Annotated[
         str | None,
         typer.Option(
             metavar="CLASS,...",
-            help=f"Comma-separated classes to track (default all: {','.join(TRACKING_CLASSES)}).",
+            help=f"Comma-separated classes to track (default all: {', '.join(TRACKING_CLASSES)}).",
         ),
     ] = None,
     frames: Annotated[
@@ -563,6 +600,20 @@ def view(
         Path | None,
         typer.Option(metavar="OUT.rrd", help="Write the recording to this .rrd instead of a viewer."),
     ] = None,
+    serve: Annotated[
+        bool,
+        typer.Option(
+            "--serve",
+            help="Serve the web viewer on localhost and print its URL (for a remote machine or no display); "
+            "Ctrl-C stops it.",
+        ),
+    ] = False,
+    web_port: Annotated[
+        int, typer.Option(metavar="PORT", help="HTTP port of the web viewer (with --serve).")
+    ] = DEFAULT_WEB_PORT,
+    grpc_port: Annotated[
+        int, typer.Option(metavar="PORT", help="gRPC port the web viewer reads the data from (with --serve).")
+    ] = DEFAULT_GRPC_PORT,
     failures: Annotated[
         bool,
         typer.Option(help="Find and mark each tracker's failures with the devkit's matching (needs GT)."),
@@ -578,6 +629,8 @@ def view(
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
 ) -> None:
     """Track SCENE into one recording and show or save it (``VIEW_HELP``)."""
+    if save is None and not serve:
+        check_display()
     request = prepare(
         scene,
         tracker or [],
@@ -590,6 +643,7 @@ def view(
         classes=classes,
         frames=frames,
         save=save,
+        serve=ServeTarget(web_port, grpc_port) if serve else None,
         argv=command_line(),
         focus=focus,
     )
@@ -603,7 +657,13 @@ def view(
     if result.comparison is not None:
         compared = f"; {len(result.comparison.disagreements)} disagreements"
     output = f"saved {request.save}" if request.save is not None else "streamed to the Rerun viewer"
+    if request.serve is not None:
+        output = f"served at {request.serve.url}"
     typer.echo(f"{request.scene.name}: {len(request.frame_range)} frames, {timing}{compared}; {output}")
+    if request.serve is not None:
+        from cli.serve import wait_for_ctrl_c
+
+        wait_for_ctrl_c(request.serve)
 
 
 @reproduce_app.command(help=REPRODUCE_HELP)
@@ -650,8 +710,18 @@ def reproduce(
 
 def main(argv: Sequence[str] | None = None) -> None:
     """The ``gnnpmb-viz`` console script: ``reproduce ...`` goes to the reproduce command, anything else to
-    the viewer command (typer cannot have a positional SCENE beside a subcommand)."""
-    args = list(sys.argv[1:] if argv is None else argv)
+    the viewer command (typer cannot have a positional SCENE beside a subcommand). As the script (``argv``
+    None) a failed run exits at once (``cli.errors.exit_now_on_failure``)."""
+    if argv is None:
+        exit_now_on_failure(lambda: _main(sys.argv[1:]))
+    else:
+        _main(list(argv))
+
+
+def _main(args: list[str]) -> None:
+    """``main`` on the arguments after the program name."""
+    check_version_flag(args, PROG)
+    os.environ.setdefault("RUST_LOG", "off")  # Rerun's own log lines; our errors say what went wrong
     token = _COMMAND_LINE.set((PROG, *args))
     try:
         if args and args[0] == "reproduce":

@@ -13,17 +13,17 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-from rich.table import Table
 
 from cli.errors import entry_point
-from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
+from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
+from cli.outputs import check_output_dir, check_output_file
 from cli.study import AddressOption, register
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.registry import TRACKER_NAMES
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # rich, numpy and the devkit load only on the paths that use them (fast --help)
+    from rich.console import Console
+
     from gnnpmb.eval.failures import FailureReport
 
 DEFAULT_DETECTOR = "centerpoint"
@@ -33,23 +33,35 @@ _TABLE_WIDTH = 160
 
 app = typer.Typer(
     add_completion=False,
-    no_args_is_help=True,
+    rich_markup_mode=None,
     pretty_exceptions_enable=False,
     help="Batch tracking on nuScenes splits, the official tracking evaluation, and the failure finder.",
 )
 
+tidy_help()
+
 SplitOption = Annotated[
     str | None,
-    typer.Option(help="Split: mini_val, val, ... or one in <version>/splits.json (default: from --version)."),
+    typer.Option(
+        metavar="NAME",
+        help="Split: mini_val, val, ... or one in <version>/splits.json (default: from --nuscenes-version).",
+    ),
 ]
 DetectorOption = Annotated[
     str | None,
-    typer.Option(help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR})."),
+    typer.Option(
+        metavar="PRESET",
+        help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR}).",
+    ),
 ]
-TrackerOption = Annotated[str, typer.Option("--tracker", "-t", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")]
+TrackerOption = Annotated[
+    str, typer.Option("--tracker", "-t", metavar="NAME", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")
+]
 
 
 def _stdout() -> Console:
+    from rich.console import Console
+
     console = Console()
     return console if console.is_terminal else Console(width=_TABLE_WIDTH)
 
@@ -65,18 +77,26 @@ def default_split(version: str) -> str:
 
 def _detector(detections: Path | None, detector: str | None) -> str:
     """The simulated detector preset to use (checked), refusing --detections together with --detector."""
-    from gnnpmb.data.simdet import get_preset
-
     if detections is not None and detector is not None:
         raise GnnpmbError("pass either --detections FILE or --detector PRESET, not both")
+    from gnnpmb.data.simdet import get_preset
+
     name = detector or DEFAULT_DETECTOR
     get_preset(name)
     return name
 
 
-@app.command()
+def _check_detections(detections: Path | None) -> None:
+    """Read a --detections file before any dataset is loaded, so a bad file fails in a second."""
+    if detections is not None:
+        from gnnpmb.data.detections import check_detection_file
+
+        check_detection_file(detections)
+
+
+@app.command(short_help="Track a split into a nuScenes tracking submission.")
 def track(
-    out: Annotated[Path, typer.Option(help="Where to write the tracking submission (.json).")],
+    out: Annotated[Path, typer.Option(metavar="FILE.json", help="Where to write the tracking submission (.json).")],
     dataroot: DatarootOption = None,
     version: VersionOption = None,
     split: SplitOption = None,
@@ -92,20 +112,25 @@ def track(
     address: AddressOption = None,
 ) -> None:
     """Track every scene of a split (all 7 classes) and write a nuScenes tracking submission."""
+    from gnnpmb.registry import check_tracker
+
+    target = check_output_file(out, "--out")
+    check_tracker(tracker)
+    preset = _detector(detections, detector)
+
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
     from gnnpmb.config import load_config
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot, split_scenes
     from gnnpmb.eval.nuscenes_eval import check_split_version, split_sample_tokens
     from gnnpmb.eval.submission import build_submission, run_results, write_submission
     from gnnpmb.pipeline import get_detections, run_tracker
-    from gnnpmb.registry import check_tracker
     from gnnpmb.study.runner import execution
 
-    check_tracker(tracker)
-    preset = _detector(detections, detector)
     config = load_config(params)
     run = execution(workers, address)
-    if detections is not None and not detections.is_file():
-        raise GnnpmbError(f"detections file not found: {detections}")
+    _check_detections(detections)
     location = resolve_dataroot(dataroot, version, (split,) if split else ())
     split = split or default_split(location.version)
     check_split_version(split, location.version)
@@ -154,29 +179,44 @@ def track(
                 n_boxes += sum(len(boxes) for boxes in results.values())
                 step_s += sum(f.step_time_s for f in scene_run.frames)
                 bar.advance(scenes_task)
-    write_submission(out, build_submission(parts, tokens))
+    write_submission(target, build_submission(parts, tokens))
     ms = 1e3 * step_s / max(n_frames, 1)
+    if n_boxes == 0:
+        typer.echo(
+            "note: no tracks were output; 'gnnpmb eval' cannot score an empty submission (check the detections "
+            "and score_threshold)",
+            err=True,
+        )
     typer.echo(
         f"{tracker}: {len(scene_names)} scenes of {split}, {n_frames} frames, {n_boxes} boxes, "
         f"{ms:.1f} ms/frame -> {out}"
     )
 
 
-@app.command("eval")
+@app.command("eval", short_help="Score a submission with the official evaluation.")
 def evaluate(
-    results: Annotated[Path, typer.Argument(help="Tracking submission .json (e.g. from 'gnnpmb track').")],
+    results: Annotated[
+        Path, typer.Argument(metavar="RESULTS.json", help="Tracking submission .json (e.g. from 'gnnpmb track').")
+    ],
     dataroot: DatarootOption = None,
     version: VersionOption = None,
     split: SplitOption = None,
     out: Annotated[
         Path | None,
-        typer.Option(help="Folder for the devkit's metrics files (default: <results>_eval/ next to the file)."),
+        typer.Option(
+            metavar="DIR", help="Folder for the devkit's metrics files (default: <results>_eval/ next to the file)."
+        ),
     ] = None,
 ) -> None:
     """Score a tracking submission with the official nuScenes evaluation (tracking_nips_2019)."""
-    from gnnpmb.data.nuscenes import resolve_dataroot
-    from gnnpmb.eval.nuscenes_eval import TABLE_METRICS, evaluate_submission, format_metric
+    from rich.table import Table
 
+    from gnnpmb.data.nuscenes import resolve_dataroot
+    from gnnpmb.eval.nuscenes_eval import TABLE_METRICS, default_eval_dir, evaluate_submission, format_metric
+    from gnnpmb.eval.submission import check_results_file
+
+    check_results_file(results)
+    out = check_output_dir(out if out is not None else default_eval_dir(results), "--out")
     location = resolve_dataroot(dataroot, version, (split,) if split else ())
     split = split or default_split(location.version)
     start = time.perf_counter()
@@ -199,9 +239,9 @@ def evaluate(
     )
 
 
-@app.command()
+@app.command(short_help="List one scene's tracking failures per frame.")
 def failures(
-    scene: Annotated[str, typer.Argument(help="Scene name, e.g. scene-0103.")],
+    scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
     tracker: TrackerOption = DEFAULT_TRACKER,
     dataroot: DatarootOption = None,
     version: VersionOption = None,
@@ -209,27 +249,33 @@ def failures(
     detector: DetectorOption = None,
     seed: SeedOption = 0,
     params: ParamsOption = None,
-    json_out: Annotated[Path | None, typer.Option("--json", help="Also write the report as JSON here.")] = None,
+    json_out: Annotated[
+        Path | None, typer.Option("--json", metavar="FILE.json", help="Also write the report as JSON here.")
+    ] = None,
 ) -> None:
     """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
     coalescence and cascading identity theft (scored with the devkit's own matching)."""
+    from gnnpmb.registry import check_tracker
+
+    json_target = check_output_file(json_out, "--json") if json_out is not None else None
+    check_tracker(tracker)
+
     from gnnpmb.config import load_config
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
     from gnnpmb.eval.failures import find_failures
     from gnnpmb.eval.submission import run_results, write_json
     from gnnpmb.pipeline import get_detections, run_tracker
-    from gnnpmb.registry import check_tracker
 
-    check_tracker(tracker)
     preset = _detector(detections, detector)
     config = load_config(params)
+    _check_detections(detections)
     location = resolve_dataroot(dataroot, version, (scene,))
     nusc = open_nuscenes(location)
     scene_data = load_scene(nusc, location, scene)
     run = run_tracker(scene_data, get_detections(scene_data, detections, preset, seed), tracker, config)
     report = find_failures(nusc, scene, run_results(run), tracker)
-    if json_out is not None:
-        write_json(json_out, report.to_json())
+    if json_target is not None:
+        write_json(json_target, report.to_json())
     print_report(report, _stdout())
     if json_out is not None:
         typer.echo(f"report -> {json_out}")
@@ -237,6 +283,8 @@ def failures(
 
 def print_report(report: FailureReport, console: Console) -> None:
     """The failure report as two tables: per class at its best-MOTA threshold, then failures per frame."""
+    from rich.table import Table
+
     from gnnpmb.eval.failures import FailureKind
     from gnnpmb.eval.nuscenes_eval import format_metric
 
@@ -268,13 +316,19 @@ def _id_span(ids: list[str]) -> str:
     return ids[0] if len(ids) == 1 else f"{ids[0]}-{ids[-1].split(':')[1]}"
 
 
-@app.command("demo-data")
+@app.command("demo-data", short_help="Write the synthetic demo dataset.")
 def demo_data(
-    out: Annotated[Path, typer.Option(help="Folder to write the demo dataroot into (new, empty or an old demo).")],
-    seed: Annotated[int, typer.Option(help="Seed of the LiDAR noise.")] = 0,
+    out: Annotated[
+        Path,
+        typer.Option(metavar="DIR", help="Folder to write the demo dataroot into (new, empty or an old demo)."),
+    ],
+    seed: Annotated[int, typer.Option(metavar="N", help="Seed of the LiDAR noise.")] = 0,
     scenes: Annotated[
         str,
-        typer.Option(help="Comma-separated scene names, or mini_val, mini_train or all (default mini_val)."),
+        typer.Option(
+            metavar="SCENES",
+            help="Comma-separated scene names, or mini_val, mini_train or all (default mini_val).",
+        ),
     ] = "mini_val",
 ) -> None:
     """Write the synthetic nuScenes-format demo dataset (v1.0-mini; the mini_val scenes scene-0103 and
@@ -284,9 +338,9 @@ def demo_data(
 
     groups = {"mini_val": DEMO_SCENES, "mini_train": TRAIN_SCENES, "all": DEMO_SCENES + TRAIN_SCENES}
     names = tuple(n for part in scenes.split(",") if part.strip() for n in groups.get(part.strip(), (part.strip(),)))
-    path = generate_demo_dataset(out, seed=seed, scenes=names)
+    path = generate_demo_dataset(check_output_dir(out, "--out"), seed=seed, scenes=names)
     typer.echo(f"demo dataset (v1.0-mini, seed {seed}, {len(set(names))} scenes) -> {path}")
 
 
 register(app)
-main = entry_point(app)
+main = entry_point(app, "gnnpmb")

@@ -1,39 +1,132 @@
-"""One place that turns user-input errors into one line on stderr and a non-zero exit, without a traceback."""
+"""One place that turns user mistakes into one line on stderr and exit code 2, without a traceback.
+
+Three kinds reach ``run_app``: usage errors from the command-line parser (a typo'd option, a missing argument,
+``--seed abc``), a ``GnnpmbError`` raised by our own checks, and an ``OSError`` while writing an output (disk
+full, permission denied). Each becomes ``error: <what is wrong and how to fix it>``. The locked typer parses with
+its own bundled copy of click (``typer._click``), whose exceptions are not ``click``'s: both are caught.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import typer
 
 from gnnpmb.errors import GnnpmbError
 
 EXIT_USER_ERROR = 2
+EXIT_INTERRUPTED = 130
+DIST_NAME = "gnnpmb-viz"
+"""The distribution whose version ``--version`` prints."""
 
 
-def run_app(app: typer.Typer, argv: list[str] | None = None) -> None:
-    """Run a typer app; a GnnpmbError (or a JSON/OS error from reading the user's files) ends the process with
-    ``error: <message>`` and exit code 2. Ctrl-C exits 130 quietly."""
+def _click_exception_types() -> tuple[type[Exception], ...]:
+    """The parser's exception base classes: typer's bundled click and, when installed, click itself."""
+    types: list[type[Exception]] = []
+    try:
+        from typer._click.exceptions import ClickException as TyperClickException
+
+        types.append(TyperClickException)
+    except ImportError:
+        pass
+    try:
+        from click.exceptions import ClickException
+
+        types.append(ClickException)
+    except ImportError:
+        pass
+    return tuple(types)
+
+
+def program_version() -> str:
+    """The installed version of this program (the ``gnnpmb-viz`` distribution)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version(DIST_NAME)
+    except metadata.PackageNotFoundError:
+        return "unknown (not installed)"
+
+
+def check_version_flag(args: Sequence[str], prog: str) -> None:
+    """``--version`` anywhere prints the program's version and exits 0, before anything else is imported.
+
+    ``--version VALUE`` was the dataset version option before it became ``--nuscenes-version``: that use gets
+    a one-line error saying so instead of silently printing the program's version.
+    """
+    for i, arg in enumerate(args):
+        if arg == "--":
+            return
+        if arg.startswith("--version="):
+            _fail(f"--version takes no value; the dataset version is --nuscenes-version {arg.split('=', 1)[1]}")
+        if arg != "--version":
+            continue
+        following = args[i + 1] if i + 1 < len(args) else None
+        if following is not None and not following.startswith("-") and following.startswith("v"):
+            _fail(f"--version takes no value; the dataset version is --nuscenes-version {following}")
+        print(f"{prog} {program_version()}")
+        sys.exit(0)
+
+
+def usage_line(exc: Exception) -> str:
+    """The parser's error as one line: what is wrong, and where the help is."""
+    ctx = getattr(exc, "ctx", None)
+    command = ctx.command_path if ctx is not None else ""
+    if ctx is not None and (type(exc).__name__ == "NoArgsIsHelpError" or str(exc).startswith("Missing command")):
+        names = ctx.command.list_commands(ctx) if hasattr(ctx.command, "list_commands") else []
+        return f"missing a command ({', '.join(names)}); see '{command} --help'"
+    format_message = getattr(exc, "format_message", None)
+    text = format_message() if callable(format_message) else str(exc)
+    text = " ".join(text.split()).rstrip(".")
+    if text[:1].isupper() and not text[1:2].isupper():
+        text = text[0].lower() + text[1:]
+    return f"{text}; see '{command} --help'" if command else text
+
+
+def os_error_line(exc: OSError) -> str:
+    """An OSError while reading or writing a user's path as one line (e.g. disk full, permission denied)."""
+    reason = exc.strerror or str(exc)
+    if exc.filename is not None:
+        return f"cannot write or read {os.fsdecode(exc.filename)}: {reason}"
+    return reason
+
+
+def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
+    """Run a typer app (or a partial of one); user mistakes end the process with one ``error:`` line and exit
+    code 2, Ctrl-C exits 130 quietly, a closed stdout pipe exits quietly."""
     try:
         code = app(args=argv, standalone_mode=False)
     except GnnpmbError as exc:
         _fail(str(exc))
     except KeyboardInterrupt:
-        sys.exit(130)
+        print("interrupted", file=sys.stderr)
+        sys.exit(EXIT_INTERRUPTED)
     except typer.Exit as exc:
         sys.exit(exc.exit_code)
     except typer.Abort:
         sys.exit(1)
-    except Exception as exc:  # click's usage errors are ClickException subclasses
-        from click.exceptions import ClickException
-
-        if isinstance(exc, ClickException):
-            exc.show()
-            sys.exit(exc.exit_code)
-        raise
+    except BrokenPipeError:
+        _quiet_broken_pipe()
+    except OSError as exc:
+        _fail(os_error_line(exc))
+    except Exception as exc:
+        if not isinstance(exc, _click_exception_types()):
+            raise
+        if getattr(exc, "exit_code", EXIT_USER_ERROR) == 0:
+            sys.exit(0)
+        _fail(usage_line(exc))
     if isinstance(code, int) and code:
         sys.exit(code)
+
+
+def _quiet_broken_pipe() -> None:
+    """Stdout was closed by the reader (``| head``): no traceback, no second error while flushing."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    sys.exit(1)
 
 
 def _fail(message: str) -> None:
@@ -41,10 +134,27 @@ def _fail(message: str) -> None:
     sys.exit(EXIT_USER_ERROR)
 
 
-def entry_point(app: typer.Typer) -> Callable[[], None]:
-    """A console-script ``main`` for ``app``."""
+def exit_now_on_failure(run: Callable[[], None]) -> None:
+    """Run a console script's body; a failed run (SystemExit with a non-zero code) ends the process at once,
+    after flushing stdout and stderr, skipping interpreter shutdown: Rerun's exit hook can wait forever on a
+    recording whose file writer died (disk full). Every output was already finished or removed."""
+    try:
+        run()
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        if code == 0:
+            raise
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(OSError, ValueError):
+                stream.flush()
+        os._exit(code)
+
+
+def entry_point(app: typer.Typer, prog: str) -> Callable[[], None]:
+    """A console-script ``main`` for ``app`` answering ``--version`` itself."""
 
     def main() -> None:
-        run_app(app)
+        check_version_flag(sys.argv[1:], prog)
+        exit_now_on_failure(lambda: run_app(app))
 
     return main

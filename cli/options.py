@@ -11,7 +11,14 @@ DatarootOption = Annotated[
     Path | None,
     typer.Option(metavar="DIR", help="nuScenes dataroot (default: $NUSCENES_DATAROOT, else the built-in demo)."),
 ]
-VersionOption = Annotated[str | None, typer.Option(metavar="V", help="Dataset version folder, e.g. v1.0-mini.")]
+VersionOption = Annotated[
+    str | None,
+    typer.Option(
+        "--nuscenes-version",
+        metavar="V",
+        help="Dataset version folder, e.g. v1.0-mini (default: the only one in the dataroot).",
+    ),
+]
 DetectionsOption = Annotated[
     Path | None,
     typer.Option(metavar="FILE.json", help="nuScenes detection results .json (default: a simulated detector)."),
@@ -21,3 +28,30 @@ ParamsOption = Annotated[
     Path | None,
     typer.Option(metavar="FILE.toml", help="Tracker parameter file (.toml) overriding the paper's."),
 ]
+
+
+def tidy_help() -> None:
+    """Help text without typer's type placeholders: ``SCENE`` not ``{scene}``, no ``<bool>`` after a flag and
+    no ``<str>`` after an argument that has a metavar (typer 0.29 adds them; click never did)."""
+    from typer import core
+
+    if getattr(core, "_gnnpmb_tidy_help", False):
+        return
+    option_type = core.TyperOption.display_type_rich
+    argument_type = core.TyperArgument.display_type_rich
+
+    def option_display_type(self: core.TyperOption, ctx: object) -> str | None:
+        return None if self.is_flag else option_type(self, ctx)
+
+    def argument_display_type(self: core.TyperArgument, ctx: object) -> str | None:
+        return None if self.metavar is not None else argument_type(self, ctx)
+
+    def usage_name(self: core.TyperArgument) -> str:
+        name = self.display_name_raw.upper() if self.metavar is None else self.display_name_raw
+        name = name if self.required else f"[{name}]"
+        return f"{name}..." if self.nargs != 1 else name
+
+    core.TyperOption.display_type_rich = option_display_type
+    core.TyperArgument.display_type_rich = argument_display_type
+    core.TyperArgument._usage_display_name = usage_name
+    core._gnnpmb_tidy_help = True

@@ -250,6 +250,17 @@ class TrackLogic:
     window: int
 
 
+@dataclass(frozen=True, slots=True)
+class BudgetReached:
+    """A per-frame budget cut the work of this frame: ``budget`` names it (e.g. "pmbm murty_block_rows"),
+    ``limit`` is its value and ``needed`` what the frame would have taken (e.g. rows of the largest block)."""
+
+    class_name: str
+    budget: str
+    limit: int
+    needed: int
+
+
 Event = (
     FrameStarted
     | MeasurementsReceived
@@ -267,6 +278,7 @@ Event = (
     | Cardinality
     | IntensityWeights
     | TrackLogic
+    | BudgetReached
 )
 
 

@@ -7,12 +7,15 @@ shares ``pmb.core.PmbCore`` and differs only in the hypothesis strategy (paper s
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
-from gnnpmb.config import TrackerConfig
+from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.errors import UnknownNameError
-from gnnpmb.events import EventSink
-from gnnpmb.types import TRACKING_CLASSES, IdAllocator, Measurements, TrackEstimate
+
+if TYPE_CHECKING:  # numpy-heavy; the CLI imports this module for its help text
+    from gnnpmb.config import TrackerConfig
+    from gnnpmb.events import EventSink
+    from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
 class ClassTracker(Protocol):

@@ -11,10 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gnnpmb.classes import TRACKING_CLASSES as TRACKING_CLASSES
 from gnnpmb.soa import StructOfArrays
-
-TRACKING_CLASSES: tuple[str, ...] = ("bicycle", "bus", "car", "motorcycle", "pedestrian", "trailer", "truck")
-"""The seven nuScenes tracking classes, in the devkit's (alphabetical) order."""
 
 STATE_DIM = 4
 """Tracker state [x, y, vx, vy] (metres, metres per second, global frame)."""

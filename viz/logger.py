@@ -33,6 +33,7 @@ from gnnpmb.events import (
     Assignment,
     AxisKind,
     Born,
+    BudgetReached,
     Cardinality,
     CostMatrix,
     Event,
@@ -226,6 +227,7 @@ class TrackerLogger:
             Cardinality: self._on_cardinality,
             IntensityWeights: self._on_intensity,
             TrackLogic: self._append("logic"),
+            BudgetReached: self._on_budget,
         }
 
     @property

@@ -25,6 +25,9 @@ SAVE_BATCHER = rr.ChunkBatcherConfig(flush_tick=3600.0, flush_num_bytes=1 << 30)
 """Saved recordings: nothing waits for the data, so each entity's rows go out as one chunk at the end. The web
 viewer's load time grows with the number of chunks, not bytes (shared notes: 9k chunks took minutes)."""
 
+FLUSH_STALL_S = 5.0
+"""At close, a saved recording's flush gives up once its file has not grown for this long. If Rerun's file writer
+died (disk full), Rerun 0.41's flush, and its disconnect, can wait forever."""
 _PENDING: dict[str, Path] = {}
 """Recording id -> the temp file a saved recording is being written to."""
 
@@ -71,23 +74,51 @@ def open_recording(
     return stream
 
 
+def _flush(stream: rr.RecordingStream, tmp: Path | None) -> None:
+    """``stream.flush()``, in 1 s steps while ``tmp`` (the file being written, if any) keeps growing; a
+    RuntimeError once it stalls for ``FLUSH_STALL_S``."""
+    if tmp is None:
+        stream.flush()
+        return
+    last_size, stalled_s = -1, 0.0
+    while True:
+        try:
+            stream.flush(timeout_sec=1.0)
+            return
+        except RuntimeError:
+            size = tmp.stat().st_size if tmp.exists() else -1
+            stalled_s = stalled_s + 1.0 if size == last_size else 0.0
+            if stalled_s >= FLUSH_STALL_S:
+                raise
+            last_size = size
+
+
 def close_recording(stream: rr.RecordingStream, save: Path | None) -> None:
     """Finish the recording: flush and disconnect, then move a saved recording's temp file to ``save``."""
-    stream.flush()
+    tmp = _PENDING.get(stream.get_recording_id())
+    _flush(stream, tmp)
     stream.disconnect()
-    tmp = _PENDING.pop(stream.get_recording_id(), None)
     if save is None:
         if tmp is not None:
             tmp.unlink(missing_ok=True)
+            _PENDING.pop(stream.get_recording_id(), None)
         return
     if tmp is None:
         raise ValueError("close_recording(save=...) on a stream that open_recording did not open for saving")
     os.replace(tmp, check_save_path(save))
+    _PENDING.pop(stream.get_recording_id(), None)
 
 
 def abort_recording(stream: rr.RecordingStream) -> None:
     """Stop the recording and delete a saved recording's temp file (nothing is left at the target path)."""
     _discard(stream)
+
+
+def _forget(stream: rr.RecordingStream) -> None:
+    """Delete a saved recording's temp file without touching the stream."""
+    tmp = _PENDING.pop(stream.get_recording_id(), None)
+    if tmp is not None:
+        tmp.unlink(missing_ok=True)
 
 
 def _discard(stream: rr.RecordingStream) -> None:
@@ -103,11 +134,21 @@ def _discard(stream: rr.RecordingStream) -> None:
 def recording(
     name: str, save: Path | None, blueprint: rrb.BlueprintLike | None, *, strict: bool | None = None
 ) -> Iterator[rr.RecordingStream]:
-    """``open_recording`` ... ``close_recording``; on an exception the temp file is deleted instead."""
+    """``open_recording`` ... ``close_recording``; on an exception (also while finishing the file, e.g. Ctrl-C
+    or a full disk) the temp file is deleted instead and the file at ``save`` is left as it was."""
     stream = open_recording(name, save, blueprint, strict=strict)
     try:
         yield stream
     except BaseException:
         abort_recording(stream)
         raise
-    close_recording(stream, save)
+    try:
+        close_recording(stream, save)
+    except RuntimeError as exc:  # Rerun's file writer failed, e.g. "File-writer thread shut down prematurely"
+        _forget(stream)  # no disconnect: with a dead file writer it can wait forever
+        raise DataError(
+            f"cannot write the recording {save} (Rerun: {exc}); is the disk full? Free space or --save elsewhere"
+        ) from None
+    except BaseException:
+        abort_recording(stream)
+        raise

@@ -52,6 +52,17 @@ def lbp_marginals_log(
     return _lbp(log_ratio, log_new, max_iterations, tolerance)
 
 
+def keep_most_likely(log_ratio: np.ndarray, limit: int) -> np.ndarray:
+    """(K, M) log ratios with all but each row's ``limit`` largest entries set to -inf (not gated); ties at the
+    cut are kept. The per-frame budget of the trackers that run LBP: at most about K * limit edges."""
+    if log_ratio.shape[1] <= limit or (np.isfinite(log_ratio).sum(axis=1) <= limit).all():
+        return log_ratio
+    cut = -np.partition(-log_ratio, limit - 1, axis=1)[:, limit - 1 : limit]  # each row's limit-th largest
+    out = log_ratio.copy()
+    out[log_ratio < cut] = -np.inf
+    return out
+
+
 def _lbp(log_ratio: np.ndarray, log_new: np.ndarray, max_iterations: int, tolerance: float) -> AssociationMarginals:
     """LBP on the gated (track, measurement) pairs only: every message lives on one edge of the gating graph, so
     a frame costs O(edges) per round however many tracks and measurements there are."""

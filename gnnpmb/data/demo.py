@@ -763,14 +763,18 @@ TRAIN_NEEDS = ("mini_train", "train")
 """Split names that need the generated train scenes."""
 
 
-def ensure_demo_dataset(needs: tuple[str, ...] = ()) -> Path:
-    """The dataroot of the cached demo (seed ``DEMO_SEED``), generated on first use. ``needs``: split or scene
-    names about to be used; only when one of them is a train split or scene are the eight train scenes
-    generated too (a separate cached dataroot), so the default val demo stays quick to build."""
+def demo_layout(needs: tuple[str, ...] = ()) -> tuple[Path, tuple[str, ...]]:
+    """The cached demo's dataroot and scenes for ``needs`` (split or scene names about to be used): the eight
+    train scenes are included (in a separate cached dataroot) only when one of them is a train split or scene."""
     full = any(n in TRAIN_NEEDS or n in TRAIN_SCENES for n in needs)
-    scenes = DEMO_SCENES + TRAIN_SCENES if full else DEMO_SCENES
-    dataroot = demo_cache_dir(full)
-    if is_demo_dataroot(dataroot, DEMO_SEED, scenes):
+    return demo_cache_dir(full), (DEMO_SCENES + TRAIN_SCENES if full else DEMO_SCENES)
+
+
+def ensure_demo_dataset(needs: tuple[str, ...] = (), *, rebuild: bool = False) -> Path:
+    """The dataroot of the cached demo (seed ``DEMO_SEED``) for ``needs`` (``demo_layout``), generated on first
+    use, so the default val demo stays quick to build; ``rebuild`` generates it again (a damaged cache)."""
+    dataroot, scenes = demo_layout(needs)
+    if not rebuild and is_demo_dataroot(dataroot, DEMO_SEED, scenes):
         return dataroot
     try:
         return generate_demo_dataset(dataroot, DEMO_SEED, scenes)

@@ -50,6 +50,12 @@ _VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
     ("rotation", 4),
     ("velocity", 2),
 )
+MAX_ABS_COORD_M = 1e5
+"""Largest accepted |x|, |y|, |z| of a box centre in the global frame (nuScenes maps span a few km)."""
+MAX_SIZE_M = 100.0
+"""Largest accepted box width, length or height; sizes must also be positive."""
+MIN_QUAT_NORM = 1e-6
+"""A rotation quaternion shorter than this has no direction (e.g. all zeros)."""
 _CACHE_FILES = 2
 """Parsed files kept in memory (each full-val file takes a few hundred MB as arrays)."""
 
@@ -88,19 +94,44 @@ def _box_problem(entry: Any) -> str | None:
         value = _as_floats(entry[name])
         if value is None or value.shape != (length,):
             return f"field '{name}' must be a list of {length} numbers, got {_short(entry[name])}"
+        if name != "velocity" and not _all_numbers(entry[name]):
+            return f"field '{name}' must hold numbers, not text or null: {_short(entry[name])}"
         if name != "velocity" and not np.isfinite(value).all():
             return f"field '{name}' has a NaN or infinite value: {_short(entry[name])}"
+        physical = _physical_problem(name, value[None, :])
+        if physical is not None:
+            return f"field '{name}' {physical}: {_short(entry[name])}"
     if "detection_name" not in entry:
         return "has no 'detection_name' field"
     if entry["detection_name"] not in DETECTION_CLASSES:
         return f"has detection_name {entry['detection_name']!r}, not a nuScenes detection class"
     if "detection_score" not in entry:
         return "has no 'detection_score' field"
-    score = _as_floats(entry["detection_score"])
+    raw_score = entry["detection_score"]
+    if isinstance(raw_score, bool) or not isinstance(raw_score, int | float):
+        return f"field 'detection_score' must be a number, got {_short(raw_score)}"
+    score = _as_floats(raw_score)
     if score is None or score.shape != () or not np.isfinite(score):
         return f"field 'detection_score' must be a finite number, got {_short(entry['detection_score'])}"
     if not 0.0 <= float(score) <= 1.0:
         return f"field 'detection_score' must lie in [0, 1], got {float(score)}"
+    return None
+
+
+def _all_numbers(value: Any) -> bool:
+    """Whether a JSON list holds only numbers (``np.asarray(..., dtype=float)`` also converts "1.5")."""
+    return isinstance(value, list) and all(type(v) in (int, float) for v in value)
+
+
+def _physical_problem(name: str, values: np.ndarray) -> str | None:
+    """Why (n, k) finite values of field ``name`` cannot be a real box, or None: centres beyond
+    ``MAX_ABS_COORD_M``, sizes not in (0, ``MAX_SIZE_M``], quaternions of (almost) zero length."""
+    if name == "translation" and (np.abs(values) > MAX_ABS_COORD_M).any():
+        return f"is beyond {MAX_ABS_COORD_M:.0e} m from the map origin"
+    if name == "size" and ((values <= 0.0) | (values > MAX_SIZE_M)).any():
+        return f"must be positive and at most {MAX_SIZE_M:g} m"
+    if name == "rotation" and (np.linalg.norm(values, axis=1) < MIN_QUAT_NORM).any():
+        return "is not a rotation (a quaternion of zero length)"
     return None
 
 
@@ -125,10 +156,16 @@ def _convert_sample(token: str, entries: Any) -> Boxes | str:
     n = len(entries)
     try:
         names = np.array([e["detection_name"] for e in entries], dtype=object)
-        score = np.array([e["detection_score"] for e in entries], dtype=float)
-        arrays = {name: np.array([e[name] for e in entries], dtype=float) for name, _ in _VECTOR_FIELDS}
+        scores = [e["detection_score"] for e in entries]
+        raw_score = np.array(scores)
+        raw = {name: np.array([e[name] for e in entries]) for name, _ in _VECTOR_FIELDS if name != "velocity"}
+        velocity = np.array([e["velocity"] for e in entries], dtype=float)
     except (KeyError, TypeError, ValueError):
         return _diagnose(token, entries)
+    if not all(type(v) in (int, float) for v in scores) or any(a.dtype.kind not in "if" for a in raw.values()):
+        return _diagnose(token, entries)
+    score = raw_score.astype(float)
+    arrays = {name: a.astype(float) for name, a in raw.items()} | {"velocity": velocity}
     fine = (
         all(arrays[name].shape == (n, length) for name, length in _VECTOR_FIELDS)
         and score.shape == (n,)
@@ -136,6 +173,7 @@ def _convert_sample(token: str, entries: Any) -> Boxes | str:
         and np.isfinite(score).all()
         and ((score >= 0.0) & (score <= 1.0)).all()
         and np.isin(names.astype(str), DETECTION_CLASSES).all()
+        and all(_physical_problem(name, arrays[name]) is None for name, _ in _VECTOR_FIELDS)
     )
     if not fine:
         return _diagnose(token, entries)
@@ -172,8 +210,7 @@ def _parse(path: Path) -> _ParsedFile:
     results = data["results"]
     if not isinstance(results, dict):
         raise DataError(
-            f"'results' in detections file {path} is a {type(results).__name__}, "
-            "not an object keyed by sample token"
+            f"'results' in detections file {path} is a {type(results).__name__}, not an object keyed by sample token"
         )
     boxes: dict[str, Boxes] = {}
     problems: dict[str, str] = {}
@@ -194,6 +231,8 @@ def _parsed(path: Path) -> _ParsedFile:
         raise DataError(
             f"detections file not found: {path}; check the path (or use a simulated detector preset)"
         ) from None
+    if path.is_dir():
+        raise DataError(f"detections path {path} is a folder; pass a nuScenes detection results .json file")
     if not path.is_file():
         raise DataError(f"detections path {path} is not a file; pass a nuScenes detection results .json file")
     key = (str(path.resolve()), st.st_ino, st.st_mtime_ns, st.st_size)
@@ -207,9 +246,13 @@ def _parsed(path: Path) -> _ParsedFile:
     return parsed
 
 
-def load_detection_file(
-    path: Path, sample_tokens: Sequence[str], scene_name: str | None = None
-) -> dict[str, Boxes]:
+def check_detection_file(path: Path) -> None:
+    """Parse (and cache) a detection file now, so a missing, non-JSON or malformed file fails before a
+    dataset is loaded; problems inside one sample's boxes are still reported when that sample is loaded."""
+    _parsed(Path(path))
+
+
+def load_detection_file(path: Path, sample_tokens: Sequence[str], scene_name: str | None = None) -> dict[str, Boxes]:
     """Tracking-class detection boxes of exactly ``sample_tokens`` (in that order) from a submission file.
 
     scene_name only makes error messages clearer. Raises ``DataError`` when the file is missing or malformed,
@@ -219,9 +262,7 @@ def load_detection_file(
     parsed = _parsed(path)
     missing = [t for t in sample_tokens if t not in parsed.boxes and t not in parsed.problems]
     if missing:
-        where = f"the {len(sample_tokens)} " + (
-            f"samples of {scene_name}" if scene_name else "requested samples"
-        )
+        where = f"the {len(sample_tokens)} " + (f"samples of {scene_name}" if scene_name else "requested samples")
         raise DataError(
             f"detections file {path.name} has no boxes entry for {len(missing)} of {where} "
             f"(first missing: {missing[0]}); is it for another split or version?"

@@ -1,8 +1,9 @@
 """Find a nuScenes dataroot, open it with the devkit and turn its scenes into ``SceneData``.
 
 Where the data comes from: an explicit ``--dataroot`` wins, then the environment variable ``NUSCENES_DATAROOT``,
-then the built-in synthetic demo (``gnnpmb.data.demo.ensure_demo_dataset``). Any dataroot is checked before the
-devkit loads it (loading the full trainval tables takes a while), so a wrong path fails fast with one line.
+then the built-in synthetic demo (``gnnpmb.data.demo.ensure_demo_dataset``); a damaged demo cache is generated
+again. Any dataroot is checked before the devkit loads it (loading the full trainval tables takes a while), so a
+wrong path fails fast with one line.
 The devkit is imported lazily: importing this module stays cheap.
 """
 
@@ -83,7 +84,8 @@ def check_dataroot(dataroot: Path, version: str | None, source: str = "--dataroo
             raise _not_a_dataroot(dataroot, why)
         if len(found) > 1:
             raise DataError(
-                f"{dataroot} holds several nuScenes versions ({', '.join(found)}); pass --version with one of them"
+                f"{dataroot} holds several nuScenes versions ({', '.join(found)}); "
+                "pass --nuscenes-version with one of them"
             )
         version = found[0]
     elif not (dataroot / version).is_dir():
@@ -110,10 +112,35 @@ def resolve_dataroot(dataroot: Path | None, version: str | None, needs: tuple[st
             f"the built-in demo dataset only has version {DEMO_VERSION}, not {version}; pass --dataroot (or set "
             f"{DATAROOT_ENV}) for real nuScenes data"
         )
-    return check_dataroot(ensure_demo_dataset(needs), DEMO_VERSION, "the built-in demo")
+    try:
+        return check_dataroot(ensure_demo_dataset(needs), DEMO_VERSION, "the built-in demo")
+    except DataError:
+        return check_dataroot(_rebuild_demo(needs), DEMO_VERSION, "the built-in demo")
+
+
+def _rebuild_demo(needs: tuple[str, ...]) -> Path:
+    """Generate the cached demo for ``needs`` again (it was damaged, e.g. a table edited or truncated)."""
+    from gnnpmb.data.demo import demo_layout
+
+    _OPENED.pop((demo_layout(needs)[0].expanduser().resolve(), DEMO_VERSION), None)
+    return ensure_demo_dataset(needs, rebuild=True)
+
+
+def _demo_needs(location: DatasetLocation) -> tuple[str, ...] | None:
+    """The ``needs`` whose cached demo is at ``location`` (None: not a cached demo)."""
+    from gnnpmb.data.demo import demo_layout
+
+    if location.version != DEMO_VERSION:
+        return None
+    for needs in ((), ("mini_train",)):
+        if location.dataroot == demo_layout(needs)[0].expanduser().resolve():
+            return needs
+    return None
 
 
 _OPENED: dict[tuple[Path, str], NuScenes] = {}
+_REBUILT: set[tuple[Path, str]] = set()
+"""Demo caches rebuilt in this process (at most once each)."""
 
 
 def open_nuscenes(location: DatasetLocation) -> NuScenes:
@@ -125,6 +152,11 @@ def open_nuscenes(location: DatasetLocation) -> NuScenes:
         try:
             _OPENED[key] = NuScenes(version=location.version, dataroot=str(location.dataroot), verbose=False)
         except Exception as exc:  # the devkit raises AssertionError, KeyError, JSONDecodeError, ... on bad tables
+            needs = _demo_needs(location)
+            if needs is not None and key not in _REBUILT:
+                _REBUILT.add(key)
+                _rebuild_demo(needs)
+                return open_nuscenes(location)
             detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise _not_a_dataroot(
                 location.dataroot, f"the devkit cannot load {location.version}/ ({type(exc).__name__}: {detail})"
@@ -229,7 +261,16 @@ def load_lidar_points(keyframe: Keyframe) -> np.ndarray:
         raise DataError(
             f"LiDAR file {path} is truncated ({size} bytes is not a whole number of 20-byte points); download it again"
         )
-    return np.ascontiguousarray(LidarPointCloud.from_file(str(path)).points.T, dtype=np.float32)
+    if size == 0:
+        raise DataError(f"LiDAR file {path} of sample {keyframe.sample_token} is empty (0 points); download it again")
+    points = np.ascontiguousarray(LidarPointCloud.from_file(str(path)).points.T, dtype=np.float32)
+    bad = int(np.count_nonzero(~np.isfinite(points).all(axis=1)))
+    if bad:
+        raise DataError(
+            f"LiDAR file {path} of sample {keyframe.sample_token} has {bad} points with NaN or infinite x, y, z "
+            "or intensity; the file is corrupt, download it again"
+        )
+    return points
 
 
 def _custom_splits(location: DatasetLocation) -> dict[str, list[str]]:

@@ -8,7 +8,10 @@
 
 Both thresholds may differ per class (``TrackerConfig.preprocess_by_class``).
 
-Boxes whose class is not among the tracked ``classes`` are simply not kept: neither ``below_threshold`` nor
+Boxes that cannot be real (a NaN or infinite field, a centre beyond ``MAX_ABS_COORD_M``, a size not in
+(0, ``MAX_SIZE_M``], a zero quaternion, a score outside [0, 1]) are never kept either: a detection file with
+such a box is refused when read (``gnnpmb.data.detections``), and this keeps the trackers safe from boxes built
+in code. Boxes whose class is not among the tracked ``classes`` are simply not kept: neither ``below_threshold`` nor
 ``suppressed_by_nms`` is set for them, so the viewer can tell "not tracked" apart from "filtered out".
 """
 
@@ -20,6 +23,7 @@ import numpy as np
 
 from gnnpmb.config import PreprocessParams
 from gnnpmb.data.boxes3d import iou_3d, overlap_candidates, yaw_from_quat_wxyz
+from gnnpmb.data.detections import MAX_ABS_COORD_M, MAX_SIZE_M, MIN_QUAT_NORM
 from gnnpmb.types import Boxes, FrameDetections
 
 
@@ -56,6 +60,21 @@ def nms_3d(boxes: Boxes, iou_threshold: float | np.ndarray) -> np.ndarray:
     return ~suppressed
 
 
+def usable(boxes: Boxes) -> np.ndarray:
+    """(N,) bool: the boxes whose every field is finite and physically possible (module docstring)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        return (
+            np.isfinite(boxes.translation_m).all(axis=1)
+            & (np.abs(boxes.translation_m) <= MAX_ABS_COORD_M).all(axis=1)
+            & ((boxes.size_wlh_m > 0.0) & (boxes.size_wlh_m <= MAX_SIZE_M)).all(axis=1)
+            & (np.linalg.norm(np.nan_to_num(boxes.quat_wxyz), axis=1) >= MIN_QUAT_NORM)
+            & np.isfinite(boxes.quat_wxyz).all(axis=1)
+            & np.isfinite(boxes.velocity_mps).all(axis=1)
+            & (boxes.score >= 0.0)
+            & (boxes.score <= 1.0)
+        )
+
+
 def _per_box(boxes: Boxes, params: PreprocessParams | Mapping[str, PreprocessParams], key: str) -> np.ndarray:
     """(N,) the value of ``key`` for each box's class."""
     if isinstance(params, PreprocessParams):
@@ -82,6 +101,7 @@ def preprocess(
         tracked = np.ones(n, dtype=bool)
     else:
         tracked = np.isin(boxes.class_name.astype(str), np.asarray(list(classes), dtype=str))
+    tracked &= usable(boxes)
     below = tracked & (boxes.score < _per_box(boxes, params, "score_threshold"))
     candidates = np.flatnonzero(tracked & ~below)
     suppressed = np.zeros(n, dtype=bool)

@@ -134,9 +134,7 @@ def build_submission(
     for part in parts:
         for token, boxes in part.items():
             if token not in results:
-                raise DataError(
-                    f"tracked sample {token} is not one of the samples the submission is built for"
-                )
+                raise DataError(f"tracked sample {token} is not one of the samples the submission is built for")
             kept = list(boxes)
             if len(kept) > MAX_BOXES_PER_SAMPLE:
                 kept = sorted(kept, key=lambda b: -float(b["tracking_score"]))[:MAX_BOXES_PER_SAMPLE]
@@ -147,18 +145,33 @@ def build_submission(
 def write_json(path: Path, data: Any) -> None:
     """Write ``data`` as JSON atomically: a temporary file in the same folder, then ``os.replace``.
 
-    NaN or infinite numbers are refused (they are not JSON); nothing is left behind on failure.
+    NaN or infinite numbers are refused (they are not JSON); nothing is left behind on failure. The file gets
+    the mode a plain ``open`` would give (0666 minus the umask); a symlink at ``path`` is kept and its target
+    written.
     """
     path = Path(path)
+    if path.is_symlink():
+        path = path.resolve()
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        os.fchmod(fd, _new_file_mode())
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             json.dump(data, f, allow_nan=False, separators=(",", ":"))
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise DataError(f"cannot write {path}: {exc.strerror or exc}; free space or write elsewhere") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _new_file_mode() -> int:
+    """0o666 minus the process umask (``mkstemp`` alone gives 0o600)."""
+    umask = os.umask(0o022)
+    os.umask(umask)
+    return 0o666 & ~umask
 
 
 def write_submission(path: Path, submission: Mapping[str, Any]) -> None:
@@ -166,11 +179,19 @@ def write_submission(path: Path, submission: Mapping[str, Any]) -> None:
     write_json(path, submission)
 
 
+def check_results_file(path: Path) -> None:
+    """A one-line ``DataError`` unless ``path`` is an existing file (checked before any slow work)."""
+    path = Path(path)
+    if path.is_dir():
+        raise DataError(f"results path {path} is a folder; pass the .json written by 'gnnpmb track'")
+    if not path.is_file():
+        raise DataError(f"results file not found: {path}; pass the .json written by 'gnnpmb track'")
+
+
 def read_submission(path: Path) -> dict[str, Any]:
     """Parse a submission file; a missing, truncated or non-JSON file is a one-line ``DataError``."""
     path = Path(path)
-    if not path.is_file():
-        raise DataError(f"results file not found: {path}; pass the .json written by 'gnnpmb track'")
+    check_results_file(path)
     try:
         data = json.loads(path.read_bytes())
     except json.JSONDecodeError as exc:
@@ -179,9 +200,7 @@ def read_submission(path: Path) -> dict[str, Any]:
             f"column {exc.colno}; is it truncated? Write it again"
         ) from None
     except UnicodeDecodeError as exc:
-        raise DataError(
-            f"results file {path.name} is not UTF-8 JSON text (bad byte at {exc.start})"
-        ) from None
+        raise DataError(f"results file {path.name} is not UTF-8 JSON text (bad byte at {exc.start})") from None
     if not isinstance(data, dict):
         raise DataError(
             f"results file {path.name} holds a JSON {type(data).__name__}, not a tracking submission "
@@ -278,8 +297,7 @@ def check_submission(
         )
     if not isinstance(data.get("meta"), dict):
         raise DataError(
-            f"{source} has no 'meta' object; add \"meta\": {json.dumps(SUBMISSION_META)} "
-            "(what the tracker used)"
+            f"{source} has no 'meta' object; add \"meta\": {json.dumps(SUBMISSION_META)} (what the tracker used)"
         )
     results: dict[str, Any] = data["results"]
     wanted = set(split_tokens)
@@ -305,9 +323,7 @@ def check_submission(
     for token in split_tokens:
         boxes = results[token]
         if not isinstance(boxes, list):
-            raise DataError(
-                f"{source}: results entry of sample {token} is a {type(boxes).__name__}, not a list"
-            )
+            raise DataError(f"{source}: results entry of sample {token} is a {type(boxes).__name__}, not a list")
         if len(boxes) > max_boxes_per_sample:
             raise DataError(
                 f"{source}: sample {token} has {len(boxes)} boxes; the evaluation allows at most "
@@ -318,5 +334,27 @@ def check_submission(
                 problem = _box_problem(token, box)
                 if problem is not None:
                     raise DataError(f"{source}: box {k} of sample {token} {problem}")
+        duplicate = _duplicate_id(boxes)
+        if duplicate is not None:
+            raise DataError(
+                f"{source}: sample {token} has two {duplicate[0]} boxes with tracking_id {duplicate[1]!r}; "
+                "a track has at most one box per sample (give each track its own id)"
+            )
         n_boxes += len(boxes)
+    if n_boxes == 0:
+        raise DataError(
+            f"{source} has no boxes in any of the {len(split_tokens)} samples of split {split}: nothing to "
+            "score (did the tracker keep no tracks? check score_threshold and the detections)"
+        )
     return SubmissionStats(samples=len(split_tokens), boxes=n_boxes)
+
+
+def _duplicate_id(boxes: list[dict[str, Any]]) -> tuple[str, str] | None:
+    """The first (class, tracking_id) that occurs twice among one sample's boxes, or None."""
+    seen: set[tuple[str, str]] = set()
+    for box in boxes:
+        key = (str(box["tracking_name"]), str(box["tracking_id"]))
+        if key in seen:
+            return key
+        seen.add(key)
+    return None

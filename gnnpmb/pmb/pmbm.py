@@ -17,6 +17,13 @@ Of a parent's H_h best assignments only those costing at most -log(hypothesis_pr
 enumerated: the parent's best child alone outweighs such a child by more than 1 / hypothesis_prune, so its
 normalised weight is below the threshold whatever the other children (it could matter only by merging).
 
+Per-frame budget (``murty_block_rows``): Murty's ranking of a gated block of R rows solves up to R assignment
+problems per extra solution, so a dense crowd (one block of 1000 detections) would take minutes and gigabytes. A
+block with more rows than the budget is given only its best assignment (children differ in the other blocks),
+only the ``crowd_hypotheses`` most likely prior hypotheses get children (each needs a Hungarian solve of the
+large block), and the frame emits ``BudgetReached``. Frames whose blocks are all within the budget are
+unaffected.
+
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
 ranked once (``murty.rank``) and shared by all hypotheses that contain it (``murty.Product``). Posteriors are
@@ -32,10 +39,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import logsumexp
 
-from gnnpmb.assign.hungarian import InfeasibleAssignment
+from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.assign.murty import Product, Ranking, blocks, forbid_beyond_private, k_best, rank
 from gnnpmb.config import PmbmParams
-from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses
+from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses
 from gnnpmb.pmb.core import (
     GlobalHypothesis,
     HypothesisLocals,
@@ -44,6 +51,14 @@ from gnnpmb.pmb.core import (
     posteriors_from_assignments,
 )
 from gnnpmb.pmb.cost import LocalHypotheses
+
+MURTY_BLOCK_ROWS = 60
+"""Default per-frame budget of PMBM: gated blocks of the cost matrix with more rows (measurements) than this get
+only their best assignment instead of a k-best ranking (module docstring)."""
+
+CROWD_HYPOTHESES = 10
+"""Default per-frame budget of PMBM over ``MURTY_BLOCK_ROWS``: in such a frame only this many of the most likely
+prior hypotheses get children (each costs a Hungarian solve of the large block); the others are dropped."""
 
 COST_MATRIX_EVENTS = 3
 """Cost matrices are emitted for the first COST_MATRIX_EVENTS prior hypotheses only (the core emits that of
@@ -68,12 +83,24 @@ def hypothesis_budget(n_hypotheses: int, log_weight: float) -> int:
 
 
 class KBest:
-    """PMBM: at most ``params.n_hypotheses`` global hypotheses from Murty's k best assignments."""
+    """PMBM: at most ``params.n_hypotheses`` global hypotheses from Murty's k best assignments; gated blocks of
+    more than ``murty_block_rows`` rows keep only their best assignment (the per-frame budget)."""
 
     name = "k-best"
 
-    def __init__(self, params: PmbmParams):
+    def __init__(
+        self,
+        params: PmbmParams,
+        murty_block_rows: int = MURTY_BLOCK_ROWS,
+        crowd_hypotheses: int = CROWD_HYPOTHESES,
+    ):
+        if murty_block_rows < 1 or crowd_hypotheses < 1:
+            raise ValueError(
+                f"murty_block_rows and crowd_hypotheses must be >= 1, got {murty_block_rows}, {crowd_hypotheses}"
+            )
         self.params = params
+        self.murty_block_rows = murty_block_rows
+        self.crowd_hypotheses = crowd_hypotheses
         self._log_prune = math.log(params.hypothesis_prune) if params.hypothesis_prune > 0 else -math.inf
         self._max_increase = -self._log_prune
 
@@ -87,14 +114,18 @@ class KBest:
             for h in range(1, min(COST_MATRIX_EVENTS, len(locals_))):
                 local = locals_[h]
                 cost = local.cost_matrix()
-                ctx.sink.emit(
-                    CostMatrix(ctx.class_name, cost, local.row_labels(), local.col_labels(), hypothesis=h)
-                )
+                ctx.sink.emit(CostMatrix(ctx.class_name, cost, local.row_labels(), local.col_labels(), hypothesis=h))
         union, members = _union_of(locals_)
-        if len(locals_) == 1:
+        largest = max((len(rows) for rows, _ in blocks(union.cost_matrix())), default=0)
+        if largest > self.murty_block_rows:
+            budgets = _trim_budgets(budgets, prior_log_w, self.crowd_hypotheses)
+            if ctx.sink.enabled:
+                ctx.sink.emit(BudgetReached(ctx.class_name, "pmbm murty_block_rows", self.murty_block_rows, largest))
+        if len(locals_) == 1 and largest <= self.murty_block_rows:
             ranked = [k_best(locals_[0].cost_matrix(), budgets[0], self._max_increase)]
         else:
-            ranked = SharedRanking(union, members, self._max_increase).k_best(budgets)
+            shared = SharedRanking(union, members, self._max_increase, self.murty_block_rows)
+            ranked = shared.k_best(budgets)
         children: list[_Child] = []
         for h, assignments in enumerate(ranked):
             base = float(prior_log_w[h]) + float(union.miss_log_lik[members[h]].sum())  # sum_k log l_k0
@@ -122,6 +153,13 @@ class KBest:
         return [children[i] for i in keep], kept_log_w
 
 
+def _trim_budgets(budgets: list[int], log_weights: np.ndarray, keep: int) -> list[int]:
+    """Children per prior hypothesis with only the ``keep`` most likely (ties: first) expanded; the others get
+    none."""
+    kept = set(np.argsort(-log_weights, kind="stable")[:keep].tolist())
+    return [k if h in kept else 0 for h, k in enumerate(budgets)]
+
+
 def _own_columns(col_of_row: np.ndarray, index: np.ndarray, n_union: int) -> np.ndarray:
     """An assignment in union columns (M,) as columns of the cost matrix of the hypothesis holding
     ``index``."""
@@ -137,9 +175,7 @@ def _union_of(locals_: Sequence[LocalHypotheses]) -> tuple[LocalHypotheses, list
         return locals_.union, locals_.members
     if len(locals_) == 1:
         return locals_[0], [np.arange(locals_[0].n_tracks)]
-    raise ValueError(
-        "PMBM needs the local hypotheses of several global hypotheses as HypothesisLocals (PmbCore)"
-    )
+    raise ValueError("PMBM needs the local hypotheses of several global hypotheses as HypothesisLocals (PmbCore)")
 
 
 class SharedRanking:
@@ -151,10 +187,17 @@ class SharedRanking:
     are forbidden first, by columns private to one row and present in every hypothesis, like the new-track
     columns (``murty.forbid_beyond_private``). Each gated block of the union matrix is then ranked once per
     distinct set of its Bernoullis present (``murty.rank``), and a hypothesis' ranking is the
-    ``murty.Product`` of its blocks.
+    ``murty.Product`` of its blocks. A block of more than ``max_block_rows`` rows is ranked with no increase
+    allowed: only its best assignment (the per-frame budget).
     """
 
-    def __init__(self, union: LocalHypotheses, members: list[np.ndarray], max_increase: float):
+    def __init__(
+        self,
+        union: LocalHypotheses,
+        members: list[np.ndarray],
+        max_increase: float,
+        max_block_rows: int = MURTY_BLOCK_ROWS,
+    ):
         self.n_union = union.n_tracks
         self.n_meas = union.n_meas
         self.members = members
@@ -165,18 +208,22 @@ class SharedRanking:
         for h, index in enumerate(members):
             has_column[h, index] = True
         cost = forbid_beyond_private(cost, max_increase, usable=has_column.all(axis=0))
+        self.cost = cost
         self.common: list[tuple[np.ndarray, np.ndarray, Ranking | None]] = []
-        self.varying: list[tuple[list[tuple[np.ndarray, np.ndarray, Ranking | None]], np.ndarray]] = []
+        self.varying: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]] = []
+        """Per block whose Bernoullis differ between hypotheses: rows, columns, the distinct presence patterns
+        (P, columns), each hypothesis' pattern (H,), and whether only the best assignment is ranked. Each
+        (block, pattern) is ranked on first use (``_varying_part``): a hypothesis with no children costs
+        nothing."""
+        self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
         for rows, cols in blocks(cost):
             present = has_column[:, cols]
+            best_only = len(rows) > max_block_rows
             if (present == present[0]).all():
-                self.common.append(_part(cost, rows, cols, present[0], max_increase))
+                self.common.append(_part(cost, rows, cols, present[0], max_increase, best_only))
                 continue
-            _, first, pattern = np.unique(
-                np.packbits(present, axis=1), axis=0, return_index=True, return_inverse=True
-            )
-            parts = [_part(cost, rows, cols, present[h], max_increase) for h in first.tolist()]
-            self.varying.append((parts, pattern.ravel()))
+            _, first, pattern = np.unique(np.packbits(present, axis=1), axis=0, return_index=True, return_inverse=True)
+            self.varying.append((rows, cols, present[first], pattern.ravel(), best_only))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
         self.common_ok = all(ranking is not None for _, _, ranking in self.common)
         if self.common_ok:
@@ -187,8 +234,17 @@ class SharedRanking:
         """The budgets[h] best assignments (col_of_row as union columns, cost) of every hypothesis."""
         return [self._hypothesis(h, k) for h, k in enumerate(budgets)]
 
+    def _varying_part(self, b: int, h: int) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
+        rows, cols, patterns, pattern, best_only = self.varying[b]
+        key = (b, int(pattern[h]))
+        if key not in self._parts:
+            self._parts[key] = _part(self.cost, rows, cols, patterns[key[1]], self.max_increase, best_only)
+        return self._parts[key]
+
     def _hypothesis(self, h: int, k: int) -> list[tuple[np.ndarray, float]]:
-        parts = self.common + [options[pattern[h]] for options, pattern in self.varying]
+        if k < 1:
+            return []
+        parts = self.common + [self._varying_part(b, h) for b in range(len(self.varying))]
         if not self.common_ok or any(ranking is None for _, _, ranking in parts[len(self.common) :]):
             return []
         base = self.common_base.copy()
@@ -204,14 +260,31 @@ class SharedRanking:
         return out
 
 
+class BestOnly:
+    """The ranking of a block over the per-frame budget: its best assignment only (one Hungarian solve)."""
+
+    def __init__(self, cost: np.ndarray):
+        self._best = solve(cost)
+
+    def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        return self._best if index == 0 else None
+
+
 def _part(
-    cost: np.ndarray, rows: np.ndarray, cols: np.ndarray, present: np.ndarray, max_increase: float
+    cost: np.ndarray,
+    rows: np.ndarray,
+    cols: np.ndarray,
+    present: np.ndarray,
+    max_increase: float,
+    best_only: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
     """(rows, columns, ranking) of a block of the union matrix with only its ``present`` columns, ranked up to
-    ``max_increase`` above its best; the ranking is None if that sub-problem has no assignment."""
+    ``max_increase`` above its best (``best_only``: its best assignment alone); the ranking is None if that
+    sub-problem has no assignment."""
     sub_cols = cols[present]
+    sub = cost[np.ix_(rows, sub_cols)]
     try:
-        return rows, sub_cols, rank(cost[np.ix_(rows, sub_cols)], max_increase=max_increase)
+        return rows, sub_cols, BestOnly(sub) if best_only else rank(sub, max_increase=max_increase)
     except InfeasibleAssignment:
         return rows, sub_cols, None
 
@@ -295,11 +368,7 @@ def _emit(
         GlobalHypotheses(
             ctx.class_name,
             log_weights=np.array([h.log_weight for h in posteriors]),
-            members=tuple(
-                tuple(h.bernoullis.track_id[a].tolist()) for h, a in zip(posteriors, alive, strict=True)
-            ),
-            local=tuple(
-                tuple(h.bernoullis.local_key[a].tolist()) for h, a in zip(posteriors, alive, strict=True)
-            ),
+            members=tuple(tuple(h.bernoullis.track_id[a].tolist()) for h, a in zip(posteriors, alive, strict=True)),
+            local=tuple(tuple(h.bernoullis.local_key[a].tolist()) for h, a in zip(posteriors, alive, strict=True)),
         )
     )

@@ -32,10 +32,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gnnpmb.assign.lbp import lbp_marginals_log
+from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.assign.marginals import AssociationMarginals
 from gnnpmb.config import LbpParams
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, Merged
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, Merged, Pruned, PruneReason
 from gnnpmb.events import Marginals as MarginalsEvent
 from gnnpmb.kalman import symmetrize
 from gnnpmb.pmb.bernoulli import Bernoullis
@@ -48,6 +48,17 @@ from gnnpmb.pmb.core import (
 )
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means
 
+MAX_BERNOULLIS = 1500
+"""Per-frame budget of TO-PMB: at most this many Bernoullis per class leave an update (the most likely, by
+existence; ties keep the first). In a dense crowd every detection adds a birth each frame while missed
+Bernoullis decay only by P_S per frame, so without a cap the LBP graph (and the time per frame) grows without
+bound; the dropped ones are reported as ``Pruned`` (``CAPPED``). The demo data never reaches it."""
+
+MAX_GATED_PER_TRACK = 32
+"""Per-frame budget of TO-PMB: each Bernoulli's association is computed over at most this many gated
+measurements (its most likely ones, by l_kj / l_k0); less likely ones get marginal 0. Bounds the LBP graph to
+K x 32 edges when inflated gates span a crowd; the demo data never reaches it."""
+
 MERGE_REPORT_WEIGHT = 0.05
 """A ``Merged`` event is emitted for a track when at least two of its components have at least this existence
 mass (``Components``), so Bernoullis with negligible existence do not flood the event log."""
@@ -58,18 +69,19 @@ class Marginals:
 
     name = "marginals"
 
-    def __init__(self, params: LbpParams):
+    def __init__(self, params: LbpParams, max_bernoullis: int = MAX_BERNOULLIS):
+        if max_bernoullis < 1:
+            raise ValueError(f"max_bernoullis must be >= 1, got {max_bernoullis}")
         self.params = params
+        self.max_bernoullis = max_bernoullis
 
     def update(
         self, priors: list[GlobalHypothesis], locals_: list[LocalHypotheses], ctx: UpdateContext
     ) -> list[GlobalHypothesis]:
         """The single posterior PMB hypothesis (weight 1) from the single prior hypothesis ``locals_[0]``."""
         local = locals_[0]
-        log_ratio = local.det_log_lik - local.miss_log_lik[:, None]
-        marg = lbp_marginals_log(
-            log_ratio, local.new.log_likelihood, self.params.max_iterations, self.params.tolerance
-        )
+        log_ratio = keep_most_likely(local.det_log_lik - local.miss_log_lik[:, None], MAX_GATED_PER_TRACK)
+        marg = lbp_marginals_log(log_ratio, local.new.log_likelihood, self.params.max_iterations, self.params.tolerance)
         tracks, components = merged_bernoullis(local, marg)
         r_new = marg.p_new * local.new.existence
         new_j = np.flatnonzero((r_new > 0.0) & (r_new >= ctx.prune_existence))
@@ -77,7 +89,27 @@ class Marginals:
         births = replace(births, existence=r_new[new_j]) if len(new_j) else births
         if ctx.sink.enabled:
             _emit(local, marg, components, ctx)
-        return [GlobalHypothesis(0.0, Bernoullis.concatenate([tracks, births]))]
+        return [GlobalHypothesis(0.0, _capped(Bernoullis.concatenate([tracks, births]), self.max_bernoullis, ctx))]
+
+
+def _capped(bernoullis: Bernoullis, limit: int, ctx: UpdateContext) -> Bernoullis:
+    """The ``limit`` most likely Bernoullis (stable by existence, original order kept); the others are reported
+    as ``Pruned`` with reason ``CAPPED`` (``MAX_BERNOULLIS``)."""
+    if len(bernoullis) <= limit:
+        return bernoullis
+    order = np.argsort(-bernoullis.existence, kind="stable")
+    keep = np.sort(order[:limit])
+    if ctx.sink.enabled:
+        for i in np.sort(order[limit:]).tolist():
+            ctx.sink.emit(
+                Pruned(
+                    ctx.class_name,
+                    int(bernoullis.track_id[i]),
+                    PruneReason.CAPPED,
+                    float(bernoullis.existence[i]),
+                )
+            )
+    return bernoullis.subset(keep)
 
 
 @dataclass(frozen=True, slots=True)
@@ -155,9 +187,7 @@ def _emit(local: LocalHypotheses, marg: AssociationMarginals, comp: Components, 
     meas, prior = local.meas, local.prior
     k, m = local.n_tracks, local.n_meas
     rows = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
-    cols = (AxisLabel(AxisKind.MISSED, -1),) + tuple(
-        AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index
-    )
+    cols = (AxisLabel(AxisKind.MISSED, -1),) + tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
     ctx.sink.emit(MarginalsEvent(ctx.class_name, marg.p_track, rows, cols, marg.method, marg.iterations))
 
     significant = comp.detected >= MERGE_REPORT_WEIGHT

@@ -38,12 +38,17 @@ from __future__ import annotations
 import numpy as np
 
 from gnnpmb.assign.exact_marginals import exact_marginals_log
-from gnnpmb.assign.lbp import lbp_marginals_log
+from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals
 from gnnpmb.kalman import Innovation, log_likelihood, symmetrize
 from gnnpmb.types import Measurements
 from gnnpmb.vector.clusters import gate_clusters
 from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
+
+MAX_GATED_PER_TRACK = 32
+"""Per-frame budget of JPDA: each track's association probabilities are computed over at most this many gated
+measurements (its most likely); the others get probability 0. In a dense crowd the PDA covariances inflate and
+the gates, hence the LBP graph, would grow every frame; the demo data never reaches it."""
 
 EXACT_ASSOCIATION_BUDGET = 5000
 """A multi-track cluster is enumerated exactly only if prod_k (1 + gated measurements of k) is at most this;
@@ -144,6 +149,7 @@ class JpdaTracker(VectorTracker):
         sink: EventSink,
     ) -> Association:
         log_ratio = log_ratios(log_likelihood(inn, d2), inside, self.params.p_detect, self.gate_chi2)
+        log_ratio = keep_most_likely(log_ratio, MAX_GATED_PER_TRACK)
         beta, p_new, method, iterations = association_probabilities(
             log_ratio,
             self.clutter_intensity,

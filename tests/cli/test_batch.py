@@ -77,7 +77,7 @@ def test_track_writes_a_submission_for_every_sample_of_the_split(tracked: tuple[
 
 def test_track_is_deterministic(tracked: tuple[Path, str], demo_dataroot: Path, tmp_path: Path, capsys) -> None:
     again = tmp_path / "again.json"
-    argv = ["track", "--dataroot", str(demo_dataroot), "--version", "v1.0-mini", "--split", "mini_val"]
+    argv = ["track", "--dataroot", str(demo_dataroot), "--nuscenes-version", "v1.0-mini", "--split", "mini_val"]
     code, _, _ = run([*argv, "--detector", "centerpoint", "--seed", "0", "--out", str(again), "--no-progress"], capsys)
     assert code == 0
     assert again.read_bytes() == tracked[0].read_bytes()

@@ -214,3 +214,13 @@ def test_lbp_deterministic_and_iteration_cap():
     check_consistent(one, 6, 6)
     with pytest.raises(ValueError, match="max_iterations"):
         lbp_marginals(ratio, new, max_iterations=0)
+
+
+def test_keep_most_likely_cuts_each_row_to_its_largest_entries():
+    from gnnpmb.assign.lbp import keep_most_likely
+
+    inf = np.inf
+    log_ratio = np.array([[0.0, -1.0, -2.0, -inf], [5.0, 5.0, 1.0, 0.0], [-inf, 3.0, -inf, -inf]])
+    out = keep_most_likely(log_ratio, 2)
+    np.testing.assert_array_equal(out, [[0.0, -1.0, -inf, -inf], [5.0, 5.0, -inf, -inf], [-inf, 3.0, -inf, -inf]])
+    assert keep_most_likely(log_ratio, 4) is log_ratio

@@ -103,6 +103,15 @@ def test_not_a_submission(tmp_path):
         (lambda b: b.pop("detection_score"), "box 1 of sample s0 has no 'detection_score' field"),
         (lambda b: b.update(detection_score=1.5), "'detection_score' must lie in \\[0, 1\\]"),
         (lambda b: b.update(detection_name="cat"), "detection_name 'cat', not a nuScenes detection class"),
+        (lambda b: b.update(size=[1.9, -4.5, 1.6]), "field 'size' must be positive and at most 100 m"),
+        (lambda b: b.update(size=[1.9, 0.0, 1.6]), "field 'size' must be positive"),
+        (lambda b: b.update(size=[1.9, 4.5, 1e3]), "field 'size' must be positive and at most 100 m"),
+        (lambda b: b.update(rotation=[0.0, 0.0, 0.0, 0.0]), "field 'rotation' is not a rotation"),
+        (lambda b: b.update(translation=[1e308, 2.0, 0.9]), "field 'translation' is beyond 1e\\+05 m"),
+        (lambda b: b.update(translation=[1.0, "2", 0.9]), "field 'translation' must hold numbers"),
+        (lambda b: b.update(size=[1.9, None, 1.6]), "field 'size' must"),
+        (lambda b: b.update(detection_score="0.8"), "field 'detection_score' must be a number, got '0.8'"),
+        (lambda b: b.update(detection_score=True), "field 'detection_score' must be a number"),
     ],
 )
 def test_malformed_box_names_sample_and_field(tmp_path, change, message):

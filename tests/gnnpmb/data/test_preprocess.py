@@ -231,3 +231,14 @@ def test_preprocess_is_deterministic():
     np.testing.assert_array_equal(a.kept, b.kept)
     assert a.below_threshold.any() and a.suppressed_by_nms.any() and a.kept.any()
     assert not np.any(a.kept & (a.below_threshold | a.suppressed_by_nms))
+
+
+def test_impossible_boxes_are_never_kept_nor_flagged():
+    boxes = make_boxes([(float(i) * 10, 0.0, 0.0, 4.0, 2.0, 1.5, 0.0) for i in range(5)])
+    boxes.translation_m[1, 0] = np.nan
+    boxes.size_wlh_m[2, 1] = -1.0
+    boxes.quat_wxyz[3] = 0.0
+    boxes.translation_m[4, 1] = 1e308
+    out = preprocess(boxes, PreprocessParams())
+    assert out.kept.tolist() == [True, False, False, False, False]
+    assert not out.below_threshold.any() and not out.suppressed_by_nms.any()

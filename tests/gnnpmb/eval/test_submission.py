@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -132,9 +134,7 @@ def test_missing_samples_name_the_split() -> None:
     del data["results"]["s0"], data["results"]["s2"]
     with pytest.raises(DataError) as err:
         check(data)
-    assert str(err.value) == (
-        "results.json lacks 2 of the 3 samples of split mini_val; was it made for another split?"
-    )
+    assert str(err.value) == ("results.json lacks 2 of the 3 samples of split mini_val; was it made for another split?")
 
 
 def test_samples_of_other_splits_and_unknown_samples_are_told_apart() -> None:
@@ -219,3 +219,31 @@ def test_read_reports_broken_files(tmp_path: Path, content: bytes, message: str)
         read_submission(path)
     with pytest.raises(DataError, match="results file not found"):
         read_submission(tmp_path / "missing.json")
+
+
+def test_empty_submission_is_refused_with_a_hint() -> None:
+    empty = {"meta": dict(SUBMISSION_META), "results": {t: [] for t in SPLIT}}
+    with pytest.raises(DataError, match=f"has no boxes in any of the {len(SPLIT)} samples of split mini_val"):
+        check(empty)
+
+
+def test_duplicate_tracking_id_in_one_sample_is_refused() -> None:
+    token = SPLIT[0]
+    twice = [box(token, "7"), box(token, "7", translation=[5.0, 2.0, 0.5])]
+    with pytest.raises(DataError, match=f"sample {token} has two car boxes with tracking_id '7'"):
+        check(submission(**{token: twice}))
+    check(submission(**{token: [box(token, "7"), box(token, "7", name="pedestrian")]}))
+
+
+def test_json_output_follows_the_umask_and_keeps_a_symlink(tmp_path: Path) -> None:
+    target = tmp_path / "real.json"
+    link = tmp_path / "link.json"
+    target.write_text("{}")
+    link.symlink_to(target)
+    old = os.umask(0o027)
+    try:
+        write_submission(link, submission())
+    finally:
+        os.umask(old)
+    assert link.is_symlink() and read_submission(target) == submission()
+    assert stat.S_IMODE(target.stat().st_mode) == 0o640

@@ -28,9 +28,7 @@ CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 
 
 def brute_esf(x: np.ndarray, order: int) -> np.ndarray:
-    return np.array(
-        [sum(math.prod(c) for c in itertools.combinations(x.tolist(), j)) for j in range(order + 1)]
-    )
+    return np.array([sum(math.prod(c) for c in itertools.combinations(x.tolist(), j)) for j in range(order + 1)])
 
 
 def test_esf_matches_brute_force_products():
@@ -75,9 +73,7 @@ def first_principles(pmf, w, q, p_d, kappa):
     total = sum(joint)
     post = [j / total for j in joint]
     p_target = sum(p * t for p, t in zip(pmf, target, strict=True)) / total
-    undetected = sum(
-        p * (c * n + t * (n - 1)) for n, (p, c, t) in enumerate(zip(pmf, clutter, target, strict=True))
-    )
+    undetected = sum(p * (c * n + t * (n - 1)) for n, (p, c, t) in enumerate(zip(pmf, clutter, target, strict=True)))
     undetected /= total
     detected = [p_target * wk * qk / wq for wk, qk in zip(w, q, strict=True)]
     missed = [undetected * wk / W for wk in w]
@@ -87,9 +83,7 @@ def first_principles(pmf, w, q, p_d, kappa):
 @pytest.mark.parametrize("pmf", [[0.2, 0.5, 0.3], [0.0, 0.1, 0.6, 0.3], [0.05, 0.15, 0.3, 0.3, 0.2]])
 def test_one_measurement_with_known_prior_cardinality_hand_computed(pmf):
     w, q, p_d, kappa = [0.7, 0.4], [0.3, 0.05], 0.9, 1e-3
-    corr = cphd_update(
-        np.array(pmf), np.array(w), np.full(2, p_d), np.log(np.array(q))[:, None], kappa, area_m2=250.0
-    )
+    corr = cphd_update(np.array(pmf), np.array(w), np.full(2, p_d), np.log(np.array(q))[:, None], kappa, area_m2=250.0)
     post, detected, missed = first_principles(pmf, w, q, p_d, kappa)
     np.testing.assert_allclose(corr.pmf, post, rtol=1e-12, atol=1e-15)
     np.testing.assert_allclose(np.exp(corr.log_detected[:, 0]), detected, rtol=1e-12)
@@ -215,3 +209,17 @@ def test_dense_frame_runs_and_stays_a_distribution():
 def test_zero_clutter_is_rejected_before_the_cphd_sees_it():
     with pytest.raises(ConfigError, match="clutter_intensity"):
         CphdTracker("car", CFG.replace(pmb=dataclasses.replace(CFG.pmb, clutter_intensity=0.0)), IdAllocator())
+
+
+def test_leave_one_out_contraction_equals_the_expanded_sum():
+    from gnnpmb.phd.cphd import _contract_leave_one_out, _esf_tables
+    from gnnpmb.phd.gmphd import log_sum_exp
+
+    rng = np.random.default_rng(4)
+    for m, order in [(1, 3), (6, 4), (30, 50)]:
+        log_x = rng.normal(5.0, 3.0, size=m)
+        log_x[::4] = -np.inf  # gated-out measurements
+        log_gamma = rng.normal(0.0, 20.0, size=order + 1)
+        pre, _ = _esf_tables(log_x, order)
+        expanded = log_sum_exp(log_esf_leave_one_out(log_x, order) + log_gamma[None, :], axis=1)
+        np.testing.assert_allclose(_contract_leave_one_out(pre, log_x, log_gamma), expanded, rtol=1e-12, atol=1e-9)

@@ -67,9 +67,7 @@ def cluttered_sequence(seed: int, n_frames: int = 12) -> list[Measurements]:
         xy = xy[rng.random(len(xy)) > 0.15]
         clutter = rng.uniform(-2.0, 8.0, size=(int(rng.integers(0, 3)), 2))
         points = np.concatenate([xy, clutter])
-        frames.append(
-            make_measurements([tuple(p) for p in points], list(rng.uniform(0.3, 0.95, len(points))))
-        )
+        frames.append(make_measurements([tuple(p) for p in points], list(rng.uniform(0.3, 0.95, len(points)))))
     return frames
 
 
@@ -149,9 +147,7 @@ def test_a_hypothesis_gnnpmb_discards_wins_later():
     assert x_pmbm[1] == pytest.approx(0.0, abs=0.05) and x_gnnpmb[1] > 2.0
     (new_pmbm,) = set(x_pmbm) - {1}
     (new_gnnpmb,) = set(x_gnnpmb) - {1}
-    assert x_pmbm[new_pmbm] == pytest.approx(2.2, abs=0.05) and x_gnnpmb[new_gnnpmb] == pytest.approx(
-        0.0, abs=0.05
-    )
+    assert x_pmbm[new_pmbm] == pytest.approx(2.2, abs=0.05) and x_gnnpmb[new_gnnpmb] == pytest.approx(0.0, abs=0.05)
 
 
 def test_hypotheses_identical_after_pruning_are_merged():
@@ -205,9 +201,7 @@ class PlainKBest:
         keep = keep if len(keep) else order[:1]
         kept_w = w[keep] - logsumexp(w[keep])
         return [
-            GlobalHypothesis(
-                float(lw), posterior_from_assignment(locals_[children[i][1]], children[i][2], ctx)
-            )
+            GlobalHypothesis(float(lw), posterior_from_assignment(locals_[children[i][1]], children[i][2], ctx))
             for i, lw in zip(keep, kept_w, strict=True)
         ]
 
@@ -316,3 +310,26 @@ def test_shared_ranking_equals_k_best_of_every_hypothesis(max_increase, enumerat
             for cols, total in ranked:  # columns of the union matrix, only the hypothesis' own
                 assert total == pytest.approx(cost[np.arange(n_meas), cols].sum(), abs=1e-9)
                 assert np.isin(cols[cols < n_union], index).all()
+
+
+def test_budget_gives_a_large_block_only_its_best_assignment_and_says_so():
+    from gnnpmb.events import BudgetReached, ListSink
+
+    unbounded = PmbCore("car", CFG, KBest(CFG.pmbm), IdAllocator())
+    budgeted = PmbCore("car", CFG, KBest(CFG.pmbm, murty_block_rows=1, crowd_hypotheses=1), IdAllocator())
+    frames = cluttered_sequence(seed=2, n_frames=6)
+    sink = ListSink()
+    for meas in frames:
+        unbounded.step(meas, 0.5, NullSink())
+        budgeted.step(meas, 0.5, sink)
+    reached = sink.of_type(BudgetReached)
+    assert reached and all(e.limit == 1 and e.needed > 1 for e in reached)
+    # with every block over budget and one hypothesis expanded, each frame keeps a single global hypothesis
+    assert len(budgeted.hypotheses) == 1 < len(unbounded.hypotheses)
+
+
+def test_budget_not_reached_changes_nothing():
+    a = PmbCore("car", CFG, KBest(CFG.pmbm), IdAllocator())
+    b = PmbCore("car", CFG, KBest(CFG.pmbm, murty_block_rows=10**6, crowd_hypotheses=10**6), IdAllocator())
+    for meas in cluttered_sequence(seed=3, n_frames=10):
+        assert a.step(meas, 0.5, NullSink()) == b.step(meas, 0.5, NullSink())

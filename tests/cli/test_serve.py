@@ -1,0 +1,70 @@
+"""``gnnpmb-viz --serve`` in a real process without a display: the web viewer answers on its port, the gRPC port
+is open, the URL is printed, and Ctrl-C ends the run with exit code 0."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+from cli.serve import ServeTarget, check_display
+from gnnpmb.errors import GnnpmbError
+
+BIN = Path(sys.executable).parent
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def test_serve_prints_the_url_serves_the_viewer_and_stops_on_ctrl_c(demo_dataroot: Path) -> None:
+    target = ServeTarget(_free_port(), _free_port())
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    argv = [str(BIN / "gnnpmb-viz"), "scene-0103", "--dataroot", str(demo_dataroot), "--tracker", "gnn"]
+    argv += ["--frames", "0:2", "--no-failures", "--no-progress", "--serve"]
+    argv += ["--web-port", str(target.web_port), "--grpc-port", str(target.grpc_port)]
+    proc = subprocess.Popen(
+        argv,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    try:
+        lines = []
+        while not (lines and lines[-1].startswith("serving")):
+            line = proc.stderr.readline()
+            assert line, f"ended early: {lines}"
+            lines.append(line)
+        assert lines[0].strip() == f"web viewer: {target.url}"
+        page = urllib.request.urlopen(f"http://localhost:{target.web_port}/", timeout=30).read()
+        assert b"<html" in page.lower()
+        socket.create_connection(("localhost", target.grpc_port), timeout=10).close()
+    finally:
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    assert out.strip().endswith(f"served at {target.url}")
+
+
+def test_url_points_the_viewer_at_the_grpc_server() -> None:
+    assert ServeTarget(9090, 9876).url == "http://localhost:9090/?url=rerun%2Bhttp%3A%2F%2Flocalhost%3A9876%2Fproxy"
+
+
+def test_no_display_is_refused_on_linux(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(sys, "platform", "linux")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    with pytest.raises(GnnpmbError, match="--save OUT.rrd .* --serve"):
+        check_display()
+    monkeypatch.setenv("WAYLAND_DISPLAY", "wayland-0")
+    check_display()
