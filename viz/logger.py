@@ -755,6 +755,13 @@ class TrackerLogger:
                 "DEBUG",
             )
 
+    def _on_budget(self, event: BudgetReached) -> None:
+        self._text(
+            event.class_name,
+            f"budget {event.budget} = {event.limit} reached (this frame needed {event.needed}); work was cut",
+            "WARN",
+        )
+
     def _story_close_calls(self, d: Decisions) -> None:
         """Close calls that involve a reported track (between candidates they are routine)."""
         for conflict in d.conflicts:
