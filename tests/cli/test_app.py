@@ -17,6 +17,7 @@ from gnnpmb.config import TrackerConfig
 from gnnpmb.errors import DataError, GnnpmbError, UnknownNameError
 from gnnpmb.pipeline import run_tracker
 from gnnpmb.provenance import PACKAGES
+from gnnpmb.registry import TRACKER_NAMES
 from tests.viz.rrd import at_frame, read_rows
 from viz import paths
 from viz.provenance import PROPERTY_ENTITY, read_provenance
@@ -247,7 +248,7 @@ def test_a_real_process_prints_no_traceback(tmp_path: Path) -> None:
     )
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
-        "error: unknown tracker 'nope'; choose one of: gnnpmb, pmbm, topmb, phd, cphd, jpda, gnn"
+        f"error: unknown tracker 'nope'; choose one of: {', '.join(TRACKER_NAMES)}"
     ]
     assert list(tmp_path.iterdir()) == []
 
