@@ -251,7 +251,7 @@ def test_a_real_process_prints_no_traceback(tmp_path: Path) -> None:
     )
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
-        "error: unknown tracker 'nope'; choose one of: gnnpmb, pmbm, topmb, phd, cphd, jpda, gnn"
+        "error: unknown tracker 'nope'; choose one of: gnnpmb, pmbm, topmb, phd, cphd, jpda, gnn, greedy"
     ]
     assert list(tmp_path.iterdir()) == []
 
