@@ -101,6 +101,7 @@ RULES: dict[str, Range] = {
     "classes.r_vx": _POSITIVE,
     "classes.r_vy": _POSITIVE,
     "pmb.measure_velocity": Range(0.0, 1.0, True, True),
+    "pmb.clutter_velocity_density": _POSITIVE,
 }
 """Allowed range of every parameter, by ``section.key`` (``classes.key`` for the per-class models). Covariance
 entries: Q may be 0 (no process noise), R must be > 0 (a zero R makes a perfect sensor and a singular S)."""
@@ -181,6 +182,9 @@ class PmbParams:
     - birth_weight 0.3 (paper 0.1): the prior rate of new objects per detection; a larger one makes a detection's
       first Bernoulli more likely (r_new = w s N / (c + w s N)), so a new object's first box is scored higher.
     measure_velocity: 1 = measure [x, y, vx, vy] (opt-in variant, ``kalman``), 0 = the paper's [x, y].
+    clutter_velocity_density: with measure_velocity = 1 the clutter intensity is per m^2 per (m/s)^2, so it is
+    clutter_intensity x this density of a clutter detection's velocity (default: uniform over a 20 x 20 m/s
+    square, 1/400); unused otherwise.
     """
 
     p_survive: float = 0.95
@@ -192,6 +196,7 @@ class PmbParams:
     prune_existence: float = 1e-6
     extraction_threshold: float = 0.01
     measure_velocity: int = 0
+    clutter_velocity_density: float = 1.0 / 400.0
 
     def __post_init__(self) -> None:
         validate_section(self, "pmb")

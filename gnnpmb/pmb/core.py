@@ -281,7 +281,8 @@ class PmbCore:
         model = cv_model(dt_s, self.class_params, p.measure_velocity == 1)
         if p.measure_velocity == 1:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
-        new = new_track_hypotheses(measurement_birth(meas, p), meas, model.R, p.clutter_intensity)
+        clutter = p.clutter_intensity * (p.clutter_velocity_density if p.measure_velocity == 1 else 1.0)
+        new = new_track_hypotheses(measurement_birth(meas, p), meas, model.R, clutter)
         priors, locals_ = self._predict_and_localise(meas, model, new)
         if sink.enabled:
             self._emit_prior(locals_[0], sink)

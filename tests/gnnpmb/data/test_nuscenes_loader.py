@@ -58,7 +58,7 @@ def test_env_dataroot_used_and_checked(demo_dataroot: Path, tmp_path: Path, monk
 
 
 def test_falls_back_to_the_demo(demo_dataroot: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(loader, "ensure_demo_dataset", lambda: demo_dataroot)
+    monkeypatch.setattr(loader, "ensure_demo_dataset", lambda needs=(): demo_dataroot)
     loc = resolve_dataroot(None, None)
     assert loc.synthetic and loc.version == DEMO_VERSION and loc.dataroot == demo_dataroot.resolve()
     with pytest.raises(DataError, match="demo dataset only has version v1.0-mini"):

@@ -46,7 +46,8 @@ def test_birth_then_update_with_velocity_measurement_match_hand_computation():
     Pb = np.diag([P.birth_pos_std_m**2] * 2 + [P.birth_vel_std_mps**2] * 2)
     lik = P.birth_weight * s1 * gauss(np.zeros(4), Pb + R4)
     b = core.hypotheses[0].bernoullis
-    assert b.existence[0] == pytest.approx(lik / (P.clutter_intensity + lik), rel=1e-9)
+    clutter = P.clutter_intensity * P.clutter_velocity_density  # per m^2 per (m/s)^2
+    assert b.existence[0] == pytest.approx(lik / (clutter + lik), rel=1e-9)
     K = Pb @ np.linalg.inv(Pb + R4)
     cov1 = (np.eye(4) - K) @ Pb
     np.testing.assert_allclose(b.mean[0], [*z1, *v1], atol=1e-12)
