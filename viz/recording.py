@@ -68,7 +68,7 @@ def open_recording(
     _PENDING[stream.get_recording_id()] = tmp
     try:
         stream.save(tmp, default_blueprint=blueprint)
-    except Exception:
+    except BaseException:  # Ctrl-C while the blueprint is written must not leave the temp file either
         _discard(stream)
         raise
     return stream

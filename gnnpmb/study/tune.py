@@ -48,7 +48,7 @@ DEFAULT_CLASS_SPACE: dict[str, tuple[float, float, bool]] = {
     "nms_iou_3d": (0.01, 0.5, False),
     "birth_weight": (1e-3, 1.0, True),
     "birth_pos_std_m": (1.0, 30.0, True),
-    "extraction_threshold": (0.3, 0.95, False),
+    "extraction_threshold": (0.005, 0.95, True),
     "q_x": (0.005, 2.0, True),
     "q_y": (0.005, 2.0, True),
     "r_x": (0.01, 1.0, True),

@@ -52,8 +52,7 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     demo_dataroot: Path, tmp_path: Path, failures_and_runs
 ) -> None:
     report, _ = failures_and_runs
-    ids = report.ids()
-    pick = next(i for i in ids if not i.startswith("miss:"))
+    pick = next(i for i, f in zip(report.ids(), report.failures, strict=True) if f.gt_ids and f.track_ids)
     failure = report.by_id(pick)
     out, stdout = record(demo_dataroot, tmp_path, pick)
     assert f"focus: {pick} at frame {failure.frame_index} (gnnpmb): {failure.describe()}" in stdout
@@ -99,7 +98,7 @@ def test_focus_in_a_comparison_highlights_each_trackers_tracks(
     demo_dataroot: Path, tmp_path: Path, failures_and_runs
 ) -> None:
     report, _ = failures_and_runs
-    pick = next(i for i in report.ids() if not i.startswith("miss:"))
+    pick = next(i for i, f in zip(report.ids(), report.failures, strict=True) if f.gt_ids and f.track_ids)
     out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", "gnn"))
     rows = read_rows(out)
     summary = rows[focus_doc()][0]["TextDocument:text"][0]

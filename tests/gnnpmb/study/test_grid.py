@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from gnnpmb.config import TrackerConfig
+from gnnpmb.config import PmbParams, TrackerConfig
 from gnnpmb.study.grid import (
     StudyError,
     base_value,
@@ -76,7 +76,7 @@ def test_configurations_go_through_the_config_loader() -> None:
 
 def test_base_values() -> None:
     config = TrackerConfig()
-    assert base_value(config, "pmb.birth_weight") == 0.1
+    assert base_value(config, "pmb.birth_weight") == PmbParams().birth_weight
     assert base_value(config, "car.q_x") == 0.1589
     assert base_value(config, "*.q_x") is None  # differs between classes
     assert base_value(config, "pmb.no_such_key") is None

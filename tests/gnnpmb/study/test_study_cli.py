@@ -16,6 +16,7 @@ from cli.batch import app
 from cli.errors import run_app
 from gnnpmb.config import load_config
 from gnnpmb.study.results import TIME_COLUMNS
+from gnnpmb.study.tune import DEFAULT_CLASS_SPACE
 
 SWEEP = ["--param", "pmb.extraction_threshold=0.5,0.9", "--no-progress", "--detector", "pointpillars"]
 
@@ -140,10 +141,10 @@ def test_tune_writes_a_params_file_that_track_accepts(
         texts.append(params.read_text())
     text = texts[0]
     assert texts[1] == text  # one worker: deterministic for a seed
-    assert "# search space: car.q_x in [0.005, 2] log" in text
+    assert "car.q_x in [0.005, 2] log" in text.split("# search space:", 1)[1].split("\n", 1)[0]
     assert "# trials: 2 of 2 (Optuna TPE sampler, seed 0, in process)" in text
     assert set(tomllib.loads(text)) == {"classes"}
-    assert set(tomllib.loads(text)["classes"]["car"]) == {"q_x", "q_y", "r_x", "r_y"}
+    assert set(tomllib.loads(text)["classes"]["car"]) == set(DEFAULT_CLASS_SPACE)  # every per-class key
     params = tmp_path / "tuned.toml"
     assert load_config(params).classes["car"].q_x == tomllib.loads(text)["classes"]["car"]["q_x"]
     out = tmp_path / "results.json"
