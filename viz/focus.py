@@ -136,15 +136,18 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
         if empty:
             parts.append(f"nothing in its gate at frame{'s' if len(empty) > 1 else ''} {_frames(empty)}")
         if passed:
-            parts.append(
-                f"detections in its gate but given elsewhere at frame{'s' if len(passed) > 1 else ''} {_frames(passed)}"
-            )
-        first, final = steps[frames[0]], steps[frames[-1]]
-        after = (
-            "pruned" if final.posterior_existence != final.posterior_existence else f"{final.posterior_existence:.2f}"
+            went = []
+            for f in passed:
+                sent = ", ".join(f"m{m} -> {logger.given.get(f, {}).get(m, '?')}" for m, _nis in steps[f].gated)
+                went.append(f"{f} ({sent})")
+            plural = "s" if len(passed) > 1 else ""
+            parts.append(f"detections in its gate went elsewhere at frame{plural} {'; '.join(went)}")
+        peak = max(frames, key=lambda f: _after(steps[f]))
+        parts.append(
+            f"existence after update {_after(steps[peak]):.2f} at frame {peak} -> "
+            f"{_after(steps[frames[-1]]):.2f} at frame {frames[-1]}"
         )
-        parts.append(f"existence {first.prior_existence:.2f} at frame {frames[0]} -> {after} at frame {frames[-1]}")
-        parts.append("reported" if final.reported else "not reported")
+        parts.append("shown as a track" if steps[frames[-1]].reported else "not shown as a track")
         out.append(f"**track {t}**: " + "; ".join(parts) + ".")
     return out
 
@@ -206,7 +209,7 @@ def _gt_markdown(
                 "",
                 f"GT {short_id(gt_id)}, frame by frame:",
                 "",
-                "| frame | nearest detection | sent to | reported tracks on it |",
+                "| frame | nearest detection | sent to | tracks shown on it |",
                 "|---|---|---|---|",
                 *rows,
                 "",
@@ -227,7 +230,7 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
         out += [
             f"Track {t}, frame by frame:",
             "",
-            "| frame | r before update | in gate (NIS) | given | r after | reported |",
+            "| frame | r before update | in gate (NIS) | given | r after | shown |",
             "|---|---|---|---|---|---|",
         ]
         for f in sorted(steps):
