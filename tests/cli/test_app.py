@@ -122,16 +122,22 @@ def test_recording_name_and_provenance(full_run: tuple[Path, str], demo_dataroot
     digest = p.track_digests["gnnpmb"]
     assert digest.frame_indices == tuple(range(N_FRAMES)) and len(set(digest.frames)) > N_FRAMES // 2
     readable = rows[PROPERTY_ENTITY.lstrip("/")][0]
-    assert readable["command"] == [f"gnnpmb-viz {SCENE} --dataroot {demo_dataroot} --save {out} --no-progress"]
+    assert readable["command"] == [
+        f"gnnpmb-viz {SCENE} --dataroot {demo_dataroot} --save {out} --no-progress"
+    ]
     assert readable["frames"] == [f"0:{N_FRAMES}"] and readable["seed"] == ["0"]
     assert readable["track_digests"] == [f"gnnpmb {digest.overall[:16]}"]
 
 
-def test_reproduce_reports_identical_tracks(full_run: tuple[Path, str], capsys: pytest.CaptureFixture[str]) -> None:
+def test_reproduce_reports_identical_tracks(
+    full_run: tuple[Path, str], capsys: pytest.CaptureFixture[str]
+) -> None:
     code, out, err = run(["reproduce", str(full_run[0])], capsys)
     assert (code, err) == (0, "")
     lines = out.strip().splitlines()
-    assert lines[0].startswith(f"{SCENE} (synthetic demo), keyframes 0:{N_FRAMES}, detections: simulated centerpoint")
+    assert lines[0].startswith(
+        f"{SCENE} (synthetic demo), keyframes 0:{N_FRAMES}, detections: simulated centerpoint"
+    )
     assert lines[1:] == [f"gnnpmb: identical ({N_FRAMES} frames)"]
 
 
@@ -212,7 +218,9 @@ def test_bad_input_is_one_line_and_leaves_no_recording(
     _truncated_submission(tmp_path / "truncated.json")
     _malformed_submission(tmp_path / "malformed.json")
     argv = [
-        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(a, a)
+        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(
+            a, a
+        )
         for a in argv
     ]
     out = tmp_path / "out" / "x.rrd"
@@ -225,7 +233,9 @@ def test_bad_input_is_one_line_and_leaves_no_recording(
 
 
 def test_missing_dataroot_and_bad_save_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run([SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys)
+    code, _, err = run(
+        [SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys
+    )
     assert code == 2 and "does not exist" in err and err.count("\n") == 1
     code, _, err = run([SCENE, "--save", str(tmp_path / "no" / "x.rrd")], capsys)
     assert code == 2 and "does not exist; create it first" in err
@@ -274,14 +284,18 @@ def test_failures_are_skipped_with_a_notice_without_ground_truth(
         keyframes=tuple(dataclasses.replace(k, gt=Boxes.empty()) for k in request.scene.keyframes),
     )
     calls: list[None] = []
-    notices = log_failures_of(None, dataclasses.replace(request, scene=unannotated), [], lambda: calls.append(None))
+    notices = log_failures_of(
+        None, dataclasses.replace(request, scene=unannotated), [], lambda: calls.append(None)
+    )
     assert notices == [f"{SCENE} has no ground-truth boxes (no annotations): failure markers skipped"]
 
     def not_in_a_split(*_args, **_kwargs):
         raise DataError(f"scene {SCENE} is in no nuScenes split, so the devkit cannot evaluate it")
 
     monkeypatch.setattr(failures, "find_failures", not_in_a_split)
-    runs = [run_tracker(request.scene, request.detections, "gnn", request.config, frame_range=request.frame_range)]
+    runs = [
+        run_tracker(request.scene, request.detections, "gnn", request.config, frame_range=request.frame_range)
+    ]
     notices = log_failures_of(None, request, runs, lambda: calls.append(None))
     assert notices == [
         f"failure markers skipped: scene {SCENE} is in no nuScenes split, so the devkit cannot evaluate it"

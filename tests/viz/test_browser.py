@@ -98,7 +98,9 @@ def test_comparison_recording_renders_in_headless_chromium(
         pytest.skip(f"no Chromium at {CHROMIUM} (set GNNPMB_REQUIRE_BROWSER=1 to make this a failure)")
     rrd = tmp_path / "comparison.rrd"
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-        main(["scene-0103", "-t", "gnnpmb", "-t", "pmbm", "--dataroot", str(demo_dataroot), "--save", str(rrd)])
+        main(
+            ["scene-0103", "-t", "gnnpmb", "-t", "pmbm", "--dataroot", str(demo_dataroot), "--save", str(rrd)]
+        )
     assert rrd.is_file()
     shot = tmp_path / "comparison.png"
     result = check_recording(rrd, shot, n_views=2, timeout_s=420.0, work_dir=tmp_path / "web")

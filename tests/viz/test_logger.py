@@ -292,6 +292,5 @@ def test_gates_of_unlikely_candidates_are_not_drawn(saved_stream: tuple[rr.Recor
     stream.disconnect()
     strips = latest_at(read_rows(path)[paths.gates(T, "car")], 1, "LineStrips3D:strips")
     assert len(strips) == 1  # track 1 (prior r = 0.68) only; track 2 (r = 0.28) is below 0.5
-    np.testing.assert_allclose(
-        np.hypot(np.array(strips[0])[:, 0] - 10.0, np.array(strips[0])[:, 1] - 2.0), np.sqrt(40.0), rtol=1e-6
-    )
+    np.testing.assert_allclose(np.hypot(np.array(strips[0])[:, 0] - 10.0, np.array(strips[0])[:, 1] - 2.0),
+                               np.sqrt(40.0), rtol=1e-6)
