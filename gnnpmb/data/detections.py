@@ -54,6 +54,8 @@ MAX_ABS_COORD_M = 1e5
 """Largest accepted |x|, |y|, |z| of a box centre in the global frame (nuScenes maps span a few km)."""
 MAX_SIZE_M = 100.0
 """Largest accepted box width, length or height; sizes must also be positive."""
+MAX_SPEED_MPS = 200.0
+"""Largest accepted |vx|, |vy| of a box (NaN is allowed: unknown velocity, read as 0)."""
 MIN_QUAT_NORM = 1e-6
 """A rotation quaternion shorter than this has no direction (e.g. all zeros)."""
 _CACHE_FILES = 2
@@ -124,12 +126,15 @@ def _all_numbers(value: Any) -> bool:
 
 
 def _physical_problem(name: str, values: np.ndarray) -> str | None:
-    """Why (n, k) finite values of field ``name`` cannot be a real box, or None: centres beyond
-    ``MAX_ABS_COORD_M``, sizes not in (0, ``MAX_SIZE_M``], quaternions of (almost) zero length."""
+    """Why (n, k) values of field ``name`` cannot be a real box, or None: centres beyond ``MAX_ABS_COORD_M``,
+    sizes not in (0, ``MAX_SIZE_M``], speeds beyond ``MAX_SPEED_MPS`` (NaN, unknown, passes), quaternions of
+    (almost) zero length."""
     if name == "translation" and (np.abs(values) > MAX_ABS_COORD_M).any():
         return f"is beyond {MAX_ABS_COORD_M:.0e} m from the map origin"
     if name == "size" and ((values <= 0.0) | (values > MAX_SIZE_M)).any():
         return f"must be positive and at most {MAX_SIZE_M:g} m"
+    if name == "velocity" and (np.abs(values) > MAX_SPEED_MPS).any():
+        return f"is faster than {MAX_SPEED_MPS:g} m/s"
     if name == "rotation" and (np.linalg.norm(values, axis=1) < MIN_QUAT_NORM).any():
         return "is not a rotation (a quaternion of zero length)"
     return None

@@ -9,10 +9,11 @@
 Both thresholds may differ per class (``TrackerConfig.preprocess_by_class``).
 
 Boxes that cannot be real (a NaN or infinite field, a centre beyond ``MAX_ABS_COORD_M``, a size not in
-(0, ``MAX_SIZE_M``], a zero quaternion, a score outside [0, 1]) are never kept either: a detection file with
-such a box is refused when read (``gnnpmb.data.detections``), and this keeps the trackers safe from boxes built
-in code. Boxes whose class is not among the tracked ``classes`` are simply not kept: neither ``below_threshold`` nor
-``suppressed_by_nms`` is set for them, so the viewer can tell "not tracked" apart from "filtered out".
+(0, ``MAX_SIZE_M``], a speed beyond ``MAX_SPEED_MPS``, a zero quaternion, a score outside [0, 1]) are never
+kept either: a detection file with such a box is refused when read (``gnnpmb.data.detections``), and this keeps
+the trackers safe from boxes built in code. Boxes whose class is not among the tracked ``classes`` are simply
+not kept: neither ``below_threshold`` nor ``suppressed_by_nms`` is set for them, so the viewer can tell "not
+tracked" apart from "filtered out".
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import numpy as np
 
 from gnnpmb.config import PreprocessParams
 from gnnpmb.data.boxes3d import iou_3d, overlap_candidates, yaw_from_quat_wxyz
-from gnnpmb.data.detections import MAX_ABS_COORD_M, MAX_SIZE_M, MIN_QUAT_NORM
+from gnnpmb.data.detections import MAX_ABS_COORD_M, MAX_SIZE_M, MAX_SPEED_MPS, MIN_QUAT_NORM
 from gnnpmb.types import Boxes, FrameDetections
 
 
@@ -69,7 +70,7 @@ def usable(boxes: Boxes) -> np.ndarray:
             & ((boxes.size_wlh_m > 0.0) & (boxes.size_wlh_m <= MAX_SIZE_M)).all(axis=1)
             & (np.linalg.norm(np.nan_to_num(boxes.quat_wxyz), axis=1) >= MIN_QUAT_NORM)
             & np.isfinite(boxes.quat_wxyz).all(axis=1)
-            & np.isfinite(boxes.velocity_mps).all(axis=1)
+            & (np.abs(boxes.velocity_mps) <= MAX_SPEED_MPS).all(axis=1)
             & (boxes.score >= 0.0)
             & (boxes.score <= 1.0)
         )

@@ -225,3 +225,4 @@ class VectorTracker(ABC):
                 threshold=self.gate_chi2,
             )
         )
+

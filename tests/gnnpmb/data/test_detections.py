@@ -112,6 +112,7 @@ def test_not_a_submission(tmp_path):
         (lambda b: b.update(size=[1.9, None, 1.6]), "field 'size' must"),
         (lambda b: b.update(detection_score="0.8"), "field 'detection_score' must be a number, got '0.8'"),
         (lambda b: b.update(detection_score=True), "field 'detection_score' must be a number"),
+        (lambda b: b.update(velocity=[1e308, 0.0]), "field 'velocity' is faster than 200 m/s"),
     ],
 )
 def test_malformed_box_names_sample_and_field(tmp_path, change, message):
