@@ -61,9 +61,7 @@ def main() -> None:
             alone = min(timed_run(scene, detections, frames, tracker, config, None) for _ in range(args.repeats))
             logged = min(timed_run(scene, detections, frames, tracker, config, out) for _ in range(args.repeats))
             chunks = sum(1 for _ in RrdReader(out).store().stream())
-            print(
-                f"{tracker:8} {1000 * alone / n:15.2f} {1000 * logged / n:18.2f} {logged / alone:6.2f} {chunks:7d}"
-            )
+            print(f"{tracker:8} {1000 * alone / n:15.2f} {1000 * logged / n:18.2f} {logged / alone:6.2f} {chunks:7d}")
 
 
 if __name__ == "__main__":

@@ -83,8 +83,10 @@ def main() -> None:
         dets = get_detections(scene, None, args.preset, seed=0)
         inputs.append((scene, dets, preprocess_frames(scene, dets, config, TRACKING_CLASSES)))
     n_dets = [int(f.kept.sum()) for _, _, frames in inputs for f in frames]
-    print(f"demo mini_val: {len(scenes)} scenes, {len(n_dets)} frames, {np.mean(n_dets):.1f} kept detections/frame "
-          f"(max {max(n_dets)}), preset {args.preset}")
+    print(
+        f"demo mini_val: {len(scenes)} scenes, {len(n_dets)} frames, {np.mean(n_dets):.1f} kept detections/frame "
+        f"(max {max(n_dets)}), preset {args.preset}"
+    )
     print(f"{'tracker':8s} {'median ms':>10s} {'p90 ms':>8s} {'max ms':>8s} {'stress ms':>10s} {'stress dets':>12s}")
     for tracker in args.tracker or TRACKER_NAMES:
         per_frame: list[float] = []
@@ -97,8 +99,10 @@ def main() -> None:
             per_frame.extend(best.tolist())
         t = np.array(per_frame) * 1e3
         stress_s, stress_n = time_stress(tracker, config, args.stress_n)
-        print(f"{tracker:8s} {np.median(t):10.2f} {np.percentile(t, 90):8.2f} {t.max():8.2f} "
-              f"{stress_s * 1e3:10.1f} {stress_n:12d}")
+        print(
+            f"{tracker:8s} {np.median(t):10.2f} {np.percentile(t, 90):8.2f} {t.max():8.2f} "
+            f"{stress_s * 1e3:10.1f} {stress_n:12d}"
+        )
 
 
 if __name__ == "__main__":

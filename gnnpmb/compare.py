@@ -133,9 +133,7 @@ def match_to_gt(
     out = np.full(n_gt, -1, dtype=np.int64)
     if n_gt == 0 or n_tracks == 0:
         return out
-    dist = np.linalg.norm(
-        np.asarray(gt_xy, float)[:, None, :] - np.asarray(track_xy, float)[None, :, :], axis=2
-    )
+    dist = np.linalg.norm(np.asarray(gt_xy, float)[:, None, :] - np.asarray(track_xy, float)[None, :, :], axis=2)
     ok = (np.asarray(gt_class, dtype=object)[:, None] == np.asarray(track_class, dtype=object)[None, :]) & (
         dist < max_dist_m
     )
@@ -190,9 +188,7 @@ def compare_trackers(
     indices = tuple(range(len(gt))) if frame_indices is None else tuple(int(i) for i in frame_indices)
     for name in names:
         if len(estimates[name]) != len(gt):
-            raise ValueError(
-                f"{name} has {len(estimates[name])} frames of estimates for {len(gt)} frames of GT"
-            )
+            raise ValueError(f"{name} has {len(estimates[name])} frames of estimates for {len(gt)} frames of GT")
     if len(indices) != len(gt):
         raise ValueError(f"got {len(indices)} frame indices for {len(gt)} frames")
     last_id: dict[str, dict[str, int]] = {name: {} for name in names}

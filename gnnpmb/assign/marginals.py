@@ -70,9 +70,7 @@ def check_log_inputs(log_ratio: np.ndarray, log_new_weight: np.ndarray) -> tuple
 
 def _check_shapes(ratio: np.ndarray, new_weight: np.ndarray) -> None:
     if ratio.ndim != 2 or new_weight.ndim != 1 or ratio.shape[1] != new_weight.shape[0]:
-        raise ValueError(
-            f"expected ratio (K, M) and new_weight (M,), got shapes {ratio.shape} and {new_weight.shape}"
-        )
+        raise ValueError(f"expected ratio (K, M) and new_weight (M,), got shapes {ratio.shape} and {new_weight.shape}")
 
 
 def normalised_weights(

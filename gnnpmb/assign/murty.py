@@ -114,9 +114,7 @@ def rank(cost: np.ndarray, first: np.ndarray | None = None, max_increase: float 
     return Product(base, parts, max_increase)
 
 
-def block_ranking(
-    cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf
-) -> Ranking:
+def block_ranking(cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf) -> Ranking:
     """Ranking of one block (not split): a sorted row for a single row, enumeration when small, else Murty;
     only assignments at most ``max_increase`` costlier than the best. ``root``: a best assignment to rank
     first (else found here). Raises ``InfeasibleAssignment``."""
@@ -135,9 +133,7 @@ def _candidates(cost: np.ndarray) -> float:
     return float(np.prod(np.count_nonzero(cost < np.inf, axis=1), dtype=float))
 
 
-def forbid_beyond_private(
-    cost: np.ndarray, max_increase: float, usable: np.ndarray | None = None
-) -> np.ndarray:
+def forbid_beyond_private(cost: np.ndarray, max_increase: float, usable: np.ndarray | None = None) -> np.ndarray:
     """``cost`` with +inf at every (i, j) with c_ij > c_ip + ``max_increase`` for a column p that only row i
     may use (a private column, like a PMB new-track column). Moving row i to p keeps any assignment feasible,
     so one using (i, j) costs more than ``max_increase`` above the best; the best assignment keeps its
@@ -202,9 +198,7 @@ class SingleRow:
 
     def __init__(self, cost_row: np.ndarray, root: int, max_increase: float = math.inf):
         order = np.argsort(cost_row, kind="stable")
-        keep = (
-            (cost_row[order] < np.inf) & (cost_row[order] <= cost_row[root] + max_increase) & (order != root)
-        )
+        keep = (cost_row[order] < np.inf) & (cost_row[order] <= cost_row[root] + max_increase) & (order != root)
         self._cols = np.concatenate([[root], order[keep]]).astype(np.int64)
         self._costs = cost_row[self._cols]
 
@@ -291,9 +285,7 @@ class Murty:
                 self._push_child(sol, q, row, free, row_barred)
             free[sol[q]] = False
 
-    def _push_child(
-        self, sol: np.ndarray, q: int, row: np.ndarray, free: np.ndarray, barred: tuple[int, ...]
-    ) -> None:
+    def _push_child(self, sol: np.ndarray, q: int, row: np.ndarray, free: np.ndarray, barred: tuple[int, ...]) -> None:
         """Solve P_q: rows < q keep ``sol``, row q costs ``row`` (barred and taken columns at +inf), later
         rows use the free columns; queue its best solution if one exists within the limit."""
         child = sol.copy()
@@ -386,9 +378,7 @@ class Product:
         i = choice[last]
         further = self._varying[last][2].solution(i + 1)
         if further is not None:
-            self._push(
-                total + further[1] - self._cost(last, i), (*choice[:last], i + 1, *choice[last + 1 :]), last
-            )
+            self._push(total + further[1] - self._cost(last, i), (*choice[:last], i + 1, *choice[last + 1 :]), last)
         if last + 1 < len(self._varying):
             step = self._cost(last + 1, 1) - self._cost(last + 1, 0)
             self._push(total + step, (*choice[: last + 1], 1, *choice[last + 2 :]), last + 1)

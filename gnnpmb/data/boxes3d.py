@@ -71,9 +71,7 @@ def _inside_convex(
 ) -> np.ndarray:
     """(P, K) bool: whether points (px, py), (P, K) each, lie in (or on) convex CCW polygons with vertices
     (vx, vy) and edge vectors (ex, ey), (P, V) each: edge x (point - vertex) >= 0 for every edge."""
-    cross = ex[:, None, :] * (py[:, :, None] - vy[:, None, :]) - ey[:, None, :] * (
-        px[:, :, None] - vx[:, None, :]
-    )
+    cross = ex[:, None, :] * (py[:, :, None] - vy[:, None, :]) - ey[:, None, :] * (px[:, :, None] - vx[:, None, :])
     return np.all(cross >= -_INSIDE_TOL, axis=2)
 
 
@@ -124,9 +122,7 @@ def convex_intersection_area(poly_a: np.ndarray, poly_b: np.ndarray) -> np.ndarr
     # Unused slots repeat the first vertex: repeated points add nothing to the shoelace sum.
     x = np.where(valid, x, x[:, :1])
     y = np.where(valid, y, y[:, :1])
-    twice_area = np.sum(x[:, :-1] * y[:, 1:] - x[:, 1:] * y[:, :-1], axis=1) + (
-        x[:, -1] * y[:, 0] - x[:, 0] * y[:, -1]
-    )
+    twice_area = np.sum(x[:, :-1] * y[:, 1:] - x[:, 1:] * y[:, :-1], axis=1) + (x[:, -1] * y[:, 0] - x[:, 0] * y[:, -1])
     return np.where(count >= 3, np.maximum(0.5 * twice_area, 0.0), 0.0)
 
 
@@ -147,9 +143,7 @@ def iou_3d(
     top = np.minimum(ta[:, 2] + 0.5 * sa[:, 2], tb[:, 2] + 0.5 * sb[:, 2])
     bottom = np.maximum(ta[:, 2] - 0.5 * sa[:, 2], tb[:, 2] - 0.5 * sb[:, 2])
     overlap_h = np.maximum(top - bottom, 0.0)
-    area = convex_intersection_area(
-        bev_corners(ta[:, :2], sa[:, :2], yaw_a), bev_corners(tb[:, :2], sb[:, :2], yaw_b)
-    )
+    area = convex_intersection_area(bev_corners(ta[:, :2], sa[:, :2], yaw_a), bev_corners(tb[:, :2], sb[:, :2], yaw_b))
     inter = area * overlap_h
     union = np.prod(sa, axis=1) + np.prod(sb, axis=1) - inter
     return np.where(union > 0.0, inter / np.where(union > 0.0, union, 1.0), 0.0)

@@ -212,9 +212,7 @@ def get_preset(preset: str | DetectorPreset) -> DetectorPreset:
     try:
         return PRESETS[preset]
     except KeyError:
-        raise UnknownNameError(
-            f"unknown detector preset '{preset}' (choose one of: {', '.join(PRESETS)})"
-        ) from None
+        raise UnknownNameError(f"unknown detector preset '{preset}' (choose one of: {', '.join(PRESETS)})") from None
 
 
 def _hash64(text: str) -> int:
@@ -222,9 +220,7 @@ def _hash64(text: str) -> int:
 
 
 def _frame_rng(seed: int, scene_token: str, frame_index: int) -> np.random.Generator:
-    return np.random.default_rng(
-        np.random.SeedSequence([seed, _TAG_FRAME, _hash64(scene_token), frame_index])
-    )
+    return np.random.default_rng(np.random.SeedSequence([seed, _TAG_FRAME, _hash64(scene_token), frame_index]))
 
 
 def _instance_offsets(seed: int, scene_token: str, instance_ids: Sequence[str]) -> np.ndarray:
@@ -289,16 +285,10 @@ def _true_detections(
     noise_scale = _class_table(CLASS_NOISE_SCALE, classes)
     xy_std = noise_scale * p.pos_noise_std_m * (1.0 + dist / _NOISE_RANGE_M)
     translation = gt.translation_m.astype(float).copy()
-    translation[:, :2] += (
-        noise_scale[:, None] * p.pos_bias_std_m * offsets[:, :2] + xy_std[:, None] * pos_noise
-    )
+    translation[:, :2] += noise_scale[:, None] * p.pos_bias_std_m * offsets[:, :2] + xy_std[:, None] * pos_noise
     translation[:, 2] += noise_scale * p.z_noise_std_m * (offsets[:, 2] + z_noise)
     size = gt.size_wlh_m * np.exp(p.size_noise_rel * size_noise)
-    yaw = (
-        yaw_from_quat_wxyz(gt.quat_wxyz)
-        + p.yaw_noise_std_rad * yaw_noise
-        + np.pi * (u_flip < p.yaw_flip_prob)
-    )
+    yaw = yaw_from_quat_wxyz(gt.quat_wxyz) + p.yaw_noise_std_rad * yaw_noise + np.pi * (u_flip < p.yaw_flip_prob)
     velocity = np.nan_to_num(gt.velocity_mps.astype(float)) + p.vel_noise_std_mps * vel_noise
     score = score_beta * (_SCORE_FLOOR + (1.0 - _SCORE_FLOOR) * f_range * f_vis)
 
@@ -307,9 +297,7 @@ def _true_detections(
     shift = p.dup_shift_rel * np.minimum(size[:, 0], size[:, 1])[:, None] * dup_shift
     dup_translation = translation.copy()
     dup_translation[:, :2] += shift
-    true_boxes = _make_boxes(translation, size, yaw, velocity, score, classes).subset(
-        np.flatnonzero(detected)
-    )
+    true_boxes = _make_boxes(translation, size, yaw, velocity, score, classes).subset(np.flatnonzero(detected))
     dup_boxes = _make_boxes(
         dup_translation,
         size * np.exp(0.5 * p.size_noise_rel * dup_size),
@@ -361,9 +349,7 @@ def _false_positives(kf: Keyframe, p: DetectorPreset, rng: np.random.Generator) 
     return _clutter(rng, count, ego_xy, p.fp_range_m, classes, score, _ground_z(kf), p.size_noise_rel)
 
 
-def _hotspot_clutter(
-    kf: Keyframe, p: DetectorPreset, rng: np.random.Generator, hotspots: Sequence[Hotspot]
-) -> Boxes:
+def _hotspot_clutter(kf: Keyframe, p: DetectorPreset, rng: np.random.Generator, hotspots: Sequence[Hotspot]) -> Boxes:
     """Ghost boxes at clutter-prone spots in range, of a class confusable with the object nearest the spot."""
     parts = []
     ego_xy = kf.ego_pose.translation_m[:2]
@@ -432,9 +418,7 @@ def simulate_detections(
         new = sorted({i for i in ids if i not in cache})
         cache.update(zip(new, _instance_offsets(seed, scene.token, new), strict=True))
         offsets = np.array([cache[i] for i in ids]).reshape(len(ids), 3)
-        out[kf.sample_token] = simulate_frame(
-            kf, p, _frame_rng(seed, scene.token, kf.index), offsets, hotspots
-        )
+        out[kf.sample_token] = simulate_frame(kf, p, _frame_rng(seed, scene.token, kf.index), offsets, hotspots)
     return out
 
 

@@ -114,9 +114,7 @@ class Failure:
                 return f"{self.class_name} {gt}"
             case FailureKind.COALESCENCE:
                 missed = ", ".join(f"GT {short_id(g)}" for g in self.gt_ids[1:])
-                return (
-                    f"{self.class_name} {tracks[0]} covers GT {short_id(self.gt_ids[0])} and missed {missed}"
-                )
+                return f"{self.class_name} {tracks[0]} covers GT {short_id(self.gt_ids[0])} and missed {missed}"
             case FailureKind.IDENTITY_THEFT:
                 cascade = f" (cascade step {self.generation})" if self.generation > 1 else ""
                 return f"{self.class_name} {tracks[0]} took {gt} from {tracks[1]}{cascade}"
@@ -468,9 +466,7 @@ def find_failures(
         try:
             pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in tokens}, TrackingBox)
         except (AssertionError, KeyError, TypeError, ValueError) as exc:
-            raise DataError(
-                f"the tracking results of {scene_name} are not valid submission boxes: {exc}"
-            ) from None
+            raise DataError(f"the tracking results of {scene_name} are not valid submission boxes: {exc}") from None
         gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
         tracks_gt = create_tracks(_prepared(nusc, gt, cfg), nusc, split, gt=True)
         tracks_pred = create_tracks(_prepared(nusc, pred, cfg), nusc, split, gt=False)
@@ -512,6 +508,4 @@ def find_failures(
             failures += _class_failures(frames, class_name, tokens, cfg.dist_th_tp, coalescence_radius_m)
     kind_order = {kind: i for i, kind in enumerate(FailureKind)}
     failures.sort(key=lambda f: (f.frame_index, kind_order[f.kind], f.class_name, f.gt_ids, f.track_ids))
-    return FailureReport(
-        scene_name, tracker, tuple(tokens), tuple(classes), tuple(failures), coalescence_radius_m
-    )
+    return FailureReport(scene_name, tracker, tuple(tokens), tuple(classes), tuple(failures), coalescence_radius_m)

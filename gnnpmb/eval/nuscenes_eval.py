@@ -145,9 +145,7 @@ class TrackingScores:
         return TrackingScores(per_class, overall, float(summary["eval_time"]), summary_path)
 
 
-def run_tracking_eval(
-    results_path: Path, dataroot: Path, version: str, split: str, out_dir: Path
-) -> TrackingScores:
+def run_tracking_eval(results_path: Path, dataroot: Path, version: str, split: str, out_dir: Path) -> TrackingScores:
     """Run ``TrackingEval`` quietly (no curves) and move its files into ``out_dir`` atomically.
 
     The devkit writes into a temporary folder beside ``out_dir``; each file then replaces its old version with
@@ -174,9 +172,7 @@ def run_tracking_eval(
                 )
                 summary = evaluation.main(render_curves=False)
             except (AssertionError, ValueError, KeyError) as exc:
-                raise DataError(
-                    f"the nuScenes evaluation rejected {Path(results_path).name}: {exc}"
-                ) from None
+                raise DataError(f"the nuScenes evaluation rejected {Path(results_path).name}: {exc}") from None
         out_dir.mkdir(parents=True, exist_ok=True)
         for name in DEVKIT_FILES:
             os.replace(tmp / name, out_dir / name)
@@ -197,9 +193,7 @@ def evaluate_submission(
     data = read_submission(results_path)  # a broken file fails before the devkit's slow import
     scene_names = split_scenes(split, location)
     if not scene_names:
-        raise DataError(
-            f"split {split} has no scenes in {location.dataroot / location.version}; pick another split"
-        )
+        raise DataError(f"split {split} has no scenes in {location.dataroot / location.version}; pick another split")
     nusc = open_nuscenes(location)
     check_submission(
         data,

@@ -163,15 +163,9 @@ def gate_components(
     if m:
         nu = z - inn.z_pred[k:]
         d2_birth = np.einsum("mi,mij,mj->m", nu, inn.S_inv[k:], nu)
-        log_lik[k + np.arange(m), np.arange(m)] = -0.5 * (
-            d2_birth + inn.log_det_S[k:] + 2.0 * np.log(2.0 * np.pi)
-        )
+        log_lik[k + np.arange(m), np.arange(m)] = -0.5 * (d2_birth + inn.log_det_S[k:] + 2.0 * np.log(2.0 * np.pi))
     pd = np.concatenate([np.full(k, p_detect), np.ones(m)])
-    return Prediction(
-        mixture=mix, n_persistent=k, p_detect=pd, inn=inn, d2=d2, inside=inside, log_lik=log_lik
-    )
-
-
+    return Prediction(mixture=mix, n_persistent=k, p_detect=pd, inn=inn, d2=d2, inside=inside, log_lik=log_lik)
 
 
 def phd_update(
@@ -271,9 +265,7 @@ class GmPhdTracker:
         """True when the filter is empty, so a frame without measurements leaves it unchanged."""
         return not len(self.mixture)
 
-    def _correct(
-        self, pred: Prediction, meas: Measurements, sink: EventSink
-    ) -> tuple[np.ndarray, np.ndarray]:
+    def _correct(self, pred: Prediction, meas: Measurements, sink: EventSink) -> tuple[np.ndarray, np.ndarray]:
         """Log missed (K + M,) and detected (K + M, M) weights of the PHD update (``phd_update``)."""
         return phd_update(pred.mixture.weight, pred.p_detect, pred.log_lik, self.config.pmb.clutter_intensity)
 
@@ -318,9 +310,7 @@ class GmPhdTracker:
         self.mixture = replace(mix, label=labels)
         alive = set(labels.tolist())
         self._copy_ids = {key: v for key, v in self._copy_ids.items() if key[0] in alive}
-        estimates = [
-            self._estimate(i, t) for i, ids in zip(sel.index.tolist(), track_ids, strict=True) for t in ids
-        ]
+        estimates = [self._estimate(i, t) for i, ids in zip(sel.index.tolist(), track_ids, strict=True) for t in ids]
         return estimates, np.asarray(born, dtype=np.int64), relabelled
 
     def _copy_id(self, label: int, copy: int) -> int:
@@ -347,9 +337,7 @@ class GmPhdTracker:
     def _emit_prior(self, pred: Prediction, meas: Measurements, sink: EventSink) -> None:
         prior = pred.persistent
         k = pred.n_persistent
-        sink.emit(
-            Predicted(self.class_name, prior.label, prior.mean, prior.cov, np.minimum(prior.weight, 1.0))
-        )
+        sink.emit(Predicted(self.class_name, prior.label, prior.mean, prior.cov, np.minimum(prior.weight, 1.0)))
         sink.emit(
             Gated(
                 self.class_name,

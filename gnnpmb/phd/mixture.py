@@ -127,9 +127,7 @@ class Reduction:
         order = np.lexsort((-weights, labels))  # by label, heaviest first within a label
         first = np.ones(len(order), dtype=bool)
         first[1:] = labels[order][1:] != labels[order][:-1]
-        return tuple(
-            LostLabel(int(labels[i]), parts[int(reasons[i])].reason, float(weights[i])) for i in order[first]
-        )
+        return tuple(LostLabel(int(labels[i]), parts[int(reasons[i])].reason, float(weights[i])) for i in order[first])
 
 
 def prune(mix: GaussianMixture, threshold: float) -> tuple[GaussianMixture, Removal]:
@@ -260,9 +258,7 @@ def cap(mix: GaussianMixture, max_components: int) -> tuple[GaussianMixture, Rem
     return mix.subset(keep), Removal(PruneReason.CAPPED, mix.label[gone], mix.weight[gone])
 
 
-def reduce_mixture(
-    mix: GaussianMixture, prune_weight: float, merge_threshold: float, max_components: int
-) -> Reduction:
+def reduce_mixture(mix: GaussianMixture, prune_weight: float, merge_threshold: float, max_components: int) -> Reduction:
     """Prune, merge and cap (Vo & Ma 2006, Table II); the result is sorted by decreasing weight."""
     pruned, low = prune(mix, prune_weight)
     merged, record, absorbed = merge(pruned, merge_threshold)

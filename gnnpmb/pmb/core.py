@@ -326,7 +326,8 @@ class PmbCore:
         """Drop Bernoullis with r < threshold from every hypothesis; report tracks that vanished from all."""
         threshold = self.params.prune_existence
         kept = [
-            h if h.bernoullis.existence.min(initial=1.0) >= threshold
+            h
+            if h.bernoullis.existence.min(initial=1.0) >= threshold
             else GlobalHypothesis(h.log_weight, h.bernoullis.subset(h.bernoullis.existence >= threshold))
             for h in posteriors
         ]

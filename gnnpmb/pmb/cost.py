@@ -99,11 +99,7 @@ def local_hypotheses(
     inside = gate(d2, gate_chi2)
     miss_log_lik, miss_existence = missed_update(prior.existence, prior.score)
     with np.errstate(divide="ignore"):
-        det = (
-            np.log(prior.existence)[:, None]
-            + np.log(meas.boxes.score)[None, :]
-            + log_likelihood(inn, d2)
-        )
+        det = np.log(prior.existence)[:, None] + np.log(meas.boxes.score)[None, :] + log_likelihood(inn, d2)
     det_log_lik = np.where(inside, det, -np.inf)
     return LocalHypotheses(
         prior=prior,
@@ -118,12 +114,9 @@ def local_hypotheses(
     )
 
 
-
 def detected_means(local: LocalHypotheses, track_index: np.ndarray, meas_index: np.ndarray) -> np.ndarray:
     """(P, 4) Kalman-updated means for P (track, measurement) pairs given as local row/column indices."""
     if len(track_index) == 0:
         return np.zeros((0, 4))
     nu = local.meas.z[meas_index] - local.inn.z_pred[track_index]
     return local.prior.mean[track_index] + np.einsum("pij,pj->pi", local.inn.gain[track_index], nu)
-
-

@@ -65,6 +65,4 @@ def new_track_hypotheses(
     birth_term = birth.weight * meas.boxes.score * np.exp(log_n)
     total = clutter_intensity + birth_term
     mean = birth.mean + np.einsum("mij,mj->mi", inn.gain, nu)
-    return NewTrackHypotheses(
-        log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=inn.cov_post
-    )
+    return NewTrackHypotheses(log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=inn.cov_post)

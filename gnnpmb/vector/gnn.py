@@ -31,9 +31,7 @@ from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
 COST_DESCRIPTION = "-log[P_D N(z; Hm, S) / ((1 - P_D) kappa)]; new-track column 0 = unassigned"
 
 
-def pair_costs(
-    log_lik: np.ndarray, inside: np.ndarray, p_detect: float, clutter_intensity: float
-) -> np.ndarray:
+def pair_costs(log_lik: np.ndarray, inside: np.ndarray, p_detect: float, clutter_intensity: float) -> np.ndarray:
     """(M, K) costs C[j, k] (module docstring) from (K, M) log N(z_j; H m_k, S_k) and gate; +inf outside."""
     offset = np.log(p_detect) - np.log1p(-p_detect) - np.log(clutter_intensity)
     return np.where(inside, -(log_lik + offset), np.inf).T
@@ -108,8 +106,6 @@ class GnnTracker(VectorTracker):
         new_cols = tuple(AxisLabel(AxisKind.NEW_TRACK, int(i)) for i in meas.source_index)
         cols = track_cols + new_cols
         sink.emit(CostMatrix(self.class_name, full, rows, cols, description=COST_DESCRIPTION))
-        pairs = tuple(
-            (rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist())
-        )
+        pairs = tuple((rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist()))
         missed = tuple(int(t) for t in prior.track_id[meas_of_track < 0])
         sink.emit(Assignment(self.class_name, pairs, total, missed))

@@ -225,4 +225,3 @@ class VectorTracker(ABC):
                 threshold=self.gate_chi2,
             )
         )
-

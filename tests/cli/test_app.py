@@ -127,22 +127,16 @@ def test_recording_name_and_provenance(full_run: tuple[Path, str], demo_dataroot
     digest = p.track_digests["gnnpmb"]
     assert digest.frame_indices == tuple(range(N_FRAMES)) and len(set(digest.frames)) > N_FRAMES // 2
     readable = rows[PROPERTY_ENTITY.lstrip("/")][0]
-    assert readable["command"] == [
-        f"gnnpmb-viz {SCENE} --dataroot {demo_dataroot} --save {out} --no-progress"
-    ]
+    assert readable["command"] == [f"gnnpmb-viz {SCENE} --dataroot {demo_dataroot} --save {out} --no-progress"]
     assert readable["frames"] == [f"0:{N_FRAMES}"] and readable["seed"] == ["0"]
     assert readable["track_digests"] == [f"gnnpmb {digest.overall[:16]}"]
 
 
-def test_reproduce_reports_identical_tracks(
-    full_run: tuple[Path, str], capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_reproduce_reports_identical_tracks(full_run: tuple[Path, str], capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run(["reproduce", str(full_run[0])], capsys)
     assert (code, err) == (0, "")
     lines = out.strip().splitlines()
-    assert lines[0].startswith(
-        f"{SCENE} (synthetic demo), keyframes 0:{N_FRAMES}, detections: simulated centerpoint"
-    )
+    assert lines[0].startswith(f"{SCENE} (synthetic demo), keyframes 0:{N_FRAMES}, detections: simulated centerpoint")
     assert lines[1:] == [f"gnnpmb: identical ({N_FRAMES} frames)"]
 
 
@@ -225,9 +219,7 @@ def test_bad_input_is_one_line_and_leaves_no_recording(
     _truncated_submission(tmp_path / "truncated.json")
     _malformed_submission(tmp_path / "malformed.json")
     argv = [
-        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(
-            a, a
-        )
+        {"TRUNCATED": str(tmp_path / "truncated.json"), "MALFORMED": str(tmp_path / "malformed.json")}.get(a, a)
         for a in argv
     ]
     out = tmp_path / "out" / "x.rrd"
@@ -240,9 +232,7 @@ def test_bad_input_is_one_line_and_leaves_no_recording(
 
 
 def test_missing_dataroot_and_bad_save_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run(
-        [SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys
-    )
+    code, _, err = run([SCENE, "--dataroot", str(tmp_path / "nowhere"), "--save", str(tmp_path / "x.rrd")], capsys)
     assert code == 2 and "does not exist" in err and err.count("\n") == 1
     code, _, err = run([SCENE, "--save", str(tmp_path / "no" / "x.rrd")], capsys)
     assert code == 2 and "does not exist; create it first" in err

@@ -54,9 +54,7 @@ def tracked(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> tu
 
 @pytest.fixture(scope="module")
 def evaluated(tracked: tuple[Path, str], demo_dataroot: Path) -> str:
-    code, stdout = run_quiet(
-        ["eval", str(tracked[0]), "--dataroot", str(demo_dataroot), "--split", "mini_val"]
-    )
+    code, stdout = run_quiet(["eval", str(tracked[0]), "--dataroot", str(demo_dataroot), "--split", "mini_val"])
     assert code == 0
     return stdout
 
@@ -77,14 +75,10 @@ def test_track_writes_a_submission_for_every_sample_of_the_split(tracked: tuple[
     assert sorted(p.name for p in path.parent.iterdir()) == ["results.json"]
 
 
-def test_track_is_deterministic(
-    tracked: tuple[Path, str], demo_dataroot: Path, tmp_path: Path, capsys
-) -> None:
+def test_track_is_deterministic(tracked: tuple[Path, str], demo_dataroot: Path, tmp_path: Path, capsys) -> None:
     again = tmp_path / "again.json"
     argv = ["track", "--dataroot", str(demo_dataroot), "--nuscenes-version", "v1.0-mini", "--split", "mini_val"]
-    code, _, _ = run(
-        [*argv, "--detector", "centerpoint", "--seed", "0", "--out", str(again), "--no-progress"], capsys
-    )
+    code, _, _ = run([*argv, "--detector", "centerpoint", "--seed", "0", "--out", str(again), "--no-progress"], capsys)
     assert code == 0
     assert again.read_bytes() == tracked[0].read_bytes()
 
@@ -112,9 +106,7 @@ def test_failures_lists_frames_and_writes_json(demo_dataroot: Path, tmp_path: Pa
     report = json.loads(report_path.read_text())
     assert report["scene"] == "scene-0916" and len(report["sample_tokens"]) == 40
     totals = report["totals"]
-    assert (
-        f"scene-0916, gnnpmb: {totals['id_switch']} id_switch, {totals['fragmentation']} fragmentation" in out
-    )
+    assert f"scene-0916, gnnpmb: {totals['id_switch']} id_switch, {totals['fragmentation']} fragmentation" in out
     assert "failures per frame" in out and "best-MOTA threshold" in out
     assert sum(totals.values()) == len(report["failures"]) > 0
     for c in report["classes"]:
@@ -174,9 +166,7 @@ def test_track_errors_write_nothing(demo_dataroot: Path, tmp_path: Path, capsys)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dets.json"]
 
 
-def test_eval_errors_are_one_line(
-    demo_dataroot: Path, tracked: tuple[Path, str], tmp_path: Path, capsys
-) -> None:
+def test_eval_errors_are_one_line(demo_dataroot: Path, tracked: tuple[Path, str], tmp_path: Path, capsys) -> None:
     good = json.loads(tracked[0].read_text())
     tokens = list(good["results"])
     missing = {"meta": good["meta"], "results": {t: good["results"][t] for t in tokens[40:]}}

@@ -102,10 +102,7 @@ def test_both_trackers_share_one_timeline(rows: dict) -> None:
         assert boxes and max(r["frame"] for r in boxes) >= N_FRAMES - 5
         misses = [r for r in rows[paths.failure_count(tracker, "miss")] if not r["static"]]
         assert [r["frame"] for r in misses] == list(range(N_FRAMES))
-    assert (
-        paths.failures_world("gnnpmb", "id_switch") in rows
-        or paths.failures_world("gnn", "id_switch") in rows
-    )
+    assert paths.failures_world("gnnpmb", "id_switch") in rows or paths.failures_world("gnn", "id_switch") in rows
 
 
 def test_comparison_counts_log_and_markers(rows: dict, expected: Comparison) -> None:
@@ -123,9 +120,7 @@ def test_comparison_counts_log_and_markers(rows: dict, expected: Comparison) -> 
             assert len(labels) == len(objects)
             assert all(compare.marker_label(d) in "; ".join(labels) for d in found)
     logged = [(r["frame"], r["TextLog:text"][0]) for r in rows[compare.log_path()]]
-    assert logged == [
-        (d.frame_index, f"{compare.KIND_LABELS[d.kind]}: {d.describe()}") for d in expected.disagreements
-    ]
+    assert logged == [(d.frame_index, f"{compare.KIND_LABELS[d.kind]}: {d.describe()}") for d in expected.disagreements]
 
 
 def test_few_chunks_one_per_entity_not_per_bernoulli_or_frame(saved: tuple[Path, str], rows: dict) -> None:
@@ -206,16 +201,12 @@ def test_reproduce_missing_dataroot_and_override(
     code, out, err = run(["reproduce", str(moved)], capsys)
     assert (code, out) == (2, "")
     gone = tmp_path / "gone"
-    assert (
-        err == f"error: the recorded dataroot {gone} does not exist; pass --dataroot DIR with a copy of it\n"
-    )
+    assert err == f"error: the recorded dataroot {gone} does not exist; pass --dataroot DIR with a copy of it\n"
     code, out, err = run(["reproduce", str(moved), "--dataroot", str(demo_dataroot)], capsys)
     assert (code, err) == (0, "") and out.count(": identical") == 2
 
 
-def test_reproduce_rejects_files_without_provenance(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_reproduce_rejects_files_without_provenance(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     plain = tmp_path / "plain.rrd"
     stream = rr.RecordingStream("other-app")
     stream.save(plain)
@@ -310,8 +301,7 @@ def tiny_scene(n: int) -> SceneData:
     """n keyframes 0.5 s apart (only the timestamps matter for logging a comparison)."""
     pose = Pose(np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
     keyframes = tuple(
-        Keyframe(i, f"s{i}", 1_000_000 + 500_000 * i, pose, pose, Path("none"), GT, np.ones(len(GT)))
-        for i in range(n)
+        Keyframe(i, f"s{i}", 1_000_000 + 500_000 * i, pose, pose, Path("none"), GT, np.ones(len(GT))) for i in range(n)
     )
     return SceneData("scene-x", "tok", "", Path("."), "v1.0-mini", True, keyframes)
 
@@ -346,9 +336,7 @@ def test_log_comparison_of_a_hand_made_case(tmp_path: Path) -> None:
         ["only A: track 8"],
     ]
     counts = [
-        r["Scalars:scalars"][0]
-        for r in rows[compare.count_path(DisagreementKind.ONLY_IN_ONE)]
-        if not r["static"]
+        r["Scalars:scalars"][0] for r in rows[compare.count_path(DisagreementKind.ONLY_IN_ONE)] if not r["static"]
     ]
     assert counts == [0.0, 2.0, 1.0]
     log = [(r["frame"], r["TextLog:level"][0], r["TextLog:text"][0]) for r in rows[compare.log_path()]]

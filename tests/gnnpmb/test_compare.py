@@ -30,9 +30,7 @@ def gt_boxes(objects: list[tuple[str, str, float, float]]) -> Boxes:
 
 
 def est(track_id: int, class_name: str, x: float, y: float) -> TrackEstimate:
-    return TrackEstimate(
-        track_id, class_name, (x, y, 1.0), (2.0, 4.5, 1.6), (1.0, 0.0, 0.0, 0.0), (0.0, 0.0), 0.9, 1.0
-    )
+    return TrackEstimate(track_id, class_name, (x, y, 1.0), (2.0, 4.5, 1.6), (1.0, 0.0, 0.0, 0.0), (0.0, 0.0), 0.9, 1.0)
 
 
 GT = gt_boxes([("g1-token-0001", "car", 0.0, 0.0), ("g2", "car", 10.0, 0.0), ("p1", "pedestrian", 20.0, 5.0)])

@@ -22,9 +22,7 @@ def ranking_mode(request, monkeypatch):
 
 def random_cost(rng: np.random.Generator, n_rows: int, n_cols: int, integer: bool) -> np.ndarray:
     """Random costs (small integers give many ties) with a random share of forbidden entries."""
-    cost = (
-        rng.integers(0, 4, size=(n_rows, n_cols)).astype(float) if integer else rng.random((n_rows, n_cols))
-    )
+    cost = rng.integers(0, 4, size=(n_rows, n_cols)).astype(float) if integer else rng.random((n_rows, n_cols))
     cost[rng.random((n_rows, n_cols)) < rng.uniform(0.0, 0.6)] = np.inf
     return cost
 

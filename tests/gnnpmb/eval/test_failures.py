@@ -133,9 +133,7 @@ def test_staged_coalescence_is_reported(nusc, scene: SceneData, gt: dict) -> Non
         ("matched gt", a),
         ("missed gt", b),
     }
-    assert any(
-        f.kind is FailureKind.MISS and f.gt_ids == (b,) and f.frame_index == k for f in report.failures
-    )
+    assert any(f.kind is FailureKind.MISS and f.gt_ids == (b,) and f.frame_index == k for f in report.failures)
     assert not report.of_kind(FailureKind.ID_SWITCH)
 
 
@@ -145,10 +143,7 @@ def _free_spot(scene: SceneData, frame: int, class_name: str, near: np.ndarray) 
     same = kf.gt.translation_m[kf.gt.class_name == class_name, :2]
     for angle in np.linspace(0.0, 2 * np.pi, 16, endpoint=False):
         spot = near + 6.0 * np.array([np.cos(angle), np.sin(angle)])
-        if (
-            np.min(np.hypot(*(same - spot).T)) >= 3.5
-            and np.hypot(*(spot - kf.ego_pose.translation_m[:2])) < 35
-        ):
+        if np.min(np.hypot(*(same - spot).T)) >= 3.5 and np.hypot(*(spot - kf.ego_pose.translation_m[:2])) < 35:
             return spot
     raise AssertionError("no free spot")
 
@@ -241,9 +236,7 @@ def test_a_robbed_track_taking_its_own_object_back_is_no_theft() -> None:
         _Frame(2, o, {"1": own, "ghost": tb("ghost", 9.0)}, [("SWITCH", "O", "1"), ("FP", None, "ghost")]),
     ]
     failures = _class_failures(frames, "car", ["s0", "s1", "s2"], 2.0, 2.0)
-    thefts = [
-        (f.frame_index, f.track_ids, f.generation) for f in failures if f.kind is FailureKind.IDENTITY_THEFT
-    ]
+    thefts = [(f.frame_index, f.track_ids, f.generation) for f in failures if f.kind is FailureKind.IDENTITY_THEFT]
     assert thefts == [(1, ("ghost", "1"), 1)]
     switches = [(f.frame_index, f.track_ids) for f in failures if f.kind is FailureKind.ID_SWITCH]
     assert switches == [(1, ("1", "ghost")), (2, ("ghost", "1"))]

@@ -92,9 +92,7 @@ def test_tracker_submission_passes_the_devkits_own_checks(
     for name in SCENES:
         scene = load_scene(nusc, location, name)
         parts.append(
-            run_results(
-                run_tracker(scene, get_detections(scene, None, "megvii", 3), "gnnpmb", TrackerConfig())
-            )
+            run_results(run_tracker(scene, get_detections(scene, None, "megvii", 3), "gnnpmb", TrackerConfig()))
         )
     path = tmp_path / "results.json"
     write_submission(path, build_submission(parts, split_tokens))
@@ -149,9 +147,7 @@ def test_results_of_another_split(tmp_path: Path, demo_dataroot: Path, gt_submis
     root = tmp_path / "nuscenes"
     shutil.copytree(demo_dataroot / "v1.0-mini", root / "v1.0-mini")
     shutil.copytree(demo_dataroot / "maps", root / "maps")
-    (root / "v1.0-mini" / "splits.json").write_text(
-        json.dumps({"first": ["scene-0103"], "second": ["scene-0916"]})
-    )
+    (root / "v1.0-mini" / "splits.json").write_text(json.dumps({"first": ["scene-0103"], "second": ["scene-0916"]}))
     custom = check_dataroot(root, "v1.0-mini")
     nusc = open_nuscenes(custom)
     first = split_sample_tokens(nusc, ["scene-0103"])

@@ -128,9 +128,7 @@ def run_two_targets(tracker: GmPhdTracker, sink, frames: int = 6) -> list:
     out = []
     for f in range(frames):
         xy = [(2.0 * f, 0.0), (30.0, 10.0 - f)]
-        out.append(
-            tracker.step(make_measurements(xy, velocity=[(4.0, 0.0), (0.0, -2.0)]), 0.5 if f else 0.0, sink)
-        )
+        out.append(tracker.step(make_measurements(xy, velocity=[(4.0, 0.0), (0.0, -2.0)]), 0.5 if f else 0.0, sink))
     return out
 
 
@@ -156,9 +154,7 @@ def test_labels_stay_stable_for_a_moving_target():
             e = est[0]
             assert e.translation_m[:2] == pytest.approx(xy, abs=0.2)
             assert e.velocity_mps == pytest.approx((6.0, 1.0), abs=0.3)
-            assert (
-                e.score == 0.8 and e.meas_index == 0 and e.existence == pytest.approx(min(1.0, e.existence))
-            )
+            assert e.score == 0.8 and e.meas_index == 0 and e.existence == pytest.approx(min(1.0, e.existence))
     assert seen[0] == [] and all(s == [1] for s in seen[1:])
     assert ids.next_id == 2
 

@@ -76,9 +76,7 @@ def test_merge_moment_matches_close_components_and_keeps_heaviest_label():
     assert merged.score[1] == mix.score[1] and merged.z_m[1] == mix.z_m[1]
     groups = record.groups()
     assert len(groups) == 1
-    assert (
-        groups[0].into_label == 12 and groups[0].from_labels == (12, 11) and groups[0].weights == (0.6, 0.3)
-    )
+    assert groups[0].into_label == 12 and groups[0].from_labels == (12, 11) and groups[0].weights == (0.6, 0.3)
     assert removal.reason is PruneReason.MERGED and removal.labels.tolist() == [11]
 
 

@@ -7,8 +7,12 @@ import numpy as np
 from gnnpmb.types import Boxes, Measurements
 
 
-def make_measurements(xy: list[tuple[float, float]], score: float | list[float] = 0.9, cls: str = "car",
-                      velocity: list[tuple[float, float]] | None = None) -> Measurements:
+def make_measurements(
+    xy: list[tuple[float, float]],
+    score: float | list[float] = 0.9,
+    cls: str = "car",
+    velocity: list[tuple[float, float]] | None = None,
+) -> Measurements:
     """M car boxes at the given BEV positions (z = 1 m, 2 x 4.5 x 1.6 m, identity rotation)."""
     m = len(xy)
     scores = np.full(m, score, dtype=float) if np.isscalar(score) else np.asarray(score, dtype=float)

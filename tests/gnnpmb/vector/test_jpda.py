@@ -98,9 +98,7 @@ def test_two_tracks_sharing_measurements_match_brute_force():
     S = P_pred[:2, :2] + R
     z = np.array([[0.7, 0.1], [1.0, -0.1]])
     tracks = np.array([[0.0, 0.0], [1.6, 0.0]])
-    log_ratio = np.log(
-        [[V.p_detect * gauss2(zj - t, S) / (1 - V.p_detect * P_GATE) for zj in z] for t in tracks]
-    )
+    log_ratio = np.log([[V.p_detect * gauss2(zj - t, S) / (1 - V.p_detect * P_GATE) for zj in z] for t in tracks])
     expected = brute_force(log_ratio, np.log(KAPPA))
     assert expected[:, 1:].max() > 0.2 and expected[:, 1:].min() > 0.05  # both tracks compete for both
     np.testing.assert_allclose(marg.probs[:, :3], expected, rtol=1e-9, atol=1e-15)
