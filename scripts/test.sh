@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The README's test command: installs what the suite needs (uv; Chromium for the browser check when running as
-# root with apt-get), then runs pytest. Extra arguments go to pytest.
+# root with apt-get), checks lint and formatting (ruff), then runs pytest. Extra arguments go to pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if command -v uv >/dev/null 2>&1; then
@@ -18,4 +18,6 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
     # Chromium can be installed here, so the browser check must run rather than skip.
     export GNNPMB_REQUIRE_BROWSER="${GNNPMB_REQUIRE_BROWSER:-1}"
 fi
+"${UV[@]}" run ruff check .
+"${UV[@]}" run ruff format --check .
 exec "${UV[@]}" run pytest "$@"
