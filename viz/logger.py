@@ -414,11 +414,9 @@ class TrackerLogger:
     def _draw_class(self, class_name: str, cf: _ClassFrame) -> set[int]:
         """Draw one class's frame; returns the ids of its extracted tracks."""
         focus = self.focus_tracks or set()
-        estimates = tuple(
-            e
-            for e in (cf.extracted.estimates if cf.extracted is not None else ())
-            if e.existence >= self.show_min_existence or e.track_id in focus
-        )
+        extracted = cf.extracted.estimates if cf.extracted is not None else ()
+        estimates = tuple(e for e in extracted if e.existence >= self.show_min_existence)
+        drawn = estimates + tuple(e for e in extracted if e.existence < self.show_min_existence and e.track_id in focus)
         if cf.extracted is not None and cf.posterior is not None:
             self._sample(
                 paths.extraction_threshold(self.tracker, class_name),
@@ -426,7 +424,7 @@ class TrackerLogger:
                 f"{class_name} shown as a track above",
                 THRESHOLD_COLOR,
             )
-        for e in estimates:
+        for e in drawn:
             self._track_z[e.track_id] = float(e.translation_m[2])
         worthy = self._draw_prior(class_name, cf)
         self._draw_associations(class_name, cf, worthy)
@@ -434,7 +432,7 @@ class TrackerLogger:
         if self.focus_tracks:
             self._record_steps(cf, estimates)
         self._story(class_name, cf, estimates)
-        self._draw_tracks(class_name, estimates)
+        self._draw_tracks(class_name, drawn, {e.track_id for e in estimates})
         return {e.track_id for e in estimates}
 
     def _draw_prior(self, class_name: str, cf: _ClassFrame) -> dict[int, int]:
@@ -655,15 +653,17 @@ class TrackerLogger:
                 t in reported,
             )
 
-    def _draw_tracks(self, class_name: str, estimates: tuple[TrackEstimate, ...]) -> None:
+    def _draw_tracks(self, class_name: str, estimates: tuple[TrackEstimate, ...], shown: set[int]) -> None:
+        """Each drawn track's box and trail on its own entity; ``shown``: the ones that count as reported tracks
+        (the others are focused tracks below ``show_min_existence``, drawn for the focus only)."""
         if not estimates:
             return
         boxes = estimate_boxes(estimates)
         ids = np.array([e.track_id for e in estimates], dtype=np.int64)
         cids = class_ids(np.array([e.class_name for e in estimates], dtype=object))
         colors = packed_track_colors(ids)
+        self._extracted_ids.update(shown)
         for k, e in enumerate(estimates):
-            self._extracted_ids.add(e.track_id)
             path = paths.track(self.tracker, class_name, e.track_id)
             self._put(
                 path,
