@@ -44,7 +44,7 @@ def main() -> None:
     parser.add_argument("--figure", type=Path, default=Path("docs/table2_ablation.png"))
     args = parser.parse_args()
 
-    location = resolve_dataroot(None, None)
+    location = resolve_dataroot(None, None, (args.split,))
     split = args.split if split_scenes(args.split, location) else "mini_val"
     if split != args.split:
         print(f"{args.split} has no scenes in this dataset; using {split}")

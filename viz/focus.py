@@ -34,6 +34,8 @@ SCALE = 1.15
 MARGIN_M = 0.25
 LINE_RADIUS_M = 0.12
 MAX_STORY_LINES = 40
+MAX_LISTED = 2
+"""Per frame, the diagnosis names where the MAX_LISTED detections nearest to a track (lowest NIS) went."""
 TABLE_FRAMES = 6
 """The frame tables show the focus frame and the TABLE_FRAMES frames before it."""
 LEGEND = (
@@ -138,8 +140,10 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
         if passed:
             went = []
             for f in passed:
-                sent = ", ".join(f"m{m} -> {logger.given.get(f, {}).get(m, '?')}" for m, _nis in steps[f].gated)
-                went.append(f"{f} ({sent})")
+                nearest = sorted(steps[f].gated, key=lambda g: g[1])  # by NIS: the detections closest to it
+                sent = ", ".join(f"m{m} -> {logger.given.get(f, {}).get(m, '?')}" for m, _ in nearest[:MAX_LISTED])
+                more = f", +{len(nearest) - MAX_LISTED} more" if len(nearest) > MAX_LISTED else ""
+                went.append(f"{f} ({sent}{more})")
             plural = "s" if len(passed) > 1 else ""
             parts.append(f"detections in its gate went elsewhere at frame{plural} {'; '.join(went)}")
         peak = max(frames, key=lambda f: _after(steps[f]))
