@@ -149,12 +149,12 @@ def test_focus_recordings_load_and_render_in_headless_chromium(
     from cli.app import find_reports, prepare, rerun_runs
 
     _require_chromium()
-    request = prepare("scene-0916", ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars")
+    request = prepare("scene-0103", ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars")
     reports, _ = find_reports(request, rerun_runs(request))
     ids = [i for i in reports["gnnpmb"].ids() if not i.startswith("miss:")]
     pick = next((i for i in ids if i.startswith(kind + ":")), ids[0])
     rrd = tmp_path / "focus.rrd"
-    argv = ["scene-0916", "--detector", "pointpillars", "--dataroot", str(demo_dataroot), "--focus", pick]
+    argv = ["scene-0103", "--detector", "pointpillars", "--dataroot", str(demo_dataroot), "--focus", pick]
     for t in trackers:
         argv += ["-t", t]
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
