@@ -167,7 +167,7 @@ def register(app: typer.Typer) -> None:
         swept = [parse_param(p) for p in param or []]
         base = base_params(params)
         run = execution(workers, address)
-        location = resolve_dataroot(dataroot, version)
+        location = resolve_dataroot(dataroot, version, (split,) if split else ())
         data = resolve_study_data(location, split or default_split(location.version), detections, preset, seed)
         plan = plan_sweep(tracker, data, base, swept, one_at_a_time)
         n = len(plan.assignments)
@@ -269,7 +269,8 @@ def register(app: typer.Typer) -> None:
         if trials < 1:
             raise GnnpmbError(f"--trials must be at least 1, got {trials}")
         run = execution(workers, address)
-        location = resolve_dataroot(dataroot, version)
+        # the demo generates its train scenes only when asked for them; tuning defaults to a train split
+        location = resolve_dataroot(dataroot, version, (split or "mini_train",))
         data = resolve_study_data(location, split or train_split(location.version), detections, preset, seed)
         seen: list[float] = []
         with _progress(progress, trials, "trials") as bar:
