@@ -402,9 +402,8 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
     and log failures and provenance. With ``request.focus`` the trackers first run without logging to find the
     focus (``resolve_request_focus``); the recording then holds the keyframes around it and opens on it."""
     import numpy as np
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from cli.progress import progress_bar
     from gnnpmb.data.nuscenes import load_lidar_points
     from gnnpmb.pipeline import run_tracker
     from viz.blueprint import default_blueprint
@@ -426,14 +425,7 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
     n = len(shown)
     gate_z_m = float(np.median([k.ego_pose.translation_m[2] for k in scene.keyframes]))
     blueprint = default_blueprint(request.trackers, request.classes, focus)
-    bar = Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=Console(stderr=True),
-        disable=not progress,
-    )
+    bar = progress_bar(progress)
     runs: list[TrackingRun] = []
     loggers: dict[str, TrackerLogger] = {}
     comparison = None

@@ -118,9 +118,7 @@ def track(
     check_tracker(tracker)
     preset = _detector(detections, detector)
 
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
+    from cli.progress import progress_bar
     from gnnpmb.config import load_config
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot, split_scenes
     from gnnpmb.eval.nuscenes_eval import check_split_version, split_sample_tokens
@@ -155,15 +153,7 @@ def track(
         parts = []
         n_frames = n_boxes = 0
         step_s = 0.0
-        with Progress(
-            TextColumn("{task.description}"),
-            BarColumn(),
-            MofNCompleteColumn(),
-            TimeElapsedColumn(),
-            console=Console(stderr=True),
-            disable=not progress,
-            transient=True,
-        ) as bar:
+        with progress_bar(progress, transient=True) as bar:
             scenes_task = bar.add_task("scenes", total=len(scene_names))
             frames_task = bar.add_task("frames", total=None)
             for name in scene_names:

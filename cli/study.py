@@ -11,10 +11,11 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import Progress
 from rich.table import Table
 
 from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
+from cli.progress import progress_bar
 from gnnpmb.errors import GnnpmbError
 
 if TYPE_CHECKING:
@@ -67,15 +68,7 @@ def check_out_file(out: Path) -> None:
 
 
 def _progress(enabled: bool, total: int, what: str) -> Progress:
-    bar = Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=Console(stderr=True),
-        disable=not enabled,
-        transient=True,
-    )
+    bar = progress_bar(enabled, transient=True)
     bar.add_task(f"{what}, best AMOTA -", total=total)
     return bar
 
