@@ -1,29 +1,40 @@
 """A simulated 3D object detector: boxes derived from ground truth, for scenes without real detections.
 
-Three presets roughly follow the published nuScenes detectors the paper tracks with: CenterPoint (best: high
-recall, small noise, well separated scores), Megvii (CBGS) and PointPillars (worst). Per ground-truth box:
+Three presets (``gnnpmb/data/simdet_presets.py``) are fitted to the published nuScenes-val figures of the
+detectors the paper tracks with: CenterPoint (best), Megvii (CBGS) and PointPillars (worst); see
+``benchmarks/detector_calibration.py``. Per ground-truth box:
 
 - detection probability ``P_D = recall_near · c_class · f_range(d) · f_vis(n)``, with ``d`` the BEV distance
   to the ego, ``f_range(d) = 1 / (1 + exp((d - range_p50_m) / range_width_m))`` and the visibility factor
   ``f_vis(n) = v0 + (1 - v0)(1 - exp(-n / pts_scale))`` of the box's LiDAR+radar point count ``n`` (v0 = 0.02:
-  a box without points is almost never detected); ``c_class`` makes small objects harder;
+  a box without points, i.e. fully occluded, is almost never detected); ``c_class`` makes small objects harder;
 - centre = truth + a persistent per-instance offset + per-frame noise growing with distance; log-normal size
-  noise; yaw noise and an occasional heading flip; velocity = truth + noise (the detector regresses velocity);
+  noise; yaw noise and a heading flip (by pi) with a per-class probability; velocity = truth + noise growing
+  with distance (the detector regresses velocity);
 - score ``~ Beta(tp_score_beta) · (0.35 + 0.65 · f_range · f_vis)``: lower for far and occluded objects;
+- class confusion: with probability ``confusion_scale · confusion_prob(class)`` the detection keeps the true
+  object's box but is labelled as a confusable class (truck <-> car/bus/trailer, bicycle <-> motorcycle), with
+  0.75 of its score;
 - sometimes a duplicate: a slightly shifted copy with a lower score, for NMS to remove.
 
 Per frame, a Poisson number of false positives spread uniformly over the disc of radius ``fp_range_m`` around
-the ego, classes weighted towards cars and pedestrians, scores ``~ Beta(fp_score_beta)`` (below true ones);
-plus, at each clutter hotspot within range, a Poisson number of ghost boxes of a class a tracker could confuse
-with the object nearest the hotspot, with higher scores ``~ Beta(hotspot_score_beta)``.
+the ego, classes weighted towards cars and pedestrians, scores ``~ Beta(fp_score_beta)``, except a fraction
+``fp_high_score_frac`` scored like true detections (scores overlap); at each clutter hotspot within range, a
+Poisson number of ghost boxes of a class a tracker could confuse with the object nearest the hotspot, scores
+``~ Beta(hotspot_score_beta)``. Per scene, persistent false positives ("ghosts"): fixed world places, a
+Poisson number over the area the ego sees (``ghost_rate`` within range on average), each with its own class,
+box and stable score ``~ Beta(ghost_score_beta)``; a ghost within ``fp_range_m`` of the ego is reported in a
+frame with probability ``ghost_presence``, with small jitter, like a real detector's repeated false alarm.
 
-Randomness: each frame draws from its own generator seeded by (seed, scene token, keyframe index), and each
-instance's persistent offset from (seed, scene token, instance token), so one frame's draws never depend on
-another frame. Boxes of a frame are returned sorted by score, highest first, like a real detector's output.
+Randomness: each frame draws from its own generator seeded by (seed, scene token, keyframe index), each
+instance's persistent offset from (seed, scene token, instance token) and the scene's ghost places from
+(seed, scene token), so one frame's draws never depend on another frame. Boxes of a frame are returned sorted
+by score, highest first, like a real detector's output.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
@@ -33,164 +44,29 @@ import numpy as np
 
 from gnnpmb.data.boxes3d import quat_wxyz_from_yaw, yaw_from_quat_wxyz
 from gnnpmb.data.scene import Keyframe, SceneData
-from gnnpmb.errors import UnknownNameError
+from gnnpmb.data.simdet_presets import (
+    CLASS_MODELS,
+    CONFUSABLE,
+    FP_CLASS_WEIGHTS,
+    PRESETS,
+    TYPICAL_SIZE_WLH_M,
+    DetectorPreset,
+    get_preset,
+)
 from gnnpmb.types import Boxes
 
-
-@dataclass(frozen=True, slots=True)
-class DetectorPreset:
-    """Quality parameters of a simulated detector (see the module docstring for the model).
-
-    Noise standard deviations are per axis, for a car at the ego; other classes scale them by
-    ``CLASS_NOISE_SCALE`` and per-frame noise grows by (1 + d / 50 m). Beta parameters are (a, b).
-    """
-
-    name: str
-    recall_near: float
-    range_p50_m: float
-    range_width_m: float
-    pts_scale: float
-    pos_bias_std_m: float
-    pos_noise_std_m: float
-    z_noise_std_m: float
-    size_noise_rel: float
-    yaw_noise_std_rad: float
-    yaw_flip_prob: float
-    vel_noise_std_mps: float
-    fp_rate: float
-    fp_range_m: float
-    hotspot_rate: float
-    dup_prob: float
-    dup_shift_rel: float
-    tp_score_beta: tuple[float, float]
-    fp_score_beta: tuple[float, float]
-    hotspot_score_beta: tuple[float, float]
-
-
-PRESETS: dict[str, DetectorPreset] = {
-    "centerpoint": DetectorPreset(
-        name="centerpoint",
-        recall_near=0.97,
-        range_p50_m=62.0,
-        range_width_m=6.0,
-        pts_scale=4.0,
-        pos_bias_std_m=0.08,
-        pos_noise_std_m=0.15,
-        z_noise_std_m=0.08,
-        size_noise_rel=0.05,
-        yaw_noise_std_rad=0.05,
-        yaw_flip_prob=0.01,
-        vel_noise_std_mps=0.3,
-        fp_rate=30.0,
-        fp_range_m=54.0,
-        hotspot_rate=1.0,
-        dup_prob=0.10,
-        dup_shift_rel=0.10,
-        tp_score_beta=(8.0, 2.0),
-        fp_score_beta=(1.2, 8.0),
-        hotspot_score_beta=(3.0, 5.0),
-    ),
-    "megvii": DetectorPreset(
-        name="megvii",
-        recall_near=0.93,
-        range_p50_m=55.0,
-        range_width_m=7.0,
-        pts_scale=6.0,
-        pos_bias_std_m=0.12,
-        pos_noise_std_m=0.22,
-        z_noise_std_m=0.12,
-        size_noise_rel=0.07,
-        yaw_noise_std_rad=0.08,
-        yaw_flip_prob=0.03,
-        vel_noise_std_mps=0.5,
-        fp_rate=45.0,
-        fp_range_m=54.0,
-        hotspot_rate=1.5,
-        dup_prob=0.15,
-        dup_shift_rel=0.12,
-        tp_score_beta=(6.0, 2.5),
-        fp_score_beta=(1.3, 6.5),
-        hotspot_score_beta=(3.0, 4.5),
-    ),
-    "pointpillars": DetectorPreset(
-        name="pointpillars",
-        recall_near=0.88,
-        range_p50_m=45.0,
-        range_width_m=8.0,
-        pts_scale=10.0,
-        pos_bias_std_m=0.18,
-        pos_noise_std_m=0.32,
-        z_noise_std_m=0.18,
-        size_noise_rel=0.10,
-        yaw_noise_std_rad=0.15,
-        yaw_flip_prob=0.08,
-        vel_noise_std_mps=0.9,
-        fp_rate=60.0,
-        fp_range_m=54.0,
-        hotspot_rate=2.0,
-        dup_prob=0.25,
-        dup_shift_rel=0.15,
-        tp_score_beta=(4.0, 3.0),
-        fp_score_beta=(1.5, 5.5),
-        hotspot_score_beta=(3.0, 4.0),
-    ),
-}
-"""The three detector presets by CLI name, best first."""
-
-CLASS_RECALL: dict[str, float] = {
-    "car": 1.0,
-    "bus": 0.95,
-    "truck": 0.90,
-    "trailer": 0.80,
-    "pedestrian": 0.92,
-    "motorcycle": 0.85,
-    "bicycle": 0.75,
-}
-"""Per-class factor ``c_class`` on the detection probability (small, thin objects are harder)."""
-
-CLASS_NOISE_SCALE: dict[str, float] = {
-    "car": 1.0,
-    "truck": 1.5,
-    "bus": 1.6,
-    "trailer": 1.8,
-    "pedestrian": 0.5,
-    "bicycle": 0.6,
-    "motorcycle": 0.7,
-}
-"""Per-class factor on position noise (ordered like the paper's per-class measurement noise R)."""
-
-TYPICAL_SIZE_WLH_M: dict[str, tuple[float, float, float]] = {
-    "car": (1.95, 4.6, 1.7),
-    "truck": (2.5, 6.9, 2.9),
-    "bus": (2.95, 11.0, 3.5),
-    "trailer": (2.9, 12.3, 3.9),
-    "pedestrian": (0.67, 0.73, 1.77),
-    "bicycle": (0.6, 1.7, 1.3),
-    "motorcycle": (0.77, 2.1, 1.5),
-}
-"""Mean box size (w, l, h) of each class on nuScenes, for false positives."""
-
-FP_CLASS_WEIGHTS: dict[str, float] = {
-    "car": 0.42,
-    "pedestrian": 0.30,
-    "truck": 0.08,
-    "trailer": 0.04,
-    "bus": 0.03,
-    "bicycle": 0.07,
-    "motorcycle": 0.06,
-}
-"""Class mix of false positives."""
-
-CONFUSABLE: dict[str, tuple[str, ...]] = {
-    "car": ("car", "truck"),
-    "truck": ("truck", "bus", "trailer"),
-    "bus": ("bus", "truck"),
-    "trailer": ("trailer", "truck"),
-    "pedestrian": ("pedestrian",),
-    "bicycle": ("bicycle", "motorcycle"),
-    "motorcycle": ("motorcycle", "bicycle"),
-}
-"""Classes a ghost box near an object of the key class is drawn from (the first with probability 0.75)."""
+__all__ = [
+    "CONFUSABLE",
+    "PRESETS",
+    "DetectorPreset",
+    "GhostSites",
+    "Hotspot",
+    "get_preset",
+    "scene_ghosts",
+    "simulate_detections",
+    "simulate_frame",
+    "to_submission",
+]
 
 Hotspot = tuple[np.ndarray, float] | tuple[np.ndarray, float, Collection[int]]
 """A clutter-prone spot: (xy_global (2,), radius_m), optionally with the keyframe indices it is active in."""
@@ -203,16 +79,33 @@ _DEFAULT_HOTSPOT_CLASSES = ("truck", "bus")
 _FP_SPEED_STD_MPS = 0.5
 _TAG_FRAME = 1
 _TAG_INSTANCE = 2
+_TAG_GHOST = 3
+_CONFUSED_SCORE_FACTOR = 0.75
+_HIGH_FP_SCORE_FACTOR = 0.8
+_GHOST_JITTER_M = 0.1
+_GHOST_SCORE_JITTER = 0.03
+_SCORE_MIN, _SCORE_MAX = 1e-3, 0.999
 
 
-def get_preset(preset: str | DetectorPreset) -> DetectorPreset:
-    """The preset itself, or the one named ``preset``; an unknown name raises ``UnknownNameError``."""
-    if isinstance(preset, DetectorPreset):
-        return preset
-    try:
-        return PRESETS[preset]
-    except KeyError:
-        raise UnknownNameError(f"unknown detector preset '{preset}' (choose one of: {', '.join(PRESETS)})") from None
+@dataclass(frozen=True, slots=True)
+class GhostSites:
+    """Persistent false positives of one scene: K fixed world places.
+
+    xy_global: (K, 2); yaw_rad: (K,); size_wlh_m: (K, 3); class_name: (K,); score: (K,) stable base scores.
+    """
+
+    xy_global: np.ndarray
+    yaw_rad: np.ndarray
+    size_wlh_m: np.ndarray
+    class_name: np.ndarray
+    score: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.xy_global.shape[0])
+
+    @staticmethod
+    def none() -> GhostSites:
+        return GhostSites(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3)), np.zeros(0, dtype=object), np.zeros(0))
 
 
 def _hash64(text: str) -> int:
@@ -232,8 +125,34 @@ def _instance_offsets(seed: int, scene_token: str, instance_ids: Sequence[str]) 
     return out
 
 
-def _class_table(table: Mapping[str, float], names: np.ndarray) -> np.ndarray:
-    return np.array([table[str(c)] for c in names], dtype=float)
+def _class_field(field: str, names: np.ndarray) -> np.ndarray:
+    return np.array([getattr(CLASS_MODELS[str(c)], field) for c in names], dtype=float)
+
+
+def _fp_classes(rng: np.random.Generator, count: int) -> np.ndarray:
+    names = list(FP_CLASS_WEIGHTS)
+    weights = np.array([FP_CLASS_WEIGHTS[c] for c in names])
+    return np.array(names, dtype=object)[rng.choice(len(names), size=count, p=weights / weights.sum())]
+
+
+def scene_ghosts(scene: SceneData, preset: str | DetectorPreset, seed: int = 0) -> GhostSites:
+    """The persistent false positives of ``scene``: a Poisson number of places, uniform over the ego path's
+    bounding box grown by ``fp_range_m``, at density ``ghost_rate / (pi fp_range_m^2)``."""
+    p = get_preset(preset)
+    if p.ghost_rate <= 0.0 or not scene.keyframes:
+        return GhostSites.none()
+    rng = np.random.default_rng(np.random.SeedSequence([seed, _TAG_GHOST, _hash64(scene.token)]))
+    ego_xy = np.array([k.ego_pose.translation_m[:2] for k in scene.keyframes], dtype=float)
+    lo, hi = ego_xy.min(axis=0) - p.fp_range_m, ego_xy.max(axis=0) + p.fp_range_m
+    area_m2 = float(np.prod(hi - lo))
+    count = int(rng.poisson(p.ghost_rate * area_m2 / (np.pi * p.fp_range_m**2)))
+    xy = lo + (hi - lo) * rng.random((count, 2))
+    yaw = rng.uniform(-np.pi, np.pi, count)
+    classes = _fp_classes(rng, count)
+    size = np.array([TYPICAL_SIZE_WLH_M[c] for c in classes], dtype=float).reshape(count, 3)
+    size = size * np.exp(p.size_noise_rel * rng.standard_normal((count, 3)))
+    score = rng.beta(*p.ghost_score_beta, size=count)
+    return GhostSites(xy, yaw, size, classes, score)
 
 
 def _make_boxes(
@@ -256,6 +175,20 @@ def _make_boxes(
     )
 
 
+def _confused_classes(
+    classes: np.ndarray, p: DetectorPreset, u_confuse: np.ndarray, u_target: np.ndarray
+) -> np.ndarray:
+    """(N,) reported class names: a confusable class where ``u_confuse`` falls below the class's confusion
+    probability (picked by ``u_target`` among ``confused_with``), else the true class."""
+    out = classes.astype(object).copy()
+    for k, name in enumerate(classes):
+        model = CLASS_MODELS[str(name)]
+        if model.confused_with and u_confuse[k] < p.confusion_scale * model.confusion_prob:
+            options = model.confused_with
+            out[k] = options[min(int(u_target[k] * len(options)), len(options) - 1)]
+    return out
+
+
 def _true_detections(
     kf: Keyframe, p: DetectorPreset, rng: np.random.Generator, offsets: np.ndarray
 ) -> tuple[Boxes, Boxes]:
@@ -267,7 +200,7 @@ def _true_detections(
     dist = np.hypot(*(gt.xy - kf.ego_pose.translation_m[:2]).T) if n else np.zeros(0)
     f_range = 1.0 / (1.0 + np.exp((dist - p.range_p50_m) / p.range_width_m))
     f_vis = _VIS_FLOOR + (1.0 - _VIS_FLOOR) * (1.0 - np.exp(-np.asarray(kf.gt_num_pts, float) / p.pts_scale))
-    p_detect = p.recall_near * _class_table(CLASS_RECALL, classes) * f_range * f_vis
+    p_detect = p.recall_near * _class_field("recall", classes) * f_range * f_vis
 
     u_detect = rng.random(n)
     pos_noise = rng.standard_normal((n, 2))
@@ -281,30 +214,37 @@ def _true_detections(
     dup_shift = rng.standard_normal((n, 2))
     dup_size = rng.standard_normal((n, 3))
     dup_score = rng.uniform(0.3, 0.9, size=n)
+    u_confuse = rng.random(n)
+    u_target = rng.random(n)
 
-    noise_scale = _class_table(CLASS_NOISE_SCALE, classes)
-    xy_std = noise_scale * p.pos_noise_std_m * (1.0 + dist / _NOISE_RANGE_M)
+    noise_scale = _class_field("noise_scale", classes)
+    range_growth = 1.0 + dist / _NOISE_RANGE_M
+    xy_std = noise_scale * p.pos_noise_std_m * range_growth
     translation = gt.translation_m.astype(float).copy()
     translation[:, :2] += noise_scale[:, None] * p.pos_bias_std_m * offsets[:, :2] + xy_std[:, None] * pos_noise
     translation[:, 2] += noise_scale * p.z_noise_std_m * (offsets[:, 2] + z_noise)
     size = gt.size_wlh_m * np.exp(p.size_noise_rel * size_noise)
-    yaw = yaw_from_quat_wxyz(gt.quat_wxyz) + p.yaw_noise_std_rad * yaw_noise + np.pi * (u_flip < p.yaw_flip_prob)
-    velocity = np.nan_to_num(gt.velocity_mps.astype(float)) + p.vel_noise_std_mps * vel_noise
+    flip = u_flip < p.yaw_flip_prob * _class_field("flip_scale", classes)
+    yaw_std = p.yaw_noise_std_rad * _class_field("yaw_noise_scale", classes)
+    yaw = yaw_from_quat_wxyz(gt.quat_wxyz) + yaw_std * yaw_noise + np.pi * flip
+    velocity = np.nan_to_num(gt.velocity_mps.astype(float)) + (p.vel_noise_std_mps * range_growth)[:, None] * vel_noise
     score = score_beta * (_SCORE_FLOOR + (1.0 - _SCORE_FLOOR) * f_range * f_vis)
+    reported = _confused_classes(classes, p, u_confuse, u_target)
+    score = np.where(reported != classes, _CONFUSED_SCORE_FACTOR * score, score)
 
     detected = u_detect < p_detect
     dup = detected & (u_dup < p.dup_prob)
     shift = p.dup_shift_rel * np.minimum(size[:, 0], size[:, 1])[:, None] * dup_shift
     dup_translation = translation.copy()
     dup_translation[:, :2] += shift
-    true_boxes = _make_boxes(translation, size, yaw, velocity, score, classes).subset(np.flatnonzero(detected))
+    true_boxes = _make_boxes(translation, size, yaw, velocity, score, reported).subset(np.flatnonzero(detected))
     dup_boxes = _make_boxes(
         dup_translation,
         size * np.exp(0.5 * p.size_noise_rel * dup_size),
         yaw,
         velocity,
         score * dup_score,
-        classes,
+        reported,
     ).subset(np.flatnonzero(dup))
     return true_boxes, dup_boxes
 
@@ -340,13 +280,34 @@ def _clutter(
 
 
 def _false_positives(kf: Keyframe, p: DetectorPreset, rng: np.random.Generator) -> Boxes:
-    names = list(FP_CLASS_WEIGHTS)
-    weights = np.array([FP_CLASS_WEIGHTS[c] for c in names])
+    """Random false positives around the ego; a fraction ``fp_high_score_frac`` scored like true detections."""
     count = int(rng.poisson(p.fp_rate))
-    classes = np.array(names, dtype=object)[rng.choice(len(names), size=count, p=weights / weights.sum())]
+    classes = _fp_classes(rng, count)
     score = rng.beta(*p.fp_score_beta, size=count)
     ego_xy = kf.ego_pose.translation_m[:2]
-    return _clutter(rng, count, ego_xy, p.fp_range_m, classes, score, _ground_z(kf), p.size_noise_rel)
+    boxes = _clutter(rng, count, ego_xy, p.fp_range_m, classes, score, _ground_z(kf), p.size_noise_rel)
+    high = rng.random(count) < p.fp_high_score_frac
+    high_score = _HIGH_FP_SCORE_FACTOR * rng.beta(*p.tp_score_beta, size=count)
+    return dataclasses.replace(boxes, score=np.where(high, high_score, boxes.score))
+
+
+def _ghost_detections(kf: Keyframe, p: DetectorPreset, rng: np.random.Generator, ghosts: GhostSites) -> Boxes:
+    """The persistent false positives within ``fp_range_m`` of the ego reported in this frame. Draws are made for
+    every site of the scene, in range or not."""
+    k = len(ghosts)
+    u_present = rng.random(k)
+    jitter = rng.standard_normal((k, 2))
+    score_jitter = rng.standard_normal(k)
+    vel_noise = rng.standard_normal((k, 2))
+    in_range = np.hypot(*(ghosts.xy_global - kf.ego_pose.translation_m[:2]).T) <= p.fp_range_m
+    shown = np.flatnonzero(in_range & (u_present < p.ghost_presence))
+    translation = np.column_stack(
+        [ghosts.xy_global + _GHOST_JITTER_M * jitter, _ground_z(kf) + 0.5 * ghosts.size_wlh_m[:, 2]]
+    )
+    score = np.clip(ghosts.score + _GHOST_SCORE_JITTER * score_jitter, _SCORE_MIN, _SCORE_MAX)
+    velocity = p.vel_noise_std_mps * vel_noise
+    boxes = _make_boxes(translation, ghosts.size_wlh_m, ghosts.yaw_rad, velocity, score, ghosts.class_name)
+    return boxes.subset(shown)
 
 
 def _hotspot_clutter(kf: Keyframe, p: DetectorPreset, rng: np.random.Generator, hotspots: Sequence[Hotspot]) -> Boxes:
@@ -387,15 +348,18 @@ def simulate_frame(
     rng: np.random.Generator,
     offsets: np.ndarray,
     hotspots: Sequence[Hotspot] = (),
+    ghosts: GhostSites | None = None,
 ) -> Boxes:
     """Detections of one keyframe, sorted by score (highest first; ties keep generation order).
 
-    offsets: (N, 3) standard-normal persistent offsets of the keyframe's N GT boxes.
+    offsets: (N, 3) standard-normal persistent offsets of the keyframe's N GT boxes; ghosts: the scene's
+    persistent false positives (``scene_ghosts``), none if not given.
     """
     true_boxes, dup_boxes = _true_detections(kf, preset, rng, offsets)
     fp_boxes = _false_positives(kf, preset, rng)
     hot_boxes = _hotspot_clutter(kf, preset, rng, hotspots)
-    boxes = Boxes.concatenate([true_boxes, dup_boxes, fp_boxes, hot_boxes])
+    ghost_boxes = _ghost_detections(kf, preset, rng, GhostSites.none() if ghosts is None else ghosts)
+    boxes = Boxes.concatenate([true_boxes, dup_boxes, fp_boxes, hot_boxes, ghost_boxes])
     return boxes.subset(np.argsort(-boxes.score, kind="stable"))
 
 
@@ -408,9 +372,11 @@ def simulate_detections(
     """Simulated detections of every keyframe of ``scene``, keyed by sample token, in the global frame.
 
     hotspots: clutter-prone spots as (xy_global (2,), radius_m) or (xy_global, radius_m, keyframe indices);
-    the third element limits a spot to those keyframes. Same inputs give the same output.
+    the third element limits a spot to those keyframes. The scene's persistent false positives come from
+    ``scene_ghosts(scene, preset, seed)``. Same inputs give the same output.
     """
     p = get_preset(preset)
+    ghosts = scene_ghosts(scene, p, seed)
     cache: dict[str, np.ndarray] = {}
     out: dict[str, Boxes] = {}
     for kf in scene.keyframes:
@@ -418,7 +384,8 @@ def simulate_detections(
         new = sorted({i for i in ids if i not in cache})
         cache.update(zip(new, _instance_offsets(seed, scene.token, new), strict=True))
         offsets = np.array([cache[i] for i in ids]).reshape(len(ids), 3)
-        out[kf.sample_token] = simulate_frame(kf, p, _frame_rng(seed, scene.token, kf.index), offsets, hotspots)
+        rng = _frame_rng(seed, scene.token, kf.index)
+        out[kf.sample_token] = simulate_frame(kf, p, rng, offsets, hotspots, ghosts)
     return out
 
 

@@ -9,7 +9,15 @@ from gnnpmb.data.boxes3d import quat_wxyz_from_yaw
 from gnnpmb.data.detections import load_detection_file, write_detection_file
 from gnnpmb.data.preprocess import preprocess
 from gnnpmb.data.scene import Keyframe, Pose, SceneData
-from gnnpmb.data.simdet import CONFUSABLE, PRESETS, DetectorPreset, simulate_detections, to_submission
+from gnnpmb.data.simdet import (
+    CONFUSABLE,
+    PRESETS,
+    DetectorPreset,
+    scene_ghosts,
+    simulate_detections,
+    to_submission,
+)
+from gnnpmb.data.simdet_presets import CLASS_MODELS
 from gnnpmb.errors import UnknownNameError
 from gnnpmb.types import TRACKING_CLASSES, Boxes
 
@@ -76,8 +84,8 @@ def street(n_frames: int = 6):
 
 
 def quiet(preset: str = "centerpoint", **changes) -> DetectorPreset:
-    """A preset without false positives and duplicates, for tests of the true detections."""
-    return dataclasses.replace(PRESETS[preset], **{"fp_rate": 0.0, "dup_prob": 0.0, **changes})
+    """A preset without false positives (random or persistent) and duplicates, for tests of the true detections."""
+    return dataclasses.replace(PRESETS[preset], **{"fp_rate": 0.0, "dup_prob": 0.0, "ghost_rate": 0.0, **changes})
 
 
 def assert_boxes_equal(a: Boxes, b: Boxes) -> None:
@@ -177,7 +185,9 @@ def test_presets_are_ordered_by_quality():
         fp_scores = np.concatenate([b.score for b in full.values()])
         tp_scores = np.concatenate([b.score for b in dets.values()])
         separation[name] = tp_scores.mean() - fp_scores.mean()
-    assert recall["centerpoint"] > recall["megvii"] > recall["pointpillars"]
+    # Recall is not ordered: each preset's recall is fitted together with its noise and clutter to the
+    # published mAP of its detector (benchmarks/detector_calibration.py).
+    assert min(recall.values()) > 0.7
     assert error["centerpoint"] < error["megvii"] < error["pointpillars"]
     assert separation["centerpoint"] > separation["megvii"] > separation["pointpillars"] > 0.2
 
@@ -274,6 +284,59 @@ def test_hotspot_clutter_near_bus_looks_like_a_large_vehicle():
     timed = simulate_detections(scene, p, seed=8, hotspots=[(hotspot_xy, 3.0, (2, 5))])
     changed = [k for k, t in enumerate(scene.sample_tokens) if len(timed[t]) != len(plain[t])]
     assert set(changed) <= {2, 5} and changed
+
+
+def test_confused_class_keeps_the_true_objects_box():
+    p = quiet(confusion_scale=5.0, pos_noise_std_m=0.0, pos_bias_std_m=0.0, size_noise_rel=0.0, recall_near=1.0)
+    frames = [[("bike-1", "bicycle", 6.0, 2.0, 0.3, 1.0, 0.0), ("ped-1", "pedestrian", -5.0, 1.0, 0.0, 0.0, 0.0)]] * 60
+    scene = make_scene(frames)
+    dets = simulate_detections(scene, p, seed=3)
+    labels = []
+    for kf in scene.keyframes:
+        boxes = dets[kf.sample_token]
+        for k in range(len(kf.gt)):
+            j = nearest_detection(boxes, kf.gt.xy[k], 1e-6)
+            if j is None:
+                continue
+            np.testing.assert_allclose(boxes.size_wlh_m[j], kf.gt.size_wlh_m[k])
+            labels.append((str(kf.gt.class_name[k]), str(boxes.class_name[j])))
+    bike = [reported for true, reported in labels if true == "bicycle"]
+    expected = 5.0 * CLASS_MODELS["bicycle"].confusion_prob
+    assert len(bike) > 40 and set(bike) == {"bicycle", "motorcycle"}
+    assert abs(np.mean(np.array(bike) == "motorcycle") - expected) < 0.2
+    assert {reported for true, reported in labels if true == "pedestrian"} == {"pedestrian"}
+
+
+def test_persistent_false_positives_stay_at_fixed_places_with_stable_scores():
+    p = quiet(ghost_rate=3.0, ghost_presence=0.8)
+    scene = make_scene([[]] * 12)
+    ghosts = scene_ghosts(scene, p, seed=5)
+    dets = simulate_detections(scene, p, seed=5)
+    ego = scene.keyframes[0].ego_pose.translation_m[:2]
+    in_range = np.flatnonzero(np.hypot(*(ghosts.xy_global - ego).T) <= p.fp_range_m)
+    assert len(in_range) >= 1
+    for g in in_range:
+        seen = [nearest_detection(dets[t], ghosts.xy_global[g], 0.5) for t in scene.sample_tokens]
+        hits = [k for k, j in enumerate(seen) if j is not None]
+        assert len(hits) >= 6  # present in most frames, at the same place
+        assert any(b - a == 1 for a, b in zip(hits, hits[1:], strict=False))  # in consecutive frames
+        scores = [dets[scene.sample_tokens[k]].score[seen[k]] for k in hits]
+        assert np.std(scores) < 0.06 and abs(np.mean(scores) - ghosts.score[g]) < 0.05
+        assert {str(dets[scene.sample_tokens[k]].class_name[seen[k]]) for k in hits} == {str(ghosts.class_name[g])}
+    # Every reported box is a ghost within range; other seeds put the ghosts elsewhere.
+    for token in scene.sample_tokens:
+        d = np.hypot(*(dets[token].xy[:, None, :] - ghosts.xy_global[None, in_range, :]).transpose(2, 0, 1))
+        assert np.all(d.min(axis=1) < 0.6)
+    other = scene_ghosts(scene, p, seed=6)
+    assert len(other) != len(ghosts) or not np.allclose(other.xy_global, ghosts.xy_global)
+
+
+def test_some_false_positive_scores_overlap_true_ones():
+    p = dataclasses.replace(PRESETS["pointpillars"], ghost_rate=0.0, fp_high_score_frac=0.1)
+    dets = simulate_detections(make_scene([[]] * 40), p, seed=1)
+    fp_scores = np.concatenate([b.score for b in dets.values()])
+    assert np.mean(fp_scores > 0.5) > 0.03
+    assert np.median(fp_scores) < 0.25
 
 
 def test_to_submission_format():

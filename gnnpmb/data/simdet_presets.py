@@ -1,0 +1,211 @@
+"""Parameters of the simulated detector (``gnnpmb/data/simdet.py``): the three presets and the per-class tables.
+
+The presets' quality knobs were fitted on the demo ``mini_train`` scenes by ``benchmarks/detector_calibration.py
+--fit`` so that the devkit's ``DetectionEval`` of the simulated detections approaches the published nuScenes-val
+figures of the detector each preset is named after (the figures and their sources are in that script).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from gnnpmb.errors import UnknownNameError
+
+
+@dataclass(frozen=True, slots=True)
+class DetectorPreset:
+    """Quality parameters of a simulated detector (see ``gnnpmb/data/simdet.py`` for the model).
+
+    Noise standard deviations are per axis, for a car at the ego; other classes scale them by their
+    ``ClassModel`` and per-frame position and velocity noise grow by (1 + d / 50 m). Beta parameters are (a, b).
+    ``confusion_scale`` multiplies every class's confusion probability; ``ghost_rate`` is the expected number of
+    persistent false positives (fixed world places) within ``fp_range_m`` of the ego, each reported in a frame
+    with probability ``ghost_presence``; ``fp_high_score_frac`` of the random false positives are scored like
+    true detections (overlapping scores).
+    """
+
+    name: str
+    recall_near: float
+    range_p50_m: float
+    range_width_m: float
+    pts_scale: float
+    pos_bias_std_m: float
+    pos_noise_std_m: float
+    z_noise_std_m: float
+    size_noise_rel: float
+    yaw_noise_std_rad: float
+    yaw_flip_prob: float
+    vel_noise_std_mps: float
+    fp_rate: float
+    fp_range_m: float
+    hotspot_rate: float
+    dup_prob: float
+    dup_shift_rel: float
+    tp_score_beta: tuple[float, float]
+    fp_score_beta: tuple[float, float]
+    hotspot_score_beta: tuple[float, float]
+    confusion_scale: float
+    ghost_rate: float
+    ghost_presence: float
+    ghost_score_beta: tuple[float, float]
+    fp_high_score_frac: float
+
+
+@dataclass(frozen=True, slots=True)
+class ClassModel:
+    """How one class fares with every preset.
+
+    recall: factor ``c_class`` on the detection probability; noise_scale: factor on position noise (ordered
+    like the paper's per-class measurement noise R); yaw_noise_scale and flip_scale: factors on the preset's
+    yaw noise and heading-flip probability (small, thin objects have ambiguous headings); confusion_prob:
+    probability (times the preset's ``confusion_scale``) that a detection of this class is labelled as one of
+    ``confused_with`` (equal odds), keeping the true object's box.
+    """
+
+    recall: float
+    noise_scale: float
+    yaw_noise_scale: float
+    flip_scale: float
+    confusion_prob: float
+    confused_with: tuple[str, ...]
+
+
+CLASS_MODELS: dict[str, ClassModel] = {
+    "car": ClassModel(1.0, 1.0, 1.0, 1.0, 0.02, ("truck",)),
+    "truck": ClassModel(0.90, 1.5, 1.0, 1.5, 0.12, ("car", "bus", "trailer")),
+    "bus": ClassModel(0.95, 1.6, 0.8, 1.0, 0.10, ("truck",)),
+    "trailer": ClassModel(0.80, 1.8, 2.0, 6.0, 0.12, ("truck",)),
+    "pedestrian": ClassModel(0.92, 0.5, 4.0, 8.0, 0.0, ()),
+    "motorcycle": ClassModel(0.85, 0.7, 2.0, 8.0, 0.10, ("bicycle",)),
+    "bicycle": ClassModel(0.75, 0.6, 3.0, 12.0, 0.12, ("motorcycle",)),
+}
+"""Per-class factors of the simulated detector. The orientation factors follow the pattern of published per-class
+nuScenes AOE (cars, buses, trucks small; trailers, pedestrians, motorcycles, bicycles large)."""
+
+TYPICAL_SIZE_WLH_M: dict[str, tuple[float, float, float]] = {
+    "car": (1.95, 4.6, 1.7),
+    "truck": (2.5, 6.9, 2.9),
+    "bus": (2.95, 11.0, 3.5),
+    "trailer": (2.9, 12.3, 3.9),
+    "pedestrian": (0.67, 0.73, 1.77),
+    "bicycle": (0.6, 1.7, 1.3),
+    "motorcycle": (0.77, 2.1, 1.5),
+}
+"""Mean box size (w, l, h) of each class on nuScenes, for false positives."""
+
+FP_CLASS_WEIGHTS: dict[str, float] = {
+    "car": 0.42,
+    "pedestrian": 0.30,
+    "truck": 0.08,
+    "trailer": 0.04,
+    "bus": 0.03,
+    "bicycle": 0.07,
+    "motorcycle": 0.06,
+}
+"""Class mix of false positives (random and persistent)."""
+
+CONFUSABLE: dict[str, tuple[str, ...]] = {
+    "car": ("car", "truck"),
+    "truck": ("truck", "bus", "trailer"),
+    "bus": ("bus", "truck"),
+    "trailer": ("trailer", "truck"),
+    "pedestrian": ("pedestrian",),
+    "bicycle": ("bicycle", "motorcycle"),
+    "motorcycle": ("motorcycle", "bicycle"),
+}
+"""Classes a hotspot ghost box near an object of the key class is drawn from (the first with probability 0.75)."""
+
+PRESETS: dict[str, DetectorPreset] = {
+    "centerpoint": DetectorPreset(
+        name="centerpoint",
+        recall_near=0.9143,
+        range_p50_m=62.0,
+        range_width_m=6.0,
+        pts_scale=4.0,
+        pos_bias_std_m=0.07329,
+        pos_noise_std_m=0.1374,
+        z_noise_std_m=0.08,
+        size_noise_rel=0.1367,
+        yaw_noise_std_rad=0.08081,
+        yaw_flip_prob=0.01616,
+        vel_noise_std_mps=0.1221,
+        fp_rate=30.0,
+        fp_range_m=54.0,
+        hotspot_rate=1.0,
+        dup_prob=0.10,
+        dup_shift_rel=0.10,
+        tp_score_beta=(8.0, 2.0),
+        fp_score_beta=(1.2, 8.0),
+        hotspot_score_beta=(3.0, 5.0),
+        confusion_scale=1.0,
+        ghost_rate=2.0,
+        ghost_presence=0.7,
+        ghost_score_beta=(3.0, 4.0),
+        fp_high_score_frac=0.03,
+    ),
+    "megvii": DetectorPreset(
+        name="megvii",
+        recall_near=0.9533,
+        range_p50_m=55.0,
+        range_width_m=7.0,
+        pts_scale=3.184,
+        pos_bias_std_m=0.08107,
+        pos_noise_std_m=0.1486,
+        z_noise_std_m=0.12,
+        size_noise_rel=0.1379,
+        yaw_noise_std_rad=0.03462,
+        yaw_flip_prob=0.01298,
+        vel_noise_std_mps=0.1504,
+        fp_rate=32.78,
+        fp_range_m=54.0,
+        hotspot_rate=1.5,
+        dup_prob=0.15,
+        dup_shift_rel=0.12,
+        tp_score_beta=(6.0, 2.5),
+        fp_score_beta=(1.3, 6.5),
+        hotspot_score_beta=(3.0, 4.5),
+        confusion_scale=1.5,
+        ghost_rate=2.185,
+        ghost_presence=0.7,
+        ghost_score_beta=(3.0, 4.0),
+        fp_high_score_frac=0.02914,
+    ),
+    "pointpillars": DetectorPreset(
+        name="pointpillars",
+        recall_near=0.9842,
+        range_p50_m=52.0,
+        range_width_m=7.0,
+        pts_scale=1.586,
+        pos_bias_std_m=0.08969,
+        pos_noise_std_m=0.1594,
+        z_noise_std_m=0.18,
+        size_noise_rel=0.1444,
+        yaw_noise_std_rad=0.03395,
+        yaw_flip_prob=0.01811,
+        vel_noise_std_mps=0.1625,
+        fp_rate=19.04,
+        fp_range_m=54.0,
+        hotspot_rate=2.0,
+        dup_prob=0.25,
+        dup_shift_rel=0.15,
+        tp_score_beta=(5.0, 2.5),
+        fp_score_beta=(1.5, 5.5),
+        hotspot_score_beta=(3.0, 4.0),
+        confusion_scale=2.0,
+        ghost_rate=1.904,
+        ghost_presence=0.7,
+        ghost_score_beta=(3.0, 4.0),
+        fp_high_score_frac=0.0238,
+    ),
+}
+"""The three detector presets by CLI name, best first."""
+
+
+def get_preset(preset: str | DetectorPreset) -> DetectorPreset:
+    """The preset itself, or the one named ``preset``; an unknown name raises ``UnknownNameError``."""
+    if isinstance(preset, DetectorPreset):
+        return preset
+    try:
+        return PRESETS[preset]
+    except KeyError:
+        raise UnknownNameError(f"unknown detector preset '{preset}' (choose one of: {', '.join(PRESETS)})") from None
