@@ -7,7 +7,8 @@ detectors the paper tracks with: CenterPoint (best), Megvii (CBGS) and PointPill
 - detection probability ``P_D = recall_near · c_class · f_range(d) · f_vis(n)``, with ``d`` the BEV distance
   to the ego, ``f_range(d) = 1 / (1 + exp((d - range_p50_m) / range_width_m))`` and the visibility factor
   ``f_vis(n) = v0 + (1 - v0)(1 - exp(-n / pts_scale))`` of the box's LiDAR+radar point count ``n`` (v0 = 0.02:
-  a box without points, i.e. fully occluded, is almost never detected); ``c_class`` makes small objects harder;
+  a box without points, i.e. fully occluded, is almost never detected); ``c_class`` (the preset's
+  ``class_recall``) sets each class's recall;
 - centre = truth + a persistent per-instance offset + per-frame noise growing with distance; log-normal size
   noise; yaw noise and a heading flip (by pi) with a per-class probability; velocity = truth + noise growing
   with distance (the detector regresses velocity);
@@ -200,7 +201,8 @@ def _true_detections(
     dist = np.hypot(*(gt.xy - kf.ego_pose.translation_m[:2]).T) if n else np.zeros(0)
     f_range = 1.0 / (1.0 + np.exp((dist - p.range_p50_m) / p.range_width_m))
     f_vis = _VIS_FLOOR + (1.0 - _VIS_FLOOR) * (1.0 - np.exp(-np.asarray(kf.gt_num_pts, float) / p.pts_scale))
-    p_detect = p.recall_near * _class_field("recall", classes) * f_range * f_vis
+    c_class = np.array([p.class_recall[str(c)] for c in classes], dtype=float)
+    p_detect = p.recall_near * c_class * f_range * f_vis
 
     u_detect = rng.random(n)
     pos_noise = rng.standard_normal((n, 2))

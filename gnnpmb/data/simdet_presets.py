@@ -7,6 +7,7 @@ figures of the detector each preset is named after (the figures and their source
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from gnnpmb.errors import UnknownNameError
@@ -18,10 +19,11 @@ class DetectorPreset:
 
     Noise standard deviations are per axis, for a car at the ego; other classes scale them by their
     ``ClassModel`` and per-frame position and velocity noise grow by (1 + d / 50 m). Beta parameters are (a, b).
-    ``confusion_scale`` multiplies every class's confusion probability; ``ghost_rate`` is the expected number of
-    persistent false positives (fixed world places) within ``fp_range_m`` of the ego, each reported in a frame
-    with probability ``ghost_presence``; ``fp_high_score_frac`` of the random false positives are scored like
-    true detections (overlapping scores).
+    ``class_recall`` is the per-class factor ``c_class`` on the detection probability (fitted per class to the
+    published per-class AP); ``confusion_scale`` multiplies every class's confusion probability; ``ghost_rate``
+    is the expected number of persistent false positives (fixed world places) within ``fp_range_m`` of the ego,
+    each reported in a frame with probability ``ghost_presence``; ``fp_high_score_frac`` of the random false
+    positives are scored like true detections (overlapping scores).
     """
 
     name: str
@@ -49,20 +51,20 @@ class DetectorPreset:
     ghost_presence: float
     ghost_score_beta: tuple[float, float]
     fp_high_score_frac: float
+    class_recall: Mapping[str, float]
 
 
 @dataclass(frozen=True, slots=True)
 class ClassModel:
     """How one class fares with every preset.
 
-    recall: factor ``c_class`` on the detection probability; noise_scale: factor on position noise (ordered
+    noise_scale: factor on position noise (ordered
     like the paper's per-class measurement noise R); yaw_noise_scale and flip_scale: factors on the preset's
     yaw noise and heading-flip probability (small, thin objects have ambiguous headings); confusion_prob:
     probability (times the preset's ``confusion_scale``) that a detection of this class is labelled as one of
     ``confused_with`` (equal odds), keeping the true object's box.
     """
 
-    recall: float
     noise_scale: float
     yaw_noise_scale: float
     flip_scale: float
@@ -71,16 +73,17 @@ class ClassModel:
 
 
 CLASS_MODELS: dict[str, ClassModel] = {
-    "car": ClassModel(1.0, 1.0, 1.0, 1.0, 0.02, ("truck",)),
-    "truck": ClassModel(0.90, 1.5, 1.0, 1.5, 0.12, ("car", "bus", "trailer")),
-    "bus": ClassModel(0.95, 1.6, 0.8, 1.0, 0.10, ("truck",)),
-    "trailer": ClassModel(0.80, 1.8, 2.0, 6.0, 0.12, ("truck",)),
-    "pedestrian": ClassModel(0.92, 0.5, 4.0, 8.0, 0.0, ()),
-    "motorcycle": ClassModel(0.85, 0.7, 2.0, 8.0, 0.10, ("bicycle",)),
-    "bicycle": ClassModel(0.75, 0.6, 3.0, 12.0, 0.12, ("motorcycle",)),
+    "car": ClassModel(1.0, 1.0, 1.0, 0.02, ("truck",)),
+    "truck": ClassModel(1.5, 1.0, 1.5, 0.12, ("car", "bus", "trailer")),
+    "bus": ClassModel(1.6, 0.8, 1.0, 0.10, ("truck",)),
+    "trailer": ClassModel(1.8, 2.0, 6.0, 0.12, ("truck",)),
+    "pedestrian": ClassModel(0.5, 4.0, 8.0, 0.0, ()),
+    "motorcycle": ClassModel(0.7, 2.0, 8.0, 0.10, ("bicycle",)),
+    "bicycle": ClassModel(0.6, 3.0, 12.0, 0.12, ("motorcycle",)),
 }
-"""Per-class factors of the simulated detector. The orientation factors follow the pattern of published per-class
-nuScenes AOE (cars, buses, trucks small; trailers, pedestrians, motorcycles, bicycles large)."""
+"""Per-class factors of the simulated detector, shared by the presets. The orientation factors follow the
+pattern of published per-class nuScenes AOE (cars, buses, trucks small; trailers, pedestrians, motorcycles,
+bicycles large)."""
 
 TYPICAL_SIZE_WLH_M: dict[str, tuple[float, float, float]] = {
     "car": (1.95, 4.6, 1.7),
@@ -118,17 +121,17 @@ CONFUSABLE: dict[str, tuple[str, ...]] = {
 PRESETS: dict[str, DetectorPreset] = {
     "centerpoint": DetectorPreset(
         name="centerpoint",
-        recall_near=0.9143,
+        recall_near=0.99,
         range_p50_m=62.0,
         range_width_m=6.0,
-        pts_scale=4.0,
-        pos_bias_std_m=0.07329,
-        pos_noise_std_m=0.1374,
+        pts_scale=3.811,
+        pos_bias_std_m=0.07194,
+        pos_noise_std_m=0.1349,
         z_noise_std_m=0.08,
-        size_noise_rel=0.1367,
-        yaw_noise_std_rad=0.08081,
-        yaw_flip_prob=0.01616,
-        vel_noise_std_mps=0.1221,
+        size_noise_rel=0.136,
+        yaw_noise_std_rad=0.08637,
+        yaw_flip_prob=0.01728,
+        vel_noise_std_mps=0.1219,
         fp_rate=30.0,
         fp_range_m=54.0,
         hotspot_rate=1.0,
@@ -142,20 +145,29 @@ PRESETS: dict[str, DetectorPreset] = {
         ghost_presence=0.7,
         ghost_score_beta=(3.0, 4.0),
         fp_high_score_frac=0.03,
+        class_recall={
+            "car": 1.005,
+            "truck": 0.8469,
+            "bus": 0.9313,
+            "trailer": 0.9102,
+            "pedestrian": 0.9763,
+            "motorcycle": 0.8118,
+            "bicycle": 0.4434,
+        },
     ),
     "megvii": DetectorPreset(
         name="megvii",
-        recall_near=0.9533,
+        recall_near=0.99,
         range_p50_m=55.0,
         range_width_m=7.0,
-        pts_scale=3.184,
-        pos_bias_std_m=0.08107,
-        pos_noise_std_m=0.1486,
+        pts_scale=2.996,
+        pos_bias_std_m=0.08083,
+        pos_noise_std_m=0.1481,
         z_noise_std_m=0.12,
-        size_noise_rel=0.1379,
-        yaw_noise_std_rad=0.03462,
-        yaw_flip_prob=0.01298,
-        vel_noise_std_mps=0.1504,
+        size_noise_rel=0.1369,
+        yaw_noise_std_rad=0.03356,
+        yaw_flip_prob=0.01258,
+        vel_noise_std_mps=0.1505,
         fp_rate=32.78,
         fp_range_m=54.0,
         hotspot_rate=1.5,
@@ -169,20 +181,29 @@ PRESETS: dict[str, DetectorPreset] = {
         ghost_presence=0.7,
         ghost_score_beta=(3.0, 4.0),
         fp_high_score_frac=0.02914,
+        class_recall={
+            "car": 1.005,
+            "truck": 1.005,
+            "bus": 1.005,
+            "trailer": 0.9993,
+            "pedestrian": 0.9876,
+            "motorcycle": 0.8212,
+            "bicycle": 0.486,
+        },
     ),
     "pointpillars": DetectorPreset(
         name="pointpillars",
-        recall_near=0.9842,
+        recall_near=0.99,
         range_p50_m=52.0,
         range_width_m=7.0,
-        pts_scale=1.586,
-        pos_bias_std_m=0.08969,
-        pos_noise_std_m=0.1594,
+        pts_scale=4.412,
+        pos_bias_std_m=0.09203,
+        pos_noise_std_m=0.1635,
         z_noise_std_m=0.18,
-        size_noise_rel=0.1444,
-        yaw_noise_std_rad=0.03395,
-        yaw_flip_prob=0.01811,
-        vel_noise_std_mps=0.1625,
+        size_noise_rel=0.1436,
+        yaw_noise_std_rad=0.03086,
+        yaw_flip_prob=0.01647,
+        vel_noise_std_mps=0.1656,
         fp_rate=19.04,
         fp_range_m=54.0,
         hotspot_rate=2.0,
@@ -196,6 +217,15 @@ PRESETS: dict[str, DetectorPreset] = {
         ghost_presence=0.7,
         ghost_score_beta=(3.0, 4.0),
         fp_high_score_frac=0.0238,
+        class_recall={
+            "car": 1.005,
+            "truck": 1.005,
+            "bus": 0.7494,
+            "trailer": 1.005,
+            "pedestrian": 0.9355,
+            "motorcycle": 0.8405,
+            "bicycle": 0.3821,
+        },
     ),
 }
 """The three detector presets by CLI name, best first."""

@@ -287,7 +287,8 @@ def test_hotspot_clutter_near_bus_looks_like_a_large_vehicle():
 
 
 def test_confused_class_keeps_the_true_objects_box():
-    p = quiet(confusion_scale=5.0, pos_noise_std_m=0.0, pos_bias_std_m=0.0, size_noise_rel=0.0, recall_near=1.0)
+    exact = {"pos_noise_std_m": 0.0, "pos_bias_std_m": 0.0, "size_noise_rel": 0.0}
+    p = quiet(confusion_scale=5.0, recall_near=1.0, class_recall=dict.fromkeys(TRACKING_CLASSES, 1.0), **exact)
     frames = [[("bike-1", "bicycle", 6.0, 2.0, 0.3, 1.0, 0.0), ("ped-1", "pedestrian", -5.0, 1.0, 0.0, 0.0, 0.0)]] * 60
     scene = make_scene(frames)
     dets = simulate_detections(scene, p, seed=3)
