@@ -1,8 +1,8 @@
 """A simulated 3D object detector: boxes derived from ground truth, for scenes without real detections.
 
-Three presets (``gnnpmb/data/simdet_presets.py``) are fitted to the published nuScenes-val figures of the
-detectors the paper tracks with: CenterPoint (best), Megvii (CBGS) and PointPillars (worst); see
-``benchmarks/detector_calibration.py``. Per ground-truth box:
+Three presets (``gnnpmb/data/simdet_presets.py``) are fitted to the published nuScenes figures (val mAP, NDS
+and TP errors; test per-class AP) of the detectors the paper tracks with: CenterPoint (best), Megvii (CBGS) and
+PointPillars (worst); see ``benchmarks/detector_calibration.py``. Per ground-truth box:
 
 - detection probability ``P_D = recall_near · c_class · f_range(d) · f_vis(n)``, with ``d`` the BEV distance
   to the ego, ``f_range(d) = 1 / (1 + exp((d - range_p50_m) / range_width_m))`` and the visibility factor

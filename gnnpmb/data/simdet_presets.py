@@ -1,8 +1,9 @@
 """Parameters of the simulated detector (``gnnpmb/data/simdet.py``): the three presets and the per-class tables.
 
 The presets' quality knobs were fitted on the demo ``mini_train`` scenes by ``benchmarks/detector_calibration.py
---fit`` so that the devkit's ``DetectionEval`` of the simulated detections approaches the published nuScenes-val
-figures of the detector each preset is named after (the figures and their sources are in that script).
+--fit`` so that the devkit's ``DetectionEval`` of the simulated detections approaches the published nuScenes
+figures of the detector each preset is named after: val mATE, mASE, mAOE, mAVE and test per-class AP (the
+figures, their splits and sources are in that script). The other knobs are set by hand.
 """
 
 from __future__ import annotations
