@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from gnnpmb.config import PreprocessParams
-from gnnpmb.data.boxes3d import quat_wxyz_from_yaw
+from gnnpmb.data.boxes3d import quat_wxyz_from_yaw, yaw_from_quat_wxyz
 from gnnpmb.data.detections import load_detection_file, write_detection_file
 from gnnpmb.data.preprocess import preprocess
 from gnnpmb.data.scene import Keyframe, Pose, SceneData
@@ -330,6 +330,21 @@ def test_persistent_false_positives_stay_at_fixed_places_with_stable_scores():
         assert np.all(d.min(axis=1) < 0.6)
     other = scene_ghosts(scene, p, seed=6)
     assert len(other) != len(ghosts) or not np.allclose(other.xy_global, ghosts.xy_global)
+
+
+def test_heading_flips_are_rarer_for_cars_than_for_bicycles():
+    p = quiet(yaw_noise_std_rad=0.0, yaw_flip_prob=0.02, recall_near=1.0, confusion_scale=0.0)
+    frames = [[("car-1", "car", 8.0, 0.0, 0.4, 0.0, 0.0), ("bike-1", "bicycle", -6.0, 3.0, 0.4, 0.0, 0.0)]] * 300
+    dets = simulate_detections(make_scene(frames), p, seed=2)
+    flipped: dict[str, list[bool]] = {"car": [], "bicycle": []}
+    for boxes in dets.values():
+        for k in range(len(boxes)):
+            yaw = float(yaw_from_quat_wxyz(boxes.quat_wxyz[k : k + 1])[0])
+            flipped[str(boxes.class_name[k])].append(abs(np.angle(np.exp(1j * (yaw - 0.4)))) > 3.0)
+    expected = {c: 0.02 * CLASS_MODELS[c].flip_scale for c in flipped}
+    assert len(flipped["car"]) > 250 and len(flipped["bicycle"]) > 50
+    assert np.mean(flipped["car"]) < 0.06 < np.mean(flipped["bicycle"])
+    assert abs(np.mean(flipped["bicycle"]) - expected["bicycle"]) < 0.1
 
 
 def test_some_false_positive_scores_overlap_true_ones():
