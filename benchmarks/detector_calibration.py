@@ -15,7 +15,7 @@ as far as their text was available); they print as "n/a".
 
 The ``--fit N`` mode (use it on ``--split mini_train`` only) runs N rounds of multiplicative updates of each
 preset's knobs: each class's recall factor towards the published per-class (test) AP (damped; where a factor
-reaches the recall cap, the point count needed for detection is lowered instead), position noise towards
+reaches the recall cap, the detection range grows instead), position noise towards
 mATE7, size noise towards mASE7, yaw noise and flip probability towards mAOE7 and velocity noise towards mAVE7
 of the preset's first (val) row; it prints the fitted values to copy into ``gnnpmb/data/simdet_presets.py``.
 mAAE is not fitted: the simulated detector reports the attribute implied by the box's speed.
@@ -263,7 +263,7 @@ def fit_step(
             capped.append(ratio)
     changes["class_recall"] = class_recall
     if capped:
-        changes["pts_scale"] = preset.pts_scale / (sum(capped) / len(capped)) ** 2
+        changes["range_p50_m"] = preset.range_p50_m * (sum(capped) / len(capped)) ** 2
     return dataclasses.replace(preset, **changes)
 
 
@@ -287,7 +287,7 @@ def main() -> None:
             print(f"{name} round {round_}: " + " ".join(f"{k} {current[k]:.3f}" for k in SUMMARY), flush=True)
             preset = fit_step(preset, summary, target, target_ap)
         if args.fit:
-            knobs = ["pts_scale", *(k for ks in FIT_KNOBS.values() for k in ks)]
+            knobs = ["range_p50_m", *(k for ks in FIT_KNOBS.values() for k in ks)]
             print(f"{name} fitted: " + ", ".join(f"{k}={getattr(preset, k):.4g}" for k in knobs))
             print(f"{name} fitted class_recall: " + ", ".join(f"{k}={v:.4g}" for k, v in preset.class_recall.items()))
         report(name, args.split, args.seed, evaluate(split, preset, args.seed, out))
