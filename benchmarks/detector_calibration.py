@@ -6,22 +6,22 @@ classes, so the 3 absent classes count AP 0 and TP errors 1 in its mAP / NDS / m
 prints the figures over the 7 tracking classes (mAP7, mTP7, NDS7 = (5 mAP7 + sum(1 - min(1, mTP7))) / 10), which
 are what is compared with (and fitted to) the published figures.
 
-Published figures, each row with its split and source (fractions, not percent): nuScenes **val** summary
-figures (mAP, NDS, mATE..mAAE) from the OpenPCDet, CenterPoint and mmdetection3d model zoos and the CBGS paper's
-listing; per-class AP of the 7 tracking classes only for the nuScenes **test** set (TransFusion paper, Table 1,
-copied from the nuScenes leaderboard). No per-class val figures and no per-class TP errors of these detectors
-were found in the sources searched (the model-zoo READMEs, the CenterPoint, CBGS, TransFusion and nuScenes papers
-as far as their text was available); they print as "n/a".
+Published figures, each row with its split and source (fractions, not percent): nuScenes **val** summary figures
+(mAP, NDS, mATE..mAAE) from the OpenPCDet, CenterPoint and mmdetection3d model zoos and paperswithcode's listing
+of the CBGS paper; per-class AP of the 7 tracking classes only for the nuScenes **test** set (TransFusion paper,
+Table 1, copied from the nuScenes leaderboard). No per-class val figures and no per-class TP errors of these
+detectors were found in the sources searched (the model-zoo READMEs, and the CenterPoint and TransFusion paper
+texts; the tables of the CBGS and nuScenes papers were not available as text); they print as "n/a".
 
 The ``--fit N`` mode (use it on ``--split mini_train`` only) runs N rounds of multiplicative updates of each
 preset's knobs: each class's recall factor towards the published per-class (test) AP (damped; where a factor
-reaches the recall cap, the detection range grows instead), position noise towards
-mATE7, size noise towards mASE7, yaw noise and flip probability towards mAOE7 and velocity noise towards mAVE7
-of the preset's first (val) row; it prints the fitted values to copy into ``gnnpmb/data/simdet_presets.py``.
+reaches the recall cap, the detection range grows instead), position noise towards mATE7, size noise towards
+mASE7, yaw noise and flip probability towards mAOE7 and velocity noise towards mAVE7 of the preset's first (val)
+row; it prints the fitted values to copy into ``gnnpmb/data/simdet_presets.py``.
 mAAE is not fitted: the simulated detector reports the attribute implied by the box's speed.
 
 Usage: uv run python benchmarks/detector_calibration.py [--split mini_val] [--seed 0] [--out DIR]
-       uv run python benchmarks/detector_calibration.py --split mini_train --fit 4
+       uv run python benchmarks/detector_calibration.py --split mini_train --fit 6
 """
 
 from __future__ import annotations
