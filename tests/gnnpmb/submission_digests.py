@@ -46,8 +46,7 @@ def submission_bytes(scenes: Sequence[SceneData], tokens: Sequence[str], tracker
     """The submission ``gnnpmb track --tracker TRACKER --detector PRESET --seed 0`` writes for ``scenes``."""
     config = TrackerConfig()
     parts = [
-        run_results(run_tracker(scene, get_detections(scene, None, preset, SEED), tracker, config))
-        for scene in scenes
+        run_results(run_tracker(scene, get_detections(scene, None, preset, SEED), tracker, config)) for scene in scenes
     ]
     text = json.dumps(build_submission(parts, tokens), allow_nan=False, separators=(",", ":"))
     return text.encode("utf-8")
