@@ -61,7 +61,18 @@ from gnnpmb.events import (
     PruneReason,
 )
 from gnnpmb.gating import gate
-from gnnpmb.kalman import Innovation, MotionModel, cv_model, innovation, log_likelihood, mahalanobis2, predict
+from gnnpmb.kalman import (
+    Innovation,
+    MotionModel,
+    cv_model,
+    gaussian_log_density,
+    innovation,
+    log_likelihood,
+    mahalanobis2,
+    paired_mahalanobis2,
+    paired_updated_means,
+    predict,
+)
 from gnnpmb.phd.mixture import GaussianMixture, Reduction, reduce_mixture
 from gnnpmb.pmb.poisson import measurement_birth
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
@@ -161,9 +172,9 @@ def gate_components(
         d2 = np.zeros((k, m))
         inside = np.zeros((k, m), dtype=bool)
     if m:
-        nu = z - inn.z_pred[k:]
-        d2_birth = np.einsum("mi,mij,mj->m", nu, inn.S_inv[k:], nu)
-        log_lik[k + np.arange(m), np.arange(m)] = -0.5 * (d2_birth + inn.log_det_S[k:] + 2.0 * np.log(2.0 * np.pi))
+        nu = z - inn.z_pred[k:]  # birth component K + j explains z_j only
+        d2_birth = paired_mahalanobis2(inn.S_inv[k:], nu)
+        log_lik[k + np.arange(m), np.arange(m)] = gaussian_log_density(d2_birth, inn.log_det_S[k:], nu.shape[1])
     pd = np.concatenate([np.full(k, p_detect), np.ones(m)])
     return Prediction(mixture=mix, n_persistent=k, p_detect=pd, inn=inn, d2=d2, inside=inside, log_lik=log_lik)
 
@@ -198,10 +209,9 @@ def posterior_mixture(
     if not len(k_idx):
         return missed
     boxes = meas.boxes
-    nu = meas.z[j_idx] - pred.inn.z_pred[k_idx]
     detected = GaussianMixture(
         weight=np.exp(log_detected[k_idx, j_idx]),
-        mean=mix.mean[k_idx] + np.einsum("pij,pj->pi", pred.inn.gain[k_idx], nu),
+        mean=paired_updated_means(mix.mean, pred.inn, meas.z, k_idx, j_idx),
         cov=pred.inn.cov_post[k_idx],
         label=mix.label[k_idx],
         score=boxes.score[j_idx].astype(float),

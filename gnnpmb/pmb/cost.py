@@ -21,7 +21,7 @@ import numpy as np
 
 from gnnpmb.events import AxisKind, AxisLabel
 from gnnpmb.gating import gate
-from gnnpmb.kalman import Innovation, innovation, log_likelihood, mahalanobis2
+from gnnpmb.kalman import Innovation, innovation, log_likelihood, mahalanobis2, paired_updated_means
 from gnnpmb.pmb.bernoulli import Bernoullis, missed_update
 from gnnpmb.pmb.poisson import NewTrackHypotheses
 from gnnpmb.types import Measurements
@@ -118,5 +118,4 @@ def detected_means(local: LocalHypotheses, track_index: np.ndarray, meas_index: 
     """(P, 4) Kalman-updated means for P (track, measurement) pairs given as local row/column indices."""
     if len(track_index) == 0:
         return np.zeros((0, 4))
-    nu = local.meas.z[meas_index] - local.inn.z_pred[track_index]
-    return local.prior.mean[track_index] + np.einsum("pij,pj->pi", local.inn.gain[track_index], nu)
+    return paired_updated_means(local.prior.mean, local.inn, local.meas.z, track_index, meas_index)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.config import PmbParams
-from gnnpmb.kalman import innovation
+from gnnpmb.kalman import gaussian_log_density, innovation, mean_update, paired_mahalanobis2
 from gnnpmb.types import Measurements
 
 
@@ -59,10 +59,9 @@ def new_track_hypotheses(
     if m == 0:
         return NewTrackHypotheses(np.zeros(0), np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4, 4)))
     inn = innovation(birth.mean, birth.cov, R)
-    nu = meas.z - inn.z_pred  # (M, D)
-    d2 = np.einsum("mi,mij,mj->m", nu, inn.S_inv, nu)
-    log_n = -0.5 * (d2 + inn.log_det_S + nu.shape[1] * np.log(2.0 * np.pi))
+    nu = meas.z - inn.z_pred  # (M, D): component j explains measurement j only
+    log_n = gaussian_log_density(paired_mahalanobis2(inn.S_inv, nu), inn.log_det_S, nu.shape[1])
     birth_term = birth.weight * meas.boxes.score * np.exp(log_n)
     total = clutter_intensity + birth_term
-    mean = birth.mean + np.einsum("mij,mj->mi", inn.gain, nu)
+    mean = mean_update(birth.mean, inn.gain, nu)
     return NewTrackHypotheses(log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=inn.cov_post)

@@ -24,7 +24,7 @@ import numpy as np
 
 from gnnpmb.assign.hungarian import solve
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, EventSink
-from gnnpmb.kalman import Innovation, log_likelihood
+from gnnpmb.kalman import Innovation, log_likelihood, paired_updated_means
 from gnnpmb.types import Measurements
 from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
 
@@ -78,8 +78,7 @@ class GnnTracker(VectorTracker):
         det_k = track_of_meas[det_j]
         mean, cov = prior.mean.copy(), prior.cov.copy()
         if len(det_j):
-            nu = meas.z[det_j] - inn.z_pred[det_k]
-            mean[det_k] += np.einsum("pij,pj->pi", inn.gain[det_k], nu)
+            mean[det_k] = paired_updated_means(prior.mean, inn, meas.z, det_k, det_j)
             cov[det_k] = inn.cov_post[det_k]
         meas_of_track = np.full(k, -1, dtype=np.int64)
         meas_of_track[det_k] = det_j
