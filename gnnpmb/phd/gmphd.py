@@ -48,6 +48,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     Born,
     EventSink,
@@ -127,7 +128,7 @@ def predict_mixture(mix: GaussianMixture, model: MotionModel, p_survive: float) 
         weight=p_survive * mix.weight,
         mean=mean,
         cov=cov,
-        meas_index=np.full(len(mix), -1, dtype=np.int64),
+        det=mix.det.undetected(),
     )
 
 
@@ -135,17 +136,12 @@ def birth_mixture(meas: Measurements, config: TrackerConfig, labels: np.ndarray)
     """One birth component per measurement (``pmb.poisson.measurement_birth``) with the given (M,) labels and the
     measurement's box fields."""
     birth = measurement_birth(meas, config.pmb)
-    boxes = meas.boxes
     return GaussianMixture(
         weight=birth.weight,
         mean=birth.mean,
         cov=birth.cov,
         label=labels,
-        score=boxes.score.astype(float),
-        z_m=boxes.translation_m[:, 2].astype(float),
-        size_wlh_m=boxes.size_wlh_m.astype(float),
-        quat_wxyz=boxes.quat_wxyz.astype(float),
-        meas_index=np.asarray(meas.source_index, dtype=np.int64),
+        det=DetectionFields.from_measurements(meas, np.arange(len(meas))),
     )
 
 
@@ -208,17 +204,12 @@ def posterior_mixture(
     k_idx, j_idx = np.nonzero(np.isfinite(log_detected))
     if not len(k_idx):
         return missed
-    boxes = meas.boxes
     detected = GaussianMixture(
         weight=np.exp(log_detected[k_idx, j_idx]),
         mean=paired_updated_means(mix.mean, pred.inn, meas.z, k_idx, j_idx),
         cov=pred.inn.cov_post[k_idx],
         label=mix.label[k_idx],
-        score=boxes.score[j_idx].astype(float),
-        z_m=boxes.translation_m[j_idx, 2].astype(float),
-        size_wlh_m=boxes.size_wlh_m[j_idx].astype(float),
-        quat_wxyz=boxes.quat_wxyz[j_idx].astype(float),
-        meas_index=np.asarray(meas.source_index, dtype=np.int64)[j_idx],
+        det=DetectionFields.from_measurements(meas, j_idx),
     )
     return GaussianMixture.concatenate([missed, detected])
 
@@ -320,7 +311,11 @@ class GmPhdTracker:
         self.mixture = replace(mix, label=labels)
         alive = set(labels.tolist())
         self._copy_ids = {key: v for key, v in self._copy_ids.items() if key[0] in alive}
-        estimates = [self._estimate(i, t) for i, ids in zip(sel.index.tolist(), track_ids, strict=True) for t in ids]
+        rows = np.array([i for i, ids in zip(sel.index.tolist(), track_ids, strict=True) for _ in ids], dtype=np.int64)
+        chosen = self.mixture.subset(rows)
+        weight = np.minimum(chosen.weight, 1.0)
+        flat_ids = np.array([t for ids in track_ids for t in ids], dtype=np.int64)
+        estimates = chosen.det.to_estimates(self.class_name, flat_ids, chosen.mean, chosen.score, weight)
         return estimates, np.asarray(born, dtype=np.int64), relabelled
 
     def _copy_id(self, label: int, copy: int) -> int:
@@ -328,21 +323,6 @@ class GmPhdTracker:
         if key not in self._copy_ids:
             self._copy_ids[key] = self.ids.allocate()
         return self._copy_ids[key]
-
-    def _estimate(self, i: int, track_id: int) -> TrackEstimate:
-        mix = self.mixture
-        mean = mix.mean[i]
-        return TrackEstimate(
-            track_id=track_id,
-            class_name=self.class_name,
-            translation_m=(float(mean[0]), float(mean[1]), float(mix.z_m[i])),
-            size_wlh_m=tuple(float(v) for v in mix.size_wlh_m[i]),
-            quat_wxyz=tuple(float(v) for v in mix.quat_wxyz[i]),
-            velocity_mps=(float(mean[2]), float(mean[3])),
-            score=float(mix.score[i]),
-            existence=float(min(mix.weight[i], 1.0)),
-            meas_index=int(mix.meas_index[i]),
-        )
 
     def _emit_prior(self, pred: Prediction, meas: Measurements, sink: EventSink) -> None:
         prior = pred.persistent

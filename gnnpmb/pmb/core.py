@@ -22,6 +22,7 @@ from typing import Protocol, overload
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     AxisLabel,
     Born,
@@ -181,7 +182,7 @@ def updated_bernoullis(local: LocalHypotheses, rows: np.ndarray, outcome: np.nda
     """Prior Bernoullis ``rows`` of ``local`` after the single-target hypotheses ``outcome`` (0 = missed: the
     misdetection update; j + 1 = detected by local measurement j: r = 1 and the Kalman update, box fields and
     score from the detection). The local key becomes ``combine_keys(parent key, outcome)``."""
-    prior, boxes = local.prior, local.meas.boxes
+    prior = local.prior
     det = np.flatnonzero(outcome > 0)
     det_k, det_j = rows[det], outcome[det] - 1
     existence = local.miss_existence[rows]
@@ -190,25 +191,13 @@ def updated_bernoullis(local: LocalHypotheses, rows: np.ndarray, outcome: np.nda
     mean[det] = detected_means(local, det_k, det_j)
     cov = prior.cov[rows]
     cov[det] = local.inn.cov_post[det_k]
-    score, z_m = prior.score[rows], prior.z_m[rows]
-    size, quat = prior.size_wlh_m[rows], prior.quat_wxyz[rows]
-    score[det] = boxes.score[det_j]
-    z_m[det] = boxes.translation_m[det_j, 2]
-    size[det] = boxes.size_wlh_m[det_j]
-    quat[det] = boxes.quat_wxyz[det_j]
-    meas_index = np.full(len(rows), -1, dtype=np.int64)
-    meas_index[det] = local.meas.source_index[det_j]
     return Bernoullis(
         track_id=prior.track_id[rows],
         local_key=combine_keys(prior.local_key[rows], outcome),
         existence=existence,
         mean=mean,
         cov=cov,
-        score=score,
-        z_m=z_m,
-        size_wlh_m=size,
-        quat_wxyz=quat,
-        meas_index=meas_index,
+        det=prior.det.subset(rows).take(det, DetectionFields.from_measurements(local.meas, det_j)),
     )
 
 
@@ -216,18 +205,14 @@ def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext
     """The Bernoullis started by local measurements ``new_j`` (existence r_j from ``poisson``)."""
     if len(new_j) == 0:
         return Bernoullis.empty()
-    boxes, new = local.meas.boxes, local.new
+    new = local.new
     return Bernoullis(
         track_id=np.array([ctx.birth_id(int(j)) for j in new_j], dtype=np.int64),
         local_key=combine_keys(np.full(len(new_j), -ctx.frame_serial), new_j + 1),
         existence=new.existence[new_j],
         mean=new.mean[new_j],
         cov=new.cov[new_j],
-        score=boxes.score[new_j],
-        z_m=boxes.translation_m[new_j, 2],
-        size_wlh_m=boxes.size_wlh_m[new_j],
-        quat_wxyz=boxes.quat_wxyz[new_j],
-        meas_index=local.meas.source_index[new_j],
+        det=DetectionFields.from_measurements(local.meas, new_j),
     )
 
 
@@ -343,21 +328,9 @@ class PmbCore:
         return kept
 
     def _extract(self, b: Bernoullis) -> list[TrackEstimate]:
-        sel = np.flatnonzero(b.existence >= self.params.extraction_threshold)
-        return [
-            TrackEstimate(
-                track_id=int(b.track_id[i]),
-                class_name=self.class_name,
-                translation_m=(float(b.mean[i, 0]), float(b.mean[i, 1]), float(b.z_m[i])),
-                size_wlh_m=tuple(float(v) for v in b.size_wlh_m[i]),
-                quat_wxyz=tuple(float(v) for v in b.quat_wxyz[i]),
-                velocity_mps=(float(b.mean[i, 2]), float(b.mean[i, 3])),
-                score=float(b.score[i] * b.existence[i]),
-                existence=float(b.existence[i]),
-                meas_index=int(b.meas_index[i]),
-            )
-            for i in sel
-        ]
+        """Tracks with r >= the extraction threshold; tracking score = detection score x r."""
+        sel = b.subset(np.flatnonzero(b.existence >= self.params.extraction_threshold))
+        return sel.det.to_estimates(self.class_name, sel.track_id, sel.mean, sel.score * sel.existence, sel.existence)
 
     def _emit_prior(self, local: LocalHypotheses, sink: EventSink) -> None:
         prior = local.prior

@@ -35,6 +35,7 @@ import numpy as np
 from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.assign.marginals import AssociationMarginals
 from gnnpmb.config import LbpParams
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, Merged, Pruned, PruneReason
 from gnnpmb.events import Marginals as MarginalsEvent
 from gnnpmb.kalman import symmetrize
@@ -150,26 +151,13 @@ def merged_bernoullis(local: LocalHypotheses, marg: AssociationMarginals) -> tup
     best = np.argmax(p, axis=1)  # 0 = missed, j + 1 = measurement j
     hit = np.flatnonzero(best > 0)
     hit_j = best[hit] - 1
-    boxes = meas.boxes
-    score, z_m = prior.score.copy(), prior.z_m.copy()
-    size, quat = prior.size_wlh_m.copy(), prior.quat_wxyz.copy()
-    score[hit] = boxes.score[hit_j]
-    z_m[hit] = boxes.translation_m[hit_j, 2]
-    size[hit] = boxes.size_wlh_m[hit_j]
-    quat[hit] = boxes.quat_wxyz[hit_j]
-    meas_index = np.full(k, -1, dtype=np.int64)
-    meas_index[hit] = meas.source_index[hit_j]
     tracks = Bernoullis(
         track_id=prior.track_id,
         local_key=combine_keys(prior.local_key, best),
         existence=np.clip(r_sum, 0.0, 1.0),
         mean=mean,
         cov=symmetrize(cov),
-        score=score,
-        z_m=z_m,
-        size_wlh_m=size,
-        quat_wxyz=quat,
-        meas_index=meas_index,
+        det=prior.det.undetected().take(hit, DetectionFields.from_measurements(meas, hit_j)),
     )
     return tracks, comp
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
+from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
 from gnnpmb.events import Born, EventSink, Extracted, Gated, Posterior, Predicted, Pruned, PruneReason
 from gnnpmb.gating import gate
 from gnnpmb.kalman import Innovation, MotionModel, cv_model, innovation, mahalanobis2, predict
@@ -36,23 +37,18 @@ from gnnpmb.vector.track_logic import LogicState, advance, emit_transitions
 
 
 @dataclass(frozen=True, slots=True)
-class VectorTracks(StructOfArrays):
+class VectorTracks(CarriesDetectionFields, StructOfArrays):
     """K tracks of one class, struct-of-arrays.
 
-    track_id: (K,) int64; mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); score: (K,) score of the last
-    associated detection; z_m: (K,), size_wlh_m: (K, 3), quat_wxyz: (K, 4) box fields of that detection;
-    meas_index: (K,) source index of the detection associated in the latest frame, -1 if missed; logic: M/N
-    state.
+    track_id: (K,) int64; mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); det: the fields of the last associated
+    detection (``score``, ``z_m``, ... read through as the tracks' own; ``meas_index`` -1 if missed this frame);
+    logic: M/N state.
     """
 
     track_id: np.ndarray
     mean: np.ndarray
     cov: np.ndarray
-    score: np.ndarray
-    z_m: np.ndarray
-    size_wlh_m: np.ndarray
-    quat_wxyz: np.ndarray
-    meas_index: np.ndarray
+    det: DetectionFields
     logic: LogicState
 
     def __len__(self) -> int:
@@ -64,11 +60,7 @@ class VectorTracks(StructOfArrays):
             track_id=np.zeros(0, dtype=np.int64),
             mean=np.zeros((0, 4)),
             cov=np.zeros((0, 4, 4)),
-            score=np.zeros(0),
-            z_m=np.zeros(0),
-            size_wlh_m=np.zeros((0, 3)),
-            quat_wxyz=np.zeros((0, 4)),
-            meas_index=np.zeros(0, dtype=np.int64),
+            det=DetectionFields.empty(),
             logic=LogicState.empty(),
         )
 
@@ -77,30 +69,13 @@ class VectorTracks(StructOfArrays):
         if not len(self):
             return self
         mean, cov = predict(self.mean, self.cov, model)
-        return replace(self, mean=mean, cov=cov, meas_index=np.full(len(self), -1, dtype=np.int64))
+        return replace(self, mean=mean, cov=cov, det=self.det.undetected())
 
     def updated(self, assoc: Association, meas: Measurements) -> VectorTracks:
         """Posterior state from ``assoc``; tracks with a hit take the box fields of their detection."""
         k = np.flatnonzero(assoc.meas_of_track >= 0)
-        j = assoc.meas_of_track[k]
-        boxes = meas.boxes
-        score, z_m = self.score.copy(), self.z_m.copy()
-        size, quat, meas_index = self.size_wlh_m.copy(), self.quat_wxyz.copy(), self.meas_index.copy()
-        score[k] = boxes.score[j]
-        z_m[k] = boxes.translation_m[j, 2]
-        size[k] = boxes.size_wlh_m[j]
-        quat[k] = boxes.quat_wxyz[j]
-        meas_index[k] = meas.source_index[j]
-        return replace(
-            self,
-            mean=assoc.mean,
-            cov=assoc.cov,
-            score=score,
-            z_m=z_m,
-            size_wlh_m=size,
-            quat_wxyz=quat,
-            meas_index=meas_index,
-        )
+        detected = DetectionFields.from_measurements(meas, assoc.meas_of_track[k])
+        return replace(self, mean=assoc.mean, cov=assoc.cov, det=self.det.take(k, detected))
 
 
 @dataclass(frozen=True, slots=True)
@@ -180,35 +155,18 @@ class VectorTracker(ABC):
         b = len(new_j)
         if b == 0:
             return VectorTracks.empty()
-        boxes = meas.boxes
         return VectorTracks(
             track_id=np.array([self.ids.allocate() for _ in range(b)], dtype=np.int64),
-            mean=np.concatenate([meas.z[new_j], boxes.velocity_mps[new_j]], axis=1),
+            mean=np.concatenate([meas.z[new_j], meas.boxes.velocity_mps[new_j]], axis=1),
             cov=np.broadcast_to(self._birth_cov, (b, 4, 4)).copy(),
-            score=boxes.score[new_j],
-            z_m=boxes.translation_m[new_j, 2],
-            size_wlh_m=boxes.size_wlh_m[new_j],
-            quat_wxyz=boxes.quat_wxyz[new_j],
-            meas_index=meas.source_index[new_j],
+            det=DetectionFields.from_measurements(meas, new_j),
             logic=LogicState.born(b, self.params),
         )
 
     def _extract(self, t: VectorTracks) -> list[TrackEstimate]:
-        sel = np.flatnonzero(t.logic.confirmed & (t.meas_index >= 0))
-        return [
-            TrackEstimate(
-                track_id=int(t.track_id[i]),
-                class_name=self.class_name,
-                translation_m=(float(t.mean[i, 0]), float(t.mean[i, 1]), float(t.z_m[i])),
-                size_wlh_m=tuple(float(v) for v in t.size_wlh_m[i]),
-                quat_wxyz=tuple(float(v) for v in t.quat_wxyz[i]),
-                velocity_mps=(float(t.mean[i, 2]), float(t.mean[i, 3])),
-                score=float(t.score[i]),
-                existence=1.0,
-                meas_index=int(t.meas_index[i]),
-            )
-            for i in sel.tolist()
-        ]
+        """The confirmed tracks hit this frame, scored by their detection; existence 1."""
+        sel = t.subset(np.flatnonzero(t.logic.confirmed & (t.meas_index >= 0)))
+        return sel.det.to_estimates(self.class_name, sel.track_id, sel.mean, sel.score, np.ones(len(sel)))
 
     def _emit_prior(
         self, prior: VectorTracks, inn: Innovation, inside: np.ndarray, meas: Measurements, sink: EventSink

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from gnnpmb.config import ConfigError, PhdParams, TrackerConfig, paper_config
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     Born,
     Extracted,
@@ -49,11 +50,13 @@ def one_component(weight: float, mean, cov, label: int = 5) -> GaussianMixture:
         mean=np.asarray(mean, dtype=float)[None],
         cov=np.asarray(cov, dtype=float)[None],
         label=np.array([label], dtype=np.int64),
-        score=np.array([0.7]),
-        z_m=np.array([0.5]),
-        size_wlh_m=np.array([[1.0, 2.0, 1.0]]),
-        quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
-        meas_index=np.array([-1]),
+        det=DetectionFields(
+            score=np.array([0.7]),
+            z_m=np.array([0.5]),
+            size_wlh_m=np.array([[1.0, 2.0, 1.0]]),
+            quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
+            meas_index=np.array([-1]),
+        ),
     )
 
 

@@ -14,6 +14,7 @@ from scipy.special import logsumexp
 from gnnpmb.assign import murty
 from gnnpmb.assign.murty import k_best
 from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig, paper_config
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses, ListSink, NullSink, Pruned, PruneReason
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext, posterior_from_assignment
@@ -41,11 +42,13 @@ def one_track(score: float = 0.9, pos_var: float = 0.1, vel_var: float = 0.5) ->
         existence=np.array([1.0]),
         mean=np.zeros((1, 4)),
         cov=np.diag([pos_var, pos_var, vel_var, vel_var])[None],
-        score=np.array([score]),
-        z_m=np.array([1.0]),
-        size_wlh_m=np.array([[2.0, 4.5, 1.6]]),
-        quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
-        meas_index=np.array([-1]),
+        det=DetectionFields(
+            score=np.array([score]),
+            z_m=np.array([1.0]),
+            size_wlh_m=np.array([[2.0, 4.5, 1.6]]),
+            quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
+            meas_index=np.array([-1]),
+        ),
     )
 
 

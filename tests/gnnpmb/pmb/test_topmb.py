@@ -7,6 +7,7 @@ import pytest
 
 from gnnpmb.assign.exact_marginals import exact_marginals_log
 from gnnpmb.config import TrackerConfig, paper_config
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import Assignment, AxisKind, ListSink, Marginals, Merged, NullSink, Posterior
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext
@@ -35,11 +36,13 @@ def make_prior(means, existence, cov_diag=(0.5, 0.5, 1.0, 1.0), score=0.8) -> Be
         existence=np.asarray(existence, dtype=float),
         mean=np.asarray(means, dtype=float).reshape(k, 4),
         cov=np.tile(np.diag(cov_diag), (k, 1, 1)),
-        score=np.full(k, score),
-        z_m=np.zeros(k),
-        size_wlh_m=np.ones((k, 3)),
-        quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (k, 1)),
-        meas_index=np.full(k, -1),
+        det=DetectionFields(
+            score=np.full(k, score),
+            z_m=np.zeros(k),
+            size_wlh_m=np.ones((k, 3)),
+            quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (k, 1)),
+            meas_index=np.full(k, -1),
+        ),
     )
 
 
