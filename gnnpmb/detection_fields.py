@@ -99,28 +99,23 @@ class DetectionFields(StructOfArrays):
 _FIELDS: tuple[str, ...] = ("score", "z_m", "size_wlh_m", "quat_wxyz", "meas_index")
 
 
+class _ReadThrough:
+    """Descriptor: ``obj.<name>`` reads ``obj.det.<name>``."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, obj: CarriesDetectionFields, owner: type | None = None) -> np.ndarray:
+        return getattr(obj.det, self.name)
+
+
 class CarriesDetectionFields:
     """Mixin for a struct-of-arrays with a ``det: DetectionFields`` field: its fields read as the item's own."""
 
     __slots__ = ()
     det: DetectionFields
-
-    @property
-    def score(self) -> np.ndarray:
-        return self.det.score
-
-    @property
-    def z_m(self) -> np.ndarray:
-        return self.det.z_m
-
-    @property
-    def size_wlh_m(self) -> np.ndarray:
-        return self.det.size_wlh_m
-
-    @property
-    def quat_wxyz(self) -> np.ndarray:
-        return self.det.quat_wxyz
-
-    @property
-    def meas_index(self) -> np.ndarray:
-        return self.det.meas_index
+    score = _ReadThrough()
+    z_m = _ReadThrough()
+    size_wlh_m = _ReadThrough()
+    quat_wxyz = _ReadThrough()
+    meas_index = _ReadThrough()
