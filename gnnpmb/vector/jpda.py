@@ -37,12 +37,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from gnnpmb.assign.clusters import gate_clusters
 from gnnpmb.assign.exact_marginals import exact_marginals_log
 from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals
 from gnnpmb.kalman import Innovation, log_likelihood, mean_update, residuals, symmetrize
 from gnnpmb.types import Measurements
-from gnnpmb.vector.clusters import gate_clusters
 from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
 
 MAX_GATED_PER_TRACK = 32
