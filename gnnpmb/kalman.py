@@ -2,7 +2,7 @@
 
 State m = [x, y, vx, vy]; measurement z = H m = [x, y] (D = 2), or [x, y, vx, vy] (D = 4, H = I) for the opt-in
 variant that also measures the detector's velocity (``[pmb] measure_velocity = 1``).
-Motion x_k = F x_{k-1} + w, w ~ N(0, Q), F = [[I, dt I], [0, I]], Q = diag(q_x, q_y, q_x, q_y) (paper sec. V-B).
+Motion x_k = F x_{k-1} + w, w ~ N(0, Q) (``gnnpmb.models.cv_model``); predict: m' = F m, P' = F P F^T + Q.
 Update: S = H P H^T + R, K = P H^T S^-1, m+ = m + K (z - H m), P+ = P - K S K^T (symmetrised).
 Gaussian log-density of a D-dimensional innovation nu: log N(nu; 0, S) = -(nu^T S^-1 nu + log|S| + D log 2 pi) / 2.
 
@@ -16,32 +16,17 @@ References: Bar-Shalom, Li & Kirubarajan, "Estimation with Applications to Track
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gnnpmb.config import ClassParams
 from gnnpmb.soa import StructOfArrays
+
+if TYPE_CHECKING:
+    from gnnpmb.models import MotionModel
 
 H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
 """Measurement matrix: picks the BEV position."""
-
-
-@dataclass(frozen=True, slots=True)
-class MotionModel:
-    """F (4, 4), Q (4, 4), R (2, 2) for one class and one time step."""
-
-    F: np.ndarray
-    Q: np.ndarray
-    R: np.ndarray
-
-
-def cv_model(dt_s: float, params: ClassParams, measure_velocity: bool = False) -> MotionModel:
-    """F, Q and R (2 x 2 diag(r_x, r_y), or 4 x 4 diag(r_x, r_y, r_vx, r_vy) when ``measure_velocity``)."""
-    F = np.eye(4)
-    F[0, 2] = F[1, 3] = dt_s
-    Q = np.diag([params.q_x, params.q_y, params.q_x, params.q_y])
-    r = [params.r_x, params.r_y] + ([params.r_vx, params.r_vy] if measure_velocity else [])
-    return MotionModel(F=F, Q=Q, R=np.diag(r))
 
 
 def symmetrize(P: np.ndarray) -> np.ndarray:

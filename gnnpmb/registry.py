@@ -26,7 +26,7 @@ class ClassTracker(Protocol):
 
 def _gnnpmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
     from gnnpmb.pmb.core import PmbCore
-    from gnnpmb.pmb.strategy import BestAssignment
+    from gnnpmb.pmb.gnnpmb import BestAssignment
 
     return PmbCore(class_name, config, BestAssignment(), ids)
 
@@ -40,9 +40,9 @@ def _pmbm(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTrac
 
 def _topmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
     from gnnpmb.pmb.core import PmbCore
-    from gnnpmb.pmb.topmb import Marginals
+    from gnnpmb.pmb.topmb import MarginalMerge
 
-    return PmbCore(class_name, config, Marginals(config.lbp), ids)
+    return PmbCore(class_name, config, MarginalMerge(config.lbp), ids)
 
 
 def _phd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:

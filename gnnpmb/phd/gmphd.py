@@ -2,15 +2,15 @@
 
 Per class and frame (Vo & Ma 2006, Table I-III):
 
-1. predict: w <- P_S w, (m, P) <- Kalman predict (eq. 20-21); P_S is ``[pmb] p_survive``;
+1. predict: w <- P_S w, (m, P) <- Kalman predict (eq. 20-21); P_S is ``[models] p_survive``;
 2. birth: one component per detection, weight w_b at [z_j, v_j] with covariance P_b (``pmb.poisson``: adaptive,
    measurement-driven birth, Ristic, Clark, Vo & Vo 2012). A birth component describes a target that produced
    detection j, so it is detected with probability 1 and explains z_j only: it has no misdetection term and
    every other detection is outside its gate (as in the PMB core, undetected birth mass is not carried on);
 3. gate: persistent component k may explain z_j only if (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < G
-   (``[pmb] gate_chi2``); outside the gate its likelihood q_k(z_j) is taken as 0;
+   (``[models] gate_chi2``); outside the gate its likelihood q_k(z_j) is taken as 0;
 4. update (eq. 23-26), with P_D,k = ``[phd] p_detect`` for persistent and 1 for birth components and clutter
-   intensity kappa = ``[pmb] clutter_intensity`` (the same clutter model as the rest of the study):
+   intensity kappa = ``[models] clutter_intensity`` (the same clutter model as the rest of the study):
      missed:    w_k (1 - P_D,k),           state unchanged,
      detected:  w_kj = P_D,k w_k q_k(z_j) / (kappa + sum_i P_D,i w_i q_i(z_j)),  Kalman update with z_j,
    computed in log space (``phd_update``);
@@ -64,8 +64,6 @@ from gnnpmb.events import (
 from gnnpmb.gating import gate
 from gnnpmb.kalman import (
     Innovation,
-    MotionModel,
-    cv_model,
     gaussian_log_density,
     innovation,
     log_likelihood,
@@ -74,8 +72,8 @@ from gnnpmb.kalman import (
     paired_updated_means,
     predict,
 )
+from gnnpmb.models import MotionModel, cv_model, measurement_birth
 from gnnpmb.phd.mixture import GaussianMixture, Reduction, reduce_mixture
-from gnnpmb.pmb.poisson import measurement_birth
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -135,7 +133,7 @@ def predict_mixture(mix: GaussianMixture, model: MotionModel, p_survive: float) 
 def birth_mixture(meas: Measurements, config: TrackerConfig, labels: np.ndarray) -> GaussianMixture:
     """One birth component per measurement (``pmb.poisson.measurement_birth``) with the given (M,) labels and the
     measurement's box fields."""
-    birth = measurement_birth(meas, config.pmb)
+    birth = measurement_birth(meas, config.models)
     return GaussianMixture(
         weight=birth.weight,
         mean=birth.mean,
@@ -244,11 +242,11 @@ class GmPhdTracker:
         """Process one frame of this class's measurements; returns the extracted tracks."""
         if not len(meas) and self._idle() and not sink.enabled:
             return []
-        pmb, p = self.config.pmb, self.params
+        models, p = self.config.models, self.params
         model = cv_model(dt_s, self.class_params)
-        persistent = predict_mixture(self.mixture, model, pmb.p_survive)
+        persistent = predict_mixture(self.mixture, model, models.p_survive)
         births = birth_mixture(meas, self.config, self._provisional_labels(len(meas)))
-        pred = gate_components(persistent, births, meas, model.R, pmb.gate_chi2, p.p_detect)
+        pred = gate_components(persistent, births, meas, model.R, models.gate_chi2, p.p_detect)
         if sink.enabled:
             self._emit_prior(pred, meas, sink)
         log_missed, log_detected = self._correct(pred, meas, sink)
@@ -268,7 +266,7 @@ class GmPhdTracker:
 
     def _correct(self, pred: Prediction, meas: Measurements, sink: EventSink) -> tuple[np.ndarray, np.ndarray]:
         """Log missed (K + M,) and detected (K + M, M) weights of the PHD update (``phd_update``)."""
-        return phd_update(pred.mixture.weight, pred.p_detect, pred.log_lik, self.config.pmb.clutter_intensity)
+        return phd_update(pred.mixture.weight, pred.p_detect, pred.log_lik, self.config.models.clutter_intensity)
 
     def _select(self, mix: GaussianMixture) -> Selection:
         """Vo & Ma 2006, Table III: w >= extraction_weight, floor(w + 1/2) copies (at least one)."""
@@ -336,7 +334,7 @@ class GmPhdTracker:
                 inside=pred.inside,
                 center_xy=pred.inn.z_pred[:k],
                 innovation_cov=pred.inn.S[:k],
-                threshold=self.config.pmb.gate_chi2,
+                threshold=self.config.models.gate_chi2,
             )
         )
 

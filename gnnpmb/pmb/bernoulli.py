@@ -13,7 +13,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
-from gnnpmb.kalman import MotionModel, predict
+from gnnpmb.kalman import predict
+from gnnpmb.models import MotionModel
 from gnnpmb.soa import StructOfArrays
 
 

@@ -1,8 +1,8 @@
 """The shared Poisson multi-Bernoulli (mixture) core: predict, gate, cost, *strategy*, update, prune, extract.
 
 GNN-PMB, PMBM and TO-PMB differ only in how the strategy manages data-association hypotheses (paper sec. III-IV):
-``strategy.BestAssignment`` keeps the single best global hypothesis (GNN-PMB), ``pmbm.KBest`` keeps up to N_h
-(PMBM, Murty), ``topmb.Marginals`` merges every local hypothesis by its marginal probability (TO-PMB, LBP).
+``gnnpmb.BestAssignment`` keeps the single best global hypothesis (GNN-PMB), ``pmbm.KBest`` keeps up to N_h
+(PMBM, Murty), ``topmb.MarginalMerge`` merges every local hypothesis by its marginal probability (TO-PMB, LBP).
 Everything else in a frame is this module, per class:
 
 1. predict every hypothesis' Bernoullis (``bernoulli.predict_bernoullis``);
@@ -35,10 +35,10 @@ from gnnpmb.events import (
     Pruned,
     PruneReason,
 )
-from gnnpmb.kalman import MotionModel, cv_model
+from gnnpmb.models import MotionModel, clutter_intensity, cv_model, measurement_birth
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
-from gnnpmb.pmb.poisson import NewTrackHypotheses, measurement_birth, new_track_hypotheses
+from gnnpmb.pmb.poisson import NewTrackHypotheses, new_track_hypotheses
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -253,6 +253,7 @@ class PmbCore:
         self.class_name = class_name
         self.config = config
         self.params = config.pmb
+        self.models = config.models
         self.class_params = config.for_class(class_name)
         self.strategy = strategy
         self.ids = ids
@@ -266,8 +267,8 @@ class PmbCore:
         model = cv_model(dt_s, self.class_params, p.measure_velocity == 1)
         if p.measure_velocity == 1:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
-        clutter = p.clutter_intensity * (p.clutter_velocity_density if p.measure_velocity == 1 else 1.0)
-        new = new_track_hypotheses(measurement_birth(meas, p), meas, model.R, clutter)
+        clutter = clutter_intensity(self.models, p)
+        new = new_track_hypotheses(measurement_birth(meas, self.models), meas, model.R, clutter)
         priors, locals_ = self._predict_and_localise(meas, model, new)
         if sink.enabled:
             self._emit_prior(locals_[0], sink)
@@ -287,7 +288,7 @@ class PmbCore:
         (equal ``local_key`` = identical component), so with several hypotheses every distinct Bernoulli is
         predicted and gated once and each hypothesis takes its rows when asked (``HypothesisLocals``; PMBM,
         García-Fernández et al. 2018, sec. V)."""
-        p = self.params
+        p = self.models
         if len(self.hypotheses) == 1:
             h = self.hypotheses[0]
             prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
@@ -343,7 +344,7 @@ class PmbCore:
                 inside=local.inside,
                 center_xy=local.inn.z_pred[:, :2],
                 innovation_cov=local.inn.S[:, :2, :2],
-                threshold=self.params.gate_chi2,
+                threshold=self.models.gate_chi2,
             )
         )
         sink.emit(CostMatrix(self.class_name, local.cost_matrix(), local.row_labels(), local.col_labels()))

@@ -11,7 +11,7 @@ since an assignment's likelihood is the product of its local hypothesis likeliho
 the same Bernoullis (same multiset of local keys after the core's existence pruning) are merged by adding
 weights; then the weights are normalised, sorted (ties keep parent, then rank order), children below
 ``hypothesis_prune`` dropped, at most N_h kept and renormalised. With N_h = 1 this is exactly GNN-PMB
-(``strategy.BestAssignment``).
+(``gnnpmb.BestAssignment``).
 
 Of a parent's H_h best assignments only those costing at most -log(hypothesis_prune) more than its best are
 enumerated: the parent's best child alone outweighs such a child by more than 1 / hypothesis_prune, so its

@@ -36,8 +36,7 @@ from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.assign.marginals import AssociationMarginals
 from gnnpmb.config import LbpParams
 from gnnpmb.detection_fields import DetectionFields
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, Merged, Pruned, PruneReason
-from gnnpmb.events import Marginals as MarginalsEvent
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, Marginals, Merged, Pruned, PruneReason
 from gnnpmb.kalman import symmetrize
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import (
@@ -65,7 +64,7 @@ MERGE_REPORT_WEIGHT = 0.05
 mass (``Components``), so Bernoullis with negligible existence do not flood the event log."""
 
 
-class Marginals:
+class MarginalMerge:
     """TO-PMB hypothesis strategy: marginal association probabilities by LBP, one merged Bernoulli per track."""
 
     name = "marginals"
@@ -176,7 +175,7 @@ def _emit(local: LocalHypotheses, marg: AssociationMarginals, comp: Components, 
     k, m = local.n_tracks, local.n_meas
     rows = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
     cols = (AxisLabel(AxisKind.MISSED, -1),) + tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
-    ctx.sink.emit(MarginalsEvent(ctx.class_name, marg.p_track, rows, cols, marg.method, marg.iterations))
+    ctx.sink.emit(Marginals(ctx.class_name, marg.p_track, rows, cols, marg.method, marg.iterations))
 
     significant = comp.detected >= MERGE_REPORT_WEIGHT
     missed = comp.missed >= MERGE_REPORT_WEIGHT

@@ -4,11 +4,11 @@ A vector-type tracker keeps a fixed list of Kalman tracks, each with an M/N trac
 random-finite-set density (Blackman & Popoli 1999, ch. 6; Bar-Shalom, Daum & Huang 2009). Per class and frame:
 
 1. Kalman predict every track (``gnnpmb.kalman``, per-class Q and R);
-2. ellipsoidal gate: d^2_kj = (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < G (``[pmb] gate_chi2``);
+2. ellipsoidal gate: d^2_kj = (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < G (``[models] gate_chi2``);
 3. data association and state update: the only part that differs (``gnn.GnnTracker``: the single best
    assignment; ``jpda.JpdaTracker``: marginal association probabilities and the PDA update);
 4. measurements left unassociated start tentative tracks: mean [z_j, v_j] with the detector's velocity v_j,
-   covariance the Kalman update of diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j (``[pmb] birth_pos_std_m``,
+   covariance the Kalman update of diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j (``[models] birth_pos_std_m``,
    ``birth_vel_std_mps``), i.e. about R in position;
 5. M/N track logic (``track_logic``) confirms and deletes tracks;
 6. output: the *confirmed* tracks associated with a detection this frame. Coasting tracks (missed, not yet
@@ -30,7 +30,8 @@ from gnnpmb.config import TrackerConfig
 from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
 from gnnpmb.events import Born, EventSink, Extracted, Gated, Posterior, Predicted, Pruned, PruneReason
 from gnnpmb.gating import gate
-from gnnpmb.kalman import Innovation, MotionModel, cv_model, innovation, mahalanobis2, predict
+from gnnpmb.kalman import Innovation, innovation, mahalanobis2, predict
+from gnnpmb.models import MotionModel, birth_covariance, cv_model
 from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 from gnnpmb.vector.track_logic import LogicState, advance, emit_transitions
@@ -100,14 +101,13 @@ class VectorTracker(ABC):
         self.class_name = class_name
         self.params = config.vector
         self.class_params = config.for_class(class_name)
-        self.gate_chi2 = config.pmb.gate_chi2
-        self.clutter_intensity = config.pmb.clutter_intensity
+        self.gate_chi2 = config.models.gate_chi2
+        self.clutter_intensity = config.models.clutter_intensity
         self.lbp = config.lbp
         self.ids = ids
         self.tracks = VectorTracks.empty()
-        var = np.array([config.pmb.birth_pos_std_m**2] * 2 + [config.pmb.birth_vel_std_mps**2] * 2)
         R = cv_model(0.0, self.class_params).R
-        self._birth_cov = innovation(np.zeros((1, 4)), np.diag(var)[None], R).cov_post[0]
+        self._birth_cov = innovation(np.zeros((1, 4)), birth_covariance(config.models)[None], R).cov_post[0]
 
     def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
         """Process one frame of this class's measurements; returns the confirmed tracks hit this frame."""

@@ -3,7 +3,6 @@ import numpy as np
 from gnnpmb.config import ClassParams
 from gnnpmb.gating import ellipse_outline, gate
 from gnnpmb.kalman import (
-    cv_model,
     innovation,
     log_likelihood,
     mahalanobis2,
@@ -13,6 +12,7 @@ from gnnpmb.kalman import (
     predict,
     updated_means,
 )
+from gnnpmb.models import cv_model
 
 PARAMS = ClassParams(0.1, 0.2, 0.3, 0.4)
 

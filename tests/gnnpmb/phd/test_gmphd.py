@@ -28,7 +28,7 @@ from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-P = CFG.pmb
+P = CFG.models
 PD = CFG.phd.p_detect
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
@@ -60,11 +60,11 @@ def one_component(weight: float, mean, cov, label: int = 5) -> GaussianMixture:
     )
 
 
-def raw_config(**pmb) -> TrackerConfig:
+def raw_config(**models) -> TrackerConfig:
     """No pruning and no merging, so every component of the update stays visible."""
     return CFG.replace(
         phd=dataclasses.replace(CFG.phd, prune_weight=0.0, merge_threshold=0.0),
-        pmb=dataclasses.replace(CFG.pmb, **pmb),
+        models=dataclasses.replace(CFG.models, **models),
     )
 
 

@@ -18,13 +18,13 @@ from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses, ListSink, NullSink, Pruned, PruneReason
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext, posterior_from_assignment
+from gnnpmb.pmb.gnnpmb import BestAssignment
 from gnnpmb.pmb.pmbm import KBest, SharedRanking, hypothesis_budget
-from gnnpmb.pmb.strategy import BestAssignment
 from gnnpmb.types import IdAllocator, Measurements
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-P = CFG.pmb
+P = CFG.models
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
 Q = np.diag([CAR.q_x, CAR.q_y, CAR.q_x, CAR.q_y])

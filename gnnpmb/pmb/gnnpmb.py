@@ -1,9 +1,9 @@
-"""Hypothesis management strategies of the PMB family; the GNN-PMB one lives here.
+"""The GNN-PMB hypothesis management strategy of the PMB family.
 
 ``BestAssignment`` is GNN-PMB (paper sec. IV): of all global hypotheses that follow from the single prior
 hypothesis, keep only the most likely one, found as the optimal assignment of the cost matrix
 (``cost.LocalHypotheses.cost_matrix``) by the Hungarian algorithm. The result is again a PMB density with one
-global hypothesis, whose weight is therefore 1 (log 0). See ``pmbm.KBest`` (PMBM) and ``topmb.Marginals`` (TO-PMB)
+global hypothesis, whose weight is therefore 1 (log 0). See ``pmbm.KBest`` (PMBM) and ``topmb.MarginalMerge`` (TO-PMB)
 for the alternatives.
 """
 
