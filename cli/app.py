@@ -423,7 +423,6 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
     shown = focus.window(frame_range) if focus is not None else frame_range
     clock = Clock(focus_end=focus.frame_index) if focus is not None else PLAIN_CLOCK
     n = len(shown)
-    gate_z_m = float(np.median([k.ego_pose.translation_m[2] for k in scene.keyframes]))
     blueprint = default_blueprint(request.trackers, request.classes, focus)
     bar = progress_bar(progress)
     runs: list[TrackingRun] = []
@@ -451,7 +450,7 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
             logger = loggers[tracker] = TrackerLogger(
                 stream,
                 tracker,
-                gate_z_m=gate_z_m,
+                gate_z_m=scene.ground_z_m,
                 clock=clock,
                 log_frames=shown if focus is not None else None,
                 focus_tracks=set(focus.track_ids.get(tracker, ())) if focus is not None else None,
@@ -460,14 +459,13 @@ def run_view(request: ViewRequest, *, progress: bool = True, failures: bool = Tr
             runs.append(
                 run_tracker(
                     scene,
-                    request.detections,
+                    request.frame_detections,
                     tracker,
                     request.config,
                     sink=logger,
                     classes=request.classes,
                     frame_range=frame_range,
                     on_frame=lambda task=task: bar.advance(task),
-                    frame_detections=request.frame_detections,
                 )
             )
             logger.finish()
@@ -495,12 +493,11 @@ def rerun_runs(request: ViewRequest) -> list[TrackingRun]:
     return [
         run_tracker(
             request.scene,
-            request.detections,
+            request.frame_detections,
             tracker,
             request.config,
             classes=request.classes,
             frame_range=request.frame_range,
-            frame_detections=request.frame_detections,
         )
         for tracker in request.trackers
     ]

@@ -30,6 +30,7 @@ from gnnpmb.events import (
     CostMatrix,
     EventSink,
     Extracted,
+    Panel,
     Posterior,
     Predicted,
     Pruned,
@@ -86,6 +87,8 @@ def greedy_pairs(dist: np.ndarray) -> np.ndarray:
 
 class GreedyTracker:
     """One class's greedy closest-pair tracker (module docstring)."""
+
+    panels: tuple[Panel, ...] = ()
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name

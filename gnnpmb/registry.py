@@ -14,12 +14,15 @@ from gnnpmb.errors import UnknownNameError
 
 if TYPE_CHECKING:  # numpy-heavy; the CLI imports this module for its help text
     from gnnpmb.config import TrackerConfig
-    from gnnpmb.events import EventSink
+    from gnnpmb.events import EventSink, Panel
     from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
 class ClassTracker(Protocol):
-    """A single-class multi-object tracker."""
+    """A single-class multi-object tracker; ``panels``: the tracker-specific viewer panels its events fill."""
+
+    @property
+    def panels(self) -> tuple[Panel, ...]: ...
 
     def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]: ...
 
@@ -113,6 +116,14 @@ def check_classes(names: list[str]) -> list[str]:
     if not names:
         raise UnknownNameError(f"no classes given; choose from: {', '.join(TRACKING_CLASSES)}")
     return names
+
+
+def tracker_panels(name: str) -> tuple[Panel, ...]:
+    """The tracker-specific viewer panels tracker ``name`` declares (the same for every class)."""
+    from gnnpmb.config import TrackerConfig
+    from gnnpmb.types import IdAllocator
+
+    return make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator()).panels
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:

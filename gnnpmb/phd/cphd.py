@@ -57,7 +57,7 @@ import numpy as np
 from scipy.special import gammaln, xlogy
 
 from gnnpmb.config import ConfigError, TrackerConfig
-from gnnpmb.events import Cardinality, EventSink
+from gnnpmb.events import Cardinality, EventSink, Panel
 from gnnpmb.phd.gmphd import GmPhdTracker, Prediction, Selection, log_sum_exp, safe_log
 from gnnpmb.phd.mixture import GaussianMixture
 from gnnpmb.types import IdAllocator, Measurements
@@ -270,6 +270,7 @@ class CphdTracker(GmPhdTracker):
     ``cardinality`` is the posterior pmf (N + 1,) of the last frame (``[1.0]`` before the first)."""
 
     name = "cphd"
+    panels = (Panel.CARDINALITY, Panel.INTENSITY)
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         if not config.models.clutter_intensity > 0.0:

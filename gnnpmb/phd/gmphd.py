@@ -56,6 +56,7 @@ from gnnpmb.events import (
     Gated,
     IntensityWeights,
     Merged,
+    Panel,
     Posterior,
     Predicted,
     Pruned,
@@ -227,6 +228,7 @@ class GmPhdTracker:
     but the weight update (``_correct``) and the extraction rule (``_select``)."""
 
     name = "phd"
+    panels: tuple[Panel, ...] = (Panel.INTENSITY,)
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name

@@ -30,6 +30,7 @@ from gnnpmb.events import (
     EventSink,
     Extracted,
     Gated,
+    Panel,
     Posterior,
     Predicted,
     Pruned,
@@ -122,9 +123,11 @@ class HypothesisLocals(Sequence[LocalHypotheses]):
 
 
 class HypothesisStrategy(Protocol):
-    """Data-association hypothesis management: the only thing that differs across GNN-PMB, PMBM and TO-PMB."""
+    """Data-association hypothesis management: the only thing that differs across GNN-PMB, PMBM and TO-PMB.
+    ``panels``: the viewer panels its events fill."""
 
     name: str
+    panels: tuple[Panel, ...]
 
     def update(
         self, priors: list[GlobalHypothesis], locals_: Sequence[LocalHypotheses], ctx: UpdateContext
@@ -259,6 +262,11 @@ class PmbCore:
         self.ids = ids
         self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty())]
         self.frame_serial = 0
+
+    @property
+    def panels(self) -> tuple[Panel, ...]:
+        """The viewer panels this tracker's events fill beyond the common ones: its strategy's."""
+        return self.strategy.panels
 
     def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
         """Process one frame of this class's measurements; returns the extracted tracks."""

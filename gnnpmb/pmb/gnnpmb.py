@@ -10,7 +10,7 @@ for the alternatives.
 from __future__ import annotations
 
 from gnnpmb.assign.hungarian import solve
-from gnnpmb.events import Assignment
+from gnnpmb.events import Assignment, Panel
 from gnnpmb.pmb.core import GlobalHypothesis, UpdateContext, assignment_pairs, posterior_from_assignment
 from gnnpmb.pmb.cost import LocalHypotheses
 
@@ -19,6 +19,7 @@ class BestAssignment:
     """GNN-PMB: the single best global hypothesis (Hungarian on the PMB cost matrix)."""
 
     name = "best-assignment"
+    panels: tuple[Panel, ...] = ()
 
     def update(
         self, priors: list[GlobalHypothesis], locals_: list[LocalHypotheses], ctx: UpdateContext

@@ -42,7 +42,7 @@ from scipy.special import logsumexp
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.assign.murty import Product, Ranking, blocks, forbid_beyond_private, k_best, rank
 from gnnpmb.config import PmbmParams
-from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses
+from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
 from gnnpmb.pmb.core import (
     GlobalHypothesis,
     HypothesisLocals,
@@ -87,6 +87,7 @@ class KBest:
     more than ``murty_block_rows`` rows keep only their best assignment (the per-frame budget)."""
 
     name = "k-best"
+    panels = (Panel.HYPOTHESES,)
 
     def __init__(
         self,

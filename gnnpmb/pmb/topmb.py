@@ -36,7 +36,7 @@ from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.assign.marginals import AssociationMarginals
 from gnnpmb.config import LbpParams
 from gnnpmb.detection_fields import DetectionFields
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, Marginals, Merged, Pruned, PruneReason
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, Marginals, Merged, Panel, Pruned, PruneReason
 from gnnpmb.kalman import symmetrize
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import (
@@ -68,6 +68,7 @@ class MarginalMerge:
     """TO-PMB hypothesis strategy: marginal association probabilities by LBP, one merged Bernoulli per track."""
 
     name = "marginals"
+    panels = (Panel.MARGINALS,)
 
     def __init__(self, params: LbpParams, max_bernoullis: int = MAX_BERNOULLIS):
         if max_bernoullis < 1:

@@ -40,7 +40,7 @@ import numpy as np
 from gnnpmb.assign.clusters import gate_clusters
 from gnnpmb.assign.exact_marginals import exact_marginals_log
 from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
-from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals
+from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals, Panel
 from gnnpmb.kalman import Innovation, log_likelihood, mean_update, residuals, symmetrize
 from gnnpmb.types import Measurements
 from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
@@ -138,6 +138,8 @@ def pda_update(
 
 class JpdaTracker(VectorTracker):
     """One class's JPDA tracker (module docstring); ``step`` is ``tracks.VectorTracker.step``."""
+
+    panels = (Panel.MARGINALS,)
 
     def _associate(
         self,

@@ -28,7 +28,7 @@ import numpy as np
 
 from gnnpmb.config import TrackerConfig
 from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
-from gnnpmb.events import Born, EventSink, Extracted, Gated, Posterior, Predicted, Pruned, PruneReason
+from gnnpmb.events import Born, EventSink, Extracted, Gated, Panel, Posterior, Predicted, Pruned, PruneReason
 from gnnpmb.gating import gate
 from gnnpmb.kalman import Innovation, innovation, mahalanobis2, predict
 from gnnpmb.models import MotionModel, birth_covariance, cv_model
@@ -96,6 +96,8 @@ class Association:
 
 class VectorTracker(ABC):
     """One class's vector-type tracker; subclasses implement ``_associate`` (module docstring, step 3)."""
+
+    panels: tuple[Panel, ...] = ()
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name

@@ -65,11 +65,10 @@ def expected(demo_dataroot: Path) -> Comparison:
     runs = [
         run_tracker(
             request.scene,
-            request.detections,
+            request.frame_detections,
             t,
             request.config,
             classes=request.classes,
-            frame_detections=request.frame_detections,
         )
         for t in TRACKERS
     ]

@@ -124,8 +124,8 @@ def test_n_h_one_equals_gnnpmb_on_a_demo_scene(demo_dataroot):
     detections = get_detections(scene, None, "centerpoint", seed=0)
     config = CFG.replace(pmbm=PmbmParams(n_hypotheses=1))
     frames = preprocess_frames(scene, detections, config, TRACKING_CLASSES)
-    a = run_tracker(scene, detections, "pmbm", config, frame_detections=frames)
-    b = run_tracker(scene, detections, "gnnpmb", config, frame_detections=frames)
+    a = run_tracker(scene, frames, "pmbm", config)
+    b = run_tracker(scene, frames, "gnnpmb", config)
     assert sum(len(f.estimates) for f in b.frames) > 0
     assert [f.estimates for f in a.frames] == [f.estimates for f in b.frames]
 
