@@ -1,5 +1,5 @@
 """The comparison recording in a real browser (Rerun's web viewer in headless Chromium), and the pieces of
-``viz.webcheck`` that decide whether a screenshot shows the rendered scene."""
+``tools.webcheck`` that decide whether a screenshot shows the rendered scene."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from cli.app import main
-from viz.webcheck import (
+from tools.webcheck import (
     CHROMIUM,
     DEFAULT_VIEWPORT,
     Expected,
@@ -146,7 +146,7 @@ def test_focus_recordings_load_and_render_in_headless_chromium(
 ) -> None:
     """The bug-report workflow end to end: the first failure of a kind (any failure when the scene has none of
     it) on the committed demo scene, as a focus recording, ready in the web viewer with every view present."""
-    from cli.app import find_reports, prepare, rerun_runs
+    from gnnpmb.session import find_reports, prepare, rerun_runs
 
     _require_chromium()
     request = prepare("scene-0103", ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars")
