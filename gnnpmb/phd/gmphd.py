@@ -52,13 +52,9 @@ from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     Born,
     EventSink,
-    Extracted,
-    Gated,
     IntensityWeights,
     Merged,
     Panel,
-    Posterior,
-    Predicted,
     Pruned,
     PruneReason,
 )
@@ -75,6 +71,7 @@ from gnnpmb.kalman import (
 )
 from gnnpmb.models import MotionModel, cv_model, measurement_birth
 from gnnpmb.phd.mixture import GaussianMixture, Reduction, reduce_mixture
+from gnnpmb.skeleton import Gating, emit_posterior, emit_prior
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -326,18 +323,11 @@ class GmPhdTracker:
 
     def _emit_prior(self, pred: Prediction, meas: Measurements, sink: EventSink) -> None:
         prior = pred.persistent
-        k = pred.n_persistent
-        sink.emit(Predicted(self.class_name, prior.label, prior.mean, prior.cov, np.minimum(prior.weight, 1.0)))
-        sink.emit(
-            Gated(
-                self.class_name,
-                track_ids=prior.label,
-                meas_indices=np.asarray(meas.source_index),
-                inside=pred.inside,
-                center_xy=pred.inn.z_pred[:k],
-                innovation_cov=pred.inn.S[:k],
-                threshold=self.config.models.gate_chi2,
-            )
+        gating = Gating(pred.inn.subset(slice(0, pred.n_persistent)), pred.d2, pred.inside)
+        existence = np.minimum(prior.weight, 1.0)
+        gate_chi2 = self.config.models.gate_chi2
+        emit_prior(
+            sink, self.class_name, prior.label, prior.mean, prior.cov, existence, gating, meas.source_index, gate_chi2
         )
 
     def _emit_posterior(
@@ -372,5 +362,5 @@ class GmPhdTracker:
                     np.minimum(mix.weight[born], 1.0),
                 )
             )
-        sink.emit(Posterior(self.class_name, mix.label, mix.mean, mix.cov, np.minimum(mix.weight, 1.0)))
-        sink.emit(Extracted(self.class_name, tuple(estimates), sel.threshold))
+        existence = np.minimum(mix.weight, 1.0)
+        emit_posterior(sink, self.class_name, mix.label, mix.mean, mix.cov, existence, estimates, sel.threshold)

@@ -28,11 +28,7 @@ from gnnpmb.events import (
     Born,
     CostMatrix,
     EventSink,
-    Extracted,
-    Gated,
     Panel,
-    Posterior,
-    Predicted,
     Pruned,
     PruneReason,
 )
@@ -40,6 +36,7 @@ from gnnpmb.models import MotionModel, clutter_intensity, cv_model, measurement_
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
 from gnnpmb.pmb.poisson import NewTrackHypotheses, new_track_hypotheses
+from gnnpmb.skeleton import Gating, emit_posterior, emit_prior
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -343,17 +340,17 @@ class PmbCore:
 
     def _emit_prior(self, local: LocalHypotheses, sink: EventSink) -> None:
         prior = local.prior
-        sink.emit(Predicted(self.class_name, prior.track_id, prior.mean, prior.cov, prior.existence))
-        sink.emit(
-            Gated(
-                self.class_name,
-                track_ids=prior.track_id,
-                meas_indices=local.meas.source_index,
-                inside=local.inside,
-                center_xy=local.inn.z_pred[:, :2],
-                innovation_cov=local.inn.S[:, :2, :2],
-                threshold=self.models.gate_chi2,
-            )
+        gating = Gating(local.inn, local.d2, local.inside)
+        emit_prior(
+            sink,
+            self.class_name,
+            prior.track_id,
+            prior.mean,
+            prior.cov,
+            prior.existence,
+            gating,
+            local.meas.source_index,
+            self.models.gate_chi2,
         )
         sink.emit(CostMatrix(self.class_name, local.cost_matrix(), local.row_labels(), local.col_labels()))
 
@@ -366,5 +363,13 @@ class PmbCore:
             sink.emit(
                 Born(self.class_name, best.track_id[sel], best.meas_index[sel], best.mean[sel], best.existence[sel])
             )
-        sink.emit(Posterior(self.class_name, best.track_id, best.mean, best.cov, best.existence))
-        sink.emit(Extracted(self.class_name, tuple(estimates), self.params.extraction_threshold))
+        emit_posterior(
+            sink,
+            self.class_name,
+            best.track_id,
+            best.mean,
+            best.cov,
+            best.existence,
+            estimates,
+            self.params.extraction_threshold,
+        )

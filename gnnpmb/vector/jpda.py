@@ -42,6 +42,7 @@ from gnnpmb.assign.exact_marginals import exact_marginals_log
 from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals, Panel
 from gnnpmb.kalman import Innovation, log_likelihood, mean_update, residuals, symmetrize
+from gnnpmb.skeleton import Gating
 from gnnpmb.types import Measurements
 from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
 
@@ -141,16 +142,9 @@ class JpdaTracker(VectorTracker):
 
     panels = (Panel.MARGINALS,)
 
-    def _associate(
-        self,
-        prior: VectorTracks,
-        inn: Innovation,
-        d2: np.ndarray,
-        inside: np.ndarray,
-        meas: Measurements,
-        sink: EventSink,
-    ) -> Association:
-        log_ratio = log_ratios(log_likelihood(inn, d2), inside, self.params.p_detect, self.gate_chi2)
+    def _associate(self, prior: VectorTracks, gating: Gating, meas: Measurements, sink: EventSink) -> Association:
+        inn = gating.inn
+        log_ratio = log_ratios(log_likelihood(inn, gating.d2), gating.inside, self.params.p_detect, self.gate_chi2)
         log_ratio = keep_most_likely(log_ratio, MAX_GATED_PER_TRACK)
         beta, p_new, method, iterations = association_probabilities(
             log_ratio,

@@ -10,7 +10,8 @@ random-finite-set density (Blackman & Popoli 1999, ch. 6; Bar-Shalom, Daum & Hua
 4. measurements left unassociated start tentative tracks: mean [z_j, v_j] with the detector's velocity v_j,
    covariance the Kalman update of diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j (``[models] birth_pos_std_m``,
    ``birth_vel_std_mps``), i.e. about R in position;
-5. M/N track logic (``track_logic``) confirms and deletes tracks;
+5. M/N track logic (``track_logic``) confirms and deletes tracks; steps 4 and 5 are the initiator / deleter pair
+   (``MeasurementInitiator``, ``MofNDeleter``), steps 1, 2 and the events the shared ``gnnpmb.skeleton``;
 6. output: the *confirmed* tracks associated with a detection this frame. Coasting tracks (missed, not yet
    deleted) are kept and predicted but not output: a coasted box drifts from the truth and the nuScenes metric
    counts it as a false positive, while the same object's next detection resumes the track under its old id.
@@ -26,15 +27,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gnnpmb.config import TrackerConfig
+from gnnpmb.config import ClassParams, ModelParams, TrackerConfig, VectorParams
 from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
-from gnnpmb.events import Born, EventSink, Extracted, Gated, Panel, Posterior, Predicted, Pruned, PruneReason
-from gnnpmb.gating import gate
-from gnnpmb.kalman import Innovation, innovation, mahalanobis2, predict
+from gnnpmb.events import Born, EventSink, Panel, Pruned, PruneReason
+from gnnpmb.kalman import innovation, predict
 from gnnpmb.models import MotionModel, birth_covariance, cv_model
+from gnnpmb.skeleton import Gating, emit_posterior, emit_prior, gate_tracks
 from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
-from gnnpmb.vector.track_logic import LogicState, advance, emit_transitions
+from gnnpmb.vector.track_logic import LogicState, LogicUpdate, advance, emit_transitions
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,8 +95,53 @@ class Association:
     birth: np.ndarray
 
 
+class MeasurementInitiator:
+    """Starts a tentative track at each measurement the association gives to no track (module docstring, step 4):
+    mean [z_j, v_j], covariance the Kalman update of P_b = diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j."""
+
+    def __init__(self, class_params: ClassParams, models: ModelParams, params: VectorParams, ids: IdAllocator):
+        R = cv_model(0.0, class_params).R
+        self.birth_cov = innovation(np.zeros((1, 4)), birth_covariance(models)[None], R).cov_post[0]
+        self.params = params
+        self.ids = ids
+
+    def initiate(self, meas: Measurements, new_j: np.ndarray) -> VectorTracks:
+        """Tentative tracks started by local measurements ``new_j``, ids allocated in measurement order."""
+        b = len(new_j)
+        if b == 0:
+            return VectorTracks.empty()
+        return VectorTracks(
+            track_id=np.array([self.ids.allocate() for _ in range(b)], dtype=np.int64),
+            mean=np.concatenate([meas.z[new_j], meas.boxes.velocity_mps[new_j]], axis=1),
+            cov=np.broadcast_to(self.birth_cov, (b, 4, 4)).copy(),
+            det=DetectionFields.from_measurements(meas, new_j),
+            logic=LogicState.born(b, self.params),
+        )
+
+
+class MofNDeleter:
+    """Confirms and deletes tracks by the M/N track logic (``track_logic``; module docstring, step 5)."""
+
+    def __init__(self, params: VectorParams):
+        self.params = params
+
+    def update(self, logic: LogicState, hit: np.ndarray) -> LogicUpdate:
+        """The track logic after a frame in which tracks ``hit`` (K,) bool were associated with a detection."""
+        return advance(logic, hit, self.params)
+
+    def emit(
+        self, class_name: str, track_ids: np.ndarray, update: LogicUpdate, born_ids: np.ndarray, sink: EventSink
+    ) -> None:
+        """``TrackLogic`` events of the frame and ``Pruned`` for every track the logic deleted."""
+        emit_transitions(class_name, track_ids, update, born_ids, self.params, sink)
+        for t in track_ids[update.deleted].tolist():
+            sink.emit(Pruned(class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
+
+
 class VectorTracker(ABC):
-    """One class's vector-type tracker; subclasses implement ``_associate`` (module docstring, step 3)."""
+    """One class's vector-type tracker: the shared gate and events (``gnnpmb.skeleton``), an initiator / deleter
+    pair for track logic, and the association that subclasses implement (``_associate``, module docstring,
+    step 3)."""
 
     panels: tuple[Panel, ...] = ()
 
@@ -106,82 +152,41 @@ class VectorTracker(ABC):
         self.gate_chi2 = config.models.gate_chi2
         self.clutter_intensity = config.models.clutter_intensity
         self.lbp = config.lbp
-        self.ids = ids
+        self.initiator = MeasurementInitiator(self.class_params, config.models, config.vector, ids)
+        self.deleter = MofNDeleter(config.vector)
         self.tracks = VectorTracks.empty()
-        R = cv_model(0.0, self.class_params).R
-        self._birth_cov = innovation(np.zeros((1, 4)), birth_covariance(config.models)[None], R).cov_post[0]
 
     def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
         """Process one frame of this class's measurements; returns the confirmed tracks hit this frame."""
         model = cv_model(dt_s, self.class_params)
         prior = self.tracks.predicted(model)
-        k, m = len(prior), len(meas)
-        inn = innovation(prior.mean, prior.cov, model.R)
-        d2 = mahalanobis2(inn, meas.z) if k and m else np.zeros((k, m))
-        inside = gate(d2, self.gate_chi2)
+        gating = gate_tracks(prior.mean, prior.cov, model.R, meas.z, self.gate_chi2)
         if sink.enabled:
-            self._emit_prior(prior, inn, inside, meas, sink)
-        assoc = self._associate(prior, inn, d2, inside, meas, sink)
-        logic = advance(prior.logic, assoc.meas_of_track >= 0, self.params)
+            ones = np.ones(len(prior))
+            track_ids = prior.track_id
+            emit_prior(
+                sink, self.class_name, track_ids, prior.mean, prior.cov, ones, gating, meas.source_index, self.gate_chi2
+            )
+        assoc = self._associate(prior, gating, meas, sink)
+        logic = self.deleter.update(prior.logic, assoc.meas_of_track >= 0)
         posterior = replace(prior.updated(assoc, meas), logic=logic.state)
-        born = self._born(meas, np.flatnonzero(assoc.birth))
+        born = self.initiator.initiate(meas, np.flatnonzero(assoc.birth))
         self.tracks = VectorTracks.concatenate([posterior.subset(~logic.deleted), born])
         estimates = self._extract(self.tracks)
         if sink.enabled:
             if len(born):
-                ones = np.ones(len(born))
-                sink.emit(Born(self.class_name, born.track_id, born.meas_index, born.mean, ones))
-            emit_transitions(self.class_name, prior.track_id, logic, born.track_id, self.params, sink)
-            for t in prior.track_id[logic.deleted].tolist():
-                sink.emit(Pruned(self.class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
+                sink.emit(Born(self.class_name, born.track_id, born.meas_index, born.mean, np.ones(len(born))))
+            self.deleter.emit(self.class_name, prior.track_id, logic, born.track_id, sink)
             t = self.tracks
-            sink.emit(Posterior(self.class_name, t.track_id, t.mean, t.cov, np.ones(len(t))))
-            sink.emit(Extracted(self.class_name, tuple(estimates), 1.0))
+            emit_posterior(sink, self.class_name, t.track_id, t.mean, t.cov, np.ones(len(t)), estimates, 1.0)
         return estimates
 
     @abstractmethod
-    def _associate(
-        self,
-        prior: VectorTracks,
-        inn: Innovation,
-        d2: np.ndarray,
-        inside: np.ndarray,
-        meas: Measurements,
-        sink: EventSink,
-    ) -> Association:
-        """Data association and state update of the K prior tracks with the M measurements; d2 and inside are
-        (K, M) squared Mahalanobis distances and gate. Emits the association's own events."""
-
-    def _born(self, meas: Measurements, new_j: np.ndarray) -> VectorTracks:
-        """Tentative tracks started by local measurements ``new_j``, ids allocated in measurement order."""
-        b = len(new_j)
-        if b == 0:
-            return VectorTracks.empty()
-        return VectorTracks(
-            track_id=np.array([self.ids.allocate() for _ in range(b)], dtype=np.int64),
-            mean=np.concatenate([meas.z[new_j], meas.boxes.velocity_mps[new_j]], axis=1),
-            cov=np.broadcast_to(self._birth_cov, (b, 4, 4)).copy(),
-            det=DetectionFields.from_measurements(meas, new_j),
-            logic=LogicState.born(b, self.params),
-        )
+    def _associate(self, prior: VectorTracks, gating: Gating, meas: Measurements, sink: EventSink) -> Association:
+        """Data association and state update of the K prior tracks with the M measurements, given their gate
+        (``gating``: innovations, (K, M) squared Mahalanobis distances and gate). Emits its own events."""
 
     def _extract(self, t: VectorTracks) -> list[TrackEstimate]:
         """The confirmed tracks hit this frame, scored by their detection; existence 1."""
         sel = t.subset(np.flatnonzero(t.logic.confirmed & (t.meas_index >= 0)))
         return sel.det.to_estimates(self.class_name, sel.track_id, sel.mean, sel.score, np.ones(len(sel)))
-
-    def _emit_prior(
-        self, prior: VectorTracks, inn: Innovation, inside: np.ndarray, meas: Measurements, sink: EventSink
-    ) -> None:
-        sink.emit(Predicted(self.class_name, prior.track_id, prior.mean, prior.cov, np.ones(len(prior))))
-        sink.emit(
-            Gated(
-                self.class_name,
-                track_ids=prior.track_id,
-                meas_indices=meas.source_index,
-                inside=inside,
-                center_xy=inn.z_pred,
-                innovation_cov=inn.S,
-                threshold=self.gate_chi2,
-            )
-        )
