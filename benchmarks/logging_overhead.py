@@ -25,15 +25,15 @@ from viz.logger import TrackerLogger
 from viz.recording import close_recording, open_recording
 
 
-def timed_run(scene, detections, frames, tracker: str, config: TrackerConfig, out: Path | None) -> float:
+def timed_run(scene, frames, tracker: str, config: TrackerConfig, out: Path | None) -> float:
     """Wall seconds of one run; with ``out`` the run logs into a recording saved there."""
     start = time.perf_counter()
     if out is None:
-        run_tracker(scene, detections, tracker, config, frame_detections=frames)
+        run_tracker(scene, frames, tracker, config)
         return time.perf_counter() - start
     stream = open_recording("bench", out, None)
     logger = TrackerLogger(stream, tracker)
-    run_tracker(scene, detections, tracker, config, sink=logger, frame_detections=frames)
+    run_tracker(scene, frames, tracker, config, sink=logger)
     logger.finish()
     close_recording(stream, out)
     return time.perf_counter() - start
@@ -58,8 +58,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         for tracker in args.tracker or ["gnnpmb", "pmbm", "gnn"]:
             out = Path(tmp) / f"{tracker}.rrd"
-            alone = min(timed_run(scene, detections, frames, tracker, config, None) for _ in range(args.repeats))
-            logged = min(timed_run(scene, detections, frames, tracker, config, out) for _ in range(args.repeats))
+            alone = min(timed_run(scene, frames, tracker, config, None) for _ in range(args.repeats))
+            logged = min(timed_run(scene, frames, tracker, config, out) for _ in range(args.repeats))
             chunks = sum(1 for _ in RrdReader(out).store().stream())
             print(f"{tracker:8} {1000 * alone / n:15.2f} {1000 * logged / n:18.2f} {logged / alone:6.2f} {chunks:7d}")
 

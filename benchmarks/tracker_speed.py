@@ -81,8 +81,8 @@ def main() -> None:
     inputs = []
     for scene in scenes:
         dets = get_detections(scene, None, args.preset, seed=0)
-        inputs.append((scene, dets, preprocess_frames(scene, dets, config, TRACKING_CLASSES)))
-    n_dets = [int(f.kept.sum()) for _, _, frames in inputs for f in frames]
+        inputs.append((scene, preprocess_frames(scene, dets, config, TRACKING_CLASSES)))
+    n_dets = [int(f.kept.sum()) for _, frames in inputs for f in frames]
     print(
         f"demo mini_val: {len(scenes)} scenes, {len(n_dets)} frames, {np.mean(n_dets):.1f} kept detections/frame "
         f"(max {max(n_dets)}), preset {args.preset}"
@@ -90,10 +90,10 @@ def main() -> None:
     print(f"{'tracker':8s} {'median ms':>10s} {'p90 ms':>8s} {'max ms':>8s} {'stress ms':>10s} {'stress dets':>12s}")
     for tracker in args.tracker or TRACKER_NAMES:
         per_frame: list[float] = []
-        for scene, dets, frames in inputs:
+        for scene, frames in inputs:
             best = None
             for _ in range(args.repeat):
-                run = run_tracker(scene, dets, tracker, config, frame_detections=frames)
+                run = run_tracker(scene, frames, tracker, config)
                 times = np.array([f.step_time_s for f in run.frames])
                 best = times if best is None else np.minimum(best, times)
             per_frame.extend(best.tolist())

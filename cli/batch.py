@@ -16,9 +16,9 @@ import typer
 
 from cli.errors import entry_point
 from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
-from cli.outputs import check_output_dir, check_output_file
 from cli.study import AddressOption, register
 from gnnpmb.errors import GnnpmbError
+from gnnpmb.outputs import check_output_dir, check_output_file
 from gnnpmb.registry import TRACKER_NAMES
 
 if TYPE_CHECKING:  # rich, numpy and the devkit load only on the paths that use them (fast --help)

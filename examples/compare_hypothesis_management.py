@@ -27,7 +27,7 @@ def main() -> None:
     print(f"{scene_name}, simulated {preset} detections, {len(frames)} keyframes")
     print(f"{'tracker':8s} {'tracks/frame':>12s} {'distinct ids':>12s} {'median ms':>10s}")
     for tracker in ("gnnpmb", "pmbm", "topmb"):
-        run = run_tracker(scene, detections, tracker, config, frame_detections=frames)
+        run = run_tracker(scene, frames, tracker, config)
         per_frame = [len(f.estimates) for f in run.frames]
         ids = {e.track_id for f in run.frames for e in f.estimates}
         ms = np.median([f.step_time_s for f in run.frames]) * 1e3

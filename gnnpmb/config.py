@@ -2,8 +2,11 @@
 
 Defaults follow Liu et al., "GNN-PMB", IEEE T-IV 2023, sec. V-B and Table II, and the per-class noise of the
 authors' public code (see ``gnnpmb/default_params.toml``, which is the editable copy of these values), except
-three ``[pmb]`` values chosen on the demo mini_train split (``PmbParams``); ``gnnpmb/params/paper.toml`` restores
-the paper's.
+three values chosen on the demo mini_train split (``ModelParams``, ``PmbParams``); ``gnnpmb/params/paper.toml``
+restores the paper's.
+The models every tracker shares (survival, gate, clutter, birth) are the ``[models]`` section (``ModelParams``,
+used through ``gnnpmb.models``); the keys they had in ``[pmb]`` before (``[pmb] p_survive`` ...) still work and
+mean the same (``MOVED_KEYS``).
 A parameter file may set any subset; unknown keys are an error so typos do not go unnoticed, and every value is
 checked against its allowed range (``RULES``; the error names the key, the value and the range).
 
@@ -69,12 +72,12 @@ def _at_least(n: int) -> Range:
 RULES: dict[str, Range] = {
     "preprocess.score_threshold": _PROB,
     "preprocess.nms_iou_3d": _PROB,
-    "pmb.p_survive": Range(0.0, 1.0, False, True),
-    "pmb.clutter_intensity": _POSITIVE,
-    "pmb.gate_chi2": _POSITIVE,
-    "pmb.birth_weight": _POSITIVE,
-    "pmb.birth_pos_std_m": _POSITIVE,
-    "pmb.birth_vel_std_mps": _POSITIVE,
+    "models.p_survive": Range(0.0, 1.0, False, True),
+    "models.clutter_intensity": _POSITIVE,
+    "models.gate_chi2": _POSITIVE,
+    "models.birth_weight": _POSITIVE,
+    "models.birth_pos_std_m": _POSITIVE,
+    "models.birth_vel_std_mps": _POSITIVE,
     "pmb.prune_existence": Range(0.0, 1.0, True, False),
     "pmb.extraction_threshold": _PROB,
     "pmbm.n_hypotheses": _at_least(1),
@@ -165,26 +168,20 @@ class PreprocessParams:
 
 
 @dataclass(frozen=True, slots=True)
-class PmbParams:
-    """Shared by the Poisson multi-Bernoulli family (GNN-PMB, PMBM, TO-PMB); survival, gate, clutter and birth
-    also by the PHD and vector trackers.
+class ModelParams:
+    """The models every tracker shares (``gnnpmb.models``): survival P_S, the gate, the clutter intensity and the
+    measurement-driven birth (paper sec. V-B). The detection probability is the detection's score for the PMB
+    family and ``p_detect`` of ``[phd]`` / ``[vector]`` for the others.
 
-    The paper's values (sec. V-B, Table II) are kept in ``gnnpmb/params/paper.toml``; three defaults differ, chosen
-    on the demo ``mini_train`` split only (``benchmarks/tune_mini_train.py``) after the failure finder showed why
-    the paper's values lose recall and identities:
+    p_survive: P_S per keyframe; clutter_intensity: kappa per m^2; gate_chi2: the squared Mahalanobis gate G;
+    birth_weight: w_b per detection; birth_pos_std_m, birth_vel_std_mps: the birth covariance
+    diag(s_p^2, s_p^2, s_v^2, s_v^2). Two defaults differ from the paper's (``gnnpmb/params/paper.toml``), chosen on
+    the demo ``mini_train`` split only (``benchmarks/tune_mini_train.py``):
 
-    - extraction_threshold 0.01 (paper 0.9): every Bernoulli with r >= 0.01 is output with tracking score = its
-      detection score x r. With 0.9 a new object is reported only from its second detection (a new Bernoulli
-      starts at r ~ 0.065 s with the paper's birth model) and a missed track not at all. AMOTA sweeps the score
-      threshold, so low-r boxes scored s r rank below every confident track and only add recall.
     - p_survive 0.95 (paper 0.7 per 0.5 s keyframe, a mean lifetime of 1.7 s): with 0.7 a track occluded for a
       few frames decays so far that its object comes back under a new id.
     - birth_weight 0.3 (paper 0.1): the prior rate of new objects per detection; a larger one makes a detection's
       first Bernoulli more likely (r_new = w s N / (c + w s N)), so a new object's first box is scored higher.
-    measure_velocity: 1 = measure [x, y, vx, vy] (opt-in variant, ``kalman``), 0 = the paper's [x, y].
-    clutter_velocity_density: with measure_velocity = 1 the clutter intensity is per m^2 per (m/s)^2, so it is
-    clutter_intensity x this density of a clutter detection's velocity (default: uniform over a 20 x 20 m/s
-    square, 1/400); unused otherwise.
     """
 
     p_survive: float = 0.95
@@ -193,6 +190,26 @@ class PmbParams:
     birth_weight: float = 0.3
     birth_pos_std_m: float = 15.0
     birth_vel_std_mps: float = 1.0
+
+    def __post_init__(self) -> None:
+        validate_section(self, "models")
+
+
+@dataclass(frozen=True, slots=True)
+class PmbParams:
+    """The Poisson multi-Bernoulli family (GNN-PMB, PMBM, TO-PMB), beyond the shared ``[models]``.
+
+    prune_existence: Bernoullis with r below it are dropped. extraction_threshold 0.01 (paper 0.9, chosen on the
+    demo ``mini_train`` split like ``ModelParams``): every Bernoulli with r >= 0.01 is output with tracking
+    score = its detection score x r. With 0.9 a new object is reported only from its second detection (a new
+    Bernoulli starts at r ~ 0.065 s with the paper's birth model) and a missed track not at all. AMOTA sweeps the
+    score threshold, so low-r boxes scored s r rank below every confident track and only add recall.
+    measure_velocity: 1 = measure [x, y, vx, vy] (opt-in variant, ``kalman``), 0 = the paper's [x, y].
+    clutter_velocity_density: with measure_velocity = 1 the clutter intensity is per m^2 per (m/s)^2, so it is
+    clutter_intensity x this density of a clutter detection's velocity (default: uniform over a 20 x 20 m/s
+    square, 1/400); unused otherwise.
+    """
+
     prune_existence: float = 1e-6
     extraction_threshold: float = 0.01
     measure_velocity: int = 0
@@ -247,7 +264,7 @@ class PhdParams:
     PHD filter reports every component at least this heavy, round(w) times (Table III). max_cardinality: hard
     upper bound of the CPHD cardinality support per class; below it the support follows the previous posterior
     plus the birth count, so most frames use far fewer terms (median 7, at most 21 on the demo scenes); the CPHD
-    reports at most this many tracks per class. Survival, gate, clutter intensity and birth come from ``[pmb]``
+    reports at most this many tracks per class. Survival, gate, clutter intensity and birth come from ``[models]``
     so every tracker of the study sees the same models. T, U, J_max and the 0.5 extraction weight are Vo & Ma's.
     """
 
@@ -273,7 +290,7 @@ class VectorParams:
     misses. exact_cluster_max: JPDA enumerates a gated cluster exactly when it has at most this many tracks
     (and at most ``vector.jpda.EXACT_ASSOCIATION_BUDGET`` joint events), otherwise it uses loopy belief
     propagation (``[lbp]``). The gate, clutter intensity kappa and
-    the initial covariance of a new track come from ``[pmb]`` (gate_chi2, clutter_intensity, birth_pos_std_m,
+    the initial covariance of a new track come from ``[models]`` (gate_chi2, clutter_intensity, birth_pos_std_m,
     birth_vel_std_mps), so every tracker of the study sees the same gate and clutter model.
     """
 
@@ -304,8 +321,10 @@ class GreedyParams:
         validate_section(self, "greedy")
 
 
-PAPER_PMB = PmbParams(p_survive=0.7, birth_weight=0.1, extraction_threshold=0.9)
-"""The paper's ``[pmb]`` values (sec. V-B, Table II), where the defaults differ (``gnnpmb/params/paper.toml``)."""
+PAPER_MODELS = ModelParams(p_survive=0.7, birth_weight=0.1)
+PAPER_PMB = PmbParams(extraction_threshold=0.9)
+"""The paper's ``[models]`` and ``[pmb]`` values (sec. V-B, Table II), where the defaults differ
+(``gnnpmb/params/paper.toml``)."""
 
 Overrides = dict[str, dict[str, dict[str, float]]]
 """Per-class overrides of shared-section keys: class name -> section -> key -> value."""
@@ -317,6 +336,7 @@ class TrackerConfig:
 
     classes: dict[str, ClassParams] = field(default_factory=lambda: dict(PAPER_CLASS_PARAMS))
     preprocess: PreprocessParams = PreprocessParams()
+    models: ModelParams = ModelParams()
     pmb: PmbParams = PmbParams()
     pmbm: PmbmParams = PmbmParams()
     lbp: LbpParams = LbpParams()
@@ -362,12 +382,13 @@ class TrackerConfig:
 
 
 def paper_config() -> TrackerConfig:
-    """The defaults with the paper's own ``[pmb]`` values: GNN-PMB exactly as published."""
-    return TrackerConfig(pmb=PAPER_PMB)
+    """The defaults with the paper's own ``[models]`` and ``[pmb]`` values: GNN-PMB exactly as published."""
+    return TrackerConfig(models=PAPER_MODELS, pmb=PAPER_PMB)
 
 
 _SECTIONS: dict[str, type] = {
     "preprocess": PreprocessParams,
+    "models": ModelParams,
     "pmb": PmbParams,
     "pmbm": PmbmParams,
     "lbp": LbpParams,
@@ -375,6 +396,16 @@ _SECTIONS: dict[str, type] = {
     "vector": VectorParams,
     "greedy": GreedyParams,
 }
+
+MOVED_KEYS: dict[tuple[str, str], str] = {("pmb", f.name): "models" for f in dataclasses.fields(ModelParams)}
+"""(old section, key) -> the section the key lives in now; parameter files and dotted names may still use the old
+section (``[pmb] p_survive``, ``pmb.gate_chi2``)."""
+
+
+def current_section(section: str, key: str) -> str:
+    """The section that holds ``key`` given as a key of ``section`` (``MOVED_KEYS``)."""
+    return MOVED_KEYS.get((section, key), section)
+
 
 _SECTIONS_OF_KEY: dict[str, tuple[str, ...]] = {}
 for _section, _kind in _SECTIONS.items():
@@ -417,9 +448,10 @@ def _class_table(name: str, values: Any, params: ClassParams, overrides: dict[st
             continue
         if key in _SECTIONS and isinstance(value, dict):
             for sub_key, sub_value in value.items():
-                typed = _typed_value(_SECTIONS[key], sub_key, sub_value, f"[classes.{name}.{key}]")
-                check_value(key, sub_key, typed, f"[classes.{name}.{key}]")
-                overrides.setdefault(key, {})[sub_key] = typed
+                section = current_section(key, sub_key)
+                typed = _typed_value(_SECTIONS[section], sub_key, sub_value, f"[classes.{name}.{key}]")
+                check_value(section, sub_key, typed, f"[classes.{name}.{key}]")
+                overrides.setdefault(section, {})[sub_key] = typed
             continue
         sections = _SECTIONS_OF_KEY.get(key, ())
         if not sections:
@@ -458,7 +490,18 @@ def config_from_dict(data: Mapping[str, Any], base: TrackerConfig | None = None)
         elif key in _SECTIONS:
             if not isinstance(values, dict):
                 raise ConfigError(f"[{key}] must be a table")
-            changes[key] = _typed_section(_SECTIONS[key], key, values, f"[{key}]", getattr(cfg, key))
+            by_section: dict[str, dict[str, Any]] = {}
+            for sub_key, value in values.items():
+                section = current_section(key, sub_key)
+                if section != key and sub_key in data.get(section, {}):
+                    raise ConfigError(
+                        f"[{key}] {sub_key} and [{section}] {sub_key} are the same parameter (it moved to "
+                        f"[{section}]); give it once"
+                    )
+                by_section.setdefault(section, {})[sub_key] = value
+            for section, section_values in by_section.items():
+                base_section = changes.get(section, getattr(cfg, section))
+                changes[section] = _typed_section(_SECTIONS[section], section, section_values, f"[{key}]", base_section)
         else:
             raise ConfigError(f"unknown section [{key}] (known: classes, {', '.join(_SECTIONS)})")
     out = cfg.replace(**changes)
@@ -493,11 +536,13 @@ def get_param(cfg: TrackerConfig, dotted: str) -> float | int:
             raise ConfigError(f"unknown class in '{dotted}' (known: {', '.join(TRACKING_CLASSES)})")
         if len(parts) == 3 and hasattr(cfg.classes[name], key):
             return getattr(cfg.classes[name], key)
-        sections = (parts[2],) if len(parts) == 4 else _SECTIONS_OF_KEY.get(key, ())
+        sections = (current_section(parts[2], key),) if len(parts) == 4 else _SECTIONS_OF_KEY.get(key, ())
         if len(sections) == 1 and sections[0] in _SECTIONS and hasattr(getattr(cfg, sections[0]), key):
             return getattr(getattr(cfg.resolved(name), sections[0]), key)
-    elif len(parts) == 2 and parts[0] in _SECTIONS and hasattr(getattr(cfg, parts[0]), parts[1]):
-        return getattr(getattr(cfg, parts[0]), parts[1])
+    elif len(parts) == 2 and parts[0] in _SECTIONS:
+        section = current_section(parts[0], parts[1])
+        if hasattr(getattr(cfg, section), parts[1]):
+            return getattr(getattr(cfg, section), parts[1])
     raise ConfigError(f"unknown parameter '{dotted}'")
 
 

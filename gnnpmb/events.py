@@ -47,6 +47,16 @@ class PruneReason(enum.Enum):
     TRACK_LOGIC = "deleted by track logic"
 
 
+class Panel(enum.Enum):
+    """A tracker-specific viewer panel, named by the event that fills it; each tracker declares the panels it
+    contributes (its ``panels``), so the viewer lays them out without knowing tracker names."""
+
+    HYPOTHESES = "hypotheses"  # GlobalHypotheses
+    MARGINALS = "marginals"  # Marginals
+    CARDINALITY = "cardinality"  # Cardinality
+    INTENSITY = "intensity"  # IntensityWeights
+
+
 class TrackLogicAction(enum.Enum):
     TENTATIVE = "tentative"
     CONFIRMED = "confirmed"

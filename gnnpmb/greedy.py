@@ -29,12 +29,12 @@ from gnnpmb.events import (
     Born,
     CostMatrix,
     EventSink,
-    Extracted,
-    Posterior,
+    Panel,
     Predicted,
     Pruned,
     PruneReason,
 )
+from gnnpmb.skeleton import emit_posterior
 from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
@@ -86,6 +86,8 @@ def greedy_pairs(dist: np.ndarray) -> np.ndarray:
 
 class GreedyTracker:
     """One class's greedy closest-pair tracker (module docstring)."""
+
+    panels: tuple[Panel, ...] = ()
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name
@@ -182,5 +184,6 @@ class GreedyTracker:
             sink.emit(Pruned(self.class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
         t = self.tracks
         state = np.concatenate([t.center_xy, t.velocity_mps], axis=1)
-        sink.emit(Posterior(self.class_name, t.track_id, state, self._disc_cov(len(t)), np.ones(len(t))))
-        sink.emit(Extracted(self.class_name, tuple(estimates), 1.0))
+        emit_posterior(
+            sink, self.class_name, t.track_id, state, self._disc_cov(len(t)), np.ones(len(t)), estimates, 1.0
+        )

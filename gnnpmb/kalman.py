@@ -2,40 +2,31 @@
 
 State m = [x, y, vx, vy]; measurement z = H m = [x, y] (D = 2), or [x, y, vx, vy] (D = 4, H = I) for the opt-in
 variant that also measures the detector's velocity (``[pmb] measure_velocity = 1``).
-Motion x_k = F x_{k-1} + w, w ~ N(0, Q), F = [[I, dt I], [0, I]], Q = diag(q_x, q_y, q_x, q_y) (paper sec. V-B).
+Motion x_k = F x_{k-1} + w, w ~ N(0, Q) (``gnnpmb.models.cv_model``); predict: m' = F m, P' = F P F^T + Q.
 Update: S = H P H^T + R, K = P H^T S^-1, m+ = m + K (z - H m), P+ = P - K S K^T (symmetrised).
+Gaussian log-density of a D-dimensional innovation nu: log N(nu; 0, S) = -(nu^T S^-1 nu + log|S| + D log 2 pi) / 2.
+
+Every Kalman and Gaussian formula the trackers use is here, in two shapes: "all pairs" functions give (K, M)
+arrays for every track-measurement pair, "paired" functions take P chosen pairs (track_index[p],
+meas_index[p]) and give (P, ...) arrays. Each function's docstring gives its equation.
+
 References: Bar-Shalom, Li & Kirubarajan, "Estimation with Applications to Tracking and Navigation", 2001, ch. 5.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gnnpmb.config import ClassParams
 from gnnpmb.soa import StructOfArrays
+
+if TYPE_CHECKING:
+    from gnnpmb.models import MotionModel
 
 H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
 """Measurement matrix: picks the BEV position."""
-
-
-@dataclass(frozen=True, slots=True)
-class MotionModel:
-    """F (4, 4), Q (4, 4), R (2, 2) for one class and one time step."""
-
-    F: np.ndarray
-    Q: np.ndarray
-    R: np.ndarray
-
-
-def cv_model(dt_s: float, params: ClassParams, measure_velocity: bool = False) -> MotionModel:
-    """F, Q and R (2 x 2 diag(r_x, r_y), or 4 x 4 diag(r_x, r_y, r_vx, r_vy) when ``measure_velocity``)."""
-    F = np.eye(4)
-    F[0, 2] = F[1, 3] = dt_s
-    Q = np.diag([params.q_x, params.q_y, params.q_x, params.q_y])
-    r = [params.r_x, params.r_y] + ([params.r_vx, params.r_vy] if measure_velocity else [])
-    return MotionModel(F=F, Q=Q, R=np.diag(r))
 
 
 def symmetrize(P: np.ndarray) -> np.ndarray:
@@ -118,20 +109,49 @@ def _innovation_general(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Inn
 
 
 def residuals(inn: Innovation, z: np.ndarray) -> np.ndarray:
-    """(K, M, 2) innovations z_j - H m_k."""
+    """(K, M, D) innovations nu_kj = z_j - H m_k of every track-measurement pair."""
     return z[None, :, :] - inn.z_pred[:, None, :]
 
 
 def mahalanobis2(inn: Innovation, z: np.ndarray) -> np.ndarray:
-    """(K, M) squared Mahalanobis distances of measurements z (M, 2) to each track's predicted measurement."""
+    """(K, M) squared Mahalanobis distances d2_kj = nu_kj^T S_k^-1 nu_kj of measurements z (M, D)."""
     nu = residuals(inn, z)
     return np.einsum("kmi,kij,kmj->km", nu, inn.S_inv, nu)
 
 
+def gaussian_log_density(d2: np.ndarray, log_det_S: np.ndarray, dim: int) -> np.ndarray:
+    """log N(z; H m, S) = -(d2 + log|S| + D log 2 pi) / 2 from squared Mahalanobis distances d2 and log|S|
+    (broadcast against each other; any shape) of a ``dim``-dimensional measurement."""
+    return -0.5 * (d2 + log_det_S + dim * np.log(2.0 * np.pi))
+
+
 def log_likelihood(inn: Innovation, d2: np.ndarray) -> np.ndarray:
-    """(K, M) log N(z_j; H m_k, S_k) from squared Mahalanobis distances (D-dimensional z)."""
-    d = inn.z_pred.shape[1]
-    return -0.5 * (d2 + inn.log_det_S[:, None] + d * np.log(2.0 * np.pi))
+    """(K, M) log N(z_j; H m_k, S_k) from (K, M) squared Mahalanobis distances (``gaussian_log_density``)."""
+    return gaussian_log_density(d2, inn.log_det_S[:, None], inn.z_pred.shape[1])
+
+
+def paired_residuals(inn: Innovation, z: np.ndarray, track_index: np.ndarray, meas_index: np.ndarray) -> np.ndarray:
+    """(P, D) innovations nu_p = z[meas_index[p]] - H m[track_index[p]] of P chosen pairs."""
+    return z[meas_index] - inn.z_pred[track_index]
+
+
+def paired_mahalanobis2(S_inv: np.ndarray, nu: np.ndarray) -> np.ndarray:
+    """(P,) d2_p = nu_p^T S_p^-1 nu_p for (P, D) innovations and their (P, D, D) inverse innovation covariances."""
+    return np.einsum("mi,mij,mj->m", nu, S_inv, nu)
+
+
+def mean_update(mean: np.ndarray, gain: np.ndarray, nu: np.ndarray) -> np.ndarray:
+    """(P, 4) posterior means m+ = m + K nu for (P, 4) means, (P, 4, D) gains and (P, D) innovations."""
+    return mean + np.einsum("pij,pj->pi", gain, nu)
+
+
+def paired_updated_means(
+    mean: np.ndarray, inn: Innovation, z: np.ndarray, track_index: np.ndarray, meas_index: np.ndarray
+) -> np.ndarray:
+    """(P, 4) posterior means m_k + K_k (z_j - H m_k) of P pairs (k, j) = (track_index[p], meas_index[p]);
+    ``mean`` (K, 4) and ``inn`` (K) are the tracks', ``z`` (M, D) the measurements."""
+    nu = paired_residuals(inn, z, track_index, meas_index)
+    return mean_update(mean[track_index], inn.gain[track_index], nu)
 
 
 def updated_means(mean: np.ndarray, inn: Innovation, z: np.ndarray) -> np.ndarray:

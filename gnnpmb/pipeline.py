@@ -43,20 +43,14 @@ class TrackingRun:
 
 def get_detections(scene: SceneData, detections_file: Path | None, detector: str, seed: int) -> dict[str, Boxes]:
     """Detections per sample token: the given nuScenes detection-submission file, else the simulated detector
-    preset ``detector`` (with the demo's clutter hotspots when the scene is the synthetic demo)."""
+    preset ``detector`` (with the scene's clutter hotspots, which only the synthetic demo's scenes have)."""
     if detections_file is not None:
         from gnnpmb.data.detections import load_detection_file
 
         return load_detection_file(detections_file, scene.sample_tokens, scene.name)
     from gnnpmb.data.simdet import simulate_detections
 
-    hotspots: list = []
-    if scene.synthetic:
-        from gnnpmb.data.demo import CLUTTER_HOTSPOTS
-
-        hotspots = [
-            (np.asarray(h.xy_global), h.radius_m, h.frames) for h in CLUTTER_HOTSPOTS if h.scene_name == scene.name
-        ]
+    hotspots = [(np.asarray(h.xy_global), h.radius_m, h.frames) for h in scene.clutter_hotspots]
     return simulate_detections(scene, detector, seed=seed, hotspots=hotspots)
 
 
@@ -75,21 +69,28 @@ def preprocess_frames(
 
 def run_tracker(
     scene: SceneData,
-    detections: Mapping[str, Boxes],
+    detections: Mapping[str, Boxes] | Sequence[FrameDetections],
     tracker: str,
     config: TrackerConfig,
     sink: EventSink | None = None,
     classes: Sequence[str] = TRACKING_CLASSES,
     frame_range: range | None = None,
     on_frame: Callable[[], None] | None = None,
-    frame_detections: Sequence[FrameDetections] | None = None,
 ) -> TrackingRun:
     """Track ``scene`` (optionally only ``frame_range`` of its keyframes) with tracker ``tracker``.
 
-    ``frame_detections`` may pass already preprocessed frames (all keyframes) to share them between trackers.
+    ``detections``: the scene's detections per sample token (preprocessed here for ``classes``), or frames
+    already preprocessed by ``preprocess_frames`` (one per keyframe), to share them between trackers.
     """
     sink = sink or NullSink()
-    frames_in = frame_detections or preprocess_frames(scene, detections, config, classes)
+    if isinstance(detections, Mapping):
+        frames_in: Sequence[FrameDetections] = preprocess_frames(scene, detections, config, classes)
+    elif len(detections) != len(scene.keyframes):
+        raise ValueError(
+            f"{len(detections)} preprocessed frames for the {len(scene.keyframes)} keyframes of {scene.name}"
+        )
+    else:
+        frames_in = detections
     mot = MultiClassTracker(tracker, config, classes)
     indices = frame_range if frame_range is not None else range(len(scene.keyframes))
     results: list[FrameResult] = []

@@ -14,19 +14,22 @@ from gnnpmb.errors import UnknownNameError
 
 if TYPE_CHECKING:  # numpy-heavy; the CLI imports this module for its help text
     from gnnpmb.config import TrackerConfig
-    from gnnpmb.events import EventSink
+    from gnnpmb.events import EventSink, Panel
     from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
 class ClassTracker(Protocol):
-    """A single-class multi-object tracker."""
+    """A single-class multi-object tracker; ``panels``: the tracker-specific viewer panels its events fill."""
+
+    @property
+    def panels(self) -> tuple[Panel, ...]: ...
 
     def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]: ...
 
 
 def _gnnpmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
     from gnnpmb.pmb.core import PmbCore
-    from gnnpmb.pmb.strategy import BestAssignment
+    from gnnpmb.pmb.gnnpmb import BestAssignment
 
     return PmbCore(class_name, config, BestAssignment(), ids)
 
@@ -40,9 +43,9 @@ def _pmbm(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTrac
 
 def _topmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
     from gnnpmb.pmb.core import PmbCore
-    from gnnpmb.pmb.topmb import Marginals
+    from gnnpmb.pmb.topmb import MarginalMerge
 
-    return PmbCore(class_name, config, Marginals(config.lbp), ids)
+    return PmbCore(class_name, config, MarginalMerge(config.lbp), ids)
 
 
 def _phd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
@@ -113,6 +116,14 @@ def check_classes(names: list[str]) -> list[str]:
     if not names:
         raise UnknownNameError(f"no classes given; choose from: {', '.join(TRACKING_CLASSES)}")
     return names
+
+
+def tracker_panels(name: str) -> tuple[Panel, ...]:
+    """The tracker-specific viewer panels tracker ``name`` declares (the same for every class)."""
+    from gnnpmb.config import TrackerConfig
+    from gnnpmb.types import IdAllocator
+
+    return make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator()).panels
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:

@@ -17,25 +17,18 @@ from above and from the side, and the series views show only the involved tracks
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import rerun.blueprint as rrb
 
+from gnnpmb.events import Panel
+from gnnpmb.registry import tracker_panels
 from viz import compare, paths
 from viz.failures import failure_log
 
 if TYPE_CHECKING:
     from gnnpmb.focus import FocusTarget
-
-_EXTRA_PLOTS: dict[str, tuple[str, ...]] = {
-    "pmbm": ("hypotheses",),
-    "topmb": ("marginals",),
-    "jpda": ("marginals",),
-    "phd": ("intensity",),
-    "cphd": ("cardinality", "intensity"),
-}
-"""Which tracker-specific plots each tracker fills (the names of ``TRACKER_NAMES``)."""
 
 EYE_POSITION_M = (-18.0, -14.0, 22.0)
 EYE_TARGET_M = (10.0, 0.0, 0.0)
@@ -131,37 +124,44 @@ def _matrix_view(origin: str, name: str) -> rrb.TensorView:
     )
 
 
+def _hypotheses_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Container:
+    return rrb.TimeSeriesView(origin=paths.hypotheses_root(tracker), name=f"{tracker} hypothesis log w")
+
+
+def _marginals_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Container:
+    return rrb.Tabs(
+        *[_matrix_view(paths.marginals(tracker, c), f"{tracker} marginals {c}") for c in classes],
+        name=f"{tracker} marginals",
+    )
+
+
+def _cardinality_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Container:
+    return rrb.Vertical(
+        rrb.TimeSeriesView(origin=paths.cardinality_mean_root(tracker), name="expected count"),
+        rrb.BarChartView(origin=paths.cardinality_pmf_root(tracker), name="cardinality pmf"),
+        name=f"{tracker} cardinality",
+    )
+
+
+def _intensity_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Container:
+    return rrb.Vertical(
+        rrb.TimeSeriesView(origin=paths.intensity_total_root(tracker), name="total intensity"),
+        rrb.BarChartView(origin=paths.intensity_weights_root(tracker), name="component weights"),
+        name=f"{tracker} intensity",
+    )
+
+
+PANEL_VIEWS: dict[Panel, Callable[[str, Sequence[str]], rrb.View | rrb.Container]] = {
+    Panel.HYPOTHESES: _hypotheses_view,
+    Panel.MARGINALS: _marginals_view,
+    Panel.CARDINALITY: _cardinality_view,
+    Panel.INTENSITY: _intensity_view,
+}
+"""The view of each tracker-specific panel; which panels a tracker gets, it declares (``registry.tracker_panels``)."""
+
+
 def _extra_views(tracker: str, classes: Sequence[str]) -> list[rrb.View | rrb.Container]:
-    views: list[rrb.View | rrb.Container] = []
-    for kind in _EXTRA_PLOTS.get(tracker, ()):
-        if kind == "hypotheses":
-            views.append(rrb.TimeSeriesView(origin=paths.hypotheses_root(tracker), name=f"{tracker} hypothesis log w"))
-        elif kind == "marginals":
-            views.append(
-                rrb.Tabs(
-                    *[_matrix_view(paths.marginals(tracker, c), f"{tracker} marginals {c}") for c in classes],
-                    name=f"{tracker} marginals",
-                )
-            )
-        elif kind == "cardinality":
-            views.append(
-                rrb.Vertical(
-                    rrb.TimeSeriesView(origin=paths.cardinality_mean_root(tracker), name="expected count"),
-                    rrb.BarChartView(origin=paths.cardinality_pmf_root(tracker), name="cardinality pmf"),
-                    name=f"{tracker} cardinality",
-                )
-            )
-        elif kind == "intensity":
-            views.append(
-                rrb.Vertical(
-                    rrb.TimeSeriesView(origin=paths.intensity_total_root(tracker), name="total intensity"),
-                    rrb.BarChartView(origin=paths.intensity_weights_root(tracker), name="component weights"),
-                    name=f"{tracker} intensity",
-                )
-            )
-        else:
-            raise ValueError(f"no view for plot kind {kind!r}")
-    return views
+    return [PANEL_VIEWS[panel](tracker, classes) for panel in tracker_panels(tracker)]
 
 
 def failure_counts_view(tracker: str) -> rrb.TimeSeriesView:

@@ -10,9 +10,8 @@ so this is for small problems and for checking ``lbp.lbp_marginals``.
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_array
-from scipy.sparse.csgraph import connected_components
 
+from gnnpmb.assign.clusters import gate_clusters
 from gnnpmb.assign.marginals import (
     AssociationMarginals,
     check_log_inputs,
@@ -54,22 +53,11 @@ def _exact(log_ratio: np.ndarray, log_new: np.ndarray, max_associations: int) ->
     gated = np.isfinite(log_w)
     p_track = np.zeros((n_tracks, n_meas + 1))
     p_track[:, 0] = 1.0  # tracks without any gated measurement
-    track_of, meas_of = _clusters(gated)
-    for c in np.unique(track_of[gated.any(axis=1)]):
-        tracks, meas = np.flatnonzero(track_of == c), np.flatnonzero(meas_of == c)
+    for tracks, meas in gate_clusters(gated):
         p_cluster = _enumerate_cluster(log_w[np.ix_(tracks, meas)], max_associations)
         p_track[tracks, 0] = p_cluster[:, 0]
         p_track[np.ix_(tracks, meas + 1)] = p_cluster[:, 1:]
     return from_track_marginals(p_track, 0, "exact")
-
-
-def _clusters(gated: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Connected-component label of every track (K,) and measurement (M,) of the bipartite gating graph."""
-    k, m = gated.shape
-    ti, mj = np.nonzero(gated)
-    graph = coo_array((np.ones(len(ti)), (ti, k + mj)), shape=(k + m, k + m))
-    _, labels = connected_components(graph, directed=False)
-    return labels[:k], labels[k:]
 
 
 def _enumerate_cluster(log_w: np.ndarray, max_associations: int) -> np.ndarray:

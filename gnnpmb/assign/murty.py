@@ -33,6 +33,7 @@ from typing import Protocol
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from gnnpmb.assign.clusters import Cluster, gate_clusters
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 
 ENUMERATION_LIMIT = 1024
@@ -156,41 +157,11 @@ def _forbid_hopeless(cost: np.ndarray, best: np.ndarray, max_increase: float) ->
     return np.where(cost <= allowed[:, None], cost, np.inf)
 
 
-def blocks(cost: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-    """(rows, cols) of every connected block of finite entries of ``cost`` (bipartite components with at least
-    one row), ordered by their first row; columns without a finite entry belong to no block.
-
-    Union-find over the finite entries by hooking the larger root under the smaller and pointer jumping, so a
-    block's label is its smallest row index.
-    """
-    n_rows, n_cols = cost.shape
-    if n_rows == 0:
-        return []
-    a, c = np.divmod(np.flatnonzero(cost < np.inf), n_cols)  # np.nonzero is slow on 2D arrays
-    b = n_rows + c
-    label = np.arange(n_rows + n_cols)
-    while True:
-        la, lb = label[a], label[b]
-        differ = la != lb
-        if not differ.any():
-            break
-        np.minimum.at(label, np.maximum(la[differ], lb[differ]), np.minimum(la[differ], lb[differ]))
-        jumped = label[label]
-        while (jumped != label).any():
-            label, jumped = jumped, jumped[jumped]
-    row_label, col_label = label[:n_rows], label[n_rows:]
-    row_order = np.argsort(row_label, kind="stable")
-    col_order = np.argsort(col_label, kind="stable")
-    row_sorted, col_sorted = row_label[row_order], col_label[col_order]
-    row_starts = np.flatnonzero(np.diff(row_sorted, prepend=-1))
-    names = row_sorted[row_starts]
-    row_stops = [*row_starts[1:].tolist(), n_rows]
-    col_starts = np.searchsorted(col_sorted, names, side="left").tolist()
-    col_stops = np.searchsorted(col_sorted, names, side="right").tolist()
-    return [
-        (row_order[i:j], col_order[k:m])
-        for i, j, k, m in zip(row_starts.tolist(), row_stops, col_starts, col_stops, strict=True)
-    ]
+def blocks(cost: np.ndarray) -> list[Cluster]:
+    """(rows, cols) of every connected block of finite entries of ``cost`` (``assign.clusters.gate_clusters``),
+    ordered by their first row; a row without a finite entry is a block of its own, a column without one is in
+    no block."""
+    return gate_clusters(cost < np.inf, with_isolated_tracks=True)
 
 
 class SingleRow:

@@ -17,7 +17,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from gnnpmb.data.demo import DEMO_VERSION, SYNTHETIC_MARKER, TABLE_NAMES, ensure_demo_dataset
+from gnnpmb.data.demo import (
+    CLUTTER_HOTSPOTS,
+    DEMO_VERSION,
+    SYNTHETIC_MARKER,
+    TABLE_NAMES,
+    ClutterHotspot,
+    ensure_demo_dataset,
+)
 from gnnpmb.data.scene import Keyframe, Pose, SceneData
 from gnnpmb.errors import DataError, UnknownNameError
 from gnnpmb.types import Boxes
@@ -235,15 +242,22 @@ def load_scene(nusc: NuScenes, location: DatasetLocation, scene_name: str) -> Sc
             )
         )
         sample_token = sample["next"]
+    synthetic = is_synthetic_description(scene["description"])
     return SceneData(
         name=scene_name,
         token=scene["token"],
         description=scene["description"],
         dataroot=location.dataroot,
         version=location.version,
-        synthetic=is_synthetic_description(scene["description"]),
+        synthetic=synthetic,
         keyframes=tuple(keyframes),
+        clutter_hotspots=_demo_hotspots(scene_name) if synthetic else (),
     )
+
+
+def _demo_hotspots(scene_name: str) -> tuple[ClutterHotspot, ...]:
+    """The clutter hotspots the demo generator placed in its scene ``scene_name``."""
+    return tuple(h for h in CLUTTER_HOTSPOTS if h.scene_name == scene_name)
 
 
 def load_lidar_points(keyframe: Keyframe) -> np.ndarray:

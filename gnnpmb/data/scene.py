@@ -4,10 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from gnnpmb.types import Boxes
+
+if TYPE_CHECKING:
+    from gnnpmb.data.demo import ClutterHotspot
 
 
 @dataclass(frozen=True, slots=True)
@@ -42,7 +46,8 @@ class Keyframe:
 class SceneData:
     """name (e.g. "scene-0103"), token, description, the dataset it came from and its keyframes in time order.
 
-    synthetic: true for the built-in demo dataset (its descriptions say so too).
+    synthetic: true for the built-in demo dataset (its descriptions say so too); clutter_hotspots: where the
+    scene's simulated detector places extra false positives (only the demo's scenes have them).
     """
 
     name: str
@@ -52,6 +57,13 @@ class SceneData:
     version: str
     synthetic: bool
     keyframes: tuple[Keyframe, ...]
+    clutter_hotspots: tuple[ClutterHotspot, ...] = ()
+
+    @property
+    def ground_z_m(self) -> float:
+        """Height of the ground along the scene (global z, metres): the median ego-pose height, as the nuScenes
+        ego frame's origin is on the ground."""
+        return float(np.median([k.ego_pose.translation_m[2] for k in self.keyframes]))
 
     @property
     def sample_tokens(self) -> tuple[str, ...]:

@@ -57,7 +57,7 @@ import numpy as np
 from scipy.special import gammaln, xlogy
 
 from gnnpmb.config import ConfigError, TrackerConfig
-from gnnpmb.events import Cardinality, EventSink
+from gnnpmb.events import Cardinality, EventSink, Panel
 from gnnpmb.phd.gmphd import GmPhdTracker, Prediction, Selection, log_sum_exp, safe_log
 from gnnpmb.phd.mixture import GaussianMixture
 from gnnpmb.types import IdAllocator, Measurements
@@ -270,11 +270,12 @@ class CphdTracker(GmPhdTracker):
     ``cardinality`` is the posterior pmf (N + 1,) of the last frame (``[1.0]`` before the first)."""
 
     name = "cphd"
+    panels = (Panel.CARDINALITY, Panel.INTENSITY)
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
-        if not config.pmb.clutter_intensity > 0.0:
+        if not config.models.clutter_intensity > 0.0:
             raise ConfigError(
-                f"[pmb] clutter_intensity must be > 0 for the CPHD filter, got {config.pmb.clutter_intensity}"
+                f"[models] clutter_intensity must be > 0 for the CPHD filter, got {config.models.clutter_intensity}"
             )
         super().__init__(class_name, config, ids)
         self.cardinality = np.ones(1)
@@ -285,10 +286,10 @@ class CphdTracker(GmPhdTracker):
     def _correct(self, pred: Prediction, meas: Measurements, sink: EventSink) -> tuple[np.ndarray, np.ndarray]:
         birth_mean = float(np.sum(pred.mixture.weight[pred.n_persistent :]))
         predicted = predict_cardinality(
-            self.cardinality, self.config.pmb.p_survive, birth_mean, self.params.max_cardinality
+            self.cardinality, self.config.models.p_survive, birth_mean, self.params.max_cardinality
         )
         corr = cphd_update(
-            predicted, pred.mixture.weight, pred.p_detect, pred.log_lik, self.config.pmb.clutter_intensity
+            predicted, pred.mixture.weight, pred.p_detect, pred.log_lik, self.config.models.clutter_intensity
         )
         self.cardinality = trim_pmf(corr.pmf)
         if sink.enabled:

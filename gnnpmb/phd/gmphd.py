@@ -2,15 +2,15 @@
 
 Per class and frame (Vo & Ma 2006, Table I-III):
 
-1. predict: w <- P_S w, (m, P) <- Kalman predict (eq. 20-21); P_S is ``[pmb] p_survive``;
+1. predict: w <- P_S w, (m, P) <- Kalman predict (eq. 20-21); P_S is ``[models] p_survive``;
 2. birth: one component per detection, weight w_b at [z_j, v_j] with covariance P_b (``pmb.poisson``: adaptive,
    measurement-driven birth, Ristic, Clark, Vo & Vo 2012). A birth component describes a target that produced
    detection j, so it is detected with probability 1 and explains z_j only: it has no misdetection term and
    every other detection is outside its gate (as in the PMB core, undetected birth mass is not carried on);
 3. gate: persistent component k may explain z_j only if (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < G
-   (``[pmb] gate_chi2``); outside the gate its likelihood q_k(z_j) is taken as 0;
+   (``[models] gate_chi2``); outside the gate its likelihood q_k(z_j) is taken as 0;
 4. update (eq. 23-26), with P_D,k = ``[phd] p_detect`` for persistent and 1 for birth components and clutter
-   intensity kappa = ``[pmb] clutter_intensity`` (the same clutter model as the rest of the study):
+   intensity kappa = ``[models] clutter_intensity`` (the same clutter model as the rest of the study):
      missed:    w_k (1 - P_D,k),           state unchanged,
      detected:  w_kj = P_D,k w_k q_k(z_j) / (kappa + sum_i P_D,i w_i q_i(z_j)),  Kalman update with z_j,
    computed in log space (``phd_update``);
@@ -48,22 +48,30 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     Born,
     EventSink,
-    Extracted,
-    Gated,
     IntensityWeights,
     Merged,
-    Posterior,
-    Predicted,
+    Panel,
     Pruned,
     PruneReason,
 )
 from gnnpmb.gating import gate
-from gnnpmb.kalman import Innovation, MotionModel, cv_model, innovation, log_likelihood, mahalanobis2, predict
+from gnnpmb.kalman import (
+    Innovation,
+    gaussian_log_density,
+    innovation,
+    log_likelihood,
+    mahalanobis2,
+    paired_mahalanobis2,
+    paired_updated_means,
+    predict,
+)
+from gnnpmb.models import MotionModel, cv_model, measurement_birth
 from gnnpmb.phd.mixture import GaussianMixture, Reduction, reduce_mixture
-from gnnpmb.pmb.poisson import measurement_birth
+from gnnpmb.skeleton import Gating, emit_posterior, emit_prior
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -116,25 +124,20 @@ def predict_mixture(mix: GaussianMixture, model: MotionModel, p_survive: float) 
         weight=p_survive * mix.weight,
         mean=mean,
         cov=cov,
-        meas_index=np.full(len(mix), -1, dtype=np.int64),
+        det=mix.det.undetected(),
     )
 
 
 def birth_mixture(meas: Measurements, config: TrackerConfig, labels: np.ndarray) -> GaussianMixture:
     """One birth component per measurement (``pmb.poisson.measurement_birth``) with the given (M,) labels and the
     measurement's box fields."""
-    birth = measurement_birth(meas, config.pmb)
-    boxes = meas.boxes
+    birth = measurement_birth(meas, config.models)
     return GaussianMixture(
         weight=birth.weight,
         mean=birth.mean,
         cov=birth.cov,
         label=labels,
-        score=boxes.score.astype(float),
-        z_m=boxes.translation_m[:, 2].astype(float),
-        size_wlh_m=boxes.size_wlh_m.astype(float),
-        quat_wxyz=boxes.quat_wxyz.astype(float),
-        meas_index=np.asarray(meas.source_index, dtype=np.int64),
+        det=DetectionFields.from_measurements(meas, np.arange(len(meas))),
     )
 
 
@@ -161,9 +164,9 @@ def gate_components(
         d2 = np.zeros((k, m))
         inside = np.zeros((k, m), dtype=bool)
     if m:
-        nu = z - inn.z_pred[k:]
-        d2_birth = np.einsum("mi,mij,mj->m", nu, inn.S_inv[k:], nu)
-        log_lik[k + np.arange(m), np.arange(m)] = -0.5 * (d2_birth + inn.log_det_S[k:] + 2.0 * np.log(2.0 * np.pi))
+        nu = z - inn.z_pred[k:]  # birth component K + j explains z_j only
+        d2_birth = paired_mahalanobis2(inn.S_inv[k:], nu)
+        log_lik[k + np.arange(m), np.arange(m)] = gaussian_log_density(d2_birth, inn.log_det_S[k:], nu.shape[1])
     pd = np.concatenate([np.full(k, p_detect), np.ones(m)])
     return Prediction(mixture=mix, n_persistent=k, p_detect=pd, inn=inn, d2=d2, inside=inside, log_lik=log_lik)
 
@@ -197,18 +200,12 @@ def posterior_mixture(
     k_idx, j_idx = np.nonzero(np.isfinite(log_detected))
     if not len(k_idx):
         return missed
-    boxes = meas.boxes
-    nu = meas.z[j_idx] - pred.inn.z_pred[k_idx]
     detected = GaussianMixture(
         weight=np.exp(log_detected[k_idx, j_idx]),
-        mean=mix.mean[k_idx] + np.einsum("pij,pj->pi", pred.inn.gain[k_idx], nu),
+        mean=paired_updated_means(mix.mean, pred.inn, meas.z, k_idx, j_idx),
         cov=pred.inn.cov_post[k_idx],
         label=mix.label[k_idx],
-        score=boxes.score[j_idx].astype(float),
-        z_m=boxes.translation_m[j_idx, 2].astype(float),
-        size_wlh_m=boxes.size_wlh_m[j_idx].astype(float),
-        quat_wxyz=boxes.quat_wxyz[j_idx].astype(float),
-        meas_index=np.asarray(meas.source_index, dtype=np.int64)[j_idx],
+        det=DetectionFields.from_measurements(meas, j_idx),
     )
     return GaussianMixture.concatenate([missed, detected])
 
@@ -228,6 +225,7 @@ class GmPhdTracker:
     but the weight update (``_correct``) and the extraction rule (``_select``)."""
 
     name = "phd"
+    panels: tuple[Panel, ...] = (Panel.INTENSITY,)
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name
@@ -243,11 +241,11 @@ class GmPhdTracker:
         """Process one frame of this class's measurements; returns the extracted tracks."""
         if not len(meas) and self._idle() and not sink.enabled:
             return []
-        pmb, p = self.config.pmb, self.params
+        models, p = self.config.models, self.params
         model = cv_model(dt_s, self.class_params)
-        persistent = predict_mixture(self.mixture, model, pmb.p_survive)
+        persistent = predict_mixture(self.mixture, model, models.p_survive)
         births = birth_mixture(meas, self.config, self._provisional_labels(len(meas)))
-        pred = gate_components(persistent, births, meas, model.R, pmb.gate_chi2, p.p_detect)
+        pred = gate_components(persistent, births, meas, model.R, models.gate_chi2, p.p_detect)
         if sink.enabled:
             self._emit_prior(pred, meas, sink)
         log_missed, log_detected = self._correct(pred, meas, sink)
@@ -267,7 +265,7 @@ class GmPhdTracker:
 
     def _correct(self, pred: Prediction, meas: Measurements, sink: EventSink) -> tuple[np.ndarray, np.ndarray]:
         """Log missed (K + M,) and detected (K + M, M) weights of the PHD update (``phd_update``)."""
-        return phd_update(pred.mixture.weight, pred.p_detect, pred.log_lik, self.config.pmb.clutter_intensity)
+        return phd_update(pred.mixture.weight, pred.p_detect, pred.log_lik, self.config.models.clutter_intensity)
 
     def _select(self, mix: GaussianMixture) -> Selection:
         """Vo & Ma 2006, Table III: w >= extraction_weight, floor(w + 1/2) copies (at least one)."""
@@ -310,7 +308,11 @@ class GmPhdTracker:
         self.mixture = replace(mix, label=labels)
         alive = set(labels.tolist())
         self._copy_ids = {key: v for key, v in self._copy_ids.items() if key[0] in alive}
-        estimates = [self._estimate(i, t) for i, ids in zip(sel.index.tolist(), track_ids, strict=True) for t in ids]
+        rows = np.array([i for i, ids in zip(sel.index.tolist(), track_ids, strict=True) for _ in ids], dtype=np.int64)
+        chosen = self.mixture.subset(rows)
+        weight = np.minimum(chosen.weight, 1.0)
+        flat_ids = np.array([t for ids in track_ids for t in ids], dtype=np.int64)
+        estimates = chosen.det.to_estimates(self.class_name, flat_ids, chosen.mean, chosen.score, weight)
         return estimates, np.asarray(born, dtype=np.int64), relabelled
 
     def _copy_id(self, label: int, copy: int) -> int:
@@ -319,35 +321,13 @@ class GmPhdTracker:
             self._copy_ids[key] = self.ids.allocate()
         return self._copy_ids[key]
 
-    def _estimate(self, i: int, track_id: int) -> TrackEstimate:
-        mix = self.mixture
-        mean = mix.mean[i]
-        return TrackEstimate(
-            track_id=track_id,
-            class_name=self.class_name,
-            translation_m=(float(mean[0]), float(mean[1]), float(mix.z_m[i])),
-            size_wlh_m=tuple(float(v) for v in mix.size_wlh_m[i]),
-            quat_wxyz=tuple(float(v) for v in mix.quat_wxyz[i]),
-            velocity_mps=(float(mean[2]), float(mean[3])),
-            score=float(mix.score[i]),
-            existence=float(min(mix.weight[i], 1.0)),
-            meas_index=int(mix.meas_index[i]),
-        )
-
     def _emit_prior(self, pred: Prediction, meas: Measurements, sink: EventSink) -> None:
         prior = pred.persistent
-        k = pred.n_persistent
-        sink.emit(Predicted(self.class_name, prior.label, prior.mean, prior.cov, np.minimum(prior.weight, 1.0)))
-        sink.emit(
-            Gated(
-                self.class_name,
-                track_ids=prior.label,
-                meas_indices=np.asarray(meas.source_index),
-                inside=pred.inside,
-                center_xy=pred.inn.z_pred[:k],
-                innovation_cov=pred.inn.S[:k],
-                threshold=self.config.pmb.gate_chi2,
-            )
+        gating = Gating(pred.inn.subset(slice(0, pred.n_persistent)), pred.d2, pred.inside)
+        existence = np.minimum(prior.weight, 1.0)
+        gate_chi2 = self.config.models.gate_chi2
+        emit_prior(
+            sink, self.class_name, prior.label, prior.mean, prior.cov, existence, gating, meas.source_index, gate_chi2
         )
 
     def _emit_posterior(
@@ -382,5 +362,5 @@ class GmPhdTracker:
                     np.minimum(mix.weight[born], 1.0),
                 )
             )
-        sink.emit(Posterior(self.class_name, mix.label, mix.mean, mix.cov, np.minimum(mix.weight, 1.0)))
-        sink.emit(Extracted(self.class_name, tuple(estimates), sel.threshold))
+        existence = np.minimum(mix.weight, 1.0)
+        emit_posterior(sink, self.class_name, mix.label, mix.mean, mix.cov, existence, estimates, sel.threshold)

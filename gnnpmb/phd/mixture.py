@@ -26,30 +26,26 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
 from gnnpmb.events import PruneReason
 from gnnpmb.kalman import symmetrize
 from gnnpmb.soa import StructOfArrays
 
 
 @dataclass(frozen=True, slots=True)
-class GaussianMixture(StructOfArrays):
+class GaussianMixture(CarriesDetectionFields, StructOfArrays):
     """K labelled Gaussian components, struct-of-arrays.
 
     weight: (K,) w_i >= 0; mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); label: (K,) int64 track label (< 0 =
-    provisional, never extracted); score: (K,) score of the detection that last updated the component;
-    z_m: (K,); size_wlh_m: (K, 3); quat_wxyz: (K, 4) box fields of that detection; meas_index: (K,) its source
-    index if it updated the component this frame, else -1.
+    provisional, never extracted); det: the fields of the detection that last updated the component
+    (``score``, ``z_m``, ... read through as the mixture's own; ``meas_index`` -1 unless updated this frame).
     """
 
     weight: np.ndarray
     mean: np.ndarray
     cov: np.ndarray
     label: np.ndarray
-    score: np.ndarray
-    z_m: np.ndarray
-    size_wlh_m: np.ndarray
-    quat_wxyz: np.ndarray
-    meas_index: np.ndarray
+    det: DetectionFields
 
     def __len__(self) -> int:
         return int(self.weight.shape[0])
@@ -61,11 +57,7 @@ class GaussianMixture(StructOfArrays):
             mean=np.zeros((0, 4)),
             cov=np.zeros((0, 4, 4)),
             label=np.zeros(0, dtype=np.int64),
-            score=np.zeros(0),
-            z_m=np.zeros(0),
-            size_wlh_m=np.zeros((0, 3)),
-            quat_wxyz=np.zeros((0, 4)),
-            meas_index=np.zeros(0, dtype=np.int64),
+            det=DetectionFields.empty(),
         )
 
 

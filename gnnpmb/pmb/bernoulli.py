@@ -12,19 +12,20 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gnnpmb.kalman import MotionModel, predict
+from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
+from gnnpmb.kalman import predict
+from gnnpmb.models import MotionModel
 from gnnpmb.soa import StructOfArrays
 
 
 @dataclass(frozen=True, slots=True)
-class Bernoullis(StructOfArrays):
+class Bernoullis(CarriesDetectionFields, StructOfArrays):
     """K Bernoulli components, struct-of-arrays.
 
     track_id: (K,) int, the track label (metadata, kept through updates);
     local_key: (K,) int64, identifies the single-target hypothesis (equal keys = identical component; PMBM);
     existence: (K,) r in [0, 1]; mean: (K, 4); cov: (K, 4, 4);
-    score: (K,) last associated detection score; z_m: (K,); size_wlh_m: (K, 3); quat_wxyz: (K, 4);
-    meas_index: (K,) source index of the detection associated in the latest update, -1 if missed.
+    det: the last associated detection's fields (``score``, ``z_m``, ... read through as the Bernoullis' own).
     """
 
     track_id: np.ndarray
@@ -32,11 +33,7 @@ class Bernoullis(StructOfArrays):
     existence: np.ndarray
     mean: np.ndarray
     cov: np.ndarray
-    score: np.ndarray
-    z_m: np.ndarray
-    size_wlh_m: np.ndarray
-    quat_wxyz: np.ndarray
-    meas_index: np.ndarray
+    det: DetectionFields
 
     @staticmethod
     def empty() -> Bernoullis:
@@ -46,11 +43,7 @@ class Bernoullis(StructOfArrays):
             existence=np.zeros(0),
             mean=np.zeros((0, 4)),
             cov=np.zeros((0, 4, 4)),
-            score=np.zeros(0),
-            z_m=np.zeros(0),
-            size_wlh_m=np.zeros((0, 3)),
-            quat_wxyz=np.zeros((0, 4)),
-            meas_index=np.zeros(0, dtype=np.int64),
+            det=DetectionFields.empty(),
         )
 
 
@@ -64,7 +57,7 @@ def predict_bernoullis(b: Bernoullis, model: MotionModel, p_survive: float) -> B
         existence=p_survive * b.existence,
         mean=mean,
         cov=cov,
-        meas_index=np.full(len(b), -1, dtype=np.int64),
+        det=b.det.undetected(),
     )
 
 

@@ -1,8 +1,8 @@
 """The shared Poisson multi-Bernoulli (mixture) core: predict, gate, cost, *strategy*, update, prune, extract.
 
 GNN-PMB, PMBM and TO-PMB differ only in how the strategy manages data-association hypotheses (paper sec. III-IV):
-``strategy.BestAssignment`` keeps the single best global hypothesis (GNN-PMB), ``pmbm.KBest`` keeps up to N_h
-(PMBM, Murty), ``topmb.Marginals`` merges every local hypothesis by its marginal probability (TO-PMB, LBP).
+``gnnpmb.BestAssignment`` keeps the single best global hypothesis (GNN-PMB), ``pmbm.KBest`` keeps up to N_h
+(PMBM, Murty), ``topmb.MarginalMerge`` merges every local hypothesis by its marginal probability (TO-PMB, LBP).
 Everything else in a frame is this module, per class:
 
 1. predict every hypothesis' Bernoullis (``bernoulli.predict_bernoullis``);
@@ -22,22 +22,21 @@ from typing import Protocol, overload
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     AxisLabel,
     Born,
     CostMatrix,
     EventSink,
-    Extracted,
-    Gated,
-    Posterior,
-    Predicted,
+    Panel,
     Pruned,
     PruneReason,
 )
-from gnnpmb.kalman import MotionModel, cv_model
+from gnnpmb.models import MotionModel, clutter_intensity, cv_model, measurement_birth
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
-from gnnpmb.pmb.poisson import NewTrackHypotheses, measurement_birth, new_track_hypotheses
+from gnnpmb.pmb.poisson import NewTrackHypotheses, new_track_hypotheses
+from gnnpmb.skeleton import Gating, emit_posterior, emit_prior
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -121,9 +120,11 @@ class HypothesisLocals(Sequence[LocalHypotheses]):
 
 
 class HypothesisStrategy(Protocol):
-    """Data-association hypothesis management: the only thing that differs across GNN-PMB, PMBM and TO-PMB."""
+    """Data-association hypothesis management: the only thing that differs across GNN-PMB, PMBM and TO-PMB.
+    ``panels``: the viewer panels its events fill."""
 
     name: str
+    panels: tuple[Panel, ...]
 
     def update(
         self, priors: list[GlobalHypothesis], locals_: Sequence[LocalHypotheses], ctx: UpdateContext
@@ -181,7 +182,7 @@ def updated_bernoullis(local: LocalHypotheses, rows: np.ndarray, outcome: np.nda
     """Prior Bernoullis ``rows`` of ``local`` after the single-target hypotheses ``outcome`` (0 = missed: the
     misdetection update; j + 1 = detected by local measurement j: r = 1 and the Kalman update, box fields and
     score from the detection). The local key becomes ``combine_keys(parent key, outcome)``."""
-    prior, boxes = local.prior, local.meas.boxes
+    prior = local.prior
     det = np.flatnonzero(outcome > 0)
     det_k, det_j = rows[det], outcome[det] - 1
     existence = local.miss_existence[rows]
@@ -190,25 +191,13 @@ def updated_bernoullis(local: LocalHypotheses, rows: np.ndarray, outcome: np.nda
     mean[det] = detected_means(local, det_k, det_j)
     cov = prior.cov[rows]
     cov[det] = local.inn.cov_post[det_k]
-    score, z_m = prior.score[rows], prior.z_m[rows]
-    size, quat = prior.size_wlh_m[rows], prior.quat_wxyz[rows]
-    score[det] = boxes.score[det_j]
-    z_m[det] = boxes.translation_m[det_j, 2]
-    size[det] = boxes.size_wlh_m[det_j]
-    quat[det] = boxes.quat_wxyz[det_j]
-    meas_index = np.full(len(rows), -1, dtype=np.int64)
-    meas_index[det] = local.meas.source_index[det_j]
     return Bernoullis(
         track_id=prior.track_id[rows],
         local_key=combine_keys(prior.local_key[rows], outcome),
         existence=existence,
         mean=mean,
         cov=cov,
-        score=score,
-        z_m=z_m,
-        size_wlh_m=size,
-        quat_wxyz=quat,
-        meas_index=meas_index,
+        det=prior.det.subset(rows).take(det, DetectionFields.from_measurements(local.meas, det_j)),
     )
 
 
@@ -216,18 +205,14 @@ def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext
     """The Bernoullis started by local measurements ``new_j`` (existence r_j from ``poisson``)."""
     if len(new_j) == 0:
         return Bernoullis.empty()
-    boxes, new = local.meas.boxes, local.new
+    new = local.new
     return Bernoullis(
         track_id=np.array([ctx.birth_id(int(j)) for j in new_j], dtype=np.int64),
         local_key=combine_keys(np.full(len(new_j), -ctx.frame_serial), new_j + 1),
         existence=new.existence[new_j],
         mean=new.mean[new_j],
         cov=new.cov[new_j],
-        score=boxes.score[new_j],
-        z_m=boxes.translation_m[new_j, 2],
-        size_wlh_m=boxes.size_wlh_m[new_j],
-        quat_wxyz=boxes.quat_wxyz[new_j],
-        meas_index=local.meas.source_index[new_j],
+        det=DetectionFields.from_measurements(local.meas, new_j),
     )
 
 
@@ -268,11 +253,17 @@ class PmbCore:
         self.class_name = class_name
         self.config = config
         self.params = config.pmb
+        self.models = config.models
         self.class_params = config.for_class(class_name)
         self.strategy = strategy
         self.ids = ids
         self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty())]
         self.frame_serial = 0
+
+    @property
+    def panels(self) -> tuple[Panel, ...]:
+        """The viewer panels this tracker's events fill beyond the common ones: its strategy's."""
+        return self.strategy.panels
 
     def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
         """Process one frame of this class's measurements; returns the extracted tracks."""
@@ -281,8 +272,8 @@ class PmbCore:
         model = cv_model(dt_s, self.class_params, p.measure_velocity == 1)
         if p.measure_velocity == 1:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
-        clutter = p.clutter_intensity * (p.clutter_velocity_density if p.measure_velocity == 1 else 1.0)
-        new = new_track_hypotheses(measurement_birth(meas, p), meas, model.R, clutter)
+        clutter = clutter_intensity(self.models, p)
+        new = new_track_hypotheses(measurement_birth(meas, self.models), meas, model.R, clutter)
         priors, locals_ = self._predict_and_localise(meas, model, new)
         if sink.enabled:
             self._emit_prior(locals_[0], sink)
@@ -302,7 +293,7 @@ class PmbCore:
         (equal ``local_key`` = identical component), so with several hypotheses every distinct Bernoulli is
         predicted and gated once and each hypothesis takes its rows when asked (``HypothesisLocals``; PMBM,
         García-Fernández et al. 2018, sec. V)."""
-        p = self.params
+        p = self.models
         if len(self.hypotheses) == 1:
             h = self.hypotheses[0]
             prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
@@ -343,35 +334,23 @@ class PmbCore:
         return kept
 
     def _extract(self, b: Bernoullis) -> list[TrackEstimate]:
-        sel = np.flatnonzero(b.existence >= self.params.extraction_threshold)
-        return [
-            TrackEstimate(
-                track_id=int(b.track_id[i]),
-                class_name=self.class_name,
-                translation_m=(float(b.mean[i, 0]), float(b.mean[i, 1]), float(b.z_m[i])),
-                size_wlh_m=tuple(float(v) for v in b.size_wlh_m[i]),
-                quat_wxyz=tuple(float(v) for v in b.quat_wxyz[i]),
-                velocity_mps=(float(b.mean[i, 2]), float(b.mean[i, 3])),
-                score=float(b.score[i] * b.existence[i]),
-                existence=float(b.existence[i]),
-                meas_index=int(b.meas_index[i]),
-            )
-            for i in sel
-        ]
+        """Tracks with r >= the extraction threshold; tracking score = detection score x r."""
+        sel = b.subset(np.flatnonzero(b.existence >= self.params.extraction_threshold))
+        return sel.det.to_estimates(self.class_name, sel.track_id, sel.mean, sel.score * sel.existence, sel.existence)
 
     def _emit_prior(self, local: LocalHypotheses, sink: EventSink) -> None:
         prior = local.prior
-        sink.emit(Predicted(self.class_name, prior.track_id, prior.mean, prior.cov, prior.existence))
-        sink.emit(
-            Gated(
-                self.class_name,
-                track_ids=prior.track_id,
-                meas_indices=local.meas.source_index,
-                inside=local.inside,
-                center_xy=local.inn.z_pred[:, :2],
-                innovation_cov=local.inn.S[:, :2, :2],
-                threshold=self.params.gate_chi2,
-            )
+        gating = Gating(local.inn, local.d2, local.inside)
+        emit_prior(
+            sink,
+            self.class_name,
+            prior.track_id,
+            prior.mean,
+            prior.cov,
+            prior.existence,
+            gating,
+            local.meas.source_index,
+            self.models.gate_chi2,
         )
         sink.emit(CostMatrix(self.class_name, local.cost_matrix(), local.row_labels(), local.col_labels()))
 
@@ -384,5 +363,13 @@ class PmbCore:
             sink.emit(
                 Born(self.class_name, best.track_id[sel], best.meas_index[sel], best.mean[sel], best.existence[sel])
             )
-        sink.emit(Posterior(self.class_name, best.track_id, best.mean, best.cov, best.existence))
-        sink.emit(Extracted(self.class_name, tuple(estimates), self.params.extraction_threshold))
+        emit_posterior(
+            sink,
+            self.class_name,
+            best.track_id,
+            best.mean,
+            best.cov,
+            best.existence,
+            estimates,
+            self.params.extraction_threshold,
+        )

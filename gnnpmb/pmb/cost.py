@@ -20,10 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.events import AxisKind, AxisLabel
-from gnnpmb.gating import gate
-from gnnpmb.kalman import Innovation, innovation, log_likelihood, mahalanobis2
+from gnnpmb.kalman import Innovation, log_likelihood, paired_updated_means
 from gnnpmb.pmb.bernoulli import Bernoullis, missed_update
 from gnnpmb.pmb.poisson import NewTrackHypotheses
+from gnnpmb.skeleton import gate_tracks
 from gnnpmb.types import Measurements
 
 
@@ -93,10 +93,8 @@ def local_hypotheses(
     prior: Bernoullis, meas: Measurements, new: NewTrackHypotheses, R: np.ndarray, gate_chi2: float
 ) -> LocalHypotheses:
     """Gate every (track, measurement) pair and compute the local hypothesis likelihoods (module docstring)."""
-    k, m = len(prior), len(meas)
-    inn = innovation(prior.mean, prior.cov, R)
-    d2 = mahalanobis2(inn, meas.z) if k and m else np.zeros((k, m))
-    inside = gate(d2, gate_chi2)
+    gating = gate_tracks(prior.mean, prior.cov, R, meas.z, gate_chi2)
+    inn, d2, inside = gating.inn, gating.d2, gating.inside
     miss_log_lik, miss_existence = missed_update(prior.existence, prior.score)
     with np.errstate(divide="ignore"):
         det = np.log(prior.existence)[:, None] + np.log(meas.boxes.score)[None, :] + log_likelihood(inn, d2)
@@ -118,5 +116,4 @@ def detected_means(local: LocalHypotheses, track_index: np.ndarray, meas_index: 
     """(P, 4) Kalman-updated means for P (track, measurement) pairs given as local row/column indices."""
     if len(track_index) == 0:
         return np.zeros((0, 4))
-    nu = local.meas.z[meas_index] - local.inn.z_pred[track_index]
-    return local.prior.mean[track_index] + np.einsum("pij,pj->pi", local.inn.gain[track_index], nu)
+    return paired_updated_means(local.prior.mean, local.inn, local.meas.z, track_index, meas_index)

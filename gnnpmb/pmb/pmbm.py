@@ -11,7 +11,7 @@ since an assignment's likelihood is the product of its local hypothesis likeliho
 the same Bernoullis (same multiset of local keys after the core's existence pruning) are merged by adding
 weights; then the weights are normalised, sorted (ties keep parent, then rank order), children below
 ``hypothesis_prune`` dropped, at most N_h kept and renormalised. With N_h = 1 this is exactly GNN-PMB
-(``strategy.BestAssignment``).
+(``gnnpmb.BestAssignment``).
 
 Of a parent's H_h best assignments only those costing at most -log(hypothesis_prune) more than its best are
 enumerated: the parent's best child alone outweighs such a child by more than 1 / hypothesis_prune, so its
@@ -42,7 +42,7 @@ from scipy.special import logsumexp
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.assign.murty import Product, Ranking, blocks, forbid_beyond_private, k_best, rank
 from gnnpmb.config import PmbmParams
-from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses
+from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
 from gnnpmb.pmb.core import (
     GlobalHypothesis,
     HypothesisLocals,
@@ -87,6 +87,7 @@ class KBest:
     more than ``murty_block_rows`` rows keep only their best assignment (the per-frame budget)."""
 
     name = "k-best"
+    panels = (Panel.HYPOTHESES,)
 
     def __init__(
         self,

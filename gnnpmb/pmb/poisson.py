@@ -1,11 +1,12 @@
 """The Poisson part of the PMB / PMBM density: a measurement-driven Gaussian-mixture birth intensity.
 
-lambda_b(x) = sum_j w_b N(x; [z_j, v_j], P_b), P_b = diag(s_p^2, s_p^2, s_v^2, s_v^2): one component per detection
-of the frame, centred on its BEV position with the detector's velocity (paper sec. V-B, birth weight 0.1, initial
-covariance from s_p = 15). Component j only explains measurement j (adaptive birth, Ristic, Clark, Vo & Vo 2012,
-"Adaptive target birth intensity for PHD and CPHD filters", IEEE T-AES 48(2)), so a new track's velocity is its own
-detection's and never an average over neighbours. As in the paper's implementation, undetected Poisson mass is not
-carried to the next frame: the birth intensity is the whole Poisson component.
+lambda_b(x) = sum_j w_b N(x; [z_j, v_j], P_b), P_b = diag(s_p^2, s_p^2, s_v^2, s_v^2) (``gnnpmb.models``): one
+component per detection of the frame, centred on its BEV position with the detector's velocity (paper sec. V-B,
+birth weight 0.1, initial covariance from s_p = 15). Component j only explains measurement j (adaptive birth,
+Ristic, Clark, Vo & Vo 2012, "Adaptive target birth intensity for PHD and CPHD filters", IEEE T-AES 48(2)), so a
+new track's velocity is its own detection's and never an average over neighbours. As in the paper's
+implementation, undetected Poisson mass is not carried to the next frame: the birth intensity is the whole
+Poisson component.
 
 New-track hypothesis of measurement j (García-Fernández et al. 2018, eq. 14-15):
 l_j = c + w_b P_D N(z_j; H m_j, H P_b H^T + R), r_j = (l_j - c) / l_j, state = Kalman update of component j,
@@ -18,27 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.config import PmbParams
-from gnnpmb.kalman import innovation
+from gnnpmb.kalman import gaussian_log_density, innovation, mean_update, paired_mahalanobis2
+from gnnpmb.models import BirthIntensity
 from gnnpmb.types import Measurements
-
-
-@dataclass(frozen=True, slots=True)
-class BirthIntensity:
-    """M Gaussian components: weight (M,), mean (M, 4), cov (M, 4, 4)."""
-
-    weight: np.ndarray
-    mean: np.ndarray
-    cov: np.ndarray
-
-
-def measurement_birth(meas: Measurements, params: PmbParams) -> BirthIntensity:
-    """One birth component per measurement at [z_j, v_j] with weight w_b."""
-    m = len(meas)
-    mean = np.concatenate([meas.boxes.xy, meas.boxes.velocity_mps], axis=1) if m else np.zeros((0, 4))
-    var = np.array([params.birth_pos_std_m**2] * 2 + [params.birth_vel_std_mps**2] * 2)
-    cov = np.broadcast_to(np.diag(var), (m, 4, 4)).copy()
-    return BirthIntensity(weight=np.full(m, params.birth_weight), mean=mean, cov=cov)
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,10 +42,9 @@ def new_track_hypotheses(
     if m == 0:
         return NewTrackHypotheses(np.zeros(0), np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4, 4)))
     inn = innovation(birth.mean, birth.cov, R)
-    nu = meas.z - inn.z_pred  # (M, D)
-    d2 = np.einsum("mi,mij,mj->m", nu, inn.S_inv, nu)
-    log_n = -0.5 * (d2 + inn.log_det_S + nu.shape[1] * np.log(2.0 * np.pi))
+    nu = meas.z - inn.z_pred  # (M, D): component j explains measurement j only
+    log_n = gaussian_log_density(paired_mahalanobis2(inn.S_inv, nu), inn.log_det_S, nu.shape[1])
     birth_term = birth.weight * meas.boxes.score * np.exp(log_n)
     total = clutter_intensity + birth_term
-    mean = birth.mean + np.einsum("mij,mj->mi", inn.gain, nu)
+    mean = mean_update(birth.mean, inn.gain, nu)
     return NewTrackHypotheses(log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=inn.cov_post)

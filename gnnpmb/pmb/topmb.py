@@ -35,8 +35,8 @@ import numpy as np
 from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.assign.marginals import AssociationMarginals
 from gnnpmb.config import LbpParams
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, Merged, Pruned, PruneReason
-from gnnpmb.events import Marginals as MarginalsEvent
+from gnnpmb.detection_fields import DetectionFields
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, Marginals, Merged, Panel, Pruned, PruneReason
 from gnnpmb.kalman import symmetrize
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import (
@@ -64,10 +64,11 @@ MERGE_REPORT_WEIGHT = 0.05
 mass (``Components``), so Bernoullis with negligible existence do not flood the event log."""
 
 
-class Marginals:
+class MarginalMerge:
     """TO-PMB hypothesis strategy: marginal association probabilities by LBP, one merged Bernoulli per track."""
 
     name = "marginals"
+    panels = (Panel.MARGINALS,)
 
     def __init__(self, params: LbpParams, max_bernoullis: int = MAX_BERNOULLIS):
         if max_bernoullis < 1:
@@ -150,26 +151,13 @@ def merged_bernoullis(local: LocalHypotheses, marg: AssociationMarginals) -> tup
     best = np.argmax(p, axis=1)  # 0 = missed, j + 1 = measurement j
     hit = np.flatnonzero(best > 0)
     hit_j = best[hit] - 1
-    boxes = meas.boxes
-    score, z_m = prior.score.copy(), prior.z_m.copy()
-    size, quat = prior.size_wlh_m.copy(), prior.quat_wxyz.copy()
-    score[hit] = boxes.score[hit_j]
-    z_m[hit] = boxes.translation_m[hit_j, 2]
-    size[hit] = boxes.size_wlh_m[hit_j]
-    quat[hit] = boxes.quat_wxyz[hit_j]
-    meas_index = np.full(k, -1, dtype=np.int64)
-    meas_index[hit] = meas.source_index[hit_j]
     tracks = Bernoullis(
         track_id=prior.track_id,
         local_key=combine_keys(prior.local_key, best),
         existence=np.clip(r_sum, 0.0, 1.0),
         mean=mean,
         cov=symmetrize(cov),
-        score=score,
-        z_m=z_m,
-        size_wlh_m=size,
-        quat_wxyz=quat,
-        meas_index=meas_index,
+        det=prior.det.undetected().take(hit, DetectionFields.from_measurements(meas, hit_j)),
     )
     return tracks, comp
 
@@ -188,7 +176,7 @@ def _emit(local: LocalHypotheses, marg: AssociationMarginals, comp: Components, 
     k, m = local.n_tracks, local.n_meas
     rows = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
     cols = (AxisLabel(AxisKind.MISSED, -1),) + tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
-    ctx.sink.emit(MarginalsEvent(ctx.class_name, marg.p_track, rows, cols, marg.method, marg.iterations))
+    ctx.sink.emit(Marginals(ctx.class_name, marg.p_track, rows, cols, marg.method, marg.iterations))
 
     significant = comp.detected >= MERGE_REPORT_WEIGHT
     missed = comp.missed >= MERGE_REPORT_WEIGHT

@@ -2,7 +2,8 @@
 
 A key is a dotted path into the parameter TOML (``gnnpmb/default_params.toml``):
 
-* ``section.name`` — a shared parameter, e.g. ``pmb.gate_chi2`` -> ``[pmb] gate_chi2``;
+* ``section.name`` — a shared parameter, e.g. ``models.gate_chi2`` -> ``[models] gate_chi2`` (a moved key's
+  former section still names it: ``pmb.gate_chi2``, ``gnnpmb.config.MOVED_KEYS``);
 * ``class.name`` — a per-class parameter, e.g. ``car.q_x`` -> ``[classes.car] q_x`` (``classes.car.q_x`` too);
 * ``*.name`` — the per-class parameter of every tracking class at once.
 
@@ -22,7 +23,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from gnnpmb.config import TrackerConfig, config_from_dict
+from gnnpmb.config import TrackerConfig, config_from_dict, current_section
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.types import TRACKING_CLASSES
 
@@ -173,6 +174,8 @@ def base_value(config: TrackerConfig, key: str) -> Scalar | None:
     values = []
     data = config.as_dict()
     for path in toml_paths(key):
+        if len(path) == 2:
+            path = (current_section(*path), path[1])
         node: Any = data
         for part in path:
             if not isinstance(node, Mapping) or part not in node:

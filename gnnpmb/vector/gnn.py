@@ -24,7 +24,8 @@ import numpy as np
 
 from gnnpmb.assign.hungarian import solve
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, EventSink
-from gnnpmb.kalman import Innovation, log_likelihood
+from gnnpmb.kalman import log_likelihood, paired_updated_means
+from gnnpmb.skeleton import Gating
 from gnnpmb.types import Measurements
 from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
 
@@ -62,24 +63,16 @@ def best_assignment(cost: np.ndarray) -> tuple[np.ndarray, float]:
 class GnnTracker(VectorTracker):
     """One class's GNN tracker (module docstring); ``step`` is ``tracks.VectorTracker.step``."""
 
-    def _associate(
-        self,
-        prior: VectorTracks,
-        inn: Innovation,
-        d2: np.ndarray,
-        inside: np.ndarray,
-        meas: Measurements,
-        sink: EventSink,
-    ) -> Association:
-        k, m = inside.shape
-        cost = pair_costs(log_likelihood(inn, d2), inside, self.params.p_detect, self.clutter_intensity)
+    def _associate(self, prior: VectorTracks, gating: Gating, meas: Measurements, sink: EventSink) -> Association:
+        k, m = gating.inside.shape
+        inn = gating.inn
+        cost = pair_costs(log_likelihood(inn, gating.d2), gating.inside, self.params.p_detect, self.clutter_intensity)
         track_of_meas, total = best_assignment(cost)
         det_j = np.flatnonzero(track_of_meas >= 0)
         det_k = track_of_meas[det_j]
         mean, cov = prior.mean.copy(), prior.cov.copy()
         if len(det_j):
-            nu = meas.z[det_j] - inn.z_pred[det_k]
-            mean[det_k] += np.einsum("pij,pj->pi", inn.gain[det_k], nu)
+            mean[det_k] = paired_updated_means(prior.mean, inn, meas.z, det_k, det_j)
             cov[det_k] = inn.cov_post[det_k]
         meas_of_track = np.full(k, -1, dtype=np.int64)
         meas_of_track[det_k] = det_j

@@ -37,12 +37,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from gnnpmb.assign.clusters import gate_clusters
 from gnnpmb.assign.exact_marginals import exact_marginals_log
 from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
-from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals
-from gnnpmb.kalman import Innovation, log_likelihood, symmetrize
+from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals, Panel
+from gnnpmb.kalman import Innovation, log_likelihood, mean_update, residuals, symmetrize
+from gnnpmb.skeleton import Gating
 from gnnpmb.types import Measurements
-from gnnpmb.vector.clusters import gate_clusters
 from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
 
 MAX_GATED_PER_TRACK = 32
@@ -125,13 +126,13 @@ def pda_update(
     mean: np.ndarray, cov: np.ndarray, inn: Innovation, z: np.ndarray, beta: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
     """PDA posterior means (K, 4) and covariances (K, 4, 4) from beta (K, M + 1) (module docstring)."""
-    nu = z[None, :, :] - inn.z_pred[:, None, :]  # (K, M, 2)
+    nu = residuals(inn, z)  # (K, M, 2)
     b = beta[:, 1:]
     nu_comb = np.einsum("km,kmi->ki", b, nu)
     spread = np.einsum("km,kmi,kmj->kij", b, nu, nu) - nu_comb[:, :, None] * nu_comb[:, None, :]
     W = inn.gain
     b0 = beta[:, 0, None, None]
-    mean_post = mean + np.einsum("kij,kj->ki", W, nu_comb)
+    mean_post = mean_update(mean, W, nu_comb)
     cov_post = b0 * cov + (1.0 - b0) * inn.cov_post + W @ spread @ np.swapaxes(W, -1, -2)
     return mean_post, symmetrize(cov_post)
 
@@ -139,16 +140,11 @@ def pda_update(
 class JpdaTracker(VectorTracker):
     """One class's JPDA tracker (module docstring); ``step`` is ``tracks.VectorTracker.step``."""
 
-    def _associate(
-        self,
-        prior: VectorTracks,
-        inn: Innovation,
-        d2: np.ndarray,
-        inside: np.ndarray,
-        meas: Measurements,
-        sink: EventSink,
-    ) -> Association:
-        log_ratio = log_ratios(log_likelihood(inn, d2), inside, self.params.p_detect, self.gate_chi2)
+    panels = (Panel.MARGINALS,)
+
+    def _associate(self, prior: VectorTracks, gating: Gating, meas: Measurements, sink: EventSink) -> Association:
+        inn = gating.inn
+        log_ratio = log_ratios(log_likelihood(inn, gating.d2), gating.inside, self.params.p_detect, self.gate_chi2)
         log_ratio = keep_most_likely(log_ratio, MAX_GATED_PER_TRACK)
         beta, p_new, method, iterations = association_probabilities(
             log_ratio,

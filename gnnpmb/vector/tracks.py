@@ -4,13 +4,14 @@ A vector-type tracker keeps a fixed list of Kalman tracks, each with an M/N trac
 random-finite-set density (Blackman & Popoli 1999, ch. 6; Bar-Shalom, Daum & Huang 2009). Per class and frame:
 
 1. Kalman predict every track (``gnnpmb.kalman``, per-class Q and R);
-2. ellipsoidal gate: d^2_kj = (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < G (``[pmb] gate_chi2``);
+2. ellipsoidal gate: d^2_kj = (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < G (``[models] gate_chi2``);
 3. data association and state update: the only part that differs (``gnn.GnnTracker``: the single best
    assignment; ``jpda.JpdaTracker``: marginal association probabilities and the PDA update);
 4. measurements left unassociated start tentative tracks: mean [z_j, v_j] with the detector's velocity v_j,
-   covariance the Kalman update of diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j (``[pmb] birth_pos_std_m``,
+   covariance the Kalman update of diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j (``[models] birth_pos_std_m``,
    ``birth_vel_std_mps``), i.e. about R in position;
-5. M/N track logic (``track_logic``) confirms and deletes tracks;
+5. M/N track logic (``track_logic``) confirms and deletes tracks; steps 4 and 5 are the initiator / deleter pair
+   (``MeasurementInitiator``, ``MofNDeleter``), steps 1, 2 and the events the shared ``gnnpmb.skeleton``;
 6. output: the *confirmed* tracks associated with a detection this frame. Coasting tracks (missed, not yet
    deleted) are kept and predicted but not output: a coasted box drifts from the truth and the nuScenes metric
    counts it as a false positive, while the same object's next detection resumes the track under its old id.
@@ -26,33 +27,30 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gnnpmb.config import TrackerConfig
-from gnnpmb.events import Born, EventSink, Extracted, Gated, Posterior, Predicted, Pruned, PruneReason
-from gnnpmb.gating import gate
-from gnnpmb.kalman import Innovation, MotionModel, cv_model, innovation, mahalanobis2, predict
+from gnnpmb.config import ClassParams, ModelParams, TrackerConfig, VectorParams
+from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
+from gnnpmb.events import Born, EventSink, Panel, Pruned, PruneReason
+from gnnpmb.kalman import innovation, predict
+from gnnpmb.models import MotionModel, birth_covariance, cv_model
+from gnnpmb.skeleton import Gating, emit_posterior, emit_prior, gate_tracks
 from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
-from gnnpmb.vector.track_logic import LogicState, advance, emit_transitions
+from gnnpmb.vector.track_logic import LogicState, LogicUpdate, advance, emit_transitions
 
 
 @dataclass(frozen=True, slots=True)
-class VectorTracks(StructOfArrays):
+class VectorTracks(CarriesDetectionFields, StructOfArrays):
     """K tracks of one class, struct-of-arrays.
 
-    track_id: (K,) int64; mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); score: (K,) score of the last
-    associated detection; z_m: (K,), size_wlh_m: (K, 3), quat_wxyz: (K, 4) box fields of that detection;
-    meas_index: (K,) source index of the detection associated in the latest frame, -1 if missed; logic: M/N
-    state.
+    track_id: (K,) int64; mean: (K, 4) [x, y, vx, vy]; cov: (K, 4, 4); det: the fields of the last associated
+    detection (``score``, ``z_m``, ... read through as the tracks' own; ``meas_index`` -1 if missed this frame);
+    logic: M/N state.
     """
 
     track_id: np.ndarray
     mean: np.ndarray
     cov: np.ndarray
-    score: np.ndarray
-    z_m: np.ndarray
-    size_wlh_m: np.ndarray
-    quat_wxyz: np.ndarray
-    meas_index: np.ndarray
+    det: DetectionFields
     logic: LogicState
 
     def __len__(self) -> int:
@@ -64,11 +62,7 @@ class VectorTracks(StructOfArrays):
             track_id=np.zeros(0, dtype=np.int64),
             mean=np.zeros((0, 4)),
             cov=np.zeros((0, 4, 4)),
-            score=np.zeros(0),
-            z_m=np.zeros(0),
-            size_wlh_m=np.zeros((0, 3)),
-            quat_wxyz=np.zeros((0, 4)),
-            meas_index=np.zeros(0, dtype=np.int64),
+            det=DetectionFields.empty(),
             logic=LogicState.empty(),
         )
 
@@ -77,30 +71,13 @@ class VectorTracks(StructOfArrays):
         if not len(self):
             return self
         mean, cov = predict(self.mean, self.cov, model)
-        return replace(self, mean=mean, cov=cov, meas_index=np.full(len(self), -1, dtype=np.int64))
+        return replace(self, mean=mean, cov=cov, det=self.det.undetected())
 
     def updated(self, assoc: Association, meas: Measurements) -> VectorTracks:
         """Posterior state from ``assoc``; tracks with a hit take the box fields of their detection."""
         k = np.flatnonzero(assoc.meas_of_track >= 0)
-        j = assoc.meas_of_track[k]
-        boxes = meas.boxes
-        score, z_m = self.score.copy(), self.z_m.copy()
-        size, quat, meas_index = self.size_wlh_m.copy(), self.quat_wxyz.copy(), self.meas_index.copy()
-        score[k] = boxes.score[j]
-        z_m[k] = boxes.translation_m[j, 2]
-        size[k] = boxes.size_wlh_m[j]
-        quat[k] = boxes.quat_wxyz[j]
-        meas_index[k] = meas.source_index[j]
-        return replace(
-            self,
-            mean=assoc.mean,
-            cov=assoc.cov,
-            score=score,
-            z_m=z_m,
-            size_wlh_m=size,
-            quat_wxyz=quat,
-            meas_index=meas_index,
-        )
+        detected = DetectionFields.from_measurements(meas, assoc.meas_of_track[k])
+        return replace(self, mean=assoc.mean, cov=assoc.cov, det=self.det.take(k, detected))
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,110 +95,98 @@ class Association:
     birth: np.ndarray
 
 
+class MeasurementInitiator:
+    """Starts a tentative track at each measurement the association gives to no track (module docstring, step 4):
+    mean [z_j, v_j], covariance the Kalman update of P_b = diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j."""
+
+    def __init__(self, class_params: ClassParams, models: ModelParams, params: VectorParams, ids: IdAllocator):
+        R = cv_model(0.0, class_params).R
+        self.birth_cov = innovation(np.zeros((1, 4)), birth_covariance(models)[None], R).cov_post[0]
+        self.params = params
+        self.ids = ids
+
+    def initiate(self, meas: Measurements, new_j: np.ndarray) -> VectorTracks:
+        """Tentative tracks started by local measurements ``new_j``, ids allocated in measurement order."""
+        b = len(new_j)
+        if b == 0:
+            return VectorTracks.empty()
+        return VectorTracks(
+            track_id=np.array([self.ids.allocate() for _ in range(b)], dtype=np.int64),
+            mean=np.concatenate([meas.z[new_j], meas.boxes.velocity_mps[new_j]], axis=1),
+            cov=np.broadcast_to(self.birth_cov, (b, 4, 4)).copy(),
+            det=DetectionFields.from_measurements(meas, new_j),
+            logic=LogicState.born(b, self.params),
+        )
+
+
+class MofNDeleter:
+    """Confirms and deletes tracks by the M/N track logic (``track_logic``; module docstring, step 5)."""
+
+    def __init__(self, params: VectorParams):
+        self.params = params
+
+    def update(self, logic: LogicState, hit: np.ndarray) -> LogicUpdate:
+        """The track logic after a frame in which tracks ``hit`` (K,) bool were associated with a detection."""
+        return advance(logic, hit, self.params)
+
+    def emit(
+        self, class_name: str, track_ids: np.ndarray, update: LogicUpdate, born_ids: np.ndarray, sink: EventSink
+    ) -> None:
+        """``TrackLogic`` events of the frame and ``Pruned`` for every track the logic deleted."""
+        emit_transitions(class_name, track_ids, update, born_ids, self.params, sink)
+        for t in track_ids[update.deleted].tolist():
+            sink.emit(Pruned(class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
+
+
 class VectorTracker(ABC):
-    """One class's vector-type tracker; subclasses implement ``_associate`` (module docstring, step 3)."""
+    """One class's vector-type tracker: the shared gate and events (``gnnpmb.skeleton``), an initiator / deleter
+    pair for track logic, and the association that subclasses implement (``_associate``, module docstring,
+    step 3)."""
+
+    panels: tuple[Panel, ...] = ()
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name
         self.params = config.vector
         self.class_params = config.for_class(class_name)
-        self.gate_chi2 = config.pmb.gate_chi2
-        self.clutter_intensity = config.pmb.clutter_intensity
+        self.gate_chi2 = config.models.gate_chi2
+        self.clutter_intensity = config.models.clutter_intensity
         self.lbp = config.lbp
-        self.ids = ids
+        self.initiator = MeasurementInitiator(self.class_params, config.models, config.vector, ids)
+        self.deleter = MofNDeleter(config.vector)
         self.tracks = VectorTracks.empty()
-        var = np.array([config.pmb.birth_pos_std_m**2] * 2 + [config.pmb.birth_vel_std_mps**2] * 2)
-        R = cv_model(0.0, self.class_params).R
-        self._birth_cov = innovation(np.zeros((1, 4)), np.diag(var)[None], R).cov_post[0]
 
     def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
         """Process one frame of this class's measurements; returns the confirmed tracks hit this frame."""
         model = cv_model(dt_s, self.class_params)
         prior = self.tracks.predicted(model)
-        k, m = len(prior), len(meas)
-        inn = innovation(prior.mean, prior.cov, model.R)
-        d2 = mahalanobis2(inn, meas.z) if k and m else np.zeros((k, m))
-        inside = gate(d2, self.gate_chi2)
+        gating = gate_tracks(prior.mean, prior.cov, model.R, meas.z, self.gate_chi2)
         if sink.enabled:
-            self._emit_prior(prior, inn, inside, meas, sink)
-        assoc = self._associate(prior, inn, d2, inside, meas, sink)
-        logic = advance(prior.logic, assoc.meas_of_track >= 0, self.params)
+            ones = np.ones(len(prior))
+            track_ids = prior.track_id
+            emit_prior(
+                sink, self.class_name, track_ids, prior.mean, prior.cov, ones, gating, meas.source_index, self.gate_chi2
+            )
+        assoc = self._associate(prior, gating, meas, sink)
+        logic = self.deleter.update(prior.logic, assoc.meas_of_track >= 0)
         posterior = replace(prior.updated(assoc, meas), logic=logic.state)
-        born = self._born(meas, np.flatnonzero(assoc.birth))
+        born = self.initiator.initiate(meas, np.flatnonzero(assoc.birth))
         self.tracks = VectorTracks.concatenate([posterior.subset(~logic.deleted), born])
         estimates = self._extract(self.tracks)
         if sink.enabled:
             if len(born):
-                ones = np.ones(len(born))
-                sink.emit(Born(self.class_name, born.track_id, born.meas_index, born.mean, ones))
-            emit_transitions(self.class_name, prior.track_id, logic, born.track_id, self.params, sink)
-            for t in prior.track_id[logic.deleted].tolist():
-                sink.emit(Pruned(self.class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
+                sink.emit(Born(self.class_name, born.track_id, born.meas_index, born.mean, np.ones(len(born))))
+            self.deleter.emit(self.class_name, prior.track_id, logic, born.track_id, sink)
             t = self.tracks
-            sink.emit(Posterior(self.class_name, t.track_id, t.mean, t.cov, np.ones(len(t))))
-            sink.emit(Extracted(self.class_name, tuple(estimates), 1.0))
+            emit_posterior(sink, self.class_name, t.track_id, t.mean, t.cov, np.ones(len(t)), estimates, 1.0)
         return estimates
 
     @abstractmethod
-    def _associate(
-        self,
-        prior: VectorTracks,
-        inn: Innovation,
-        d2: np.ndarray,
-        inside: np.ndarray,
-        meas: Measurements,
-        sink: EventSink,
-    ) -> Association:
-        """Data association and state update of the K prior tracks with the M measurements; d2 and inside are
-        (K, M) squared Mahalanobis distances and gate. Emits the association's own events."""
-
-    def _born(self, meas: Measurements, new_j: np.ndarray) -> VectorTracks:
-        """Tentative tracks started by local measurements ``new_j``, ids allocated in measurement order."""
-        b = len(new_j)
-        if b == 0:
-            return VectorTracks.empty()
-        boxes = meas.boxes
-        return VectorTracks(
-            track_id=np.array([self.ids.allocate() for _ in range(b)], dtype=np.int64),
-            mean=np.concatenate([meas.z[new_j], boxes.velocity_mps[new_j]], axis=1),
-            cov=np.broadcast_to(self._birth_cov, (b, 4, 4)).copy(),
-            score=boxes.score[new_j],
-            z_m=boxes.translation_m[new_j, 2],
-            size_wlh_m=boxes.size_wlh_m[new_j],
-            quat_wxyz=boxes.quat_wxyz[new_j],
-            meas_index=meas.source_index[new_j],
-            logic=LogicState.born(b, self.params),
-        )
+    def _associate(self, prior: VectorTracks, gating: Gating, meas: Measurements, sink: EventSink) -> Association:
+        """Data association and state update of the K prior tracks with the M measurements, given their gate
+        (``gating``: innovations, (K, M) squared Mahalanobis distances and gate). Emits its own events."""
 
     def _extract(self, t: VectorTracks) -> list[TrackEstimate]:
-        sel = np.flatnonzero(t.logic.confirmed & (t.meas_index >= 0))
-        return [
-            TrackEstimate(
-                track_id=int(t.track_id[i]),
-                class_name=self.class_name,
-                translation_m=(float(t.mean[i, 0]), float(t.mean[i, 1]), float(t.z_m[i])),
-                size_wlh_m=tuple(float(v) for v in t.size_wlh_m[i]),
-                quat_wxyz=tuple(float(v) for v in t.quat_wxyz[i]),
-                velocity_mps=(float(t.mean[i, 2]), float(t.mean[i, 3])),
-                score=float(t.score[i]),
-                existence=1.0,
-                meas_index=int(t.meas_index[i]),
-            )
-            for i in sel.tolist()
-        ]
-
-    def _emit_prior(
-        self, prior: VectorTracks, inn: Innovation, inside: np.ndarray, meas: Measurements, sink: EventSink
-    ) -> None:
-        sink.emit(Predicted(self.class_name, prior.track_id, prior.mean, prior.cov, np.ones(len(prior))))
-        sink.emit(
-            Gated(
-                self.class_name,
-                track_ids=prior.track_id,
-                meas_indices=meas.source_index,
-                inside=inside,
-                center_xy=inn.z_pred,
-                innovation_cov=inn.S,
-                threshold=self.gate_chi2,
-            )
-        )
+        """The confirmed tracks hit this frame, scored by their detection; existence 1."""
+        sel = t.subset(np.flatnonzero(t.logic.confirmed & (t.meas_index >= 0)))
+        return sel.det.to_estimates(self.class_name, sel.track_id, sel.mean, sel.score, np.ones(len(sel)))

@@ -12,12 +12,13 @@ from pathlib import Path
 
 import pytest
 
-from cli.app import find_reports, main, parse_classes, parse_frames, prepare
+from cli.app import main
 from gnnpmb.config import TrackerConfig
 from gnnpmb.errors import DataError, GnnpmbError, UnknownNameError
 from gnnpmb.pipeline import run_tracker
 from gnnpmb.provenance import PACKAGES
 from gnnpmb.registry import TRACKER_NAMES
+from gnnpmb.session import find_reports, parse_classes, parse_frames, prepare
 from tests.viz.rrd import at_frame, read_rows
 from viz import paths
 from viz.provenance import PROPERTY_ENTITY, read_provenance

@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 import rerun as rr
 
-from cli.app import compare_runs, main, prepare
+from cli.app import main
 from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import Keyframe, Pose, SceneData
 from gnnpmb.pipeline import run_tracker
 from gnnpmb.provenance import Provenance, TrackDigest
+from gnnpmb.session import compare_runs, prepare
 from tests.gnnpmb.test_compare import A_FRAMES, B_FRAMES, GT
 from tests.viz.rrd import at_frame, read_rows
 from tests.viz.test_blueprint import stored_views
@@ -65,11 +66,10 @@ def expected(demo_dataroot: Path) -> Comparison:
     runs = [
         run_tracker(
             request.scene,
-            request.detections,
+            request.frame_detections,
             t,
             request.config,
             classes=request.classes,
-            frame_detections=request.frame_detections,
         )
         for t in TRACKERS
     ]

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from cli.app import find_reports, main, prepare, rerun_runs
+from cli.app import main
+from gnnpmb.session import find_reports, prepare, rerun_runs
 from tests.viz.rrd import read_rows
 from viz import paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world

@@ -31,7 +31,7 @@ def test_partial_override(tmp_path):
     path = tmp_path / "p.toml"
     path.write_text("[pmb]\np_survive = 0.9\n[classes.car]\nq_x = 0.5\n[pmbm]\nn_hypotheses = 10\n")
     cfg = load_config(path)
-    assert cfg.pmb.p_survive == 0.9 and cfg.pmb.gate_chi2 == 40.0
+    assert cfg.models.p_survive == 0.9 and cfg.models.gate_chi2 == 40.0
     assert cfg.classes["car"].q_x == 0.5 and cfg.classes["car"].r_x == PAPER_CLASS_PARAMS["car"].r_x
     assert cfg.pmbm.n_hypotheses == 10 and isinstance(cfg.pmbm.n_hypotheses, int)
 
@@ -99,7 +99,7 @@ def test_per_class_overrides_fall_back_to_the_section_values(tmp_path):
     )
     cfg = load_config(path)
     ped, car, bus = cfg.resolved("pedestrian"), cfg.resolved("car"), cfg.resolved("bus")
-    assert ped.pmb.birth_weight == 0.05 and car.pmb.birth_weight == 0.2 and bus.pmb.birth_weight == 0.2
+    assert ped.models.birth_weight == 0.05 and car.models.birth_weight == 0.2 and bus.models.birth_weight == 0.2
     assert ped.preprocess.score_threshold == 0.3 and car.preprocess.score_threshold == 0.1
     assert car.vector.p_detect == 0.8 and ped.vector.p_detect == 0.9 and car.phd.p_detect == 0.9
     assert cfg.preprocess_by_class()["pedestrian"].score_threshold == 0.3
@@ -126,12 +126,32 @@ def test_every_tracker_of_a_class_sees_its_overrides():
     from gnnpmb.types import IdAllocator
 
     cfg = with_params(TrackerConfig(), {"classes.pedestrian.gate_chi2": 9.0, "classes.pedestrian.max_age": 5})
-    assert make_class_tracker("gnnpmb", "pedestrian", cfg, IdAllocator()).params.gate_chi2 == 9.0
-    assert make_class_tracker("gnnpmb", "car", cfg, IdAllocator()).params.gate_chi2 == 40.0
+    assert make_class_tracker("gnnpmb", "pedestrian", cfg, IdAllocator()).models.gate_chi2 == 9.0
+    assert make_class_tracker("gnnpmb", "car", cfg, IdAllocator()).models.gate_chi2 == 40.0
     assert make_class_tracker("gnn", "pedestrian", cfg, IdAllocator()).gate_chi2 == 9.0
     assert make_class_tracker("greedy", "pedestrian", cfg, IdAllocator()).max_age == 5
 
 
 def test_paper_parameter_file_is_the_paper_config():
     assert load_config(DEFAULT_FILE.parent / "params" / "paper.toml") == paper_config()
-    assert paper_config().pmb.p_survive == 0.7 and paper_config().pmb.extraction_threshold == 0.9
+    assert paper_config().models.p_survive == 0.7 and paper_config().pmb.extraction_threshold == 0.9
+
+
+def test_model_keys_given_in_their_former_pmb_section_still_work(tmp_path):
+    path = tmp_path / "old.toml"
+    path.write_text("[pmb]\np_survive = 0.8\nextraction_threshold = 0.5\n[classes.car.pmb]\ngate_chi2 = 12.0\n")
+    cfg = load_config(path)
+    assert cfg.models.p_survive == 0.8 and cfg.pmb.extraction_threshold == 0.5
+    assert cfg.resolved("car").models.gate_chi2 == 12.0 and cfg.resolved("bus").models.gate_chi2 == 40.0
+    assert get_param(cfg, "pmb.p_survive") == 0.8 and get_param(cfg, "classes.car.pmb.gate_chi2") == 12.0
+    assert with_params(TrackerConfig(), {"pmb.birth_weight": 0.2}).models.birth_weight == 0.2
+
+
+def test_a_model_key_given_in_both_sections_is_an_error_naming_it(tmp_path):
+    path = tmp_path / "both.toml"
+    path.write_text("[models]\np_survive = 0.8\n[pmb]\np_survive = 0.9\n")
+    with pytest.raises(ConfigError, match=r"\[pmb\] p_survive and \[models\] p_survive are the same parameter"):
+        load_config(path)
+    path.write_text("[models]\np_survive = 1.5\n")
+    with pytest.raises(ConfigError, match=r"\[models\] p_survive must be in \(0, 1\], got 1.5"):
+        load_config(path)

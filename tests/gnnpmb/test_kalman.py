@@ -2,7 +2,17 @@ import numpy as np
 
 from gnnpmb.config import ClassParams
 from gnnpmb.gating import ellipse_outline, gate
-from gnnpmb.kalman import cv_model, innovation, log_likelihood, mahalanobis2, predict, updated_means
+from gnnpmb.kalman import (
+    innovation,
+    log_likelihood,
+    mahalanobis2,
+    paired_mahalanobis2,
+    paired_residuals,
+    paired_updated_means,
+    predict,
+    updated_means,
+)
+from gnnpmb.models import cv_model
 
 PARAMS = ClassParams(0.1, 0.2, 0.3, 0.4)
 
@@ -46,6 +56,21 @@ def test_update_matches_textbook_and_stays_spd():
             assert abs(d2[k, j] - d) < 1e-10
             expect = -0.5 * d - np.log(2 * np.pi) - 0.5 * np.log(np.linalg.det(S))
             assert abs(ll[k, j] - expect) < 1e-10
+
+
+def test_paired_formulas_equal_the_all_pairs_ones():
+    rng = np.random.default_rng(2)
+    m, P = rng.normal(size=(3, 4)), random_spd(rng, 4, 3)
+    z = rng.normal(size=(4, 2))
+    inn = innovation(m, P, np.diag([0.3, 0.4]))
+    k_idx, j_idx = np.array([2, 0, 1, 2]), np.array([0, 3, 1, 1])
+    np.testing.assert_allclose(
+        paired_updated_means(m, inn, z, k_idx, j_idx), updated_means(m, inn, z)[k_idx, j_idx], atol=1e-12
+    )
+    nu = paired_residuals(inn, z, k_idx, j_idx)
+    np.testing.assert_allclose(
+        paired_mahalanobis2(inn.S_inv[k_idx], nu), mahalanobis2(inn, z)[k_idx, j_idx], atol=1e-12
+    )
 
 
 def test_gate_and_ellipse_boundary():

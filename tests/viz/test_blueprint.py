@@ -123,3 +123,17 @@ def test_blueprint_is_accepted_in_strict_mode_and_saved(tmp_path: Path, strict: 
         if row.get("TimePanelBlueprint:timeline")
     ]
     assert panel[0]["TimePanelBlueprint:timeline"] == ["frame"]  # paused: opens at the first frame
+
+
+def test_the_viewer_names_no_tracker_and_lays_out_the_panels_each_declares() -> None:
+    from pathlib import Path
+
+    import viz.blueprint
+    from gnnpmb.events import Panel
+    from gnnpmb.registry import TRACKER_NAMES, tracker_panels
+
+    source = Path(viz.blueprint.__file__).read_text()
+    assert not [name for name in TRACKER_NAMES if f'"{name}"' in source]
+    assert tracker_panels("cphd") == (Panel.CARDINALITY, Panel.INTENSITY)
+    assert tracker_panels("pmbm") == (Panel.HYPOTHESES,) and tracker_panels("gnnpmb") == ()
+    assert set(viz.blueprint.PANEL_VIEWS) == set(Panel)

@@ -208,7 +208,7 @@ def test_dense_frame_runs_and_stays_a_distribution():
 
 def test_zero_clutter_is_rejected_before_the_cphd_sees_it():
     with pytest.raises(ConfigError, match="clutter_intensity"):
-        CphdTracker("car", CFG.replace(pmb=dataclasses.replace(CFG.pmb, clutter_intensity=0.0)), IdAllocator())
+        CphdTracker("car", CFG.replace(models=dataclasses.replace(CFG.models, clutter_intensity=0.0)), IdAllocator())
 
 
 def test_leave_one_out_contraction_equals_the_expanded_sum():

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from gnnpmb.config import ConfigError, PhdParams, TrackerConfig, paper_config
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     Born,
     Extracted,
@@ -27,7 +28,7 @@ from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-P = CFG.pmb
+P = CFG.models
 PD = CFG.phd.p_detect
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
@@ -49,19 +50,21 @@ def one_component(weight: float, mean, cov, label: int = 5) -> GaussianMixture:
         mean=np.asarray(mean, dtype=float)[None],
         cov=np.asarray(cov, dtype=float)[None],
         label=np.array([label], dtype=np.int64),
-        score=np.array([0.7]),
-        z_m=np.array([0.5]),
-        size_wlh_m=np.array([[1.0, 2.0, 1.0]]),
-        quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
-        meas_index=np.array([-1]),
+        det=DetectionFields(
+            score=np.array([0.7]),
+            z_m=np.array([0.5]),
+            size_wlh_m=np.array([[1.0, 2.0, 1.0]]),
+            quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
+            meas_index=np.array([-1]),
+        ),
     )
 
 
-def raw_config(**pmb) -> TrackerConfig:
+def raw_config(**models) -> TrackerConfig:
     """No pruning and no merging, so every component of the update stays visible."""
     return CFG.replace(
         phd=dataclasses.replace(CFG.phd, prune_weight=0.0, merge_threshold=0.0),
-        pmb=dataclasses.replace(CFG.pmb, **pmb),
+        models=dataclasses.replace(CFG.models, **models),
     )
 
 

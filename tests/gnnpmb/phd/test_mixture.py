@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import PruneReason
 from gnnpmb.phd.mixture import (
     GaussianMixture,
@@ -25,11 +26,13 @@ def make_mixture(weights, means, covs=None, labels=None) -> GaussianMixture:
         mean=means,
         cov=covs,
         label=np.arange(1, k + 1, dtype=np.int64) if labels is None else np.asarray(labels, dtype=np.int64),
-        score=np.linspace(0.5, 0.9, k),
-        z_m=np.arange(k, dtype=float),
-        size_wlh_m=np.tile([2.0, 4.5, 1.6], (k, 1)),
-        quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (k, 1)),
-        meas_index=np.arange(k, dtype=np.int64),
+        det=DetectionFields(
+            score=np.linspace(0.5, 0.9, k),
+            z_m=np.arange(k, dtype=float),
+            size_wlh_m=np.tile([2.0, 4.5, 1.6], (k, 1)),
+            quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (k, 1)),
+            meas_index=np.arange(k, dtype=np.int64),
+        ),
     )
 
 
@@ -119,11 +122,13 @@ def test_reduce_reports_labels_that_vanished_with_their_heaviest_removed_compone
         mean=np.vstack([mix.mean, [[40.0, 0, 0, 0]]]),
         cov=np.concatenate([mix.cov, np.eye(4)[None]]),
         label=np.append(mix.label, 4),
-        score=np.append(mix.score, 0.5),
-        z_m=np.append(mix.z_m, 0.0),
-        size_wlh_m=np.vstack([mix.size_wlh_m, [[1.0, 1.0, 1.0]]]),
-        quat_wxyz=np.vstack([mix.quat_wxyz, [[1.0, 0, 0, 0]]]),
-        meas_index=np.append(mix.meas_index, -1),
+        det=DetectionFields(
+            score=np.append(mix.score, 0.5),
+            z_m=np.append(mix.z_m, 0.0),
+            size_wlh_m=np.vstack([mix.size_wlh_m, [[1.0, 1.0, 1.0]]]),
+            quat_wxyz=np.vstack([mix.quat_wxyz, [[1.0, 0, 0, 0]]]),
+            meas_index=np.append(mix.meas_index, -1),
+        ),
     )
     red = reduce_mixture(mix, prune_weight=1e-5, merge_threshold=4.0, max_components=3)
     assert np.all(np.diff(red.mixture.weight) <= 0)

@@ -8,12 +8,12 @@ import pytest
 from gnnpmb.config import TrackerConfig, paper_config
 from gnnpmb.events import Assignment, AxisKind, Born, CostMatrix, Gated, ListSink, NullSink, Pruned
 from gnnpmb.pmb.core import PmbCore
-from gnnpmb.pmb.strategy import BestAssignment
+from gnnpmb.pmb.gnnpmb import BestAssignment
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-P = CFG.pmb
+P = CFG.models
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
 Q = np.diag([CAR.q_x, CAR.q_y, CAR.q_x, CAR.q_y])
@@ -47,7 +47,7 @@ def test_first_detection_starts_bernoulli_with_hand_computed_existence():
     assert b.existence[0] == pytest.approx(r, rel=1e-12)
     np.testing.assert_allclose(b.mean[0], mean, atol=1e-12)
     np.testing.assert_allclose(b.cov[0], cov, atol=1e-9)
-    assert r < P.extraction_threshold and est == []
+    assert r < CFG.pmb.extraction_threshold and est == []
 
 
 def test_with_the_defaults_a_new_bernoulli_is_reported_at_once_scored_score_times_existence():
@@ -144,7 +144,7 @@ def test_pruning_reports_low_existence():
         core.step(make_measurements([]), 0.5, sink)
     pruned = sink.of_type(Pruned)
     assert [p.track_id for p in pruned] == [1]
-    assert pruned[0].last_existence < P.prune_existence
+    assert pruned[0].last_existence < CFG.pmb.prune_existence
     assert len(core.hypotheses[0].bernoullis) == 0
 
 

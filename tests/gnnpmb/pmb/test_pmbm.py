@@ -14,16 +14,17 @@ from scipy.special import logsumexp
 from gnnpmb.assign import murty
 from gnnpmb.assign.murty import k_best
 from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig, paper_config
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses, ListSink, NullSink, Pruned, PruneReason
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext, posterior_from_assignment
+from gnnpmb.pmb.gnnpmb import BestAssignment
 from gnnpmb.pmb.pmbm import KBest, SharedRanking, hypothesis_budget
-from gnnpmb.pmb.strategy import BestAssignment
 from gnnpmb.types import IdAllocator, Measurements
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-P = CFG.pmb
+P = CFG.models
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
 Q = np.diag([CAR.q_x, CAR.q_y, CAR.q_x, CAR.q_y])
@@ -41,11 +42,13 @@ def one_track(score: float = 0.9, pos_var: float = 0.1, vel_var: float = 0.5) ->
         existence=np.array([1.0]),
         mean=np.zeros((1, 4)),
         cov=np.diag([pos_var, pos_var, vel_var, vel_var])[None],
-        score=np.array([score]),
-        z_m=np.array([1.0]),
-        size_wlh_m=np.array([[2.0, 4.5, 1.6]]),
-        quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
-        meas_index=np.array([-1]),
+        det=DetectionFields(
+            score=np.array([score]),
+            z_m=np.array([1.0]),
+            size_wlh_m=np.array([[2.0, 4.5, 1.6]]),
+            quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
+            meas_index=np.array([-1]),
+        ),
     )
 
 
@@ -121,8 +124,8 @@ def test_n_h_one_equals_gnnpmb_on_a_demo_scene(demo_dataroot):
     detections = get_detections(scene, None, "centerpoint", seed=0)
     config = CFG.replace(pmbm=PmbmParams(n_hypotheses=1))
     frames = preprocess_frames(scene, detections, config, TRACKING_CLASSES)
-    a = run_tracker(scene, detections, "pmbm", config, frame_detections=frames)
-    b = run_tracker(scene, detections, "gnnpmb", config, frame_detections=frames)
+    a = run_tracker(scene, frames, "pmbm", config)
+    b = run_tracker(scene, frames, "gnnpmb", config)
     assert sum(len(f.estimates) for f in b.frames) > 0
     assert [f.estimates for f in a.frames] == [f.estimates for f in b.frames]
 

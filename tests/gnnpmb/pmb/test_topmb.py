@@ -7,18 +7,20 @@ import pytest
 
 from gnnpmb.assign.exact_marginals import exact_marginals_log
 from gnnpmb.config import TrackerConfig, paper_config
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import Assignment, AxisKind, ListSink, Marginals, Merged, NullSink, Posterior
+from gnnpmb.models import measurement_birth
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext
 from gnnpmb.pmb.cost import local_hypotheses
-from gnnpmb.pmb.poisson import measurement_birth, new_track_hypotheses
-from gnnpmb.pmb.strategy import BestAssignment
-from gnnpmb.pmb.topmb import Marginals as TopmbMarginals
+from gnnpmb.pmb.gnnpmb import BestAssignment
+from gnnpmb.pmb.poisson import new_track_hypotheses
+from gnnpmb.pmb.topmb import MarginalMerge as TopmbMarginals
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-P = CFG.pmb
+P = CFG.models
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
 
@@ -35,15 +37,17 @@ def make_prior(means, existence, cov_diag=(0.5, 0.5, 1.0, 1.0), score=0.8) -> Be
         existence=np.asarray(existence, dtype=float),
         mean=np.asarray(means, dtype=float).reshape(k, 4),
         cov=np.tile(np.diag(cov_diag), (k, 1, 1)),
-        score=np.full(k, score),
-        z_m=np.zeros(k),
-        size_wlh_m=np.ones((k, 3)),
-        quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (k, 1)),
-        meas_index=np.full(k, -1),
+        det=DetectionFields(
+            score=np.full(k, score),
+            z_m=np.zeros(k),
+            size_wlh_m=np.ones((k, 3)),
+            quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (k, 1)),
+            meas_index=np.full(k, -1),
+        ),
     )
 
 
-def run_update(prior: Bernoullis, xy, score=0.7, strategy=None, sink=None, prune_existence=P.prune_existence):
+def run_update(prior: Bernoullis, xy, score=0.7, strategy=None, sink=None, prune_existence=CFG.pmb.prune_existence):
     """One strategy update of ``prior`` with car measurements at ``xy``; ids continue after the prior's."""
     meas = make_measurements(xy, score)
     new = new_track_hypotheses(measurement_birth(meas, P), meas, R, P.clutter_intensity)

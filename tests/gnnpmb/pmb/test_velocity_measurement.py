@@ -8,9 +8,10 @@ import pytest
 
 from gnnpmb.config import TrackerConfig, with_params
 from gnnpmb.events import Gated, ListSink, NullSink
-from gnnpmb.kalman import _innovation_general, cv_model, innovation
+from gnnpmb.kalman import _innovation_general, innovation
+from gnnpmb.models import cv_model
 from gnnpmb.pmb.core import PmbCore
-from gnnpmb.pmb.strategy import BestAssignment
+from gnnpmb.pmb.gnnpmb import BestAssignment
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
@@ -18,7 +19,7 @@ CFG = with_params(
     TrackerConfig(),
     {"pmb.measure_velocity": 1, "pmb.birth_weight": 50.0, "classes.car.r_vx": 0.3, "classes.car.r_vy": 0.4},
 )
-P = CFG.pmb
+P = CFG.models
 CAR = CFG.for_class("car")
 R4 = np.diag([CAR.r_x, CAR.r_y, 0.3, 0.4])
 
@@ -46,7 +47,7 @@ def test_birth_then_update_with_velocity_measurement_match_hand_computation():
     Pb = np.diag([P.birth_pos_std_m**2] * 2 + [P.birth_vel_std_mps**2] * 2)
     lik = P.birth_weight * s1 * gauss(np.zeros(4), Pb + R4)
     b = core.hypotheses[0].bernoullis
-    clutter = P.clutter_intensity * P.clutter_velocity_density  # per m^2 per (m/s)^2
+    clutter = P.clutter_intensity * CFG.pmb.clutter_velocity_density  # per m^2 per (m/s)^2
     assert b.existence[0] == pytest.approx(lik / (clutter + lik), rel=1e-9)
     K = Pb @ np.linalg.inv(Pb + R4)
     cov1 = (np.eye(4) - K) @ Pb

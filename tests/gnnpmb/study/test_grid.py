@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from gnnpmb.config import PmbParams, TrackerConfig
+from gnnpmb.config import ModelParams, TrackerConfig
 from gnnpmb.study.grid import (
     StudyError,
     base_value,
@@ -64,7 +64,7 @@ def test_configurations_go_through_the_config_loader() -> None:
     base = {"pmb": {"p_survive": 0.8}, "classes": {"car": {"r_x": 0.5}}}
     toml = config_toml(base, (("pmb.gate_chi2", 20), ("*.q_x", 0.3)))
     config = build_config(toml)
-    assert config.pmb.gate_chi2 == 20.0 and config.pmb.p_survive == 0.8
+    assert config.models.gate_chi2 == 20.0 and config.models.p_survive == 0.8
     assert {config.classes[c].q_x for c in TRACKING_CLASSES} == {0.3}
     assert config.classes["car"].r_x == 0.5 and config.classes["bus"].r_x == TrackerConfig().classes["bus"].r_x
     assert base == {"pmb": {"p_survive": 0.8}, "classes": {"car": {"r_x": 0.5}}}
@@ -76,7 +76,7 @@ def test_configurations_go_through_the_config_loader() -> None:
 
 def test_base_values() -> None:
     config = TrackerConfig()
-    assert base_value(config, "pmb.birth_weight") == PmbParams().birth_weight
+    assert base_value(config, "pmb.birth_weight") == ModelParams().birth_weight
     assert base_value(config, "car.q_x") == 0.1589
     assert base_value(config, "*.q_x") is None  # differs between classes
     assert base_value(config, "pmb.no_such_key") is None

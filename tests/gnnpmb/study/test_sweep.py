@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from gnnpmb.config import PmbParams
+from gnnpmb.config import ModelParams
 from gnnpmb.data.nuscenes import resolve_dataroot
 from gnnpmb.study.cache import ResultCache
 from gnnpmb.study.data import resolve_study_data
@@ -42,7 +42,7 @@ def test_one_at_a_time_plan_starts_with_the_base(tiny_dataroot: Path) -> None:
         "gnnpmb", data, {}, [parse_param("pmb.birth_weight=0.05"), parse_param("preprocess.nms_iou_3d=0.2")], True
     )
     assert plan.assignments == ((), (("pmb.birth_weight", 0.05),), (("preprocess.nms_iou_3d", 0.2),))
-    assert plan.base_values == {"pmb.birth_weight": PmbParams().birth_weight, "preprocess.nms_iou_3d": 0.1}
+    assert plan.base_values == {"pmb.birth_weight": ModelParams().birth_weight, "preprocess.nms_iou_3d": 0.1}
     with pytest.raises(Exception, match="unknown parameter"):
         plan_sweep("gnnpmb", data, {}, [parse_param("pmb.nope=1")], True)
 

@@ -62,6 +62,6 @@ def test_written_params_load_back(tmp_path: Path) -> None:
     path = tmp_path / "p.toml"
     write_params(path, toml, ["x"])
     config = load_config(path)
-    assert config.pmb.gate_chi2 == 30.0 and config.classes["car"].q_x == 0.25 and config.classes["car"].r_y == 0.125
+    assert config.models.gate_chi2 == 30.0 and config.classes["car"].q_x == 0.25 and config.classes["car"].r_y == 0.125
     with pytest.raises(StudyError):
         dump_toml({"pmb": {"gate_chi2": [1, 2]}})

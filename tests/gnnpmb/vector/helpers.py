@@ -7,7 +7,7 @@ import numpy as np
 from gnnpmb.config import paper_config
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-V, P = CFG.vector, CFG.pmb
+V, P = CFG.vector, CFG.models
 CAR = CFG.for_class("car")
 R = np.diag([CAR.r_x, CAR.r_y])
 Q = np.diag([CAR.q_x, CAR.q_y, CAR.q_x, CAR.q_y])

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gnnpmb.vector.clusters import gate_clusters
+from gnnpmb.assign.clusters import gate_clusters
 
 
 def as_lists(clusters):

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from cli.serve import ServeTarget, check_display
 from gnnpmb.errors import GnnpmbError
+from gnnpmb.serve import ServeTarget, check_display
 
 BIN = Path(sys.executable).parent
 

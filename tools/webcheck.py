@@ -11,7 +11,7 @@ varied, non-background pixels (LiDAR points, coloured boxes) in two shots in a r
 enough: panels can still be empty while the 3D views look finished. Both servers run in their own process
 groups and are killed (group-wide) on every exit path.
 
-By hand: ``uv run python -m viz.webcheck FILE.rrd --out shot.png [--views 2]``.
+By hand: ``uv run python -m tools.webcheck FILE.rrd --out shot.png [--views 2]``.
 """
 
 from __future__ import annotations
@@ -552,7 +552,7 @@ def _write_atomic(path: Path, data: bytes) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m viz.webcheck",
+        prog="python -m tools.webcheck",
         description="Open a saved .rrd in Rerun's web viewer in headless Chromium; screenshot its 3D views.",
     )
     parser.add_argument("rrd", type=Path, help="the recording (.rrd)")

@@ -1,0 +1,121 @@
+"""The detection box fields a track carries: what every tracker copies from its associated detection.
+
+Only x, y (and vx, vy) are filtered; z, size, rotation and the score pass through from the detection that last
+updated a track (paper sec. V-B), and ``meas_index`` names that detection for the viewer. Bernoullis, Gaussian
+mixture components and vector tracks all hold one ``DetectionFields`` (their field ``det``), so the copy from
+detections to tracks and from tracks to ``TrackEstimate`` is written once, here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gnnpmb.soa import StructOfArrays
+from gnnpmb.types import Measurements, TrackEstimate
+
+
+@dataclass(frozen=True, slots=True)
+class DetectionFields(StructOfArrays):
+    """K items' detection fields, struct-of-arrays.
+
+    score: (K,) score of the detection; z_m: (K,) its box centre's height; size_wlh_m: (K, 3); quat_wxyz: (K, 4);
+    meas_index: (K,) its source index (``Measurements.source_index``) if it updated the item this frame, else -1.
+    """
+
+    score: np.ndarray
+    z_m: np.ndarray
+    size_wlh_m: np.ndarray
+    quat_wxyz: np.ndarray
+    meas_index: np.ndarray
+
+    @staticmethod
+    def empty() -> DetectionFields:
+        return DetectionFields(
+            score=np.zeros(0),
+            z_m=np.zeros(0),
+            size_wlh_m=np.zeros((0, 3)),
+            quat_wxyz=np.zeros((0, 4)),
+            meas_index=np.zeros(0, dtype=np.int64),
+        )
+
+    @staticmethod
+    def from_measurements(meas: Measurements, index: np.ndarray) -> DetectionFields:
+        """The fields of the measurements ``index`` (local indices into ``meas``), in that order."""
+        boxes = meas.boxes
+        return DetectionFields(
+            score=np.asarray(boxes.score[index], dtype=float),
+            z_m=np.asarray(boxes.translation_m[index, 2], dtype=float),
+            size_wlh_m=np.asarray(boxes.size_wlh_m[index], dtype=float),
+            quat_wxyz=np.asarray(boxes.quat_wxyz[index], dtype=float),
+            meas_index=np.asarray(meas.source_index, dtype=np.int64)[index],
+        )
+
+    def undetected(self) -> DetectionFields:
+        """The same fields with no detection this frame (``meas_index`` -1): after a prediction."""
+        return DetectionFields(
+            score=self.score,
+            z_m=self.z_m,
+            size_wlh_m=self.size_wlh_m,
+            quat_wxyz=self.quat_wxyz,
+            meas_index=np.full(len(self), -1, dtype=np.int64),
+        )
+
+    def take(self, rows: np.ndarray, detected: DetectionFields) -> DetectionFields:
+        """A copy in which items ``rows`` take the fields of ``detected`` (one per row, in order): the items
+        associated with a detection this frame; the other items keep theirs."""
+        out = {name: getattr(self, name).copy() for name in _FIELDS}
+        for name in _FIELDS:
+            out[name][rows] = getattr(detected, name)
+        return DetectionFields(**out)
+
+    def to_estimates(
+        self,
+        class_name: str,
+        track_id: np.ndarray,
+        mean: np.ndarray,
+        score: np.ndarray,
+        existence: np.ndarray,
+    ) -> list[TrackEstimate]:
+        """One ``TrackEstimate`` per item: x, y, vx, vy from ``mean`` (K, 4), z, size, rotation and meas_index from
+        these fields; ``track_id``, ``score`` and ``existence`` (K,) are the tracker's."""
+        return [
+            TrackEstimate(
+                track_id=int(track_id[i]),
+                class_name=class_name,
+                translation_m=(float(mean[i, 0]), float(mean[i, 1]), float(self.z_m[i])),
+                size_wlh_m=tuple(float(v) for v in self.size_wlh_m[i]),
+                quat_wxyz=tuple(float(v) for v in self.quat_wxyz[i]),
+                velocity_mps=(float(mean[i, 2]), float(mean[i, 3])),
+                score=float(score[i]),
+                existence=float(existence[i]),
+                meas_index=int(self.meas_index[i]),
+            )
+            for i in range(len(self))
+        ]
+
+
+_FIELDS: tuple[str, ...] = ("score", "z_m", "size_wlh_m", "quat_wxyz", "meas_index")
+
+
+class _ReadThrough:
+    """Descriptor: ``obj.<name>`` reads ``obj.det.<name>``."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, obj: CarriesDetectionFields, owner: type | None = None) -> np.ndarray:
+        return getattr(obj.det, self.name)
+
+
+class CarriesDetectionFields:
+    """Mixin for a struct-of-arrays with a ``det: DetectionFields`` field: its fields read as the item's own."""
+
+    __slots__ = ()
+    det: DetectionFields
+    score = _ReadThrough()
+    z_m = _ReadThrough()
+    size_wlh_m = _ReadThrough()
+    quat_wxyz = _ReadThrough()
+    meas_index = _ReadThrough()
