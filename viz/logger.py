@@ -480,7 +480,7 @@ class TrackerLogger:
         if gated is not None:
             gids = np.asarray(gated.track_ids, dtype=np.int64)
             lookup = dict(zip(ids.tolist(), worthy.tolist(), strict=True))  # focused tracks count as worthy
-            drawn = np.array([lookup.get(int(t), True) for t in gids], dtype=bool)
+            drawn = np.array([lookup.get(t, True) for t in gids.tolist()], dtype=bool)
             if drawn.any():
                 outline = ellipse_outline(
                     np.asarray(gated.center_xy, dtype=np.float64)[drawn],
@@ -857,8 +857,8 @@ def _pair_cost_lookup(matrix: CostMatrix | None) -> Callable[[int, int], float]:
     cost = np.asarray(matrix.cost, dtype=np.float64)
     if cost.size == 0:
         return lambda m, t: math.nan
-    row_of = {int(label.ref): i for i, label in enumerate(matrix.rows)}
-    col_of = {int(label.ref): j for j, label in enumerate(matrix.cols) if label.kind is AxisKind.TRACK}
+    row_of = {label.ref: i for i, label in enumerate(matrix.rows)}
+    col_of = {label.ref: j for j, label in enumerate(matrix.cols) if label.kind is AxisKind.TRACK}
 
     def cost_of(m: int, t: int) -> float:
         i, j = row_of.get(m), col_of.get(t)
