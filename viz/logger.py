@@ -634,6 +634,9 @@ class TrackerLogger:
         ids = np.array([e.track_id for e in estimates], dtype=np.int64)
         cids = class_ids(np.array([e.class_name for e in estimates], dtype=object))
         colors = packed_track_colors(ids)
+        half_sizes = 0.5 * boxes.sizes_xyz_m
+        box_radius = np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32)  # rows are copied when sent: shareable
+        trail_radius = np.full(1, TRAIL_RADIUS_M, dtype=np.float32)
         self._extracted_ids.update(shown)
         for k, e in enumerate(estimates):
             path = paths.track(self.tracker, class_name, e.track_id)
@@ -642,12 +645,12 @@ class TrackerLogger:
                 rr.Boxes3D,
                 1,
                 centers=boxes.centers_m[k : k + 1],
-                half_sizes=0.5 * boxes.sizes_xyz_m[k : k + 1],
+                half_sizes=half_sizes[k : k + 1],
                 quaternions=boxes.quat_xyzw[k : k + 1],
                 colors=colors[k : k + 1],
                 class_ids=cids[k : k + 1],
                 labels=[str(e.track_id)],
-                radii=np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32),
+                radii=box_radius,
             )
             trail = list(self._trails.get(e.track_id, ()))
             if len(trail) >= 2:
@@ -657,7 +660,7 @@ class TrackerLogger:
                     1,
                     strips=[np.array(trail)],
                     colors=colors[k : k + 1],
-                    radii=np.full(1, TRAIL_RADIUS_M, dtype=np.float32),
+                    radii=trail_radius,
                 )
 
     # The story log.
