@@ -1,11 +1,12 @@
 """Tracker alone vs tracker + Rerun logger, per frame, on the same demo frames (issue: logging overhead <= 1.5x).
 
-Each tracker runs over a demo scene three times without a sink, three times with a ``ListSink`` (the events
-are built, nothing is drawn: what the tracker itself pays for being watched) and three times with a
-``TrackerLogger`` writing a recording to a temp file (opening, ``finish`` and closing included), the way
-``gnnpmb-viz --save`` does (rows sent at the end; ``--live``: every ``FLUSH_FRAMES`` frames, as for a viewer).
-The best of three wall times per mode is printed as ms per frame with the ratios to the tracker alone, plus the
-recording's chunk count.
+Each tracker runs over a demo scene without a sink, with a ``ListSink`` (the events are built, nothing is
+drawn: what the tracker itself pays for being watched) and with a ``TrackerLogger`` writing a recording to a temp
+file (opening, ``finish`` and closing included), the way ``gnnpmb-viz --save`` does (rows sent at the end;
+``--live``: every ``FLUSH_FRAMES`` frames, as for a viewer), the three modes interleaved, three times. The best
+wall time and the best CPU time of the process (all threads: Rerun's writer too; the fairer figure on a shared
+machine) per mode are printed as ms per frame with the ratios to the tracker alone, plus the recording's chunk
+count.
 
     uv run python benchmarks/logging_overhead.py [--scene scene-0103] [--detector centerpoint] [--tracker gnnpmb]
         [--live]
@@ -16,6 +17,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 from rerun.chunk import RrdReader
@@ -30,27 +32,35 @@ from viz.logger import FLUSH_FRAMES, TrackerLogger
 from viz.recording import close_recording, open_recording
 
 
+@dataclass(frozen=True, slots=True)
+class Timing:
+    """Seconds of one run: wall clock and CPU of this process (all its threads, Rerun's writer included)."""
+
+    wall_s: float
+    cpu_s: float
+
+    @staticmethod
+    def best(runs: list[Timing]) -> Timing:
+        return Timing(min(r.wall_s for r in runs), min(r.cpu_s for r in runs))
+
+
 def timed_run(
-    scene, detections, frames, tracker: str, config: TrackerConfig, out: Path | None, flush_frames: int | None
-) -> float:
-    """Wall seconds of one run; with ``out`` the run logs into a recording saved there."""
-    start = time.perf_counter()
-    if out is None:
+    scene, detections, frames, tracker: str, config: TrackerConfig, mode: str, out: Path, flush_frames: int | None
+) -> Timing:
+    """One run: ``alone`` (no sink), ``events`` (``ListSink``: built, not drawn) or ``logger`` (a recording
+    saved to ``out``, opening, ``finish`` and closing included)."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    if mode == "alone":
         run_tracker(scene, detections, tracker, config, frame_detections=frames)
-        return time.perf_counter() - start
-    stream = open_recording("bench", out, None)
-    logger = TrackerLogger(stream, tracker, flush_frames=flush_frames)
-    run_tracker(scene, detections, tracker, config, sink=logger, frame_detections=frames)
-    logger.finish()
-    close_recording(stream, out)
-    return time.perf_counter() - start
-
-
-def events_run(scene, detections, frames, tracker: str, config: TrackerConfig) -> float:
-    """Wall seconds of one run whose events are built and kept (``ListSink``), not drawn."""
-    start = time.perf_counter()
-    run_tracker(scene, detections, tracker, config, sink=ListSink(), frame_detections=frames)
-    return time.perf_counter() - start
+    elif mode == "events":
+        run_tracker(scene, detections, tracker, config, sink=ListSink(), frame_detections=frames)
+    else:
+        stream = open_recording("bench", out, None)
+        logger = TrackerLogger(stream, tracker, flush_frames=flush_frames)
+        run_tracker(scene, detections, tracker, config, sink=logger, frame_detections=frames)
+        logger.finish()
+        close_recording(stream, out)
+    return Timing(time.perf_counter() - wall, time.process_time() - cpu)
 
 
 def main() -> None:
@@ -70,23 +80,31 @@ def main() -> None:
     n = len(scene.keyframes)
     flush_frames = FLUSH_FRAMES if args.live else None
     mode = f"rows sent every {FLUSH_FRAMES} frames (live)" if args.live else "rows sent at the end (--save)"
-    print(f"{args.scene}, {args.detector}, {n} frames, best of {args.repeats}, {mode}")
-    print(
-        f"{'tracker':8} {'alone ms/frame':>15} {'+ events ms/frame':>18} {'ratio':>6} "
-        f"{'+ logger ms/frame':>18} {'ratio':>6} {'chunks':>7}"
-    )
+    print(f"{args.scene}, {args.detector}, {n} frames, best of {args.repeats} (runs interleaved), {mode}")
+    print("ms per frame, wall clock / CPU time of the process; ratios to the tracker alone")
+    print(f"{'tracker':8} {'alone':>13} {'+ events':>13} {'ratio':>11} {'+ logger':>13} {'ratio':>11} {'chunks':>7}")
+    modes = ("alone", "events", "logger")
     with tempfile.TemporaryDirectory() as tmp:
         for tracker in args.tracker or ["gnnpmb", "pmbm", "gnn"]:
             out = Path(tmp) / f"{tracker}.rrd"
-            repeats = range(args.repeats)
-            alone = min(timed_run(scene, detections, frames, tracker, config, None, None) for _ in repeats)
-            events = min(events_run(scene, detections, frames, tracker, config) for _ in repeats)
-            logged = min(timed_run(scene, detections, frames, tracker, config, out, flush_frames) for _ in repeats)
+            runs: dict[str, list[Timing]] = {m: [] for m in modes}
+            for _ in range(args.repeats):  # interleaved, so a change of load hits every mode alike
+                for m in modes:
+                    runs[m].append(timed_run(scene, detections, frames, tracker, config, m, out, flush_frames))
+            alone, events, logged = (Timing.best(runs[m]) for m in modes)
             chunks = sum(1 for _ in RrdReader(out).store().stream())
             print(
-                f"{tracker:8} {1000 * alone / n:15.2f} {1000 * events / n:18.2f} {events / alone:6.2f} "
-                f"{1000 * logged / n:18.2f} {logged / alone:6.2f} {chunks:7d}"
+                f"{tracker:8} {_ms(alone, n)} {_ms(events, n)} {_ratio(events, alone)} {_ms(logged, n)} "
+                f"{_ratio(logged, alone)} {chunks:7d}"
             )
+
+
+def _ms(t: Timing, n_frames: int) -> str:
+    return f"{1000 * t.wall_s / n_frames:6.2f}/{1000 * t.cpu_s / n_frames:6.2f}"
+
+
+def _ratio(t: Timing, alone: Timing) -> str:
+    return f"{t.wall_s / alone.wall_s:5.2f}/{t.cpu_s / alone.cpu_s:5.2f}"
 
 
 if __name__ == "__main__":
