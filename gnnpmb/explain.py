@@ -132,15 +132,19 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
         or any(c.kind is not AxisKind.NEW_TRACK for c in matrix.cols[n_tracks:])
     ):
         return None
-    # Index by ref, one map per kind: hashing AxisLabels (dataclasses holding an enum) costs more than the rest.
+    # Index by ref, one map per kind: hashing AxisLabels (dataclasses holding an enum, whose hash is Python code)
+    # costs more than the rest.
     row_of = {label.ref: i for i, label in enumerate(matrix.rows)}
-    col_of = {
-        AxisKind.TRACK: {label.ref: j for j, label in enumerate(matrix.cols[:n_tracks])},
-        AxisKind.NEW_TRACK: {label.ref: j for j, label in enumerate(matrix.cols[n_tracks:], n_tracks)},
-    }
+    track_col_of = {label.ref: j for j, label in enumerate(matrix.cols[:n_tracks])}
+    new_col_of = {label.ref: j for j, label in enumerate(matrix.cols[n_tracks:], n_tracks)}
     chosen = np.full(n_rows, -1, dtype=np.int64)
     for row_label, col_label in assignment.pairs:
-        cols_of_kind = col_of.get(col_label.kind, {})
+        if col_label.kind is AxisKind.TRACK:
+            cols_of_kind = track_col_of
+        elif col_label.kind is AxisKind.NEW_TRACK:
+            cols_of_kind = new_col_of
+        else:
+            return None
         if row_label.kind is not AxisKind.MEASUREMENT or row_label.ref not in row_of:
             return None
         if col_label.ref not in cols_of_kind:

@@ -233,8 +233,8 @@ def decision_grid(
         m = matrices[class_name]
         cost = np.asarray(m.cost, dtype=np.float64)
         row_of = {label.ref: i for i, label in enumerate(m.rows)}
-        col_of = {(label.kind, label.ref): j for j, label in enumerate(m.cols)}
-        picked = {(c.meas.ref, c.chosen.kind, c.chosen.ref) for c in conflict.choices}
+        col_of = {(label.kind.value, label.ref): j for j, label in enumerate(m.cols)}  # str keys: fast to hash
+        picked = {(c.meas.ref, c.chosen.kind.value, c.chosen.ref) for c in conflict.choices}
         given = {c.chosen.ref for c in conflict.choices if c.chosen.kind is AxisKind.TRACK}
         track_ids = [t for t in conflict.track_ids if reported is None or t in reported or t in given]
         axis_pos.append((-0.6, y0 - 1.1))
@@ -249,8 +249,8 @@ def decision_grid(
             axis_pos.append((-0.6, y))
             axis_lab.append(meas_name(ref))
             r = row_of[ref]
-            cells = [(k, (AxisKind.TRACK, t)) for k, t in enumerate(track_ids)]
-            cells.append((len(track_ids), (AxisKind.NEW_TRACK, ref)))
+            cells = [(k, (AxisKind.TRACK.value, t)) for k, t in enumerate(track_ids)]
+            cells.append((len(track_ids), (AxisKind.NEW_TRACK.value, ref)))
             for k, key in cells:
                 v = cost[r, col_of[key]]
                 if not math.isfinite(v):
