@@ -771,7 +771,7 @@ class TrackerLogger:
             reported=self._extracted_ids,
             hypotheses=hypotheses,
         )
-        self._show(paths.decisions(self.tracker), rr.TextDocument(doc, media_type="text/markdown"))
+        self._put(paths.decisions(self.tracker), rr.TextDocument, 1, text=[doc], media_type=["text/markdown"])
         grid = decision_grid(decisions, matrices, reported=self._extracted_ids, focus_tracks=self.focus_tracks)
         root = paths.decision_matrix(self.tracker)
         if grid.costs.size:
