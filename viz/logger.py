@@ -210,6 +210,7 @@ class TrackerLogger:
         self._reported: set[int] = set()  # tracks extracted in the previous frame
         self._extracted_ids: set[int] = set()  # tracks extracted at least once
         self._track_series: dict[str, tuple[str, int]] = {}  # series path -> (class, track id)
+        self._track_paths: dict[tuple[Callable, str, int], str] = {}  # (paths function, class, track id) -> path
         self._handlers: dict[type, Callable] = {
             FrameStarted: self._on_frame_started,
             MeasurementsReceived: self._store("meas"),
@@ -276,6 +277,7 @@ class TrackerLogger:
             )
         self._series.clear()
         self._track_series.clear()
+        self._track_paths.clear()
         self._multi.clear()
 
     # Event intake.
@@ -402,8 +404,15 @@ class TrackerLogger:
         series.timestamps_us.append(self._timestamp_us)
         series.values.append(float(value))
 
-    def _track_sample(self, path: str, class_name: str, track_id: int, value: float, what: str) -> None:
-        self._track_series.setdefault(path, (class_name, track_id))
+    def _track_sample(
+        self, series: Callable[[str, str, int], str], class_name: str, track_id: int, value: float, what: str
+    ) -> None:
+        """A sample of one track's series (``series``: its ``viz.paths`` function); paths are built once."""
+        key = (series, class_name, track_id)
+        path = self._track_paths.get(key)
+        if path is None:
+            path = self._track_paths[key] = series(self.tracker, class_name, track_id)
+            self._track_series.setdefault(path, (class_name, track_id))
         self._sample(path, value, f"{track_id} {class_name} {what}", track_color(track_id))
 
     def _z_of(self, track_ids: np.ndarray) -> np.ndarray:
@@ -523,9 +532,9 @@ class TrackerLogger:
             for (t, m), nis_tm in zip(pairs, nis, strict=True):
                 cost = cost_of(m, t)
                 labels.append(f"{meas_name(m)} → {t} (cost {cost:.2f})")
-                self._track_sample(paths.chosen_cost(self.tracker, class_name, t), class_name, t, cost, "chosen cost")
+                self._track_sample(paths.chosen_cost, class_name, t, cost, "chosen cost")
                 if nis_tm is not None:
-                    self._track_sample(paths.nis(self.tracker, class_name, t), class_name, t, nis_tm, "NIS")
+                    self._track_sample(paths.nis, class_name, t, nis_tm, "NIS")
             self._put(
                 paths.associations(self.tracker, class_name),
                 rr.LineStrips3D,
@@ -574,7 +583,7 @@ class TrackerLogger:
         follow = np.flatnonzero((existence >= self.gate_min_existence) | np.isin(ids, list(self._extracted_ids)))
         for k in follow.tolist():
             t = int(ids[k])
-            self._track_sample(paths.existence(self.tracker, class_name, t), class_name, t, existence[k], "existence")
+            self._track_sample(paths.existence, class_name, t, existence[k], "existence")
             trail = self._trails.setdefault(t, deque(maxlen=TRAIL_FRAMES))
             trail.append((float(mean[k, 0]), float(mean[k, 1]), self._track_z.get(t, self.gate_z_m)))
 
