@@ -132,13 +132,24 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
         or any(c.kind is not AxisKind.NEW_TRACK for c in matrix.cols[n_tracks:])
     ):
         return None
-    row_of = {label: i for i, label in enumerate(matrix.rows)}
-    col_of = {label: j for j, label in enumerate(matrix.cols)}
+    # Index by ref, one map per kind: hashing AxisLabels (dataclasses holding an enum, whose hash is Python code)
+    # costs more than the rest.
+    row_of = {label.ref: i for i, label in enumerate(matrix.rows)}
+    track_col_of = {label.ref: j for j, label in enumerate(matrix.cols[:n_tracks])}
+    new_col_of = {label.ref: j for j, label in enumerate(matrix.cols[n_tracks:], n_tracks)}
     chosen = np.full(n_rows, -1, dtype=np.int64)
     for row_label, col_label in assignment.pairs:
-        if row_label not in row_of or col_label not in col_of:
+        if col_label.kind is AxisKind.TRACK:
+            cols_of_kind = track_col_of
+        elif col_label.kind is AxisKind.NEW_TRACK:
+            cols_of_kind = new_col_of
+        else:
             return None
-        chosen[row_of[row_label]] = col_of[col_label]
+        if row_label.kind is not AxisKind.MEASUREMENT or row_label.ref not in row_of:
+            return None
+        if col_label.ref not in cols_of_kind:
+            return None
+        chosen[row_of[row_label.ref]] = cols_of_kind[col_label.ref]
     if n_rows and (chosen < 0).any():
         return None
     if cost.shape[1] != n_tracks + n_rows:
@@ -193,7 +204,11 @@ def _conflict(
 
 
 def _margin(sub: np.ndarray, i: int, j: int, total: float) -> float:
-    """Best total of ``sub`` with entry (i, j) forbidden, minus ``total`` (inf if then infeasible)."""
+    """Best total of ``sub`` with entry (i, j) forbidden, minus ``total`` (inf if then infeasible). A one-row
+    ``sub`` (one detection) needs no solver: its best total is its cheapest other entry."""
+    if sub.shape[0] == 1:
+        best = float(np.min(np.delete(sub[0], j))) if sub.shape[1] > 1 else math.inf
+        return math.inf if not math.isfinite(best) else min(max(best - total, 0.0), LINK_SLACK)
     forbidden = sub.copy()
     forbidden[i, j] = np.inf
     try:

@@ -233,8 +233,8 @@ def decision_grid(
         m = matrices[class_name]
         cost = np.asarray(m.cost, dtype=np.float64)
         row_of = {label.ref: i for i, label in enumerate(m.rows)}
-        col_of = {label: j for j, label in enumerate(m.cols)}
-        picked = {(c.meas.ref, c.chosen) for c in conflict.choices}
+        col_of = {(label.kind.value, label.ref): j for j, label in enumerate(m.cols)}  # str keys: fast to hash
+        picked = {(c.meas.ref, c.chosen.kind.value, c.chosen.ref) for c in conflict.choices}
         given = {c.chosen.ref for c in conflict.choices if c.chosen.kind is AxisKind.TRACK}
         track_ids = [t for t in conflict.track_ids if reported is None or t in reported or t in given]
         axis_pos.append((-0.6, y0 - 1.1))
@@ -249,16 +249,16 @@ def decision_grid(
             axis_pos.append((-0.6, y))
             axis_lab.append(meas_name(ref))
             r = row_of[ref]
-            cells = [(k, AxisLabel(AxisKind.TRACK, t)) for k, t in enumerate(track_ids)]
-            cells.append((len(track_ids), AxisLabel(AxisKind.NEW_TRACK, ref)))
-            for k, label in cells:
-                v = cost[r, col_of[label]]
+            cells = [(k, (AxisKind.TRACK.value, t)) for k, t in enumerate(track_ids)]
+            cells.append((len(track_ids), (AxisKind.NEW_TRACK.value, ref)))
+            for k, key in cells:
+                v = cost[r, col_of[key]]
                 if not math.isfinite(v):
                     continue
                 centers.append((k + 0.5, y))
                 costs.append(float(v))
                 labels.append(f"{v:.1f}")
-                chosen.append((ref, label) in picked)
+                chosen.append((ref, *key) in picked)
         y0 += len(conflict.meas_indices) + 2.2
     return Grid(
         np.array(centers, dtype=np.float64).reshape(-1, 2),

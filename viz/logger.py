@@ -210,6 +210,7 @@ class TrackerLogger:
         self._reported: set[int] = set()  # tracks extracted in the previous frame
         self._extracted_ids: set[int] = set()  # tracks extracted at least once
         self._track_series: dict[str, tuple[str, int]] = {}  # series path -> (class, track id)
+        self._track_paths: dict[tuple[Callable, str, int], str] = {}  # (paths function, class, track id) -> path
         self._handlers: dict[type, Callable] = {
             FrameStarted: self._on_frame_started,
             MeasurementsReceived: self._store("meas"),
@@ -276,6 +277,7 @@ class TrackerLogger:
             )
         self._series.clear()
         self._track_series.clear()
+        self._track_paths.clear()
         self._multi.clear()
 
     # Event intake.
@@ -402,8 +404,15 @@ class TrackerLogger:
         series.timestamps_us.append(self._timestamp_us)
         series.values.append(float(value))
 
-    def _track_sample(self, path: str, class_name: str, track_id: int, value: float, what: str) -> None:
-        self._track_series.setdefault(path, (class_name, track_id))
+    def _track_sample(
+        self, series: Callable[[str, str, int], str], class_name: str, track_id: int, value: float, what: str
+    ) -> None:
+        """A sample of one track's series (``series``: its ``viz.paths`` function); paths are built once."""
+        key = (series, class_name, track_id)
+        path = self._track_paths.get(key)
+        if path is None:
+            path = self._track_paths[key] = series(self.tracker, class_name, track_id)
+            self._track_series.setdefault(path, (class_name, track_id))
         self._sample(path, value, f"{track_id} {class_name} {what}", track_color(track_id))
 
     def _z_of(self, track_ids: np.ndarray) -> np.ndarray:
@@ -441,7 +450,7 @@ class TrackerLogger:
             return {}
         ids = np.asarray(cf.predicted.track_ids, dtype=np.int64)
         existence = np.asarray(cf.predicted.existence, dtype=np.float64)
-        focused = np.isin(ids, list(self.focus_tracks or ()))
+        focused = np.isin(ids, list(self.focus_tracks)) if self.focus_tracks else np.zeros(ids.size, dtype=bool)
         worthy = (existence >= self.gate_min_existence) | focused
         xy = np.asarray(cf.predicted.mean, dtype=np.float64).reshape(-1, 4)[:, :2]
         if self.log_predicted:
@@ -459,7 +468,7 @@ class TrackerLogger:
                     positions=lift_xy(xy[sel], self._z_of(ids[sel])),
                     colors=packed_track_colors(ids[sel]),
                     radii=np.full(sel.size, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
-                    labels=[f"{t} predicted r={r:.2f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
+                    labels=_labels("{} predicted r={:.2f}", ids[sel], existence[sel]),
                 )
         if (~worthy).any():
             sel = np.flatnonzero(~worthy)
@@ -471,7 +480,7 @@ class TrackerLogger:
                 positions=lift_xy(xy[sel], self.gate_z_m),
                 colors=np.full(sel.size, CANDIDATE_COLOR, dtype=np.uint32),
                 radii=np.full(sel.size, CANDIDATE_POINT_RADIUS_M, dtype=np.float32),
-                labels=[f"candidate {t}, r={r:.3f}" for t, r in zip(ids[sel], existence[sel], strict=True)],
+                labels=_labels("candidate {}, r={:.3f}", ids[sel], existence[sel]),
             )
         self._sample(
             paths.candidate_count(self.tracker, class_name), float((~worthy).sum()), f"{class_name} candidates"
@@ -480,7 +489,7 @@ class TrackerLogger:
         if gated is not None:
             gids = np.asarray(gated.track_ids, dtype=np.int64)
             lookup = dict(zip(ids.tolist(), worthy.tolist(), strict=True))  # focused tracks count as worthy
-            drawn = np.array([lookup.get(int(t), True) for t in gids], dtype=bool)
+            drawn = np.array([lookup.get(t, True) for t in gids.tolist()], dtype=bool)
             if drawn.any():
                 outline = ellipse_outline(
                     np.asarray(gated.center_xy, dtype=np.float64)[drawn],
@@ -493,7 +502,7 @@ class TrackerLogger:
                     paths.gates(self.tracker, class_name),
                     rr.LineStrips3D,
                     n,
-                    strips=list(lift_xy(outline, self._z_of(gids[drawn])[:, None])),
+                    strips=lift_xy(outline, self._z_of(gids[drawn])[:, None]),
                     colors=packed_track_colors(gids[drawn]),
                     radii=np.full(n, GATE_LINE_RADIUS_M, dtype=np.float32),
                 )
@@ -505,90 +514,62 @@ class TrackerLogger:
         and chosen-cost samples."""
         if cf.meas is None or cf.predicted is None or cf.assignment is None:
             return
-        pos = {int(m): k for k, m in enumerate(np.asarray(cf.meas.meas_indices).tolist())}
+        pos = {m: k for k, m in enumerate(np.asarray(cf.meas.meas_indices, dtype=np.int64).tolist())}
         xyz = np.asarray(cf.meas.xyz_m, dtype=np.float64).reshape(-1, 3)
-        pred_ids = np.asarray(cf.predicted.track_ids, dtype=np.int64)
-        pred_xy = {int(t): m[:2] for t, m in zip(pred_ids, np.asarray(cf.predicted.mean).reshape(-1, 4), strict=True)}
-        costs = self._pair_costs(cf.cost)
-        strips, owners, labels = [], [], []
-        chosen: set[tuple[int, int]] = set()
-        for row, col in cf.assignment.pairs:
-            if col.kind is not AxisKind.TRACK or row.ref not in pos or col.ref not in pred_xy:
-                continue
-            m, t = int(row.ref), int(col.ref)
-            chosen.add((t, m))
-            z = xyz[pos[m], 2]
-            strips.append([(*pred_xy[t], z), tuple(xyz[pos[m]])])
-            owners.append(t)
-            cost = costs.get((m, t), math.nan)
-            labels.append(f"{meas_name(m)} → {t} (cost {cost:.2f})")
-            self._track_sample(paths.chosen_cost(self.tracker, class_name, t), class_name, t, cost, "chosen cost")
-            nis = self._nis(cf.gated, t, xyz[pos[m], :2])
-            if nis is not None:
-                self._track_sample(paths.nis(self.tracker, class_name, t), class_name, t, nis, "NIS")
-        if strips:
+        pred_row = {t: k for k, t in enumerate(np.asarray(cf.predicted.track_ids, dtype=np.int64).tolist())}
+        pred_xy = np.asarray(cf.predicted.mean, dtype=np.float64).reshape(-1, 4)[:, :2]
+        cost_of = _pair_cost_lookup(cf.cost)
+        pairs = [
+            (int(col.ref), int(row.ref))
+            for row, col in cf.assignment.pairs
+            if col.kind is AxisKind.TRACK and row.ref in pos and col.ref in pred_row
+        ]
+        if pairs:
+            owners = [t for t, _ in pairs]
+            meas_rows = np.array([pos[m] for _, m in pairs], dtype=np.int64)
+            nis = _nis_of(cf.gated, owners, xyz[meas_rows, :2])
+            labels = []
+            for (t, m), nis_tm in zip(pairs, nis, strict=True):
+                cost = cost_of(m, t)
+                labels.append(f"{meas_name(m)} → {t} (cost {cost:.2f})")
+                self._track_sample(paths.chosen_cost, class_name, t, cost, "chosen cost")
+                if nis_tm is not None:
+                    self._track_sample(paths.nis, class_name, t, nis_tm, "NIS")
             self._put(
                 paths.associations(self.tracker, class_name),
                 rr.LineStrips3D,
-                len(strips),
+                len(pairs),
                 static={"show_labels": False},
-                strips=strips,
+                strips=_pair_lines(pred_xy, [pred_row[t] for t in owners], xyz, meas_rows),
                 colors=packed_track_colors(np.array(owners, dtype=np.int64)),
-                radii=np.full(len(strips), ASSOCIATION_RADIUS_M, dtype=np.float32),
+                radii=np.full(len(pairs), ASSOCIATION_RADIUS_M, dtype=np.float32),
                 labels=labels,
             )
         gated = cf.gated
         if gated is None:
             return
-        inside = np.asarray(gated.inside, dtype=bool)
+        chosen = set(pairs)
         gids = np.asarray(gated.track_ids, dtype=np.int64).tolist()
         gmeas = np.asarray(gated.meas_indices, dtype=np.int64).tolist()
-        rejected, rowners, rlabels = [], [], []
-        for k, j in zip(*np.nonzero(inside), strict=True):
-            t, m = gids[k], gmeas[j]
-            if t not in worthy or (t, m) in chosen or m not in pos:
-                continue
-            rejected.append([(*pred_xy[t], xyz[pos[m], 2]), tuple(xyz[pos[m]])])
-            rowners.append(t)
-            rlabels.append(f"{meas_name(m)} in gate of {t}, not chosen (cost {costs.get((m, t), math.nan):.2f})")
+        rejected = [
+            (gids[k], gmeas[j])
+            for k, j in zip(*(idx.tolist() for idx in np.nonzero(np.asarray(gated.inside, dtype=bool))), strict=True)
+            if gids[k] in worthy and (gids[k], gmeas[j]) not in chosen and gmeas[j] in pos
+        ]
         if rejected:
+            rowners = [t for t, _ in rejected]
             self._put(
                 paths.gated_pairs(self.tracker, class_name),
                 rr.LineStrips3D,
                 len(rejected),
                 static={"show_labels": False},
-                strips=rejected,
+                strips=_pair_lines(
+                    pred_xy, [pred_row[t] for t in rowners], xyz, np.array([pos[m] for _, m in rejected])
+                ),
                 colors=packed_track_colors(np.array(rowners, dtype=np.int64), alpha=GATED_PAIR_ALPHA),
                 radii=np.full(len(rejected), GATED_PAIR_RADIUS_M, dtype=np.float32),
-                labels=rlabels,
+                labels=[f"{meas_name(m)} in gate of {t}, not chosen (cost {cost_of(m, t):.2f})" for t, m in rejected],
             )
-
-    @staticmethod
-    def _pair_costs(matrix: CostMatrix | None) -> dict[tuple[int, int], float]:
-        """(meas index, track id) -> cost of every finite track entry of the matrix."""
-        if matrix is None:
-            return {}
-        cost = np.asarray(matrix.cost, dtype=np.float64)
-        cols = [j for j, c in enumerate(matrix.cols) if c.kind is AxisKind.TRACK]
-        if not cols or cost.size == 0:
-            return {}
-        sub = cost[:, cols]
-        rows, ks = np.nonzero(np.isfinite(sub))
-        meas = [int(matrix.rows[i].ref) for i in rows.tolist()]
-        tracks = [int(matrix.cols[cols[k]].ref) for k in ks.tolist()]
-        return dict(zip(zip(meas, tracks, strict=True), sub[rows, ks].tolist(), strict=True))
-
-    @staticmethod
-    def _nis(gated: Gated | None, track_id: int, z: np.ndarray) -> float | None:
-        """(z - H m)^T S^-1 (z - H m) of detection z for a track, from its gate (None if not gated)."""
-        if gated is None:
-            return None
-        hit = np.flatnonzero(np.asarray(gated.track_ids) == track_id)
-        if hit.size == 0:
-            return None
-        k = int(hit[0])
-        nu = z - np.asarray(gated.center_xy[k], dtype=np.float64)
-        return float(nu @ np.linalg.solve(np.asarray(gated.innovation_cov[k], dtype=np.float64), nu))
 
     def _record_posterior(self, class_name: str, cf: _ClassFrame) -> None:
         """Existence samples and trail points of the Bernoullis worth following (r >= gate_min_existence or
@@ -602,7 +583,7 @@ class TrackerLogger:
         follow = np.flatnonzero((existence >= self.gate_min_existence) | np.isin(ids, list(self._extracted_ids)))
         for k in follow.tolist():
             t = int(ids[k])
-            self._track_sample(paths.existence(self.tracker, class_name, t), class_name, t, existence[k], "existence")
+            self._track_sample(paths.existence, class_name, t, existence[k], "existence")
             trail = self._trails.setdefault(t, deque(maxlen=TRAIL_FRAMES))
             trail.append((float(mean[k, 0]), float(mean[k, 1]), self._track_z.get(t, self.gate_z_m)))
 
@@ -642,7 +623,7 @@ class TrackerLogger:
                     inside = np.asarray(cf.gated.inside, dtype=bool)[g[0]]
                     for j in np.flatnonzero(inside).tolist():
                         m = int(np.asarray(cf.gated.meas_indices)[j])
-                        nis = self._nis(cf.gated, t, meas_xy[m]) if m in meas_xy else math.nan
+                        nis = _nis_of(cf.gated, [t], meas_xy[m][None, :])[0] if m in meas_xy else math.nan
                         gated.append((m, float(nis) if nis is not None else math.nan))
             self.track_steps.setdefault(t, {})[self._frame] = TrackStep(
                 float(prior_r[k]),
@@ -662,6 +643,9 @@ class TrackerLogger:
         ids = np.array([e.track_id for e in estimates], dtype=np.int64)
         cids = class_ids(np.array([e.class_name for e in estimates], dtype=object))
         colors = packed_track_colors(ids)
+        half_sizes = 0.5 * boxes.sizes_xyz_m
+        box_radius = np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32)  # rows are copied when sent: shareable
+        trail_radius = np.full(1, TRAIL_RADIUS_M, dtype=np.float32)
         self._extracted_ids.update(shown)
         for k, e in enumerate(estimates):
             path = paths.track(self.tracker, class_name, e.track_id)
@@ -670,12 +654,12 @@ class TrackerLogger:
                 rr.Boxes3D,
                 1,
                 centers=boxes.centers_m[k : k + 1],
-                half_sizes=0.5 * boxes.sizes_xyz_m[k : k + 1],
+                half_sizes=half_sizes[k : k + 1],
                 quaternions=boxes.quat_xyzw[k : k + 1],
                 colors=colors[k : k + 1],
                 class_ids=cids[k : k + 1],
                 labels=[str(e.track_id)],
-                radii=np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32),
+                radii=box_radius,
             )
             trail = list(self._trails.get(e.track_id, ()))
             if len(trail) >= 2:
@@ -685,7 +669,7 @@ class TrackerLogger:
                     1,
                     strips=[np.array(trail)],
                     colors=colors[k : k + 1],
-                    radii=np.full(1, TRAIL_RADIUS_M, dtype=np.float32),
+                    radii=trail_radius,
                 )
 
     # The story log.
@@ -796,7 +780,7 @@ class TrackerLogger:
             reported=self._extracted_ids,
             hypotheses=hypotheses,
         )
-        self._show(paths.decisions(self.tracker), rr.TextDocument(doc, media_type="text/markdown"))
+        self._put(paths.decisions(self.tracker), rr.TextDocument, 1, text=[doc], media_type=["text/markdown"])
         grid = decision_grid(decisions, matrices, reported=self._extracted_ids, focus_tracks=self.focus_tracks)
         root = paths.decision_matrix(self.tracker)
         if grid.costs.size:
@@ -875,3 +859,57 @@ class TrackerLogger:
         )
         if weights.size:
             self._show(paths.intensity_weights(self.tracker, event.class_name), rr.BarChart(weights))
+
+
+def _pair_cost_lookup(matrix: CostMatrix | None) -> Callable[[int, int], float]:
+    """cost(meas index, track id): the matrix entry of that detection's row and that track's column, NaN when
+    there is none or it is not finite (outside the gate)."""
+    if matrix is None:
+        return lambda m, t: math.nan
+    cost = np.asarray(matrix.cost, dtype=np.float64)
+    if cost.size == 0:
+        return lambda m, t: math.nan
+    row_of = {label.ref: i for i, label in enumerate(matrix.rows)}
+    col_of = {label.ref: j for j, label in enumerate(matrix.cols) if label.kind is AxisKind.TRACK}
+
+    def cost_of(m: int, t: int) -> float:
+        i, j = row_of.get(m), col_of.get(t)
+        if i is None or j is None:
+            return math.nan
+        value = float(cost[i, j])
+        return value if math.isfinite(value) else math.nan
+
+    return cost_of
+
+
+def _nis_of(gated: Gated | None, track_ids: list[int], z_xy: np.ndarray) -> list[float | None]:
+    """(z - H m)^T S^-1 (z - H m) of detection k (z_xy: (P, 2)) for track_ids[k], from that track's gate
+    (its first row in ``gated``); None where the track has no gate."""
+    if gated is None:
+        return [None] * len(track_ids)
+    first: dict[int, int] = {}
+    for k, t in enumerate(np.asarray(gated.track_ids, dtype=np.int64).tolist()):
+        first.setdefault(t, k)
+    hit = [k for k, t in enumerate(track_ids) if t in first]
+    out: list[float | None] = [None] * len(track_ids)
+    if not hit:
+        return out
+    rows = np.array([first[track_ids[k]] for k in hit], dtype=np.int64)
+    nu = np.asarray(z_xy, dtype=np.float64)[hit] - np.asarray(gated.center_xy, dtype=np.float64)[rows]
+    x = np.linalg.solve(np.asarray(gated.innovation_cov, dtype=np.float64)[rows], nu[:, :, None])[:, :, 0]
+    for k, value in zip(hit, np.vecdot(nu, x).tolist(), strict=True):  # the same dot kernel as nu @ x per pair
+        out[k] = value
+    return out
+
+
+def _pair_lines(pred_xy: np.ndarray, pred_rows: list[int], xyz: np.ndarray, meas_rows: np.ndarray) -> np.ndarray:
+    """(P, 2, 3) lines from each track's predicted BEV position (pred_xy: (K, 2), at its detection's height) to
+    its detection (xyz: (M, 3))."""
+    end = xyz[np.asarray(meas_rows, dtype=np.int64)]
+    start = np.column_stack([pred_xy[np.asarray(pred_rows, dtype=np.int64)], end[:, 2]])
+    return np.stack([start, end], axis=1)
+
+
+def _labels(template: str, track_ids: np.ndarray, existence: np.ndarray) -> list[str]:
+    """``template.format(id, r)`` per track (Python scalars: formatting numpy scalars is several times slower)."""
+    return [template.format(t, r) for t, r in zip(track_ids.tolist(), existence.tolist(), strict=True)]

@@ -13,7 +13,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import pyarrow as pa
 import rerun as rr
+from rerun.components import LineStrip3DBatch
+from rerun.encodings import Vec3DBatch
 
 from viz.timeline import Clock
 
@@ -99,10 +102,25 @@ def _columns(rows: _Rows):
         fields = {}
         for name, per_row in values.items():
             chosen = [per_row[i] for i in selected.tolist() if per_row[i] is not None]
-            if isinstance(empty[name], list):
-                fields[name] = [item for row in chosen for item in row]
+            if name == "strips":
+                fields[name] = _strips_array(chosen)
+            elif isinstance(empty[name], list):
+                fields[name] = pa.array([item for row in chosen for item in row], type=pa.utf8())
             else:
-                fields[name] = np.concatenate([np.asarray(v) for v in chosen]) if chosen else empty[name]
+                fields[name] = np.concatenate(chosen) if chosen else empty[name]
         return archetype.columns(**fields).partition(lengths[selected])
 
     return columns_of
+
+
+def _strips_array(rows: list[Any]) -> pa.Array:
+    """The Arrow ``LineStrip3D`` array of every strip of ``rows`` (each an (n, k, 3) array of n strips of k
+    points, or a list of (k_i, 3) strips), built from one concatenated point array: Rerun's own conversion
+    handles strips one at a time."""
+    strips = [np.asarray(strip, dtype=np.float32).reshape(-1, 3) for row in rows for strip in row]
+    lengths = np.fromiter((s.shape[0] for s in strips), dtype=np.int32, count=len(strips))
+    offsets = np.zeros(len(strips) + 1, dtype=np.int32)
+    np.cumsum(lengths, out=offsets[1:])
+    points = np.concatenate(strips) if strips else np.zeros((0, 3), dtype=np.float32)
+    inner = Vec3DBatch(points).as_arrow_array()
+    return pa.ListArray.from_arrays(pa.array(offsets), inner, type=LineStrip3DBatch._ARROW_DATATYPE)

@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix
-from gnnpmb.explain import LINK_SLACK, explain
+from gnnpmb.explain import LINK_SLACK, _margin, explain
 
 INF = math.inf
 
@@ -106,3 +107,21 @@ def test_other_layouts_and_unknown_columns_are_not_explained() -> None:
     assert explain(matrix, other) is None
     transposed = CostMatrix("car", matrix.cost.T, matrix.cols, matrix.rows)
     assert explain(transposed, assignment) is None
+
+
+def test_a_one_detection_margin_is_what_re_solving_without_the_pair_gives() -> None:
+    """The closed form for a one-row conflict (its cheapest other entry) equals re-solving with the pair
+    forbidden, to the last bit, including rows where nothing else is possible."""
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        row = rng.normal(0.0, 4.0, size=(1, int(rng.integers(1, 6))))
+        row[rng.random(row.shape) < 0.3] = INF
+        for j in np.flatnonzero(np.isfinite(row[0])).tolist():
+            forbidden = row.copy()
+            forbidden[0, j] = INF
+            try:
+                _, best = solve(forbidden)
+                expected = min(max(best - row[0, j], 0.0), LINK_SLACK)
+            except InfeasibleAssignment:
+                expected = INF
+            assert _margin(row, 0, j, float(row[0, j])) == expected

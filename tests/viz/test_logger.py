@@ -36,7 +36,7 @@ from gnnpmb.types import TrackEstimate
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
 from viz.colors import pack_rgba, track_colors
-from viz.logger import TrackerLogger
+from viz.logger import TrackerLogger, _nis_of
 from viz.timeline import Clock
 
 T = "gnnpmb"
@@ -345,3 +345,28 @@ def test_pmbm_hypotheses_are_listed_with_what_tells_them_apart(saved_stream) -> 
     assert "| h0 | 0.600 | (the best, shown in the views) |" in doc
     assert "| h1 | 0.300 | other association for 1 candidate |" in doc
     assert "| h2 | 0.100 | without 1 candidate |" in doc
+
+
+def test_nis_of_many_pairs_at_once_equals_the_per_pair_formula_to_the_last_bit() -> None:
+    rng = np.random.default_rng(5)
+    k = 40
+    a = rng.normal(size=(k, 2, 2))
+    gated = Gated(
+        "car",
+        np.arange(100, 100 + k),
+        np.arange(3),
+        np.ones((k, 3), dtype=bool),
+        rng.normal(size=(k, 2)) * 10.0,
+        a @ a.transpose(0, 2, 1) + np.eye(2),
+        9.0,
+    )
+    tracks = [int(t) for t in rng.integers(95, 100 + k + 5, size=60)]
+    z = rng.normal(size=(60, 2)) * 10.0
+    got = _nis_of(gated, tracks, z)
+    for t, zk, value in zip(tracks, z, got, strict=True):
+        if not 100 <= t < 100 + k:
+            assert value is None
+            continue
+        nu = zk - gated.center_xy[t - 100]
+        assert value == float(nu @ np.linalg.solve(gated.innovation_cov[t - 100], nu))
+    assert _nis_of(None, [1, 2], z[:2]) == [None, None]
