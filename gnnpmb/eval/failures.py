@@ -28,8 +28,6 @@ from __future__ import annotations
 
 import enum
 import json
-import multiprocessing
-import os
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -442,31 +440,22 @@ def _class_failures(
     return out
 
 
-EVAL_WORKERS = min(2, os.cpu_count() or 1)
-"""Classes are evaluated in this many processes (forked, so the scene's boxes are shared, not copied); 1: in
-this process. Each class is the devkit's own ``accumulate`` either way, so the report does not depend on it."""
-
-_FORKED: dict[str, Any] = {}
-"""What a forked class worker reads: the arguments of ``_class_report`` except the class name."""
-
-
 def find_failures(
     nusc: NuScenes,
     scene_name: str,
     results: Mapping[str, Sequence[Mapping[str, Any]]],
     tracker: str,
     coalescence_radius_m: float = COALESCENCE_RADIUS_M,
-    workers: int = EVAL_WORKERS,
 ) -> FailureReport:
     """Evaluate one scene of a tracking submission with the devkit and list its failures.
 
     results: submission boxes keyed by sample token (``submission.run_results``); samples of the scene without
-    an entry count as empty. Failures are sorted by frame, then kind, class and ids. workers: see
-    ``EVAL_WORKERS`` (the report is the same for any number).
+    an entry count as empty. Failures are sorted by frame, then kind, class and ids.
     """
     from nuscenes.eval.common.data_classes import EvalBoxes
     from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
-    from nuscenes.eval.tracking.data_classes import TrackingBox
+    from nuscenes.eval.tracking.algo import TrackingEvaluation
+    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetricData
     from nuscenes.eval.tracking.loaders import create_tracks
 
     tokens = scene_sample_tokens(nusc, scene_name)
@@ -482,84 +471,41 @@ def find_failures(
         tracks_gt = create_tracks(_prepared(nusc, gt, cfg), nusc, split, gt=True)
         tracks_pred = create_tracks(_prepared(nusc, pred, cfg), nusc, split, gt=False)
         scene_token = nusc.get("sample", tokens[0])["scene_token"]
-        shared = {
-            "tracks_gt": tracks_gt,
-            "tracks_pred": tracks_pred,
-            "scene_token": scene_token,
-            "cfg": cfg,
-            "tokens": tokens,
-            "frame_of_timestamp": frame_of_timestamp,
-            "coalescence_radius_m": coalescence_radius_m,
-        }
-        gt_boxes = dict.fromkeys(cfg.class_names, 0)  # the devkit skips classes without; the rest, largest first
-        for scene_gt in tracks_gt.values():
-            for frame_gt in scene_gt.values():
-                for box in frame_gt:
-                    gt_boxes[box.tracking_name] = gt_boxes.get(box.tracking_name, 0) + 1
-        scored = sorted((name for name in cfg.class_names if gt_boxes[name]), key=lambda n: -gt_boxes[n])
-        if workers > 1 and len(scored) > 1 and "fork" in multiprocessing.get_all_start_methods():
-            _FORKED.update(shared)
-            try:
-                with multiprocessing.get_context("fork").Pool(min(workers, len(scored))) as pool:
-                    done = dict(zip(scored, pool.imap(_forked_class_report, scored, chunksize=1), strict=True))
-            finally:
-                _FORKED.clear()
-        else:
-            done = {name: _class_report(name, **shared) for name in scored}
-    classes: list[ClassEvaluation] = []
-    failures: list[Failure] = []
-    for class_name in cfg.class_names:  # the devkit's class order, whichever class finished first
-        if done.get(class_name) is not None:
-            evaluation, found = done[class_name]
-            classes.append(evaluation)
-            failures += found
+        classes: list[ClassEvaluation] = []
+        failures: list[Failure] = []
+        for class_name in cfg.class_names:
+            evaluation = TrackingEvaluation(
+                tracks_gt,
+                tracks_pred,
+                class_name,
+                cfg.dist_fcn_callable,
+                cfg.dist_th_tp,
+                cfg.min_recall,
+                num_thresholds=TrackingMetricData.nelem,
+                metric_worst=cfg.metric_worst,
+                verbose=False,
+            )
+            md = evaluation.accumulate()
+            if np.all(np.isnan(md.mota)):
+                continue  # no ground truth of this class: the devkit does not score it
+            best = int(np.nanargmax(md.mota))
+            threshold = None if np.isnan(md.confidence[best]) else float(md.confidence[best])
+            classes.append(
+                ClassEvaluation(
+                    class_name,
+                    threshold,
+                    *(float(md.get_metric(m)[best]) for m in ("mota", "tp", "fp", "fn", "ids", "frag")),
+                )
+            )
+            frames = _accumulate(
+                tracks_gt[scene_token],
+                tracks_pred[scene_token],
+                class_name,
+                threshold,
+                cfg.dist_th_tp,
+                frame_of_timestamp,
+            )
+            failures += _class_failures(frames, class_name, tokens, cfg.dist_th_tp, coalescence_radius_m)
     kind_order = {kind: i for i, kind in enumerate(FailureKind)}
     failures.sort(key=lambda f: (f.frame_index, kind_order[f.kind], f.class_name, f.gt_ids, f.track_ids))
     return FailureReport(scene_name, tracker, tuple(tokens), tuple(classes), tuple(failures), coalescence_radius_m)
-
-
-def _forked_class_report(class_name: str) -> tuple[ClassEvaluation, list[Failure]] | None:
-    return _class_report(class_name, **_FORKED)
-
-
-def _class_report(
-    class_name: str,
-    *,
-    tracks_gt: Mapping[str, Mapping[int, list[TrackingBox]]],
-    tracks_pred: Mapping[str, Mapping[int, list[TrackingBox]]],
-    scene_token: str,
-    cfg: TrackingConfig,
-    tokens: Sequence[str],
-    frame_of_timestamp: Mapping[int, int],
-    coalescence_radius_m: float,
-) -> tuple[ClassEvaluation, list[Failure]] | None:
-    """One class: the devkit's ``TrackingEvaluation.accumulate`` over every recall threshold, its numbers at
-    the best-MOTA threshold, and the failures replayed there (None: the devkit does not score the class)."""
-    from nuscenes.eval.tracking.algo import TrackingEvaluation
-    from nuscenes.eval.tracking.data_classes import TrackingMetricData
-
-    evaluation = TrackingEvaluation(
-        tracks_gt,
-        tracks_pred,
-        class_name,
-        cfg.dist_fcn_callable,
-        cfg.dist_th_tp,
-        cfg.min_recall,
-        num_thresholds=TrackingMetricData.nelem,
-        metric_worst=cfg.metric_worst,
-        verbose=False,
-    )
-    md = evaluation.accumulate()
-    if np.all(np.isnan(md.mota)):
-        return None  # no ground truth of this class: the devkit does not score it
-    best = int(np.nanargmax(md.mota))
-    threshold = None if np.isnan(md.confidence[best]) else float(md.confidence[best])
-    numbers = ClassEvaluation(
-        class_name,
-        threshold,
-        *(float(md.get_metric(m)[best]) for m in ("mota", "tp", "fp", "fn", "ids", "frag")),
-    )
-    frames = _accumulate(
-        tracks_gt[scene_token], tracks_pred[scene_token], class_name, threshold, cfg.dist_th_tp, frame_of_timestamp
-    )
-    return numbers, _class_failures(frames, class_name, tokens, cfg.dist_th_tp, coalescence_radius_m)

@@ -195,8 +195,7 @@ def test_staged_cascading_identity_theft(nusc, scene: SceneData, gt: dict) -> No
 
 def test_failures_of_a_tracker_run_add_up_to_the_devkits_counts(nusc, scene: SceneData) -> None:
     run = run_tracker(scene, get_detections(scene, None, "pointpillars", 0), "gnnpmb", TrackerConfig())
-    report = find_failures(nusc, SCENE, run_results(run), "gnnpmb", workers=2)
-    assert report == find_failures(nusc, SCENE, run_results(run), "gnnpmb", workers=1)  # classes in 2 processes
+    report = find_failures(nusc, SCENE, run_results(run), "gnnpmb")
     assert report.failures
     for c in report.classes:
         mine = Counter(f.kind for f in report.failures if f.class_name == c.class_name)
