@@ -31,8 +31,11 @@ FRAMES_BEFORE = 8
 FRAMES_AFTER = 4
 """A focus recording holds the keyframes from FRAMES_BEFORE before the focus frame to FRAMES_AFTER after it."""
 NEAR_M = 2.0
-"""Tracks of other trackers within this BEV distance of an involved object are involved too (the devkit's match
+"""Tracks (of every tracker) within this BEV distance of an involved object are involved too (the devkit's match
 distance)."""
+NEAR_FRAMES = 4
+"""... and so are tracks that were that close to it in this many keyframes before the failure (a track that
+followed the object with too low a score to be counted is often the failure's cause)."""
 _SPEC = re.compile(r"^(?P<kind>[a-z_]+):(?P<ref>\S+)$")
 _KIND_ORDER = (
     FailureKind.IDENTITY_THEFT,
@@ -121,11 +124,15 @@ def _from_failure(
 ) -> FocusTarget:
     centers = np.array([b.translation_m[:2] for b in failure.boxes], dtype=np.float64).reshape(-1, 2)
     gt_centers = np.array([b.translation_m[:2] for b in failure.boxes if b.is_gt], dtype=np.float64).reshape(-1, 2)
-    center = centers.mean(axis=0) if len(centers) else _ego_xy(scene, failure.frame_index)
+    # The ground truth is where the failure happens; a lost track's last box can be frames old and metres away.
+    place = gt_centers if len(gt_centers) else centers
+    center = place.mean(axis=0) if len(place) else _ego_xy(scene, failure.frame_index)
     ids: dict[str, tuple[int, ...]] = {}
     for name, per_frame in estimates.items():
         own = {int(t) for t in failure.track_ids} if name == tracker else set()
-        near = _tracks_near(per_frame[failure.frame_index - frames.start], failure.class_name, gt_centers)
+        near: set[int] = set()
+        for i in range(max(frames.start, failure.frame_index - NEAR_FRAMES), failure.frame_index + 1):
+            near |= _tracks_near(per_frame[i - frames.start], failure.class_name, _gt_xy(scene, i, failure.gt_ids))
         ids[name] = tuple(sorted(own | near))
     label = failure_id or failure.kind.value
     return FocusTarget(
@@ -231,6 +238,14 @@ def _tracks_near(estimates: Sequence[TrackEstimate], class_name: str, centers_xy
         if d.min() < NEAR_M:
             out.add(e.track_id)
     return out
+
+
+def _gt_xy(scene: SceneData, frame_index: int, gt_ids: Sequence[str]) -> np.ndarray:
+    """(G, 2) BEV centres of the ground-truth objects ``gt_ids`` present at keyframe ``frame_index``."""
+    gt = scene.keyframes[frame_index].gt
+    if not len(gt) or not gt_ids:
+        return np.zeros((0, 2))
+    return np.asarray(gt.translation_m[np.isin(gt.instance_id.astype(str), list(gt_ids)), :2], dtype=np.float64)
 
 
 def _ego_xy(scene: SceneData, frame_index: int) -> np.ndarray:

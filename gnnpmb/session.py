@@ -485,7 +485,8 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
             for name, report in reports.items():
                 log_failures(stream, name, report, scene, shown, clock, show_labels=focus is None)
         if focus is not None:
-            log_focus(stream, focus, scene, runs, loggers, clock, shown)
+            thresholds = {name: report.threshold_of(focus.class_name) for name, report in reports.items()}
+            log_focus(stream, focus, scene, runs, loggers, clock, shown, thresholds)
         digests = {run.tracker: run_digest(run) for run in runs}
         log_provenance(stream, provenance_of(request, digests))
     ms = {run.tracker: 1000.0 * float(np.mean([f.step_time_s for f in run.frames])) for run in runs}

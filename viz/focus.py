@@ -66,9 +66,11 @@ def focus_markdown(
     shown: range,
     scene: SceneData,
     runs: Mapping[str, TrackingRun],
+    thresholds: Mapping[str, float | None] | None = None,
 ) -> str:
     """The summary document: the failure, the ids; per tracker a diagnosis line per involved track, the involved
-    objects' and tracks' frames, its decisions about them and their story."""
+    objects' and tracks' frames, its decisions about them and their story. thresholds: per tracker, the score
+    from which the evaluation counted a track of the focused class (its best-MOTA threshold; None: every box)."""
     lines = [
         f"# {focus.title}",
         "",
@@ -88,7 +90,7 @@ def focus_markdown(
         lines.append("")
         run = runs.get(tracker)
         if run is not None:
-            lines += _gt_markdown(focus, scene, run, logger, shown)
+            lines += _gt_markdown(focus, scene, run, logger, shown, (thresholds or {}).get(tracker))
         lines += _steps_markdown(logger, sorted(ids), shown, focus.frame_index)
         decided = [
             c
@@ -166,11 +168,20 @@ def _frames(frames: list[int]) -> str:
     return ", ".join(str(f) for f in frames)
 
 
+_NOT_COUNTED = ", not counted"
+
+
 def _gt_markdown(
-    focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: TrackerLogger, shown: range
+    focus: FocusTarget,
+    scene: SceneData,
+    run: TrackingRun,
+    logger: TrackerLogger,
+    shown: range,
+    threshold: float | None = None,
 ) -> list[str]:
     """Per involved ground-truth object, frame by frame up to the focus frame: the nearest detection of its class
-    (distance, score), where the tracker sent it, and the tracks reported on the object."""
+    (distance, score), where the tracker sent it, and the tracks output on the object with their tracking scores
+    (those below the evaluation's ``threshold`` were not counted)."""
     out: list[str] = []
     by_frame = {f.keyframe.index: f for f in run.frames}
     for gt_id in focus.gt_ids:
@@ -195,7 +206,7 @@ def _gt_markdown(
                     nearest = f"m{m} at {d[k]:.1f} m (score {boxes.score[m]:.2f})"
                     went = logger.given.get(i, {}).get(m, "—")
             covering = [
-                str(e.track_id)
+                f"{e.track_id} ({e.score:.2f}{_NOT_COUNTED if threshold is not None and e.score < threshold else ''})"
                 for e in frame.estimates
                 if e.class_name == focus.class_name
                 and np.hypot(e.translation_m[0] - xy[0], e.translation_m[1] - xy[1]) < NEAR_DETECTION_M
@@ -206,14 +217,19 @@ def _gt_markdown(
             sent += [went] if nearest != "none" else []
         if rows:
             news = sent.count("new")
+            counted = (
+                "every output box"
+                if threshold is None
+                else f"{focus.class_name} tracks with score >= {threshold:.3f} (its best-MOTA threshold)"
+            )
             out += [
                 f"**GT {short_id(gt_id)}**: a detection within {NEAR_DETECTION_M:.0f} m in {detected} of its {seen} "
                 f"frames up to {focus.frame_index}; {news} of them started a new track, the others went to "
                 f"{', '.join(sorted({w for w in sent if w not in ('new', '—')})) or 'no track'}.",
                 "",
-                f"GT {short_id(gt_id)}, frame by frame:",
+                f"GT {short_id(gt_id)}, frame by frame (the evaluation counted {counted}):",
                 "",
-                "| frame | nearest detection | sent to | tracks shown on it |",
+                "| frame | nearest detection | sent to | tracks output on it (score) |",
                 "|---|---|---|---|",
                 *rows,
                 "",
@@ -257,12 +273,15 @@ def log_focus(
     loggers: Mapping[str, TrackerLogger],
     clock: Clock,
     shown: range,
+    thresholds: Mapping[str, float | None] | None = None,
 ) -> None:
-    """The summary document and, at every keyframe of ``shown``, the highlighted objects."""
+    """The summary document and, at every keyframe of ``shown``, the highlighted objects (thresholds: see
+    ``focus_markdown``)."""
     stream.log(
         focus_doc(),
         rr.TextDocument(
-            focus_markdown(focus, loggers, shown, scene, {run.tracker: run for run in runs}), media_type="text/markdown"
+            focus_markdown(focus, loggers, shown, scene, {run.tracker: run for run in runs}, thresholds),
+            media_type="text/markdown",
         ),
         static=True,
     )

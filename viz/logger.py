@@ -253,7 +253,7 @@ class TrackerLogger:
         self._rows.flush()
         for path, series in self._series.items():
             owner = self._track_series.get(path)
-            if owner is not None and owner[1] not in self._extracted_ids:
+            if owner is not None and owner[1] not in self._extracted_ids and owner[1] not in self._focused:
                 continue  # a candidate's series: only the per-class candidate count is kept
             colors = None if series.color is None else [series.color]
             self.stream.log(path, rr.SeriesLines(names=series.name, colors=colors), static=True)
@@ -572,15 +572,16 @@ class TrackerLogger:
             )
 
     def _record_posterior(self, class_name: str, cf: _ClassFrame) -> None:
-        """Existence samples and trail points of the Bernoullis worth following (r >= gate_min_existence or
-        already reported); candidates only count."""
+        """Existence samples and trail points of the Bernoullis worth following (r >= gate_min_existence,
+        already reported, or focused); candidates only count."""
         post = cf.posterior
         if post is None:
             return
         ids = np.asarray(post.track_ids, dtype=np.int64)
         existence = np.asarray(post.existence, dtype=np.float64)
         mean = np.asarray(post.mean, dtype=np.float64).reshape(-1, 4)
-        follow = np.flatnonzero((existence >= self.gate_min_existence) | np.isin(ids, list(self._extracted_ids)))
+        followed = list(self._extracted_ids | self._focused)
+        follow = np.flatnonzero((existence >= self.gate_min_existence) | np.isin(ids, followed))
         for k in follow.tolist():
             t = int(ids[k])
             self._track_sample(paths.existence, class_name, t, existence[k], "existence")
@@ -691,6 +692,7 @@ class TrackerLogger:
                     strict=True,
                 )
             )
+        self._story_focused(class_name, cf, posterior_r, known)
         pruned_ids = {p.track_id for p in cf.pruned}
         limit = max(cf.extracted.threshold if cf.extracted is not None else 0.0, self.show_min_existence)
         for t in sorted(self._reported - set(now) - pruned_ids):
@@ -738,6 +740,23 @@ class TrackerLogger:
                 f"{', '.join(map(str, shown_missed)) or 'none'}",
                 "DEBUG",
             )
+
+    def _story_focused(self, class_name: str, cf: _ClassFrame, posterior_r: dict[int, float], known: set[int]) -> None:
+        """A focused track below the show floor still gets one INFO line per frame: a failure is often about a
+        track the tracker kept but no longer reported (its low existence is the story)."""
+        hidden = sorted((self._focused & set(posterior_r)) - known)
+        if not hidden:
+            return
+        given = {}
+        if cf.assignment is not None:
+            given = {c.ref: r.ref for r, c in cf.assignment.pairs if c.kind is AxisKind.TRACK}
+        for t in hidden:
+            via = f"given {meas_name(given[t])}" if t in given else "given no detection"
+            self._text(class_name, f"focused track {t} (not shown): {via}, r={posterior_r[t]:.2f}", "INFO")
+
+    @property
+    def _focused(self) -> set[int]:
+        return self.focus_tracks or set()
 
     def _on_budget(self, event: BudgetReached) -> None:
         self._text(

@@ -174,6 +174,10 @@ class FailureReport:
     def of_kind(self, kind: FailureKind) -> list[Failure]:
         return [f for f in self.failures if f.kind is kind]
 
+    def threshold_of(self, class_name: str) -> float | None:
+        """The score from which the evaluation counted boxes of ``class_name`` (None: every box, or not scored)."""
+        return next((c.threshold for c in self.classes if c.class_name == class_name), None)
+
     def ids(self) -> list[str]:
         """A stable id per failure, in order: ``<kind>:<n>`` numbering each kind from 1 by frame (e.g.
         ``id_switch:2``); ``gnnpmb failures`` prints them and ``gnnpmb-viz --focus`` takes them."""

@@ -68,7 +68,7 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     panel = {k: v for _, r in bp for k, v in r.items() if k.startswith("TimePanelBlueprint:")}
     assert panel["TimePanelBlueprint:timeline"] == [FOCUS_TIMELINE]
     eyes = [r for path, r in bp if path.endswith("EyeControls3D")]
-    center = np.mean([b.translation_m[:2] for b in failure.boxes], axis=0)
+    center = np.mean([b.translation_m[:2] for b in failure.boxes if b.is_gt], axis=0)  # where the object is
     assert len(eyes) == 2  # bird's-eye and perspective, both looking at the place
     for eye in eyes:
         np.testing.assert_allclose(eye["EyeControls3D:look_target"][0][:2], center, atol=1e-3)
@@ -79,6 +79,11 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     assert summary.startswith(f"# {pick} at frame {failure.frame_index}")
     for t in failure.track_ids:
         assert f"Track {t}, frame by frame:" in summary
+    # The object's table gives the tracking score of every track output on it and whether the evaluation counted
+    # it; the involved tracks' existence is plotted whatever it is (a starved track is often the cause).
+    assert "frame by frame (the evaluation counted " in summary and "tracks output on it (score)" in summary
+    followed = [t for t in failure.track_ids if paths.existence("gnnpmb", failure.class_name, t) in rows]
+    assert followed, f"no existence series for the involved tracks {failure.track_ids}"
     highlighted = [r for r in rows[focus_world()] if r.get("frame") == failure.frame_index]
     labels = highlighted[0]["Boxes3D:labels"]
     assert any(label.startswith("GT ") for label in labels)
