@@ -136,7 +136,8 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
         if given:
             parts.append(f"last given a detection at frame {given[-1]} (m{steps[given[-1]].given})")
         else:
-            parts.append(f"given no detection in frames {frames[0]}-{frames[-1]}")
+            span = f"frames {frames[0]}-{frames[-1]}" if len(frames) > 1 else f"frame {frames[0]}"
+            parts.append(f"given no detection in {span}")
         if empty:
             parts.append(f"nothing in its gate at frame{'s' if len(empty) > 1 else ''} {_frames(empty)}")
         if passed:
@@ -216,7 +217,7 @@ def _gt_markdown(
             detected += nearest != "none"
             sent += [went] if nearest != "none" else []
         if rows:
-            news = sent.count("new")
+            news = sum(w.startswith("new") for w in sent)
             counted = (
                 "every output box"
                 if threshold is None
@@ -225,7 +226,7 @@ def _gt_markdown(
             out += [
                 f"**GT {short_id(gt_id)}**: a detection within {NEAR_DETECTION_M:.0f} m in {detected} of its {seen} "
                 f"frames up to {focus.frame_index}; {news} of them started a new track, the others went to "
-                f"{', '.join(sorted({w for w in sent if w not in ('new', '—')})) or 'no track'}.",
+                f"{', '.join(sorted({w for w in sent if w != '—' and not w.startswith('new')})) or 'no track'}.",
                 "",
                 f"GT {short_id(gt_id)}, frame by frame (the evaluation counted {counted}):",
                 "",

@@ -32,6 +32,7 @@ import rerun as rr
 from gnnpmb.events import (
     Assignment,
     AxisKind,
+    AxisLabel,
     Born,
     BudgetReached,
     Cardinality,
@@ -331,7 +332,7 @@ class TrackerLogger:
                 else:
                     decisions.append(d)
                     matrices[class_name] = cf.cost
-                    self._story_close_calls(d)
+                    self._story_close_calls(d, _born_tracks(cf))
         self._reported = reported
         self._classes = {}
         if decisions or fallbacks:
@@ -609,7 +610,8 @@ class TrackerLogger:
             given = {int(c.ref): int(r.ref) for r, c in cf.assignment.pairs if c.kind is AxisKind.TRACK}
         reported = {e.track_id for e in estimates}
         if cf.assignment is not None and any(t in self.focus_tracks for t in ids):
-            self.given[self._frame] = {int(r.ref): column_name(c) for r, c in cf.assignment.pairs}
+            born = _born_tracks(cf)
+            self.given[self._frame] = {int(r.ref): destination(c, born.get(int(r.ref))) for r, c in cf.assignment.pairs}
         meas_xy = {}
         if cf.meas is not None:
             xyz = np.asarray(cf.meas.xyz_m, dtype=np.float64).reshape(-1, 3)
@@ -765,7 +767,7 @@ class TrackerLogger:
             "WARN",
         )
 
-    def _story_close_calls(self, d: Decisions) -> None:
+    def _story_close_calls(self, d: Decisions, born: dict[int, int]) -> None:
         """Close calls that involve a reported track (between candidates they are routine)."""
         for conflict in d.conflicts:
             for c in conflict.choices:
@@ -777,7 +779,8 @@ class TrackerLogger:
                 if c.margin < CLOSE_CALL_MARGIN and c.alternative is not None and reported:
                     self._text(
                         d.class_name,
-                        f"close call: {meas_name(c.meas.ref)} → {column_name(c.chosen)} (cost {c.chosen_cost:.2f}) "
+                        f"close call: {meas_name(c.meas.ref)} → {destination(c.chosen, born.get(c.meas.ref))} "
+                        f"(cost {c.chosen_cost:.2f}) "
                         f"over {column_name(c.alternative)} ({c.alternative_cost:.2f}), margin {c.margin:.2f}",
                         "INFO",
                     )
@@ -927,6 +930,17 @@ def _pair_lines(pred_xy: np.ndarray, pred_rows: list[int], xyz: np.ndarray, meas
     end = xyz[np.asarray(meas_rows, dtype=np.int64)]
     start = np.column_stack([pred_xy[np.asarray(pred_rows, dtype=np.int64)], end[:, 2]])
     return np.stack([start, end], axis=1)
+
+
+def _born_tracks(cf: _ClassFrame) -> dict[int, int]:
+    """Detection index -> the id of the track it started this frame."""
+    return {int(m): int(t) for b in cf.born for t, m in zip(b.track_ids, b.meas_indices, strict=True)}
+
+
+def destination(column: AxisLabel, born_id: int | None) -> str:
+    """Where a detection went, in words: ``column_name``, with the id of the track a "new" detection started."""
+    name = column_name(column)
+    return f"new track {born_id}" if column.kind is AxisKind.NEW_TRACK and born_id is not None else name
 
 
 def _labels(template: str, track_ids: np.ndarray, existence: np.ndarray) -> list[str]:

@@ -370,3 +370,13 @@ def test_nis_of_many_pairs_at_once_equals_the_per_pair_formula_to_the_last_bit()
         nu = zk - gated.center_xy[t - 100]
         assert value == float(nu @ np.linalg.solve(gated.innovation_cov[t - 100], nu))
     assert _nis_of(None, [1, 2], z[:2]) == [None, None]
+
+
+def test_a_detection_that_started_a_track_is_named_with_that_tracks_id() -> None:
+    """Story lines and focus tables say "m2 -> new track 315", so a reader can follow the new track."""
+    from gnnpmb.events import AxisKind, AxisLabel
+    from viz.logger import destination
+
+    assert destination(AxisLabel(AxisKind.NEW_TRACK, 2), 315) == "new track 315"
+    assert destination(AxisLabel(AxisKind.NEW_TRACK, 2), None) == "new"  # clutter: no track started
+    assert destination(AxisLabel(AxisKind.TRACK, 61), None) == "track 61"
