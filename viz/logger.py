@@ -752,8 +752,12 @@ class TrackerLogger:
         given = {}
         if cf.assignment is not None:
             given = {c.ref: r.ref for r, c in cf.assignment.pairs if c.kind is AxisKind.TRACK}
+        started = {t: m for m, t in _born_tracks(cf).items()}
         for t in hidden:
-            via = f"given {meas_name(given[t])}" if t in given else "given no detection"
+            if t in started:
+                via = f"started by {meas_name(started[t])}"
+            else:
+                via = f"given {meas_name(given[t])}" if t in given else "given no detection"
             self._text(class_name, f"focused track {t} (not shown): {via}, r={posterior_r[t]:.2f}", "INFO")
 
     @property

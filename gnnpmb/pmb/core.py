@@ -297,12 +297,12 @@ class PmbCore:
         if len(self.hypotheses) == 1:
             h = self.hypotheses[0]
             prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
-            local = local_hypotheses(prior, meas, new, model.R, p.gate_chi2)
+            local = local_hypotheses(prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max)
             return [GlobalHypothesis(h.log_weight, prior)], [local]
         every = Bernoullis.concatenate([h.bernoullis for h in self.hypotheses])
         _, first, inverse = np.unique(every.local_key, return_index=True, return_inverse=True)
         union_prior = predict_bernoullis(every.subset(first), model, p.p_survive)
-        union_local = local_hypotheses(union_prior, meas, new, model.R, p.gate_chi2)
+        union_local = local_hypotheses(union_prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max)
         bounds = np.cumsum([0] + [len(h.bernoullis) for h in self.hypotheses])
         members = [inverse[start:stop] for start, stop in zip(bounds[:-1], bounds[1:], strict=True)]
         priors = [

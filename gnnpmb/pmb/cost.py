@@ -90,12 +90,18 @@ class LocalHypotheses:
 
 
 def local_hypotheses(
-    prior: Bernoullis, meas: Measurements, new: NewTrackHypotheses, R: np.ndarray, gate_chi2: float
+    prior: Bernoullis,
+    meas: Measurements,
+    new: NewTrackHypotheses,
+    R: np.ndarray,
+    gate_chi2: float,
+    miss_p_detect_max: float = 1.0,
 ) -> LocalHypotheses:
-    """Gate every (track, measurement) pair and compute the local hypothesis likelihoods (module docstring)."""
+    """Gate every (track, measurement) pair and compute the local hypothesis likelihoods (module docstring); a
+    missed track's P_D is its last detection score capped at ``miss_p_detect_max`` (``PmbParams``)."""
     gating = gate_tracks(prior.mean, prior.cov, R, meas.z, gate_chi2)
     inn, d2, inside = gating.inn, gating.d2, gating.inside
-    miss_log_lik, miss_existence = missed_update(prior.existence, prior.score)
+    miss_log_lik, miss_existence = missed_update(prior.existence, np.minimum(prior.score, miss_p_detect_max))
     with np.errstate(divide="ignore"):
         det = np.log(prior.existence)[:, None] + np.log(meas.boxes.score)[None, :] + log_likelihood(inn, d2)
     det_log_lik = np.where(inside, det, -np.inf)

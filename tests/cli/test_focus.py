@@ -18,7 +18,7 @@ from tests.viz.rrd import read_rows
 from viz import paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world
 
-SCENE = "scene-0916"
+SCENE = "scene-0103"
 SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
 ARGS = ["--detector", "pointpillars"]
 
@@ -117,8 +117,8 @@ def test_focus_in_a_comparison_highlights_each_trackers_tracks(
     [
         ("switch", "bad --focus 'switch': use track:ID, gt:TOKEN or a failure id such as id_switch:1"),
         ("track:abc", "bad --focus 'track:abc': track:ID takes a track number"),
-        ("id_switch:999", "--focus id_switch:999: no such failure of gnnpmb on scene-0916"),
-        ("gt:zzzz", "--focus gt:zzzz: no ground-truth object of scene-0916 has an id starting so"),
+        ("id_switch:999", "--focus id_switch:999: no such failure of gnnpmb on scene-0103"),
+        ("gt:zzzz", "--focus gt:zzzz: no ground-truth object of scene-0103 has an id starting so"),
     ],
 )
 def test_bad_focus_is_one_line_and_exit_2(demo_dataroot: Path, tmp_path: Path, focus: str, message: str) -> None:

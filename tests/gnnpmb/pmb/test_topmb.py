@@ -237,3 +237,22 @@ def test_demo_scene_runs_without_nan(demo_dataroot):
     for e in estimates:
         assert np.all(np.isfinite(e.translation_m)) and np.all(np.isfinite(e.velocity_mps))
         assert 0.0 <= e.existence <= 1.0 and 0.0 <= e.score <= 1.0
+
+
+def test_a_missed_tracks_detection_probability_is_capped_by_miss_p_detect_max() -> None:
+    """Hand-computed misdetection hypothesis: r = 0.95, last score 0.9. Paper (no cap): l0 = 1 - 0.855 = 0.145,
+    r' = 0.095 / 0.145 = 0.655; capped at 0.3: l0 = 1 - 0.285 = 0.715, r' = 0.665 / 0.715 = 0.930. The default
+    config caps (``PmbParams.miss_p_detect_max``); the paper's file does not."""
+    prior = make_prior([[0.0, 0.0, 0.0, 0.0]], [0.95], score=0.9)
+    meas = make_measurements([(30.0, 0.0)], 0.7)  # outside the gate: only the misdetection matters
+    new = new_track_hypotheses(measurement_birth(meas, P), meas, R, P.clutter_intensity)
+    paper = local_hypotheses(prior, meas, new, R, P.gate_chi2)
+    capped = local_hypotheses(prior, meas, new, R, P.gate_chi2, miss_p_detect_max=0.3)
+    np.testing.assert_allclose(np.exp(paper.miss_log_lik), [0.145])
+    np.testing.assert_allclose(paper.miss_existence, [0.095 / 0.145])
+    np.testing.assert_allclose(np.exp(capped.miss_log_lik), [0.715])
+    np.testing.assert_allclose(capped.miss_existence, [0.665 / 0.715])
+    assert CFG.pmb.miss_p_detect_max == 1.0
+    from gnnpmb.config import TrackerConfig
+
+    assert TrackerConfig().pmb.miss_p_detect_max == 0.3
