@@ -209,8 +209,8 @@ class PmbParams:
     (paper: no cap, 1.0). With the paper's rule (r' = r (1 - P_D) / (1 - r P_D) after P_S = 0.95) a track last
     detected at 0.9 falls 0.95 -> 0.48 -> 0.08 -> 0.01 in three missed frames; with the cap 0.3, 0.95 -> 0.87 ->
     0.76 -> 0.65. A returning object's detection then updates its track instead of starting a new one (seen with
-    ``--focus identity_theft:1`` on
-    scene-0103 pointpillars: "m2 -> new track 315 over track 61, margin 0.31"). 0.3 was chosen on the demo
+    ``--focus identity_theft:1`` on scene-0103 pointpillars: "m2 -> new track 315 over track 61, margin 0.31").
+    0.3 was chosen on the demo
     ``mini_train`` split among 1.0 / 0.7 / 0.5 / 0.3 (gnnpmb AMOTA centerpoint 0.878 / 0.912 / 0.926 / 0.925,
     pointpillars 0.799 / 0.803 / 0.802 / 0.828; IDS 27 -> 4 and 18 -> 4).
     measure_velocity: 1 = measure [x, y, vx, vy] (opt-in variant, ``kalman``), 0 = the paper's [x, y].
