@@ -19,6 +19,7 @@ from gnnpmb.pipeline import run_tracker
 from gnnpmb.provenance import PACKAGES
 from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.session import find_reports, parse_classes, parse_frames, prepare
+from tests.inprocess import run_main
 from tests.viz.rrd import at_frame, read_rows
 from viz import paths
 from viz.provenance import PROPERTY_ENTITY, read_provenance
@@ -29,14 +30,8 @@ SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
 
 
 def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    """Run the app in-process: (exit code, stdout, stderr)."""
-    try:
-        main(argv)
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out, err = capsys.readouterr()
-    return code, out, err
+    """The command in-process: (exit code, stdout, stderr)."""
+    return run_main(main, argv, capsys)
 
 
 @pytest.fixture(scope="module")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 import subprocess
@@ -13,20 +14,15 @@ import pytest
 from cli.batch import app, default_split
 from cli.errors import run_app
 from gnnpmb.eval.submission import check_submission
+from tests.inprocess import run_main
 
 SCRIPT = Path(sys.executable).parent / "gnnpmb"
 N_SAMPLES = 80
 
 
 def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    """Run the app in-process: (exit code, stdout, stderr)."""
-    try:
-        run_app(app, argv)
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out, err = capsys.readouterr()
-    return code, out, err
+    """The command in-process: (exit code, stdout, stderr)."""
+    return run_main(functools.partial(run_app, app), argv, capsys)
 
 
 def run_quiet(argv: list[str]) -> tuple[int, str]:

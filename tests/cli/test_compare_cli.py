@@ -21,6 +21,7 @@ from gnnpmb.pipeline import run_tracker
 from gnnpmb.provenance import Provenance, TrackDigest
 from gnnpmb.session import compare_runs, prepare
 from tests.gnnpmb.test_compare import A_FRAMES, B_FRAMES, GT
+from tests.inprocess import run_main
 from tests.viz.rrd import at_frame, read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
@@ -33,14 +34,8 @@ MAX_RECORDING_BYTES = 50_000_000
 
 
 def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    """Run ``gnnpmb-viz`` in-process: (exit code, stdout, stderr)."""
-    try:
-        main(argv)
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out, err = capsys.readouterr()
-    return code, out, err
+    """The command in-process: (exit code, stdout, stderr)."""
+    return run_main(main, argv, capsys)
 
 
 @pytest.fixture(scope="module")

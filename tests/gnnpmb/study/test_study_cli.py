@@ -6,6 +6,7 @@ Ray tests share one local Ray session per module (``ray_local``); in-process run
 from __future__ import annotations
 
 import csv
+import functools
 import json
 import tomllib
 from pathlib import Path
@@ -17,18 +18,14 @@ from cli.errors import run_app
 from gnnpmb.config import load_config
 from gnnpmb.study.results import TIME_COLUMNS
 from gnnpmb.study.tune import DEFAULT_CLASS_SPACE
+from tests.inprocess import run_main
 
 SWEEP = ["--param", "pmb.extraction_threshold=0.5,0.9", "--no-progress", "--detector", "pointpillars"]
 
 
 def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
-    try:
-        run_app(app, argv)
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    out, err = capsys.readouterr()
-    return code, out, err
+    """The command in-process: (exit code, stdout, stderr)."""
+    return run_main(functools.partial(run_app, app), argv, capsys)
 
 
 def scores(rows: list[dict]) -> list[dict]:
