@@ -251,7 +251,9 @@ def failures(
     check_tracker(tracker)
 
     from gnnpmb.config import load_config
+    from gnnpmb.data.demo import cache_root
     from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.eval.failure_cache import cached_report
     from gnnpmb.eval.failures import find_failures
     from gnnpmb.eval.submission import run_results, write_json
     from gnnpmb.pipeline import get_detections, run_tracker
@@ -263,7 +265,10 @@ def failures(
     nusc = open_nuscenes(location)
     scene_data = load_scene(nusc, location, scene)
     run = run_tracker(scene_data, get_detections(scene_data, detections, preset, seed), tracker, config)
-    report = find_failures(nusc, scene, run_results(run), tracker)
+    results = run_results(run)
+    report = cached_report(
+        cache_root(), location, scene, tracker, results, lambda: find_failures(nusc, scene, results, tracker)
+    )
     if json_target is not None:
         write_json(json_target, report.to_json())
     print_report(report, _stdout())

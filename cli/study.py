@@ -298,8 +298,7 @@ def _provenance(
     params: Path | None,
 ) -> list[str]:
     """Comment header of a tuned parameter file: search space, trials, data, versions, scores."""
-    from gnnpmb.provenance import package_versions
-    from gnnpmb.study.data import code_version
+    from gnnpmb.provenance import code_version, package_versions
     from gnnpmb.study.evaluate import class_column
     from gnnpmb.types import TRACKING_CLASSES
 

@@ -28,12 +28,15 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from gnnpmb.errors import DataError
 from gnnpmb.types import Boxes, TrackEstimate
+
+if TYPE_CHECKING:
+    from gnnpmb.data.nuscenes import DatasetLocation
 
 FORMAT_VERSION = 1
 """Bumped when the stored layout or the digest definition changes."""
@@ -294,3 +297,31 @@ class Provenance:
         except json.JSONDecodeError as exc:
             raise DataError(f"the stored provenance is not valid JSON ({exc})") from None
         return Provenance.from_json(data)
+
+
+def tables_fingerprint(location: DatasetLocation) -> list[list[Any]]:
+    """Name, size and modification time of every table file: cheap even for trainval, and changes whenever a
+    table is rewritten."""
+    folder = location.dataroot / location.version
+    return [[p.name, p.stat().st_size, p.stat().st_mtime_ns] for p in sorted(folder.glob("*.json"))]
+
+
+_SCORING_STUDY_FILES = frozenset({"study/data.py", "study/evaluate.py"})
+
+
+def code_version() -> str:
+    """SHA-256 of the ``gnnpmb`` package's source files and the versions of the packages that score the runs,
+    so a change of tracker code or of the evaluation invalidates cached results. Of ``gnnpmb/study`` only the
+    files that produce scores count (editing plots or the runner keeps the cache)."""
+    import gnnpmb
+
+    root = Path(gnnpmb.__file__).parent
+    digest = hashlib.sha256()
+    for path in sorted(root.rglob("*")):
+        relative = path.relative_to(root).as_posix()
+        if relative.startswith("study/") and relative not in _SCORING_STUDY_FILES:
+            continue
+        if path.suffix in (".py", ".toml") and path.is_file():
+            digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes() + b"\0")
+    digest.update(json.dumps(package_versions(("nuscenes-devkit", "motmetrics", "numpy")), sort_keys=True).encode())
+    return digest.hexdigest()

@@ -368,20 +368,32 @@ def compare_runs(runs: Sequence[TrackingRun]) -> Comparison:
 def find_reports(
     request: ViewRequest, runs: Sequence[TrackingRun], on_done: Callable[[], None] = lambda: None
 ) -> tuple[dict[str, FailureReport], list[str]]:
-    """Each run's failures found with the devkit's matching, and notices: a scene without ground truth, or one
-    the devkit cannot evaluate, gives no reports."""
+    """Each run's failures found with the devkit's matching (or stored from an earlier run of the same tracks,
+    ``eval.failure_cache``), and notices: a scene without ground truth, or one the devkit cannot evaluate, gives
+    no reports."""
+    from gnnpmb.data.demo import cache_root
     from gnnpmb.data.nuscenes import open_nuscenes
+    from gnnpmb.eval.failure_cache import cached_report
     from gnnpmb.eval.failures import find_failures
     from gnnpmb.eval.submission import run_results
 
     scene = request.scene
     if not any(len(k.gt) for k in scene.keyframes):
         return {}, [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
-    nusc = open_nuscenes(request.location)
     reports = {}
     for run in runs:
+        results = run_results(run)
         try:
-            reports[run.tracker] = find_failures(nusc, scene.name, run_results(run), run.tracker)
+            reports[run.tracker] = cached_report(
+                cache_root(),
+                request.location,
+                scene.name,
+                run.tracker,
+                results,
+                lambda results=results, tracker=run.tracker: find_failures(
+                    open_nuscenes(request.location), scene.name, results, tracker
+                ),
+            )
         except DataError as exc:
             return {}, [f"failure markers skipped: {exc}"]
         on_done()

@@ -747,16 +747,20 @@ def generate_demo_dataset(out_dir: Path, seed: int = DEMO_SEED, scenes: tuple[st
     return out_dir
 
 
-def demo_cache_dir(full: bool = False) -> Path:
-    """Where ``ensure_demo_dataset`` keeps the demo: ``$GNNPMB_CACHE_DIR`` or the user cache dir of gnnpmb-viz,
-    in a ``demo-v<GENERATOR_VERSION>`` subfolder (the two mini_val scenes) or ``demo-v<GENERATOR_VERSION>-all``
-    (all ten scenes, when ``full``)."""
+def cache_root() -> Path:
+    """gnnpmb-viz's cache folder: ``$GNNPMB_CACHE_DIR`` or the user cache dir of gnnpmb-viz."""
     root = os.environ.get(CACHE_ENV)
     if not root:
         import platformdirs
 
         root = platformdirs.user_cache_dir("gnnpmb-viz")
-    return Path(root).expanduser() / f"demo-v{GENERATOR_VERSION}{'-all' if full else ''}"
+    return Path(root).expanduser()
+
+
+def demo_cache_dir(full: bool = False) -> Path:
+    """Where ``ensure_demo_dataset`` keeps the demo: a ``demo-v<GENERATOR_VERSION>`` subfolder of ``cache_root``
+    (the two mini_val scenes) or ``demo-v<GENERATOR_VERSION>-all`` (all ten scenes, when ``full``)."""
+    return cache_root() / f"demo-v{GENERATOR_VERSION}{'-all' if full else ''}"
 
 
 TRAIN_NEEDS = ("mini_train", "train")

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import enum
 import json
+import math
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -142,6 +143,29 @@ class Failure:
             ],
         }
 
+    @staticmethod
+    def from_json(data: Mapping[str, Any]) -> Failure:
+        """The failure ``to_json`` wrote (its description is derived, so not read)."""
+        return Failure(
+            kind=FailureKind(data["kind"]),
+            frame_index=int(data["frame_index"]),
+            sample_token=str(data["sample_token"]),
+            class_name=str(data["class_name"]),
+            gt_ids=tuple(data["gt_ids"]),
+            track_ids=tuple(data["track_ids"]),
+            boxes=tuple(
+                FailureBox(
+                    role=b["role"],
+                    object_id=b["id"],
+                    translation_m=tuple(b["translation"]),
+                    size_wlh_m=tuple(b["size"]),
+                    quat_wxyz=tuple(b["rotation"]),
+                )
+                for b in data["boxes"]
+            ),
+            generation=int(data["generation"]),
+        )
+
 
 @dataclass(frozen=True, slots=True)
 class ClassEvaluation:
@@ -216,6 +240,26 @@ class FailureReport:
             "totals": {kind.value: len(self.of_kind(kind)) for kind in FailureKind},
             "failures": [f.to_json() for f in self.failures],
         }
+
+    @staticmethod
+    def from_json(data: Mapping[str, Any]) -> FailureReport:
+        """The report ``to_json`` wrote (totals are derived, so not read; a null count reads as NaN)."""
+        counts = ("mota", "tp", "fp", "fn", "ids", "frag")
+        return FailureReport(
+            scene_name=str(data["scene"]),
+            tracker=str(data["tracker"]),
+            sample_tokens=tuple(data["sample_tokens"]),
+            classes=tuple(
+                ClassEvaluation(
+                    c["class_name"],
+                    None if c["threshold"] is None else float(c["threshold"]),
+                    *(math.nan if c[k] is None else float(c[k]) for k in counts),
+                )
+                for c in data["classes"]
+            ),
+            failures=tuple(Failure.from_json(f) for f in data["failures"]),
+            coalescence_radius_m=float(data["coalescence_radius_m"]),
+        )
 
 
 def _json_number(value: float) -> float | None:

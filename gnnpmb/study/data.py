@@ -100,17 +100,10 @@ def track_scene(data: StudyData, scene_name: str, tracker: str, config: TrackerC
     )
 
 
-def _tables_fingerprint(location: DatasetLocation) -> list[list[Any]]:
-    """Name, size and modification time of every table file: cheap even for trainval, and changes whenever a
-    table is rewritten."""
-    folder = location.dataroot / location.version
-    return [[p.name, p.stat().st_size, p.stat().st_mtime_ns] for p in sorted(folder.glob("*.json"))]
-
-
 def inputs_fingerprint(data: StudyData) -> str:
     """SHA-256 of what the results depend on apart from parameters and code: dataset path, version, tables,
     split scenes, and the detections (a file's bytes, or the simulated preset and seed)."""
-    from gnnpmb.provenance import file_sha256
+    from gnnpmb.provenance import file_sha256, tables_fingerprint
 
     detections: Any = (
         {"file_sha256": file_sha256(data.detections)}
@@ -120,31 +113,9 @@ def inputs_fingerprint(data: StudyData) -> str:
     blob = {
         "dataroot": str(data.location.dataroot),
         "version": data.location.version,
-        "tables": _tables_fingerprint(data.location),
+        "tables": tables_fingerprint(data.location),
         "split": data.split,
         "scenes": list(data.scene_names),
         "detections": detections,
     }
     return hashlib.sha256(json.dumps(blob, sort_keys=True).encode()).hexdigest()
-
-
-_SCORING_STUDY_FILES = frozenset({"study/data.py", "study/evaluate.py"})
-
-
-def code_version() -> str:
-    """SHA-256 of the ``gnnpmb`` package's source files and the versions of the packages that score the runs,
-    so a change of tracker code or of the evaluation invalidates cached results. Of ``gnnpmb/study`` only the
-    files that produce scores count (editing plots or the runner keeps the cache)."""
-    import gnnpmb
-    from gnnpmb.provenance import package_versions
-
-    root = Path(gnnpmb.__file__).parent
-    digest = hashlib.sha256()
-    for path in sorted(root.rglob("*")):
-        relative = path.relative_to(root).as_posix()
-        if relative.startswith("study/") and relative not in _SCORING_STUDY_FILES:
-            continue
-        if path.suffix in (".py", ".toml") and path.is_file():
-            digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes() + b"\0")
-    digest.update(json.dumps(package_versions(("nuscenes-devkit", "motmetrics", "numpy")), sort_keys=True).encode())
-    return digest.hexdigest()

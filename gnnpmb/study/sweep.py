@@ -10,8 +10,9 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from gnnpmb.provenance import code_version
 from gnnpmb.study.cache import ResultCache, config_key
-from gnnpmb.study.data import StudyData, code_version, inputs_fingerprint
+from gnnpmb.study.data import StudyData, inputs_fingerprint
 from gnnpmb.study.evaluate import ConfigJob, score_config
 from gnnpmb.study.grid import (
     Assignment,

@@ -1,0 +1,79 @@
+"""Failure reports kept between runs, so reopening a scene does not evaluate the same tracks again.
+
+``find_failures`` runs the devkit's evaluation of a scene (about 3 s of a 6 s ``gnnpmb-viz`` run on the demo);
+an engineer often runs the same command again, e.g. with ``--focus`` on a failure the first run listed. A
+report is a pure function of the scene's ground truth, the tracker's submission boxes and the code, so it is
+stored under ``<cache root>/failures/<key>.json`` where key = SHA-256 of (scene, tracker, the submission boxes,
+the dataset's table files (name, size, mtime), the code version: ``gnnpmb`` sources and devkit, motmetrics and
+numpy versions). Any change of tracks, parameters, data or code gives another key. A damaged file counts as
+absent and one that cannot be written is skipped; files are written atomically, and only the newest
+``MAX_REPORTS`` are kept.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from gnnpmb.eval.failures import FailureReport
+from gnnpmb.study.cache import ResultCache
+
+if TYPE_CHECKING:
+    from gnnpmb.data.nuscenes import DatasetLocation
+
+FAILURES_FOLDER = "failures"
+MAX_REPORTS = 500
+"""The cache keeps the most recently written reports up to this many (each is tens of kB)."""
+
+
+def report_key(
+    location: DatasetLocation, scene_name: str, tracker: str, results: Mapping[str, Sequence[Mapping[str, Any]]]
+) -> str:
+    """Cache key (hex SHA-256) of the failure report of ``results`` (submission boxes by sample token)."""
+    from gnnpmb.provenance import code_version, tables_fingerprint
+
+    blob = {
+        "dataroot": str(location.dataroot),
+        "version": location.version,
+        "tables": tables_fingerprint(location),
+        "scene": scene_name,
+        "tracker": tracker,
+        "results": results,
+        "code": code_version(),
+    }
+    return hashlib.sha256(json.dumps(blob, sort_keys=True, allow_nan=True).encode()).hexdigest()
+
+
+def cached_report(
+    root: Path,
+    location: DatasetLocation,
+    scene_name: str,
+    tracker: str,
+    results: Mapping[str, Sequence[Mapping[str, Any]]],
+    find: Callable[[], FailureReport],
+) -> FailureReport:
+    """The stored report for these inputs, else ``find()``'s, stored under ``root/failures``."""
+    cache = ResultCache(root / FAILURES_FOLDER)
+    key = report_key(location, scene_name, tracker, results)
+    stored = cache.get(key)
+    if stored is not None:
+        try:
+            return FailureReport.from_json(stored)
+        except (KeyError, TypeError, ValueError):
+            pass  # written by an incompatible version: evaluate again and overwrite
+    report = find()
+    with contextlib.suppress(OSError):  # a read-only or full cache only costs the next run the evaluation
+        cache.put(key, report.to_json())
+        _drop_oldest(root / FAILURES_FOLDER, MAX_REPORTS)
+    return report
+
+
+def _drop_oldest(folder: Path, keep: int) -> None:
+    """Delete all but the ``keep`` most recently modified reports in ``folder``."""
+    files = sorted(folder.glob("*.json"), key=lambda p: p.stat().st_mtime_ns, reverse=True)
+    for path in files[keep:]:
+        path.unlink(missing_ok=True)
