@@ -38,7 +38,9 @@ BEV_EYE_POSITION_M = (12.0, 0.0, 80.0)
 BEV_TARGET_M = (12.0, 0.0, 0.0)
 """Bird's-eye camera in the ego frame: straight down on a point 12 m ahead, forward pointing up the screen."""
 FOCUS_HEIGHT_M: dict[str, float] = {"pedestrian": 16.0, "bicycle": 18.0, "motorcycle": 18.0, "car": 28.0}
-"""Height of the bird's-eye camera above a focused place by class (small objects closer); 40 m otherwise."""
+"""Height of the bird's-eye camera above a focused place by class (small objects closer)."""
+DEFAULT_FOCUS_HEIGHT_M = 40.0
+"""The same for the other classes."""
 STORY_COLUMNS = rrb.TextLogColumns(
     text_log_columns=[
         rrb.components.TextLogColumn(kind="LogLevel", visible=True),
@@ -72,10 +74,14 @@ def _contents(tracker: str) -> list[str]:
     return ["+ world/**", "- world/trackers/**", f"+ {paths.tracker_world(tracker)}/**"]
 
 
-def _hidden(tracker: str, *, lidar: bool) -> dict[str, rrb.EntityBehavior]:
+def _hidden(tracker: str, *, lidar: bool, callouts: bool = False) -> dict[str, rrb.EntityBehavior]:
+    """Entities a view holds but does not show: candidates, suppressed detections, the LiDAR (``lidar``) and
+    the focus callouts (``callouts``; their column is laid out for the bird's-eye camera)."""
     hidden = [paths.tracker_world(tracker) + "/candidates", paths.DETECTIONS_SUPPRESSED]
     if lidar:
         hidden.append(paths.LIDAR)
+    if callouts:
+        hidden += [paths.focus_callouts(tracker), paths.focus_callouts(tracker) + "/leaders"]
     return {p: rrb.EntityBehavior(visible=False) for p in hidden}
 
 
@@ -92,7 +98,7 @@ def spatial_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3
         contents=_contents(tracker),
         name=f"{tracker} 3D",
         eye_controls=eye,
-        overrides=_hidden(tracker, lidar=False),
+        overrides=_hidden(tracker, lidar=False, callouts=focus is not None),
     )
 
 
@@ -104,7 +110,7 @@ def bev_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3DVie
     else:
         x, y = focus.center_xy_m
         origin = paths.WORLD
-        height = FOCUS_HEIGHT_M.get(focus.class_name, 40.0)
+        height = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
         eye = rrb.EyeControls3D(position=(x, y, height), look_target=(x, y, 0.0), eye_up=(0, 1, 0))
     return rrb.Spatial3DView(
         origin=origin,

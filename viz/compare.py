@@ -93,10 +93,16 @@ def _markers(
 
 
 def log_comparison(
-    stream: rr.RecordingStream, comparison: Comparison, scene: SceneData, clock: Clock = PLAIN_CLOCK
+    stream: rr.RecordingStream,
+    comparison: Comparison,
+    scene: SceneData,
+    clock: Clock = PLAIN_CLOCK,
+    *,
+    show_labels: bool = True,
 ) -> None:
     """Log ``comparison`` (over keyframes of ``scene``) on the recording's timelines (``clock``): per kind a
-    count at every compared frame and marker boxes (an empty batch at frames without any), plus the text log."""
+    count at every compared frame and marker boxes (an empty batch at frames without any), plus the text log.
+    show_labels: show the marker labels (a focus recording labels the involved objects itself)."""
     frames = np.asarray(comparison.frame_indices, dtype=np.int64)
     stamps = np.array([scene.keyframes[i].timestamp_us for i in frames.tolist()], dtype=np.int64)
     for kind in DisagreementKind:
@@ -119,6 +125,7 @@ def log_comparison(
             scale=MARKER_SCALE,
             margin_m=MARKER_MARGIN_M,
             line_radius_m=MARKER_LINE_RADIUS_M,
+            show_labels=show_labels,
         )
     if comparison.disagreements:
         at = np.array([d.frame_index for d in comparison.disagreements], dtype=np.int64)

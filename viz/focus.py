@@ -4,9 +4,12 @@
   about them at the focus frame (the conflict tables of the decision view) and the story lines of the involved
   tracks, so the document alone explains the failure;
 * ``world/focus``: the involved ground-truth objects and the detections the involved tracks were given, drawn
-  slightly enlarged in their class colours with their labels shown (``GT 8bccf2``, ``m10 0.83``);
+  slightly enlarged in their class colours;
 * ``world/trackers/<tracker>/focus``: that tracker's involved tracks, enlarged, in their colours (their own
-  boxes carry the id labels).
+  boxes carry the id labels);
+* ``world/trackers/<tracker>/focus/callouts``: the labels of the involved objects (``GT 8bccf2``, ``m10 0.83``,
+  ``26 predicted r=0.04``) in a column beside them with leader lines (``viz.callouts``), so labels of objects
+  on one spot do not cover each other.
 """
 
 from __future__ import annotations
@@ -21,12 +24,14 @@ from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import short_id
 from gnnpmb.focus import FocusTarget
 from gnnpmb.pipeline import TrackingRun
+from gnnpmb.types import Boxes
 from viz import paths
-from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world
-from viz.colors import class_ids, track_colors
+from viz.blueprint import DEFAULT_FOCUS_HEIGHT_M, FOCUS_HEIGHT_M, FOCUS_TIMELINE, focus_doc, focus_world
+from viz.callouts import Callout, log_callouts
+from viz.colors import CLASS_COLORS, class_ids, track_colors
 from viz.decisions import conflict_markdown
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
-from viz.logger import TrackerLogger
+from viz.logger import TrackerLogger, TrackStep
 from viz.scene import detection_label
 from viz.timeline import Clock
 
@@ -45,6 +50,7 @@ LEGEND = (
     "gate that it was not given; enlarged boxes mark failures (magenta ID switch, orange fragmentation, red false "
     "track, green coalescence, yellow identity theft, grey miss) and the involved objects carry their labels."
 )
+GREY = (160, 160, 160)
 NEAR_DETECTION_M = 2.0
 """A detection or track within this BEV distance of a ground-truth object is "on" it (the devkit's match
 distance)."""
@@ -288,6 +294,7 @@ def log_focus(
     )
     frames = {run.tracker: {f.keyframe.index: f for f in run.frames} for run in runs}
     gt_ids = set(focus.gt_ids)
+    height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
     for i in shown:
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
@@ -298,11 +305,17 @@ def log_focus(
         quats = [quat_wxyz_to_xyzw(gt.quat_wxyz[rows])]
         names = [gt.class_name[rows]]
         labels = [f"GT {short_id(str(t))}" for t in gt.instance_id[rows]]
+        gt_callouts = [
+            Callout(tuple(gt.translation_m[r]), label, CLASS_COLORS.get(str(gt.class_name[r]), GREY))
+            for r, label in zip(rows.tolist(), labels, strict=True)
+        ]
+        z_m = float(gt.translation_m[rows[0], 2]) if rows.size else scene.ground_z_m
         meas: set[int] = set()
         detections = None
         for tracker, ids in focus.track_ids.items():
             frame = frames[tracker].get(i)
             if frame is None:
+                log_callouts(stream, paths.focus_callouts(tracker), [], height_m)
                 continue
             chosen = [e for e in frame.estimates if e.track_id in ids]
             boxes = estimate_boxes(chosen)
@@ -316,8 +329,17 @@ def log_focus(
                     radii=LINE_RADIUS_M,
                 ),
             )
-            meas |= {e.meas_index for e in chosen if e.meas_index >= 0}
+            steps = {t: loggers[tracker].track_steps.get(t, {}).get(i) for t in sorted(ids)}
+            given = {e.meas_index for e in chosen if e.meas_index >= 0}
+            given |= {s.given for s in steps.values() if s is not None and s.given >= 0}
+            meas |= given
             detections = frame.detections.boxes
+            log_callouts(
+                stream,
+                paths.focus_callouts(tracker),
+                gt_callouts + _detection_callouts(detections, sorted(given)) + _prediction_callouts(steps, z_m),
+                height_m,
+            )
         if meas and detections is not None:
             given = sorted(meas)
             det = detections.subset(np.array(given, dtype=np.int64))
@@ -336,6 +358,31 @@ def log_focus(
                 class_ids=class_ids(np.concatenate(names)),
                 labels=labels,
                 radii=LINE_RADIUS_M,
-                show_labels=True,
+                show_labels=False,
             ),
         )
+
+
+def _detection_callouts(detections: Boxes, given: list[int]) -> list[Callout]:
+    """``m<idx> <score>`` at each detection ``given`` (indices into the frame's detections)."""
+    return [
+        Callout(
+            tuple(detections.translation_m[m]),
+            detection_label(m, detections.score[m]),
+            CLASS_COLORS.get(str(detections.class_name[m]), GREY),
+        )
+        for m in given
+    ]
+
+
+def _prediction_callouts(steps: Mapping[int, TrackStep | None], z_m: float) -> list[Callout]:
+    """``<id> predicted r=<prior existence>`` at each focused track's predicted position this frame."""
+    return [
+        Callout(
+            (*step.predicted_xy_m, z_m),
+            f"{t} predicted r={step.prior_existence:.2f}",
+            tuple(int(v) for v in track_colors(np.array([t], dtype=np.int64))[0]),
+        )
+        for t, step in steps.items()
+        if step is not None
+    ]

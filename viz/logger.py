@@ -465,7 +465,7 @@ class TrackerLogger:
                     path,
                     rr.Points3D,
                     sel.size,
-                    static={"show_labels": path != paths.predicted(self.tracker, class_name)},
+                    static={"show_labels": False},
                     positions=lift_xy(xy[sel], self._z_of(ids[sel])),
                     colors=packed_track_colors(ids[sel]),
                     radii=np.full(sel.size, PREDICTED_POINT_RADIUS_M, dtype=np.float32),

@@ -35,6 +35,11 @@ def tracker_world(tracker: str) -> str:
     return f"{WORLD_TRACKERS}/{_name(tracker)}"
 
 
+def focus_callouts(tracker: str) -> str:
+    """Points3D labels and leader lines of a focus recording's involved objects in one tracker's views."""
+    return f"{tracker_world(tracker)}/focus/callouts"
+
+
 def tracks(tracker: str, class_name: str) -> str:
     """Parent of the extracted tracks of one class (one entity per track, ``track``)."""
     return f"{tracker_world(tracker)}/tracks/{_name(class_name)}"
@@ -52,7 +57,8 @@ def predicted(tracker: str, class_name: str) -> str:
 
 
 def predicted_focus(tracker: str, class_name: str) -> str:
-    """Points3D of the predicted means of the focused tracks of a focus recording, labelled."""
+    """Points3D of the predicted means of the focused tracks of a focus recording (their labels are shown by
+    the focus callouts, ``viz.callouts``)."""
     return f"{predicted(tracker, class_name)}/focus"
 
 

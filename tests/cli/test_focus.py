@@ -85,8 +85,17 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     followed = [t for t in failure.track_ids if paths.existence("gnnpmb", failure.class_name, t) in rows]
     assert followed, f"no existence series for the involved tracks {failure.track_ids}"
     highlighted = [r for r in rows[focus_world()] if r.get("frame") == failure.frame_index]
-    labels = highlighted[0]["Boxes3D:labels"]
+    assert any(label.startswith("GT ") for label in highlighted[0]["Boxes3D:labels"])
+    # Their labels are in a column beside them (callouts), one row each, with a leader line to each object.
+    callouts = [r for r in rows[paths.focus_callouts("gnnpmb")] if r.get("frame") == failure.frame_index][0]
+    labels = callouts["Points3D:labels"]
     assert any(label.startswith("GT ") for label in labels)
+    assert any(label.startswith(f"{failure.track_ids[0]} predicted r=") for label in labels)
+    assert callouts["Points3D:positions.len"] == len(labels)
+    leaders = [r for r in rows[paths.focus_callouts("gnnpmb") + "/leaders"] if r.get("frame") == failure.frame_index]
+    label_at = np.array([strip[1] for strip in leaders[0]["LineStrips3D:strips"]])  # each: object -> label
+    assert len(label_at) == len(labels) and len(set(label_at[:, 0].tolist())) == 1
+    assert len(set(np.round(label_at[:, 1], 6).tolist())) == len(labels)
 
 
 def test_focus_on_a_track_and_on_a_ground_truth_prefix(demo_dataroot: Path, tmp_path: Path, failures_and_runs) -> None:

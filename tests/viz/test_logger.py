@@ -291,7 +291,8 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     assert [m for m, _ in step.gated] == [0]
     focused = rows[paths.predicted_focus(T, "car")]
     assert at_frame(focused, 1)[0]["Points3D:labels"] == ["2 predicted r=0.28"]
-    assert [r for r in focused if r["static"]][0]["Points3D:show_labels"] == [True]
+    # The label is shown by the focus callouts (viz.callouts), in a column, not on the point.
+    assert [r for r in focused if r["static"]][0]["Points3D:show_labels"] == [False]
 
 
 def test_events_outside_a_frame_and_unknown_events_are_rejected(saved_stream) -> None:
