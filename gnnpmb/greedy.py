@@ -13,6 +13,12 @@ new track; a track missed ``max_age`` frames in a row is deleted, and while it c
 last velocity times dt. Every detection is output, with its own box and score, under its track's id; coasting
 tracks are not output. The thresholds d_class are CenterPoint's per-class values (``config.ClassParams``:
 ``match_distance_m``) and ``max_age`` is ``[greedy] max_age`` (3 in CenterPoint's nuScenes script).
+
+Not a Bayesian filter, but its frame has the shape of ``skeleton.ClassFilter`` and plugs into it like the
+filters: predict = each track's coasted centre and each detection's back-projected one, gate = the distance
+threshold, update = the greedy matching, extract = every detection. It has no Gaussian gate (no ``Gated`` event)
+and no covariance: its ``Predicted`` and ``Posterior`` events carry the matching disc instead
+(``GreedyTracker._view``).
 """
 
 from __future__ import annotations
@@ -22,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
+from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     Assignment,
     AxisKind,
@@ -29,12 +36,10 @@ from gnnpmb.events import (
     Born,
     CostMatrix,
     EventSink,
-    Panel,
-    Predicted,
     Pruned,
     PruneReason,
 )
-from gnnpmb.skeleton import emit_posterior
+from gnnpmb.skeleton import ClassFilter, TrackView
 from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
@@ -84,25 +89,43 @@ def greedy_pairs(dist: np.ndarray) -> np.ndarray:
     return np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
 
-class GreedyTracker:
-    """One class's greedy closest-pair tracker (module docstring)."""
+@dataclass(frozen=True, slots=True)
+class GreedyPrior:
+    """The K live tracks as the last frame left them, their centres coasted to this frame t_k + v_k dt (K, 2),
+    and the (M, K) distances of this frame's back-projected detections to them (``distance_matrix``)."""
 
-    panels: tuple[Panel, ...] = ()
+    tracks: GreedyTracks
+    coasted_xy: np.ndarray
+    dist: np.ndarray
+
+
+class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]]):
+    """One class's greedy closest-pair tracker (module docstring); the frame loop is ``skeleton.ClassFilter.step``."""
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
-        self.class_name = class_name
-        self.max_distance_m = config.for_class(class_name).match_distance_m
+        super().__init__(class_name, config, ids)
+        self.max_distance_m = self.class_params.match_distance_m
         self.max_age = config.greedy.max_age
-        self.ids = ids
         self.tracks = GreedyTracks.empty()
 
-    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
-        """Match this frame's detections to the live tracks; returns one estimate per detection."""
-        prior = self.tracks
-        boxes = meas.boxes
-        m, k = len(meas), len(prior)
-        dist = distance_matrix(meas.z, boxes.velocity_mps, dt_s, prior.center_xy, self.max_distance_m)
-        pairs = greedy_pairs(dist)
+    def predict(self, meas: Measurements, dt_s: float) -> GreedyPrior:
+        """The distances D[j, k] = || (p_j - v_j dt) - t_k || (+inf above the threshold) and the coasted
+        centres t_k + v_k dt of the K tracks (module docstring)."""
+        t = self.tracks
+        dist = distance_matrix(meas.z, meas.boxes.velocity_mps, dt_s, t.center_xy, self.max_distance_m)
+        return GreedyPrior(t, t.center_xy + t.velocity_mps * dt_s, dist)
+
+    def prior_view(self, prior: GreedyPrior) -> tuple[TrackView, None]:
+        """The K tracks at their last centres with their matching discs; no Gaussian gate."""
+        return self._view(prior.tracks), None
+
+    def update(self, prior: GreedyPrior, meas: Measurements, sink: EventSink) -> tuple[GreedyTracks, Measurements]:
+        """Closest pairs first (``greedy_pairs``): a matched track takes its detection's centre and velocity, an
+        unmatched detection starts a track, an unmatched track coasts and is deleted after ``max_age`` misses.
+        Returns the new tracks, whose first M are this frame's M detections in order, and those detections.
+        Events: ``CostMatrix``, ``Assignment``, ``Born``, ``Pruned``."""
+        m, k = prior.dist.shape
+        pairs = greedy_pairs(prior.dist)
         track_of_meas = np.full(m, -1, dtype=np.int64)
         track_of_meas[pairs[:, 0]] = pairs[:, 1]
         matched = np.zeros(k, dtype=bool)
@@ -110,80 +133,66 @@ class GreedyTracker:
         new_j = np.flatnonzero(track_of_meas < 0)
         new_ids = np.array([self.ids.allocate() for _ in new_j], dtype=np.int64)
         ids_of_meas = np.empty(m, dtype=np.int64)
-        ids_of_meas[pairs[:, 0]] = prior.track_id[pairs[:, 1]]
+        ids_of_meas[pairs[:, 0]] = prior.tracks.track_id[pairs[:, 1]]
         ids_of_meas[new_j] = new_ids
-        coasting = prior.subset(~matched)
-        coasting = GreedyTracks(
-            track_id=coasting.track_id,
-            center_xy=coasting.center_xy + coasting.velocity_mps * dt_s,
-            velocity_mps=coasting.velocity_mps,
-            misses=coasting.misses + 1,
-        )
+        t = prior.tracks
+        coasting = GreedyTracks(t.track_id, prior.coasted_xy, t.velocity_mps, t.misses + 1).subset(~matched)
         deleted = coasting.misses >= self.max_age
-        self.tracks = GreedyTracks.concatenate(
-            [
-                GreedyTracks(ids_of_meas, meas.z.copy(), boxes.velocity_mps.copy(), np.zeros(m, dtype=np.int64)),
-                coasting.subset(~deleted),
-            ]
-        )
-        estimates = [
-            TrackEstimate(
-                track_id=int(ids_of_meas[j]),
-                class_name=self.class_name,
-                translation_m=tuple(float(v) for v in boxes.translation_m[j]),
-                size_wlh_m=tuple(float(v) for v in boxes.size_wlh_m[j]),
-                quat_wxyz=tuple(float(v) for v in boxes.quat_wxyz[j]),
-                velocity_mps=tuple(float(v) for v in boxes.velocity_mps[j]),
-                score=float(boxes.score[j]),
-                existence=1.0,
-                meas_index=int(meas.source_index[j]),
-            )
-            for j in range(m)
-        ]
+        velocity = meas.boxes.velocity_mps
+        detected = GreedyTracks(ids_of_meas, meas.z.copy(), velocity.copy(), np.zeros(m, dtype=np.int64))
+        self.tracks = GreedyTracks.concatenate([detected, coasting.subset(~deleted)])
         if sink.enabled:
-            self._emit(prior, meas, dist, track_of_meas, new_j, new_ids, coasting.track_id[deleted], estimates, sink)
-        return estimates
+            self._emit(prior, meas, track_of_meas, new_j, new_ids, coasting.track_id[deleted], sink)
+        return self.tracks, meas
 
-    def _disc_cov(self, k: int) -> np.ndarray:
-        """(k, 4, 4) diag(d^2, d^2, 1, 1): the greedy tracker has no covariance, so events carry the matching
-        disc of radius d = the class threshold (one standard deviation drawn = the disc) and unit velocity."""
+    def extract(
+        self, posterior: tuple[GreedyTracks, Measurements], sink: EventSink
+    ) -> tuple[list[TrackEstimate], float]:
+        """Every detection with its own box and score, under its track's id (threshold 1: none is withheld)."""
+        tracks, meas = posterior
+        m = len(meas)
+        det = DetectionFields.from_measurements(meas, np.arange(m))
+        state = np.concatenate([tracks.center_xy[:m], tracks.velocity_mps[:m]], axis=1)
+        return det.to_estimates(self.class_name, tracks.track_id[:m], state, det.score, np.ones(m)), 1.0
+
+    def posterior_view(self, posterior: tuple[GreedyTracks, Measurements]) -> TrackView:
+        return self._view(posterior[0])
+
+    def _view(self, t: GreedyTracks) -> TrackView:
+        """K tracks as events show them: state [x, y, vx, vy] (K, 4), existence 1, and covariance (K, 4, 4)
+        diag(d^2, d^2, 1, 1): the greedy tracker has no covariance, so events carry the matching disc of radius
+        d = the class threshold (one standard deviation drawn = the disc) and unit velocity."""
         d2 = self.max_distance_m**2
-        return np.broadcast_to(np.diag([d2, d2, 1.0, 1.0]), (k, 4, 4)).copy()
+        cov = np.broadcast_to(np.diag([d2, d2, 1.0, 1.0]), (len(t), 4, 4)).copy()
+        return TrackView(t.track_id, np.concatenate([t.center_xy, t.velocity_mps], axis=1), cov, np.ones(len(t)))
 
     def _emit(
         self,
-        prior: GreedyTracks,
+        prior: GreedyPrior,
         meas: Measurements,
-        dist: np.ndarray,
         track_of_meas: np.ndarray,
         new_j: np.ndarray,
         new_ids: np.ndarray,
         deleted_ids: np.ndarray,
-        estimates: list[TrackEstimate],
         sink: EventSink,
     ) -> None:
+        """``CostMatrix`` (distances, new-track column = the threshold), ``Assignment``, ``Born``, ``Pruned``."""
+        dist = prior.dist
         m, k = dist.shape
-        state = np.concatenate([prior.center_xy, prior.velocity_mps], axis=1)
-        sink.emit(Predicted(self.class_name, prior.track_id, state, self._disc_cov(k), np.ones(k)))
         full = np.full((m, k + m), np.inf)
         full[:, :k] = dist
         full[np.arange(m), k + np.arange(m)] = self.max_distance_m
         rows = tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
-        track_cols = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
+        track_cols = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.tracks.track_id)
         new_cols = tuple(AxisLabel(AxisKind.NEW_TRACK, int(i)) for i in meas.source_index)
         sink.emit(CostMatrix(self.class_name, full, rows, track_cols + new_cols, description=COST_DESCRIPTION))
         pairs = tuple((rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist()))
         total = float(sum(full[j, t] if t >= 0 else full[j, k + j] for j, t in enumerate(track_of_meas.tolist())))
         detected = set(track_of_meas[track_of_meas >= 0].tolist())
-        missed = tuple(int(t) for i, t in enumerate(prior.track_id.tolist()) if i not in detected)
+        missed = tuple(int(t) for i, t in enumerate(prior.tracks.track_id.tolist()) if i not in detected)
         sink.emit(Assignment(self.class_name, pairs, total, missed))
         if len(new_j):
             born_state = np.concatenate([meas.z[new_j], meas.boxes.velocity_mps[new_j]], axis=1)
             sink.emit(Born(self.class_name, new_ids, meas.source_index[new_j], born_state, np.ones(len(new_j))))
         for t in deleted_ids.tolist():
             sink.emit(Pruned(self.class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
-        t = self.tracks
-        state = np.concatenate([t.center_xy, t.velocity_mps], axis=1)
-        emit_posterior(
-            sink, self.class_name, t.track_id, state, self._disc_cov(len(t)), np.ones(len(t)), estimates, 1.0
-        )

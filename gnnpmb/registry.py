@@ -1,84 +1,78 @@
-"""Tracker names (the ``--tracker`` values) and how each is built, one instance per class.
+"""Tracker names (the ``--tracker`` values) and how each is built, one instance per class; wiring only.
 
-Every tracker is a ``ClassTracker``: ``step(measurements, dt_s, sink) -> list[TrackEstimate]``. The PMB family
-shares ``pmb.core.PmbCore`` and differs only in the hypothesis strategy (paper sec. III-IV).
+Every tracker is a ``skeleton.ClassFilter``, whose ``step(measurements, dt_s, sink) -> list[TrackEstimate]`` is
+the one frame loop; a family writes its hooks. The PMB family shares ``pmb.core.PmbCore`` and differs only in
+the hypothesis strategy (paper sec. III-IV). Adding a tracker: its ``ClassFilter`` subclass (or strategy), one
+factory here, one line in ``TRACKER_DESCRIPTIONS``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.errors import UnknownNameError
 
 if TYPE_CHECKING:  # numpy-heavy; the CLI imports this module for its help text
     from gnnpmb.config import TrackerConfig
-    from gnnpmb.events import EventSink, Panel
-    from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
+    from gnnpmb.events import Panel
+    from gnnpmb.skeleton import ClassFilter
+    from gnnpmb.types import IdAllocator
 
 
-class ClassTracker(Protocol):
-    """A single-class multi-object tracker; ``panels``: the tracker-specific viewer panels its events fill."""
-
-    @property
-    def panels(self) -> tuple[Panel, ...]: ...
-
-    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]: ...
-
-
-def _gnnpmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def _gnnpmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     from gnnpmb.pmb.core import PmbCore
     from gnnpmb.pmb.gnnpmb import BestAssignment
 
     return PmbCore(class_name, config, BestAssignment(), ids)
 
 
-def _pmbm(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def _pmbm(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     from gnnpmb.pmb.core import PmbCore
     from gnnpmb.pmb.pmbm import KBest
 
     return PmbCore(class_name, config, KBest(config.pmbm), ids)
 
 
-def _topmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def _topmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     from gnnpmb.pmb.core import PmbCore
     from gnnpmb.pmb.topmb import MarginalMerge
 
     return PmbCore(class_name, config, MarginalMerge(config.lbp), ids)
 
 
-def _phd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def _phd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     from gnnpmb.phd.gmphd import GmPhdTracker
 
     return GmPhdTracker(class_name, config, ids)
 
 
-def _cphd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def _cphd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     from gnnpmb.phd.cphd import CphdTracker
 
     return CphdTracker(class_name, config, ids)
 
 
-def _jpda(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def _jpda(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     from gnnpmb.vector.jpda import JpdaTracker
 
     return JpdaTracker(class_name, config, ids)
 
 
-def _gnn(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def _gnn(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     from gnnpmb.vector.gnn import GnnTracker
 
     return GnnTracker(class_name, config, ids)
 
 
-def _greedy(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def _greedy(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     from gnnpmb.greedy import GreedyTracker
 
     return GreedyTracker(class_name, config, ids)
 
 
-_FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassTracker]] = {
+_FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassFilter]] = {
     "gnnpmb": _gnnpmb,
     "pmbm": _pmbm,
     "topmb": _topmb,
@@ -126,6 +120,6 @@ def tracker_panels(name: str) -> tuple[Panel, ...]:
     return make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator()).panels
 
 
-def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassTracker:
+def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     """Tracker ``name`` for class ``class_name``; it sees ``config`` with that class's overrides applied."""
     return _FACTORIES[check_tracker(name)](class_name, config.resolved(class_name), ids)

@@ -1,26 +1,53 @@
-"""The steps every per-class filter shares: predict -> gate -> emit -> *family update* -> extract -> emit.
+"""The per-class filter skeleton every tracker plugs into: predict -> gate -> emit -> *update* -> extract -> emit.
 
-The PMB core (``pmb.core``), the GM-PHD / CPHD filters (``phd.gmphd``) and the vector trackers
-(``vector.tracks``) differ only in their density and its update; the gate and the events around the update are
-these functions, so every family gates and reports the same way:
+``ClassFilter.step`` is the only frame loop of the code base. A tracker family subclasses ``ClassFilter`` with
+its prior type (the predicted density gated against the frame's measurements) and its posterior type, and writes
+the hooks; ``step`` calls them in this order and emits the events every family shares:
 
-- gate: d2_kj = (z_j - H m_k)^T S_k^-1 (z_j - H m_k), inside iff d2_kj < G (``gating.gate``; paper sec. V-B);
-- before the update: ``Predicted`` (track ids, means, covariances, existence) and ``Gated`` (the gate of each
-  track in the BEV plane);
-- after it: ``Posterior`` and ``Extracted`` (the estimates and the extraction threshold).
+1. ``predict(meas, dt_s)``: the motion model applied to the density, birth, and the gate
+   d2_kj = (z_j - H m_k)^T S_k^-1 (z_j - H m_k), inside iff d2_kj < G (``gate_tracks``; paper sec. V-B);
+2. ``prior_view(prior)``: the predicted tracks and their gate, which ``step`` emits as ``Predicted`` and
+   ``Gated`` (``emit_prior``; no ``Gated`` for a family without a Gaussian gate);
+3. ``update(prior, meas, sink)``: the family's update rule, the only part that really differs (PMB strategy,
+   PHD / CPHD weights, GNN / JPDA association, greedy matching); it emits its own events (cost matrices,
+   assignments, births, pruning);
+4. ``extract(posterior, sink)``: the estimates of the frame and the threshold they were extracted with;
+5. ``posterior_view(posterior)``: the updated tracks, which ``step`` emits as ``Posterior`` with ``Extracted``
+   (``emit_posterior``).
+
+``idle()`` lets a filter skip a frame without measurements when that leaves it unchanged (the PHD filters).
+Families: ``pmb.core.PmbCore`` (GNN-PMB, PMBM, TO-PMB), ``phd.gmphd.GmPhdTracker`` and ``phd.cphd.CphdTracker``,
+``vector.tracks.VectorTracker`` (GNN, JPDA) and ``greedy.GreedyTracker``; ``registry`` only wires names to them.
 """
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Generic, TypeVar
 
 import numpy as np
 
-from gnnpmb.events import EventSink, Extracted, Gated, Posterior, Predicted
+from gnnpmb.config import TrackerConfig
+from gnnpmb.events import EventSink, Extracted, Gated, Panel, Posterior, Predicted
 from gnnpmb.gating import gate
 from gnnpmb.kalman import Innovation, innovation, mahalanobis2
-from gnnpmb.types import TrackEstimate
+from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
+
+PriorT = TypeVar("PriorT")
+PosteriorT = TypeVar("PosteriorT")
+
+
+@dataclass(frozen=True, slots=True)
+class TrackView:
+    """K tracks as ``Predicted`` and ``Posterior`` show them: track_id (K,) int64, mean (K, 4) [x, y, vx, vy],
+    cov (K, 4, 4), existence (K,) (1 for trackers without one)."""
+
+    track_id: np.ndarray
+    mean: np.ndarray
+    cov: np.ndarray
+    existence: np.ndarray
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,12 +75,15 @@ def emit_prior(
     mean: np.ndarray,
     cov: np.ndarray,
     existence: np.ndarray,
-    gating: Gating,
+    gating: Gating | None,
     meas_indices: np.ndarray,
     gate_chi2: float,
 ) -> None:
-    """``Predicted`` and ``Gated`` of K predicted tracks (gate ellipses in the BEV plane: the x, y block of S)."""
+    """``Predicted`` and ``Gated`` of K predicted tracks (gate ellipses in the BEV plane: the x, y block of S);
+    ``Predicted`` only when ``gating`` is None."""
     sink.emit(Predicted(class_name, track_ids, mean, cov, existence))
+    if gating is None:
+        return
     sink.emit(
         Gated(
             class_name,
@@ -80,3 +110,63 @@ def emit_posterior(
     """``Posterior`` of the K updated tracks and ``Extracted`` with the estimates and the extraction threshold."""
     sink.emit(Posterior(class_name, track_ids, mean, cov, existence))
     sink.emit(Extracted(class_name, tuple(estimates), threshold))
+
+
+class ClassFilter(ABC, Generic[PriorT, PosteriorT]):
+    """One class's tracker: the frame loop (``step``) and the hooks a family writes (module docstring).
+
+    ``panels``: the tracker-specific viewer panels its events fill."""
+
+    panels: tuple[Panel, ...] = ()
+
+    def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
+        self.class_name = class_name
+        self.config = config
+        self.class_params = config.for_class(class_name)
+        self.ids = ids
+
+    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
+        """Process one frame of this class's M measurements; returns the extracted tracks."""
+        if not len(meas) and not sink.enabled and self.idle():
+            return []
+        prior = self.predict(meas, dt_s)
+        if sink.enabled:
+            t, gating = self.prior_view(prior)
+            gate_chi2 = self.config.models.gate_chi2
+            emit_prior(
+                sink, self.class_name, t.track_id, t.mean, t.cov, t.existence, gating, meas.source_index, gate_chi2
+            )
+        posterior = self.update(prior, meas, sink)
+        estimates, threshold = self.extract(posterior, sink)
+        if sink.enabled:
+            t = self.posterior_view(posterior)
+            emit_posterior(sink, self.class_name, t.track_id, t.mean, t.cov, t.existence, estimates, threshold)
+        return estimates
+
+    def idle(self) -> bool:
+        """True when a frame without measurements would leave the filter unchanged and extract nothing, so
+        ``step`` may skip it (when no sink listens)."""
+        return False
+
+    @abstractmethod
+    def predict(self, meas: Measurements, dt_s: float) -> PriorT:
+        """The prior of this frame: the density predicted over ``dt_s`` seconds, with its births and its gate
+        over the M measurements."""
+
+    @abstractmethod
+    def prior_view(self, prior: PriorT) -> tuple[TrackView, Gating | None]:
+        """The K predicted tracks and their gate over the M measurements, as ``Predicted`` and ``Gated`` show
+        them (None: no Gaussian gate, no ``Gated``). Called only when the sink is enabled."""
+
+    @abstractmethod
+    def update(self, prior: PriorT, meas: Measurements, sink: EventSink) -> PosteriorT:
+        """The family's update rule: the posterior density, kept as the filter's state; emits its own events."""
+
+    @abstractmethod
+    def extract(self, posterior: PosteriorT, sink: EventSink) -> tuple[list[TrackEstimate], float]:
+        """The estimates of the frame and the threshold they were extracted with (``Extracted.threshold``)."""
+
+    @abstractmethod
+    def posterior_view(self, posterior: PosteriorT) -> TrackView:
+        """The updated tracks as ``Posterior`` shows them (after ``extract``). Called only when the sink is
+        enabled."""

@@ -280,8 +280,9 @@ class CphdTracker(GmPhdTracker):
         super().__init__(class_name, config, ids)
         self.cardinality = np.ones(1)
 
-    def _idle(self) -> bool:
-        return super()._idle() and len(self.cardinality) == 1
+    def idle(self) -> bool:
+        """True when the filter is empty and certain of it (cardinality pmf [1.0])."""
+        return super().idle() and len(self.cardinality) == 1
 
     def _correct(self, pred: Prediction, meas: Measurements, sink: EventSink) -> tuple[np.ndarray, np.ndarray]:
         birth_mean = float(np.sum(pred.mixture.weight[pred.n_persistent :]))

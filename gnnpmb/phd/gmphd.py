@@ -71,7 +71,7 @@ from gnnpmb.kalman import (
 )
 from gnnpmb.models import MotionModel, cv_model, measurement_birth
 from gnnpmb.phd.mixture import GaussianMixture, Reduction, reduce_mixture
-from gnnpmb.skeleton import Gating, emit_posterior, emit_prior
+from gnnpmb.skeleton import ClassFilter, Gating, TrackView
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -220,48 +220,72 @@ class Selection:
     threshold: float
 
 
-class GmPhdTracker:
-    """One class's GM-PHD filter with labelled components (module docstring). ``CphdTracker`` reuses everything
-    but the weight update (``_correct``) and the extraction rule (``_select``)."""
+@dataclass(frozen=True, slots=True)
+class PhdPosterior:
+    """The reduced posterior intensity and, for the events, the extracted labels that vanished in the update
+    (every part got weight 0; only looked for when the sink is enabled)."""
+
+    reduction: Reduction
+    vanished: np.ndarray
+
+
+class GmPhdTracker(ClassFilter[Prediction, PhdPosterior]):
+    """One class's GM-PHD filter with labelled components (module docstring); the frame loop is
+    ``skeleton.ClassFilter.step``. ``CphdTracker`` reuses everything but the weight update (``_correct``), the
+    extraction rule (``_select``) and ``idle``."""
 
     name = "phd"
     panels: tuple[Panel, ...] = (Panel.INTENSITY,)
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
-        self.class_name = class_name
-        self.config = config
+        super().__init__(class_name, config, ids)
         self.params = config.phd
-        self.class_params = config.for_class(class_name)
-        self.ids = ids
         self.mixture = GaussianMixture.empty()
         self._next_provisional = -1
         self._copy_ids: dict[tuple[int, int], int] = {}
 
-    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
-        """Process one frame of this class's measurements; returns the extracted tracks."""
-        if not len(meas) and self._idle() and not sink.enabled:
-            return []
-        models, p = self.config.models, self.params
+    def idle(self) -> bool:
+        """True when the filter is empty, so a frame without measurements leaves it unchanged."""
+        return not len(self.mixture)
+
+    def predict(self, meas: Measurements, dt_s: float) -> Prediction:
+        """Steps 1-3 of the module docstring: K predicted components, M birth components, their gate."""
+        models = self.config.models
         model = cv_model(dt_s, self.class_params)
         persistent = predict_mixture(self.mixture, model, models.p_survive)
         births = birth_mixture(meas, self.config, self._provisional_labels(len(meas)))
-        pred = gate_components(persistent, births, meas, model.R, models.gate_chi2, p.p_detect)
-        if sink.enabled:
-            self._emit_prior(pred, meas, sink)
-        log_missed, log_detected = self._correct(pred, meas, sink)
-        posterior = posterior_mixture(pred, meas, log_missed, log_detected)
+        return gate_components(persistent, births, meas, model.R, models.gate_chi2, self.params.p_detect)
+
+    def prior_view(self, prior: Prediction) -> tuple[TrackView, Gating]:
+        """The K persistent components (labels as track ids, existence = min(w, 1)) and their gate."""
+        mix, k = prior.persistent, prior.n_persistent
+        gating = Gating(prior.inn.subset(slice(0, k)), prior.d2, prior.inside)
+        return TrackView(mix.label, mix.mean, mix.cov, np.minimum(mix.weight, 1.0)), gating
+
+    def update(self, prior: Prediction, meas: Measurements, sink: EventSink) -> PhdPosterior:
+        """Steps 4-5: the weight update (``_correct``), the updated components, and the reduction, whose mixture
+        becomes the state."""
+        p = self.params
+        log_missed, log_detected = self._correct(prior, meas, sink)
+        posterior = posterior_mixture(prior, meas, log_missed, log_detected)
         reduction = reduce_mixture(posterior, p.prune_weight, p.merge_threshold, p.max_components)
         self.mixture = reduction.mixture
-        selection = self._select(self.mixture)
-        estimates, born, relabelled = self._extract(selection)
-        if sink.enabled:
-            vanished = np.setdiff1d(pred.persistent.label, posterior.label)
-            self._emit_posterior(reduction, vanished, relabelled, born, selection, estimates, sink)
-        return estimates
+        vanished = np.setdiff1d(prior.persistent.label, posterior.label) if sink.enabled else np.zeros(0, np.int64)
+        return PhdPosterior(reduction, vanished)
 
-    def _idle(self) -> bool:
-        """True when the filter is empty, so a frame without measurements leaves it unchanged."""
-        return not len(self.mixture)
+    def extract(self, posterior: PhdPosterior, sink: EventSink) -> tuple[list[TrackEstimate], float]:
+        """Step 6 (``_select``) with the label bookkeeping of the module docstring (``_label``); emits ``Merged``,
+        ``Pruned``, ``IntensityWeights`` and ``Born``."""
+        selection = self._select(self.mixture)
+        estimates, born, relabelled = self._label(selection)
+        if sink.enabled:
+            self._emit_reduction(posterior, relabelled, born, sink)
+        return estimates, selection.threshold
+
+    def posterior_view(self, posterior: PhdPosterior) -> TrackView:
+        """Every component of the labelled posterior (existence = min(w, 1))."""
+        mix = self.mixture
+        return TrackView(mix.label, mix.mean, mix.cov, np.minimum(mix.weight, 1.0))
 
     def _correct(self, pred: Prediction, meas: Measurements, sink: EventSink) -> tuple[np.ndarray, np.ndarray]:
         """Log missed (K + M,) and detected (K + M, M) weights of the PHD update (``phd_update``)."""
@@ -280,7 +304,7 @@ class GmPhdTracker:
         self._next_provisional -= n
         return labels
 
-    def _extract(self, sel: Selection) -> tuple[list[TrackEstimate], np.ndarray, dict[int, int]]:
+    def _label(self, sel: Selection) -> tuple[list[TrackEstimate], np.ndarray, dict[int, int]]:
         """Estimates of the selected components and the label bookkeeping of the module docstring.
 
         Returns the estimates, the indices of components that got a new track id this frame, and the map
@@ -321,25 +345,11 @@ class GmPhdTracker:
             self._copy_ids[key] = self.ids.allocate()
         return self._copy_ids[key]
 
-    def _emit_prior(self, pred: Prediction, meas: Measurements, sink: EventSink) -> None:
-        prior = pred.persistent
-        gating = Gating(pred.inn.subset(slice(0, pred.n_persistent)), pred.d2, pred.inside)
-        existence = np.minimum(prior.weight, 1.0)
-        gate_chi2 = self.config.models.gate_chi2
-        emit_prior(
-            sink, self.class_name, prior.label, prior.mean, prior.cov, existence, gating, meas.source_index, gate_chi2
-        )
-
-    def _emit_posterior(
-        self,
-        reduction: Reduction,
-        vanished: np.ndarray,
-        relabelled: dict[int, int],
-        born: np.ndarray,
-        sel: Selection,
-        estimates: list[TrackEstimate],
-        sink: EventSink,
+    def _emit_reduction(
+        self, posterior: PhdPosterior, relabelled: dict[int, int], born: np.ndarray, sink: EventSink
     ) -> None:
+        """``Merged`` (coalescence only), ``Pruned``, ``IntensityWeights`` and ``Born`` (module docstring)."""
+        reduction, vanished = posterior.reduction, posterior.vanished
         for group in reduction.merges():
             into = relabelled.get(group.into_label, group.into_label)
             from_ids = tuple(relabelled.get(t, t) for t in group.from_labels)
@@ -362,5 +372,3 @@ class GmPhdTracker:
                     np.minimum(mix.weight[born], 1.0),
                 )
             )
-        existence = np.minimum(mix.weight, 1.0)
-        emit_posterior(sink, self.class_name, mix.label, mix.mean, mix.cov, existence, estimates, sel.threshold)

@@ -3,7 +3,7 @@
 GNN-PMB, PMBM and TO-PMB differ only in how the strategy manages data-association hypotheses (paper sec. III-IV):
 ``gnnpmb.BestAssignment`` keeps the single best global hypothesis (GNN-PMB), ``pmbm.KBest`` keeps up to N_h
 (PMBM, Murty), ``topmb.MarginalMerge`` merges every local hypothesis by its marginal probability (TO-PMB, LBP).
-Everything else in a frame is this module, per class:
+Everything else in a frame is this module, per class (``PmbCore``: the hooks of ``skeleton.ClassFilter``):
 
 1. predict every hypothesis' Bernoullis (``bernoulli.predict_bernoullis``);
 2. birth intensity at this frame's detections and new-track hypotheses (``poisson``);
@@ -36,7 +36,7 @@ from gnnpmb.models import MotionModel, clutter_intensity, cv_model, measurement_
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
 from gnnpmb.pmb.poisson import NewTrackHypotheses, new_track_hypotheses
-from gnnpmb.skeleton import Gating, emit_posterior, emit_prior
+from gnnpmb.skeleton import ClassFilter, Gating, TrackView
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 
@@ -246,17 +246,23 @@ class VelocityMeasurements(Measurements):
         return np.concatenate([self.boxes.xy, self.boxes.velocity_mps], axis=1)
 
 
-class PmbCore:
-    """One class's PMB / PMBM filter; ``strategy`` decides the hypothesis management (module docstring)."""
+@dataclass(frozen=True, slots=True)
+class PmbPrior:
+    """The predicted prior global hypotheses and the local hypotheses of each over this frame's measurements."""
+
+    hypotheses: list[GlobalHypothesis]
+    locals_: Sequence[LocalHypotheses]
+
+
+class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
+    """One class's PMB / PMBM filter; ``strategy`` decides the hypothesis management (module docstring). The
+    frame loop is ``skeleton.ClassFilter.step``; the posterior it extracts from is the most likely hypothesis."""
 
     def __init__(self, class_name: str, config: TrackerConfig, strategy: HypothesisStrategy, ids: IdAllocator):
-        self.class_name = class_name
-        self.config = config
+        super().__init__(class_name, config, ids)
         self.params = config.pmb
         self.models = config.models
-        self.class_params = config.for_class(class_name)
         self.strategy = strategy
-        self.ids = ids
         self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty())]
         self.frame_serial = 0
 
@@ -265,8 +271,9 @@ class PmbCore:
         """The viewer panels this tracker's events fill beyond the common ones: its strategy's."""
         return self.strategy.panels
 
-    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
-        """Process one frame of this class's measurements; returns the extracted tracks."""
+    def predict(self, meas: Measurements, dt_s: float) -> PmbPrior:
+        """Steps 1-3 of the module docstring: the birth intensity at the M measurements, then every hypothesis'
+        Bernoullis predicted and gated (z = [x, y], or [x, y, vx, vy] with ``[pmb] measure_velocity = 1``)."""
         p = self.params
         self.frame_serial += 1
         model = cv_model(dt_s, self.class_params, p.measure_velocity == 1)
@@ -274,21 +281,43 @@ class PmbCore:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
         clutter = clutter_intensity(self.models, p)
         new = new_track_hypotheses(measurement_birth(meas, self.models), meas, model.R, clutter)
-        priors, locals_ = self._predict_and_localise(meas, model, new)
-        if sink.enabled:
-            self._emit_prior(locals_[0], sink)
-        ctx = UpdateContext(self.class_name, sink, self.ids, self.frame_serial, p.prune_existence)
-        posteriors = self.strategy.update(priors, locals_, ctx)
-        self.hypotheses = self._prune(priors, posteriors, ctx, sink)
-        best = self.hypotheses[0].bernoullis
-        estimates = self._extract(best)
-        if sink.enabled:
-            self._emit_posterior(best, ctx, estimates, sink)
-        return estimates
+        return self._predict_and_localise(meas, model, new)
 
-    def _predict_and_localise(
-        self, meas: Measurements, model: MotionModel, new: NewTrackHypotheses
-    ) -> tuple[list[GlobalHypothesis], Sequence[LocalHypotheses]]:
+    def prior_view(self, prior: PmbPrior) -> tuple[TrackView, Gating]:
+        """The K Bernoullis of the most likely prior hypothesis and their gate."""
+        local = prior.locals_[0]
+        b = local.prior
+        return TrackView(b.track_id, b.mean, b.cov, b.existence), Gating(local.inn, local.d2, local.inside)
+
+    def update(self, prior: PmbPrior, meas: Measurements, sink: EventSink) -> Bernoullis:
+        """Steps 4-5: the strategy's posterior hypotheses, pruned, become the state; returns the Bernoullis of the
+        most likely one. Events: ``CostMatrix`` (of the most likely prior hypothesis), the strategy's, ``Pruned``,
+        ``Born``."""
+        if sink.enabled:
+            local = prior.locals_[0]
+            sink.emit(CostMatrix(self.class_name, local.cost_matrix(), local.row_labels(), local.col_labels()))
+        ctx = UpdateContext(self.class_name, sink, self.ids, self.frame_serial, self.params.prune_existence)
+        posteriors = self.strategy.update(prior.hypotheses, prior.locals_, ctx)
+        self.hypotheses = self._prune(prior.hypotheses, posteriors, ctx, sink)
+        best = self.hypotheses[0].bernoullis
+        if sink.enabled:
+            self._emit_born(best, ctx, sink)
+        return best
+
+    def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
+        """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r."""
+        threshold = self.params.extraction_threshold
+        sel = posterior.subset(np.flatnonzero(posterior.existence >= threshold))
+        estimates = sel.det.to_estimates(
+            self.class_name, sel.track_id, sel.mean, sel.score * sel.existence, sel.existence
+        )
+        return estimates, threshold
+
+    def posterior_view(self, posterior: Bernoullis) -> TrackView:
+        b = posterior
+        return TrackView(b.track_id, b.mean, b.cov, b.existence)
+
+    def _predict_and_localise(self, meas: Measurements, model: MotionModel, new: NewTrackHypotheses) -> PmbPrior:
         """Predicted prior hypotheses and their local hypotheses. Global hypotheses share most Bernoullis
         (equal ``local_key`` = identical component), so with several hypotheses every distinct Bernoulli is
         predicted and gated once and each hypothesis takes its rows when asked (``HypothesisLocals``; PMBM,
@@ -298,7 +327,7 @@ class PmbCore:
             h = self.hypotheses[0]
             prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
             local = local_hypotheses(prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max)
-            return [GlobalHypothesis(h.log_weight, prior)], [local]
+            return PmbPrior([GlobalHypothesis(h.log_weight, prior)], [local])
         every = Bernoullis.concatenate([h.bernoullis for h in self.hypotheses])
         _, first, inverse = np.unique(every.local_key, return_index=True, return_inverse=True)
         union_prior = predict_bernoullis(every.subset(first), model, p.p_survive)
@@ -309,7 +338,7 @@ class PmbCore:
             GlobalHypothesis(h.log_weight, union_prior.subset(index))
             for h, index in zip(self.hypotheses, members, strict=True)
         ]
-        return priors, HypothesisLocals(union_local, members)
+        return PmbPrior(priors, HypothesisLocals(union_local, members))
 
     def _prune(
         self, priors: list[GlobalHypothesis], posteriors: list[GlobalHypothesis], ctx: UpdateContext, sink: EventSink
@@ -333,43 +362,10 @@ class PmbCore:
                     sink.emit(Pruned(self.class_name, t, PruneReason.NOT_IN_ANY_HYPOTHESIS, prior_r[t]))
         return kept
 
-    def _extract(self, b: Bernoullis) -> list[TrackEstimate]:
-        """Tracks with r >= the extraction threshold; tracking score = detection score x r."""
-        sel = b.subset(np.flatnonzero(b.existence >= self.params.extraction_threshold))
-        return sel.det.to_estimates(self.class_name, sel.track_id, sel.mean, sel.score * sel.existence, sel.existence)
-
-    def _emit_prior(self, local: LocalHypotheses, sink: EventSink) -> None:
-        prior = local.prior
-        gating = Gating(local.inn, local.d2, local.inside)
-        emit_prior(
-            sink,
-            self.class_name,
-            prior.track_id,
-            prior.mean,
-            prior.cov,
-            prior.existence,
-            gating,
-            local.meas.source_index,
-            self.models.gate_chi2,
-        )
-        sink.emit(CostMatrix(self.class_name, local.cost_matrix(), local.row_labels(), local.col_labels()))
-
-    def _emit_posterior(
-        self, best: Bernoullis, ctx: UpdateContext, estimates: list[TrackEstimate], sink: EventSink
-    ) -> None:
-        born = set(ctx.born_ids.values())
-        sel = np.flatnonzero(np.isin(best.track_id, list(born)))
+    def _emit_born(self, best: Bernoullis, ctx: UpdateContext, sink: EventSink) -> None:
+        """``Born`` of the Bernoullis of ``best`` started this frame."""
+        sel = np.flatnonzero(np.isin(best.track_id, list(set(ctx.born_ids.values()))))
         if len(sel):
             sink.emit(
                 Born(self.class_name, best.track_id[sel], best.meas_index[sel], best.mean[sel], best.existence[sel])
             )
-        emit_posterior(
-            sink,
-            self.class_name,
-            best.track_id,
-            best.mean,
-            best.cov,
-            best.existence,
-            estimates,
-            self.params.extraction_threshold,
-        )

@@ -61,7 +61,7 @@ def best_assignment(cost: np.ndarray) -> tuple[np.ndarray, float]:
 
 
 class GnnTracker(VectorTracker):
-    """One class's GNN tracker (module docstring); ``step`` is ``tracks.VectorTracker.step``."""
+    """One class's GNN tracker (module docstring): ``tracks.VectorTracker`` with this ``_associate``."""
 
     def _associate(self, prior: VectorTracks, gating: Gating, meas: Measurements, sink: EventSink) -> Association:
         k, m = gating.inside.shape

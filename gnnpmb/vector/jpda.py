@@ -138,7 +138,7 @@ def pda_update(
 
 
 class JpdaTracker(VectorTracker):
-    """One class's JPDA tracker (module docstring); ``step`` is ``tracks.VectorTracker.step``."""
+    """One class's JPDA tracker (module docstring): ``tracks.VectorTracker`` with this ``_associate``."""
 
     panels = (Panel.MARGINALS,)
 

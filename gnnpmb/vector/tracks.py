@@ -1,4 +1,4 @@
-"""The vector track set and the frame loop shared by the vector-type trackers (GNN, JPDA).
+"""The vector track set and the ``skeleton.ClassFilter`` hooks shared by the vector-type trackers (GNN, JPDA).
 
 A vector-type tracker keeps a fixed list of Kalman tracks, each with an M/N track-logic state, instead of a
 random-finite-set density (Blackman & Popoli 1999, ch. 6; Bar-Shalom, Daum & Huang 2009). Per class and frame:
@@ -11,7 +11,7 @@ random-finite-set density (Blackman & Popoli 1999, ch. 6; Bar-Shalom, Daum & Hua
    covariance the Kalman update of diag(s_p^2, s_p^2, s_v^2, s_v^2) by z_j (``[models] birth_pos_std_m``,
    ``birth_vel_std_mps``), i.e. about R in position;
 5. M/N track logic (``track_logic``) confirms and deletes tracks; steps 4 and 5 are the initiator / deleter pair
-   (``MeasurementInitiator``, ``MofNDeleter``), steps 1, 2 and the events the shared ``gnnpmb.skeleton``;
+   (``MeasurementInitiator``, ``MofNDeleter``); the frame loop is ``skeleton.ClassFilter.step``;
 6. output: the *confirmed* tracks associated with a detection this frame. Coasting tracks (missed, not yet
    deleted) are kept and predicted but not output: a coasted box drifts from the truth and the nuScenes metric
    counts it as a false positive, while the same object's next detection resumes the track under its old id.
@@ -22,17 +22,17 @@ existence is 1 (vector trackers have no existence probability).
 
 from __future__ import annotations
 
-from abc import ABC, abstractmethod
+from abc import abstractmethod
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from gnnpmb.config import ClassParams, ModelParams, TrackerConfig, VectorParams
 from gnnpmb.detection_fields import CarriesDetectionFields, DetectionFields
-from gnnpmb.events import Born, EventSink, Panel, Pruned, PruneReason
+from gnnpmb.events import Born, EventSink, Pruned, PruneReason
 from gnnpmb.kalman import innovation, predict
 from gnnpmb.models import MotionModel, birth_covariance, cv_model
-from gnnpmb.skeleton import Gating, emit_posterior, emit_prior, gate_tracks
+from gnnpmb.skeleton import ClassFilter, Gating, TrackView, gate_tracks
 from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 from gnnpmb.vector.track_logic import LogicState, LogicUpdate, advance, emit_transitions
@@ -138,17 +138,13 @@ class MofNDeleter:
             sink.emit(Pruned(class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
 
 
-class VectorTracker(ABC):
-    """One class's vector-type tracker: the shared gate and events (``gnnpmb.skeleton``), an initiator / deleter
-    pair for track logic, and the association that subclasses implement (``_associate``, module docstring,
-    step 3)."""
-
-    panels: tuple[Panel, ...] = ()
+class VectorTracker(ClassFilter[tuple[VectorTracks, Gating], VectorTracks]):
+    """One class's vector-type tracker: the frame loop ``skeleton.ClassFilter.step``, an initiator / deleter pair
+    for track logic, and the association that subclasses implement (``_associate``, module docstring, step 3)."""
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
-        self.class_name = class_name
+        super().__init__(class_name, config, ids)
         self.params = config.vector
-        self.class_params = config.for_class(class_name)
         self.gate_chi2 = config.models.gate_chi2
         self.clutter_intensity = config.models.clutter_intensity
         self.lbp = config.lbp
@@ -156,37 +152,42 @@ class VectorTracker(ABC):
         self.deleter = MofNDeleter(config.vector)
         self.tracks = VectorTracks.empty()
 
-    def step(self, meas: Measurements, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
-        """Process one frame of this class's measurements; returns the confirmed tracks hit this frame."""
+    def predict(self, meas: Measurements, dt_s: float) -> tuple[VectorTracks, Gating]:
+        """Steps 1-2 of the module docstring: the K predicted tracks and their gate over the M measurements."""
         model = cv_model(dt_s, self.class_params)
         prior = self.tracks.predicted(model)
-        gating = gate_tracks(prior.mean, prior.cov, model.R, meas.z, self.gate_chi2)
-        if sink.enabled:
-            ones = np.ones(len(prior))
-            track_ids = prior.track_id
-            emit_prior(
-                sink, self.class_name, track_ids, prior.mean, prior.cov, ones, gating, meas.source_index, self.gate_chi2
-            )
-        assoc = self._associate(prior, gating, meas, sink)
-        logic = self.deleter.update(prior.logic, assoc.meas_of_track >= 0)
-        posterior = replace(prior.updated(assoc, meas), logic=logic.state)
+        return prior, gate_tracks(prior.mean, prior.cov, model.R, meas.z, self.gate_chi2)
+
+    def prior_view(self, prior: tuple[VectorTracks, Gating]) -> tuple[TrackView, Gating]:
+        t, gating = prior
+        return TrackView(t.track_id, t.mean, t.cov, np.ones(len(t))), gating
+
+    def update(self, prior: tuple[VectorTracks, Gating], meas: Measurements, sink: EventSink) -> VectorTracks:
+        """Steps 3-5: association and state update (``_associate``), track logic (``deleter``), new tentative
+        tracks (``initiator``); the surviving and new tracks become the state. Events: the association's,
+        ``Born``, ``TrackLogic``, ``Pruned``."""
+        tracks, gating = prior
+        assoc = self._associate(tracks, gating, meas, sink)
+        logic = self.deleter.update(tracks.logic, assoc.meas_of_track >= 0)
+        posterior = replace(tracks.updated(assoc, meas), logic=logic.state)
         born = self.initiator.initiate(meas, np.flatnonzero(assoc.birth))
         self.tracks = VectorTracks.concatenate([posterior.subset(~logic.deleted), born])
-        estimates = self._extract(self.tracks)
         if sink.enabled:
             if len(born):
                 sink.emit(Born(self.class_name, born.track_id, born.meas_index, born.mean, np.ones(len(born))))
-            self.deleter.emit(self.class_name, prior.track_id, logic, born.track_id, sink)
-            t = self.tracks
-            emit_posterior(sink, self.class_name, t.track_id, t.mean, t.cov, np.ones(len(t)), estimates, 1.0)
-        return estimates
+            self.deleter.emit(self.class_name, tracks.track_id, logic, born.track_id, sink)
+        return self.tracks
+
+    def extract(self, posterior: VectorTracks, sink: EventSink) -> tuple[list[TrackEstimate], float]:
+        """Step 6: the confirmed tracks hit this frame, scored by their detection; existence 1 (threshold 1)."""
+        sel = posterior.subset(np.flatnonzero(posterior.logic.confirmed & (posterior.meas_index >= 0)))
+        return sel.det.to_estimates(self.class_name, sel.track_id, sel.mean, sel.score, np.ones(len(sel))), 1.0
+
+    def posterior_view(self, posterior: VectorTracks) -> TrackView:
+        t = posterior
+        return TrackView(t.track_id, t.mean, t.cov, np.ones(len(t)))
 
     @abstractmethod
     def _associate(self, prior: VectorTracks, gating: Gating, meas: Measurements, sink: EventSink) -> Association:
         """Data association and state update of the K prior tracks with the M measurements, given their gate
         (``gating``: innovations, (K, M) squared Mahalanobis distances and gate). Emits its own events."""
-
-    def _extract(self, t: VectorTracks) -> list[TrackEstimate]:
-        """The confirmed tracks hit this frame, scored by their detection; existence 1."""
-        sel = t.subset(np.flatnonzero(t.logic.confirmed & (t.meas_index >= 0)))
-        return sel.det.to_estimates(self.class_name, sel.track_id, sel.mean, sel.score, np.ones(len(sel)))
