@@ -25,7 +25,7 @@ CHAR_PX = 7.5
 GAP_PX = 40.0
 """Clear space between the rightmost object and the left end of the longest label."""
 POINT_RADIUS_M = 0.08
-LEADER_RADIUS_M = 0.03
+LEADER_RADIUS_M = 0.05
 
 
 @dataclass(frozen=True, slots=True)

@@ -22,6 +22,7 @@ import rerun as rr
 
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import short_id
+from gnnpmb.events import AxisKind
 from gnnpmb.focus import FocusTarget
 from gnnpmb.pipeline import TrackingRun
 from gnnpmb.types import Boxes
@@ -29,7 +30,7 @@ from viz import paths
 from viz.blueprint import DEFAULT_FOCUS_HEIGHT_M, FOCUS_HEIGHT_M, FOCUS_TIMELINE, focus_doc, focus_world
 from viz.callouts import Callout, log_callouts
 from viz.colors import CLASS_COLORS, class_ids, track_colors
-from viz.decisions import conflict_markdown
+from viz.decisions import CLOSE_CALL_MARGIN, column_name, conflict_markdown, meas_name
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
 from viz.logger import TrackerLogger, TrackStep
 from viz.scene import detection_label
@@ -39,6 +40,8 @@ SCALE = 1.15
 MARGIN_M = 0.25
 LINE_RADIUS_M = 0.12
 MAX_STORY_LINES = 40
+MAX_KEY = 3
+"""The summary's head names at most this many key decisions per tracker (the newest)."""
 MAX_LISTED = 2
 """Per frame, the diagnosis names where the MAX_LISTED detections nearest to a track (lowest NIS) went."""
 TABLE_FRAMES = 6
@@ -77,9 +80,13 @@ def focus_markdown(
     """The summary document: the failure, the ids; per tracker a diagnosis line per involved track, the involved
     objects' and tracks' frames, its decisions about them and their story. thresholds: per tracker, the score
     from which the evaluation counted a track of the focused class (its best-MOTA threshold; None: every box)."""
-    lines = [
-        f"# {focus.title}",
-        "",
+    lines = [f"# {focus.title}", ""]
+    for tracker, logger in loggers.items():
+        key = _key_decisions(logger, set(focus.track_ids.get(tracker, ())), focus.class_name, shown, focus.frame_index)
+        if key:
+            lines += [f"**Key decisions of {tracker}** (a detection an involved track could have taken):", ""]
+            lines += [f"- {line}" for line in key] + [""]
+    lines += [
         f"Opened at frame **{focus.frame_index}** on the `{FOCUS_TIMELINE}` timeline, which ends there; choose the "
         f"`frame` timeline in the time panel to step past it. Recorded frames: {shown.start}–{shown.stop - 1}.",
         "",
@@ -123,6 +130,29 @@ def focus_markdown(
             lines += [f"- frame {f}: {text}" for f, text in story[-MAX_STORY_LINES:]]
             lines.append("")
     return "\n".join(lines) + "\n"
+
+
+def _key_decisions(logger: TrackerLogger, ids: set[int], class_name: str, shown: range, last: int) -> list[str]:
+    """The solver's choices up to frame ``last`` that decided the involved tracks' fate, newest ``MAX_KEY``: a
+    detection given elsewhere while an involved track was its next best column, or given to an involved track by
+    a close call (``decisions.CLOSE_CALL_MARGIN``)."""
+    out = []
+    for f in range(shown.start, last + 1):
+        for d in logger.decisions.get(f, []):
+            if d.class_name != class_name:
+                continue
+            for c in (c for conflict in d.conflicts for c in conflict.choices):
+                alt = c.alternative
+                alt_involved = alt is not None and alt.kind is AxisKind.TRACK and alt.ref in ids
+                chosen_involved = c.chosen.kind is AxisKind.TRACK and c.chosen.ref in ids
+                if (alt_involved and not chosen_involved) or (chosen_involved and c.margin < CLOSE_CALL_MARGIN):
+                    went = logger.given.get(f, {}).get(int(c.meas.ref), column_name(c.chosen))
+                    other = f"over {column_name(alt)} ({c.alternative_cost:.2f})" if alt is not None else "(no other)"
+                    out.append(
+                        f"frame {f}: {meas_name(c.meas.ref)} → **{went}** (cost {c.chosen_cost:.2f}) {other}, "
+                        f"margin {c.margin:.2f}"
+                    )
+    return out[-MAX_KEY:]
 
 
 def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: int) -> list[str]:

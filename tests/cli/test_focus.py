@@ -144,3 +144,18 @@ def test_bad_focus_is_one_line_and_exit_2(demo_dataroot: Path, tmp_path: Path, f
     assert len(errors) == 1 and message in errors[0], proc.stderr
     assert "Traceback" not in proc.stderr
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir() if p.suffix == ".rrd") == []
+
+
+def test_the_summary_opens_with_the_decisions_that_made_the_switch(
+    demo_dataroot: Path, tmp_path: Path, failures_and_runs
+) -> None:
+    report, _ = failures_and_runs
+    switch = report.by_id("id_switch:1")
+    old, new = switch.track_ids
+    out, _ = record(demo_dataroot, tmp_path, "id_switch:1")
+    summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
+    head = summary.split("Opened at frame")[0]
+    assert "**Key decisions of gnnpmb**" in head
+    # The detection that started the new track, with the old track as the choice the solver passed over.
+    line = next(x for x in head.splitlines() if f"**new track {new}**" in x)
+    assert line.startswith(f"- frame {switch.frame_index}: m") and "over track " in line and "margin " in line
