@@ -141,7 +141,8 @@ class CostMatrix:
 class Assignment:
     """The chosen association: pairs of (row, col) labels from the cost matrix and the total cost.
 
-    missed_track_ids: tracks associated with no measurement this frame.
+    missed_track_ids: tracks associated with no measurement this frame. hypothesis: the ``CostMatrix`` the pairs
+    index, by its ``hypothesis`` (PMBM: the prior global hypothesis the best posterior hypothesis came from).
     """
 
     class_name: str

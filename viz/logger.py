@@ -132,7 +132,7 @@ class _ClassFrame:
     meas: MeasurementsReceived | None = None
     predicted: Predicted | None = None
     gated: Gated | None = None
-    cost: CostMatrix | None = None
+    costs: dict[int, CostMatrix] = field(default_factory=dict)
     assignment: Assignment | None = None
     born: list[Born] = field(default_factory=list)
     pruned: list[Pruned] = field(default_factory=list)
@@ -141,6 +141,12 @@ class _ClassFrame:
     posterior: Posterior | None = None
     extracted: Extracted | None = None
     hypotheses: GlobalHypotheses | None = None
+
+    @property
+    def cost(self) -> CostMatrix | None:
+        """The cost matrix the frame's assignment was chosen over: that of the assignment's prior hypothesis (PMBM's
+        best posterior may come from another prior hypothesis than the first); hypothesis 0's without one."""
+        return self.costs.get(self.assignment.hypothesis if self.assignment is not None else 0)
 
 
 class TrackerLogger:
@@ -298,12 +304,10 @@ class TrackerLogger:
         return self._classes.setdefault(class_name, _ClassFrame())
 
     def _on_cost(self, event: CostMatrix) -> None:
-        if event.hypothesis == 0:
-            self._class_frame(event.class_name).cost = event
+        self._class_frame(event.class_name).costs[event.hypothesis] = event
 
     def _on_assignment(self, event: Assignment) -> None:
-        if event.hypothesis == 0:
-            self._class_frame(event.class_name).assignment = event
+        self._class_frame(event.class_name).assignment = event
 
     # Frame bookkeeping.
     def _on_frame_started(self, event: FrameStarted) -> None:
