@@ -27,7 +27,8 @@ unaffected.
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
 ranked once (``murty.rank``) and shared by all hypotheses that contain it (``murty.Product``). Posteriors are
-built once per distinct (Bernoulli, outcome) (``core.posteriors_from_assignments``).
+built once per distinct (Bernoulli, outcome) into one store that the posterior hypotheses index
+(``core.posteriors_from_assignments``, ``core.GlobalHypothesis``).
 """
 
 from __future__ import annotations
@@ -132,10 +133,10 @@ class KBest:
             base = float(prior_log_w[h]) + float(union.miss_log_lik[members[h]].sum())  # sum_k log l_k0
             children.extend(_Child(base - total, h, col_of_row, total) for col_of_row, total in assignments)
         kept, log_w = self._select(_merge_identical(children, union, members, ctx))
-        bernoullis = posteriors_from_assignments(
+        store, rows = posteriors_from_assignments(
             union, [members[c.parent] for c in kept], [c.col_of_row for c in kept], ctx
         )
-        posteriors = [GlobalHypothesis(float(lw), b) for lw, b in zip(log_w, bernoullis, strict=True)]
+        posteriors = [GlobalHypothesis(float(lw), store, index) for lw, index in zip(log_w, rows, strict=True)]
         if ctx.sink.enabled:
             best = kept[0]
             own = _own_columns(best.col_of_row, members[best.parent], union.n_tracks)
@@ -364,12 +365,12 @@ def _emit(
     ``GlobalHypotheses`` as the core will keep them (after pruning)."""
     pairs, missed = assignment_pairs(local, col_of_row)
     ctx.sink.emit(Assignment(ctx.class_name, pairs, total_cost, missed, hypothesis=0))
-    alive = [h.bernoullis.existence >= ctx.prune_existence for h in posteriors]
+    alive = [h.without_existence_below(ctx.prune_existence).bernoullis for h in posteriors]
     ctx.sink.emit(
         GlobalHypotheses(
             ctx.class_name,
             log_weights=np.array([h.log_weight for h in posteriors]),
-            members=tuple(tuple(h.bernoullis.track_id[a].tolist()) for h, a in zip(posteriors, alive, strict=True)),
-            local=tuple(tuple(h.bernoullis.local_key[a].tolist()) for h, a in zip(posteriors, alive, strict=True)),
+            members=tuple(tuple(b.track_id.tolist()) for b in alive),
+            local=tuple(tuple(b.local_key.tolist()) for b in alive),
         )
     )
