@@ -179,18 +179,32 @@ class SingleRow:
         return self._cols[index : index + 1], float(self._costs[index])
 
 
-class Enumerated:
-    """Ranking of a small block by listing every assignment: rows' allowed columns are combined row by row,
-    dropping combinations that reuse a column, then sorted by cost (stable); ``root``, if given, comes
-    first."""
+def enumerate_assignments(allowed: np.ndarray) -> np.ndarray:
+    """(N, R) every assignment of the R rows of ``allowed`` ((R, C) bool) to distinct allowed columns, in
+    lexicographic order of their columns: rows' allowed columns are combined row by row, dropping combinations
+    that reuse a column."""
+    combos = np.zeros((1, 0), dtype=np.int64)
+    for i in range(allowed.shape[0]):
+        cols = np.flatnonzero(allowed[i])
+        grown = np.column_stack([np.repeat(combos, len(cols), axis=0), np.tile(cols, len(combos))])
+        combos = grown[(grown[:, :i] != grown[:, i : i + 1]).all(axis=1)]
+    return combos
 
-    def __init__(self, cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf):
+
+class Enumerated:
+    """Ranking of a small block by listing every assignment (``enumerate_assignments``, or ``combos`` if
+    already listed in that order), sorted by cost (stable); ``root``, if given, comes first."""
+
+    def __init__(
+        self,
+        cost: np.ndarray,
+        root: np.ndarray | None = None,
+        max_increase: float = math.inf,
+        combos: np.ndarray | None = None,
+    ):
         n_rows = cost.shape[0]
-        combos = np.zeros((1, 0), dtype=np.int64)
-        for i in range(n_rows):
-            allowed = np.flatnonzero(cost[i] < np.inf)
-            grown = np.column_stack([np.repeat(combos, len(allowed), axis=0), np.tile(allowed, len(combos))])
-            combos = grown[(grown[:, :i] != grown[:, i : i + 1]).all(axis=1)]
+        if combos is None:
+            combos = enumerate_assignments(cost < np.inf)
         if len(combos) == 0:
             raise InfeasibleAssignment("no assignment avoids the forbidden entries")
         costs = cost[np.arange(n_rows), combos].sum(axis=1)
@@ -206,6 +220,48 @@ class Enumerated:
         if index >= len(self._combos):
             return None
         return self._combos[index], float(self._costs[index])
+
+
+SUBSET_ENUMERATION_LIMIT = 16 * 1024
+"""``ColumnSubsets`` lists a block's assignments once, to be filtered for each column subset, when its rows'
+allowed-column counts multiply to at most this."""
+
+
+class ColumnSubsets:
+    """Rankings of the sub-problems of one (R, C) block that keep only some of its columns (PMBM: a gated block
+    of the union of all hypotheses' Bernoullis, cut to the Bernoullis one hypothesis holds).
+
+    ``rank(present)`` gives the ranking ``rank(cost[:, present], max_increase=max_increase)`` gives, solution
+    for solution. Small sub-problems share work: a sub-problem's assignments are those of the whole block that
+    use only present columns, in the same (lexicographic) order, so the block's are listed once
+    (``enumerate_assignments``) and filtered per subset.
+    """
+
+    def __init__(self, cost: np.ndarray, max_increase: float = math.inf):
+        self.cost = cost
+        self.max_increase = max_increase
+        self.allowed = cost < np.inf
+        self._listed: np.ndarray | None = None
+        self._few = _candidates(cost) <= SUBSET_ENUMERATION_LIMIT
+
+    def rank(self, present: np.ndarray) -> Ranking:
+        """The ranking of the sub-problem with columns ``present`` ((C,) bool). Raises ``InfeasibleAssignment``."""
+        n_rows = self.cost.shape[0]
+        counts = np.count_nonzero(self.allowed & present, axis=1)
+        if n_rows == 0 or float(np.prod(counts, dtype=float)) > ENUMERATION_LIMIT:
+            return rank(self.cost[:, present], max_increase=self.max_increase)
+        sub = self.cost[:, present]
+        if n_rows == 1:
+            if not counts[0]:
+                raise InfeasibleAssignment("the only row has no allowed column")
+            return SingleRow(sub[0], int(np.argmin(sub[0])), self.max_increase)
+        if not self._few:
+            return Enumerated(sub, None, self.max_increase)
+        if self._listed is None:
+            self._listed = enumerate_assignments(self.allowed)
+        listed = self._listed
+        local_of_col = np.cumsum(present) - 1
+        return Enumerated(sub, None, self.max_increase, local_of_col[listed[present[listed].all(axis=1)]])
 
 
 class Murty:

@@ -41,7 +41,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.assign.murty import Product, Ranking, blocks, forbid_beyond_private, k_best, rank
+from gnnpmb.assign.murty import ColumnSubsets, Product, Ranking, blocks, forbid_beyond_private, k_best, rank
 from gnnpmb.config import PmbmParams
 from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
 from gnnpmb.pmb.core import (
@@ -212,11 +212,11 @@ class SharedRanking:
         cost = forbid_beyond_private(cost, max_increase, usable=has_column.all(axis=0))
         self.cost = cost
         self.common: list[tuple[np.ndarray, np.ndarray, Ranking | None]] = []
-        self.varying: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]] = []
+        self.varying: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, ColumnSubsets | None]] = []
         """Per block whose Bernoullis differ between hypotheses: rows, columns, the distinct presence patterns
-        (P, columns), each hypothesis' pattern (H,), and whether only the best assignment is ranked. Each
-        (block, pattern) is ranked on first use (``_varying_part``): a hypothesis with no children costs
-        nothing."""
+        (P, columns), each hypothesis' pattern (H,), and the block's ``murty.ColumnSubsets`` (None when only
+        the best assignment is ranked). Each (block, pattern) is ranked on first use (``_varying_part``): a
+        hypothesis with no children costs nothing."""
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
         for rows, cols in blocks(cost):
             present = has_column[:, cols]
@@ -225,7 +225,8 @@ class SharedRanking:
                 self.common.append(_part(cost, rows, cols, present[0], max_increase, best_only))
                 continue
             _, first, pattern = np.unique(np.packbits(present, axis=1), axis=0, return_index=True, return_inverse=True)
-            self.varying.append((rows, cols, present[first], pattern.ravel(), best_only))
+            subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase)
+            self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
         self.common_ok = all(ranking is not None for _, _, ranking in self.common)
         if self.common_ok:
@@ -237,10 +238,17 @@ class SharedRanking:
         return [self._hypothesis(h, k) for h, k in enumerate(budgets)]
 
     def _varying_part(self, b: int, h: int) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
-        rows, cols, patterns, pattern, best_only = self.varying[b]
+        rows, cols, patterns, pattern, subsets = self.varying[b]
         key = (b, int(pattern[h]))
         if key not in self._parts:
-            self._parts[key] = _part(self.cost, rows, cols, patterns[key[1]], self.max_increase, best_only)
+            present = patterns[key[1]]
+            if subsets is None:
+                self._parts[key] = _part(self.cost, rows, cols, present, self.max_increase, True)
+            else:
+                try:
+                    self._parts[key] = rows, cols[present], subsets.rank(present)
+                except InfeasibleAssignment:
+                    self._parts[key] = rows, cols[present], None
         return self._parts[key]
 
     def _hypothesis(self, h: int, k: int) -> list[tuple[np.ndarray, float]]:
@@ -252,6 +260,8 @@ class SharedRanking:
         base = self.common_base.copy()
         for rows, cols, ranking in parts[len(self.common) :]:
             base[rows] = cols[ranking.solution(0)[0]]
+        if k == 1:  # Product's best, without its set-up
+            return [(base, float(sum(ranking.solution(0)[1] for _, _, ranking in parts)))]
         product = Product(base, parts, self.max_increase)
         out = []
         for i in range(k):

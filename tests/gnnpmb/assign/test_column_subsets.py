@@ -1,0 +1,46 @@
+"""``murty.ColumnSubsets`` ranks a block cut to some of its columns exactly as ``murty.rank`` ranks the cut
+matrix: the same assignments with the same float costs in the same order, ties included."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gnnpmb.assign import murty
+
+
+def all_solutions(ranking: murty.Ranking) -> list[tuple[list[int], float]]:
+    out = []
+    while (found := ranking.solution(len(out))) is not None:
+        out.append((found[0].tolist(), found[1]))
+    return out
+
+
+@pytest.mark.parametrize("max_increase", [math.inf, 1.5])
+@pytest.mark.parametrize(("enumeration_limit", "subset_limit"), [(1024, 16 * 1024), (1024, 0), (8, 16 * 1024)])
+def test_rank_of_a_column_subset_equals_rank_of_the_cut_matrix(
+    max_increase, enumeration_limit, subset_limit, monkeypatch
+):
+    monkeypatch.setattr(murty, "ENUMERATION_LIMIT", enumeration_limit)
+    monkeypatch.setattr(murty, "SUBSET_ENUMERATION_LIMIT", subset_limit)
+    rng = np.random.default_rng(5)
+    checked = 0
+    for trial in range(150):
+        # a PMB-like block: K track columns, then one private (new-track) column per row, always present
+        n_rows, n_tracks = int(rng.integers(1, 5)), int(rng.integers(1, 7))
+        integer = trial % 2 == 0  # small integers: many equal costs
+        shape = (n_rows, n_tracks)
+        tracks = rng.integers(0, 4, size=shape).astype(float) if integer else rng.random(shape)
+        tracks[rng.random(shape) < 0.3] = np.inf
+        private = np.full((n_rows, n_rows), np.inf)
+        private[np.arange(n_rows), np.arange(n_rows)] = rng.integers(0, 4, size=n_rows) if integer else 1.0
+        cost = np.hstack([tracks, private])
+        subsets = murty.ColumnSubsets(cost, max_increase)
+        for _ in range(4):
+            present = np.concatenate([rng.random(n_tracks) < 0.7, np.ones(n_rows, dtype=bool)])
+            want = all_solutions(murty.rank(cost[:, present], max_increase=max_increase))
+            assert all_solutions(subsets.rank(present)) == want
+            checked += len(want) > 1
+    assert checked > 100
