@@ -83,36 +83,57 @@ def k_best(cost: np.ndarray, k: int, max_increase: float = math.inf) -> list[tup
     return out
 
 
-def rank(cost: np.ndarray, first: np.ndarray | None = None, max_increase: float = math.inf) -> Ranking:
+BlockCache = dict[tuple[tuple[int, ...], bytes, bytes | None, float], "Ranking"]
+"""Block rankings by (shape, cost bytes, root bytes, max_increase): a ranking depends on nothing else."""
+
+
+def rank(
+    cost: np.ndarray,
+    first: np.ndarray | None = None,
+    max_increase: float = math.inf,
+    cache: BlockCache | None = None,
+) -> Ranking:
     """Lazy ranking of the assignments of ``cost`` (R <= C rows, +inf forbidden) that cost at most
     ``max_increase`` more than the best, split into blocks unless small.
 
-    ``first``: a best assignment to start from (else found here). Raises ``InfeasibleAssignment`` when no
+    ``first``: a best assignment to start from (else found here). ``cache``: rankings of blocks met before,
+    reused for a block with equal costs and root (and filled). Raises ``InfeasibleAssignment`` when no
     assignment exists.
     """
     n_rows = cost.shape[0]
     if n_rows == 0:
         return Product(np.zeros(0, dtype=np.int64), [], max_increase)
     if _candidates(cost) <= ENUMERATION_LIMIT:
-        return block_ranking(cost, first, max_increase)
+        return _block_ranking(cost, first, max_increase, cache)
     if max_increase < math.inf:
         if first is None:
             first, _ = solve(cost)
         cost = _forbid_hopeless(forbid_beyond_private(cost, max_increase), first, max_increase)
         if _candidates(cost) <= ENUMERATION_LIMIT:
-            return block_ranking(cost, first, max_increase)
+            return _block_ranking(cost, first, max_increase, cache)
     parts = []
     base = np.empty(n_rows, dtype=np.int64)
+    local_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
     for rows, cols in blocks(cost):
         root = None
         if first is not None:
-            local_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
             local_of_col[cols] = np.arange(len(cols))
             root = local_of_col[first[rows]]
-        ranking = block_ranking(cost[np.ix_(rows, cols)], root, max_increase)
+        ranking = _block_ranking(cost[np.ix_(rows, cols)], root, max_increase, cache)
         base[rows] = cols[ranking.solution(0)[0]]
         parts.append((rows, cols, ranking))
     return Product(base, parts, max_increase)
+
+
+def _block_ranking(cost: np.ndarray, root: np.ndarray | None, max_increase: float, cache: BlockCache | None) -> Ranking:
+    """``block_ranking``, looked up in and added to ``cache`` if given."""
+    if cache is None:
+        return block_ranking(cost, root, max_increase)
+    key = (cost.shape, cost.tobytes(), None if root is None else root.tobytes(), max_increase)
+    ranking = cache.get(key)
+    if ranking is None:
+        ranking = cache[key] = block_ranking(cost, root, max_increase)
+    return ranking
 
 
 def block_ranking(cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf) -> Ranking:
@@ -234,12 +255,15 @@ class ColumnSubsets:
     ``rank(present)`` gives the ranking ``rank(cost[:, present], max_increase=max_increase)`` gives, solution
     for solution. Small sub-problems share work: a sub-problem's assignments are those of the whole block that
     use only present columns, in the same (lexicographic) order, so the block's are listed once
-    (``enumerate_assignments``) and filtered per subset.
+    (``enumerate_assignments``) and filtered per subset. Larger ones are split by ``rank`` into blocks, most
+    of them the same for many subsets: ``cache`` (shared, e.g. by every block of a PMBM frame) ranks each
+    distinct one once.
     """
 
-    def __init__(self, cost: np.ndarray, max_increase: float = math.inf):
+    def __init__(self, cost: np.ndarray, max_increase: float = math.inf, cache: BlockCache | None = None):
         self.cost = cost
         self.max_increase = max_increase
+        self.cache = cache
         self.allowed = cost < np.inf
         self._listed: np.ndarray | None = None
         self._few = _candidates(cost) <= SUBSET_ENUMERATION_LIMIT
@@ -249,7 +273,7 @@ class ColumnSubsets:
         n_rows = self.cost.shape[0]
         counts = np.count_nonzero(self.allowed & present, axis=1)
         if n_rows == 0 or float(np.prod(counts, dtype=float)) > ENUMERATION_LIMIT:
-            return rank(self.cost[:, present], max_increase=self.max_increase)
+            return rank(self.cost[:, present], max_increase=self.max_increase, cache=self.cache)
         sub = self.cost[:, present]
         if n_rows == 1:
             if not counts[0]:

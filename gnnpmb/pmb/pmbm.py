@@ -41,7 +41,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.assign.murty import ColumnSubsets, Product, Ranking, blocks, forbid_beyond_private, k_best, rank
+from gnnpmb.assign.murty import BlockCache, ColumnSubsets, Product, Ranking, blocks, forbid_beyond_private, k_best, rank
 from gnnpmb.config import PmbmParams
 from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
 from gnnpmb.pmb.core import (
@@ -218,6 +218,7 @@ class SharedRanking:
         the best assignment is ranked). Each (block, pattern) is ranked on first use (``_varying_part``): a
         hypothesis with no children costs nothing."""
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
+        self._blocks: BlockCache = {}
         for rows, cols in blocks(cost):
             present = has_column[:, cols]
             best_only = len(rows) > max_block_rows
@@ -225,7 +226,7 @@ class SharedRanking:
                 self.common.append(_part(cost, rows, cols, present[0], max_increase, best_only))
                 continue
             _, first, pattern = np.unique(np.packbits(present, axis=1), axis=0, return_index=True, return_inverse=True)
-            subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase)
+            subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase, self._blocks)
             self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
         self.common_ok = all(ranking is not None for _, _, ranking in self.common)

@@ -18,15 +18,17 @@ def all_solutions(ranking: murty.Ranking) -> list[tuple[list[int], float]]:
     return out
 
 
+@pytest.mark.parametrize("shared_cache", [False, True])
 @pytest.mark.parametrize("max_increase", [math.inf, 1.5])
 @pytest.mark.parametrize(("enumeration_limit", "subset_limit"), [(1024, 16 * 1024), (1024, 0), (8, 16 * 1024)])
 def test_rank_of_a_column_subset_equals_rank_of_the_cut_matrix(
-    max_increase, enumeration_limit, subset_limit, monkeypatch
+    shared_cache, max_increase, enumeration_limit, subset_limit, monkeypatch
 ):
     monkeypatch.setattr(murty, "ENUMERATION_LIMIT", enumeration_limit)
     monkeypatch.setattr(murty, "SUBSET_ENUMERATION_LIMIT", subset_limit)
     rng = np.random.default_rng(5)
     checked = 0
+    cache: murty.BlockCache | None = {} if shared_cache else None
     for trial in range(150):
         # a PMB-like block: K track columns, then one private (new-track) column per row, always present
         n_rows, n_tracks = int(rng.integers(1, 5)), int(rng.integers(1, 7))
@@ -37,10 +39,24 @@ def test_rank_of_a_column_subset_equals_rank_of_the_cut_matrix(
         private = np.full((n_rows, n_rows), np.inf)
         private[np.arange(n_rows), np.arange(n_rows)] = rng.integers(0, 4, size=n_rows) if integer else 1.0
         cost = np.hstack([tracks, private])
-        subsets = murty.ColumnSubsets(cost, max_increase)
+        subsets = murty.ColumnSubsets(cost, max_increase, cache)
         for _ in range(4):
             present = np.concatenate([rng.random(n_tracks) < 0.7, np.ones(n_rows, dtype=bool)])
             want = all_solutions(murty.rank(cost[:, present], max_increase=max_increase))
             assert all_solutions(subsets.rank(present)) == want
             checked += len(want) > 1
     assert checked > 100
+
+
+def test_block_cache_ranks_a_repeated_block_once(monkeypatch):
+    monkeypatch.setattr(murty, "ENUMERATION_LIMIT", 0)  # split into blocks, each ranked by Murty
+    rng = np.random.default_rng(8)
+    block = rng.random((2, 3))
+    cost = np.full((4, 6), np.inf)
+    cost[:2, :3] = cost[2:, 3:] = block  # two independent blocks with equal costs
+    cache: murty.BlockCache = {}
+    ranking = murty.rank(cost, max_increase=math.inf, cache=cache)
+    assert isinstance(ranking, murty.Product)
+    (_, _, first), (_, _, second) = ranking.parts
+    assert first is second and len(cache) == 1
+    assert all_solutions(ranking) == all_solutions(murty.rank(cost, max_increase=math.inf))
