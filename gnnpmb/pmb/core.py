@@ -213,12 +213,28 @@ def posteriors_from_assignments(
     born, first = np.unique(birth_j, return_index=True)
     for j in birth_j[np.sort(first)].tolist():
         ctx.birth_id(j)
-    distinct, inverse = np.unique(codes, return_inverse=True)
+    distinct, inverse = _unique_codes(codes, n_union * (m + 1))
     tracks = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1))
     store = Bernoullis.concatenate([tracks, new_bernoullis(union, born, ctx)])
-    track_rows = np.split(inverse, np.cumsum(lengths)[:-1])
-    birth_rows = np.split(len(tracks) + np.searchsorted(born, birth_j), np.cumsum(is_birth.sum(axis=1))[:-1])
-    return store, [np.concatenate([t, b]) for t, b in zip(track_rows, birth_rows, strict=True)]
+    birth_rows = len(tracks) + np.searchsorted(born, birth_j)
+    track_bounds = np.concatenate([[0], np.cumsum(lengths)]).tolist()
+    birth_bounds = np.concatenate([[0], np.cumsum(is_birth.sum(axis=1))]).tolist()
+    return store, [
+        np.concatenate([inverse[track_bounds[i] : track_bounds[i + 1]], birth_rows[b0:b1]])
+        if b1 > b0
+        else inverse[track_bounds[i] : track_bounds[i + 1]]
+        for i, (b0, b1) in enumerate(zip(birth_bounds[:-1], birth_bounds[1:], strict=True))
+    ]
+
+
+def _unique_codes(codes: np.ndarray, n_codes: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(codes, return_inverse=True)`` for integer codes in [0, n_codes), by a presence table when that
+    is small (no sort)."""
+    if n_codes > 1 << 20:
+        return np.unique(codes, return_inverse=True)
+    seen = np.zeros(n_codes, dtype=bool)
+    seen[codes] = True
+    return np.flatnonzero(seen), (np.cumsum(seen) - 1)[codes]
 
 
 def meas_of_track(n_tracks: int, col_of_row: np.ndarray) -> np.ndarray:

@@ -38,7 +38,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import logsumexp
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.assign.murty import BlockCache, ColumnSubsets, Product, Ranking, blocks, forbid_beyond_private, k_best, rank
@@ -77,6 +76,25 @@ class _Child:
     total_cost: float
 
 
+def log_sum_exp(a: np.ndarray) -> np.float64:
+    """log sum_i exp(a_i) of a 1-D float64 array, bit for bit ``scipy.special.logsumexp(a)`` (scipy 1.17: the
+    largest terms are taken out of the sum, log1p(s / m) + log m + max a, with m their count; the direct
+    log sum exp where that is not finite), with the same NumPy operations on the same array shapes but without
+    its array-API dispatch, which cost more than the computation (3 calls per class and frame in PMBM)."""
+    if a.size == 0:
+        return np.float64(-np.inf)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        direct = np.log(np.sum(np.exp(a), axis=(0,), keepdims=True))
+        a_max = np.max(a, axis=(0,), keepdims=True)
+        is_max = a == a_max
+        count = np.sum(is_max.astype(a.dtype), axis=(0,), keepdims=True, dtype=a.dtype)
+        rest = np.exp(np.where(is_max, -np.inf, a) - a_max)
+        s = np.sum(rest, axis=(0,), keepdims=True, dtype=rest.dtype)
+        s = np.where(s == 0, s, s / count)
+        out = np.log1p(s) + np.log(count) + a_max
+    return np.where(np.isfinite(out), out, direct)[0]
+
+
 def hypothesis_budget(n_hypotheses: int, log_weight: float) -> int:
     """H_h = ceil(N_h w_h) >= 1 children for a prior hypothesis of normalised log weight ``log_weight``
     (a relative 1e-9 slack keeps N_h w_h = 2 + rounding error at 2)."""
@@ -110,7 +128,7 @@ class KBest:
         self, priors: list[GlobalHypothesis], locals_: Sequence[LocalHypotheses], ctx: UpdateContext
     ) -> list[GlobalHypothesis]:
         prior_log_w = np.array([h.log_weight for h in priors])
-        prior_log_w = prior_log_w - logsumexp(prior_log_w)
+        prior_log_w = prior_log_w - log_sum_exp(prior_log_w)
         budgets = [hypothesis_budget(self.params.n_hypotheses, lw) for lw in prior_log_w]
         if ctx.sink.enabled:
             for h in range(1, min(COST_MATRIX_EVENTS, len(locals_))):
@@ -147,11 +165,11 @@ class KBest:
         """Normalise, sort descending (stable), drop below ``hypothesis_prune`` (the best always stays), cap
         to N_h, renormalise. Returns the kept children and their normalised log weights."""
         log_w = np.array([c.log_weight for c in children])
-        log_w = log_w - logsumexp(log_w)
+        log_w = log_w - log_sum_exp(log_w)
         order = np.argsort(-log_w, kind="stable")
         keep = order[log_w[order] >= self._log_prune]
         keep = (keep if len(keep) else order[:1])[: self.params.n_hypotheses]
-        kept_log_w = log_w[keep] - logsumexp(log_w[keep])
+        kept_log_w = log_w[keep] - log_sum_exp(log_w[keep])
         return [children[i] for i in keep], kept_log_w
 
 
@@ -225,7 +243,9 @@ class SharedRanking:
             if (present == present[0]).all():
                 self.common.append(_part(cost, rows, cols, present[0], max_increase, best_only))
                 continue
-            _, first, pattern = np.unique(np.packbits(present, axis=1), axis=0, return_index=True, return_inverse=True)
+            packed = np.ascontiguousarray(np.packbits(present, axis=1))
+            rows_as_bytes = packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
+            _, first, pattern = np.unique(rows_as_bytes, return_index=True, return_inverse=True)
             subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase, self._blocks)
             self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
