@@ -79,17 +79,33 @@ def hypothesis_union(hypotheses: Sequence[GlobalHypothesis]) -> tuple[Bernoullis
     equal keys) and each hypothesis' rows of it, (K_h,) in the hypothesis' order. Hypotheses indexing one
     shared store are read through their indices, without gathering their Bernoullis."""
     store = hypotheses[0].store
+    bounds = np.cumsum([0] + [h.n_bernoullis for h in hypotheses]).tolist()
     if all(h.store is store and h.index is not None for h in hypotheses):
         rows = np.concatenate([h.index for h in hypotheses])
-        every = None
-        keys = store.local_key[rows]
+        union_rows, inverse = _union_rows(store.local_key, rows)
+        union = store.subset(union_rows)
     else:
         every = Bernoullis.concatenate([h.bernoullis for h in hypotheses])
-        keys = every.local_key
-    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
-    union = every.subset(first) if every is not None else store.subset(rows[first])
-    bounds = np.cumsum([0] + [h.n_bernoullis for h in hypotheses])
+        _, first, inverse = np.unique(every.local_key, return_index=True, return_inverse=True)
+        union = every.subset(first)
     return union, [inverse[start:stop] for start, stop in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
+def _union_rows(store_keys: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(store_keys[rows], return_index=True, return_inverse=True)`` as (store rows of the distinct
+    keys, inverse): when the store rows used hold distinct keys (as a posterior store does), by sorting only
+    those rows instead of every occurrence."""
+    seen = np.zeros(len(store_keys), dtype=bool)
+    seen[rows] = True
+    used = np.flatnonzero(seen)
+    order = np.argsort(store_keys[used], kind="stable")
+    sorted_keys = store_keys[used[order]]
+    if not (sorted_keys[1:] > sorted_keys[:-1]).all():
+        _, first, inverse = np.unique(store_keys[rows], return_index=True, return_inverse=True)
+        return rows[first], inverse
+    position = np.empty(len(store_keys), dtype=np.intp)
+    position[used[order]] = np.arange(len(used))
+    return used[order], position[rows]
 
 
 _MASK63 = np.uint64((1 << 63) - 1)
