@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import heapq
 import math
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -357,12 +358,33 @@ class Murty:
             self._serial += 1
 
 
+@dataclass(frozen=True, slots=True)
+class PartsSummary:
+    """What ``Product`` reads of its first parts, worked out once for products that share them
+    (``pmb.pmbm.SharedRanking``): their best costs, in order, and (cost(1) - cost(0), position) of those with a
+    second solution."""
+
+    best_costs: tuple[float, ...]
+    steps: tuple[tuple[float, int], ...]
+
+    @staticmethod
+    def of(parts: list[tuple[np.ndarray, np.ndarray, Ranking]]) -> PartsSummary:
+        best = tuple(ranking.solution(0)[1] for _, _, ranking in parts)
+        steps = []
+        for n, (_, _, ranking) in enumerate(parts):
+            second = ranking.solution(1)
+            if second is not None:
+                steps.append((second[1] - best[n], n))
+        return PartsSummary(best, tuple(steps))
+
+
 class Product:
     """Ranking of a problem made of independent parts (disjoint rows and columns): the smallest sums of one
     solution per part, up to ``max_increase`` above the best.
 
     base: (R,) the best assignment (every part's solution 0 on its rows; not modified); parts: (rows, cols,
-    ranking) with the part's rows in the problem and its local-to-problem column map.
+    ranking) with the part's rows in the problem and its local-to-problem column map; ``prefix``: the
+    ``PartsSummary`` of the first parts, if known (same result, less work).
 
     Index tuples t (solution index per part) are ranked with a heap. Parts with a second solution are sorted
     by d_q = cost(1) - cost(0); with q the last nonzero position of t, its successors are t + e_q, t + e_(q+1)
@@ -375,10 +397,13 @@ class Product:
         base: np.ndarray,
         parts: list[tuple[np.ndarray, np.ndarray, Ranking]],
         max_increase: float = math.inf,
+        prefix: PartsSummary | None = None,
     ):
         self.base = base
         self.parts = parts
-        total = float(sum(ranking.solution(0)[1] for _, _, ranking in parts))
+        self._prefix = prefix or PartsSummary((), ())
+        known = len(self._prefix.best_costs)
+        total = float(sum([*self._prefix.best_costs, *(ranking.solution(0)[1] for _, _, ranking in parts[known:])]))
         self._limit = total + max_increase
         self._varying: list[tuple[np.ndarray, np.ndarray, Ranking]] = []
         self._found: list[tuple[tuple[int, ...], float]] = [((), total)]
@@ -416,8 +441,9 @@ class Product:
 
     def _push_successors(self, choice: tuple[int, ...], total: float, last: int) -> None:
         if last < 0:
-            steps = []
-            for n, (_, _, ranking) in enumerate(self.parts):
+            steps = list(self._prefix.steps)
+            for n in range(len(self._prefix.best_costs), len(self.parts)):
+                ranking = self.parts[n][2]
                 second = ranking.solution(1)
                 if second is not None:
                     steps.append((second[1] - ranking.solution(0)[1], n))

@@ -40,7 +40,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.assign.murty import BlockCache, ColumnSubsets, Product, Ranking, blocks, forbid_beyond_private, k_best, rank
+from gnnpmb.assign.murty import (
+    BlockCache,
+    ColumnSubsets,
+    PartsSummary,
+    Product,
+    Ranking,
+    blocks,
+    forbid_beyond_private,
+    k_best,
+    rank,
+)
 from gnnpmb.config import PmbmParams
 from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
 from gnnpmb.pmb.core import (
@@ -237,6 +247,7 @@ class SharedRanking:
         hypothesis with no children costs nothing."""
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
         self._blocks: BlockCache = {}
+        self._common: PartsSummary | None = None
         for rows, cols in blocks(cost):
             present = has_column[:, cols]
             best_only = len(rows) > max_block_rows
@@ -250,13 +261,22 @@ class SharedRanking:
             self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
         self.common_ok = all(ranking is not None for _, _, ranking in self.common)
+        self.common_best: tuple[float, ...] = ()
         if self.common_ok:
+            self.common_best = tuple(ranking.solution(0)[1] for _, _, ranking in self.common)
             for rows, cols, ranking in self.common:
                 self.common_base[rows] = cols[ranking.solution(0)[0]]
 
     def k_best(self, budgets: list[int]) -> list[list[tuple[np.ndarray, float]]]:
         """The budgets[h] best assignments (col_of_row as union columns, cost) of every hypothesis."""
         return [self._hypothesis(h, k) for h, k in enumerate(budgets)]
+
+    def _common_summary(self) -> PartsSummary:
+        """The ``murty.PartsSummary`` of the common parts, which lead every hypothesis' parts (worked out when
+        a hypothesis first has more than one child)."""
+        if self._common is None:
+            self._common = PartsSummary.of(self.common)
+        return self._common
 
     def _varying_part(self, b: int, h: int) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
         rows, cols, patterns, pattern, subsets = self.varying[b]
@@ -282,8 +302,9 @@ class SharedRanking:
         for rows, cols, ranking in parts[len(self.common) :]:
             base[rows] = cols[ranking.solution(0)[0]]
         if k == 1:  # Product's best, without its set-up
-            return [(base, float(sum(ranking.solution(0)[1] for _, _, ranking in parts)))]
-        product = Product(base, parts, self.max_increase)
+            varying_best = (ranking.solution(0)[1] for _, _, ranking in parts[len(self.common) :])
+            return [(base, float(sum([*self.common_best, *varying_best])))]
+        product = Product(base, parts, self.max_increase, self._common_summary())
         out = []
         for i in range(k):
             found = product.solution(i)

@@ -60,3 +60,20 @@ def test_block_cache_ranks_a_repeated_block_once(monkeypatch):
     (_, _, first), (_, _, second) = ranking.parts
     assert first is second and len(cache) == 1
     assert all_solutions(ranking) == all_solutions(murty.rank(cost, max_increase=math.inf))
+
+
+@pytest.mark.parametrize("known", [0, 1, 2, 3])
+def test_product_with_a_known_prefix_equals_the_plain_product(known, monkeypatch):
+    monkeypatch.setattr(murty, "ENUMERATION_LIMIT", 0)  # keep the blocks apart: a Product of 3 parts
+    rng = np.random.default_rng(9)
+    for _ in range(30):
+        cost = np.full((6, 9), np.inf)
+        for b in range(3):
+            block = rng.integers(0, 3, size=(2, 3)).astype(float)  # ties between and within parts
+            cost[2 * b : 2 * b + 2, 3 * b : 3 * b + 3] = block
+        plain = murty.rank(cost)
+        assert isinstance(plain, murty.Product) and len(plain.parts) == 3
+        summary = murty.PartsSummary.of(plain.parts[:known])
+        assert len(summary.best_costs) == known
+        with_prefix = murty.Product(plain.base, plain.parts, math.inf, summary)
+        assert all_solutions(with_prefix) == all_solutions(plain)
