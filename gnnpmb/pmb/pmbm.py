@@ -26,9 +26,12 @@ unaffected.
 
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
-ranked once (``murty.rank``) and shared by all hypotheses that contain it (``murty.Product``). Posteriors are
-built once per distinct (Bernoulli, outcome) into one store that the posterior hypotheses index
-(``core.posteriors_from_assignments``, ``core.GlobalHypothesis``).
+ranked once and shared by all hypotheses that contain it (``murty.Product``). The sub-problems of one block
+share a listing of its assignments and the rankings of equal smaller blocks (``murty.ColumnSubsets``,
+``murty.BlockCache``); a hypothesis with one child gets its best assignment without a ``Product``. Posteriors
+are built once per distinct (Bernoulli, outcome) into one store that the posterior hypotheses index
+(``core.posteriors_from_assignments``, ``core.GlobalHypothesis``). These pieces only share work: each gives
+the same assignments, costs and Bernoullis, bit for bit, as the plain computation it replaces (their tests).
 """
 
 from __future__ import annotations
