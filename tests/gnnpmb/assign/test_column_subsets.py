@@ -3,6 +3,7 @@ matrix: the same assignments with the same float costs in the same order, ties i
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -77,3 +78,18 @@ def test_product_with_a_known_prefix_equals_the_plain_product(known, monkeypatch
         assert len(summary.best_costs) == known
         with_prefix = murty.Product(plain.base, plain.parts, math.inf, summary)
         assert all_solutions(with_prefix) == all_solutions(plain)
+
+
+def test_enumerate_assignments_lists_every_assignment_in_lexicographic_order():
+    rng = np.random.default_rng(4)
+    sizes = set()
+    for _ in range(300):
+        n_rows, n_cols = int(rng.integers(0, 6)), int(rng.integers(1, 8))
+        allowed = rng.random((n_rows, n_cols)) < 0.7
+        product = itertools.product(*[np.flatnonzero(row).tolist() for row in allowed])
+        want = [c for c in product if len(set(c)) == n_rows]
+        got = murty.enumerate_assignments(allowed)
+        assert got.dtype == np.int64 and got.shape == (len(want), n_rows) and got.flags.c_contiguous
+        assert [tuple(c) for c in got.tolist()] == want
+        sizes.add(math.prod(int(n) for n in allowed.sum(axis=1)) <= murty.SMALL_PRODUCT)
+    assert sizes == {False, True}  # both ways of listing were checked
