@@ -225,7 +225,12 @@ this machine: 16 vs 36 us for 12 candidates of 2 rows; NumPy is faster from abou
 
 class Enumerated:
     """Ranking of a small block by listing every assignment (``enumerate_assignments``, or ``combos`` if
-    already listed in that order), sorted by cost (stable); ``root``, if given, comes first."""
+    already listed in that order), sorted by cost (stable); ``root``, if given, comes first.
+
+    Work is done on demand: with a ``root``, nothing is listed until a second solution is asked for (the root's
+    cost is summed as one row of the listing's cost array); without, the costs are listed and the best is the
+    first cheapest (as the stable sort puts it); the rest are sorted when first asked for.
+    """
 
     def __init__(
         self,
@@ -234,24 +239,34 @@ class Enumerated:
         max_increase: float = math.inf,
         combos: np.ndarray | None = None,
     ):
-        n_rows = cost.shape[0]
-        if combos is None:
-            combos = enumerate_assignments(cost < np.inf)
-        if len(combos) == 0:
-            raise InfeasibleAssignment("no assignment avoids the forbidden entries")
-        costs = cost[np.arange(n_rows), combos].sum(axis=1)
-        self._listed = combos
-        self._listed_costs = costs
+        self._cost = cost
         self._root = root
         self._max_increase = max_increase
-        # the best: the root, else the first cheapest (as the stable sort puts it); the rest sorted on demand
-        self._best = int(np.argmin(costs) if root is None else np.flatnonzero((combos == root).all(axis=1))[0])
+        self._listed: np.ndarray | None = None
+        self._listed_costs: np.ndarray | None = None
         self._combos: np.ndarray | None = None
         self._costs: np.ndarray | None = None
+        if root is not None and combos is None:
+            self._best = root, float(cost[np.arange(cost.shape[0]), root[None, :]].sum(axis=1)[0])
+            return
+        listed, costs = self._list(combos)
+        at = int(np.argmin(costs) if root is None else np.flatnonzero((listed == root).all(axis=1))[0])
+        self._best = listed[at], float(costs[at])
+
+    def _list(self, combos: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Every assignment (N, R) and its cost (N,); raises ``InfeasibleAssignment`` if there is none."""
+        if self._listed is None or self._listed_costs is None:
+            if combos is None:
+                combos = enumerate_assignments(self._cost < np.inf)
+            if len(combos) == 0:
+                raise InfeasibleAssignment("no assignment avoids the forbidden entries")
+            self._listed = combos
+            self._listed_costs = self._cost[np.arange(self._cost.shape[0]), combos].sum(axis=1)
+        return self._listed, self._listed_costs
 
     def solution(self, index: int) -> tuple[np.ndarray, float] | None:
         if index == 0:
-            return self._listed[self._best], float(self._listed_costs[self._best])
+            return self._best
         if self._combos is None or self._costs is None:
             self._sort()
         if index >= len(self._combos):
@@ -259,7 +274,7 @@ class Enumerated:
         return self._combos[index], float(self._costs[index])
 
     def _sort(self) -> None:
-        combos, costs = self._listed, self._listed_costs
+        combos, costs = self._list()
         order = np.argsort(costs, kind="stable")
         if self._root is not None:
             at = np.flatnonzero((combos[order] == self._root).all(axis=1))[0]

@@ -93,3 +93,22 @@ def test_enumerate_assignments_lists_every_assignment_in_lexicographic_order():
         assert [tuple(c) for c in got.tolist()] == want
         sizes.add(math.prod(int(n) for n in allowed.sum(axis=1)) <= murty.SMALL_PRODUCT)
     assert sizes == {False, True}  # both ways of listing were checked
+
+
+def test_enumerated_with_a_root_defers_listing_and_agrees_with_its_listing():
+    """With a root, the best is the root and its cost is summed alone; once listed, the root's cost in the
+    listing is the same float, and the ranking is that of the eagerly listed block."""
+    rng = np.random.default_rng(12)
+    for _ in range(300):
+        n_rows = int(rng.integers(1, 16))
+        cost = np.full((n_rows, n_rows + 3), np.inf)
+        cost[:, :3] = rng.normal(0.0, 10.0, size=(n_rows, 3)) * (rng.random((n_rows, 3)) < 0.3)
+        cost[np.arange(n_rows), 3 + np.arange(n_rows)] = rng.normal(0.0, 10.0, size=n_rows)
+        cost[cost == 0.0] = np.inf
+        root, _ = murty.solve(cost)
+        lazy = murty.Enumerated(cost, root)
+        eager = murty.Enumerated(cost, root, combos=murty.enumerate_assignments(cost < np.inf))
+        best = lazy.solution(0)
+        assert best is not None and best[0].tolist() == root.tolist()
+        assert best[1] == eager.solution(0)[1]  # bit for bit
+        assert all_solutions(lazy) == all_solutions(eager)
