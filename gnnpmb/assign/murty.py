@@ -429,7 +429,9 @@ class Product:
     Index tuples t (solution index per part) are ranked with a heap. Parts with a second solution are sorted
     by d_q = cost(1) - cost(0); with q the last nonzero position of t, its successors are t + e_q, t + e_(q+1)
     and, if t_q = 1, t - e_q + e_(q+1). Every tuple then has exactly one parent and costs no less than it (a
-    part's costs never decrease and d is sorted), so at most three heap entries are pushed per solution.
+    part's costs never decrease and d is sorted), so at most three heap entries are pushed per solution. A
+    tuple is held sparse, as its (q, t_q) with t_q > 0 by increasing q, so a step costs O(nonzeros), not
+    O(parts).
     """
 
     def __init__(
@@ -446,11 +448,11 @@ class Product:
         total = float(sum([*self._prefix.best_costs, *(ranking.solution(0)[1] for _, _, ranking in parts[known:])]))
         self._limit = total + max_increase
         self._varying: list[tuple[np.ndarray, np.ndarray, Ranking]] = []
-        self._found: list[tuple[tuple[int, ...], float]] = [((), total)]
+        self._found: list[tuple[tuple[tuple[int, int], ...], float]] = [((), total)]
         self._solutions: dict[int, tuple[np.ndarray, float]] = {0: (base, total)}
-        self._heap: list[tuple[float, int, tuple[int, ...], int]] = []
+        self._heap: list[tuple[float, int, tuple[tuple[int, int], ...], int]] = []
         self._serial = 0
-        self._unexpanded: tuple[tuple[int, ...], float, int] | None = ((), total, -1)
+        self._unexpanded: tuple[tuple[tuple[int, int], ...], float, int] | None = ((), total, -1)
 
     def solution(self, index: int) -> tuple[np.ndarray, float] | None:
         while len(self._found) <= index:
@@ -465,21 +467,21 @@ class Product:
         if index not in self._solutions:
             choice, total = self._found[index]
             cols = self.base.copy()
-            for (rows, part_cols, ranking), i in zip(self._varying, choice, strict=True):
-                if i:
-                    cols[rows] = part_cols[ranking.solution(i)[0]]
+            for q, i in choice:
+                rows, part_cols, ranking = self._varying[q]
+                cols[rows] = part_cols[ranking.solution(i)[0]]
             self._solutions[index] = (cols, total)
         return self._solutions[index]
 
     def _cost(self, q: int, i: int) -> float:
         return self._varying[q][2].solution(i)[1]
 
-    def _push(self, total: float, choice: tuple[int, ...], last: int) -> None:
+    def _push(self, total: float, choice: tuple[tuple[int, int], ...], last: int) -> None:
         if total <= self._limit:
             heapq.heappush(self._heap, (total, self._serial, choice, last))
             self._serial += 1
 
-    def _push_successors(self, choice: tuple[int, ...], total: float, last: int) -> None:
+    def _push_successors(self, choice: tuple[tuple[int, int], ...], total: float, last: int) -> None:
         if last < 0:
             steps = list(self._prefix.steps)
             for n in range(len(self._prefix.best_costs), len(self.parts)):
@@ -490,15 +492,15 @@ class Product:
             steps.sort()
             self._varying = [self.parts[n] for _, n in steps]
             if steps:
-                self._push(total + steps[0][0], (1,) + (0,) * (len(steps) - 1), 0)
+                self._push(total + steps[0][0], ((0, 1),), 0)
             return
-        i = choice[last]
+        i = choice[-1][1]  # the entry of position ``last``, the last nonzero one
         further = self._varying[last][2].solution(i + 1)
         if further is not None:
-            self._push(total + further[1] - self._cost(last, i), (*choice[:last], i + 1, *choice[last + 1 :]), last)
+            self._push(total + further[1] - self._cost(last, i), (*choice[:-1], (last, i + 1)), last)
         if last + 1 < len(self._varying):
             step = self._cost(last + 1, 1) - self._cost(last + 1, 0)
-            self._push(total + step, (*choice[: last + 1], 1, *choice[last + 2 :]), last + 1)
+            self._push(total + step, (*choice, (last + 1, 1)), last + 1)
             if i == 1:
                 undo = self._cost(last, 1) - self._cost(last, 0)
-                self._push(total - undo + step, (*choice[:last], 0, 1, *choice[last + 2 :]), last + 1)
+                self._push(total - undo + step, (*choice[:-1], (last + 1, 1)), last + 1)
