@@ -60,12 +60,27 @@ class GlobalHypothesis:
         return self.store if self.index is None else self.store.subset(self.index)
 
     @property
+    def track_id(self) -> np.ndarray:
+        """(K,) the Bernoullis' track ids (one array gathered, not all)."""
+        return self.store.track_id if self.index is None else self.store.track_id[self.index]
+
+    @property
+    def existence(self) -> np.ndarray:
+        """(K,) the Bernoullis' existence probabilities."""
+        return self.store.existence if self.index is None else self.store.existence[self.index]
+
+    @property
+    def local_key(self) -> np.ndarray:
+        """(K,) the Bernoullis' single-target hypothesis keys."""
+        return self.store.local_key if self.index is None else self.store.local_key[self.index]
+
+    @property
     def n_bernoullis(self) -> int:
         return len(self.store) if self.index is None else len(self.index)
 
     def without_existence_below(self, threshold: float) -> GlobalHypothesis:
         """This hypothesis without its Bernoullis of existence r < ``threshold`` (itself if it has none)."""
-        existence = self.store.existence if self.index is None else self.store.existence[self.index]
+        existence = self.existence
         if existence.min(initial=1.0) >= threshold:
             return self
         keep = existence >= threshold
@@ -312,10 +327,10 @@ def assignment_pairs(
 
 def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
     """Track id -> its largest existence probability over the hypotheses."""
-    ids = np.concatenate([h.bernoullis.track_id for h in hypotheses])
+    ids = np.concatenate([h.track_id for h in hypotheses])
     ids, inverse = np.unique(ids, return_inverse=True)
     largest = np.zeros(len(ids))
-    np.maximum.at(largest, inverse, np.concatenate([h.bernoullis.existence for h in hypotheses]))
+    np.maximum.at(largest, inverse, np.concatenate([h.existence for h in hypotheses]))
     return dict(zip(ids.tolist(), largest.tolist(), strict=True))
 
 
@@ -397,7 +412,7 @@ class PmbCore:
         if sink.enabled:
             posterior_r = _max_existence(posteriors)
             prior_r = _max_existence(priors)
-            alive = set(np.concatenate([h.bernoullis.track_id for h in kept]).tolist())
+            alive = set(np.concatenate([h.track_id for h in kept]).tolist())
             for t in sorted((set(posterior_r) | set(prior_r)) - alive):
                 if t in posterior_r:
                     sink.emit(Pruned(self.class_name, t, PruneReason.LOW_EXISTENCE, posterior_r[t]))

@@ -420,12 +420,12 @@ def _emit(
     ``GlobalHypotheses`` as the core will keep them (after pruning)."""
     pairs, missed = assignment_pairs(local, col_of_row)
     ctx.sink.emit(Assignment(ctx.class_name, pairs, total_cost, missed, hypothesis=0))
-    alive = [h.without_existence_below(ctx.prune_existence).bernoullis for h in posteriors]
+    alive = [h.without_existence_below(ctx.prune_existence) for h in posteriors]
     ctx.sink.emit(
         GlobalHypotheses(
             ctx.class_name,
             log_weights=np.array([h.log_weight for h in posteriors]),
-            members=tuple(tuple(b.track_id.tolist()) for b in alive),
-            local=tuple(tuple(b.local_key.tolist()) for b in alive),
+            members=tuple(tuple(h.track_id.tolist()) for h in alive),
+            local=tuple(tuple(h.local_key.tolist()) for h in alive),
         )
     )
