@@ -27,7 +27,9 @@ min_j' c_i'j', or the best cost + c_ij - c_ip for a column p that only row i may
 from __future__ import annotations
 
 import heapq
+import itertools
 import math
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -83,36 +85,57 @@ def k_best(cost: np.ndarray, k: int, max_increase: float = math.inf) -> list[tup
     return out
 
 
-def rank(cost: np.ndarray, first: np.ndarray | None = None, max_increase: float = math.inf) -> Ranking:
+BlockCache = dict[tuple[tuple[int, ...], bytes, bytes | None, float], "Ranking"]
+"""Block rankings by (shape, cost bytes, root bytes, max_increase): a ranking depends on nothing else."""
+
+
+def rank(
+    cost: np.ndarray,
+    first: np.ndarray | None = None,
+    max_increase: float = math.inf,
+    cache: BlockCache | None = None,
+) -> Ranking:
     """Lazy ranking of the assignments of ``cost`` (R <= C rows, +inf forbidden) that cost at most
     ``max_increase`` more than the best, split into blocks unless small.
 
-    ``first``: a best assignment to start from (else found here). Raises ``InfeasibleAssignment`` when no
+    ``first``: a best assignment to start from (else found here). ``cache``: rankings of blocks met before,
+    reused for a block with equal costs and root (and filled). Raises ``InfeasibleAssignment`` when no
     assignment exists.
     """
     n_rows = cost.shape[0]
     if n_rows == 0:
         return Product(np.zeros(0, dtype=np.int64), [], max_increase)
     if _candidates(cost) <= ENUMERATION_LIMIT:
-        return block_ranking(cost, first, max_increase)
+        return _block_ranking(cost, first, max_increase, cache)
     if max_increase < math.inf:
         if first is None:
             first, _ = solve(cost)
         cost = _forbid_hopeless(forbid_beyond_private(cost, max_increase), first, max_increase)
         if _candidates(cost) <= ENUMERATION_LIMIT:
-            return block_ranking(cost, first, max_increase)
+            return _block_ranking(cost, first, max_increase, cache)
     parts = []
     base = np.empty(n_rows, dtype=np.int64)
+    local_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
     for rows, cols in blocks(cost):
         root = None
         if first is not None:
-            local_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
             local_of_col[cols] = np.arange(len(cols))
             root = local_of_col[first[rows]]
-        ranking = block_ranking(cost[np.ix_(rows, cols)], root, max_increase)
+        ranking = _block_ranking(cost[np.ix_(rows, cols)], root, max_increase, cache)
         base[rows] = cols[ranking.solution(0)[0]]
         parts.append((rows, cols, ranking))
     return Product(base, parts, max_increase)
+
+
+def _block_ranking(cost: np.ndarray, root: np.ndarray | None, max_increase: float, cache: BlockCache | None) -> Ranking:
+    """``block_ranking``, looked up in and added to ``cache`` if given."""
+    if cache is None:
+        return block_ranking(cost, root, max_increase)
+    key = (cost.shape, cost.tobytes(), None if root is None else root.tobytes(), max_increase)
+    ranking = cache.get(key)
+    if ranking is None:
+        ranking = cache[key] = block_ranking(cost, root, max_increase)
+    return ranking
 
 
 def block_ranking(cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf) -> Ranking:
@@ -179,33 +202,131 @@ class SingleRow:
         return self._cols[index : index + 1], float(self._costs[index])
 
 
-class Enumerated:
-    """Ranking of a small block by listing every assignment: rows' allowed columns are combined row by row,
-    dropping combinations that reuse a column, then sorted by cost (stable); ``root``, if given, comes
-    first."""
+def enumerate_assignments(allowed: np.ndarray) -> np.ndarray:
+    """(N, R) every assignment of the R rows of ``allowed`` ((R, C) bool) to distinct allowed columns, in
+    lexicographic order of their columns: rows' allowed columns are combined row by row, dropping combinations
+    that reuse a column. Up to ``SMALL_PRODUCT`` candidates are combined in Python (fewer calls)."""
+    n_rows = allowed.shape[0]
+    row_cols = [np.flatnonzero(row) for row in allowed]
+    if math.prod(len(cols) for cols in row_cols) <= SMALL_PRODUCT:
+        listed = [c for c in itertools.product(*[cols.tolist() for cols in row_cols]) if len(set(c)) == n_rows]
+        return np.array(listed, dtype=np.int64).reshape(len(listed), n_rows)
+    combos = np.zeros((1, 0), dtype=np.int64)
+    for i, cols in enumerate(row_cols):
+        grown = np.column_stack([np.repeat(combos, len(cols), axis=0), np.tile(cols, len(combos))])
+        combos = grown[(grown[:, :i] != grown[:, i : i + 1]).all(axis=1)]
+    return combos
 
-    def __init__(self, cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf):
-        n_rows = cost.shape[0]
-        combos = np.zeros((1, 0), dtype=np.int64)
-        for i in range(n_rows):
-            allowed = np.flatnonzero(cost[i] < np.inf)
-            grown = np.column_stack([np.repeat(combos, len(allowed), axis=0), np.tile(allowed, len(combos))])
-            combos = grown[(grown[:, :i] != grown[:, i : i + 1]).all(axis=1)]
-        if len(combos) == 0:
-            raise InfeasibleAssignment("no assignment avoids the forbidden entries")
-        costs = cost[np.arange(n_rows), combos].sum(axis=1)
-        order = np.argsort(costs, kind="stable")
-        if root is not None:
-            at = np.flatnonzero((combos[order] == root).all(axis=1))[0]
-            order = np.concatenate([order[at : at + 1], order[:at], order[at + 1 :]])
-        order = order[costs[order] <= costs[order[0]] + max_increase]
-        self._combos = combos[order]
-        self._costs = costs[order]
+
+SMALL_PRODUCT = 32
+"""``enumerate_assignments`` combines at most this many candidates in Python, more with NumPy (measured on
+this machine: 16 vs 36 us for 12 candidates of 2 rows; NumPy is faster from about 100)."""
+
+
+class Enumerated:
+    """Ranking of a small block by listing every assignment (``enumerate_assignments``, or ``combos`` if
+    already listed in that order), sorted by cost (stable); ``root``, if given, comes first.
+
+    Work is done on demand: with a ``root``, nothing is listed until a second solution is asked for (the root's
+    cost is summed as one row of the listing's cost array); without, the costs are listed and the best is the
+    first cheapest (as the stable sort puts it); the rest are sorted when first asked for.
+    """
+
+    def __init__(
+        self,
+        cost: np.ndarray,
+        root: np.ndarray | None = None,
+        max_increase: float = math.inf,
+        combos: np.ndarray | None = None,
+    ):
+        self._cost = cost
+        self._root = root
+        self._max_increase = max_increase
+        self._listed: np.ndarray | None = None
+        self._listed_costs: np.ndarray | None = None
+        self._combos: np.ndarray | None = None
+        self._costs: np.ndarray | None = None
+        if root is not None and combos is None:
+            self._best = root, float(cost[np.arange(cost.shape[0]), root[None, :]].sum(axis=1)[0])
+            return
+        listed, costs = self._list(combos)
+        at = int(np.argmin(costs) if root is None else np.flatnonzero((listed == root).all(axis=1))[0])
+        self._best = listed[at], float(costs[at])
+
+    def _list(self, combos: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Every assignment (N, R) and its cost (N,); raises ``InfeasibleAssignment`` if there is none."""
+        if self._listed is None or self._listed_costs is None:
+            if combos is None:
+                combos = enumerate_assignments(self._cost < np.inf)
+            if len(combos) == 0:
+                raise InfeasibleAssignment("no assignment avoids the forbidden entries")
+            self._listed = combos
+            self._listed_costs = self._cost[np.arange(self._cost.shape[0]), combos].sum(axis=1)
+        return self._listed, self._listed_costs
 
     def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        if index == 0:
+            return self._best
+        if self._combos is None or self._costs is None:
+            self._sort()
         if index >= len(self._combos):
             return None
         return self._combos[index], float(self._costs[index])
+
+    def _sort(self) -> None:
+        combos, costs = self._list()
+        order = np.argsort(costs, kind="stable")
+        if self._root is not None:
+            at = np.flatnonzero((combos[order] == self._root).all(axis=1))[0]
+            order = np.concatenate([order[at : at + 1], order[:at], order[at + 1 :]])
+        order = order[costs[order] <= costs[order[0]] + self._max_increase]
+        self._combos = combos[order]
+        self._costs = costs[order]
+
+
+SUBSET_ENUMERATION_LIMIT = 16 * 1024
+"""``ColumnSubsets`` lists a block's assignments once, to be filtered for each column subset, when its rows'
+allowed-column counts multiply to at most this."""
+
+
+class ColumnSubsets:
+    """Rankings of the sub-problems of one (R, C) block that keep only some of its columns (PMBM: a gated block
+    of the union of all hypotheses' Bernoullis, cut to the Bernoullis one hypothesis holds).
+
+    ``rank(present)`` gives the ranking ``rank(cost[:, present], max_increase=max_increase)`` gives, solution
+    for solution. Small sub-problems share work: a sub-problem's assignments are those of the whole block that
+    use only present columns, in the same (lexicographic) order, so the block's are listed once
+    (``enumerate_assignments``) and filtered per subset. Larger ones are split by ``rank`` into blocks, most
+    of them the same for many subsets: ``cache`` (shared, e.g. by every block of a PMBM frame) ranks each
+    distinct one once.
+    """
+
+    def __init__(self, cost: np.ndarray, max_increase: float = math.inf, cache: BlockCache | None = None):
+        self.cost = cost
+        self.max_increase = max_increase
+        self.cache = cache
+        self.allowed = cost < np.inf
+        self._listed: np.ndarray | None = None
+        self._few = _candidates(cost) <= SUBSET_ENUMERATION_LIMIT
+
+    def rank(self, present: np.ndarray) -> Ranking:
+        """The ranking of the sub-problem with columns ``present`` ((C,) bool). Raises ``InfeasibleAssignment``."""
+        n_rows = self.cost.shape[0]
+        counts = np.count_nonzero(self.allowed & present, axis=1)
+        if n_rows == 0 or float(np.prod(counts, dtype=float)) > ENUMERATION_LIMIT:
+            return rank(self.cost[:, present], max_increase=self.max_increase, cache=self.cache)
+        sub = self.cost[:, present]
+        if n_rows == 1:
+            if not counts[0]:
+                raise InfeasibleAssignment("the only row has no allowed column")
+            return SingleRow(sub[0], int(np.argmin(sub[0])), self.max_increase)
+        if not self._few:
+            return Enumerated(sub, None, self.max_increase)
+        if self._listed is None:
+            self._listed = enumerate_assignments(self.allowed)
+        listed = self._listed
+        local_of_col = np.cumsum(present) - 1
+        return Enumerated(sub, None, self.max_increase, local_of_col[listed[present[listed].all(axis=1)]])
 
 
 class Murty:
@@ -277,17 +398,40 @@ class Murty:
             self._serial += 1
 
 
+@dataclass(frozen=True, slots=True)
+class PartsSummary:
+    """What ``Product`` reads of its first parts, worked out once for products that share them
+    (``pmb.pmbm.SharedRanking``): their best costs, in order, and (cost(1) - cost(0), position) of those with a
+    second solution."""
+
+    best_costs: tuple[float, ...]
+    steps: tuple[tuple[float, int], ...]
+
+    @staticmethod
+    def of(parts: list[tuple[np.ndarray, np.ndarray, Ranking]]) -> PartsSummary:
+        best = tuple(ranking.solution(0)[1] for _, _, ranking in parts)
+        steps = []
+        for n, (_, _, ranking) in enumerate(parts):
+            second = ranking.solution(1)
+            if second is not None:
+                steps.append((second[1] - best[n], n))
+        return PartsSummary(best, tuple(steps))
+
+
 class Product:
     """Ranking of a problem made of independent parts (disjoint rows and columns): the smallest sums of one
     solution per part, up to ``max_increase`` above the best.
 
     base: (R,) the best assignment (every part's solution 0 on its rows; not modified); parts: (rows, cols,
-    ranking) with the part's rows in the problem and its local-to-problem column map.
+    ranking) with the part's rows in the problem and its local-to-problem column map; ``prefix``: the
+    ``PartsSummary`` of the first parts, if known (same result, less work).
 
     Index tuples t (solution index per part) are ranked with a heap. Parts with a second solution are sorted
     by d_q = cost(1) - cost(0); with q the last nonzero position of t, its successors are t + e_q, t + e_(q+1)
     and, if t_q = 1, t - e_q + e_(q+1). Every tuple then has exactly one parent and costs no less than it (a
-    part's costs never decrease and d is sorted), so at most three heap entries are pushed per solution.
+    part's costs never decrease and d is sorted), so at most three heap entries are pushed per solution. A
+    tuple is held sparse, as its (q, t_q) with t_q > 0 by increasing q, so a step costs O(nonzeros), not
+    O(parts).
     """
 
     def __init__(
@@ -295,17 +439,20 @@ class Product:
         base: np.ndarray,
         parts: list[tuple[np.ndarray, np.ndarray, Ranking]],
         max_increase: float = math.inf,
+        prefix: PartsSummary | None = None,
     ):
         self.base = base
         self.parts = parts
-        total = float(sum(ranking.solution(0)[1] for _, _, ranking in parts))
+        self._prefix = prefix or PartsSummary((), ())
+        known = len(self._prefix.best_costs)
+        total = float(sum([*self._prefix.best_costs, *(ranking.solution(0)[1] for _, _, ranking in parts[known:])]))
         self._limit = total + max_increase
         self._varying: list[tuple[np.ndarray, np.ndarray, Ranking]] = []
-        self._found: list[tuple[tuple[int, ...], float]] = [((), total)]
+        self._found: list[tuple[tuple[tuple[int, int], ...], float]] = [((), total)]
         self._solutions: dict[int, tuple[np.ndarray, float]] = {0: (base, total)}
-        self._heap: list[tuple[float, int, tuple[int, ...], int]] = []
+        self._heap: list[tuple[float, int, tuple[tuple[int, int], ...], int]] = []
         self._serial = 0
-        self._unexpanded: tuple[tuple[int, ...], float, int] | None = ((), total, -1)
+        self._unexpanded: tuple[tuple[tuple[int, int], ...], float, int] | None = ((), total, -1)
 
     def solution(self, index: int) -> tuple[np.ndarray, float] | None:
         while len(self._found) <= index:
@@ -320,39 +467,40 @@ class Product:
         if index not in self._solutions:
             choice, total = self._found[index]
             cols = self.base.copy()
-            for (rows, part_cols, ranking), i in zip(self._varying, choice, strict=True):
-                if i:
-                    cols[rows] = part_cols[ranking.solution(i)[0]]
+            for q, i in choice:
+                rows, part_cols, ranking = self._varying[q]
+                cols[rows] = part_cols[ranking.solution(i)[0]]
             self._solutions[index] = (cols, total)
         return self._solutions[index]
 
     def _cost(self, q: int, i: int) -> float:
         return self._varying[q][2].solution(i)[1]
 
-    def _push(self, total: float, choice: tuple[int, ...], last: int) -> None:
+    def _push(self, total: float, choice: tuple[tuple[int, int], ...], last: int) -> None:
         if total <= self._limit:
             heapq.heappush(self._heap, (total, self._serial, choice, last))
             self._serial += 1
 
-    def _push_successors(self, choice: tuple[int, ...], total: float, last: int) -> None:
+    def _push_successors(self, choice: tuple[tuple[int, int], ...], total: float, last: int) -> None:
         if last < 0:
-            steps = []
-            for n, (_, _, ranking) in enumerate(self.parts):
+            steps = list(self._prefix.steps)
+            for n in range(len(self._prefix.best_costs), len(self.parts)):
+                ranking = self.parts[n][2]
                 second = ranking.solution(1)
                 if second is not None:
                     steps.append((second[1] - ranking.solution(0)[1], n))
             steps.sort()
             self._varying = [self.parts[n] for _, n in steps]
             if steps:
-                self._push(total + steps[0][0], (1,) + (0,) * (len(steps) - 1), 0)
+                self._push(total + steps[0][0], ((0, 1),), 0)
             return
-        i = choice[last]
+        i = choice[-1][1]  # the entry of position ``last``, the last nonzero one
         further = self._varying[last][2].solution(i + 1)
         if further is not None:
-            self._push(total + further[1] - self._cost(last, i), (*choice[:last], i + 1, *choice[last + 1 :]), last)
+            self._push(total + further[1] - self._cost(last, i), (*choice[:-1], (last, i + 1)), last)
         if last + 1 < len(self._varying):
             step = self._cost(last + 1, 1) - self._cost(last + 1, 0)
-            self._push(total + step, (*choice[: last + 1], 1, *choice[last + 2 :]), last + 1)
+            self._push(total + step, (*choice, (last + 1, 1)), last + 1)
             if i == 1:
                 undo = self._cost(last, 1) - self._cost(last, 0)
-                self._push(total - undo + step, (*choice[:last], 0, 1, *choice[last + 2 :]), last + 1)
+                self._push(total - undo + step, (*choice[:-1], (last + 1, 1)), last + 1)

@@ -42,10 +42,85 @@ from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 @dataclass(frozen=True, slots=True)
 class GlobalHypothesis:
-    """One global data-association hypothesis: its log weight and the Bernoullis it contains."""
+    """One global data-association hypothesis: its log weight and the Bernoullis it contains, the rows ``index``
+    (K,) of ``store`` (all of ``store`` when ``index`` is None).
+
+    PMBM's hypotheses share one store per class and frame that holds every distinct single-target hypothesis
+    once (track-oriented storage, García-Fernández et al. 2018, sec. V): a global hypothesis is an index array
+    into it, and its own ``Bernoullis`` are gathered only when asked for.
+    """
 
     log_weight: float
-    bernoullis: Bernoullis
+    store: Bernoullis
+    index: np.ndarray | None = None
+
+    @property
+    def bernoullis(self) -> Bernoullis:
+        """The K Bernoullis of this hypothesis, in order (a copy gathered from the store for an indexed one)."""
+        return self.store if self.index is None else self.store.subset(self.index)
+
+    @property
+    def track_id(self) -> np.ndarray:
+        """(K,) the Bernoullis' track ids (one array gathered, not all)."""
+        return self.store.track_id if self.index is None else self.store.track_id[self.index]
+
+    @property
+    def existence(self) -> np.ndarray:
+        """(K,) the Bernoullis' existence probabilities."""
+        return self.store.existence if self.index is None else self.store.existence[self.index]
+
+    @property
+    def local_key(self) -> np.ndarray:
+        """(K,) the Bernoullis' single-target hypothesis keys."""
+        return self.store.local_key if self.index is None else self.store.local_key[self.index]
+
+    @property
+    def n_bernoullis(self) -> int:
+        return len(self.store) if self.index is None else len(self.index)
+
+    def without_existence_below(self, threshold: float) -> GlobalHypothesis:
+        """This hypothesis without its Bernoullis of existence r < ``threshold`` (itself if it has none)."""
+        existence = self.existence
+        if existence.min(initial=1.0) >= threshold:
+            return self
+        keep = existence >= threshold
+        if self.index is None:
+            return GlobalHypothesis(self.log_weight, self.store.subset(keep))
+        return GlobalHypothesis(self.log_weight, self.store, self.index[keep])
+
+
+def hypothesis_union(hypotheses: Sequence[GlobalHypothesis]) -> tuple[Bernoullis, list[np.ndarray]]:
+    """The distinct Bernoullis of ``hypotheses`` (one per ``local_key``, by increasing key; the first met of
+    equal keys) and each hypothesis' rows of it, (K_h,) in the hypothesis' order. Hypotheses indexing one
+    shared store are read through their indices, without gathering their Bernoullis."""
+    store = hypotheses[0].store
+    bounds = np.cumsum([0] + [h.n_bernoullis for h in hypotheses]).tolist()
+    if all(h.store is store and h.index is not None for h in hypotheses):
+        rows = np.concatenate([h.index for h in hypotheses])
+        union_rows, inverse = _union_rows(store.local_key, rows)
+        union = store.subset(union_rows)
+    else:
+        every = Bernoullis.concatenate([h.bernoullis for h in hypotheses])
+        _, first, inverse = np.unique(every.local_key, return_index=True, return_inverse=True)
+        union = every.subset(first)
+    return union, [inverse[start:stop] for start, stop in zip(bounds[:-1], bounds[1:], strict=True)]
+
+
+def _union_rows(store_keys: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(store_keys[rows], return_index=True, return_inverse=True)`` as (store rows of the distinct
+    keys, inverse): when the store rows used hold distinct keys (as a posterior store does), by sorting only
+    those rows instead of every occurrence."""
+    seen = np.zeros(len(store_keys), dtype=bool)
+    seen[rows] = True
+    used = np.flatnonzero(seen)
+    order = np.argsort(store_keys[used], kind="stable")
+    sorted_keys = store_keys[used[order]]
+    if not (sorted_keys[1:] > sorted_keys[:-1]).all():
+        _, first, inverse = np.unique(store_keys[rows], return_index=True, return_inverse=True)
+        return rows[first], inverse
+    position = np.empty(len(store_keys), dtype=np.intp)
+    position[used[order]] = np.arange(len(used))
+    return used[order], position[rows]
 
 
 _MASK63 = np.uint64((1 << 63) - 1)
@@ -145,29 +220,52 @@ def posterior_from_assignment(local: LocalHypotheses, col_of_row: np.ndarray, ct
 
 def posteriors_from_assignments(
     union: LocalHypotheses, members: list[np.ndarray], assignments: list[np.ndarray], ctx: UpdateContext
-) -> list[Bernoullis]:
-    """``posterior_from_assignment`` for many hypotheses at once (PMBM): hypothesis i holds the Bernoullis
+) -> tuple[Bernoullis, list[np.ndarray]]:
+    """``posterior_from_assignment`` for H hypotheses at once (PMBM): hypothesis i holds the Bernoullis
     ``members[i]`` of ``union`` and assigns measurements by ``assignments[i]`` (M,), given as columns of the
-    union's cost matrix (u < U: union Bernoulli u, U + j: new track of measurement j). Each distinct
-    (Bernoulli, outcome) is updated once; the Bernoullis keep the order of ``members[i]``, births follow in
-    measurement order, and birth ids are allocated hypothesis by hypothesis, all as calling
-    ``posterior_from_assignment`` on each hypothesis' own local hypotheses in turn would."""
+    union's cost matrix (u < U: union Bernoulli u, U + j: new track of measurement j).
+
+    Returns one store holding each distinct (Bernoulli, outcome) once, updated once, then the births in
+    measurement order, and per hypothesis its rows of the store (``GlobalHypothesis.index``): its Bernoullis in
+    the order of ``members[i]``, then its births in measurement order. Birth ids are allocated hypothesis by
+    hypothesis, all as calling ``posterior_from_assignment`` on each hypothesis' own local hypotheses in turn
+    would."""
     n_union, m = union.n_tracks, union.n_meas
-    codes, births = [], []
-    for index, col_of_row in zip(members, assignments, strict=True):
-        codes.append(index * (m + 1) + meas_of_track(n_union, col_of_row)[index] + 1)
-        births.append(np.flatnonzero(col_of_row == n_union + np.arange(m)))
-        for j in births[-1].tolist():
-            ctx.birth_id(j)
-    distinct, inverse = np.unique(np.concatenate(codes), return_inverse=True)
+    assigned = np.stack(assignments)
+    n_hyp = len(members)
+    meas = np.full((n_hyp, n_union), -1, dtype=np.int64)
+    hyp, row = np.nonzero(assigned < n_union)
+    meas[hyp, assigned[hyp, row]] = row
+    lengths = np.array([len(index) for index in members], dtype=np.int64)
+    index = np.concatenate(members)
+    codes = index * (m + 1) + meas[np.repeat(np.arange(n_hyp), lengths), index] + 1
+    is_birth = assigned == n_union + np.arange(m)
+    birth_j = np.nonzero(is_birth)[1]
+    born, first = np.unique(birth_j, return_index=True)
+    for j in birth_j[np.sort(first)].tolist():
+        ctx.birth_id(j)
+    distinct, inverse = _unique_codes(codes, n_union * (m + 1))
     tracks = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1))
-    born = np.unique(np.concatenate(births))
-    every = Bernoullis.concatenate([tracks, new_bernoullis(union, born, ctx)])
-    bounds = np.cumsum([0] + [len(c) for c in codes])
-    return [
-        every.subset(np.concatenate([inverse[start:stop], len(tracks) + np.searchsorted(born, new_j)]))
-        for start, stop, new_j in zip(bounds[:-1], bounds[1:], births, strict=True)
+    store = Bernoullis.concatenate([tracks, new_bernoullis(union, born, ctx)])
+    birth_rows = len(tracks) + np.searchsorted(born, birth_j)
+    track_bounds = np.concatenate([[0], np.cumsum(lengths)]).tolist()
+    birth_bounds = np.concatenate([[0], np.cumsum(is_birth.sum(axis=1))]).tolist()
+    return store, [
+        np.concatenate([inverse[track_bounds[i] : track_bounds[i + 1]], birth_rows[b0:b1]])
+        if b1 > b0
+        else inverse[track_bounds[i] : track_bounds[i + 1]]
+        for i, (b0, b1) in enumerate(zip(birth_bounds[:-1], birth_bounds[1:], strict=True))
     ]
+
+
+def _unique_codes(codes: np.ndarray, n_codes: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(codes, return_inverse=True)`` for integer codes in [0, n_codes), by a presence table when that
+    is small (no sort)."""
+    if n_codes > 1 << 20:
+        return np.unique(codes, return_inverse=True)
+    seen = np.zeros(n_codes, dtype=bool)
+    seen[codes] = True
+    return np.flatnonzero(seen), (np.cumsum(seen) - 1)[codes]
 
 
 def meas_of_track(n_tracks: int, col_of_row: np.ndarray) -> np.ndarray:
@@ -229,10 +327,10 @@ def assignment_pairs(
 
 def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
     """Track id -> its largest existence probability over the hypotheses."""
-    ids = np.concatenate([h.bernoullis.track_id for h in hypotheses])
+    ids = np.concatenate([h.track_id for h in hypotheses])
     ids, inverse = np.unique(ids, return_inverse=True)
     largest = np.zeros(len(ids))
-    np.maximum.at(largest, inverse, np.concatenate([h.bernoullis.existence for h in hypotheses]))
+    np.maximum.at(largest, inverse, np.concatenate([h.existence for h in hypotheses]))
     return dict(zip(ids.tolist(), largest.tolist(), strict=True))
 
 
@@ -328,16 +426,10 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
             prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
             local = local_hypotheses(prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max)
             return PmbPrior([GlobalHypothesis(h.log_weight, prior)], [local])
-        every = Bernoullis.concatenate([h.bernoullis for h in self.hypotheses])
-        _, first, inverse = np.unique(every.local_key, return_index=True, return_inverse=True)
-        union_prior = predict_bernoullis(every.subset(first), model, p.p_survive)
+        union, members = hypothesis_union(self.hypotheses)
+        union_prior = predict_bernoullis(union, model, p.p_survive)
         union_local = local_hypotheses(union_prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max)
-        bounds = np.cumsum([0] + [len(h.bernoullis) for h in self.hypotheses])
-        members = [inverse[start:stop] for start, stop in zip(bounds[:-1], bounds[1:], strict=True)]
-        priors = [
-            GlobalHypothesis(h.log_weight, union_prior.subset(index))
-            for h, index in zip(self.hypotheses, members, strict=True)
-        ]
+        priors = [GlobalHypothesis(h.log_weight, union_prior, i) for h, i in zip(self.hypotheses, members, strict=True)]
         return PmbPrior(priors, HypothesisLocals(union_local, members))
 
     def _prune(
@@ -345,16 +437,11 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     ) -> list[GlobalHypothesis]:
         """Drop Bernoullis with r < threshold from every hypothesis; report tracks that vanished from all."""
         threshold = self.params.prune_existence
-        kept = [
-            h
-            if h.bernoullis.existence.min(initial=1.0) >= threshold
-            else GlobalHypothesis(h.log_weight, h.bernoullis.subset(h.bernoullis.existence >= threshold))
-            for h in posteriors
-        ]
+        kept = [h.without_existence_below(threshold) for h in posteriors]
         if sink.enabled:
             posterior_r = _max_existence(posteriors)
             prior_r = _max_existence(priors)
-            alive = set(np.concatenate([h.bernoullis.track_id for h in kept]).tolist())
+            alive = set(np.concatenate([h.track_id for h in kept]).tolist())
             for t in sorted((set(posterior_r) | set(prior_r)) - alive):
                 if t in posterior_r:
                     sink.emit(Pruned(self.class_name, t, PruneReason.LOW_EXISTENCE, posterior_r[t]))

@@ -26,8 +26,12 @@ unaffected.
 
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
-ranked once (``murty.rank``) and shared by all hypotheses that contain it (``murty.Product``). Posteriors are
-built once per distinct (Bernoulli, outcome) (``core.posteriors_from_assignments``).
+ranked once and shared by all hypotheses that contain it (``murty.Product``). The sub-problems of one block
+share a listing of its assignments and the rankings of equal smaller blocks (``murty.ColumnSubsets``,
+``murty.BlockCache``); a hypothesis with one child gets its best assignment without a ``Product``. Posteriors
+are built once per distinct (Bernoulli, outcome) into one store that the posterior hypotheses index
+(``core.posteriors_from_assignments``, ``core.GlobalHypothesis``). These pieces only share work: each gives
+the same assignments, costs and Bernoullis, bit for bit, as the plain computation it replaces (their tests).
 """
 
 from __future__ import annotations
@@ -37,10 +41,19 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import logsumexp
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.assign.murty import Product, Ranking, blocks, forbid_beyond_private, k_best, rank
+from gnnpmb.assign.murty import (
+    BlockCache,
+    ColumnSubsets,
+    PartsSummary,
+    Product,
+    Ranking,
+    blocks,
+    forbid_beyond_private,
+    k_best,
+    rank,
+)
 from gnnpmb.config import PmbmParams
 from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
 from gnnpmb.pmb.core import (
@@ -76,6 +89,25 @@ class _Child:
     total_cost: float
 
 
+def log_sum_exp(a: np.ndarray) -> np.float64:
+    """log sum_i exp(a_i) of a 1-D float64 array, bit for bit ``scipy.special.logsumexp(a)`` (scipy 1.17: the
+    largest terms are taken out of the sum, log1p(s / m) + log m + max a, with m their count; the direct
+    log sum exp where that is not finite), with the same NumPy operations on the same array shapes but without
+    its array-API dispatch, which cost more than the computation (3 calls per class and frame in PMBM)."""
+    if a.size == 0:
+        return np.float64(-np.inf)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        direct = np.log(np.sum(np.exp(a), axis=(0,), keepdims=True))
+        a_max = np.max(a, axis=(0,), keepdims=True)
+        is_max = a == a_max
+        count = np.sum(is_max.astype(a.dtype), axis=(0,), keepdims=True, dtype=a.dtype)
+        rest = np.exp(np.where(is_max, -np.inf, a) - a_max)
+        s = np.sum(rest, axis=(0,), keepdims=True, dtype=rest.dtype)
+        s = np.where(s == 0, s, s / count)
+        out = np.log1p(s) + np.log(count) + a_max
+    return np.where(np.isfinite(out), out, direct)[0]
+
+
 def hypothesis_budget(n_hypotheses: int, log_weight: float) -> int:
     """H_h = ceil(N_h w_h) >= 1 children for a prior hypothesis of normalised log weight ``log_weight``
     (a relative 1e-9 slack keeps N_h w_h = 2 + rounding error at 2)."""
@@ -109,7 +141,7 @@ class KBest:
         self, priors: list[GlobalHypothesis], locals_: Sequence[LocalHypotheses], ctx: UpdateContext
     ) -> list[GlobalHypothesis]:
         prior_log_w = np.array([h.log_weight for h in priors])
-        prior_log_w = prior_log_w - logsumexp(prior_log_w)
+        prior_log_w = prior_log_w - log_sum_exp(prior_log_w)
         budgets = [hypothesis_budget(self.params.n_hypotheses, lw) for lw in prior_log_w]
         if ctx.sink.enabled:
             for h in range(1, min(COST_MATRIX_EVENTS, len(locals_))):
@@ -132,10 +164,10 @@ class KBest:
             base = float(prior_log_w[h]) + float(union.miss_log_lik[members[h]].sum())  # sum_k log l_k0
             children.extend(_Child(base - total, h, col_of_row, total) for col_of_row, total in assignments)
         kept, log_w = self._select(_merge_identical(children, union, members, ctx))
-        bernoullis = posteriors_from_assignments(
+        store, rows = posteriors_from_assignments(
             union, [members[c.parent] for c in kept], [c.col_of_row for c in kept], ctx
         )
-        posteriors = [GlobalHypothesis(float(lw), b) for lw, b in zip(log_w, bernoullis, strict=True)]
+        posteriors = [GlobalHypothesis(float(lw), store, index) for lw, index in zip(log_w, rows, strict=True)]
         if ctx.sink.enabled:
             best = kept[0]
             own = _own_columns(best.col_of_row, members[best.parent], union.n_tracks)
@@ -146,11 +178,11 @@ class KBest:
         """Normalise, sort descending (stable), drop below ``hypothesis_prune`` (the best always stays), cap
         to N_h, renormalise. Returns the kept children and their normalised log weights."""
         log_w = np.array([c.log_weight for c in children])
-        log_w = log_w - logsumexp(log_w)
+        log_w = log_w - log_sum_exp(log_w)
         order = np.argsort(-log_w, kind="stable")
         keep = order[log_w[order] >= self._log_prune]
         keep = (keep if len(keep) else order[:1])[: self.params.n_hypotheses]
-        kept_log_w = log_w[keep] - logsumexp(log_w[keep])
+        kept_log_w = log_w[keep] - log_sum_exp(log_w[keep])
         return [children[i] for i in keep], kept_log_w
 
 
@@ -211,23 +243,30 @@ class SharedRanking:
         cost = forbid_beyond_private(cost, max_increase, usable=has_column.all(axis=0))
         self.cost = cost
         self.common: list[tuple[np.ndarray, np.ndarray, Ranking | None]] = []
-        self.varying: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]] = []
+        self.varying: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, ColumnSubsets | None]] = []
         """Per block whose Bernoullis differ between hypotheses: rows, columns, the distinct presence patterns
-        (P, columns), each hypothesis' pattern (H,), and whether only the best assignment is ranked. Each
-        (block, pattern) is ranked on first use (``_varying_part``): a hypothesis with no children costs
-        nothing."""
+        (P, columns), each hypothesis' pattern (H,), and the block's ``murty.ColumnSubsets`` (None when only
+        the best assignment is ranked). Each (block, pattern) is ranked on first use (``_varying_part``): a
+        hypothesis with no children costs nothing."""
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
+        self._blocks: BlockCache = {}
+        self._common: PartsSummary | None = None
         for rows, cols in blocks(cost):
             present = has_column[:, cols]
             best_only = len(rows) > max_block_rows
             if (present == present[0]).all():
                 self.common.append(_part(cost, rows, cols, present[0], max_increase, best_only))
                 continue
-            _, first, pattern = np.unique(np.packbits(present, axis=1), axis=0, return_index=True, return_inverse=True)
-            self.varying.append((rows, cols, present[first], pattern.ravel(), best_only))
+            packed = np.ascontiguousarray(np.packbits(present, axis=1))
+            rows_as_bytes = packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
+            _, first, pattern = np.unique(rows_as_bytes, return_index=True, return_inverse=True)
+            subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase, self._blocks)
+            self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
         self.common_ok = all(ranking is not None for _, _, ranking in self.common)
+        self.common_best: tuple[float, ...] = ()
         if self.common_ok:
+            self.common_best = tuple(ranking.solution(0)[1] for _, _, ranking in self.common)
             for rows, cols, ranking in self.common:
                 self.common_base[rows] = cols[ranking.solution(0)[0]]
 
@@ -235,11 +274,25 @@ class SharedRanking:
         """The budgets[h] best assignments (col_of_row as union columns, cost) of every hypothesis."""
         return [self._hypothesis(h, k) for h, k in enumerate(budgets)]
 
+    def _common_summary(self) -> PartsSummary:
+        """The ``murty.PartsSummary`` of the common parts, which lead every hypothesis' parts (worked out when
+        a hypothesis first has more than one child)."""
+        if self._common is None:
+            self._common = PartsSummary.of(self.common)
+        return self._common
+
     def _varying_part(self, b: int, h: int) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
-        rows, cols, patterns, pattern, best_only = self.varying[b]
+        rows, cols, patterns, pattern, subsets = self.varying[b]
         key = (b, int(pattern[h]))
         if key not in self._parts:
-            self._parts[key] = _part(self.cost, rows, cols, patterns[key[1]], self.max_increase, best_only)
+            present = patterns[key[1]]
+            if subsets is None:
+                self._parts[key] = _part(self.cost, rows, cols, present, self.max_increase, True)
+            else:
+                try:
+                    self._parts[key] = rows, cols[present], subsets.rank(present)
+                except InfeasibleAssignment:
+                    self._parts[key] = rows, cols[present], None
         return self._parts[key]
 
     def _hypothesis(self, h: int, k: int) -> list[tuple[np.ndarray, float]]:
@@ -251,7 +304,10 @@ class SharedRanking:
         base = self.common_base.copy()
         for rows, cols, ranking in parts[len(self.common) :]:
             base[rows] = cols[ranking.solution(0)[0]]
-        product = Product(base, parts, self.max_increase)
+        if k == 1:  # Product's best, without its set-up
+            varying_best = (ranking.solution(0)[1] for _, _, ranking in parts[len(self.common) :])
+            return [(base, float(sum([*self.common_best, *varying_best])))]
+        product = Product(base, parts, self.max_increase, self._common_summary())
         out = []
         for i in range(k):
             found = product.solution(i)
@@ -364,12 +420,12 @@ def _emit(
     ``GlobalHypotheses`` as the core will keep them (after pruning)."""
     pairs, missed = assignment_pairs(local, col_of_row)
     ctx.sink.emit(Assignment(ctx.class_name, pairs, total_cost, missed, hypothesis=0))
-    alive = [h.bernoullis.existence >= ctx.prune_existence for h in posteriors]
+    alive = [h.without_existence_below(ctx.prune_existence) for h in posteriors]
     ctx.sink.emit(
         GlobalHypotheses(
             ctx.class_name,
             log_weights=np.array([h.log_weight for h in posteriors]),
-            members=tuple(tuple(h.bernoullis.track_id[a].tolist()) for h, a in zip(posteriors, alive, strict=True)),
-            local=tuple(tuple(h.bernoullis.local_key[a].tolist()) for h, a in zip(posteriors, alive, strict=True)),
+            members=tuple(tuple(h.track_id.tolist()) for h in alive),
+            local=tuple(tuple(h.local_key.tolist()) for h in alive),
         )
     )
