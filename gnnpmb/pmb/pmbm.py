@@ -75,7 +75,7 @@ prior hypotheses get children (each costs a Hungarian solve of the large block);
 
 COST_MATRIX_EVENTS = 3
 """Cost matrices are emitted for the first COST_MATRIX_EVENTS prior hypotheses only (the core emits that of
-hypothesis 0, the strategy the others), to keep recordings small."""
+hypothesis 0, the strategy the others), to keep recordings small, plus that of the best posterior's parent."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -170,8 +170,14 @@ class KBest:
         posteriors = [GlobalHypothesis(float(lw), store, index) for lw, index in zip(log_w, rows, strict=True)]
         if ctx.sink.enabled:
             best = kept[0]
+            local = locals_[best.parent]
+            if best.parent >= COST_MATRIX_EVENTS:  # the matrix its assignment is explained over
+                cost = local.cost_matrix()
+                ctx.sink.emit(
+                    CostMatrix(ctx.class_name, cost, local.row_labels(), local.col_labels(), hypothesis=best.parent)
+                )
             own = _own_columns(best.col_of_row, members[best.parent], union.n_tracks)
-            _emit(best.total_cost, own, locals_[best.parent], posteriors, ctx)
+            _emit(best.total_cost, own, local, best.parent, posteriors, ctx)
         return posteriors
 
     def _select(self, children: list[_Child]) -> tuple[list[_Child], np.ndarray]:
@@ -413,13 +419,15 @@ def _emit(
     total_cost: float,
     col_of_row: np.ndarray,
     local: LocalHypotheses,
+    parent: int,
     posteriors: list[GlobalHypothesis],
     ctx: UpdateContext,
 ) -> None:
-    """The best child's ``Assignment`` (``col_of_row`` over its parent's ``local`` columns) and the
-    ``GlobalHypotheses`` as the core will keep them (after pruning)."""
+    """The best child's ``Assignment`` (``col_of_row`` over the ``local`` columns of its prior hypothesis
+    ``parent``, whose ``CostMatrix`` has ``hypothesis=parent``) and the ``GlobalHypotheses`` as the core will keep
+    them (after pruning)."""
     pairs, missed = assignment_pairs(local, col_of_row)
-    ctx.sink.emit(Assignment(ctx.class_name, pairs, total_cost, missed, hypothesis=0))
+    ctx.sink.emit(Assignment(ctx.class_name, pairs, total_cost, missed, hypothesis=parent))
     alive = [h.without_existence_below(ctx.prune_existence) for h in posteriors]
     ctx.sink.emit(
         GlobalHypotheses(
