@@ -80,19 +80,34 @@ class DetectionFields(StructOfArrays):
     ) -> list[TrackEstimate]:
         """One ``TrackEstimate`` per item: x, y, vx, vy from ``mean`` (K, 4), z, size, rotation and meas_index from
         these fields; ``track_id``, ``score`` and ``existence`` (K,) are the tracker's."""
+        # Python scalars from ``tolist`` once per array: the same values as float()/int() of each numpy element,
+        # several times faster than indexing element by element.
+        if not len(self):
+            return []
+        xy_v = np.asarray(mean, dtype=np.float64)[:, :4].tolist()
         return [
             TrackEstimate(
-                track_id=int(track_id[i]),
+                track_id=t,
                 class_name=class_name,
-                translation_m=(float(mean[i, 0]), float(mean[i, 1]), float(self.z_m[i])),
-                size_wlh_m=tuple(float(v) for v in self.size_wlh_m[i]),
-                quat_wxyz=tuple(float(v) for v in self.quat_wxyz[i]),
-                velocity_mps=(float(mean[i, 2]), float(mean[i, 3])),
-                score=float(score[i]),
-                existence=float(existence[i]),
-                meas_index=int(self.meas_index[i]),
+                translation_m=(x, y, z),
+                size_wlh_m=tuple(size),
+                quat_wxyz=tuple(quat),
+                velocity_mps=(vx, vy),
+                score=s,
+                existence=r,
+                meas_index=m,
             )
-            for i in range(len(self))
+            for t, (x, y, vx, vy), z, size, quat, s, r, m in zip(
+                np.asarray(track_id).tolist(),
+                xy_v,
+                np.asarray(self.z_m, dtype=np.float64).tolist(),
+                np.asarray(self.size_wlh_m, dtype=np.float64).tolist(),
+                np.asarray(self.quat_wxyz, dtype=np.float64).tolist(),
+                np.asarray(score, dtype=np.float64).tolist(),
+                np.asarray(existence, dtype=np.float64).tolist(),
+                np.asarray(self.meas_index).tolist(),
+                strict=True,
+            )
         ]
 
 
