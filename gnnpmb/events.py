@@ -12,6 +12,8 @@ Measurements are named by their *source index* into the frame's full detection l
 from __future__ import annotations
 
 import enum
+import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -36,6 +38,18 @@ class AxisLabel:
 
     def __str__(self) -> str:
         return f"{self.kind.value} {self.ref}"
+
+
+def axis_labels(kind: AxisKind, refs: np.ndarray | Sequence[int]) -> tuple[AxisLabel, ...]:
+    """``AxisLabel(kind, r)`` for each of the (N,) refs. Labels come from a cache: building a frozen dataclass
+    (and ``int`` of a numpy scalar) per row and column was the largest cost of emitting events (about 4 ms per
+    frame of GNN-PMB's 13 ms with the logger on the centerpoint demo)."""
+    return tuple(_axis_label(kind, r) for r in np.asarray(refs).tolist())
+
+
+@functools.lru_cache(maxsize=1 << 16)
+def _axis_label(kind: AxisKind, ref: int) -> AxisLabel:
+    return AxisLabel(kind, ref)
 
 
 class PruneReason(enum.Enum):

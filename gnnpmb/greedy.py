@@ -32,12 +32,12 @@ from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     Assignment,
     AxisKind,
-    AxisLabel,
     Born,
     CostMatrix,
     EventSink,
     Pruned,
     PruneReason,
+    axis_labels,
 )
 from gnnpmb.skeleton import ClassFilter, TrackView
 from gnnpmb.soa import StructOfArrays
@@ -182,9 +182,9 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
         full = np.full((m, k + m), np.inf)
         full[:, :k] = dist
         full[np.arange(m), k + np.arange(m)] = self.max_distance_m
-        rows = tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
-        track_cols = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.tracks.track_id)
-        new_cols = tuple(AxisLabel(AxisKind.NEW_TRACK, int(i)) for i in meas.source_index)
+        rows = axis_labels(AxisKind.MEASUREMENT, meas.source_index)
+        track_cols = axis_labels(AxisKind.TRACK, prior.tracks.track_id)
+        new_cols = axis_labels(AxisKind.NEW_TRACK, meas.source_index)
         sink.emit(CostMatrix(self.class_name, full, rows, track_cols + new_cols, description=COST_DESCRIPTION))
         pairs = tuple((rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist()))
         total = float(sum(full[j, t] if t >= 0 else full[j, k + j] for j, t in enumerate(track_of_meas.tolist())))

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.events import AxisKind, AxisLabel
+from gnnpmb.events import AxisKind, AxisLabel, axis_labels
 from gnnpmb.kalman import Innovation, log_likelihood, paired_updated_means
 from gnnpmb.pmb.bernoulli import Bernoullis, missed_update
 from gnnpmb.pmb.poisson import NewTrackHypotheses
@@ -82,11 +82,11 @@ class LocalHypotheses:
         )
 
     def row_labels(self) -> tuple[AxisLabel, ...]:
-        return tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in self.meas.source_index)
+        return axis_labels(AxisKind.MEASUREMENT, self.meas.source_index)
 
     def col_labels(self) -> tuple[AxisLabel, ...]:
-        tracks = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in self.prior.track_id)
-        return tracks + tuple(AxisLabel(AxisKind.NEW_TRACK, int(i)) for i in self.meas.source_index)
+        tracks = axis_labels(AxisKind.TRACK, self.prior.track_id)
+        return tracks + axis_labels(AxisKind.NEW_TRACK, self.meas.source_index)
 
 
 def local_hypotheses(

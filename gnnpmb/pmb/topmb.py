@@ -36,7 +36,7 @@ from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
 from gnnpmb.assign.marginals import AssociationMarginals
 from gnnpmb.config import LbpParams
 from gnnpmb.detection_fields import DetectionFields
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, Marginals, Merged, Panel, Pruned, PruneReason
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, Marginals, Merged, Panel, Pruned, PruneReason, axis_labels
 from gnnpmb.kalman import symmetrize
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import (
@@ -174,8 +174,8 @@ def _emit(local: LocalHypotheses, marg: AssociationMarginals, comp: Components, 
     """
     meas, prior = local.meas, local.prior
     k, m = local.n_tracks, local.n_meas
-    rows = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
-    cols = (AxisLabel(AxisKind.MISSED, -1),) + tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
+    rows = axis_labels(AxisKind.TRACK, prior.track_id)
+    cols = (AxisLabel(AxisKind.MISSED, -1),) + axis_labels(AxisKind.MEASUREMENT, meas.source_index)
     ctx.sink.emit(Marginals(ctx.class_name, marg.p_track, rows, cols, marg.method, marg.iterations))
 
     significant = comp.detected >= MERGE_REPORT_WEIGHT

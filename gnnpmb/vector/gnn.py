@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from gnnpmb.assign.hungarian import solve
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, EventSink
+from gnnpmb.events import Assignment, AxisKind, CostMatrix, EventSink, axis_labels
 from gnnpmb.kalman import log_likelihood, paired_updated_means
 from gnnpmb.skeleton import Gating
 from gnnpmb.types import Measurements
@@ -94,9 +94,9 @@ class GnnTracker(VectorTracker):
         full = np.full((m, k + m), np.inf)
         full[:, :k] = cost
         full[np.arange(m), k + np.arange(m)] = 0.0
-        rows = tuple(AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index)
-        track_cols = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
-        new_cols = tuple(AxisLabel(AxisKind.NEW_TRACK, int(i)) for i in meas.source_index)
+        rows = axis_labels(AxisKind.MEASUREMENT, meas.source_index)
+        track_cols = axis_labels(AxisKind.TRACK, prior.track_id)
+        new_cols = axis_labels(AxisKind.NEW_TRACK, meas.source_index)
         cols = track_cols + new_cols
         sink.emit(CostMatrix(self.class_name, full, rows, cols, description=COST_DESCRIPTION))
         pairs = tuple((rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist()))

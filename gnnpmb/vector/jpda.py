@@ -40,7 +40,7 @@ import numpy as np
 from gnnpmb.assign.clusters import gate_clusters
 from gnnpmb.assign.exact_marginals import exact_marginals_log
 from gnnpmb.assign.lbp import keep_most_likely, lbp_marginals_log
-from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals, Panel
+from gnnpmb.events import AxisKind, AxisLabel, EventSink, Marginals, Panel, axis_labels
 from gnnpmb.kalman import Innovation, log_likelihood, mean_update, residuals, symmetrize
 from gnnpmb.skeleton import Gating
 from gnnpmb.types import Measurements
@@ -159,9 +159,7 @@ class JpdaTracker(VectorTracker):
             hit = beta[:, 0] < 0.5
             meas_of_track[hit] = np.argmax(beta[hit, 1:], axis=1)
         if sink.enabled:
-            rows = tuple(AxisLabel(AxisKind.TRACK, int(t)) for t in prior.track_id)
-            cols = (AxisLabel(AxisKind.MISSED, -1),) + tuple(
-                AxisLabel(AxisKind.MEASUREMENT, int(i)) for i in meas.source_index
-            )
+            rows = axis_labels(AxisKind.TRACK, prior.track_id)
+            cols = (AxisLabel(AxisKind.MISSED, -1),) + axis_labels(AxisKind.MEASUREMENT, meas.source_index)
             sink.emit(Marginals(self.class_name, beta, rows, cols, method, iterations))
         return Association(mean=mean, cov=cov, meas_of_track=meas_of_track, birth=p_new > 0.5)
