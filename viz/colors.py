@@ -128,3 +128,17 @@ def _hsv_to_rgb(h: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(N, 3) RGB in [0, 1] from (N,) hue, saturation, value in [0, 1] (standard hexcone model)."""
     k = np.mod(np.array([5.0, 3.0, 1.0])[None, :] + h[:, None] * 6.0, 6.0)
     return v[:, None] - v[:, None] * s[:, None] * np.clip(np.minimum(k, 4.0 - k), 0.0, 1.0)
+
+
+FADE_TO = np.array([236, 236, 236], dtype=np.float64)
+"""The light grey that faded colours are mixed towards (near the viewer's white background)."""
+
+
+def faded(packed: np.ndarray, keep: float) -> np.ndarray:
+    """(N,) packed 0xRRGGBBAA colours mixed towards ``FADE_TO``, keeping ``keep`` (0..1) of each colour; opaque.
+    Rerun draws lines with a colour's alpha darker rather than see-through on a white background, so receding
+    lines are made pale instead."""
+    p = np.asarray(packed, dtype=np.uint32).reshape(-1)
+    rgb = np.stack([(p >> 24) & 0xFF, (p >> 16) & 0xFF, (p >> 8) & 0xFF], axis=1).astype(np.float64)
+    mixed = np.rint(keep * rgb + (1.0 - keep) * FADE_TO).astype(np.uint8)
+    return pack_rgba(mixed)

@@ -51,7 +51,8 @@ LEGEND = (
     "are ground truth, boxes labelled with a number are tracks (trail: their last positions); circles are gates; "
     "a solid line joins a track's prediction to the detection it was given, a faint one a detection inside its "
     "gate that it was not given; enlarged boxes mark failures (magenta ID switch, orange fragmentation, red false "
-    "track, green coalescence, yellow identity theft, grey miss) and the involved objects carry their labels."
+    "track, green coalescence, yellow identity theft, grey miss); the involved objects' labels stand in a column "
+    "beside them, and tracks not involved are drawn pale."
 )
 GREY = (160, 160, 160)
 NEAR_DETECTION_M = 2.0

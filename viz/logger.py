@@ -56,7 +56,7 @@ from gnnpmb.explain import Decisions, explain
 from gnnpmb.gating import ellipse_outline
 from gnnpmb.types import TrackEstimate
 from viz import paths
-from viz.colors import class_ids, pack_rgba, packed_track_colors, track_color
+from viz.colors import class_ids, faded, pack_rgba, packed_track_colors, track_color
 from viz.decisions import (
     CLOSE_CALL_MARGIN,
     column_name,
@@ -75,7 +75,12 @@ TRAIL_FRAMES = 10
 """A track's trail shows its positions over the last this many frames."""
 ASSOCIATION_RADIUS_M = 0.07
 GATED_PAIR_RADIUS_M = 0.025
-GATED_PAIR_ALPHA = 90
+GATED_PAIR_KEEP = 0.45
+"""Lines from a track to a detection inside its gate that it was not given keep this share of the track's colour
+(``colors.faded``): faint beside the chosen pairs."""
+DIMMED_KEEP = 0.3
+"""In a focus recording, the tracks not involved (their boxes, trails, gates, predictions and association lines)
+keep this share of their colour, so the involved ones stand out."""
 GATE_LINE_RADIUS_M = 0.03
 PREDICTED_POINT_RADIUS_M = 0.25
 CANDIDATE_POINT_RADIUS_M = 0.12
@@ -471,7 +476,7 @@ class TrackerLogger:
                     sel.size,
                     static={"show_labels": False},
                     positions=lift_xy(xy[sel], self._z_of(ids[sel])),
-                    colors=packed_track_colors(ids[sel]),
+                    colors=self._track_colors(ids[sel]),
                     radii=np.full(sel.size, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
                     labels=_labels("{} predicted r={:.2f}", ids[sel], existence[sel]),
                 )
@@ -508,7 +513,7 @@ class TrackerLogger:
                     rr.LineStrips3D,
                     n,
                     strips=lift_xy(outline, self._z_of(gids[drawn])[:, None]),
-                    colors=packed_track_colors(gids[drawn]),
+                    colors=self._track_colors(gids[drawn]),
                     radii=np.full(n, GATE_LINE_RADIUS_M, dtype=np.float32),
                 )
             return {int(t): k for k, (t, d) in enumerate(zip(gids.tolist(), drawn.tolist(), strict=True)) if d}
@@ -546,7 +551,7 @@ class TrackerLogger:
                 len(pairs),
                 static={"show_labels": False},
                 strips=_pair_lines(pred_xy, [pred_row[t] for t in owners], xyz, meas_rows),
-                colors=packed_track_colors(np.array(owners, dtype=np.int64)),
+                colors=self._track_colors(np.array(owners, dtype=np.int64)),
                 radii=np.full(len(pairs), ASSOCIATION_RADIUS_M, dtype=np.float32),
                 labels=labels,
             )
@@ -571,7 +576,7 @@ class TrackerLogger:
                 strips=_pair_lines(
                     pred_xy, [pred_row[t] for t in rowners], xyz, np.array([pos[m] for _, m in rejected])
                 ),
-                colors=packed_track_colors(np.array(rowners, dtype=np.int64), alpha=GATED_PAIR_ALPHA),
+                colors=self._track_colors(np.array(rowners, dtype=np.int64), GATED_PAIR_KEEP),
                 radii=np.full(len(rejected), GATED_PAIR_RADIUS_M, dtype=np.float32),
                 labels=[f"{meas_name(m)} in gate of {t}, not chosen (cost {cost_of(m, t):.2f})" for t, m in rejected],
             )
@@ -641,6 +646,17 @@ class TrackerLogger:
                 t in reported,
             )
 
+    def _track_colors(self, track_ids: np.ndarray, keep: float = 1.0) -> np.ndarray:
+        """(N,) packed colours of (N,) track ids, ``keep`` of each colour (``colors.faded``); with focus tracks,
+        the others keep ``DIMMED_KEEP`` of that."""
+        ids = np.asarray(track_ids, dtype=np.int64).reshape(-1)
+        colors = packed_track_colors(ids) if keep == 1.0 else faded(packed_track_colors(ids), keep)
+        if not self.focus_tracks:
+            return colors
+        others = ~np.isin(ids, list(self.focus_tracks))
+        colors[others] = faded(packed_track_colors(ids[others]), keep * DIMMED_KEEP)
+        return colors
+
     def _draw_tracks(self, class_name: str, estimates: tuple[TrackEstimate, ...], shown: set[int]) -> None:
         """Each drawn track's box and trail on its own entity; ``shown``: the ones that count as reported tracks
         (the others are focused tracks below ``show_min_existence``, drawn for the focus only)."""
@@ -649,7 +665,7 @@ class TrackerLogger:
         boxes = estimate_boxes(estimates)
         ids = np.array([e.track_id for e in estimates], dtype=np.int64)
         cids = class_ids(np.array([e.class_name for e in estimates], dtype=object))
-        colors = packed_track_colors(ids)
+        colors = self._track_colors(ids)
         half_sizes = 0.5 * boxes.sizes_xyz_m
         box_radius = np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32)  # rows are copied when sent: shareable
         trail_radius = np.full(1, TRAIL_RADIUS_M, dtype=np.float32)

@@ -37,3 +37,14 @@ def test_consecutive_ids_are_well_separated() -> None:
     gap = np.linalg.norm(np.diff(a, axis=0), axis=1)
     assert gap.min() > 60.0
     assert len({tuple(c) for c in a[:50].astype(int)}) == 50
+
+
+def test_faded_colours_are_opaque_and_move_towards_the_background() -> None:
+    from viz.colors import FADE_TO, faded, pack_rgba
+
+    red = pack_rgba(np.array([[200, 0, 0]], dtype=np.uint8))
+    assert int(faded(red, 1.0)[0]) == int(red[0])
+    pale = int(faded(red, 0.3)[0])
+    assert pale & 0xFF == 255
+    rgb = np.array([(pale >> 24) & 0xFF, (pale >> 16) & 0xFF, (pale >> 8) & 0xFF])
+    np.testing.assert_array_equal(rgb, np.rint(0.3 * np.array([200, 0, 0]) + 0.7 * FADE_TO))

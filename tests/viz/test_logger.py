@@ -35,8 +35,8 @@ from gnnpmb.events import (
 from gnnpmb.types import TrackEstimate
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
-from viz.colors import pack_rgba, track_colors
-from viz.logger import TrackerLogger, _nis_of
+from viz.colors import faded, pack_rgba, track_colors
+from viz.logger import DIMMED_KEEP, TrackerLogger, _nis_of
 from viz.timeline import Clock
 
 T = "gnnpmb"
@@ -184,7 +184,8 @@ def test_an_association_line_for_every_assigned_pair_and_dim_lines_for_gated_rej
         "m1 in gate of 1, not chosen (cost -5.00)",
         "m0 in gate of 2, not chosen (cost -4.00)",
     ]
-    assert all(c & 0xFF == 90 for c in rejected["LineStrips3D:colors"])  # dimmed
+    # Faint: the tracks' colours (1, 2) mixed towards the background, opaque (Rerun darkens see-through lines).
+    assert rejected["LineStrips3D:colors"] == [int(c) for c in faded(pack_rgba(track_colors(np.array([1, 2]))), 0.45)]
     assert not latest_at(rows[paths.associations(T, "car")], 2, "LineStrips3D:strips")
 
 
@@ -282,6 +283,9 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     rows = read_rows(path)
     assert not at_frame(rows[paths.track(T, "car", 1)], 0)  # frame 0 is outside the recorded window
     assert at_frame(rows[paths.track(T, "car", 1)], 1)[0]["Boxes3D:labels"] == ["1"]
+    # Track 1 is not involved: drawn pale so that the focused track 2 stands out.
+    pale = faded(pack_rgba(track_colors(np.array([1]))), DIMMED_KEEP)
+    assert at_frame(rows[paths.track(T, "car", 1)], 1)[0]["Boxes3D:colors"] == [int(pale[0])]
     assert [r["frame"] for r in rows[paths.existence(T, "car", 1)] if not r["static"]] == [0, 1]  # history
     assert [r.get("focus") for r in rows[paths.existence(T, "car", 1)] if not r["static"]] == [0, 1]
     assert {r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 1)} == {1}
