@@ -69,25 +69,17 @@ def gate_tracks(mean: np.ndarray, cov: np.ndarray, R: np.ndarray, z: np.ndarray,
 
 
 def emit_prior(
-    sink: EventSink,
-    class_name: str,
-    track_ids: np.ndarray,
-    mean: np.ndarray,
-    cov: np.ndarray,
-    existence: np.ndarray,
-    gating: Gating | None,
-    meas_indices: np.ndarray,
-    gate_chi2: float,
+    sink: EventSink, class_name: str, t: TrackView, gating: Gating | None, meas_indices: np.ndarray, gate_chi2: float
 ) -> None:
     """``Predicted`` and ``Gated`` of K predicted tracks (gate ellipses in the BEV plane: the x, y block of S);
     ``Predicted`` only when ``gating`` is None."""
-    sink.emit(Predicted(class_name, track_ids, mean, cov, existence))
+    sink.emit(Predicted(class_name, t.track_id, t.mean, t.cov, t.existence))
     if gating is None:
         return
     sink.emit(
         Gated(
             class_name,
-            track_ids=track_ids,
+            track_ids=t.track_id,
             meas_indices=np.asarray(meas_indices),
             inside=gating.inside,
             center_xy=gating.inn.z_pred[:, :2],
@@ -98,17 +90,10 @@ def emit_prior(
 
 
 def emit_posterior(
-    sink: EventSink,
-    class_name: str,
-    track_ids: np.ndarray,
-    mean: np.ndarray,
-    cov: np.ndarray,
-    existence: np.ndarray,
-    estimates: Sequence[TrackEstimate],
-    threshold: float,
+    sink: EventSink, class_name: str, t: TrackView, estimates: Sequence[TrackEstimate], threshold: float
 ) -> None:
     """``Posterior`` of the K updated tracks and ``Extracted`` with the estimates and the extraction threshold."""
-    sink.emit(Posterior(class_name, track_ids, mean, cov, existence))
+    sink.emit(Posterior(class_name, t.track_id, t.mean, t.cov, t.existence))
     sink.emit(Extracted(class_name, tuple(estimates), threshold))
 
 
@@ -132,15 +117,11 @@ class ClassFilter(ABC, Generic[PriorT, PosteriorT]):
         prior = self.predict(meas, dt_s)
         if sink.enabled:
             t, gating = self.prior_view(prior)
-            gate_chi2 = self.config.models.gate_chi2
-            emit_prior(
-                sink, self.class_name, t.track_id, t.mean, t.cov, t.existence, gating, meas.source_index, gate_chi2
-            )
+            emit_prior(sink, self.class_name, t, gating, meas.source_index, self.config.models.gate_chi2)
         posterior = self.update(prior, meas, sink)
         estimates, threshold = self.extract(posterior, sink)
         if sink.enabled:
-            t = self.posterior_view(posterior)
-            emit_posterior(sink, self.class_name, t.track_id, t.mean, t.cov, t.existence, estimates, threshold)
+            emit_posterior(sink, self.class_name, self.posterior_view(posterior), estimates, threshold)
         return estimates
 
     def idle(self) -> bool:

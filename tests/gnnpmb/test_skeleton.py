@@ -35,8 +35,9 @@ def test_emitted_events_carry_the_bev_gate_and_the_estimates() -> None:
     g = gate_tracks(mean, cov, R, np.array([[1.0, 2.0, 0.0, 0.0]]), 40.0)
     sink = ListSink()
     ids = np.array([7])
-    emit_prior(sink, "car", ids, mean, cov, np.ones(1), g, np.array([3]), 40.0)
-    emit_posterior(sink, "car", ids, mean, cov, np.ones(1), [], 0.5)
+    view = TrackView(ids, mean, cov, np.ones(1))
+    emit_prior(sink, "car", view, g, np.array([3]), 40.0)
+    emit_posterior(sink, "car", view, [], 0.5)
     predicted, gated, posterior, extracted = sink.events
     assert isinstance(predicted, Predicted) and isinstance(posterior, Posterior)
     assert isinstance(gated, Gated) and gated.innovation_cov.shape == (1, 2, 2) and gated.center_xy.shape == (1, 2)
