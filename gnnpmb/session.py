@@ -427,7 +427,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
     from viz.blueprint import default_blueprint
     from viz.compare import log_comparison
     from viz.failures import log_failures
-    from viz.focus import log_focus
+    from viz.focus import focus_legends, log_focus
     from viz.logger import FLUSH_FRAMES, TrackerLogger
     from viz.provenance import log_provenance
     from viz.recording import recording
@@ -441,7 +441,8 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
     shown = focus.window(frame_range) if focus is not None else frame_range
     clock = Clock(focus_end=focus.frame_index) if focus is not None else PLAIN_CLOCK
     n = len(shown)
-    blueprint = default_blueprint(request.trackers, request.classes, focus)
+    # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
+    blueprint = default_blueprint(request.trackers, request.classes) if focus is None else None
     bar = progress if progress is not None else SilentProgress()
     runs: list[TrackingRun] = []
     loggers: dict[str, TrackerLogger] = {}
@@ -499,6 +500,12 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
         if focus is not None:
             thresholds = {name: report.threshold_of(focus.class_name) for name, report in reports.items()}
             log_focus(stream, focus, scene, runs, loggers, clock, shown, thresholds)
+            legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
+            stream.send_blueprint(
+                default_blueprint(request.trackers, request.classes, focus, legends),
+                make_active=True,
+                make_default=True,
+            )
         digests = {run.tracker: run_digest(run) for run in runs}
         log_provenance(stream, provenance_of(request, digests))
     ms = {run.tracker: 1000.0 * float(np.mean([f.step_time_s for f in run.frames])) for run in runs}

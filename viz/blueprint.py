@@ -17,7 +17,7 @@ from above and from the side, and the series views show only the involved tracks
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import rerun.blueprint as rrb
@@ -26,6 +26,7 @@ from gnnpmb.events import Panel
 from gnnpmb.registry import tracker_panels
 from viz import compare, paths
 from viz.failures import failure_log
+from viz.legend import LegendPlacement
 
 if TYPE_CHECKING:
     from gnnpmb.focus import FocusTarget
@@ -63,6 +64,11 @@ def failures_root(tracker: str) -> str:
 def focus_doc() -> str:
     """TextDocument describing the focused failure (static)."""
     return "focus/summary"
+
+
+def reading_guide_doc() -> str:
+    """TextDocument explaining the marks of a focus recording's views (static)."""
+    return "focus/how_to_read"
 
 
 def focus_world() -> str:
@@ -181,15 +187,24 @@ def _series_contents(root: str, focus: FocusTarget | None, tracker: str) -> list
     return [f"+ {root}/{focus.class_name}/{t}" for t in (*focus.track_ids[tracker], "threshold")]
 
 
-def track_series_views(tracker: str, focus: FocusTarget | None = None) -> list[rrb.TimeSeriesView]:
-    """Existence, normalised innovation and chosen cost per track; only the involved tracks when focused."""
-    legend = rrb.PlotLegend(visible=focus is not None)
+def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visible: bool) -> dict:
+    """The legend (and y axis) of the series view at ``root``: as placed in ``legends`` (``viz.legend``), else
+    Rerun's default corner, shown or not."""
+    placed = (legends or {}).get(root)
+    return placed.view_args() if placed is not None else {"plot_legend": rrb.PlotLegend(visible=visible)}
+
+
+def track_series_views(
+    tracker: str, focus: FocusTarget | None = None, legends: Mapping[str, LegendPlacement] | None = None
+) -> list[rrb.TimeSeriesView]:
+    """Existence, normalised innovation and chosen cost per track; only the involved tracks when focused, with a
+    legend (placed by ``legends``, keyed by the view's origin)."""
     return [
         rrb.TimeSeriesView(
             origin=root,
             contents=_series_contents(root, focus, tracker),
             name=f"{tracker} {what}",
-            plot_legend=legend,
+            **_legend_args(root, legends, focus is not None),
         )
         for root, what in (
             (paths.existence_root(tracker), "existence"),
@@ -219,11 +234,17 @@ def decision_views(tracker: str) -> rrb.Horizontal:
     )
 
 
-def tracker_panel(tracker: str, classes: Sequence[str], focus: FocusTarget | None = None) -> rrb.Vertical:
+def tracker_panel(
+    tracker: str,
+    classes: Sequence[str],
+    focus: FocusTarget | None = None,
+    legends: Mapping[str, LegendPlacement] | None = None,
+) -> rrb.Vertical:
     """Decision view, story and failure logs, and series (per-track, candidates, failures, extra plots); with a
-    focus the summary of the failure comes first and the decision document goes to a tab beside the story."""
+    focus the summary of the failure comes first (beside a tab on how to read the views) and the decision
+    document goes to a tab beside the story."""
     series = rrb.Tabs(
-        *track_series_views(tracker, focus),
+        *track_series_views(tracker, focus, legends),
         rrb.TimeSeriesView(origin=paths.candidates_root(tracker), name=f"{tracker} candidates"),
         failure_counts_view(tracker),
         *_extra_views(tracker, classes),
@@ -239,15 +260,22 @@ def tracker_panel(tracker: str, classes: Sequence[str], focus: FocusTarget | Non
             rrb.Spatial2DView(origin=paths.decision_matrix(tracker), name=f"{tracker} cost grid"),
             rrb.TextLogView(origin=failure_log(tracker), name=f"{tracker} failures", columns=STORY_COLUMNS),
         )
-        summary = rrb.TextDocumentView(origin=focus_doc(), name="focus")
-        return rrb.Vertical(summary, logs, series, row_shares=[6, 3, 2], name=tracker)
+        summary = rrb.Tabs(
+            rrb.TextDocumentView(origin=focus_doc(), name="focus"),
+            rrb.TextDocumentView(origin=reading_guide_doc(), name="how to read the views"),
+        )
+        return rrb.Vertical(summary, logs, series, row_shares=[6, 3, 3], name=tracker)
     return rrb.Vertical(decision_views(tracker), logs, series, row_shares=[5, 3, 2], name=tracker)
 
 
-def comparison_panel(trackers: Sequence[str]) -> rrb.Horizontal:
+def comparison_panel(trackers: Sequence[str], legends: Mapping[str, LegendPlacement] | None = None) -> rrb.Horizontal:
     """Disagreements per frame (and each tracker's failures per frame) as tabs, beside the disagreement log."""
     counts = rrb.Tabs(
-        rrb.TimeSeriesView(origin=compare.counts_root(), name="disagreements per frame"),
+        rrb.TimeSeriesView(
+            origin=compare.counts_root(),
+            name="disagreements per frame",
+            **_legend_args(compare.counts_root(), legends, True),
+        ),
         *[failure_counts_view(t) for t in trackers],
     )
     log = rrb.TextLogView(origin=compare.log_path(), name="disagreements", columns=STORY_COLUMNS)
@@ -259,18 +287,22 @@ def _tracker_views(tracker: str, focus: FocusTarget | None) -> rrb.Container:
 
 
 def default_blueprint(
-    trackers: Sequence[str], classes: Sequence[str], focus: FocusTarget | None = None
+    trackers: Sequence[str],
+    classes: Sequence[str],
+    focus: FocusTarget | None = None,
+    legends: Mapping[str, LegendPlacement] | None = None,
 ) -> rrb.Blueprint:
     """The layout for a recording of ``trackers`` (one or more, side by side) over ``classes``; with ``focus``
-    the layout opens at and looks at the failure."""
+    the layout opens at and looks at the failure. ``legends``: where the legends of series views go, keyed by
+    the view's origin (``viz.legend.place_legend``; default: Rerun's corner)."""
     if not trackers:
         raise ValueError("default_blueprint needs at least one tracker")
-    panels = [tracker_panel(t, classes, focus) for t in trackers]
+    panels = [tracker_panel(t, classes, focus, legends) for t in trackers]
     scene = rrb.Horizontal(*[_tracker_views(t, focus) for t in trackers])
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:
-        left = rrb.Vertical(scene, comparison_panel(trackers), row_shares=[4, 1])
+        left = rrb.Vertical(scene, comparison_panel(trackers, legends), row_shares=[4, 1])
         layout = rrb.Horizontal(left, rrb.Tabs(*panels), column_shares=[3, 2])
     if focus is None:
         time_panel = rrb.TimePanel(state="collapsed", timeline="frame", play_state="paused")

@@ -20,18 +20,27 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import rerun as rr
 
+from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import short_id
 from gnnpmb.events import AxisKind
 from gnnpmb.focus import FocusTarget
 from gnnpmb.pipeline import TrackingRun
 from gnnpmb.types import Boxes
-from viz import paths
-from viz.blueprint import DEFAULT_FOCUS_HEIGHT_M, FOCUS_HEIGHT_M, FOCUS_TIMELINE, focus_doc, focus_world
+from viz import compare, paths
+from viz.blueprint import (
+    DEFAULT_FOCUS_HEIGHT_M,
+    FOCUS_HEIGHT_M,
+    FOCUS_TIMELINE,
+    focus_doc,
+    focus_world,
+    reading_guide_doc,
+)
 from viz.callouts import Callout, log_callouts
 from viz.colors import CLASS_COLORS, class_ids, track_colors
 from viz.decisions import CLOSE_CALL_MARGIN, column_name, conflict_markdown, meas_name
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
+from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, place_legend
 from viz.logger import TrackerLogger, TrackStep
 from viz.scene import detection_label
 from viz.timeline import Clock
@@ -46,14 +55,31 @@ MAX_LISTED = 2
 """Per frame, the diagnosis names where the MAX_LISTED detections nearest to a track (lowest NIS) went."""
 TABLE_FRAMES = 6
 """The frame tables show the focus frame and the TABLE_FRAMES frames before it."""
-LEGEND = (
-    "How to read the views: thin boxes in class colours are detections (`m<idx> <score>`), translucent boxes "
-    "are ground truth, boxes labelled with a number are tracks (trail: their last positions); circles are gates; "
-    "a solid line joins a track's prediction to the detection it was given, a faint one a detection inside its "
-    "gate that it was not given; enlarged boxes mark failures (magenta ID switch, orange fragmentation, red false "
-    "track, green coalescence, yellow identity theft, grey miss); the involved objects' labels stand in a column "
-    "beside them, and tracks not involved are drawn pale."
-)
+READING_GUIDE = """# How to read the views
+
+**Bird's-eye and 3D views** (one pair per tracker)
+
+- **Detections**: thin boxes in class colours, labelled `m<idx> <score>` (the same `m<idx>` everywhere: lines,
+  tables, logs).
+- **Ground truth**: translucent boxes.
+- **Tracks**: boxes labelled with their id; the trail behind a track shows its last positions.
+- **Gates**: the circles around each track's predicted position.
+- **Association lines**: a solid line joins a track's prediction to the detection it was given; a faint line, a
+  detection inside its gate that it was not given.
+- **Failures**: enlarged boxes: magenta ID switch, orange fragmentation, red false track, green coalescence,
+  yellow identity theft, grey miss.
+- **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
+  Tracks that are not involved are drawn pale.
+
+**Panels**
+
+- **focus**: the failure in words, the key decisions, and per tracker what happened to each involved track.
+- **story**: each frame's events of the involved class (confirmed, missed, ended, close calls).
+- **decisions** and **cost grid**: per conflict the chosen pair, its cost, the next best and the margin (lower
+  cost = more likely).
+- **existence**, **NIS**, **chosen cost**: the involved tracks' series up to the failure; the grey line is the
+  existence from which a Bernoulli is shown as a track.
+"""
 GREY = (160, 160, 160)
 NEAR_DETECTION_M = 2.0
 """A detection or track within this BEV distance of a ground-truth object is "on" it (the devkit's match
@@ -87,16 +113,16 @@ def focus_markdown(
         if key:
             lines += [f"**Key decisions of {tracker}** (a detection an involved track could have taken):", ""]
             lines += [f"- {line}" for line in key] + [""]
-    lines += [
-        f"Opened at frame **{focus.frame_index}** on the `{FOCUS_TIMELINE}` timeline, which ends there; choose the "
-        f"`frame` timeline in the time panel to step past it. Recorded frames: {shown.start}–{shown.stop - 1}.",
-        "",
-        LEGEND,
-        "",
-    ]
     involved = [f"GT {short_id(g)}" for g in focus.gt_ids]
     involved += [f"{t}: tracks {', '.join(map(str, ids))}" for t, ids in focus.track_ids.items() if ids]
-    lines += [f"**Involved** ({focus.class_name}): " + (" · ".join(involved) or "nothing else"), ""]
+    lines += [
+        f"**Involved** ({focus.class_name}): " + (" · ".join(involved) or "nothing else"),
+        "",
+        f"Opened at frame **{focus.frame_index}** on the `{FOCUS_TIMELINE}` timeline, which ends there; choose the "
+        f"`frame` timeline in the time panel to step past it. Recorded frames: {shown.start}–{shown.stop - 1}. "
+        "The tab *how to read the views* explains the boxes, lines and colours.",
+        "",
+    ]
     for tracker, logger in loggers.items():
         ids = set(focus.track_ids.get(tracker, ()))
         lines.append(f"## {tracker}")
@@ -323,6 +349,7 @@ def log_focus(
         ),
         static=True,
     )
+    stream.log(reading_guide_doc(), rr.TextDocument(READING_GUIDE, media_type="text/markdown"), static=True)
     frames = {run.tracker: {f.keyframe.index: f for f in run.frames} for run in runs}
     gt_ids = set(focus.gt_ids)
     height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
@@ -392,6 +419,35 @@ def log_focus(
                 show_labels=False,
             ),
         )
+
+
+def focus_legends(
+    focus: FocusTarget, loggers: Mapping[str, TrackerLogger], comparison: Comparison | None = None
+) -> dict[str, LegendPlacement]:
+    """Legend placements (``viz.legend``) of the series views a focus recording opens with, keyed by the view's
+    origin: per tracker the existence (the involved tracks and the class's threshold) and NIS views, and the
+    disagreement counts; from the values the views show, which end at the focus frame."""
+    out: dict[str, LegendPlacement] = {}
+    last = focus.frame_index
+    for tracker, logger in loggers.items():
+        ids = focus.track_ids.get(tracker, ())
+        views = {
+            paths.existence_root(tracker): [
+                *(paths.existence(tracker, focus.class_name, t) for t in ids),
+                paths.extraction_threshold(tracker, focus.class_name),
+            ],
+            paths.nis_root(tracker): [paths.nis(tracker, focus.class_name, t) for t in ids],
+        }
+        for root, series in views.items():
+            sent = [logger.sent_series[p] for p in series if p in logger.sent_series]
+            # The legend names every series of the view, also those without a value up to the focus frame.
+            out[root] = place_legend([(f[f <= last], v[f <= last]) for f, v in sent], len(sent))
+    if comparison is not None:
+        frames = np.asarray(comparison.frame_indices)
+        upto = frames <= last
+        counts = [(frames[upto], comparison.counts(kind)[upto]) for kind in DisagreementKind]
+        out[compare.counts_root()] = place_legend(counts, plot_height_px=COMPARISON_PLOT_HEIGHT_PX)
+    return out
 
 
 def _detection_callouts(detections: Boxes, given: list[int]) -> list[Callout]:

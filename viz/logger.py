@@ -208,6 +208,9 @@ class TrackerLogger:
         """Focused track id -> frame -> its ``TrackStep`` (only for ``focus_tracks``)."""
         self.story: list[tuple[int, str, str, str]] = []
         """Every story line logged: (frame, class, text, level)."""
+        self.sent_series: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        """With ``focus_tracks``: series path -> (K,) frames and (K,) values of every time series ``finish`` sent
+        (the focus view places its plots' legends from them)."""
         self._frame = -1  # current keyframe index; -1 before the first FrameStarted
         self._timestamp_us = 0
         self._live: set[str] = set()
@@ -270,6 +273,8 @@ class TrackerLogger:
             colors = None if series.color is None else [series.color]
             self.stream.log(path, rr.SeriesLines(names=series.name, colors=colors), static=True)
             values = np.asarray(series.values, dtype=np.float64)
+            if self.focus_tracks:
+                self.sent_series[path] = (np.asarray(series.frames), values)
             self.clock.send(
                 self.stream,
                 path,

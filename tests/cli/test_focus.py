@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -16,7 +17,8 @@ from cli.app import main
 from gnnpmb.session import find_reports, prepare, rerun_runs
 from tests.viz.rrd import read_rows
 from viz import paths
-from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world
+from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
+from viz.legend import place_legend
 
 SCENE = "scene-0103"
 SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
@@ -36,6 +38,14 @@ def blueprint_rows(path: Path) -> list[tuple[str, dict]]:
     reader = RrdReader(path)
     (blueprint,) = reader.blueprints()
     return [(c.entity_path, row) for c in reader.stream(store=blueprint) for row in c.to_record_batch().to_pylist()]
+
+
+def stored_legends(bp: list[tuple[str, dict]]) -> dict[str, tuple[int | None, list[float] | None]]:
+    """View name -> (legend corner, y range) of every view whose legend the blueprint places."""
+    names = {path: r["ViewBlueprint:display_name"][0] for path, r in bp if r.get("ViewBlueprint:display_name")}
+    corners = {path.rsplit("/", 1)[0]: r["PlotLegend:corner"][0] for path, r in bp if r.get("PlotLegend:corner")}
+    ranges = {path.rsplit("/", 1)[0]: r["ScalarAxis:range"][0] for path, r in bp if r.get("ScalarAxis:range")}
+    return {names[v]: (corner, ranges.get(v)) for v, corner in corners.items()}
 
 
 def record(demo_dataroot: Path, tmp_path: Path, focus: str, trackers: tuple[str, ...] = ("gnnpmb",)) -> tuple:
@@ -84,6 +94,21 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     assert "frame by frame (the evaluation counted " in summary and "tracks output on it (score)" in summary
     followed = [t for t in failure.track_ids if paths.existence("gnnpmb", failure.class_name, t) in rows]
     assert followed, f"no existence series for the involved tracks {failure.track_ids}"
+    # The existence plot's legend is placed clear of the lines the recording shows up to the failure frame.
+    involved = re.search(r"gnnpmb: tracks ([\d, ]+)", summary).group(1).split(", ")  # the plot's tracks
+    shown = [paths.existence("gnnpmb", failure.class_name, int(t)) for t in involved]
+    shown = [p for p in shown if p in rows]
+    shown.append(paths.extraction_threshold("gnnpmb", failure.class_name))
+    lines = [
+        (np.array([r["focus"] for r in points]), np.array([r["Scalars:scalars"][0] for r in points]))
+        for points in ([r for r in rows[p] if r.get("focus") is not None] for p in shown)
+    ]
+    placed = place_legend(lines, len(shown))
+    corner, y_range = stored_legends(bp)["gnnpmb existence"]
+    assert corner == placed.corner.value
+    assert y_range == (None if placed.y_range is None else pytest.approx(placed.y_range))
+    guide = rows[reading_guide_doc()][0]["TextDocument:text"][0]
+    assert guide.startswith("# How to read the views") and "how to read the views" in summary
     highlighted = [r for r in rows[focus_world()] if r.get("frame") == failure.frame_index]
     assert any(label.startswith("GT ") for label in highlighted[0]["Boxes3D:labels"])
     # Their labels are in a column beside them (callouts), one row each, with a leader line to each object.

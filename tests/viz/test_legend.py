@@ -1,0 +1,62 @@
+"""``viz.legend.place_legend``: a legend corner that covers no line, or room made for it above the lines."""
+
+from __future__ import annotations
+
+import numpy as np
+import rerun.blueprint as rrb
+
+from viz.legend import LegendPlacement, legend_height, place_legend
+
+Corner = rrb.components.Corner2D
+
+
+def line(x: list[float], y: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    return np.array(x, dtype=np.float64), np.array(y, dtype=np.float64)
+
+
+def test_the_legend_height_grows_with_its_rows_up_to_a_cap() -> None:
+    assert legend_height(1, 100.0) == (10.0 + 21.0) / 100.0
+    assert legend_height(4, 180.0) > legend_height(2, 180.0)
+    assert legend_height(40, 180.0) == 0.75
+
+
+def test_a_corner_no_line_passes_through_is_taken_in_order_of_preference() -> None:
+    low = line([0, 10], [0, 0])  # along the bottom: both bottom corners hold data
+    assert place_legend([low, line([0, 4], [1, 1])]) == LegendPlacement(Corner.RightTop)  # high on the left
+    assert place_legend([low, line([6, 10], [1, 1])]) == LegendPlacement(Corner.LeftTop)  # high on the right
+    high = line([0, 10], [1, 1])
+    assert place_legend([high, line([0, 4], [0, 0])]) == LegendPlacement(Corner.RightBottom)
+
+
+def test_a_line_crossing_a_corner_between_its_points_occupies_it() -> None:
+    # Two points only, at the bottom left and the top right: the straight line between them crosses neither
+    # top-left nor bottom-right box, but it ends in the top-right one.
+    diagonal = line([0, 10], [0, 1])
+    assert place_legend([diagonal], 1) == LegendPlacement(Corner.LeftTop)
+    # A rise late in the plot (a track confirmed at the last frame) occupies the top right.
+    rise = line([0, 8, 9, 10], [0.1, 0.1, 0.1, 1.0])
+    assert place_legend([rise, line([0, 10], [0.5, 0.5])], 3).corner is Corner.LeftTop
+
+
+def test_when_every_corner_holds_data_the_y_range_leaves_the_top_band_to_the_legend() -> None:
+    lines = [line([0, 10], [0, 0]), line([0, 10], [1, 1])]
+    placed = place_legend(lines, 3)
+    assert placed.corner is Corner.RightTop and placed.y_range is not None
+    lo, hi = placed.y_range
+    height = legend_height(3)
+    # The highest line, in the new range, ends below the legend's box.
+    assert (1.0 - lo) / (hi - lo) < 1.0 - height
+    assert lo < 0.0  # and the lowest line keeps a margin above the plot's bottom
+    args = placed.view_args()
+    assert set(args) == {"plot_legend", "axis_y"}
+
+
+def test_gaps_and_empty_plots() -> None:
+    assert place_legend([]) == LegendPlacement(Corner.RightTop)
+    assert place_legend([line([0, 1], [np.nan, np.nan])]) == LegendPlacement(Corner.RightTop)
+    # NaN samples are skipped: the line's finite points alone decide.
+    gap = line([0, 5, 10], [0.0, np.nan, 0.0])
+    assert place_legend([gap, line([0, 10], [1, 1])], 2).corner is Corner.RightTop
+    assert place_legend([gap, line([0, 10], [1, 1])], 2).y_range is not None
+    single = line([3], [0.5])  # one point, in the middle: every corner is free
+    assert place_legend([single]) == LegendPlacement(Corner.RightTop)
