@@ -182,6 +182,16 @@ def view(
     if request.serve is not None:
         output = f"served at {request.serve.url}"
     typer.echo(f"{request.scene.name}: {len(request.frame_range)} frames, {timing}{compared}; {output}")
+    if result.focus is None:  # where to look next: --focus ids name the first tracker's failures
+        for k, (name, report) in enumerate(result.reports.items()):
+            first = report.first_worth_opening()
+            if first is None:
+                continue
+            how = f"add --focus {first}" if k == 0 else f"give --tracker {name} first and add --focus {first}"
+            typer.echo(
+                f"{name} failures: {report.totals_text()}. To open {first} at its frame, {how} to this command; "
+                f"to list them all: gnnpmb failures {request.scene.name} --tracker {name} (same options)."
+            )
     if request.serve is not None:
         from gnnpmb.serve import wait_for_ctrl_c
 

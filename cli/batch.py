@@ -302,8 +302,7 @@ def print_report(report: FailureReport, console: Console) -> None:
     for (frame, _kind), entries in grouped.items():
         rows.add_row(str(frame), _id_span([i for i, _ in entries]), "; ".join(text for _, text in entries))
     console.print(rows)
-    totals = ", ".join(f"{len(report.of_kind(k))} {k.value}" for k in FailureKind)
-    console.print(f"{report.scene_name}, {report.tracker}: {totals}", highlight=False, soft_wrap=True)
+    console.print(f"{report.scene_name}, {report.tracker}: {report.totals_text()}", highlight=False, soft_wrap=True)
 
 
 def _id_span(ids: list[str]) -> str:

@@ -20,8 +20,8 @@ viewer.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any, Protocol
@@ -108,13 +108,15 @@ class ViewRequest:
 @dataclass(frozen=True, slots=True)
 class ViewResult:
     """What ``run_view`` did: mean tracker ms per frame and track digest per tracker, the comparison (None
-    with one tracker) and notices for the user (e.g. failures skipped)."""
+    with one tracker), notices for the user (e.g. failures skipped), the focus and each tracker's failures
+    (empty when not looked for)."""
 
     ms_per_frame: dict[str, float]
     digests: dict[str, TrackDigest]
     comparison: Comparison | None
     notices: tuple[str, ...]
     focus: FocusTarget | None = None
+    reports: Mapping[str, FailureReport] = field(default_factory=dict)
 
 
 def parse_frames(text: str | None) -> tuple[int | None, int | None]:
@@ -509,7 +511,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
         digests = {run.tracker: run_digest(run) for run in runs}
         log_provenance(stream, provenance_of(request, digests))
     ms = {run.tracker: 1000.0 * float(np.mean([f.step_time_s for f in run.frames])) for run in runs}
-    return ViewResult(ms, digests, comparison, tuple(notices), focus)
+    return ViewResult(ms, digests, comparison, tuple(notices), focus, reports)
 
 
 def rerun_runs(request: ViewRequest) -> list[TrackingRun]:

@@ -66,6 +66,18 @@ def short_id(object_id: str) -> str:
     return object_id if len(object_id) <= 8 else object_id[:6]
 
 
+OPEN_FIRST = (
+    FailureKind.ID_SWITCH,
+    FailureKind.IDENTITY_THEFT,
+    FailureKind.COALESCENCE,
+    FailureKind.FRAGMENTATION,
+    FailureKind.FALSE_TRACK,
+    FailureKind.MISS,
+)
+"""The order in which failure kinds are suggested for a first look (``FailureReport.first_worth_opening``): the
+association errors a tracker debugger is for come before misses and false tracks, which the detector often causes."""
+
+
 @dataclass(frozen=True, slots=True)
 class FailureBox:
     """A box involved in a failure, as the evaluation saw it (ground truth or track, possibly interpolated).
@@ -211,6 +223,19 @@ class FailureReport:
             seen[f.kind] = seen.get(f.kind, 0) + 1
             out.append(f"{f.kind.value}:{seen[f.kind]}")
         return out
+
+    def totals_text(self) -> str:
+        """E.g. "3 id_switch, 4 fragmentation, 38 false_track, 27 miss, 0 coalescence, 1 identity_theft"."""
+        return ", ".join(f"{len(self.of_kind(k))} {k.value}" for k in FailureKind)
+
+    def first_worth_opening(self) -> str | None:
+        """The id of the first failure of the first kind in ``OPEN_FIRST`` that occurred (None: no failure)."""
+        ids = self.ids()
+        for kind in OPEN_FIRST:
+            hit = next((i for i, f in zip(ids, self.failures, strict=True) if f.kind is kind), None)
+            if hit is not None:
+                return hit
+        return None
 
     def by_id(self, failure_id: str) -> Failure | None:
         """The failure with ``failure_id`` (see ``ids``), None if there is none."""

@@ -18,7 +18,7 @@ from gnnpmb.errors import DataError, GnnpmbError, UnknownNameError
 from gnnpmb.pipeline import run_tracker
 from gnnpmb.provenance import PACKAGES
 from gnnpmb.registry import TRACKER_NAMES
-from gnnpmb.session import find_reports, parse_classes, parse_frames, prepare
+from gnnpmb.session import find_reports, parse_classes, parse_frames, prepare, rerun_runs
 from tests.inprocess import run_main
 from tests.viz.rrd import at_frame, read_rows
 from viz import paths
@@ -49,11 +49,21 @@ def rows(full_run: tuple[Path, str]) -> dict:
     return read_rows(full_run[0])
 
 
-def test_summary_line(full_run: tuple[Path, str]) -> None:
-    out, summary = full_run
+def test_summary_line_and_where_to_look_next(full_run: tuple[Path, str], demo_dataroot: Path) -> None:
+    out, stdout = full_run
+    summary, *hints = stdout.splitlines()
     assert summary.startswith(f"{SCENE}: {N_FRAMES} frames, gnnpmb ")
     assert "ms/frame" in summary and summary.endswith(f"saved {out}")
     assert sorted(p.name for p in out.parent.iterdir()) == ["x.rrd"]
+    # The failures found, and the id of the one to open first with --focus (the same ids `gnnpmb failures` prints).
+    request = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot)
+    report = find_reports(request, rerun_runs(request))[0]["gnnpmb"]
+    first = report.first_worth_opening()
+    assert first is not None and report.by_id(first) is not None
+    assert hints == [
+        f"gnnpmb failures: {report.totals_text()}. To open {first} at its frame, add --focus {first} to this "
+        f"command; to list them all: gnnpmb failures {SCENE} --tracker gnnpmb (same options)."
+    ]
 
 
 def test_sensors_and_ground_truth_on_every_frame(rows: dict) -> None:

@@ -72,7 +72,11 @@ def expected(demo_dataroot: Path) -> Comparison:
 
 
 def test_summary_size_and_name(saved: tuple[Path, str], expected: Comparison, rows: dict) -> None:
-    out, summary = saved
+    out, stdout = saved
+    summary, *hints = stdout.splitlines()
+    # --focus ids name the first tracker's failures: the second tracker's hint says to put it first.
+    assert [h.split(" failures: ")[0] for h in hints] == list(TRACKERS)
+    assert "add --focus " in hints[0] and f"give --tracker {TRACKERS[1]} first and add --focus " in hints[1]
     assert summary.startswith(f"{SCENE}: {N_FRAMES} frames, gnnpmb ")
     assert " ms/frame, gnn " in summary
     assert summary.endswith(f"; {len(expected.disagreements)} disagreements; saved {out}")

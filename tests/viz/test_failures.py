@@ -129,3 +129,18 @@ def test_frame_range_limits_markers_counts_and_log(saved_stream, tiny_scene) -> 
     switches = [r for r in rows[paths.failures_world(T, "id_switch")] if not r["static"]]
     assert [r["frame"] for r in switches] == [1]
     assert {r["frame"] for r in rows[failure_log(T)] if not r["static"]} == {1}
+
+
+def test_totals_and_the_failure_suggested_first(tiny_scene) -> None:
+    scene, _ = tiny_scene
+    report = report_for(scene)
+    assert report.totals_text() == (
+        "1 id_switch, 0 fragmentation, 0 false_track, 3 miss, 0 coalescence, 1 identity_theft"
+    )
+    # Misses come first in time, but an association error is what a tracker debugger is opened for.
+    assert report.ids()[0] == "miss:1" and report.first_worth_opening() == "id_switch:1"
+    only_misses = FailureReport(
+        scene.name, T, report.sample_tokens, report.classes, tuple(report.of_kind(FailureKind.MISS))
+    )
+    assert only_misses.first_worth_opening() == "miss:1"
+    assert FailureReport(scene.name, T, report.sample_tokens, report.classes, ()).first_worth_opening() is None
