@@ -188,9 +188,16 @@ def view(
             if first is None:
                 continue
             how = f"add --focus {first}" if k == 0 else f"give --tracker {name} first and add --focus {first}"
+            interpolated = sum(f.gt_interpolated for f in report.failures)
+            at_interpolated = (
+                f" ({interpolated} at a GT box the evaluation interpolated: the object had no points)"
+                if interpolated
+                else ""
+            )
             typer.echo(
-                f"{name} failures: {report.totals_text()}. To open {first} at its frame, {how} to this command; "
-                f"to list them all: gnnpmb failures {request.scene.name} --tracker {name} (same options)."
+                f"{name} failures: {report.totals_text()}{at_interpolated}. To open {first} at its frame, {how} to "
+                f"this command; to list them all: gnnpmb failures {request.scene.name} --tracker {name} (same "
+                "options)."
             )
     if request.serve is not None:
         from gnnpmb.serve import wait_for_ctrl_c

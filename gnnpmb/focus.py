@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -53,7 +53,10 @@ class FocusTarget:
 
     title: the failure in words; frame_index: the keyframe shown on opening; center_xy_m: global BEV centre of
     the place; class_name; track_ids: involved track ids per tracker; gt_ids: involved instance tokens;
-    failure_id: the id ``gnnpmb failures`` prints (None when the focus is not a failure).
+    failure_id: the id ``gnnpmb failures`` prints (None when the focus is not a failure); evaluated_gt_xy_m:
+    instance token -> global BEV centre of its box as the evaluation saw it at ``frame_index`` (the devkit
+    interpolates a box between annotated frames where it had no LiDAR points, so this can lie metres from the
+    annotation; empty when the focus is not a failure).
     """
 
     title: str
@@ -63,6 +66,7 @@ class FocusTarget:
     track_ids: dict[str, tuple[int, ...]]
     gt_ids: tuple[str, ...]
     failure_id: str | None = None
+    evaluated_gt_xy_m: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     def window(self, frames: range) -> range:
         """The keyframes of a focus recording, within ``frames``."""
@@ -143,6 +147,7 @@ def _from_failure(
         track_ids=ids,
         gt_ids=failure.gt_ids,
         failure_id=failure_id,
+        evaluated_gt_xy_m={b.object_id: (b.translation_m[0], b.translation_m[1]) for b in failure.boxes if b.is_gt},
     )
 
 

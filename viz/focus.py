@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import rerun as rr
@@ -70,6 +71,8 @@ READING_GUIDE = """# How to read the views
   yellow identity theft, grey miss.
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
   Tracks that are not involved are drawn pale.
+- **GT … as evaluated**: where the evaluation put an object that had no LiDAR or radar points at this frame (it
+  interpolates a box between the frames where the object had points); the failure is scored against that box.
 
 **Panels**
 
@@ -84,6 +87,10 @@ GREY = (160, 160, 160)
 NEAR_DETECTION_M = 2.0
 """A detection or track within this BEV distance of a ground-truth object is "on" it (the devkit's match
 distance)."""
+EVALUATED_OFFSET_M = 0.5
+"""An object whose box as evaluated lies farther than this from its annotated box gets a note and a label."""
+MIRROR_MATCH_M = 0.05
+"""The evaluated box is taken for the devkit's swapped-weight interpolation when it lies this close to it."""
 
 
 def tracker_focus(tracker: str) -> str:
@@ -108,6 +115,7 @@ def focus_markdown(
     objects' and tracks' frames, its decisions about them and their story. thresholds: per tracker, the score
     from which the evaluation counted a track of the focused class (its best-MOTA threshold; None: every box)."""
     lines = [f"# {focus.title}", ""]
+    lines += _evaluated_gt_notes(focus, scene, runs)
     for tracker, logger in loggers.items():
         key = _key_decisions(logger, set(focus.track_ids.get(tracker, ())), focus.class_name, shown, focus.frame_index)
         if key:
@@ -157,6 +165,106 @@ def focus_markdown(
             lines += [f"- frame {f}: {text}" for f, text in story[-MAX_STORY_LINES:]]
             lines.append("")
     return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True, slots=True)
+class EvaluatedGt:
+    """An involved object the evaluation saw elsewhere than its annotation at the focus frame.
+
+    center_m: (3,) annotated centre; offset_m: BEV distance of the evaluated box from it; points: LiDAR + radar
+    points in the annotated box; mirror_frame: when the evaluated box is the devkit's interpolation with its
+    weights swapped (nuscenes-devkit issue #1141), the frame whose annotated place it took (else None).
+    """
+
+    center_m: np.ndarray
+    offset_m: float
+    points: int
+    mirror_frame: int | None
+
+
+def evaluated_offsets(focus: FocusTarget, scene: SceneData) -> dict[str, EvaluatedGt]:
+    """The involved objects whose box as evaluated at the focus frame lies more than ``EVALUATED_OFFSET_M`` from
+    their annotated box."""
+    i = focus.frame_index
+    out = {}
+    for gt_id, xy in focus.evaluated_gt_xy_m.items():
+        annotated = _annotated_track(scene, gt_id)
+        if i not in annotated:
+            continue
+        center, points = annotated[i]
+        offset = float(np.hypot(center[0] - xy[0], center[1] - xy[1]))
+        if offset > EVALUATED_OFFSET_M:
+            out[gt_id] = EvaluatedGt(center, offset, points, _mirror_frame(scene, annotated, i, np.array(xy)))
+    return out
+
+
+def _annotated_track(scene: SceneData, gt_id: str) -> dict[int, tuple[np.ndarray, int]]:
+    """Frame -> (3,) annotated centre and points in the box of one object."""
+    out = {}
+    for keyframe in scene.keyframes:
+        hit = np.flatnonzero(keyframe.gt.instance_id.astype(str) == gt_id)
+        if hit.size:
+            out[keyframe.index] = (keyframe.gt.translation_m[hit[0]], int(keyframe.gt_num_pts[hit[0]]))
+    return out
+
+
+def _mirror_frame(
+    scene: SceneData, annotated: Mapping[int, tuple[np.ndarray, int]], i: int, evaluated_xy: np.ndarray
+) -> int | None:
+    """The frame mirrored about frame ``i`` between the nearest annotated frames with points, if the evaluated
+    box is the devkit's interpolation with swapped weights (``right_ratio`` = (t_right - t) / (t_right - t_left)
+    applied to the right box; nuscenes-devkit issue #1141) and that frame is annotated; else None."""
+    seen = sorted(f for f, (_c, points) in annotated.items() if points > 0)
+    left = max((f for f in seen if f < i), default=None)
+    right = min((f for f in seen if f > i), default=None)
+    if left is None or right is None:
+        return None
+    t = [scene.keyframes[f].timestamp_us for f in (left, i, right)]
+    swapped = (t[2] - t[1]) / (t[2] - t[0])
+    xy = (1.0 - swapped) * annotated[left][0][:2] + swapped * annotated[right][0][:2]
+    mirror = left + right - i
+    if np.hypot(*(xy - evaluated_xy)) > MIRROR_MATCH_M or mirror not in annotated:
+        return None
+    return mirror
+
+
+def _evaluated_gt_notes(focus: FocusTarget, scene: SceneData, runs: Mapping[str, TrackingRun]) -> list[str]:
+    """A paragraph per involved object the evaluation saw elsewhere than its annotation (``evaluated_offsets``):
+    why, how far, and which tracks were within match distance of each box."""
+    out = []
+    for gt_id, seen in evaluated_offsets(focus, scene).items():
+        xy = np.array(focus.evaluated_gt_xy_m[gt_id])
+        near_evaluated, near_annotated = [], []
+        for tracker, run in runs.items():
+            frame = next((f for f in run.frames if f.keyframe.index == focus.frame_index), None)
+            mine = [e for e in (frame.estimates if frame is not None else ()) if e.class_name == focus.class_name]
+            for box_xy, found in ((xy, near_evaluated), (seen.center_m[:2], near_annotated)):
+                ids = [
+                    str(e.track_id)
+                    for e in mine
+                    if np.hypot(*(np.array(e.translation_m[:2]) - box_xy)) < NEAR_DETECTION_M
+                ]
+                found.append(f"{tracker} {'track ' + ', '.join(ids) if ids else 'no track'}")
+        if seen.points == 0:
+            why = (
+                "it had no LiDAR or radar points, so the evaluation dropped its annotated box and interpolated one "
+                "from the frames around it where it had points"
+            )
+            if seen.mirror_frame is not None:
+                why += (
+                    f". The devkit weights the two frames the wrong way round (nuscenes-devkit issue #1141), so "
+                    f"the box sits where the object is annotated at frame {seen.mirror_frame}"
+                )
+        else:
+            why = "the evaluation's box differs from the annotated one"
+        out += [
+            f"**GT {short_id(gt_id)} as evaluated**: at frame {focus.frame_index} {why}; that box lies "
+            f"**{seen.offset_m:.1f} m** from the annotated one (the column beside the views labels both). Within "
+            f"{NEAR_DETECTION_M:.0f} m of the evaluated box: {'; '.join(near_evaluated)}. Within "
+            f"{NEAR_DETECTION_M:.0f} m of the annotated box: {'; '.join(near_annotated)}.",
+            "",
+        ]
+    return out
 
 
 def _key_decisions(logger: TrackerLogger, ids: set[int], class_name: str, shown: range, last: int) -> list[str]:
@@ -275,7 +383,9 @@ def _gt_markdown(
                 if e.class_name == focus.class_name
                 and np.hypot(e.translation_m[0] - xy[0], e.translation_m[1] - xy[1]) < NEAR_DETECTION_M
             ]
-            rows.append(f"| {i} | {nearest} | {went} | {', '.join(covering) or 'none'} |")
+            points = int(scene.keyframes[i].gt_num_pts[hit[0]])
+            evaluated = f"{points}" if points else "0: not scored as annotated (interpolated)"
+            rows.append(f"| {i} | {evaluated} | {nearest} | {went} | {', '.join(covering) or 'none'} |")
             seen += 1
             detected += nearest != "none"
             sent += [went] if nearest != "none" else []
@@ -293,8 +403,8 @@ def _gt_markdown(
                 "",
                 f"GT {short_id(gt_id)}, frame by frame (the evaluation counted {counted}):",
                 "",
-                "| frame | nearest detection | sent to | tracks output on it (score) |",
-                "|---|---|---|---|",
+                "| frame | points in box | nearest detection | sent to | tracks output on it (score) |",
+                "|---|---|---|---|---|",
                 *rows,
                 "",
             ]
@@ -368,6 +478,15 @@ def log_focus(
             for r, label in zip(rows.tolist(), labels, strict=True)
         ]
         z_m = float(gt.translation_m[rows[0], 2]) if rows.size else scene.ground_z_m
+        if i == focus.frame_index:
+            gt_callouts += [
+                Callout(
+                    (*focus.evaluated_gt_xy_m[gt_id], float(seen.center_m[2])),
+                    f"GT {short_id(gt_id)} as evaluated ({seen.offset_m:.1f} m off)",
+                    CLASS_COLORS.get(focus.class_name, GREY),
+                )
+                for gt_id, seen in evaluated_offsets(focus, scene).items()
+            ]
         meas: set[int] = set()
         detections = None
         for tracker, ids in focus.track_ids.items():

@@ -83,7 +83,9 @@ class FailureBox:
     """A box involved in a failure, as the evaluation saw it (ground truth or track, possibly interpolated).
 
     role: "gt" or "track" plus what it did (e.g. "missed gt", "old track"); object_id: instance token or
-    tracking id; translation_m (3,), size_wlh_m (3,), quat_wxyz (4,) in the global frame.
+    tracking id; translation_m (3,), size_wlh_m (3,), quat_wxyz (4,) in the global frame; interpolated: a
+    ground-truth box the evaluation made up between annotated frames because the object had no LiDAR or radar
+    points at this one (the devkit drops such boxes, then interpolates its tracks over the gap).
     """
 
     role: str
@@ -91,6 +93,7 @@ class FailureBox:
     translation_m: tuple[float, float, float]
     size_wlh_m: tuple[float, float, float]
     quat_wxyz: tuple[float, float, float, float]
+    interpolated: bool = False
 
     @property
     def is_gt(self) -> bool:
@@ -113,7 +116,16 @@ class Failure:
     generation: int = 0
 
     def describe(self) -> str:
-        """One readable line naming the ids."""
+        """One readable line naming the ids (and saying when a ground-truth box was interpolated)."""
+        interpolated = " (GT box interpolated by the evaluation: no points)" if self.gt_interpolated else ""
+        return self._what() + interpolated
+
+    @property
+    def gt_interpolated(self) -> bool:
+        """Whether a ground-truth box of this failure is one the evaluation interpolated (``FailureBox``)."""
+        return any(b.interpolated for b in self.boxes if b.is_gt)
+
+    def _what(self) -> str:
         gt = ", ".join(f"GT {short_id(g)}" for g in self.gt_ids)
         tracks = [f"track {t}" for t in self.track_ids]
         match self.kind:
@@ -150,6 +162,7 @@ class Failure:
                     "translation": list(b.translation_m),
                     "size": list(b.size_wlh_m),
                     "rotation": list(b.quat_wxyz),
+                    "interpolated": b.interpolated,
                 }
                 for b in self.boxes
             ],
@@ -172,6 +185,7 @@ class Failure:
                     translation_m=tuple(b["translation"]),
                     size_wlh_m=tuple(b["size"]),
                     quat_wxyz=tuple(b["rotation"]),
+                    interpolated=bool(b.get("interpolated", False)),
                 )
                 for b in data["boxes"]
             ),
@@ -229,12 +243,17 @@ class FailureReport:
         return ", ".join(f"{len(self.of_kind(k))} {k.value}" for k in FailureKind)
 
     def first_worth_opening(self) -> str | None:
-        """The id of the first failure of the first kind in ``OPEN_FIRST`` that occurred (None: no failure)."""
-        ids = self.ids()
-        for kind in OPEN_FIRST:
-            hit = next((i for i, f in zip(ids, self.failures, strict=True) if f.kind is kind), None)
-            if hit is not None:
-                return hit
+        """The id of the first failure of the first kind in ``OPEN_FIRST`` that occurred, preferring failures
+        whose ground truth the evaluation did not interpolate (those are often the devkit's doing, see
+        ``FailureBox``); None: no failure."""
+        ids = list(zip(self.ids(), self.failures, strict=True))
+        for allow_interpolated in (False, True):
+            for kind in OPEN_FIRST:
+                hit = next(
+                    (i for i, f in ids if f.kind is kind and (allow_interpolated or not f.gt_interpolated)), None
+                )
+                if hit is not None:
+                    return hit
         return None
 
     def by_id(self, failure_id: str) -> Failure | None:
@@ -292,12 +311,15 @@ def _json_number(value: float) -> float | None:
 
 
 def _box(role: str, box: TrackingBox) -> FailureBox:
+    """The evaluation's box; a ground-truth box without a point count (the devkit's ``num_pts`` stays -1 on the
+    boxes ``interpolate_tracks`` makes; annotated boxes with 0 points were filtered out before) is interpolated."""
     return FailureBox(
         role=role,
         object_id=str(box.tracking_id),
         translation_m=tuple(float(v) for v in box.translation),
         size_wlh_m=tuple(float(v) for v in box.size),
         quat_wxyz=tuple(float(v) for v in box.rotation),
+        interpolated=role.endswith("gt") and box.num_pts < 0,
     )
 
 

@@ -14,6 +14,7 @@ import pytest
 from rerun.chunk import RrdReader
 
 from cli.app import main
+from gnnpmb.eval.failures import FailureKind, short_id
 from gnnpmb.session import find_reports, prepare, rerun_runs
 from tests.viz.rrd import read_rows
 from viz import paths
@@ -184,3 +185,33 @@ def test_the_summary_opens_with_the_decisions_that_made_the_switch(
     # The detection that started the new track, with the old track as the choice the solver passed over.
     line = next(x for x in head.splitlines() if f"**new track {new}**" in x)
     assert line.startswith(f"- frame {switch.frame_index}: m") and "over track " in line and "margin " in line
+
+
+def test_a_failure_at_an_interpolated_gt_box_is_explained(
+    demo_dataroot: Path, tmp_path: Path, failures_and_runs
+) -> None:
+    report, _ = failures_and_runs
+    scene = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars").scene
+    # The devkit's boxes are flagged interpolated exactly where the annotated object has no points.
+    for f in report.failures:
+        for b in (b for b in f.boxes if b.is_gt):
+            gt = scene.keyframes[f.frame_index].gt
+            hit = np.flatnonzero(gt.instance_id.astype(str) == b.object_id)
+            assert b.interpolated == (scene.keyframes[f.frame_index].gt_num_pts[hit[0]] == 0)
+    pick, failure = next(
+        (i, f)
+        for i, f in zip(report.ids(), report.failures, strict=True)
+        if f.kind is FailureKind.FRAGMENTATION and f.gt_interpolated
+    )
+    out, _ = record(demo_dataroot, tmp_path, pick)
+    rows = read_rows(out)
+    summary = rows[focus_doc()][0]["TextDocument:text"][0]
+    gt = short_id(failure.gt_ids[0])
+    # Right below the headline: where the evaluation put the object, how far from the annotation, and why.
+    note = summary.split("\n\n")[1]
+    assert note.startswith(f"**GT {gt} as evaluated**: at frame {failure.frame_index} it had no LiDAR or radar")
+    assert "nuscenes-devkit issue #1141" in note and " m** from the annotated one" in note
+    # The frame table says which frames the evaluation did not score as annotated.
+    assert f"| {failure.frame_index} | 0: not scored as annotated (interpolated) |" in summary
+    callouts = [r for r in rows[paths.focus_callouts("gnnpmb")] if r.get("frame") == failure.frame_index][0]
+    assert any(label.startswith(f"GT {gt} as evaluated (") for label in callouts["Points3D:labels"])

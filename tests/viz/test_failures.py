@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -144,3 +145,18 @@ def test_totals_and_the_failure_suggested_first(tiny_scene) -> None:
     )
     assert only_misses.first_worth_opening() == "miss:1"
     assert FailureReport(scene.name, T, report.sample_tokens, report.classes, ()).first_worth_opening() is None
+
+
+def test_a_failure_at_an_interpolated_gt_box_is_named_and_suggested_last(tiny_scene) -> None:
+    scene, _ = tiny_scene
+    report = report_for(scene)
+    switch = report.of_kind(FailureKind.ID_SWITCH)[0]
+    made_up = tuple(replace(b, interpolated=b.is_gt) for b in switch.boxes)
+    interpolated_switch = replace(switch, boxes=made_up)
+    assert interpolated_switch.gt_interpolated and not switch.gt_interpolated
+    assert interpolated_switch.describe() == switch.describe() + " (GT box interpolated by the evaluation: no points)"
+    failures = tuple(interpolated_switch if f is switch else f for f in report.failures)
+    mixed = FailureReport(scene.name, T, report.sample_tokens, report.classes, failures)
+    # The identity theft (not interpolated) comes before the interpolated switch; both before misses.
+    assert mixed.first_worth_opening() == "identity_theft:1"
+    assert Failure.from_json(interpolated_switch.to_json()) == interpolated_switch
