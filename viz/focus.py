@@ -41,7 +41,7 @@ from viz.callouts import Callout, log_callouts
 from viz.colors import CLASS_COLORS, class_ids, track_colors
 from viz.decisions import CLOSE_CALL_MARGIN, column_name, conflict_markdown, meas_name
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
-from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, place_legend
+from viz.legend import COMPARISON_PLOT_HEIGHT_PX, PROBABILITY_RANGE, LegendPlacement, place_legend
 from viz.logger import TrackerLogger, TrackStep
 from viz.scene import detection_label
 from viz.timeline import Clock
@@ -73,6 +73,8 @@ READING_GUIDE = """# How to read the views
   Tracks that are not involved are drawn pale.
 - **GT … as evaluated**: where the evaluation put an object that had no LiDAR or radar points at this frame (it
   interpolates a box between the frames where the object had points); the failure is scored against that box.
+  It is drawn thin in the class colour, with a line to the annotated box and a circle of 2 m around it: a track
+  outside that circle is not matched to the object.
 
 **Panels**
 
@@ -172,14 +174,15 @@ class EvaluatedGt:
     """An involved object the evaluation saw elsewhere than its annotation at the focus frame.
 
     center_m: (3,) annotated centre; offset_m: BEV distance of the evaluated box from it; points: LiDAR + radar
-    points in the annotated box; mirror_frame: when the evaluated box is the devkit's interpolation with its
-    weights swapped (nuscenes-devkit issue #1141), the frame whose annotated place it took (else None).
+    points in the annotated box; swapped: when the evaluated box is the devkit's interpolation with its weights
+    swapped (nuscenes-devkit issue #1141), the frames it interpolated between (the nearest with points) and the
+    frame whose annotated place it took (else None).
     """
 
     center_m: np.ndarray
     offset_m: float
     points: int
-    mirror_frame: int | None
+    swapped: tuple[int, int, int] | None
 
 
 def evaluated_offsets(focus: FocusTarget, scene: SceneData) -> dict[str, EvaluatedGt]:
@@ -210,10 +213,11 @@ def _annotated_track(scene: SceneData, gt_id: str) -> dict[int, tuple[np.ndarray
 
 def _mirror_frame(
     scene: SceneData, annotated: Mapping[int, tuple[np.ndarray, int]], i: int, evaluated_xy: np.ndarray
-) -> int | None:
-    """The frame mirrored about frame ``i`` between the nearest annotated frames with points, if the evaluated
-    box is the devkit's interpolation with swapped weights (``right_ratio`` = (t_right - t) / (t_right - t_left)
-    applied to the right box; nuscenes-devkit issue #1141) and that frame is annotated; else None."""
+) -> tuple[int, int, int] | None:
+    """The nearest annotated frames with points before and after frame ``i`` and the frame mirrored about ``i``
+    between them, if the evaluated box is the devkit's interpolation with swapped weights (``right_ratio`` =
+    (t_right - t) / (t_right - t_left) applied to the right box; nuscenes-devkit issue #1141) and that frame is
+    annotated; else None."""
     seen = sorted(f for f, (_c, points) in annotated.items() if points > 0)
     left = max((f for f in seen if f < i), default=None)
     right = min((f for f in seen if f > i), default=None)
@@ -225,7 +229,7 @@ def _mirror_frame(
     mirror = left + right - i
     if np.hypot(*(xy - evaluated_xy)) > MIRROR_MATCH_M or mirror not in annotated:
         return None
-    return mirror
+    return left, right, mirror
 
 
 def _evaluated_gt_notes(focus: FocusTarget, scene: SceneData, runs: Mapping[str, TrackingRun]) -> list[str]:
@@ -234,7 +238,7 @@ def _evaluated_gt_notes(focus: FocusTarget, scene: SceneData, runs: Mapping[str,
     out = []
     for gt_id, seen in evaluated_offsets(focus, scene).items():
         xy = np.array(focus.evaluated_gt_xy_m[gt_id])
-        near_evaluated, near_annotated = [], []
+        near_evaluated, near_annotated, on_it = [], [], []
         for tracker, run in runs.items():
             frame = next((f for f in run.frames if f.keyframe.index == focus.frame_index), None)
             mine = [e for e in (frame.estimates if frame is not None else ()) if e.class_name == focus.class_name]
@@ -245,15 +249,28 @@ def _evaluated_gt_notes(focus: FocusTarget, scene: SceneData, runs: Mapping[str,
                     if np.hypot(*(np.array(e.translation_m[:2]) - box_xy)) < NEAR_DETECTION_M
                 ]
                 found.append(f"{tracker} {'track ' + ', '.join(ids) if ids else 'no track'}")
+            if near_evaluated[-1].endswith("no track") and not near_annotated[-1].endswith("no track"):
+                on_it.append(near_annotated[-1])
+        verdict = (
+            f"**Verdict: the evaluation's doing.** {' and '.join(on_it)} followed the annotated object, but the "
+            f"evaluation scored it against a box {seen.offset_m:.1f} m away."
+            if on_it
+            else ""
+        )
         if seen.points == 0:
             why = (
                 "it had no LiDAR or radar points, so the evaluation dropped its annotated box and interpolated one "
                 "from the frames around it where it had points"
             )
-            if seen.mirror_frame is not None:
+            if seen.swapped is not None:
+                left, right, mirror = seen.swapped
+                t = [scene.keyframes[f].timestamp_us for f in (left, focus.frame_index, right)]
+                share = (t[1] - t[0]) / (t[2] - t[0])
                 why += (
-                    f". The devkit weights the two frames the wrong way round (nuscenes-devkit issue #1141), so "
-                    f"the box sits where the object is annotated at frame {seen.mirror_frame}"
+                    f" (frames {left} and {right}). Frame {focus.frame_index} is {share:.2f} of the way from "
+                    f"{left} to {right}, but the devkit weights the two ends the wrong way round (nuscenes-devkit "
+                    f"issue #1141) and puts the box {1.0 - share:.2f} of the way, where the object is annotated at "
+                    f"frame {mirror}"
                 )
         else:
             why = "the evaluation's box differs from the annotated one"
@@ -264,6 +281,8 @@ def _evaluated_gt_notes(focus: FocusTarget, scene: SceneData, runs: Mapping[str,
             f"{NEAR_DETECTION_M:.0f} m of the annotated box: {'; '.join(near_annotated)}.",
             "",
         ]
+        if verdict:
+            out[-2:-2] = [verdict, ""]
     return out
 
 
@@ -462,6 +481,7 @@ def log_focus(
     stream.log(reading_guide_doc(), rr.TextDocument(READING_GUIDE, media_type="text/markdown"), static=True)
     frames = {run.tracker: {f.keyframe.index: f for f in run.frames} for run in runs}
     gt_ids = set(focus.gt_ids)
+    evaluated = evaluated_offsets(focus, scene)
     height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
     for i in shown:
         keyframe = scene.keyframes[i]
@@ -538,6 +558,47 @@ def log_focus(
                 show_labels=False,
             ),
         )
+        if evaluated:
+            _log_evaluated(stream, focus, scene, evaluated if i == focus.frame_index else {})
+
+
+def evaluated_world() -> str:
+    """Where the evaluation put the involved objects it interpolated (``EvaluatedGt``), at the focus frame."""
+    return f"{focus_world()}/as_evaluated"
+
+
+def _log_evaluated(
+    stream: rr.RecordingStream, focus: FocusTarget, scene: SceneData, evaluated: Mapping[str, EvaluatedGt]
+) -> None:
+    """Each ``evaluated`` object's box as evaluated (its annotated size and heading at the evaluated centre), the
+    circle of the evaluation's match distance around it and a line from the annotated centre labelled with the
+    offset; an empty batch clears them (frames other than the focus frame)."""
+    gt = scene.keyframes[focus.frame_index].gt
+    centers, sizes, quats, strips, labels = [], [], [], [], []
+    for gt_id, seen in evaluated.items():
+        row = int(np.flatnonzero(gt.instance_id.astype(str) == gt_id)[0])
+        at = np.array([*focus.evaluated_gt_xy_m[gt_id], seen.center_m[2]])
+        centers.append(at)
+        sizes.append(size_wlh_to_xyz(gt.size_wlh_m[row : row + 1])[0])
+        quats.append(quat_wxyz_to_xyzw(gt.quat_wxyz[row : row + 1])[0])
+        angles = np.linspace(0.0, 2.0 * np.pi, 65)
+        circle = np.stack([at[0] + NEAR_DETECTION_M * np.cos(angles), at[1] + NEAR_DETECTION_M * np.sin(angles)], 1)
+        strips += [np.column_stack([circle, np.full(len(angles), at[2])]), np.stack([seen.center_m, at])]
+        labels += [f"{NEAR_DETECTION_M:.0f} m: match distance", f"{seen.offset_m:.1f} m from the annotation"]
+    color = CLASS_COLORS.get(focus.class_name, GREY)
+    stream.log(
+        evaluated_world(),
+        rr.Boxes3D(
+            centers=np.array(centers).reshape(-1, 3),
+            half_sizes=0.5 * np.array(sizes).reshape(-1, 3),
+            quaternions=np.array(quats).reshape(-1, 4),
+            colors=[color],
+            radii=LINE_RADIUS_M / 2,
+            labels=[f"GT {short_id(g)} as evaluated" for g in evaluated],
+            show_labels=False,
+        ),
+        rr.LineStrips3D(strips, colors=[color], radii=LINE_RADIUS_M / 3, labels=labels, show_labels=False),
+    )
 
 
 def focus_legends(
@@ -560,7 +621,9 @@ def focus_legends(
         for root, series in views.items():
             sent = [logger.sent_series[p] for p in series if p in logger.sent_series]
             # The legend names every series of the view, also those without a value up to the focus frame.
-            out[root] = place_legend([(f[f <= last], v[f <= last]) for f, v in sent], len(sent))
+            lines = [(f[f <= last], v[f <= last]) for f, v in sent]
+            fixed = PROBABILITY_RANGE if root == paths.existence_root(tracker) else None
+            out[root] = place_legend(lines, len(sent), y_range=fixed)
     if comparison is not None:
         frames = np.asarray(comparison.frame_indices)
         upto = frames <= last

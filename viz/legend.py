@@ -4,7 +4,8 @@ Rerun draws a plot's legend inside the plot, in one corner. With the few series 
 takes a large share of a small plot, and in a fixed corner it hid the very lines it names (a starving track's
 existence near 0 under a bottom-left legend). ``place_legend`` looks at the lines, as Rerun will scale them, and
 picks a corner the legend's box leaves empty; when every corner holds data it puts the legend at the top and
-stretches the y axis so the lines stay below it.
+stretches the y axis so the lines stay below it, except on a plot with a fixed range (a probability's), where it
+takes the corner that covers the least.
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ LEGEND_WIDTH = 0.3
 """Share of the plot's width the legend's box takes (its entries are short: "<track id> <class> existence")."""
 MAX_LEGEND_HEIGHT = 0.75
 """The legend is assumed to take at most this share of the plot's height (Rerun scrolls a longer one)."""
+PROBABILITY_RANGE = (-0.02, 1.02)
+"""The y range of plots of probabilities (existence): [0, 1] with room for the lines at either end."""
 Y_MARGIN = 0.05
 """Share of the data's y span added below and above it (Rerun's automatic bounds leave a similar margin)."""
 SAMPLES = 200
@@ -61,30 +64,39 @@ def place_legend(
     lines: Sequence[tuple[np.ndarray, np.ndarray]],
     n_entries: int | None = None,
     plot_height_px: float = PLOT_HEIGHT_PX,
+    y_range: tuple[float, float] | None = None,
 ) -> LegendPlacement:
     """The corner for the legend of a plot of ``lines`` ((K,) x, (K,) y each; NaN values are gaps): the first
-    of ``CORNER_ORDER`` whose legend box no line passes through; if there is none, the top right with a y range
-    whose upper part is left free for it. ``n_entries``: legend rows (default: one per line)."""
+    of ``CORNER_ORDER`` whose legend box no line passes through. If there is none: with a fixed ``y_range``
+    (e.g. a probability's [0, 1]) the corner that covers the fewest line samples; else the top right with a y
+    range whose upper part is left free for it. ``n_entries``: legend rows (default: one per line)."""
     drawn = [(np.asarray(x, np.float64), np.asarray(y, np.float64)) for x, y in lines]
     drawn = [(x[np.isfinite(y)], y[np.isfinite(y)]) for x, y in drawn]
     drawn = [(x, y) for x, y in drawn if x.size]
     if not drawn:
-        return LegendPlacement(CORNER_ORDER[0])
+        return LegendPlacement(CORNER_ORDER[0], y_range)
     height = legend_height(len(lines) if n_entries is None else n_entries, plot_height_px)
     x_lo = min(float(x.min()) for x, _ in drawn)
     x_hi = max(float(x.max()) for x, _ in drawn)
-    y_lo = min(float(y.min()) for _, y in drawn)
-    y_hi = max(float(y.max()) for _, y in drawn)
-    span = y_hi - y_lo if y_hi > y_lo else max(abs(y_hi), 1.0)
-    y_lo, y_hi = y_lo - Y_MARGIN * span, y_hi + Y_MARGIN * span
+    if y_range is None:
+        y_lo = min(float(y.min()) for _, y in drawn)
+        y_hi = max(float(y.max()) for _, y in drawn)
+        span = y_hi - y_lo if y_hi > y_lo else max(abs(y_hi), 1.0)
+        y_lo, y_hi = y_lo - Y_MARGIN * span, y_hi + Y_MARGIN * span
+    else:
+        y_lo, y_hi = y_range
     u, v = _normalised(drawn, (x_lo, x_hi), (y_lo, y_hi))
+    covered = []
     for corner in CORNER_ORDER:
         left = corner in (Corner.LeftTop, Corner.LeftBottom)
         top = corner in (Corner.LeftTop, Corner.RightTop)
         in_x = u <= LEGEND_WIDTH if left else u >= 1.0 - LEGEND_WIDTH
         in_y = v >= 1.0 - height if top else v <= height
-        if not np.any(in_x & in_y):
-            return LegendPlacement(corner)
+        covered.append(int(np.count_nonzero(in_x & in_y)))
+        if covered[-1] == 0:
+            return LegendPlacement(corner, y_range)
+    if y_range is not None:
+        return LegendPlacement(CORNER_ORDER[int(np.argmin(covered))], y_range)
     # Every corner holds data: the data keeps the lower (1 - height) of the plot, the legend the band above it.
     top = y_lo + (y_hi - y_lo) / (1.0 - height)
     return LegendPlacement(Corner.RightTop, (y_lo, top))

@@ -19,7 +19,8 @@ from gnnpmb.session import find_reports, prepare, rerun_runs
 from tests.viz.rrd import read_rows
 from viz import paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
-from viz.legend import place_legend
+from viz.focus import evaluated_world
+from viz.legend import PROBABILITY_RANGE, place_legend
 
 SCENE = "scene-0103"
 SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
@@ -95,7 +96,8 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     assert "frame by frame (the evaluation counted " in summary and "tracks output on it (score)" in summary
     followed = [t for t in failure.track_ids if paths.existence("gnnpmb", failure.class_name, t) in rows]
     assert followed, f"no existence series for the involved tracks {failure.track_ids}"
-    # The existence plot's legend is placed clear of the lines the recording shows up to the failure frame.
+    # The existence plot (fixed at [0, 1]) has its legend where it covers least of the lines the recording
+    # shows up to the failure frame.
     involved = re.search(r"gnnpmb: tracks ([\d, ]+)", summary).group(1).split(", ")  # the plot's tracks
     shown = [paths.existence("gnnpmb", failure.class_name, int(t)) for t in involved]
     shown = [p for p in shown if p in rows]
@@ -104,10 +106,10 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
         (np.array([r["focus"] for r in points]), np.array([r["Scalars:scalars"][0] for r in points]))
         for points in ([r for r in rows[p] if r.get("focus") is not None] for p in shown)
     ]
-    placed = place_legend(lines, len(shown))
+    placed = place_legend(lines, len(shown), y_range=PROBABILITY_RANGE)
     corner, y_range = stored_legends(bp)["gnnpmb existence"]
     assert corner == placed.corner.value
-    assert y_range == (None if placed.y_range is None else pytest.approx(placed.y_range))
+    assert y_range == pytest.approx(PROBABILITY_RANGE)
     guide = rows[reading_guide_doc()][0]["TextDocument:text"][0]
     assert guide.startswith("# How to read the views") and "how to read the views" in summary
     highlighted = [r for r in rows[focus_world()] if r.get("frame") == failure.frame_index]
@@ -208,10 +210,17 @@ def test_a_failure_at_an_interpolated_gt_box_is_explained(
     summary = rows[focus_doc()][0]["TextDocument:text"][0]
     gt = short_id(failure.gt_ids[0])
     # Right below the headline: where the evaluation put the object, how far from the annotation, and why.
-    note = summary.split("\n\n")[1]
+    verdict, note = summary.split("\n\n")[1:3]
+    assert verdict.startswith("**Verdict: the evaluation's doing.** gnnpmb track ")
     assert note.startswith(f"**GT {gt} as evaluated**: at frame {failure.frame_index} it had no LiDAR or radar")
     assert "nuscenes-devkit issue #1141" in note and " m** from the annotated one" in note
     # The frame table says which frames the evaluation did not score as annotated.
     assert f"| {failure.frame_index} | 0: not scored as annotated (interpolated) |" in summary
     callouts = [r for r in rows[paths.focus_callouts("gnnpmb")] if r.get("frame") == failure.frame_index][0]
     assert any(label.startswith(f"GT {gt} as evaluated (") for label in callouts["Points3D:labels"])
+    # The evaluated box is drawn at the failure frame with the 2 m match circle, and cleared at the others.
+    drawn = {r["frame"]: r for r in rows[evaluated_world()] if r.get("frame") is not None and "Boxes3D:centers" in r}
+    assert drawn[failure.frame_index]["Boxes3D:labels"] == [f"GT {gt} as evaluated"]
+    gt_box = next(b for b in failure.boxes if b.is_gt)
+    np.testing.assert_allclose(drawn[failure.frame_index]["Boxes3D:centers"][0][:2], gt_box.translation_m[:2])
+    assert all(not r["Boxes3D:centers"] for f, r in drawn.items() if f != failure.frame_index)

@@ -60,3 +60,16 @@ def test_gaps_and_empty_plots() -> None:
     assert place_legend([gap, line([0, 10], [1, 1])], 2).y_range is not None
     single = line([3], [0.5])  # one point, in the middle: every corner is free
     assert place_legend([single]) == LegendPlacement(Corner.RightTop)
+
+
+def test_a_fixed_range_is_kept_and_the_least_covered_corner_taken() -> None:
+    # Existence of a healthy track (top, whole width) and a starving one (falling to 0 on the right).
+    healthy = line([0, 10], [0.95, 0.95])
+    starving = line([0, 4, 10], [0.9, 0.9, 0.0])
+    placed = place_legend([healthy, starving], 3, y_range=(-0.02, 1.02))
+    assert placed.y_range == (-0.02, 1.02)
+    assert placed.corner is Corner.LeftBottom  # the only corner no line passes through
+    full = [line([0, 10], [0.0, 0.0]), line([0, 10], [1.0, 1.0]), line([0, 2, 10], [0.5, 0.98, 0.98])]
+    crowded = place_legend(full, 3, y_range=(-0.02, 1.02))
+    assert crowded.y_range == (-0.02, 1.02)  # never stretched
+    assert crowded.corner in (Corner.RightBottom, Corner.LeftBottom)  # the top holds two lines, the bottom one
