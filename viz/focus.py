@@ -25,6 +25,7 @@ from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import short_id
 from gnnpmb.events import AxisKind
+from gnnpmb.explain import PairChoice
 from gnnpmb.focus import FocusTarget
 from gnnpmb.pipeline import TrackingRun
 from gnnpmb.types import Boxes
@@ -123,6 +124,14 @@ def focus_markdown(
         if key:
             lines += [f"**Key decisions of {tracker}** (a detection an involved track could have taken):", ""]
             lines += [f"- {line}" for line in key] + [""]
+    parting = _parting(focus, loggers)
+    if parting:
+        lines += [
+            f"**Where the trackers part** at frame {focus.frame_index} (each detection an involved track took "
+            "or could have taken, in every tracker):",
+            "",
+        ]
+        lines += [f"- {line}" for line in parting] + [""]
     involved = [f"GT {short_id(g)}" for g in focus.gt_ids]
     involved += [f"{t}: tracks {', '.join(map(str, ids))}" for t, ids in focus.track_ids.items() if ids]
     lines += [
@@ -283,6 +292,44 @@ def _evaluated_gt_notes(focus: FocusTarget, scene: SceneData, runs: Mapping[str,
         ]
         if verdict:
             out[-2:-2] = [verdict, ""]
+    return out
+
+
+def _parting(focus: FocusTarget, loggers: Mapping[str, TrackerLogger]) -> list[str]:
+    """With several trackers: per detection of the focus frame that went to different places in different
+    trackers, with an involved track chosen or next best in one of them, each tracker's choice, its cost and
+    the next best column with its cost."""
+    if len(loggers) < 2:
+        return []
+    f = focus.frame_index
+    choices: dict[str, dict[int, PairChoice]] = {}
+    for tracker, logger in loggers.items():
+        choices[tracker] = {
+            int(c.meas.ref): c
+            for d in logger.decisions.get(f, [])
+            if d.class_name == focus.class_name
+            for conflict in d.conflicts
+            for c in conflict.choices
+        }
+    out = []
+    for m in sorted({m for mine in choices.values() for m in mine}):
+        went = {t: logger.given.get(f, {}).get(m) for t, logger in loggers.items()}
+        if len(set(went.values())) < 2:
+            continue
+        touches, parts = False, []
+        for tracker in loggers:
+            ids = set(focus.track_ids.get(tracker, ()))
+            c = choices[tracker].get(m)
+            if c is None:
+                parts.append(f"{tracker}: {meas_name(m)} → {went[tracker] or 'in no gate'}")
+                continue
+            labels = [c.chosen] if c.alternative is None else [c.chosen, c.alternative]
+            touches |= any(label.kind is AxisKind.TRACK and label.ref in ids for label in labels)
+            touches |= any(str(t) in str(went[tracker]).split() for t in ids)
+            other = f"; next {column_name(c.alternative)} {c.alternative_cost:.2f}" if c.alternative is not None else ""
+            parts.append(f"{tracker}: {meas_name(m)} → **{went[tracker]}** ({c.chosen_cost:.2f}{other})")
+        if touches:
+            out.append(" · ".join(parts))
     return out
 
 

@@ -224,3 +224,20 @@ def test_a_failure_at_an_interpolated_gt_box_is_explained(
     gt_box = next(b for b in failure.boxes if b.is_gt)
     np.testing.assert_allclose(drawn[failure.frame_index]["Boxes3D:centers"][0][:2], gt_box.translation_m[:2])
     assert all(not r["Boxes3D:centers"] for f, r in drawn.items() if f != failure.frame_index)
+
+
+def test_where_two_trackers_part_on_the_failure_frame(demo_dataroot: Path, tmp_path: Path, failures_and_runs) -> None:
+    report, _ = failures_and_runs
+    pick = next(i for i in report.ids() if i.startswith("id_switch:"))
+    failure = report.by_id(pick)
+    out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", "pmbm"))
+    summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
+    head, _, rest = summary.partition(f"**Where the trackers part** at frame {failure.frame_index}")
+    assert rest, "the two trackers sent a detection on the object to different places; the summary says where"
+    assert "## gnnpmb" not in head  # it comes before the per-tracker sections
+    lines = [line for line in rest.split("\n\n")[1].splitlines() if line.startswith("- ")]
+    new_track = f"new track {failure.track_ids[1]}"
+    assert any("gnnpmb: m" in line and new_track in line and " · pmbm: m" in line for line in lines)
+    for line in lines:
+        gnnpmb, pmbm = line[2:].split(" · ")
+        assert gnnpmb.split("→")[1].split("(")[0] != pmbm.split("→")[1].split("(")[0]  # different destinations
