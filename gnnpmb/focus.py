@@ -56,7 +56,9 @@ class FocusTarget:
     failure_id: the id ``gnnpmb failures`` prints (None when the focus is not a failure); evaluated_gt_xy_m:
     instance token -> global BEV centre of its box as the evaluation saw it at ``frame_index`` (the devkit
     interpolates a box between annotated frames where it had no LiDAR points, so this can lie metres from the
-    annotation; empty when the focus is not a failure).
+    annotation; empty when the focus is not a failure); failure_kind, failure_tracker and failure_tracks: the
+    failure's kind, the tracker it is of and its own track ids in their order (e.g. old, new for an ID switch;
+    thief, victim for an identity theft).
     """
 
     title: str
@@ -67,6 +69,9 @@ class FocusTarget:
     gt_ids: tuple[str, ...]
     failure_id: str | None = None
     evaluated_gt_xy_m: dict[str, tuple[float, float]] = field(default_factory=dict)
+    failure_kind: FailureKind | None = None
+    failure_tracker: str | None = None
+    failure_tracks: tuple[int, ...] = ()
 
     def window(self, frames: range) -> range:
         """The keyframes of a focus recording, within ``frames``."""
@@ -148,6 +153,9 @@ def _from_failure(
         gt_ids=failure.gt_ids,
         failure_id=failure_id,
         evaluated_gt_xy_m={b.object_id: (b.translation_m[0], b.translation_m[1]) for b in failure.boxes if b.is_gt},
+        failure_kind=failure.kind,
+        failure_tracker=tracker,
+        failure_tracks=tuple(int(t) for t in failure.track_ids),
     )
 
 

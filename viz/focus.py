@@ -23,11 +23,11 @@ import rerun as rr
 
 from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import SceneData
-from gnnpmb.eval.failures import short_id
+from gnnpmb.eval.failures import FailureKind, short_id
 from gnnpmb.events import AxisKind
 from gnnpmb.explain import PairChoice
 from gnnpmb.focus import FocusTarget
-from gnnpmb.pipeline import TrackingRun
+from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import Boxes
 from viz import compare, paths
 from viz.blueprint import (
@@ -119,6 +119,9 @@ def focus_markdown(
     from which the evaluation counted a track of the focused class (its best-MOTA threshold; None: every box)."""
     lines = [f"# {focus.title}", ""]
     lines += _evaluated_gt_notes(focus, scene, runs)
+    owner = focus.failure_tracker
+    if owner in loggers and owner in runs and not evaluated_offsets(focus, scene):
+        lines += _why(focus, scene, runs[owner], loggers[owner], shown)
     for tracker, logger in loggers.items():
         key = _key_decisions(logger, set(focus.track_ids.get(tracker, ())), focus.class_name, shown, focus.frame_index)
         if key:
@@ -409,6 +412,71 @@ def _frames(frames: list[int]) -> str:
 _NOT_COUNTED = ", not counted"
 
 
+def _nearest_detection(frame: FrameResult, class_name: str, xy_m: np.ndarray) -> tuple[int, float] | None:
+    """The index and BEV distance of the kept detection of ``class_name`` nearest to ``xy_m`` if it is within
+    ``NEAR_DETECTION_M``, else None."""
+    boxes = frame.detections.boxes
+    mine = np.flatnonzero(np.asarray(frame.detections.kept) & (boxes.class_name == class_name))
+    if not mine.size:
+        return None
+    d = np.hypot(*(boxes.translation_m[mine, :2] - xy_m).T)
+    k = int(np.argmin(d))
+    return (int(mine[k]), float(d[k])) if d[k] < NEAR_DETECTION_M else None
+
+
+WHY_KINDS = {
+    FailureKind.ID_SWITCH: (0, 1),
+    FailureKind.IDENTITY_THEFT: (1, 0),
+    FailureKind.FRAGMENTATION: (0, None),
+}
+"""Per failure kind with a track that lost the object: the positions in ``Failure.track_ids`` of that track and
+of the track that took the object over (None: none did)."""
+
+
+def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: TrackerLogger, shown: range) -> list[str]:
+    """One line for a failure where a track lost its object: how often the object was detected, what the lost
+    track's existence did meanwhile and the choice that gave the object's detection to the other track."""
+    if focus.failure_kind not in WHY_KINDS or not focus.gt_ids or not focus.failure_tracks:
+        return []
+    lost_at, took_at = WHY_KINDS[focus.failure_kind]
+    lost = focus.failure_tracks[lost_at]
+    took = focus.failure_tracks[took_at] if took_at is not None else None
+    by_frame = {f.keyframe.index: f for f in run.frames}
+    gt_id, detected, seen, empty = focus.gt_ids[0], [], 0, 0
+    for i in range(shown.start, focus.frame_index + 1):
+        gt = scene.keyframes[i].gt
+        hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
+        if hit.size == 0 or i not in by_frame:
+            continue
+        seen += 1
+        empty += int(scene.keyframes[i].gt_num_pts[hit[0]] == 0)
+        if _nearest_detection(by_frame[i], focus.class_name, gt.translation_m[hit[0], :2]) is not None:
+            detected.append(i)
+    parts = [
+        f"GT {short_id(gt_id)} had a detection within {NEAR_DETECTION_M:.0f} m in {len(detected)} of its {seen} "
+        f"recorded frames up to {focus.frame_index}"
+        + (f" ({empty} of them with no LiDAR or radar points)" if empty else "")
+    ]
+    steps = {f: st for f, st in logger.track_steps.get(lost, {}).items() if shown.start <= f <= focus.frame_index}
+    if steps:
+        peak = max(steps, key=lambda f: _after(steps[f]))
+        parts.append(
+            f"track {lost}'s existence went from {_after(steps[peak]):.2f} (frame {peak}) to "
+            f"{_after(steps[max(steps)]):.2f} (frame {max(steps)})"
+        )
+    if took is not None:
+        chosen = [
+            line
+            for line in _key_decisions(
+                logger, set(focus.track_ids.get(run.tracker, ())), focus.class_name, shown, focus.frame_index
+            )
+            if f"**new track {took}**" in line or f"**track {took}**" in line
+        ]
+        if chosen:
+            parts.append(f"then, {chosen[-1]}")
+    return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]
+
+
 def _gt_markdown(
     focus: FocusTarget,
     scene: SceneData,
@@ -432,17 +500,13 @@ def _gt_markdown(
             if hit.size == 0 or frame is None:
                 continue
             xy = gt.translation_m[hit[0], :2]
-            boxes = frame.detections.boxes
-            mine = np.flatnonzero(np.asarray(frame.detections.kept) & (boxes.class_name == focus.class_name))
             nearest = "none"
             went = "—"
-            if mine.size:
-                d = np.hypot(*(boxes.translation_m[mine, :2] - xy).T)
-                k = int(np.argmin(d))
-                if d[k] < NEAR_DETECTION_M:
-                    m = int(mine[k])
-                    nearest = f"m{m} at {d[k]:.1f} m (score {boxes.score[m]:.2f})"
-                    went = logger.given.get(i, {}).get(m, "—")
+            found = _nearest_detection(frame, focus.class_name, xy)
+            if found is not None:
+                m, distance_m = found
+                nearest = f"m{m} at {distance_m:.1f} m (score {frame.detections.boxes.score[m]:.2f})"
+                went = logger.given.get(i, {}).get(m, "—")
             covering = [
                 f"{e.track_id} ({e.score:.2f}{_NOT_COUNTED if threshold is not None and e.score < threshold else ''})"
                 for e in frame.estimates

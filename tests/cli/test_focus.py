@@ -185,7 +185,7 @@ def test_the_summary_opens_with_the_decisions_that_made_the_switch(
     head = summary.split("Opened at frame")[0]
     assert "**Key decisions of gnnpmb**" in head
     # The detection that started the new track, with the old track as the choice the solver passed over.
-    line = next(x for x in head.splitlines() if f"**new track {new}**" in x)
+    line = next(x for x in head.splitlines() if x.startswith("- ") and f"**new track {new}**" in x)
     assert line.startswith(f"- frame {switch.frame_index}: m") and "over track " in line and "margin " in line
 
 
@@ -226,12 +226,19 @@ def test_a_failure_at_an_interpolated_gt_box_is_explained(
     assert all(not r["Boxes3D:centers"] for f, r in drawn.items() if f != failure.frame_index)
 
 
-def test_where_two_trackers_part_on_the_failure_frame(demo_dataroot: Path, tmp_path: Path, failures_and_runs) -> None:
+def test_why_and_where_two_trackers_part_on_the_failure_frame(
+    demo_dataroot: Path, tmp_path: Path, failures_and_runs
+) -> None:
     report, _ = failures_and_runs
     pick = next(i for i in report.ids() if i.startswith("id_switch:"))
     failure = report.by_id(pick)
     out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", "pmbm"))
     summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
+    # The cause in one line under the headline: detections of the object, the old track's existence, the choice.
+    old, new = failure.track_ids
+    why = summary.split("\n\n")[1]
+    assert why.startswith(f"**Why** (gnnpmb): GT {short_id(failure.gt_ids[0])} had a detection within 2 m in ")
+    assert f"track {old}'s existence went from " in why and f"→ **new track {new}** (cost " in why
     head, _, rest = summary.partition(f"**Where the trackers part** at frame {failure.frame_index}")
     assert rest, "the two trackers sent a detection on the object to different places; the summary says where"
     assert "## gnnpmb" not in head  # it comes before the per-tracker sections
