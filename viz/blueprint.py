@@ -283,7 +283,10 @@ def comparison_panel(trackers: Sequence[str], legends: Mapping[str, LegendPlacem
 
 
 def _tracker_views(tracker: str, focus: FocusTarget | None) -> rrb.Container:
-    return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[3, 2])
+    """The bird's-eye view above the perspective view; with a focus the bird's-eye view, where the failure is
+    read, takes more of the height."""
+    shares = [3, 2] if focus is None else [7, 3]
+    return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=shares)
 
 
 def default_blueprint(
