@@ -500,8 +500,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
             for name, report in reports.items():
                 log_failures(stream, name, report, scene, shown, clock, show_labels=focus is None)
         if focus is not None:
-            thresholds = {name: report.threshold_of(focus.class_name) for name, report in reports.items()}
-            log_focus(stream, focus, scene, runs, loggers, clock, shown, thresholds)
+            log_focus(stream, focus, scene, runs, loggers, clock, shown, reports)
             legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
             stream.send_blueprint(
                 default_blueprint(request.trackers, request.classes, focus, legends),

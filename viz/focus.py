@@ -23,7 +23,7 @@ import rerun as rr
 
 from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import SceneData
-from gnnpmb.eval.failures import FailureKind, short_id
+from gnnpmb.eval.failures import FailureKind, FailureReport, short_id
 from gnnpmb.events import AxisKind
 from gnnpmb.explain import PairChoice
 from gnnpmb.focus import FocusTarget
@@ -112,11 +112,11 @@ def focus_markdown(
     shown: range,
     scene: SceneData,
     runs: Mapping[str, TrackingRun],
-    thresholds: Mapping[str, float | None] | None = None,
+    reports: Mapping[str, FailureReport] | None = None,
 ) -> str:
     """The summary document: the failure, the ids; per tracker a diagnosis line per involved track, the involved
-    objects' and tracks' frames, its decisions about them and their story. thresholds: per tracker, the score
-    from which the evaluation counted a track of the focused class (its best-MOTA threshold; None: every box)."""
+    objects' and tracks' frames, its decisions about them and their story. reports: per tracker, its failure
+    report (the evaluation's score threshold of the focused class and each track's averaged score)."""
     lines = [f"# {focus.title}", ""]
     lines += _evaluated_gt_notes(focus, scene, runs)
     owner = focus.failure_tracker
@@ -152,7 +152,7 @@ def focus_markdown(
         lines.append("")
         run = runs.get(tracker)
         if run is not None:
-            lines += _gt_markdown(focus, scene, run, logger, shown, (thresholds or {}).get(tracker))
+            lines += _gt_markdown(focus, scene, run, logger, shown, (reports or {}).get(tracker))
         lines += _steps_markdown(logger, sorted(ids), shown, focus.frame_index)
         decided = [
             c
@@ -409,7 +409,13 @@ def _frames(frames: list[int]) -> str:
     return ", ".join(str(f) for f in frames)
 
 
-_NOT_COUNTED = ", not counted"
+def _counted(average: float | None, threshold: float | None) -> str:
+    """How the evaluation saw a track: its averaged score and, below ``threshold``, that it was not counted."""
+    if threshold is None:
+        return ""
+    if average is None:
+        return "; not evaluated (out of the class's range)"
+    return f"; track average {average:.2f}" + (", not counted" if average < threshold else "")
 
 
 def _nearest_detection(frame: FrameResult, class_name: str, xy_m: np.ndarray) -> tuple[int, float] | None:
@@ -483,11 +489,15 @@ def _gt_markdown(
     run: TrackingRun,
     logger: TrackerLogger,
     shown: range,
-    threshold: float | None = None,
+    report: FailureReport | None = None,
 ) -> list[str]:
     """Per involved ground-truth object, frame by frame up to the focus frame: the nearest detection of its class
     (distance, score), where the tracker sent it, and the tracks output on the object with their tracking scores
-    (those below the evaluation's ``threshold`` were not counted)."""
+    and whether the evaluation counted them: it compares each track's score averaged over the whole track
+    (``FailureReport.track_scores``) with the class's threshold, so a track is counted at every frame or at none.
+    """
+    threshold = report.threshold_of(focus.class_name) if report is not None else None
+    averaged = report.track_scores if report is not None else {}
     out: list[str] = []
     by_frame = {f.keyframe.index: f for f in run.frames}
     for gt_id in focus.gt_ids:
@@ -508,7 +518,7 @@ def _gt_markdown(
                 nearest = f"m{m} at {distance_m:.1f} m (score {frame.detections.boxes.score[m]:.2f})"
                 went = logger.given.get(i, {}).get(m, "—")
             covering = [
-                f"{e.track_id} ({e.score:.2f}{_NOT_COUNTED if threshold is not None and e.score < threshold else ''})"
+                f"{e.track_id} ({e.score:.2f}{_counted(averaged.get(str(e.track_id)), threshold)})"
                 for e in frame.estimates
                 if e.class_name == focus.class_name
                 and np.hypot(e.translation_m[0] - xy[0], e.translation_m[1] - xy[1]) < NEAR_DETECTION_M
@@ -524,7 +534,8 @@ def _gt_markdown(
             counted = (
                 "every output box"
                 if threshold is None
-                else f"{focus.class_name} tracks with score >= {threshold:.3f} (its best-MOTA threshold)"
+                else f"{focus.class_name} tracks whose score averaged over the track is >= {threshold:.3f} (its "
+                "best-MOTA threshold)"
             )
             out += [
                 f"**GT {short_id(gt_id)}**: a detection within {NEAR_DETECTION_M:.0f} m in {detected} of its {seen} "
@@ -577,14 +588,14 @@ def log_focus(
     loggers: Mapping[str, TrackerLogger],
     clock: Clock,
     shown: range,
-    thresholds: Mapping[str, float | None] | None = None,
+    reports: Mapping[str, FailureReport] | None = None,
 ) -> None:
-    """The summary document and, at every keyframe of ``shown``, the highlighted objects (thresholds: see
+    """The summary document and, at every keyframe of ``shown``, the highlighted objects (reports: see
     ``focus_markdown``)."""
     stream.log(
         focus_doc(),
         rr.TextDocument(
-            focus_markdown(focus, loggers, shown, scene, {run.tracker: run for run in runs}, thresholds),
+            focus_markdown(focus, loggers, shown, scene, {run.tracker: run for run in runs}, reports),
             media_type="text/markdown",
         ),
         static=True,

@@ -212,7 +212,9 @@ class ClassEvaluation:
 @dataclass(frozen=True, slots=True)
 class FailureReport:
     """Every failure of one tracker on one scene; sample_tokens (F,) in keyframe order; classes: the evaluated
-    classes (those with ground truth in the scene after the devkit's filters)."""
+    classes (those with ground truth in the scene after the devkit's filters); track_scores: tracking id -> the
+    score the evaluation compared with its class's threshold, the devkit's average of the track's box scores
+    (after its range filter), the same at every frame of the track."""
 
     scene_name: str
     tracker: str
@@ -220,6 +222,7 @@ class FailureReport:
     classes: tuple[ClassEvaluation, ...]
     failures: tuple[Failure, ...]
     coalescence_radius_m: float = COALESCENCE_RADIUS_M
+    track_scores: Mapping[str, float] = field(default_factory=dict)
 
     def of_kind(self, kind: FailureKind) -> list[Failure]:
         return [f for f in self.failures if f.kind is kind]
@@ -282,6 +285,7 @@ class FailureReport:
                 for c in self.classes
             ],
             "totals": {kind.value: len(self.of_kind(kind)) for kind in FailureKind},
+            "track_scores": dict(self.track_scores),
             "failures": [f.to_json() for f in self.failures],
         }
 
@@ -303,6 +307,7 @@ class FailureReport:
             ),
             failures=tuple(Failure.from_json(f) for f in data["failures"]),
             coalescence_radius_m=float(data["coalescence_radius_m"]),
+            track_scores={str(k): float(v) for k, v in data.get("track_scores", {}).items()},
         )
 
 
@@ -603,4 +608,9 @@ def find_failures(
             failures += _class_failures(frames, class_name, tokens, cfg.dist_th_tp, coalescence_radius_m)
     kind_order = {kind: i for i, kind in enumerate(FailureKind)}
     failures.sort(key=lambda f: (f.frame_index, kind_order[f.kind], f.class_name, f.gt_ids, f.track_ids))
-    return FailureReport(scene_name, tracker, tuple(tokens), tuple(classes), tuple(failures), coalescence_radius_m)
+    track_scores = {
+        str(b.tracking_id): float(b.tracking_score) for boxes in tracks_pred[scene_token].values() for b in boxes
+    }
+    return FailureReport(
+        scene_name, tracker, tuple(tokens), tuple(classes), tuple(failures), coalescence_radius_m, track_scores
+    )

@@ -94,6 +94,13 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     # The object's table gives the tracking score of every track output on it and whether the evaluation counted
     # it; the involved tracks' existence is plotted whatever it is (a starved track is often the cause).
     assert "frame by frame (the evaluation counted " in summary and "tracks output on it (score)" in summary
+    # "Counted" is the evaluation's: the track's score averaged over the whole track against the threshold.
+    threshold = report.threshold_of(failure.class_name)
+    listed = re.findall(r"(\d+) \((\d\.\d\d); track average (\d\.\d\d)(, not counted)?\)", summary)
+    assert listed
+    for track_id, _score, average, not_counted in listed:
+        assert average == f"{report.track_scores[track_id]:.2f}"
+        assert bool(not_counted) == (report.track_scores[track_id] < threshold)
     followed = [t for t in failure.track_ids if paths.existence("gnnpmb", failure.class_name, t) in rows]
     assert followed, f"no existence series for the involved tracks {failure.track_ids}"
     # The existence plot (fixed at [0, 1]) has its legend where it covers least of the lines the recording

@@ -160,3 +160,5 @@ def test_a_failure_at_an_interpolated_gt_box_is_named_and_suggested_last(tiny_sc
     # The identity theft (not interpolated) comes before the interpolated switch; both before misses.
     assert mixed.first_worth_opening() == "identity_theft:1"
     assert Failure.from_json(interpolated_switch.to_json()) == interpolated_switch
+    scored = replace(mixed, track_scores={"4": 0.25, "9": 0.5})
+    assert FailureReport.from_json(scored.to_json()) == scored
