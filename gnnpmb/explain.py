@@ -158,9 +158,11 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
     finite[np.arange(n_rows), chosen] = np.isfinite(cost[np.arange(n_rows), chosen])  # whatever was chosen links
     conflicts = []
     in_conflict = np.zeros(n_rows, dtype=bool)
-    for rows, tcols in _components(finite, n_tracks):
+    components = _components(finite, n_tracks)
+    linked = np.where(finite, cost, np.inf) if components else cost
+    for rows, tcols in components:
         in_conflict[rows] = True
-        conflicts.append(_conflict(matrix, np.where(finite, cost, np.inf), chosen, rows, tcols, n_tracks))
+        conflicts.append(_conflict(matrix, linked, chosen, rows, tcols, n_tracks))
     conflicts.sort(key=lambda c: (c.closest_margin, c.track_ids))
     births = tuple(int(matrix.rows[i].ref) for i in np.flatnonzero(~in_conflict))
     return Decisions(matrix.class_name, tuple(conflicts), births, matrix.description)
@@ -169,50 +171,69 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
 def _conflict(
     matrix: CostMatrix, cost: np.ndarray, chosen: np.ndarray, rows: np.ndarray, tcols: np.ndarray, n_tracks: int
 ) -> Conflict:
-    """Decisions of one component: its sub-matrix is [its track columns | its rows' new-track columns]."""
+    """Decisions of one component: its sub-matrix is [its track columns | its rows' new-track columns].
+
+    Every row's chosen column is in the sub-matrix: a chosen track column links its row to the component, and a
+    row's own new-track column is always there. The cheapest other column of each row is found for all rows at
+    once (first minimum, as ``argmin``)."""
     cols = np.concatenate([tcols, n_tracks + rows])
     sub = cost[np.ix_(rows, cols)]
-    position = {int(c): k for k, c in enumerate(cols)}
-    chosen_sub = np.array([position.get(int(chosen[r]), -1) for r in rows])
-    total = float(sub[np.arange(rows.size), chosen_sub].sum()) if rows.size else 0.0
+    position = {c: k for k, c in enumerate(cols.tolist())}
+    chosen_list = chosen[rows].tolist()
+    chosen_sub = np.array([position.get(c, -1) for c in chosen_list], dtype=np.int64)
+    at = np.arange(rows.size)
+    chosen_cost = sub[at, chosen_sub]
+    total = float(chosen_cost.sum()) if rows.size else 0.0
+    others = sub.copy()
+    kept = chosen_sub >= 0
+    others[at[kept], chosen_sub[kept]] = np.inf
+    best = np.argmin(others, axis=1) if cols.size else np.full(rows.size, -1, dtype=np.int64)
+    best_cost = others[at, best] if cols.size else np.full(rows.size, np.inf)
+    mrows, mcols = matrix.rows, matrix.cols
+    cols_list = cols.tolist()
+    one_row = rows.size == 1  # its best total without the chosen pair is its cheapest other entry
     choices = []
-    for i, r in enumerate(rows):
-        j = chosen_sub[i]
-        others = np.where(np.arange(cols.size) == j, np.inf, sub[i])
-        k = int(np.argmin(others)) if others.size else -1
-        has_alt = k >= 0 and np.isfinite(others[k])
+    for i, (r, j, k, c_chosen, c_best) in enumerate(
+        zip(rows.tolist(), chosen_sub.tolist(), best.tolist(), chosen_cost.tolist(), best_cost.tolist(), strict=True)
+    ):
+        has_alt = k >= 0 and math.isfinite(c_best)
         choices.append(
             PairChoice(
-                meas=matrix.rows[r],
-                chosen=matrix.cols[cols[j]],
-                chosen_cost=float(sub[i, j]),
-                alternative=matrix.cols[cols[k]] if has_alt else None,
-                alternative_cost=float(others[k]) if has_alt else math.inf,
-                margin=_margin(sub, i, j, total),
+                meas=mrows[r],
+                chosen=mcols[cols_list[j]],
+                chosen_cost=c_chosen,
+                alternative=mcols[cols_list[k]] if has_alt else None,
+                alternative_cost=c_best if has_alt else math.inf,
+                margin=_capped(c_best, total) if one_row and j >= 0 else _margin(sub, i, j, total),
             )
         )
-    used = {int(cols[j]) for j in chosen_sub if cols[j] < n_tracks}
-    missed = tuple(int(matrix.cols[c].ref) for c in tcols if int(c) not in used)
+    used = {cols_list[j] for j in chosen_sub.tolist() if cols_list[j] < n_tracks}
+    track_refs = tuple(int(mcols[c].ref) for c in tcols.tolist())
+    missed = tuple(ref for c, ref in zip(tcols.tolist(), track_refs, strict=True) if c not in used)
     return Conflict(
         matrix.class_name,
-        tuple(int(matrix.cols[c].ref) for c in tcols),
-        tuple(int(matrix.rows[r].ref) for r in rows),
+        track_refs,
+        tuple(int(mrows[r].ref) for r in rows.tolist()),
         tuple(choices),
         missed,
         total,
     )
 
 
+def _capped(best: float, total: float) -> float:
+    """``best - total`` clipped to [0, LINK_SLACK]; inf when ``best`` is not finite (no other assignment)."""
+    return math.inf if not math.isfinite(best) else min(max(best - total, 0.0), LINK_SLACK)
+
+
 def _margin(sub: np.ndarray, i: int, j: int, total: float) -> float:
     """Best total of ``sub`` with entry (i, j) forbidden, minus ``total`` (inf if then infeasible). A one-row
     ``sub`` (one detection) needs no solver: its best total is its cheapest other entry."""
     if sub.shape[0] == 1:
-        best = float(np.min(np.delete(sub[0], j))) if sub.shape[1] > 1 else math.inf
-        return math.inf if not math.isfinite(best) else min(max(best - total, 0.0), LINK_SLACK)
+        return _capped(float(np.min(np.delete(sub[0], j))) if sub.shape[1] > 1 else math.inf, total)
     forbidden = sub.copy()
     forbidden[i, j] = np.inf
     try:
         _, best = solve(forbidden)
     except InfeasibleAssignment:
         return math.inf
-    return min(max(best - total, 0.0), LINK_SLACK)
+    return _capped(best, total)
