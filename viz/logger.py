@@ -66,7 +66,7 @@ from viz.decisions import (
     meas_name,
 )
 from viz.geometry import estimate_boxes, lift_xy
-from viz.rows import RowBuffer
+from viz.rows import EntityRows, RowBuffer, send_entities
 from viz.timeline import PLAIN_CLOCK, Clock
 
 TRACK_LINE_RADIUS_M = 0.06
@@ -263,6 +263,7 @@ class TrackerLogger:
             self._frame = -1
         self._flush_texts()
         self._rows.flush()
+        scalars: list[EntityRows] = []
         for path, series in self._series.items():
             owner = self._track_series.get(path)
             if owner is not None and owner[1] not in self._extracted_ids and owner[1] not in self._focused:
@@ -270,23 +271,17 @@ class TrackerLogger:
             colors = None if series.color is None else [series.color]
             self.stream.log(path, rr.SeriesLines(names=series.name, colors=colors), static=True)
             values = np.asarray(series.values, dtype=np.float64)
-            self.clock.send(
-                self.stream,
-                path,
-                np.asarray(series.frames),
-                np.asarray(series.timestamps_us),
-                lambda rows, values=values: rr.Scalars.columns(scalars=values[rows]),
+            scalars.append(
+                EntityRows(path, np.asarray(series.frames), np.asarray(series.timestamps_us), _one_per_row(values))
             )
         for path, (names, frames, stamps, values) in self._multi.items():
             self.stream.log(path, rr.SeriesLines(names=names), static=True)
             stacked = np.stack(values)
-            self.clock.send(
-                self.stream,
-                path,
-                np.asarray(frames),
-                np.asarray(stamps),
-                lambda rows, stacked=stacked: rr.Scalars.columns(scalars=stacked[rows]),
+            lengths = np.full(stacked.shape[0], stacked.shape[1], dtype=np.int64)
+            scalars.append(
+                EntityRows(path, np.asarray(frames), np.asarray(stamps), {"scalars": (stacked.ravel(), lengths)})
             )
+        send_entities(self.stream, self.clock, rr.Scalars, scalars)
         self._series.clear()
         self._track_series.clear()
         self._track_paths.clear()
@@ -306,7 +301,10 @@ class TrackerLogger:
         return handler
 
     def _class_frame(self, class_name: str) -> _ClassFrame:
-        return self._classes.setdefault(class_name, _ClassFrame())
+        cf = self._classes.get(class_name)
+        if cf is None:
+            cf = self._classes[class_name] = _ClassFrame()
+        return cf
 
     def _on_cost(self, event: CostMatrix) -> None:
         self._class_frame(event.class_name).costs[event.hypothesis] = event
@@ -361,16 +359,19 @@ class TrackerLogger:
             self._rows.flush()
 
     def _flush_texts(self) -> None:
-        for path, (frames, stamps, texts, levels) in self._texts.items():
-            self.clock.send(
-                self.stream,
+        logs = [
+            EntityRows(
                 path,
                 np.asarray(frames),
                 np.asarray(stamps),
-                lambda rows, texts=texts, levels=levels: rr.TextLog.columns(
-                    text=[texts[i] for i in rows], level=[levels[i] for i in rows]
-                ),
+                {
+                    "text": (texts, np.ones(len(texts), dtype=np.int64)),
+                    "level": (levels, np.ones(len(levels), dtype=np.int64)),
+                },
             )
+            for path, (frames, stamps, texts, levels) in self._texts.items()
+        ]
+        send_entities(self.stream, self.clock, rr.TextLog, logs)
         self._texts.clear()
         self._frames_since_text_flush = 0
 
@@ -965,6 +966,11 @@ def destination(column: AxisLabel, born_id: int | None) -> str:
     """Where a detection went, in words: ``column_name``, with the id of the track a "new" detection started."""
     name = column_name(column)
     return f"new track {born_id}" if column.kind is AxisKind.NEW_TRACK and born_id is not None else name
+
+
+def _one_per_row(values: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The ``Scalars`` field of a series of (R,) values, one per row (``viz.rows.EntityRows``)."""
+    return {"scalars": (values, np.ones(values.size, dtype=np.int64))}
 
 
 def _labels(template: str, track_ids: np.ndarray, existence: np.ndarray) -> list[str]:

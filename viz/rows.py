@@ -1,10 +1,13 @@
-"""Per-frame rows of spatial entities, kept as plain arrays and sent column-wise.
+"""Per-frame rows of entities, kept as plain arrays and sent column-wise, many entities at once.
 
 Building a Rerun archetype and logging it costs ~100 µs per call, and the tracker logger draws a dozen
 entities per class and frame plus one per reported track: logging them one call at a time made the logger six
-times slower than the tracker. ``RowBuffer`` keeps each row's instance arrays instead and sends every entity's
-rows with one ``send_columns`` per flush (``Archetype.columns(...).partition(lengths)``), through the
-recording's ``Clock``. A row with no instances is an empty batch: the entity shows nothing from that frame on.
+times slower than the tracker. ``RowBuffer`` keeps each row's instance arrays instead, and a flush sends every
+entity's rows with one ``send_columns``. Converting each entity's rows to Arrow on its own (``Archetype.columns``,
+``TimeColumn``) still cost ~250 µs per entity, most of a saved recording's finish; ``send_entities`` converts the
+rows of all entities of one archetype in one go (one Arrow array per field and timeline) and sends each entity a
+zero-copy slice of them, with its own list offsets. A row with no instances is an empty batch: the entity shows
+nothing from that frame on.
 """
 
 from __future__ import annotations
@@ -20,6 +23,68 @@ from rerun.encodings import Vec3DBatch
 
 from viz.timeline import Clock
 
+STRIPS = "strips"
+"""The field holding line strips (each row: an (n, k, 3) array or a list of (k_i, 3) strips)."""
+
+
+@dataclass(frozen=True, slots=True)
+class EntityRows:
+    """Rows of one archetype on one entity, ready to send.
+
+    frames: (R,) keyframe indices, non-decreasing; timestamps_us: (R,); fields: field name -> (instances of all
+    rows, concatenated: an (N, ...) array or a list of N items; (R,) instances per row, summing to N).
+    """
+
+    path: str
+    frames: np.ndarray
+    timestamps_us: np.ndarray
+    fields: dict[str, tuple[Any, np.ndarray]]
+
+
+def send_entities(stream: rr.RecordingStream, clock: Clock, archetype: type, entities: list[EntityRows]) -> None:
+    """``send_columns`` of each entity's rows (one call per entity, split only by the clock), with the Arrow
+    arrays of every field and timeline built once for all of them."""
+    entities = [e for e in entities if len(e.frames)]
+    if not entities:
+        return
+    row_counts = np.array([len(e.frames) for e in entities], dtype=np.int64)
+    row_start = np.concatenate([[0], np.cumsum(row_counts)])
+    frames = np.concatenate([np.asarray(e.frames, dtype=np.int64) for e in entities])
+    stamps = np.concatenate([np.asarray(e.timestamps_us, dtype=np.int64) for e in entities])
+    times = clock.time_arrays(frames, stamps)
+    names = list(dict.fromkeys(name for e in entities for name in e.fields))
+    columns: dict[str, tuple[rr.ComponentDescriptor, pa.Array, np.ndarray]] = {}
+    for name in names:
+        parts = [e.fields[name] for e in entities if name in e.fields]
+        descriptor, flat = _flat_column(archetype, name, [p[0] for p in parts])
+        counts = np.array([int(np.sum(p[1])) for p in parts], dtype=np.int64)
+        columns[name] = (descriptor, flat, np.concatenate([[0], np.cumsum(counts)]))
+    seen = dict.fromkeys(names, 0)  # field -> how many entities holding it were sent
+    for k, e in enumerate(entities):
+        r0, r1 = int(row_start[k]), int(row_start[k + 1])
+        cols = []
+        for name, (_, lengths) in e.fields.items():
+            descriptor, flat, start = columns[name]
+            i = seen[name]
+            seen[name] = i + 1
+            offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
+            np.cumsum(lengths, out=offsets[1:])
+            cols.append((descriptor, flat.slice(int(start[i]), int(start[i + 1] - start[i])), offsets))
+        clock.send_rows(stream, e.path, frames[r0:r1], [t.slice(r0, r1 - r0) for t in times], cols)
+
+
+def _flat_column(archetype: type, name: str, flats: list[Any]) -> tuple[rr.ComponentDescriptor, pa.Array]:
+    """The descriptor and the flat Arrow array (one element per instance) of field ``name`` of ``archetype``
+    over the concatenated instances ``flats`` (arrays, or lists of strings or strips)."""
+    if name == STRIPS:
+        value: Any = _strips_array([strip for flat in flats for strip in flat])
+    elif isinstance(flats[0], list):
+        value = pa.array([item for flat in flats for item in flat], type=pa.utf8())
+    else:
+        value = np.concatenate(flats)
+    (column,) = archetype.columns(**{name: value})
+    return column.descriptor, column.component_batch.as_arrow_array()
+
 
 @dataclass(slots=True)
 class _Rows:
@@ -28,9 +93,22 @@ class _Rows:
     archetype: type
     frames: list[int] = field(default_factory=list)
     stamps: list[int] = field(default_factory=list)
-    lengths: list[int] = field(default_factory=list)
     values: dict[str, list[Any]] = field(default_factory=dict)
     empty: dict[str, Any] = field(default_factory=dict)
+
+    def entity(self, path: str) -> EntityRows:
+        """The rows as ``EntityRows``; a row without a field (a cleared row) has no instances of it."""
+        fields = {}
+        for name, per_row in self.values.items():
+            present = [v for v in per_row if v is not None]
+            lengths = np.fromiter((0 if v is None else len(v) for v in per_row), dtype=np.int64, count=len(per_row))
+            empty = self.empty[name]
+            if isinstance(empty, list):
+                flat: Any = [item for v in present for item in v]
+            else:
+                flat = np.concatenate(present) if present else empty
+            fields[name] = (flat, lengths)
+        return EntityRows(path, np.asarray(self.frames), np.asarray(self.stamps), fields)
 
 
 class RowBuffer:
@@ -40,6 +118,7 @@ class RowBuffer:
         self.stream = stream
         self.clock = clock
         self._rows: dict[tuple[str, type], _Rows] = {}
+        self._by_path: dict[str, list[_Rows]] = {}
         self._static_sent: set[tuple[str, type]] = set()
 
     def put(
@@ -58,66 +137,50 @@ class RowBuffer:
         rows = self._rows.get(key)
         if rows is None:
             rows = self._rows[key] = _Rows(archetype)
+            self._by_path.setdefault(path, []).append(rows)
         if static and key not in self._static_sent:
             self.stream.log(path, archetype.from_fields(**static), static=True)
             self._static_sent.add(key)
         rows.frames.append(int(frame))
         rows.stamps.append(int(timestamp_us))
-        rows.lengths.append(int(n))
+        n_rows = len(rows.frames)
+        values = rows.values
         for name, value in fields.items():
-            if name not in rows.values:
-                rows.values[name] = [None] * (len(rows.frames) - 1)
-                rows.empty[name] = [] if isinstance(value, list) else np.asarray(value)[:0]
-            rows.values[name].append(value)
-        for values in rows.values.values():
-            if len(values) < len(rows.frames):
-                values.append(None)
+            per_row = values.get(name)
+            if per_row is None:
+                per_row = values[name] = [None] * (n_rows - 1)
+                rows.empty[name] = [] if name == STRIPS or isinstance(value, list) else np.asarray(value)[:0]
+            per_row.append(value)
+        if len(fields) != len(values):
+            for per_row in values.values():
+                if len(per_row) < n_rows:
+                    per_row.append(None)
 
     def clear(self, path: str, frame: int, timestamp_us: int) -> None:
         """An empty row (nothing shown from ``frame`` on) for every archetype drawn on ``path``."""
-        for (p, _), rows in self._rows.items():
-            if p == path:
-                rows.frames.append(int(frame))
-                rows.stamps.append(int(timestamp_us))
-                rows.lengths.append(0)
-                for values in rows.values.values():
-                    values.append(None)
+        for rows in self._by_path.get(path, ()):
+            rows.frames.append(int(frame))
+            rows.stamps.append(int(timestamp_us))
+            for values in rows.values.values():
+                values.append(None)
 
     def flush(self) -> None:
         """Send every collected row (one ``send_columns`` per entity and archetype, split only by the clock)."""
-        for (path, _), rows in self._rows.items():
+        by_archetype: dict[type, list[EntityRows]] = {}
+        for (path, archetype), rows in self._rows.items():
             if rows.frames:
-                self.clock.send(self.stream, path, np.asarray(rows.frames), np.asarray(rows.stamps), _columns(rows))
-            rows.frames, rows.stamps, rows.lengths = [], [], []
+                by_archetype.setdefault(archetype, []).append(rows.entity(path))
+            rows.frames, rows.stamps = [], []
             rows.values = {name: [] for name in rows.values}
+        for archetype, entities in by_archetype.items():
+            send_entities(self.stream, self.clock, archetype, entities)
 
 
-def _columns(rows: _Rows):
-    lengths = np.asarray(rows.lengths, dtype=np.int64)
-    values = {name: list(v) for name, v in rows.values.items()}
-    empty = dict(rows.empty)
-    archetype = rows.archetype
-
-    def columns_of(selected: np.ndarray) -> rr.ComponentColumnList:
-        fields = {}
-        for name, per_row in values.items():
-            chosen = [per_row[i] for i in selected.tolist() if per_row[i] is not None]
-            if name == "strips":
-                fields[name] = _strips_array(chosen)
-            elif isinstance(empty[name], list):
-                fields[name] = pa.array([item for row in chosen for item in row], type=pa.utf8())
-            else:
-                fields[name] = np.concatenate(chosen) if chosen else empty[name]
-        return archetype.columns(**fields).partition(lengths[selected])
-
-    return columns_of
-
-
-def _strips_array(rows: list[Any]) -> pa.Array:
-    """The Arrow ``LineStrip3D`` array of every strip of ``rows`` (each an (n, k, 3) array of n strips of k
-    points, or a list of (k_i, 3) strips), built from one concatenated point array: Rerun's own conversion
-    handles strips one at a time."""
-    strips = [np.asarray(strip, dtype=np.float32).reshape(-1, 3) for row in rows for strip in row]
+def _strips_array(strips: list[Any]) -> pa.Array:
+    """The Arrow ``LineStrip3D`` array of ``strips`` (each a (k_i, 3) array or list of points; an (n, k, 3) array
+    counts as n strips), built from one concatenated point array: Rerun's own conversion handles strips one at a
+    time."""
+    strips = [np.asarray(strip, dtype=np.float32).reshape(-1, 3) for strip in strips]
     lengths = np.fromiter((s.shape[0] for s in strips), dtype=np.int32, count=len(strips))
     offsets = np.zeros(len(strips) + 1, dtype=np.int32)
     np.cumsum(lengths, out=offsets[1:])

@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import pyarrow as pa
 import rerun as rr
 
 FRAME = "frame"
@@ -66,6 +67,68 @@ class Clock:
             if self.focus_end is not None and k == 0:
                 indexes.append(rr.TimeColumn(FOCUS, sequence=frames[rows]))
             stream.send_columns(path, indexes=indexes, columns=columns_of(rows))
+
+    def time_arrays(self, frames: np.ndarray, timestamps_us: np.ndarray) -> tuple[pa.Array, pa.Array]:
+        """The Arrow ``frame`` and ``timestamp`` columns of rows at (N,) keyframes, for ``send_rows``."""
+        frames = np.asarray(frames, dtype=np.int64)
+        stamps_ns = np.asarray(timestamps_us, dtype=np.int64).astype("datetime64[us]").astype("datetime64[ns]")
+        return pa.array(frames, pa.int64()), pa.array(stamps_ns, pa.timestamp("ns"))
+
+    def send_rows(
+        self,
+        stream: rr.RecordingStream,
+        path: str,
+        frames: np.ndarray,
+        times: tuple[pa.Array, pa.Array],
+        columns: list[tuple[rr.ComponentDescriptor, pa.Array, np.ndarray]],
+    ) -> None:
+        """``send_columns`` of R rows at (R,) non-decreasing keyframes, already in Arrow form: ``times`` from
+        ``time_arrays``; per component its descriptor, its instances (flat) and (R + 1,) int32 offsets of each
+        row's instances in them. Rows past ``focus_end`` go in a second call without the focus time."""
+        n = len(frames)
+        if n == 0:
+            return
+        split = n
+        if self.focus_end is not None:
+            if np.any(np.diff(frames) < 0):
+                raise ValueError(f"rows of {path} are not in frame order")
+            split = int(np.searchsorted(frames, self.focus_end, side="right"))
+        for lo, hi, on_focus in ((0, split, self.focus_end is not None), (split, n, False)):
+            if hi == lo:
+                continue
+            indexes = [_Times(FRAME, times[0].slice(lo, hi - lo)), _Times(TIMESTAMP, times[1].slice(lo, hi - lo))]
+            if on_focus:
+                indexes.append(_Times(FOCUS, times[0].slice(lo, hi - lo)))
+            part = []
+            for descriptor, flat, offsets in columns:
+                first = int(offsets[lo])
+                instances = flat.slice(first, int(offsets[hi]) - first)
+                part.append(rr.ComponentColumn(descriptor, _Arrow(instances), offsets=offsets[lo : hi + 1] - first))
+            stream.send_columns(path, indexes=indexes, columns=part)
+
+
+@dataclass(frozen=True, slots=True)
+class _Arrow:
+    """An Arrow array as a ``rr.ComponentBatchLike`` (what ``rr.ComponentColumn`` partitions)."""
+
+    array: pa.Array
+
+    def as_arrow_array(self) -> pa.Array:
+        return self.array
+
+
+@dataclass(frozen=True, slots=True)
+class _Times:
+    """A timeline column already in Arrow form (``rr.TimeColumnLike``)."""
+
+    timeline: str
+    times: pa.Array
+
+    def timeline_name(self) -> str:
+        return self.timeline
+
+    def as_arrow_array(self) -> pa.Array:
+        return self.times
 
 
 PLAIN_CLOCK = Clock()
