@@ -109,10 +109,16 @@ def _components(finite: np.ndarray, n_tracks: int) -> list[tuple[np.ndarray, np.
         if np.array_equal(new, row_label):
             break
         row_label = new
-    out = []
-    for label in np.unique(col_label[col_label < none]):
-        out.append((np.flatnonzero(row_label == label), np.flatnonzero(col_label == label)))
-    return out
+    rows_of: dict[int, list[int]] = {}
+    for i, label in enumerate(row_label.tolist()):
+        rows_of.setdefault(label, []).append(i)
+    cols_of: dict[int, list[int]] = {}
+    for j, label in enumerate(col_label.tolist()):
+        if label < none:
+            cols_of.setdefault(label, []).append(j)
+    return [
+        (np.array(rows_of[label], dtype=np.intp), np.array(cols_of[label], dtype=np.intp)) for label in sorted(cols_of)
+    ]
 
 
 def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
@@ -123,13 +129,12 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
     """
     cost = np.asarray(matrix.cost, dtype=np.float64)
     n_rows = cost.shape[0] if cost.ndim == 2 else 0
-    track_cols = [i for i, c in enumerate(matrix.cols) if c.kind is AxisKind.TRACK]
-    n_tracks = len(track_cols)
+    col_kinds = [c.kind for c in matrix.cols]
+    n_tracks = col_kinds.count(AxisKind.TRACK)
     if (
         cost.ndim != 2
-        or track_cols != list(range(n_tracks))
+        or col_kinds[n_tracks:].count(AxisKind.NEW_TRACK) != len(col_kinds) - n_tracks  # tracks first, then births
         or any(r.kind is not AxisKind.MEASUREMENT for r in matrix.rows)
-        or any(c.kind is not AxisKind.NEW_TRACK for c in matrix.cols[n_tracks:])
     ):
         return None
     # Index by ref, one map per kind: hashing AxisLabels (dataclasses holding an enum, whose hash is Python code)
@@ -175,28 +180,42 @@ def _conflict(
 
     Every row's chosen column is in the sub-matrix: a chosen track column links its row to the component, and a
     row's own new-track column is always there. The cheapest other column of each row is found for all rows at
-    once (first minimum, as ``argmin``)."""
-    cols = np.concatenate([tcols, n_tracks + rows])
-    sub = cost[np.ix_(rows, cols)]
-    position = {c: k for k, c in enumerate(cols.tolist())}
-    chosen_list = chosen[rows].tolist()
-    chosen_sub = np.array([position.get(c, -1) for c in chosen_list], dtype=np.int64)
-    at = np.arange(rows.size)
-    chosen_cost = sub[at, chosen_sub]
-    total = float(chosen_cost.sum()) if rows.size else 0.0
-    others = sub.copy()
-    kept = chosen_sub >= 0
-    others[at[kept], chosen_sub[kept]] = np.inf
-    best = np.argmin(others, axis=1) if cols.size else np.full(rows.size, -1, dtype=np.int64)
-    best_cost = others[at, best] if cols.size else np.full(rows.size, np.inf)
+    once (first minimum, as ``argmin``); a one-row component, the usual case, is done in plain Python (NumPy's
+    per-call overhead dominates on a handful of entries)."""
+    if rows.size == 1:
+        r = int(rows[0])
+        cols_list = [*tcols.tolist(), n_tracks + r]
+        sub_row = cost[r, cols_list].tolist()
+        c = int(chosen[r])
+        j = cols_list.index(c) if c in cols_list else -1
+        others = [math.inf if k == j else v for k, v in enumerate(sub_row)]
+        k = min(range(len(others)), key=others.__getitem__)  # the first minimum, as argmin
+        chosen_list, best_list = [j], [k]
+        chosen_costs, best_costs = [sub_row[j]], [others[k]]
+        total = sub_row[j]
+        rest = others if j >= 0 else sub_row[:-1]  # the row without its chosen entry (as np.delete(row, j))
+        margins = [_capped(min(rest) if len(sub_row) > 1 else math.inf, total)]
+    else:
+        cols = np.concatenate([tcols, n_tracks + rows])
+        sub = cost[np.ix_(rows, cols)]
+        position = {c: k for k, c in enumerate(cols.tolist())}
+        chosen_sub = np.array([position.get(c, -1) for c in chosen[rows].tolist()], dtype=np.int64)
+        at = np.arange(rows.size)
+        chosen_cost = sub[at, chosen_sub]
+        total = float(chosen_cost.sum())
+        masked = sub.copy()
+        kept = chosen_sub >= 0
+        masked[at[kept], chosen_sub[kept]] = np.inf
+        best = np.argmin(masked, axis=1)
+        cols_list, chosen_list, best_list = cols.tolist(), chosen_sub.tolist(), best.tolist()
+        chosen_costs, best_costs = chosen_cost.tolist(), masked[at, best].tolist()
+        margins = [_margin(sub, i, j, total) for i, j in enumerate(chosen_list)]
     mrows, mcols = matrix.rows, matrix.cols
-    cols_list = cols.tolist()
-    one_row = rows.size == 1  # its best total without the chosen pair is its cheapest other entry
     choices = []
-    for i, (r, j, k, c_chosen, c_best) in enumerate(
-        zip(rows.tolist(), chosen_sub.tolist(), best.tolist(), chosen_cost.tolist(), best_cost.tolist(), strict=True)
+    for r, j, k, c_chosen, c_best, margin in zip(
+        rows.tolist(), chosen_list, best_list, chosen_costs, best_costs, margins, strict=True
     ):
-        has_alt = k >= 0 and math.isfinite(c_best)
+        has_alt = math.isfinite(c_best)
         choices.append(
             PairChoice(
                 meas=mrows[r],
@@ -204,10 +223,10 @@ def _conflict(
                 chosen_cost=c_chosen,
                 alternative=mcols[cols_list[k]] if has_alt else None,
                 alternative_cost=c_best if has_alt else math.inf,
-                margin=_capped(c_best, total) if one_row and j >= 0 else _margin(sub, i, j, total),
+                margin=margin,
             )
         )
-    used = {cols_list[j] for j in chosen_sub.tolist() if cols_list[j] < n_tracks}
+    used = {cols_list[j] for j in chosen_list if cols_list[j] < n_tracks}
     track_refs = tuple(int(mcols[c].ref) for c in tcols.tolist())
     missed = tuple(ref for c, ref in zip(tcols.tolist(), track_refs, strict=True) if c not in used)
     return Conflict(

@@ -424,7 +424,10 @@ class TrackerLogger:
         if path is None:
             path = self._track_paths[key] = series(self.tracker, class_name, track_id)
             self._track_series.setdefault(path, (class_name, track_id))
-        self._sample(path, value, f"{track_id} {class_name} {what}", track_color(track_id))
+        if path in self._series:  # name and colour only matter for a new series
+            self._sample(path, value)
+        else:
+            self._sample(path, value, f"{track_id} {class_name} {what}", track_color(track_id))
 
     def _z_of(self, track_ids: np.ndarray) -> np.ndarray:
         """(K,) last known box height of each track, gate_z_m for tracks never extracted."""
@@ -591,13 +594,21 @@ class TrackerLogger:
         ids = np.asarray(post.track_ids, dtype=np.int64)
         existence = np.asarray(post.existence, dtype=np.float64)
         mean = np.asarray(post.mean, dtype=np.float64).reshape(-1, 4)
-        followed = list(self._extracted_ids | self._focused)
-        follow = np.flatnonzero((existence >= self.gate_min_existence) | np.isin(ids, followed))
-        for k in follow.tolist():
-            t = int(ids[k])
-            self._track_sample(paths.existence, class_name, t, existence[k], "existence")
-            trail = self._trails.setdefault(t, deque(maxlen=TRAIL_FRAMES))
-            trail.append((float(mean[k, 0]), float(mean[k, 1]), self._track_z.get(t, self.gate_z_m)))
+        reported, focused = self._extracted_ids, self._focused
+        id_list, r_list = ids.tolist(), existence.tolist()
+        follow = [
+            k
+            for k, (t, r) in enumerate(zip(id_list, r_list, strict=True))
+            if r >= self.gate_min_existence or t in reported or t in focused
+        ]
+        xy = mean[follow, :2].tolist()
+        for k, (x, y) in zip(follow, xy, strict=True):
+            t = id_list[k]
+            self._track_sample(paths.existence, class_name, t, r_list[k], "existence")
+            trail = self._trails.get(t)
+            if trail is None:
+                trail = self._trails[t] = deque(maxlen=TRAIL_FRAMES)
+            trail.append((x, y, self._track_z.get(t, self.gate_z_m)))
 
     def _record_steps(self, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
         """The frame's ``TrackStep`` of every focused track this class predicted."""
