@@ -96,6 +96,8 @@ FLUSH_FRAMES = 10
 """Default cadence: story lines and spatial rows are sent column-wise every this many frames (and at the end),
 so a live viewer sees them within seconds; a saved recording passes ``flush_frames=None`` (only at the end: one
 chunk per entity)."""
+_STATIC_ROW = np.zeros(1, dtype=np.int64)
+"""The one row of static data (``viz.rows.send_entities(static=True)`` ignores its time)."""
 CANDIDATE_COLOR = int(pack_rgba(np.array([[160, 160, 160]], dtype=np.uint8))[0])
 
 _LEVEL_BY_ACTION = {
@@ -264,23 +266,28 @@ class TrackerLogger:
         self._flush_texts()
         self._rows.flush()
         scalars: list[EntityRows] = []
+        styles: list[EntityRows] = []
+        one = np.ones(1, dtype=np.int64)
         for path, series in self._series.items():
             owner = self._track_series.get(path)
             if owner is not None and owner[1] not in self._extracted_ids and owner[1] not in self._focused:
                 continue  # a candidate's series: only the per-class candidate count is kept
-            colors = None if series.color is None else [series.color]
-            self.stream.log(path, rr.SeriesLines(names=series.name, colors=colors), static=True)
+            style = {"names": ([series.name], one)}
+            if series.color is not None:
+                style["colors"] = (np.array([series.color], dtype=np.uint8), one)
+            styles.append(EntityRows(path, _STATIC_ROW, _STATIC_ROW, style))
             values = np.asarray(series.values, dtype=np.float64)
             scalars.append(
                 EntityRows(path, np.asarray(series.frames), np.asarray(series.timestamps_us), _one_per_row(values))
             )
         for path, (names, frames, stamps, values) in self._multi.items():
-            self.stream.log(path, rr.SeriesLines(names=names), static=True)
+            styles.append(EntityRows(path, _STATIC_ROW, _STATIC_ROW, {"names": (names, np.array([len(names)]))}))
             stacked = np.stack(values)
             lengths = np.full(stacked.shape[0], stacked.shape[1], dtype=np.int64)
             scalars.append(
                 EntityRows(path, np.asarray(frames), np.asarray(stamps), {"scalars": (stacked.ravel(), lengths)})
             )
+        send_entities(self.stream, self.clock, rr.SeriesLines, styles, static=True)
         send_entities(self.stream, self.clock, rr.Scalars, scalars)
         self._series.clear()
         self._track_series.clear()

@@ -21,7 +21,7 @@ import rerun as rr
 from rerun.components import LineStrip3DBatch
 from rerun.encodings import Vec3DBatch
 
-from viz.timeline import Clock
+from viz.timeline import Clock, column
 
 STRIPS = "strips"
 """The field holding line strips (each row: an (n, k, 3) array or a list of (k_i, 3) strips)."""
@@ -41,17 +41,22 @@ class EntityRows:
     fields: dict[str, tuple[Any, np.ndarray]]
 
 
-def send_entities(stream: rr.RecordingStream, clock: Clock, archetype: type, entities: list[EntityRows]) -> None:
+def send_entities(
+    stream: rr.RecordingStream, clock: Clock, archetype: type, entities: list[EntityRows], *, static: bool = False
+) -> None:
     """``send_columns`` of each entity's rows (one call per entity, split only by the clock), with the Arrow
-    arrays of every field and timeline built once for all of them."""
+    arrays of every field and timeline built once for all of them. static: each entity holds one row, logged
+    as static data (its frames and timestamps are ignored)."""
     entities = [e for e in entities if len(e.frames)]
     if not entities:
         return
     row_counts = np.array([len(e.frames) for e in entities], dtype=np.int64)
+    if static and np.any(row_counts != 1):
+        raise ValueError("static entities hold one row each")
     row_start = np.concatenate([[0], np.cumsum(row_counts)])
     frames = np.concatenate([np.asarray(e.frames, dtype=np.int64) for e in entities])
     stamps = np.concatenate([np.asarray(e.timestamps_us, dtype=np.int64) for e in entities])
-    times = clock.time_arrays(frames, stamps)
+    times = None if static else clock.time_arrays(frames, stamps)
     names = list(dict.fromkeys(name for e in entities for name in e.fields))
     columns: dict[str, tuple[rr.ComponentDescriptor, pa.Array, np.ndarray]] = {}
     for name in names:
@@ -70,7 +75,12 @@ def send_entities(stream: rr.RecordingStream, clock: Clock, archetype: type, ent
             offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
             np.cumsum(lengths, out=offsets[1:])
             cols.append((descriptor, flat.slice(int(start[i]), int(start[i + 1] - start[i])), offsets))
-        clock.send_rows(stream, e.path, frames[r0:r1], [t.slice(r0, r1 - r0) for t in times], cols)
+        if times is None:
+            stream.send_columns(e.path, indexes=[], columns=[column(*c) for c in cols])
+        else:
+            clock.send_rows(
+                stream, e.path, frames[r0:r1], (times[0].slice(r0, r1 - r0), times[1].slice(r0, r1 - r0)), cols
+            )
 
 
 def _flat_column(archetype: type, name: str, flats: list[Any]) -> tuple[rr.ComponentDescriptor, pa.Array]:

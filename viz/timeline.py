@@ -102,9 +102,15 @@ class Clock:
             part = []
             for descriptor, flat, offsets in columns:
                 first = int(offsets[lo])
-                instances = flat.slice(first, int(offsets[hi]) - first)
-                part.append(rr.ComponentColumn(descriptor, _Arrow(instances), offsets=offsets[lo : hi + 1] - first))
+                part.append(
+                    column(descriptor, flat.slice(first, int(offsets[hi]) - first), offsets[lo : hi + 1] - first)
+                )
             stream.send_columns(path, indexes=indexes, columns=part)
+
+
+def column(descriptor: rr.ComponentDescriptor, instances: pa.Array, offsets: np.ndarray) -> rr.ComponentColumn:
+    """A component column of R rows: row r holds ``instances[offsets[r]:offsets[r + 1]]`` ((R + 1,) int32)."""
+    return rr.ComponentColumn(descriptor, _Arrow(instances), offsets=offsets)
 
 
 @dataclass(frozen=True, slots=True)
