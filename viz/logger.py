@@ -56,7 +56,7 @@ from gnnpmb.explain import Decisions, explain
 from gnnpmb.gating import ellipse_outline
 from gnnpmb.types import TrackEstimate
 from viz import paths
-from viz.colors import class_ids, faded, pack_rgba, packed_track_colors, track_color
+from viz.colors import CLASS_IDS, faded, pack_rgba, packed_track_colors, track_color
 from viz.decisions import (
     CLOSE_CALL_MARGIN,
     column_name,
@@ -489,7 +489,7 @@ class TrackerLogger:
                     positions=lift_xy(xy[sel], self._z_of(ids[sel])),
                     colors=self._track_colors(ids[sel]),
                     radii=np.full(sel.size, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
-                    labels=_labels("{} predicted r={:.2f}", ids[sel], existence[sel]),
+                    labels=_labels("%d predicted r=%.2f", ids[sel], existence[sel]),
                 )
         if (~worthy).any():
             sel = np.flatnonzero(~worthy)
@@ -501,7 +501,7 @@ class TrackerLogger:
                 positions=lift_xy(xy[sel], self.gate_z_m),
                 colors=np.full(sel.size, CANDIDATE_COLOR, dtype=np.uint32),
                 radii=np.full(sel.size, CANDIDATE_POINT_RADIUS_M, dtype=np.float32),
-                labels=_labels("candidate {}, r={:.3f}", ids[sel], existence[sel]),
+                labels=_labels("candidate %d, r=%.3f", ids[sel], existence[sel]),
             )
         self._sample(
             paths.candidate_count(self.tracker, class_name), float((~worthy).sum()), f"{class_name} candidates"
@@ -683,14 +683,17 @@ class TrackerLogger:
             return
         boxes = estimate_boxes(estimates)
         ids = np.array([e.track_id for e in estimates], dtype=np.int64)
-        cids = class_ids(np.array([e.class_name for e in estimates], dtype=object))
+        cids = np.array([CLASS_IDS.get(e.class_name, 0) for e in estimates], dtype=np.uint16)  # as colors.class_ids
         colors = self._track_colors(ids)
         half_sizes = 0.5 * boxes.sizes_xyz_m
         box_radius = np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32)  # rows are copied when sent: shareable
         trail_radius = np.full(1, TRAIL_RADIUS_M, dtype=np.float32)
         self._extracted_ids.update(shown)
         for k, e in enumerate(estimates):
-            path = paths.track(self.tracker, class_name, e.track_id)
+            key = (paths.track, class_name, e.track_id)
+            path = self._track_paths.get(key)
+            if path is None:
+                path = self._track_paths[key] = paths.track(self.tracker, class_name, e.track_id)
             self._put(
                 path,
                 rr.Boxes3D,
@@ -709,7 +712,7 @@ class TrackerLogger:
                     path,
                     rr.LineStrips3D,
                     1,
-                    strips=[np.array(trail)],
+                    strips=[trail],  # (x, y, z) tuples; converted for all rows at once when sent
                     colors=colors[k : k + 1],
                     radii=trail_radius,
                 )
@@ -992,5 +995,6 @@ def _one_per_row(values: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]
 
 
 def _labels(template: str, track_ids: np.ndarray, existence: np.ndarray) -> list[str]:
-    """``template.format(id, r)`` per track (Python scalars: formatting numpy scalars is several times slower)."""
-    return [template.format(t, r) for t, r in zip(track_ids.tolist(), existence.tolist(), strict=True)]
+    """``template % (id, r)`` per track (Python scalars and %-formatting: formatting numpy scalars, or with
+    ``str.format``, is several times slower)."""
+    return [template % (t, r) for t, r in zip(track_ids.tolist(), existence.tolist(), strict=True)]
