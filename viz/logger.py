@@ -66,7 +66,7 @@ from viz.decisions import (
     meas_name,
 )
 from viz.geometry import estimate_boxes, lift_xy
-from viz.rows import EntityRows, RowBuffer, send_entities
+from viz.rows import Build, EntityRows, RowBuffer, send_entities
 from viz.timeline import PLAIN_CLOCK, Clock
 
 TRACK_LINE_RADIUS_M = 0.06
@@ -389,11 +389,13 @@ class TrackerLogger:
             self.stream.log(path, archetype)
         self._touched.add(path)
 
-    def _put(self, path: str, archetype: type, n: int, static: dict | None = None, **fields) -> None:
+    def _put(
+        self, path: str, archetype: type, n: int, static: dict | None = None, build: Build | None = None, **fields
+    ) -> None:
         """A buffered row of ``n`` instances on ``path`` (see ``viz.rows``)."""
         if not self._drawing:
             return
-        self._rows.put(path, archetype, self._frame, self._timestamp_us, n, static, **fields)
+        self._rows.put(path, archetype, self._frame, self._timestamp_us, n, static, build, **fields)
         self._buffered.add(path)
         self._touched.add(path)
 
@@ -486,10 +488,11 @@ class TrackerLogger:
                     rr.Points3D,
                     sel.size,
                     static={"show_labels": False},
-                    positions=lift_xy(xy[sel], self._z_of(ids[sel])),
-                    colors=self._track_colors(ids[sel]),
-                    radii=np.full(sel.size, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
-                    labels=_labels("%d predicted r=%.2f", ids[sel], existence[sel]),
+                    build=self._predicted_points,
+                    xy=xy[sel],
+                    z=self._z_of(ids[sel]),
+                    ids=ids[sel],
+                    existence=existence[sel],
                 )
         if (~worthy).any():
             sel = np.flatnonzero(~worthy)
@@ -498,10 +501,10 @@ class TrackerLogger:
                 rr.Points3D,
                 sel.size,
                 static={"show_labels": False},
-                positions=lift_xy(xy[sel], self.gate_z_m),
-                colors=np.full(sel.size, CANDIDATE_COLOR, dtype=np.uint32),
-                radii=np.full(sel.size, CANDIDATE_POINT_RADIUS_M, dtype=np.float32),
-                labels=_labels("candidate %d, r=%.3f", ids[sel], existence[sel]),
+                build=self._candidate_points,
+                xy=xy[sel],
+                ids=ids[sel],
+                existence=existence[sel],
             )
         self._sample(
             paths.candidate_count(self.tracker, class_name), float((~worthy).sum()), f"{class_name} candidates"
@@ -512,23 +515,55 @@ class TrackerLogger:
             lookup = dict(zip(ids.tolist(), worthy.tolist(), strict=True))  # focused tracks count as worthy
             drawn = np.array([lookup.get(t, True) for t in gids.tolist()], dtype=bool)
             if drawn.any():
-                outline = ellipse_outline(
-                    np.asarray(gated.center_xy, dtype=np.float64)[drawn],
-                    np.asarray(gated.innovation_cov, dtype=np.float64)[drawn],
-                    gated.threshold,
-                    self.gate_points,
-                )
                 n = int(drawn.sum())
                 self._put(
                     paths.gates(self.tracker, class_name),
                     rr.LineStrips3D,
                     n,
-                    strips=lift_xy(outline, self._z_of(gids[drawn])[:, None]),
-                    colors=self._track_colors(gids[drawn]),
-                    radii=np.full(n, GATE_LINE_RADIUS_M, dtype=np.float32),
+                    build=self._gate_outlines,
+                    center_xy=np.asarray(gated.center_xy, dtype=np.float64)[drawn],
+                    cov=np.asarray(gated.innovation_cov, dtype=np.float64)[drawn],
+                    threshold=np.full(n, gated.threshold, dtype=np.float64),
+                    z=self._z_of(gids[drawn]),
+                    ids=gids[drawn],
                 )
             return {int(t): k for k, (t, d) in enumerate(zip(gids.tolist(), drawn.tolist(), strict=True)) if d}
         return {int(t): k for k, t in enumerate(ids.tolist()) if worthy[k]}
+
+    # Row builders (``viz.rows.Build``): the elementwise part of drawing, run once per entity over all its rows.
+    def _predicted_points(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
+        """Points3D of predicted means: xy (N, 2) at height z (N,), coloured by track, labelled with existence."""
+        n = raw["ids"].size
+        return {
+            "positions": lift_xy(raw["xy"], raw["z"]),
+            "colors": self._track_colors(raw["ids"]),
+            "radii": np.full(n, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
+            "labels": _labels("%d predicted r=%.2f", raw["ids"], raw["existence"]),
+        }
+
+    def _candidate_points(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
+        """Points3D of candidates' predicted means (N, 2), grey, at ``gate_z_m``."""
+        n = raw["ids"].size
+        return {
+            "positions": lift_xy(raw["xy"], self.gate_z_m),
+            "colors": np.full(n, CANDIDATE_COLOR, dtype=np.uint32),
+            "radii": np.full(n, CANDIDATE_POINT_RADIUS_M, dtype=np.float32),
+            "labels": _labels("candidate %d, r=%.3f", raw["ids"], raw["existence"]),
+        }
+
+    def _gate_outlines(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
+        """LineStrips3D of gate ellipses {z : (z - c)^T S^-1 (z - c) = threshold} (``ellipse_outline``) of
+        centres (N, 2) and innovation covariances S (N, 2, 2), at height z (N,), in the track's colour."""
+        n = raw["ids"].size
+        outline = np.empty((n, self.gate_points + 1, 2), dtype=np.float64)
+        for threshold in np.unique(raw["threshold"]).tolist():
+            rows = raw["threshold"] == threshold
+            outline[rows] = ellipse_outline(raw["center_xy"][rows], raw["cov"][rows], threshold, self.gate_points)
+        return {
+            "strips": lift_xy(outline, raw["z"][:, None]),
+            "colors": self._track_colors(raw["ids"]),
+            "radii": np.full(n, GATE_LINE_RADIUS_M, dtype=np.float32),
+        }
 
     def _draw_associations(self, class_name: str, cf: _ClassFrame, worthy: dict[int, int]) -> None:
         """Chosen (track, detection) lines in the track's colour, gated-but-rejected ones dimmed; per-track NIS

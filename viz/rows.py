@@ -12,6 +12,7 @@ nothing from that frame on.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -87,7 +88,9 @@ def _flat_column(archetype: type, name: str, flats: list[Any]) -> tuple[rr.Compo
     """The descriptor and the flat Arrow array (one element per instance) of field ``name`` of ``archetype``
     over the concatenated instances ``flats`` (arrays, or lists of strings or strips)."""
     if name == STRIPS:
-        value: Any = _strips_array([strip for flat in flats for strip in flat])
+        arrays = all(isinstance(f, np.ndarray) and f.ndim == 3 for f in flats)
+        same = arrays and len({f.shape[1] for f in flats}) == 1
+        value: Any = _strips_array(np.concatenate(flats) if same else [strip for flat in flats for strip in flat])
     elif isinstance(flats[0], list):
         value = pa.array([item for flat in flats for item in flat], type=pa.utf8())
     else:
@@ -96,11 +99,18 @@ def _flat_column(archetype: type, name: str, flats: list[Any]) -> tuple[rr.Compo
     return column.descriptor, column.component_batch.as_arrow_array()
 
 
+Build = Callable[[dict[str, Any]], dict[str, Any]]
+"""Turns the concatenated raw fields of rows (each (N, ...) or a list of N) into the archetype's fields, one
+instance per raw instance (see ``RowBuffer.put``)."""
+
+
 @dataclass(slots=True)
 class _Rows:
-    """Rows of one archetype on one entity: frames, timestamps (us), instances per row, per-field values."""
+    """Rows of one archetype on one entity: frames, timestamps (us), per-field values per row (None: cleared),
+    each field's empty value, and the ``Build`` of raw rows (None: the rows hold the archetype's fields)."""
 
     archetype: type
+    build: Build | None = None
     frames: list[int] = field(default_factory=list)
     stamps: list[int] = field(default_factory=list)
     values: dict[str, list[Any]] = field(default_factory=dict)
@@ -108,16 +118,22 @@ class _Rows:
 
     def entity(self, path: str) -> EntityRows:
         """The rows as ``EntityRows``; a row without a field (a cleared row) has no instances of it."""
-        fields = {}
+        flats, lengths = {}, {}
         for name, per_row in self.values.items():
             present = [v for v in per_row if v is not None]
-            lengths = np.fromiter((0 if v is None else len(v) for v in per_row), dtype=np.int64, count=len(per_row))
+            lengths[name] = np.fromiter(
+                (0 if v is None else len(v) for v in per_row), dtype=np.int64, count=len(per_row)
+            )
             empty = self.empty[name]
             if isinstance(empty, list):
-                flat: Any = [item for v in present for item in v]
+                flats[name] = [item for v in present for item in v]
             else:
-                flat = np.concatenate(present) if present else empty
-            fields[name] = (flat, lengths)
+                flats[name] = np.concatenate(present) if present else empty
+        if self.build is None:
+            fields = {name: (flat, lengths[name]) for name, flat in flats.items()}
+        else:
+            per_row = next(iter(lengths.values()))
+            fields = {name: (flat, per_row) for name, flat in self.build(flats).items()}
         return EntityRows(path, np.asarray(self.frames), np.asarray(self.stamps), fields)
 
 
@@ -139,14 +155,18 @@ class RowBuffer:
         timestamp_us: int,
         n: int,
         static: dict[str, Any] | None = None,
+        build: Build | None = None,
         **fields: Any,
     ) -> None:
         """One row of ``n`` instances: each field is an (n, ...) array or a list of n items (``strips``,
-        ``labels``). ``static`` mono fields (e.g. show_labels) are logged once for the entity."""
+        ``labels``). ``static`` mono fields (e.g. show_labels) are logged once for the entity. With ``build``
+        (the same for every row of the entity) the fields are raw values, each with n instances, that ``build``
+        turns into the archetype's fields when the rows are sent: elementwise work done once for all the rows
+        instead of once per frame."""
         key = (path, archetype)
         rows = self._rows.get(key)
         if rows is None:
-            rows = self._rows[key] = _Rows(archetype)
+            rows = self._rows[key] = _Rows(archetype, build)
             self._by_path.setdefault(path, []).append(rows)
         if static and key not in self._static_sent:
             self.stream.log(path, archetype.from_fields(**static), static=True)
@@ -186,14 +206,19 @@ class RowBuffer:
             send_entities(self.stream, self.clock, archetype, entities)
 
 
-def _strips_array(strips: list[Any]) -> pa.Array:
+def _strips_array(strips: list[Any] | np.ndarray) -> pa.Array:
     """The Arrow ``LineStrip3D`` array of ``strips`` (each a (k_i, 3) array or list of points; an (n, k, 3) array
     counts as n strips), built from one concatenated point array: Rerun's own conversion handles strips one at a
     time."""
-    strips = [np.asarray(strip, dtype=np.float32).reshape(-1, 3) for strip in strips]
-    lengths = np.fromiter((s.shape[0] for s in strips), dtype=np.int32, count=len(strips))
-    offsets = np.zeros(len(strips) + 1, dtype=np.int32)
-    np.cumsum(lengths, out=offsets[1:])
-    points = np.concatenate(strips) if strips else np.zeros((0, 3), dtype=np.float32)
+    if isinstance(strips, np.ndarray) and strips.ndim == 3:  # N strips of k points each
+        n, k = strips.shape[:2]
+        offsets = np.arange(0, (n + 1) * k, k, dtype=np.int32)
+        points = np.asarray(strips, dtype=np.float32).reshape(-1, 3)
+    else:
+        strips = [np.asarray(strip, dtype=np.float32).reshape(-1, 3) for strip in strips]
+        lengths = np.fromiter((s.shape[0] for s in strips), dtype=np.int32, count=len(strips))
+        offsets = np.zeros(len(strips) + 1, dtype=np.int32)
+        np.cumsum(lengths, out=offsets[1:])
+        points = np.concatenate(strips) if strips else np.zeros((0, 3), dtype=np.float32)
     inner = Vec3DBatch(points).as_arrow_array()
     return pa.ListArray.from_arrays(pa.array(offsets), inner, type=LineStrip3DBatch._ARROW_DATATYPE)
