@@ -716,31 +716,15 @@ class TrackerLogger:
         (the others are focused tracks below ``show_min_existence``, drawn for the focus only)."""
         if not estimates:
             return
-        boxes = estimate_boxes(estimates)
-        ids = np.array([e.track_id for e in estimates], dtype=np.int64)
-        cids = np.array([CLASS_IDS.get(e.class_name, 0) for e in estimates], dtype=np.uint16)  # as colors.class_ids
-        colors = self._track_colors(ids)
-        half_sizes = 0.5 * boxes.sizes_xyz_m
-        box_radius = np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32)  # rows are copied when sent: shareable
-        trail_radius = np.full(1, TRAIL_RADIUS_M, dtype=np.float32)
+        colors = self._track_colors(np.array([e.track_id for e in estimates], dtype=np.int64))
+        trail_radius = np.full(1, TRAIL_RADIUS_M, dtype=np.float32)  # rows are copied when sent: shareable
         self._extracted_ids.update(shown)
         for k, e in enumerate(estimates):
             key = (paths.track, class_name, e.track_id)
             path = self._track_paths.get(key)
             if path is None:
                 path = self._track_paths[key] = paths.track(self.tracker, class_name, e.track_id)
-            self._put(
-                path,
-                rr.Boxes3D,
-                1,
-                centers=boxes.centers_m[k : k + 1],
-                half_sizes=half_sizes[k : k + 1],
-                quaternions=boxes.quat_xyzw[k : k + 1],
-                colors=colors[k : k + 1],
-                class_ids=cids[k : k + 1],
-                labels=[str(e.track_id)],
-                radii=box_radius,
-            )
+            self._put(path, rr.Boxes3D, 1, build=self._track_boxes, estimate=[e])
             trail = list(self._trails.get(e.track_id, ()))
             if len(trail) >= 2:
                 self._put(
@@ -751,6 +735,22 @@ class TrackerLogger:
                     colors=colors[k : k + 1],
                     radii=trail_radius,
                 )
+
+    def _track_boxes(self, raw: dict[str, list[TrackEstimate]]) -> dict[str, object]:
+        """Boxes3D of extracted tracks (``estimate_boxes``), in the track's colour, labelled with the track id
+        (``viz.rows.Build``)."""
+        estimates = raw["estimate"]
+        boxes = estimate_boxes(estimates)
+        n = len(estimates)
+        return {
+            "centers": boxes.centers_m,
+            "half_sizes": 0.5 * boxes.sizes_xyz_m,
+            "quaternions": boxes.quat_xyzw,
+            "colors": self._track_colors(np.array([e.track_id for e in estimates], dtype=np.int64)),
+            "class_ids": np.array([CLASS_IDS.get(e.class_name, 0) for e in estimates], dtype=np.uint16),
+            "labels": [str(e.track_id) for e in estimates],
+            "radii": np.full(n, TRACK_LINE_RADIUS_M, dtype=np.float32),
+        }
 
     # The story log.
     def _story(self, class_name: str, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
