@@ -22,7 +22,7 @@ import rerun as rr
 from rerun.components import LineStrip3DBatch
 from rerun.encodings import Vec3DBatch
 
-from viz.timeline import Clock, column
+from viz.timeline import Clock, ListColumn
 
 STRIPS = "strips"
 """The field holding line strips (each row: an (n, k, 3) array or a list of (k_i, 3) strips)."""
@@ -59,25 +59,24 @@ def send_entities(
     stamps = np.concatenate([np.asarray(e.timestamps_us, dtype=np.int64) for e in entities])
     times = None if static else clock.time_arrays(frames, stamps)
     names = list(dict.fromkeys(name for e in entities for name in e.fields))
-    columns: dict[str, tuple[rr.ComponentDescriptor, pa.Array, np.ndarray]] = {}
+    lists: dict[str, tuple[rr.ComponentDescriptor, pa.ListArray]] = {}
     for name in names:
         parts = [e.fields[name] for e in entities if name in e.fields]
         descriptor, flat = _flat_column(archetype, name, [p[0] for p in parts])
-        counts = np.array([int(np.sum(p[1])) for p in parts], dtype=np.int64)
-        columns[name] = (descriptor, flat, np.concatenate([[0], np.cumsum(counts)]))
-    seen = dict.fromkeys(names, 0)  # field -> how many entities holding it were sent
+        lengths = np.concatenate([np.asarray(p[1], dtype=np.int64) for p in parts])
+        offsets = np.zeros(lengths.size + 1, dtype=np.int32)
+        np.cumsum(lengths, out=offsets[1:])
+        lists[name] = (descriptor, pa.ListArray.from_arrays(pa.array(offsets), flat))
+    first_row = dict.fromkeys(names, 0)  # field -> its list row of the next entity holding it
     for k, e in enumerate(entities):
         r0, r1 = int(row_start[k]), int(row_start[k + 1])
         cols = []
-        for name, (_, lengths) in e.fields.items():
-            descriptor, flat, start = columns[name]
-            i = seen[name]
-            seen[name] = i + 1
-            offsets = np.zeros(len(lengths) + 1, dtype=np.int32)
-            np.cumsum(lengths, out=offsets[1:])
-            cols.append((descriptor, flat.slice(int(start[i]), int(start[i + 1] - start[i])), offsets))
+        for name in e.fields:
+            descriptor, rows = lists[name]
+            cols.append(ListColumn(descriptor, rows.slice(first_row[name], r1 - r0)))
+            first_row[name] += r1 - r0
         if times is None:
-            stream.send_columns(e.path, indexes=[], columns=[column(*c) for c in cols])
+            stream.send_columns(e.path, indexes=[], columns=cols)
         else:
             clock.send_rows(
                 stream, e.path, frames[r0:r1], (times[0].slice(r0, r1 - r0), times[1].slice(r0, r1 - r0)), cols

@@ -80,11 +80,11 @@ class Clock:
         path: str,
         frames: np.ndarray,
         times: tuple[pa.Array, pa.Array],
-        columns: list[tuple[rr.ComponentDescriptor, pa.Array, np.ndarray]],
+        columns: list[ListColumn],
     ) -> None:
         """``send_columns`` of R rows at (R,) non-decreasing keyframes, already in Arrow form: ``times`` from
-        ``time_arrays``; per component its descriptor, its instances (flat) and (R + 1,) int32 offsets of each
-        row's instances in them. Rows past ``focus_end`` go in a second call without the focus time."""
+        ``time_arrays``, one list per row in each column. Rows past ``focus_end`` go in a second call without the
+        focus time."""
         n = len(frames)
         if n == 0:
             return
@@ -99,28 +99,27 @@ class Clock:
             indexes = [_Times(FRAME, times[0].slice(lo, hi - lo)), _Times(TIMESTAMP, times[1].slice(lo, hi - lo))]
             if on_focus:
                 indexes.append(_Times(FOCUS, times[0].slice(lo, hi - lo)))
-            part = []
-            for descriptor, flat, offsets in columns:
-                first = int(offsets[lo])
-                part.append(
-                    column(descriptor, flat.slice(first, int(offsets[hi]) - first), offsets[lo : hi + 1] - first)
-                )
+            part = columns if (lo, hi) == (0, n) else [c.rows(lo, hi) for c in columns]
             stream.send_columns(path, indexes=indexes, columns=part)
 
 
-def column(descriptor: rr.ComponentDescriptor, instances: pa.Array, offsets: np.ndarray) -> rr.ComponentColumn:
-    """A component column of R rows: row r holds ``instances[offsets[r]:offsets[r + 1]]`` ((R + 1,) int32)."""
-    return rr.ComponentColumn(descriptor, _Arrow(instances), offsets=offsets)
-
-
 @dataclass(frozen=True, slots=True)
-class _Arrow:
-    """An Arrow array as a ``rr.ComponentBatchLike`` (what ``rr.ComponentColumn`` partitions)."""
+class ListColumn:
+    """A component column already in Arrow form, one list (the row's instances) per row: what
+    ``rr.ComponentColumn`` builds, for ``send_columns``, without rebuilding the list array per call."""
 
-    array: pa.Array
+    descriptor: rr.ComponentDescriptor
+    lists: pa.ListArray
 
-    def as_arrow_array(self) -> pa.Array:
-        return self.array
+    def component_descriptor(self) -> rr.ComponentDescriptor:
+        return self.descriptor
+
+    def as_arrow_array(self) -> pa.ListArray:
+        return self.lists
+
+    def rows(self, lo: int, hi: int) -> ListColumn:
+        """Rows lo..hi-1 (a zero-copy slice)."""
+        return ListColumn(self.descriptor, self.lists.slice(lo, hi - lo))
 
 
 @dataclass(frozen=True, slots=True)
