@@ -18,6 +18,7 @@ the usual cause of an ID switch.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +26,8 @@ import numpy as np
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix
 
+_KIND = operator.attrgetter("kind")
+_REF = operator.attrgetter("ref")
 LINK_SLACK = 5.0
 """Pairs costlier than the measurement's new-track cost plus this do not link a conflict; margins are capped at
 it (in cost units: nats for the PMB family)."""
@@ -113,9 +116,9 @@ def _components(finite: np.ndarray, n_tracks: int) -> list[tuple[np.ndarray, np.
     for i, label in enumerate(row_label.tolist()):
         rows_of.setdefault(label, []).append(i)
     cols_of: dict[int, list[int]] = {}
-    for j, label in enumerate(col_label.tolist()):
-        if label < none:
-            cols_of.setdefault(label, []).append(j)
+    linked = np.flatnonzero(col_label < none).tolist()
+    for j, label in zip(linked, col_label[linked].tolist(), strict=True):
+        cols_of.setdefault(label, []).append(j)
     return [
         (np.array(rows_of[label], dtype=np.intp), np.array(cols_of[label], dtype=np.intp)) for label in sorted(cols_of)
     ]
@@ -129,7 +132,7 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
     """
     cost = np.asarray(matrix.cost, dtype=np.float64)
     n_rows = cost.shape[0] if cost.ndim == 2 else 0
-    col_kinds = [c.kind for c in matrix.cols]
+    col_kinds = list(map(_KIND, matrix.cols))
     n_tracks = col_kinds.count(AxisKind.TRACK)
     if (
         cost.ndim != 2
@@ -139,9 +142,9 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
         return None
     # Index by ref, one map per kind: hashing AxisLabels (dataclasses holding an enum, whose hash is Python code)
     # costs more than the rest.
-    row_of = {label.ref: i for i, label in enumerate(matrix.rows)}
-    track_col_of = {label.ref: j for j, label in enumerate(matrix.cols[:n_tracks])}
-    new_col_of = {label.ref: j for j, label in enumerate(matrix.cols[n_tracks:], n_tracks)}
+    row_of = dict(zip(map(_REF, matrix.rows), range(len(matrix.rows)), strict=True))
+    track_col_of = dict(zip(map(_REF, matrix.cols[:n_tracks]), range(n_tracks), strict=True))
+    new_col_of = dict(zip(map(_REF, matrix.cols[n_tracks:]), range(n_tracks, len(matrix.cols)), strict=True))
     chosen = np.full(n_rows, -1, dtype=np.int64)
     for row_label, col_label in assignment.pairs:
         if col_label.kind is AxisKind.TRACK:
@@ -169,7 +172,7 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
         in_conflict[rows] = True
         conflicts.append(_conflict(matrix, linked, chosen, rows, tcols, n_tracks))
     conflicts.sort(key=lambda c: (c.closest_margin, c.track_ids))
-    births = tuple(int(matrix.rows[i].ref) for i in np.flatnonzero(~in_conflict))
+    births = tuple(int(matrix.rows[i].ref) for i in np.flatnonzero(~in_conflict).tolist())
     return Decisions(matrix.class_name, tuple(conflicts), births, matrix.description)
 
 
