@@ -565,6 +565,26 @@ class TrackerLogger:
             "radii": np.full(n, GATE_LINE_RADIUS_M, dtype=np.float32),
         }
 
+    def _association_lines(self, raw: dict[str, object]) -> dict[str, object]:
+        """LineStrips3D of chosen pairs: lines (N, 2, 3) in their tracks' colours (ids (N,)), labelled."""
+        n = len(raw["labels"])
+        return {
+            "strips": raw["lines"],
+            "colors": self._track_colors(raw["ids"]),
+            "radii": np.full(n, ASSOCIATION_RADIUS_M, dtype=np.float32),
+            "labels": raw["labels"],
+        }
+
+    def _gated_pair_lines(self, raw: dict[str, object]) -> dict[str, object]:
+        """LineStrips3D of gated pairs not chosen: lines (N, 2, 3), faint (``GATED_PAIR_KEEP``), labelled."""
+        n = len(raw["labels"])
+        return {
+            "strips": raw["lines"],
+            "colors": self._track_colors(raw["ids"], GATED_PAIR_KEEP),
+            "radii": np.full(n, GATED_PAIR_RADIUS_M, dtype=np.float32),
+            "labels": raw["labels"],
+        }
+
     def _draw_associations(self, class_name: str, cf: _ClassFrame, worthy: dict[int, int]) -> None:
         """Chosen (track, detection) lines in the track's colour, gated-but-rejected ones dimmed; per-track NIS
         and chosen-cost samples."""
@@ -596,9 +616,9 @@ class TrackerLogger:
                 rr.LineStrips3D,
                 len(pairs),
                 static={"show_labels": False},
-                strips=_pair_lines(pred_xy, [pred_row[t] for t in owners], xyz, meas_rows),
-                colors=self._track_colors(np.array(owners, dtype=np.int64)),
-                radii=np.full(len(pairs), ASSOCIATION_RADIUS_M, dtype=np.float32),
+                build=self._association_lines,
+                lines=_pair_lines(pred_xy, [pred_row[t] for t in owners], xyz, meas_rows),
+                ids=np.array(owners, dtype=np.int64),
                 labels=labels,
             )
         gated = cf.gated
@@ -619,11 +639,11 @@ class TrackerLogger:
                 rr.LineStrips3D,
                 len(rejected),
                 static={"show_labels": False},
-                strips=_pair_lines(
+                build=self._gated_pair_lines,
+                lines=_pair_lines(
                     pred_xy, [pred_row[t] for t in rowners], xyz, np.array([pos[m] for _, m in rejected])
                 ),
-                colors=self._track_colors(np.array(rowners, dtype=np.int64), GATED_PAIR_KEEP),
-                radii=np.full(len(rejected), GATED_PAIR_RADIUS_M, dtype=np.float32),
+                ids=np.array(rowners, dtype=np.int64),
                 labels=[f"{meas_name(m)} in gate of {t}, not chosen (cost {cost_of(m, t):.2f})" for t, m in rejected],
             )
 
