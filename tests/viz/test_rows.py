@@ -86,3 +86,27 @@ def test_rows_out_of_frame_order_are_refused_with_a_focus_clock(saved_stream: tu
     rows = EntityRows("s/x", np.array([2, 1]), _stamps([2, 1]), {"scalars": (np.array([1.0, 2.0]), np.ones(2))})
     with pytest.raises(ValueError, match="not in frame order"):
         send_entities(stream, Clock(focus_end=1), rr.Scalars, [rows])
+
+
+def test_a_row_builder_runs_once_per_flush_over_every_row_of_the_entity(
+    saved_stream: tuple[rr.RecordingStream, Path],
+) -> None:
+    stream, path = saved_stream
+    calls: list[int] = []
+
+    def boxes(raw: dict[str, np.ndarray]) -> dict[str, object]:
+        calls.append(raw["x"].size)
+        return {
+            "centers": np.column_stack([raw["x"], np.zeros((raw["x"].size, 2))]),
+            "labels": [f"{x:g}" for x in raw["x"]],
+        }
+
+    buffer = RowBuffer(stream, Clock())
+    buffer.put("b", rr.Boxes3D, 0, _stamps([0])[0], 2, build=boxes, x=np.array([1.0, 2.0]))
+    buffer.put("b", rr.Boxes3D, 1, _stamps([1])[0], 1, build=boxes, x=np.array([3.0]))
+    buffer.clear("b", 2, _stamps([2])[0])
+    buffer.flush()
+    stream.disconnect()
+    assert calls == [3]
+    rows = [(r["frame"], [c[0] for c in r["Boxes3D:centers"]], r["Boxes3D:labels"]) for r in read_rows(path)["b"]]
+    assert rows == [(0, [1.0, 2.0], ["1", "2"]), (1, [3.0], ["3"]), (2, [], [])]
