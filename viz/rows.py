@@ -5,9 +5,11 @@ entities per class and frame plus one per reported track: logging them one call 
 times slower than the tracker. ``RowBuffer`` keeps each row's instance arrays instead, and a flush sends every
 entity's rows with one ``send_columns``. Converting each entity's rows to Arrow on its own (``Archetype.columns``,
 ``TimeColumn``) still cost ~250 µs per entity, most of a saved recording's finish; ``send_entities`` converts the
-rows of all entities of one archetype in one go (one Arrow array per field and timeline) and sends each entity a
-zero-copy slice of them, with its own list offsets. A row with no instances is an empty batch: the entity shows
-nothing from that frame on.
+rows of all entities of one archetype in one go (one Arrow list array per field, one array per timeline) and sends
+each entity zero-copy slices of them. Elementwise drawing work (positions, colours, labels, outlines) can wait
+for the flush too: a row put with a ``Build`` holds raw values that the builder turns into the archetype's fields
+once for all the entity's rows. A row with no instances is an empty batch: the entity shows nothing from that
+frame on.
 """
 
 from __future__ import annotations
@@ -131,7 +133,7 @@ class _Rows:
         if self.build is None:
             fields = {name: (flat, lengths[name]) for name, flat in flats.items()}
         else:
-            per_row = next(iter(lengths.values()))
+            per_row = next(iter(lengths.values()), np.zeros(len(self.frames), dtype=np.int64))
             fields = {name: (flat, per_row) for name, flat in self.build(flats).items()}
         return EntityRows(path, np.asarray(self.frames), np.asarray(self.stamps), fields)
 
