@@ -736,25 +736,25 @@ class TrackerLogger:
         (the others are focused tracks below ``show_min_existence``, drawn for the focus only)."""
         if not estimates:
             return
-        colors = self._track_colors(np.array([e.track_id for e in estimates], dtype=np.int64))
-        trail_radius = np.full(1, TRAIL_RADIUS_M, dtype=np.float32)  # rows are copied when sent: shareable
         self._extracted_ids.update(shown)
-        for k, e in enumerate(estimates):
+        for e in estimates:
             key = (paths.track, class_name, e.track_id)
             path = self._track_paths.get(key)
             if path is None:
                 path = self._track_paths[key] = paths.track(self.tracker, class_name, e.track_id)
             self._put(path, rr.Boxes3D, 1, build=self._track_boxes, estimate=[e])
-            trail = list(self._trails.get(e.track_id, ()))
+            trail = self._trails.get(e.track_id, ())
             if len(trail) >= 2:
-                self._put(
-                    path,
-                    rr.LineStrips3D,
-                    1,
-                    strips=[trail],  # (x, y, z) tuples; converted for all rows at once when sent
-                    colors=colors[k : k + 1],
-                    radii=trail_radius,
-                )
+                self._put(path, rr.LineStrips3D, 1, build=self._trail_lines, trail=[list(trail)], ids=[e.track_id])
+
+    def _trail_lines(self, raw: dict[str, list]) -> dict[str, object]:
+        """LineStrips3D of tracks' trails (each a list of (x, y, z) points), in the track's colour
+        (``viz.rows.Build``)."""
+        return {
+            "strips": raw["trail"],
+            "colors": self._track_colors(np.array(raw["ids"], dtype=np.int64)),
+            "radii": np.full(len(raw["ids"]), TRAIL_RADIUS_M, dtype=np.float32),
+        }
 
     def _track_boxes(self, raw: dict[str, list[TrackEstimate]]) -> dict[str, object]:
         """Boxes3D of extracted tracks (``estimate_boxes``), in the track's colour, labelled with the track id
