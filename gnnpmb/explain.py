@@ -18,6 +18,7 @@ the usual cause of an ID switch.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +26,8 @@ import numpy as np
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix
 
+_KIND = operator.attrgetter("kind")
+_REF = operator.attrgetter("ref")
 LINK_SLACK = 5.0
 """Pairs costlier than the measurement's new-track cost plus this do not link a conflict; margins are capped at
 it (in cost units: nats for the PMB family)."""
@@ -109,10 +112,16 @@ def _components(finite: np.ndarray, n_tracks: int) -> list[tuple[np.ndarray, np.
         if np.array_equal(new, row_label):
             break
         row_label = new
-    out = []
-    for label in np.unique(col_label[col_label < none]):
-        out.append((np.flatnonzero(row_label == label), np.flatnonzero(col_label == label)))
-    return out
+    rows_of: dict[int, list[int]] = {}
+    for i, label in enumerate(row_label.tolist()):
+        rows_of.setdefault(label, []).append(i)
+    cols_of: dict[int, list[int]] = {}
+    linked = np.flatnonzero(col_label < none).tolist()
+    for j, label in zip(linked, col_label[linked].tolist(), strict=True):
+        cols_of.setdefault(label, []).append(j)
+    return [
+        (np.array(rows_of[label], dtype=np.intp), np.array(cols_of[label], dtype=np.intp)) for label in sorted(cols_of)
+    ]
 
 
 def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
@@ -123,20 +132,19 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
     """
     cost = np.asarray(matrix.cost, dtype=np.float64)
     n_rows = cost.shape[0] if cost.ndim == 2 else 0
-    track_cols = [i for i, c in enumerate(matrix.cols) if c.kind is AxisKind.TRACK]
-    n_tracks = len(track_cols)
+    col_kinds = list(map(_KIND, matrix.cols))
+    n_tracks = col_kinds.count(AxisKind.TRACK)
     if (
         cost.ndim != 2
-        or track_cols != list(range(n_tracks))
+        or col_kinds[n_tracks:].count(AxisKind.NEW_TRACK) != len(col_kinds) - n_tracks  # tracks first, then births
         or any(r.kind is not AxisKind.MEASUREMENT for r in matrix.rows)
-        or any(c.kind is not AxisKind.NEW_TRACK for c in matrix.cols[n_tracks:])
     ):
         return None
     # Index by ref, one map per kind: hashing AxisLabels (dataclasses holding an enum, whose hash is Python code)
     # costs more than the rest.
-    row_of = {label.ref: i for i, label in enumerate(matrix.rows)}
-    track_col_of = {label.ref: j for j, label in enumerate(matrix.cols[:n_tracks])}
-    new_col_of = {label.ref: j for j, label in enumerate(matrix.cols[n_tracks:], n_tracks)}
+    row_of = dict(zip(map(_REF, matrix.rows), range(len(matrix.rows)), strict=True))
+    track_col_of = dict(zip(map(_REF, matrix.cols[:n_tracks]), range(n_tracks), strict=True))
+    new_col_of = dict(zip(map(_REF, matrix.cols[n_tracks:]), range(n_tracks, len(matrix.cols)), strict=True))
     chosen = np.full(n_rows, -1, dtype=np.int64)
     for row_label, col_label in assignment.pairs:
         if col_label.kind is AxisKind.TRACK:
@@ -158,61 +166,96 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
     finite[np.arange(n_rows), chosen] = np.isfinite(cost[np.arange(n_rows), chosen])  # whatever was chosen links
     conflicts = []
     in_conflict = np.zeros(n_rows, dtype=bool)
-    for rows, tcols in _components(finite, n_tracks):
+    components = _components(finite, n_tracks)
+    linked = np.where(finite, cost, np.inf) if components else cost
+    for rows, tcols in components:
         in_conflict[rows] = True
-        conflicts.append(_conflict(matrix, np.where(finite, cost, np.inf), chosen, rows, tcols, n_tracks))
+        conflicts.append(_conflict(matrix, linked, chosen, rows, tcols, n_tracks))
     conflicts.sort(key=lambda c: (c.closest_margin, c.track_ids))
-    births = tuple(int(matrix.rows[i].ref) for i in np.flatnonzero(~in_conflict))
+    births = tuple(int(matrix.rows[i].ref) for i in np.flatnonzero(~in_conflict).tolist())
     return Decisions(matrix.class_name, tuple(conflicts), births, matrix.description)
 
 
 def _conflict(
     matrix: CostMatrix, cost: np.ndarray, chosen: np.ndarray, rows: np.ndarray, tcols: np.ndarray, n_tracks: int
 ) -> Conflict:
-    """Decisions of one component: its sub-matrix is [its track columns | its rows' new-track columns]."""
-    cols = np.concatenate([tcols, n_tracks + rows])
-    sub = cost[np.ix_(rows, cols)]
-    position = {int(c): k for k, c in enumerate(cols)}
-    chosen_sub = np.array([position.get(int(chosen[r]), -1) for r in rows])
-    total = float(sub[np.arange(rows.size), chosen_sub].sum()) if rows.size else 0.0
+    """Decisions of one component: its sub-matrix is [its track columns | its rows' new-track columns].
+
+    Every row's chosen column is in the sub-matrix: a chosen track column links its row to the component, and a
+    row's own new-track column is always there. The cheapest other column of each row is found for all rows at
+    once (first minimum, as ``argmin``); a one-row component, the usual case, is done in plain Python (NumPy's
+    per-call overhead dominates on a handful of entries)."""
+    if rows.size == 1:
+        r = int(rows[0])
+        cols_list = [*tcols.tolist(), n_tracks + r]
+        sub_row = cost[r, cols_list].tolist()
+        c = int(chosen[r])
+        j = cols_list.index(c) if c in cols_list else -1
+        others = [math.inf if k == j else v for k, v in enumerate(sub_row)]
+        k = min(range(len(others)), key=others.__getitem__)  # the first minimum, as argmin
+        chosen_list, best_list = [j], [k]
+        chosen_costs, best_costs = [sub_row[j]], [others[k]]
+        total = sub_row[j]
+        rest = others if j >= 0 else sub_row[:-1]  # the row without its chosen entry (as np.delete(row, j))
+        margins = [_capped(min(rest) if len(sub_row) > 1 else math.inf, total)]
+    else:
+        cols = np.concatenate([tcols, n_tracks + rows])
+        sub = cost[np.ix_(rows, cols)]
+        position = {c: k for k, c in enumerate(cols.tolist())}
+        chosen_sub = np.array([position.get(c, -1) for c in chosen[rows].tolist()], dtype=np.int64)
+        at = np.arange(rows.size)
+        chosen_cost = sub[at, chosen_sub]
+        total = float(chosen_cost.sum())
+        masked = sub.copy()
+        kept = chosen_sub >= 0
+        masked[at[kept], chosen_sub[kept]] = np.inf
+        best = np.argmin(masked, axis=1)
+        cols_list, chosen_list, best_list = cols.tolist(), chosen_sub.tolist(), best.tolist()
+        chosen_costs, best_costs = chosen_cost.tolist(), masked[at, best].tolist()
+        margins = [_margin(sub, i, j, total) for i, j in enumerate(chosen_list)]
+    mrows, mcols = matrix.rows, matrix.cols
     choices = []
-    for i, r in enumerate(rows):
-        j = chosen_sub[i]
-        others = np.where(np.arange(cols.size) == j, np.inf, sub[i])
-        k = int(np.argmin(others)) if others.size else -1
-        has_alt = k >= 0 and np.isfinite(others[k])
+    for r, j, k, c_chosen, c_best, margin in zip(
+        rows.tolist(), chosen_list, best_list, chosen_costs, best_costs, margins, strict=True
+    ):
+        has_alt = math.isfinite(c_best)
         choices.append(
             PairChoice(
-                meas=matrix.rows[r],
-                chosen=matrix.cols[cols[j]],
-                chosen_cost=float(sub[i, j]),
-                alternative=matrix.cols[cols[k]] if has_alt else None,
-                alternative_cost=float(others[k]) if has_alt else math.inf,
-                margin=_margin(sub, i, j, total),
+                meas=mrows[r],
+                chosen=mcols[cols_list[j]],
+                chosen_cost=c_chosen,
+                alternative=mcols[cols_list[k]] if has_alt else None,
+                alternative_cost=c_best if has_alt else math.inf,
+                margin=margin,
             )
         )
-    used = {int(cols[j]) for j in chosen_sub if cols[j] < n_tracks}
-    missed = tuple(int(matrix.cols[c].ref) for c in tcols if int(c) not in used)
+    used = {cols_list[j] for j in chosen_list if cols_list[j] < n_tracks}
+    track_refs = tuple(int(mcols[c].ref) for c in tcols.tolist())
+    missed = tuple(ref for c, ref in zip(tcols.tolist(), track_refs, strict=True) if c not in used)
     return Conflict(
         matrix.class_name,
-        tuple(int(matrix.cols[c].ref) for c in tcols),
-        tuple(int(matrix.rows[r].ref) for r in rows),
+        track_refs,
+        tuple(int(mrows[r].ref) for r in rows.tolist()),
         tuple(choices),
         missed,
         total,
     )
 
 
+def _capped(best: float, total: float) -> float:
+    """``best - total`` clipped to [0, LINK_SLACK]; inf when ``best`` is not finite (no other assignment)."""
+    return math.inf if not math.isfinite(best) else min(max(best - total, 0.0), LINK_SLACK)
+
+
 def _margin(sub: np.ndarray, i: int, j: int, total: float) -> float:
     """Best total of ``sub`` with entry (i, j) forbidden, minus ``total`` (inf if then infeasible). A one-row
     ``sub`` (one detection) needs no solver: its best total is its cheapest other entry."""
     if sub.shape[0] == 1:
-        best = float(np.min(np.delete(sub[0], j))) if sub.shape[1] > 1 else math.inf
-        return math.inf if not math.isfinite(best) else min(max(best - total, 0.0), LINK_SLACK)
+        return _capped(float(np.min(np.delete(sub[0], j))) if sub.shape[1] > 1 else math.inf, total)
     forbidden = sub.copy()
     forbidden[i, j] = np.inf
     try:
         _, best = solve(forbidden)
     except InfeasibleAssignment:
         return math.inf
-    return min(max(best - total, 0.0), LINK_SLACK)
+    return _capped(best, total)

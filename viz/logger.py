@@ -56,7 +56,7 @@ from gnnpmb.explain import Decisions, explain
 from gnnpmb.gating import ellipse_outline
 from gnnpmb.types import TrackEstimate
 from viz import paths
-from viz.colors import class_ids, faded, pack_rgba, packed_track_colors, track_color
+from viz.colors import CLASS_IDS, faded, pack_rgba, packed_track_colors, track_color
 from viz.decisions import (
     CLOSE_CALL_MARGIN,
     column_name,
@@ -66,7 +66,7 @@ from viz.decisions import (
     meas_name,
 )
 from viz.geometry import estimate_boxes, lift_xy
-from viz.rows import RowBuffer
+from viz.rows import Build, EntityRows, RowBuffer, send_entities
 from viz.timeline import PLAIN_CLOCK, Clock
 
 TRACK_LINE_RADIUS_M = 0.06
@@ -96,6 +96,8 @@ FLUSH_FRAMES = 10
 """Default cadence: story lines and spatial rows are sent column-wise every this many frames (and at the end),
 so a live viewer sees them within seconds; a saved recording passes ``flush_frames=None`` (only at the end: one
 chunk per entity)."""
+_STATIC_ROW = np.zeros(1, dtype=np.int64)
+"""The one row of static data (``viz.rows.send_entities(static=True)`` ignores its time)."""
 CANDIDATE_COLOR = int(pack_rgba(np.array([[160, 160, 160]], dtype=np.uint8))[0])
 
 _LEVEL_BY_ACTION = {
@@ -266,32 +268,32 @@ class TrackerLogger:
             self._frame = -1
         self._flush_texts()
         self._rows.flush()
+        scalars: list[EntityRows] = []
+        styles: list[EntityRows] = []
+        one = np.ones(1, dtype=np.int64)
         for path, series in self._series.items():
             owner = self._track_series.get(path)
             if owner is not None and owner[1] not in self._extracted_ids and owner[1] not in self._focused:
                 continue  # a candidate's series: only the per-class candidate count is kept
-            colors = None if series.color is None else [series.color]
-            self.stream.log(path, rr.SeriesLines(names=series.name, colors=colors), static=True)
+            style = {"names": ([series.name], one)}
+            if series.color is not None:
+                style["colors"] = (np.array([series.color], dtype=np.uint8), one)
+            styles.append(EntityRows(path, _STATIC_ROW, _STATIC_ROW, style))
             values = np.asarray(series.values, dtype=np.float64)
             if self.focus_tracks:
                 self.sent_series[path] = (np.asarray(series.frames), values)
-            self.clock.send(
-                self.stream,
-                path,
-                np.asarray(series.frames),
-                np.asarray(series.timestamps_us),
-                lambda rows, values=values: rr.Scalars.columns(scalars=values[rows]),
+            scalars.append(
+                EntityRows(path, np.asarray(series.frames), np.asarray(series.timestamps_us), _one_per_row(values))
             )
         for path, (names, frames, stamps, values) in self._multi.items():
-            self.stream.log(path, rr.SeriesLines(names=names), static=True)
+            styles.append(EntityRows(path, _STATIC_ROW, _STATIC_ROW, {"names": (names, np.array([len(names)]))}))
             stacked = np.stack(values)
-            self.clock.send(
-                self.stream,
-                path,
-                np.asarray(frames),
-                np.asarray(stamps),
-                lambda rows, stacked=stacked: rr.Scalars.columns(scalars=stacked[rows]),
+            lengths = np.full(stacked.shape[0], stacked.shape[1], dtype=np.int64)
+            scalars.append(
+                EntityRows(path, np.asarray(frames), np.asarray(stamps), {"scalars": (stacked.ravel(), lengths)})
             )
+        send_entities(self.stream, self.clock, rr.SeriesLines, styles, static=True)
+        send_entities(self.stream, self.clock, rr.Scalars, scalars)
         self._series.clear()
         self._track_series.clear()
         self._track_paths.clear()
@@ -311,7 +313,10 @@ class TrackerLogger:
         return handler
 
     def _class_frame(self, class_name: str) -> _ClassFrame:
-        return self._classes.setdefault(class_name, _ClassFrame())
+        cf = self._classes.get(class_name)
+        if cf is None:
+            cf = self._classes[class_name] = _ClassFrame()
+        return cf
 
     def _on_cost(self, event: CostMatrix) -> None:
         self._class_frame(event.class_name).costs[event.hypothesis] = event
@@ -366,16 +371,19 @@ class TrackerLogger:
             self._rows.flush()
 
     def _flush_texts(self) -> None:
-        for path, (frames, stamps, texts, levels) in self._texts.items():
-            self.clock.send(
-                self.stream,
+        logs = [
+            EntityRows(
                 path,
                 np.asarray(frames),
                 np.asarray(stamps),
-                lambda rows, texts=texts, levels=levels: rr.TextLog.columns(
-                    text=[texts[i] for i in rows], level=[levels[i] for i in rows]
-                ),
+                {
+                    "text": (texts, np.ones(len(texts), dtype=np.int64)),
+                    "level": (levels, np.ones(len(levels), dtype=np.int64)),
+                },
             )
+            for path, (frames, stamps, texts, levels) in self._texts.items()
+        ]
+        send_entities(self.stream, self.clock, rr.TextLog, logs)
         self._texts.clear()
         self._frames_since_text_flush = 0
 
@@ -386,11 +394,13 @@ class TrackerLogger:
             self.stream.log(path, archetype)
         self._touched.add(path)
 
-    def _put(self, path: str, archetype: type, n: int, static: dict | None = None, **fields) -> None:
+    def _put(
+        self, path: str, archetype: type, n: int, static: dict | None = None, build: Build | None = None, **fields
+    ) -> None:
         """A buffered row of ``n`` instances on ``path`` (see ``viz.rows``)."""
         if not self._drawing:
             return
-        self._rows.put(path, archetype, self._frame, self._timestamp_us, n, static, **fields)
+        self._rows.put(path, archetype, self._frame, self._timestamp_us, n, static, build, **fields)
         self._buffered.add(path)
         self._touched.add(path)
 
@@ -428,7 +438,10 @@ class TrackerLogger:
         if path is None:
             path = self._track_paths[key] = series(self.tracker, class_name, track_id)
             self._track_series.setdefault(path, (class_name, track_id))
-        self._sample(path, value, f"{track_id} {class_name} {what}", track_color(track_id))
+        if path in self._series:  # name and colour only matter for a new series
+            self._sample(path, value)
+        else:
+            self._sample(path, value, f"{track_id} {class_name} {what}", track_color(track_id))
 
     def _z_of(self, track_ids: np.ndarray) -> np.ndarray:
         """(K,) last known box height of each track, gate_z_m for tracks never extracted."""
@@ -480,10 +493,11 @@ class TrackerLogger:
                     rr.Points3D,
                     sel.size,
                     static={"show_labels": False},
-                    positions=lift_xy(xy[sel], self._z_of(ids[sel])),
-                    colors=self._track_colors(ids[sel]),
-                    radii=np.full(sel.size, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
-                    labels=_labels("{} predicted r={:.2f}", ids[sel], existence[sel]),
+                    build=self._predicted_points,
+                    xy=xy[sel],
+                    z=self._z_of(ids[sel]),
+                    ids=ids[sel],
+                    existence=existence[sel],
                 )
         if (~worthy).any():
             sel = np.flatnonzero(~worthy)
@@ -492,10 +506,10 @@ class TrackerLogger:
                 rr.Points3D,
                 sel.size,
                 static={"show_labels": False},
-                positions=lift_xy(xy[sel], self.gate_z_m),
-                colors=np.full(sel.size, CANDIDATE_COLOR, dtype=np.uint32),
-                radii=np.full(sel.size, CANDIDATE_POINT_RADIUS_M, dtype=np.float32),
-                labels=_labels("candidate {}, r={:.3f}", ids[sel], existence[sel]),
+                build=self._candidate_points,
+                xy=xy[sel],
+                ids=ids[sel],
+                existence=existence[sel],
             )
         self._sample(
             paths.candidate_count(self.tracker, class_name), float((~worthy).sum()), f"{class_name} candidates"
@@ -506,23 +520,75 @@ class TrackerLogger:
             lookup = dict(zip(ids.tolist(), worthy.tolist(), strict=True))  # focused tracks count as worthy
             drawn = np.array([lookup.get(t, True) for t in gids.tolist()], dtype=bool)
             if drawn.any():
-                outline = ellipse_outline(
-                    np.asarray(gated.center_xy, dtype=np.float64)[drawn],
-                    np.asarray(gated.innovation_cov, dtype=np.float64)[drawn],
-                    gated.threshold,
-                    self.gate_points,
-                )
                 n = int(drawn.sum())
                 self._put(
                     paths.gates(self.tracker, class_name),
                     rr.LineStrips3D,
                     n,
-                    strips=lift_xy(outline, self._z_of(gids[drawn])[:, None]),
-                    colors=self._track_colors(gids[drawn]),
-                    radii=np.full(n, GATE_LINE_RADIUS_M, dtype=np.float32),
+                    build=self._gate_outlines,
+                    center_xy=np.asarray(gated.center_xy, dtype=np.float64)[drawn],
+                    cov=np.asarray(gated.innovation_cov, dtype=np.float64)[drawn],
+                    threshold=np.full(n, gated.threshold, dtype=np.float64),
+                    z=self._z_of(gids[drawn]),
+                    ids=gids[drawn],
                 )
             return {int(t): k for k, (t, d) in enumerate(zip(gids.tolist(), drawn.tolist(), strict=True)) if d}
         return {int(t): k for k, t in enumerate(ids.tolist()) if worthy[k]}
+
+    # Row builders (``viz.rows.Build``): the elementwise part of drawing, run once per entity over all its rows.
+    def _predicted_points(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
+        """Points3D of predicted means: xy (N, 2) at height z (N,), coloured by track, labelled with existence."""
+        n = raw["ids"].size
+        return {
+            "positions": lift_xy(raw["xy"], raw["z"]),
+            "colors": self._track_colors(raw["ids"]),
+            "radii": np.full(n, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
+            "labels": _labels("%d predicted r=%.2f", raw["ids"], raw["existence"]),
+        }
+
+    def _candidate_points(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
+        """Points3D of candidates' predicted means (N, 2), grey, at ``gate_z_m``."""
+        n = raw["ids"].size
+        return {
+            "positions": lift_xy(raw["xy"], self.gate_z_m),
+            "colors": np.full(n, CANDIDATE_COLOR, dtype=np.uint32),
+            "radii": np.full(n, CANDIDATE_POINT_RADIUS_M, dtype=np.float32),
+            "labels": _labels("candidate %d, r=%.3f", raw["ids"], raw["existence"]),
+        }
+
+    def _gate_outlines(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
+        """LineStrips3D of gate ellipses {z : (z - c)^T S^-1 (z - c) = threshold} (``ellipse_outline``) of
+        centres (N, 2) and innovation covariances S (N, 2, 2), at height z (N,), in the track's colour."""
+        n = raw["ids"].size
+        outline = np.empty((n, self.gate_points + 1, 2), dtype=np.float64)
+        for threshold in np.unique(raw["threshold"]).tolist():
+            rows = raw["threshold"] == threshold
+            outline[rows] = ellipse_outline(raw["center_xy"][rows], raw["cov"][rows], threshold, self.gate_points)
+        return {
+            "strips": lift_xy(outline, raw["z"][:, None]),
+            "colors": self._track_colors(raw["ids"]),
+            "radii": np.full(n, GATE_LINE_RADIUS_M, dtype=np.float32),
+        }
+
+    def _association_lines(self, raw: dict[str, object]) -> dict[str, object]:
+        """LineStrips3D of chosen pairs: lines (N, 2, 3) in their tracks' colours (ids (N,)), labelled."""
+        n = len(raw["labels"])
+        return {
+            "strips": raw["lines"],
+            "colors": self._track_colors(raw["ids"]),
+            "radii": np.full(n, ASSOCIATION_RADIUS_M, dtype=np.float32),
+            "labels": raw["labels"],
+        }
+
+    def _gated_pair_lines(self, raw: dict[str, object]) -> dict[str, object]:
+        """LineStrips3D of gated pairs not chosen: lines (N, 2, 3), faint (``GATED_PAIR_KEEP``), labelled."""
+        n = len(raw["labels"])
+        return {
+            "strips": raw["lines"],
+            "colors": self._track_colors(raw["ids"], GATED_PAIR_KEEP),
+            "radii": np.full(n, GATED_PAIR_RADIUS_M, dtype=np.float32),
+            "labels": raw["labels"],
+        }
 
     def _draw_associations(self, class_name: str, cf: _ClassFrame, worthy: dict[int, int]) -> None:
         """Chosen (track, detection) lines in the track's colour, gated-but-rejected ones dimmed; per-track NIS
@@ -555,9 +621,9 @@ class TrackerLogger:
                 rr.LineStrips3D,
                 len(pairs),
                 static={"show_labels": False},
-                strips=_pair_lines(pred_xy, [pred_row[t] for t in owners], xyz, meas_rows),
-                colors=self._track_colors(np.array(owners, dtype=np.int64)),
-                radii=np.full(len(pairs), ASSOCIATION_RADIUS_M, dtype=np.float32),
+                build=self._association_lines,
+                lines=_pair_lines(pred_xy, [pred_row[t] for t in owners], xyz, meas_rows),
+                ids=np.array(owners, dtype=np.int64),
                 labels=labels,
             )
         gated = cf.gated
@@ -578,11 +644,11 @@ class TrackerLogger:
                 rr.LineStrips3D,
                 len(rejected),
                 static={"show_labels": False},
-                strips=_pair_lines(
+                build=self._gated_pair_lines,
+                lines=_pair_lines(
                     pred_xy, [pred_row[t] for t in rowners], xyz, np.array([pos[m] for _, m in rejected])
                 ),
-                colors=self._track_colors(np.array(rowners, dtype=np.int64), GATED_PAIR_KEEP),
-                radii=np.full(len(rejected), GATED_PAIR_RADIUS_M, dtype=np.float32),
+                ids=np.array(rowners, dtype=np.int64),
                 labels=[f"{meas_name(m)} in gate of {t}, not chosen (cost {cost_of(m, t):.2f})" for t, m in rejected],
             )
 
@@ -595,13 +661,21 @@ class TrackerLogger:
         ids = np.asarray(post.track_ids, dtype=np.int64)
         existence = np.asarray(post.existence, dtype=np.float64)
         mean = np.asarray(post.mean, dtype=np.float64).reshape(-1, 4)
-        followed = list(self._extracted_ids | self._focused)
-        follow = np.flatnonzero((existence >= self.gate_min_existence) | np.isin(ids, followed))
-        for k in follow.tolist():
-            t = int(ids[k])
-            self._track_sample(paths.existence, class_name, t, existence[k], "existence")
-            trail = self._trails.setdefault(t, deque(maxlen=TRAIL_FRAMES))
-            trail.append((float(mean[k, 0]), float(mean[k, 1]), self._track_z.get(t, self.gate_z_m)))
+        reported, focused = self._extracted_ids, self._focused
+        id_list, r_list = ids.tolist(), existence.tolist()
+        follow = [
+            k
+            for k, (t, r) in enumerate(zip(id_list, r_list, strict=True))
+            if r >= self.gate_min_existence or t in reported or t in focused
+        ]
+        xy = mean[follow, :2].tolist()
+        for k, (x, y) in zip(follow, xy, strict=True):
+            t = id_list[k]
+            self._track_sample(paths.existence, class_name, t, r_list[k], "existence")
+            trail = self._trails.get(t)
+            if trail is None:
+                trail = self._trails[t] = deque(maxlen=TRAIL_FRAMES)
+            trail.append((x, y, self._track_z.get(t, self.gate_z_m)))
 
     def _record_steps(self, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
         """The frame's ``TrackStep`` of every focused track this class predicted."""
@@ -667,38 +741,41 @@ class TrackerLogger:
         (the others are focused tracks below ``show_min_existence``, drawn for the focus only)."""
         if not estimates:
             return
-        boxes = estimate_boxes(estimates)
-        ids = np.array([e.track_id for e in estimates], dtype=np.int64)
-        cids = class_ids(np.array([e.class_name for e in estimates], dtype=object))
-        colors = self._track_colors(ids)
-        half_sizes = 0.5 * boxes.sizes_xyz_m
-        box_radius = np.full(1, TRACK_LINE_RADIUS_M, dtype=np.float32)  # rows are copied when sent: shareable
-        trail_radius = np.full(1, TRAIL_RADIUS_M, dtype=np.float32)
         self._extracted_ids.update(shown)
-        for k, e in enumerate(estimates):
-            path = paths.track(self.tracker, class_name, e.track_id)
-            self._put(
-                path,
-                rr.Boxes3D,
-                1,
-                centers=boxes.centers_m[k : k + 1],
-                half_sizes=half_sizes[k : k + 1],
-                quaternions=boxes.quat_xyzw[k : k + 1],
-                colors=colors[k : k + 1],
-                class_ids=cids[k : k + 1],
-                labels=[str(e.track_id)],
-                radii=box_radius,
-            )
-            trail = list(self._trails.get(e.track_id, ()))
+        for e in estimates:
+            key = (paths.track, class_name, e.track_id)
+            path = self._track_paths.get(key)
+            if path is None:
+                path = self._track_paths[key] = paths.track(self.tracker, class_name, e.track_id)
+            self._put(path, rr.Boxes3D, 1, build=self._track_boxes, estimate=[e])
+            trail = self._trails.get(e.track_id, ())
             if len(trail) >= 2:
-                self._put(
-                    path,
-                    rr.LineStrips3D,
-                    1,
-                    strips=[np.array(trail)],
-                    colors=colors[k : k + 1],
-                    radii=trail_radius,
-                )
+                self._put(path, rr.LineStrips3D, 1, build=self._trail_lines, trail=[list(trail)], ids=[e.track_id])
+
+    def _trail_lines(self, raw: dict[str, list]) -> dict[str, object]:
+        """LineStrips3D of tracks' trails (each a list of (x, y, z) points), in the track's colour
+        (``viz.rows.Build``)."""
+        return {
+            "strips": raw["trail"],
+            "colors": self._track_colors(np.array(raw["ids"], dtype=np.int64)),
+            "radii": np.full(len(raw["ids"]), TRAIL_RADIUS_M, dtype=np.float32),
+        }
+
+    def _track_boxes(self, raw: dict[str, list[TrackEstimate]]) -> dict[str, object]:
+        """Boxes3D of extracted tracks (``estimate_boxes``), in the track's colour, labelled with the track id
+        (``viz.rows.Build``)."""
+        estimates = raw["estimate"]
+        boxes = estimate_boxes(estimates)
+        n = len(estimates)
+        return {
+            "centers": boxes.centers_m,
+            "half_sizes": 0.5 * boxes.sizes_xyz_m,
+            "quaternions": boxes.quat_xyzw,
+            "colors": self._track_colors(np.array([e.track_id for e in estimates], dtype=np.int64)),
+            "class_ids": np.array([CLASS_IDS.get(e.class_name, 0) for e in estimates], dtype=np.uint16),
+            "labels": [str(e.track_id) for e in estimates],
+            "radii": np.full(n, TRACK_LINE_RADIUS_M, dtype=np.float32),
+        }
 
     # The story log.
     def _story(self, class_name: str, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
@@ -783,7 +860,12 @@ class TrackerLogger:
                 via = f"started by {meas_name(started[t])}"
             else:
                 via = f"given {meas_name(given[t])}" if t in given else "given no detection"
-            self._text(class_name, f"focused track {t} (not shown): {via}, r={posterior_r[t]:.2f}", "INFO")
+            self._text(
+                class_name,
+                f"involved track {t} (r < {self.show_min_existence:g}, drawn for the focus only): {via}, "
+                f"r={posterior_r[t]:.2f}",
+                "INFO",
+            )
 
     @property
     def _focused(self) -> set[int]:
@@ -972,6 +1054,12 @@ def destination(column: AxisLabel, born_id: int | None) -> str:
     return f"new track {born_id}" if column.kind is AxisKind.NEW_TRACK and born_id is not None else name
 
 
+def _one_per_row(values: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The ``Scalars`` field of a series of (R,) values, one per row (``viz.rows.EntityRows``)."""
+    return {"scalars": (values, np.ones(values.size, dtype=np.int64))}
+
+
 def _labels(template: str, track_ids: np.ndarray, existence: np.ndarray) -> list[str]:
-    """``template.format(id, r)`` per track (Python scalars: formatting numpy scalars is several times slower)."""
-    return [template.format(t, r) for t, r in zip(track_ids.tolist(), existence.tolist(), strict=True)]
+    """``template % (id, r)`` per track (Python scalars and %-formatting: formatting numpy scalars, or with
+    ``str.format``, is several times slower)."""
+    return [template % (t, r) for t, r in zip(track_ids.tolist(), existence.tolist(), strict=True)]

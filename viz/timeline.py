@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import pyarrow as pa
 import rerun as rr
 
 FRAME = "frame"
@@ -66,6 +67,73 @@ class Clock:
             if self.focus_end is not None and k == 0:
                 indexes.append(rr.TimeColumn(FOCUS, sequence=frames[rows]))
             stream.send_columns(path, indexes=indexes, columns=columns_of(rows))
+
+    def time_arrays(self, frames: np.ndarray, timestamps_us: np.ndarray) -> tuple[pa.Array, pa.Array]:
+        """The Arrow ``frame`` and ``timestamp`` columns of rows at (N,) keyframes, for ``send_rows``."""
+        frames = np.asarray(frames, dtype=np.int64)
+        stamps_ns = np.asarray(timestamps_us, dtype=np.int64).astype("datetime64[us]").astype("datetime64[ns]")
+        return pa.array(frames, pa.int64()), pa.array(stamps_ns, pa.timestamp("ns"))
+
+    def send_rows(
+        self,
+        stream: rr.RecordingStream,
+        path: str,
+        frames: np.ndarray,
+        times: tuple[pa.Array, pa.Array],
+        columns: list[ListColumn],
+    ) -> None:
+        """``send_columns`` of R rows at (R,) non-decreasing keyframes, already in Arrow form: ``times`` from
+        ``time_arrays``, one list per row in each column. Rows past ``focus_end`` go in a second call without the
+        focus time."""
+        n = len(frames)
+        if n == 0:
+            return
+        split = n
+        if self.focus_end is not None:
+            if np.any(np.diff(frames) < 0):
+                raise ValueError(f"rows of {path} are not in frame order")
+            split = int(np.searchsorted(frames, self.focus_end, side="right"))
+        for lo, hi, on_focus in ((0, split, self.focus_end is not None), (split, n, False)):
+            if hi == lo:
+                continue
+            indexes = [_Times(FRAME, times[0].slice(lo, hi - lo)), _Times(TIMESTAMP, times[1].slice(lo, hi - lo))]
+            if on_focus:
+                indexes.append(_Times(FOCUS, times[0].slice(lo, hi - lo)))
+            part = columns if (lo, hi) == (0, n) else [c.rows(lo, hi) for c in columns]
+            stream.send_columns(path, indexes=indexes, columns=part)
+
+
+@dataclass(frozen=True, slots=True)
+class ListColumn:
+    """A component column already in Arrow form, one list (the row's instances) per row: what
+    ``rr.ComponentColumn`` builds, for ``send_columns``, without rebuilding the list array per call."""
+
+    descriptor: rr.ComponentDescriptor
+    lists: pa.ListArray
+
+    def component_descriptor(self) -> rr.ComponentDescriptor:
+        return self.descriptor
+
+    def as_arrow_array(self) -> pa.ListArray:
+        return self.lists
+
+    def rows(self, lo: int, hi: int) -> ListColumn:
+        """Rows lo..hi-1 (a zero-copy slice)."""
+        return ListColumn(self.descriptor, self.lists.slice(lo, hi - lo))
+
+
+@dataclass(frozen=True, slots=True)
+class _Times:
+    """A timeline column already in Arrow form (``rr.TimeColumnLike``)."""
+
+    timeline: str
+    times: pa.Array
+
+    def timeline_name(self) -> str:
+        return self.timeline
+
+    def as_arrow_array(self) -> pa.Array:
+        return self.times
 
 
 PLAIN_CLOCK = Clock()
