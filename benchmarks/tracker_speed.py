@@ -1,6 +1,7 @@
 """Per-frame tracker time on the demo mini_val scenes and on a dense stress frame.
 
 Usage: uv run python benchmarks/tracker_speed.py [--tracker NAME ...] [--preset centerpoint] [--stress-n 320]
+       [--params FILE.toml]
 
 Prints, per tracker: median / max per-frame step time (all 7 classes, preprocessing excluded) over the demo
 mini_val scenes with the simulated detector preset, and the step time of a stress frame with >= 300 detections,
@@ -11,10 +12,11 @@ from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
 
 import numpy as np
 
-from gnnpmb.config import TrackerConfig
+from gnnpmb.config import TrackerConfig, load_config
 from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot, split_scenes
 from gnnpmb.data.preprocess import preprocess
 from gnnpmb.events import NullSink
@@ -73,8 +75,9 @@ def main() -> None:
     parser.add_argument("--preset", default="centerpoint")
     parser.add_argument("--stress-n", type=int, default=320)
     parser.add_argument("--repeat", type=int, default=3, help="runs per scene; the fastest time per frame counts")
+    parser.add_argument("--params", type=Path, help="parameter file, as gnnpmb track --params")
     args = parser.parse_args()
-    config = TrackerConfig()
+    config = load_config(args.params)
     location = resolve_dataroot(None, None)
     nusc = open_nuscenes(location)
     scenes = [load_scene(nusc, location, name) for name in split_scenes("mini_val", location)]
