@@ -188,15 +188,25 @@ def blocks(cost: np.ndarray) -> list[Cluster]:
 
 
 class SingleRow:
-    """Ranking of a one-row problem: its finite entries, ``root`` first, then by cost (stable)."""
+    """Ranking of a one-row problem: its finite entries, ``root`` first, then by cost (stable). The entries
+    are sorted when a second solution is first asked for (most one-row blocks of PMBM only give their best)."""
 
     def __init__(self, cost_row: np.ndarray, root: int, max_increase: float = math.inf):
-        order = np.argsort(cost_row, kind="stable")
-        keep = (cost_row[order] < np.inf) & (cost_row[order] <= cost_row[root] + max_increase) & (order != root)
-        self._cols = np.concatenate([[root], order[keep]]).astype(np.int64)
-        self._costs = cost_row[self._cols]
+        self._row = cost_row
+        self._max_increase = max_increase
+        self._best = np.array([root], dtype=np.int64), float(cost_row[root])
+        self._cols: np.ndarray | None = None
+        self._costs: np.ndarray | None = None
 
     def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        if index == 0:
+            return self._best
+        if self._cols is None or self._costs is None:
+            cost_row, root = self._row, int(self._best[0][0])
+            order = np.argsort(cost_row, kind="stable")
+            keep = (cost_row[order] < np.inf) & (cost_row[order] <= cost_row[root] + self._max_increase)
+            self._cols = np.concatenate([[root], order[keep & (order != root)]]).astype(np.int64)
+            self._costs = cost_row[self._cols]
         if index >= len(self._cols):
             return None
         return self._cols[index : index + 1], float(self._costs[index])

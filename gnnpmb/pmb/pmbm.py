@@ -277,8 +277,23 @@ class SharedRanking:
                 self.common_base[rows] = cols[ranking.solution(0)[0]]
 
     def k_best(self, budgets: list[int]) -> list[list[tuple[np.ndarray, float]]]:
-        """The budgets[h] best assignments (col_of_row as union columns, cost) of every hypothesis."""
-        return [self._hypothesis(h, k) for h, k in enumerate(budgets)]
+        """The budgets[h] best assignments (col_of_row as union columns, cost) of every hypothesis.
+
+        The best assignments of all hypotheses with a budget are assembled at once, block by block
+        (``_best_assignments``); only hypotheses with budgets[h] > 1 get a ``murty.Product``."""
+        out: list[list[tuple[np.ndarray, float]]] = [[] for _ in budgets]
+        active = np.flatnonzero(np.array(budgets, dtype=np.int64) >= 1)
+        if not len(active) or not self.common_ok:
+            return out
+        bases, totals, feasible = self._best_assignments(active)
+        for i, h in enumerate(active.tolist()):
+            if not feasible[i]:
+                continue
+            if budgets[h] == 1:
+                out[h] = [(bases[i], float(totals[i]))]
+            else:
+                out[h] = self._ranked(h, budgets[h], bases[i])
+        return out
 
     def _common_summary(self) -> PartsSummary:
         """The ``murty.PartsSummary`` of the common parts, which lead every hypothesis' parts (worked out when
@@ -287,11 +302,13 @@ class SharedRanking:
             self._common = PartsSummary.of(self.common)
         return self._common
 
-    def _varying_part(self, b: int, h: int) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
-        rows, cols, patterns, pattern, subsets = self.varying[b]
-        key = (b, int(pattern[h]))
+    def _varying_part(self, b: int, p: int) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
+        """(rows, columns, ranking or None if infeasible) of varying block ``b`` cut to its presence pattern
+        ``p``, ranked on first use."""
+        key = (b, p)
         if key not in self._parts:
-            present = patterns[key[1]]
+            rows, cols, patterns, _, subsets = self.varying[b]
+            present = patterns[p]
             if subsets is None:
                 self._parts[key] = _part(self.cost, rows, cols, present, self.max_increase, True)
             else:
@@ -301,18 +318,35 @@ class SharedRanking:
                     self._parts[key] = rows, cols[present], None
         return self._parts[key]
 
-    def _hypothesis(self, h: int, k: int) -> list[tuple[np.ndarray, float]]:
-        if k < 1:
-            return []
-        parts = self.common + [self._varying_part(b, h) for b in range(len(self.varying))]
-        if not self.common_ok or any(ranking is None for _, _, ranking in parts[len(self.common) :]):
-            return []
-        base = self.common_base.copy()
-        for rows, cols, ranking in parts[len(self.common) :]:
-            base[rows] = cols[ranking.solution(0)[0]]
-        if k == 1:  # Product's best, without its set-up
-            varying_best = (ranking.solution(0)[1] for _, _, ranking in parts[len(self.common) :])
-            return [(base, float(sum([*self.common_best, *varying_best])))]
+    def _best_assignments(self, hypotheses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Best assignment (H, M) in union columns, its cost (H,) and feasibility (H,) of each of
+        ``hypotheses`` (H,): the common parts' best, then per varying block the best of the hypothesis'
+        presence pattern. Costs are summed part by part in the order of the parts, as ``murty.Product`` sums
+        them (the same float additions in the same order)."""
+        bases = np.tile(self.common_base, (len(hypotheses), 1))
+        totals = np.zeros(len(hypotheses))
+        for best_cost in self.common_best:
+            totals += best_cost
+        feasible = np.ones(len(hypotheses), dtype=bool)
+        for b, (rows, _, patterns, pattern, _) in enumerate(self.varying):
+            of_hypothesis = pattern[hypotheses]
+            cols_of = np.zeros((len(patterns), len(rows)), dtype=np.int64)
+            cost_of = np.zeros(len(patterns))
+            ok_of = np.zeros(len(patterns), dtype=bool)
+            for p in np.unique(of_hypothesis).tolist():
+                _, part_cols, ranking = self._varying_part(b, p)
+                if ranking is not None:
+                    best, cost = ranking.solution(0)
+                    cols_of[p], cost_of[p], ok_of[p] = part_cols[best], cost, True
+            bases[:, rows] = cols_of[of_hypothesis]
+            totals += cost_of[of_hypothesis]
+            feasible &= ok_of[of_hypothesis]
+        return bases, totals, feasible
+
+    def _ranked(self, h: int, k: int, base: np.ndarray) -> list[tuple[np.ndarray, float]]:
+        """The k best assignments of feasible hypothesis ``h``, whose best is ``base``."""
+        varying = [self._varying_part(b, int(pattern[h])) for b, (*_, pattern, _) in enumerate(self.varying)]
+        parts = self.common + varying
         product = Product(base, parts, self.max_increase, self._common_summary())
         out = []
         for i in range(k):
