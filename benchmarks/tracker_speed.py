@@ -57,16 +57,19 @@ def stress_frames(n: int, n_frames: int, seed: int = 0) -> list[Boxes]:
     return frames
 
 
-def time_stress(tracker: str, config: TrackerConfig, n: int) -> tuple[float, int]:
-    """Step time of the last of 4 stress frames (tracks exist by then) and its number of kept detections."""
-    mot = MultiClassTracker(tracker, config)
+def time_stress(tracker: str, config: TrackerConfig, n: int, repeat: int = 1) -> tuple[float, int]:
+    """Step time of the last of 4 stress frames (tracks exist by then), the fastest of ``repeat`` runs, and its
+    number of kept detections."""
     frames = [preprocess(b, config.preprocess, TRACKING_CLASSES) for b in stress_frames(n, 4)]
-    elapsed = 0.0
-    for i, frame in enumerate(frames):
-        start = time.perf_counter()
-        mot.step(frame, 0.5 if i else 0.0, NullSink())
-        elapsed = time.perf_counter() - start
-    return elapsed, int(frames[-1].kept.sum())
+    fastest = float("inf")
+    for _ in range(repeat):
+        mot = MultiClassTracker(tracker, config)
+        for i, frame in enumerate(frames):
+            start = time.perf_counter()
+            mot.step(frame, 0.5 if i else 0.0, NullSink())
+            elapsed = time.perf_counter() - start
+        fastest = min(fastest, elapsed)
+    return fastest, int(frames[-1].kept.sum())
 
 
 def main() -> None:
@@ -74,7 +77,9 @@ def main() -> None:
     parser.add_argument("--tracker", action="append", choices=TRACKER_NAMES)
     parser.add_argument("--preset", default="centerpoint")
     parser.add_argument("--stress-n", type=int, default=320)
-    parser.add_argument("--repeat", type=int, default=3, help="runs per scene; the fastest time per frame counts")
+    parser.add_argument(
+        "--repeat", type=int, default=3, help="runs per scene and of the stress frames; the fastest per frame counts"
+    )
     parser.add_argument("--params", type=Path, help="parameter file, as gnnpmb track --params")
     args = parser.parse_args()
     config = load_config(args.params)
@@ -101,7 +106,7 @@ def main() -> None:
                 best = times if best is None else np.minimum(best, times)
             per_frame.extend(best.tolist())
         t = np.array(per_frame) * 1e3
-        stress_s, stress_n = time_stress(tracker, config, args.stress_n)
+        stress_s, stress_n = time_stress(tracker, config, args.stress_n, args.repeat)
         print(
             f"{tracker:8s} {np.median(t):10.2f} {np.percentile(t, 90):8.2f} {t.max():8.2f} "
             f"{stress_s * 1e3:10.1f} {stress_n:12d}"

@@ -105,49 +105,68 @@ def rank(
     n_rows = cost.shape[0]
     if n_rows == 0:
         return Product(np.zeros(0, dtype=np.int64), [], max_increase)
-    if _candidates(cost) <= ENUMERATION_LIMIT:
+    counts = np.count_nonzero(cost < np.inf, axis=1)
+    if float(np.prod(counts, dtype=float)) <= ENUMERATION_LIMIT:
         return _block_ranking(cost, first, max_increase, cache)
     if max_increase < math.inf:
         if first is None:
             first, _ = solve(cost)
         cost = _forbid_hopeless(forbid_beyond_private(cost, max_increase), first, max_increase)
-        if _candidates(cost) <= ENUMERATION_LIMIT:
+        counts = np.count_nonzero(cost < np.inf, axis=1)
+        if float(np.prod(counts, dtype=float)) <= ENUMERATION_LIMIT:
             return _block_ranking(cost, first, max_increase, cache)
-    parts = []
+    parts: list[tuple[np.ndarray, np.ndarray, Ranking]] = []
     base = np.empty(n_rows, dtype=np.int64)
     local_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
     for rows, cols in blocks(cost):
-        root = None
-        if first is not None:
-            local_of_col[cols] = np.arange(len(cols))
-            root = local_of_col[first[rows]]
-        ranking = _block_ranking(cost[np.ix_(rows, cols)], root, max_increase, cache)
-        base[rows] = cols[ranking.solution(0)[0]]
+        if len(rows) == 1:  # a one-row block (the most common): ``block_ranking``'s SingleRow, without a copy
+            if not len(cols):
+                raise InfeasibleAssignment("a row has no allowed column")
+            row = cost[rows[0], cols]
+            at = int(np.argmin(row)) if first is None else int(np.searchsorted(cols, first[rows[0]]))
+            ranking: Ranking = SingleRow(row, at, max_increase)
+            base[rows[0]] = cols[at]
+        else:
+            root = None
+            if first is not None:
+                local_of_col[cols] = np.arange(len(cols))
+                root = local_of_col[first[rows]]
+            candidates = float(np.prod(counts[rows], dtype=float))  # its columns are all its rows' allowed ones
+            ranking = _block_ranking(cost[np.ix_(rows, cols)], root, max_increase, cache, candidates)
+            base[rows] = cols[ranking.solution(0)[0]]
         parts.append((rows, cols, ranking))
     return Product(base, parts, max_increase)
 
 
-def _block_ranking(cost: np.ndarray, root: np.ndarray | None, max_increase: float, cache: BlockCache | None) -> Ranking:
+def _block_ranking(
+    cost: np.ndarray,
+    root: np.ndarray | None,
+    max_increase: float,
+    cache: BlockCache | None,
+    candidates: float | None = None,
+) -> Ranking:
     """``block_ranking``, looked up in and added to ``cache`` if given."""
     if cache is None:
-        return block_ranking(cost, root, max_increase)
+        return block_ranking(cost, root, max_increase, candidates)
     key = (cost.shape, cost.tobytes(), None if root is None else root.tobytes(), max_increase)
     ranking = cache.get(key)
     if ranking is None:
-        ranking = cache[key] = block_ranking(cost, root, max_increase)
+        ranking = cache[key] = block_ranking(cost, root, max_increase, candidates)
     return ranking
 
 
-def block_ranking(cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf) -> Ranking:
+def block_ranking(
+    cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf, candidates: float | None = None
+) -> Ranking:
     """Ranking of one block (not split): a sorted row for a single row, enumeration when small, else Murty;
     only assignments at most ``max_increase`` costlier than the best. ``root``: a best assignment to rank
-    first (else found here). Raises ``InfeasibleAssignment``."""
+    first (else found here); ``candidates``: ``_candidates(cost)`` if known. Raises ``InfeasibleAssignment``."""
     n_rows = cost.shape[0]
     if n_rows == 1:
         if not np.isfinite(cost[0]).any():
             raise InfeasibleAssignment("the only row has no allowed column")
         return SingleRow(cost[0], int(np.argmin(cost[0]) if root is None else root[0]), max_increase)
-    if _candidates(cost) <= ENUMERATION_LIMIT:
+    if (_candidates(cost) if candidates is None else candidates) <= ENUMERATION_LIMIT:
         return Enumerated(cost, root, max_increase)
     return Murty(cost, solve(cost)[0] if root is None else root, max_increase)
 
@@ -294,21 +313,15 @@ class Enumerated:
         self._costs = costs[order]
 
 
-SUBSET_ENUMERATION_LIMIT = 16 * 1024
-"""``ColumnSubsets`` lists a block's assignments once, to be filtered for each column subset, when its rows'
-allowed-column counts multiply to at most this."""
-
-
 class ColumnSubsets:
     """Rankings of the sub-problems of one (R, C) block that keep only some of its columns (PMBM: a gated block
     of the union of all hypotheses' Bernoullis, cut to the Bernoullis one hypothesis holds).
 
     ``rank(present)`` gives the ranking ``rank(cost[:, present], max_increase=max_increase)`` gives, solution
-    for solution. Small sub-problems share work: a sub-problem's assignments are those of the whole block that
-    use only present columns, in the same (lexicographic) order, so the block's are listed once
-    (``enumerate_assignments``) and filtered per subset. Larger ones are split by ``rank`` into blocks, most
-    of them the same for many subsets: ``cache`` (shared, e.g. by every block of a PMBM frame) ranks each
-    distinct one once.
+    for solution. Small sub-problems are listed on their own (``Enumerated``: filtering one listing of the whole
+    block per subset was measured slower, since the block's listing is much longer than a subset's). Larger
+    ones are split by ``rank`` into blocks, most of them the same for many subsets: ``cache`` (shared, e.g. by
+    every block of a PMBM frame) ranks each distinct one once.
     """
 
     def __init__(self, cost: np.ndarray, max_increase: float = math.inf, cache: BlockCache | None = None):
@@ -316,8 +329,6 @@ class ColumnSubsets:
         self.max_increase = max_increase
         self.cache = cache
         self.allowed = cost < np.inf
-        self._listed: np.ndarray | None = None
-        self._few = _candidates(cost) <= SUBSET_ENUMERATION_LIMIT
 
     def rank(self, present: np.ndarray) -> Ranking:
         """The ranking of the sub-problem with columns ``present`` ((C,) bool). Raises ``InfeasibleAssignment``."""
@@ -330,13 +341,7 @@ class ColumnSubsets:
             if not counts[0]:
                 raise InfeasibleAssignment("the only row has no allowed column")
             return SingleRow(sub[0], int(np.argmin(sub[0])), self.max_increase)
-        if not self._few:
-            return Enumerated(sub, None, self.max_increase)
-        if self._listed is None:
-            self._listed = enumerate_assignments(self.allowed)
-        listed = self._listed
-        local_of_col = np.cumsum(present) - 1
-        return Enumerated(sub, None, self.max_increase, local_of_col[listed[present[listed].all(axis=1)]])
+        return Enumerated(sub, None, self.max_increase)
 
 
 class Murty:
