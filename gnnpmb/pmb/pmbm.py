@@ -44,11 +44,13 @@ import numpy as np
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.assign.murty import (
+    ENUMERATION_LIMIT,
     BlockCache,
     ColumnSubsets,
     PartsSummary,
     Product,
     Ranking,
+    SingleRow,
     blocks,
     forbid_beyond_private,
     k_best,
@@ -149,7 +151,9 @@ class KBest:
                 cost = local.cost_matrix()
                 ctx.sink.emit(CostMatrix(ctx.class_name, cost, local.row_labels(), local.col_labels(), hypothesis=h))
         union, members = _union_of(locals_)
-        largest = max((len(rows) for rows, _ in blocks(union.cost_matrix())), default=0)
+        largest = union.n_meas  # rows of the largest gated block: at most M, computed only if M is over budget
+        if largest > self.murty_block_rows:
+            largest = max((len(rows) for rows, _ in blocks(union.cost_matrix())), default=0)
         if largest > self.murty_block_rows:
             budgets = _trim_budgets(budgets, prior_log_w, self.crowd_hypotheses)
             if ctx.sink.enabled:
@@ -379,6 +383,11 @@ def _part(
     ``max_increase`` above its best (``best_only``: its best assignment alone); the ranking is None if that
     sub-problem has no assignment."""
     sub_cols = cols[present]
+    if len(rows) == 1 and not best_only and len(sub_cols) <= ENUMERATION_LIMIT:  # ``rank``'s SingleRow, directly
+        row = cost[rows[0], sub_cols]
+        if not (row < np.inf).any():
+            return rows, sub_cols, None
+        return rows, sub_cols, SingleRow(row, int(np.argmin(row)), max_increase)
     sub = cost[np.ix_(rows, sub_cols)]
     try:
         return rows, sub_cols, BestOnly(sub) if best_only else rank(sub, max_increase=max_increase)
