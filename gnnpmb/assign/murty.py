@@ -348,6 +348,53 @@ class ColumnSubsets:
             return SingleRow(sub[0], int(np.argmin(sub[0])), self.max_increase)
         return Enumerated(sub, None, self.max_increase)
 
+    def ranks(self, patterns: np.ndarray) -> list[Ranking | None]:
+        """``rank(present)`` of every row of ``patterns`` ((P, C) bool), None where it raises
+        ``InfeasibleAssignment``.
+
+        The best assignments of the small sub-problems of two or more rows (those ``rank`` lists) are found
+        together when the whole block's listing is short (``SHARED_LISTING_LIMIT``): one listing and its costs,
+        masked per pattern, the first cheapest of each (the listing's order restricted to a pattern is that
+        pattern's own lexicographic order, and each cost is the same sum of the same entries). Each gets an
+        ``Enumerated`` with that best as its root, which lists nothing more unless asked for a second solution."""
+        n_rows = self.cost.shape[0]
+        counts = (self.allowed[None, :, :] & patterns[:, None, :]).sum(axis=2)
+        listed_together = np.zeros(len(patterns), dtype=bool)
+        if n_rows >= 2 and _candidates(self.cost) <= SHARED_LISTING_LIMIT:
+            listed_together = np.prod(counts, axis=1, dtype=float) <= ENUMERATION_LIMIT
+        out: list[Ranking | None] = [None] * len(patterns)
+        for p in np.flatnonzero(~listed_together).tolist():
+            try:
+                out[p] = self.rank(patterns[p])
+            except InfeasibleAssignment:
+                out[p] = None
+        if listed_together.sum() < 2:
+            for p in np.flatnonzero(listed_together).tolist():
+                try:
+                    out[p] = self.rank(patterns[p])
+                except InfeasibleAssignment:
+                    out[p] = None
+            return out
+        together = np.flatnonzero(listed_together)
+        listed = enumerate_assignments(self.allowed)
+        if not len(listed):  # no assignment of the block, so none of a subset
+            return out
+        costs = self.cost[np.arange(n_rows), listed].sum(axis=1)
+        valid = patterns[together][:, listed].all(axis=2)
+        first_cheapest = np.argmin(np.where(valid, costs, np.inf), axis=1)
+        local_of_col = np.cumsum(patterns[together], axis=1) - 1
+        roots = local_of_col[np.arange(len(together))[:, None], listed[first_cheapest]]
+        feasible = valid[np.arange(len(together)), first_cheapest]
+        for i, p in enumerate(together.tolist()):
+            if feasible[i]:
+                out[p] = Enumerated(self.cost[:, patterns[p]], roots[i], self.max_increase)
+        return out
+
+
+SHARED_LISTING_LIMIT = 4096
+"""``ColumnSubsets.ranks`` finds the best assignments of several small column subsets from one listing of the
+whole block when that block has at most this many candidates."""
+
 
 class Murty:
     """Ranking of one (r, c) block by Murty's partitioning (module docstring); ``root`` is a best assignment.

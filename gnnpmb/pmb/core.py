@@ -89,6 +89,23 @@ class GlobalHypothesis:
         return GlobalHypothesis(self.log_weight, self.store, self.index[keep])
 
 
+def _without_existence_below(hypotheses: list[GlobalHypothesis], threshold: float) -> list[GlobalHypothesis]:
+    """``[h.without_existence_below(threshold) for h in hypotheses]``; for hypotheses indexing one store (PMBM),
+    its low-existence rows are found once and only the hypotheses holding one are cut."""
+    store = hypotheses[0].store
+    indices = [h.index for h in hypotheses if h.store is store and h.index is not None]
+    if len(indices) < len(hypotheses):
+        return [h.without_existence_below(threshold) for h in hypotheses]
+    low = store.existence < threshold
+    if not low.any():
+        return list(hypotheses)
+    kept = []
+    for h, index in zip(hypotheses, indices, strict=True):
+        drop = low[index]
+        kept.append(GlobalHypothesis(h.log_weight, store, index[~drop]) if drop.any() else h)
+    return kept
+
+
 def hypothesis_union(hypotheses: Sequence[GlobalHypothesis]) -> tuple[Bernoullis, list[np.ndarray]]:
     """The distinct Bernoullis of ``hypotheses`` (one per ``local_key``, by increasing key; the first met of
     equal keys) and each hypothesis' rows of it, (K_h,) in the hypothesis' order. Hypotheses indexing one
@@ -437,7 +454,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     ) -> list[GlobalHypothesis]:
         """Drop Bernoullis with r < threshold from every hypothesis; report tracks that vanished from all."""
         threshold = self.params.prune_existence
-        kept = [h.without_existence_below(threshold) for h in posteriors]
+        kept = _without_existence_below(posteriors, threshold)
         if sink.enabled:
             posterior_r = _max_existence(posteriors)
             prior_r = _max_existence(priors)

@@ -332,12 +332,17 @@ class SharedRanking:
         for best_cost in self.common_best:
             totals += best_cost
         feasible = np.ones(len(hypotheses), dtype=bool)
-        for b, (rows, _, patterns, pattern, _) in enumerate(self.varying):
+        for b, (rows, cols, patterns, pattern, subsets) in enumerate(self.varying):
             of_hypothesis = pattern[hypotheses]
             cols_of = np.zeros((len(patterns), len(rows)), dtype=np.int64)
             cost_of = np.zeros(len(patterns))
             ok_of = np.zeros(len(patterns), dtype=bool)
-            for p in np.unique(of_hypothesis).tolist():
+            used = np.unique(of_hypothesis).tolist()
+            unranked = [p for p in used if (b, p) not in self._parts]
+            if subsets is not None and len(unranked) > 1:  # ranked together (``murty.ColumnSubsets.ranks``)
+                for p, ranking in zip(unranked, subsets.ranks(patterns[unranked]), strict=True):
+                    self._parts[(b, p)] = rows, cols[patterns[p]], ranking
+            for p in used:
                 _, part_cols, ranking = self._varying_part(b, p)
                 if ranking is not None:
                     best, cost = ranking.solution(0)

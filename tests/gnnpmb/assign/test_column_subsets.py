@@ -111,3 +111,33 @@ def test_enumerated_with_a_root_defers_listing_and_agrees_with_its_listing():
         assert best is not None and best[0].tolist() == root.tolist()
         assert best[1] == eager.solution(0)[1]  # bit for bit
         assert all_solutions(lazy) == all_solutions(eager)
+
+
+@pytest.mark.parametrize("max_increase", [math.inf, 1.5])
+def test_ranks_of_several_column_subsets_equal_each_rank(max_increase):
+    """``ColumnSubsets.ranks`` (best assignments of small subsets from one listing of the block) gives what
+    ``rank`` gives for each subset, solution for solution, ties included, None where it is infeasible."""
+    rng = np.random.default_rng(11)
+    together = infeasible = 0
+    for trial in range(200):
+        n_rows, n_tracks = int(rng.integers(1, 6)), int(rng.integers(1, 8))
+        integer = trial % 2 == 0
+        shape = (n_rows, n_tracks)
+        tracks = rng.integers(0, 4, size=shape).astype(float) if integer else rng.random(shape)
+        tracks[rng.random(shape) < 0.3] = np.inf
+        private = np.full((n_rows, n_rows), np.inf)
+        private[np.arange(n_rows), np.arange(n_rows)] = rng.integers(0, 4, size=n_rows) if integer else 1.0
+        private[rng.random((n_rows, n_rows)) < 0.1] = np.inf  # now and then a row with no private column
+        cost = np.hstack([tracks, private])
+        patterns = rng.random((int(rng.integers(1, 6)), cost.shape[1])) < 0.7
+        subsets = murty.ColumnSubsets(cost, max_increase)
+        got = subsets.ranks(patterns)
+        for present, ranking in zip(patterns, got, strict=True):
+            try:
+                want = all_solutions(murty.ColumnSubsets(cost, max_increase).rank(present))
+            except murty.InfeasibleAssignment:
+                want = None
+            assert (None if ranking is None else all_solutions(ranking)) == want
+            infeasible += want is None
+        together += n_rows >= 2 and len(patterns) >= 2
+    assert together > 50 and infeasible > 10
