@@ -356,8 +356,17 @@ class ColumnSubsets:
         together when the whole block's listing is short (``SHARED_LISTING_LIMIT``): one listing and its costs,
         masked per pattern, the first cheapest of each (the listing's order restricted to a pattern is that
         pattern's own lexicographic order, and each cost is the same sum of the same entries). Each gets an
-        ``Enumerated`` with that best as its root, which lists nothing more unless asked for a second solution."""
+        ``Enumerated`` with that best as its root, which lists nothing more unless asked for a second solution.
+        A one-row block gives each pattern its ``SingleRow`` from one masked argmin."""
         n_rows = self.cost.shape[0]
+        if n_rows == 1 and self.cost.shape[1] <= ENUMERATION_LIMIT:  # each pattern's SingleRow (``rank``)
+            row = np.where(patterns, self.cost[0], np.inf)
+            cheapest = np.argmin(row, axis=1)
+            local = (np.cumsum(patterns, axis=1) - 1)[np.arange(len(patterns)), cheapest]
+            return [
+                SingleRow(self.cost[0, present], int(at), self.max_increase) if row[p, c] < np.inf else None
+                for p, (present, c, at) in enumerate(zip(patterns, cheapest.tolist(), local.tolist(), strict=True))
+            ]
         counts = (self.allowed[None, :, :] & patterns[:, None, :]).sum(axis=2)
         listed_together = np.zeros(len(patterns), dtype=bool)
         if n_rows >= 2 and _candidates(self.cost) <= SHARED_LISTING_LIMIT:

@@ -261,12 +261,13 @@ class SharedRanking:
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
         self._blocks: BlockCache = {}
         self._common: PartsSummary | None = None
+        varies = has_column.any(axis=0) & ~has_column.all(axis=0)  # columns only some hypotheses hold
         for rows, cols in blocks(cost):
-            present = has_column[:, cols]
             best_only = len(rows) > max_block_rows
-            if (present == present[0]).all():
-                self.common.append(_part(cost, rows, cols, present[0], max_increase, best_only))
+            if not varies[cols].any():
+                self.common.append(_part(cost, rows, cols, has_column[0, cols], max_increase, best_only))
                 continue
+            present = has_column[:, cols]
             packed = np.ascontiguousarray(np.packbits(present, axis=1))
             rows_as_bytes = packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
             _, first, pattern = np.unique(rows_as_bytes, return_index=True, return_inverse=True)
