@@ -268,9 +268,7 @@ class SharedRanking:
                 self.common.append(_part(cost, rows, cols, has_column[0, cols], max_increase, best_only))
                 continue
             present = has_column[:, cols]
-            packed = np.ascontiguousarray(np.packbits(present, axis=1))
-            rows_as_bytes = packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
-            _, first, pattern = np.unique(rows_as_bytes, return_index=True, return_inverse=True)
+            _, first, pattern = np.unique(_row_keys(present), return_index=True, return_inverse=True)
             subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase, self._blocks)
             self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
@@ -375,6 +373,19 @@ class BestOnly:
 
     def solution(self, index: int) -> tuple[np.ndarray, float] | None:
         return self._best if index == 0 else None
+
+
+def _row_keys(present: np.ndarray) -> np.ndarray:
+    """(H,) one sortable key per row of an (H, C) bool array, ordered as the rows' packed bytes compare
+    (memcmp): the packed bytes as a void scalar, or, for C <= 64, as one big-endian uint64 (zero-padded), which
+    ``np.unique`` sorts much faster and in the same order."""
+    packed = np.packbits(present, axis=1)
+    if packed.shape[1] <= 8:
+        padded = np.zeros((len(packed), 8), dtype=np.uint8)
+        padded[:, : packed.shape[1]] = packed
+        return padded.view(">u8").ravel()
+    packed = np.ascontiguousarray(packed)
+    return packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
 
 
 def _part(
