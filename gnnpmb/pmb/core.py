@@ -265,14 +265,16 @@ def posteriors_from_assignments(
     tracks = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1))
     store = Bernoullis.concatenate([tracks, new_bernoullis(union, born, ctx)])
     birth_rows = len(tracks) + np.searchsorted(born, birth_j)
-    track_bounds = np.concatenate([[0], np.cumsum(lengths)]).tolist()
-    birth_bounds = np.concatenate([[0], np.cumsum(is_birth.sum(axis=1))]).tolist()
-    return store, [
-        np.concatenate([inverse[track_bounds[i] : track_bounds[i + 1]], birth_rows[b0:b1]])
-        if b1 > b0
-        else inverse[track_bounds[i] : track_bounds[i + 1]]
-        for i, (b0, b1) in enumerate(zip(birth_bounds[:-1], birth_bounds[1:], strict=True))
-    ]
+    n_births = is_birth.sum(axis=1)
+    sizes = lengths + n_births
+    starts = np.cumsum(sizes) - sizes  # each hypothesis' rows: its tracks, then its births, laid end to end
+    rows = np.empty(int(sizes.sum()), dtype=np.int64)
+    hyp_of_track = np.repeat(np.arange(n_hyp), lengths)
+    rows[starts[hyp_of_track] + np.arange(len(index)) - (np.cumsum(lengths) - lengths)[hyp_of_track]] = inverse
+    hyp_of_birth = np.repeat(np.arange(n_hyp), n_births)
+    birth_starts = np.cumsum(n_births) - n_births
+    rows[(starts + lengths)[hyp_of_birth] + np.arange(len(birth_j)) - birth_starts[hyp_of_birth]] = birth_rows
+    return store, np.split(rows, np.cumsum(sizes)[:-1].tolist())
 
 
 def _unique_codes(codes: np.ndarray, n_codes: int) -> tuple[np.ndarray, np.ndarray]:
