@@ -26,9 +26,11 @@ unaffected.
 
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
-ranked once and shared by all hypotheses that contain it (``murty.Product``). The sub-problems of one block
-share a listing of its assignments and the rankings of equal smaller blocks (``murty.ColumnSubsets``,
-``murty.BlockCache``); a hypothesis with one child gets its best assignment without a ``Product``. Posteriors
+ranked once and shared by all hypotheses that contain it (``murty.Product``). The small sub-problems of one
+block get their best assignments from one listing of the block, and larger ones share the rankings of equal
+smaller blocks (``murty.ColumnSubsets.ranks``, ``murty.BlockCache``); a ranking goes past its best only when a
+hypothesis has more than one child. The best assignments of all hypotheses are assembled block by block, at
+once; a hypothesis with more than one child gets a ``Product`` (``SharedRanking``). Posteriors
 are built once per distinct (Bernoulli, outcome) into one store that the posterior hypotheses index
 (``core.posteriors_from_assignments``, ``core.GlobalHypothesis``). These pieces only share work: each gives
 the same assignments, costs and Bernoullis, bit for bit, as the plain computation it replaces (their tests).
