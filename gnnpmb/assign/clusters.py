@@ -8,6 +8,8 @@ ranked block by block (Murty).
 One implementation serves JPDA, the exact marginals and Murty's blocks: a union-find over the edges that hooks
 the larger root under the smaller and jumps pointers, so a component's label is its smallest track index. It is
 2.5-4x faster than scipy's ``connected_components`` on one class's gate matrix (``benchmarks/gate_clustering.py``).
+Graphs of at most ``SMALL_GRAPH_EDGES`` edges (most PMBM sub-problems: a few rows) are joined by the same
+union-find in plain Python, which gives the same clusters without the fixed cost of a dozen NumPy calls.
 """
 
 from __future__ import annotations
@@ -15,6 +17,10 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+
+SMALL_GRAPH_EDGES = 96
+"""Gate graphs with at most this many edges are clustered in Python (``_small_graph_clusters``); measured on
+this machine: 14 vs 49 us at 6 x 25 with 22 edges, about equal at 150 edges."""
 
 
 class Cluster(NamedTuple):
@@ -36,6 +42,8 @@ def gate_clusters(inside: np.ndarray, with_isolated_tracks: bool = False) -> lis
     if n_tracks == 0:
         return []
     a, c = np.divmod(np.flatnonzero(inside), n_meas)  # np.nonzero is slow on 2D arrays
+    if len(a) <= SMALL_GRAPH_EDGES:
+        return _small_graph_clusters(a.tolist(), c.tolist(), n_tracks, with_isolated_tracks)
     b = n_tracks + c
     label = np.arange(n_tracks + n_meas)
     while True:
@@ -60,4 +68,40 @@ def gate_clusters(inside: np.ndarray, with_isolated_tracks: bool = False) -> lis
         Cluster(track_order[i:j], meas_order[k:m])
         for i, j, k, m in zip(track_starts.tolist(), track_stops, meas_starts, meas_stops, strict=True)
         if with_isolated_tracks or k < m
+    ]
+
+
+def _small_graph_clusters(a: list[int], c: list[int], n_tracks: int, with_isolated_tracks: bool) -> list[Cluster]:
+    """``gate_clusters`` of the graph with edges (track a_e, measurement c_e), in Python: a union-find that
+    hooks the larger root under the smaller, so a component's root is its smallest node (its smallest track);
+    tracks and measurements are listed in increasing index, components in increasing root."""
+    parent: dict[int, int] = {k: k for k in range(n_tracks)}
+    for j in c:
+        parent[n_tracks + j] = n_tracks + j
+    for ta, mc in zip(a, c, strict=True):
+        ra, rb = ta, n_tracks + mc
+        while parent[ra] != ra:
+            ra = parent[ra]
+        while parent[rb] != rb:
+            rb = parent[rb]
+        if ra < rb:
+            parent[rb] = ra
+        elif rb < ra:
+            parent[ra] = rb
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            node = parent[node]
+        return node
+
+    tracks: dict[int, list[int]] = {}
+    for k in range(n_tracks):
+        tracks.setdefault(root(k), []).append(k)
+    meas: dict[int, list[int]] = {}
+    for j in sorted(set(c)):
+        meas.setdefault(root(n_tracks + j), []).append(j)
+    return [
+        Cluster(np.array(members, dtype=np.intp), np.array(meas.get(r, ()), dtype=np.intp))
+        for r, members in tracks.items()
+        if with_isolated_tracks or r in meas
     ]

@@ -105,49 +105,68 @@ def rank(
     n_rows = cost.shape[0]
     if n_rows == 0:
         return Product(np.zeros(0, dtype=np.int64), [], max_increase)
-    if _candidates(cost) <= ENUMERATION_LIMIT:
+    counts = np.count_nonzero(cost < np.inf, axis=1)
+    if float(np.prod(counts, dtype=float)) <= ENUMERATION_LIMIT:
         return _block_ranking(cost, first, max_increase, cache)
     if max_increase < math.inf:
         if first is None:
             first, _ = solve(cost)
         cost = _forbid_hopeless(forbid_beyond_private(cost, max_increase), first, max_increase)
-        if _candidates(cost) <= ENUMERATION_LIMIT:
+        counts = np.count_nonzero(cost < np.inf, axis=1)
+        if float(np.prod(counts, dtype=float)) <= ENUMERATION_LIMIT:
             return _block_ranking(cost, first, max_increase, cache)
-    parts = []
+    parts: list[tuple[np.ndarray, np.ndarray, Ranking]] = []
     base = np.empty(n_rows, dtype=np.int64)
     local_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
     for rows, cols in blocks(cost):
-        root = None
-        if first is not None:
-            local_of_col[cols] = np.arange(len(cols))
-            root = local_of_col[first[rows]]
-        ranking = _block_ranking(cost[np.ix_(rows, cols)], root, max_increase, cache)
-        base[rows] = cols[ranking.solution(0)[0]]
+        if len(rows) == 1:  # a one-row block (the most common): ``block_ranking``'s SingleRow, without a copy
+            if not len(cols):
+                raise InfeasibleAssignment("a row has no allowed column")
+            row = cost[rows[0], cols]
+            at = int(np.argmin(row)) if first is None else int(np.searchsorted(cols, first[rows[0]]))
+            ranking: Ranking = SingleRow(row, at, max_increase)
+            base[rows[0]] = cols[at]
+        else:
+            root = None
+            if first is not None:
+                local_of_col[cols] = np.arange(len(cols))
+                root = local_of_col[first[rows]]
+            candidates = float(np.prod(counts[rows], dtype=float))  # its columns are all its rows' allowed ones
+            ranking = _block_ranking(cost[np.ix_(rows, cols)], root, max_increase, cache, candidates)
+            base[rows] = cols[ranking.solution(0)[0]]
         parts.append((rows, cols, ranking))
     return Product(base, parts, max_increase)
 
 
-def _block_ranking(cost: np.ndarray, root: np.ndarray | None, max_increase: float, cache: BlockCache | None) -> Ranking:
+def _block_ranking(
+    cost: np.ndarray,
+    root: np.ndarray | None,
+    max_increase: float,
+    cache: BlockCache | None,
+    candidates: float | None = None,
+) -> Ranking:
     """``block_ranking``, looked up in and added to ``cache`` if given."""
     if cache is None:
-        return block_ranking(cost, root, max_increase)
+        return block_ranking(cost, root, max_increase, candidates)
     key = (cost.shape, cost.tobytes(), None if root is None else root.tobytes(), max_increase)
     ranking = cache.get(key)
     if ranking is None:
-        ranking = cache[key] = block_ranking(cost, root, max_increase)
+        ranking = cache[key] = block_ranking(cost, root, max_increase, candidates)
     return ranking
 
 
-def block_ranking(cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf) -> Ranking:
+def block_ranking(
+    cost: np.ndarray, root: np.ndarray | None = None, max_increase: float = math.inf, candidates: float | None = None
+) -> Ranking:
     """Ranking of one block (not split): a sorted row for a single row, enumeration when small, else Murty;
     only assignments at most ``max_increase`` costlier than the best. ``root``: a best assignment to rank
-    first (else found here). Raises ``InfeasibleAssignment``."""
+    first (else found here); ``candidates``: ``_candidates(cost)`` if known. Raises ``InfeasibleAssignment``."""
     n_rows = cost.shape[0]
     if n_rows == 1:
         if not np.isfinite(cost[0]).any():
             raise InfeasibleAssignment("the only row has no allowed column")
         return SingleRow(cost[0], int(np.argmin(cost[0]) if root is None else root[0]), max_increase)
-    if _candidates(cost) <= ENUMERATION_LIMIT:
+    if (_candidates(cost) if candidates is None else candidates) <= ENUMERATION_LIMIT:
         return Enumerated(cost, root, max_increase)
     return Murty(cost, solve(cost)[0] if root is None else root, max_increase)
 
@@ -188,15 +207,25 @@ def blocks(cost: np.ndarray) -> list[Cluster]:
 
 
 class SingleRow:
-    """Ranking of a one-row problem: its finite entries, ``root`` first, then by cost (stable)."""
+    """Ranking of a one-row problem: its finite entries, ``root`` first, then by cost (stable). The entries
+    are sorted when a second solution is first asked for (most one-row blocks of PMBM only give their best)."""
 
     def __init__(self, cost_row: np.ndarray, root: int, max_increase: float = math.inf):
-        order = np.argsort(cost_row, kind="stable")
-        keep = (cost_row[order] < np.inf) & (cost_row[order] <= cost_row[root] + max_increase) & (order != root)
-        self._cols = np.concatenate([[root], order[keep]]).astype(np.int64)
-        self._costs = cost_row[self._cols]
+        self._row = cost_row
+        self._max_increase = max_increase
+        self._best = np.array([root], dtype=np.int64), float(cost_row[root])
+        self._cols: np.ndarray | None = None
+        self._costs: np.ndarray | None = None
 
     def solution(self, index: int) -> tuple[np.ndarray, float] | None:
+        if index == 0:
+            return self._best
+        if self._cols is None or self._costs is None:
+            cost_row, root = self._row, int(self._best[0][0])
+            order = np.argsort(cost_row, kind="stable")
+            keep = (cost_row[order] < np.inf) & (cost_row[order] <= cost_row[root] + self._max_increase)
+            self._cols = np.concatenate([[root], order[keep & (order != root)]]).astype(np.int64)
+            self._costs = cost_row[self._cols]
         if index >= len(self._cols):
             return None
         return self._cols[index : index + 1], float(self._costs[index])
@@ -204,18 +233,23 @@ class SingleRow:
 
 def enumerate_assignments(allowed: np.ndarray) -> np.ndarray:
     """(N, R) every assignment of the R rows of ``allowed`` ((R, C) bool) to distinct allowed columns, in
-    lexicographic order of their columns: rows' allowed columns are combined row by row, dropping combinations
-    that reuse a column. Up to ``SMALL_PRODUCT`` candidates are combined in Python (fewer calls)."""
-    n_rows = allowed.shape[0]
-    row_cols = [np.flatnonzero(row) for row in allowed]
-    if math.prod(len(cols) for cols in row_cols) <= SMALL_PRODUCT:
-        listed = [c for c in itertools.product(*[cols.tolist() for cols in row_cols]) if len(set(c)) == n_rows]
+    lexicographic order of their columns. Up to ``SMALL_PRODUCT`` candidates are combined in Python (fewer
+    calls); more with NumPy in a fixed number of calls: every index tuple of the rows' allowed columns in C order
+    (``np.indices``, lexicographic), mapped to columns, keeping those whose sorted columns are distinct."""
+    n_rows, n_cols = allowed.shape
+    rows, cols = np.divmod(np.flatnonzero(allowed), max(n_cols, 1))
+    counts = np.bincount(rows, minlength=n_rows)
+    if n_rows == 0 or math.prod(counts.tolist()) <= SMALL_PRODUCT:
+        bounds = np.concatenate([[0], np.cumsum(counts)]).tolist()
+        flat = cols.tolist()
+        row_cols = [flat[start:stop] for start, stop in zip(bounds[:-1], bounds[1:], strict=True)]
+        listed = [c for c in itertools.product(*row_cols) if len(set(c)) == n_rows]
         return np.array(listed, dtype=np.int64).reshape(len(listed), n_rows)
-    combos = np.zeros((1, 0), dtype=np.int64)
-    for i, cols in enumerate(row_cols):
-        grown = np.column_stack([np.repeat(combos, len(cols), axis=0), np.tile(cols, len(combos))])
-        combos = grown[(grown[:, :i] != grown[:, i : i + 1]).all(axis=1)]
-    return combos
+    table = np.zeros((n_rows, int(counts.max())), dtype=np.int64)
+    table[rows, np.arange(len(rows)) - np.repeat(np.cumsum(counts) - counts, counts)] = cols
+    combos = table[np.arange(n_rows)[:, None], np.indices(counts.tolist()).reshape(n_rows, -1)].T
+    ordered = np.sort(combos, axis=1)
+    return np.ascontiguousarray(combos[(ordered[:, 1:] != ordered[:, :-1]).all(axis=1)])
 
 
 SMALL_PRODUCT = 32
@@ -284,21 +318,15 @@ class Enumerated:
         self._costs = costs[order]
 
 
-SUBSET_ENUMERATION_LIMIT = 16 * 1024
-"""``ColumnSubsets`` lists a block's assignments once, to be filtered for each column subset, when its rows'
-allowed-column counts multiply to at most this."""
-
-
 class ColumnSubsets:
     """Rankings of the sub-problems of one (R, C) block that keep only some of its columns (PMBM: a gated block
     of the union of all hypotheses' Bernoullis, cut to the Bernoullis one hypothesis holds).
 
     ``rank(present)`` gives the ranking ``rank(cost[:, present], max_increase=max_increase)`` gives, solution
-    for solution. Small sub-problems share work: a sub-problem's assignments are those of the whole block that
-    use only present columns, in the same (lexicographic) order, so the block's are listed once
-    (``enumerate_assignments``) and filtered per subset. Larger ones are split by ``rank`` into blocks, most
-    of them the same for many subsets: ``cache`` (shared, e.g. by every block of a PMBM frame) ranks each
-    distinct one once.
+    for solution. Small sub-problems are listed on their own (``Enumerated``: filtering one listing of the whole
+    block per subset was measured slower, since the block's listing is much longer than a subset's). Larger
+    ones are split by ``rank`` into blocks, most of them the same for many subsets: ``cache`` (shared, e.g. by
+    every block of a PMBM frame) ranks each distinct one once.
     """
 
     def __init__(self, cost: np.ndarray, max_increase: float = math.inf, cache: BlockCache | None = None):
@@ -306,8 +334,6 @@ class ColumnSubsets:
         self.max_increase = max_increase
         self.cache = cache
         self.allowed = cost < np.inf
-        self._listed: np.ndarray | None = None
-        self._few = _candidates(cost) <= SUBSET_ENUMERATION_LIMIT
 
     def rank(self, present: np.ndarray) -> Ranking:
         """The ranking of the sub-problem with columns ``present`` ((C,) bool). Raises ``InfeasibleAssignment``."""
@@ -320,13 +346,63 @@ class ColumnSubsets:
             if not counts[0]:
                 raise InfeasibleAssignment("the only row has no allowed column")
             return SingleRow(sub[0], int(np.argmin(sub[0])), self.max_increase)
-        if not self._few:
-            return Enumerated(sub, None, self.max_increase)
-        if self._listed is None:
-            self._listed = enumerate_assignments(self.allowed)
-        listed = self._listed
-        local_of_col = np.cumsum(present) - 1
-        return Enumerated(sub, None, self.max_increase, local_of_col[listed[present[listed].all(axis=1)]])
+        return Enumerated(sub, None, self.max_increase)
+
+    def ranks(self, patterns: np.ndarray) -> list[Ranking | None]:
+        """``rank(present)`` of every row of ``patterns`` ((P, C) bool), None where it raises
+        ``InfeasibleAssignment``.
+
+        The best assignments of the small sub-problems of two or more rows (those ``rank`` lists) are found
+        together when the whole block's listing is short (``SHARED_LISTING_LIMIT``): one listing and its costs,
+        masked per pattern, the first cheapest of each (the listing's order restricted to a pattern is that
+        pattern's own lexicographic order, and each cost is the same sum of the same entries). Each gets an
+        ``Enumerated`` with that best as its root, which lists nothing more unless asked for a second solution.
+        A one-row block gives each pattern its ``SingleRow`` from one masked argmin."""
+        n_rows = self.cost.shape[0]
+        if n_rows == 1 and self.cost.shape[1] <= ENUMERATION_LIMIT:  # each pattern's SingleRow (``rank``)
+            row = np.where(patterns, self.cost[0], np.inf)
+            cheapest = np.argmin(row, axis=1)
+            local = (np.cumsum(patterns, axis=1) - 1)[np.arange(len(patterns)), cheapest]
+            return [
+                SingleRow(self.cost[0, present], int(at), self.max_increase) if row[p, c] < np.inf else None
+                for p, (present, c, at) in enumerate(zip(patterns, cheapest.tolist(), local.tolist(), strict=True))
+            ]
+        counts = (self.allowed[None, :, :] & patterns[:, None, :]).sum(axis=2)
+        listed_together = np.zeros(len(patterns), dtype=bool)
+        if n_rows >= 2 and _candidates(self.cost) <= SHARED_LISTING_LIMIT:
+            listed_together = np.prod(counts, axis=1, dtype=float) <= ENUMERATION_LIMIT
+        out: list[Ranking | None] = [None] * len(patterns)
+        for p in np.flatnonzero(~listed_together).tolist():
+            try:
+                out[p] = self.rank(patterns[p])
+            except InfeasibleAssignment:
+                out[p] = None
+        if listed_together.sum() < 2:
+            for p in np.flatnonzero(listed_together).tolist():
+                try:
+                    out[p] = self.rank(patterns[p])
+                except InfeasibleAssignment:
+                    out[p] = None
+            return out
+        together = np.flatnonzero(listed_together)
+        listed = enumerate_assignments(self.allowed)
+        if not len(listed):  # no assignment of the block, so none of a subset
+            return out
+        costs = self.cost[np.arange(n_rows), listed].sum(axis=1)
+        valid = patterns[together][:, listed].all(axis=2)
+        first_cheapest = np.argmin(np.where(valid, costs, np.inf), axis=1)
+        local_of_col = np.cumsum(patterns[together], axis=1) - 1
+        roots = local_of_col[np.arange(len(together))[:, None], listed[first_cheapest]]
+        feasible = valid[np.arange(len(together)), first_cheapest]
+        for i, p in enumerate(together.tolist()):
+            if feasible[i]:
+                out[p] = Enumerated(self.cost[:, patterns[p]], roots[i], self.max_increase)
+        return out
+
+
+SHARED_LISTING_LIMIT = 4096
+"""``ColumnSubsets.ranks`` finds the best assignments of several small column subsets from one listing of the
+whole block when that block has at most this many candidates."""
 
 
 class Murty:

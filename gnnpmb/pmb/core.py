@@ -89,6 +89,23 @@ class GlobalHypothesis:
         return GlobalHypothesis(self.log_weight, self.store, self.index[keep])
 
 
+def _without_existence_below(hypotheses: list[GlobalHypothesis], threshold: float) -> list[GlobalHypothesis]:
+    """``[h.without_existence_below(threshold) for h in hypotheses]``; for hypotheses indexing one store (PMBM),
+    its low-existence rows are found once and only the hypotheses holding one are cut."""
+    store = hypotheses[0].store
+    indices = [h.index for h in hypotheses if h.store is store and h.index is not None]
+    if len(indices) < len(hypotheses):
+        return [h.without_existence_below(threshold) for h in hypotheses]
+    low = store.existence < threshold
+    if not low.any():
+        return list(hypotheses)
+    kept = []
+    for h, index in zip(hypotheses, indices, strict=True):
+        drop = low[index]
+        kept.append(GlobalHypothesis(h.log_weight, store, index[~drop]) if drop.any() else h)
+    return kept
+
+
 def hypothesis_union(hypotheses: Sequence[GlobalHypothesis]) -> tuple[Bernoullis, list[np.ndarray]]:
     """The distinct Bernoullis of ``hypotheses`` (one per ``local_key``, by increasing key; the first met of
     equal keys) and each hypothesis' rows of it, (K_h,) in the hypothesis' order. Hypotheses indexing one
@@ -248,14 +265,16 @@ def posteriors_from_assignments(
     tracks = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1))
     store = Bernoullis.concatenate([tracks, new_bernoullis(union, born, ctx)])
     birth_rows = len(tracks) + np.searchsorted(born, birth_j)
-    track_bounds = np.concatenate([[0], np.cumsum(lengths)]).tolist()
-    birth_bounds = np.concatenate([[0], np.cumsum(is_birth.sum(axis=1))]).tolist()
-    return store, [
-        np.concatenate([inverse[track_bounds[i] : track_bounds[i + 1]], birth_rows[b0:b1]])
-        if b1 > b0
-        else inverse[track_bounds[i] : track_bounds[i + 1]]
-        for i, (b0, b1) in enumerate(zip(birth_bounds[:-1], birth_bounds[1:], strict=True))
-    ]
+    n_births = is_birth.sum(axis=1)
+    sizes = lengths + n_births
+    starts = np.cumsum(sizes) - sizes  # each hypothesis' rows: its tracks, then its births, laid end to end
+    rows = np.empty(int(sizes.sum()), dtype=np.int64)
+    hyp_of_track = np.repeat(np.arange(n_hyp), lengths)
+    rows[starts[hyp_of_track] + np.arange(len(index)) - (np.cumsum(lengths) - lengths)[hyp_of_track]] = inverse
+    hyp_of_birth = np.repeat(np.arange(n_hyp), n_births)
+    birth_starts = np.cumsum(n_births) - n_births
+    rows[(starts + lengths)[hyp_of_birth] + np.arange(len(birth_j)) - birth_starts[hyp_of_birth]] = birth_rows
+    return store, np.split(rows, np.cumsum(sizes)[:-1].tolist())
 
 
 def _unique_codes(codes: np.ndarray, n_codes: int) -> tuple[np.ndarray, np.ndarray]:
@@ -437,7 +456,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     ) -> list[GlobalHypothesis]:
         """Drop Bernoullis with r < threshold from every hypothesis; report tracks that vanished from all."""
         threshold = self.params.prune_existence
-        kept = [h.without_existence_below(threshold) for h in posteriors]
+        kept = _without_existence_below(posteriors, threshold)
         if sink.enabled:
             posterior_r = _max_existence(posteriors)
             prior_r = _max_existence(priors)

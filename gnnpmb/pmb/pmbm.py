@@ -26,9 +26,11 @@ unaffected.
 
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
-ranked once and shared by all hypotheses that contain it (``murty.Product``). The sub-problems of one block
-share a listing of its assignments and the rankings of equal smaller blocks (``murty.ColumnSubsets``,
-``murty.BlockCache``); a hypothesis with one child gets its best assignment without a ``Product``. Posteriors
+ranked once and shared by all hypotheses that contain it (``murty.Product``). The small sub-problems of one
+block get their best assignments from one listing of the block, and larger ones share the rankings of equal
+smaller blocks (``murty.ColumnSubsets.ranks``, ``murty.BlockCache``); a ranking goes past its best only when a
+hypothesis has more than one child. The best assignments of all hypotheses are assembled block by block, at
+once; a hypothesis with more than one child gets a ``Product`` (``SharedRanking``). Posteriors
 are built once per distinct (Bernoulli, outcome) into one store that the posterior hypotheses index
 (``core.posteriors_from_assignments``, ``core.GlobalHypothesis``). These pieces only share work: each gives
 the same assignments, costs and Bernoullis, bit for bit, as the plain computation it replaces (their tests).
@@ -44,11 +46,13 @@ import numpy as np
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.assign.murty import (
+    ENUMERATION_LIMIT,
     BlockCache,
     ColumnSubsets,
     PartsSummary,
     Product,
     Ranking,
+    SingleRow,
     blocks,
     forbid_beyond_private,
     k_best,
@@ -149,7 +153,9 @@ class KBest:
                 cost = local.cost_matrix()
                 ctx.sink.emit(CostMatrix(ctx.class_name, cost, local.row_labels(), local.col_labels(), hypothesis=h))
         union, members = _union_of(locals_)
-        largest = max((len(rows) for rows, _ in blocks(union.cost_matrix())), default=0)
+        largest = union.n_meas  # rows of the largest gated block: at most M, computed only if M is over budget
+        if largest > self.murty_block_rows:
+            largest = max((len(rows) for rows, _ in blocks(union.cost_matrix())), default=0)
         if largest > self.murty_block_rows:
             budgets = _trim_budgets(budgets, prior_log_w, self.crowd_hypotheses)
             if ctx.sink.enabled:
@@ -257,15 +263,14 @@ class SharedRanking:
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
         self._blocks: BlockCache = {}
         self._common: PartsSummary | None = None
+        varies = has_column.any(axis=0) & ~has_column.all(axis=0)  # columns only some hypotheses hold
         for rows, cols in blocks(cost):
-            present = has_column[:, cols]
             best_only = len(rows) > max_block_rows
-            if (present == present[0]).all():
-                self.common.append(_part(cost, rows, cols, present[0], max_increase, best_only))
+            if not varies[cols].any():
+                self.common.append(_part(cost, rows, cols, has_column[0, cols], max_increase, best_only))
                 continue
-            packed = np.ascontiguousarray(np.packbits(present, axis=1))
-            rows_as_bytes = packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
-            _, first, pattern = np.unique(rows_as_bytes, return_index=True, return_inverse=True)
+            present = has_column[:, cols]
+            _, first, pattern = np.unique(_row_keys(present), return_index=True, return_inverse=True)
             subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase, self._blocks)
             self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
@@ -277,8 +282,23 @@ class SharedRanking:
                 self.common_base[rows] = cols[ranking.solution(0)[0]]
 
     def k_best(self, budgets: list[int]) -> list[list[tuple[np.ndarray, float]]]:
-        """The budgets[h] best assignments (col_of_row as union columns, cost) of every hypothesis."""
-        return [self._hypothesis(h, k) for h, k in enumerate(budgets)]
+        """The budgets[h] best assignments (col_of_row as union columns, cost) of every hypothesis.
+
+        The best assignments of all hypotheses with a budget are assembled at once, block by block
+        (``_best_assignments``); only hypotheses with budgets[h] > 1 get a ``murty.Product``."""
+        out: list[list[tuple[np.ndarray, float]]] = [[] for _ in budgets]
+        active = np.flatnonzero(np.array(budgets, dtype=np.int64) >= 1)
+        if not len(active) or not self.common_ok:
+            return out
+        bases, totals, feasible = self._best_assignments(active)
+        for i, h in enumerate(active.tolist()):
+            if not feasible[i]:
+                continue
+            if budgets[h] == 1:
+                out[h] = [(bases[i], float(totals[i]))]
+            else:
+                out[h] = self._ranked(h, budgets[h], bases[i])
+        return out
 
     def _common_summary(self) -> PartsSummary:
         """The ``murty.PartsSummary`` of the common parts, which lead every hypothesis' parts (worked out when
@@ -287,11 +307,13 @@ class SharedRanking:
             self._common = PartsSummary.of(self.common)
         return self._common
 
-    def _varying_part(self, b: int, h: int) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
-        rows, cols, patterns, pattern, subsets = self.varying[b]
-        key = (b, int(pattern[h]))
+    def _varying_part(self, b: int, p: int) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
+        """(rows, columns, ranking or None if infeasible) of varying block ``b`` cut to its presence pattern
+        ``p``, ranked on first use."""
+        key = (b, p)
         if key not in self._parts:
-            present = patterns[key[1]]
+            rows, cols, patterns, _, subsets = self.varying[b]
+            present = patterns[p]
             if subsets is None:
                 self._parts[key] = _part(self.cost, rows, cols, present, self.max_increase, True)
             else:
@@ -301,18 +323,40 @@ class SharedRanking:
                     self._parts[key] = rows, cols[present], None
         return self._parts[key]
 
-    def _hypothesis(self, h: int, k: int) -> list[tuple[np.ndarray, float]]:
-        if k < 1:
-            return []
-        parts = self.common + [self._varying_part(b, h) for b in range(len(self.varying))]
-        if not self.common_ok or any(ranking is None for _, _, ranking in parts[len(self.common) :]):
-            return []
-        base = self.common_base.copy()
-        for rows, cols, ranking in parts[len(self.common) :]:
-            base[rows] = cols[ranking.solution(0)[0]]
-        if k == 1:  # Product's best, without its set-up
-            varying_best = (ranking.solution(0)[1] for _, _, ranking in parts[len(self.common) :])
-            return [(base, float(sum([*self.common_best, *varying_best])))]
+    def _best_assignments(self, hypotheses: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Best assignment (H, M) in union columns, its cost (H,) and feasibility (H,) of each of
+        ``hypotheses`` (H,): the common parts' best, then per varying block the best of the hypothesis'
+        presence pattern. Costs are summed part by part in the order of the parts, as ``murty.Product`` sums
+        them (the same float additions in the same order)."""
+        bases = np.tile(self.common_base, (len(hypotheses), 1))
+        totals = np.zeros(len(hypotheses))
+        for best_cost in self.common_best:
+            totals += best_cost
+        feasible = np.ones(len(hypotheses), dtype=bool)
+        for b, (rows, cols, patterns, pattern, subsets) in enumerate(self.varying):
+            of_hypothesis = pattern[hypotheses]
+            cols_of = np.zeros((len(patterns), len(rows)), dtype=np.int64)
+            cost_of = np.zeros(len(patterns))
+            ok_of = np.zeros(len(patterns), dtype=bool)
+            used = np.unique(of_hypothesis).tolist()
+            unranked = [p for p in used if (b, p) not in self._parts]
+            if subsets is not None and len(unranked) > 1:  # ranked together (``murty.ColumnSubsets.ranks``)
+                for p, ranking in zip(unranked, subsets.ranks(patterns[unranked]), strict=True):
+                    self._parts[(b, p)] = rows, cols[patterns[p]], ranking
+            for p in used:
+                _, part_cols, ranking = self._varying_part(b, p)
+                if ranking is not None:
+                    best, cost = ranking.solution(0)
+                    cols_of[p], cost_of[p], ok_of[p] = part_cols[best], cost, True
+            bases[:, rows] = cols_of[of_hypothesis]
+            totals += cost_of[of_hypothesis]
+            feasible &= ok_of[of_hypothesis]
+        return bases, totals, feasible
+
+    def _ranked(self, h: int, k: int, base: np.ndarray) -> list[tuple[np.ndarray, float]]:
+        """The k best assignments of feasible hypothesis ``h``, whose best is ``base``."""
+        varying = [self._varying_part(b, int(pattern[h])) for b, (*_, pattern, _) in enumerate(self.varying)]
+        parts = self.common + varying
         product = Product(base, parts, self.max_increase, self._common_summary())
         out = []
         for i in range(k):
@@ -333,6 +377,19 @@ class BestOnly:
         return self._best if index == 0 else None
 
 
+def _row_keys(present: np.ndarray) -> np.ndarray:
+    """(H,) one sortable key per row of an (H, C) bool array, ordered as the rows' packed bytes compare
+    (memcmp): the packed bytes as a void scalar, or, for C <= 64, as one big-endian uint64 (zero-padded), which
+    ``np.unique`` sorts much faster and in the same order."""
+    packed = np.packbits(present, axis=1)
+    if packed.shape[1] <= 8:
+        padded = np.zeros((len(packed), 8), dtype=np.uint8)
+        padded[:, : packed.shape[1]] = packed
+        return padded.view(">u8").ravel()
+    packed = np.ascontiguousarray(packed)
+    return packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
+
+
 def _part(
     cost: np.ndarray,
     rows: np.ndarray,
@@ -345,6 +402,11 @@ def _part(
     ``max_increase`` above its best (``best_only``: its best assignment alone); the ranking is None if that
     sub-problem has no assignment."""
     sub_cols = cols[present]
+    if len(rows) == 1 and not best_only and len(sub_cols) <= ENUMERATION_LIMIT:  # ``rank``'s SingleRow, directly
+        row = cost[rows[0], sub_cols]
+        if not (row < np.inf).any():
+            return rows, sub_cols, None
+        return rows, sub_cols, SingleRow(row, int(np.argmin(row)), max_increase)
     sub = cost[np.ix_(rows, sub_cols)]
     try:
         return rows, sub_cols, BestOnly(sub) if best_only else rank(sub, max_increase=max_increase)

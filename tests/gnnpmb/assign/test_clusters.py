@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gnnpmb.assign import clusters
 from gnnpmb.assign.clusters import gate_clusters
 
 
@@ -64,3 +65,21 @@ def test_random_gates_match_flood_fill():
         assert found == reference_components(inside)
         firsts = [int(c.tracks[0]) for c in clusters]
         assert firsts == sorted(firsts)
+
+
+def test_small_and_large_graph_paths_agree(monkeypatch):
+    """The Python union-find for small graphs gives the NumPy path's clusters, array for array (order, dtype),
+    with and without isolated tracks."""
+    rng = np.random.default_rng(5)
+    cases = [rng.random((k, m)) < p for k, m, p in [(3, 12, 0.3), (6, 25, 0.15), (12, 40, 0.1), (1, 1, 1.0)]]
+    cases += [rng.random((int(k), int(m))) < 0.1 for k, m in rng.integers(1, 20, size=(30, 2))]
+    for isolated in (False, True):
+        small = [gate_clusters(inside, isolated) for inside in cases]
+        monkeypatch.setattr(clusters, "SMALL_GRAPH_EDGES", -1)
+        large = [gate_clusters(inside, isolated) for inside in cases]
+        monkeypatch.undo()
+        for got, want in zip(small, large, strict=True):
+            assert len(got) == len(want)
+            for g, w in zip(got, want, strict=True):
+                for x, y in ((g.tracks, w.tracks), (g.meas, w.meas)):
+                    assert x.dtype == y.dtype and x.shape == y.shape and (x == y).all()

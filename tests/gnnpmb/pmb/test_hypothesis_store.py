@@ -10,7 +10,7 @@ import pytest
 
 from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.pmb.bernoulli import Bernoullis
-from gnnpmb.pmb.core import GlobalHypothesis, hypothesis_union
+from gnnpmb.pmb.core import GlobalHypothesis, _without_existence_below, hypothesis_union
 
 
 def random_store(rng: np.random.Generator, n: int, keys: np.ndarray) -> Bernoullis:
@@ -74,3 +74,16 @@ def test_pruning_an_indexed_hypothesis_equals_pruning_its_copy():
         assert_same_bernoullis(indexed.bernoullis, copied.bernoullis)
         assert indexed.n_bernoullis == copied.n_bernoullis == int((h.bernoullis.existence >= threshold).sum())
     assert GlobalHypothesis(0.0, store, np.arange(3)).without_existence_below(0.0).index is not None
+
+
+def test_pruning_hypotheses_of_one_store_at_once_equals_pruning_each():
+    rng = np.random.default_rng(7)
+    store = random_store(rng, 12, np.arange(12, dtype=np.int64))
+    for threshold in [0.0, *rng.random(10).tolist(), 1.5]:
+        hypotheses = [GlobalHypothesis(float(w), store, rng.permutation(12)[:7]) for w in rng.random(5)]
+        want = [h.without_existence_below(threshold) for h in hypotheses]
+        got = _without_existence_below(hypotheses, threshold)
+        unchanged = [w is h for w, h in zip(want, hypotheses, strict=True)]
+        assert [g is h for g, h in zip(got, hypotheses, strict=True)] == unchanged
+        for g, w in zip(got, want, strict=True):
+            assert g.log_weight == w.log_weight and g.index.tolist() == w.index.tolist()

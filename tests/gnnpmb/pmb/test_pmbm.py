@@ -19,7 +19,7 @@ from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses, ListSink, Nu
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext, posterior_from_assignment
 from gnnpmb.pmb.gnnpmb import BestAssignment
-from gnnpmb.pmb.pmbm import KBest, SharedRanking, hypothesis_budget
+from gnnpmb.pmb.pmbm import KBest, SharedRanking, _row_keys, hypothesis_budget
 from gnnpmb.types import IdAllocator, Measurements
 from tests.gnnpmb.pmb.helpers import make_measurements
 
@@ -347,3 +347,16 @@ def test_budget_not_reached_changes_nothing():
     b = PmbCore("car", CFG, KBest(CFG.pmbm, murty_block_rows=10**6, crowd_hypotheses=10**6), IdAllocator())
     for meas in cluttered_sequence(seed=3, n_frames=10):
         assert a.step(meas, 0.5, NullSink()) == b.step(meas, 0.5, NullSink())
+
+
+def test_row_keys_sort_as_the_packed_bytes():
+    """``pmbm._row_keys`` gives ``np.unique`` the distinct rows in the order of their packed bytes, with the same
+    first occurrences and inverse, for narrow (uint64 keys) and wide (void keys) presence arrays."""
+    rng = np.random.default_rng(13)
+    for n_cols in (1, 5, 8, 9, 40, 64, 65, 100):
+        present = rng.random((60, n_cols)) < 0.5
+        present[30:] = present[rng.integers(0, 30, size=30)]  # repeated rows
+        packed = np.ascontiguousarray(np.packbits(present, axis=1))
+        want = np.unique(packed.view(np.dtype((np.void, packed.shape[1]))).ravel(), True, True)
+        got = np.unique(_row_keys(present), True, True)
+        assert got[1].tolist() == want[1].tolist() and got[2].ravel().tolist() == want[2].ravel().tolist()
