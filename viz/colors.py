@@ -19,6 +19,8 @@ CLASS_COLORS: dict[str, tuple[int, int, int]] = {
     "truck": (70, 240, 240),
 }
 """One colour per tracking class, fixed so every recording looks the same."""
+GREY = (160, 160, 160)
+"""The colour of a label whose class has no colour of its own."""
 
 CLASS_IDS: dict[str, int] = {name: i + 1 for i, name in enumerate(TRACKING_CLASSES)}
 """Rerun class ids 1..7 in the devkit's class order (0 is left for 'unknown')."""

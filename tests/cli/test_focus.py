@@ -19,7 +19,7 @@ from gnnpmb.session import find_reports, prepare, rerun_runs
 from tests.viz.rrd import read_rows
 from viz import paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
-from viz.focus import evaluated_world
+from viz.evaluated import evaluated_world
 from viz.legend import PROBABILITY_RANGE, place_legend
 
 SCENE = "scene-0103"
