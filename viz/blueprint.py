@@ -214,11 +214,18 @@ def track_series_views(
     ]
 
 
-def story_view(tracker: str, focus: FocusTarget | None = None) -> rrb.TextLogView:
-    origin = paths.events_root(tracker) if focus is None else paths.events(tracker, focus.class_name)
+def story_view(tracker: str, focus: FocusTarget | None = None, *, involved: bool = False) -> rrb.TextLogView:
+    """The tracker's story log: every class; with a focus its class, or (``involved``) only the lines that name
+    an involved track."""
+    if focus is None:
+        origin, name = paths.events_root(tracker), f"{tracker} story"
+    elif involved:
+        origin, name = paths.involved_story(tracker), f"{tracker} story (involved tracks)"
+    else:
+        origin, name = paths.events(tracker, focus.class_name), f"{tracker} story (every {focus.class_name})"
     return rrb.TextLogView(
         origin=origin,
-        name=f"{tracker} story",
+        name=name,
         rows=rrb.TextLogRows(filter_by_log_level=list(STORY_LEVELS)),
         columns=STORY_COLUMNS,
     )
@@ -255,6 +262,7 @@ def tracker_panel(
     )
     if focus is not None:
         logs = rrb.Tabs(
+            story_view(tracker, focus, involved=True),
             story_view(tracker, focus),
             rrb.TextDocumentView(origin=paths.decisions(tracker), name=f"{tracker} decisions"),
             rrb.Spatial2DView(origin=paths.decision_matrix(tracker), name=f"{tracker} cost grid"),

@@ -38,10 +38,11 @@ from viz.blueprint import (
 from viz.callouts import Callout, log_callouts
 from viz.colors import CLASS_COLORS, GREY, class_ids, track_colors
 from viz.evaluated import evaluated_offsets, log_evaluated
-from viz.focus_summary import READING_GUIDE, focus_markdown
+from viz.focus_summary import READING_GUIDE, focus_markdown, mentions
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
 from viz.legend import COMPARISON_PLOT_HEIGHT_PX, PROBABILITY_RANGE, LegendPlacement, place_legend
 from viz.logger import TrackerLogger, TrackStep
+from viz.markers import send_text_lines
 from viz.scene import detection_label
 from viz.timeline import Clock
 
@@ -76,6 +77,8 @@ def log_focus(
         static=True,
     )
     stream.log(reading_guide_doc(), rr.TextDocument(READING_GUIDE, media_type="text/markdown"), static=True)
+    for tracker, logger in loggers.items():
+        _log_involved_story(stream, clock, scene, focus, tracker, logger)
     frames = {run.tracker: {f.keyframe.index: f for f in run.frames} for run in runs}
     gt_ids = set(focus.gt_ids)
     evaluated = evaluated_offsets(focus, scene)
@@ -157,6 +160,21 @@ def log_focus(
         )
         if evaluated:
             log_evaluated(stream, focus, scene, evaluated if i == focus.frame_index else {})
+
+
+def _log_involved_story(
+    stream: rr.RecordingStream, clock: Clock, scene: SceneData, focus: FocusTarget, tracker: str, logger: TrackerLogger
+) -> None:
+    """The story lines of the focused class that name one of ``tracker``'s involved tracks, at their frames."""
+    ids = set(focus.track_ids.get(tracker, ()))
+    lines = [(f, text, level) for f, c, text, level in logger.story if c == focus.class_name and mentions(text, ids)]
+    if not lines:
+        return
+    frames = np.array([f for f, _, _ in lines], dtype=np.int64)
+    stamps = np.array([scene.keyframes[f].timestamp_us for f in frames.tolist()], dtype=np.int64)
+    send_text_lines(
+        stream, clock, paths.involved_story(tracker), frames, stamps, [t for _, t, _ in lines], [v for *_, v in lines]
+    )
 
 
 def focus_legends(

@@ -69,7 +69,8 @@ READING_GUIDE = """# How to read the views
 """
 
 
-def _mentions(text: str, track_ids: set[int]) -> bool:
+def mentions(text: str, track_ids: set[int]) -> bool:
+    """Whether a story line names one of ``track_ids`` ("track 26", "→ 26")."""
     numbers = {int(n) for n in re.findall(r"(?:track |→ )(\d+)", text)}
     return bool(numbers & track_ids)
 
@@ -139,7 +140,7 @@ def focus_markdown(
         story = [
             (f, text)
             for f, class_name, text, _level in logger.story
-            if class_name == focus.class_name and f <= focus.frame_index and _mentions(text, ids)
+            if class_name == focus.class_name and f <= focus.frame_index and mentions(text, ids)
         ]
         if story:
             lines.append("Story of the involved tracks:")

@@ -796,7 +796,7 @@ class TrackerLogger:
                     strict=True,
                 )
             )
-        self._story_focused(class_name, cf, posterior_r, known)
+        self._story_focused(class_name, cf, posterior_r, known | set(now))
         pruned_ids = {p.track_id for p in cf.pruned}
         limit = max(cf.extracted.threshold if cf.extracted is not None else 0.0, self.show_min_existence)
         for t in sorted(self._reported - set(now) - pruned_ids):
@@ -862,8 +862,7 @@ class TrackerLogger:
                 via = f"given {meas_name(given[t])}" if t in given else "given no detection"
             self._text(
                 class_name,
-                f"involved track {t} (r < {self.show_min_existence:g}, drawn for the focus only): {via}, "
-                f"r={posterior_r[t]:.2f}",
+                f"involved track {t} (not reported; drawn for the focus only): {via}, r={posterior_r[t]:.2f}",
                 "INFO",
             )
 

@@ -150,6 +150,11 @@ def events_root(tracker: str) -> str:
     return f"{tracker_root(tracker)}/events"
 
 
+def involved_story(tracker: str) -> str:
+    """TextLog of a focus recording: the story lines of one tracker that name an involved track."""
+    return f"{tracker_root(tracker)}/involved_story"
+
+
 def events(tracker: str, class_name: str) -> str:
     """TextLog of births, prunings, assignments, confirmations and merges of one class."""
     return f"{events_root(tracker)}/{_name(class_name)}"

@@ -17,6 +17,7 @@ from cli.app import main
 from gnnpmb.eval.failures import FailureKind, short_id
 from gnnpmb.session import find_reports, prepare, rerun_runs
 from tests.viz.rrd import read_rows
+from tests.viz.test_blueprint import stored_views
 from viz import paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
 from viz.evaluated import evaluated_world
@@ -117,6 +118,12 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     corner, y_range = stored_legends(bp)["gnnpmb existence"]
     assert corner == placed.corner.value
     assert y_range == pytest.approx(PROBABILITY_RANGE)
+    # The story opens on the lines that name an involved track (the class's whole story is the next tab).
+    views = stored_views(out)
+    assert views["gnnpmb story (involved tracks)"] == ("TextLog", paths.involved_story("gnnpmb"))
+    assert views[f"gnnpmb story (every {failure.class_name})"][1] == paths.events("gnnpmb", failure.class_name)
+    story = [r["TextLog:text"][0] for r in rows[paths.involved_story("gnnpmb")] if r.get("TextLog:text")]
+    assert story and all(re.search(r"(?:track |→ )(" + "|".join(involved) + r")\b", line) for line in story)
     guide = rows[reading_guide_doc()][0]["TextDocument:text"][0]
     assert guide.startswith("# How to read the views") and "how to read the views" in summary
     highlighted = [r for r in rows[focus_world()] if r.get("frame") == failure.frame_index]
