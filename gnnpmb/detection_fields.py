@@ -52,6 +52,19 @@ class DetectionFields(StructOfArrays):
             meas_index=np.asarray(meas.source_index, dtype=np.int64)[index],
         )
 
+    def gather_with(self, meas: Measurements, source: np.ndarray) -> DetectionFields:
+        """The fields of the K items followed by those of the M measurements ``meas``, gathered by ``source``
+        (N,): source[i] < K picks item source[i], K + j measurement j (``from_measurements``)."""
+        boxes = meas.boxes
+        pairs = (
+            (self.score, boxes.score),
+            (self.z_m, boxes.translation_m[:, 2]),
+            (self.size_wlh_m, boxes.size_wlh_m),
+            (self.quat_wxyz, boxes.quat_wxyz),
+            (self.meas_index, meas.source_index),
+        )
+        return DetectionFields(*(np.concatenate([own, theirs])[source] for own, theirs in pairs))
+
     def undetected(self) -> DetectionFields:
         """The same fields with no detection this frame (``meas_index`` -1): after a prediction."""
         return DetectionFields(

@@ -22,7 +22,6 @@ from typing import Protocol, overload
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     AxisLabel,
     Born,
@@ -32,7 +31,8 @@ from gnnpmb.events import (
     Pruned,
     PruneReason,
 )
-from gnnpmb.models import MotionModel, clutter_intensity, cv_model, measurement_birth
+from gnnpmb.kalman import innovation
+from gnnpmb.models import MotionModel, birth_covariance, clutter_intensity, cv_model, measurement_birth
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
 from gnnpmb.pmb.poisson import NewTrackHypotheses, new_track_hypotheses
@@ -230,9 +230,8 @@ def posterior_from_assignment(local: LocalHypotheses, col_of_row: np.ndarray, ct
     (``cost.LocalHypotheses.cost_matrix``): detected tracks get r = 1 and the Kalman update, missed tracks the
     misdetection update, measurements on their new-track column start a Bernoulli (module ``cost`` docstring)."""
     k = local.n_tracks
-    tracks = updated_bernoullis(local, np.arange(k), meas_of_track(k, col_of_row) + 1)
     new_j = np.flatnonzero(col_of_row == k + np.arange(local.n_meas))
-    return Bernoullis.concatenate([tracks, new_bernoullis(local, new_j, ctx)])
+    return updated_bernoullis(local, np.arange(k), meas_of_track(k, col_of_row) + 1, new_j, ctx)
 
 
 def posteriors_from_assignments(
@@ -262,9 +261,8 @@ def posteriors_from_assignments(
     for j in birth_j[np.sort(first)].tolist():
         ctx.birth_id(j)
     distinct, inverse = _unique_codes(codes, n_union * (m + 1))
-    tracks = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1))
-    store = Bernoullis.concatenate([tracks, new_bernoullis(union, born, ctx)])
-    birth_rows = len(tracks) + np.searchsorted(born, birth_j)
+    store = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1), born, ctx)
+    birth_rows = len(distinct) + np.searchsorted(born, birth_j)
     n_births = is_birth.sum(axis=1)
     sizes = lengths + n_births
     starts = np.cumsum(sizes) - sizes  # each hypothesis' rows: its tracks, then its births, laid end to end
@@ -295,26 +293,41 @@ def meas_of_track(n_tracks: int, col_of_row: np.ndarray) -> np.ndarray:
     return out
 
 
-def updated_bernoullis(local: LocalHypotheses, rows: np.ndarray, outcome: np.ndarray) -> Bernoullis:
+def updated_bernoullis(
+    local: LocalHypotheses, rows: np.ndarray, outcome: np.ndarray, new_j: np.ndarray, ctx: UpdateContext
+) -> Bernoullis:
     """Prior Bernoullis ``rows`` of ``local`` after the single-target hypotheses ``outcome`` (0 = missed: the
     misdetection update; j + 1 = detected by local measurement j: r = 1 and the Kalman update, box fields and
-    score from the detection). The local key becomes ``combine_keys(parent key, outcome)``."""
-    prior = local.prior
+    score from the detection), then the Bernoullis started by local measurements ``new_j`` (existence r_j and
+    state from ``poisson``). The local key becomes ``combine_keys(parent key, outcome)``, a new Bernoulli's
+    ``combine_keys(-frame serial, j + 1)``.
+
+    Every field is gathered in one indexing from the prior's rows followed by the new-track hypotheses' (K + M
+    sources), so the posterior is built without intermediate Bernoullis."""
+    prior, new = local.prior, local.new
+    k = len(prior)
     det = np.flatnonzero(outcome > 0)
     det_k, det_j = rows[det], outcome[det] - 1
-    existence = local.miss_existence[rows]
+    source = np.concatenate([rows, k + new_j])  # row of the K + M sources each posterior Bernoulli copies
+    existence = np.concatenate([local.miss_existence, new.existence])[source]
     existence[det] = 1.0
-    mean = prior.mean[rows]
+    mean = np.concatenate([prior.mean, new.mean])[source]
     mean[det] = detected_means(local, det_k, det_j)
-    cov = prior.cov[rows]
+    cov = np.concatenate([prior.cov, new.cov])[source]
     cov[det] = local.inn.cov_post[det_k]
+    det_source = source.copy()
+    det_source[det] = k + det_j  # detected Bernoullis take their detection's box fields
+    births = np.array([ctx.birth_id(j) for j in new_j.tolist()], dtype=np.int64)
     return Bernoullis(
-        track_id=prior.track_id[rows],
-        local_key=combine_keys(prior.local_key[rows], outcome),
+        track_id=np.concatenate([prior.track_id[rows], births]),
+        local_key=combine_keys(
+            np.concatenate([prior.local_key[rows], np.full(len(new_j), -ctx.frame_serial)]),
+            np.concatenate([outcome, new_j + 1]),
+        ),
         existence=existence,
         mean=mean,
         cov=cov,
-        det=prior.det.subset(rows).take(det, DetectionFields.from_measurements(local.meas, det_j)),
+        det=prior.det.gather_with(local.meas, det_source),
     )
 
 
@@ -322,15 +335,8 @@ def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext
     """The Bernoullis started by local measurements ``new_j`` (existence r_j from ``poisson``)."""
     if len(new_j) == 0:
         return Bernoullis.empty()
-    new = local.new
-    return Bernoullis(
-        track_id=np.array([ctx.birth_id(int(j)) for j in new_j], dtype=np.int64),
-        local_key=combine_keys(np.full(len(new_j), -ctx.frame_serial), new_j + 1),
-        existence=new.existence[new_j],
-        mean=new.mean[new_j],
-        cov=new.cov[new_j],
-        det=DetectionFields.from_measurements(local.meas, new_j),
-    )
+    none = np.zeros(0, dtype=np.int64)
+    return updated_bernoullis(local, none, none, new_j, ctx)
 
 
 def assignment_pairs(
@@ -382,6 +388,9 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         self.strategy = strategy
         self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty())]
         self.frame_serial = 0
+        R = cv_model(0.0, self.class_params, self.params.measure_velocity == 1).R
+        # one birth component's innovation: the same for every frame and measurement (``poisson``)
+        self.birth_innovation = innovation(np.zeros((1, 4)), birth_covariance(self.models)[None], R)
 
     @property
     def panels(self) -> tuple[Panel, ...]:
@@ -397,7 +406,8 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         if p.measure_velocity == 1:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
         clutter = clutter_intensity(self.models, p)
-        new = new_track_hypotheses(measurement_birth(meas, self.models), meas, model.R, clutter)
+        birth = measurement_birth(meas, self.models)
+        new = new_track_hypotheses(birth, meas, model.R, clutter, self.birth_innovation)
         return self._predict_and_localise(meas, model, new)
 
     def prior_view(self, prior: PmbPrior) -> tuple[TrackView, Gating]:
@@ -424,9 +434,10 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
         """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r."""
         threshold = self.params.extraction_threshold
-        sel = posterior.subset(np.flatnonzero(posterior.existence >= threshold))
-        estimates = sel.det.to_estimates(
-            self.class_name, sel.track_id, sel.mean, sel.score * sel.existence, sel.existence
+        sel = np.flatnonzero(posterior.existence >= threshold)
+        det, existence = posterior.det.subset(sel), posterior.existence[sel]
+        estimates = det.to_estimates(
+            self.class_name, posterior.track_id[sel], posterior.mean[sel], det.score * existence, existence
         )
         return estimates, threshold
 

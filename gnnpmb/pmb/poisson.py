@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.kalman import gaussian_log_density, innovation, mean_update, paired_mahalanobis2
+from gnnpmb.kalman import Innovation, gaussian_log_density, innovation, mean_update, paired_mahalanobis2
 from gnnpmb.models import BirthIntensity
 from gnnpmb.types import Measurements
 
@@ -35,14 +35,25 @@ class NewTrackHypotheses:
 
 
 def new_track_hypotheses(
-    birth: BirthIntensity, meas: Measurements, R: np.ndarray, clutter_intensity: float
+    birth: BirthIntensity,
+    meas: Measurements,
+    R: np.ndarray,
+    clutter_intensity: float,
+    birth_innovation: Innovation | None = None,
 ) -> NewTrackHypotheses:
-    """Likelihood, existence and state of the Bernoulli each measurement would start (module docstring)."""
+    """Likelihood, existence and state of the Bernoulli each measurement would start (module docstring).
+
+    ``birth_innovation``: the innovation (``kalman.innovation``, one row) of a birth component, whose S, gain and
+    posterior covariance every component shares (they all have covariance P_b): given, it is repeated instead of
+    computed for each of the M components."""
     m = len(meas)
     if m == 0:
         return NewTrackHypotheses(np.zeros(0), np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4, 4)))
-    inn = innovation(birth.mean, birth.cov, R)
-    nu = meas.z - inn.z_pred  # (M, D): component j explains measurement j only
+    if birth_innovation is None:
+        inn = innovation(birth.mean, birth.cov, R)
+    else:
+        inn = birth_innovation.subset(np.zeros(m, dtype=np.intp))
+    nu = meas.z - birth.mean[:, : R.shape[0]]  # (M, D) z_j - H m_j: component j explains measurement j only
     log_n = gaussian_log_density(paired_mahalanobis2(inn.S_inv, nu), inn.log_det_S, nu.shape[1])
     birth_term = birth.weight * meas.boxes.score * np.exp(log_n)
     total = clutter_intensity + birth_term
