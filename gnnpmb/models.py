@@ -57,9 +57,12 @@ def _noise(params: ClassParams, measure_velocity: bool) -> tuple[np.ndarray, np.
     return Q, R
 
 
+@functools.lru_cache(maxsize=64)
 def birth_covariance(models: ModelParams) -> np.ndarray:
-    """(4, 4) P_b = diag(s_p^2, s_p^2, s_v^2, s_v^2) of a birth component."""
-    return np.diag([models.birth_pos_std_m**2] * 2 + [models.birth_vel_std_mps**2] * 2)
+    """(4, 4) P_b = diag(s_p^2, s_p^2, s_v^2, s_v^2) of a birth component (shared between calls, read-only)."""
+    P_b = np.diag([models.birth_pos_std_m**2] * 2 + [models.birth_vel_std_mps**2] * 2)
+    P_b.flags.writeable = False
+    return P_b
 
 
 @dataclass(frozen=True, slots=True)

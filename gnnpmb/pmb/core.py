@@ -145,14 +145,14 @@ _MASK63 = np.uint64((1 << 63) - 1)
 
 def combine_keys(parent: np.ndarray, outcome: np.ndarray) -> np.ndarray:
     """Deterministic 63-bit key of a child single-target hypothesis from its parent key and outcome
-    (0 = missed, j + 1 = detected by local measurement j; new tracks use a negative parent). SplitMix64 finaliser."""
-    with np.errstate(over="ignore"):
-        x = parent.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15) + outcome.astype(np.uint64)
-        x ^= x >> np.uint64(30)
-        x *= np.uint64(0xBF58476D1CE4E5B9)
-        x ^= x >> np.uint64(27)
-        x *= np.uint64(0x94D049BB133111EB)
-        x ^= x >> np.uint64(31)
+    (0 = missed, j + 1 = detected by local measurement j; new tracks use a negative parent). SplitMix64 finaliser.
+    ``parent`` and ``outcome`` are (N,) arrays: array arithmetic on uint64 wraps modulo 2^64 without a warning."""
+    x = parent.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15) + outcome.astype(np.uint64)
+    x ^= x >> np.uint64(30)
+    x *= np.uint64(0xBF58476D1CE4E5B9)
+    x ^= x >> np.uint64(27)
+    x *= np.uint64(0x94D049BB133111EB)
+    x ^= x >> np.uint64(31)
     return (x & _MASK63).astype(np.int64)
 
 
