@@ -31,11 +31,10 @@ from gnnpmb.events import (
     Pruned,
     PruneReason,
 )
-from gnnpmb.kalman import innovation
 from gnnpmb.models import MotionModel, birth_covariance, clutter_intensity, cv_model, measurement_birth
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
-from gnnpmb.pmb.poisson import NewTrackHypotheses, new_track_hypotheses
+from gnnpmb.pmb.poisson import NewTrackHypotheses, birth_update, new_track_hypotheses
 from gnnpmb.skeleton import ClassFilter, Gating, TrackView
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
@@ -389,8 +388,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty())]
         self.frame_serial = 0
         R = cv_model(0.0, self.class_params, self.params.measure_velocity == 1).R
-        # one birth component's innovation: the same for every frame and measurement (``poisson``)
-        self.birth_innovation = innovation(np.zeros((1, 4)), birth_covariance(self.models)[None], R)
+        self.birth_update = birth_update(birth_covariance(self.models), R)
 
     @property
     def panels(self) -> tuple[Panel, ...]:
@@ -407,7 +405,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
         clutter = clutter_intensity(self.models, p)
         birth = measurement_birth(meas, self.models)
-        new = new_track_hypotheses(birth, meas, model.R, clutter, self.birth_innovation)
+        new = new_track_hypotheses(birth, meas, model.R, clutter, self.birth_update)
         return self._predict_and_localise(meas, model, new)
 
     def prior_view(self, prior: PmbPrior) -> tuple[TrackView, Gating]:
