@@ -404,7 +404,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         if p.measure_velocity == 1:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
         clutter = clutter_intensity(self.models, p)
-        birth = measurement_birth(meas, self.models)
+        birth = measurement_birth(meas, self.models, shared_cov=True)
         new = new_track_hypotheses(birth, meas, model.R, clutter, self.birth_update)
         return self._predict_and_localise(meas, model, new)
 
@@ -432,10 +432,10 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
         """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r."""
         threshold = self.params.extraction_threshold
-        sel = np.flatnonzero(posterior.existence >= threshold)
-        det, existence = posterior.det.subset(sel), posterior.existence[sel]
-        estimates = det.to_estimates(
-            self.class_name, posterior.track_id[sel], posterior.mean[sel], det.score * existence, existence
+        keep = posterior.existence >= threshold
+        sel = posterior if keep.all() else posterior.subset(np.flatnonzero(keep))
+        estimates = sel.det.to_estimates(
+            self.class_name, sel.track_id, sel.mean, sel.score * sel.existence, sel.existence
         )
         return estimates, threshold
 
