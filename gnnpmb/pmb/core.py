@@ -302,32 +302,44 @@ def updated_bernoullis(
     ``combine_keys(-frame serial, j + 1)``.
 
     Every field is gathered in one indexing from the prior's rows followed by the new-track hypotheses' (K + M
-    sources), so the posterior is built without intermediate Bernoullis."""
+    sources; the prior's alone when nothing is born), so the posterior is built without intermediate
+    Bernoullis."""
     prior, new = local.prior, local.new
-    k = len(prior)
+    k, n_new = len(prior), len(new_j)
     det = np.flatnonzero(outcome > 0)
     det_k, det_j = rows[det], outcome[det] - 1
-    source = np.concatenate([rows, k + new_j])  # row of the K + M sources each posterior Bernoulli copies
-    existence = np.concatenate([local.miss_existence, new.existence])[source]
+    source = np.concatenate([rows, k + new_j]) if n_new else rows  # row of the sources each Bernoulli copies
+    existence = _gather(local.miss_existence, new.existence, source, n_new)
     existence[det] = 1.0
-    mean = np.concatenate([prior.mean, new.mean])[source]
+    mean = _gather(prior.mean, new.mean, source, n_new)
     mean[det] = detected_means(local, det_k, det_j)
-    cov = np.concatenate([prior.cov, new.cov])[source]
+    cov = _gather(prior.cov, new.cov, source, n_new)
     cov[det] = local.inn.cov_post[det_k]
-    det_source = source.copy()
-    det_source[det] = k + det_j  # detected Bernoullis take their detection's box fields
-    births = np.array([ctx.birth_id(j) for j in new_j.tolist()], dtype=np.int64)
+    if len(det) or n_new:
+        det_source = source.copy()
+        det_source[det] = k + det_j  # detected Bernoullis take their detection's box fields
+        fields = prior.det.gather_with(local.meas, det_source)
+    else:
+        fields = prior.det.subset(rows)
+    track_id, parent, outcome = prior.track_id[rows], prior.local_key[rows], outcome
+    if n_new:
+        births = np.array([ctx.birth_id(j) for j in new_j.tolist()], dtype=np.int64)
+        track_id = np.concatenate([track_id, births])
+        parent = np.concatenate([parent, np.full(n_new, -ctx.frame_serial)])
+        outcome = np.concatenate([outcome, new_j + 1])
     return Bernoullis(
-        track_id=np.concatenate([prior.track_id[rows], births]),
-        local_key=combine_keys(
-            np.concatenate([prior.local_key[rows], np.full(len(new_j), -ctx.frame_serial)]),
-            np.concatenate([outcome, new_j + 1]),
-        ),
+        track_id=track_id,
+        local_key=combine_keys(parent, outcome),
         existence=existence,
         mean=mean,
         cov=cov,
-        det=prior.det.gather_with(local.meas, det_source),
+        det=fields,
     )
+
+
+def _gather(own: np.ndarray, born: np.ndarray, source: np.ndarray, n_new: int) -> np.ndarray:
+    """Rows ``source`` of ``own`` followed by ``born`` (of ``own`` alone when no row is born: ``n_new`` 0)."""
+    return np.concatenate([own, born])[source] if n_new else own[source]
 
 
 def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext) -> Bernoullis:
