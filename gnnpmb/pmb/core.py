@@ -444,11 +444,12 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
         """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r."""
         threshold = self.params.extraction_threshold
-        keep = posterior.existence >= threshold
-        sel = posterior if keep.all() else posterior.subset(np.flatnonzero(keep))
-        estimates = sel.det.to_estimates(
-            self.class_name, sel.track_id, sel.mean, sel.score * sel.existence, sel.existence
-        )
+        b, keep = posterior, posterior.existence >= threshold
+        det, track_id, mean, existence = b.det, b.track_id, b.mean, b.existence
+        if not keep.all():
+            sel = np.flatnonzero(keep)
+            det, track_id, mean, existence = det.subset(sel), track_id[sel], mean[sel], existence[sel]
+        estimates = det.to_estimates(self.class_name, track_id, mean, det.score * existence, existence)
         return estimates, threshold
 
     def posterior_view(self, posterior: Bernoullis) -> TrackView:

@@ -58,8 +58,8 @@ class LocalHypotheses:
         """(M, K + M) cost matrix described in the module docstring."""
         k, m = self.n_tracks, self.n_meas
         cost = np.full((m, k + m), np.inf)
-        cost[:, :k] = -(self.det_log_lik - self.miss_log_lik[:, None]).T
-        cost[np.arange(m), k + np.arange(m)] = -self.new.log_likelihood
+        cost[:, :k] = (self.miss_log_lik[:, None] - self.det_log_lik).T  # = -(log l_kj - log l_k0), exactly
+        cost.reshape(-1)[k :: k + m + 1] = -self.new.log_likelihood  # C[j, K + j]: flat index K + j (K + M + 1)
         return cost
 
     def base_log_weight(self) -> float:
