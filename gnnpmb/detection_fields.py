@@ -30,6 +30,9 @@ class DetectionFields(StructOfArrays):
     quat_wxyz: np.ndarray
     meas_index: np.ndarray
 
+    def __len__(self) -> int:
+        return len(self.score)
+
     @staticmethod
     def empty() -> DetectionFields:
         return DetectionFields(

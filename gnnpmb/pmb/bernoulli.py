@@ -35,6 +35,9 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
     cov: np.ndarray
     det: DetectionFields
 
+    def __len__(self) -> int:
+        return len(self.track_id)
+
     @staticmethod
     def empty() -> Bernoullis:
         return Bernoullis(
