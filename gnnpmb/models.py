@@ -74,15 +74,11 @@ class BirthIntensity:
     cov: np.ndarray
 
 
-def measurement_birth(meas: Measurements, models: ModelParams, shared_cov: bool = False) -> BirthIntensity:
-    """One birth component per measurement at [z_j, v_j] with weight w_b and covariance P_b; ``shared_cov``: the
-    covariances are one read-only broadcast view of P_b instead of an (M, 4, 4) copy (for a caller that updates
-    the components with ``pmb.poisson.BirthUpdate``, not one by one)."""
+def measurement_birth(meas: Measurements, models: ModelParams) -> BirthIntensity:
+    """One birth component per measurement at [z_j, v_j] with weight w_b and covariance P_b."""
     m = len(meas)
     mean = np.concatenate([meas.boxes.xy, meas.boxes.velocity_mps], axis=1) if m else np.zeros((0, 4))
-    cov = np.broadcast_to(birth_covariance(models), (m, 4, 4))
-    if not shared_cov:
-        cov = cov.copy()
+    cov = birth_covariance(models)[None].repeat(m, axis=0)
     return BirthIntensity(weight=np.full(m, models.birth_weight), mean=mean, cov=cov)
 
 

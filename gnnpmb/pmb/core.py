@@ -229,7 +229,7 @@ def posterior_from_assignment(local: LocalHypotheses, col_of_row: np.ndarray, ct
     (``cost.LocalHypotheses.cost_matrix``): detected tracks get r = 1 and the Kalman update, missed tracks the
     misdetection update, measurements on their new-track column start a Bernoulli (module ``cost`` docstring)."""
     k = local.n_tracks
-    new_j = np.flatnonzero(col_of_row == k + np.arange(local.n_meas))
+    new_j = (col_of_row == k + np.arange(local.n_meas)).nonzero()[0]
     return updated_bernoullis(local, np.arange(k), meas_of_track(k, col_of_row) + 1, new_j, ctx)
 
 
@@ -288,7 +288,7 @@ def meas_of_track(n_tracks: int, col_of_row: np.ndarray) -> np.ndarray:
     """(K,) the measurement an assignment (M,) gives each of the K track columns, -1 if none."""
     out = np.full(n_tracks, -1, dtype=np.int64)
     on_track = col_of_row < n_tracks
-    out[col_of_row[on_track]] = np.flatnonzero(on_track)
+    out[col_of_row[on_track]] = on_track.nonzero()[0]
     return out
 
 
@@ -306,7 +306,7 @@ def updated_bernoullis(
     Bernoullis."""
     prior, new = local.prior, local.new
     k, n_new = len(prior), len(new_j)
-    det = np.flatnonzero(outcome > 0)
+    det = (outcome > 0).nonzero()[0]
     det_k, det_j = rows[det], outcome[det] - 1
     source = np.concatenate([rows, k + new_j]) if n_new else rows  # row of the sources each Bernoulli copies
     existence = _gather(local.miss_existence, new.existence, source, n_new)
@@ -416,7 +416,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         if p.measure_velocity == 1:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
         clutter = clutter_intensity(self.models, p)
-        birth = measurement_birth(meas, self.models, shared_cov=True)
+        birth = measurement_birth(meas, self.models)
         new = new_track_hypotheses(birth, meas, model.R, clutter, self.birth_update)
         return self._predict_and_localise(meas, model, new)
 
@@ -447,7 +447,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         b, keep = posterior, posterior.existence >= threshold
         det, track_id, mean, existence = b.det, b.track_id, b.mean, b.existence
         if not keep.all():
-            sel = np.flatnonzero(keep)
+            sel = keep.nonzero()[0]
             det, track_id, mean, existence = det.subset(sel), track_id[sel], mean[sel], existence[sel]
         estimates = det.to_estimates(self.class_name, track_id, mean, det.score * existence, existence)
         return estimates, threshold

@@ -26,8 +26,7 @@ from gnnpmb.types import Measurements
 
 @dataclass(frozen=True, slots=True)
 class NewTrackHypotheses:
-    """Per measurement j: log l_j (M,), existence r_j (M,), posterior mean (M, 4) and cov (M, 4, 4) (read-only
-    when computed from a ``BirthUpdate``)."""
+    """Per measurement j: log l_j (M,), existence r_j (M,), posterior mean (M, 4) and cov (M, 4, 4)."""
 
     log_likelihood: np.ndarray
     existence: np.ndarray
@@ -71,8 +70,7 @@ def new_track_hypotheses(
     """Likelihood, existence and state of the Bernoulli each measurement would start (module docstring).
 
     ``shared``: the update every component shares (``birth_update`` of P_b and R; the PMB filters compute it once
-    per class), used instead of a Kalman update per component; the posterior covariance is then a read-only
-    (M, 4, 4) broadcast view."""
+    per class), used instead of a Kalman update per component."""
     m = len(meas)
     if m == 0:
         return NewTrackHypotheses(np.zeros(0), np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4, 4)))
@@ -83,7 +81,7 @@ def new_track_hypotheses(
         mean, cov = mean_update(birth.mean, inn.gain, nu), inn.cov_post
     else:
         log_n = np.full(m, shared.log_density)
-        mean, cov = birth.mean + shared.mean_increment, np.broadcast_to(shared.cov, (m, 4, 4))
+        mean, cov = birth.mean + shared.mean_increment, shared.cov[None].repeat(m, axis=0)
     birth_term = birth.weight * meas.boxes.score * np.exp(log_n)
     total = clutter_intensity + birth_term
     return NewTrackHypotheses(log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=cov)
