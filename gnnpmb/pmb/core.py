@@ -152,7 +152,7 @@ def combine_keys(parent: np.ndarray, outcome: np.ndarray) -> np.ndarray:
     x ^= x >> np.uint64(27)
     x *= np.uint64(0x94D049BB133111EB)
     x ^= x >> np.uint64(31)
-    return (x & _MASK63).astype(np.int64)
+    return (x & _MASK63).view(np.int64)  # below 2^63: the same values
 
 
 @dataclass(slots=True)
