@@ -30,6 +30,9 @@ class DetectionFields(StructOfArrays):
     quat_wxyz: np.ndarray
     meas_index: np.ndarray
 
+    def __len__(self) -> int:
+        return len(self.score)
+
     @staticmethod
     def empty() -> DetectionFields:
         return DetectionFields(
@@ -51,6 +54,19 @@ class DetectionFields(StructOfArrays):
             quat_wxyz=np.asarray(boxes.quat_wxyz[index], dtype=float),
             meas_index=np.asarray(meas.source_index, dtype=np.int64)[index],
         )
+
+    def gather_with(self, meas: Measurements, source: np.ndarray) -> DetectionFields:
+        """The fields of the K items followed by those of the M measurements ``meas``, gathered by ``source``
+        (N,): source[i] < K picks item source[i], K + j measurement j (``from_measurements``)."""
+        boxes = meas.boxes
+        pairs = (
+            (self.score, boxes.score),
+            (self.z_m, boxes.translation_m[:, 2]),
+            (self.size_wlh_m, boxes.size_wlh_m),
+            (self.quat_wxyz, boxes.quat_wxyz),
+            (self.meas_index, meas.source_index),
+        )
+        return DetectionFields(*(np.concatenate([own, theirs])[source] for own, theirs in pairs))
 
     def undetected(self) -> DetectionFields:
         """The same fields with no detection this frame (``meas_index`` -1): after a prediction."""
@@ -80,35 +96,29 @@ class DetectionFields(StructOfArrays):
     ) -> list[TrackEstimate]:
         """One ``TrackEstimate`` per item: x, y, vx, vy from ``mean`` (K, 4), z, size, rotation and meas_index from
         these fields; ``track_id``, ``score`` and ``existence`` (K,) are the tracker's."""
-        # Python scalars from ``tolist`` once per array: the same values as float()/int() of each numpy element,
-        # several times faster than indexing element by element.
-        if not len(self):
+        # Python scalars from ``tolist`` once per array (the same values as float()/int() of each numpy element,
+        # several times faster than indexing element by element), the tuples zipped from columns, and the
+        # estimates built by ``map`` with positional fields: the Python work per estimate is its constructor.
+        k = len(self)
+        if not len(track_id) == len(mean) == len(score) == len(existence) == k:
+            raise ValueError(f"{k} items but {len(track_id)} ids, {len(mean)} means, {len(score)} scores")
+        if not k:
             return []
-        xy_v = np.asarray(mean, dtype=np.float64)[:, :4].tolist()
-        return [
-            TrackEstimate(
-                track_id=t,
-                class_name=class_name,
-                translation_m=(x, y, z),
-                size_wlh_m=tuple(size),
-                quat_wxyz=tuple(quat),
-                velocity_mps=(vx, vy),
-                score=s,
-                existence=r,
-                meas_index=m,
-            )
-            for t, (x, y, vx, vy), z, size, quat, s, r, m in zip(
+        x, y, vx, vy = np.asarray(mean, dtype=np.float64)[:, :4].T.tolist()
+        return list(
+            map(
+                TrackEstimate,
                 np.asarray(track_id).tolist(),
-                xy_v,
-                np.asarray(self.z_m, dtype=np.float64).tolist(),
-                np.asarray(self.size_wlh_m, dtype=np.float64).tolist(),
-                np.asarray(self.quat_wxyz, dtype=np.float64).tolist(),
+                [class_name] * k,
+                zip(x, y, np.asarray(self.z_m, dtype=np.float64).tolist(), strict=True),
+                zip(*np.asarray(self.size_wlh_m, dtype=np.float64).T.tolist(), strict=True),
+                zip(*np.asarray(self.quat_wxyz, dtype=np.float64).T.tolist(), strict=True),
+                zip(vx, vy, strict=True),
                 np.asarray(score, dtype=np.float64).tolist(),
                 np.asarray(existence, dtype=np.float64).tolist(),
                 np.asarray(self.meas_index).tolist(),
-                strict=True,
             )
-        ]
+        )
 
 
 _FIELDS: tuple[str, ...] = ("score", "z_m", "size_wlh_m", "quat_wxyz", "meas_index")

@@ -31,7 +31,7 @@ H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
 
 def symmetrize(P: np.ndarray) -> np.ndarray:
     """(P + P^T) / 2 over the last two axes."""
-    return 0.5 * (P + np.swapaxes(P, -1, -2))
+    return 0.5 * (P + P.swapaxes(-1, -2))
 
 
 def predict(mean: np.ndarray, cov: np.ndarray, model: MotionModel) -> tuple[np.ndarray, np.ndarray]:
@@ -76,22 +76,22 @@ def innovation(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:
     """
     if R.shape[0] != 2:
         return _innovation_general(mean, cov, R)
-    z_pred = mean[:, :2]
+    if not len(mean):
+        return Innovation.empty()
     PHt = cov[:, :, :2]  # P H^T, (K, 4, 2)
-    S = cov[:, :2, :2] + R
-    s00, s11 = S[:, 0, 0], S[:, 1, 1]
-    s01 = 0.5 * (S[:, 0, 1] + S[:, 1, 0])
+    S = symmetrize(cov[:, :2, :2] + R)  # the diagonal is exact: (s + s) / 2 = s
+    s00, s11, s01 = S[:, 0, 0], S[:, 1, 1], S[:, 0, 1]
     det = s00 * s11 - s01 * s01
-    if np.any(det <= 0) or np.any(s00 <= 0):
+    if ((det <= 0) | (s00 <= 0)).any():
         raise FloatingPointError("innovation covariance is not positive-definite")
-    S = np.empty_like(S)
-    S[:, 0, 0], S[:, 1, 1], S[:, 0, 1], S[:, 1, 0] = s00, s11, s01, s01
-    S_inv = np.empty_like(S)
-    S_inv[:, 0, 0], S_inv[:, 1, 1] = s11 / det, s00 / det
-    S_inv[:, 0, 1] = S_inv[:, 1, 0] = -s01 / det
+    S_inv = S[:, ::-1, ::-1] * _ADJUGATE_SIGN / det[:, None, None]  # [[s11, -s01], [-s01, s00]] / det
     gain = PHt @ S_inv
-    cov_post = symmetrize(cov - gain @ np.swapaxes(PHt, -1, -2))
-    return Innovation(z_pred=z_pred, S=S, S_inv=S_inv, log_det_S=np.log(det), gain=gain, cov_post=cov_post)
+    cov_post = symmetrize(cov - gain @ PHt.swapaxes(-1, -2))
+    return Innovation(z_pred=mean[:, :2], S=S, S_inv=S_inv, log_det_S=np.log(det), gain=gain, cov_post=cov_post)
+
+
+_ADJUGATE_SIGN = np.array([[1.0, -1.0], [-1.0, 1.0]])
+"""Signs of the 2 x 2 adjugate [[d, -b], [-c, a]] of [[a, b], [c, d]] read from the matrix reversed on both axes."""
 
 
 def _innovation_general(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:
@@ -104,7 +104,7 @@ def _innovation_general(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Inn
         raise FloatingPointError("innovation covariance is not positive-definite")
     S_inv = symmetrize(np.linalg.inv(S)) if len(S) else np.zeros((0, d, d))
     gain = PHt @ S_inv
-    cov_post = symmetrize(cov - gain @ np.swapaxes(PHt, -1, -2))
+    cov_post = symmetrize(cov - gain @ PHt.swapaxes(-1, -2))
     return Innovation(z_pred=mean[:, :d], S=S, S_inv=S_inv, log_det_S=log_det, gain=gain, cov_post=cov_post)
 
 
@@ -119,10 +119,13 @@ def mahalanobis2(inn: Innovation, z: np.ndarray) -> np.ndarray:
     return np.einsum("kmi,kij,kmj->km", nu, inn.S_inv, nu)
 
 
+_LOG_2PI = np.log(2.0 * np.pi)
+
+
 def gaussian_log_density(d2: np.ndarray, log_det_S: np.ndarray, dim: int) -> np.ndarray:
     """log N(z; H m, S) = -(d2 + log|S| + D log 2 pi) / 2 from squared Mahalanobis distances d2 and log|S|
     (broadcast against each other; any shape) of a ``dim``-dimensional measurement."""
-    return -0.5 * (d2 + log_det_S + dim * np.log(2.0 * np.pi))
+    return -0.5 * (d2 + log_det_S + dim * _LOG_2PI)
 
 
 def log_likelihood(inn: Innovation, d2: np.ndarray) -> np.ndarray:

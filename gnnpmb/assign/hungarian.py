@@ -6,6 +6,8 @@ accepts inf entries as long as a finite full row assignment exists and raises Va
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
@@ -27,9 +29,11 @@ def solve(cost: np.ndarray) -> tuple[np.ndarray, float]:
         rows, cols = linear_sum_assignment(cost)
     except ValueError as exc:
         raise InfeasibleAssignment(str(exc)) from exc
+    total = float(cost[rows, cols].sum())
+    if not math.isfinite(total):
+        raise InfeasibleAssignment("cost matrix is infeasible")
+    if len(rows) == n_rows:  # every row assigned: rows is 0..R-1 in order (scipy sorts them)
+        return cols.astype(np.int64, copy=False), total
     col_of_row = np.empty(n_rows, dtype=np.int64)
     col_of_row[rows] = cols
-    total = float(cost[rows, cols].sum())
-    if not np.isfinite(total):
-        raise InfeasibleAssignment("cost matrix is infeasible")
     return col_of_row, total

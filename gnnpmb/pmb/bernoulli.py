@@ -8,7 +8,7 @@ both the tracking score and the P_D used when the track is missed (paper sec. V-
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -35,6 +35,9 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
     cov: np.ndarray
     det: DetectionFields
 
+    def __len__(self) -> int:
+        return len(self.track_id)
+
     @staticmethod
     def empty() -> Bernoullis:
         return Bernoullis(
@@ -52,13 +55,7 @@ def predict_bernoullis(b: Bernoullis, model: MotionModel, p_survive: float) -> B
     if not len(b):
         return b
     mean, cov = predict(b.mean, b.cov, model)
-    return replace(
-        b,
-        existence=p_survive * b.existence,
-        mean=mean,
-        cov=cov,
-        det=b.det.undetected(),
-    )
+    return Bernoullis(b.track_id, b.local_key, p_survive * b.existence, mean, cov, b.det.undetected())
 
 
 def missed_update(existence: np.ndarray, p_detect: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -22,7 +22,6 @@ from typing import Protocol, overload
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
     AxisLabel,
     Born,
@@ -32,10 +31,10 @@ from gnnpmb.events import (
     Pruned,
     PruneReason,
 )
-from gnnpmb.models import MotionModel, clutter_intensity, cv_model, measurement_birth
+from gnnpmb.models import MotionModel, birth_covariance, clutter_intensity, cv_model, measurement_birth
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
-from gnnpmb.pmb.poisson import NewTrackHypotheses, new_track_hypotheses
+from gnnpmb.pmb.poisson import NewTrackHypotheses, birth_update, new_track_hypotheses
 from gnnpmb.skeleton import ClassFilter, Gating, TrackView
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
@@ -145,15 +144,15 @@ _MASK63 = np.uint64((1 << 63) - 1)
 
 def combine_keys(parent: np.ndarray, outcome: np.ndarray) -> np.ndarray:
     """Deterministic 63-bit key of a child single-target hypothesis from its parent key and outcome
-    (0 = missed, j + 1 = detected by local measurement j; new tracks use a negative parent). SplitMix64 finaliser."""
-    with np.errstate(over="ignore"):
-        x = parent.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15) + outcome.astype(np.uint64)
-        x ^= x >> np.uint64(30)
-        x *= np.uint64(0xBF58476D1CE4E5B9)
-        x ^= x >> np.uint64(27)
-        x *= np.uint64(0x94D049BB133111EB)
-        x ^= x >> np.uint64(31)
-    return (x & _MASK63).astype(np.int64)
+    (0 = missed, j + 1 = detected by local measurement j; new tracks use a negative parent). SplitMix64 finaliser.
+    ``parent`` and ``outcome`` are (N,) arrays: array arithmetic on uint64 wraps modulo 2^64 without a warning."""
+    x = parent.astype(np.uint64) * np.uint64(0x9E3779B97F4A7C15) + outcome.astype(np.uint64)
+    x ^= x >> np.uint64(30)
+    x *= np.uint64(0xBF58476D1CE4E5B9)
+    x ^= x >> np.uint64(27)
+    x *= np.uint64(0x94D049BB133111EB)
+    x ^= x >> np.uint64(31)
+    return (x & _MASK63).view(np.int64)  # below 2^63: the same values
 
 
 @dataclass(slots=True)
@@ -230,9 +229,8 @@ def posterior_from_assignment(local: LocalHypotheses, col_of_row: np.ndarray, ct
     (``cost.LocalHypotheses.cost_matrix``): detected tracks get r = 1 and the Kalman update, missed tracks the
     misdetection update, measurements on their new-track column start a Bernoulli (module ``cost`` docstring)."""
     k = local.n_tracks
-    tracks = updated_bernoullis(local, np.arange(k), meas_of_track(k, col_of_row) + 1)
-    new_j = np.flatnonzero(col_of_row == k + np.arange(local.n_meas))
-    return Bernoullis.concatenate([tracks, new_bernoullis(local, new_j, ctx)])
+    new_j = (col_of_row == k + np.arange(local.n_meas)).nonzero()[0]
+    return updated_bernoullis(local, np.arange(k), meas_of_track(k, col_of_row) + 1, new_j, ctx)
 
 
 def posteriors_from_assignments(
@@ -262,9 +260,8 @@ def posteriors_from_assignments(
     for j in birth_j[np.sort(first)].tolist():
         ctx.birth_id(j)
     distinct, inverse = _unique_codes(codes, n_union * (m + 1))
-    tracks = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1))
-    store = Bernoullis.concatenate([tracks, new_bernoullis(union, born, ctx)])
-    birth_rows = len(tracks) + np.searchsorted(born, birth_j)
+    store = updated_bernoullis(union, distinct // (m + 1), distinct % (m + 1), born, ctx)
+    birth_rows = len(distinct) + np.searchsorted(born, birth_j)
     n_births = is_birth.sum(axis=1)
     sizes = lengths + n_births
     starts = np.cumsum(sizes) - sizes  # each hypothesis' rows: its tracks, then its births, laid end to end
@@ -291,46 +288,66 @@ def meas_of_track(n_tracks: int, col_of_row: np.ndarray) -> np.ndarray:
     """(K,) the measurement an assignment (M,) gives each of the K track columns, -1 if none."""
     out = np.full(n_tracks, -1, dtype=np.int64)
     on_track = col_of_row < n_tracks
-    out[col_of_row[on_track]] = np.flatnonzero(on_track)
+    out[col_of_row[on_track]] = on_track.nonzero()[0]
     return out
 
 
-def updated_bernoullis(local: LocalHypotheses, rows: np.ndarray, outcome: np.ndarray) -> Bernoullis:
+def updated_bernoullis(
+    local: LocalHypotheses, rows: np.ndarray, outcome: np.ndarray, new_j: np.ndarray, ctx: UpdateContext
+) -> Bernoullis:
     """Prior Bernoullis ``rows`` of ``local`` after the single-target hypotheses ``outcome`` (0 = missed: the
     misdetection update; j + 1 = detected by local measurement j: r = 1 and the Kalman update, box fields and
-    score from the detection). The local key becomes ``combine_keys(parent key, outcome)``."""
-    prior = local.prior
-    det = np.flatnonzero(outcome > 0)
+    score from the detection), then the Bernoullis started by local measurements ``new_j`` (existence r_j and
+    state from ``poisson``). The local key becomes ``combine_keys(parent key, outcome)``, a new Bernoulli's
+    ``combine_keys(-frame serial, j + 1)``.
+
+    Every field is gathered in one indexing from the prior's rows followed by the new-track hypotheses' (K + M
+    sources; the prior's alone when nothing is born), so the posterior is built without intermediate
+    Bernoullis."""
+    prior, new = local.prior, local.new
+    k, n_new = len(prior), len(new_j)
+    det = (outcome > 0).nonzero()[0]
     det_k, det_j = rows[det], outcome[det] - 1
-    existence = local.miss_existence[rows]
+    source = np.concatenate([rows, k + new_j]) if n_new else rows  # row of the sources each Bernoulli copies
+    existence = _gather(local.miss_existence, new.existence, source, n_new)
     existence[det] = 1.0
-    mean = prior.mean[rows]
+    mean = _gather(prior.mean, new.mean, source, n_new)
     mean[det] = detected_means(local, det_k, det_j)
-    cov = prior.cov[rows]
+    cov = _gather(prior.cov, new.cov, source, n_new)
     cov[det] = local.inn.cov_post[det_k]
+    if len(det) or n_new:
+        det_source = source.copy()
+        det_source[det] = k + det_j  # detected Bernoullis take their detection's box fields
+        fields = prior.det.gather_with(local.meas, det_source)
+    else:
+        fields = prior.det.subset(rows)
+    track_id, parent, outcome = prior.track_id[rows], prior.local_key[rows], outcome
+    if n_new:
+        births = np.array([ctx.birth_id(j) for j in new_j.tolist()], dtype=np.int64)
+        track_id = np.concatenate([track_id, births])
+        parent = np.concatenate([parent, np.full(n_new, -ctx.frame_serial)])
+        outcome = np.concatenate([outcome, new_j + 1])
     return Bernoullis(
-        track_id=prior.track_id[rows],
-        local_key=combine_keys(prior.local_key[rows], outcome),
+        track_id=track_id,
+        local_key=combine_keys(parent, outcome),
         existence=existence,
         mean=mean,
         cov=cov,
-        det=prior.det.subset(rows).take(det, DetectionFields.from_measurements(local.meas, det_j)),
+        det=fields,
     )
+
+
+def _gather(own: np.ndarray, born: np.ndarray, source: np.ndarray, n_new: int) -> np.ndarray:
+    """Rows ``source`` of ``own`` followed by ``born`` (of ``own`` alone when no row is born: ``n_new`` 0)."""
+    return np.concatenate([own, born])[source] if n_new else own[source]
 
 
 def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext) -> Bernoullis:
     """The Bernoullis started by local measurements ``new_j`` (existence r_j from ``poisson``)."""
     if len(new_j) == 0:
         return Bernoullis.empty()
-    new = local.new
-    return Bernoullis(
-        track_id=np.array([ctx.birth_id(int(j)) for j in new_j], dtype=np.int64),
-        local_key=combine_keys(np.full(len(new_j), -ctx.frame_serial), new_j + 1),
-        existence=new.existence[new_j],
-        mean=new.mean[new_j],
-        cov=new.cov[new_j],
-        det=DetectionFields.from_measurements(local.meas, new_j),
-    )
+    none = np.zeros(0, dtype=np.int64)
+    return updated_bernoullis(local, none, none, new_j, ctx)
 
 
 def assignment_pairs(
@@ -382,6 +399,8 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         self.strategy = strategy
         self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty())]
         self.frame_serial = 0
+        R = cv_model(0.0, self.class_params, self.params.measure_velocity == 1).R
+        self.birth_update = birth_update(birth_covariance(self.models), R)
 
     @property
     def panels(self) -> tuple[Panel, ...]:
@@ -397,7 +416,8 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         if p.measure_velocity == 1:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
         clutter = clutter_intensity(self.models, p)
-        new = new_track_hypotheses(measurement_birth(meas, self.models), meas, model.R, clutter)
+        birth = measurement_birth(meas, self.models)
+        new = new_track_hypotheses(birth, meas, model.R, clutter, self.birth_update)
         return self._predict_and_localise(meas, model, new)
 
     def prior_view(self, prior: PmbPrior) -> tuple[TrackView, Gating]:
@@ -424,10 +444,12 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
         """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r."""
         threshold = self.params.extraction_threshold
-        sel = posterior.subset(np.flatnonzero(posterior.existence >= threshold))
-        estimates = sel.det.to_estimates(
-            self.class_name, sel.track_id, sel.mean, sel.score * sel.existence, sel.existence
-        )
+        b, keep = posterior, posterior.existence >= threshold
+        det, track_id, mean, existence = b.det, b.track_id, b.mean, b.existence
+        if not keep.all():
+            sel = keep.nonzero()[0]
+            det, track_id, mean, existence = det.subset(sel), track_id[sel], mean[sel], existence[sel]
+        estimates = det.to_estimates(self.class_name, track_id, mean, det.score * existence, existence)
         return estimates, threshold
 
     def posterior_view(self, posterior: Bernoullis) -> TrackView:

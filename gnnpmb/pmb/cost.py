@@ -57,9 +57,10 @@ class LocalHypotheses:
     def cost_matrix(self) -> np.ndarray:
         """(M, K + M) cost matrix described in the module docstring."""
         k, m = self.n_tracks, self.n_meas
-        cost = np.full((m, k + m), np.inf)
-        cost[:, :k] = -(self.det_log_lik - self.miss_log_lik[:, None]).T
-        cost[np.arange(m), k + np.arange(m)] = -self.new.log_likelihood
+        cost = np.empty((m, k + m))
+        cost.fill(np.inf)
+        cost[:, :k] = (self.miss_log_lik[:, None] - self.det_log_lik).T  # = -(log l_kj - log l_k0), exactly
+        cost.reshape(-1)[k :: k + m + 1] = -self.new.log_likelihood  # C[j, K + j]: flat index K + j (K + M + 1)
         return cost
 
     def base_log_weight(self) -> float:
@@ -101,7 +102,9 @@ def local_hypotheses(
     missed track's P_D is its last detection score capped at ``miss_p_detect_max`` (``PmbParams``)."""
     gating = gate_tracks(prior.mean, prior.cov, R, meas.z, gate_chi2)
     inn, d2, inside = gating.inn, gating.d2, gating.inside
-    miss_log_lik, miss_existence = missed_update(prior.existence, np.minimum(prior.score, miss_p_detect_max))
+    # missed_update caps P_D below 1 itself: a cap at or above 1 changes nothing
+    p_detect = prior.score if miss_p_detect_max >= 1.0 else np.minimum(prior.score, miss_p_detect_max)
+    miss_log_lik, miss_existence = missed_update(prior.existence, p_detect)
     with np.errstate(divide="ignore"):
         det = np.log(prior.existence)[:, None] + np.log(meas.boxes.score)[None, :] + log_likelihood(inn, d2)
     det_log_lik = np.where(inside, det, -np.inf)

@@ -34,17 +34,54 @@ class NewTrackHypotheses:
     cov: np.ndarray
 
 
+@dataclass(frozen=True, slots=True)
+class BirthUpdate:
+    """The update of a birth component by its own measurement, the same for every component: all have covariance
+    P_b, and the innovation z_j - H m_j is exactly 0 (component j is centred on measurement j, which preprocessing
+    keeps finite). log_density: log N(z_j; H m_j, S); mean_increment: K (z_j - H m_j), (4,) signed zeros;
+    cov: the posterior covariance (4, 4), read-only."""
+
+    log_density: float
+    mean_increment: np.ndarray
+    cov: np.ndarray
+
+
+def birth_update(birth_cov: np.ndarray, R: np.ndarray) -> BirthUpdate:
+    """``BirthUpdate`` of components with covariance ``birth_cov`` (4, 4): the arithmetic of
+    ``new_track_hypotheses`` on one component with a zero innovation, so each quantity has the bits the
+    per-component computation gives."""
+    d = R.shape[0]
+    inn = innovation(np.zeros((1, 4)), birth_cov[None], R)
+    nu = np.zeros((1, d))
+    log_density = gaussian_log_density(paired_mahalanobis2(inn.S_inv, nu), inn.log_det_S, d)
+    increment = mean_update(np.full((1, 4), -0.0), inn.gain, nu)[0]  # -0 + x = x, signed zeros included
+    cov = inn.cov_post[0]
+    increment.flags.writeable = cov.flags.writeable = False
+    return BirthUpdate(log_density=float(log_density[0]), mean_increment=increment, cov=cov)
+
+
 def new_track_hypotheses(
-    birth: BirthIntensity, meas: Measurements, R: np.ndarray, clutter_intensity: float
+    birth: BirthIntensity,
+    meas: Measurements,
+    R: np.ndarray,
+    clutter_intensity: float,
+    shared: BirthUpdate | None = None,
 ) -> NewTrackHypotheses:
-    """Likelihood, existence and state of the Bernoulli each measurement would start (module docstring)."""
+    """Likelihood, existence and state of the Bernoulli each measurement would start (module docstring).
+
+    ``shared``: the update every component shares (``birth_update`` of P_b and R; the PMB filters compute it once
+    per class), used instead of a Kalman update per component."""
     m = len(meas)
     if m == 0:
         return NewTrackHypotheses(np.zeros(0), np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4, 4)))
-    inn = innovation(birth.mean, birth.cov, R)
-    nu = meas.z - inn.z_pred  # (M, D): component j explains measurement j only
-    log_n = gaussian_log_density(paired_mahalanobis2(inn.S_inv, nu), inn.log_det_S, nu.shape[1])
+    if shared is None:
+        inn = innovation(birth.mean, birth.cov, R)
+        nu = meas.z - inn.z_pred  # (M, D): component j explains measurement j only
+        log_n = gaussian_log_density(paired_mahalanobis2(inn.S_inv, nu), inn.log_det_S, nu.shape[1])
+        mean, cov = mean_update(birth.mean, inn.gain, nu), inn.cov_post
+    else:
+        log_n = np.full(m, shared.log_density)
+        mean, cov = birth.mean + shared.mean_increment, shared.cov[None].repeat(m, axis=0)
     birth_term = birth.weight * meas.boxes.score * np.exp(log_n)
     total = clutter_intensity + birth_term
-    mean = mean_update(birth.mean, inn.gain, nu)
-    return NewTrackHypotheses(log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=inn.cov_post)
+    return NewTrackHypotheses(log_likelihood=np.log(total), existence=birth_term / total, mean=mean, cov=cov)

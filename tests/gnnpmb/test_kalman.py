@@ -81,3 +81,27 @@ def test_gate_and_ellipse_boundary():
     d2 = np.einsum("ni,ij,nj->n", nu, np.linalg.inv(S[0]), nu)
     np.testing.assert_allclose(d2, 40.0, rtol=1e-10)
     assert gate(np.array([[39.9, 40.0, 40.1]]), 40.0).tolist() == [[True, False, False]]
+
+
+def test_innovation_rows_do_not_depend_on_the_batch():
+    """A row of a batched innovation is bit for bit the innovation of that row alone (the PMB filters compute a
+    birth component's innovation once and repeat it) and S^-1 is the symmetric inverse of S."""
+    rng = np.random.default_rng(2)
+    m, P = rng.normal(size=(6, 4)), random_spd(rng, 4, 6)
+    R = np.diag([0.3, 0.4])
+    batch = innovation(m, P, R)
+    for k in range(6):
+        alone = innovation(m[k : k + 1], P[k : k + 1], R)
+        for name in ("z_pred", "S", "S_inv", "log_det_S", "gain", "cov_post"):
+            assert getattr(alone, name).tobytes() == getattr(batch, name)[k : k + 1].tobytes(), name
+    np.testing.assert_allclose(batch.S_inv @ batch.S, np.broadcast_to(np.eye(2), (6, 2, 2)), atol=1e-12)
+    assert np.array_equal(batch.S_inv, np.swapaxes(batch.S_inv, 1, 2))
+    assert len(innovation(np.zeros((0, 4)), np.zeros((0, 4, 4)), R)) == 0
+
+
+def test_cv_model_matrices_are_shared_and_read_only():
+    a, b = cv_model(0.5, PARAMS), cv_model(0.5, PARAMS)
+    assert a.F is b.F and a.Q is b.Q and a.R is b.R
+    assert cv_model(1.0, PARAMS).F[0, 2] == 1.0 and a.F[0, 2] == 0.5
+    for matrix in (a.F, a.Q, a.R):
+        assert not matrix.flags.writeable
