@@ -337,20 +337,21 @@ def assignment_pairs(
     local: LocalHypotheses, col_of_row: np.ndarray
 ) -> tuple[tuple[tuple[AxisLabel, AxisLabel], ...], tuple[int, ...]]:
     """(row label, column label) of every assigned measurement, and the ids of tracks left undetected."""
-    rows, cols = local.row_labels(), local.col_labels()
-    pairs = tuple((rows[j], cols[int(c)]) for j, c in enumerate(col_of_row))
-    detected = set(int(c) for c in col_of_row if c < local.n_tracks)
-    missed = tuple(int(t) for i, t in enumerate(local.prior.track_id) if i not in detected)
-    return pairs, missed
+    cols = local.col_labels()
+    pairs = tuple(zip(local.row_labels(), map(cols.__getitem__, col_of_row.tolist()), strict=True))
+    missed = local.prior.track_id[meas_of_track(local.n_tracks, col_of_row) < 0]
+    return pairs, tuple(missed.tolist())
 
 
-def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
-    """Track id -> its largest existence probability over the hypotheses."""
-    ids = np.concatenate([h.track_id for h in hypotheses])
-    ids, inverse = np.unique(ids, return_inverse=True)
-    largest = np.zeros(len(ids))
-    np.maximum.at(largest, inverse, np.concatenate([h.existence for h in hypotheses]))
-    return dict(zip(ids.tolist(), largest.tolist(), strict=True))
+def _gone_existence(hypotheses: list[GlobalHypothesis], gone: np.ndarray) -> dict[int, float]:
+    """Track id -> its largest existence probability over the hypotheses, for the tracks ``gone`` (K,) bool of
+    the hypotheses' track ids laid end to end selects (a few: the pruned ones)."""
+    ids = np.concatenate([h.track_id for h in hypotheses])[gone].tolist()
+    existence = np.concatenate([h.existence for h in hypotheses])[gone].tolist()
+    largest: dict[int, float] = {}
+    for t, r in zip(ids, existence, strict=True):
+        largest[t] = max(largest.get(t, 0.0), r)
+    return largest
 
 
 @dataclass(frozen=True, slots=True)
@@ -458,10 +459,12 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         threshold = self.params.prune_existence
         kept = _without_existence_below(posteriors, threshold)
         if sink.enabled:
-            posterior_r = _max_existence(posteriors)
-            prior_r = _max_existence(priors)
-            alive = set(np.concatenate([h.track_id for h in kept]).tolist())
-            for t in sorted((set(posterior_r) | set(prior_r)) - alive):
+            posterior_ids = np.concatenate([h.track_id for h in posteriors])
+            alive = np.concatenate([h.track_id for h in kept])
+            posterior_r = _gone_existence(posteriors, ~np.isin(posterior_ids, alive))
+            prior_ids = np.concatenate([h.track_id for h in priors])
+            prior_r = _gone_existence(priors, ~np.isin(prior_ids, posterior_ids))  # kept tracks are posterior ones
+            for t in sorted(set(posterior_r) | set(prior_r)):
                 if t in posterior_r:
                     sink.emit(Pruned(self.class_name, t, PruneReason.LOW_EXISTENCE, posterior_r[t]))
                 else:
@@ -470,7 +473,10 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
 
     def _emit_born(self, best: Bernoullis, ctx: UpdateContext, sink: EventSink) -> None:
         """``Born`` of the Bernoullis of ``best`` started this frame."""
-        sel = np.flatnonzero(np.isin(best.track_id, list(set(ctx.born_ids.values()))))
+        born = ctx.born_ids
+        if not born:
+            return
+        sel = np.flatnonzero(np.isin(best.track_id, list(born.values())))
         if len(sel):
             sink.emit(
                 Born(self.class_name, best.track_id[sel], best.meas_index[sel], best.mean[sel], best.existence[sel])
