@@ -343,15 +343,20 @@ def assignment_pairs(
     return pairs, tuple(missed.tolist())
 
 
-def _gone_existence(hypotheses: list[GlobalHypothesis], gone: np.ndarray) -> dict[int, float]:
-    """Track id -> its largest existence probability over the hypotheses, for the tracks ``gone`` (K,) bool of
-    the hypotheses' track ids laid end to end selects (a few: the pruned ones)."""
-    ids = np.concatenate([h.track_id for h in hypotheses])[gone].tolist()
-    existence = np.concatenate([h.existence for h in hypotheses])[gone].tolist()
-    largest: dict[int, float] = {}
-    for t, r in zip(ids, existence, strict=True):
-        largest[t] = max(largest.get(t, 0.0), r)
-    return largest
+def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
+    """Track id -> its largest existence probability over the hypotheses (at least 0). One hypothesis (GNN-PMB)
+    is read in plain Python: NumPy's set routines cost more than the loop on a hundred tracks."""
+    ids = np.concatenate([h.track_id for h in hypotheses])
+    existence = np.concatenate([h.existence for h in hypotheses])
+    if len(hypotheses) > 1:
+        ids, inverse = np.unique(ids, return_inverse=True)
+        largest = np.zeros(len(ids))
+        np.maximum.at(largest, inverse, existence)
+        return dict(zip(ids.tolist(), largest.tolist(), strict=True))
+    out: dict[int, float] = {}
+    for t, r in zip(ids.tolist(), existence.tolist(), strict=True):
+        out[t] = max(out.get(t, 0.0), r)
+    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -459,12 +464,10 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         threshold = self.params.prune_existence
         kept = _without_existence_below(posteriors, threshold)
         if sink.enabled:
-            posterior_ids = np.concatenate([h.track_id for h in posteriors])
-            alive = np.concatenate([h.track_id for h in kept])
-            posterior_r = _gone_existence(posteriors, ~np.isin(posterior_ids, alive))
-            prior_ids = np.concatenate([h.track_id for h in priors])
-            prior_r = _gone_existence(priors, ~np.isin(prior_ids, posterior_ids))  # kept tracks are posterior ones
-            for t in sorted(set(posterior_r) | set(prior_r)):
+            posterior_r = _max_existence(posteriors)
+            prior_r = _max_existence(priors)
+            alive = set(np.concatenate([h.track_id for h in kept]).tolist())
+            for t in sorted((posterior_r.keys() | prior_r.keys()) - alive):
                 if t in posterior_r:
                     sink.emit(Pruned(self.class_name, t, PruneReason.LOW_EXISTENCE, posterior_r[t]))
                 else:
@@ -473,10 +476,10 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
 
     def _emit_born(self, best: Bernoullis, ctx: UpdateContext, sink: EventSink) -> None:
         """``Born`` of the Bernoullis of ``best`` started this frame."""
-        born = ctx.born_ids
+        born = set(ctx.born_ids.values())
         if not born:
             return
-        sel = np.flatnonzero(np.isin(best.track_id, list(born.values())))
+        sel = np.array([k for k, t in enumerate(best.track_id.tolist()) if t in born], dtype=np.intp)
         if len(sel):
             sink.emit(
                 Born(self.class_name, best.track_id[sel], best.meas_index[sel], best.mean[sel], best.existence[sel])
