@@ -12,6 +12,7 @@ and the table show exactly the same columns.
 from __future__ import annotations
 
 import math
+import operator
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -19,6 +20,9 @@ import numpy as np
 
 from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, GlobalHypotheses
 from gnnpmb.explain import Conflict, Decisions
+
+_KIND = operator.attrgetter("kind")
+_REF = operator.attrgetter("ref")
 
 CLOSE_CALL_MARGIN = 1.0
 """A choice whose margin (in cost units, nats for the PMB family) is below this is flagged as a close call."""
@@ -229,11 +233,13 @@ def decision_grid(
         key=lambda b: (not b[0].involves(focus_tracks or set()), b[0].closest_margin),
     )[:max_blocks]
     y0 = 0.0
+    lookups: dict[str, tuple[dict[int, int], dict[tuple[str, int], int]]] = {}
     for conflict, class_name in blocks:
         m = matrices[class_name]
         cost = np.asarray(m.cost, dtype=np.float64)
-        row_of = {label.ref: i for i, label in enumerate(m.rows)}
-        col_of = {(label.kind.value, label.ref): j for j, label in enumerate(m.cols)}  # str keys: fast to hash
+        if class_name not in lookups:  # one class may give several blocks
+            lookups[class_name] = _label_positions(m)
+        row_of, col_of = lookups[class_name]
         picked = {(c.meas.ref, c.chosen.kind.value, c.chosen.ref) for c in conflict.choices}
         given = {c.chosen.ref for c in conflict.choices if c.chosen.kind is AxisKind.TRACK}
         track_ids = [t for t in conflict.track_ids if reported is None or t in reported or t in given]
@@ -267,6 +273,16 @@ def decision_grid(
         np.array(chosen, dtype=bool),
         np.array(axis_pos, dtype=np.float64).reshape(-1, 2),
         axis_lab,
+    )
+
+
+def _label_positions(matrix: CostMatrix) -> tuple[dict[int, int], dict[tuple[str, int], int]]:
+    """Row ref -> row and (column kind value, ref) -> column of ``matrix`` (str keys: fast to hash; the last of
+    equal labels wins)."""
+    kinds = [kind.value for kind in map(_KIND, matrix.cols)]
+    return (
+        dict(zip(map(_REF, matrix.rows), range(len(matrix.rows)), strict=True)),
+        dict(zip(zip(kinds, map(_REF, matrix.cols), strict=True), range(len(matrix.cols)), strict=True)),
     )
 
 
