@@ -12,6 +12,8 @@ Measurements are named by their *source index* into the frame's full detection l
 from __future__ import annotations
 
 import enum
+import itertools
+import operator
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
@@ -66,6 +68,24 @@ class _LabelCache(dict):
 
 _LABEL_CACHE_MAX = 1 << 16
 _LABELS = {kind: _LabelCache(kind) for kind in AxisKind}
+
+
+def label_positions(labels: Sequence[AxisLabel]) -> dict[AxisKind, dict[int, int]]:
+    """kind -> (ref -> position in ``labels`` of the last label of that kind and ref): the row or column of a
+    cost matrix that a label names. Built run by run of equal kinds with C-level ``map`` and ``zip``: an
+    ``AxisKind`` hashes in Python code, so it is hashed once per run, not once per label."""
+    out: dict[AxisKind, dict[int, int]] = {}
+    refs = list(map(_REF, labels))
+    start = 0
+    for kind, run in itertools.groupby(map(_KIND, labels)):
+        stop = start + len(list(run))
+        out.setdefault(kind, {}).update(zip(refs[start:stop], range(start, stop), strict=True))
+        start = stop
+    return out
+
+
+_KIND = operator.attrgetter("kind")
+_REF = operator.attrgetter("ref")
 
 
 class PruneReason(enum.Enum):

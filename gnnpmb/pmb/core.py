@@ -343,12 +343,26 @@ def assignment_pairs(
     return pairs, tuple(missed.tolist())
 
 
+def _track_rows(hypotheses: list[GlobalHypothesis]) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) track ids and (N,) existence probabilities of the Bernoullis of ``hypotheses``: for hypotheses
+    indexing one store (PMBM), each store row used once (a row repeated across hypotheses adds nothing to a
+    maximum or a set); otherwise every hypothesis' Bernoullis laid end to end."""
+    store = hypotheses[0].store
+    if len(hypotheses) > 1 and all(h.store is store and h.index is not None for h in hypotheses):
+        used = np.zeros(len(store), dtype=bool)
+        used[np.concatenate([h.index for h in hypotheses])] = True
+        return store.track_id[used], store.existence[used]
+    return np.concatenate([h.track_id for h in hypotheses]), np.concatenate([h.existence for h in hypotheses])
+
+
+_PYTHON_MAX_ROWS = 512
+"""``_max_existence`` reads up to this many Bernoullis in plain Python: NumPy's set routines cost more below."""
+
+
 def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
-    """Track id -> its largest existence probability over the hypotheses (at least 0). One hypothesis (GNN-PMB)
-    is read in plain Python: NumPy's set routines cost more than the loop on a hundred tracks."""
-    ids = np.concatenate([h.track_id for h in hypotheses])
-    existence = np.concatenate([h.existence for h in hypotheses])
-    if len(hypotheses) > 1:
+    """Track id -> its largest existence probability over the hypotheses (at least 0)."""
+    ids, existence = _track_rows(hypotheses)
+    if len(ids) > _PYTHON_MAX_ROWS:
         ids, inverse = np.unique(ids, return_inverse=True)
         largest = np.zeros(len(ids))
         np.maximum.at(largest, inverse, existence)
@@ -466,7 +480,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         if sink.enabled:
             posterior_r = _max_existence(posteriors)
             prior_r = _max_existence(priors)
-            alive = set(np.concatenate([h.track_id for h in kept]).tolist())
+            alive = set(_track_rows(kept)[0].tolist())
             for t in sorted((posterior_r.keys() | prior_r.keys()) - alive):
                 if t in posterior_r:
                     sink.emit(Pruned(self.class_name, t, PruneReason.LOW_EXISTENCE, posterior_r[t]))

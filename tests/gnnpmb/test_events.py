@@ -1,7 +1,7 @@
 import numpy as np
 
 from gnnpmb import events
-from gnnpmb.events import AxisKind, AxisLabel, axis_labels
+from gnnpmb.events import AxisKind, AxisLabel, axis_labels, label_positions
 
 
 def test_axis_labels_equal_constructed_labels_for_arrays_and_lists():
@@ -21,3 +21,15 @@ def test_axis_labels_are_cached_per_kind_and_the_cache_is_bounded(monkeypatch):
     labels = axis_labels(AxisKind.MISSED, [1, 2, 3, 4])
     assert labels == tuple(AxisLabel(AxisKind.MISSED, r) for r in (1, 2, 3, 4))
     assert len(events._LABELS[AxisKind.MISSED]) <= 2
+
+
+def test_label_positions_match_a_dict_per_kind_last_label_wins():
+    rng = np.random.default_rng(3)
+    kinds = list(AxisKind)
+    pairs = zip(rng.integers(0, 4, 60).tolist(), rng.integers(0, 9, 60).tolist(), strict=True)
+    labels = [AxisLabel(kinds[k], r) for k, r in pairs]
+    expected: dict[AxisKind, dict[int, int]] = {}
+    for j, label in enumerate(labels):
+        expected.setdefault(label.kind, {})[label.ref] = j
+    assert label_positions(labels) == expected
+    assert label_positions(()) == {}
