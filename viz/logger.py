@@ -51,6 +51,7 @@ from gnnpmb.events import (
     Pruned,
     TrackLogic,
     TrackLogicAction,
+    label_positions,
 )
 from gnnpmb.explain import Decisions, explain
 from gnnpmb.gating import ellipse_outline
@@ -1010,7 +1011,7 @@ def _pair_cost_lookup(matrix: CostMatrix | None) -> Callable[[int, int], float]:
     if cost.size == 0:
         return lambda m, t: math.nan
     row_of = {label.ref: i for i, label in enumerate(matrix.rows)}
-    col_of = {label.ref: j for j, label in enumerate(matrix.cols) if label.kind is AxisKind.TRACK}
+    col_of = label_positions(matrix.cols).get(AxisKind.TRACK, {})
 
     def cost_of(m: int, t: int) -> float:
         i, j = row_of.get(m), col_of.get(t)
