@@ -367,8 +367,12 @@ def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
         largest = np.zeros(len(ids))
         np.maximum.at(largest, inverse, existence)
         return dict(zip(ids.tolist(), largest.tolist(), strict=True))
-    out: dict[int, float] = {}
-    for t, r in zip(ids.tolist(), existence.tolist(), strict=True):
+    id_list, r_list = ids.tolist(), existence.tolist()
+    out = dict(zip(id_list, r_list, strict=True))
+    if len(out) == len(id_list) and not (np.signbit(existence) | np.isnan(existence)).any():
+        return out  # distinct ids (one hypothesis): each value is its own maximum, and max(0, r) is r
+    out = {}
+    for t, r in zip(id_list, r_list, strict=True):
         out[t] = max(out.get(t, 0.0), r)
     return out
 
