@@ -6,7 +6,8 @@ file (opening, ``finish`` and closing included), the way ``gnnpmb-viz --save`` d
 ``--live``: every ``FLUSH_FRAMES`` frames, as for a viewer), the three modes interleaved, three times. The best
 wall time and the best CPU time of the process (all threads: Rerun's writer too; the fairer figure on a shared
 machine) per mode are printed as ms per frame with the ratios to the tracker alone, plus the recording's chunk
-count.
+count. Everything loaded before the runs is frozen out of the garbage collector's reach, as ``gnnpmb-viz`` does
+(``gnnpmb.session.freeze_loaded``).
 
     uv run python benchmarks/logging_overhead.py [--scene scene-0103] [--detector centerpoint] [--tracker gnnpmb]
         [--live]
@@ -15,6 +16,7 @@ count.
 from __future__ import annotations
 
 import argparse
+import gc
 import tempfile
 import time
 from dataclasses import dataclass
@@ -77,6 +79,8 @@ def main() -> None:
     config = TrackerConfig()
     detections = get_detections(scene, None, args.detector, 0)
     frames = preprocess_frames(scene, detections, config, TRACKING_CLASSES)
+    gc.collect()
+    gc.freeze()  # as gnnpmb.session.prepare does: no full collection walks the devkit's tables mid-run
     n = len(scene.keyframes)
     flush_frames = FLUSH_FRAMES if args.live else None
     mode = f"rows sent every {FLUSH_FRAMES} frames (live)" if args.live else "rows sent at the end (--save)"

@@ -12,7 +12,8 @@ Measurements are named by their *source index* into the frame's full detection l
 from __future__ import annotations
 
 import enum
-import functools
+import itertools
+import operator
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
@@ -41,15 +42,50 @@ class AxisLabel:
 
 
 def axis_labels(kind: AxisKind, refs: np.ndarray | Sequence[int]) -> tuple[AxisLabel, ...]:
-    """``AxisLabel(kind, r)`` for each of the (N,) refs. Labels come from a cache: building a frozen dataclass
-    (and ``int`` of a numpy scalar) per row and column was the largest cost of emitting events (about 4 ms per
-    frame of GNN-PMB's 13 ms with the logger on the centerpoint demo)."""
-    return tuple(_axis_label(kind, r) for r in np.asarray(refs).tolist())
+    """``AxisLabel(kind, r)`` for each of the (N,) refs. Labels come from a cache, one dict per kind read through
+    C-level ``map``: building a frozen dataclass (and ``int`` of a numpy scalar) per row and column was the
+    largest cost of emitting events (about 4 ms per frame of GNN-PMB's 13 ms with the logger on the centerpoint
+    demo), and a Python loop over a cached constructor still cost ~1 µs per label."""
+    return tuple(map(_LABELS[kind].__getitem__, np.asarray(refs).tolist()))
 
 
-@functools.lru_cache(maxsize=1 << 16)
-def _axis_label(kind: AxisKind, ref: int) -> AxisLabel:
-    return AxisLabel(kind, ref)
+class _LabelCache(dict):
+    """ref -> ``AxisLabel(kind, ref)`` of one kind, built on first use; emptied when it reaches
+    ``_LABEL_CACHE_MAX`` entries (track ids keep growing over a long run)."""
+
+    __slots__ = ("kind",)
+
+    def __init__(self, kind: AxisKind) -> None:
+        super().__init__()
+        self.kind = kind
+
+    def __missing__(self, ref: int) -> AxisLabel:
+        if len(self) >= _LABEL_CACHE_MAX:
+            self.clear()
+        label = self[ref] = AxisLabel(self.kind, ref)
+        return label
+
+
+_LABEL_CACHE_MAX = 1 << 16
+_LABELS = {kind: _LabelCache(kind) for kind in AxisKind}
+
+
+def label_positions(labels: Sequence[AxisLabel]) -> dict[AxisKind, dict[int, int]]:
+    """kind -> (ref -> position in ``labels`` of the last label of that kind and ref): the row or column of a
+    cost matrix that a label names. Built run by run of equal kinds with C-level ``map`` and ``zip``: an
+    ``AxisKind`` hashes in Python code, so it is hashed once per run, not once per label."""
+    out: dict[AxisKind, dict[int, int]] = {}
+    refs = list(map(_REF, labels))
+    start = 0
+    for kind, run in itertools.groupby(map(_KIND, labels)):
+        stop = start + len(list(run))
+        out.setdefault(kind, {}).update(zip(refs[start:stop], range(start, stop), strict=True))
+        start = stop
+    return out
+
+
+_KIND = operator.attrgetter("kind")
+_REF = operator.attrgetter("ref")
 
 
 class PruneReason(enum.Enum):

@@ -19,6 +19,7 @@ viewer.
 
 from __future__ import annotations
 
+import gc
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -222,6 +223,7 @@ def prepare(
     detections = get_detections(scene, detections_file, detector, seed)
     source = detections_source(scene, detections, detections_file, detector, seed)
     frame_detections = preprocess_frames(scene, detections, config, class_names)
+    freeze_loaded()
     return ViewRequest(
         scene,
         location,
@@ -238,6 +240,15 @@ def prepare(
         focus=focus,
         serve=serve,
     )
+
+
+def freeze_loaded() -> None:
+    """Collect garbage, then move every object alive (the devkit's tables, the scene, the frames) out of the
+    garbage collector's reach (``gc.freeze``): they live as long as the process, and a full collection walking
+    them cost ~130 ms in the middle of tracking. Objects frozen are still freed by reference counting; only
+    reference cycles among them would outlive their use."""
+    gc.collect()
+    gc.freeze()
 
 
 def prepare_reproduction(
@@ -295,6 +306,7 @@ def prepare_reproduction(
                 f"recorded (sha256 {source.sha256[:12]}, recorded {recorded.sha256[:12]})"
             )
     frame_detections = preprocess_frames(scene, detections, config, classes)
+    freeze_loaded()
     return ViewRequest(
         scene,
         location,

@@ -17,8 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, GlobalHypotheses
+from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, GlobalHypotheses, label_positions
 from gnnpmb.explain import Conflict, Decisions
+
+_TRACK = AxisKind.TRACK.value
+_NEW = AxisKind.NEW_TRACK.value
 
 CLOSE_CALL_MARGIN = 1.0
 """A choice whose margin (in cost units, nats for the PMB family) is below this is flagged as a close call."""
@@ -229,14 +232,22 @@ def decision_grid(
         key=lambda b: (not b[0].involves(focus_tracks or set()), b[0].closest_margin),
     )[:max_blocks]
     y0 = 0.0
+    lookups: dict[str, tuple[dict[int, int], dict[int, int], dict[int, int]]] = {}
     for conflict, class_name in blocks:
         m = matrices[class_name]
         cost = np.asarray(m.cost, dtype=np.float64)
-        row_of = {label.ref: i for i, label in enumerate(m.rows)}
-        col_of = {(label.kind.value, label.ref): j for j, label in enumerate(m.cols)}  # str keys: fast to hash
+        if class_name not in lookups:  # one class may give several blocks
+            rows_by_kind, cols_by_kind = label_positions(m.rows), label_positions(m.cols)
+            lookups[class_name] = (
+                rows_by_kind.get(AxisKind.MEASUREMENT, {}),
+                cols_by_kind.get(AxisKind.TRACK, {}),
+                cols_by_kind.get(AxisKind.NEW_TRACK, {}),
+            )
+        row_of, track_col_of, new_col_of = lookups[class_name]
         picked = {(c.meas.ref, c.chosen.kind.value, c.chosen.ref) for c in conflict.choices}
         given = {c.chosen.ref for c in conflict.choices if c.chosen.kind is AxisKind.TRACK}
         track_ids = [t for t in conflict.track_ids if reported is None or t in reported or t in given]
+        track_cells = [(k, _TRACK, t, track_col_of[t]) for k, t in enumerate(track_ids)]
         axis_pos.append((-0.6, y0 - 1.1))
         axis_lab.append(f"{class_name}, margin {_fmt(conflict.closest_margin)}")
         for k, t in enumerate(track_ids):
@@ -249,16 +260,14 @@ def decision_grid(
             axis_pos.append((-0.6, y))
             axis_lab.append(meas_name(ref))
             r = row_of[ref]
-            cells = [(k, (AxisKind.TRACK.value, t)) for k, t in enumerate(track_ids)]
-            cells.append((len(track_ids), (AxisKind.NEW_TRACK.value, ref)))
-            for k, key in cells:
-                v = cost[r, col_of[key]]
+            for k, kind, col_ref, col in [*track_cells, (len(track_ids), _NEW, ref, new_col_of[ref])]:
+                v = cost[r, col]
                 if not math.isfinite(v):
                     continue
                 centers.append((k + 0.5, y))
                 costs.append(float(v))
                 labels.append(f"{v:.1f}")
-                chosen.append((ref, *key) in picked)
+                chosen.append((ref, kind, col_ref) in picked)
         y0 += len(conflict.meas_indices) + 2.2
     return Grid(
         np.array(centers, dtype=np.float64).reshape(-1, 2),

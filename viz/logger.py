@@ -51,6 +51,7 @@ from gnnpmb.events import (
     Pruned,
     TrackLogic,
     TrackLogicAction,
+    label_positions,
 )
 from gnnpmb.explain import Decisions, explain
 from gnnpmb.gating import ellipse_outline
@@ -445,7 +446,8 @@ class TrackerLogger:
 
     def _z_of(self, track_ids: np.ndarray) -> np.ndarray:
         """(K,) last known box height of each track, gate_z_m for tracks never extracted."""
-        return np.array([self._track_z.get(int(t), self.gate_z_m) for t in track_ids], dtype=np.float64)
+        z_of, default = self._track_z.get, self.gate_z_m
+        return np.array([z_of(t, default) for t in np.asarray(track_ids).tolist()], dtype=np.float64)
 
     # One class, one frame.
     def _draw_class(self, class_name: str, cf: _ClassFrame) -> set[int]:
@@ -472,10 +474,10 @@ class TrackerLogger:
         self._draw_tracks(class_name, drawn, {e.track_id for e in estimates})
         return {e.track_id for e in estimates}
 
-    def _draw_prior(self, class_name: str, cf: _ClassFrame) -> dict[int, int]:
-        """Predicted means (tracks vs candidates) and gates; returns track id -> row of the tracks worth a gate."""
+    def _draw_prior(self, class_name: str, cf: _ClassFrame) -> set[int]:
+        """Predicted means (tracks vs candidates) and gates; returns the ids of the tracks worth a gate."""
         if cf.predicted is None:
-            return {}
+            return set()
         ids = np.asarray(cf.predicted.track_ids, dtype=np.int64)
         existence = np.asarray(cf.predicted.existence, dtype=np.float64)
         focused = np.isin(ids, list(self.focus_tracks)) if self.focus_tracks else np.zeros(ids.size, dtype=bool)
@@ -517,8 +519,12 @@ class TrackerLogger:
         gated = cf.gated
         if gated is not None:
             gids = np.asarray(gated.track_ids, dtype=np.int64)
-            lookup = dict(zip(ids.tolist(), worthy.tolist(), strict=True))  # focused tracks count as worthy
-            drawn = np.array([lookup.get(t, True) for t in gids.tolist()], dtype=bool)
+            id_list = ids.tolist()
+            if np.array_equal(gids, ids) and len(set(id_list)) == len(id_list):  # the usual case: same tracks
+                drawn = worthy
+            else:
+                lookup = dict(zip(id_list, worthy.tolist(), strict=True))  # focused tracks count as worthy
+                drawn = np.array([lookup.get(t, True) for t in gids.tolist()], dtype=bool)
             if drawn.any():
                 n = int(drawn.sum())
                 self._put(
@@ -532,8 +538,8 @@ class TrackerLogger:
                     z=self._z_of(gids[drawn]),
                     ids=gids[drawn],
                 )
-            return {int(t): k for k, (t, d) in enumerate(zip(gids.tolist(), drawn.tolist(), strict=True)) if d}
-        return {int(t): k for k, t in enumerate(ids.tolist()) if worthy[k]}
+            return set(gids[drawn].tolist())
+        return set(ids[worthy].tolist())
 
     # Row builders (``viz.rows.Build``): the elementwise part of drawing, run once per entity over all its rows.
     def _predicted_points(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
@@ -590,7 +596,7 @@ class TrackerLogger:
             "labels": raw["labels"],
         }
 
-    def _draw_associations(self, class_name: str, cf: _ClassFrame, worthy: dict[int, int]) -> None:
+    def _draw_associations(self, class_name: str, cf: _ClassFrame, worthy: set[int]) -> None:
         """Chosen (track, detection) lines in the track's colour, gated-but-rejected ones dimmed; per-track NIS
         and chosen-cost samples."""
         if cf.meas is None or cf.predicted is None or cf.assignment is None:
@@ -632,10 +638,12 @@ class TrackerLogger:
         chosen = set(pairs)
         gids = np.asarray(gated.track_ids, dtype=np.int64).tolist()
         gmeas = np.asarray(gated.meas_indices, dtype=np.int64).tolist()
+        drawn = np.array([t in worthy for t in gids], dtype=bool).reshape(-1, 1)
+        rows, cols = np.nonzero(np.asarray(gated.inside, dtype=bool) & drawn)  # candidates' gates are not drawn
         rejected = [
             (gids[k], gmeas[j])
-            for k, j in zip(*(idx.tolist() for idx in np.nonzero(np.asarray(gated.inside, dtype=bool))), strict=True)
-            if gids[k] in worthy and (gids[k], gmeas[j]) not in chosen and gmeas[j] in pos
+            for k, j in zip(rows.tolist(), cols.tolist(), strict=True)
+            if (gids[k], gmeas[j]) not in chosen and gmeas[j] in pos
         ]
         if rejected:
             rowners = [t for t, _ in rejected]
@@ -813,7 +821,7 @@ class TrackerLogger:
             else:
                 candidates_pruned += 1
             self._trails.pop(p.track_id, None)
-        born = [(int(t), int(m)) for b in cf.born for t, m in zip(b.track_ids, b.meas_indices, strict=True)]
+        born = [(t, m) for b in cf.born for t, m in zip(_ints(b.track_ids), _ints(b.meas_indices), strict=True)]
         if born or candidates_pruned:
             names = ", ".join(meas_name(m) for _, m in born[:12]) + (" …" if len(born) > 12 else "")
             self._text(
@@ -1002,7 +1010,7 @@ def _pair_cost_lookup(matrix: CostMatrix | None) -> Callable[[int, int], float]:
     if cost.size == 0:
         return lambda m, t: math.nan
     row_of = {label.ref: i for i, label in enumerate(matrix.rows)}
-    col_of = {label.ref: j for j, label in enumerate(matrix.cols) if label.kind is AxisKind.TRACK}
+    col_of = label_positions(matrix.cols).get(AxisKind.TRACK, {})
 
     def cost_of(m: int, t: int) -> float:
         i, j = row_of.get(m), col_of.get(t)
@@ -1019,9 +1027,8 @@ def _nis_of(gated: Gated | None, track_ids: list[int], z_xy: np.ndarray) -> list
     (its first row in ``gated``); None where the track has no gate."""
     if gated is None:
         return [None] * len(track_ids)
-    first: dict[int, int] = {}
-    for k, t in enumerate(np.asarray(gated.track_ids, dtype=np.int64).tolist()):
-        first.setdefault(t, k)
+    ids = np.asarray(gated.track_ids, dtype=np.int64).tolist()
+    first = dict(zip(reversed(ids), range(len(ids) - 1, -1, -1), strict=True))  # the first row of each id wins
     hit = [k for k, t in enumerate(track_ids) if t in first]
     out: list[float | None] = [None] * len(track_ids)
     if not hit:
@@ -1044,7 +1051,7 @@ def _pair_lines(pred_xy: np.ndarray, pred_rows: list[int], xyz: np.ndarray, meas
 
 def _born_tracks(cf: _ClassFrame) -> dict[int, int]:
     """Detection index -> the id of the track it started this frame."""
-    return {int(m): int(t) for b in cf.born for t, m in zip(b.track_ids, b.meas_indices, strict=True)}
+    return {m: t for b in cf.born for t, m in zip(_ints(b.track_ids), _ints(b.meas_indices), strict=True)}
 
 
 def destination(column: AxisLabel, born_id: int | None) -> str:
@@ -1062,3 +1069,8 @@ def _labels(template: str, track_ids: np.ndarray, existence: np.ndarray) -> list
     """``template % (id, r)`` per track (Python scalars and %-formatting: formatting numpy scalars, or with
     ``str.format``, is several times slower)."""
     return [template % (t, r) for t, r in zip(track_ids.tolist(), existence.tolist(), strict=True)]
+
+
+def _ints(values: np.ndarray) -> list[int]:
+    """(N,) ids as Python ints (one ``tolist``: iterating a NumPy array makes a NumPy scalar per element)."""
+    return np.asarray(values, dtype=np.int64).tolist()

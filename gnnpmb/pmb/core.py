@@ -354,20 +354,44 @@ def assignment_pairs(
     local: LocalHypotheses, col_of_row: np.ndarray
 ) -> tuple[tuple[tuple[AxisLabel, AxisLabel], ...], tuple[int, ...]]:
     """(row label, column label) of every assigned measurement, and the ids of tracks left undetected."""
-    rows, cols = local.row_labels(), local.col_labels()
-    pairs = tuple((rows[j], cols[int(c)]) for j, c in enumerate(col_of_row))
-    detected = set(int(c) for c in col_of_row if c < local.n_tracks)
-    missed = tuple(int(t) for i, t in enumerate(local.prior.track_id) if i not in detected)
-    return pairs, missed
+    cols = local.col_labels()
+    pairs = tuple(zip(local.row_labels(), map(cols.__getitem__, col_of_row.tolist()), strict=True))
+    missed = local.prior.track_id[meas_of_track(local.n_tracks, col_of_row) < 0]
+    return pairs, tuple(missed.tolist())
+
+
+def _track_rows(hypotheses: list[GlobalHypothesis]) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) track ids and (N,) existence probabilities of the Bernoullis of ``hypotheses``: for hypotheses
+    indexing one store (PMBM), each store row used once (a row repeated across hypotheses adds nothing to a
+    maximum or a set); otherwise every hypothesis' Bernoullis laid end to end."""
+    store = hypotheses[0].store
+    if len(hypotheses) > 1 and all(h.store is store and h.index is not None for h in hypotheses):
+        used = np.zeros(len(store), dtype=bool)
+        used[np.concatenate([h.index for h in hypotheses])] = True
+        return store.track_id[used], store.existence[used]
+    return np.concatenate([h.track_id for h in hypotheses]), np.concatenate([h.existence for h in hypotheses])
+
+
+_PYTHON_MAX_ROWS = 512
+"""``_max_existence`` reads up to this many Bernoullis in plain Python: NumPy's set routines cost more below."""
 
 
 def _max_existence(hypotheses: list[GlobalHypothesis]) -> dict[int, float]:
-    """Track id -> its largest existence probability over the hypotheses."""
-    ids = np.concatenate([h.track_id for h in hypotheses])
-    ids, inverse = np.unique(ids, return_inverse=True)
-    largest = np.zeros(len(ids))
-    np.maximum.at(largest, inverse, np.concatenate([h.existence for h in hypotheses]))
-    return dict(zip(ids.tolist(), largest.tolist(), strict=True))
+    """Track id -> its largest existence probability over the hypotheses (at least 0)."""
+    ids, existence = _track_rows(hypotheses)
+    if len(ids) > _PYTHON_MAX_ROWS:
+        ids, inverse = np.unique(ids, return_inverse=True)
+        largest = np.zeros(len(ids))
+        np.maximum.at(largest, inverse, existence)
+        return dict(zip(ids.tolist(), largest.tolist(), strict=True))
+    id_list, r_list = ids.tolist(), existence.tolist()
+    out = dict(zip(id_list, r_list, strict=True))
+    if len(out) == len(id_list) and not (np.signbit(existence) | np.isnan(existence)).any():
+        return out  # distinct ids (one hypothesis): each value is its own maximum, and max(0, r) is r
+    out = {}
+    for t, r in zip(id_list, r_list, strict=True):
+        out[t] = max(out.get(t, 0.0), r)
+    return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -482,8 +506,8 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         if sink.enabled:
             posterior_r = _max_existence(posteriors)
             prior_r = _max_existence(priors)
-            alive = set(np.concatenate([h.track_id for h in kept]).tolist())
-            for t in sorted((set(posterior_r) | set(prior_r)) - alive):
+            alive = set(_track_rows(kept)[0].tolist())
+            for t in sorted((posterior_r.keys() | prior_r.keys()) - alive):
                 if t in posterior_r:
                     sink.emit(Pruned(self.class_name, t, PruneReason.LOW_EXISTENCE, posterior_r[t]))
                 else:
@@ -492,7 +516,10 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
 
     def _emit_born(self, best: Bernoullis, ctx: UpdateContext, sink: EventSink) -> None:
         """``Born`` of the Bernoullis of ``best`` started this frame."""
-        sel = np.flatnonzero(np.isin(best.track_id, list(set(ctx.born_ids.values()))))
+        born = set(ctx.born_ids.values())
+        if not born:
+            return
+        sel = np.array([k for k, t in enumerate(best.track_id.tolist()) if t in born], dtype=np.intp)
         if len(sel):
             sink.emit(
                 Born(self.class_name, best.track_id[sel], best.meas_index[sel], best.mean[sel], best.existence[sel])
