@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 import rerun as rr
@@ -60,38 +61,90 @@ def evaluated_offsets(focus: FocusTarget, scene: SceneData) -> dict[str, Evaluat
         annotated = _annotated_track(scene, gt_id)
         if i not in annotated:
             continue
-        center, points = annotated[i]
+        center, points, _kept = annotated[i]
         offset = float(np.hypot(center[0] - xy[0], center[1] - xy[1]))
         if offset > EVALUATED_OFFSET_M:
             out[gt_id] = EvaluatedGt(center, offset, points, _mirror_frame(scene, annotated, i, np.array(xy)))
     return out
 
 
-def _annotated_track(scene: SceneData, gt_id: str) -> dict[int, tuple[np.ndarray, int]]:
-    """Frame -> (3,) annotated centre and points in the box of one object."""
+def _annotated_track(scene: SceneData, gt_id: str) -> dict[int, tuple[np.ndarray, int, bool]]:
+    """Frame -> (3,) annotated centre, points in the box and whether the devkit keeps the box (some points and
+    within its class's range of the ego vehicle: ``filter_eval_boxes``) for one object."""
+    ranges = _class_ranges()
     out = {}
     for keyframe in scene.keyframes:
         hit = np.flatnonzero(keyframe.gt.instance_id.astype(str) == gt_id)
         if hit.size:
-            out[keyframe.index] = (keyframe.gt.translation_m[hit[0]], int(keyframe.gt_num_pts[hit[0]]))
+            center = keyframe.gt.translation_m[hit[0]]
+            points = int(keyframe.gt_num_pts[hit[0]])
+            ego_m = float(np.hypot(*(center[:2] - keyframe.ego_pose.translation_m[:2])))
+            reach = ranges.get(str(keyframe.gt.class_name[hit[0]]), np.inf)
+            out[keyframe.index] = (center, points, points > 0 and ego_m <= reach)
     return out
 
 
-def _mirror_frame(
-    scene: SceneData, annotated: Mapping[int, tuple[np.ndarray, int]], i: int, evaluated_xy: np.ndarray
-) -> tuple[int, int, int] | None:
-    """The nearest annotated frames with points before and after frame ``i`` and the frame mirrored about ``i``
-    between them, if the evaluated box is the devkit's interpolation with swapped weights (``right_ratio`` =
-    (t_right - t) / (t_right - t_left) applied to the right box; nuscenes-devkit issue #1141) and that frame is
-    annotated; else None."""
-    seen = sorted(f for f, (_c, points) in annotated.items() if points > 0)
-    left = max((f for f in seen if f < i), default=None)
-    right = min((f for f in seen if f > i), default=None)
+@cache
+def _class_ranges() -> dict[str, float]:
+    """The evaluation's range per class (m from the ego vehicle; ``tracking_nips_2019``)."""
+    from gnnpmb.eval.nuscenes_eval import tracking_config
+
+    return {k: float(v) for k, v in tracking_config().class_range.items()}
+
+
+def _devkit_interpolation(
+    scene: SceneData, annotated: Mapping[int, tuple[np.ndarray, int, bool]], i: int
+) -> tuple[int, int, np.ndarray] | None:
+    """The nearest frames before and after frame ``i`` where the devkit keeps the object's box, and the (2,) BEV
+    centre it interpolates between them for frame ``i``, with its weights swapped (``right_ratio`` = (t_right - t) /
+    (t_right - t_left) applied to the right box; nuscenes-devkit issue #1141); None without such frames on both
+    sides (the devkit then has no box for the object at frame ``i``)."""
+    kept = sorted(f for f, (_c, _p, keep) in annotated.items() if keep)
+    left = max((f for f in kept if f < i), default=None)
+    right = min((f for f in kept if f > i), default=None)
     if left is None or right is None:
         return None
     t = [scene.keyframes[f].timestamp_us for f in (left, i, right)]
     swapped = (t[2] - t[1]) / (t[2] - t[0])
-    xy = (1.0 - swapped) * annotated[left][0][:2] + swapped * annotated[right][0][:2]
+    return left, right, (1.0 - swapped) * annotated[left][0][:2] + swapped * annotated[right][0][:2]
+
+
+@dataclass(frozen=True, slots=True)
+class DevkitBox:
+    """Where the evaluation has an object at one frame: the (2,) BEV centre (None: it has no box for it) and why
+    (``annotated``, ``interpolated`` or the reason it has none)."""
+
+    xy_m: np.ndarray | None
+    why: str
+
+
+def devkit_gt(scene: SceneData, gt_id: str, i: int) -> DevkitBox:
+    """The box the evaluation has for object ``gt_id`` at frame ``i``: its annotation when the devkit keeps it,
+    else the devkit's interpolation (``_devkit_interpolation``), else none."""
+    annotated = _annotated_track(scene, gt_id)
+    if i not in annotated:
+        return DevkitBox(None, "not annotated at this frame")
+    center, points, keep = annotated[i]
+    if keep:
+        return DevkitBox(center[:2], "annotated")
+    interpolated = _devkit_interpolation(scene, annotated, i)
+    if interpolated is not None:
+        return DevkitBox(interpolated[2], "interpolated")
+    if points == 0:
+        return DevkitBox(None, "it has no LiDAR or radar points here and no kept frame on one side to interpolate from")
+    return DevkitBox(None, "it lies beyond the evaluation's range for its class and no kept frame on one side")
+
+
+def _mirror_frame(
+    scene: SceneData, annotated: Mapping[int, tuple[np.ndarray, int, bool]], i: int, evaluated_xy: np.ndarray
+) -> tuple[int, int, int] | None:
+    """The frames the devkit interpolated between and the frame mirrored about ``i`` between them, if the
+    evaluated box is the devkit's swapped-weight interpolation (``_devkit_interpolation``) and that frame is
+    annotated; else None."""
+    interpolated = _devkit_interpolation(scene, annotated, i)
+    if interpolated is None:
+        return None
+    left, right, xy = interpolated
     mirror = left + right - i
     if np.hypot(*(xy - evaluated_xy)) > MIRROR_MATCH_M or mirror not in annotated:
         return None

@@ -24,7 +24,7 @@ from viz.blueprint import (
     FOCUS_TIMELINE,
 )
 from viz.decisions import CLOSE_CALL_MARGIN, column_name, conflict_markdown, meas_name
-from viz.evaluated import NEAR_DETECTION_M, evaluated_notes, evaluated_offsets
+from viz.evaluated import NEAR_DETECTION_M, devkit_gt, evaluated_notes, evaluated_offsets
 from viz.logger import TrackerLogger
 
 MAX_STORY_LINES = 40
@@ -91,6 +91,7 @@ def focus_markdown(
     owner = focus.failure_tracker
     if owner in loggers and owner in runs and not evaluated_offsets(focus, scene):
         lines += _why(focus, scene, runs[owner], loggers[owner], shown)
+        lines += _why_false_track(focus, scene, runs[owner], (reports or {}).get(owner))
     for tracker, logger in loggers.items():
         key = _key_decisions(logger, set(focus.track_ids.get(tracker, ())), focus.class_name, shown, focus.frame_index)
         if key:
@@ -334,6 +335,63 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
         ]
         if chosen:
             parts.append(f"then, {chosen[-1]}")
+    return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]
+
+
+def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, report: FailureReport | None) -> list[str]:
+    """One line for a false track: the detection it was output on, the nearest ground truth of its class and of
+    any class (a near object of another class: the detector gave it the wrong class; none: a detection of
+    nothing), and the averaged score by which the evaluation counted it."""
+    if focus.failure_kind is not FailureKind.FALSE_TRACK or not focus.failure_tracks:
+        return []
+    t, f = focus.failure_tracks[0], focus.frame_index
+    frame = next((fr for fr in run.frames if fr.keyframe.index == f), None)
+    estimate = next((e for e in frame.estimates if e.track_id == t), None) if frame is not None else None
+    if estimate is None:
+        return []
+    boxes = frame.detections.boxes
+    m = estimate.meas_index
+    if m >= 0:
+        xy = boxes.translation_m[m, :2]
+        source = f"detection {meas_name(m)} ({boxes.class_name[m]}, score {boxes.score[m]:.2f})"
+    else:
+        xy = np.array(estimate.translation_m[:2])
+        source = "no detection this frame (predicted)"
+    gt = scene.keyframes[f].gt
+    d = np.hypot(*(gt.translation_m[:, :2] - xy).T) if len(gt) else np.zeros(0)
+    same = np.flatnonzero(gt.class_name == focus.class_name) if len(gt) else np.zeros(0, int)
+    parts = [f"at frame {f} track {t} ({focus.class_name}) was output on {source}"]
+    if same.size and d[same].min() < NEAR_DETECTION_M:
+        k = int(same[np.argmin(d[same])])
+        gt_id = str(gt.instance_id[k])
+        evaluated = devkit_gt(scene, gt_id, f)
+        on = f"{focus.class_name} GT {short_id(gt_id)} lies {d[k]:.1f} m away"
+        if evaluated.xy_m is None:
+            parts.append(f"{on}, but the evaluation has no box for it here ({evaluated.why}): a track on it is false")
+        elif np.hypot(*(evaluated.xy_m - estimate.translation_m[:2])) >= NEAR_DETECTION_M:
+            parts.append(
+                f"{on}, but the evaluation has it {evaluated.why} "
+                f"{np.hypot(*(evaluated.xy_m - gt.translation_m[k, :2])):.1f} m from the annotation, out of the "
+                "track's reach (see nuscenes-devkit issue #1141)"
+            )
+        else:
+            parts.append(f"{on} and the evaluation matched it to another track")
+    elif d.size and d.min() < NEAR_DETECTION_M:
+        k = int(np.argmin(d))
+        parts.append(
+            f"no {focus.class_name} GT lies within {NEAR_DETECTION_M:.0f} m, but GT {gt.class_name[k]} "
+            f"{short_id(str(gt.instance_id[k]))} does ({d[k]:.1f} m): the detector gave it the wrong class"
+        )
+    else:
+        nearest = f" (the nearest is {d.min():.1f} m away)" if d.size else ""
+        parts.append(f"no object of any class lies within {NEAR_DETECTION_M:.0f} m{nearest}: a detection of nothing")
+    threshold = report.threshold_of(focus.class_name) if report is not None else None
+    average = report.track_scores.get(str(t)) if report is not None else None
+    if threshold is not None and average is not None:
+        parts.append(
+            f"the evaluation counted the track: its score averaged over the track, {average:.2f}, is at least the "
+            f"{focus.class_name} threshold {threshold:.3f}"
+        )
     return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]
 
 

@@ -870,7 +870,8 @@ class TrackerLogger:
                 via = f"given {meas_name(given[t])}" if t in given else "given no detection"
             self._text(
                 class_name,
-                f"involved track {t} (not reported; drawn for the focus only): {via}, r={posterior_r[t]:.2f}",
+                f"involved track {t} (r < {self.show_min_existence:g}: drawn only in focus recordings): {via}, "
+                f"r={posterior_r[t]:.2f}",
                 "INFO",
             )
 

@@ -262,3 +262,30 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     for line in lines:
         gnnpmb, pmbm = line[2:].split(" · ")
         assert gnnpmb.split("→")[1].split("(")[0] != pmbm.split("→")[1].split("(")[0]  # different destinations
+
+
+def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
+    demo_dataroot: Path, tmp_path: Path, failures_and_runs
+) -> None:
+    report, _ = failures_and_runs
+    pick, failure = next(
+        (i, f) for i, f in zip(report.ids(), report.failures, strict=True) if f.kind is FailureKind.FALSE_TRACK
+    )
+    out, _ = record(demo_dataroot, tmp_path, pick)
+    why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
+    track = failure.track_ids[0]
+    assert why.startswith(f"**Why** (gnnpmb): at frame {failure.frame_index} track {track} ({failure.class_name})")
+    average, threshold = report.track_scores[track], report.threshold_of(failure.class_name)
+    assert f"averaged over the track, {average:.2f}, is at least the {failure.class_name} threshold" in why
+    assert average >= threshold
+    # Where the evaluation's ground truth was: the reason the track matched nothing.
+    assert any(
+        phrase in why
+        for phrase in (
+            "the evaluation has no box for it",
+            "the evaluation has it",
+            "matched it to another track",
+            "the detector gave it the wrong class",
+            "a detection of nothing",
+        )
+    )
