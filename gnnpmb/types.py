@@ -7,7 +7,9 @@ so a tracker can vectorise over all boxes of a class.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from bisect import bisect_left, bisect_right
+from collections.abc import Iterable
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -58,6 +60,9 @@ class Boxes(StructOfArrays):
         )
 
 
+_BOX_FIELDS: tuple[str, ...] = tuple(f.name for f in fields(Boxes))
+
+
 @dataclass(frozen=True, slots=True)
 class Measurements:
     """The detections of one class in one frame, as a tracker sees them.
@@ -92,8 +97,24 @@ class FrameDetections:
     suppressed_by_nms: np.ndarray
 
     def measurements(self, class_name: str) -> Measurements:
+        """The kept detections of ``class_name``, in input order."""
         idx = np.flatnonzero(self.kept & (self.boxes.class_name == class_name))
         return Measurements(boxes=self.boxes.subset(idx), source_index=idx)
+
+    def measurements_by_class(self, classes: Iterable[str]) -> dict[str, Measurements]:
+        """``measurements(c)`` for every class ``c`` in ``classes``, grouped once: the kept detections are
+        sorted by class (stable, so each class keeps input order), gathered once per field and sliced per class.
+        Each class's arrays are views of those gathered copies, never of ``boxes``."""
+        kept_idx = np.flatnonzero(self.kept)
+        order = np.argsort(self.boxes.class_name[kept_idx], kind="stable")
+        idx = kept_idx[order]
+        gathered = [getattr(self.boxes, name)[idx] for name in _BOX_FIELDS]
+        names = self.boxes.class_name[idx].tolist()
+        out: dict[str, Measurements] = {}
+        for c in classes:
+            rows = slice(bisect_left(names, c), bisect_right(names, c))
+            out[c] = Measurements(boxes=Boxes(*[value[rows] for value in gathered]), source_index=idx[rows])
+        return out
 
 
 @dataclass(frozen=True, slots=True)
