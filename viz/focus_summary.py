@@ -389,7 +389,7 @@ def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, rep
     average = report.track_scores.get(str(t)) if report is not None else None
     if threshold is not None and average is not None:
         parts.append(
-            f"the evaluation counted the track: its score averaged over the track, {average:.2f}, is at least the "
+            f"the evaluation counted the track: its score averaged over the track, {average:.3f}, is at least the "
             f"{focus.class_name} threshold {threshold:.3f}"
         )
     return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]

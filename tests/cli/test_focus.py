@@ -276,7 +276,7 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
     track = failure.track_ids[0]
     assert why.startswith(f"**Why** (gnnpmb): at frame {failure.frame_index} track {track} ({failure.class_name})")
     average, threshold = report.track_scores[track], report.threshold_of(failure.class_name)
-    assert f"averaged over the track, {average:.2f}, is at least the {failure.class_name} threshold" in why
+    assert f"averaged over the track, {average:.3f}, is at least the {failure.class_name} threshold" in why
     assert average >= threshold
     # Where the evaluation's ground truth was: the reason the track matched nothing.
     assert any(
