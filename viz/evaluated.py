@@ -4,7 +4,8 @@ The devkit drops every ground-truth box without LiDAR or radar points and interp
 the gap (``nuscenes.eval.tracking.loaders.interpolate_tracks``), with the two ends' weights swapped
 (nuscenes-devkit issue #1141): the box a failure is scored against can lie metres from the annotation. This
 module finds such objects at the focus frame (``evaluated_offsets``), says so in the focus summary
-(``evaluated_notes``) and draws the evaluated box with its match circle (``log_evaluated``).
+(``evaluated_notes``) and draws the evaluated box with its match circle (``log_evaluated``); ``devkit_gt`` says
+where the evaluation has any object at any frame.
 """
 
 from __future__ import annotations
@@ -151,11 +152,14 @@ def _mirror_frame(
     return left, right, mirror
 
 
-def evaluated_notes(focus: FocusTarget, scene: SceneData, runs: Mapping[str, TrackingRun]) -> list[str]:
-    """A paragraph per involved object the evaluation saw elsewhere than its annotation (``evaluated_offsets``):
+def evaluated_notes(
+    focus: FocusTarget, scene: SceneData, runs: Mapping[str, TrackingRun], evaluated: Mapping[str, EvaluatedGt]
+) -> list[str]:
+    """A paragraph per involved object the evaluation saw elsewhere than its annotation (``evaluated``, from
+    ``evaluated_offsets``):
     why, how far, and which tracks were within match distance of each box."""
     out = []
-    for gt_id, seen in evaluated_offsets(focus, scene).items():
+    for gt_id, seen in evaluated.items():
         xy = np.array(focus.evaluated_gt_xy_m[gt_id])
         near_evaluated, near_annotated, on_it = [], [], []
         for tracker, run in runs.items():

@@ -105,7 +105,7 @@ def log_focus(
                     f"GT {short_id(gt_id)} as evaluated ({seen.offset_m:.1f} m off)",
                     CLASS_COLORS.get(focus.class_name, GREY),
                 )
-                for gt_id, seen in evaluated_offsets(focus, scene).items()
+                for gt_id, seen in evaluated.items()
             ]
         meas: set[int] = set()
         detections = None

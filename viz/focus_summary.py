@@ -87,9 +87,10 @@ def focus_markdown(
     objects' and tracks' frames, its decisions about them and their story. reports: per tracker, its failure
     report (the evaluation's score threshold of the focused class and each track's averaged score)."""
     lines = [f"# {focus.title}", ""]
-    lines += evaluated_notes(focus, scene, runs)
+    evaluated = evaluated_offsets(focus, scene)
+    lines += evaluated_notes(focus, scene, runs, evaluated)
     owner = focus.failure_tracker
-    if owner in loggers and owner in runs and not evaluated_offsets(focus, scene):
+    if owner in loggers and owner in runs and not evaluated:
         lines += _why(focus, scene, runs[owner], loggers[owner], shown)
         lines += _why_false_track(focus, scene, runs[owner], (reports or {}).get(owner))
     for tracker, logger in loggers.items():
