@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import enum
 import itertools
+import math
 import operator
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -170,6 +171,75 @@ class Gated:
 
 
 @dataclass(frozen=True, slots=True)
+class PairTerms:
+    """What one (detection j, track k) cost of the PMB family is made of, in nats (``CostTerms``).
+
+    existence: the track's predicted existence r_k; p_detect: the P_D its miss hypothesis used; existence_nats:
+    log(1 - r_k P_D) - log r_k; score: the detection's score s_j; score_nats: -log s_j; d2: squared Mahalanobis
+    distance; distance_nats: d2 / 2; spread_m: the predicted measurement's spread |S_k|^(1 / 2D) (the geometric
+    mean of its standard deviations, metres); spread_nats: (log|S_k| + D log 2 pi) / 2. The last two terms make
+    -log N(z_j; H m_k, S_k).
+    """
+
+    existence: float
+    p_detect: float
+    existence_nats: float
+    score: float
+    score_nats: float
+    d2: float
+    distance_nats: float
+    spread_m: float
+    spread_nats: float
+
+    @property
+    def total_nats(self) -> float:
+        return self.existence_nats + self.score_nats + self.distance_nats + self.spread_nats
+
+    def existence_for(self, cheaper_by_nats: float) -> float | None:
+        """The predicted existence at which this cost would be ``cheaper_by_nats`` lower, all else equal: solves
+        log(1 - r P_D) - log r = existence_nats - cheaper_by_nats, i.e. r = 1 / (exp(existence_nats -
+        cheaper_by_nats) + P_D); None when no existence <= 1 gets there."""
+        target = self.existence_nats - cheaper_by_nats
+        if target < math.log1p(-self.p_detect):  # the cost at r = 1
+            return None
+        return 1.0 / (math.exp(target) + self.p_detect)
+
+
+@dataclass(frozen=True, slots=True)
+class CostTerms:
+    """The track entries of a PMB-family cost matrix taken apart (``gnnpmb.pmb.cost``, García-Fernández et al.
+    2018, eq. 12-13): C[j, k] = existence_nats[k] + score_nats[j] + distance_nats[j, k] + spread_nats[k] on every gated
+    entry (``PairTerms``).
+
+    Holds the arrays the tracker computed anyway (no copies): existence r (K,), miss_log_lik log(1 - r P_D) (K,),
+    score s (M,), d2 (K, M) squared Mahalanobis distances, log_det_S (K,), dim D of the measurement."""
+
+    existence: np.ndarray
+    miss_log_lik: np.ndarray
+    score: np.ndarray
+    d2: np.ndarray
+    log_det_S: np.ndarray
+    dim: int
+
+    def pair(self, j: int, k: int) -> PairTerms:
+        """The terms of detection row ``j`` and track column ``k``."""
+        r, miss = float(self.existence[k]), float(self.miss_log_lik[k])
+        d2, log_det_S = float(self.d2[k, j]), float(self.log_det_S[k])
+        score = float(self.score[j])
+        return PairTerms(
+            existence=r,
+            p_detect=-math.expm1(miss) / r if r > 0 else 0.0,
+            existence_nats=miss - math.log(r) if r > 0 else math.inf,
+            score=score,
+            score_nats=-math.log(score) if score > 0 else math.inf,
+            d2=d2,
+            distance_nats=0.5 * d2,
+            spread_m=math.exp(log_det_S / (2 * self.dim)),
+            spread_nats=0.5 * (log_det_S + self.dim * math.log(2.0 * math.pi)),
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class CostMatrix:
     """An assignment cost matrix with the meaning of every row and column.
 
@@ -177,6 +247,7 @@ class CostMatrix:
     measurements and columns are [existing tracks | one new-track column per measurement]; entries are negative
     log-likelihood ratios against the track being missed (paper eq. for the PMB update).
     hypothesis: index of the global hypothesis the matrix belongs to (0 for single-hypothesis trackers).
+    terms: what the track entries are made of (PMB family), None where the tracker does not say.
     """
 
     class_name: str
@@ -185,6 +256,7 @@ class CostMatrix:
     cols: tuple[AxisLabel, ...]
     hypothesis: int = 0
     description: str = "negative log-likelihood ratio"
+    terms: CostTerms | None = None
 
 
 @dataclass(frozen=True, slots=True)

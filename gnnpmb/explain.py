@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms, PairTerms
 
 _KIND = operator.attrgetter("kind")
 _REF = operator.attrgetter("ref")
@@ -37,7 +37,9 @@ it (in cost units: nats for the PMB family)."""
 class PairChoice:
     """One measurement's decision: the chosen column and its cost; the row's cheapest other column
     (None if it had no other) and its cost; margin = best total without this pair minus the chosen total
-    (inf when no other assignment is possible)."""
+    (inf when no other assignment is possible). terms: the matrix's ``CostTerms`` (None if it has none), read
+    at this row (``row``) and the chosen / alternative columns (``chosen_col``, ``alternative_col``; -1: none)
+    by ``chosen_terms`` and ``alternative_terms``, only when asked."""
 
     meas: AxisLabel
     chosen: AxisLabel
@@ -45,6 +47,25 @@ class PairChoice:
     alternative: AxisLabel | None
     alternative_cost: float
     margin: float
+    terms: CostTerms | None = None
+    row: int = -1
+    chosen_col: int = -1
+    alternative_col: int = -1
+
+    @property
+    def chosen_terms(self) -> PairTerms | None:
+        """What the chosen cost is made of, if the chosen column is a track and the matrix says."""
+        return self._terms(self.chosen, self.chosen_col)
+
+    @property
+    def alternative_terms(self) -> PairTerms | None:
+        """What the alternative's cost is made of, if it is a track and the matrix says."""
+        return self._terms(self.alternative, self.alternative_col)
+
+    def _terms(self, label: AxisLabel | None, col: int) -> PairTerms | None:
+        if self.terms is None or label is None or label.kind is not AxisKind.TRACK or col < 0 or self.row < 0:
+            return None
+        return self.terms.pair(self.row, col)
 
 
 @dataclass(frozen=True, slots=True)
@@ -227,6 +248,10 @@ def _conflict(
                 alternative=mcols[cols_list[k]] if has_alt else None,
                 alternative_cost=c_best if has_alt else math.inf,
                 margin=margin,
+                terms=matrix.terms,
+                row=r,
+                chosen_col=cols_list[j],
+                alternative_col=cols_list[k] if has_alt else -1,
             )
         )
     used = {cols_list[j] for j in chosen_list if cols_list[j] < n_tracks}

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, GlobalHypotheses, label_positions
-from gnnpmb.explain import Conflict, Decisions
+from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, GlobalHypotheses, PairTerms, label_positions
+from gnnpmb.explain import Conflict, Decisions, PairChoice
 
 _TRACK = AxisKind.TRACK.value
 _NEW = AxisKind.NEW_TRACK.value
@@ -49,6 +49,44 @@ def column_name(label: AxisLabel) -> str:
         case AxisKind.MEASUREMENT:
             return meas_name(label.ref)
     raise AssertionError(label.kind)
+
+
+def cost_breakdown(terms: PairTerms) -> str:
+    """A track's cost in words: the nats its predicted existence, the spread of its prediction, the distance and
+    the detection's score add (``events.PairTerms``)."""
+    return (
+        f"{terms.existence_nats:.2f} for its predicted existence {terms.existence:.2f} + {terms.spread_nats:.2f} "
+        f"for its predicted spread ({terms.spread_m:.1f} m) + {terms.distance_nats:.2f} for the distance "
+        f"(d² {terms.d2:.1f}) + {terms.score_nats:.2f} for the detection's score {terms.score:.2f}"
+    )
+
+
+def choice_why(c: PairChoice) -> str | None:
+    """Why a detection did not go to the track that was its next best column: both costs taken apart (when the
+    tracker's matrix says what they are made of) and the predicted existence at which that track would have been
+    the cheaper of the two. None when the next best is not a track or its terms are unknown."""
+    alt = c.alternative_terms
+    if alt is None or c.alternative is None:
+        return None
+    meas = meas_name(c.meas.ref)
+    parts = []
+    chosen = c.chosen_terms
+    if chosen is not None:
+        parts.append(f"{column_name(c.chosen)} costs {c.chosen_cost:.2f} = {cost_breakdown(chosen)}")
+    elif c.chosen.kind is AxisKind.NEW_TRACK:
+        parts.append(f"a new track (or clutter) costs {c.chosen_cost:.2f}")
+    else:
+        parts.append(f"{column_name(c.chosen)} costs {c.chosen_cost:.2f}")
+    parts.append(f"{column_name(c.alternative)} costs {c.alternative_cost:.2f} = {cost_breakdown(alt)}")
+    needed = alt.existence_for(c.alternative_cost - c.chosen_cost)
+    if needed is None:
+        parts.append(f"no existence would have made {column_name(c.alternative)} the cheaper one for {meas}")
+    else:
+        parts.append(
+            f"{column_name(c.alternative)} would have been the cheaper one for {meas} with a predicted existence "
+            f"above {needed:.2f}"
+        )
+    return "; ".join(parts)
 
 
 def _fmt(value: float) -> str:
@@ -86,6 +124,10 @@ def conflict_markdown(conflict: Conflict, reported: set[int] | None = None) -> s
             f"| {meas_name(c.meas.ref)} | **{column_name(c.chosen)}** | {_fmt(c.chosen_cost)} | {alt} | "
             f"{_fmt(c.alternative_cost)} | {_fmt(c.margin)} |"
         )
+    whys = [(c, why) for c in conflict.choices if (why := choice_why(c)) is not None]
+    if whys:
+        lines.append("")
+        lines += [f"- {meas_name(c.meas.ref)}: {why}" for c, why in whys]
     if conflict.missed_track_ids:
         lines.append("")
         lines.append(f"missed (no detection, cost 0): {_ids(conflict.missed_track_ids, reported)}")

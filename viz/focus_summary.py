@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,7 +24,7 @@ from gnnpmb.pipeline import FrameResult, TrackingRun
 from viz.blueprint import (
     FOCUS_TIMELINE,
 )
-from viz.decisions import CLOSE_CALL_MARGIN, column_name, conflict_markdown, meas_name
+from viz.decisions import CLOSE_CALL_MARGIN, choice_why, column_name, conflict_markdown, meas_name
 from viz.evaluated import NEAR_DETECTION_M, devkit_gt, evaluated_notes, evaluated_offsets
 from viz.logger import TrackerLogger
 
@@ -63,7 +64,10 @@ READING_GUIDE = """# How to read the views
 - **focus**: the failure in words, the key decisions, and per tracker what happened to each involved track.
 - **story**: each frame's events of the involved class (confirmed, missed, ended, close calls).
 - **decisions** and **cost grid**: per conflict the chosen pair, its cost, the next best and the margin (lower
-  cost = more likely).
+  cost = more likely). When the next best was a track, the line under the table takes both costs apart (GNN-PMB,
+  PMBM, PMB): a track's cost is what its predicted existence adds (low existence, high cost), plus the spread of
+  its prediction (a track not seen for a while is spread wide), plus the distance to the detection, plus the
+  detection's score; and it gives the existence at which that track would have won the detection.
 - **existence**, **NIS**, **chosen cost**: the involved tracks' series up to the failure; the grey line is the
   existence from which a Bernoulli is shown as a track.
 """
@@ -97,7 +101,7 @@ def focus_markdown(
         key = _key_decisions(logger, set(focus.track_ids.get(tracker, ())), focus.class_name, shown, focus.frame_index)
         if key:
             lines += [f"**Key decisions of {tracker}** (a detection an involved track could have taken):", ""]
-            lines += [f"- {line}" for line in key] + [""]
+            lines += [f"- {k.text}" for k in key] + [""]
     parting = _parting(focus, loggers)
     if parting:
         lines += [
@@ -190,9 +194,20 @@ def _parting(focus: FocusTarget, loggers: Mapping[str, TrackerLogger]) -> list[s
     return out
 
 
+@dataclass(frozen=True, slots=True)
+class KeyDecision:
+    """A choice of the solver at ``frame`` that decided an involved track's fate, and how the summary words it
+    (where the detection went: ``went``)."""
+
+    frame: int
+    choice: PairChoice
+    went: str
+    text: str
+
+
 def _key_decisions(
     logger: TrackerLogger, ids: set[int], class_name: str, shown: range, last: int, limit: int | None = MAX_KEY
-) -> list[str]:
+) -> list[KeyDecision]:
     """The solver's choices up to frame ``last`` that decided the involved tracks' fate, newest ``MAX_KEY``: a
     detection given elsewhere while an involved track was its next best column, or given to an involved track by
     a close call (``decisions.CLOSE_CALL_MARGIN``)."""
@@ -208,10 +223,11 @@ def _key_decisions(
                 if (alt_involved and not chosen_involved) or (chosen_involved and c.margin < CLOSE_CALL_MARGIN):
                     went = logger.given.get(f, {}).get(int(c.meas.ref), column_name(c.chosen))
                     other = f"over {column_name(alt)} ({c.alternative_cost:.2f})" if alt is not None else "(no other)"
-                    out.append(
+                    text = (
                         f"frame {f}: {meas_name(c.meas.ref)} → **{went}** (cost {c.chosen_cost:.2f}) {other}, "
                         f"margin {c.margin:.2f}"
                     )
+                    out.append(KeyDecision(f, c, went, text))
     return out if limit is None else out[-limit:]
 
 
@@ -326,17 +342,28 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
             f"track {lost}'s existence went from {_after(steps[peak]):.2f} (frame {peak}) to "
             f"{_after(steps[max(steps)]):.2f} (frame {max(steps)})"
         )
+    because = []
     if took is not None:
         chosen = [
-            line
-            for line in _key_decisions(
+            k
+            for k in _key_decisions(
                 logger, set(focus.track_ids.get(run.tracker, ())), focus.class_name, shown, focus.frame_index, None
             )
-            if f"**new track {took}**" in line or f"**track {took}**" in line
+            if k.went in (f"new track {took}", f"track {took}")
         ]
         if chosen:
-            parts.append(f"then, {chosen[-1]}")
-    return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]
+            parts.append(f"then, {chosen[-1].text}")
+            because = _because(chosen[-1])
+    return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", "", *because]
+
+
+def _because(key: KeyDecision) -> list[str]:
+    """The decisive choice's costs taken apart (``decisions.choice_why``), as a paragraph; none when the
+    tracker's cost matrix does not say what its costs are made of."""
+    why = choice_why(key.choice)
+    if why is None:
+        return []
+    return [f"**Because** (frame {key.frame}, {meas_name(key.choice.meas.ref)} → {key.went}): {why}.", ""]
 
 
 def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, report: FailureReport | None) -> list[str]:

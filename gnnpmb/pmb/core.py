@@ -456,7 +456,15 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         ``Born``."""
         if sink.enabled:
             local = prior.locals_[0]
-            sink.emit(CostMatrix(self.class_name, local.cost_matrix(), local.row_labels(), local.col_labels()))
+            sink.emit(
+                CostMatrix(
+                    self.class_name,
+                    local.cost_matrix(),
+                    local.row_labels(),
+                    local.col_labels(),
+                    terms=local.cost_terms(),
+                )
+            )
         ctx = UpdateContext(self.class_name, sink, self.ids, self.frame_serial, self.params.prune_existence)
         posteriors = self.strategy.update(prior.hypotheses, prior.locals_, ctx)
         self.hypotheses = self._prune(prior.hypotheses, posteriors, ctx, sink)

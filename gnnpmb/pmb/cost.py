@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.events import AxisKind, AxisLabel, axis_labels
+from gnnpmb.events import AxisKind, AxisLabel, CostTerms, axis_labels
 from gnnpmb.kalman import Innovation, log_likelihood, paired_updated_means
 from gnnpmb.pmb.bernoulli import Bernoullis, missed_update
 from gnnpmb.pmb.poisson import NewTrackHypotheses
@@ -62,6 +62,18 @@ class LocalHypotheses:
         cost[:, :k] = (self.miss_log_lik[:, None] - self.det_log_lik).T  # = -(log l_kj - log l_k0), exactly
         cost.reshape(-1)[k :: k + m + 1] = -self.new.log_likelihood  # C[j, K + j]: flat index K + j (K + M + 1)
         return cost
+
+    def cost_terms(self) -> CostTerms:
+        """The track entries of ``cost_matrix`` taken apart: C[j, k] = (log l_k0 - log r_k) - log P_D,j
+        - log N(z_j; H m_k, S_k) (``events.CostTerms``), from the arrays already computed."""
+        return CostTerms(
+            existence=self.prior.existence,
+            miss_log_lik=self.miss_log_lik,
+            score=self.meas.boxes.score,
+            d2=self.d2,
+            log_det_S=self.inn.log_det_S,
+            dim=self.inn.z_pred.shape[1],
+        )
 
     def base_log_weight(self) -> float:
         """sum_k log l_k0: the log weight of the hypothesis before subtracting the assignment cost."""

@@ -151,7 +151,16 @@ class KBest:
             for h in range(1, min(COST_MATRIX_EVENTS, len(locals_))):
                 local = locals_[h]
                 cost = local.cost_matrix()
-                ctx.sink.emit(CostMatrix(ctx.class_name, cost, local.row_labels(), local.col_labels(), hypothesis=h))
+                ctx.sink.emit(
+                    CostMatrix(
+                        ctx.class_name,
+                        cost,
+                        local.row_labels(),
+                        local.col_labels(),
+                        hypothesis=h,
+                        terms=local.cost_terms(),
+                    )
+                )
         union, members = _union_of(locals_)
         largest = union.n_meas  # rows of the largest gated block: at most M, computed only if M is over budget
         if largest > self.murty_block_rows:
@@ -180,7 +189,14 @@ class KBest:
             if best.parent >= COST_MATRIX_EVENTS:  # the matrix its assignment is explained over
                 cost = local.cost_matrix()
                 ctx.sink.emit(
-                    CostMatrix(ctx.class_name, cost, local.row_labels(), local.col_labels(), hypothesis=best.parent)
+                    CostMatrix(
+                        ctx.class_name,
+                        cost,
+                        local.row_labels(),
+                        local.col_labels(),
+                        hypothesis=best.parent,
+                        terms=local.cost_terms(),
+                    )
                 )
             own = _own_columns(best.col_of_row, members[best.parent], union.n_tracks)
             _emit(best.total_cost, own, local, best.parent, posteriors, ctx)

@@ -253,6 +253,24 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     why = summary.split("\n\n")[1]
     assert why.startswith(f"**Why** (gnnpmb): GT {short_id(failure.gt_ids[0])} had a detection within 2 m in ")
     assert f"track {old}'s existence went from " in why and f"→ **new track {new}** (cost " in why
+    # Then the decisive choice's costs taken apart; the parts add up to the cost the decision table shows.
+    because = summary.split("\n\n")[2]
+    assert because.startswith("**Because** (frame ")
+    assert f"→ new track {new}): a new track (or clutter) costs " in because
+    lost = re.search(r"track (\d+) costs ([-\d.]+) = (.*?); (?:track \d+ would|no existence)", because)
+    assert lost, because
+    parts = [float(p.split(" for ")[0]) for p in lost.group(3).split(" + ")]
+    assert [p.split(" for ")[1].split(" ")[:3] for p in lost.group(3).split(" + ")] == [
+        ["its", "predicted", "existence"],
+        ["its", "predicted", "spread"],
+        ["the", "distance", "(d²"],
+        ["the", "detection's", "score"],
+    ]
+    assert sum(parts) == pytest.approx(float(lost.group(2)), abs=0.03)
+    # The decision view of that frame takes the same choice apart under its table.
+    decided = because.split("(frame ")[1].split(",")[0]
+    doc = next(r for r in read_rows(out)[paths.decisions("gnnpmb")] if r.get("frame") == int(decided))
+    assert f"- {because.split(', ')[1].split(' →')[0]}: a new track (or clutter) costs " in doc["TextDocument:text"][0]
     head, _, rest = summary.partition(f"**Where the trackers part** at frame {failure.frame_index}")
     assert rest, "the two trackers sent a detection on the object to different places; the summary says where"
     assert "## gnnpmb" not in head  # it comes before the per-tracker sections

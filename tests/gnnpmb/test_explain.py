@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms
 from gnnpmb.explain import LINK_SLACK, _margin, explain
 
 INF = math.inf
@@ -168,3 +168,27 @@ def test_choices_equal_a_row_by_row_reference_on_random_matrices() -> None:
                     assert (c.alternative, c.alternative_cost) == (None, INF)
                 assert c.margin == _margin(sub, i, j, conflict.total_cost)
     assert checked[1] > 20 and checked[2] > 20  # both paths were exercised
+
+
+def test_choices_read_the_terms_of_their_track_columns() -> None:
+    """A matrix that says what its costs are made of: each choice reads the terms at its row and the chosen /
+    alternative track column; a "new" column or a matrix without terms gives None."""
+    matrix, assignment = staged()
+    terms = CostTerms(
+        existence=np.array([0.9, 0.5, 0.2]),
+        miss_log_lik=np.log(1 - np.array([0.9, 0.5, 0.2]) * 0.8),
+        score=np.array([0.7, 0.6, 0.5]),
+        d2=np.arange(9.0).reshape(3, 3),
+        log_det_S=np.array([0.1, 0.2, 0.3]),
+        dim=2,
+    )
+    with_terms = CostMatrix("car", matrix.cost, matrix.rows, matrix.cols, terms=terms)
+    first, second = explain(with_terms, assignment).conflicts[0].choices
+    assert first.chosen_terms == terms.pair(0, 0) and first.alternative_terms == terms.pair(0, 1)
+    assert (second.meas, second.chosen) == (meas(5), track(8)) and second.chosen_terms == terms.pair(1, 1)
+    assert first.chosen_terms.existence == 0.9 and first.chosen_terms.d2 == 0.0 and first.alternative_terms.d2 == 3.0
+    (plain,) = [c for c in explain(matrix, assignment).conflicts[0].choices if c.meas == meas(3)]
+    assert plain.chosen_terms is None and plain.alternative_terms is None
+    births = CostMatrix("car", np.array([[-1.0, 0.5]]), (meas(0),), (track(1), new(0)), terms=terms)
+    (only,) = explain(births, Assignment("car", ((meas(0), track(1)),), -1.0, ())).conflicts[0].choices
+    assert only.chosen_terms == terms.pair(0, 0) and only.alternative == new(0) and only.alternative_terms is None

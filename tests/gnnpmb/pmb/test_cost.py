@@ -41,3 +41,44 @@ def test_cost_matrix_entries():
             cost = local.cost_matrix()
             assert cost.shape == (m, k + m) and cost.tobytes() == expected.tobytes()
             assert k == 0 or m == 0 or np.isinf(cost[:, 2]).all()  # the track 60 m away gates nothing
+
+
+def test_cost_terms_add_up_to_every_gated_entry():
+    """existence + spread + distance + score nats = C[j, k] wherever the pair is gated."""
+    meas = make_measurements([(0.2, 0.1), (5.5, -0.3), (0.9, 0.4)], 0.7)
+    new = new_track_hypotheses(measurement_birth(meas, CFG.models), meas, R, CFG.models.clutter_intensity)
+    local = local_hypotheses(bernoullis([(0.0, 0.0), (5.0, 0.0), (1.0, 1.0)]), meas, new, R, CFG.models.gate_chi2)
+    cost, terms = local.cost_matrix(), local.cost_terms()
+    gated = np.argwhere(np.isfinite(cost[:, : local.n_tracks]))
+    assert len(gated) >= 4
+    for j, k in gated.tolist():
+        assert np.isclose(terms.pair(j, k).total_nats, cost[j, k], rtol=0, atol=1e-12)
+
+
+def test_cost_terms_by_hand():
+    """One track at the origin, r = 0.5, last score 0.8, cov I (S = I + R); a detection of score 0.7 at (1, 0)."""
+    meas = make_measurements([(1.0, 0.0)], 0.7)
+    new = new_track_hypotheses(measurement_birth(meas, CFG.models), meas, R, CFG.models.clutter_intensity)
+    track = bernoullis([(0.0, 0.0)])
+    local = local_hypotheses(track, meas, new, R, CFG.models.gate_chi2)
+    t = local.cost_terms().pair(0, 0)
+    s = np.eye(2) + R
+    assert np.isclose(t.existence, 0.5) and np.isclose(t.p_detect, 0.8)
+    assert np.isclose(t.existence_nats, np.log(1 - 0.5 * 0.8) - np.log(0.5))
+    assert np.isclose(t.score_nats, -np.log(0.7))
+    assert np.isclose(t.d2, 1.0 / s[0, 0]) and np.isclose(t.distance_nats, 0.5 / s[0, 0])
+    assert np.isclose(t.spread_nats, 0.5 * np.log(np.linalg.det(2 * np.pi * s)))
+    assert np.isclose(t.spread_m, np.linalg.det(s) ** 0.25)
+
+
+def test_existence_for_a_cheaper_cost():
+    """The existence at which the cost is lower by a gap, put back into the formula, gives exactly that gap;
+    a gap larger than any existence can close gives None."""
+    meas = make_measurements([(1.0, 0.0)], 0.7)
+    new = new_track_hypotheses(measurement_birth(meas, CFG.models), meas, R, CFG.models.clutter_intensity)
+    t = local_hypotheses(bernoullis([(0.0, 0.0)]), meas, new, R, CFG.models.gate_chi2).cost_terms().pair(0, 0)
+    r = t.existence_for(0.3)
+    assert r is not None and 0.5 < r < 1
+    assert np.isclose(np.log(1 - r * t.p_detect) - np.log(r), t.existence_nats - 0.3)
+    assert t.existence_for(-0.3) < 0.5
+    assert t.existence_for(t.existence_nats - np.log(1 - t.p_detect) + 0.01) is None  # beyond r = 1
