@@ -64,7 +64,10 @@ def failure_log(tracker: str) -> str:
 
 
 def _label(kind: FailureKind, box: FailureBox) -> str:
+    """``ID switch: old track 26``; a role that already names the kind is not repeated (``false track 20``)."""
     name = short_id(box.object_id) if box.is_gt else box.object_id
+    if box.role.startswith(KIND_LABELS[kind]):
+        return f"{box.role} {name}"
     return f"{KIND_LABELS[kind]}: {box.role} {name}"
 
 

@@ -13,7 +13,7 @@ from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import ClassEvaluation, Failure, FailureBox, FailureKind, FailureReport
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
-from viz.failures import KIND_COLORS, MARKER_MARGIN_M, MARKER_SCALE, failure_log, log_failures
+from viz.failures import KIND_COLORS, MARKER_MARGIN_M, MARKER_SCALE, _label, failure_log, log_failures
 
 T = "gnnpmb"
 GT_ID = "a1b2c3d4e5f6"
@@ -78,9 +78,9 @@ def test_failures_are_logged_per_kind_and_frame(saved_stream, tiny_scene) -> Non
     miss_rows = [r for r in rows[paths.failures_world(T, "miss")] if not r["static"]]
     assert [r for r in rows[paths.failures_world(T, "miss")] if r["static"]][0]["Boxes3D:show_labels"] == [False]
     assert [r["Boxes3D:labels"] for r in miss_rows] == [
-        ["miss: missed gt a1b2c3", "miss: missed gt p9"],
+        ["missed gt a1b2c3", "missed gt p9"],  # the role names the kind: not "miss: missed gt"
         [],
-        ["miss: missed gt p9"],
+        ["missed gt p9"],
     ]
 
     counts = {
@@ -162,3 +162,9 @@ def test_a_failure_at_an_interpolated_gt_box_is_named_and_suggested_last(tiny_sc
     assert Failure.from_json(interpolated_switch.to_json()) == interpolated_switch
     scored = replace(mixed, track_scores={"4": 0.25, "9": 0.5})
     assert FailureReport.from_json(scored.to_json()) == scored
+
+
+def test_a_marker_label_does_not_repeat_the_kind() -> None:
+    assert _label(FailureKind.FALSE_TRACK, fbox("false track", "20", 0.0)) == "false track 20"
+    assert _label(FailureKind.FRAGMENTATION, fbox("missed gt", GT_ID, 0.0)) == "fragmentation: missed gt a1b2c3"
+    assert _label(FailureKind.IDENTITY_THEFT, fbox("thief track", "9", 0.0)) == "identity theft: thief track 9"
