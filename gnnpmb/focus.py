@@ -150,13 +150,27 @@ def _from_failure(
         center_xy_m=(float(center[0]), float(center[1])),
         class_name=failure.class_name,
         track_ids=ids,
-        gt_ids=failure.gt_ids,
+        gt_ids=failure.gt_ids or _gt_under_false_track(failure, scene),
         failure_id=failure_id,
         evaluated_gt_xy_m={b.object_id: (b.translation_m[0], b.translation_m[1]) for b in failure.boxes if b.is_gt},
         failure_kind=failure.kind,
         failure_tracker=tracker,
         failure_tracks=tuple(int(t) for t in failure.track_ids),
     )
+
+
+def _gt_under_false_track(failure: Failure, scene: SceneData) -> tuple[str, ...]:
+    """For a false track: the ground-truth object (any class) nearest its box within ``NEAR_M`` at the failure
+    frame, which the evaluation did not match to it (out of its range, no points, another class); () if none or
+    another kind of failure."""
+    if failure.kind is not FailureKind.FALSE_TRACK or not failure.boxes:
+        return ()
+    gt = scene.keyframes[failure.frame_index].gt
+    if not len(gt):
+        return ()
+    d = np.hypot(*(gt.translation_m[:, :2] - np.asarray(failure.boxes[0].translation_m[:2])).T)
+    k = int(np.argmin(d))
+    return (str(gt.instance_id[k]),) if d[k] <= NEAR_M else ()
 
 
 def _first_failure(reports: Mapping[str, FailureReport], involved, frames: range) -> tuple[Failure, str, str] | None:

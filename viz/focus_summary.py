@@ -477,10 +477,11 @@ def _gt_markdown(
                 else f"{focus.class_name} tracks whose score averaged over the track is >= {threshold:.3f} (its "
                 "best-MOTA threshold)"
             )
+            tracks = sorted({w for w in sent if w != "—" and not w.startswith("new")})
+            rest = f", the others went to {', '.join(tracks) or 'no track'}" if news < len(sent) else ""
             out += [
                 f"**GT {short_id(gt_id)}**: a detection within {NEAR_DETECTION_M:.0f} m in {detected} of its {seen} "
-                f"frames up to {focus.frame_index}; {news} of them started a new track, the others went to "
-                f"{', '.join(sorted({w for w in sent if w != '—' and not w.startswith('new')})) or 'no track'}.",
+                f"frames up to {focus.frame_index}; {news} of them started a new track{rest}.",
                 "",
                 f"GT {short_id(gt_id)}, frame by frame (the evaluation counted {counted}):",
                 "",

@@ -705,9 +705,12 @@ class TrackerLogger:
         if cf.assignment is not None:
             given = {int(c.ref): int(r.ref) for r, c in cf.assignment.pairs if c.kind is AxisKind.TRACK}
         reported = {e.track_id for e in estimates}
-        if cf.assignment is not None and any(t in self.focus_tracks for t in ids):
-            born = _born_tracks(cf)
-            self.given[self._frame] = {int(r.ref): destination(c, born.get(int(r.ref))) for r, c in cf.assignment.pairs}
+        if cf.assignment is not None:
+            born = _born_tracks(cf)  # a focused track started this frame was not predicted, but its detection counts
+            if any(t in self.focus_tracks for t in (*ids, *born.values())):
+                self.given[self._frame] = {
+                    int(r.ref): destination(c, born.get(int(r.ref))) for r, c in cf.assignment.pairs
+                }
         meas_xy = {}
         if cf.meas is not None:
             xyz = np.asarray(cf.meas.xyz_m, dtype=np.float64).reshape(-1, 3)

@@ -290,8 +290,14 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
         (i, f) for i, f in zip(report.ids(), report.failures, strict=True) if f.kind is FailureKind.FALSE_TRACK
     )
     out, _ = record(demo_dataroot, tmp_path, pick)
-    why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
+    summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
+    why = summary.split("\n\n")[1]
     track = failure.track_ids[0]
+    # The object the false track sat on (if any) is involved: labelled in the views, with its frame table.
+    near = re.search(r"GT ([0-9a-f]{6}) (?:lies|does) \(?([\d.]+) m", why)
+    if near and float(near.group(2)) <= 2.0:
+        assert f"GT {near.group(1)}" in summary.split("**Involved**")[1].split("\n")[0]
+        assert f"**GT {near.group(1)}**: a detection within 2 m in " in summary
     assert why.startswith(f"**Why** (gnnpmb): at frame {failure.frame_index} track {track} ({failure.class_name})")
     average, threshold = report.track_scores[track], report.threshold_of(failure.class_name)
     assert f"averaged over the track, {average:.3f}, is at least the {failure.class_name} threshold" in why
