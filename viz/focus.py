@@ -6,9 +6,9 @@
   slightly enlarged in their class colours;
 * ``world/trackers/<tracker>/focus``: that tracker's involved tracks, enlarged, in their colours (their own
   boxes carry the id labels);
-* ``world/trackers/<tracker>/focus/callouts``: the labels of the involved objects (``GT 8bccf2``, ``m10 0.83``,
-  ``26 predicted r=0.04``) in a column beside them with leader lines (``viz.callouts``), so labels of objects
-  on one spot do not cover each other;
+* ``world/trackers/<tracker>/focus/callouts``: the labels of the involved objects (``GT 8bccf2``,
+  ``m10 0.83 → track 26``, ``26 predicted r=0.04 → m10``, ``31 predicted r=0.02, missed``) in a column beside
+  them with leader lines (``viz.callouts``), so labels of objects on one spot do not cover each other;
 * ``world/focus/as_evaluated``: where the evaluation put an object it interpolated (``viz.evaluated``).
 
 ``focus_legends`` places the legends of the series views the layout opens with (``viz.legend``).
@@ -129,12 +129,18 @@ def log_focus(
             steps = {t: loggers[tracker].track_steps.get(t, {}).get(i) for t in sorted(ids)}
             given = {e.meas_index for e in chosen if e.meas_index >= 0}
             given |= {s.given for s in steps.values() if s is not None and s.given >= 0}
+            # and, for a track given none, the detection nearest it (by NIS) in its gate: where that one went
+            given |= {
+                min(s.gated, key=lambda g: g[1])[0] for s in steps.values() if s is not None and s.given < 0 and s.gated
+            }
             meas |= given
             detections = frame.detections.boxes
             log_callouts(
                 stream,
                 paths.focus_callouts(tracker),
-                gt_callouts + _detection_callouts(detections, sorted(given)) + _prediction_callouts(steps, z_m),
+                gt_callouts
+                + _detection_callouts(detections, sorted(given), loggers[tracker].given.get(i, {}))
+                + _prediction_callouts(steps, z_m),
                 height_m,
             )
         if meas and detections is not None:
@@ -208,12 +214,13 @@ def focus_legends(
     return out
 
 
-def _detection_callouts(detections: Boxes, given: list[int]) -> list[Callout]:
-    """``m<idx> <score>`` at each detection ``given`` (indices into the frame's detections)."""
+def _detection_callouts(detections: Boxes, given: list[int], went: Mapping[int, str]) -> list[Callout]:
+    """``m<idx> <score> → <where it went>`` at each detection ``given`` (indices into the frame's detections;
+    went: detection -> "track 12", "new track 40", as ``TrackerLogger.given`` holds it)."""
     return [
         Callout(
             tuple(detections.translation_m[m]),
-            detection_label(m, detections.score[m]),
+            detection_label(m, detections.score[m]) + (f" → {went[m]}" if m in went else ""),
             CLASS_COLORS.get(str(detections.class_name[m]), GREY),
         )
         for m in given
@@ -221,11 +228,12 @@ def _detection_callouts(detections: Boxes, given: list[int]) -> list[Callout]:
 
 
 def _prediction_callouts(steps: Mapping[int, TrackStep | None], z_m: float) -> list[Callout]:
-    """``<id> predicted r=<prior existence>`` at each focused track's predicted position this frame."""
+    """``<id> predicted r=<prior existence> → m<idx>`` (the detection it was given; ``, missed``: none) at each
+    focused track's predicted position this frame."""
     return [
         Callout(
             (*step.predicted_xy_m, z_m),
-            f"{t} predicted r={step.prior_existence:.2f}",
+            f"{t} predicted r={step.prior_existence:.2f}" + (f" → m{step.given}" if step.given >= 0 else ", missed"),
             tuple(int(v) for v in track_colors(np.array([t], dtype=np.int64))[0]),
         )
         for t, step in steps.items()

@@ -53,6 +53,8 @@ READING_GUIDE = """# How to read the views
 - **Failures**: enlarged boxes: magenta ID switch, orange fragmentation, red false track, green coalescence,
   yellow identity theft, grey miss.
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
+  A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`); a track's predicted
+  position, its predicted existence and the detection it was given (`26 predicted r=0.40 → m2`) or `missed`.
   Tracks that are not involved are drawn pale.
 - **GT … as evaluated**: where the evaluation put an object that had no LiDAR or radar points at this frame (it
   interpolates a box between the frames where the object had points); the failure is scored against that box.

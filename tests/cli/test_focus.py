@@ -133,6 +133,9 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     labels = callouts["Points3D:labels"]
     assert any(label.startswith("GT ") for label in labels)
     assert any(label.startswith(f"{failure.track_ids[0]} predicted r=") for label in labels)
+    # Which detection each involved track was given, on the picture itself (here none: nothing in their gates).
+    predicted = [label for label in labels if " predicted r=" in label]
+    assert predicted and all(re.fullmatch(r"\d+ predicted r=[\d.]+(?: → m\d+|, missed)", p) for p in predicted)
     assert callouts["Points3D:positions.len"] == len(labels)
     leaders = [r for r in rows[paths.focus_callouts("gnnpmb") + "/leaders"] if r.get("frame") == failure.frame_index]
     label_at = np.array([strip[1] for strip in leaders[0]["LineStrips3D:strips"]])  # each: object -> label
@@ -267,6 +270,13 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
         ["the", "detection's", "score"],
     ]
     assert sum(parts) == pytest.approx(float(lost.group(2)), abs=0.03)
+    # The picture says it too: the detection's label names where it went, in each tracker's view.
+    for tracker in ("gnnpmb", "pmbm"):
+        callouts = [r for r in read_rows(out)[paths.focus_callouts(tracker)] if r.get("frame") == failure.frame_index]
+        went = [label.split(" → ")[1] for label in callouts[0]["Points3D:labels"] if re.match(r"m\d+ ", label)]
+        assert went and all(re.fullmatch(r"(?:new )?track \d+", w) for w in went)
+        if tracker == "gnnpmb":
+            assert f"new track {new}" in went
     # The decision view of that frame takes the same choice apart under its table.
     decided = because.split("(frame ")[1].split(",")[0]
     doc = next(r for r in read_rows(out)[paths.decisions("gnnpmb")] if r.get("frame") == int(decided))
