@@ -51,42 +51,48 @@ def column_name(label: AxisLabel) -> str:
     raise AssertionError(label.kind)
 
 
-def cost_breakdown(terms: PairTerms) -> str:
-    """A track's cost in words: the nats its predicted existence, the spread of its prediction, the distance and
-    the detection's score add (``events.PairTerms``)."""
+def cost_breakdown(terms: PairTerms, meas: str) -> str:
+    """A track's cost for detection ``meas`` in words: the nats its predicted existence, the uncertainty of its
+    predicted position, the distance and the detection's score add (``events.PairTerms``)."""
     return (
-        f"{terms.existence_nats:.2f} for its predicted existence {terms.existence:.2f} + {terms.spread_nats:.2f} "
-        f"for its predicted spread ({terms.spread_m:.1f} m) + {terms.distance_nats:.2f} for the distance "
-        f"(d² {terms.d2:.1f}) + {terms.score_nats:.2f} for the detection's score {terms.score:.2f}"
+        f"{terms.existence_nats:.2f} for its predicted existence {terms.existence:.2f} + {terms.spread_nats:.2f} for "
+        f"the uncertainty of its predicted position (±{terms.spread_m:.1f} m) + {terms.distance_nats:.2f} for the "
+        f"distance to {meas} (d² {terms.d2:.1f}) + {terms.score_nats:.2f} for {meas}'s score {terms.score:.2f}"
     )
 
 
-def choice_why(c: PairChoice) -> str | None:
-    """Why a detection did not go to the track that was its next best column: both costs taken apart (when the
-    tracker's matrix says what they are made of) and the predicted existence at which that track would have been
-    the cheaper of the two. None when the next best is not a track or its terms are unknown."""
+def choice_why(c: PairChoice, went: str | None = None) -> str | None:
+    """Why a detection went to its chosen column rather than the track that was its next best: both costs, each
+    track's taken apart (when the tracker's matrix says what they are made of), and the predicted existence at
+    which that track would have been the cheaper of the two. went: how to name the chosen column ("new track
+    212"; default ``column_name``). None when the next best is not a track or its terms are unknown."""
     alt = c.alternative_terms
     if alt is None or c.alternative is None:
         return None
     meas = meas_name(c.meas.ref)
-    parts = []
-    chosen = c.chosen_terms
-    if chosen is not None:
-        parts.append(f"{column_name(c.chosen)} costs {c.chosen_cost:.2f} = {cost_breakdown(chosen)}")
-    elif c.chosen.kind is AxisKind.NEW_TRACK:
-        parts.append(f"a new track (or clutter) costs {c.chosen_cost:.2f}")
+    other = column_name(c.alternative)
+    if c.chosen.kind is AxisKind.NEW_TRACK:
+        chosen = went if went and went.startswith("new track ") else "a new track"
     else:
-        parts.append(f"{column_name(c.chosen)} costs {c.chosen_cost:.2f}")
-    parts.append(f"{column_name(c.alternative)} costs {c.alternative_cost:.2f} = {cost_breakdown(alt)}")
+        chosen = went or column_name(c.chosen)
+    lines = [
+        f"{meas} went to {chosen} (cost {c.chosen_cost:.2f}) rather than {other} (cost {c.alternative_cost:.2f}): "
+        "the lower cost wins"
+    ]
+    if c.chosen_terms is not None:
+        lines.append(
+            f"{column_name(c.chosen).capitalize()}'s {c.chosen_cost:.2f} = {cost_breakdown(c.chosen_terms, meas)}"
+        )
+    lines.append(f"{other.capitalize()}'s {c.alternative_cost:.2f} = {cost_breakdown(alt, meas)}")
     needed = alt.existence_for(c.alternative_cost - c.chosen_cost)
     if needed is None:
-        parts.append(f"no existence would have made {column_name(c.alternative)} the cheaper one for {meas}")
+        lines.append(f"No predicted existence would have given {meas} to {other}")
     else:
-        parts.append(
-            f"{column_name(c.alternative)} would have been the cheaper one for {meas} with a predicted existence "
-            f"above {needed:.2f}"
+        lines.append(
+            f"With a predicted existence above {needed:.2f} (instead of {alt.existence:.2f}), {other} would have "
+            f"taken {meas}"
         )
-    return "; ".join(parts)
+    return ". ".join(lines)
 
 
 def _fmt(value: float) -> str:
@@ -127,7 +133,7 @@ def conflict_markdown(conflict: Conflict, reported: set[int] | None = None) -> s
     whys = [(c, why) for c in conflict.choices if (why := choice_why(c)) is not None]
     if whys:
         lines.append("")
-        lines += [f"- {meas_name(c.meas.ref)}: {why}" for c, why in whys]
+        lines += [f"- {why}" for _, why in whys]
     if conflict.missed_track_ids:
         lines.append("")
         lines.append(f"missed (no detection, cost 0): {_ids(conflict.missed_track_ids, reported)}")

@@ -72,6 +72,26 @@ READING_GUIDE = """# How to read the views
   detection's score; and it gives the existence at which that track would have won the detection.
 - **existence**, **NIS**, **chosen cost**: the involved tracks' series up to the failure; the grey line is the
   existence from which a Bernoulli is shown as a track.
+
+**Terms**
+
+- **r, existence**: the filter's probability that a track's object exists (a Bernoulli's existence); it falls
+  each frame the track gets no detection. **Predicted** values are before this frame's detections are used.
+- **candidate**: a track (Bernoulli) never shown, because its existence never reached the line above.
+- **d², NIS**: the squared Mahalanobis distance between a detection and a track's predicted position (normalised
+  innovation squared); the gate keeps detections with d² ≤ 40.
+- **uncertainty of the predicted position (± m)**: the spread of the track's predicted position plus the
+  detection noise (the fourth root of det S); it grows while a track gets no detection.
+- **cost**: −log of how much more likely a pairing is than the track being missed; the solver picks the set of
+  pairings of least total cost. **new**: the cost of a detection starting a track (or being clutter), about the
+  same for every detection (the birth weight against the clutter rate, −log(clutter + birth weight × score ×
+  birth density)).
+- **margin**: how much the best total cost rises without a chosen pair; shown up to 5.00 (larger is no contest).
+- **identity theft** (the paper's cascading identity theft): a track whose first frames were false (matched to
+  no object) takes over a real object another track held, an ID switch; the victim, left without its object,
+  may steal the next one in turn.
+- **counted**: the evaluation keeps a track only if its score averaged over the whole track reaches the class's
+  threshold (chosen for the best MOTA), at all its frames or at none.
 """
 
 
@@ -283,6 +303,11 @@ def _frames(frames: list[int]) -> str:
     return ", ".join(str(f) for f in frames)
 
 
+def _frames_named(frames: list[int]) -> str:
+    """``frame 7`` or ``frames 7, 13``."""
+    return f"frame{'s' if len(frames) > 1 else ''} {_frames(frames)}"
+
+
 def _counted(average: float | None, threshold: float | None) -> str:
     """How the evaluation saw a track: its averaged score and, below ``threshold``, that it was not counted."""
     if threshold is None:
@@ -322,21 +347,26 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
     lost = focus.failure_tracks[lost_at]
     took = focus.failure_tracks[took_at] if took_at is not None else None
     by_frame = {f.keyframe.index: f for f in run.frames}
-    gt_id, detected, seen, empty = focus.gt_ids[0], [], 0, 0
+    gt_id, detected, seen, empty = focus.gt_ids[0], [], [], []
     for i in range(shown.start, focus.frame_index + 1):
         gt = scene.keyframes[i].gt
         hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
         if hit.size == 0 or i not in by_frame:
             continue
-        seen += 1
-        empty += int(scene.keyframes[i].gt_num_pts[hit[0]] == 0)
+        seen.append(i)
+        if scene.keyframes[i].gt_num_pts[hit[0]] == 0:
+            empty.append(i)
         if _nearest_detection(by_frame[i], focus.class_name, gt.translation_m[hit[0], :2]) is not None:
             detected.append(i)
-    parts = [
-        f"GT {short_id(gt_id)} had a detection within {NEAR_DETECTION_M:.0f} m in {len(detected)} of its {seen} "
-        f"recorded frames up to {focus.frame_index}"
-        + (f" ({empty} of them with no LiDAR or radar points)" if empty else "")
-    ]
+    parts = []
+    if seen:
+        only = " only" if len(detected) < len(seen) else ""
+        at = f"{_frames_named(detected)}{only}" if detected else "no frame"
+        no_points = f" and no LiDAR or radar points at {_frames_named(empty)}" if empty else ""
+        parts.append(
+            f"in the {len(seen)} recorded frames up to {focus.frame_index} ({seen[0]}–{seen[-1]}), GT "
+            f"{short_id(gt_id)} had a detection within {NEAR_DETECTION_M:.0f} m at {at}{no_points}"
+        )
     steps = {f: st for f, st in logger.track_steps.get(lost, {}).items() if shown.start <= f <= focus.frame_index}
     if steps:
         peak = max(steps, key=lambda f: _after(steps[f]))
@@ -362,10 +392,10 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
 def _because(key: KeyDecision) -> list[str]:
     """The decisive choice's costs taken apart (``decisions.choice_why``), as a paragraph; none when the
     tracker's cost matrix does not say what its costs are made of."""
-    why = choice_why(key.choice)
+    why = choice_why(key.choice, key.went)
     if why is None:
         return []
-    return [f"**Because** (frame {key.frame}, {meas_name(key.choice.meas.ref)} → {key.went}): {why}.", ""]
+    return [f"**Because** (frame {key.frame}): {why}.", ""]
 
 
 def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, report: FailureReport | None) -> list[str]:
@@ -481,9 +511,10 @@ def _gt_markdown(
             )
             tracks = sorted({w for w in sent if w != "—" and not w.startswith("new")})
             rest = f", the others went to {', '.join(tracks) or 'no track'}" if news < len(sent) else ""
+            first = max(shown.start, focus.frame_index - TABLE_FRAMES)
             out += [
-                f"**GT {short_id(gt_id)}**: a detection within {NEAR_DETECTION_M:.0f} m in {detected} of its {seen} "
-                f"frames up to {focus.frame_index}; {news} of them started a new track{rest}.",
+                f"**GT {short_id(gt_id)}**, in the {seen} frames of the table ({first}–{focus.frame_index}): a "
+                f"detection within {NEAR_DETECTION_M:.0f} m in {detected}; {news} of them started a new track{rest}.",
                 "",
                 f"GT {short_id(gt_id)}, frame by frame (the evaluation counted {counted}):",
                 "",

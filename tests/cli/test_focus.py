@@ -254,20 +254,28 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     # The cause in one line under the headline: detections of the object, the old track's existence, the choice.
     old, new = failure.track_ids
     why = summary.split("\n\n")[1]
-    assert why.startswith(f"**Why** (gnnpmb): GT {short_id(failure.gt_ids[0])} had a detection within 2 m in ")
+    last = failure.frame_index
+    assert re.match(
+        rf"\*\*Why\*\* \(gnnpmb\): in the \d+ recorded frames up to {last} \(\d+–{last}\), "
+        rf"GT {short_id(failure.gt_ids[0])} had a detection within 2 m at (?:frames? [\d, ]+|no frame)",
+        why,
+    ), why
     assert f"track {old}'s existence went from " in why and f"→ **new track {new}** (cost " in why
     # Then the decisive choice's costs taken apart; the parts add up to the cost the decision table shows.
     because = summary.split("\n\n")[2]
-    assert because.startswith("**Because** (frame ")
-    assert f"→ new track {new}): a new track (or clutter) costs " in because
-    lost = re.search(r"track (\d+) costs ([-\d.]+) = (.*?); (?:track \d+ would|no existence)", because)
+    assert re.match(
+        rf"\*\*Because\*\* \(frame \d+\): m\d+ went to new track {new} \(cost [\d.]+\) rather than ", because
+    )
+    lost = re.search(
+        r"Track (\d+)'s ([-\d.]+) = (.*?)\. (?:With a predicted existence above|No predicted existence)", because
+    )
     assert lost, because
     parts = [float(p.split(" for ")[0]) for p in lost.group(3).split(" + ")]
-    assert [p.split(" for ")[1].split(" ")[:3] for p in lost.group(3).split(" + ")] == [
-        ["its", "predicted", "existence"],
-        ["its", "predicted", "spread"],
-        ["the", "distance", "(d²"],
-        ["the", "detection's", "score"],
+    assert [" ".join(p.split(" for ")[1].split(" ")[:3]) for p in lost.group(3).split(" + ")] == [
+        "its predicted existence",
+        "the uncertainty of",
+        "the distance to",
+        re.search(r"for (m\d+'s score [\d.]+)", lost.group(3)).group(1),
     ]
     assert sum(parts) == pytest.approx(float(lost.group(2)), abs=0.03)
     # The picture says it too: the detection's label names where it went, in each tracker's view.
@@ -278,9 +286,9 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
         if tracker == "gnnpmb":
             assert f"new track {new}" in went
     # The decision view of that frame takes the same choice apart under its table.
-    decided = because.split("(frame ")[1].split(",")[0]
+    decided, meas = re.match(r"\*\*Because\*\* \(frame (\d+)\): (m\d+) ", because).groups()
     doc = next(r for r in read_rows(out)[paths.decisions("gnnpmb")] if r.get("frame") == int(decided))
-    assert f"- {because.split(', ')[1].split(' →')[0]}: a new track (or clutter) costs " in doc["TextDocument:text"][0]
+    assert f"- {meas} went to a new track (cost " in doc["TextDocument:text"][0]
     head, _, rest = summary.partition(f"**Where the trackers part** at frame {failure.frame_index}")
     assert rest, "the two trackers sent a detection on the object to different places; the summary says where"
     assert "## gnnpmb" not in head  # it comes before the per-tracker sections
@@ -307,7 +315,7 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
     near = re.search(r"GT ([0-9a-f]{6}) (?:lies|does) \(?([\d.]+) m", why)
     if near and float(near.group(2)) <= 2.0:
         assert f"GT {near.group(1)}" in summary.split("**Involved**")[1].split("\n")[0]
-        assert f"**GT {near.group(1)}**: a detection within 2 m in " in summary
+        assert f"**GT {near.group(1)}**, in the 1 frames of the table (0–0): a detection within 2 m in 1" in summary
     assert why.startswith(f"**Why** (gnnpmb): at frame {failure.frame_index} track {track} ({failure.class_name})")
     average, threshold = report.track_scores[track], report.threshold_of(failure.class_name)
     assert f"averaged over the track, {average:.3f}, is at least the {failure.class_name} threshold" in why
