@@ -61,6 +61,13 @@ def cost_breakdown(terms: PairTerms, meas: str) -> str:
     )
 
 
+def cost_brief(terms: PairTerms | None) -> str:
+    """What a track's cost depended on, briefly: ``existence 0.62, ±1.2 m, d² 0.3`` ("" without terms)."""
+    if terms is None:
+        return ""
+    return f"existence {terms.existence:.2f}, ±{terms.spread_m:.1f} m, d² {terms.d2:.1f}"
+
+
 def choice_why(c: PairChoice, went: str | None = None) -> str | None:
     """Why a detection went to its chosen column rather than the track that was its next best: both costs, each
     track's taken apart (when the tracker's matrix says what they are made of), and the predicted existence at

@@ -140,7 +140,7 @@ def log_focus(
                 paths.focus_callouts(tracker),
                 gt_callouts
                 + _detection_callouts(detections, sorted(given), loggers[tracker].given.get(i, {}))
-                + _prediction_callouts(steps, z_m),
+                + _prediction_callouts(steps, z_m, _existence_as_decided(loggers[tracker], i, focus.class_name)),
                 height_m,
             )
         if meas and detections is not None:
@@ -227,13 +227,34 @@ def _detection_callouts(detections: Boxes, given: list[int], went: Mapping[int, 
     ]
 
 
-def _prediction_callouts(steps: Mapping[int, TrackStep | None], z_m: float) -> list[Callout]:
-    """``<id> predicted r=<prior existence> → m<idx>`` (the detection it was given; ``, missed``: none) at each
-    focused track's predicted position this frame."""
+def _existence_as_decided(logger: TrackerLogger, frame: int, class_name: str) -> dict[int, float]:
+    """Track id -> its predicted existence in the cost matrix the frame's assignment was explained on, for the
+    tracks given a detection. For PMBM that is the chosen posterior's parent hypothesis, whose Bernoullis can
+    differ from the most likely prior hypothesis's that ``Predicted`` shows (a track nearly dead in one
+    hypothesis can be alive in another)."""
+    out = {}
+    for d in logger.decisions.get(frame, []):
+        if d.class_name != class_name:
+            continue
+        for c in (c for conflict in d.conflicts for c in conflict.choices):
+            terms = c.chosen_terms
+            if terms is not None:
+                out[int(c.chosen.ref)] = terms.existence
+    return out
+
+
+def _prediction_callouts(
+    steps: Mapping[int, TrackStep | None], z_m: float, decided: Mapping[int, float] | None = None
+) -> list[Callout]:
+    """``<id> predicted r=<existence> → m<idx>`` (the detection it was given; ``, missed``: none) at each focused
+    track's predicted position this frame; the existence is the one its detection was decided with (``decided``,
+    see ``_existence_as_decided``) if known, else its prior existence."""
+    decided = decided or {}
     return [
         Callout(
             (*step.predicted_xy_m, z_m),
-            f"{t} predicted r={step.prior_existence:.2f}" + (f" → m{step.given}" if step.given >= 0 else ", missed"),
+            f"{t} predicted r={decided.get(t, step.prior_existence):.2f}"
+            + (f" → m{step.given}" if step.given >= 0 else ", missed"),
             tuple(int(v) for v in track_colors(np.array([t], dtype=np.int64))[0]),
         )
         for t, step in steps.items()

@@ -17,14 +17,14 @@ import numpy as np
 
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import FailureKind, FailureReport, short_id
-from gnnpmb.events import AxisKind
+from gnnpmb.events import AxisKind, PairTerms
 from gnnpmb.explain import PairChoice
 from gnnpmb.focus import FocusTarget
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from viz.blueprint import (
     FOCUS_TIMELINE,
 )
-from viz.decisions import CLOSE_CALL_MARGIN, choice_why, column_name, conflict_markdown, meas_name
+from viz.decisions import CLOSE_CALL_MARGIN, choice_why, column_name, conflict_markdown, cost_brief, meas_name
 from viz.evaluated import NEAR_DETECTION_M, devkit_gt, evaluated_notes, evaluated_offsets
 from viz.logger import TrackerLogger
 
@@ -209,11 +209,19 @@ def _parting(focus: FocusTarget, loggers: Mapping[str, TrackerLogger]) -> list[s
             labels = [c.chosen] if c.alternative is None else [c.chosen, c.alternative]
             touches |= any(label.kind is AxisKind.TRACK and label.ref in ids for label in labels)
             touches |= any(str(t) in str(went[tracker]).split() for t in ids)
-            other = f"; next {column_name(c.alternative)} {c.alternative_cost:.2f}" if c.alternative is not None else ""
-            parts.append(f"{tracker}: {meas_name(m)} → **{went[tracker]}** ({c.chosen_cost:.2f}{other})")
+            other = ""
+            if c.alternative is not None:
+                other = f"; next {column_name(c.alternative)} {c.alternative_cost:.2f}" + _brief(c.alternative_terms)
+            chosen = f"{c.chosen_cost:.2f}{_brief(c.chosen_terms)}"
+            parts.append(f"{tracker}: {meas_name(m)} → **{went[tracker]}** ({chosen}{other})")
         if touches:
             out.append(" · ".join(parts))
     return out
+
+
+def _brief(terms: PairTerms | None) -> str:
+    """`` at existence 0.62, ±1.2 m, d² 0.3`` (``decisions.cost_brief``), or "" for a column without terms."""
+    return f" at {cost_brief(terms)}" if terms is not None else ""
 
 
 @dataclass(frozen=True, slots=True)

@@ -285,6 +285,14 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
         assert went and all(re.fullmatch(r"(?:new )?track \d+", w) for w in went)
         if tracker == "gnnpmb":
             assert f"new track {new}" in went
+        # A track given a detection is labelled with the existence its detection was decided with, as the
+        # "Where the trackers part" line gives it (PMBM: the chosen hypothesis's, not the most likely prior's).
+        for label in callouts[0]["Points3D:labels"]:
+            given = re.fullmatch(r"(\d+) predicted r=([\d.]+) → (m\d+)", label)
+            if given and tracker == "pmbm":
+                track_id, r, meas = given.groups()
+                parting = summary.partition("**Where the trackers part**")[2]
+                assert f"pmbm: {meas} → **track {track_id}** (" in parting and f" at existence {r}, " in parting
     # The decision view of that frame takes the same choice apart under its table.
     decided, meas = re.match(r"\*\*Because\*\* \(frame (\d+)\): (m\d+) ", because).groups()
     doc = next(r for r in read_rows(out)[paths.decisions("gnnpmb")] if r.get("frame") == int(decided))
