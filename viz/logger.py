@@ -873,8 +873,7 @@ class TrackerLogger:
                 via = f"given {meas_name(given[t])}" if t in given else "given no detection"
             self._text(
                 class_name,
-                f"involved track {t} (r < {self.show_min_existence:g}: drawn only in focus recordings): {via}, "
-                f"r={posterior_r[t]:.2f}",
+                f"track {t} (not shown, r < {self.show_min_existence:g}): {via}, r={posterior_r[t]:.2f}",
                 "INFO",
             )
 
