@@ -1,8 +1,10 @@
 """Where two or more trackers disagree, frame by frame, judged against the ground truth.
 
-Per tracker and keyframe, the estimates are matched to the ground-truth boxes with the nuScenes tracking
-criterion: BEV centre distance below ``MATCH_DISTANCE_M`` (2 m, ``dist_th_tp`` of ``tracking_nips_2019``),
-same class, one-to-one, the pairing found by the Hungarian method (most pairs, then least summed distance).
+The estimates compared are the tracks each tracker shows (``gnnpmb.session.compare_runs``: existence at least the
+viewer's show floor), so the lines say "shown". Per tracker and keyframe, the estimates are matched to the
+ground-truth boxes with the nuScenes tracking criterion: BEV centre distance below ``MATCH_DISTANCE_M`` (2 m,
+``dist_th_tp`` of ``tracking_nips_2019``), same class, one-to-one, the pairing found by the Hungarian method (most
+pairs, then least summed distance).
 Then, for every pair of trackers (A, B), in either role:
 
 * ``missed_by_one``: a GT object A's estimates cover and B's do not.
@@ -67,14 +69,16 @@ class Disagreement:
         gt = f"{self.class_name} GT {short_gt_id(self.gt_id)}"
         match self.kind:
             case DisagreementKind.MISSED_BY_ONE:
-                return f"{gt}: tracked by {self.tracker} (track {self.track_ids[0]}), no track of {self.other} on it"
+                return (
+                    f"{gt}: tracked by {self.tracker} (track {self.track_ids[0]}), no shown track of {self.other} on it"
+                )
             case DisagreementKind.ID_CHANGE:
                 old, new, kept = self.track_ids
                 return f"{gt}: {self.tracker} switched track {old} -> {new}, {self.other} kept track {kept}"
             case DisagreementKind.ONLY_IN_ONE:
                 return (
                     f"{self.class_name} track {self.track_ids[0]} of {self.tracker} matches no GT; "
-                    f"{self.other} has no {self.class_name} track there"
+                    f"{self.other} shows no {self.class_name} track there"
                 )
         raise AssertionError(self.kind)
 
