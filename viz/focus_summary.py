@@ -384,17 +384,29 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
         )
     because = []
     if took is not None:
-        chosen = [
-            k
-            for k in _key_decisions(
-                logger, set(focus.track_ids.get(run.tracker, ())), focus.class_name, shown, focus.frame_index, None
-            )
-            if k.went in (f"new track {took}", f"track {took}")
-        ]
+        keys = _key_decisions(
+            logger, set(focus.track_ids.get(run.tracker, ())), focus.class_name, shown, focus.frame_index, None
+        )
+        chosen = [k for k in keys if k.went in (f"new track {took}", f"track {took}")]
         if chosen:
             parts.append(f"then, {chosen[-1].text}")
+            parts += _where_from(chosen[-1], keys, (lost, took))
             because = _because(chosen[-1])
     return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", "", *because]
+
+
+def _where_from(key: KeyDecision, keys: list[KeyDecision], named: tuple[int | None, ...]) -> list[str]:
+    """When the decisive choice's next best is a track the failure does not name (a track in between), where that
+    track came from: the earlier key decision that started it."""
+    alt = key.choice.alternative
+    if alt is None or alt.kind is not AxisKind.TRACK or alt.ref in named:
+        return []
+    started = [k for k in keys if k.frame < key.frame and k.went == f"new track {alt.ref}"]
+    if not started:
+        return []
+    k = started[-1]
+    instead = f" instead of going to {column_name(k.choice.alternative)}" if k.choice.alternative is not None else ""
+    return [f"track {alt.ref} had been started at frame {k.frame} by {meas_name(k.choice.meas.ref)}{instead}"]
 
 
 def _because(key: KeyDecision) -> list[str]:

@@ -261,6 +261,10 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
         why,
     ), why
     assert f"track {old}'s existence went from " in why and f"→ **new track {new}** (cost " in why
+    # A track in between (neither the old nor the new one) is traced to the choice that started it.
+    between = re.search(rf"→ \*\*new track {new}\*\* \(cost [\d.]+\) over track (\d+) ", why)
+    if between and between.group(1) not in (str(old), str(new)):
+        assert re.search(rf"track {between.group(1)} had been started at frame \d+ by m\d+", why), why
     # Then the decisive choice's costs taken apart; the parts add up to the cost the decision table shows.
     because = summary.split("\n\n")[2]
     assert re.match(
