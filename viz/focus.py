@@ -40,7 +40,7 @@ from viz.colors import CLASS_COLORS, GREY, class_ids, track_colors
 from viz.evaluated import evaluated_offsets, log_evaluated
 from viz.focus_summary import READING_GUIDE, focus_markdown, mentions
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
-from viz.legend import COMPARISON_PLOT_HEIGHT_PX, PROBABILITY_RANGE, LegendPlacement, place_legend
+from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
 from viz.logger import TrackerLogger, TrackStep
 from viz.markers import send_text_lines
 from viz.scene import detection_label
@@ -204,7 +204,10 @@ def focus_legends(
             sent = [logger.sent_series[p] for p in series if p in logger.sent_series]
             # The legend names every series of the view, also those without a value up to the focus frame.
             lines = [(f[f <= last], v[f <= last]) for f, v in sent]
-            fixed = PROBABILITY_RANGE if root == paths.existence_root(tracker) else None
+            fixed = None
+            if root == paths.existence_root(tracker):
+                tracks = [logger.sent_series[p] for p in series[:-1] if p in logger.sent_series]  # not the threshold
+                fixed = existence_range([v[f <= last] for f, v in tracks])
             out[root] = place_legend(lines, len(sent), y_range=fixed)
     if comparison is not None:
         frames = np.asarray(comparison.frame_indices)

@@ -32,6 +32,21 @@ MAX_LEGEND_HEIGHT = 0.75
 """The legend is assumed to take at most this share of the plot's height (Rerun scrolls a longer one)."""
 PROBABILITY_RANGE = (-0.02, 1.02)
 """The y range of plots of probabilities (existence): [0, 1] with room for the lines at either end."""
+LOW_EXISTENCE = 0.25
+"""An existence plot whose tracks all stay below this is zoomed to them (``existence_range``)."""
+
+
+def existence_range(values: Sequence[np.ndarray]) -> tuple[float, float]:
+    """The y range of an existence plot of the tracks' (K,) value arrays: ``PROBABILITY_RANGE``, or, when every
+    value is below ``LOW_EXISTENCE`` (tracks that never came close to being shown), [0, their peak] with the same
+    relative room, so their rise and fall stay visible instead of flat lines on the floor of [0, 1]."""
+    peak = max((float(np.max(v)) for v in values if len(v)), default=1.0)
+    if peak >= LOW_EXISTENCE:
+        return PROBABILITY_RANGE
+    top = max(peak, 0.01)
+    return (PROBABILITY_RANGE[0] * top, PROBABILITY_RANGE[1] * top)
+
+
 Y_MARGIN = 0.05
 """Share of the data's y span added below and above it (Rerun's automatic bounds leave a similar margin)."""
 SAMPLES = 200

@@ -21,7 +21,7 @@ from tests.viz.test_blueprint import stored_views
 from viz import paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
 from viz.evaluated import evaluated_world
-from viz.legend import PROBABILITY_RANGE, place_legend
+from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_legend
 
 SCENE = "scene-0103"
 SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
@@ -104,8 +104,8 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
         assert bool(not_counted) == (report.track_scores[track_id] < threshold)
     followed = [t for t in failure.track_ids if paths.existence("gnnpmb", failure.class_name, t) in rows]
     assert followed, f"no existence series for the involved tracks {failure.track_ids}"
-    # The existence plot (fixed at [0, 1]) has its legend where it covers least of the lines the recording
-    # shows up to the failure frame.
+    # The existence plot (fixed at [0, 1], or zoomed to tracks that all stay low) has its legend where it covers
+    # least of the lines the recording shows up to the failure frame.
     involved = re.search(r"gnnpmb: tracks ([\d, ]+)", summary).group(1).split(", ")  # the plot's tracks
     shown = [paths.existence("gnnpmb", failure.class_name, int(t)) for t in involved]
     shown = [p for p in shown if p in rows]
@@ -114,10 +114,14 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
         (np.array([r["focus"] for r in points]), np.array([r["Scalars:scalars"][0] for r in points]))
         for points in ([r for r in rows[p] if r.get("focus") is not None] for p in shown)
     ]
-    placed = place_legend(lines, len(shown), y_range=PROBABILITY_RANGE)
+    expected = existence_range([v for _, v in lines[:-1]])  # the tracks' values, not the threshold line
+    placed = place_legend(lines, len(shown), y_range=expected)
     corner, y_range = stored_legends(bp)["gnnpmb existence"]
     assert corner == placed.corner.value
-    assert y_range == pytest.approx(PROBABILITY_RANGE)
+    assert y_range == pytest.approx(expected)
+    # These tracks never came near being shown: the plot is zoomed to them, not flat on the floor of [0, 1].
+    peak = max(float(v.max()) for _, v in lines[:-1] if len(v))
+    assert peak < LOW_EXISTENCE and y_range[1] == pytest.approx(PROBABILITY_RANGE[1] * max(peak, 0.01))
     # The story opens on the lines that name an involved track (the class's whole story is the next tab).
     views = stored_views(out)
     assert views["gnnpmb story (involved tracks)"] == ("TextLog", paths.involved_story("gnnpmb"))

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import rerun.blueprint as rrb
 
-from viz.legend import LegendPlacement, legend_height, place_legend
+from viz.legend import PROBABILITY_RANGE, LegendPlacement, existence_range, legend_height, place_legend
 
 Corner = rrb.components.Corner2D
 
@@ -73,3 +74,11 @@ def test_a_fixed_range_is_kept_and_the_least_covered_corner_taken() -> None:
     crowded = place_legend(full, 3, y_range=(-0.02, 1.02))
     assert crowded.y_range == (-0.02, 1.02)  # never stretched
     assert crowded.corner in (Corner.RightBottom, Corner.LeftBottom)  # the top holds two lines, the bottom one
+
+
+def test_an_existence_plot_of_tracks_that_all_stay_low_is_zoomed_to_them() -> None:
+    assert existence_range([np.array([0.1, 0.9]), np.array([0.02])]) == PROBABILITY_RANGE
+    low = existence_range([np.array([0.03, 0.01]), np.array([0.07, 0.0]), np.array([])])
+    assert low == pytest.approx((PROBABILITY_RANGE[0] * 0.07, PROBABILITY_RANGE[1] * 0.07))
+    assert existence_range([np.zeros(3)]) == pytest.approx((PROBABILITY_RANGE[0] * 0.01, PROBABILITY_RANGE[1] * 0.01))
+    assert existence_range([]) == PROBABILITY_RANGE
