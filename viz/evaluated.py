@@ -133,7 +133,16 @@ def devkit_gt(scene: SceneData, gt_id: str, i: int) -> DevkitBox:
         return DevkitBox(interpolated[2], "interpolated")
     if points == 0:
         return DevkitBox(None, "it has no LiDAR or radar points here and no kept frame on one side to interpolate from")
-    return DevkitBox(None, "it lies beyond the evaluation's range for its class and no kept frame on one side")
+    keyframe = scene.keyframes[i]
+    hit = np.flatnonzero(keyframe.gt.instance_id.astype(str) == gt_id)[0]
+    class_name = str(keyframe.gt.class_name[hit])
+    ego_m = float(np.hypot(*(center[:2] - keyframe.ego_pose.translation_m[:2])))
+    reach = _class_ranges().get(class_name, np.inf)
+    return DevkitBox(
+        None,
+        f"it lies {ego_m:.2f} m from the ego vehicle, beyond the evaluation's {reach:g} m range for {class_name}, "
+        "and no kept frame on one side",
+    )
 
 
 def _mirror_frame(

@@ -248,15 +248,14 @@ class FailureReport:
     def first_worth_opening(self) -> str | None:
         """The id of the first failure of the first kind in ``OPEN_FIRST`` that occurred, preferring failures
         whose ground truth the evaluation did not interpolate (those are often the devkit's doing, see
-        ``FailureBox``); None: no failure."""
+        ``FailureBox``), and, within a kind, one after the first keyframe (a failure there has no history to
+        show); None: no failure."""
         ids = list(zip(self.ids(), self.failures, strict=True))
         for allow_interpolated in (False, True):
             for kind in OPEN_FIRST:
-                hit = next(
-                    (i for i, f in ids if f.kind is kind and (allow_interpolated or not f.gt_interpolated)), None
-                )
-                if hit is not None:
-                    return hit
+                hits = [(i, f) for i, f in ids if f.kind is kind and (allow_interpolated or not f.gt_interpolated)]
+                if hits:
+                    return next((i for i, f in hits if f.frame_index > 0), hits[0][0])
         return None
 
     def by_id(self, failure_id: str) -> Failure | None:

@@ -3,6 +3,7 @@ tracks (its filters and its interpolation, swapped weights included) on every ob
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -54,3 +55,14 @@ def test_devkit_gt_matches_the_devkits_tracks_on_every_object_and_frame(demo_dat
                 np.testing.assert_allclose(box.xy_m, want, atol=1e-6)
     # The scene exercises every case: kept as annotated, interpolated, and dropped.
     assert {"annotated", "interpolated"} <= kinds and len(kinds) > 2
+    # A box dropped for its range says how far it was and the class's range, which it exceeds.
+    far = [
+        re.fullmatch(
+            r"it lies ([\d.]+) m from the ego vehicle, beyond the evaluation's (\d+) m range for \w+, and no "
+            r"kept frame on one side",
+            why,
+        )
+        for why in kinds
+        if why.startswith("it lies")
+    ]
+    assert far and all(m and float(m.group(1)) >= float(m.group(2)) for m in far)

@@ -143,7 +143,9 @@ def test_totals_and_the_failure_suggested_first(tiny_scene) -> None:
     only_misses = FailureReport(
         scene.name, T, report.sample_tokens, report.classes, tuple(report.of_kind(FailureKind.MISS))
     )
-    assert only_misses.first_worth_opening() == "miss:1"
+    assert only_misses.first_worth_opening() == "miss:3"  # misses 1 and 2 are at frame 0: no history to show
+    at_start = FailureReport(scene.name, T, report.sample_tokens, report.classes, only_misses.failures[:2])
+    assert at_start.first_worth_opening() == "miss:1"
     assert FailureReport(scene.name, T, report.sample_tokens, report.classes, ()).first_worth_opening() is None
 
 
