@@ -255,3 +255,42 @@ def log_evaluated(
         ),
         rr.LineStrips3D(strips, colors=[color], radii=CIRCLE_LINE_RADIUS_M, labels=labels, show_labels=False),
     )
+
+
+RANGE_SHOWN_M = 5.0
+"""The evaluation's range circle is drawn when the focused place lies within this of it (a failure made by an
+object or track crossing the range)."""
+RANGE_CIRCLE_POINTS = 721
+
+
+def evaluation_range_world() -> str:
+    """The evaluation's range around the ego vehicle for the focused class, when the failure lies near it."""
+    return f"{focus_world()}/evaluation_range"
+
+
+def range_near_focus(focus: FocusTarget, scene: SceneData) -> float | None:
+    """The evaluation's range (m) for the focused class if the focused place lies within ``RANGE_SHOWN_M`` of it
+    at the focus frame (the devkit drops boxes, ground truth and tracks alike, beyond it), else None."""
+    reach = _class_ranges().get(focus.class_name)
+    if reach is None:
+        return None
+    ego_xy = scene.keyframes[focus.frame_index].ego_pose.translation_m[:2]
+    ego_m = float(np.hypot(focus.center_xy_m[0] - ego_xy[0], focus.center_xy_m[1] - ego_xy[1]))
+    return reach if abs(ego_m - reach) <= RANGE_SHOWN_M else None
+
+
+def log_evaluation_range(
+    stream: rr.RecordingStream, focus: FocusTarget, scene: SceneData, frame_index: int, reach_m: float, z_m: float
+) -> tuple[float, float, float]:
+    """The circle of radius ``reach_m`` around the ego vehicle at ``frame_index`` (at height ``z_m``) in the
+    focused class's colour; returns its point nearest the focused place, where its label goes."""
+    ego_xy = scene.keyframes[frame_index].ego_pose.translation_m[:2]
+    angles = np.linspace(0.0, 2.0 * np.pi, RANGE_CIRCLE_POINTS)
+    circle = np.column_stack(
+        [ego_xy[0] + reach_m * np.cos(angles), ego_xy[1] + reach_m * np.sin(angles), np.full(len(angles), z_m)]
+    )
+    color = CLASS_COLORS.get(focus.class_name, GREY)
+    stream.log(evaluation_range_world(), rr.LineStrips3D([circle], colors=[color], radii=CIRCLE_LINE_RADIUS_M))
+    toward = np.asarray(focus.center_xy_m) - ego_xy
+    nearest = ego_xy + reach_m * toward / max(float(np.hypot(*toward)), 1e-9)
+    return float(nearest[0]), float(nearest[1]), z_m

@@ -9,7 +9,8 @@
 * ``world/trackers/<tracker>/focus/callouts``: the labels of the involved objects (``GT 8bccf2``,
   ``m10 0.83 → track 26``, ``26 predicted r=0.04 → m10``, ``31 predicted r=0.02, missed``) in a column beside
   them with leader lines (``viz.callouts``), so labels of objects on one spot do not cover each other;
-* ``world/focus/as_evaluated``: where the evaluation put an object it interpolated (``viz.evaluated``).
+* ``world/focus/as_evaluated``: where the evaluation put an object it interpolated (``viz.evaluated``);
+* ``world/focus/evaluation_range``: the evaluation's range around the ego vehicle, when the failure lies near it.
 
 ``focus_legends`` places the legends of the series views the layout opens with (``viz.legend``).
 """
@@ -37,7 +38,7 @@ from viz.blueprint import (
 )
 from viz.callouts import Callout, log_callouts
 from viz.colors import CLASS_COLORS, GREY, class_ids, track_colors
-from viz.evaluated import evaluated_offsets, log_evaluated
+from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
 from viz.focus_summary import READING_GUIDE, focus_markdown, mentions
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
 from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
@@ -82,6 +83,7 @@ def log_focus(
     frames = {run.tracker: {f.keyframe.index: f for f in run.frames} for run in runs}
     gt_ids = set(focus.gt_ids)
     evaluated = evaluated_offsets(focus, scene)
+    reach_m = range_near_focus(focus, scene)
     height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
     for i in shown:
         keyframe = scene.keyframes[i]
@@ -107,6 +109,15 @@ def log_focus(
                 )
                 for gt_id, seen in evaluated.items()
             ]
+        if reach_m is not None:
+            label_at = log_evaluation_range(stream, focus, scene, i, reach_m, z_m)
+            gt_callouts.append(
+                Callout(
+                    label_at,
+                    f"evaluation range for {focus.class_name}: {reach_m:g} m",
+                    CLASS_COLORS.get(focus.class_name, GREY),
+                )
+            )
         meas: set[int] = set()
         detections = None
         for tracker, ids in focus.track_ids.items():

@@ -60,6 +60,9 @@ READING_GUIDE = """# How to read the views
   interpolates a box between the frames where the object had points); the failure is scored against that box.
   It is drawn thin in the class colour, with a line to the annotated box and a circle of 2 m around it: a track
   outside that circle is not matched to the object.
+- **evaluation range**: when the failure lies near it, the circle around the ego vehicle beyond which the
+  evaluation drops boxes of the class (50 m for vehicles, 40 m for pedestrians and two-wheelers), ground truth
+  and tracks alike: an object just beyond it with a track just inside makes a false track.
 
 **Panels**
 

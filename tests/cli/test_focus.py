@@ -20,7 +20,7 @@ from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
-from viz.evaluated import evaluated_world
+from viz.evaluated import evaluated_world, evaluation_range_world
 from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_legend
 
 SCENE = "scene-0103"
@@ -336,6 +336,13 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
     average, threshold = report.track_scores[track], report.threshold_of(failure.class_name)
     assert f"averaged over the track, {average:.3f}, is at least the {failure.class_name} threshold" in why
     assert average >= threshold
+    # An object dropped for its range: the range is drawn around the ego vehicle and labelled beside the track.
+    if "beyond the evaluation's" in why:
+        rows = read_rows(out)
+        strips = [r for r in rows[evaluation_range_world()] if r.get("frame") == failure.frame_index]
+        assert strips and len(strips[0]["LineStrips3D:strips"]) == 1
+        callouts = [r for r in rows[paths.focus_callouts("gnnpmb")] if r.get("frame") == failure.frame_index][0]
+        assert f"evaluation range for {failure.class_name}: 50 m" in callouts["Points3D:labels"]
     # Where the evaluation's ground truth was: the reason the track matched nothing.
     assert any(
         phrase in why
