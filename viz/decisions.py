@@ -118,15 +118,30 @@ def _ids(track_ids: tuple[int, ...], reported: set[int] | None) -> str:
     return ", ".join(shown) + (f" (+{counted})" if hidden else "")
 
 
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}{'s' if n != 1 else ''}"
+
+
+def _tracks_phrase(track_ids: tuple[int, ...], reported: set[int] | None) -> str:
+    """``track 26``, ``tracks 26, 123 and 1 candidate``, ``2 candidate tracks`` (candidates: never reported)."""
+    shown = [str(t) for t in track_ids if reported is None or t in reported]
+    hidden = len(track_ids) - len(shown)
+    if not shown:
+        return f"{hidden} candidate track{'s' if hidden != 1 else ''}" if hidden else "no track"
+    named = f"track{'s' if len(shown) > 1 else ''} {', '.join(shown)}"
+    return named + (f" and {_plural(hidden, 'candidate')}" if hidden else "")
+
+
 def conflict_markdown(conflict: Conflict, reported: set[int] | None = None) -> str:
     """One conflict as a heading line and a table (one row per detection). reported: tracks named by id (the
     others, candidates never reported, are counted); None names all."""
-    tracks = _ids(conflict.track_ids, reported)
+    tracks = _tracks_phrase(conflict.track_ids, reported)
     meas = ", ".join(meas_name(m) for m in conflict.meas_indices)
+    meas = f"detection{'s' if len(conflict.meas_indices) != 1 else ''} {meas}"
     margin = conflict.closest_margin
     flag = " **close call**" if margin < CLOSE_CALL_MARGIN else ""
     lines = [
-        f"tracks {tracks} · detections {meas} — closest margin {_fmt(margin)}{flag}",
+        f"{tracks} · {meas} — closest margin {_fmt(margin)}{flag}",
         "",
         "| detection | chosen | cost | next best | cost | margin |",
         "|---|---|---|---|---|---|",
@@ -180,7 +195,7 @@ def decisions_markdown(
         body.append(f"### {d.class_name}")
         if d.births_only:
             body.append(
-                f"{len(d.births_only)} detections outside every gate (new track or clutter): "
+                f"{_plural(len(d.births_only), 'detection')} outside every gate (new track or clutter): "
                 + ", ".join(meas_name(m) for m in d.births_only)
             )
             body.append("")

@@ -209,7 +209,7 @@ def test_gates_and_predictions_only_for_tracks_worth_it(saved_stream: tuple[rr.R
 def test_decision_view_names_the_choice_the_alternative_and_the_margin(logged: tuple[dict, Path]) -> None:
     rows = logged[0]
     doc = at_frame(rows[paths.decisions(T)], 1)[0]["TextDocument:text"][0]
-    assert "tracks 1 (+1 candidate) · detections m0, m1 — closest margin 0.50 **close call**" in doc
+    assert "track 1 and 1 candidate · detections m0, m1 — closest margin 0.50 **close call**" in doc
     assert "| m0 | **track 1** | -5.00 | track 2 | -4.00 | 0.50 |" in doc
     assert "| m1 | **track 2** | -4.50 | track 1 | -5.00 | 0.50 |" in doc
     grid = rows[f"{paths.decision_matrix(T)}/cells"]

@@ -1,0 +1,62 @@
+"""The decision view's wording: conflict headings, and a choice's costs taken apart (hand-computed)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms
+from gnnpmb.explain import explain
+from viz.decisions import _tracks_phrase, choice_why
+
+
+def test_conflict_headings_count_tracks_and_candidates() -> None:
+    assert _tracks_phrase((26,), {26}) == "track 26"
+    assert _tracks_phrase((26, 123, 7), {26, 123}) == "tracks 26, 123 and 1 candidate"
+    assert _tracks_phrase((7, 8), set()) == "2 candidate tracks"
+    assert _tracks_phrase((7,), set()) == "1 candidate track"
+    assert _tracks_phrase((7, 8), None) == "tracks 7, 8"
+
+
+def one_detection(existence: float, d2: float) -> tuple[CostMatrix, Assignment, CostTerms]:
+    """Detection m4 (score 0.5) in the gate of track 9 (P_D of its miss 0.8, |S| = 1); new-track cost 3.0."""
+    terms = CostTerms(
+        existence=np.array([existence]),
+        miss_log_lik=np.log1p(-np.array([existence * 0.8])),
+        score=np.array([0.5]),
+        d2=np.array([[d2]]),
+        log_det_S=np.array([0.0]),
+        dim=2,
+    )
+    track_cost = terms.pair(0, 0).total_nats
+    rows, cols = (AxisLabel(AxisKind.MEASUREMENT, 4),), (AxisLabel(AxisKind.TRACK, 9), AxisLabel(AxisKind.NEW_TRACK, 4))
+    matrix = CostMatrix("car", np.array([[track_cost, 3.0]]), rows, cols, terms=terms)
+    chosen = cols[1] if track_cost > 3.0 else cols[0]
+    return matrix, Assignment("car", ((rows[0], chosen),), min(track_cost, 3.0), ()), terms
+
+
+def test_a_detection_that_started_a_track_names_what_its_track_cost_was_made_of() -> None:
+    matrix, assignment, terms = one_detection(existence=0.05, d2=1.0)
+    (choice,) = explain(matrix, assignment).conflicts[0].choices
+    t = terms.pair(0, 0)
+    assert math.isclose(t.existence_nats, math.log(1 - 0.04) - math.log(0.05))  # 2.955
+    assert math.isclose(t.spread_nats, math.log(2 * math.pi)) and math.isclose(t.spread_m, 1.0)
+    why = choice_why(choice, "new track 40")
+    assert why.startswith(f"m4 went to new track 40 (cost 3.00) rather than track 9 (cost {t.total_nats:.2f})")
+    assert (
+        f"Track 9's {t.total_nats:.2f} = {t.existence_nats:.2f} for its predicted existence 0.05 + 1.84 for the "
+        "uncertainty of its predicted position (±1.0 m) + 0.50 for the distance to m4 (d² 1.0) + 0.69 for m4's score "
+        "0.50" in why
+    )
+    # The existence at which the track would have cost exactly the new track's 3.0: (1 - r 0.8) / r = exp(...).
+    needed = 1 / (math.exp(3.0 - t.spread_nats - t.distance_nats - t.score_nats) + 0.8)
+    assert why.endswith(f"With a predicted existence above {needed:.2f} (instead of 0.05), track 9 would have taken m4")
+
+
+def test_no_existence_helps_a_detection_far_outside_the_prediction() -> None:
+    matrix, assignment, _ = one_detection(existence=0.5, d2=10.0)  # 7.71 against 3.0
+    (choice,) = explain(matrix, assignment).conflicts[0].choices
+    assert choice.chosen.kind is AxisKind.NEW_TRACK
+    assert choice_why(choice).endswith("No predicted existence would have given m4 to track 9")
+    assert choice_why(choice).startswith("m4 went to a new track (cost 3.00)")
