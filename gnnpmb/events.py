@@ -172,70 +172,93 @@ class Gated:
 
 @dataclass(frozen=True, slots=True)
 class PairTerms:
-    """What one (detection j, track k) cost of the PMB family is made of, in nats (``CostTerms``).
+    """What one (detection j, track k) assignment cost is made of, in nats (``CostTerms``).
 
     existence: the track's predicted existence r_k; p_detect: the P_D its miss hypothesis used; existence_nats:
-    log(1 - r_k P_D) - log r_k; score: the detection's score s_j; score_nats: -log s_j; d2: squared Mahalanobis
-    distance; distance_nats: d2 / 2; spread_m: the predicted measurement's spread |S_k|^(1 / 2D) (the geometric
-    mean of its standard deviations, metres); spread_nats: (log|S_k| + D log 2 pi) / 2. The last two terms make
-    -log N(z_j; H m_k, S_k).
+    log(1 - r_k P_D) - log r_k; score: the detection's score s_j; score_nats: -log s_j (all four None / 0 for a
+    tracker without existences or score-based P_D); d2: squared Mahalanobis distance; distance_nats: d2 / 2;
+    spread_m: the predicted measurement's spread |S_k|^(1 / 2D) (the geometric mean of its standard deviations,
+    metres); spread_nats: (log|S_k| + D log 2 pi) / 2 (with distance_nats, -log N(z_j; H m_k, S_k));
+    offset_nats: a constant every pair of the matrix shares, named by offset_text (GNN: detection against clutter).
     """
 
-    existence: float
-    p_detect: float
+    existence: float | None
+    p_detect: float | None
     existence_nats: float
-    score: float
+    score: float | None
     score_nats: float
     d2: float
     distance_nats: float
     spread_m: float
     spread_nats: float
+    offset_nats: float = 0.0
+    offset_text: str = ""
 
     @property
     def total_nats(self) -> float:
-        return self.existence_nats + self.score_nats + self.distance_nats + self.spread_nats
+        return self.offset_nats + self.existence_nats + self.score_nats + self.distance_nats + self.spread_nats
 
     def existence_for(self, cheaper_by_nats: float) -> float | None:
         """The predicted existence at which this cost would be ``cheaper_by_nats`` lower, all else equal: solves
         log(1 - r P_D) - log r = existence_nats - cheaper_by_nats, i.e. r = 1 / (exp(existence_nats -
-        cheaper_by_nats) + P_D); None when no existence <= 1 gets there."""
+        cheaper_by_nats) + P_D); None when no existence <= 1 gets there, or the cost has no existence term."""
+        if self.existence is None or self.p_detect is None:
+            return None
         target = self.existence_nats - cheaper_by_nats
         if target < math.log1p(-self.p_detect):  # the cost at r = 1
             return None
         return 1.0 / (math.exp(target) + self.p_detect)
 
+    def d2_for(self, cheaper_by_nats: float) -> float | None:
+        """The squared distance at which this cost would be ``cheaper_by_nats`` lower, all else equal (d2 - 2
+        cheaper_by_nats); None when even d2 = 0 is not enough."""
+        target = self.d2 - 2.0 * cheaper_by_nats
+        return target if target >= 0.0 else None
+
 
 @dataclass(frozen=True, slots=True)
 class CostTerms:
-    """The track entries of a PMB-family cost matrix taken apart (``gnnpmb.pmb.cost``, García-Fernández et al.
-    2018, eq. 12-13): C[j, k] = existence_nats[k] + score_nats[j] + distance_nats[j, k] + spread_nats[k] on every gated
-    entry (``PairTerms``).
+    """The track entries of a cost matrix taken apart: C[j, k] = offset_nats + existence_nats[k] + score_nats[j] +
+    distance_nats[j, k] + spread_nats[k] on every gated entry (``PairTerms``).
 
-    Holds the arrays the tracker computed anyway (no copies): existence r (K,), miss_log_lik log(1 - r P_D) (K,),
-    score s (M,), d2 (K, M) squared Mahalanobis distances, log_det_S (K,), dim D of the measurement."""
+    PMB family (``gnnpmb.pmb.cost``, García-Fernández et al. 2018, eq. 12-13): existence r (K,), miss_log_lik
+    log(1 - r P_D) (K,), score s (M,), offset 0. GNN (``gnnpmb.vector.gnn``): no existence or score (None), the
+    offset -log(P_D / ((1 - P_D) kappa)). Both: d2 (K, M) squared Mahalanobis distances, log_det_S (K,), dim D of
+    the measurement. Holds the arrays the tracker computed anyway (no copies)."""
 
-    existence: np.ndarray
-    miss_log_lik: np.ndarray
-    score: np.ndarray
+    existence: np.ndarray | None
+    miss_log_lik: np.ndarray | None
+    score: np.ndarray | None
     d2: np.ndarray
     log_det_S: np.ndarray
     dim: int
+    offset_nats: float = 0.0
+    offset_text: str = ""
 
     def pair(self, j: int, k: int) -> PairTerms:
         """The terms of detection row ``j`` and track column ``k``."""
-        r, miss = float(self.existence[k]), float(self.miss_log_lik[k])
+        r = p_detect = score = None
+        existence_nats = score_nats = 0.0
+        if self.existence is not None and self.miss_log_lik is not None:
+            r, miss = float(self.existence[k]), float(self.miss_log_lik[k])
+            p_detect = -math.expm1(miss) / r if r > 0 else 0.0
+            existence_nats = miss - math.log(r) if r > 0 else math.inf
+        if self.score is not None:
+            score = float(self.score[j])
+            score_nats = -math.log(score) if score > 0 else math.inf
         d2, log_det_S = float(self.d2[k, j]), float(self.log_det_S[k])
-        score = float(self.score[j])
         return PairTerms(
             existence=r,
-            p_detect=-math.expm1(miss) / r if r > 0 else 0.0,
-            existence_nats=miss - math.log(r) if r > 0 else math.inf,
+            p_detect=p_detect,
+            existence_nats=existence_nats,
             score=score,
-            score_nats=-math.log(score) if score > 0 else math.inf,
+            score_nats=score_nats,
             d2=d2,
             distance_nats=0.5 * d2,
             spread_m=math.exp(log_det_S / (2 * self.dim)),
             spread_nats=0.5 * (log_det_S + self.dim * math.log(2.0 * math.pi)),
+            offset_nats=self.offset_nats,
+            offset_text=self.offset_text,
         )
 
 

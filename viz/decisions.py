@@ -53,19 +53,26 @@ def column_name(label: AxisLabel) -> str:
 
 def cost_breakdown(terms: PairTerms, meas: str) -> str:
     """A track's cost for detection ``meas`` in words: the nats its predicted existence, the uncertainty of its
-    predicted position, the distance and the detection's score add (``events.PairTerms``)."""
-    return (
-        f"{terms.existence_nats:.2f} for its predicted existence {terms.existence:.2f} + {terms.spread_nats:.2f} for "
-        f"the uncertainty of its predicted position (±{terms.spread_m:.1f} m) + {terms.distance_nats:.2f} for the "
-        f"distance to {meas} (d² {terms.d2:.1f}) + {terms.score_nats:.2f} for {meas}'s score {terms.score:.2f}"
-    )
+    predicted position, the distance and the detection's score add, and the constant the tracker adds to every
+    pair (``events.PairTerms``; the parts a tracker's cost does not have are left out)."""
+    parts = []
+    if terms.offset_text:
+        parts.append(f"{terms.offset_nats:.2f} for {terms.offset_text}")
+    if terms.existence is not None:
+        parts.append(f"{terms.existence_nats:.2f} for its predicted existence {terms.existence:.2f}")
+    parts.append(f"{terms.spread_nats:.2f} for the uncertainty of its predicted position (±{terms.spread_m:.1f} m)")
+    parts.append(f"{terms.distance_nats:.2f} for the distance to {meas} (d² {terms.d2:.1f})")
+    if terms.score is not None:
+        parts.append(f"{terms.score_nats:.2f} for {meas}'s score {terms.score:.2f}")
+    return " + ".join(parts)
 
 
 def cost_brief(terms: PairTerms | None) -> str:
     """What a track's cost depended on, briefly: ``existence 0.62, ±1.2 m, d² 0.3`` ("" without terms)."""
     if terms is None:
         return ""
-    return f"existence {terms.existence:.2f}, ±{terms.spread_m:.1f} m, d² {terms.d2:.1f}"
+    existence = f"existence {terms.existence:.2f}, " if terms.existence is not None else ""
+    return f"{existence}±{terms.spread_m:.1f} m, d² {terms.d2:.1f}"
 
 
 def choice_why(c: PairChoice, went: str | None = None) -> str | None:
@@ -91,14 +98,22 @@ def choice_why(c: PairChoice, went: str | None = None) -> str | None:
             f"{column_name(c.chosen).capitalize()}'s {c.chosen_cost:.2f} = {cost_breakdown(c.chosen_terms, meas)}"
         )
     lines.append(f"{other.capitalize()}'s {c.alternative_cost:.2f} = {cost_breakdown(alt, meas)}")
-    needed = alt.existence_for(c.alternative_cost - c.chosen_cost)
-    if needed is None:
-        lines.append(f"No predicted existence would have given {meas} to {other}")
+    gap = c.alternative_cost - c.chosen_cost
+    if alt.existence is not None:
+        needed = alt.existence_for(gap)
+        if needed is None:
+            lines.append(f"No predicted existence would have given {meas} to {other}")
+        else:
+            lines.append(
+                f"With a predicted existence above {needed:.2f} (instead of {alt.existence:.2f}), {other} would have "
+                f"taken {meas}"
+            )
     else:
-        lines.append(
-            f"With a predicted existence above {needed:.2f} (instead of {alt.existence:.2f}), {other} would have "
-            f"taken {meas}"
-        )
+        closer = alt.d2_for(gap)
+        if closer is None:
+            lines.append(f"Even with {meas} right on its prediction (d² 0), {other} would have cost more")
+        else:
+            lines.append(f"Within d² {closer:.1f} (instead of {alt.d2:.1f}), {other} would have taken {meas}")
     return ". ".join(lines)
 
 

@@ -252,7 +252,7 @@ def _existence_as_decided(logger: TrackerLogger, frame: int, class_name: str) ->
             continue
         for c in (c for conflict in d.conflicts for c in conflict.choices):
             terms = c.chosen_terms
-            if terms is not None:
+            if terms is not None and terms.existence is not None:
                 out[int(c.chosen.ref)] = terms.existence
     return out
 

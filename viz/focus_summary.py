@@ -70,9 +70,11 @@ READING_GUIDE = """# How to read the views
 - **story**: each frame's events of the involved class (confirmed, missed, ended, close calls).
 - **decisions** and **cost grid**: per conflict the chosen pair, its cost, the next best and the margin (lower
   cost = more likely). When the next best was a track, the line under the table takes both costs apart (GNN-PMB,
-  PMBM, PMB): a track's cost is what its predicted existence adds (low existence, high cost), plus the spread of
-  its prediction (a track not seen for a while is spread wide), plus the distance to the detection, plus the
-  detection's score; and it gives the existence at which that track would have won the detection.
+  PMBM, TO-PMB): a track's cost is what its predicted existence adds (low existence, high cost), plus the
+  uncertainty of its predicted position (a track not seen for a while is spread wide), plus the distance to the
+  detection, plus the detection's score; and it gives the existence at which that track would have won the
+  detection. GNN has no existence or score in its cost, but a constant (a detection against clutter); it gives
+  the distance at which the track would have won.
 - **existence**, **NIS**, **chosen cost**: the involved tracks' series up to the failure; the grey line is the
   existence from which a Bernoulli is shown as a track.
 

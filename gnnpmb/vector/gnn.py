@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from gnnpmb.assign.hungarian import solve
-from gnnpmb.events import Assignment, AxisKind, CostMatrix, EventSink, axis_labels
+from gnnpmb.events import Assignment, AxisKind, CostMatrix, CostTerms, EventSink, axis_labels
 from gnnpmb.kalman import log_likelihood, paired_updated_means
 from gnnpmb.skeleton import Gating
 from gnnpmb.types import Measurements
@@ -32,10 +32,15 @@ from gnnpmb.vector.tracks import Association, VectorTracker, VectorTracks
 COST_DESCRIPTION = "-log[P_D N(z; Hm, S) / ((1 - P_D) kappa)]; new-track column 0 = unassigned"
 
 
+def pair_offset_nats(p_detect: float, clutter_intensity: float) -> float:
+    """-log(P_D / ((1 - P_D) kappa)): the part of every pair cost that does not depend on the pair."""
+    return -float(np.log(p_detect) - np.log1p(-p_detect) - np.log(clutter_intensity))
+
+
 def pair_costs(log_lik: np.ndarray, inside: np.ndarray, p_detect: float, clutter_intensity: float) -> np.ndarray:
-    """(M, K) costs C[j, k] (module docstring) from (K, M) log N(z_j; H m_k, S_k) and gate; +inf outside."""
-    offset = np.log(p_detect) - np.log1p(-p_detect) - np.log(clutter_intensity)
-    return np.where(inside, -(log_lik + offset), np.inf).T
+    """(M, K) costs C[j, k] = pair_offset_nats - log N(z_j; H m_k, S_k) (module docstring) from (K, M)
+    log N(z_j; H m_k, S_k) and gate; +inf outside."""
+    return np.where(inside, pair_offset_nats(p_detect, clutter_intensity) - log_lik, np.inf).T  # = -(log_lik + offset)
 
 
 def best_assignment(cost: np.ndarray) -> tuple[np.ndarray, float]:
@@ -77,7 +82,17 @@ class GnnTracker(VectorTracker):
         meas_of_track = np.full(k, -1, dtype=np.int64)
         meas_of_track[det_k] = det_j
         if sink.enabled:
-            self._emit_assignment(prior, meas, cost, track_of_meas, meas_of_track, total, sink)
+            terms = CostTerms(
+                existence=None,
+                miss_log_lik=None,
+                score=None,
+                d2=gating.d2,
+                log_det_S=inn.log_det_S,
+                dim=inn.z_pred.shape[1],
+                offset_nats=pair_offset_nats(self.params.p_detect, self.clutter_intensity),
+                offset_text=f"a detection against clutter (P_D {self.params.p_detect:g})",
+            )
+            self._emit_assignment(prior, meas, cost, terms, track_of_meas, meas_of_track, total, sink)
         return Association(mean=mean, cov=cov, meas_of_track=meas_of_track, birth=track_of_meas < 0)
 
     def _emit_assignment(
@@ -85,6 +100,7 @@ class GnnTracker(VectorTracker):
         prior: VectorTracks,
         meas: Measurements,
         cost: np.ndarray,
+        terms: CostTerms,
         track_of_meas: np.ndarray,
         meas_of_track: np.ndarray,
         total: float,
@@ -98,7 +114,7 @@ class GnnTracker(VectorTracker):
         track_cols = axis_labels(AxisKind.TRACK, prior.track_id)
         new_cols = axis_labels(AxisKind.NEW_TRACK, meas.source_index)
         cols = track_cols + new_cols
-        sink.emit(CostMatrix(self.class_name, full, rows, cols, description=COST_DESCRIPTION))
+        sink.emit(CostMatrix(self.class_name, full, rows, cols, description=COST_DESCRIPTION, terms=terms))
         pairs = tuple((rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist()))
         missed = tuple(int(t) for t in prior.track_id[meas_of_track < 0])
         sink.emit(Assignment(self.class_name, pairs, total, missed))

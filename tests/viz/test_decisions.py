@@ -60,3 +60,27 @@ def test_no_existence_helps_a_detection_far_outside_the_prediction() -> None:
     assert choice.chosen.kind is AxisKind.NEW_TRACK
     assert choice_why(choice).endswith("No predicted existence would have given m4 to track 9")
     assert choice_why(choice).startswith("m4 went to a new track (cost 3.00)")
+
+
+def test_a_gnn_cost_has_no_existence_but_a_constant_and_a_distance_to_win_at() -> None:
+    """GNN: C = -log(P_D / ((1 - P_D) kappa)) - log N; track 9 (|S| = 1) at d² 4 loses m4 to track 5 at d² 1."""
+    terms = CostTerms(
+        existence=None,
+        miss_log_lik=None,
+        score=None,
+        d2=np.array([[1.0], [4.0]]),
+        log_det_S=np.zeros(2),
+        dim=2,
+        offset_nats=-5.0,
+        offset_text="a detection against clutter (P_D 0.9)",
+    )
+    costs = [terms.pair(0, k).total_nats for k in (0, 1)]  # -5 + log 2 pi + d² / 2
+    assert np.allclose(costs, [-5.0 + math.log(2 * math.pi) + 0.5, -5.0 + math.log(2 * math.pi) + 2.0])
+    rows = (AxisLabel(AxisKind.MEASUREMENT, 4),)
+    cols = (AxisLabel(AxisKind.TRACK, 5), AxisLabel(AxisKind.TRACK, 9), AxisLabel(AxisKind.NEW_TRACK, 4))
+    matrix = CostMatrix("car", np.array([[*costs, 0.0]]), rows, cols, terms=terms)
+    (choice,) = explain(matrix, Assignment("car", ((rows[0], cols[0]),), costs[0], (9,))).conflicts[0].choices
+    why = choice_why(choice)
+    assert "Track 9's -1.16 = -5.00 for a detection against clutter (P_D 0.9) + 1.84 for the uncertainty" in why
+    assert "existence" not in why and "score" not in why
+    assert why.endswith("Within d² 1.0 (instead of 4.0), track 9 would have taken m4")  # 4 - 2 (2.0 - 0.5)
