@@ -82,14 +82,21 @@ _PACKED: list[np.ndarray] = [np.zeros(0, dtype=np.uint32)]
 
 
 def packed_track_colors(track_ids: np.ndarray, alpha: int = 255) -> np.ndarray:
-    """(N,) uint32 0xRRGGBBAA track colours of (N,) non-negative ids: ``pack_rgba(track_colors(ids))`` from a
-    table that grows with the largest id seen (the logger asks for the same ids every frame)."""
+    """(N,) uint32 0xRRGGBBAA track colours of (N,) ids: ``pack_rgba(track_colors(ids))``, for non-negative ids
+    from a table that grows with the largest id seen (the logger asks for the same ids every frame); negative ids
+    (GM-PHD's unlabelled components) are computed directly."""
     ids = np.asarray(track_ids, dtype=np.int64).reshape(-1)
     table = _PACKED[0]
     if ids.size and ids.max() >= table.size:
         size = max(int(ids.max()) + 1, 2 * table.size, 1024)
         _PACKED[0] = table = pack_rgba(track_colors(np.arange(size)))
-    packed = table[ids]
+    negative = ids < 0
+    if negative.any():
+        packed = np.empty(ids.size, dtype=np.uint32)
+        packed[~negative] = table[ids[~negative]]
+        packed[negative] = pack_rgba(track_colors(ids[negative]))
+    else:
+        packed = table[ids]
     return packed if alpha == 255 else (packed & np.uint32(0xFFFFFF00)) | np.uint32(alpha)
 
 

@@ -3,7 +3,18 @@ from __future__ import annotations
 import numpy as np
 
 from gnnpmb.types import TRACKING_CLASSES
-from viz.colors import CLASS_COLORS, CLASS_IDS, annotation_context, class_colors, class_ids, track_color, track_colors
+from viz import colors
+from viz.colors import (
+    CLASS_COLORS,
+    CLASS_IDS,
+    annotation_context,
+    class_colors,
+    class_ids,
+    pack_rgba,
+    packed_track_colors,
+    track_color,
+    track_colors,
+)
 
 
 def test_every_class_has_a_distinct_id_and_colour() -> None:
@@ -48,3 +59,12 @@ def test_faded_colours_are_opaque_and_move_towards_the_background() -> None:
     assert pale & 0xFF == 255
     rgb = np.array([(pale >> 24) & 0xFF, (pale >> 16) & 0xFF, (pale >> 8) & 0xFF])
     np.testing.assert_array_equal(rgb, np.rint(0.3 * np.array([200, 0, 0]) + 0.7 * FADE_TO))
+
+
+def test_packed_colours_of_negative_ids_are_their_own_not_a_wrapped_table_entry() -> None:
+    """GM-PHD's provisional labels are negative: they get ``track_colors`` of themselves, also as the first ids
+    ever asked (an empty table), and the table's entries for the others."""
+    colors._PACKED[0] = np.zeros(0, dtype=np.uint32)  # as in a fresh process
+    np.testing.assert_array_equal(packed_track_colors(np.array([-16])), pack_rgba(track_colors(np.array([-16]))))
+    ids = np.array([-16, 3, -1, 2000])  # the table now grows; -16 must not wrap to its entry 2032 - 16
+    np.testing.assert_array_equal(packed_track_colors(ids), pack_rgba(track_colors(ids)))
