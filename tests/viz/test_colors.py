@@ -66,5 +66,5 @@ def test_packed_colours_of_negative_ids_are_their_own_not_a_wrapped_table_entry(
     ever asked (an empty table), and the table's entries for the others."""
     colors._PACKED[0] = np.zeros(0, dtype=np.uint32)  # as in a fresh process
     np.testing.assert_array_equal(packed_track_colors(np.array([-16])), pack_rgba(track_colors(np.array([-16]))))
-    ids = np.array([-16, 3, -1, 2000])  # the table now grows; -16 must not wrap to its entry 2032 - 16
+    ids = np.array([-16, 3, -1, 2000])  # the table now grows; -16 must not wrap around to one of its entries
     np.testing.assert_array_equal(packed_track_colors(ids), pack_rgba(track_colors(ids)))
