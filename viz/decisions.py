@@ -51,6 +51,12 @@ def column_name(label: AxisLabel) -> str:
     raise AssertionError(label.kind)
 
 
+def existence_text(r: float) -> str:
+    """An existence probability with two decimals, or one significant digit below 0.01 (``0.004``, ``4e-05``),
+    so a small but non-zero existence does not read as 0.00."""
+    return f"{r:.2f}" if r >= 0.01 or r == 0 else f"{r:.1g}"
+
+
 def cost_breakdown(terms: PairTerms, meas: str) -> str:
     """A track's cost for detection ``meas`` in words: the nats its predicted existence, the uncertainty of its
     predicted position, the distance and the detection's score add, and the constant the tracker adds to every
@@ -59,7 +65,7 @@ def cost_breakdown(terms: PairTerms, meas: str) -> str:
     if terms.offset_text:
         parts.append(f"{terms.offset_nats:.2f} for {terms.offset_text}")
     if terms.existence is not None:
-        parts.append(f"{terms.existence_nats:.2f} for its predicted existence {terms.existence:.2f}")
+        parts.append(f"{terms.existence_nats:.2f} for its predicted existence {existence_text(terms.existence)}")
     parts.append(f"{terms.spread_nats:.2f} for the uncertainty of its predicted position (±{terms.spread_m:.1f} m)")
     parts.append(f"{terms.distance_nats:.2f} for the distance to {meas} (d² {terms.d2:.1f})")
     if terms.score is not None:
@@ -71,7 +77,7 @@ def cost_brief(terms: PairTerms | None) -> str:
     """What a track's cost depended on, briefly: ``existence 0.62, ±1.2 m, d² 0.3`` ("" without terms)."""
     if terms is None:
         return ""
-    existence = f"existence {terms.existence:.2f}, " if terms.existence is not None else ""
+    existence = f"existence {existence_text(terms.existence)}, " if terms.existence is not None else ""
     return f"{existence}±{terms.spread_m:.1f} m, d² {terms.d2:.1f}"
 
 
@@ -104,8 +110,9 @@ def choice_why(c: PairChoice, went: str | None = None) -> str | None:
         if needed is None:
             lines.append(f"No predicted existence would have given {meas} to {other}")
         else:
+            now = existence_text(alt.existence)
             lines.append(
-                f"With a predicted existence above {needed:.2f} (instead of {alt.existence:.2f}), {other} would have "
+                f"With a predicted existence above {existence_text(needed)} (instead of {now}), {other} would have "
                 f"taken {meas}"
             )
     else:

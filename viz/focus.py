@@ -38,6 +38,7 @@ from viz.blueprint import (
 )
 from viz.callouts import Callout, log_callouts
 from viz.colors import CLASS_COLORS, GREY, class_ids, track_colors
+from viz.decisions import existence_text
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
 from viz.focus_summary import READING_GUIDE, focus_markdown, mentions
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
@@ -267,7 +268,7 @@ def _prediction_callouts(
     return [
         Callout(
             (*step.predicted_xy_m, z_m),
-            f"{t} predicted r={decided.get(t, step.prior_existence):.2f}"
+            f"{t} predicted r={existence_text(decided.get(t, step.prior_existence))}"
             + (f" → m{step.given}" if step.given >= 0 else ", missed"),
             tuple(int(v) for v in track_colors(np.array([t], dtype=np.int64))[0]),
         )

@@ -24,7 +24,15 @@ from gnnpmb.pipeline import FrameResult, TrackingRun
 from viz.blueprint import (
     FOCUS_TIMELINE,
 )
-from viz.decisions import CLOSE_CALL_MARGIN, choice_why, column_name, conflict_markdown, cost_brief, meas_name
+from viz.decisions import (
+    CLOSE_CALL_MARGIN,
+    choice_why,
+    column_name,
+    conflict_markdown,
+    cost_brief,
+    existence_text,
+    meas_name,
+)
 from viz.evaluated import NEAR_DETECTION_M, devkit_gt, evaluated_notes, evaluated_offsets
 from viz.logger import TrackerLogger
 
@@ -298,8 +306,8 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
             parts.append(f"detections in its gate went elsewhere at frame{plural} {'; '.join(went)}")
         peak = max(frames, key=lambda f: _after(steps[f]))
         parts.append(
-            f"existence after update {_after(steps[peak]):.2f} at frame {peak} -> "
-            f"{_after(steps[frames[-1]]):.2f} at frame {frames[-1]}"
+            f"existence after update {existence_text(_after(steps[peak]))} at frame {peak} -> "
+            f"{existence_text(_after(steps[frames[-1]]))} at frame {frames[-1]}"
         )
         parts.append("shown as a track" if steps[frames[-1]].reported else "not shown as a track")
         out.append(f"**track {t}**: " + "; ".join(parts) + ".")
@@ -384,8 +392,8 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
     if steps:
         peak = max(steps, key=lambda f: _after(steps[f]))
         parts.append(
-            f"track {lost}'s existence went from {_after(steps[peak]):.2f} (frame {peak}) to "
-            f"{_after(steps[max(steps)]):.2f} (frame {max(steps)})"
+            f"track {lost}'s existence went from {existence_text(_after(steps[peak]))} (frame {peak}) to "
+            f"{existence_text(_after(steps[max(steps)]))} (frame {max(steps)})"
         )
     because = []
     if took is not None:
@@ -571,9 +579,12 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
             s = steps[f]
             gated = ", ".join(f"m{m} ({nis:.1f})" for m, nis in s.gated) or "nothing"
             given = f"m{s.given}" if s.given >= 0 else "—"
-            after = "pruned" if s.posterior_existence != s.posterior_existence else f"{s.posterior_existence:.2f}"
+            after = (
+                "pruned" if s.posterior_existence != s.posterior_existence else existence_text(s.posterior_existence)
+            )
             out.append(
-                f"| {f} | {s.prior_existence:.2f} | {gated} | {given} | {after} | {'yes' if s.reported else 'no'} |"
+                f"| {f} | {existence_text(s.prior_existence)} | {gated} | {given} | {after} | "
+                f"{'yes' if s.reported else 'no'} |"
             )
         out.append("")
     return out

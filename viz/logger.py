@@ -64,6 +64,7 @@ from viz.decisions import (
     cost_colors,
     decision_grid,
     decisions_markdown,
+    existence_text,
     meas_name,
 )
 from viz.geometry import estimate_boxes, lift_xy
@@ -873,7 +874,7 @@ class TrackerLogger:
                 via = f"given {meas_name(given[t])}" if t in given else "given no detection"
             self._text(
                 class_name,
-                f"track {t} (not shown, r < {self.show_min_existence:g}): {via}, r={posterior_r[t]:.2f}",
+                f"track {t} (not shown, r < {self.show_min_existence:g}): {via}, r={existence_text(posterior_r[t])}",
                 "INFO",
             )
 
