@@ -270,7 +270,7 @@ class CostMatrix:
     measurements and columns are [existing tracks | one new-track column per measurement]; entries are negative
     log-likelihood ratios against the track being missed (paper eq. for the PMB update).
     hypothesis: index of the global hypothesis the matrix belongs to (0 for single-hypothesis trackers).
-    terms: what the track entries are made of (PMB family), None where the tracker does not say.
+    terms: what the track entries are made of (PMB family, GNN), None where the tracker does not say.
     """
 
     class_name: str
