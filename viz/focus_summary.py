@@ -74,7 +74,10 @@ READING_GUIDE = """# How to read the views
 
 **Panels**
 
-- **focus**: the failure in words, the key decisions, and per tracker what happened to each involved track.
+- **focus**: the failure in words: **Why** (the cause: for a lost object, its detections and the lost track's
+  existence up to the choice that gave it away; for a false track, what it was output on and why no object
+  matched it; for a miss, whether the detector or the tracker missed it), **Because** (that choice's costs taken
+  apart), the key decisions, and per tracker what happened to each involved track.
 - **story**: each frame's events of the involved class (confirmed, missed, ended, close calls).
 - **decisions** and **cost grid**: per conflict the chosen pair, its cost, the next best and the margin (lower
   cost = more likely). When the next best was a track, the line under the table takes both costs apart (GNN-PMB,
@@ -132,6 +135,7 @@ def focus_markdown(
     if owner in loggers and owner in runs and not evaluated:
         lines += _why(focus, scene, runs[owner], loggers[owner], shown)
         lines += _why_false_track(focus, scene, runs[owner], (reports or {}).get(owner))
+        lines += _why_miss(focus, scene, runs[owner], loggers[owner], (reports or {}).get(owner))
     for tracker, logger in loggers.items():
         key = _key_decisions(logger, set(focus.track_ids.get(tracker, ())), focus.class_name, shown, focus.frame_index)
         if key:
@@ -485,6 +489,68 @@ def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, rep
             f"the evaluation counted the track: its score averaged over the track, {average:.3f}, is at least the "
             f"{focus.class_name} threshold {threshold:.3f}"
         )
+    return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]
+
+
+def _why_miss(
+    focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: TrackerLogger, report: FailureReport | None
+) -> list[str]:
+    """One line for a missed object: whether the detector gave a detection of its class within match distance
+    (none: the detector missed it, or gave it another class); if it did, where the solver sent it; and the tracks
+    output on the object with why the evaluation did not count them (their averaged score below the threshold)."""
+    if focus.failure_kind is not FailureKind.MISS or not focus.gt_ids:
+        return []
+    f, gt_id = focus.frame_index, focus.gt_ids[0]
+    frame = next((fr for fr in run.frames if fr.keyframe.index == f), None)
+    gt = scene.keyframes[f].gt
+    hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
+    if frame is None or hit.size == 0:
+        return []
+    xy, points = gt.translation_m[hit[0], :2], int(scene.keyframes[f].gt_num_pts[hit[0]])
+    name = f"{focus.class_name} GT {short_id(gt_id)}"
+    parts = []
+    found = _nearest_detection(frame, focus.class_name, xy)
+    if found is None:
+        boxes = frame.detections.boxes
+        kept = np.flatnonzero(np.asarray(frame.detections.kept))
+        d = np.hypot(*(boxes.translation_m[kept, :2] - xy).T) if kept.size else np.zeros(0)
+        inside = f"{points} LiDAR and radar points in its box"
+        if d.size and d.min() < NEAR_DETECTION_M:
+            m = int(kept[np.argmin(d)])
+            parts.append(
+                f"at frame {f} the detector gave no {focus.class_name} detection within {NEAR_DETECTION_M:.0f} m of "
+                f"{name} ({inside}), but a {boxes.class_name[m]} detection, {meas_name(m)} (score "
+                f"{boxes.score[m]:.2f}), {d.min():.1f} m away: the detector gave it the wrong class"
+            )
+        else:
+            parts.append(
+                f"at frame {f} the detector gave no detection within {NEAR_DETECTION_M:.0f} m of {name} ({inside}): "
+                "the detector missed it"
+            )
+    else:
+        m, distance_m = found
+        went = logger.given.get(f, {}).get(m)
+        where = f" and went to {went}" if went else ""
+        parts.append(
+            f"at frame {f} detection {meas_name(m)} (score {frame.detections.boxes.score[m]:.2f}) lay "
+            f"{distance_m:.1f} m from {name}{where}"
+        )
+    threshold = report.threshold_of(focus.class_name) if report is not None else None
+    on = [
+        e
+        for e in frame.estimates
+        if e.class_name == focus.class_name and np.hypot(*(np.asarray(e.translation_m[:2]) - xy)) < NEAR_DETECTION_M
+    ]
+    for e in on:
+        average = report.track_scores.get(str(e.track_id)) if report is not None else None
+        if threshold is not None and average is not None and average < threshold:
+            parts.append(
+                f"track {e.track_id} was output on it (score {e.score:.2f}), but its score averaged over the track, "
+                f"{average:.3f}, is below the {focus.class_name} threshold {threshold:.3f}: the evaluation did not "
+                "count it"
+            )
+    if found is not None and not on:
+        parts.append(f"no {focus.class_name} track was output within {NEAR_DETECTION_M:.0f} m of it")
     return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]
 
 

@@ -354,3 +354,31 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
             "a detection of nothing",
         )
     )
+
+
+def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(
+    demo_dataroot: Path, tmp_path: Path, failures_and_runs
+) -> None:
+    report, _ = failures_and_runs
+    pick, failure = next(
+        (i, f)
+        for i, f in zip(report.ids(), report.failures, strict=True)
+        if f.kind is FailureKind.MISS and not f.gt_interpolated and f.frame_index > 0
+    )
+    out, _ = record(demo_dataroot, tmp_path, pick)
+    why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
+    gt = f"{failure.class_name} GT {short_id(failure.gt_ids[0])}"
+    assert why.startswith(f"**Why** (gnnpmb): at frame {failure.frame_index} "), why
+    assert (
+        (f"no detection within 2 m of {gt} (" in why and "the detector missed it" in why)
+        or "the detector gave it the wrong class" in why
+        or re.search(rf"detection m\d+ \(score [\d.]+\) lay [\d.]+ m from {gt}", why)
+    )
+    # Every track said to be on it was not counted: its averaged score is below the class threshold.
+    for track, average in re.findall(
+        r"track (\d+) was output on it \(score [\d.]+\), but its score averaged over the "
+        r"track, ([\d.]+)",
+        why,
+    ):
+        assert float(average) == pytest.approx(report.track_scores[track], abs=5e-4)
+        assert report.track_scores[track] < report.threshold_of(failure.class_name)
