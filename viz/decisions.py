@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, GlobalHypotheses, PairTerms, label_positions
-from gnnpmb.explain import Conflict, Decisions, PairChoice
+from gnnpmb.explain import LINK_SLACK, Conflict, Decisions, PairChoice
 
 _TRACK = AxisKind.TRACK.value
 _NEW = AxisKind.NEW_TRACK.value
@@ -217,7 +217,8 @@ def decisions_markdown(
         body.append(f"### {d.class_name}")
         if d.births_only:
             body.append(
-                f"{_plural(len(d.births_only), 'detection')} outside every gate (new track or clutter): "
+                f"{_plural(len(d.births_only), 'detection')} no track competed for (outside every gate, or dearer "
+                f"than a new track by over {LINK_SLACK:g}): new track or clutter: "
                 + ", ".join(meas_name(m) for m in d.births_only)
             )
             body.append("")

@@ -119,6 +119,9 @@ class DevkitBox:
     why: str
 
 
+NO_INTERPOLATION = "and the evaluation cannot interpolate it (it scores no frame of it both before and after)"
+
+
 def devkit_gt(scene: SceneData, gt_id: str, i: int) -> DevkitBox:
     """The box the evaluation has for object ``gt_id`` at frame ``i``: its annotation when the devkit keeps it,
     else the devkit's interpolation (``_devkit_interpolation``), else none."""
@@ -132,7 +135,7 @@ def devkit_gt(scene: SceneData, gt_id: str, i: int) -> DevkitBox:
     if interpolated is not None:
         return DevkitBox(interpolated[2], "interpolated")
     if points == 0:
-        return DevkitBox(None, "it has no LiDAR or radar points here and no kept frame on one side to interpolate from")
+        return DevkitBox(None, f"it has no LiDAR or radar points here, {NO_INTERPOLATION}")
     keyframe = scene.keyframes[i]
     hit = np.flatnonzero(keyframe.gt.instance_id.astype(str) == gt_id)[0]
     class_name = str(keyframe.gt.class_name[hit])
@@ -141,7 +144,7 @@ def devkit_gt(scene: SceneData, gt_id: str, i: int) -> DevkitBox:
     return DevkitBox(
         None,
         f"it lies {ego_m:.2f} m from the ego vehicle, beyond the evaluation's {reach:g} m range for {class_name}, "
-        "and no kept frame on one side",
+        f"{NO_INTERPOLATION}",
     )
 
 

@@ -58,8 +58,8 @@ def test_devkit_gt_matches_the_devkits_tracks_on_every_object_and_frame(demo_dat
     # A box dropped for its range says how far it was and the class's range, which it exceeds.
     far = [
         re.fullmatch(
-            r"it lies ([\d.]+) m from the ego vehicle, beyond the evaluation's (\d+) m range for \w+, and no "
-            r"kept frame on one side",
+            r"it lies ([\d.]+) m from the ego vehicle, beyond the evaluation's (\d+) m range for \w+, and the "
+            r"evaluation cannot interpolate it \(it scores no frame of it both before and after\)",
             why,
         )
         for why in kinds
