@@ -263,7 +263,8 @@ class Enumerated:
 
     Work is done on demand: with a ``root``, nothing is listed until a second solution is asked for (the root's
     cost is summed as one row of the listing's cost array); without, the costs are listed and the best is the
-    first cheapest (as the stable sort puts it); the rest are sorted when first asked for.
+    first cheapest (as the stable sort puts it); the rest are sorted when first asked for. ``ranked``: the
+    assignments (N, R) and costs (N,) as that sort leaves them, already worked out (``subset_rankings``).
     """
 
     def __init__(
@@ -272,6 +273,7 @@ class Enumerated:
         root: np.ndarray | None = None,
         max_increase: float = math.inf,
         combos: np.ndarray | None = None,
+        ranked: tuple[np.ndarray, np.ndarray] | None = None,
     ):
         self._cost = cost
         self._root = root
@@ -280,6 +282,10 @@ class Enumerated:
         self._listed_costs: np.ndarray | None = None
         self._combos: np.ndarray | None = None
         self._costs: np.ndarray | None = None
+        if ranked is not None:
+            self._combos, self._costs = ranked
+            self._best = self._combos[0], float(self._costs[0])
+            return
         if root is not None and combos is None:
             self._best = root, float(cost[np.arange(cost.shape[0]), root[None, :]].sum(axis=1)[0])
             return
@@ -323,10 +329,11 @@ class ColumnSubsets:
     of the union of all hypotheses' Bernoullis, cut to the Bernoullis one hypothesis holds).
 
     ``rank(present)`` gives the ranking ``rank(cost[:, present], max_increase=max_increase)`` gives, solution
-    for solution. Small sub-problems are listed on their own (``Enumerated``: filtering one listing of the whole
-    block per subset was measured slower, since the block's listing is much longer than a subset's). Larger
-    ones are split by ``rank`` into blocks, most of them the same for many subsets: ``cache`` (shared, e.g. by
-    every block of a PMBM frame) ranks each distinct one once.
+    for solution. Small sub-problems are listed on their own (``Enumerated``), several at once side by side
+    (``subset_rankings``; filtering one listing of the whole block per subset was measured slower, since the
+    block's listing is much longer than a subset's). Larger ones are split by ``rank`` into blocks, most of them
+    the same for many subsets: ``cache`` (shared, e.g. by every block of a PMBM frame) ranks each distinct one
+    once.
     """
 
     def __init__(self, cost: np.ndarray, max_increase: float = math.inf, cache: BlockCache | None = None):
@@ -350,59 +357,109 @@ class ColumnSubsets:
 
     def ranks(self, patterns: np.ndarray) -> list[Ranking | None]:
         """``rank(present)`` of every row of ``patterns`` ((P, C) bool), None where it raises
-        ``InfeasibleAssignment``.
+        ``InfeasibleAssignment`` (``subset_rankings``: the small ones found together)."""
+        return subset_rankings([self.cost] * len(patterns), list(patterns), self.max_increase, self.cache)
 
-        The best assignments of the small sub-problems of two or more rows (those ``rank`` lists) are found
-        together when the whole block's listing is short (``SHARED_LISTING_LIMIT``): one listing and its costs,
-        masked per pattern, the first cheapest of each (the listing's order restricted to a pattern is that
-        pattern's own lexicographic order, and each cost is the same sum of the same entries). Each gets an
-        ``Enumerated`` with that best as its root, which lists nothing more unless asked for a second solution.
-        A one-row block gives each pattern its ``SingleRow`` from one masked argmin."""
-        n_rows = self.cost.shape[0]
-        if n_rows == 1 and self.cost.shape[1] <= ENUMERATION_LIMIT:  # each pattern's SingleRow (``rank``)
-            row = np.where(patterns, self.cost[0], np.inf)
-            cheapest = np.argmin(row, axis=1)
-            local = (np.cumsum(patterns, axis=1) - 1)[np.arange(len(patterns)), cheapest]
-            return [
-                SingleRow(self.cost[0, present], int(at), self.max_increase) if row[p, c] < np.inf else None
-                for p, (present, c, at) in enumerate(zip(patterns, cheapest.tolist(), local.tolist(), strict=True))
-            ]
-        counts = (self.allowed[None, :, :] & patterns[:, None, :]).sum(axis=2)
-        listed_together = np.zeros(len(patterns), dtype=bool)
-        if n_rows >= 2 and _candidates(self.cost) <= SHARED_LISTING_LIMIT:
-            listed_together = np.prod(counts, axis=1, dtype=float) <= ENUMERATION_LIMIT
-        out: list[Ranking | None] = [None] * len(patterns)
-        for p in np.flatnonzero(~listed_together).tolist():
+
+def subset_rankings(
+    costs: list[np.ndarray],
+    patterns: list[np.ndarray],
+    max_increase: float = math.inf,
+    cache: BlockCache | None = None,
+) -> list[Ranking | None]:
+    """``ColumnSubsets(costs[i], max_increase, cache).rank(patterns[i])`` for every i ((R_i, C_i) blocks, (C_i,)
+    bool columns kept), None where it raises ``InfeasibleAssignment``.
+
+    Sub-problems with the same number of rows are worked on together, padded with absent columns to the widest:
+    those of one row get their ``SingleRow`` from one masked argmin; the small ones of several rows (whose
+    candidates ``rank`` would list) are listed and sorted together (``_listed_subsets``; listing a whole block
+    once and masking it per subset costs more when the block has many more candidates than its subsets); the
+    others are ranked one by one.
+    """
+    out: list[Ranking | None] = [None] * len(costs)
+    by_rows: dict[int, list[int]] = {}
+    for i, cost in enumerate(costs):
+        by_rows.setdefault(cost.shape[0], []).append(i)
+    for n_rows, items in by_rows.items():
+        width = max(costs[i].shape[1] for i in items)
+        stacked = np.full((len(items), n_rows, width), np.inf)
+        present = np.zeros((len(items), width), dtype=bool)
+        for k, i in enumerate(items):
+            n_cols = costs[i].shape[1]
+            stacked[k, :, :n_cols] = costs[i]
+            present[k, :n_cols] = patterns[i]
+        counts = ((stacked < np.inf) & present[:, None, :]).sum(axis=2)
+        small = (np.prod(counts, axis=1, dtype=float) <= ENUMERATION_LIMIT) & (n_rows >= 1)
+        for k in np.flatnonzero(~small).tolist():
+            i = items[k]
             try:
-                out[p] = self.rank(patterns[p])
+                out[i] = rank(costs[i][:, patterns[i]], max_increase=max_increase, cache=cache)
             except InfeasibleAssignment:
-                out[p] = None
-        if listed_together.sum() < 2:
-            for p in np.flatnonzero(listed_together).tolist():
-                try:
-                    out[p] = self.rank(patterns[p])
-                except InfeasibleAssignment:
-                    out[p] = None
-            return out
-        together = np.flatnonzero(listed_together)
-        listed = enumerate_assignments(self.allowed)
-        if not len(listed):  # no assignment of the block, so none of a subset
-            return out
-        costs = self.cost[np.arange(n_rows), listed].sum(axis=1)
-        valid = patterns[together][:, listed].all(axis=2)
-        first_cheapest = np.argmin(np.where(valid, costs, np.inf), axis=1)
-        local_of_col = np.cumsum(patterns[together], axis=1) - 1
-        roots = local_of_col[np.arange(len(together))[:, None], listed[first_cheapest]]
-        feasible = valid[np.arange(len(together)), first_cheapest]
-        for i, p in enumerate(together.tolist()):
-            if feasible[i]:
-                out[p] = Enumerated(self.cost[:, patterns[p]], roots[i], self.max_increase)
-        return out
+                out[i] = None
+        listed = np.flatnonzero(small)
+        if not len(listed):
+            continue
+        if n_rows == 1:
+            row = np.where(present[listed], stacked[listed, 0], np.inf)
+            cheapest = np.argmin(row, axis=1)
+            local = (np.cumsum(present[listed], axis=1) - 1)[np.arange(len(listed)), cheapest]
+            for k, c, at in zip(listed.tolist(), cheapest.tolist(), local.tolist(), strict=True):
+                i = items[k]
+                if row[k, c] < np.inf:
+                    out[i] = SingleRow(costs[i][0, patterns[i]], int(at), max_increase)
+            continue
+        listings = _listed_subsets(stacked[listed], present[listed], max_increase)
+        for k, ranked in zip(listed.tolist(), listings, strict=True):
+            i = items[k]
+            if ranked is not None:
+                out[i] = Enumerated(costs[i][:, patterns[i]], max_increase=max_increase, ranked=ranked)
+    return out
 
 
-SHARED_LISTING_LIMIT = 4096
-"""``ColumnSubsets.ranks`` finds the best assignments of several small column subsets from one listing of the
-whole block when that block has at most this many candidates."""
+def _listed_subsets(
+    costs: np.ndarray, patterns: np.ndarray, max_increase: float
+) -> list[tuple[np.ndarray, np.ndarray] | None]:
+    """The assignments and costs ``Enumerated(costs[p][:, patterns[p]], None, max_increase)`` ranks, in its
+    order and cut where it cuts, of P sub-problems (``costs`` (P, R, C), ``patterns`` (P, C) bool, R >= 2);
+    None where one has no assignment. Assignments are given as columns of the sub-problem.
+
+    All are listed together, in a fixed number of NumPy calls: sub-problem p's candidates are the index tuples
+    of its rows' allowed columns in C order (as ``enumerate_assignments``: lexicographic), numbered
+    0 .. n_p - 1 and laid end to end; a tuple's digits are its number in the mixed radix of the rows' counts.
+    Each cost is summed from the same entries in the same order as the sub-problem's own listing sums them (an
+    (N, R) array reduced along its rows), so the floats are equal; a stable sort by sub-problem, then cost, gives
+    each its own stable order by cost, whose first is the first cheapest in lexicographic order, the best
+    ``Enumerated`` finds.
+    """
+    n_patterns, n_rows = costs.shape[0], costs.shape[1]
+    allowed = (costs < np.inf) & patterns[:, None, :]  # (P, R, C)
+    counts = allowed.sum(axis=2)  # (P, R)
+    _, _, cols = np.nonzero(allowed)  # allowed columns by sub-problem, row, column
+    starts = (np.cumsum(counts.ravel()) - counts.ravel()).reshape(counts.shape)
+    later = np.cumprod(counts[:, ::-1], axis=1)[:, ::-1]  # (P, R): products of the counts of rows >= r
+    n_listed = later[:, 0]
+    strides = np.concatenate([later[:, 1:], np.ones((n_patterns, 1), dtype=later.dtype)], axis=1)
+    pattern = np.repeat(np.arange(n_patterns), n_listed)
+    number = np.arange(len(pattern)) - np.repeat(np.cumsum(n_listed) - n_listed, n_listed)
+    digits = (number[:, None] // strides[pattern]) % np.maximum(counts[pattern], 1)
+    combos = cols[starts[pattern] + digits]  # (N, R) columns of the block
+    ordered = np.sort(combos, axis=1)
+    distinct = np.flatnonzero((ordered[:, 1:] != ordered[:, :-1]).all(axis=1))
+    combos, pattern = combos[distinct], pattern[distinct]
+    total = costs[pattern[:, None], np.arange(n_rows), combos].sum(axis=1)
+    by_cost = np.argsort(total, kind="stable")
+    order = by_cost[np.argsort(pattern[by_cost], kind="stable")]
+    combos, pattern, total = combos[order], pattern[order], total[order]
+    bounds = np.searchsorted(pattern, np.arange(n_patterns + 1)).tolist()
+    local = (np.cumsum(patterns, axis=1) - 1)[pattern[:, None], combos]
+    out: list[tuple[np.ndarray, np.ndarray] | None] = [None] * n_patterns
+    for p in range(n_patterns):
+        start, stop = bounds[p], bounds[p + 1]
+        if start < stop:
+            p_total = total[start:stop]
+            kept = start + int(np.count_nonzero(p_total <= p_total[0] + max_increase))
+            out[p] = local[start:kept], total[start:kept]
+    return out
 
 
 class Murty:

@@ -26,10 +26,10 @@ unaffected.
 
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
-ranked once and shared by all hypotheses that contain it (``murty.Product``). The small sub-problems of one
-block get their best assignments from one listing of the block, and larger ones share the rankings of equal
-smaller blocks (``murty.ColumnSubsets.ranks``, ``murty.BlockCache``); a ranking goes past its best only when a
-hypothesis has more than one child. The best assignments of all hypotheses are assembled block by block, at
+ranked once and shared by all hypotheses that contain it (``murty.Product``). The small sub-problems of all
+blocks are listed and sorted together, per row count, and larger ones share the rankings of equal smaller
+blocks (``murty.subset_rankings``, ``murty.BlockCache``); a ranking goes past its best only when a hypothesis
+has more than one child. The best assignments of all hypotheses are assembled block by block, at
 once; a hypothesis with more than one child gets a ``Product`` (``SharedRanking``). Posteriors
 are built once per distinct (Bernoulli, outcome) into one store that the posterior hypotheses index
 (``core.posteriors_from_assignments``, ``core.GlobalHypothesis``). These pieces only share work: each gives
@@ -57,6 +57,7 @@ from gnnpmb.assign.murty import (
     forbid_beyond_private,
     k_best,
     rank,
+    subset_rankings,
 )
 from gnnpmb.config import PmbmParams
 from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
@@ -333,17 +334,14 @@ class SharedRanking:
         for best_cost in self.common_best:
             totals += best_cost
         feasible = np.ones(len(hypotheses), dtype=bool)
-        for b, (rows, cols, patterns, pattern, subsets) in enumerate(self.varying):
+        used = [np.unique(pattern[hypotheses]).tolist() for _, _, _, pattern, _ in self.varying]
+        self._rank_together(used)
+        for b, (rows, _, patterns, pattern, _) in enumerate(self.varying):
             of_hypothesis = pattern[hypotheses]
             cols_of = np.zeros((len(patterns), len(rows)), dtype=np.int64)
             cost_of = np.zeros(len(patterns))
             ok_of = np.zeros(len(patterns), dtype=bool)
-            used = np.unique(of_hypothesis).tolist()
-            unranked = [p for p in used if (b, p) not in self._parts]
-            if subsets is not None and len(unranked) > 1:  # ranked together (``murty.ColumnSubsets.ranks``)
-                for p, ranking in zip(unranked, subsets.ranks(patterns[unranked]), strict=True):
-                    self._parts[(b, p)] = rows, cols[patterns[p]], ranking
-            for p in used:
+            for p in used[b]:
                 _, part_cols, ranking = self._varying_part(b, p)
                 if ranking is not None:
                     best, cost = ranking.solution(0)
@@ -352,6 +350,23 @@ class SharedRanking:
             totals += cost_of[of_hypothesis]
             feasible &= ok_of[of_hypothesis]
         return bases, totals, feasible
+
+    def _rank_together(self, used: list[list[int]]) -> None:
+        """Rank the patterns ``used[b]`` of every varying block b not ranked yet, all blocks at once
+        (``murty.subset_rankings``: the small sub-problems of equal row counts are worked on together)."""
+        todo = [
+            (b, p)
+            for b, patterns in enumerate(used)
+            if self.varying[b][4] is not None
+            for p in patterns
+            if (b, p) not in self._parts
+        ]
+        costs = [self.varying[b][4].cost for b, _ in todo]
+        present = [self.varying[b][2][p] for b, p in todo]
+        rankings = subset_rankings(costs, present, self.max_increase, self._blocks)
+        for (b, p), keep, ranking in zip(todo, present, rankings, strict=True):
+            rows, cols, *_ = self.varying[b]
+            self._parts[(b, p)] = rows, cols[keep], ranking
 
     def _ranked(self, h: int, k: int, base: np.ndarray) -> list[tuple[np.ndarray, float]]:
         """The k best assignments of feasible hypothesis ``h``, whose best is ``base``."""

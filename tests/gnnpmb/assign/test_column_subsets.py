@@ -141,3 +141,41 @@ def test_ranks_of_several_column_subsets_equal_each_rank(max_increase):
             infeasible += want is None
         together += n_rows >= 2 and len(patterns) >= 2
     assert together > 50 and infeasible > 10
+
+
+@pytest.mark.parametrize("max_increase", [math.inf, 1.5])
+def test_subset_rankings_of_several_blocks_equal_each_rank(max_increase, monkeypatch):
+    """``subset_rankings`` over blocks of different shapes (worked on together per row count, padded to the
+    widest) gives what ``ColumnSubsets.rank`` gives for each, solution for solution, ties included, None where
+    it is infeasible; with a small enumeration limit some sub-problems are ranked one by one."""
+    monkeypatch.setattr(murty, "ENUMERATION_LIMIT", 16)
+    rng = np.random.default_rng(13)
+    kinds = {"single": 0, "listed": 0, "ranked": 0, "infeasible": 0}
+    for trial in range(60):
+        costs, patterns = [], []
+        for _ in range(int(rng.integers(1, 9))):
+            n_rows, n_tracks = int(rng.integers(1, 5)), int(rng.integers(1, 9))
+            shape = (n_rows, n_tracks)
+            tracks = rng.integers(0, 4, size=shape).astype(float) if trial % 2 == 0 else rng.random(shape)
+            tracks[rng.random(shape) < 0.3] = np.inf
+            private = np.full((n_rows, n_rows), np.inf)
+            private[np.arange(n_rows), np.arange(n_rows)] = rng.integers(0, 4, size=n_rows)
+            private[rng.random((n_rows, n_rows)) < 0.1] = np.inf
+            costs.append(np.hstack([tracks, private]))
+            patterns.append(rng.random(costs[-1].shape[1]) < 0.7)
+        got = murty.subset_rankings(costs, patterns, max_increase)
+        for cost, present, ranking in zip(costs, patterns, got, strict=True):
+            try:
+                want = all_solutions(murty.ColumnSubsets(cost, max_increase).rank(present))
+            except murty.InfeasibleAssignment:
+                want = None
+            assert (None if ranking is None else all_solutions(ranking)) == want
+            if want is None:
+                kinds["infeasible"] += 1
+            elif isinstance(ranking, murty.SingleRow):
+                kinds["single"] += 1
+            elif isinstance(ranking, murty.Enumerated):
+                kinds["listed"] += 1
+            else:
+                kinds["ranked"] += 1
+    assert min(kinds.values()) > 5, kinds
