@@ -44,19 +44,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gnnpmb.assign.clusters import Cluster
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.assign.murty import (
-    ENUMERATION_LIMIT,
     BlockCache,
     ColumnSubsets,
     PartsSummary,
     Product,
     Ranking,
-    SingleRow,
     blocks,
     forbid_beyond_private,
     k_best,
-    rank,
     subset_rankings,
 )
 from gnnpmb.config import PmbmParams
@@ -251,8 +249,8 @@ class SharedRanking:
         cost = union.cost_matrix()
         has_column = np.ones((len(members), cost.shape[1]), dtype=bool)
         has_column[:, : self.n_union] = False
-        for h, index in enumerate(members):
-            has_column[h, index] = True
+        lengths = [len(index) for index in members]
+        has_column[np.repeat(np.arange(len(members)), lengths), np.concatenate(members)] = True
         cost = forbid_beyond_private(cost, max_increase, usable=has_column.all(axis=0))
         self.cost = cost
         self.common: list[tuple[np.ndarray, np.ndarray, Ranking | None]] = []
@@ -264,16 +262,23 @@ class SharedRanking:
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
         self._blocks: BlockCache = {}
         self._common: PartsSummary | None = None
+        found = blocks(cost)
         varies = has_column.any(axis=0) & ~has_column.all(axis=0)  # columns only some hypotheses hold
-        for rows, cols in blocks(cost):
+        block_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
+        for b, (_, cols) in enumerate(found):
+            block_of_col[cols] = b
+        is_varying = np.zeros(len(found), dtype=bool)
+        is_varying[block_of_col[varies & (block_of_col >= 0)]] = True
+        common = _common_parts(cost, found, ~is_varying, has_column[0], max_increase, max_block_rows, self._blocks)
+        patterns = _presence_patterns(has_column, found, is_varying)
+        for b, (rows, cols) in enumerate(found):
             best_only = len(rows) > max_block_rows
-            if not varies[cols].any():
-                self.common.append(_part(cost, rows, cols, has_column[0, cols], max_increase, best_only))
+            if not is_varying[b]:
+                self.common.append(common[b])
                 continue
-            present = has_column[:, cols]
-            _, first, pattern = np.unique(_row_keys(present), return_index=True, return_inverse=True)
+            first, pattern = patterns[b]
             subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase, self._blocks)
-            self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
+            self.varying.append((rows, cols, has_column[np.ix_(first, cols)], pattern, subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
         self.common_ok = all(ranking is not None for _, _, ranking in self.common)
         self.common_best: tuple[float, ...] = ()
@@ -316,7 +321,7 @@ class SharedRanking:
             rows, cols, patterns, _, subsets = self.varying[b]
             present = patterns[p]
             if subsets is None:
-                self._parts[key] = _part(self.cost, rows, cols, present, self.max_increase, True)
+                self._parts[key] = _best_only_part(self.cost, rows, cols, present)
             else:
                 try:
                     self._parts[key] = rows, cols[present], subsets.rank(present)
@@ -392,6 +397,70 @@ class BestOnly:
         return self._best if index == 0 else None
 
 
+def _common_parts(
+    cost: np.ndarray,
+    found: list[Cluster],
+    wanted: np.ndarray,
+    present: np.ndarray,
+    max_increase: float,
+    max_block_rows: int,
+    cache: BlockCache,
+) -> dict[int, tuple[np.ndarray, np.ndarray, Ranking | None]]:
+    """(rows, columns, ranking or None if infeasible) of every ``wanted`` block of ``found`` cut to its
+    ``present`` columns, by block index: ``murty.rank`` of the cut matrix up to ``max_increase`` above its best,
+    all blocks within the per-frame budget together (``murty.subset_rankings``), or ``_best_only_part``."""
+    out: dict[int, tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
+    ranked = []
+    for b in np.flatnonzero(wanted).tolist():
+        rows, cols = found[b]
+        if len(rows) > max_block_rows:
+            out[b] = _best_only_part(cost, rows, cols, present[cols])
+        else:
+            ranked.append(b)
+    costs = [cost[np.ix_(found[b][0], found[b][1])] for b in ranked]
+    keep = [present[found[b][1]] for b in ranked]
+    for b, kept, ranking in zip(ranked, keep, subset_rankings(costs, keep, max_increase, cache), strict=True):
+        rows, cols = found[b]
+        out[b] = rows, cols[kept], ranking
+    return out
+
+
+def _presence_patterns(
+    has_column: np.ndarray, found: list[Cluster], wanted: np.ndarray
+) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """Per ``wanted`` block b of ``found``: ``np.unique(_row_keys(has_column[:, cols]), return_index=True,
+    return_inverse=True)``'s first occurrences (P,) and inverse (H,): the hypotheses that first hold each
+    distinct set of the block's columns, in the order of the sets' keys, and each hypothesis' set. The blocks of
+    at most 64 columns are done together: their keys, sorted column by column (stable, so a set's first
+    hypothesis leads it)."""
+    out: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    narrow = []
+    for b in np.flatnonzero(wanted).tolist():
+        cols = found[b][1]
+        if len(cols) <= 64:
+            narrow.append(b)
+            continue
+        _, first, pattern = np.unique(_row_keys(has_column[:, cols]), return_index=True, return_inverse=True)
+        out[b] = first, pattern.ravel()
+    if not narrow:
+        return out
+    widths = [len(found[b][1]) for b in narrow]
+    cols = np.concatenate([found[b][1] for b in narrow])
+    starts = np.cumsum(widths) - widths
+    shift = (63 - (np.arange(len(cols)) - np.repeat(starts, widths))).astype(np.uint64)
+    bits = has_column[:, cols].astype(np.uint64) << shift  # column i of a block at bit 63 - i: ``_row_keys``
+    keys = np.bitwise_or.reduceat(bits, starts, axis=1)  # (H, blocks)
+    order = np.argsort(keys, axis=0, kind="stable")
+    ordered = np.take_along_axis(keys, order, axis=0)
+    starts_set = np.ones(keys.shape, dtype=bool)
+    starts_set[1:] = ordered[1:] != ordered[:-1]
+    pattern = np.empty(keys.shape, dtype=np.int64)
+    np.put_along_axis(pattern, order, np.cumsum(starts_set, axis=0) - 1, axis=0)
+    for i, b in enumerate(narrow):
+        out[b] = order[starts_set[:, i], i], pattern[:, i]
+    return out
+
+
 def _row_keys(present: np.ndarray) -> np.ndarray:
     """(H,) one sortable key per row of an (H, C) bool array, ordered as the rows' packed bytes compare
     (memcmp): the packed bytes as a void scalar, or, for C <= 64, as one big-endian uint64 (zero-padded), which
@@ -405,26 +474,14 @@ def _row_keys(present: np.ndarray) -> np.ndarray:
     return packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
 
 
-def _part(
-    cost: np.ndarray,
-    rows: np.ndarray,
-    cols: np.ndarray,
-    present: np.ndarray,
-    max_increase: float,
-    best_only: bool = False,
+def _best_only_part(
+    cost: np.ndarray, rows: np.ndarray, cols: np.ndarray, present: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
-    """(rows, columns, ranking) of a block of the union matrix with only its ``present`` columns, ranked up to
-    ``max_increase`` above its best (``best_only``: its best assignment alone); the ranking is None if that
-    sub-problem has no assignment."""
+    """(rows, columns, ranking) of a block of the union matrix over the per-frame budget, with only its
+    ``present`` columns: its best assignment alone (``BestOnly``), or None if that sub-problem has none."""
     sub_cols = cols[present]
-    if len(rows) == 1 and not best_only and len(sub_cols) <= ENUMERATION_LIMIT:  # ``rank``'s SingleRow, directly
-        row = cost[rows[0], sub_cols]
-        if not (row < np.inf).any():
-            return rows, sub_cols, None
-        return rows, sub_cols, SingleRow(row, int(np.argmin(row)), max_increase)
-    sub = cost[np.ix_(rows, sub_cols)]
     try:
-        return rows, sub_cols, BestOnly(sub) if best_only else rank(sub, max_increase=max_increase)
+        return rows, sub_cols, BestOnly(cost[np.ix_(rows, sub_cols)])
     except InfeasibleAssignment:
         return rows, sub_cols, None
 
