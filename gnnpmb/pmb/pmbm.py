@@ -165,9 +165,9 @@ class KBest:
             shared = SharedRanking(union, members, self._max_increase, self.murty_block_rows)
             ranked = shared.k_best(budgets)
         children: list[_Child] = []
+        bases = (prior_log_w + _sums_of_rows(union.miss_log_lik, members)).tolist()  # + sum_k log l_k0
         for h, assignments in enumerate(ranked):
-            base = float(prior_log_w[h]) + float(union.miss_log_lik[members[h]].sum())  # sum_k log l_k0
-            children.extend(_Child(base - total, h, col_of_row, total) for col_of_row, total in assignments)
+            children.extend(_Child(bases[h] - total, h, col_of_row, total) for col_of_row, total in assignments)
         kept, log_w = self._select(_merge_identical(children, union, members, ctx))
         store, rows = posteriors_from_assignments(
             union, [members[c.parent] for c in kept], [c.col_of_row for c in kept], ctx
@@ -195,6 +195,19 @@ class KBest:
         keep = (keep if len(keep) else order[:1])[: self.params.n_hypotheses]
         kept_log_w = log_w[keep] - log_sum_exp(log_w[keep])
         return [children[i] for i in keep], kept_log_w
+
+
+def _sums_of_rows(values: np.ndarray, members: list[np.ndarray]) -> np.ndarray:
+    """(H,) ``values[members[h]].sum()`` for every h, bit for bit: the members of equal length L are gathered
+    into one (n, L) array and summed along its rows, which NumPy sums as it sums each (L,) array."""
+    lengths = np.array([len(index) for index in members], dtype=np.int64)
+    gathered = values[np.concatenate(members)] if len(members) else values[:0]
+    starts = np.cumsum(lengths) - lengths
+    out = np.zeros(len(members))
+    for length in np.unique(lengths).tolist():
+        of_length = np.flatnonzero(lengths == length)
+        out[of_length] = gathered[starts[of_length][:, None] + np.arange(length)].sum(axis=1)
+    return out
 
 
 def _trim_budgets(budgets: list[int], log_weights: np.ndarray, keep: int) -> list[int]:
