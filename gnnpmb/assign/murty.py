@@ -9,8 +9,9 @@ queue; the next best solution overall is the queue's minimum.
 
 Speed-ups in the spirit of Miller, Stone & Cox (1997), "Optimizing Murty's ranked assignment method", IEEE
 T-AES 33(3): rows pinned by the partition and their columns are removed from the subproblem, a subproblem
-whose constrained row has no allowed column is skipped unsolved, a single free row is solved by argmin, and
-solutions are ranked lazily, only as deep as asked. Above all, gating makes tracking matrices block diagonal:
+whose constrained row has no allowed column is skipped unsolved, a single free row is solved by argmin, a
+subproblem is solved only when a lower bound on its cost reaches the front of the queue, and solutions are ranked
+lazily, only as deep as asked. Above all, gating makes tracking matrices block diagonal:
 rows and columns joined by finite entries form independent blocks (``blocks``), an assignment is one solution
 per block and its cost the sum, so the ranked assignments are the smallest sums over per-block rankings
 (``Product``, a lazy heap over index tuples). A block is ranked by ``Murty``, or, when its candidate
@@ -465,10 +466,15 @@ def _listed_subsets(
 class Murty:
     """Ranking of one (r, c) block by Murty's partitioning (module docstring); ``root`` is a best assignment.
 
-    A queued subproblem is (cost, serial, best solution, p, barred): rows < p pinned to the solution's
-    columns, row p may not take the columns in ``barred``; ``serial`` makes equal costs pop first in, first
-    out. The latest solution is partitioned only when a further one is asked for; subproblems costing more
-    than the root plus ``max_increase`` are not queued.
+    A queued subproblem is (key, serial, solved, state): rows < p pinned to the solution's columns, row p may
+    not take the columns in ``barred``; ``serial`` (the order subproblems are made in) makes equal costs pop first
+    in, first out. The latest solution is partitioned only when a further one is asked for, and a subproblem is
+    solved only when it reaches the front of the queue (lazy evaluation, Miller, Stone & Cox 1997): until then
+    its key is a lower bound on its cost, the pinned rows' cost plus every other row's cheapest column still
+    free, less a margin far above rounding error. A solved one is queued again under its cost, if within the
+    root plus ``max_increase``. Keys never exceed costs, so a solved subproblem reaches the front only when every
+    unsolved one would cost more, or as much and was made later: the solutions come in the order of solving
+    every subproblem at once and queueing them by (cost, serial), as plain Murty does.
     """
 
     def __init__(self, cost: np.ndarray, root: np.ndarray, max_increase: float = math.inf):
@@ -476,7 +482,7 @@ class Murty:
         self._arange = np.arange(cost.shape[0])
         self.solutions: list[tuple[np.ndarray, float]] = [(root, self._total(root))]
         self._limit = self.solutions[0][1] + max_increase
-        self._queue: list[tuple[float, int, np.ndarray, int, tuple[int, ...]]] = []
+        self._queue: list[tuple[float, int, bool, tuple]] = []
         self._serial = 0
         self._unexpanded: tuple[np.ndarray, int, tuple[int, ...]] | None = (root, 0, ())
 
@@ -488,31 +494,49 @@ class Murty:
             if self._unexpanded is not None:
                 self._expand(*self._unexpanded)
                 self._unexpanded = None
-            if not self._queue:
-                return None
-            total, _, sol, pinned, barred = heapq.heappop(self._queue)
-            self.solutions.append((sol, total))
+            while True:
+                if not self._queue:
+                    return None
+                key, serial, solved, state = heapq.heappop(self._queue)
+                if solved:
+                    break
+                self._solve(serial, *state)
+            sol, pinned, barred = state
+            self.solutions.append((sol, key))
             self._unexpanded = (sol, pinned, barred)
         return self.solutions[index]
 
     def _expand(self, sol: np.ndarray, pinned: int, barred: tuple[int, ...]) -> None:
-        """Queue the best solution of every subproblem P_q, q = pinned .. r-1, that partitions the rest of the
-        subproblem (pinned, barred) whose best is ``sol``."""
+        """Queue, unsolved, every subproblem P_q, q = pinned .. r-1, that partitions the rest of the subproblem
+        (pinned, barred) whose best is ``sol``, keyed by a lower bound on its cost; those with a row that has no
+        column left, or whose bound exceeds the limit, are not queued (they have no solution within it)."""
         cost = self.cost
         n_rows = cost.shape[0]
-        free = np.ones(cost.shape[1], dtype=bool)
-        free[sol[:pinned]] = False
-        for q in range(pinned, n_rows):
-            row_barred = (*barred, int(sol[q])) if q == pinned else (int(sol[q]),)
-            row = np.where(free, cost[q], np.inf)
-            row[list(row_barred)] = np.inf
-            if np.isfinite(row).any():
-                self._push_child(sol, q, row, free, row_barred)
-            free[sol[q]] = False
+        n_sub = n_rows - pinned
+        free = np.ones((n_sub, cost.shape[1]), dtype=bool)  # row i: the columns free for row pinned + i
+        free[:, sol[:pinned]] = False
+        earlier, later = np.tril_indices(n_sub, -1)
+        free[earlier, sol[pinned + later]] = False  # rows before pinned + i keep their columns
+        rows = np.where(free, cost[pinned:], np.inf)
+        rows[np.arange(n_sub), sol[pinned:]] = np.inf
+        rows[0, list(barred)] = np.inf
+        pinned_cost = np.cumsum(cost[self._arange, sol])[pinned:] - cost[np.arange(pinned, n_rows), sol[pinned:]]
+        cheapest_later = np.where(free[:, None, :], cost[None, pinned:, :], np.inf).min(axis=2)  # (i, row)
+        after = np.triu(np.ones((n_sub, n_sub), dtype=bool), 1)
+        bound = pinned_cost + rows.min(axis=1) + np.where(after, cheapest_later, 0.0).sum(axis=1)
+        margin = 1e-9 * (1.0 + np.abs(cost[pinned:][np.isfinite(cost[pinned:])]).sum() + abs(pinned_cost[-1]))
+        for i in np.flatnonzero(np.isfinite(bound) & (bound - margin <= self._limit)).tolist():
+            q = pinned + i
+            row_barred = (*barred, int(sol[q])) if i == 0 else (int(sol[q]),)
+            key = float(bound[i] - margin)
+            heapq.heappush(self._queue, (key, self._serial, False, (sol, q, rows[i], free[i], row_barred)))
+            self._serial += 1
 
-    def _push_child(self, sol: np.ndarray, q: int, row: np.ndarray, free: np.ndarray, barred: tuple[int, ...]) -> None:
+    def _solve(
+        self, serial: int, sol: np.ndarray, q: int, row: np.ndarray, free: np.ndarray, barred: tuple[int, ...]
+    ) -> None:
         """Solve P_q: rows < q keep ``sol``, row q costs ``row`` (barred and taken columns at +inf), later
-        rows use the free columns; queue its best solution if one exists within the limit."""
+        rows use the free columns; queue its best solution, solved, if one exists within the limit."""
         child = sol.copy()
         if q == len(sol) - 1:
             child[q] = int(np.argmin(row))
@@ -527,8 +551,7 @@ class Murty:
             child[q:] = sub_cols[picked]
         total = self._total(child)
         if total <= self._limit and total < np.inf:
-            heapq.heappush(self._queue, (total, self._serial, child, q, barred))
-            self._serial += 1
+            heapq.heappush(self._queue, (total, serial, True, (child, q, barred)))
 
 
 @dataclass(frozen=True, slots=True)
