@@ -133,7 +133,7 @@ def rank(
                 local_of_col[cols] = np.arange(len(cols))
                 root = local_of_col[first[rows]]
             candidates = float(np.prod(counts[rows], dtype=float))  # its columns are all its rows' allowed ones
-            ranking = _block_ranking(cost[np.ix_(rows, cols)], root, max_increase, cache, candidates)
+            ranking = _block_ranking(cost[rows[:, None], cols], root, max_increase, cache, candidates)
             base[rows] = cols[ranking.solution(0)[0]]
         parts.append((rows, cols, ranking))
     return Product(base, parts, max_increase)

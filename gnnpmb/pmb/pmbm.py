@@ -275,6 +275,9 @@ class SharedRanking:
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
         self._blocks: BlockCache = {}
         self._common: PartsSummary | None = None
+        self._summaries: dict[tuple[int, int], tuple[float, float | None]] = {}
+        """Per (varying block, pattern) ranked past its best: its best cost and cost(1) - cost(0) (None if it has
+        no second solution), what ``murty.PartsSummary`` reads of it."""
         found = blocks(cost)
         varies = has_column.any(axis=0) & ~has_column.all(axis=0)  # columns only some hypotheses hold
         block_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
@@ -290,8 +293,8 @@ class SharedRanking:
                 self.common.append(common[b])
                 continue
             first, pattern = patterns[b]
-            subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase, self._blocks)
-            self.varying.append((rows, cols, has_column[np.ix_(first, cols)], pattern, subsets))
+            subsets = None if best_only else ColumnSubsets(cost[rows[:, None], cols], max_increase, self._blocks)
+            self.varying.append((rows, cols, has_column[first[:, None], cols], pattern, subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
         self.common_ok = all(ranking is not None for _, _, ranking in self.common)
         self.common_best: tuple[float, ...] = ()
@@ -388,9 +391,22 @@ class SharedRanking:
 
     def _ranked(self, h: int, k: int, base: np.ndarray) -> list[tuple[np.ndarray, float]]:
         """The k best assignments of feasible hypothesis ``h``, whose best is ``base``."""
-        varying = [self._varying_part(b, int(pattern[h])) for b, (*_, pattern, _) in enumerate(self.varying)]
-        parts = self.common + varying
-        product = Product(base, parts, self.max_increase, self._common_summary())
+        common = self._common_summary()
+        best_costs, steps = list(common.best_costs), list(common.steps)
+        varying = []
+        for b, (*_, pattern, _) in enumerate(self.varying):
+            p = int(pattern[h])
+            varying.append(self._varying_part(b, p))
+            if (b, p) not in self._summaries:
+                ranking = varying[-1][2]  # not None: a feasible hypothesis' parts are feasible
+                best, second = ranking.solution(0)[1], ranking.solution(1)
+                self._summaries[(b, p)] = best, None if second is None else second[1] - best
+            best, step = self._summaries[(b, p)]
+            best_costs.append(best)
+            if step is not None:
+                steps.append((step, len(self.common) + b))
+        summary = PartsSummary(tuple(best_costs), tuple(steps))  # what PartsSummary.of(parts) works out
+        product = Product(base, self.common + varying, self.max_increase, summary)
         out = []
         for i in range(k):
             found = product.solution(i)
@@ -430,7 +446,7 @@ def _common_parts(
             out[b] = _best_only_part(cost, rows, cols, present[cols])
         else:
             ranked.append(b)
-    costs = [cost[np.ix_(found[b][0], found[b][1])] for b in ranked]
+    costs = [cost[found[b][0][:, None], found[b][1]] for b in ranked]
     keep = [present[found[b][1]] for b in ranked]
     for b, kept, ranking in zip(ranked, keep, subset_rankings(costs, keep, max_increase, cache), strict=True):
         rows, cols = found[b]
