@@ -482,6 +482,7 @@ class Murty:
         self._arange = np.arange(cost.shape[0])
         self.solutions: list[tuple[np.ndarray, float]] = [(root, self._total(root))]
         self._limit = self.solutions[0][1] + max_increase
+        self._margin = 1e-9 * (1.0 + float(np.abs(cost[cost < np.inf]).sum()))  # >> rounding error of any sum
         self._queue: list[tuple[float, int, bool, tuple]] = []
         self._serial = 0
         self._unexpanded: tuple[np.ndarray, int, tuple[int, ...]] | None = (root, 0, ())
@@ -513,22 +514,24 @@ class Murty:
         cost = self.cost
         n_rows = cost.shape[0]
         n_sub = n_rows - pinned
+        index = np.arange(n_sub)
+        after = index[None, :] > index[:, None]  # (i, i'): row pinned + i' comes after row pinned + i
         free = np.ones((n_sub, cost.shape[1]), dtype=bool)  # row i: the columns free for row pinned + i
         free[:, sol[:pinned]] = False
-        earlier, later = np.tril_indices(n_sub, -1)
+        earlier, later = np.nonzero(after.T)
         free[earlier, sol[pinned + later]] = False  # rows before pinned + i keep their columns
         rows = np.where(free, cost[pinned:], np.inf)
-        rows[np.arange(n_sub), sol[pinned:]] = np.inf
+        rows[index, sol[pinned:]] = np.inf
         rows[0, list(barred)] = np.inf
-        pinned_cost = np.cumsum(cost[self._arange, sol])[pinned:] - cost[np.arange(pinned, n_rows), sol[pinned:]]
+        taken = cost[self._arange, sol]
+        pinned_cost = np.cumsum(taken)[pinned:] - taken[pinned:]
         cheapest_later = np.where(free[:, None, :], cost[None, pinned:, :], np.inf).min(axis=2)  # (i, row)
-        after = np.triu(np.ones((n_sub, n_sub), dtype=bool), 1)
         bound = pinned_cost + rows.min(axis=1) + np.where(after, cheapest_later, 0.0).sum(axis=1)
-        margin = 1e-9 * (1.0 + np.abs(cost[pinned:][np.isfinite(cost[pinned:])]).sum() + abs(pinned_cost[-1]))
-        for i in np.flatnonzero(np.isfinite(bound) & (bound - margin <= self._limit)).tolist():
+        keys = bound - self._margin
+        for i in np.flatnonzero(np.isfinite(bound) & (keys <= self._limit)).tolist():
             q = pinned + i
             row_barred = (*barred, int(sol[q])) if i == 0 else (int(sol[q]),)
-            key = float(bound[i] - margin)
+            key = float(keys[i])
             heapq.heappush(self._queue, (key, self._serial, False, (sol, q, rows[i], free[i], row_barred)))
             self._serial += 1
 
