@@ -264,8 +264,8 @@ class Enumerated:
 
     Work is done on demand: with a ``root``, nothing is listed until a second solution is asked for (the root's
     cost is summed as one row of the listing's cost array); without, the costs are listed and the best is the
-    first cheapest (as the stable sort puts it); the rest are sorted when first asked for. ``ranked``: the
-    assignments (N, R) and costs (N,) as that sort leaves them, already worked out (``subset_rankings``).
+    first cheapest (as the stable sort puts it); the rest are sorted when first asked for. ``listed``: the
+    listing (N, R) and its costs (N,), already worked out (``subset_rankings``).
     """
 
     def __init__(
@@ -274,7 +274,7 @@ class Enumerated:
         root: np.ndarray | None = None,
         max_increase: float = math.inf,
         combos: np.ndarray | None = None,
-        ranked: tuple[np.ndarray, np.ndarray] | None = None,
+        listed: tuple[np.ndarray, np.ndarray] | None = None,
     ):
         self._cost = cost
         self._root = root
@@ -283,10 +283,8 @@ class Enumerated:
         self._listed_costs: np.ndarray | None = None
         self._combos: np.ndarray | None = None
         self._costs: np.ndarray | None = None
-        if ranked is not None:
-            self._combos, self._costs = ranked
-            self._best = self._combos[0], float(self._costs[0])
-            return
+        if listed is not None:
+            self._listed, self._listed_costs = listed
         if root is not None and combos is None:
             self._best = root, float(cost[np.arange(cost.shape[0]), root[None, :]].sum(axis=1)[0])
             return
@@ -373,9 +371,9 @@ def subset_rankings(
 
     Sub-problems with the same number of rows are worked on together, padded with absent columns to the widest:
     those of one row get their ``SingleRow`` from one masked argmin; the small ones of several rows (whose
-    candidates ``rank`` would list) are listed and sorted together (``_listed_subsets``; listing a whole block
-    once and masking it per subset costs more when the block has many more candidates than its subsets); the
-    others are ranked one by one.
+    candidates ``rank`` would list) are listed together when they have at most ``JOINT_LISTING_LIMIT``
+    candidates (``_listed_subsets``; listing a whole block once and masking it per subset costs more when the
+    block has many more candidates than its subsets), else on their own; the others are ranked one by one.
     """
     out: list[Ranking | None] = [None] * len(costs)
     by_rows: dict[int, list[int]] = {}
@@ -397,40 +395,51 @@ def subset_rankings(
                 out[i] = rank(costs[i][:, patterns[i]], max_increase=max_increase, cache=cache)
             except InfeasibleAssignment:
                 out[i] = None
-        listed = np.flatnonzero(small)
-        if not len(listed):
+        kept = np.flatnonzero(small)
+        if not len(kept):
             continue
         if n_rows == 1:
-            row = np.where(present[listed], stacked[listed, 0], np.inf)
+            row = np.where(present[kept], stacked[kept, 0], np.inf)
             cheapest = np.argmin(row, axis=1)
-            local = (np.cumsum(present[listed], axis=1) - 1)[np.arange(len(listed)), cheapest]
-            for k, c, at in zip(listed.tolist(), cheapest.tolist(), local.tolist(), strict=True):
+            local = (np.cumsum(present[kept], axis=1) - 1)[np.arange(len(kept)), cheapest]
+            for j, (k, c, at) in enumerate(zip(kept.tolist(), cheapest.tolist(), local.tolist(), strict=True)):
                 i = items[k]
-                if row[k, c] < np.inf:
+                if row[j, c] < np.inf:
                     out[i] = SingleRow(costs[i][0, patterns[i]], int(at), max_increase)
             continue
-        listings = _listed_subsets(stacked[listed], present[listed], max_increase)
-        for k, ranked in zip(listed.tolist(), listings, strict=True):
+        together = np.prod(counts[kept], axis=1, dtype=float) <= JOINT_LISTING_LIMIT
+        for k in kept[~together].tolist():
             i = items[k]
-            if ranked is not None:
-                out[i] = Enumerated(costs[i][:, patterns[i]], max_increase=max_increase, ranked=ranked)
+            try:
+                out[i] = Enumerated(costs[i][:, patterns[i]], None, max_increase)
+            except InfeasibleAssignment:
+                out[i] = None
+        kept = kept[together]
+        for k, listed in zip(kept.tolist(), _listed_subsets(stacked[kept], present[kept]), strict=True):
+            i = items[k]
+            if listed is not None:
+                out[i] = Enumerated(costs[i][:, patterns[i]], max_increase=max_increase, listed=listed)
     return out
 
 
-def _listed_subsets(
-    costs: np.ndarray, patterns: np.ndarray, max_increase: float
-) -> list[tuple[np.ndarray, np.ndarray] | None]:
-    """The assignments and costs ``Enumerated(costs[p][:, patterns[p]], None, max_increase)`` ranks, in its
-    order and cut where it cuts, of P sub-problems (``costs`` (P, R, C), ``patterns`` (P, C) bool, R >= 2);
-    None where one has no assignment. Assignments are given as columns of the sub-problem.
+JOINT_LISTING_LIMIT = 256
+"""``subset_rankings`` lists sub-problems of at most this many candidates together (``_listed_subsets``), larger
+ones on their own (``Enumerated``). Measured on this machine: 51k candidates of 66 sub-problems of 4 rows took
+15.5 ms listed together and 7.4 ms listed one by one, while many small sub-problems (the stress frame of
+``benchmarks/tracker_speed.py``) gain from one call; of 64, 128, 256 and 1024, 256 was fastest on both."""
+
+
+def _listed_subsets(costs: np.ndarray, patterns: np.ndarray) -> list[tuple[np.ndarray, np.ndarray] | None]:
+    """The listing and its costs that ``Enumerated(costs[p][:, patterns[p]])`` makes, of P sub-problems
+    (``costs`` (P, R, C), ``patterns`` (P, C) bool, R >= 2): every assignment (N_p, R), as columns of the
+    sub-problem, in lexicographic order, and its cost (N_p,); None where one has no assignment.
 
     All are listed together, in a fixed number of NumPy calls: sub-problem p's candidates are the index tuples
     of its rows' allowed columns in C order (as ``enumerate_assignments``: lexicographic), numbered
     0 .. n_p - 1 and laid end to end; a tuple's digits are its number in the mixed radix of the rows' counts.
     Each cost is summed from the same entries in the same order as the sub-problem's own listing sums them (an
-    (N, R) array reduced along its rows), so the floats are equal; a stable sort by sub-problem, then cost, gives
-    each its own stable order by cost, whose first is the first cheapest in lexicographic order, the best
-    ``Enumerated`` finds.
+    (N, R) array reduced along its rows), so the floats are equal. Nothing is sorted here: ``Enumerated``
+    finds the best by argmin and sorts only when asked for a second solution, as most are not.
     """
     n_patterns, n_rows = costs.shape[0], costs.shape[1]
     allowed = (costs < np.inf) & patterns[:, None, :]  # (P, R, C)
@@ -448,19 +457,12 @@ def _listed_subsets(
     distinct = np.flatnonzero((ordered[:, 1:] != ordered[:, :-1]).all(axis=1))
     combos, pattern = combos[distinct], pattern[distinct]
     total = costs[pattern[:, None], np.arange(n_rows), combos].sum(axis=1)
-    by_cost = np.argsort(total, kind="stable")
-    order = by_cost[np.argsort(pattern[by_cost], kind="stable")]
-    combos, pattern, total = combos[order], pattern[order], total[order]
     bounds = np.searchsorted(pattern, np.arange(n_patterns + 1)).tolist()
     local = (np.cumsum(patterns, axis=1) - 1)[pattern[:, None], combos]
-    out: list[tuple[np.ndarray, np.ndarray] | None] = [None] * n_patterns
-    for p in range(n_patterns):
-        start, stop = bounds[p], bounds[p + 1]
-        if start < stop:
-            p_total = total[start:stop]
-            kept = start + int(np.count_nonzero(p_total <= p_total[0] + max_increase))
-            out[p] = local[start:kept], total[start:kept]
-    return out
+    return [
+        (local[start:stop], total[start:stop]) if start < stop else None
+        for start, stop in zip(bounds[:-1], bounds[1:], strict=True)
+    ]
 
 
 class Murty:

@@ -27,7 +27,7 @@ unaffected.
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
 ranked once and shared by all hypotheses that contain it (``murty.Product``). The small sub-problems of all
-blocks are listed and sorted together, per row count, and larger ones share the rankings of equal smaller
+blocks are listed together, per row count, and larger ones share the rankings of equal smaller
 blocks (``murty.subset_rankings``, ``murty.BlockCache``); a ranking goes past its best only when a hypothesis
 has more than one child. The best assignments of all hypotheses are assembled block by block, at
 once; a hypothesis with more than one child gets a ``Product`` (``SharedRanking``). Posteriors

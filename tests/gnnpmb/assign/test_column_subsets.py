@@ -143,18 +143,21 @@ def test_ranks_of_several_column_subsets_equal_each_rank(max_increase):
     assert together > 50 and infeasible > 10
 
 
+@pytest.mark.parametrize("joint_limit", [4, 256])
 @pytest.mark.parametrize("max_increase", [math.inf, 1.5])
-def test_subset_rankings_of_several_blocks_equal_each_rank(max_increase, monkeypatch):
+def test_subset_rankings_of_several_blocks_equal_each_rank(max_increase, joint_limit, monkeypatch):
     """``subset_rankings`` over blocks of different shapes (worked on together per row count, padded to the
     widest) gives what ``ColumnSubsets.rank`` gives for each, solution for solution, ties included, None where
     it is infeasible; with a small enumeration limit some sub-problems are ranked one by one."""
     monkeypatch.setattr(murty, "ENUMERATION_LIMIT", 16)
+    monkeypatch.setattr(murty, "JOINT_LISTING_LIMIT", joint_limit)  # 4: many listed on their own
     rng = np.random.default_rng(13)
     kinds = {"single": 0, "listed": 0, "ranked": 0, "infeasible": 0}
     for trial in range(60):
         costs, patterns = [], []
         for _ in range(int(rng.integers(1, 9))):
-            n_rows, n_tracks = int(rng.integers(1, 5)), int(rng.integers(1, 9))
+            n_rows = int(rng.integers(1, 5))
+            n_tracks = int(rng.integers(1, 9 if n_rows > 1 else 30))  # one row: some over the limit
             shape = (n_rows, n_tracks)
             tracks = rng.integers(0, 4, size=shape).astype(float) if trial % 2 == 0 else rng.random(shape)
             tracks[rng.random(shape) < 0.3] = np.inf
@@ -162,7 +165,7 @@ def test_subset_rankings_of_several_blocks_equal_each_rank(max_increase, monkeyp
             private[np.arange(n_rows), np.arange(n_rows)] = rng.integers(0, 4, size=n_rows)
             private[rng.random((n_rows, n_rows)) < 0.1] = np.inf
             costs.append(np.hstack([tracks, private]))
-            patterns.append(rng.random(costs[-1].shape[1]) < 0.7)
+            patterns.append(np.concatenate([rng.random(n_tracks) < 0.7, np.ones(n_rows, dtype=bool)]))
         got = murty.subset_rankings(costs, patterns, max_increase)
         for cost, present, ranking in zip(costs, patterns, got, strict=True):
             try:
