@@ -408,12 +408,14 @@ def subset_rankings(
                     out[i] = SingleRow(costs[i][0, patterns[i]], int(at), max_increase)
             continue
         together = np.prod(counts[kept], axis=1, dtype=float) <= JOINT_LISTING_LIMIT
+        of_block: dict[int, list[int]] = {}  # the larger ones, by the block (cost array) they cut
         for k in kept[~together].tolist():
-            i = items[k]
-            try:
-                out[i] = Enumerated(costs[i][:, patterns[i]], None, max_increase)
-            except InfeasibleAssignment:
-                out[i] = None
+            of_block.setdefault(id(costs[items[k]]), []).append(items[k])
+        for cut in of_block.values():
+            for i, listed in zip(cut, _block_listings(costs[cut[0]], [patterns[i] for i in cut]), strict=True):
+                out[i] = (
+                    None if listed is None else Enumerated(costs[i][:, patterns[i]], None, max_increase, listed=listed)
+                )
         kept = kept[together]
         for k, listed in zip(kept.tolist(), _listed_subsets(stacked[kept], present[kept]), strict=True):
             i = items[k]
@@ -421,6 +423,31 @@ def subset_rankings(
                 out[i] = Enumerated(costs[i][:, patterns[i]], max_increase=max_increase, listed=listed)
     return out
 
+
+def _block_listings(cost: np.ndarray, patterns: list[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray] | None]:
+    """The listing and its costs that ``Enumerated(cost[:, present])`` makes of each column subset ``present``
+    of one (R, C) block (None where it has no assignment): for several subsets of a block of at most
+    ``SHARED_LISTING_LIMIT`` candidates, the block's listing masked per subset (its lexicographic order restricted
+    to a subset is the subset's own, and each cost the same sum of the same entries), else each its own."""
+    if len(patterns) < 2 or _candidates(cost) > SHARED_LISTING_LIMIT:
+        listings = [enumerate_assignments(cost[:, present] < np.inf) for present in patterns]
+        return [
+            (listed, cost[:, present][np.arange(cost.shape[0]), listed].sum(axis=1)) if len(listed) else None
+            for listed, present in zip(listings, patterns, strict=True)
+        ]
+    listed = enumerate_assignments(cost < np.inf)
+    totals = cost[np.arange(cost.shape[0]), listed].sum(axis=1)
+    out: list[tuple[np.ndarray, np.ndarray] | None] = []
+    for present in patterns:
+        valid = present[listed].all(axis=1)
+        local = (np.cumsum(present) - 1)[listed[valid]]
+        out.append((local, totals[valid]) if valid.any() else None)
+    return out
+
+
+SHARED_LISTING_LIMIT = 4096
+"""``_block_listings`` lists a block once for several of its column subsets when it has at most this many
+candidates."""
 
 JOINT_LISTING_LIMIT = 256
 """``subset_rankings`` lists sub-problems of at most this many candidates together (``_listed_subsets``), larger

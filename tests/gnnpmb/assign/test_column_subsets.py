@@ -113,10 +113,14 @@ def test_enumerated_with_a_root_defers_listing_and_agrees_with_its_listing():
         assert all_solutions(lazy) == all_solutions(eager)
 
 
+@pytest.mark.parametrize(("joint_limit", "shared_limit"), [(256, 4096), (0, 4096), (0, 0)])
 @pytest.mark.parametrize("max_increase", [math.inf, 1.5])
-def test_ranks_of_several_column_subsets_equal_each_rank(max_increase):
-    """``ColumnSubsets.ranks`` (best assignments of small subsets from one listing of the block) gives what
-    ``rank`` gives for each subset, solution for solution, ties included, None where it is infeasible."""
+def test_ranks_of_several_column_subsets_equal_each_rank(max_increase, joint_limit, shared_limit, monkeypatch):
+    """``ColumnSubsets.ranks`` (small subsets listed side by side, or from one listing of the block, or each on
+    its own) gives what ``rank`` gives for each subset, solution for solution, ties included, None where it is
+    infeasible."""
+    monkeypatch.setattr(murty, "JOINT_LISTING_LIMIT", joint_limit)
+    monkeypatch.setattr(murty, "SHARED_LISTING_LIMIT", shared_limit)
     rng = np.random.default_rng(11)
     together = infeasible = 0
     for trial in range(200):
