@@ -9,8 +9,9 @@ queue; the next best solution overall is the queue's minimum.
 
 Speed-ups in the spirit of Miller, Stone & Cox (1997), "Optimizing Murty's ranked assignment method", IEEE
 T-AES 33(3): rows pinned by the partition and their columns are removed from the subproblem, a subproblem
-whose constrained row has no allowed column is skipped unsolved, a single free row is solved by argmin, and
-solutions are ranked lazily, only as deep as asked. Above all, gating makes tracking matrices block diagonal:
+whose constrained row has no allowed column is skipped unsolved, a single free row is solved by argmin, a
+subproblem is solved only when a lower bound on its cost reaches the front of the queue, and solutions are ranked
+lazily, only as deep as asked. Above all, gating makes tracking matrices block diagonal:
 rows and columns joined by finite entries form independent blocks (``blocks``), an assignment is one solution
 per block and its cost the sum, so the ranked assignments are the smallest sums over per-block rankings
 (``Product``, a lazy heap over index tuples). A block is ranked by ``Murty``, or, when its candidate
@@ -132,7 +133,7 @@ def rank(
                 local_of_col[cols] = np.arange(len(cols))
                 root = local_of_col[first[rows]]
             candidates = float(np.prod(counts[rows], dtype=float))  # its columns are all its rows' allowed ones
-            ranking = _block_ranking(cost[np.ix_(rows, cols)], root, max_increase, cache, candidates)
+            ranking = _block_ranking(cost[rows[:, None], cols], root, max_increase, cache, candidates)
             base[rows] = cols[ranking.solution(0)[0]]
         parts.append((rows, cols, ranking))
     return Product(base, parts, max_increase)
@@ -263,7 +264,8 @@ class Enumerated:
 
     Work is done on demand: with a ``root``, nothing is listed until a second solution is asked for (the root's
     cost is summed as one row of the listing's cost array); without, the costs are listed and the best is the
-    first cheapest (as the stable sort puts it); the rest are sorted when first asked for.
+    first cheapest (as the stable sort puts it); the rest are sorted when first asked for. ``listed``: the
+    listing (N, R) and its costs (N,), already worked out (``subset_rankings``).
     """
 
     def __init__(
@@ -272,6 +274,7 @@ class Enumerated:
         root: np.ndarray | None = None,
         max_increase: float = math.inf,
         combos: np.ndarray | None = None,
+        listed: tuple[np.ndarray, np.ndarray] | None = None,
     ):
         self._cost = cost
         self._root = root
@@ -280,6 +283,8 @@ class Enumerated:
         self._listed_costs: np.ndarray | None = None
         self._combos: np.ndarray | None = None
         self._costs: np.ndarray | None = None
+        if listed is not None:
+            self._listed, self._listed_costs = listed
         if root is not None and combos is None:
             self._best = root, float(cost[np.arange(cost.shape[0]), root[None, :]].sum(axis=1)[0])
             return
@@ -323,10 +328,11 @@ class ColumnSubsets:
     of the union of all hypotheses' Bernoullis, cut to the Bernoullis one hypothesis holds).
 
     ``rank(present)`` gives the ranking ``rank(cost[:, present], max_increase=max_increase)`` gives, solution
-    for solution. Small sub-problems are listed on their own (``Enumerated``: filtering one listing of the whole
-    block per subset was measured slower, since the block's listing is much longer than a subset's). Larger
-    ones are split by ``rank`` into blocks, most of them the same for many subsets: ``cache`` (shared, e.g. by
-    every block of a PMBM frame) ranks each distinct one once.
+    for solution. Small sub-problems are listed on their own (``Enumerated``), several at once side by side
+    (``subset_rankings``; filtering one listing of the whole block per subset was measured slower, since the
+    block's listing is much longer than a subset's). Larger ones are split by ``rank`` into blocks, most of them
+    the same for many subsets: ``cache`` (shared, e.g. by every block of a PMBM frame) ranks each distinct one
+    once.
     """
 
     def __init__(self, cost: np.ndarray, max_increase: float = math.inf, cache: BlockCache | None = None):
@@ -350,68 +356,154 @@ class ColumnSubsets:
 
     def ranks(self, patterns: np.ndarray) -> list[Ranking | None]:
         """``rank(present)`` of every row of ``patterns`` ((P, C) bool), None where it raises
-        ``InfeasibleAssignment``.
+        ``InfeasibleAssignment`` (``subset_rankings``: the small ones found together)."""
+        return subset_rankings([self.cost] * len(patterns), list(patterns), self.max_increase, self.cache)
 
-        The best assignments of the small sub-problems of two or more rows (those ``rank`` lists) are found
-        together when the whole block's listing is short (``SHARED_LISTING_LIMIT``): one listing and its costs,
-        masked per pattern, the first cheapest of each (the listing's order restricted to a pattern is that
-        pattern's own lexicographic order, and each cost is the same sum of the same entries). Each gets an
-        ``Enumerated`` with that best as its root, which lists nothing more unless asked for a second solution.
-        A one-row block gives each pattern its ``SingleRow`` from one masked argmin."""
-        n_rows = self.cost.shape[0]
-        if n_rows == 1 and self.cost.shape[1] <= ENUMERATION_LIMIT:  # each pattern's SingleRow (``rank``)
-            row = np.where(patterns, self.cost[0], np.inf)
-            cheapest = np.argmin(row, axis=1)
-            local = (np.cumsum(patterns, axis=1) - 1)[np.arange(len(patterns)), cheapest]
-            return [
-                SingleRow(self.cost[0, present], int(at), self.max_increase) if row[p, c] < np.inf else None
-                for p, (present, c, at) in enumerate(zip(patterns, cheapest.tolist(), local.tolist(), strict=True))
-            ]
-        counts = (self.allowed[None, :, :] & patterns[:, None, :]).sum(axis=2)
-        listed_together = np.zeros(len(patterns), dtype=bool)
-        if n_rows >= 2 and _candidates(self.cost) <= SHARED_LISTING_LIMIT:
-            listed_together = np.prod(counts, axis=1, dtype=float) <= ENUMERATION_LIMIT
-        out: list[Ranking | None] = [None] * len(patterns)
-        for p in np.flatnonzero(~listed_together).tolist():
+
+def subset_rankings(
+    costs: list[np.ndarray],
+    patterns: list[np.ndarray],
+    max_increase: float = math.inf,
+    cache: BlockCache | None = None,
+) -> list[Ranking | None]:
+    """``ColumnSubsets(costs[i], max_increase, cache).rank(patterns[i])`` for every i ((R_i, C_i) blocks, (C_i,)
+    bool columns kept), None where it raises ``InfeasibleAssignment``.
+
+    Sub-problems with the same number of rows are worked on together, padded with absent columns to the widest:
+    those of one row get their ``SingleRow`` from one masked argmin; the small ones of several rows (whose
+    candidates ``rank`` would list) are listed together when they have at most ``JOINT_LISTING_LIMIT``
+    candidates (``_listed_subsets``; listing a whole block once and masking it per subset costs more when the
+    block has many more candidates than its subsets), else on their own; the others are ranked one by one.
+    """
+    out: list[Ranking | None] = [None] * len(costs)
+    by_rows: dict[int, list[int]] = {}
+    for i, cost in enumerate(costs):
+        by_rows.setdefault(cost.shape[0], []).append(i)
+    for n_rows, items in by_rows.items():
+        width = max(costs[i].shape[1] for i in items)
+        stacked = np.full((len(items), n_rows, width), np.inf)
+        present = np.zeros((len(items), width), dtype=bool)
+        for k, i in enumerate(items):
+            n_cols = costs[i].shape[1]
+            stacked[k, :, :n_cols] = costs[i]
+            present[k, :n_cols] = patterns[i]
+        counts = ((stacked < np.inf) & present[:, None, :]).sum(axis=2)
+        small = (np.prod(counts, axis=1, dtype=float) <= ENUMERATION_LIMIT) & (n_rows >= 1)
+        for k in np.flatnonzero(~small).tolist():
+            i = items[k]
             try:
-                out[p] = self.rank(patterns[p])
+                out[i] = rank(costs[i][:, patterns[i]], max_increase=max_increase, cache=cache)
             except InfeasibleAssignment:
-                out[p] = None
-        if listed_together.sum() < 2:
-            for p in np.flatnonzero(listed_together).tolist():
-                try:
-                    out[p] = self.rank(patterns[p])
-                except InfeasibleAssignment:
-                    out[p] = None
-            return out
-        together = np.flatnonzero(listed_together)
-        listed = enumerate_assignments(self.allowed)
-        if not len(listed):  # no assignment of the block, so none of a subset
-            return out
-        costs = self.cost[np.arange(n_rows), listed].sum(axis=1)
-        valid = patterns[together][:, listed].all(axis=2)
-        first_cheapest = np.argmin(np.where(valid, costs, np.inf), axis=1)
-        local_of_col = np.cumsum(patterns[together], axis=1) - 1
-        roots = local_of_col[np.arange(len(together))[:, None], listed[first_cheapest]]
-        feasible = valid[np.arange(len(together)), first_cheapest]
-        for i, p in enumerate(together.tolist()):
-            if feasible[i]:
-                out[p] = Enumerated(self.cost[:, patterns[p]], roots[i], self.max_increase)
-        return out
+                out[i] = None
+        kept = np.flatnonzero(small)
+        if not len(kept):
+            continue
+        if n_rows == 1:
+            row = np.where(present[kept], stacked[kept, 0], np.inf)
+            cheapest = np.argmin(row, axis=1)
+            local = (np.cumsum(present[kept], axis=1) - 1)[np.arange(len(kept)), cheapest]
+            for j, (k, c, at) in enumerate(zip(kept.tolist(), cheapest.tolist(), local.tolist(), strict=True)):
+                i = items[k]
+                if row[j, c] < np.inf:
+                    out[i] = SingleRow(costs[i][0, patterns[i]], int(at), max_increase)
+            continue
+        together = np.prod(counts[kept], axis=1, dtype=float) <= JOINT_LISTING_LIMIT
+        of_block: dict[int, list[int]] = {}  # the larger ones, by the block (cost array) they cut
+        for k in kept[~together].tolist():
+            of_block.setdefault(id(costs[items[k]]), []).append(items[k])
+        for cut in of_block.values():
+            for i, listed in zip(cut, _block_listings(costs[cut[0]], [patterns[i] for i in cut]), strict=True):
+                out[i] = (
+                    None if listed is None else Enumerated(costs[i][:, patterns[i]], None, max_increase, listed=listed)
+                )
+        kept = kept[together]
+        for k, listed in zip(kept.tolist(), _listed_subsets(stacked[kept], present[kept]), strict=True):
+            i = items[k]
+            if listed is not None:
+                out[i] = Enumerated(costs[i][:, patterns[i]], max_increase=max_increase, listed=listed)
+    return out
+
+
+def _block_listings(cost: np.ndarray, patterns: list[np.ndarray]) -> list[tuple[np.ndarray, np.ndarray] | None]:
+    """The listing and its costs that ``Enumerated(cost[:, present])`` makes of each column subset ``present``
+    of one (R, C) block (None where it has no assignment): for several subsets of a block of at most
+    ``SHARED_LISTING_LIMIT`` candidates, the block's listing masked per subset (its lexicographic order restricted
+    to a subset is the subset's own, and each cost the same sum of the same entries), else each its own."""
+    if len(patterns) < 2 or _candidates(cost) > SHARED_LISTING_LIMIT:
+        listings = [enumerate_assignments(cost[:, present] < np.inf) for present in patterns]
+        return [
+            (listed, cost[:, present][np.arange(cost.shape[0]), listed].sum(axis=1)) if len(listed) else None
+            for listed, present in zip(listings, patterns, strict=True)
+        ]
+    listed = enumerate_assignments(cost < np.inf)
+    totals = cost[np.arange(cost.shape[0]), listed].sum(axis=1)
+    out: list[tuple[np.ndarray, np.ndarray] | None] = []
+    for present in patterns:
+        valid = present[listed].all(axis=1)
+        local = (np.cumsum(present) - 1)[listed[valid]]
+        out.append((local, totals[valid]) if valid.any() else None)
+    return out
 
 
 SHARED_LISTING_LIMIT = 4096
-"""``ColumnSubsets.ranks`` finds the best assignments of several small column subsets from one listing of the
-whole block when that block has at most this many candidates."""
+"""``_block_listings`` lists a block once for several of its column subsets when it has at most this many
+candidates."""
+
+JOINT_LISTING_LIMIT = 256
+"""``subset_rankings`` lists sub-problems of at most this many candidates together (``_listed_subsets``), larger
+ones on their own (``Enumerated``). Measured on this machine: 51k candidates of 66 sub-problems of 4 rows took
+15.5 ms listed together and 7.4 ms listed one by one, while many small sub-problems (the stress frame of
+``benchmarks/tracker_speed.py``) gain from one call; of 64, 128, 256 and 1024, 256 was fastest on both."""
+
+
+def _listed_subsets(costs: np.ndarray, patterns: np.ndarray) -> list[tuple[np.ndarray, np.ndarray] | None]:
+    """The listing and its costs that ``Enumerated(costs[p][:, patterns[p]])`` makes, of P sub-problems
+    (``costs`` (P, R, C), ``patterns`` (P, C) bool, R >= 2): every assignment (N_p, R), as columns of the
+    sub-problem, in lexicographic order, and its cost (N_p,); None where one has no assignment.
+
+    All are listed together, in a fixed number of NumPy calls: sub-problem p's candidates are the index tuples
+    of its rows' allowed columns in C order (as ``enumerate_assignments``: lexicographic), numbered
+    0 .. n_p - 1 and laid end to end; a tuple's digits are its number in the mixed radix of the rows' counts.
+    Each cost is summed from the same entries in the same order as the sub-problem's own listing sums them (an
+    (N, R) array reduced along its rows), so the floats are equal. Nothing is sorted here: ``Enumerated``
+    finds the best by argmin and sorts only when asked for a second solution, as most are not.
+    """
+    n_patterns, n_rows = costs.shape[0], costs.shape[1]
+    allowed = (costs < np.inf) & patterns[:, None, :]  # (P, R, C)
+    counts = allowed.sum(axis=2)  # (P, R)
+    _, _, cols = np.nonzero(allowed)  # allowed columns by sub-problem, row, column
+    starts = (np.cumsum(counts.ravel()) - counts.ravel()).reshape(counts.shape)
+    later = np.cumprod(counts[:, ::-1], axis=1)[:, ::-1]  # (P, R): products of the counts of rows >= r
+    n_listed = later[:, 0]
+    strides = np.concatenate([later[:, 1:], np.ones((n_patterns, 1), dtype=later.dtype)], axis=1)
+    pattern = np.repeat(np.arange(n_patterns), n_listed)
+    number = np.arange(len(pattern)) - np.repeat(np.cumsum(n_listed) - n_listed, n_listed)
+    digits = (number[:, None] // strides[pattern]) % np.maximum(counts[pattern], 1)
+    combos = cols[starts[pattern] + digits]  # (N, R) columns of the block
+    ordered = np.sort(combos, axis=1)
+    distinct = np.flatnonzero((ordered[:, 1:] != ordered[:, :-1]).all(axis=1))
+    combos, pattern = combos[distinct], pattern[distinct]
+    total = costs[pattern[:, None], np.arange(n_rows), combos].sum(axis=1)
+    bounds = np.searchsorted(pattern, np.arange(n_patterns + 1)).tolist()
+    local = (np.cumsum(patterns, axis=1) - 1)[pattern[:, None], combos]
+    return [
+        (local[start:stop], total[start:stop]) if start < stop else None
+        for start, stop in zip(bounds[:-1], bounds[1:], strict=True)
+    ]
 
 
 class Murty:
     """Ranking of one (r, c) block by Murty's partitioning (module docstring); ``root`` is a best assignment.
 
-    A queued subproblem is (cost, serial, best solution, p, barred): rows < p pinned to the solution's
-    columns, row p may not take the columns in ``barred``; ``serial`` makes equal costs pop first in, first
-    out. The latest solution is partitioned only when a further one is asked for; subproblems costing more
-    than the root plus ``max_increase`` are not queued.
+    A queued subproblem is (key, serial, solved, state): rows < p pinned to the solution's columns, row p may
+    not take the columns in ``barred``; ``serial`` (the order subproblems are made in) makes equal costs pop first
+    in, first out. The latest solution is partitioned only when a further one is asked for, and a subproblem is
+    solved only when it reaches the front of the queue (lazy evaluation, Miller, Stone & Cox 1997): until then
+    its key is a lower bound on its cost, the pinned rows' cost plus every other row's cheapest column still
+    free, less a margin far above rounding error. A solved one is queued again under its cost, if within the
+    root plus ``max_increase``. Keys never exceed costs, so a solved subproblem reaches the front only when every
+    unsolved one would cost more, or as much and was made later: the solutions come in the order of solving
+    every subproblem at once and queueing them by (cost, serial), as plain Murty does.
     """
 
     def __init__(self, cost: np.ndarray, root: np.ndarray, max_increase: float = math.inf):
@@ -419,7 +511,8 @@ class Murty:
         self._arange = np.arange(cost.shape[0])
         self.solutions: list[tuple[np.ndarray, float]] = [(root, self._total(root))]
         self._limit = self.solutions[0][1] + max_increase
-        self._queue: list[tuple[float, int, np.ndarray, int, tuple[int, ...]]] = []
+        self._margin = 1e-9 * (1.0 + float(np.abs(cost[cost < np.inf]).sum()))  # >> rounding error of any sum
+        self._queue: list[tuple[float, int, bool, tuple]] = []
         self._serial = 0
         self._unexpanded: tuple[np.ndarray, int, tuple[int, ...]] | None = (root, 0, ())
 
@@ -431,31 +524,51 @@ class Murty:
             if self._unexpanded is not None:
                 self._expand(*self._unexpanded)
                 self._unexpanded = None
-            if not self._queue:
-                return None
-            total, _, sol, pinned, barred = heapq.heappop(self._queue)
-            self.solutions.append((sol, total))
+            while True:
+                if not self._queue:
+                    return None
+                key, serial, solved, state = heapq.heappop(self._queue)
+                if solved:
+                    break
+                self._solve(serial, *state)
+            sol, pinned, barred = state
+            self.solutions.append((sol, key))
             self._unexpanded = (sol, pinned, barred)
         return self.solutions[index]
 
     def _expand(self, sol: np.ndarray, pinned: int, barred: tuple[int, ...]) -> None:
-        """Queue the best solution of every subproblem P_q, q = pinned .. r-1, that partitions the rest of the
-        subproblem (pinned, barred) whose best is ``sol``."""
+        """Queue, unsolved, every subproblem P_q, q = pinned .. r-1, that partitions the rest of the subproblem
+        (pinned, barred) whose best is ``sol``, keyed by a lower bound on its cost; those with a row that has no
+        column left, or whose bound exceeds the limit, are not queued (they have no solution within it)."""
         cost = self.cost
         n_rows = cost.shape[0]
-        free = np.ones(cost.shape[1], dtype=bool)
-        free[sol[:pinned]] = False
-        for q in range(pinned, n_rows):
-            row_barred = (*barred, int(sol[q])) if q == pinned else (int(sol[q]),)
-            row = np.where(free, cost[q], np.inf)
-            row[list(row_barred)] = np.inf
-            if np.isfinite(row).any():
-                self._push_child(sol, q, row, free, row_barred)
-            free[sol[q]] = False
+        n_sub = n_rows - pinned
+        index = np.arange(n_sub)
+        after = index[None, :] > index[:, None]  # (i, i'): row pinned + i' comes after row pinned + i
+        free = np.ones((n_sub, cost.shape[1]), dtype=bool)  # row i: the columns free for row pinned + i
+        free[:, sol[:pinned]] = False
+        earlier, later = np.nonzero(after.T)
+        free[earlier, sol[pinned + later]] = False  # rows before pinned + i keep their columns
+        rows = np.where(free, cost[pinned:], np.inf)
+        rows[index, sol[pinned:]] = np.inf
+        rows[0, list(barred)] = np.inf
+        taken = cost[self._arange, sol]
+        pinned_cost = np.cumsum(taken)[pinned:] - taken[pinned:]
+        cheapest_later = np.where(free[:, None, :], cost[None, pinned:, :], np.inf).min(axis=2)  # (i, row)
+        bound = pinned_cost + rows.min(axis=1) + np.where(after, cheapest_later, 0.0).sum(axis=1)
+        keys = bound - self._margin
+        for i in np.flatnonzero(np.isfinite(bound) & (keys <= self._limit)).tolist():
+            q = pinned + i
+            row_barred = (*barred, int(sol[q])) if i == 0 else (int(sol[q]),)
+            key = float(keys[i])
+            heapq.heappush(self._queue, (key, self._serial, False, (sol, q, rows[i], free[i], row_barred)))
+            self._serial += 1
 
-    def _push_child(self, sol: np.ndarray, q: int, row: np.ndarray, free: np.ndarray, barred: tuple[int, ...]) -> None:
+    def _solve(
+        self, serial: int, sol: np.ndarray, q: int, row: np.ndarray, free: np.ndarray, barred: tuple[int, ...]
+    ) -> None:
         """Solve P_q: rows < q keep ``sol``, row q costs ``row`` (barred and taken columns at +inf), later
-        rows use the free columns; queue its best solution if one exists within the limit."""
+        rows use the free columns; queue its best solution, solved, if one exists within the limit."""
         child = sol.copy()
         if q == len(sol) - 1:
             child[q] = int(np.argmin(row))
@@ -470,8 +583,7 @@ class Murty:
             child[q:] = sub_cols[picked]
         total = self._total(child)
         if total <= self._limit and total < np.inf:
-            heapq.heappush(self._queue, (total, self._serial, child, q, barred))
-            self._serial += 1
+            heapq.heappush(self._queue, (total, serial, True, (child, q, barred)))
 
 
 @dataclass(frozen=True, slots=True)

@@ -271,7 +271,8 @@ def posteriors_from_assignments(
     hyp_of_birth = np.repeat(np.arange(n_hyp), n_births)
     birth_starts = np.cumsum(n_births) - n_births
     rows[(starts + lengths)[hyp_of_birth] + np.arange(len(birth_j)) - birth_starts[hyp_of_birth]] = birth_rows
-    return store, np.split(rows, np.cumsum(sizes)[:-1].tolist())
+    bounds = np.cumsum(sizes).tolist()
+    return store, [rows[start:stop] for start, stop in zip([0, *bounds[:-1]], bounds, strict=True)]
 
 
 def _unique_codes(codes: np.ndarray, n_codes: int) -> tuple[np.ndarray, np.ndarray]:

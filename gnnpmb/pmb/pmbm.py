@@ -26,10 +26,10 @@ unaffected.
 
 Speed: the hypotheses share most Bernoullis, so the core gates them as one union (``core.HypothesisLocals``),
 whose cost matrix is split once into gated blocks; every distinct (block, Bernoullis present) sub-problem is
-ranked once and shared by all hypotheses that contain it (``murty.Product``). The small sub-problems of one
-block get their best assignments from one listing of the block, and larger ones share the rankings of equal
-smaller blocks (``murty.ColumnSubsets.ranks``, ``murty.BlockCache``); a ranking goes past its best only when a
-hypothesis has more than one child. The best assignments of all hypotheses are assembled block by block, at
+ranked once and shared by all hypotheses that contain it (``murty.Product``). The small sub-problems of all
+blocks are listed together, per row count, and larger ones share the rankings of equal smaller
+blocks (``murty.subset_rankings``, ``murty.BlockCache``); a ranking goes past its best only when a hypothesis
+has more than one child. The best assignments of all hypotheses are assembled block by block, at
 once; a hypothesis with more than one child gets a ``Product`` (``SharedRanking``). Posteriors
 are built once per distinct (Bernoulli, outcome) into one store that the posterior hypotheses index
 (``core.posteriors_from_assignments``, ``core.GlobalHypothesis``). These pieces only share work: each gives
@@ -44,19 +44,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gnnpmb.assign.clusters import Cluster
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
 from gnnpmb.assign.murty import (
-    ENUMERATION_LIMIT,
     BlockCache,
     ColumnSubsets,
     PartsSummary,
     Product,
     Ranking,
-    SingleRow,
     blocks,
     forbid_beyond_private,
     k_best,
-    rank,
+    subset_rankings,
 )
 from gnnpmb.config import PmbmParams
 from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
@@ -175,9 +174,9 @@ class KBest:
             shared = SharedRanking(union, members, self._max_increase, self.murty_block_rows)
             ranked = shared.k_best(budgets)
         children: list[_Child] = []
+        bases = (prior_log_w + _sums_of_rows(union.miss_log_lik, members)).tolist()  # + sum_k log l_k0
         for h, assignments in enumerate(ranked):
-            base = float(prior_log_w[h]) + float(union.miss_log_lik[members[h]].sum())  # sum_k log l_k0
-            children.extend(_Child(base - total, h, col_of_row, total) for col_of_row, total in assignments)
+            children.extend(_Child(bases[h] - total, h, col_of_row, total) for col_of_row, total in assignments)
         kept, log_w = self._select(_merge_identical(children, union, members, ctx))
         store, rows = posteriors_from_assignments(
             union, [members[c.parent] for c in kept], [c.col_of_row for c in kept], ctx
@@ -212,6 +211,19 @@ class KBest:
         keep = (keep if len(keep) else order[:1])[: self.params.n_hypotheses]
         kept_log_w = log_w[keep] - log_sum_exp(log_w[keep])
         return [children[i] for i in keep], kept_log_w
+
+
+def _sums_of_rows(values: np.ndarray, members: list[np.ndarray]) -> np.ndarray:
+    """(H,) ``values[members[h]].sum()`` for every h, bit for bit: the members of equal length L are gathered
+    into one (n, L) array and summed along its rows, which NumPy sums as it sums each (L,) array."""
+    lengths = np.array([len(index) for index in members], dtype=np.int64)
+    gathered = values[np.concatenate(members)] if len(members) else values[:0]
+    starts = np.cumsum(lengths) - lengths
+    out = np.zeros(len(members))
+    for length in np.unique(lengths).tolist():
+        of_length = np.flatnonzero(lengths == length)
+        out[of_length] = gathered[starts[of_length][:, None] + np.arange(length)].sum(axis=1)
+    return out
 
 
 def _trim_budgets(budgets: list[int], log_weights: np.ndarray, keep: int) -> list[int]:
@@ -266,8 +278,8 @@ class SharedRanking:
         cost = union.cost_matrix()
         has_column = np.ones((len(members), cost.shape[1]), dtype=bool)
         has_column[:, : self.n_union] = False
-        for h, index in enumerate(members):
-            has_column[h, index] = True
+        lengths = [len(index) for index in members]
+        has_column[np.repeat(np.arange(len(members)), lengths), np.concatenate(members)] = True
         cost = forbid_beyond_private(cost, max_increase, usable=has_column.all(axis=0))
         self.cost = cost
         self.common: list[tuple[np.ndarray, np.ndarray, Ranking | None]] = []
@@ -279,16 +291,26 @@ class SharedRanking:
         self._parts: dict[tuple[int, int], tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
         self._blocks: BlockCache = {}
         self._common: PartsSummary | None = None
+        self._summaries: dict[tuple[int, int], tuple[float, float | None]] = {}
+        """Per (varying block, pattern) ranked past its best: its best cost and cost(1) - cost(0) (None if it has
+        no second solution), what ``murty.PartsSummary`` reads of it."""
+        found = blocks(cost)
         varies = has_column.any(axis=0) & ~has_column.all(axis=0)  # columns only some hypotheses hold
-        for rows, cols in blocks(cost):
+        block_of_col = np.full(cost.shape[1], -1, dtype=np.int64)
+        for b, (_, cols) in enumerate(found):
+            block_of_col[cols] = b
+        is_varying = np.zeros(len(found), dtype=bool)
+        is_varying[block_of_col[varies & (block_of_col >= 0)]] = True
+        common = _common_parts(cost, found, ~is_varying, has_column[0], max_increase, max_block_rows, self._blocks)
+        patterns = _presence_patterns(has_column, found, is_varying)
+        for b, (rows, cols) in enumerate(found):
             best_only = len(rows) > max_block_rows
-            if not varies[cols].any():
-                self.common.append(_part(cost, rows, cols, has_column[0, cols], max_increase, best_only))
+            if not is_varying[b]:
+                self.common.append(common[b])
                 continue
-            present = has_column[:, cols]
-            _, first, pattern = np.unique(_row_keys(present), return_index=True, return_inverse=True)
-            subsets = None if best_only else ColumnSubsets(cost[np.ix_(rows, cols)], max_increase, self._blocks)
-            self.varying.append((rows, cols, present[first], pattern.ravel(), subsets))
+            first, pattern = patterns[b]
+            subsets = None if best_only else ColumnSubsets(cost[rows[:, None], cols], max_increase, self._blocks)
+            self.varying.append((rows, cols, has_column[first[:, None], cols], pattern, subsets))
         self.common_base = np.zeros(self.n_meas, dtype=np.int64)
         self.common_ok = all(ranking is not None for _, _, ranking in self.common)
         self.common_best: tuple[float, ...] = ()
@@ -331,7 +353,7 @@ class SharedRanking:
             rows, cols, patterns, _, subsets = self.varying[b]
             present = patterns[p]
             if subsets is None:
-                self._parts[key] = _part(self.cost, rows, cols, present, self.max_increase, True)
+                self._parts[key] = _best_only_part(self.cost, rows, cols, present)
             else:
                 try:
                     self._parts[key] = rows, cols[present], subsets.rank(present)
@@ -349,17 +371,14 @@ class SharedRanking:
         for best_cost in self.common_best:
             totals += best_cost
         feasible = np.ones(len(hypotheses), dtype=bool)
-        for b, (rows, cols, patterns, pattern, subsets) in enumerate(self.varying):
+        used = [np.unique(pattern[hypotheses]).tolist() for _, _, _, pattern, _ in self.varying]
+        self._rank_together(used)
+        for b, (rows, _, patterns, pattern, _) in enumerate(self.varying):
             of_hypothesis = pattern[hypotheses]
             cols_of = np.zeros((len(patterns), len(rows)), dtype=np.int64)
             cost_of = np.zeros(len(patterns))
             ok_of = np.zeros(len(patterns), dtype=bool)
-            used = np.unique(of_hypothesis).tolist()
-            unranked = [p for p in used if (b, p) not in self._parts]
-            if subsets is not None and len(unranked) > 1:  # ranked together (``murty.ColumnSubsets.ranks``)
-                for p, ranking in zip(unranked, subsets.ranks(patterns[unranked]), strict=True):
-                    self._parts[(b, p)] = rows, cols[patterns[p]], ranking
-            for p in used:
+            for p in used[b]:
                 _, part_cols, ranking = self._varying_part(b, p)
                 if ranking is not None:
                     best, cost = ranking.solution(0)
@@ -369,11 +388,41 @@ class SharedRanking:
             feasible &= ok_of[of_hypothesis]
         return bases, totals, feasible
 
+    def _rank_together(self, used: list[list[int]]) -> None:
+        """Rank the patterns ``used[b]`` of every varying block b not ranked yet, all blocks at once
+        (``murty.subset_rankings``: the small sub-problems of equal row counts are worked on together)."""
+        todo = [
+            (b, p)
+            for b, patterns in enumerate(used)
+            if self.varying[b][4] is not None
+            for p in patterns
+            if (b, p) not in self._parts
+        ]
+        costs = [self.varying[b][4].cost for b, _ in todo]
+        present = [self.varying[b][2][p] for b, p in todo]
+        rankings = subset_rankings(costs, present, self.max_increase, self._blocks)
+        for (b, p), keep, ranking in zip(todo, present, rankings, strict=True):
+            rows, cols, *_ = self.varying[b]
+            self._parts[(b, p)] = rows, cols[keep], ranking
+
     def _ranked(self, h: int, k: int, base: np.ndarray) -> list[tuple[np.ndarray, float]]:
         """The k best assignments of feasible hypothesis ``h``, whose best is ``base``."""
-        varying = [self._varying_part(b, int(pattern[h])) for b, (*_, pattern, _) in enumerate(self.varying)]
-        parts = self.common + varying
-        product = Product(base, parts, self.max_increase, self._common_summary())
+        common = self._common_summary()
+        best_costs, steps = list(common.best_costs), list(common.steps)
+        varying = []
+        for b, (*_, pattern, _) in enumerate(self.varying):
+            p = int(pattern[h])
+            varying.append(self._varying_part(b, p))
+            if (b, p) not in self._summaries:
+                ranking = varying[-1][2]  # not None: a feasible hypothesis' parts are feasible
+                best, second = ranking.solution(0)[1], ranking.solution(1)
+                self._summaries[(b, p)] = best, None if second is None else second[1] - best
+            best, step = self._summaries[(b, p)]
+            best_costs.append(best)
+            if step is not None:
+                steps.append((step, len(self.common) + b))
+        summary = PartsSummary(tuple(best_costs), tuple(steps))  # what PartsSummary.of(parts) works out
+        product = Product(base, self.common + varying, self.max_increase, summary)
         out = []
         for i in range(k):
             found = product.solution(i)
@@ -393,6 +442,70 @@ class BestOnly:
         return self._best if index == 0 else None
 
 
+def _common_parts(
+    cost: np.ndarray,
+    found: list[Cluster],
+    wanted: np.ndarray,
+    present: np.ndarray,
+    max_increase: float,
+    max_block_rows: int,
+    cache: BlockCache,
+) -> dict[int, tuple[np.ndarray, np.ndarray, Ranking | None]]:
+    """(rows, columns, ranking or None if infeasible) of every ``wanted`` block of ``found`` cut to its
+    ``present`` columns, by block index: ``murty.rank`` of the cut matrix up to ``max_increase`` above its best,
+    all blocks within the per-frame budget together (``murty.subset_rankings``), or ``_best_only_part``."""
+    out: dict[int, tuple[np.ndarray, np.ndarray, Ranking | None]] = {}
+    ranked = []
+    for b in np.flatnonzero(wanted).tolist():
+        rows, cols = found[b]
+        if len(rows) > max_block_rows:
+            out[b] = _best_only_part(cost, rows, cols, present[cols])
+        else:
+            ranked.append(b)
+    costs = [cost[found[b][0][:, None], found[b][1]] for b in ranked]
+    keep = [present[found[b][1]] for b in ranked]
+    for b, kept, ranking in zip(ranked, keep, subset_rankings(costs, keep, max_increase, cache), strict=True):
+        rows, cols = found[b]
+        out[b] = rows, cols[kept], ranking
+    return out
+
+
+def _presence_patterns(
+    has_column: np.ndarray, found: list[Cluster], wanted: np.ndarray
+) -> dict[int, tuple[np.ndarray, np.ndarray]]:
+    """Per ``wanted`` block b of ``found``: ``np.unique(_row_keys(has_column[:, cols]), return_index=True,
+    return_inverse=True)``'s first occurrences (P,) and inverse (H,): the hypotheses that first hold each
+    distinct set of the block's columns, in the order of the sets' keys, and each hypothesis' set. The blocks of
+    at most 64 columns are done together: their keys, sorted column by column (stable, so a set's first
+    hypothesis leads it)."""
+    out: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    narrow = []
+    for b in np.flatnonzero(wanted).tolist():
+        cols = found[b][1]
+        if len(cols) <= 64:
+            narrow.append(b)
+            continue
+        _, first, pattern = np.unique(_row_keys(has_column[:, cols]), return_index=True, return_inverse=True)
+        out[b] = first, pattern.ravel()
+    if not narrow:
+        return out
+    widths = [len(found[b][1]) for b in narrow]
+    cols = np.concatenate([found[b][1] for b in narrow])
+    starts = np.cumsum(widths) - widths
+    shift = (63 - (np.arange(len(cols)) - np.repeat(starts, widths))).astype(np.uint64)
+    bits = has_column[:, cols].astype(np.uint64) << shift  # column i of a block at bit 63 - i: ``_row_keys``
+    keys = np.bitwise_or.reduceat(bits, starts, axis=1)  # (H, blocks)
+    order = np.argsort(keys, axis=0, kind="stable")
+    ordered = np.take_along_axis(keys, order, axis=0)
+    starts_set = np.ones(keys.shape, dtype=bool)
+    starts_set[1:] = ordered[1:] != ordered[:-1]
+    pattern = np.empty(keys.shape, dtype=np.int64)
+    np.put_along_axis(pattern, order, np.cumsum(starts_set, axis=0) - 1, axis=0)
+    for i, b in enumerate(narrow):
+        out[b] = order[starts_set[:, i], i], pattern[:, i]
+    return out
+
+
 def _row_keys(present: np.ndarray) -> np.ndarray:
     """(H,) one sortable key per row of an (H, C) bool array, ordered as the rows' packed bytes compare
     (memcmp): the packed bytes as a void scalar, or, for C <= 64, as one big-endian uint64 (zero-padded), which
@@ -406,26 +519,14 @@ def _row_keys(present: np.ndarray) -> np.ndarray:
     return packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
 
 
-def _part(
-    cost: np.ndarray,
-    rows: np.ndarray,
-    cols: np.ndarray,
-    present: np.ndarray,
-    max_increase: float,
-    best_only: bool = False,
+def _best_only_part(
+    cost: np.ndarray, rows: np.ndarray, cols: np.ndarray, present: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, Ranking | None]:
-    """(rows, columns, ranking) of a block of the union matrix with only its ``present`` columns, ranked up to
-    ``max_increase`` above its best (``best_only``: its best assignment alone); the ranking is None if that
-    sub-problem has no assignment."""
+    """(rows, columns, ranking) of a block of the union matrix over the per-frame budget, with only its
+    ``present`` columns: its best assignment alone (``BestOnly``), or None if that sub-problem has none."""
     sub_cols = cols[present]
-    if len(rows) == 1 and not best_only and len(sub_cols) <= ENUMERATION_LIMIT:  # ``rank``'s SingleRow, directly
-        row = cost[rows[0], sub_cols]
-        if not (row < np.inf).any():
-            return rows, sub_cols, None
-        return rows, sub_cols, SingleRow(row, int(np.argmin(row)), max_increase)
-    sub = cost[np.ix_(rows, sub_cols)]
     try:
-        return rows, sub_cols, BestOnly(sub) if best_only else rank(sub, max_increase=max_increase)
+        return rows, sub_cols, BestOnly(cost[np.ix_(rows, sub_cols)])
     except InfeasibleAssignment:
         return rows, sub_cols, None
 

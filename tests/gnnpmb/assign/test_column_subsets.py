@@ -113,10 +113,14 @@ def test_enumerated_with_a_root_defers_listing_and_agrees_with_its_listing():
         assert all_solutions(lazy) == all_solutions(eager)
 
 
+@pytest.mark.parametrize(("joint_limit", "shared_limit"), [(256, 4096), (0, 4096), (0, 0)])
 @pytest.mark.parametrize("max_increase", [math.inf, 1.5])
-def test_ranks_of_several_column_subsets_equal_each_rank(max_increase):
-    """``ColumnSubsets.ranks`` (best assignments of small subsets from one listing of the block) gives what
-    ``rank`` gives for each subset, solution for solution, ties included, None where it is infeasible."""
+def test_ranks_of_several_column_subsets_equal_each_rank(max_increase, joint_limit, shared_limit, monkeypatch):
+    """``ColumnSubsets.ranks`` (small subsets listed side by side, or from one listing of the block, or each on
+    its own) gives what ``rank`` gives for each subset, solution for solution, ties included, None where it is
+    infeasible."""
+    monkeypatch.setattr(murty, "JOINT_LISTING_LIMIT", joint_limit)
+    monkeypatch.setattr(murty, "SHARED_LISTING_LIMIT", shared_limit)
     rng = np.random.default_rng(11)
     together = infeasible = 0
     for trial in range(200):
@@ -141,3 +145,44 @@ def test_ranks_of_several_column_subsets_equal_each_rank(max_increase):
             infeasible += want is None
         together += n_rows >= 2 and len(patterns) >= 2
     assert together > 50 and infeasible > 10
+
+
+@pytest.mark.parametrize("joint_limit", [4, 256])
+@pytest.mark.parametrize("max_increase", [math.inf, 1.5])
+def test_subset_rankings_of_several_blocks_equal_each_rank(max_increase, joint_limit, monkeypatch):
+    """``subset_rankings`` over blocks of different shapes (worked on together per row count, padded to the
+    widest) gives what ``ColumnSubsets.rank`` gives for each, solution for solution, ties included, None where
+    it is infeasible; with a small enumeration limit some sub-problems are ranked one by one."""
+    monkeypatch.setattr(murty, "ENUMERATION_LIMIT", 16)
+    monkeypatch.setattr(murty, "JOINT_LISTING_LIMIT", joint_limit)  # 4: many listed on their own
+    rng = np.random.default_rng(13)
+    kinds = {"single": 0, "listed": 0, "ranked": 0, "infeasible": 0}
+    for trial in range(60):
+        costs, patterns = [], []
+        for _ in range(int(rng.integers(1, 9))):
+            n_rows = int(rng.integers(1, 5))
+            n_tracks = int(rng.integers(1, 9 if n_rows > 1 else 30))  # one row: some over the limit
+            shape = (n_rows, n_tracks)
+            tracks = rng.integers(0, 4, size=shape).astype(float) if trial % 2 == 0 else rng.random(shape)
+            tracks[rng.random(shape) < 0.3] = np.inf
+            private = np.full((n_rows, n_rows), np.inf)
+            private[np.arange(n_rows), np.arange(n_rows)] = rng.integers(0, 4, size=n_rows)
+            private[rng.random((n_rows, n_rows)) < 0.1] = np.inf
+            costs.append(np.hstack([tracks, private]))
+            patterns.append(np.concatenate([rng.random(n_tracks) < 0.7, np.ones(n_rows, dtype=bool)]))
+        got = murty.subset_rankings(costs, patterns, max_increase)
+        for cost, present, ranking in zip(costs, patterns, got, strict=True):
+            try:
+                want = all_solutions(murty.ColumnSubsets(cost, max_increase).rank(present))
+            except murty.InfeasibleAssignment:
+                want = None
+            assert (None if ranking is None else all_solutions(ranking)) == want
+            if want is None:
+                kinds["infeasible"] += 1
+            elif isinstance(ranking, murty.SingleRow):
+                kinds["single"] += 1
+            elif isinstance(ranking, murty.Enumerated):
+                kinds["listed"] += 1
+            else:
+                kinds["ranked"] += 1
+    assert min(kinds.values()) > 5, kinds

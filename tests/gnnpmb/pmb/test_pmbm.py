@@ -5,6 +5,7 @@ reference."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 
 import numpy as np
@@ -12,6 +13,7 @@ import pytest
 from scipy.special import logsumexp
 
 from gnnpmb.assign import murty
+from gnnpmb.assign.clusters import Cluster
 from gnnpmb.assign.murty import k_best
 from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig, paper_config
 from gnnpmb.detection_fields import DetectionFields
@@ -19,7 +21,7 @@ from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses, ListSink, Nu
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext, posterior_from_assignment
 from gnnpmb.pmb.gnnpmb import BestAssignment
-from gnnpmb.pmb.pmbm import KBest, SharedRanking, _row_keys, hypothesis_budget
+from gnnpmb.pmb.pmbm import KBest, SharedRanking, _presence_patterns, _row_keys, hypothesis_budget
 from gnnpmb.types import IdAllocator, Measurements
 from tests.gnnpmb.pmb.helpers import make_measurements
 
@@ -360,3 +362,22 @@ def test_row_keys_sort_as_the_packed_bytes():
         want = np.unique(packed.view(np.dtype((np.void, packed.shape[1]))).ravel(), True, True)
         got = np.unique(_row_keys(present), True, True)
         assert got[1].tolist() == want[1].tolist() and got[2].ravel().tolist() == want[2].ravel().tolist()
+
+
+def test_presence_patterns_of_many_blocks_equal_each_blocks_unique():
+    """``pmbm._presence_patterns`` (the blocks of at most 64 columns at once) gives every wanted block the first
+    occurrences and inverse of ``np.unique`` on its own row keys, in the same order."""
+    rng = np.random.default_rng(14)
+    widths = [1, 3, 8, 9, 30, 64, 65, 90, 2]
+    bounds = np.cumsum([0, *widths]).tolist()
+    has_column = rng.random((50, bounds[-1])) < 0.6
+    has_column[25:] = has_column[rng.integers(0, 25, size=25)]  # repeated hypotheses
+    found = [
+        Cluster(np.array([b]), np.arange(start, stop)) for b, (start, stop) in enumerate(itertools.pairwise(bounds))
+    ]
+    wanted = np.array([True, True, False, True, True, True, True, True, True])
+    got = _presence_patterns(has_column, found, wanted)
+    assert sorted(got) == np.flatnonzero(wanted).tolist()
+    for b, (first, pattern) in got.items():
+        _, want_first, want_pattern = np.unique(_row_keys(has_column[:, found[b].meas]), True, True)
+        assert first.tolist() == want_first.tolist() and pattern.tolist() == want_pattern.ravel().tolist()
