@@ -224,7 +224,7 @@ class CostTerms:
     PMB family (``gnnpmb.pmb.cost``, García-Fernández et al. 2018, eq. 12-13): existence r (K,), miss_log_lik
     log(1 - r P_D) (K,), score s (M,), offset 0. GNN (``gnnpmb.vector.gnn``): no existence or score (None), the
     offset -log(P_D / ((1 - P_D) kappa)). Both: d2 (K, M) squared Mahalanobis distances, log_det_S (K,), dim D of
-    the measurement. Holds the arrays the tracker computed anyway (no copies)."""
+    the measurement; track_ids (K,) of the columns. Holds the arrays the tracker computed anyway (no copies)."""
 
     existence: np.ndarray | None
     miss_log_lik: np.ndarray | None
@@ -234,6 +234,14 @@ class CostTerms:
     dim: int
     offset_nats: float = 0.0
     offset_text: str = ""
+    track_ids: np.ndarray | None = None
+
+    def column_of(self, track_id: int) -> int | None:
+        """The track column of ``track_id``, None if the matrix has no such track (or no ids)."""
+        if self.track_ids is None:
+            return None
+        hit = np.flatnonzero(self.track_ids == track_id)
+        return int(hit[0]) if hit.size else None
 
     def pair(self, j: int, k: int) -> PairTerms:
         """The terms of detection row ``j`` and track column ``k``."""

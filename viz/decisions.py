@@ -104,24 +104,38 @@ def choice_why(c: PairChoice, went: str | None = None) -> str | None:
             f"{column_name(c.chosen).capitalize()}'s {c.chosen_cost:.2f} = {cost_breakdown(c.chosen_terms, meas)}"
         )
     lines.append(f"{other.capitalize()}'s {c.alternative_cost:.2f} = {cost_breakdown(alt, meas)}")
-    gap = c.alternative_cost - c.chosen_cost
-    if alt.existence is not None:
-        needed = alt.existence_for(gap)
-        if needed is None:
-            lines.append(f"No predicted existence would have given {meas} to {other}")
-        else:
-            now = existence_text(alt.existence)
-            lines.append(
-                f"With a predicted existence above {existence_text(needed)} (instead of {now}), {other} would have "
-                f"taken {meas}"
-            )
-    else:
-        closer = alt.d2_for(gap)
-        if closer is None:
-            lines.append(f"Even with {meas} right on its prediction (d² 0), {other} would have cost more")
-        else:
-            lines.append(f"Within d² {closer:.1f} (instead of {alt.d2:.1f}), {other} would have taken {meas}")
+    lines.append(_would_have(alt, other, c.alternative_cost - c.chosen_cost, meas))
     return ". ".join(lines)
+
+
+def track_why(c: PairChoice, track_id: int, role: str = "") -> str | None:
+    """What track ``track_id`` (neither the chosen nor the next best column of ``c``; ``role``: words after its
+    name, e.g. ", which had the object,") would have cost for c's detection, taken apart, and what would have made
+    it cheaper than the chosen column; None when the matrix does not say or has no such track."""
+    if c.terms is None or c.row < 0:
+        return None
+    col = c.terms.column_of(track_id)
+    if col is None:
+        return None
+    t = c.terms.pair(c.row, col)
+    meas, name = meas_name(c.meas.ref), f"track {track_id}"
+    cost = f"Track {track_id}{role} would have cost {t.total_nats:.2f} = {cost_breakdown(t, meas)}"
+    return f"{cost}. {_would_have(t, name, t.total_nats - c.chosen_cost, meas)}"
+
+
+def _would_have(t: PairTerms, name: str, gap: float, meas: str) -> str:
+    """What would have made track ``name`` (terms ``t``) ``gap`` nats cheaper: its predicted existence (PMB
+    family) or its distance (GNN)."""
+    if t.existence is not None:
+        needed = t.existence_for(gap)
+        if needed is None:
+            return f"No predicted existence would have given {meas} to {name}"
+        now, above = existence_text(t.existence), existence_text(needed)
+        return f"With a predicted existence above {above} (instead of {now}), {name} would have taken {meas}"
+    closer = t.d2_for(gap)
+    if closer is None:
+        return f"Even with {meas} right on its prediction (d² 0), {name} would have cost more"
+    return f"Within d² {closer:.1f} (instead of {t.d2:.1f}), {name} would have taken {meas}"
 
 
 def _fmt(value: float) -> str:

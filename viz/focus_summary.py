@@ -32,9 +32,10 @@ from viz.decisions import (
     cost_brief,
     existence_text,
     meas_name,
+    track_why,
 )
 from viz.evaluated import NEAR_DETECTION_M, devkit_gt, evaluated_notes, evaluated_offsets
-from viz.logger import TrackerLogger
+from viz.logger import TrackerLogger, TrackStep
 
 MAX_STORY_LINES = 40
 
@@ -309,10 +310,11 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
             plural = "s" if len(passed) > 1 else ""
             parts.append(f"detections in its gate went elsewhere at frame{plural} {'; '.join(went)}")
         peak = max(frames, key=lambda f: _after(steps[f]))
-        parts.append(
-            f"existence after update {existence_text(_after(steps[peak]))} at frame {peak} -> "
-            f"{existence_text(_after(steps[frames[-1]]))} at frame {frames[-1]}"
-        )
+        then = f"{existence_text(_after(steps[frames[-1]]))} at frame {frames[-1]}"
+        if peak == frames[-1]:
+            parts.append(f"existence after update {then}")
+        else:
+            parts.append(f"existence after update {existence_text(_after(steps[peak]))} at frame {peak} -> {then}")
         parts.append("shown as a track" if steps[frames[-1]].reported else "not shown as a track")
         out.append(f"**track {t}**: " + "; ".join(parts) + ".")
     return out
@@ -408,7 +410,8 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
         if chosen:
             parts.append(f"then, {chosen[-1].text}")
             parts += _where_from(chosen[-1], keys, (lost, took))
-            because = _because(chosen[-1])
+            step = logger.track_steps.get(lost, {}).get(chosen[-1].frame)
+            because = _because(chosen[-1], lost, step)
     return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", "", *because]
 
 
@@ -426,12 +429,21 @@ def _where_from(key: KeyDecision, keys: list[KeyDecision], named: tuple[int | No
     return [f"track {alt.ref} had been started at frame {k.frame} by {meas_name(k.choice.meas.ref)}{instead}"]
 
 
-def _because(key: KeyDecision) -> list[str]:
-    """The decisive choice's costs taken apart (``decisions.choice_why``), as a paragraph; none when the
-    tracker's cost matrix does not say what its costs are made of."""
+def _because(key: KeyDecision, lost: int, step: TrackStep | None) -> list[str]:
+    """The decisive choice's costs taken apart (``decisions.choice_why``), as a paragraph, and, when the track
+    that lost the object (``lost``, its ``TrackStep`` at that frame) was neither of the two columns compared,
+    what it would have cost or that the detection was outside its gate; none when the tracker's cost matrix does
+    not say what its costs are made of."""
     why = choice_why(key.choice, key.went)
     if why is None:
         return []
+    c = key.choice
+    compared = {label.ref for label in (c.chosen, c.alternative) if label is not None and label.kind is AxisKind.TRACK}
+    if lost not in compared:
+        if step is not None and all(m != c.meas.ref for m, _ in step.gated):
+            why += f". {meas_name(c.meas.ref)} was outside the gate of track {lost}, which had the object"
+        elif (lost_why := track_why(c, lost, ", which had the object,")) is not None:
+            why += f". {lost_why}"
     return [f"**Because** (frame {key.frame}): {why}.", ""]
 
 
@@ -573,7 +585,7 @@ def _gt_markdown(
     by_frame = {f.keyframe.index: f for f in run.frames}
     for gt_id in focus.gt_ids:
         rows = []
-        seen, detected, sent = 0, 0, []
+        seen, detected, sent, first = 0, 0, [], focus.frame_index
         for i in range(max(shown.start, focus.frame_index - TABLE_FRAMES), focus.frame_index + 1):
             gt = scene.keyframes[i].gt
             hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
@@ -597,6 +609,7 @@ def _gt_markdown(
             points = int(scene.keyframes[i].gt_num_pts[hit[0]])
             evaluated = f"{points}" if points else "0: not scored as annotated (interpolated)"
             rows.append(f"| {i} | {evaluated} | {nearest} | {went} | {', '.join(covering) or 'none'} |")
+            first = i if not seen else first
             seen += 1
             detected += nearest != "none"
             sent += [went] if nearest != "none" else []
@@ -610,7 +623,6 @@ def _gt_markdown(
             )
             tracks = sorted({w for w in sent if w != "—" and not w.startswith("new")})
             rest = f", the others went to {', '.join(tracks) or 'no track'}" if news < len(sent) else ""
-            first = max(shown.start, focus.frame_index - TABLE_FRAMES)
             out += [
                 f"**GT {short_id(gt_id)}**, in the {seen} frames of the table ({first}–{focus.frame_index}): a "
                 f"detection within {NEAR_DETECTION_M:.0f} m in {detected}; {news} of them started a new track{rest}.",

@@ -73,6 +73,7 @@ class LocalHypotheses:
             d2=self.d2,
             log_det_S=self.inn.log_det_S,
             dim=self.inn.z_pred.shape[1],
+            track_ids=self.prior.track_id,
         )
 
     def base_log_weight(self) -> float:

@@ -91,6 +91,7 @@ class GnnTracker(VectorTracker):
                 dim=inn.z_pred.shape[1],
                 offset_nats=pair_offset_nats(self.params.p_detect, self.clutter_intensity),
                 offset_text=f"a detection against clutter (P_D {self.params.p_detect:g})",
+                track_ids=prior.track_id,
             )
             self._emit_assignment(prior, meas, cost, terms, track_of_meas, meas_of_track, total, sink)
         return Association(mean=mean, cov=cov, meas_of_track=meas_of_track, birth=track_of_meas < 0)

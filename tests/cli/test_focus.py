@@ -286,6 +286,13 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
         re.search(r"for (m\d+'s score [\d.]+)", lost.group(3)).group(1),
     ]
     assert sum(parts) == pytest.approx(float(lost.group(2)), abs=0.03)
+    # The track that had the object, when it was not the next best, gets its own cost (or: out of its gate).
+    if lost.group(1) != str(old):
+        had = re.search(rf"Track {old}, which had the object, would have cost ([-\d.]+) = (.*?)\. ", because)
+        assert had or f"was outside the gate of track {old}, which had the object" in because, because
+        if had:
+            total = sum(float(p.split(" for ")[0]) for p in had.group(2).split(" + "))
+            assert total == pytest.approx(float(had.group(1)), abs=0.03)
     # The picture says it too: the detection's label names where it went, in each tracker's view.
     for tracker in ("gnnpmb", "pmbm"):
         callouts = [r for r in read_rows(out)[paths.focus_callouts(tracker)] if r.get("frame") == failure.frame_index]

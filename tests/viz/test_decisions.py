@@ -8,7 +8,7 @@ import numpy as np
 
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms
 from gnnpmb.explain import explain
-from viz.decisions import _tracks_phrase, choice_why
+from viz.decisions import _tracks_phrase, choice_why, track_why
 
 
 def test_conflict_headings_count_tracks_and_candidates() -> None:
@@ -84,3 +84,31 @@ def test_a_gnn_cost_has_no_existence_but_a_constant_and_a_distance_to_win_at() -
     assert "Track 9's -1.16 = -5.00 for a detection against clutter (P_D 0.9) + 1.84 for the uncertainty" in why
     assert "existence" not in why and "score" not in why
     assert why.endswith("Within d² 1.0 (instead of 4.0), track 9 would have taken m4")  # 4 - 2 (2.0 - 0.5)
+
+
+def test_the_track_that_had_the_object_gets_its_own_cost_when_it_was_not_the_next_best() -> None:
+    """Tracks 5, 9, 11 (PMB terms) gate m4; 5 wins, 9 is next best; track 11's cost is read by its id."""
+    r = np.array([0.9, 0.5, 0.05])
+    terms = CostTerms(
+        existence=r,
+        miss_log_lik=np.log1p(-r * 0.8),
+        score=np.array([0.5]),
+        d2=np.array([[0.5], [1.0], [0.2]]),
+        log_det_S=np.zeros(3),
+        dim=2,
+        track_ids=np.array([5, 9, 11]),
+    )
+    costs = [terms.pair(0, k).total_nats for k in range(3)]
+    assert costs[0] < costs[1] < costs[2]
+    rows = (AxisLabel(AxisKind.MEASUREMENT, 4),)
+    cols = (*(AxisLabel(AxisKind.TRACK, t) for t in (5, 9, 11)), AxisLabel(AxisKind.NEW_TRACK, 4))
+    matrix = CostMatrix("car", np.array([[*costs, 8.0]]), rows, cols, terms=terms)
+    (choice,) = explain(matrix, Assignment("car", ((rows[0], cols[0]),), costs[0], (9, 11))).conflicts[0].choices
+    assert choice.alternative == cols[1] and terms.column_of(11) == 2 and terms.column_of(7) is None
+    why = track_why(choice, 11, ", which had the object,")
+    assert why.startswith(f"Track 11, which had the object, would have cost {costs[2]:.2f} = ")
+    needed = terms.pair(0, 2).existence_for(costs[2] - costs[0])
+    assert why.endswith(
+        f"With a predicted existence above {needed:.2f} (instead of 0.05), track 11 would have taken m4"
+    )
+    assert track_why(choice, 7) is None
