@@ -356,6 +356,12 @@ def _nearest_detection(frame: FrameResult, class_name: str, xy_m: np.ndarray) ->
     return (int(mine[k]), float(d[k])) if d[k] < NEAR_DETECTION_M else None
 
 
+DETECTOR = "the detector's doing"
+TRACKER = "the tracker's doing"
+EVALUATION = "the evaluation's doing"
+"""Whose doing a failure was, as the Why line opens: the detector gave no (or a wrong) detection, the tracker
+had one and did not use it well, or the evaluation scored a box where there was none."""
+
 WHY_KINDS = {
     FailureKind.ID_SWITCH: (0, 1),
     FailureKind.IDENTITY_THEFT: (1, 0),
@@ -402,6 +408,7 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
             f"{existence_text(_after(steps[max(steps)]))} (frame {max(steps)})"
         )
     because = []
+    doing = TRACKER if focus.frame_index in detected else DETECTOR
     if took is not None:
         keys = _key_decisions(
             logger, set(focus.track_ids.get(run.tracker, ())), focus.class_name, shown, focus.frame_index, None
@@ -412,7 +419,7 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
             parts += _where_from(chosen[-1], keys, (lost, took))
             step = logger.track_steps.get(lost, {}).get(chosen[-1].frame)
             because = _because(chosen[-1], lost, step)
-    return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", "", *because]
+    return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", "", *because]
 
 
 def _where_from(key: KeyDecision, keys: list[KeyDecision], named: tuple[int | None, ...]) -> list[str]:
@@ -470,11 +477,13 @@ def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, rep
     d = np.hypot(*(gt.translation_m[:, :2] - xy).T) if len(gt) else np.zeros(0)
     same = np.flatnonzero(gt.class_name == focus.class_name) if len(gt) else np.zeros(0, int)
     parts = [f"at frame {f} track {t} ({focus.class_name}) was output on {source}"]
+    doing = DETECTOR
     if same.size and d[same].min() < NEAR_DETECTION_M:
         k = int(same[np.argmin(d[same])])
         gt_id = str(gt.instance_id[k])
         evaluated = devkit_gt(scene, gt_id, f)
         on = f"{focus.class_name} GT {short_id(gt_id)} lies {d[k]:.1f} m away"
+        doing = EVALUATION
         if evaluated.xy_m is None:
             parts.append(f"{on}, but the evaluation has no box for it here ({evaluated.why}): a track on it is false")
         elif np.hypot(*(evaluated.xy_m - estimate.translation_m[:2])) >= NEAR_DETECTION_M:
@@ -484,7 +493,8 @@ def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, rep
                 "track's reach (see nuscenes-devkit issue #1141)"
             )
         else:
-            parts.append(f"{on} and the evaluation matched it to another track")
+            doing = TRACKER
+            parts.append(f"{on} and the evaluation matched it to another track: two tracks on one object")
     elif d.size and d.min() < NEAR_DETECTION_M:
         k = int(np.argmin(d))
         parts.append(
@@ -501,7 +511,7 @@ def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, rep
             f"the evaluation counted the track: its score averaged over the track, {average:.3f}, is at least the "
             f"{focus.class_name} threshold {threshold:.3f}"
         )
-    return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]
+    return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", ""]
 
 
 def _why_miss(
@@ -522,6 +532,7 @@ def _why_miss(
     name = f"{focus.class_name} GT {short_id(gt_id)}"
     parts = []
     found = _nearest_detection(frame, focus.class_name, xy)
+    doing = DETECTOR if found is None else TRACKER
     if found is None:
         boxes = frame.detections.boxes
         kept = np.flatnonzero(np.asarray(frame.detections.kept))
@@ -563,7 +574,7 @@ def _why_miss(
             )
     if found is not None and not on:
         parts.append(f"no {focus.class_name} track was output within {NEAR_DETECTION_M:.0f} m of it")
-    return [f"**Why** ({run.tracker}): " + "; ".join(parts) + ".", ""]
+    return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", ""]
 
 
 def _gt_markdown(

@@ -260,7 +260,7 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     why = summary.split("\n\n")[1]
     last = failure.frame_index
     assert re.match(
-        rf"\*\*Why\*\* \(gnnpmb\): in the \d+ recorded frames up to {last} \(\d+–{last}\), "
+        rf"\*\*Why\*\* \(gnnpmb, the tracker's doing\): in the \d+ recorded frames up to {last} \(\d+–{last}\), "
         rf"GT {short_id(failure.gt_ids[0])} had a detection within 2 m at (?:frames? [\d, ]+|no frame)",
         why,
     ), why
@@ -339,7 +339,14 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
     if near and float(near.group(2)) <= 2.0:
         assert f"GT {near.group(1)}" in summary.split("**Involved**")[1].split("\n")[0]
         assert f"**GT {near.group(1)}**, in the 1 frames of the table (0–0): a detection within 2 m in 1" in summary
-    assert why.startswith(f"**Why** (gnnpmb): at frame {failure.frame_index} track {track} ({failure.class_name})")
+    doing = re.match(r"\*\*Why\*\* \(gnnpmb, the (detector|tracker|evaluation)'s doing\): ", why)
+    assert doing, why
+    assert why[doing.end() :].startswith(f"at frame {failure.frame_index} track {track} ({failure.class_name})")
+    # Whose doing it was follows from why no object matched the track.
+    if "the evaluation has no box for it" in why or "the evaluation has it" in why:
+        assert doing.group(1) == "evaluation"
+    elif "the detector gave it the wrong class" in why or "a detection of nothing" in why:
+        assert doing.group(1) == "detector"
     average, threshold = report.track_scores[track], report.threshold_of(failure.class_name)
     assert f"averaged over the track, {average:.3f}, is at least the {failure.class_name} threshold" in why
     assert average >= threshold
@@ -375,7 +382,9 @@ def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(
     out, _ = record(demo_dataroot, tmp_path, pick)
     why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
     gt = f"{failure.class_name} GT {short_id(failure.gt_ids[0])}"
-    assert why.startswith(f"**Why** (gnnpmb): at frame {failure.frame_index} "), why
+    detector = "the detector missed it" in why or "the detector gave it the wrong class" in why
+    doing = "the detector's doing" if detector else "the tracker's doing"
+    assert why.startswith(f"**Why** (gnnpmb, {doing}): at frame {failure.frame_index} "), why
     assert (
         (f"no detection within 2 m of {gt} (" in why and "the detector missed it" in why)
         or "the detector gave it the wrong class" in why
