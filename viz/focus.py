@@ -40,7 +40,7 @@ from viz.callouts import Callout, log_callouts
 from viz.colors import CLASS_COLORS, GREY, class_ids, track_colors
 from viz.decisions import existence_text
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
-from viz.focus_summary import READING_GUIDE, focus_markdown, mentions
+from viz.focus_summary import READING_GUIDE, existence_as_decided, focus_markdown, mentions
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
 from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
 from viz.logger import TrackerLogger, TrackStep
@@ -152,7 +152,7 @@ def log_focus(
                 paths.focus_callouts(tracker),
                 gt_callouts
                 + _detection_callouts(detections, sorted(given), loggers[tracker].given.get(i, {}))
-                + _prediction_callouts(steps, z_m, _existence_as_decided(loggers[tracker], i, focus.class_name)),
+                + _prediction_callouts(steps, z_m, existence_as_decided(loggers[tracker], i, focus.class_name)),
                 height_m,
             )
         if meas and detections is not None:
@@ -242,28 +242,12 @@ def _detection_callouts(detections: Boxes, given: list[int], went: Mapping[int, 
     ]
 
 
-def _existence_as_decided(logger: TrackerLogger, frame: int, class_name: str) -> dict[int, float]:
-    """Track id -> its predicted existence in the cost matrix the frame's assignment was explained on, for the
-    tracks given a detection. For PMBM that is the chosen posterior's parent hypothesis, whose Bernoullis can
-    differ from the most likely prior hypothesis's that ``Predicted`` shows (a track nearly dead in one
-    hypothesis can be alive in another)."""
-    out = {}
-    for d in logger.decisions.get(frame, []):
-        if d.class_name != class_name:
-            continue
-        for c in (c for conflict in d.conflicts for c in conflict.choices):
-            terms = c.chosen_terms
-            if terms is not None and terms.existence is not None:
-                out[int(c.chosen.ref)] = terms.existence
-    return out
-
-
 def _prediction_callouts(
     steps: Mapping[int, TrackStep | None], z_m: float, decided: Mapping[int, float] | None = None
 ) -> list[Callout]:
     """``<id> predicted r=<existence> → m<idx>`` (the detection it was given; ``, missed``: none) at each focused
     track's predicted position this frame; the existence is the one its detection was decided with (``decided``,
-    see ``_existence_as_decided``) if known, else its prior existence."""
+    see ``focus_summary.existence_as_decided``) if known, else its prior existence."""
     decided = decided or {}
     return [
         Callout(

@@ -168,7 +168,7 @@ def focus_markdown(
         run = runs.get(tracker)
         if run is not None:
             lines += _gt_markdown(focus, scene, run, logger, shown, (reports or {}).get(tracker))
-        lines += _steps_markdown(logger, sorted(ids), shown, focus.frame_index)
+        lines += _steps_markdown(logger, sorted(ids), shown, focus.frame_index, focus.class_name)
         decided = [
             c
             for d in logger.decisions.get(focus.frame_index, [])
@@ -648,9 +648,26 @@ def _gt_markdown(
     return out
 
 
-def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, last: int) -> list[str]:
-    """Per involved track, a table of its frames up to ``last``: existence before and after the update, the
-    detections in its gate (with NIS) and the one it was given, and whether it was reported."""
+def existence_as_decided(logger: TrackerLogger, frame: int, class_name: str) -> dict[int, float]:
+    """Track id -> its predicted existence in the cost matrix the frame's assignment was explained on, for the
+    tracks given a detection. For PMBM that is the chosen posterior's parent hypothesis, whose Bernoullis can
+    differ from those of the most likely prior hypothesis, which ``Predicted`` (and ``TrackStep``) show: a track
+    nearly dead in one hypothesis can be alive in another."""
+    out = {}
+    for d in logger.decisions.get(frame, []):
+        if d.class_name != class_name:
+            continue
+        for c in (c for conflict in d.conflicts for c in conflict.choices):
+            terms = c.chosen_terms
+            if terms is not None and terms.existence is not None:
+                out[int(c.chosen.ref)] = terms.existence
+    return out
+
+
+def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, last: int, class_name: str) -> list[str]:
+    """Per involved track, a table of its frames up to ``last``: existence before (and, if it differs, in the
+    hypothesis its detection was decided in: ``existence_as_decided``) and after the update, the detections in
+    its gate (with NIS) and the one it was given, and whether it was reported."""
     out: list[str] = []
     for t in track_ids:
         steps = {
@@ -671,9 +688,10 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
             after = (
                 "pruned" if s.posterior_existence != s.posterior_existence else existence_text(s.posterior_existence)
             )
-            out.append(
-                f"| {f} | {existence_text(s.prior_existence)} | {gated} | {given} | {after} | "
-                f"{'yes' if s.reported else 'no'} |"
-            )
+            before = existence_text(s.prior_existence)
+            decided = existence_as_decided(logger, f, class_name).get(t)
+            if decided is not None and existence_text(decided) != before:
+                before += f" ({existence_text(decided)} in the hypothesis its detection was decided in)"
+            out.append(f"| {f} | {before} | {gated} | {given} | {after} | {'yes' if s.reported else 'no'} |")
         out.append("")
     return out
