@@ -308,6 +308,11 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
                 track_id, r, meas = given.groups()
                 parting = summary.partition("**Where the trackers part**")[2]
                 assert f"pmbm: {meas} → **track {track_id}** (" in parting and f" at existence {r}, " in parting
+                # Its table gives the most likely prior hypothesis's existence and, if another, this one.
+                table = summary.partition("## pmbm")[2].partition(f"Track {track_id}, frame by frame:")[2]
+                row = next(line for line in table.splitlines() if line.startswith(f"| {failure.frame_index} | "))
+                before = row.split(" | ")[1]
+                assert before == r or before.endswith(f" ({r} in the hypothesis its detection was decided in)")
     # The decision view of that frame takes the same choice apart under its table.
     decided, meas = re.match(r"\*\*Because\*\* \(frame (\d+)\): (m\d+) ", because).groups()
     doc = next(r for r in read_rows(out)[paths.decisions("gnnpmb")] if r.get("frame") == int(decided))
