@@ -34,7 +34,7 @@ from viz.decisions import (
     meas_name,
     track_why,
 )
-from viz.evaluated import NEAR_DETECTION_M, devkit_gt, evaluated_notes, evaluated_offsets
+from viz.evaluated import NEAR_DETECTION_M, devkit_gt, evaluated_notes, evaluated_offsets, range_near_focus
 from viz.logger import TrackerLogger, TrackStep
 
 MAX_STORY_LINES = 40
@@ -574,6 +574,11 @@ def _why_miss(
             )
     if found is not None and not on:
         parts.append(f"no {focus.class_name} track was output within {NEAR_DETECTION_M:.0f} m of it")
+    reach_m = range_near_focus(focus, scene)
+    if reach_m is not None:  # the circle is drawn: say which side of it the object is
+        ego_m = float(np.hypot(*(xy - scene.keyframes[f].ego_pose.translation_m[:2])))
+        side = "inside" if ego_m <= reach_m else "beyond"
+        parts.append(f"it lies {ego_m:.1f} m from the ego vehicle, {side} the evaluation's {reach_m:g} m range")
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", ""]
 
 
