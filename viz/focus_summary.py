@@ -61,6 +61,8 @@ READING_GUIDE = """# How to read the views
   detection inside its gate that it was not given.
 - **Failures**: enlarged boxes: magenta ID switch, orange fragmentation, red false track, green coalescence,
   yellow identity theft, grey miss.
+- **Disagreements** (several trackers): boxes around the object in sky blue where only one tracker shows a track
+  on it, violet where one changed its id and the other kept it, pink around a track only one shows.
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
   A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`); a track's predicted
   position, its predicted existence and the detection it was given (`26 predicted r=0.40 → m2`) or `missed`.
