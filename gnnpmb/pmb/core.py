@@ -25,7 +25,6 @@ from gnnpmb.config import TrackerConfig
 from gnnpmb.events import (
     AxisLabel,
     Born,
-    CostMatrix,
     EventSink,
     Panel,
     Pruned,
@@ -456,16 +455,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         most likely one. Events: ``CostMatrix`` (of the most likely prior hypothesis), the strategy's, ``Pruned``,
         ``Born``."""
         if sink.enabled:
-            local = prior.locals_[0]
-            sink.emit(
-                CostMatrix(
-                    self.class_name,
-                    local.cost_matrix(),
-                    local.row_labels(),
-                    local.col_labels(),
-                    terms=local.cost_terms(),
-                )
-            )
+            sink.emit(prior.locals_[0].cost_event(self.class_name))
         ctx = UpdateContext(self.class_name, sink, self.ids, self.frame_serial, self.params.prune_existence)
         posteriors = self.strategy.update(prior.hypotheses, prior.locals_, ctx)
         self.hypotheses = self._prune(prior.hypotheses, posteriors, ctx, sink)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.events import AxisKind, AxisLabel, CostTerms, axis_labels
+from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, CostTerms, axis_labels
 from gnnpmb.kalman import Innovation, log_likelihood, paired_updated_means
 from gnnpmb.pmb.bernoulli import Bernoullis, missed_update
 from gnnpmb.pmb.poisson import NewTrackHypotheses
@@ -74,6 +74,18 @@ class LocalHypotheses:
             log_det_S=self.inn.log_det_S,
             dim=self.inn.z_pred.shape[1],
             track_ids=self.prior.track_id,
+        )
+
+    def cost_event(self, class_name: str, hypothesis: int = 0) -> CostMatrix:
+        """The ``CostMatrix`` event of this matrix: its labels and what its entries are made of (``cost_terms``);
+        ``hypothesis``: the prior global hypothesis it belongs to."""
+        return CostMatrix(
+            class_name,
+            self.cost_matrix(),
+            self.row_labels(),
+            self.col_labels(),
+            hypothesis=hypothesis,
+            terms=self.cost_terms(),
         )
 
     def base_log_weight(self) -> float:

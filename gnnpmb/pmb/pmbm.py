@@ -58,7 +58,7 @@ from gnnpmb.assign.murty import (
     subset_rankings,
 )
 from gnnpmb.config import PmbmParams
-from gnnpmb.events import Assignment, BudgetReached, CostMatrix, GlobalHypotheses, Panel
+from gnnpmb.events import Assignment, BudgetReached, GlobalHypotheses, Panel
 from gnnpmb.pmb.core import (
     GlobalHypothesis,
     HypothesisLocals,
@@ -148,18 +148,7 @@ class KBest:
         budgets = [hypothesis_budget(self.params.n_hypotheses, lw) for lw in prior_log_w]
         if ctx.sink.enabled:
             for h in range(1, min(COST_MATRIX_EVENTS, len(locals_))):
-                local = locals_[h]
-                cost = local.cost_matrix()
-                ctx.sink.emit(
-                    CostMatrix(
-                        ctx.class_name,
-                        cost,
-                        local.row_labels(),
-                        local.col_labels(),
-                        hypothesis=h,
-                        terms=local.cost_terms(),
-                    )
-                )
+                ctx.sink.emit(locals_[h].cost_event(ctx.class_name, h))
         union, members = _union_of(locals_)
         largest = union.n_meas  # rows of the largest gated block: at most M, computed only if M is over budget
         if largest > self.murty_block_rows:
@@ -186,17 +175,7 @@ class KBest:
             best = kept[0]
             local = locals_[best.parent]
             if best.parent >= COST_MATRIX_EVENTS:  # the matrix its assignment is explained over
-                cost = local.cost_matrix()
-                ctx.sink.emit(
-                    CostMatrix(
-                        ctx.class_name,
-                        cost,
-                        local.row_labels(),
-                        local.col_labels(),
-                        hypothesis=best.parent,
-                        terms=local.cost_terms(),
-                    )
-                )
+                ctx.sink.emit(local.cost_event(ctx.class_name, best.parent))
             own = _own_columns(best.col_of_row, members[best.parent], union.n_tracks)
             _emit(best.total_cost, own, local, best.parent, posteriors, ctx)
         return posteriors
