@@ -504,7 +504,14 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
             logger.finish()
         if len(runs) > 1:
             comparison = compare_runs(runs)
-            log_comparison(stream, comparison.within(shown), scene, clock, show_labels=focus is None)
+            log_comparison(
+                stream,
+                comparison.within(shown),
+                scene,
+                clock,
+                show_labels=focus is None,
+                focus_class=focus.class_name if focus is not None else None,
+            )
         if failures and focus is None:
             task = bar.add_task(f"{scene.name} failures", total=len(runs))
             reports, notices = find_reports(request, runs, lambda: bar.advance(task))

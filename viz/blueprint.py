@@ -276,8 +276,13 @@ def tracker_panel(
     return rrb.Vertical(decision_views(tracker), logs, series, row_shares=[5, 3, 2], name=tracker)
 
 
-def comparison_panel(trackers: Sequence[str], legends: Mapping[str, LegendPlacement] | None = None) -> rrb.Horizontal:
-    """Disagreements per frame (and each tracker's failures per frame) as tabs, beside the disagreement log."""
+def comparison_panel(
+    trackers: Sequence[str],
+    legends: Mapping[str, LegendPlacement] | None = None,
+    focus: FocusTarget | None = None,
+) -> rrb.Horizontal:
+    """Disagreements per frame (and each tracker's failures per frame) as tabs, beside the disagreement log; with
+    a focus, the log opens on the disagreements about the focused class (the whole log is the next tab)."""
     counts = rrb.Tabs(
         rrb.TimeSeriesView(
             origin=compare.counts_root(),
@@ -287,6 +292,11 @@ def comparison_panel(trackers: Sequence[str], legends: Mapping[str, LegendPlacem
         *[failure_counts_view(t) for t in trackers],
     )
     log = rrb.TextLogView(origin=compare.log_path(), name="disagreements", columns=STORY_COLUMNS)
+    if focus is not None:
+        about = rrb.TextLogView(
+            origin=compare.focus_log_path(), name=f"disagreements ({focus.class_name})", columns=STORY_COLUMNS
+        )
+        log = rrb.Tabs(about, log)
     return rrb.Horizontal(counts, log, column_shares=[2, 3], name="comparison")
 
 
@@ -313,7 +323,7 @@ def default_blueprint(
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:
-        left = rrb.Vertical(scene, comparison_panel(trackers, legends), row_shares=[4, 1])
+        left = rrb.Vertical(scene, comparison_panel(trackers, legends, focus), row_shares=[4, 1])
         layout = rrb.Horizontal(left, rrb.Tabs(*panels), column_shares=[3, 2])
     if focus is None:
         time_panel = rrb.TimePanel(state="collapsed", timeline="frame", play_state="paused")

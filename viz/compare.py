@@ -9,6 +9,8 @@ column-wise: a few calls however many disagreements there are.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import rerun as rr
 
@@ -44,6 +46,11 @@ MARKER_LINE_RADIUS_M = 0.1
 def log_path() -> str:
     """TextLog of every disagreement."""
     return f"{COMPARISON}/log"
+
+
+def focus_log_path() -> str:
+    """TextLog of the disagreements about the focused class (a focus recording opens on it)."""
+    return f"{COMPARISON}/log_focus_class"
 
 
 def counts_root() -> str:
@@ -99,10 +106,12 @@ def log_comparison(
     clock: Clock = PLAIN_CLOCK,
     *,
     show_labels: bool = True,
+    focus_class: str | None = None,
 ) -> None:
     """Log ``comparison`` (over keyframes of ``scene``) on the recording's timelines (``clock``): per kind a
     count at every compared frame and marker boxes (an empty batch at frames without any), plus the text log.
-    show_labels: show the marker labels (a focus recording labels the involved objects itself)."""
+    show_labels: show the marker labels (a focus recording labels the involved objects itself); focus_class: also
+    log the disagreements about this class on their own (``focus_log_path``)."""
     frames = np.asarray(comparison.frame_indices, dtype=np.int64)
     stamps = np.array([scene.keyframes[i].timestamp_us for i in frames.tolist()], dtype=np.int64)
     for kind in DisagreementKind:
@@ -127,14 +136,25 @@ def log_comparison(
             line_radius_m=MARKER_LINE_RADIUS_M,
             show_labels=show_labels,
         )
-    if comparison.disagreements:
-        at = np.array([d.frame_index for d in comparison.disagreements], dtype=np.int64)
-        send_text_lines(
-            stream,
-            clock,
-            log_path(),
-            at,
-            np.array([scene.keyframes[i].timestamp_us for i in at.tolist()], dtype=np.int64),
-            [f"{KIND_LABELS[d.kind]}: {d.describe()}" for d in comparison.disagreements],
-            [KIND_LEVELS[d.kind] for d in comparison.disagreements],
-        )
+    _log_lines(stream, clock, log_path(), comparison.disagreements, scene)
+    if focus_class is not None:
+        about = [d for d in comparison.disagreements if d.class_name == focus_class]
+        _log_lines(stream, clock, focus_log_path(), about, scene)
+
+
+def _log_lines(
+    stream: rr.RecordingStream, clock: Clock, path: str, disagreements: Sequence[Disagreement], scene: SceneData
+) -> None:
+    """One TextLog line per disagreement, at its frame (nothing if there is none)."""
+    if not disagreements:
+        return
+    at = np.array([d.frame_index for d in disagreements], dtype=np.int64)
+    send_text_lines(
+        stream,
+        clock,
+        path,
+        at,
+        np.array([scene.keyframes[i].timestamp_us for i in at.tolist()], dtype=np.int64),
+        [f"{KIND_LABELS[d.kind]}: {d.describe()}" for d in disagreements],
+        [KIND_LEVELS[d.kind] for d in disagreements],
+    )

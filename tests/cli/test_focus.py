@@ -18,7 +18,7 @@ from gnnpmb.eval.failures import FailureKind, short_id
 from gnnpmb.session import find_reports, prepare, rerun_runs
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
-from viz import paths
+from viz import compare, paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
 from viz.evaluated import evaluated_world, evaluation_range_world
 from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_legend
@@ -293,6 +293,13 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
         if had:
             total = sum(float(p.split(" for ")[0]) for p in had.group(2).split(" + "))
             assert total == pytest.approx(float(had.group(1)), abs=0.03)
+    # The disagreement log opens on the focused class's lines (the whole log is the next tab).
+    rows = read_rows(out)
+    assert stored_views(out)[f"disagreements ({failure.class_name})"] == ("TextLog", compare.focus_log_path())
+    about = [r["TextLog:text"][0] for r in rows[compare.focus_log_path()] if r.get("TextLog:text")]
+    everything = [r["TextLog:text"][0] for r in rows[compare.log_path()] if r.get("TextLog:text")]
+    assert about and all(f": {failure.class_name} " in line for line in about)
+    assert about == [line for line in everything if f": {failure.class_name} " in line] and len(everything) > len(about)
     # The picture says it too: the detection's label names where it went, in each tracker's view.
     for tracker in ("gnnpmb", "pmbm"):
         callouts = [r for r in read_rows(out)[paths.focus_callouts(tracker)] if r.get("frame") == failure.frame_index]
