@@ -188,10 +188,10 @@ def conflict_markdown(conflict: Conflict, reported: set[int] | None = None) -> s
             f"| {meas_name(c.meas.ref)} | **{column_name(c.chosen)}** | {_fmt(c.chosen_cost)} | {alt} | "
             f"{_fmt(c.alternative_cost)} | {_fmt(c.margin)} |"
         )
-    whys = [(c, why) for c in conflict.choices if (why := choice_why(c)) is not None]
+    whys = [why for c in conflict.choices if (why := choice_why(c)) is not None]
     if whys:
         lines.append("")
-        lines += [f"- {why}" for _, why in whys]
+        lines += [f"- {why}" for why in whys]
     if conflict.missed_track_ids:
         lines.append("")
         lines.append(f"missed (no detection, cost 0): {_ids(conflict.missed_track_ids, reported)}")
@@ -232,7 +232,7 @@ def decisions_markdown(
         if d.births_only:
             body.append(
                 f"{_plural(len(d.births_only), 'detection')} no track competed for (outside every gate, or dearer "
-                f"than a new track by over {LINK_SLACK:g}): new track or clutter: "
+                f"than a new track by over {LINK_SLACK:g}), so each is a new track or clutter: "
                 + ", ".join(meas_name(m) for m in d.births_only)
             )
             body.append("")

@@ -119,7 +119,7 @@ class DevkitBox:
     why: str
 
 
-NO_INTERPOLATION = "and the evaluation cannot interpolate it (it scores no frame of it both before and after)"
+NO_INTERPOLATION = "and the evaluation cannot interpolate it (it keeps no box of it both before and after this frame)"
 
 
 def devkit_gt(scene: SceneData, gt_id: str, i: int) -> DevkitBox:

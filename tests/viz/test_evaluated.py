@@ -59,7 +59,7 @@ def test_devkit_gt_matches_the_devkits_tracks_on_every_object_and_frame(demo_dat
     far = [
         re.fullmatch(
             r"it lies ([\d.]+) m from the ego vehicle, beyond the evaluation's (\d+) m range for \w+, and the "
-            r"evaluation cannot interpolate it \(it scores no frame of it both before and after\)",
+            r"evaluation cannot interpolate it \(it keeps no box of it both before and after this frame\)",
             why,
         )
         for why in kinds
