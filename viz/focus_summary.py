@@ -421,6 +421,16 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
             parts += _where_from(chosen[-1], keys, (lost, took))
             step = logger.track_steps.get(lost, {}).get(chosen[-1].frame)
             because = _because(chosen[-1], lost, step)
+        else:  # no close call: say where the track that took the object came from
+            started = [
+                (f, m)
+                for f in sorted(logger.given)
+                for m, went in logger.given[f].items()
+                if went == f"new track {took}"
+            ]
+            if started:
+                f, m = started[0]
+                parts.append(f"then, at frame {f}, {meas_name(m)} started track {took} (not a close call)")
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", "", *because]
 
 

@@ -410,3 +410,17 @@ def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(
     ):
         assert float(average) == pytest.approx(report.track_scores[track], abs=5e-4)
         assert report.track_scores[track] < report.threshold_of(failure.class_name)
+
+
+def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(
+    demo_dataroot: Path, tmp_path: Path
+) -> None:
+    """GNN on pointpillars: the old track ended while the object had no points; the new one was started later."""
+    request = prepare(SCENE, ["gnn"], dataroot=demo_dataroot, detector="pointpillars")
+    report = find_reports(request, rerun_runs(request))[0]["gnn"]
+    pick = next(i for i in report.ids() if i.startswith("id_switch:"))
+    old, new = report.by_id(pick).track_ids
+    out, _ = record(demo_dataroot, tmp_path, pick, ("gnn",))
+    why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
+    assert why.startswith("**Why** (gnn, ") and f"track {old}'s existence went from " in why
+    assert re.search(rf"then, at frame \d+, m\d+ started track {new} \(not a close call\)\.$", why), why
