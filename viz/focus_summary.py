@@ -272,7 +272,9 @@ def _key_decisions(
                 chosen_involved = c.chosen.kind is AxisKind.TRACK and c.chosen.ref in ids
                 if (alt_involved and not chosen_involved) or (chosen_involved and c.margin < CLOSE_CALL_MARGIN):
                     went = logger.given.get(f, {}).get(int(c.meas.ref), column_name(c.chosen))
-                    other = f"over {column_name(alt)} ({c.alternative_cost:.2f})" if alt is not None else "(no other)"
+                    other = "(no other)"
+                    if alt is not None:
+                        other = f"over {column_name(alt)} ({c.alternative_cost:.2f}{_brief(c.alternative_terms)})"
                     text = (
                         f"frame {f}: {meas_name(c.meas.ref)} → **{went}** (cost {c.chosen_cost:.2f}) {other}, "
                         f"margin {c.margin:.2f}"
