@@ -522,7 +522,7 @@ def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, rep
     average = report.track_scores.get(str(t)) if report is not None else None
     if threshold is not None and average is not None:
         parts.append(
-            f"the evaluation counted the track: its score averaged over the track, {average:.3f}, is at least the "
+            f"the evaluation counted the track: its score averaged over all its frames, {average:.3f}, is at least the "
             f"{focus.class_name} threshold {threshold:.3f}"
         )
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", ""]
@@ -582,9 +582,9 @@ def _why_miss(
         average = report.track_scores.get(str(e.track_id)) if report is not None else None
         if threshold is not None and average is not None and average < threshold:
             parts.append(
-                f"track {e.track_id} was output on it (score {e.score:.2f}), but its score averaged over the track, "
-                f"{average:.3f}, is below the {focus.class_name} threshold {threshold:.3f}: the evaluation did not "
-                "count it"
+                f"track {e.track_id} was output on it (score {e.score:.2f}), but its score averaged over all its "
+                f"frames, {average:.3f}, is below the {focus.class_name} threshold {threshold:.3f}: the evaluation "
+                "did not count it"
             )
     if found is not None and not on:
         parts.append(f"no {focus.class_name} track was output within {NEAR_DETECTION_M:.0f} m of it")

@@ -360,7 +360,7 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
     elif "the detector gave it the wrong class" in why or "a detection of nothing" in why:
         assert doing.group(1) == "detector"
     average, threshold = report.track_scores[track], report.threshold_of(failure.class_name)
-    assert f"averaged over the track, {average:.3f}, is at least the {failure.class_name} threshold" in why
+    assert f"averaged over all its frames, {average:.3f}, is at least the {failure.class_name} threshold" in why
     assert average >= threshold
     # An object dropped for its range: the range is drawn around the ego vehicle and labelled beside the track.
     if "beyond the evaluation's" in why:
@@ -404,8 +404,8 @@ def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(
     )
     # Every track said to be on it was not counted: its averaged score is below the class threshold.
     for track, average in re.findall(
-        r"track (\d+) was output on it \(score [\d.]+\), but its score averaged over the "
-        r"track, ([\d.]+)",
+        r"track (\d+) was output on it \(score [\d.]+\), but its score averaged over all its "
+        r"frames, ([\d.]+)",
         why,
     ):
         assert float(average) == pytest.approx(report.track_scores[track], abs=5e-4)
