@@ -688,6 +688,7 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
     hypothesis its detection was decided in: ``existence_as_decided``) and after the update, the detections in
     its gate (with NIS) and the one it was given, and whether it was reported."""
     out: list[str] = []
+    decided: dict[int, dict[int, float]] = {}  # frame -> existence_as_decided, worked out once per frame
     for t in track_ids:
         steps = {
             f: s for f, s in logger.track_steps.get(t, {}).items() if max(shown.start, last - TABLE_FRAMES) <= f <= last
@@ -708,9 +709,11 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
                 "pruned" if s.posterior_existence != s.posterior_existence else existence_text(s.posterior_existence)
             )
             before = existence_text(s.prior_existence)
-            decided = existence_as_decided(logger, f, class_name).get(t)
-            if decided is not None and existence_text(decided) != before:
-                before += f" ({existence_text(decided)} in the hypothesis its detection was decided in)"
+            if f not in decided:
+                decided[f] = existence_as_decided(logger, f, class_name)
+            r = decided[f].get(t)
+            if r is not None and existence_text(r) != before:
+                before += f" ({existence_text(r)} in the hypothesis its detection was decided in)"
             out.append(f"| {f} | {before} | {gated} | {given} | {after} | {'yes' if s.reported else 'no'} |")
         out.append("")
     return out

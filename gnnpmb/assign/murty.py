@@ -388,7 +388,7 @@ def subset_rankings(
             stacked[k, :, :n_cols] = costs[i]
             present[k, :n_cols] = patterns[i]
         counts = ((stacked < np.inf) & present[:, None, :]).sum(axis=2)
-        small = (np.prod(counts, axis=1, dtype=float) <= ENUMERATION_LIMIT) & (n_rows >= 1)
+        small = np.prod(counts, axis=1, dtype=float) <= ENUMERATION_LIMIT
         for k in np.flatnonzero(~small).tolist():
             i = items[k]
             try:
