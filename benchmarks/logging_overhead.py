@@ -29,6 +29,7 @@ from gnnpmb.data.demo import ensure_demo_dataset
 from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
 from gnnpmb.events import ListSink
 from gnnpmb.pipeline import get_detections, preprocess_frames, run_tracker
+from gnnpmb.registry import tracker_has_existence
 from gnnpmb.types import TRACKING_CLASSES
 from viz.logger import FLUSH_FRAMES, TrackerLogger
 from viz.recording import close_recording, open_recording
@@ -58,7 +59,9 @@ def timed_run(
         run_tracker(scene, frames, tracker, config, sink=ListSink())
     else:
         stream = open_recording("bench", out, None)
-        logger = TrackerLogger(stream, tracker, flush_frames=flush_frames)
+        logger = TrackerLogger(
+            stream, tracker, flush_frames=flush_frames, existence_series=tracker_has_existence(tracker)
+        )
         run_tracker(scene, frames, tracker, config, sink=logger)
         logger.finish()
         close_recording(stream, out)

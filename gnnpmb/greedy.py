@@ -102,6 +102,8 @@ class GreedyPrior:
 class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]]):
     """One class's greedy closest-pair tracker (module docstring); the frame loop is ``skeleton.ClassFilter.step``."""
 
+    has_existence = False  # a track lives until max_age misses
+
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         super().__init__(class_name, config, ids)
         self.max_distance_m = self.class_params.match_distance_m

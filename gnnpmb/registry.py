@@ -114,10 +114,20 @@ def check_classes(names: list[str]) -> list[str]:
 
 def tracker_panels(name: str) -> tuple[Panel, ...]:
     """The tracker-specific viewer panels tracker ``name`` declares (the same for every class)."""
+    return _sample_tracker(name).panels
+
+
+def tracker_has_existence(name: str) -> bool:
+    """Whether tracker ``name``'s tracks have an existence probability (``skeleton.ClassFilter.has_existence``)."""
+    return _sample_tracker(name).has_existence
+
+
+def _sample_tracker(name: str) -> ClassFilter:
+    """Tracker ``name`` for the first class with the default configuration: what it declares for the viewer."""
     from gnnpmb.config import TrackerConfig
     from gnnpmb.types import IdAllocator
 
-    return make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator()).panels
+    return make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator())
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:

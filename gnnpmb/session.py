@@ -30,7 +30,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.errors import DataError, GnnpmbError
 from gnnpmb.outputs import check_output_file
-from gnnpmb.registry import check_classes, check_tracker
+from gnnpmb.registry import check_classes, check_tracker, tracker_has_existence
 from gnnpmb.serve import ServeTarget, check_serve_ports
 
 if TYPE_CHECKING:
@@ -488,6 +488,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                 log_frames=shown if focus is not None else None,
                 focus_tracks=set(focus.track_ids.get(tracker, ())) if focus is not None else None,
                 flush_frames=None if request.save is not None else FLUSH_FRAMES,
+                existence_series=tracker_has_existence(tracker),
             )
             runs.append(
                 run_tracker(

@@ -100,9 +100,12 @@ def emit_posterior(
 class ClassFilter(ABC, Generic[PriorT, PosteriorT]):
     """One class's tracker: the frame loop (``step``) and the hooks a family writes (module docstring).
 
-    ``panels``: the tracker-specific viewer panels its events fill."""
+    ``panels``: the tracker-specific viewer panels its events fill. ``has_existence``: False for trackers whose
+    tracks have no existence probability (track logic instead; their events carry existence 1), so the viewer
+    draws no existence plot for them."""
 
     panels: tuple[Panel, ...] = ()
+    has_existence: bool = True
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import rerun.blueprint as rrb
 
 from gnnpmb.events import Panel
-from gnnpmb.registry import tracker_panels
+from gnnpmb.registry import tracker_has_existence, tracker_panels
 from viz import compare, paths
 from viz.failures import failure_log
 from viz.legend import LegendPlacement
@@ -197,8 +197,10 @@ def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visib
 def track_series_views(
     tracker: str, focus: FocusTarget | None = None, legends: Mapping[str, LegendPlacement] | None = None
 ) -> list[rrb.TimeSeriesView]:
-    """Existence, normalised innovation and chosen cost per track; only the involved tracks when focused, with a
-    legend (placed by ``legends``, keyed by the view's origin)."""
+    """Existence (for a tracker that has it, ``registry.tracker_has_existence``), normalised innovation and chosen
+    cost per track; only the involved tracks when focused, with a legend (placed by ``legends``, keyed by the
+    view's origin)."""
+    existence = [(paths.existence_root(tracker), "existence")] if tracker_has_existence(tracker) else []
     return [
         rrb.TimeSeriesView(
             origin=root,
@@ -207,7 +209,7 @@ def track_series_views(
             **_legend_args(root, legends, focus is not None),
         )
         for root, what in (
-            (paths.existence_root(tracker), "existence"),
+            *existence,
             (paths.nis_root(tracker), "NIS (innovation²/S)"),
             (paths.chosen_cost_root(tracker), "chosen cost"),
         )

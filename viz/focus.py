@@ -212,6 +212,8 @@ def focus_legends(
             ],
             paths.nis_root(tracker): [paths.nis(tracker, focus.class_name, t) for t in ids],
         }
+        if not logger.existence_series:
+            del views[paths.existence_root(tracker)]
         for root, series in views.items():
             sent = [logger.sent_series[p] for p in series if p in logger.sent_series]
             # The legend names every series of the view, also those without a value up to the focus frame.

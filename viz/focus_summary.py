@@ -90,7 +90,8 @@ READING_GUIDE = """# How to read the views
   detection. GNN has no existence or score in its cost, but a constant (a detection against clutter); it gives
   the distance at which the track would have won.
 - **existence**, **NIS**, **chosen cost**: the involved tracks' series up to the failure; the grey line is the
-  existence from which a Bernoulli is shown as a track.
+  existence from which a Bernoulli is shown as a track. GNN, JPDA and greedy have no existence plot: their
+  tracks have no existence probability (track logic keeps a track or deletes it).
 
 **Terms**
 

@@ -168,7 +168,9 @@ class TrackerLogger:
     tracks always are). clock: the timelines rows go on (``viz.timeline``). log_frames: draw and log
     only these keyframes (None: all); the others still feed the tracks' history (trails, series, story state).
     focus_tracks: their conflicts come first in the decision view. flush_frames: send buffered rows every this
-    many frames (None: only at the end). Call ``finish()`` after the last frame: it sends what is buffered and
+    many frames (None: only at the end). existence_series: plot each track's existence and the class's threshold
+    (False for a tracker without existence probabilities, ``registry.tracker_has_existence``: flat lines at 1,
+    and a chunk pair per track). Call ``finish()`` after the last frame: it sends what is buffered and
     the time series.
     """
 
@@ -188,6 +190,7 @@ class TrackerLogger:
         log_frames: range | None = None,
         focus_tracks: set[int] | None = None,
         flush_frames: int | None = FLUSH_FRAMES,
+        existence_series: bool = True,
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
         self.stream = stream
@@ -201,6 +204,7 @@ class TrackerLogger:
         self.log_frames = log_frames
         self.focus_tracks = focus_tracks
         self.flush_frames = flush_frames
+        self.existence_series = existence_series
         self._rows = RowBuffer(stream, clock)
         self._buffered: set[str] = set()
         self._drawing = True
@@ -457,7 +461,7 @@ class TrackerLogger:
         extracted = cf.extracted.estimates if cf.extracted is not None else ()
         estimates = tuple(e for e in extracted if e.existence >= self.show_min_existence)
         drawn = estimates + tuple(e for e in extracted if e.existence < self.show_min_existence and e.track_id in focus)
-        if cf.extracted is not None and cf.posterior is not None:
+        if self.existence_series and cf.extracted is not None and cf.posterior is not None:
             self._sample(
                 paths.extraction_threshold(self.tracker, class_name),
                 max(cf.extracted.threshold, self.show_min_existence),
@@ -680,7 +684,8 @@ class TrackerLogger:
         xy = mean[follow, :2].tolist()
         for k, (x, y) in zip(follow, xy, strict=True):
             t = id_list[k]
-            self._track_sample(paths.existence, class_name, t, r_list[k], "existence")
+            if self.existence_series:
+                self._track_sample(paths.existence, class_name, t, r_list[k], "existence")
             trail = self._trails.get(t)
             if trail is None:
                 trail = self._trails[t] = deque(maxlen=TRAIL_FRAMES)

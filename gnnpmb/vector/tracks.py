@@ -142,6 +142,8 @@ class VectorTracker(ClassFilter[tuple[VectorTracks, Gating], VectorTracks]):
     """One class's vector-type tracker: the frame loop ``skeleton.ClassFilter.step``, an initiator / deleter pair
     for track logic, and the association that subclasses implement (``_associate``, module docstring, step 3)."""
 
+    has_existence = False  # M-of-N track logic: a track exists or not
+
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         super().__init__(class_name, config, ids)
         self.params = config.vector

@@ -137,3 +137,13 @@ def test_the_viewer_names_no_tracker_and_lays_out_the_panels_each_declares() -> 
     assert tracker_panels("cphd") == (Panel.CARDINALITY, Panel.INTENSITY)
     assert tracker_panels("pmbm") == (Panel.HYPOTHESES,) and tracker_panels("gnnpmb") == ()
     assert set(viz.blueprint.PANEL_VIEWS) == set(Panel)
+
+
+def test_an_existence_plot_only_for_trackers_whose_tracks_have_an_existence_probability() -> None:
+    from gnnpmb.registry import TRACKER_NAMES, tracker_has_existence
+
+    without = {name for name in TRACKER_NAMES if not tracker_has_existence(name)}
+    assert without == {"gnn", "jpda", "greedy"}  # track logic: a track exists or not
+    origins = {v.origin for v in views(default_blueprint(["gnnpmb", "gnn"], ["car"]))}
+    assert paths.existence_root("gnnpmb") in origins and paths.existence_root("gnn") not in origins
+    assert paths.nis_root("gnn") in origins and paths.chosen_cost_root("gnn") in origins
