@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+import math
+from collections.abc import Iterable
 
 import numpy as np
 import rerun as rr
@@ -112,6 +114,36 @@ def track_color(track_id: int) -> tuple[int, int, int]:
     """RGB colour of one track id (see ``track_colors``)."""
     r, g, b = track_colors(np.array([track_id]))[0]
     return int(r), int(g), int(b)
+
+
+INVOLVED_PALETTE: tuple[tuple[int, int, int], ...] = (
+    (0, 90, 230),  # blue
+    (40, 170, 30),  # green
+    (20, 35, 140),  # navy
+    (130, 200, 60),  # light green
+    (90, 160, 255),  # light blue
+    (15, 100, 35),  # dark green
+)
+"""Colours of the tracks involved in a focused failure, in the order of their ids, so that no two involved tracks
+look alike (hash colours of nearby hues are hard to tell apart in a legend). All in ``TRACK_HUE_BANDS``, far apart
+in hue or brightness; tracks beyond the palette keep their own colour."""
+
+
+AVOID_DISTANCE = 80.0
+"""An involved track's colour lies at least this far (RGB distance) from its class's colour, which its detections
+and ground truth are drawn in."""
+
+
+def involved_track_colors(
+    track_ids: Iterable[int], avoid: tuple[int, int, int] | None = None
+) -> dict[int, tuple[int, int, int]]:
+    """Track id -> RGB for the involved tracks of a focus: ``INVOLVED_PALETTE`` in increasing id order (the same
+    in every view and module that draws them), without the colours within ``AVOID_DISTANCE`` of ``avoid`` (the
+    focus class's colour: a car track must not look like a car detection); the id's own ``track_color`` beyond
+    the palette."""
+    palette = [rgb for rgb in INVOLVED_PALETTE if avoid is None or math.dist(rgb, avoid) >= AVOID_DISTANCE]
+    ordered = sorted(set(int(t) for t in track_ids))
+    return {t: palette[k] if k < len(palette) else track_color(t) for k, t in enumerate(ordered)}
 
 
 def _band_hue(u: np.ndarray) -> np.ndarray:

@@ -37,7 +37,7 @@ from viz.blueprint import (
     reading_guide_doc,
 )
 from viz.callouts import Callout, log_callouts
-from viz.colors import CLASS_COLORS, GREY, class_ids, track_colors
+from viz.colors import CLASS_COLORS, GREY, class_ids
 from viz.decisions import existence_text
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
 from viz.focus_summary import READING_GUIDE, existence_as_decided, focus_markdown, mentions
@@ -127,6 +127,7 @@ def log_focus(
                 log_callouts(stream, paths.focus_callouts(tracker), [], height_m)
                 continue
             chosen = [e for e in frame.estimates if e.track_id in ids]
+            palette = loggers[tracker].involved_rgb
             boxes = estimate_boxes(chosen)
             stream.log(
                 tracker_focus(tracker),
@@ -134,7 +135,7 @@ def log_focus(
                     centers=boxes.centers_m,
                     half_sizes=0.5 * (boxes.sizes_xyz_m * SCALE + MARGIN_M),
                     quaternions=boxes.quat_xyzw,
-                    colors=track_colors(np.array([e.track_id for e in chosen], dtype=np.int64)),
+                    colors=np.array([palette[e.track_id] for e in chosen], dtype=np.uint8).reshape(-1, 3),
                     radii=LINE_RADIUS_M,
                 ),
             )
@@ -152,7 +153,9 @@ def log_focus(
                 paths.focus_callouts(tracker),
                 gt_callouts
                 + _detection_callouts(detections, sorted(given), loggers[tracker].given.get(i, {}))
-                + _prediction_callouts(steps, z_m, existence_as_decided(loggers[tracker], i, focus.class_name)),
+                + _prediction_callouts(
+                    steps, z_m, palette, existence_as_decided(loggers[tracker], i, focus.class_name)
+                ),
                 height_m,
             )
         if meas and detections is not None:
@@ -245,18 +248,22 @@ def _detection_callouts(detections: Boxes, given: list[int], went: Mapping[int, 
 
 
 def _prediction_callouts(
-    steps: Mapping[int, TrackStep | None], z_m: float, decided: Mapping[int, float] | None = None
+    steps: Mapping[int, TrackStep | None],
+    z_m: float,
+    palette: Mapping[int, tuple[int, int, int]],
+    decided: Mapping[int, float] | None = None,
 ) -> list[Callout]:
     """``<id> predicted r=<existence> → m<idx>`` (the detection it was given; ``, missed``: none) at each focused
-    track's predicted position this frame; the existence is the one its detection was decided with (``decided``,
-    see ``focus_summary.existence_as_decided``) if known, else its prior existence."""
+    track's predicted position this frame, in the track's involved colour (``palette``); the existence is the one
+    its detection was decided with (``decided``, see ``focus_summary.existence_as_decided``) if known, else its
+    prior existence."""
     decided = decided or {}
     return [
         Callout(
             (*step.predicted_xy_m, z_m),
             f"{t} predicted r={existence_text(decided.get(t, step.prior_existence))}"
             + (f" → m{step.given}" if step.given >= 0 else ", missed"),
-            tuple(int(v) for v in track_colors(np.array([t], dtype=np.int64))[0]),
+            palette[t],
         )
         for t, step in steps.items()
         if step is not None

@@ -57,7 +57,15 @@ from gnnpmb.explain import Decisions, explain
 from gnnpmb.gating import ellipse_outline
 from gnnpmb.types import TrackEstimate
 from viz import paths
-from viz.colors import CLASS_IDS, faded, pack_rgba, packed_track_colors, track_color
+from viz.colors import (
+    CLASS_COLORS,
+    CLASS_IDS,
+    faded,
+    involved_track_colors,
+    pack_rgba,
+    packed_track_colors,
+    track_color,
+)
 from viz.decisions import (
     CLOSE_CALL_MARGIN,
     column_name,
@@ -167,11 +175,12 @@ class TrackerLogger:
     the others are candidates. show_min_existence: extracted tracks below it are not drawn as tracks (focused
     tracks always are). clock: the timelines rows go on (``viz.timeline``). log_frames: draw and log
     only these keyframes (None: all); the others still feed the tracks' history (trails, series, story state).
-    focus_tracks: their conflicts come first in the decision view. flush_frames: send buffered rows every this
-    many frames (None: only at the end). existence_series: plot each track's existence and the class's threshold
-    (False for a tracker without existence probabilities, ``registry.tracker_has_existence``: flat lines at 1,
-    and a chunk pair per track). Call ``finish()`` after the last frame: it sends what is buffered and
-    the time series.
+    focus_tracks: their conflicts come first in the decision view, and they take distinct colours
+    (``colors.involved_track_colors``, away from the colour of ``focus_class``, their class). flush_frames: send
+    buffered rows every this many frames (None: only at the end). existence_series: plot each track's existence
+    and the class's threshold (False for a tracker without existence probabilities,
+    ``registry.tracker_has_existence``: flat lines at 1, and a chunk pair per track). Call ``finish()`` after the
+    last frame: it sends what is buffered and the time series.
     """
 
     enabled = True
@@ -191,6 +200,7 @@ class TrackerLogger:
         focus_tracks: set[int] | None = None,
         flush_frames: int | None = FLUSH_FRAMES,
         existence_series: bool = True,
+        focus_class: str | None = None,
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
         self.stream = stream
@@ -205,6 +215,10 @@ class TrackerLogger:
         self.focus_tracks = focus_tracks
         self.flush_frames = flush_frames
         self.existence_series = existence_series
+        self.involved_rgb = involved_track_colors(focus_tracks or (), CLASS_COLORS.get(focus_class or ""))
+        """Focus track id -> its RGB (``colors.involved_track_colors``), in every view and plot."""
+        packed = pack_rgba(np.array(list(self.involved_rgb.values()), dtype=np.uint8).reshape(-1, 3))
+        self._involved_packed = dict(zip(self.involved_rgb, packed.tolist(), strict=True))
         self._rows = RowBuffer(stream, clock)
         self._buffered: set[str] = set()
         self._drawing = True
@@ -447,7 +461,8 @@ class TrackerLogger:
         if path in self._series:  # name and colour only matter for a new series
             self._sample(path, value)
         else:
-            self._sample(path, value, f"{track_id} {class_name} {what}", track_color(track_id))
+            color = self.involved_rgb.get(track_id) or track_color(track_id)
+            self._sample(path, value, f"{track_id} {class_name} {what}", color)
 
     def _z_of(self, track_ids: np.ndarray) -> np.ndarray:
         """(K,) last known box height of each track, gate_z_m for tracks never extracted."""
@@ -744,13 +759,16 @@ class TrackerLogger:
 
     def _track_colors(self, track_ids: np.ndarray, keep: float = 1.0) -> np.ndarray:
         """(N,) packed colours of (N,) track ids, ``keep`` of each colour (``colors.faded``); with focus tracks,
-        the others keep ``DIMMED_KEEP`` of that."""
+        those take their involved colour (``involved_rgb``) and the others keep ``DIMMED_KEEP`` of theirs."""
         ids = np.asarray(track_ids, dtype=np.int64).reshape(-1)
         colors = packed_track_colors(ids) if keep == 1.0 else faded(packed_track_colors(ids), keep)
         if not self.focus_tracks:
             return colors
         others = ~np.isin(ids, list(self.focus_tracks))
         colors[others] = faded(packed_track_colors(ids[others]), keep * DIMMED_KEEP)
+        for k in np.flatnonzero(~others).tolist():
+            own = self._involved_packed[int(ids[k])]
+            colors[k] = own if keep == 1.0 else faded(np.array([own], dtype=np.uint32), keep)[0]
         return colors
 
     def _draw_tracks(self, class_name: str, estimates: tuple[TrackEstimate, ...], shown: set[int]) -> None:

@@ -35,7 +35,7 @@ from gnnpmb.events import (
 from gnnpmb.types import TrackEstimate
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
-from viz.colors import faded, pack_rgba, track_colors
+from viz.colors import INVOLVED_PALETTE, faded, pack_rgba, track_colors
 from viz.logger import DIMMED_KEEP, TrackerLogger, _nis_of
 from viz.timeline import Clock
 
@@ -297,6 +297,8 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     assert [m for m, _ in step.gated] == [0]
     focused = rows[paths.predicted_focus(T, "car")]
     assert at_frame(focused, 1)[0]["Points3D:labels"] == ["2 predicted r=0.28"]
+    (style,) = [r for r in rows[paths.existence(T, "car", 2)] if r["static"]]  # its plot line: a distinct colour
+    assert style["SeriesLines:colors"] == [int(pack_rgba(np.array([INVOLVED_PALETTE[0]]))[0])]
     # The label is shown by the focus callouts (viz.callouts), in a column, not on the point.
     assert [r for r in focused if r["static"]][0]["Points3D:show_labels"] == [False]
 
