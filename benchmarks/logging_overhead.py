@@ -6,8 +6,10 @@ file (opening, ``finish`` and closing included), the way ``gnnpmb-viz --save`` d
 ``--live``: every ``FLUSH_FRAMES`` frames, as for a viewer), the three modes interleaved, three times. The best
 wall time and the best CPU time of the process (all threads: Rerun's writer too; the fairer figure on a shared
 machine) per mode are printed as ms per frame with the ratios to the tracker alone, plus the recording's chunk
-count. Everything loaded before the runs is frozen out of the garbage collector's reach, as ``gnnpmb-viz`` does
-(``gnnpmb.session.freeze_loaded``).
+count. "sending" is the wall time per frame of the logger's ``finish`` and closing the recording alone (no
+drawing; with ``--live`` only the last rows), "budget" what the logger may take per frame on top of the events
+for tracker + logger <= 1.5x the tracker alone (wall). Everything loaded before the runs is frozen out of the
+garbage collector's reach, as ``gnnpmb-viz`` does (``gnnpmb.session.freeze_loaded``).
 
     uv run python benchmarks/logging_overhead.py [--scene scene-0103] [--detector centerpoint] [--tracker gnnpmb]
         [--live]
@@ -37,14 +39,17 @@ from viz.recording import close_recording, open_recording
 
 @dataclass(frozen=True, slots=True)
 class Timing:
-    """Seconds of one run: wall clock and CPU of this process (all its threads, Rerun's writer included)."""
+    """Seconds of one run: wall clock and CPU of this process (all its threads, Rerun's writer included), and
+    for a logger run the wall clock of sending alone (``finish`` and closing the recording: the rows are built,
+    converted to Arrow and written; no drawing)."""
 
     wall_s: float
     cpu_s: float
+    send_s: float = 0.0
 
     @staticmethod
     def best(runs: list[Timing]) -> Timing:
-        return Timing(min(r.wall_s for r in runs), min(r.cpu_s for r in runs))
+        return Timing(min(r.wall_s for r in runs), min(r.cpu_s for r in runs), min(r.send_s for r in runs))
 
 
 def timed_run(
@@ -63,8 +68,10 @@ def timed_run(
             stream, tracker, flush_frames=flush_frames, existence_series=tracker_has_existence(tracker)
         )
         run_tracker(scene, frames, tracker, config, sink=logger)
+        send = time.perf_counter()
         logger.finish()
         close_recording(stream, out)
+        return Timing(time.perf_counter() - wall, time.process_time() - cpu, time.perf_counter() - send)
     return Timing(time.perf_counter() - wall, time.process_time() - cpu)
 
 
@@ -89,7 +96,10 @@ def main() -> None:
     mode = f"rows sent every {FLUSH_FRAMES} frames (live)" if args.live else "rows sent at the end (--save)"
     print(f"{args.scene}, {args.detector}, {n} frames, best of {args.repeats} (runs interleaved), {mode}")
     print("ms per frame, wall clock / CPU time of the process; ratios to the tracker alone")
-    print(f"{'tracker':8} {'alone':>13} {'+ events':>13} {'ratio':>11} {'+ logger':>13} {'ratio':>11} {'chunks':>7}")
+    print(
+        f"{'tracker':8} {'alone':>13} {'+ events':>13} {'ratio':>11} {'+ logger':>13} {'ratio':>11} {'chunks':>7} "
+        f"{'sending':>8} {'budget':>7}"
+    )
     modes = ("alone", "events", "logger")
     with tempfile.TemporaryDirectory() as tmp:
         for tracker in args.tracker or ["gnnpmb", "pmbm", "gnn"]:
@@ -100,9 +110,11 @@ def main() -> None:
                     runs[m].append(timed_run(scene, frames, tracker, config, m, out, flush_frames))
             alone, events, logged = (Timing.best(runs[m]) for m in modes)
             chunks = sum(1 for _ in RrdReader(out).store().stream())
+            # What the logger may cost on top of the events for tracker + logger <= 1.5x the tracker alone.
+            budget_ms = 1000 * (1.5 * alone.wall_s - events.wall_s) / n
             print(
                 f"{tracker:8} {_ms(alone, n)} {_ms(events, n)} {_ratio(events, alone)} {_ms(logged, n)} "
-                f"{_ratio(logged, alone)} {chunks:7d}"
+                f"{_ratio(logged, alone)} {chunks:7d} {1000 * logged.send_s / n:8.2f} {budget_ms:7.2f}"
             )
 
 
