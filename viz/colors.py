@@ -119,17 +119,18 @@ def track_color(track_id: int) -> tuple[int, int, int]:
 INVOLVED_PALETTE: tuple[tuple[int, int, int], ...] = (
     (0, 90, 230),  # blue
     (40, 170, 30),  # green
-    (20, 35, 140),  # navy
-    (130, 200, 60),  # light green
-    (90, 160, 255),  # light blue
+    (35, 35, 35),  # black
+    (110, 170, 255),  # light blue
+    (170, 220, 90),  # lime
     (15, 100, 35),  # dark green
 )
 """Colours of the tracks involved in a focused failure, in the order of their ids, so that no two involved tracks
-look alike (hash colours of nearby hues are hard to tell apart in a legend). All in ``TRACK_HUE_BANDS``, far apart
-in hue or brightness; tracks beyond the palette keep their own colour."""
+look alike (hash colours of nearby hues are hard to tell apart in a legend). Greens, blues and black, the colours
+no marker uses (``TRACK_HUE_BANDS``), each far from the next in hue or brightness; tracks beyond the palette keep
+their own colour."""
 
 
-AVOID_DISTANCE = 80.0
+AVOID_DISTANCE = 130.0
 """An involved track's colour lies at least this far (RGB distance) from its class's colour, which its detections
 and ground truth are drawn in."""
 

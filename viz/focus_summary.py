@@ -66,8 +66,8 @@ READING_GUIDE = """# How to read the views
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
   A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`); a track's predicted
   position, its predicted existence and the detection it was given (`26 predicted r=0.40 → m2`) or `missed`.
-  The involved tracks take distinct colours (blue, green, navy, light green, … in order of their ids), the same
-  in every view and plot; tracks that are not involved are drawn pale.
+  The involved tracks take distinct colours (blue, green, black, light blue, lime, … in order of their ids,
+  skipping a colour close to their class's own), the same in every view and plot; the others are pale.
 - **GT … as evaluated**: where the evaluation put an object that had no LiDAR or radar points at this frame (it
   interpolates a box between the frames where the object had points); the failure is scored against that box.
   It is drawn thin in the class colour, with a line to the annotated box and a circle of 2 m around it: a track

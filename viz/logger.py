@@ -94,6 +94,9 @@ keep this share of their colour, so the involved ones stand out."""
 GATE_LINE_RADIUS_M = 0.03
 PREDICTED_POINT_RADIUS_M = 0.25
 CANDIDATE_POINT_RADIUS_M = 0.12
+SERIES_MARKER_SIZE = 3.0
+"""Marker size of the samples of an involved track's series (a track born at the focus frame has one sample:
+a line alone would not show it)."""
 MAX_HYPOTHESIS_SERIES = 10
 """Log weights are plotted for the best this many PMBM global hypotheses."""
 CHOSEN_CELL_RGBA = int(pack_rgba(np.array([[255, 210, 0]], dtype=np.uint8))[0])
@@ -299,6 +302,11 @@ class TrackerLogger:
             if series.color is not None:
                 style["colors"] = (np.array([series.color], dtype=np.uint8), one)
             styles.append(EntityRows(path, _STATIC_ROW, _STATIC_ROW, style))
+            if owner is not None and owner[1] in self._focused:  # an involved track: a marker at every sample
+                marked = rr.SeriesPoints(
+                    names=series.name, colors=series.color, markers="circle", marker_sizes=SERIES_MARKER_SIZE
+                )
+                self.stream.log(path, marked, static=True)  # a handful of series: one call each is cheap
             values = np.asarray(series.values, dtype=np.float64)
             if self.focus_tracks:
                 self.sent_series[path] = (np.asarray(series.frames), values)

@@ -70,7 +70,7 @@ def test_packed_colours_of_negative_ids_are_their_own_not_a_wrapped_table_entry(
     np.testing.assert_array_equal(packed_track_colors(ids), pack_rgba(track_colors(ids)))
 
 
-def test_involved_tracks_get_distinct_palette_colours_in_the_track_hue_bands() -> None:
+def test_involved_tracks_get_distinct_palette_colours_no_marker_uses() -> None:
     from viz.colors import INVOLVED_PALETTE, TRACK_HUE_BANDS, hue_of, involved_track_colors
 
     assert involved_track_colors([212, 26, 123]) == {
@@ -81,7 +81,9 @@ def test_involved_tracks_get_distinct_palette_colours_in_the_track_hue_bands() -
     palette = np.array(INVOLVED_PALETTE, dtype=float)
     gaps = np.linalg.norm(palette[:, None] - palette[None], axis=2)[np.triu_indices(len(palette), 1)]
     assert gaps.min() > 60.0  # no two look alike, unlike hash colours of nearby hues
-    hues = hue_of(palette)
+    chromatic = np.ptp(palette, axis=1) > 30
+    assert (palette[~chromatic].max(axis=1) < 60).all()  # the grey one is black, no marker's grey
+    hues = hue_of(palette[chromatic])  # no marker's hue either
     assert all(any(a - 0.01 <= h <= b + 0.01 for a, b in TRACK_HUE_BANDS) for h in hues.tolist())
     car = involved_track_colors([26, 123], avoid=CLASS_COLORS["car"])  # not the blue of car detections
     assert car == {26: INVOLVED_PALETTE[1], 123: INVOLVED_PALETTE[2]}
