@@ -297,8 +297,11 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     assert [m for m, _ in step.gated] == [0]
     focused = rows[paths.predicted_focus(T, "car")]
     assert at_frame(focused, 1)[0]["Points3D:labels"] == ["2 predicted r=0.28"]
-    (style,) = [r for r in rows[paths.existence(T, "car", 2)] if r["static"]]  # its plot line: a distinct colour
-    assert style["SeriesLines:colors"] == [int(pack_rgba(np.array([INVOLVED_PALETTE[0]]))[0])]
+    style = {k: v for r in rows[paths.existence(T, "car", 2)] if r["static"] for k, v in r.items()}
+    own = [int(pack_rgba(np.array([INVOLVED_PALETTE[0]]))[0])]  # its plot line: a distinct colour
+    assert style["SeriesLines:colors"] == own and style["SeriesPoints:colors"] == own
+    assert style["SeriesPoints:markers"] == [1]  # circles: a single sample shows too
+    assert not [r for r in rows[paths.existence(T, "car", 1)] if "SeriesPoints:markers" in r]  # not involved
     # The label is shown by the focus callouts (viz.callouts), in a column, not on the point.
     assert [r for r in focused if r["static"]][0]["Points3D:show_labels"] == [False]
 
