@@ -73,6 +73,11 @@ class FocusTarget:
     failure_tracker: str | None = None
     failure_tracks: tuple[int, ...] = ()
 
+    def object_ids(self, tracker: str) -> set[str]:
+        """The ids the failure report names this focus's objects by, for ``tracker``: the involved instance tokens
+        and that tracker's involved track ids (as strings)."""
+        return {*self.gt_ids, *(str(t) for t in self.track_ids.get(tracker, ()))}
+
     def window(self, frames: range) -> range:
         """The keyframes of a focus recording, within ``frames``."""
         start = max(frames.start, self.frame_index - FRAMES_BEFORE)

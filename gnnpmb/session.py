@@ -519,7 +519,17 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
             reports, notices = find_reports(request, runs, lambda: bar.advance(task))
         if failures or focus is not None:
             for name, report in reports.items():
-                log_failures(stream, name, report, scene, shown, clock, show_labels=focus is None)
+                log_failures(
+                    stream,
+                    name,
+                    report,
+                    scene,
+                    shown,
+                    clock,
+                    show_labels=focus is None,
+                    involved=focus.object_ids(name) if focus is not None else None,
+                    focus_kind=focus.failure_kind if focus is not None else None,
+                )
         if focus is not None:
             log_focus(stream, focus, scene, runs, loggers, clock, shown, reports)
             legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)

@@ -52,6 +52,9 @@ MARKER_SCALE = 1.1
 MARKER_MARGIN_M = 0.3
 """A marker box is the object's box times MARKER_SCALE plus MARKER_MARGIN_M: it encloses the drawn object."""
 MARKER_LINE_RADIUS_M = 0.08
+FOCUS_MARGIN_M = 0.5
+"""In a focus recording, the focused failure's markers are this much wider than other markers of the same box
+(an identity theft is also an ID switch of the same objects: its box would hide under the other's)."""
 
 
 def failure_log(tracker: str) -> str:
@@ -99,10 +102,16 @@ def log_failures(
     clock: Clock = PLAIN_CLOCK,
     *,
     show_labels: bool = True,
+    involved: set[str] | None = None,
+    focus_kind: FailureKind | None = None,
 ) -> None:
     """Log ``report`` (failures of ``tracker`` on ``scene``) on the recording's timelines (``clock``).
 
     show_labels: show the marker labels (a focus recording labels the involved objects itself); misses never do.
+    involved: in a focus recording, the ids (instance tokens, track ids) of the objects the focus is about: the
+    markers of other objects are drawn pale, so that another failure at the same frame does not read as this one;
+    focus_kind: the focused failure's kind, whose markers are drawn around the others of the same objects
+    (``FOCUS_MARGIN_M`` wider) instead of under them.
     Boxes of a kind show only at their frame (other frames get an empty batch); the count series has a value
     at every keyframe of ``frame_range`` (default: the whole scene; 0 when nothing failed). Failures outside the
     range are left out.
@@ -140,9 +149,10 @@ def log_failures(
             lengths[every_frame],
             color=color,
             scale=MARKER_SCALE,
-            margin_m=MARKER_MARGIN_M,
+            margin_m=MARKER_MARGIN_M + (FOCUS_MARGIN_M if kind is focus_kind else 0.0),
             line_radius_m=MARKER_LINE_RADIUS_M,
             show_labels=show_labels and kind is not FailureKind.MISS,
+            pale=None if involved is None else np.array([b.object_id not in involved for b in boxes], dtype=bool),
         )
     ids = dict(zip(map(id, report.failures), report.ids(), strict=True))
     logged = [f for f in report.failures if f.frame_index in in_range]

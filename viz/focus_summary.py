@@ -9,6 +9,7 @@ at the focus frame and the story lines, so the document alone explains the failu
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -60,7 +61,8 @@ READING_GUIDE = """# How to read the views
 - **Association lines**: a solid line joins a track's prediction to the detection it was given; a faint line, a
   detection inside its gate that it was not given.
 - **Failures**: enlarged boxes: magenta ID switch, orange fragmentation, red false track, green coalescence,
-  yellow identity theft, grey miss.
+  yellow identity theft, grey miss. This failure's box encloses the others on the same objects; failures of
+  other objects at the same frame are pale.
 - **Disagreements** (several trackers): boxes around the object in sky blue where only one tracker shows a track
   on it, violet where one changed its id and the other kept it, pink around a track only one shows.
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
@@ -138,7 +140,7 @@ def focus_markdown(
     lines += evaluated_notes(focus, scene, runs, evaluated)
     owner = focus.failure_tracker
     if owner in loggers and owner in runs and not evaluated:
-        lines += _why(focus, scene, runs[owner], loggers[owner], shown)
+        lines += _why(focus, scene, runs[owner], loggers[owner], shown, (reports or {}).get(owner))
         lines += _why_false_track(focus, scene, runs[owner], (reports or {}).get(owner))
         lines += _why_miss(focus, scene, runs[owner], loggers[owner], (reports or {}).get(owner))
     for tracker, logger in loggers.items():
@@ -241,6 +243,13 @@ def _parting(focus: FocusTarget, loggers: Mapping[str, TrackerLogger]) -> list[s
     return out
 
 
+def _score_of(choice: PairChoice) -> str:
+    """`` (score 0.75)``: the detection's score where its costs hold one (it is part of every track's cost), else
+    ""."""
+    terms = choice.chosen_terms or choice.alternative_terms
+    return f" (score {terms.score:.2f})" if terms is not None and terms.score is not None else ""
+
+
 def _brief(terms: PairTerms | None) -> str:
     """`` at existence 0.62, ±1.2 m, d² 0.3`` (``decisions.cost_brief``), or "" for a column without terms."""
     return f" at {cost_brief(terms)}" if terms is not None else ""
@@ -278,8 +287,8 @@ def _key_decisions(
                     if alt is not None:
                         other = f"over {column_name(alt)} ({c.alternative_cost:.2f}{_brief(c.alternative_terms)})"
                     text = (
-                        f"frame {f}: {meas_name(c.meas.ref)} → **{went}** (cost {c.chosen_cost:.2f}) {other}, "
-                        f"margin {c.margin:.2f}"
+                        f"frame {f}: {meas_name(c.meas.ref)}{_score_of(c)} → **{went}** (cost {c.chosen_cost:.2f}) "
+                        f"{other}, margin {c.margin:.2f}"
                     )
                     out.append(KeyDecision(f, c, went, text))
     return out if limit is None else out[-limit:]
@@ -316,7 +325,12 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
             plural = "s" if len(passed) > 1 else ""
             parts.append(f"detections in its gate went elsewhere at frame{plural} {'; '.join(went)}")
         peak = max(frames, key=lambda f: _after(steps[f]))
-        then = f"{existence_text(_after(steps[frames[-1]]))} at frame {frames[-1]}"
+        final_r = steps[frames[-1]].posterior_existence
+        then = (
+            f"{existence_text(final_r)} at frame {frames[-1]}"
+            if final_r == final_r
+            else f"pruned at frame {frames[-1]}"
+        )
         if peak == frames[-1]:
             parts.append(f"existence after update {then}")
         else:
@@ -377,9 +391,18 @@ WHY_KINDS = {
 of the track that took the object over (None: none did)."""
 
 
-def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: TrackerLogger, shown: range) -> list[str]:
+def _why(
+    focus: FocusTarget,
+    scene: SceneData,
+    run: TrackingRun,
+    logger: TrackerLogger,
+    shown: range,
+    report: FailureReport | None = None,
+) -> list[str]:
     """One line for a failure where a track lost its object: how often the object was detected, what the lost
-    track's existence did meanwhile and the choice that gave the object's detection to the other track."""
+    track's existence did meanwhile (and, when it was too low for the track to be shown, why the evaluation still
+    counted the track: ``report``'s averaged score) and the choice that gave the object's detection to the other
+    track."""
     if focus.failure_kind not in WHY_KINDS or not focus.gt_ids or not focus.failure_tracks:
         return []
     lost_at, took_at = WHY_KINDS[focus.failure_kind]
@@ -413,6 +436,8 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
             f"track {lost}'s existence went from {existence_text(_after(steps[peak]))} (frame {peak}) to "
             f"{existence_text(_after(steps[max(steps)]))} (frame {max(steps)})"
         )
+        if report is not None and not any(step.reported for step in steps.values()):
+            parts += _counted_unshown(lost, report, focus.class_name, logger.show_min_existence)
     because = []
     doing = TRACKER if focus.frame_index in detected else DETECTOR
     if took is not None:
@@ -436,6 +461,23 @@ def _why(focus: FocusTarget, scene: SceneData, run: TrackingRun, logger: Tracker
                 f, m = started[0]
                 parts.append(f"then, at frame {f}, {meas_name(m)} started track {took} (not a close call)")
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", "", *because]
+
+
+def _counted_unshown(track_id: int, report: FailureReport, class_name: str, show_min: float) -> list[str]:
+    """Why a track the viewer did not show (existence below ``show_min``) still counts for the evaluation: it
+    scores a track by its score averaged over all its frames, against the class's threshold."""
+    average, threshold = report.track_scores.get(str(track_id)), report.threshold_of(class_name)
+    if average is None or threshold is None or average < threshold:
+        return []
+    # The threshold is one of the averaged scores (the devkit's best-MOTA threshold), possibly this track's own.
+    if math.isclose(average, threshold, rel_tol=1e-9):
+        versus = f"is exactly the {class_name} threshold (the lowest score counted)"
+    else:
+        versus = f"is above the {class_name} threshold {threshold:.3f}"
+    return [
+        f"too low for track {track_id} to be shown here (existence below {show_min:g}), yet the evaluation counted "
+        f"it: its score averaged over all its frames, {average:.3f}, {versus}"
+    ]
 
 
 def _where_from(key: KeyDecision, keys: list[KeyDecision], named: tuple[int | None, ...]) -> list[str]:
@@ -654,7 +696,8 @@ def _gt_markdown(
                 "best-MOTA threshold)"
             )
             tracks = sorted({w for w in sent if w != "—" and not w.startswith("new")})
-            rest = f", the others went to {', '.join(tracks) or 'no track'}" if news < len(sent) else ""
+            others = "the other" if len(sent) - news == 1 else "the others"
+            rest = f", {others} went to {', '.join(tracks) or 'no track'}" if news < len(sent) else ""
             out += [
                 f"**GT {short_id(gt_id)}**, in the {seen} frames of the table ({first}–{focus.frame_index}): a "
                 f"detection within {NEAR_DETECTION_M:.0f} m in {detected}; {news} of them started a new track{rest}.",

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 import rerun as rr
 
+from viz.colors import faded, pack_rgba
 from viz.geometry import quat_wxyz_to_xyzw, size_wlh_to_xyz
 from viz.timeline import Clock
 
@@ -47,15 +48,21 @@ def send_marker_boxes(
     margin_m: float,
     line_radius_m: float,
     show_labels: bool = True,
+    pale: np.ndarray | None = None,
+    pale_keep: float = 0.35,
 ) -> None:
     """Boxes (objects with ``translation_m``, ``size_wlh_m``, ``quat_wxyz``) drawn ``scale`` times larger plus
-    ``margin_m``, ``lengths[i]`` of them at keyframe ``frames[i]`` (0 = an empty batch, clearing the frame)."""
+    ``margin_m``, ``lengths[i]`` of them at keyframe ``frames[i]`` (0 = an empty batch, clearing the frame).
+    pale: (N,) bool per box, drawn with ``pale_keep`` of ``color`` (``colors.faded``): markers beside the point."""
     sizes = size_wlh_to_xyz(np.array([b.size_wlh_m for b in boxes], dtype=np.float64)).reshape(-1, 3)
     centers = np.array([b.translation_m for b in boxes], dtype=np.float64).reshape(-1, 3)
     quats = quat_wxyz_to_xyzw(np.array([b.quat_wxyz for b in boxes], dtype=np.float64)).reshape(-1, 4)
     lengths = np.asarray(lengths, dtype=np.int64)
     starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
     labels = list(labels)
+    packed = np.full(len(labels), pack_rgba(np.array([color], dtype=np.uint8))[0], dtype=np.uint32)
+    if pale is not None and np.any(pale):
+        packed[np.asarray(pale, dtype=bool)] = faded(packed[:1], pale_keep)[0]
 
     def columns(rows: np.ndarray) -> rr.ComponentColumnList:
         idx = np.concatenate([np.arange(starts[r], starts[r] + lengths[r]) for r in rows]).astype(np.int64)
@@ -63,7 +70,7 @@ def send_marker_boxes(
             centers=centers[idx],
             half_sizes=0.5 * (sizes[idx] * scale + margin_m),
             quaternions=quats[idx],
-            colors=np.tile(np.array(color, dtype=np.uint8), (idx.size, 1)),
+            colors=packed[idx],
             radii=np.full(idx.size, line_radius_m, dtype=np.float32),
             labels=[labels[i] for i in idx.tolist()],
         ).partition(lengths[rows])

@@ -13,7 +13,8 @@ from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import ClassEvaluation, Failure, FailureBox, FailureKind, FailureReport
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
-from viz.failures import KIND_COLORS, MARKER_MARGIN_M, MARKER_SCALE, _label, failure_log, log_failures
+from viz.colors import faded, pack_rgba
+from viz.failures import FOCUS_MARGIN_M, KIND_COLORS, MARKER_MARGIN_M, MARKER_SCALE, _label, failure_log, log_failures
 
 T = "gnnpmb"
 GT_ID = "a1b2c3d4e5f6"
@@ -170,3 +171,22 @@ def test_a_marker_label_does_not_repeat_the_kind() -> None:
     assert _label(FailureKind.FALSE_TRACK, fbox("false track", "20", 0.0)) == "false track 20"
     assert _label(FailureKind.FRAGMENTATION, fbox("missed gt", GT_ID, 0.0)) == "fragmentation: missed gt a1b2c3"
     assert _label(FailureKind.IDENTITY_THEFT, fbox("thief track", "9", 0.0)) == "identity theft: thief track 9"
+
+
+def test_a_focus_pales_the_markers_of_other_objects_and_draws_its_kind_around_the_others(
+    saved_stream, tiny_scene
+) -> None:
+    stream, path = saved_stream
+    scene, _ = tiny_scene
+    # Focused on the identity theft of track 9: old track 4 is not among its objects.
+    log_failures(stream, T, report_for(scene), scene, involved={GT_ID, "9"}, focus_kind=FailureKind.IDENTITY_THEFT)
+    stream.disconnect()
+    rows = read_rows(path)
+    switch = at_frame(rows[paths.failures_world(T, "id_switch")], 1)[0]
+    strong = int(pack_rgba(np.array([KIND_COLORS[FailureKind.ID_SWITCH]]))[0])
+    pale = int(faded(np.array([strong], dtype=np.uint32), 0.35)[0])
+    assert switch["Boxes3D:labels"][2] == "ID switch: old track 4"
+    assert switch["Boxes3D:colors"] == [strong, strong, pale]
+    theft = at_frame(rows[paths.failures_world(T, "identity_theft")], 1)[0]
+    widened = 0.5 * (np.array([4.0, 2.0, 1.5]) * MARKER_SCALE + MARKER_MARGIN_M + FOCUS_MARGIN_M)
+    np.testing.assert_allclose(theft["Boxes3D:half_sizes"][0], widened, rtol=1e-6)  # encloses the switch's box
