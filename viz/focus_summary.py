@@ -449,7 +449,7 @@ def _why(
             parts.append(f"then, {chosen[-1].text}")
             parts += _where_from(chosen[-1], keys, (lost, took))
             step = logger.track_steps.get(lost, {}).get(chosen[-1].frame)
-            because = _because(chosen[-1], lost, step)
+            because = _because(chosen[-1], lost, step, focus.frame_index)
         else:  # no close call: say where the track that took the object came from
             started = [
                 (f, m)
@@ -460,7 +460,24 @@ def _why(
             if started:
                 f, m = started[0]
                 parts.append(f"then, at frame {f}, {meas_name(m)} started track {took} (not a close call)")
+    if focus.failure_kind is FailureKind.IDENTITY_THEFT and report is not None and took is not None:
+        parts += _first_false(report, took, lost, gt_id, focus.frame_index)
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", "", *because]
+
+
+def _first_false(report: FailureReport, thief: int, victim: int, gt_id: str, frame: int) -> list[str]:
+    """What makes a takeover an identity theft rather than a plain ID switch: the thief's earlier frames the
+    evaluation counted as a false track (matched to no object)."""
+    false_at = sorted(
+        {f.frame_index for f in report.of_kind(FailureKind.FALSE_TRACK) if str(thief) in f.track_ids}
+        & set(range(frame))
+    )
+    if not false_at:
+        return []
+    return [
+        f"track {thief} had been a false track at {_frames_named(false_at)} (the evaluation matched it to no "
+        f"object), so its taking GT {short_id(gt_id)} from track {victim} is an identity theft"
+    ]
 
 
 def _counted_unshown(track_id: int, report: FailureReport, class_name: str, show_min: float) -> list[str]:
@@ -494,11 +511,12 @@ def _where_from(key: KeyDecision, keys: list[KeyDecision], named: tuple[int | No
     return [f"track {alt.ref} had been started at frame {k.frame} by {meas_name(k.choice.meas.ref)}{instead}"]
 
 
-def _because(key: KeyDecision, lost: int, step: TrackStep | None) -> list[str]:
+def _because(key: KeyDecision, lost: int, step: TrackStep | None, opened_at: int) -> list[str]:
     """The decisive choice's costs taken apart (``decisions.choice_why``), as a paragraph, and, when the track
     that lost the object (``lost``, its ``TrackStep`` at that frame) was neither of the two columns compared,
     what it would have cost or that the detection was outside its gate; none when the tracker's cost matrix does
-    not say what its costs are made of."""
+    not say what its costs are made of. A choice before the frame the views open at (``opened_at``) says how
+    far to step back to see it."""
     why = choice_why(key.choice, key.went)
     if why is None:
         return []
@@ -509,7 +527,11 @@ def _because(key: KeyDecision, lost: int, step: TrackStep | None) -> list[str]:
             why += f". {meas_name(c.meas.ref)} was outside the gate of track {lost}, which had the object"
         elif (lost_why := track_why(c, lost, ", which had the object,")) is not None:
             why += f". {lost_why}"
-    return [f"**Because** (frame {key.frame}): {why}.", ""]
+    back = opened_at - key.frame
+    where = ""
+    if back > 0:
+        where = f"; the views open at frame {opened_at}: step back {back} frame{'s' if back > 1 else ''} to see it"
+    return [f"**Because** (frame {key.frame}{where}): {why}.", ""]
 
 
 def _why_false_track(focus: FocusTarget, scene: SceneData, run: TrackingRun, report: FailureReport | None) -> list[str]:

@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
-from gnnpmb.eval.failures import ClassEvaluation, FailureReport
-from viz.focus_summary import _counted_unshown
+from gnnpmb.eval.failures import ClassEvaluation, Failure, FailureKind, FailureReport
+from viz.focus_summary import _counted_unshown, _first_false
 
 
-def report(track_scores: dict[str, float], threshold: float | None = 0.037) -> FailureReport:
+def report(
+    track_scores: dict[str, float], threshold: float | None = 0.037, failures: tuple[Failure, ...] = ()
+) -> FailureReport:
     classes = (ClassEvaluation("bicycle", threshold, 0.5, 1.0, 0.0, 1.0, 1.0, 0.0),)
-    return FailureReport("scene-x", "gnnpmb", ("t0",), classes, (), track_scores=track_scores)
+    tokens = tuple(f"t{i}" for i in range(25))
+    return FailureReport("scene-x", "gnnpmb", tokens, classes, failures, track_scores=track_scores)
 
 
 def test_a_track_too_unlikely_to_be_shown_is_said_to_count_when_its_average_reaches_the_threshold() -> None:
@@ -22,3 +25,16 @@ def test_a_track_too_unlikely_to_be_shown_is_said_to_count_when_its_average_reac
     assert _counted_unshown(26, report({"26": 0.01}), "bicycle", 0.5) == []  # not counted: nothing to explain
     assert _counted_unshown(26, report({}), "bicycle", 0.5) == []  # not evaluated
     assert _counted_unshown(26, report({"26": 0.2}, threshold=None), "bicycle", 0.5) == []
+
+
+def test_an_identity_theft_names_the_frames_its_thief_was_a_false_track() -> None:
+    def false_track(frame: int, track: str) -> Failure:
+        return Failure(FailureKind.FALSE_TRACK, frame, f"t{frame}", "car", (), (track,), ())
+
+    failures = (false_track(17, "315"), false_track(19, "315"), false_track(19, "321"), false_track(21, "315"))
+    (line,) = _first_false(report({}, failures=failures), 315, 61, "7b025b" + "0" * 26, 20)
+    assert line == (
+        "track 315 had been a false track at frames 17, 19 (the evaluation matched it to no object), so its taking "
+        "GT 7b025b from track 61 is an identity theft"
+    )
+    assert _first_false(report({}, failures=failures), 315, 61, "7b025b" + "0" * 26, 17) == []  # none before frame 17
