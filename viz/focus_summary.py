@@ -36,7 +36,7 @@ from viz.decisions import (
     track_why,
 )
 from viz.evaluated import NEAR_DETECTION_M, devkit_gt, evaluated_notes, evaluated_offsets, range_near_focus
-from viz.logger import TrackerLogger, TrackStep
+from viz.logger import SHOW_MIN_EXISTENCE, TrackerLogger, TrackStep
 
 MAX_STORY_LINES = 40
 
@@ -49,7 +49,7 @@ MAX_LISTED = 2
 TABLE_FRAMES = 6
 """The frame tables show the focus frame and the TABLE_FRAMES frames before it."""
 
-READING_GUIDE = """# How to read the views
+READING_GUIDE = f"""# How to read the views
 
 **Bird's-eye and 3D views** (one pair per tracker)
 
@@ -64,7 +64,9 @@ READING_GUIDE = """# How to read the views
   yellow identity theft, grey miss. This failure's box encloses the others on the same objects; failures of
   other objects at the same frame are pale.
 - **Disagreements** (several trackers): boxes around the object in sky blue where only one tracker shows a track
-  on it, violet where one changed its id and the other kept it, pink around a track only one shows.
+  on it, violet where one changed its id and the other kept it, pink around a track only one shows. Shown means
+  an existence of {SHOW_MIN_EXISTENCE:g} or more: an involved track below that is drawn here all the same, but
+  counts as not shown in the comparison (and is not drawn in the full recording).
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
   A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`); a track's predicted
   position, its predicted existence and the detection it was given (`26 predicted r=0.40 → m2`) or `missed`.
