@@ -65,7 +65,7 @@ def timed_run(
     else:
         stream = open_recording("bench", out, None)
         logger = TrackerLogger(
-            stream, tracker, flush_frames=flush_frames, existence_series=tracker_has_existence(tracker)
+            stream, tracker, flush_frames=flush_frames, has_existence=tracker_has_existence(tracker)
         )
         run_tracker(scene, frames, tracker, config, sink=logger)
         send = time.perf_counter()

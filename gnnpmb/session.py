@@ -488,7 +488,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                 log_frames=shown if focus is not None else None,
                 focus_tracks=set(focus.track_ids.get(tracker, ())) if focus is not None else None,
                 flush_frames=None if request.save is not None else FLUSH_FRAMES,
-                existence_series=tracker_has_existence(tracker),
+                has_existence=tracker_has_existence(tracker),
                 focus_class=focus.class_name if focus is not None else None,
             )
             runs.append(

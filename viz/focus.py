@@ -154,7 +154,12 @@ def log_focus(
                 gt_callouts
                 + _detection_callouts(detections, sorted(given), loggers[tracker].given.get(i, {}))
                 + _prediction_callouts(
-                    steps, z_m, palette, existence_as_decided(loggers[tracker], i, focus.class_name)
+                    steps,
+                    z_m,
+                    palette,
+                    existence_as_decided(loggers[tracker], i, focus.class_name)
+                    if loggers[tracker].has_existence
+                    else None,
                 ),
                 height_m,
             )
@@ -215,7 +220,7 @@ def focus_legends(
             ],
             paths.nis_root(tracker): [paths.nis(tracker, focus.class_name, t) for t in ids],
         }
-        if not logger.existence_series:
+        if not logger.has_existence:
             del views[paths.existence_root(tracker)]
         for root, series in views.items():
             sent = [logger.sent_series[p] for p in series if p in logger.sent_series]
@@ -256,12 +261,12 @@ def _prediction_callouts(
     """``<id> predicted r=<existence> → m<idx>`` (the detection it was given; ``, missed``: none) at each focused
     track's predicted position this frame, in the track's involved colour (``palette``); the existence is the one
     its detection was decided with (``decided``, see ``focus_summary.existence_as_decided``) if known, else its
-    prior existence."""
-    decided = decided or {}
+    prior existence. decided None: the tracker has no existences (``<id> predicted → m<idx>``)."""
     return [
         Callout(
             (*step.predicted_xy_m, z_m),
-            f"{t} predicted r={existence_text(decided.get(t, step.prior_existence))}"
+            f"{t} predicted"
+            + ("" if decided is None else f" r={existence_text(decided.get(t, step.prior_existence))}")
             + (f" → m{step.given}" if step.given >= 0 else ", missed"),
             palette[t],
         )

@@ -326,6 +326,10 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
                 went.append(f"{f} ({sent}{more})")
             plural = "s" if len(passed) > 1 else ""
             parts.append(f"detections in its gate went elsewhere at frame{plural} {'; '.join(went)}")
+        if not logger.has_existence:
+            parts.append("shown as a track" if steps[frames[-1]].reported else "not output")
+            out.append(f"**track {t}**: " + "; ".join(parts) + ".")
+            continue
         peak = max(frames, key=lambda f: _after(steps[f]))
         final_r = steps[frames[-1]].posterior_existence
         then = (
@@ -432,7 +436,7 @@ def _why(
             f"{short_id(gt_id)} had a detection within {NEAR_DETECTION_M:.0f} m at {at}{no_points}"
         )
     steps = {f: st for f, st in logger.track_steps.get(lost, {}).items() if shown.start <= f <= focus.frame_index}
-    if steps:
+    if steps and logger.has_existence:
         peak = max(steps, key=lambda f: _after(steps[f]))
         parts.append(
             f"track {lost}'s existence went from {existence_text(_after(steps[peak]))} (frame {peak}) to "
@@ -754,8 +758,9 @@ def existence_as_decided(logger: TrackerLogger, frame: int, class_name: str) -> 
 
 def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, last: int, class_name: str) -> list[str]:
     """Per involved track, a table of its frames up to ``last``: existence before (and, if it differs, in the
-    hypothesis its detection was decided in: ``existence_as_decided``) and after the update, the detections in
-    its gate (with NIS) and the one it was given, and whether it was reported."""
+    hypothesis its detection was decided in: ``existence_as_decided``) and after the update (for a tracker that
+    has existences), the detections in its gate (with NIS) and the one it was given, and whether it was
+    reported."""
     out: list[str] = []
     decided: dict[int, dict[int, float]] = {}  # frame -> existence_as_decided, worked out once per frame
     for t in track_ids:
@@ -764,16 +769,21 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
         }
         if not steps:
             continue
-        out += [
-            f"Track {t}, frame by frame:",
-            "",
-            "| frame | r before update | in gate (NIS) | given | r after | shown |",
-            "|---|---|---|---|---|---|",
-        ]
+        out += [f"Track {t}, frame by frame:", ""]
+        if not logger.has_existence:  # a track-logic tracker: no existence to tabulate
+            out += ["| frame | in gate (NIS) | given | shown |", "|---|---|---|---|"]
+        else:
+            out += [
+                "| frame | r before update | in gate (NIS) | given | r after | shown |",
+                "|---|---|---|---|---|---|",
+            ]
         for f in sorted(steps):
             s = steps[f]
             gated = ", ".join(f"m{m} ({nis:.1f})" for m, nis in s.gated) or "nothing"
             given = f"m{s.given}" if s.given >= 0 else "—"
+            if not logger.has_existence:
+                out.append(f"| {f} | {gated} | {given} | {'yes' if s.reported else 'no'} |")
+                continue
             after = (
                 "pruned" if s.posterior_existence != s.posterior_existence else existence_text(s.posterior_existence)
             )

@@ -180,9 +180,9 @@ class TrackerLogger:
     only these keyframes (None: all); the others still feed the tracks' history (trails, series, story state).
     focus_tracks: their conflicts come first in the decision view, and they take distinct colours
     (``colors.involved_track_colors``, away from the colour of ``focus_class``, their class). flush_frames: send
-    buffered rows every this many frames (None: only at the end). existence_series: plot each track's existence
-    and the class's threshold (False for a tracker without existence probabilities,
-    ``registry.tracker_has_existence``: flat lines at 1, and a chunk pair per track). Call ``finish()`` after the
+    buffered rows every this many frames (None: only at the end). has_existence: False for a tracker whose
+    tracks have no existence probability (``registry.tracker_has_existence``; its events carry 1): no existence
+    series (flat lines at 1, a chunk pair per track) and no existence in the story. Call ``finish()`` after the
     last frame: it sends what is buffered and the time series.
     """
 
@@ -202,7 +202,7 @@ class TrackerLogger:
         log_frames: range | None = None,
         focus_tracks: set[int] | None = None,
         flush_frames: int | None = FLUSH_FRAMES,
-        existence_series: bool = True,
+        has_existence: bool = True,
         focus_class: str | None = None,
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
@@ -217,7 +217,7 @@ class TrackerLogger:
         self.log_frames = log_frames
         self.focus_tracks = focus_tracks
         self.flush_frames = flush_frames
-        self.existence_series = existence_series
+        self.has_existence = has_existence
         self.involved_rgb = involved_track_colors(focus_tracks or (), CLASS_COLORS.get(focus_class or ""))
         """Focus track id -> its RGB (``colors.involved_track_colors``), in every view and plot."""
         packed = pack_rgba(np.array(list(self.involved_rgb.values()), dtype=np.uint8).reshape(-1, 3))
@@ -484,7 +484,7 @@ class TrackerLogger:
         extracted = cf.extracted.estimates if cf.extracted is not None else ()
         estimates = tuple(e for e in extracted if e.existence >= self.show_min_existence)
         drawn = estimates + tuple(e for e in extracted if e.existence < self.show_min_existence and e.track_id in focus)
-        if self.existence_series and cf.extracted is not None and cf.posterior is not None:
+        if self.has_existence and cf.extracted is not None and cf.posterior is not None:
             self._sample(
                 paths.extraction_threshold(self.tracker, class_name),
                 max(cf.extracted.threshold, self.show_min_existence),
@@ -707,7 +707,7 @@ class TrackerLogger:
         xy = mean[follow, :2].tolist()
         for k, (x, y) in zip(follow, xy, strict=True):
             t = id_list[k]
-            if self.existence_series:
+            if self.has_existence:
                 self._track_sample(paths.existence, class_name, t, r_list[k], "existence")
             trail = self._trails.get(t)
             if trail is None:
@@ -827,9 +827,9 @@ class TrackerLogger:
         for t, e in now.items():
             via = f"from {meas_name(e.meas_index)}" if e.meas_index >= 0 else "without a detection"
             if t not in known:
-                self._text(class_name, f"track {t} confirmed (r={e.existence:.2f}, {via})", "INFO")
+                self._text(class_name, f"track {t} confirmed ({self._r(e.existence)}{via})", "INFO")
             elif e.meas_index < 0:
-                self._text(class_name, f"track {t} missed this frame, still reported (r={e.existence:.2f})", "INFO")
+                self._text(class_name, f"track {t} missed this frame, still reported{self._r_in(e.existence)}", "INFO")
         posterior_r: dict[int, float] = {}
         if cf.posterior is not None:
             posterior_r = dict(
@@ -845,13 +845,20 @@ class TrackerLogger:
         for t in sorted(self._reported - set(now) - pruned_ids):
             if t in posterior_r:
                 self._text(
-                    class_name, f"track {t} no longer shown (r={posterior_r[t]:.2f} fell below {limit:.2f})", "WARN"
+                    class_name,
+                    f"track {t} no longer shown (r={posterior_r[t]:.2f} fell below {limit:.2f})"
+                    if self.has_existence
+                    else f"track {t} no longer shown (not output this frame)",
+                    "WARN",
                 )
         candidates_pruned = 0
         for p in cf.pruned:
             if p.track_id in known:
                 self._text(
-                    class_name, f"track {p.track_id} ended: {p.reason.value} (last r={p.last_existence:.3g})", "WARN"
+                    class_name,
+                    f"track {p.track_id} ended: {p.reason.value}"
+                    + (f" (last r={p.last_existence:.3g})" if self.has_existence else ""),
+                    "WARN",
                 )
             else:
                 candidates_pruned += 1
@@ -905,9 +912,19 @@ class TrackerLogger:
                 via = f"given {meas_name(given[t])}" if t in given else "given no detection"
             self._text(
                 class_name,
-                f"track {t} (not shown, r < {self.show_min_existence:g}): {via}, r={existence_text(posterior_r[t])}",
+                f"track {t} (not shown, r < {self.show_min_existence:g}): {via}, r={existence_text(posterior_r[t])}"
+                if self.has_existence
+                else f"track {t} (not output): {via}",
                 "INFO",
             )
+
+    def _r(self, existence: float) -> str:
+        """``r=0.97, `` for a story line, nothing for a tracker without existences."""
+        return f"r={existence:.2f}, " if self.has_existence else ""
+
+    def _r_in(self, existence: float) -> str:
+        """`` (r=0.97)`` for a story line, nothing for a tracker without existences."""
+        return f" (r={existence:.2f})" if self.has_existence else ""
 
     @property
     def _focused(self) -> set[int]:

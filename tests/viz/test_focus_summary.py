@@ -38,3 +38,27 @@ def test_an_identity_theft_names_the_frames_its_thief_was_a_false_track() -> Non
         "GT 7b025b from track 61 is an identity theft"
     )
     assert _first_false(report({}, failures=failures), 315, 61, "7b025b" + "0" * 26, 17) == []  # none before frame 17
+
+
+def test_a_tracker_without_existences_gets_no_existence_in_its_track_tables_and_summaries() -> None:
+    import rerun as rr
+
+    from viz.focus_summary import _diagnosis, _steps_markdown
+    from viz.logger import TrackerLogger, TrackStep
+
+    def logger(has_existence: bool) -> TrackerLogger:
+        out = TrackerLogger(rr.RecordingStream("x"), "gnn", focus_tracks={25}, has_existence=has_existence)
+        out.track_steps = {25: {5: TrackStep(1.0, (0.0, 0.0), ((8, 0.3),), 8, 1.0, True)}}
+        return out
+
+    table = _steps_markdown(logger(False), [25], range(0, 10), 5, "car")
+    assert table[2:5] == [
+        "| frame | in gate (NIS) | given | shown |",
+        "|---|---|---|---|",
+        "| 5 | m8 (0.3) | m8 | yes |",
+    ]
+    assert _diagnosis(logger(False), [25], range(0, 10), 5) == [
+        "**track 25**: last given a detection at frame 5 (m8); shown as a track."
+    ]
+    assert "r before update" in _steps_markdown(logger(True), [25], range(0, 10), 5, "car")[2]
+    assert "existence after update 1.00 at frame 5" in _diagnosis(logger(True), [25], range(0, 10), 5)[0]

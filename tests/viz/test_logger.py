@@ -394,13 +394,17 @@ def test_a_detection_that_started_a_track_is_named_with_that_tracks_id() -> None
     assert destination(AxisLabel(AxisKind.TRACK, 61), None) == "track 61"
 
 
-def test_no_existence_series_for_a_tracker_without_existence_but_the_rest_is_drawn(
+def test_no_existence_series_or_story_existence_for_a_tracker_without_existence_but_the_rest_is_drawn(
     saved_stream: tuple[rr.RecordingStream, Path],
 ) -> None:
     stream, path = saved_stream
-    log_all(stream, scripted_events(), existence_series=False)
+    log_all(stream, scripted_events(), has_existence=False)
     stream.disconnect()
     rows = read_rows(path)
     assert not [p for p in rows if p.startswith(paths.existence_root(T) + "/")]
     assert [r["Scalars:scalars"][0] for r in rows[paths.nis(T, "car", 1)] if not r["static"]] == pytest.approx([0.25])
     assert any("LineStrips3D:strips" in r for r in at_frame(rows[paths.track(T, "car", 1)], 1))  # its trail
+    # The story names no existence either (a track-logic tracker's events carry 1).
+    story = rows[paths.events(T, "car")]
+    assert ("track 1 confirmed (from m0)", "INFO") in lines(story, 0)
+    assert ("track 1 ended: existence below pruning threshold", "WARN") in lines(story, 2)
