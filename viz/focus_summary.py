@@ -436,6 +436,12 @@ def _why(
             f"{short_id(gt_id)} had a detection within {NEAR_DETECTION_M:.0f} m at {at}{no_points}"
         )
     steps = {f: st for f, st in logger.track_steps.get(lost, {}).items() if shown.start <= f <= focus.frame_index}
+    if steps and not logger.has_existence:  # track logic: when it last had a detection, and whether it ended
+        given = [f for f in sorted(steps) if steps[f].given >= 0]
+        span = f"frames {min(steps)}–{max(steps)}" if len(steps) > 1 else f"frame {min(steps)}"
+        had = f"was last given a detection at frame {given[-1]}" if given else f"was given no detection in {span}"
+        ended = f" and ended after frame {max(steps)}" if max(steps) < focus.frame_index else ""
+        parts.append(f"track {lost} {had}{ended}")
     if steps and logger.has_existence:
         peak = max(steps, key=lambda f: _after(steps[f]))
         parts.append(
@@ -466,9 +472,33 @@ def _why(
             if started:
                 f, m = started[0]
                 parts.append(f"then, at frame {f}, {meas_name(m)} started track {took} (not a close call)")
+    parts += _lost_elsewhere(focus, scene, by_frame.get(focus.frame_index), logger, lost)
     if focus.failure_kind is FailureKind.IDENTITY_THEFT and report is not None and took is not None:
         parts += _first_false(report, took, lost, gt_id, focus.frame_index)
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", "", *because]
+
+
+def _lost_elsewhere(
+    focus: FocusTarget, scene: SceneData, frame: FrameResult | None, logger: TrackerLogger, lost: int
+) -> list[str]:
+    """When the track that lost the object is still output at the failure frame, but too far from the object for
+    the evaluation to match it: where it was, and the detection it followed there."""
+    if frame is None or not focus.gt_ids:
+        return []
+    estimate = next((e for e in frame.estimates if e.track_id == lost), None)
+    gt = scene.keyframes[focus.frame_index].gt
+    hit = np.flatnonzero(gt.instance_id.astype(str) == focus.gt_ids[0])
+    if estimate is None or hit.size == 0:
+        return []
+    gap_m = float(np.hypot(*(np.asarray(estimate.translation_m[:2]) - gt.translation_m[hit[0], :2])))
+    if gap_m < NEAR_DETECTION_M:
+        return []
+    step = logger.track_steps.get(lost, {}).get(focus.frame_index)
+    on = f", on {meas_name(step.given)}" if step is not None and step.given >= 0 else ""
+    return [
+        f"at frame {focus.frame_index} track {lost} was output {gap_m:.1f} m from GT {short_id(focus.gt_ids[0])}"
+        f"{on}: beyond the evaluation's {NEAR_DETECTION_M:.0f} m, so it no longer matched the object"
+    ]
 
 
 def _first_false(report: FailureReport, thief: int, victim: int, gt_id: str, frame: int) -> list[str]:

@@ -422,5 +422,6 @@ def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(
     old, new = report.by_id(pick).track_ids
     out, _ = record(demo_dataroot, tmp_path, pick, ("gnn",))
     why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
-    assert why.startswith("**Why** (gnn, ") and f"track {old}'s existence went from " in why
-    assert re.search(rf"then, at frame \d+, m\d+ started track {new} \(not a close call\)\.$", why), why
+    assert why.startswith("**Why** (gnn, ") and "existence" not in why  # GNN's tracks have none
+    assert re.search(rf"track {old} (was last given a detection at frame \d+|was given no detection)", why), why
+    assert re.search(rf"then, at frame \d+, m\d+ started track {new} \(not a close call\)[.;]", why), why
