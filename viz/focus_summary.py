@@ -189,7 +189,8 @@ def focus_markdown(
             lines.append("")
             lines += [conflict_markdown(c, logger.reported_ever) for c in decided]
         else:
-            lines.append(f"No conflict involved these tracks at frame {focus.frame_index} (nothing in their gates).")
+            reach = "nothing in their gates" if logger.has_gates else "no detection within their matching distance"
+            lines.append(f"No conflict involved these tracks at frame {focus.frame_index} ({reach}).")
             lines.append("")
         story = [
             (f, text)
@@ -315,7 +316,7 @@ def _diagnosis(logger: TrackerLogger, track_ids: list[int], shown: range, last: 
         else:
             span = f"frames {frames[0]}-{frames[-1]}" if len(frames) > 1 else f"frame {frames[0]}"
             parts.append(f"given no detection in {span}")
-        if empty:
+        if empty and logger.has_gates:
             parts.append(f"nothing in its gate at frame{'s' if len(empty) > 1 else ''} {_frames(empty)}")
         if passed:
             went = []
@@ -800,7 +801,9 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
         if not steps:
             continue
         out += [f"Track {t}, frame by frame:", ""]
-        if not logger.has_existence:  # a track-logic tracker: no existence to tabulate
+        if not logger.has_gates:  # greedy: neither gates nor existences
+            out += ["| frame | given | shown |", "|---|---|---|"]
+        elif not logger.has_existence:  # a track-logic tracker: no existence to tabulate
             out += ["| frame | in gate (NIS) | given | shown |", "|---|---|---|---|"]
         else:
             out += [
@@ -811,6 +814,9 @@ def _steps_markdown(logger: TrackerLogger, track_ids: list[int], shown: range, l
             s = steps[f]
             gated = ", ".join(f"m{m} ({nis:.1f})" for m, nis in s.gated) or "nothing"
             given = f"m{s.given}" if s.given >= 0 else "—"
+            if not logger.has_gates:
+                out.append(f"| {f} | {given} | {'yes' if s.reported else 'no'} |")
+                continue
             if not logger.has_existence:
                 out.append(f"| {f} | {gated} | {given} | {'yes' if s.reported else 'no'} |")
                 continue

@@ -225,6 +225,8 @@ class TrackerLogger:
         self._rows = RowBuffer(stream, clock)
         self._buffered: set[str] = set()
         self._drawing = True
+        self.has_gates = False
+        """Whether the tracker gates (a ``Gated`` event came): greedy matches within a distance instead."""
         self.decisions: dict[int, list[Decisions]] = {}
         """Frame index -> the decisions of every class (kept for the focus view and tests)."""
         self.given: dict[int, dict[int, str]] = {}
@@ -255,7 +257,7 @@ class TrackerLogger:
             FrameStarted: self._on_frame_started,
             MeasurementsReceived: self._store("meas"),
             Predicted: self._store("predicted"),
-            Gated: self._store("gated"),
+            Gated: self._on_gated,
             CostMatrix: self._on_cost,
             Assignment: self._on_assignment,
             Born: self._append("born"),
@@ -345,6 +347,10 @@ class TrackerLogger:
         if cf is None:
             cf = self._classes[class_name] = _ClassFrame()
         return cf
+
+    def _on_gated(self, event: Gated) -> None:
+        self.has_gates = True
+        self._class_frame(event.class_name).gated = event
 
     def _on_cost(self, event: CostMatrix) -> None:
         self._class_frame(event.class_name).costs[event.hypothesis] = event

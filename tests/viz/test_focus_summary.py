@@ -46,9 +46,10 @@ def test_a_tracker_without_existences_gets_no_existence_in_its_track_tables_and_
     from viz.focus_summary import _diagnosis, _steps_markdown
     from viz.logger import TrackerLogger, TrackStep
 
-    def logger(has_existence: bool) -> TrackerLogger:
+    def logger(has_existence: bool, has_gates: bool = True) -> TrackerLogger:
         out = TrackerLogger(rr.RecordingStream("x"), "gnn", focus_tracks={25}, has_existence=has_existence)
         out.track_steps = {25: {5: TrackStep(1.0, (0.0, 0.0), ((8, 0.3),), 8, 1.0, True)}}
+        out.has_gates = has_gates  # set by its first Gated event
         return out
 
     table = _steps_markdown(logger(False), [25], range(0, 10), 5, "car")
@@ -62,3 +63,5 @@ def test_a_tracker_without_existences_gets_no_existence_in_its_track_tables_and_
     ]
     assert "r before update" in _steps_markdown(logger(True), [25], range(0, 10), 5, "car")[2]
     assert "existence after update 1.00 at frame 5" in _diagnosis(logger(True), [25], range(0, 10), 5)[0]
+    greedy = _steps_markdown(logger(False, has_gates=False), [25], range(0, 10), 5, "car")  # no gates either
+    assert greedy[2:5] == ["| frame | given | shown |", "|---|---|---|", "| 5 | m8 | yes |"]

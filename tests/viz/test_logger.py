@@ -292,6 +292,7 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     assert [r.get("focus") for r in rows[paths.existence(T, "car", 1)] if not r["static"]] == [0, 1]
     assert {r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 1)} == {1}
     assert {r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 2)} == {None}  # past the focus
+    assert logger.has_gates  # the scripted tracker gates (greedy does not)
     step = logger.track_steps[2][1]
     assert (step.prior_existence, step.given, step.reported) == (pytest.approx(0.28), 1, False)
     assert [m for m, _ in step.gated] == [0]
