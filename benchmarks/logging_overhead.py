@@ -64,9 +64,7 @@ def timed_run(
         run_tracker(scene, frames, tracker, config, sink=ListSink())
     else:
         stream = open_recording("bench", out, None)
-        logger = TrackerLogger(
-            stream, tracker, flush_frames=flush_frames, has_existence=tracker_has_existence(tracker)
-        )
+        logger = TrackerLogger(stream, tracker, flush_frames=flush_frames, has_existence=tracker_has_existence(tracker))
         run_tracker(scene, frames, tracker, config, sink=logger)
         send = time.perf_counter()
         logger.finish()
