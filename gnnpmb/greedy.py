@@ -103,6 +103,7 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
     """One class's greedy closest-pair tracker (module docstring); the frame loop is ``skeleton.ClassFilter.step``."""
 
     has_existence = False  # a track lives until max_age misses
+    has_gates = False  # a matching distance, no Gaussian gate
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         super().__init__(class_name, config, ids)

@@ -122,6 +122,11 @@ def tracker_has_existence(name: str) -> bool:
     return _sample_tracker(name).has_existence
 
 
+def tracker_has_gates(name: str) -> bool:
+    """Whether tracker ``name`` gates with the innovation covariance (``skeleton.ClassFilter.has_gates``)."""
+    return _sample_tracker(name).has_gates
+
+
 def _sample_tracker(name: str) -> ClassFilter:
     """Tracker ``name`` for the first class with the default configuration: what it declares for the viewer."""
     from gnnpmb.config import TrackerConfig

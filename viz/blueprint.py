@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import rerun.blueprint as rrb
 
 from gnnpmb.events import Panel
-from gnnpmb.registry import tracker_has_existence, tracker_panels
+from gnnpmb.registry import tracker_has_existence, tracker_has_gates, tracker_panels
 from viz import compare, paths
 from viz.failures import failure_log
 from viz.legend import LegendPlacement
@@ -197,10 +197,11 @@ def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visib
 def track_series_views(
     tracker: str, focus: FocusTarget | None = None, legends: Mapping[str, LegendPlacement] | None = None
 ) -> list[rrb.TimeSeriesView]:
-    """Existence (for a tracker that has it, ``registry.tracker_has_existence``), normalised innovation and chosen
-    cost per track; only the involved tracks when focused, with a legend (placed by ``legends``, keyed by the
-    view's origin)."""
+    """Existence (for a tracker that has it, ``registry.tracker_has_existence``), normalised innovation (for a
+    tracker that gates, ``registry.tracker_has_gates``) and chosen cost per track; only the involved tracks when
+    focused, with a legend (placed by ``legends``, keyed by the view's origin)."""
     existence = [(paths.existence_root(tracker), "existence")] if tracker_has_existence(tracker) else []
+    nis = [(paths.nis_root(tracker), "NIS (innovation²/S)")] if tracker_has_gates(tracker) else []
     return [
         rrb.TimeSeriesView(
             origin=root,
@@ -210,7 +211,7 @@ def track_series_views(
         )
         for root, what in (
             *existence,
-            (paths.nis_root(tracker), "NIS (innovation²/S)"),
+            *nis,
             (paths.chosen_cost_root(tracker), "chosen cost"),
         )
     ]
@@ -251,10 +252,14 @@ def tracker_panel(
 ) -> rrb.Vertical:
     """Decision view, story and failure logs, and series (per-track, candidates, failures, extra plots); with a
     focus the summary of the failure comes first (beside a tab on how to read the views) and the decision
-    document goes to a tab beside the story."""
+    document goes to a tab beside the story. Candidates (Bernoullis too unlikely to be drawn as tracks) only for
+    a tracker with existences."""
+    candidates = []
+    if tracker_has_existence(tracker):
+        candidates = [rrb.TimeSeriesView(origin=paths.candidates_root(tracker), name=f"{tracker} candidates")]
     series = rrb.Tabs(
         *track_series_views(tracker, focus, legends),
-        rrb.TimeSeriesView(origin=paths.candidates_root(tracker), name=f"{tracker} candidates"),
+        *candidates,
         failure_counts_view(tracker),
         *_extra_views(tracker, classes),
     )

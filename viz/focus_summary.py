@@ -65,8 +65,9 @@ READING_GUIDE = f"""# How to read the views
   other objects at the same frame are pale.
 - **Disagreements** (several trackers): boxes around the object in sky blue where only one tracker shows a track
   on it, violet where one changed its id and the other kept it, pink around a track only one shows. Shown means
-  an existence of {SHOW_MIN_EXISTENCE:g} or more: an involved track below that is drawn here all the same, but
-  counts as not shown in the comparison (and is not drawn in the full recording).
+  an existence of {SHOW_MIN_EXISTENCE:g} or more (output, for GNN, JPDA and greedy, which have no existences):
+  an involved track below that is drawn here all the same, but counts as not shown in the comparison (and is
+  not drawn in the full recording).
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
   A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`); a track's predicted
   position, its predicted existence and the detection it was given (`26 predicted r=0.40 → m2`) or `missed`.
@@ -437,7 +438,9 @@ def _why(
             f"{short_id(gt_id)} had a detection within {NEAR_DETECTION_M:.0f} m at {at}{no_points}"
         )
     steps = {f: st for f, st in logger.track_steps.get(lost, {}).items() if shown.start <= f <= focus.frame_index}
-    if steps and not logger.has_existence:  # track logic: when it last had a detection, and whether it ended
+    if steps and not logger.has_existence and steps.get(focus.frame_index, _NOT_GIVEN).given < 0:
+        # track logic: when it last had a detection and whether it ended (a track given one at the failure frame
+        # followed something else: ``_lost_elsewhere`` says where)
         given = [f for f in sorted(steps) if steps[f].given >= 0]
         span = f"frames {min(steps)}–{max(steps)}" if len(steps) > 1 else f"frame {min(steps)}"
         had = f"was last given a detection at frame {given[-1]}" if given else f"was given no detection in {span}"
@@ -479,6 +482,10 @@ def _why(
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", "", *because]
 
 
+_NOT_GIVEN = TrackStep(math.nan, (math.nan, math.nan), (), -1, math.nan, False)
+"""The step of a track absent from a frame (given no detection)."""
+
+
 def _lost_elsewhere(
     focus: FocusTarget, scene: SceneData, frame: FrameResult | None, logger: TrackerLogger, lost: int
 ) -> list[str]:
@@ -512,8 +519,8 @@ def _first_false(report: FailureReport, thief: int, victim: int, gt_id: str, fra
     if not false_at:
         return []
     return [
-        f"track {thief} had been a false track at {_frames_named(false_at)} (the evaluation matched it to no "
-        f"object), so its taking GT {short_id(gt_id)} from track {victim} is an identity theft"
+        f"track {thief} had been a false track at {_frames_named(false_at)} (matched to no object: the evaluation "
+        f"still gave GT {short_id(gt_id)} to track {victim}), so its taking the object is an identity theft"
     ]
 
 

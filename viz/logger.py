@@ -547,9 +547,10 @@ class TrackerLogger:
                 ids=ids[sel],
                 existence=existence[sel],
             )
-        self._sample(
-            paths.candidate_count(self.tracker, class_name), float((~worthy).sum()), f"{class_name} candidates"
-        )
+        if self.has_existence:  # a track-logic tracker has no candidates (every existence is 1)
+            self._sample(
+                paths.candidate_count(self.tracker, class_name), float((~worthy).sum()), f"{class_name} candidates"
+            )
         gated = cf.gated
         if gated is not None:
             gids = np.asarray(gated.track_ids, dtype=np.int64)

@@ -147,3 +147,13 @@ def test_an_existence_plot_only_for_trackers_whose_tracks_have_an_existence_prob
     origins = {v.origin for v in views(default_blueprint(["gnnpmb", "gnn"], ["car"]))}
     assert paths.existence_root("gnnpmb") in origins and paths.existence_root("gnn") not in origins
     assert paths.nis_root("gnn") in origins and paths.chosen_cost_root("gnn") in origins
+    assert paths.candidates_root("gnnpmb") in origins and paths.candidates_root("gnn") not in origins
+
+
+def test_no_innovation_plot_for_a_tracker_without_gates() -> None:
+    from gnnpmb.registry import TRACKER_NAMES, tracker_has_gates
+
+    assert {name for name in TRACKER_NAMES if not tracker_has_gates(name)} == {"greedy"}
+    origins = {v.origin for v in views(default_blueprint(["gnn", "greedy"], ["car"]))}
+    assert paths.nis_root("gnn") in origins and paths.nis_root("greedy") not in origins
+    assert paths.chosen_cost_root("greedy") in origins

@@ -34,8 +34,8 @@ def test_an_identity_theft_names_the_frames_its_thief_was_a_false_track() -> Non
     failures = (false_track(17, "315"), false_track(19, "315"), false_track(19, "321"), false_track(21, "315"))
     (line,) = _first_false(report({}, failures=failures), 315, 61, "7b025b" + "0" * 26, 20)
     assert line == (
-        "track 315 had been a false track at frames 17, 19 (the evaluation matched it to no object), so its taking "
-        "GT 7b025b from track 61 is an identity theft"
+        "track 315 had been a false track at frames 17, 19 (matched to no object: the evaluation still gave GT "
+        "7b025b to track 61), so its taking the object is an identity theft"
     )
     assert _first_false(report({}, failures=failures), 315, 61, "7b025b" + "0" * 26, 17) == []  # none before frame 17
 

@@ -405,6 +405,7 @@ def test_no_existence_series_or_story_existence_for_a_tracker_without_existence_
     assert not [p for p in rows if p.startswith(paths.existence_root(T) + "/")]
     assert [r["Scalars:scalars"][0] for r in rows[paths.nis(T, "car", 1)] if not r["static"]] == pytest.approx([0.25])
     assert any("LineStrips3D:strips" in r for r in at_frame(rows[paths.track(T, "car", 1)], 1))  # its trail
+    assert paths.candidate_count(T, "car") not in rows  # every track counts: no candidates
     # The story names no existence either (a track-logic tracker's events carry 1).
     story = rows[paths.events(T, "car")]
     assert ("track 1 confirmed (from m0)", "INFO") in lines(story, 0)
