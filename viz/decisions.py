@@ -61,16 +61,30 @@ def cost_breakdown(terms: PairTerms, meas: str) -> str:
     """A track's cost for detection ``meas`` in words: the nats its predicted existence, the uncertainty of its
     predicted position, the distance and the detection's score add, and the constant the tracker adds to every
     pair (``events.PairTerms``; the parts a tracker's cost does not have are left out)."""
-    parts = []
+    parts: list[tuple[float, str]] = []
     if terms.offset_text:
-        parts.append(f"{terms.offset_nats:.2f} for {terms.offset_text}")
+        parts.append((terms.offset_nats, f"for {terms.offset_text}"))
     if terms.existence is not None:
-        parts.append(f"{terms.existence_nats:.2f} for its predicted existence {existence_text(terms.existence)}")
-    parts.append(f"{terms.spread_nats:.2f} for the uncertainty of its predicted position (±{terms.spread_m:.1f} m)")
-    parts.append(f"{terms.distance_nats:.2f} for the distance to {meas} (d² {terms.d2:.1f})")
+        parts.append((terms.existence_nats, f"for its predicted existence {existence_text(terms.existence)}"))
+    parts.append((terms.spread_nats, f"for the uncertainty of its predicted position (±{terms.spread_m:.1f} m)"))
+    parts.append((terms.distance_nats, f"for the distance to {meas} (d² {terms.d2:.1f})"))
     if terms.score is not None:
-        parts.append(f"{terms.score_nats:.2f} for {meas}'s score {terms.score:.2f}")
-    return " + ".join(parts)
+        parts.append((terms.score_nats, f"for {meas}'s score {terms.score:.2f}"))
+    shown = hundredths_summing_to([v for v, _ in parts], terms.total_nats)
+    return " + ".join(f"{v:.2f} {text}" for v, (_, text) in zip(shown, parts, strict=True))
+
+
+def hundredths_summing_to(values: list[float], total: float) -> list[float]:
+    """``values`` rounded to hundredths so that they add up to ``total`` rounded to hundredths (largest
+    remainder: each is rounded down, then the ones with the largest remainders get a hundredth more), so a
+    reader adding the parts finds the total shown beside them."""
+    scaled = [100.0 * v for v in values]
+    down = [math.floor(x) for x in scaled]
+    missing = round(100.0 * total) - sum(down)
+    order = sorted(range(len(values)), key=lambda k: scaled[k] - down[k], reverse=True)
+    for k in order[: max(0, min(missing, len(values)))]:
+        down[k] += 1
+    return [d / 100.0 for d in down]
 
 
 def cost_brief(terms: PairTerms | None) -> str:

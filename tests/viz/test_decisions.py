@@ -45,7 +45,8 @@ def test_a_detection_that_started_a_track_names_what_its_track_cost_was_made_of(
     why = choice_why(choice, "new track 40")
     assert why.startswith(f"m4 went to new track 40 (cost 3.00) rather than track 9 (cost {t.total_nats:.2f})")
     assert (
-        f"Track 9's {t.total_nats:.2f} = {t.existence_nats:.2f} for its predicted existence 0.05 + 1.84 for the "
+        # 2.955 shown as 2.96 (not 2.95) so that the parts add up to the 5.99 shown
+        f"Track 9's {t.total_nats:.2f} = 2.96 for its predicted existence 0.05 + 1.84 for the "
         "uncertainty of its predicted position (±1.0 m) + 0.50 for the distance to m4 (d² 1.0) + 0.69 for m4's score "
         "0.50" in why
     )
@@ -112,3 +113,13 @@ def test_the_track_that_had_the_object_gets_its_own_cost_when_it_was_not_the_nex
         f"With a predicted existence above {needed:.2f} (instead of 0.05), track 11 would have taken m4"
     )
     assert track_why(choice, 7) is None
+
+
+def test_the_parts_of_a_cost_are_rounded_so_that_they_add_up_to_the_cost_shown() -> None:
+    from viz.decisions import hundredths_summing_to
+
+    parts = [3.014, 3.784, 0.054, 0.234]  # rounded one by one: 3.01 + 3.78 + 0.05 + 0.23 = 7.07, not 7.09
+    shown = hundredths_summing_to(parts, sum(parts))
+    assert round(sum(shown), 2) == round(sum(parts), 2) == 7.09
+    assert all(abs(a - b) < 0.01 for a, b in zip(shown, parts, strict=True))  # each moved by under a hundredth
+    assert hundredths_summing_to([-1.005, 2.004], 0.999) == [-1.0, 2.0]
