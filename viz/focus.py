@@ -26,7 +26,7 @@ from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import FailureReport, short_id
 from gnnpmb.focus import FocusTarget
-from gnnpmb.pipeline import TrackingRun
+from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import Boxes
 from viz import compare, paths
 from viz.blueprint import (
@@ -37,7 +37,7 @@ from viz.blueprint import (
     reading_guide_doc,
 )
 from viz.callouts import Callout, log_callouts
-from viz.colors import CLASS_COLORS, GREY, class_ids
+from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
 from viz.decisions import existence_text
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
 from viz.focus_summary import READING_GUIDE, existence_as_decided, focus_markdown, mentions
@@ -51,6 +51,11 @@ from viz.timeline import Clock
 SCALE = 1.15
 MARGIN_M = 0.25
 LINE_RADIUS_M = 0.12
+GHOST_LOOKBACK = 20
+"""An involved track not output this frame is drawn at its prediction with its last output box of at most this
+many frames back."""
+GHOST_KEEP = 0.55
+GHOST_LINE_RADIUS_M = 0.05
 
 
 def tracker_focus(tracker: str) -> str:
@@ -140,6 +145,7 @@ def log_focus(
                 ),
             )
             steps = {t: loggers[tracker].track_steps.get(t, {}).get(i) for t in sorted(ids)}
+            _log_ghosts(stream, tracker, frames[tracker], i, steps, {e.track_id for e in chosen}, palette)
             given = {e.meas_index for e in chosen if e.meas_index >= 0}
             given |= {s.given for s in steps.values() if s is not None and s.given >= 0}
             # and, for a track given none, the detection nearest it (by NIS) in its gate: where that one went
@@ -250,6 +256,58 @@ def _detection_callouts(detections: Boxes, given: list[int], went: Mapping[int, 
         )
         for m in given
     ]
+
+
+def predicted_ghosts(tracker: str) -> str:
+    """Boxes3D of one tracker's involved tracks that are predicted but not output this frame."""
+    return f"{tracker_focus(tracker)}/predicted"
+
+
+def _log_ghosts(
+    stream: rr.RecordingStream,
+    tracker: str,
+    frames: Mapping[int, FrameResult],
+    i: int,
+    steps: Mapping[int, TrackStep | None],
+    output: set[int],
+    palette: Mapping[int, tuple[int, int, int]],
+) -> None:
+    """A pale box at the predicted position of each involved track the tracker kept but did not output at frame
+    ``i``, with the size and heading of its last output box (within ``GHOST_LOOKBACK`` frames): where the
+    tracker expected the object, so a label "61 predicted …, missed" points at a track's shape, not at bare
+    ground. An empty batch when there is none."""
+    ghosts = []
+    for t, step in steps.items():
+        if step is None or t in output:
+            continue
+        last = next(
+            (
+                e
+                for j in range(i - 1, max(-1, i - 1 - GHOST_LOOKBACK), -1)
+                for e in (frames[j].estimates if j in frames else ())
+                if e.track_id == t
+            ),
+            None,
+        )
+        if last is not None:
+            ghosts.append((t, step.predicted_xy_m, last))
+    boxes = estimate_boxes([e for *_, e in ghosts])
+    centers = boxes.centers_m.copy()
+    if ghosts:
+        centers[:, :2] = np.array([xy for _, xy, _ in ghosts], dtype=np.float64)
+    colors = pack_rgba(np.array([palette[t] for t, *_ in ghosts], dtype=np.uint8).reshape(-1, 3))
+    stream.log(
+        predicted_ghosts(tracker),
+        rr.Boxes3D(
+            centers=centers,
+            half_sizes=0.5 * boxes.sizes_xyz_m,
+            quaternions=boxes.quat_xyzw,
+            colors=faded(colors, GHOST_KEEP),
+            radii=GHOST_LINE_RADIUS_M,
+            labels=[f"{t} (predicted)" for t, *_ in ghosts],
+            show_labels=False,
+        ),
+    )
 
 
 def _prediction_callouts(

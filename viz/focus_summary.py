@@ -71,6 +71,8 @@ READING_GUIDE = f"""# How to read the views
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
   A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`); a track's predicted
   position, its predicted existence and the detection it was given (`26 predicted r=0.40 → m2`) or `missed`.
+  An involved track kept but not output this frame is a pale box at its predicted position, in the shape of its
+  last output box: where the tracker expected the object.
   The involved tracks take distinct colours (blue, green, black, light blue, lime, … in order of their ids,
   skipping a colour close to their class's own), the same in every view and plot; the others are pale.
 - **GT … as evaluated**: where the evaluation put an object that had no LiDAR or radar points at this frame (it

@@ -21,6 +21,7 @@ from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
 from viz.evaluated import evaluated_world, evaluation_range_world
+from viz.focus import predicted_ghosts
 from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_legend
 
 SCENE = "scene-0103"
@@ -141,6 +142,9 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     predicted = [label for label in labels if " predicted r=" in label]
     assert predicted and all(re.fullmatch(r"\d+ predicted r=[\d.]+(?: → m\d+|, missed)", p) for p in predicted)
     assert callouts["Points3D:positions.len"] == len(labels)
+    # A track kept but not output this frame is drawn at its prediction with its last box: the shape it expected.
+    ghosts = [r for r in rows[predicted_ghosts("gnnpmb")] if r.get("frame") == failure.frame_index][0]
+    assert f"{failure.track_ids[0]} (predicted)" in ghosts["Boxes3D:labels"], ghosts
     leaders = [r for r in rows[paths.focus_callouts("gnnpmb") + "/leaders"] if r.get("frame") == failure.frame_index]
     label_at = np.array([strip[1] for strip in leaders[0]["LineStrips3D:strips"]])  # each: object -> label
     assert len(label_at) == len(labels) and len(set(label_at[:, 0].tolist())) == 1
