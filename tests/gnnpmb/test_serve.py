@@ -19,14 +19,20 @@ from gnnpmb.serve import ServeTarget, check_display
 BIN = Path(sys.executable).parent
 
 
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
+def _free_ports(n: int) -> list[int]:
+    """``n`` distinct free ports: all bound at once, so that two calls cannot hand out the same port twice."""
+    sockets = [socket.socket() for _ in range(n)]
+    try:
+        for sock in sockets:
+            sock.bind(("127.0.0.1", 0))
+        return [sock.getsockname()[1] for sock in sockets]
+    finally:
+        for sock in sockets:
+            sock.close()
 
 
 def test_serve_prints_the_url_serves_the_viewer_and_stops_on_ctrl_c(demo_dataroot: Path) -> None:
-    target = ServeTarget(_free_port(), _free_port())
+    target = ServeTarget(*_free_ports(2))
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     argv = [str(BIN / "gnnpmb-viz"), "scene-0103", "--dataroot", str(demo_dataroot), "--tracker", "gnn"]
     argv += ["--frames", "0:2", "--no-failures", "--no-progress", "--serve"]
