@@ -478,7 +478,7 @@ def _why(
             if started:
                 f, m = started[0]
                 parts.append(f"then, at frame {f}, {meas_name(m)} started track {took} (not a close call)")
-    parts += _lost_elsewhere(focus, scene, by_frame.get(focus.frame_index), logger, lost)
+    parts += _lost_elsewhere(focus, scene, by_frame, logger, lost)
     if focus.failure_kind is FailureKind.IDENTITY_THEFT and report is not None and took is not None:
         parts += _first_false(report, took, lost, gt_id, focus.frame_index)
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", "", *because]
@@ -489,26 +489,47 @@ _NOT_GIVEN = TrackStep(math.nan, (math.nan, math.nan), (), -1, math.nan, False)
 
 
 def _lost_elsewhere(
-    focus: FocusTarget, scene: SceneData, frame: FrameResult | None, logger: TrackerLogger, lost: int
+    focus: FocusTarget, scene: SceneData, by_frame: Mapping[int, FrameResult], logger: TrackerLogger, lost: int
 ) -> list[str]:
     """When the track that lost the object is still output at the failure frame, but too far from the object for
-    the evaluation to match it: where it was, and the detection it followed there."""
+    the evaluation to match it: where it was, the detection it followed there, and the earlier frames it was
+    given a detection that far from the object (it drifted onto something else)."""
+    frame = by_frame.get(focus.frame_index)
     if frame is None or not focus.gt_ids:
         return []
     estimate = next((e for e in frame.estimates if e.track_id == lost), None)
-    gt = scene.keyframes[focus.frame_index].gt
-    hit = np.flatnonzero(gt.instance_id.astype(str) == focus.gt_ids[0])
-    if estimate is None or hit.size == 0:
+    gt_xy = _gt_xy_at(scene, focus.frame_index, focus.gt_ids[0])
+    if estimate is None or gt_xy is None:
         return []
-    gap_m = float(np.hypot(*(np.asarray(estimate.translation_m[:2]) - gt.translation_m[hit[0], :2])))
+    gap_m = float(np.hypot(*(np.asarray(estimate.translation_m[:2]) - gt_xy)))
     if gap_m < NEAR_DETECTION_M:
         return []
-    step = logger.track_steps.get(lost, {}).get(focus.frame_index)
+    steps = logger.track_steps.get(lost, {})
+    step = steps.get(focus.frame_index)
     on = f", on {meas_name(step.given)}" if step is not None and step.given >= 0 else ""
+    away = []
+    for f in sorted(f for f in steps if f < focus.frame_index and steps[f].given >= 0 and f in by_frame):
+        xy = _gt_xy_at(scene, f, focus.gt_ids[0])
+        m = steps[f].given
+        if xy is not None and np.hypot(*(by_frame[f].detections.boxes.translation_m[m, :2] - xy)) >= NEAR_DETECTION_M:
+            away.append(f"{f} ({meas_name(m)})")
+    before = (
+        f"; it had been given detections {NEAR_DETECTION_M:.0f} m or more from the object at frame"
+        f"{'s' if len(away) > 1 else ''} {', '.join(away)}"
+        if away
+        else ""
+    )
     return [
         f"at frame {focus.frame_index} track {lost} was output {gap_m:.1f} m from GT {short_id(focus.gt_ids[0])}"
-        f"{on}: beyond the evaluation's {NEAR_DETECTION_M:.0f} m, so it no longer matched the object"
+        f"{on}: beyond the evaluation's {NEAR_DETECTION_M:.0f} m, so it no longer matched the object{before}"
     ]
+
+
+def _gt_xy_at(scene: SceneData, frame: int, gt_id: str) -> np.ndarray | None:
+    """(2,) BEV centre of ground-truth object ``gt_id`` at keyframe ``frame``, None where it has no box."""
+    gt = scene.keyframes[frame].gt
+    hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
+    return gt.translation_m[hit[0], :2] if hit.size else None
 
 
 def _first_false(report: FailureReport, thief: int, victim: int, gt_id: str, frame: int) -> list[str]:

@@ -65,3 +65,41 @@ def test_a_tracker_without_existences_gets_no_existence_in_its_track_tables_and_
     assert "existence after update 1.00 at frame 5" in _diagnosis(logger(True), [25], range(0, 10), 5)[0]
     greedy = _steps_markdown(logger(False, has_gates=False), [25], range(0, 10), 5, "car")  # no gates either
     assert greedy[2:5] == ["| frame | given | shown |", "|---|---|---|", "| 5 | m8 | yes |"]
+
+
+def test_a_lost_track_output_away_from_its_object_is_traced_to_the_detections_that_led_it_off() -> None:
+    from types import SimpleNamespace
+
+    import numpy as np
+    import rerun as rr
+
+    from gnnpmb.focus import FocusTarget
+    from viz.focus_summary import _lost_elsewhere
+    from viz.logger import TrackerLogger, TrackStep
+
+    gt_id = "a8b080" + "0" * 26
+    gt_x = {9: 10.0, 10: 10.0, 11: 10.0}  # the object stands still at x = 10 m
+    det_x = {9: [10.5], 10: [14.0], 11: [15.4]}  # m0 on it at frame 9, then m0 of another object 4 m off
+    scene = SimpleNamespace(
+        keyframes={
+            f: SimpleNamespace(gt=SimpleNamespace(instance_id=np.array([gt_id]), translation_m=np.array([[x, 0, 0]])))
+            for f, x in gt_x.items()
+        }
+    )
+    by_frame = {
+        f: SimpleNamespace(
+            estimates=[SimpleNamespace(track_id=25, translation_m=(det_x[f][0], 0.0, 0.0))],
+            detections=SimpleNamespace(boxes=SimpleNamespace(translation_m=np.array([[x, 0.0, 0.0] for x in xs]))),
+        )
+        for f, xs in det_x.items()
+    }
+    logger = TrackerLogger(rr.RecordingStream("x"), "gnn", focus_tracks={25}, has_existence=False)
+    logger.track_steps = {25: {f: TrackStep(1.0, (0.0, 0.0), (), 0, 1.0, True) for f in det_x}}
+    focus = FocusTarget("t", 11, (10.0, 0.0), "car", {"gnn": (25, 174)}, (gt_id,))
+    (line,) = _lost_elsewhere(focus, scene, by_frame, logger, 25)
+    assert line == (
+        "at frame 11 track 25 was output 5.4 m from GT a8b080, on m0: beyond the evaluation's 2 m, so it no longer "
+        "matched the object; it had been given detections 2 m or more from the object at frame 10 (m0)"
+    )
+    by_frame[11].estimates[0].translation_m = (11.0, 0.0, 0.0)  # within 2 m: still matched, nothing to say
+    assert _lost_elsewhere(focus, scene, by_frame, logger, 25) == []
