@@ -146,7 +146,7 @@ def _from_failure(
         own = {int(t) for t in failure.track_ids} if name == tracker else set()
         near: set[int] = set()
         for i in range(max(frames.start, failure.frame_index - NEAR_FRAMES), failure.frame_index + 1):
-            near |= _tracks_near(per_frame[i - frames.start], failure.class_name, _gt_xy(scene, i, failure.gt_ids))
+            near |= _tracks_near(per_frame[i - frames.start], failure.class_name, gt_xy(scene, i, failure.gt_ids))
         ids[name] = tuple(sorted(own | near))
     label = failure_id or failure.kind.value
     return FocusTarget(
@@ -272,7 +272,7 @@ def _tracks_near(estimates: Sequence[TrackEstimate], class_name: str, centers_xy
     return out
 
 
-def _gt_xy(scene: SceneData, frame_index: int, gt_ids: Sequence[str]) -> np.ndarray:
+def gt_xy(scene: SceneData, frame_index: int, gt_ids: Sequence[str]) -> np.ndarray:
     """(G, 2) BEV centres of the ground-truth objects ``gt_ids`` present at keyframe ``frame_index``."""
     gt = scene.keyframes[frame_index].gt
     if not len(gt) or not gt_ids:

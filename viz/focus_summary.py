@@ -20,7 +20,7 @@ from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import FailureKind, FailureReport, short_id
 from gnnpmb.events import AxisKind, PairTerms
 from gnnpmb.explain import PairChoice
-from gnnpmb.focus import FocusTarget
+from gnnpmb.focus import FocusTarget, gt_xy
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from viz.blueprint import (
     FOCUS_TIMELINE,
@@ -498,10 +498,10 @@ def _lost_elsewhere(
     if frame is None or not focus.gt_ids:
         return []
     estimate = next((e for e in frame.estimates if e.track_id == lost), None)
-    gt_xy = _gt_xy_at(scene, focus.frame_index, focus.gt_ids[0])
-    if estimate is None or gt_xy is None:
+    at = gt_xy(scene, focus.frame_index, focus.gt_ids[:1])
+    if estimate is None or not len(at):
         return []
-    gap_m = float(np.hypot(*(np.asarray(estimate.translation_m[:2]) - gt_xy)))
+    gap_m = float(np.hypot(*(np.asarray(estimate.translation_m[:2]) - at[0])))
     if gap_m < NEAR_DETECTION_M:
         return []
     steps = logger.track_steps.get(lost, {})
@@ -509,9 +509,9 @@ def _lost_elsewhere(
     on = f", on {meas_name(step.given)}" if step is not None and step.given >= 0 else ""
     away = []
     for f in sorted(f for f in steps if f < focus.frame_index and steps[f].given >= 0 and f in by_frame):
-        xy = _gt_xy_at(scene, f, focus.gt_ids[0])
+        xy = gt_xy(scene, f, focus.gt_ids[:1])
         m = steps[f].given
-        if xy is not None and np.hypot(*(by_frame[f].detections.boxes.translation_m[m, :2] - xy)) >= NEAR_DETECTION_M:
+        if len(xy) and np.hypot(*(by_frame[f].detections.boxes.translation_m[m, :2] - xy[0])) >= NEAR_DETECTION_M:
             away.append(f"{f} ({meas_name(m)})")
     before = (
         f"; it had been given detections {NEAR_DETECTION_M:.0f} m or more from the object at frame"
@@ -523,13 +523,6 @@ def _lost_elsewhere(
         f"at frame {focus.frame_index} track {lost} was output {gap_m:.1f} m from GT {short_id(focus.gt_ids[0])}"
         f"{on}: beyond the evaluation's {NEAR_DETECTION_M:.0f} m, so it no longer matched the object{before}"
     ]
-
-
-def _gt_xy_at(scene: SceneData, frame: int, gt_id: str) -> np.ndarray | None:
-    """(2,) BEV centre of ground-truth object ``gt_id`` at keyframe ``frame``, None where it has no box."""
-    gt = scene.keyframes[frame].gt
-    hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
-    return gt.translation_m[hit[0], :2] if hit.size else None
 
 
 def _first_false(report: FailureReport, thief: int, victim: int, gt_id: str, frame: int) -> list[str]:

@@ -77,12 +77,16 @@ def test_a_lost_track_output_away_from_its_object_is_traced_to_the_detections_th
     from viz.focus_summary import _lost_elsewhere
     from viz.logger import TrackerLogger, TrackStep
 
+    class Gt(SimpleNamespace):  # one ground-truth box per frame (``types.Boxes`` has a length)
+        def __len__(self) -> int:
+            return len(self.instance_id)
+
     gt_id = "a8b080" + "0" * 26
     gt_x = {9: 10.0, 10: 10.0, 11: 10.0}  # the object stands still at x = 10 m
     det_x = {9: [10.5], 10: [14.0], 11: [15.4]}  # m0 on it at frame 9, then m0 of another object 4 m off
     scene = SimpleNamespace(
         keyframes={
-            f: SimpleNamespace(gt=SimpleNamespace(instance_id=np.array([gt_id]), translation_m=np.array([[x, 0, 0]])))
+            f: SimpleNamespace(gt=Gt(instance_id=np.array([gt_id]), translation_m=np.array([[x, 0, 0]])))
             for f, x in gt_x.items()
         }
     )
