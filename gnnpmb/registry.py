@@ -8,6 +8,7 @@ factory here, one line in ``TRACKER_DESCRIPTIONS``.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -114,25 +115,29 @@ def check_classes(names: list[str]) -> list[str]:
 
 def tracker_panels(name: str) -> tuple[Panel, ...]:
     """The tracker-specific viewer panels tracker ``name`` declares (the same for every class)."""
-    return _sample_tracker(name).panels
+    return _declared(name)[0]
 
 
 def tracker_has_existence(name: str) -> bool:
     """Whether tracker ``name``'s tracks have an existence probability (``skeleton.ClassFilter.has_existence``)."""
-    return _sample_tracker(name).has_existence
+    return _declared(name)[1]
 
 
 def tracker_has_gates(name: str) -> bool:
     """Whether tracker ``name`` gates with the innovation covariance (``skeleton.ClassFilter.has_gates``)."""
-    return _sample_tracker(name).has_gates
+    return _declared(name)[2]
 
 
-def _sample_tracker(name: str) -> ClassFilter:
-    """Tracker ``name`` for the first class with the default configuration: what it declares for the viewer."""
+@functools.cache
+def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool]:
+    """What tracker ``name`` declares for the viewer (panels, has_existence, has_gates), read once from an instance
+    for the first class with the default configuration (building one costs a couple of milliseconds, and the
+    blueprint asks several times per tracker)."""
     from gnnpmb.config import TrackerConfig
     from gnnpmb.types import IdAllocator
 
-    return make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator())
+    sample = make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator())
+    return sample.panels, sample.has_existence, sample.has_gates
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:

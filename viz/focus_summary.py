@@ -440,7 +440,8 @@ def _why(
             f"{short_id(gt_id)} had a detection within {NEAR_DETECTION_M:.0f} m at {at}{no_points}"
         )
     steps = {f: st for f, st in logger.track_steps.get(lost, {}).items() if shown.start <= f <= focus.frame_index}
-    if steps and not logger.has_existence and steps.get(focus.frame_index, _NOT_GIVEN).given < 0:
+    at_failure = steps.get(focus.frame_index)
+    if steps and not logger.has_existence and (at_failure is None or at_failure.given < 0):
         # track logic: when it last had a detection and whether it ended (a track given one at the failure frame
         # followed something else: ``_lost_elsewhere`` says where)
         given = [f for f in sorted(steps) if steps[f].given >= 0]
@@ -482,10 +483,6 @@ def _why(
     if focus.failure_kind is FailureKind.IDENTITY_THEFT and report is not None and took is not None:
         parts += _first_false(report, took, lost, gt_id, focus.frame_index)
     return [f"**Why** ({run.tracker}, {doing}): " + "; ".join(parts) + ".", "", *because]
-
-
-_NOT_GIVEN = TrackStep(math.nan, (math.nan, math.nan), (), -1, math.nan, False)
-"""The step of a track absent from a frame (given no detection)."""
 
 
 def _lost_elsewhere(
