@@ -8,7 +8,7 @@ provenance of the run (command line, versions, parameters, inputs and their hash
 whether the tracks are identical. Typer cannot mix a positional SCENE with a subcommand, so ``main``
 dispatches on the first argument being ``reproduce``.
 
-This module only parses and prints: the work is ``gnnpmb.session`` (``prepare``, ``run_view``, ...), which a
+This module only parses and prints: the work is ``gnnpmb.session`` (``prepare``, ...) and ``viz.view.run_view``, which a
 notebook can call the same way (``examples/notebook_session.py``). Everything the user typed is checked before a
 recording is opened (names, --frames, files, the dataset), so a
 mistake costs one line on stderr and leaves no ``.rrd`` behind. Without ``--save`` or ``--serve`` the run needs
@@ -39,7 +39,6 @@ from gnnpmb.session import (
     prepare,
     prepare_reproduction,
     rerun_digests,
-    run_view,
     version_notes,
 )
 
@@ -169,6 +168,8 @@ def view(
         argv=command_line(),
         focus=focus,
     )
+    from viz.view import run_view
+
     result = run_view(request, progress=progress_bar(progress), failures=failures)
     if result.focus is not None:
         typer.echo(f"focus: {result.focus.title}")
@@ -200,7 +201,7 @@ def view(
                 "options)."
             )
     if request.serve is not None:
-        from gnnpmb.serve import wait_for_ctrl_c
+        from viz.serving import wait_for_ctrl_c
 
         wait_for_ctrl_c(request.serve)
 
@@ -226,6 +227,7 @@ def reproduce(
 ) -> None:
     """Re-run a recording's trackers and compare their track digests (``REPRODUCE_HELP``)."""
     from viz.provenance import read_provenance
+    from viz.view import run_view
 
     provenance = read_provenance(recording_file)
     request = prepare_reproduction(

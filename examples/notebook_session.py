@@ -12,7 +12,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from gnnpmb.session import prepare, rerun_digests, run_view
+from gnnpmb.session import prepare, rerun_digests
+from viz.view import run_view
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else "session.rrd")
 

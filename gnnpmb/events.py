@@ -158,7 +158,9 @@ class Gated:
     """Ellipsoidal gating: measurement j is in track k's gate iff (z_j - H m_k)^T S_k^-1 (z_j - H m_k) < threshold.
 
     track_ids: (K,); meas_indices: (M,) source indices; inside: (K, M) bool; center_xy: (K, 2) predicted
-    measurement H m_k; innovation_cov: (K, 2, 2) S_k; threshold: squared Mahalanobis gate (chi-square value).
+    measurement H m_k; innovation_cov: (K, 2, 2) S_k; threshold: squared Mahalanobis gate (chi-square value);
+    d2: (K, M) the squared Mahalanobis distances the tracker computed (over its full measurement vector, which can
+    hold more than x, y), the NIS every explanation quotes.
     """
 
     class_name: str
@@ -168,6 +170,7 @@ class Gated:
     center_xy: np.ndarray
     innovation_cov: np.ndarray
     threshold: float
+    d2: np.ndarray
 
 
 @dataclass(frozen=True, slots=True)
@@ -271,6 +274,26 @@ class CostTerms:
 
 
 @dataclass(frozen=True, slots=True)
+class CostScale:
+    """What the numbers of a ``CostMatrix`` are, so a decision is judged on the tracker's own scale.
+
+    name: what a cost is ("negative log-likelihood ratio", "distance"); unit: "nats", "m", ...; close_call: a
+    choice whose margin is below this is a close call (in ``unit``); optimal: the assignment minimises the total
+    cost (Hungarian / Murty), so a margin is how much the best total rises without a pair; False for a greedy
+    matcher, whose margin is the row's next cheapest entry minus the chosen one.
+    """
+
+    name: str
+    unit: str
+    close_call: float
+    optimal: bool = True
+
+
+NATS = CostScale("negative log-likelihood ratio", "nats", 1.0)
+"""The scale of the Bayesian trackers' costs: a margin under 1 nat (a likelihood ratio under e) is a close call."""
+
+
+@dataclass(frozen=True, slots=True)
 class CostMatrix:
     """An assignment cost matrix with the meaning of every row and column.
 
@@ -279,6 +302,7 @@ class CostMatrix:
     log-likelihood ratios against the track being missed (paper eq. for the PMB update).
     hypothesis: index of the global hypothesis the matrix belongs to (0 for single-hypothesis trackers).
     terms: what the track entries are made of (PMB family, GNN), None where the tracker does not say.
+    scale: what the numbers are and when a choice is a close call (``CostScale``).
     """
 
     class_name: str
@@ -288,6 +312,7 @@ class CostMatrix:
     hypothesis: int = 0
     description: str = "negative log-likelihood ratio"
     terms: CostTerms | None = None
+    scale: CostScale = NATS
 
 
 @dataclass(frozen=True, slots=True)
@@ -353,12 +378,17 @@ class Extracted:
 @dataclass(frozen=True, slots=True)
 class GlobalHypotheses:
     """PMBM global hypotheses after the update: log_weights (H,) normalised (logsumexp = 0), sorted descending;
-    members[h] the track ids present in hypothesis h; local[h] the single-target hypothesis key of each member."""
+    members[h] the track ids present in hypothesis h; local[h] the single-target hypothesis key of each member;
+    existence[h] each member's existence probability in hypothesis h; parents (H,): the prior global hypothesis
+    each came from (its index in the previous frame's ``GlobalHypotheses`` of the class, which are the prior
+    hypotheses of this frame in the same order)."""
 
     class_name: str
     log_weights: np.ndarray
     members: tuple[tuple[int, ...], ...]
     local: tuple[tuple[int, ...], ...]
+    existence: tuple[tuple[float, ...], ...]
+    parents: tuple[int, ...]
 
 
 @dataclass(frozen=True, slots=True)
@@ -392,6 +422,27 @@ class Cardinality:
 
     class_name: str
     pmf: np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class UpdateWeights:
+    """How a GM-PHD or CPHD update spread the predicted intensity over the frame's detections (Vo & Ma 2006,
+    eq. 23-26), per track label (the components that carry it, summed).
+
+    labels: (K,) track labels of the predicted components (their final track ids this frame; negative for
+    provisional labels of components never extracted); meas_indices: (M,) source indices; prior: (K,) predicted
+    weight; missed: (K,) weight kept by the missed-detection term; detected: (K, M) weight of the components
+    updated with each detection; birth: (M,) weight of each detection's birth component. The update *used*
+    detection j for label k in proportion to detected[k, j] / (missed[k] + detected[k].sum()).
+    """
+
+    class_name: str
+    labels: np.ndarray
+    meas_indices: np.ndarray
+    prior: np.ndarray
+    missed: np.ndarray
+    detected: np.ndarray
+    birth: np.ndarray
 
 
 @dataclass(frozen=True, slots=True)
@@ -440,6 +491,7 @@ Event = (
     | Marginals
     | Merged
     | Cardinality
+    | UpdateWeights
     | IntensityWeights
     | TrackLogic
     | BudgetReached

@@ -12,7 +12,9 @@ always free, new-track column is cheaper by more than the slack), so the conflic
 closer than the slack, and stay small even when wide gates of low-existence candidates overlap everything.
 For every chosen pair the *margin* is how much the best assignment of the conflict gets worse when that pair is
 forbidden (re-solved with the Hungarian algorithm), capped at ``LINK_SLACK``: a margin near 0 is a close call,
-the usual cause of an ID switch.
+the usual cause of an ID switch. A greedy matcher's choices are not a best total (``CostScale.optimal`` False):
+its margin is the detection's next cheapest column minus its chosen one. What counts as close is the matrix's own
+``CostScale.close_call`` (nats, metres, ...).
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms, PairTerms
+from gnnpmb.events import NATS, Assignment, AxisKind, AxisLabel, CostMatrix, CostScale, CostTerms, PairTerms
 
 _KIND = operator.attrgetter("kind")
 _REF = operator.attrgetter("ref")
@@ -51,6 +53,12 @@ class PairChoice:
     row: int = -1
     chosen_col: int = -1
     alternative_col: int = -1
+    scale: CostScale = NATS
+
+    @property
+    def close_call(self) -> bool:
+        """Whether another column came within the matrix's close-call margin (``CostScale.close_call``)."""
+        return self.alternative is not None and self.margin < self.scale.close_call
 
     @property
     def chosen_terms(self) -> PairTerms | None:
@@ -82,6 +90,12 @@ class Conflict:
     choices: tuple[PairChoice, ...]
     missed_track_ids: tuple[int, ...]
     total_cost: float
+    scale: CostScale = NATS
+
+    @property
+    def close_call(self) -> bool:
+        """Whether one of its choices was a close call (``PairChoice.close_call``)."""
+        return any(c.close_call for c in self.choices)
 
     @property
     def closest_margin(self) -> float:
@@ -101,6 +115,7 @@ class Decisions:
     conflicts: tuple[Conflict, ...]
     births_only: tuple[int, ...]
     description: str
+    scale: CostScale = NATS
 
 
 def _competitive(cost: np.ndarray, n_tracks: int) -> np.ndarray:
@@ -194,7 +209,7 @@ def explain(matrix: CostMatrix, assignment: Assignment) -> Decisions | None:
         conflicts.append(_conflict(matrix, linked, chosen, rows, tcols, n_tracks))
     conflicts.sort(key=lambda c: (c.closest_margin, c.track_ids))
     births = tuple(int(matrix.rows[i].ref) for i in np.flatnonzero(~in_conflict).tolist())
-    return Decisions(matrix.class_name, tuple(conflicts), births, matrix.description)
+    return Decisions(matrix.class_name, tuple(conflicts), births, matrix.description, matrix.scale)
 
 
 def _conflict(
@@ -233,7 +248,10 @@ def _conflict(
         best = np.argmin(masked, axis=1)
         cols_list, chosen_list, best_list = cols.tolist(), chosen_sub.tolist(), best.tolist()
         chosen_costs, best_costs = chosen_cost.tolist(), masked[at, best].tolist()
-        margins = [_margin(sub, i, j, total) for i, j in enumerate(chosen_list)]
+        if matrix.scale.optimal:
+            margins = [_margin(sub, i, j, total) for i, j in enumerate(chosen_list)]
+        else:  # a greedy matcher: the row's next cheapest entry against its chosen one
+            margins = [_capped(b, c) for b, c in zip(masked[at, best].tolist(), chosen_cost.tolist(), strict=True)]
     mrows, mcols = matrix.rows, matrix.cols
     choices = []
     for r, j, k, c_chosen, c_best, margin in zip(
@@ -252,6 +270,7 @@ def _conflict(
                 row=r,
                 chosen_col=cols_list[j],
                 alternative_col=cols_list[k] if has_alt else -1,
+                scale=matrix.scale,
             )
         )
     used = {cols_list[j] for j in chosen_list if cols_list[j] < n_tracks}
@@ -264,6 +283,7 @@ def _conflict(
         tuple(choices),
         missed,
         total,
+        matrix.scale,
     )
 
 

@@ -26,13 +26,11 @@ from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport, short_id
 from gnnpmb.types import TrackEstimate
+from gnnpmb.why.findings import NEAR_M
 
 FRAMES_BEFORE = 8
 FRAMES_AFTER = 4
 """A focus recording holds the keyframes from FRAMES_BEFORE before the focus frame to FRAMES_AFTER after it."""
-NEAR_M = 2.0
-"""Tracks (of every tracker) within this BEV distance of an involved object are involved too (the devkit's match
-distance)."""
 NEAR_FRAMES = 4
 """... and so are tracks that were that close to it in this many keyframes before the failure (a track that
 followed the object with too low a score to be counted is often the failure's cause)."""

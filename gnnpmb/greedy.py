@@ -34,6 +34,7 @@ from gnnpmb.events import (
     AxisKind,
     Born,
     CostMatrix,
+    CostScale,
     EventSink,
     Pruned,
     PruneReason,
@@ -44,6 +45,10 @@ from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 COST_DESCRIPTION = "distance (m) from the detection's centre minus velocity x dt; new-track column = threshold"
+COST_SCALE = CostScale("distance", "m", 0.3, optimal=False)
+"""Greedy's costs are metres and its matching is greedy, not optimal: a margin is the detection's next closest
+column minus its chosen one, and a close call one under 0.3 m, about the detectors' mean translation error
+(mATE 0.29-0.34 m on nuScenes val, README "Detector calibration")."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -188,7 +193,11 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
         rows = axis_labels(AxisKind.MEASUREMENT, meas.source_index)
         track_cols = axis_labels(AxisKind.TRACK, prior.tracks.track_id)
         new_cols = axis_labels(AxisKind.NEW_TRACK, meas.source_index)
-        sink.emit(CostMatrix(self.class_name, full, rows, track_cols + new_cols, description=COST_DESCRIPTION))
+        sink.emit(
+            CostMatrix(
+                self.class_name, full, rows, track_cols + new_cols, description=COST_DESCRIPTION, scale=COST_SCALE
+            )
+        )
         pairs = tuple((rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist()))
         total = float(sum(full[j, t] if t >= 0 else full[j, k + j] for j, t in enumerate(track_of_meas.tolist())))
         detected = set(track_of_meas[track_of_meas >= 0].tolist())

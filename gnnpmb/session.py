@@ -1,20 +1,21 @@
 """One viewer session, callable from Python: check a request, track, log the recording, reproduce a recording.
 
-``gnnpmb-viz`` (``cli.app``) only parses its command line into ``prepare`` and prints what ``run_view`` returns;
-a notebook does the same::
+``gnnpmb-viz`` (``cli.app``) only parses its command line into ``prepare`` and prints what ``viz.view.run_view``
+returns; a notebook does the same::
 
-    from gnnpmb.session import prepare, run_view
+    from gnnpmb.session import prepare
+    from viz.view import run_view
 
     request = prepare("scene-0103", ["gnnpmb", "pmbm"], frames="0:20", save=Path("demo.rrd"))
     result = run_view(request)
     result.ms_per_frame, result.comparison
 
 ``prepare`` checks every argument (names, frames, output path, ports, the detections file) before loading the
-scene, so a mistake raises a one-line ``GnnpmbError`` and no recording is opened. ``run_view`` logs the scene,
-runs every tracker into one recording (sharing the preprocessed detections), compares them, marks their failures
-and records the provenance; ``prepare_reproduction`` and ``rerun_digests`` re-run a recorded run from its
-provenance. The recording goes to ``request.save``, to a served web viewer (``request.serve``) or to a spawned
-viewer.
+scene, so a mistake raises a one-line ``GnnpmbError`` and no recording is opened. ``run_view`` (in ``viz``: it
+draws) logs the scene, runs every tracker into one recording (sharing the preprocessed detections), compares them,
+marks their failures and explains the focus; this module finds the failures (``find_reports``), the focus
+(``resolve_request_focus``) and the evidence of a failure's finding (``focus_evidence``); ``prepare_reproduction``
+and ``rerun_digests`` re-run a recorded run from its provenance.
 """
 
 from __future__ import annotations
@@ -43,6 +44,8 @@ if TYPE_CHECKING:
     from gnnpmb.pipeline import TrackingRun
     from gnnpmb.provenance import DetectionsSource, Provenance, TrackDigest
     from gnnpmb.types import Boxes, FrameDetections
+    from gnnpmb.why.findings import Finding
+    from gnnpmb.why.reason import Evidence
 
 DEFAULT_TRACKER = "gnnpmb"
 DEFAULT_DETECTOR = "centerpoint"
@@ -364,9 +367,9 @@ def run_digest(run: TrackingRun) -> TrackDigest:
 
 def compare_runs(runs: Sequence[TrackingRun]) -> Comparison:
     """Per-frame disagreements between tracker runs over the same keyframes (``gnnpmb.compare``), between the
-    tracks the viewer draws (existence at least ``viz.logger.SHOW_MIN_EXISTENCE``)."""
+    tracks the viewer draws (existence at least ``why.words.SHOW_MIN_EXISTENCE``)."""
     from gnnpmb.compare import compare_trackers
-    from viz.logger import SHOW_MIN_EXISTENCE
+    from gnnpmb.why.words import SHOW_MIN_EXISTENCE
 
     frames = runs[0].frames
     return compare_trackers(
@@ -429,121 +432,6 @@ def resolve_request_focus(request: ViewRequest) -> tuple[FocusTarget, dict[str, 
     return resolve_focus(request.focus, request.scene, reports, estimates, request.frame_range), reports, notices
 
 
-def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failures: bool = True) -> ViewResult:
-    """Log the scene, run every tracker into one recording (sharing the preprocessed detections), compare them
-    and log failures and provenance. With ``request.focus`` the trackers first run without logging to find the
-    focus (``resolve_request_focus``); the recording then holds the keyframes around it and opens on it.
-    ``progress``: a progress display (e.g. a rich ``Progress``; none by default)."""
-    import numpy as np
-
-    from gnnpmb.data.nuscenes import load_lidar_points
-    from gnnpmb.pipeline import run_tracker
-    from viz.blueprint import default_blueprint
-    from viz.compare import log_comparison
-    from viz.failures import log_failures
-    from viz.focus import focus_legends, log_focus
-    from viz.logger import FLUSH_FRAMES, TrackerLogger
-    from viz.provenance import log_provenance
-    from viz.recording import recording
-    from viz.scene import log_scene
-    from viz.timeline import PLAIN_CLOCK, Clock
-
-    scene, frame_range = request.scene, request.frame_range
-    focus, reports, notices = None, {}, []
-    if request.focus is not None:  # the logged runs below give the same tracks (deterministic): reuse the reports
-        focus, reports, notices = resolve_request_focus(request)
-    shown = focus.window(frame_range) if focus is not None else frame_range
-    clock = Clock(focus_end=focus.frame_index) if focus is not None else PLAIN_CLOCK
-    n = len(shown)
-    # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
-    blueprint = default_blueprint(request.trackers, request.classes) if focus is None else None
-    bar = progress if progress is not None else SilentProgress()
-    runs: list[TrackingRun] = []
-    loggers: dict[str, TrackerLogger] = {}
-    comparison = None
-    if request.serve is not None:
-        from gnnpmb.serve import serving
-
-        opened = serving(recording_name(request, focus), request.serve, blueprint)
-    else:
-        opened = recording(recording_name(request, focus), request.save, blueprint)
-    with opened as stream, bar:
-        sensors = bar.add_task(f"{scene.name} sensors", total=n)
-        log_scene(
-            stream,
-            scene,
-            [request.frame_detections[i] for i in shown],
-            shown,
-            points_loader=load_lidar_points,
-            on_frame=lambda: bar.advance(sensors),
-            clock=clock,
-        )
-        for tracker in request.trackers:
-            task = bar.add_task(f"{scene.name} {tracker}", total=len(frame_range))
-            logger = loggers[tracker] = TrackerLogger(
-                stream,
-                tracker,
-                gate_z_m=scene.ground_z_m,
-                clock=clock,
-                log_frames=shown if focus is not None else None,
-                focus_tracks=set(focus.track_ids.get(tracker, ())) if focus is not None else None,
-                flush_frames=None if request.save is not None else FLUSH_FRAMES,
-                has_existence=tracker_has_existence(tracker),
-                focus_class=focus.class_name if focus is not None else None,
-            )
-            runs.append(
-                run_tracker(
-                    scene,
-                    request.frame_detections,
-                    tracker,
-                    request.config,
-                    sink=logger,
-                    classes=request.classes,
-                    frame_range=frame_range,
-                    on_frame=lambda task=task: bar.advance(task),
-                )
-            )
-            logger.finish()
-        if len(runs) > 1:
-            comparison = compare_runs(runs)
-            log_comparison(
-                stream,
-                comparison.within(shown),
-                scene,
-                clock,
-                show_labels=focus is None,
-                focus_class=focus.class_name if focus is not None else None,
-            )
-        if failures and focus is None:
-            task = bar.add_task(f"{scene.name} failures", total=len(runs))
-            reports, notices = find_reports(request, runs, lambda: bar.advance(task))
-        if failures or focus is not None:
-            for name, report in reports.items():
-                log_failures(
-                    stream,
-                    name,
-                    report,
-                    scene,
-                    shown,
-                    clock,
-                    show_labels=focus is None,
-                    involved=focus.object_ids(name) if focus is not None else None,
-                    focus_kind=focus.failure_kind if focus is not None else None,
-                )
-        if focus is not None:
-            log_focus(stream, focus, scene, runs, loggers, clock, shown, reports)
-            legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
-            stream.send_blueprint(
-                default_blueprint(request.trackers, request.classes, focus, legends),
-                make_active=True,
-                make_default=True,
-            )
-        digests = {run.tracker: run_digest(run) for run in runs}
-        log_provenance(stream, provenance_of(request, digests))
-    ms = {run.tracker: 1000.0 * float(np.mean([f.step_time_s for f in run.frames])) for run in runs}
-    return ViewResult(ms, digests, comparison, tuple(notices), focus, reports)
-
-
 def rerun_runs(request: ViewRequest) -> list[TrackingRun]:
     """Run every tracker of ``request`` without logging."""
     from gnnpmb.pipeline import run_tracker
@@ -559,6 +447,52 @@ def rerun_runs(request: ViewRequest) -> list[TrackingRun]:
         )
         for tracker in request.trackers
     ]
+
+
+def gather_evidence(request: ViewRequest) -> tuple[dict[str, Evidence], list[str]]:
+    """Every tracker of ``request`` run with a ``why.facts.FactSink``, its failures found: the evidence a finding
+    is explained from (``why.reason.explain_failure``), per tracker, and notices (as ``find_reports``)."""
+    from gnnpmb.events import TeeSink
+    from gnnpmb.pipeline import run_tracker
+    from gnnpmb.why.facts import FactSink
+    from gnnpmb.why.reason import Evidence
+
+    runs, facts = [], {}
+    for tracker in request.trackers:
+        sink = FactSink(tracker, has_existence=tracker_has_existence(tracker))
+        facts[tracker] = sink.facts
+        runs.append(
+            run_tracker(
+                request.scene,
+                request.frame_detections,
+                tracker,
+                request.config,
+                sink=TeeSink(sink),
+                classes=request.classes,
+                frame_range=request.frame_range,
+            )
+        )
+    reports, notices = find_reports(request, runs)
+    return {
+        run.tracker: Evidence(reports[run.tracker], facts[run.tracker], run) for run in runs if run.tracker in reports
+    }, notices
+
+
+def explain_all(request: ViewRequest, evidence: Mapping[str, Evidence]) -> dict[str, list[Finding]]:
+    """Per tracker, the finding of each of its failures (in ``FailureReport.ids`` order), the other trackers'
+    evidence beside it."""
+    from gnnpmb.focus import FRAMES_BEFORE
+    from gnnpmb.why.reason import explain_failure
+
+    out = {}
+    for tracker, ev in evidence.items():
+        others = [o for t, o in evidence.items() if t != tracker]
+        start = request.frame_range.start
+        out[tracker] = [
+            explain_failure(fid, ev, request.scene, others, first_frame=max(start, f.frame_index - FRAMES_BEFORE))
+            for fid, f in zip(ev.report.ids(), ev.report.failures, strict=True)
+        ]
+    return out
 
 
 def rerun_digests(request: ViewRequest) -> dict[str, TrackDigest]:

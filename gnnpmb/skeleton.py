@@ -85,6 +85,7 @@ def emit_prior(
             center_xy=gating.inn.z_pred[:, :2],
             innovation_cov=gating.inn.S[:, :2, :2],
             threshold=gate_chi2,
+            d2=gating.d2,
         )
     )
 

@@ -17,139 +17,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, GlobalHypotheses, PairTerms, label_positions
-from gnnpmb.explain import LINK_SLACK, Conflict, Decisions, PairChoice
+from gnnpmb.events import AxisKind, CostMatrix, GlobalHypotheses, label_positions
+from gnnpmb.explain import LINK_SLACK, Conflict, Decisions
+from gnnpmb.why.words import choice_why, column_name, meas_name
 
 _TRACK = AxisKind.TRACK.value
 _NEW = AxisKind.NEW_TRACK.value
 
-CLOSE_CALL_MARGIN = 1.0
-"""A choice whose margin (in cost units, nats for the PMB family) is below this is flagged as a close call."""
 MAX_CONFLICTS_PER_CLASS = 6
 """The decision document lists at most this many conflicts per class (closest calls first)."""
 MAX_TABLE_CELLS = 400
 MAX_HYPOTHESES_LISTED = 5
 """The decision document lists the best this many PMBM global hypotheses per class."""
-
-
-def meas_name(ref: int) -> str:
-    """How every view names detection ``ref`` (its source index): ``m<ref>``."""
-    return f"m{int(ref)}"
-
-
-def column_name(label: AxisLabel) -> str:
-    """``track 802``, ``new`` (start a track / clutter) or ``missed``."""
-    match label.kind:
-        case AxisKind.TRACK:
-            return f"track {label.ref}"
-        case AxisKind.NEW_TRACK:
-            return "new"
-        case AxisKind.MISSED:
-            return f"missed {label.ref}"
-        case AxisKind.MEASUREMENT:
-            return meas_name(label.ref)
-    raise AssertionError(label.kind)
-
-
-def existence_text(r: float) -> str:
-    """An existence probability with two decimals, or one significant digit below 0.01 (``0.004``, ``4e-05``),
-    so a small but non-zero existence does not read as 0.00."""
-    return f"{r:.2f}" if r >= 0.01 or r == 0 else f"{r:.1g}"
-
-
-def cost_breakdown(terms: PairTerms, meas: str) -> str:
-    """A track's cost for detection ``meas`` in words: the nats its predicted existence, the uncertainty of its
-    predicted position, the distance and the detection's score add, and the constant the tracker adds to every
-    pair (``events.PairTerms``; the parts a tracker's cost does not have are left out)."""
-    parts: list[tuple[float, str]] = []
-    if terms.offset_text:
-        parts.append((terms.offset_nats, f"for {terms.offset_text}"))
-    if terms.existence is not None:
-        parts.append((terms.existence_nats, f"for its predicted existence {existence_text(terms.existence)}"))
-    parts.append((terms.spread_nats, f"for the uncertainty of its predicted position (±{terms.spread_m:.1f} m)"))
-    parts.append((terms.distance_nats, f"for the distance to {meas} (d² {terms.d2:.1f})"))
-    if terms.score is not None:
-        parts.append((terms.score_nats, f"for {meas}'s score {terms.score:.2f}"))
-    shown = hundredths_summing_to([v for v, _ in parts], terms.total_nats)
-    return " + ".join(f"{v:.2f} {text}" for v, (_, text) in zip(shown, parts, strict=True))
-
-
-def hundredths_summing_to(values: list[float], total: float) -> list[float]:
-    """``values`` rounded to hundredths so that they add up to ``total`` rounded to hundredths (largest
-    remainder: each is rounded down, then the ones with the largest remainders get a hundredth more), so a
-    reader adding the parts finds the total shown beside them."""
-    scaled = [100.0 * v for v in values]
-    down = [math.floor(x) for x in scaled]
-    missing = round(100.0 * total) - sum(down)
-    order = sorted(range(len(values)), key=lambda k: scaled[k] - down[k], reverse=True)
-    for k in order[: max(0, min(missing, len(values)))]:
-        down[k] += 1
-    return [d / 100.0 for d in down]
-
-
-def cost_brief(terms: PairTerms | None) -> str:
-    """What a track's cost depended on, briefly: ``existence 0.62, ±1.2 m, d² 0.3`` ("" without terms)."""
-    if terms is None:
-        return ""
-    existence = f"existence {existence_text(terms.existence)}, " if terms.existence is not None else ""
-    return f"{existence}±{terms.spread_m:.1f} m, d² {terms.d2:.1f}"
-
-
-def choice_why(c: PairChoice, went: str | None = None) -> str | None:
-    """Why a detection went to its chosen column rather than the track that was its next best: both costs, each
-    track's taken apart (when the tracker's matrix says what they are made of), and the predicted existence at
-    which that track would have been the cheaper of the two. went: how to name the chosen column ("new track
-    212"; default ``column_name``). None when the next best is not a track or its terms are unknown."""
-    alt = c.alternative_terms
-    if alt is None or c.alternative is None:
-        return None
-    meas = meas_name(c.meas.ref)
-    other = column_name(c.alternative)
-    if c.chosen.kind is AxisKind.NEW_TRACK:
-        chosen = went if went and went.startswith("new track ") else "a new track"
-    else:
-        chosen = went or column_name(c.chosen)
-    lines = [
-        f"{meas} went to {chosen} (cost {c.chosen_cost:.2f}) rather than {other} (cost {c.alternative_cost:.2f}): "
-        "the lower cost wins"
-    ]
-    if c.chosen_terms is not None:
-        lines.append(
-            f"{column_name(c.chosen).capitalize()}'s {c.chosen_cost:.2f} = {cost_breakdown(c.chosen_terms, meas)}"
-        )
-    lines.append(f"{other.capitalize()}'s {c.alternative_cost:.2f} = {cost_breakdown(alt, meas)}")
-    lines.append(_would_have(alt, other, c.alternative_cost - c.chosen_cost, meas))
-    return ". ".join(lines)
-
-
-def track_why(c: PairChoice, track_id: int, role: str = "") -> str | None:
-    """What track ``track_id`` (neither the chosen nor the next best column of ``c``; ``role``: words after its
-    name, e.g. ", which had the object,") would have cost for c's detection, taken apart, and what would have made
-    it cheaper than the chosen column; None when the matrix does not say or has no such track."""
-    if c.terms is None or c.row < 0:
-        return None
-    col = c.terms.column_of(track_id)
-    if col is None:
-        return None
-    t = c.terms.pair(c.row, col)
-    meas, name = meas_name(c.meas.ref), f"track {track_id}"
-    cost = f"Track {track_id}{role} would have cost {t.total_nats:.2f} = {cost_breakdown(t, meas)}"
-    return f"{cost}. {_would_have(t, name, t.total_nats - c.chosen_cost, meas)}"
-
-
-def _would_have(t: PairTerms, name: str, gap: float, meas: str) -> str:
-    """What would have made track ``name`` (terms ``t``) ``gap`` nats cheaper: its predicted existence (PMB
-    family) or its distance (GNN)."""
-    if t.existence is not None:
-        needed = t.existence_for(gap)
-        if needed is None:
-            return f"No predicted existence would have given {meas} to {name}"
-        now, above = existence_text(t.existence), existence_text(needed)
-        return f"With a predicted existence above {above} (instead of {now}), {name} would have taken {meas}"
-    closer = t.d2_for(gap)
-    if closer is None:
-        return f"Even with {meas} right on its prediction (d² 0), {name} would have cost more"
-    return f"Within d² {closer:.1f} (instead of {t.d2:.1f}), {name} would have taken {meas}"
 
 
 def _fmt(value: float) -> str:
@@ -189,7 +68,7 @@ def conflict_markdown(conflict: Conflict, reported: set[int] | None = None) -> s
     meas = ", ".join(meas_name(m) for m in conflict.meas_indices)
     meas = f"detection{'s' if len(conflict.meas_indices) != 1 else ''} {meas}"
     margin = conflict.closest_margin
-    flag = " **close call**" if margin < CLOSE_CALL_MARGIN else ""
+    flag = " **close call**" if conflict.close_call else ""
     lines = [
         f"{tracks} · {meas} — closest margin {_fmt(margin)}{flag}",
         "",
@@ -229,9 +108,7 @@ def decisions_markdown(
     head = [
         f"## {tracker} · frame {frame_index}: why each detection went where it did",
         "",
-        "cost = −log likelihood ratio against *the track was missed* (lower = more likely; "
-        "**new** = the detection starts a track or is clutter). "
-        "margin = how much worse the best assignment gets without that pair (small = close call).",
+        *_scale_notes(decisions),
         "",
     ]
     body: list[str] = []
@@ -261,6 +138,28 @@ def decisions_markdown(
     if not body:
         body.append("No detections and no tracks to decide about in this frame.")
     return "\n".join(head + body) + "\n"
+
+
+def _scale_notes(decisions: Sequence[Decisions]) -> list[str]:
+    """What the costs and margins of the frame's matrices are, once per cost scale (``events.CostScale``)."""
+    out = []
+    for scale in dict.fromkeys(d.scale for d in decisions):
+        if scale.unit == "nats":
+            out.append(
+                "cost = −log likelihood ratio against *the track was missed* (lower = more likely; **new** = the "
+                "detection starts a track or is clutter). margin = how much worse the best assignment gets without "
+                f"that pair (a close call below {scale.close_call:g})."
+            )
+        else:
+            how = "the best assignment gets" if scale.optimal else "the detection's next closest column is"
+            out.append(
+                f"cost = {scale.name} in {scale.unit} (lower = closer; **new** = the detection starts a track). margin "
+                f"= how much worse {how} (a close call below {scale.close_call:g} {scale.unit})."
+            )
+    return out or [
+        "cost = −log likelihood ratio against *the track was missed* (lower = more likely; **new** = the detection "
+        "starts a track or is clutter). margin = how much worse the best assignment gets without that pair."
+    ]
 
 
 def hypotheses_markdown(event: GlobalHypotheses, reported: set[int] | None = None) -> str:

@@ -17,17 +17,20 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 import numpy as np
 import rerun as rr
 
 from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import SceneData
-from gnnpmb.eval.failures import FailureReport, short_id
+from gnnpmb.eval.failures import short_id
 from gnnpmb.focus import FocusTarget
-from gnnpmb.pipeline import FrameResult, TrackingRun
+from gnnpmb.pipeline import FrameResult
 from gnnpmb.types import Boxes
+from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode
+from gnnpmb.why.findings import Finding
+from gnnpmb.why.words import existence_text, share_text, went_text
 from viz import compare, paths
 from viz.blueprint import (
     DEFAULT_FOCUS_HEIGHT_M,
@@ -38,13 +41,13 @@ from viz.blueprint import (
 )
 from viz.callouts import Callout, log_callouts
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
-from viz.decisions import existence_text
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
-from viz.focus_summary import READING_GUIDE, existence_as_decided, focus_markdown, mentions
+from viz.focus_summary import TrackerView, focus_markdown
 from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
 from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
-from viz.logger import TrackerLogger, TrackStep
+from viz.logger import TrackerLogger
 from viz.markers import send_text_lines
+from viz.reading_guide import READING_GUIDE
 from viz.scene import detection_label
 from viz.timeline import Clock
 
@@ -67,28 +70,27 @@ def log_focus(
     stream: rr.RecordingStream,
     focus: FocusTarget,
     scene: SceneData,
-    runs: Sequence[TrackingRun],
+    views: Mapping[str, TrackerView],
     loggers: Mapping[str, TrackerLogger],
     clock: Clock,
     shown: range,
-    reports: Mapping[str, FailureReport] | None = None,
+    finding: Finding | None = None,
 ) -> None:
-    """The summary document and, at every keyframe of ``shown``, the highlighted objects (reports: see
-    ``focus_markdown``)."""
+    """The summary document and, at every keyframe of ``shown``, the highlighted objects. views: per tracker its
+    evidence (report, facts, run) as the document shows it; finding: the failure's (None: the focus is no
+    failure)."""
     stream.log(
         focus_doc(),
-        rr.TextDocument(
-            focus_markdown(focus, loggers, shown, scene, {run.tracker: run for run in runs}, reports),
-            media_type="text/markdown",
-        ),
+        rr.TextDocument(focus_markdown(focus, finding, views, shown, scene), media_type="text/markdown"),
         static=True,
     )
     stream.log(reading_guide_doc(), rr.TextDocument(READING_GUIDE, media_type="text/markdown"), static=True)
+    reports = {t: v.evidence.report for t, v in views.items()}
     for tracker, logger in loggers.items():
         _log_involved_story(stream, clock, scene, focus, tracker, logger)
-    frames = {run.tracker: {f.keyframe.index: f for f in run.frames} for run in runs}
+    frames = {t: {f.keyframe.index: f for f in v.evidence.run.frames} for t, v in views.items()}
     gt_ids = set(focus.gt_ids)
-    evaluated = evaluated_offsets(focus, scene)
+    evaluated = evaluated_offsets(focus, reports.get(focus.failure_tracker or ""))
     reach_m = range_near_focus(focus, scene)
     height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
     for i in shown:
@@ -109,7 +111,7 @@ def log_focus(
         if i == focus.frame_index:
             gt_callouts += [
                 Callout(
-                    (*focus.evaluated_gt_xy_m[gt_id], float(seen.center_m[2])),
+                    (*seen.evaluated_xy_m, z_m),
                     f"GT {short_id(gt_id)} as evaluated ({seen.offset_m:.1f} m off)",
                     CLASS_COLORS.get(focus.class_name, GREY),
                 )
@@ -144,29 +146,23 @@ def log_focus(
                     radii=LINE_RADIUS_M,
                 ),
             )
-            steps = {t: loggers[tracker].track_steps.get(t, {}).get(i) for t in sorted(ids)}
+            facts = views[tracker].facts
+            steps = {t: facts.steps(t, focus.class_name).get(i) for t in sorted(ids)}
             _log_ghosts(stream, tracker, frames[tracker], i, steps, {e.track_id for e in chosen}, palette)
             given = {e.meas_index for e in chosen if e.meas_index >= 0}
-            given |= {s.given for s in steps.values() if s is not None and s.given >= 0}
-            # and, for a track given none, the detection nearest it (by NIS) in its gate: where that one went
-            given |= {
-                min(s.gated, key=lambda g: g[1])[0] for s in steps.values() if s is not None and s.given < 0 and s.gated
-            }
+            given |= {m for s in steps.values() if s is not None for m in s.used}
+            # and, for a track that used none, the detection nearest it (by NIS) in its gate: where that one went
+            given |= {s.gated[0][0] for s in steps.values() if s is not None and not s.used and s.gated}
             meas |= given
             detections = frame.detections.boxes
+            use = facts.use(i, focus.class_name)
+            mode = use.mode if use is not None else UseMode.ASSIGNED
             log_callouts(
                 stream,
                 paths.focus_callouts(tracker),
                 gt_callouts
-                + _detection_callouts(detections, sorted(given), loggers[tracker].given.get(i, {}))
-                + _prediction_callouts(
-                    steps,
-                    z_m,
-                    palette,
-                    existence_as_decided(loggers[tracker], i, focus.class_name)
-                    if loggers[tracker].has_existence
-                    else None,
-                ),
+                + _detection_callouts(detections, sorted(given), facts, i, focus.class_name, mode)
+                + _prediction_callouts(steps, z_m, palette, facts.has_existence),
                 height_m,
             )
         if meas and detections is not None:
@@ -194,18 +190,37 @@ def log_focus(
             log_evaluated(stream, focus, scene, evaluated if i == focus.frame_index else {})
 
 
+def tracker_views(evidence: Mapping[str, object], loggers: Mapping[str, TrackerLogger]) -> dict[str, TrackerView]:
+    """Each tracker's ``TrackerView`` from its evidence and its logger (story, gates, shown tracks)."""
+    return {
+        t: TrackerView(ev, loggers[t].has_gates, tuple(loggers[t].story), frozenset(loggers[t].reported_ever))
+        for t, ev in evidence.items()
+    }
+
+
 def _log_involved_story(
     stream: rr.RecordingStream, clock: Clock, scene: SceneData, focus: FocusTarget, tracker: str, logger: TrackerLogger
 ) -> None:
-    """The story lines of the focused class that name one of ``tracker``'s involved tracks, at their frames."""
+    """The story lines of the focused class about one of ``tracker``'s involved tracks, at their frames (not the
+    per-frame DEBUG summaries, which the class's whole story keeps)."""
     ids = set(focus.track_ids.get(tracker, ()))
-    lines = [(f, text, level) for f, c, text, level in logger.story if c == focus.class_name and mentions(text, ids)]
+    lines = [
+        line
+        for line in logger.story
+        if line.class_name == focus.class_name and line.level != "DEBUG" and set(line.track_ids) & ids
+    ]
     if not lines:
         return
-    frames = np.array([f for f, _, _ in lines], dtype=np.int64)
+    frames = np.array([line.frame for line in lines], dtype=np.int64)
     stamps = np.array([scene.keyframes[f].timestamp_us for f in frames.tolist()], dtype=np.int64)
     send_text_lines(
-        stream, clock, paths.involved_story(tracker), frames, stamps, [t for _, t, _ in lines], [v for *_, v in lines]
+        stream,
+        clock,
+        paths.involved_story(tracker),
+        frames,
+        stamps,
+        [line.text for line in lines],
+        [line.level for line in lines],
     )
 
 
@@ -245,17 +260,23 @@ def focus_legends(
     return out
 
 
-def _detection_callouts(detections: Boxes, given: list[int], went: Mapping[int, str]) -> list[Callout]:
+def _detection_callouts(
+    detections: Boxes, given: list[int], facts: TrackerFacts, frame: int, class_name: str, mode: UseMode
+) -> list[Callout]:
     """``m<idx> <score> → <where it went>`` at each detection ``given`` (indices into the frame's detections;
-    went: detection -> "track 12", "new track 40", as ``TrackerLogger.given`` holds it)."""
-    return [
-        Callout(
-            tuple(detections.translation_m[m]),
-            detection_label(m, detections.score[m]) + (f" → {went[m]}" if m in went else ""),
-            CLASS_COLORS.get(str(detections.class_name[m]), GREY),
+    where it went: ``why.facts.Destination``, in the tracker's terms)."""
+    out = []
+    for m in given:
+        d = facts.destination(frame, class_name, m)
+        went = f" {went_text(d, mode)}" if d is not None else ""
+        out.append(
+            Callout(
+                tuple(detections.translation_m[m]),
+                detection_label(m, detections.score[m]) + went,
+                CLASS_COLORS.get(str(detections.class_name[m]), GREY),
+            )
         )
-        for m in given
-    ]
+    return out
 
 
 def predicted_ghosts(tracker: str) -> str:
@@ -278,7 +299,7 @@ def _log_ghosts(
     ground. An empty batch when there is none."""
     ghosts = []
     for t, step in steps.items():
-        if step is None or t in output:
+        if step is None or step.predicted_xy_m is None or t in output:
             continue
         last = next(
             (
@@ -314,20 +335,30 @@ def _prediction_callouts(
     steps: Mapping[int, TrackStep | None],
     z_m: float,
     palette: Mapping[int, tuple[int, int, int]],
-    decided: Mapping[int, float] | None = None,
+    has_existence: bool,
 ) -> list[Callout]:
-    """``<id> predicted r=<existence> → m<idx>`` (the detection it was given; ``, missed``: none) at each focused
-    track's predicted position this frame, in the track's involved colour (``palette``); the existence is the one
-    its detection was decided with (``decided``, see ``focus_summary.existence_as_decided``) if known, else its
-    prior existence. decided None: the tracker has no existences (``<id> predicted → m<idx>``)."""
-    return [
-        Callout(
-            (*step.predicted_xy_m, z_m),
-            f"{t} predicted"
-            + ("" if decided is None else f" r={existence_text(decided.get(t, step.prior_existence))}")
-            + (f" → m{step.given}" if step.given >= 0 else ", missed"),
-            palette[t],
-        )
-        for t, step in steps.items()
-        if step is not None
-    ]
+    """``<id> predicted r=<existence> → m<idx>`` (the detection its update used most, with its share for a soft
+    update) or ``, missed`` at each focused track's predicted position this frame, in the track's involved colour
+    (``palette``). The existence is the predicted one; for PMBM, when the frame's assignment was decided in another
+    prior hypothesis, the one there, with the best hypothesis's beside it. Without existences: ``<id> predicted
+    → m<idx>``."""
+    out = []
+    for t, step in steps.items():
+        if step is None or step.predicted_xy_m is None:
+            continue
+        r = ""
+        if has_existence and step.prior_existence is not None:
+            r = f" r={existence_text(step.prior_existence)}"
+            decided = step.decided_existence
+            if decided is not None and existence_text(decided) != existence_text(step.prior_existence):
+                best = existence_text(step.prior_existence)
+                r = f" r={existence_text(decided)} in the deciding hypothesis ({best} in the best)"
+        use = step.use
+        if use is not None and use.shares:
+            m, share = use.shares[0]
+            extra = share_text(share, use.mode)
+            went = f" → m{m}" + (f" ({extra})" if extra else "")
+        else:
+            went = ", missed"
+        out.append(Callout((*step.predicted_xy_m, z_m), f"{t} predicted{r}{went}", palette[t]))
+    return out

@@ -1,22 +1,23 @@
 """``TrackerLogger``: an ``EventSink`` that draws one tracker's introspection events in Rerun so a failure can be
-explained from the picture.
+explained from the picture. It only draws: what the events mean (which detection each track's update used,
+the solver's decisions, the story) comes from the tracker's facts (``gnnpmb.why.facts``, ``gnnpmb.why.story``).
 
-Per frame and class, from the events alone:
+Per frame and class:
 
-* **which detection went to which track**: a line from each track's predicted position to the detection it was
-  given, in the track's colour (``associations``); pairs inside a gate that the solver did not choose as dimmed
-  lines (``gated_pairs``); detections are named ``m<idx>`` everywhere (labels, lines, tables, log);
+* **which detection went to which track**: a line from each track's predicted position to each detection its
+  update used, in the track's colour (``associations``: an assignment, or every detection with a share of an
+  association probability or PHD weight, labelled with it); detections inside a gate that the update did not
+  use as dimmed lines (``gated_pairs``); detections are named ``m<idx>`` everywhere (labels, lines, tables, log);
 * **why**: the decision view (``viz.decisions``): per conflict the chosen pair, its cost, the best alternative
   and the margin, as a document and as a labelled cost grid with the chosen cells outlined;
 * **what happened before**: one entity per extracted track (``tracks/<class>/<id>``: its box and a trail of its
-  last ``TRAIL_FRAMES`` positions), per-track series (existence, normalised innovation, chosen cost) and a story
-  log per class: confirmed, missed, no longer shown, ended at INFO/WARN; candidates' births and prunings
-  aggregated into one DEBUG line per class and frame; close calls at INFO.
+  last ``TRAIL_FRAMES`` positions), per-track series (existence, normalised innovation of the detection that
+  dominated its update, chosen cost) and the story log per class (``gnnpmb.why.story``).
 
 Candidate Bernoullis (predicted existence below ``gate_min_existence``, the many births on clutter) get no gate,
 no box and no own series: their predicted means go to one hidden-by-default entity per class and their number to
 one series per class. Time series are collected and sent column-wise by ``finish()`` (one chunk per series).
-Events of one class are buffered and drawn when the frame closes, so every view of a frame is consistent.
+A frame is drawn when it closes (the next ``FrameStarted``, or ``finish``), from the facts of all its events.
 """
 
 from __future__ import annotations
@@ -30,32 +31,23 @@ import numpy as np
 import rerun as rr
 
 from gnnpmb.events import (
-    Assignment,
     AxisKind,
-    AxisLabel,
-    Born,
-    BudgetReached,
     Cardinality,
     CostMatrix,
     Event,
-    Extracted,
     FrameStarted,
     Gated,
     GlobalHypotheses,
     IntensityWeights,
     Marginals,
-    MeasurementsReceived,
-    Merged,
-    Posterior,
-    Predicted,
-    Pruned,
-    TrackLogic,
-    TrackLogicAction,
     label_positions,
 )
-from gnnpmb.explain import Decisions, explain
+from gnnpmb.explain import Decisions
 from gnnpmb.gating import ellipse_outline
 from gnnpmb.types import TrackEstimate
+from gnnpmb.why.facts import ClassFrame, TrackerFacts, UseMode
+from gnnpmb.why.story import StoryLine, Storyteller
+from gnnpmb.why.words import SHOW_MIN_EXISTENCE, meas_name, share_text
 from viz import paths
 from viz.colors import (
     CLASS_COLORS,
@@ -66,15 +58,7 @@ from viz.colors import (
     packed_track_colors,
     track_color,
 )
-from viz.decisions import (
-    CLOSE_CALL_MARGIN,
-    column_name,
-    cost_colors,
-    decision_grid,
-    decisions_markdown,
-    existence_text,
-    meas_name,
-)
+from viz.decisions import cost_colors, decision_grid, decisions_markdown
 from viz.geometry import estimate_boxes, lift_xy
 from viz.rows import Build, EntityRows, RowBuffer, send_entities
 from viz.timeline import PLAIN_CLOCK, Clock
@@ -101,10 +85,6 @@ MAX_HYPOTHESIS_SERIES = 10
 """Log weights are plotted for the best this many PMBM global hypotheses."""
 CHOSEN_CELL_RGBA = int(pack_rgba(np.array([[255, 210, 0]], dtype=np.uint8))[0])
 THRESHOLD_COLOR = (150, 150, 150)
-SHOW_MIN_EXISTENCE = 0.5
-"""Extracted tracks are drawn as tracks (own entity, box, trail, story, series) from this existence on. The
-submission may hold far less likely Bernoullis (a low extraction threshold with score = detection score x
-existence helps AMOTA); drawing them all would bury the picture (and the viewer in chunks)."""
 FLUSH_FRAMES = 10
 """Default cadence: story lines and spatial rows are sent column-wise every this many frames (and at the end),
 so a live viewer sees them within seconds; a saved recording passes ``flush_frames=None`` (only at the end: one
@@ -112,12 +92,6 @@ chunk per entity)."""
 _STATIC_ROW = np.zeros(1, dtype=np.int64)
 """The one row of static data (``viz.rows.send_entities(static=True)`` ignores its time)."""
 CANDIDATE_COLOR = int(pack_rgba(np.array([[160, 160, 160]], dtype=np.uint8))[0])
-
-_LEVEL_BY_ACTION = {
-    TrackLogicAction.TENTATIVE: "DEBUG",
-    TrackLogicAction.CONFIRMED: "INFO",
-    TrackLogicAction.DELETED: "WARN",
-}
 
 
 @dataclass(slots=True)
@@ -129,44 +103,6 @@ class _Series:
     frames: list[int] = field(default_factory=list)
     timestamps_us: list[int] = field(default_factory=list)
     values: list[float] = field(default_factory=list)
-
-
-@dataclass(frozen=True, slots=True)
-class TrackStep:
-    """One focused track at one frame: predicted existence and BEV position, the detections inside its gate with
-    their NIS, the detection it was given (-1: none), its existence after the update (NaN if gone) and
-    whether it was reported."""
-
-    prior_existence: float
-    predicted_xy_m: tuple[float, float]
-    gated: tuple[tuple[int, float], ...]
-    given: int
-    posterior_existence: float
-    reported: bool
-
-
-@dataclass(slots=True)
-class _ClassFrame:
-    """The events of one class in the current frame, drawn together when the frame closes."""
-
-    meas: MeasurementsReceived | None = None
-    predicted: Predicted | None = None
-    gated: Gated | None = None
-    costs: dict[int, CostMatrix] = field(default_factory=dict)
-    assignment: Assignment | None = None
-    born: list[Born] = field(default_factory=list)
-    pruned: list[Pruned] = field(default_factory=list)
-    merged: list[Merged] = field(default_factory=list)
-    logic: list[TrackLogic] = field(default_factory=list)
-    posterior: Posterior | None = None
-    extracted: Extracted | None = None
-    hypotheses: GlobalHypotheses | None = None
-
-    @property
-    def cost(self) -> CostMatrix | None:
-        """The cost matrix the frame's assignment was chosen over: that of the assignment's prior hypothesis (PMBM's
-        best posterior may come from another prior hypothesis than the first); hypothesis 0's without one."""
-        return self.costs.get(self.assignment.hypothesis if self.assignment is not None else 0)
 
 
 class TrackerLogger:
@@ -182,8 +118,9 @@ class TrackerLogger:
     (``colors.involved_track_colors``, away from the colour of ``focus_class``, their class). flush_frames: send
     buffered rows every this many frames (None: only at the end). has_existence: False for a tracker whose
     tracks have no existence probability (``registry.tracker_has_existence``; its events carry 1): no existence
-    series (flat lines at 1, a chunk pair per track) and no existence in the story. Call ``finish()`` after the
-    last frame: it sends what is buffered and the time series.
+    series (flat lines at 1, a chunk pair per track) and no existence in the story. facts: the tracker's facts,
+    fed by a ``why.facts.FactSink`` placed before this logger in a ``TeeSink`` (None: the logger keeps and feeds
+    its own). Call ``finish()`` after the last frame: it sends what is buffered and the time series.
     """
 
     enabled = True
@@ -204,6 +141,7 @@ class TrackerLogger:
         flush_frames: int | None = FLUSH_FRAMES,
         has_existence: bool = True,
         focus_class: str | None = None,
+        facts: TrackerFacts | None = None,
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
         self.stream = stream
@@ -218,6 +156,10 @@ class TrackerLogger:
         self.focus_tracks = focus_tracks
         self.flush_frames = flush_frames
         self.has_existence = has_existence
+        self.facts = facts if facts is not None else TrackerFacts(tracker_name, has_existence=has_existence)
+        """What the tracker did (``why.facts``): the logger draws from it."""
+        self._feeds_facts = facts is None
+        self.storyteller = Storyteller(self.facts, show_min=show_min_existence, involved=frozenset(focus_tracks or ()))
         self.involved_rgb = involved_track_colors(focus_tracks or (), CLASS_COLORS.get(focus_class or ""))
         """Focus track id -> its RGB (``colors.involved_track_colors``), in every view and plot."""
         packed = pack_rgba(np.array(list(self.involved_rgb.values()), dtype=np.uint8).reshape(-1, 3))
@@ -227,14 +169,8 @@ class TrackerLogger:
         self._drawing = True
         self.has_gates = False
         """Whether the tracker gates (a ``Gated`` event came): greedy matches within a distance instead."""
-        self.decisions: dict[int, list[Decisions]] = {}
-        """Frame index -> the decisions of every class (kept for the focus view and tests)."""
-        self.given: dict[int, dict[int, str]] = {}
-        """Frame -> detection index -> where it went ("track 12", "new"), for the focus tracks' class only."""
-        self.track_steps: dict[int, dict[int, TrackStep]] = {}
-        """Focused track id -> frame -> its ``TrackStep`` (only for ``focus_tracks``)."""
-        self.story: list[tuple[int, str, str, str]] = []
-        """Every story line logged: (frame, class, text, level)."""
+        self.story: list[StoryLine] = []
+        """Every story line logged (``why.story.StoryLine``)."""
         self.sent_series: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         """With ``focus_tracks``: series path -> (K,) frames and (K,) values of every time series ``finish`` sent
         (the focus view places its plots' legends from them)."""
@@ -242,36 +178,19 @@ class TrackerLogger:
         self._timestamp_us = 0
         self._live: set[str] = set()
         self._touched: set[str] = set()
-        self._classes: dict[str, _ClassFrame] = {}
         self._texts: dict[str, tuple[list[int], list[int], list[str], list[str]]] = {}
         self._frames_since_text_flush = 0
         self._series: dict[str, _Series] = {}
         self._multi: dict[str, tuple[list[str], list[int], list[int], list[np.ndarray]]] = {}
         self._track_z: dict[int, float] = {}
         self._trails: dict[int, deque[tuple[float, float, float]]] = {}
-        self._reported: set[int] = set()  # tracks extracted in the previous frame
         self._extracted_ids: set[int] = set()  # tracks extracted at least once
         self._track_series: dict[str, tuple[str, int]] = {}  # series path -> (class, track id)
         self._track_paths: dict[tuple[Callable, str, int], str] = {}  # (paths function, class, track id) -> path
-        self._handlers: dict[type, Callable] = {
-            FrameStarted: self._on_frame_started,
-            MeasurementsReceived: self._store("meas"),
-            Predicted: self._store("predicted"),
-            Gated: self._on_gated,
-            CostMatrix: self._on_cost,
-            Assignment: self._on_assignment,
-            Born: self._append("born"),
-            Posterior: self._store("posterior"),
-            Pruned: self._append("pruned"),
-            Extracted: self._store("extracted"),
-            GlobalHypotheses: self._on_hypotheses,
-            Marginals: self._on_marginals,
-            Merged: self._append("merged"),
-            Cardinality: self._on_cardinality,
-            IntensityWeights: self._on_intensity,
-            TrackLogic: self._append("logic"),
-            BudgetReached: self._on_budget,
-        }
+
+    @property
+    def _focused(self) -> set[int]:
+        return self.focus_tracks or set()
 
     @property
     def reported_ever(self) -> set[int]:
@@ -279,12 +198,16 @@ class TrackerLogger:
         return self._extracted_ids
 
     def emit(self, event: Event) -> None:
-        handler = self._handlers.get(type(event))
-        if handler is None:
-            raise TypeError(f"TrackerLogger cannot log {type(event).__name__}")
-        if self._frame < 0 and not isinstance(event, FrameStarted):
+        if self._feeds_facts:
+            self.facts.add(event)
+        elif self._frame < 0 and not isinstance(event, FrameStarted):
             raise RuntimeError(f"{type(event).__name__} emitted outside a frame (before FrameStarted or after finish)")
-        handler(event)
+        if isinstance(event, FrameStarted):
+            self._on_frame_started(event)
+        elif self._frame < 0:
+            raise RuntimeError(f"{type(event).__name__} emitted outside a frame (before FrameStarted or after finish)")
+        elif isinstance(event, Gated):
+            self.has_gates = True
 
     def finish(self) -> None:
         """End the last frame and send every collected time series (column-wise). Safe to call twice."""
@@ -329,35 +252,6 @@ class TrackerLogger:
         self._track_paths.clear()
         self._multi.clear()
 
-    # Event intake.
-    def _store(self, name: str) -> Callable[[Event], None]:
-        def handler(event: Event) -> None:
-            setattr(self._class_frame(event.class_name), name, event)
-
-        return handler
-
-    def _append(self, name: str) -> Callable[[Event], None]:
-        def handler(event: Event) -> None:
-            getattr(self._class_frame(event.class_name), name).append(event)
-
-        return handler
-
-    def _class_frame(self, class_name: str) -> _ClassFrame:
-        cf = self._classes.get(class_name)
-        if cf is None:
-            cf = self._classes[class_name] = _ClassFrame()
-        return cf
-
-    def _on_gated(self, event: Gated) -> None:
-        self.has_gates = True
-        self._class_frame(event.class_name).gated = event
-
-    def _on_cost(self, event: CostMatrix) -> None:
-        self._class_frame(event.class_name).costs[event.hypothesis] = event
-
-    def _on_assignment(self, event: Assignment) -> None:
-        self._class_frame(event.class_name).assignment = event
-
     # Frame bookkeeping.
     def _on_frame_started(self, event: FrameStarted) -> None:
         if self._frame >= 0:
@@ -371,25 +265,24 @@ class TrackerLogger:
         """Draw the frame's classes, the decision view and the story lines; clear what was drawn last frame but
         not in this one."""
         self.clock.set(self.stream, self._frame, self._timestamp_us)
-        reported: set[int] = set()
         decisions: list[Decisions] = []
         matrices: dict[str, CostMatrix] = {}
         fallbacks: list[CostMatrix] = []
-        hypotheses = [cf.hypotheses for cf in self._classes.values() if cf.hypotheses is not None]
-        for class_name, cf in self._classes.items():
-            reported |= self._draw_class(class_name, cf)
-            if self._drawing and cf.cost is not None and cf.assignment is not None:
-                d = explain(cf.cost, cf.assignment)
+        classes = self.facts.frames.get(self._frame, {})
+        hypotheses = [cf.hypotheses for cf in classes.values() if cf.hypotheses is not None]
+        for class_name, cf in classes.items():
+            self._draw_class(class_name, cf)
+            self._draw_family(class_name, cf)
+            if self._drawing and cf.cost is not None and cf.assignment is not None and cf.marginals is None:
+                d = self.facts.decisions(self._frame, class_name)
                 if d is None:
                     fallbacks.append(cf.cost)
                 else:
                     decisions.append(d)
                     matrices[class_name] = cf.cost
-                    self._story_close_calls(d, _born_tracks(cf))
-        self._reported = reported
-        self._classes = {}
+        for line in self.storyteller.frame_lines(self._frame):
+            self._text(line)
         if decisions or fallbacks:
-            self.decisions[self._frame] = decisions
             self._draw_decisions(decisions, matrices, fallbacks, hypotheses)
         if self._drawing:
             for path in sorted(self._live - self._touched):
@@ -438,15 +331,16 @@ class TrackerLogger:
         self._buffered.add(path)
         self._touched.add(path)
 
-    def _text(self, class_name: str, text: str, level: str) -> None:
+    def _text(self, line: StoryLine) -> None:
         if not self._drawing:
             return
-        self.story.append((self._frame, class_name, text, level))
-        frames, stamps, texts, levels = self._texts.setdefault(paths.events(self.tracker, class_name), ([], [], [], []))
-        frames.append(self._frame)
+        self.story.append(line)
+        path = paths.events(self.tracker, line.class_name)
+        frames, stamps, texts, levels = self._texts.setdefault(path, ([], [], [], []))
+        frames.append(line.frame)
         stamps.append(self._timestamp_us)
-        texts.append(text)
-        levels.append(level)
+        texts.append(line.text)
+        levels.append(line.level)
 
     def _sample(self, path: str, value: float, name: str = "", color: tuple[int, int, int] | None = None) -> None:
         """Append one point to a time series at the current frame (a repeat in the same frame replaces it);
@@ -484,7 +378,7 @@ class TrackerLogger:
         return np.array([z_of(t, default) for t in np.asarray(track_ids).tolist()], dtype=np.float64)
 
     # One class, one frame.
-    def _draw_class(self, class_name: str, cf: _ClassFrame) -> set[int]:
+    def _draw_class(self, class_name: str, cf: ClassFrame) -> set[int]:
         """Draw one class's frame; returns the ids of its extracted tracks."""
         focus = self.focus_tracks or set()
         extracted = cf.extracted.estimates if cf.extracted is not None else ()
@@ -502,13 +396,12 @@ class TrackerLogger:
         worthy = self._draw_prior(class_name, cf)
         self._draw_associations(class_name, cf, worthy)
         self._record_posterior(class_name, cf)
-        if self.focus_tracks:
-            self._record_steps(cf, estimates)
-        self._story(class_name, cf, estimates)
+        for p in cf.pruned:
+            self._trails.pop(p.track_id, None)
         self._draw_tracks(class_name, drawn, {e.track_id for e in estimates})
         return {e.track_id for e in estimates}
 
-    def _draw_prior(self, class_name: str, cf: _ClassFrame) -> set[int]:
+    def _draw_prior(self, class_name: str, cf: ClassFrame) -> set[int]:
         """Predicted means (tracks vs candidates) and gates; returns the ids of the tracks worth a gate."""
         if cf.predicted is None:
             return set()
@@ -631,46 +524,62 @@ class TrackerLogger:
             "labels": raw["labels"],
         }
 
-    def _draw_associations(self, class_name: str, cf: _ClassFrame, worthy: set[int]) -> None:
-        """Chosen (track, detection) lines in the track's colour, gated-but-rejected ones dimmed; per-track NIS
-        and chosen-cost samples."""
-        if cf.meas is None or cf.predicted is None or cf.assignment is None:
+    def _draw_associations(self, class_name: str, cf: ClassFrame, worthy: set[int]) -> None:
+        """A line from each track's prediction to each detection its update used (``why.facts.Use``: one for an
+        assignment, every one with a share for association probabilities or PHD weights; shares below one half
+        dimmed), gated detections it did not use dimmed; per-track samples of the NIS of the detection that
+        dominated its update and, where the tracker chose from a cost matrix, the chosen cost."""
+        use = self.facts.use(self._frame, class_name)
+        if use is None or cf.meas is None or cf.predicted is None:
             return
         pos = {m: k for k, m in enumerate(np.asarray(cf.meas.meas_indices, dtype=np.int64).tolist())}
         xyz = np.asarray(cf.meas.xyz_m, dtype=np.float64).reshape(-1, 3)
         pred_row = {t: k for k, t in enumerate(np.asarray(cf.predicted.track_ids, dtype=np.int64).tolist())}
         pred_xy = np.asarray(cf.predicted.mean, dtype=np.float64).reshape(-1, 4)[:, :2]
-        cost_of = _pair_cost_lookup(cf.cost)
-        pairs = [
-            (int(col.ref), int(row.ref))
-            for row, col in cf.assignment.pairs
-            if col.kind is AxisKind.TRACK and row.ref in pos and col.ref in pred_row
-        ]
-        if pairs:
-            owners = [t for t, _ in pairs]
-            meas_rows = np.array([pos[m] for _, m in pairs], dtype=np.int64)
-            nis = _nis_of(cf.gated, owners, xyz[meas_rows, :2])
+        cost_of = _pair_cost_lookup(cf.cost if cf.marginals is None else None)
+        d2_of = _pair_d2_lookup(cf.gated)
+        pairs, weak = [], []
+        for t, u in use.tracks.items():
+            if t not in pred_row:
+                continue
+            for m, share in u.shares:
+                if m in pos:
+                    (pairs if share >= 0.5 else weak).append((t, m, share))
+            dominant = u.dominant
+            if dominant is not None:
+                cost = cost_of(dominant, t)
+                if cost == cost:
+                    self._track_sample(paths.chosen_cost, class_name, t, cost, "chosen cost")
+                nis = d2_of(dominant, t)
+                if nis == nis:
+                    self._track_sample(paths.nis, class_name, t, nis, "NIS")
+        for kept, path, build in (
+            (pairs, paths.associations(self.tracker, class_name), self._association_lines),
+            (weak, paths.weak_associations(self.tracker, class_name), self._gated_pair_lines),
+        ):
+            if not kept:
+                continue
+            owners = [t for t, _, _ in kept]
             labels = []
-            for (t, m), nis_tm in zip(pairs, nis, strict=True):
+            for t, m, share in kept:
                 cost = cost_of(m, t)
-                labels.append(f"{meas_name(m)} → {t} (cost {cost:.2f})")
-                self._track_sample(paths.chosen_cost, class_name, t, cost, "chosen cost")
-                if nis_tm is not None:
-                    self._track_sample(paths.nis, class_name, t, nis_tm, "NIS")
+                extra = share_text(share, use.mode) if use.mode is not UseMode.ASSIGNED else ""
+                extra = extra or (f"cost {cost:.2f}" if cost == cost else "")
+                labels.append(f"{meas_name(m)} → {t}" + (f" ({extra})" if extra else ""))
             self._put(
-                paths.associations(self.tracker, class_name),
+                path,
                 rr.LineStrips3D,
-                len(pairs),
+                len(kept),
                 static={"show_labels": False},
-                build=self._association_lines,
-                lines=_pair_lines(pred_xy, [pred_row[t] for t in owners], xyz, meas_rows),
+                build=build,
+                lines=_pair_lines(pred_xy, [pred_row[t] for t in owners], xyz, np.array([pos[m] for _, m, _ in kept])),
                 ids=np.array(owners, dtype=np.int64),
                 labels=labels,
             )
         gated = cf.gated
         if gated is None:
             return
-        chosen = set(pairs)
+        used = {(t, m) for t, m, _ in (*pairs, *weak)}
         gids = np.asarray(gated.track_ids, dtype=np.int64).tolist()
         gmeas = np.asarray(gated.meas_indices, dtype=np.int64).tolist()
         drawn = np.array([t in worthy for t in gids], dtype=bool).reshape(-1, 1)
@@ -678,10 +587,15 @@ class TrackerLogger:
         rejected = [
             (gids[k], gmeas[j])
             for k, j in zip(rows.tolist(), cols.tolist(), strict=True)
-            if (gids[k], gmeas[j]) not in chosen and gmeas[j] in pos
+            if (gids[k], gmeas[j]) not in used and gmeas[j] in pos and gids[k] in pred_row
         ]
         if rejected:
             rowners = [t for t, _ in rejected]
+            labels = []
+            for t, m in rejected:
+                cost = cost_of(m, t)
+                why = f" (cost {cost:.2f})" if cost == cost else ""
+                labels.append(f"{meas_name(m)} in gate of {t}, not used{why}")
             self._put(
                 paths.gated_pairs(self.tracker, class_name),
                 rr.LineStrips3D,
@@ -692,10 +606,10 @@ class TrackerLogger:
                     pred_xy, [pred_row[t] for t in rowners], xyz, np.array([pos[m] for _, m in rejected])
                 ),
                 ids=np.array(rowners, dtype=np.int64),
-                labels=[f"{meas_name(m)} in gate of {t}, not chosen (cost {cost_of(m, t):.2f})" for t, m in rejected],
+                labels=labels,
             )
 
-    def _record_posterior(self, class_name: str, cf: _ClassFrame) -> None:
+    def _record_posterior(self, class_name: str, cf: ClassFrame) -> None:
         """Existence samples and trail points of the Bernoullis worth following (r >= gate_min_existence,
         already reported, or focused); candidates only count."""
         post = cf.posterior
@@ -720,57 +634,6 @@ class TrackerLogger:
             if trail is None:
                 trail = self._trails[t] = deque(maxlen=TRAIL_FRAMES)
             trail.append((x, y, self._track_z.get(t, self.gate_z_m)))
-
-    def _record_steps(self, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
-        """The frame's ``TrackStep`` of every focused track this class predicted."""
-        if cf.predicted is None:
-            return
-        ids = np.asarray(cf.predicted.track_ids, dtype=np.int64).tolist()
-        mean = np.asarray(cf.predicted.mean, dtype=np.float64).reshape(-1, 4)
-        prior_r = np.asarray(cf.predicted.existence, dtype=np.float64)
-        post = {}
-        if cf.posterior is not None:
-            post = dict(
-                zip(
-                    np.asarray(cf.posterior.track_ids).tolist(),
-                    np.asarray(cf.posterior.existence).tolist(),
-                    strict=True,
-                )
-            )
-        given = {}
-        if cf.assignment is not None:
-            given = {int(c.ref): int(r.ref) for r, c in cf.assignment.pairs if c.kind is AxisKind.TRACK}
-        reported = {e.track_id for e in estimates}
-        if cf.assignment is not None:
-            born = _born_tracks(cf)  # a focused track started this frame was not predicted, but its detection counts
-            if any(t in self.focus_tracks for t in (*ids, *born.values())):
-                self.given[self._frame] = {
-                    int(r.ref): destination(c, born.get(int(r.ref))) for r, c in cf.assignment.pairs
-                }
-        meas_xy = {}
-        if cf.meas is not None:
-            xyz = np.asarray(cf.meas.xyz_m, dtype=np.float64).reshape(-1, 3)
-            meas_xy = {int(m): xyz[k, :2] for k, m in enumerate(np.asarray(cf.meas.meas_indices).tolist())}
-        for k, t in enumerate(ids):
-            if t not in self.focus_tracks:
-                continue
-            gated: list[tuple[int, float]] = []
-            if cf.gated is not None:
-                g = np.flatnonzero(np.asarray(cf.gated.track_ids) == t)
-                if g.size:
-                    inside = np.asarray(cf.gated.inside, dtype=bool)[g[0]]
-                    for j in np.flatnonzero(inside).tolist():
-                        m = int(np.asarray(cf.gated.meas_indices)[j])
-                        nis = _nis_of(cf.gated, [t], meas_xy[m][None, :])[0] if m in meas_xy else math.nan
-                        gated.append((m, float(nis) if nis is not None else math.nan))
-            self.track_steps.setdefault(t, {})[self._frame] = TrackStep(
-                float(prior_r[k]),
-                (float(mean[k, 0]), float(mean[k, 1])),
-                tuple(gated),
-                given.get(t, -1),
-                float(post.get(t, math.nan)),
-                t in reported,
-            )
 
     def _track_colors(self, track_ids: np.ndarray, keep: float = 1.0) -> np.ndarray:
         """(N,) packed colours of (N,) track ids, ``keep`` of each colour (``colors.faded``); with focus tracks,
@@ -826,141 +689,6 @@ class TrackerLogger:
             "labels": [str(e.track_id) for e in estimates],
             "radii": np.full(n, TRACK_LINE_RADIUS_M, dtype=np.float32),
         }
-
-    # The story log.
-    def _story(self, class_name: str, cf: _ClassFrame, estimates: tuple[TrackEstimate, ...]) -> None:
-        now = {e.track_id: e for e in estimates}
-        known = self._extracted_ids
-        for t, e in now.items():
-            via = f"from {meas_name(e.meas_index)}" if e.meas_index >= 0 else "without a detection"
-            if t not in known:
-                self._text(class_name, f"track {t} confirmed ({self._r(e.existence)}{via})", "INFO")
-            elif e.meas_index < 0:
-                self._text(class_name, f"track {t} missed this frame, still reported{self._r_in(e.existence)}", "INFO")
-        posterior_r: dict[int, float] = {}
-        if cf.posterior is not None:
-            posterior_r = dict(
-                zip(
-                    np.asarray(cf.posterior.track_ids).tolist(),
-                    np.asarray(cf.posterior.existence).tolist(),
-                    strict=True,
-                )
-            )
-        self._story_focused(class_name, cf, posterior_r, known | set(now))
-        pruned_ids = {p.track_id for p in cf.pruned}
-        limit = max(cf.extracted.threshold if cf.extracted is not None else 0.0, self.show_min_existence)
-        for t in sorted(self._reported - set(now) - pruned_ids):
-            if t in posterior_r:
-                self._text(
-                    class_name,
-                    f"track {t} no longer shown (r={posterior_r[t]:.2f} fell below {limit:.2f})"
-                    if self.has_existence
-                    else f"track {t} no longer shown (not output this frame)",
-                    "WARN",
-                )
-        candidates_pruned = 0
-        for p in cf.pruned:
-            if p.track_id in known:
-                self._text(
-                    class_name,
-                    f"track {p.track_id} ended: {p.reason.value}"
-                    + (f" (last r={p.last_existence:.3g})" if self.has_existence else ""),
-                    "WARN",
-                )
-            else:
-                candidates_pruned += 1
-            self._trails.pop(p.track_id, None)
-        born = [(t, m) for b in cf.born for t, m in zip(_ints(b.track_ids), _ints(b.meas_indices), strict=True)]
-        if born or candidates_pruned:
-            names = ", ".join(meas_name(m) for _, m in born[:12]) + (" …" if len(born) > 12 else "")
-            self._text(
-                class_name,
-                f"{len(born)} new candidates{' from ' + names if born else ''}; {candidates_pruned} candidates pruned",
-                "DEBUG",
-            )
-        for m in cf.merged:
-            if m.into_id in known or any(f in known for f in m.from_ids):
-                weights = ", ".join(f"{w:.3g}" for w in m.weights)
-                ids = ", ".join(str(i) for i in m.from_ids)
-                self._text(class_name, f"merged {ids} into track {m.into_id} (weights {weights})", "INFO")
-        for ev in cf.logic:
-            if ev.action is not TrackLogicAction.DELETED:
-                continue  # tentative is a candidate's birth; confirmation shows as "confirmed" above
-            self._text(
-                class_name,
-                f"track {ev.track_id} {ev.action.value} ({ev.hits}/{ev.window} hits)",
-                _LEVEL_BY_ACTION[ev.action],
-            )
-        if cf.assignment is not None and cf.meas is not None:
-            to_tracks = sum(1 for _, c in cf.assignment.pairs if c.kind is AxisKind.TRACK)
-            shown_missed = [t for t in cf.assignment.missed_track_ids if t in known]
-            self._text(
-                class_name,
-                f"{len(cf.meas.meas_indices)} detections: {to_tracks} updated tracks, "
-                f"{len(cf.assignment.pairs) - to_tracks} new or clutter; reported tracks missed: "
-                f"{', '.join(map(str, shown_missed)) or 'none'}",
-                "DEBUG",
-            )
-
-    def _story_focused(self, class_name: str, cf: _ClassFrame, posterior_r: dict[int, float], known: set[int]) -> None:
-        """A focused track below the show floor still gets one INFO line per frame: a failure is often about a
-        track the tracker kept but no longer reported (its low existence is the story)."""
-        hidden = sorted((self._focused & set(posterior_r)) - known)
-        if not hidden:
-            return
-        given = {}
-        if cf.assignment is not None:
-            given = {c.ref: r.ref for r, c in cf.assignment.pairs if c.kind is AxisKind.TRACK}
-        started = {t: m for m, t in _born_tracks(cf).items()}
-        for t in hidden:
-            if t in started:
-                via = f"started by {meas_name(started[t])}"
-            else:
-                via = f"given {meas_name(given[t])}" if t in given else "given no detection"
-            self._text(
-                class_name,
-                f"track {t} (not shown, r < {self.show_min_existence:g}): {via}, r={existence_text(posterior_r[t])}"
-                if self.has_existence
-                else f"track {t} (not output): {via}",
-                "INFO",
-            )
-
-    def _r(self, existence: float) -> str:
-        """``r=0.97, `` for a story line, nothing for a tracker without existences."""
-        return f"r={existence:.2f}, " if self.has_existence else ""
-
-    def _r_in(self, existence: float) -> str:
-        """`` (r=0.97)`` for a story line, nothing for a tracker without existences."""
-        return f" (r={existence:.2f})" if self.has_existence else ""
-
-    @property
-    def _focused(self) -> set[int]:
-        return self.focus_tracks or set()
-
-    def _on_budget(self, event: BudgetReached) -> None:
-        self._text(
-            event.class_name,
-            f"budget {event.budget} = {event.limit} reached (this frame needed {event.needed}); work was cut",
-            "WARN",
-        )
-
-    def _story_close_calls(self, d: Decisions, born: dict[int, int]) -> None:
-        """Close calls that involve a reported track (between candidates they are routine)."""
-        for conflict in d.conflicts:
-            for c in conflict.choices:
-                reported = {
-                    label.ref
-                    for label in (c.chosen, c.alternative)
-                    if label is not None and label.kind is AxisKind.TRACK
-                } & self._extracted_ids
-                if c.margin < CLOSE_CALL_MARGIN and c.alternative is not None and reported:
-                    self._text(
-                        d.class_name,
-                        f"close call: {meas_name(c.meas.ref)} → {destination(c.chosen, born.get(c.meas.ref))} "
-                        f"(cost {c.chosen_cost:.2f}) "
-                        f"over {column_name(c.alternative)} ({c.alternative_cost:.2f}), margin {c.margin:.2f}",
-                        "INFO",
-                    )
 
     # The decision view.
     def _draw_decisions(
@@ -1018,7 +746,19 @@ class TrackerLogger:
             )
 
     # Tracker-specific plots.
-    def _on_marginals(self, event: Marginals) -> None:
+    def _draw_family(self, class_name: str, cf: ClassFrame) -> None:
+        """The panels a tracker family declares: association probabilities, hypothesis weights, cardinality,
+        intensity."""
+        if cf.marginals is not None:
+            self._draw_marginals(cf.marginals)
+        if cf.hypotheses is not None:
+            self._sample_hypotheses(cf.hypotheses)
+        if cf.cardinality is not None:
+            self._draw_cardinality(cf.cardinality)
+        if cf.intensity is not None:
+            self._draw_intensity(cf.intensity)
+
+    def _draw_marginals(self, event: Marginals) -> None:
         probs = np.asarray(event.probs, dtype=np.float32)
         if probs.ndim != 2 or probs.size == 0:
             return
@@ -1029,10 +769,9 @@ class TrackerLogger:
             rr.Tensor(probs, dim_names=[kinds, col_kinds], value_range=(0.0, 1.0)),
         )
 
-    def _on_hypotheses(self, event: GlobalHypotheses) -> None:
-        """Kept for the decision document; log weights of the best MAX_HYPOTHESIS_SERIES hypotheses as one
-        multi-line series per class (NaN where fewer are kept), each line named by class and rank."""
-        self._class_frame(event.class_name).hypotheses = event
+    def _sample_hypotheses(self, event: GlobalHypotheses) -> None:
+        """Log weights of the best MAX_HYPOTHESIS_SERIES hypotheses as one multi-line series per class (NaN where
+        fewer are kept), each line named by class and rank."""
         w = np.full(MAX_HYPOTHESIS_SERIES, np.nan)
         top = np.asarray(event.log_weights, dtype=np.float64)[:MAX_HYPOTHESIS_SERIES]
         w[: top.size] = top
@@ -1043,7 +782,7 @@ class TrackerLogger:
         stamps.append(self._timestamp_us)
         values.append(w)
 
-    def _on_cardinality(self, event: Cardinality) -> None:
+    def _draw_cardinality(self, event: Cardinality) -> None:
         pmf = np.asarray(event.pmf, dtype=np.float64)
         if pmf.size == 0:
             return
@@ -1051,7 +790,7 @@ class TrackerLogger:
         expected = float(np.arange(pmf.size) @ pmf)
         self._sample(paths.cardinality_mean(self.tracker, event.class_name), expected, f"E[n] {event.class_name}")
 
-    def _on_intensity(self, event: IntensityWeights) -> None:
+    def _draw_intensity(self, event: IntensityWeights) -> None:
         weights = np.asarray(event.weights, dtype=np.float64)
         self._sample(
             paths.intensity_total(self.tracker, event.class_name), float(weights.sum()), f"sum w {event.class_name}"
@@ -1081,23 +820,22 @@ def _pair_cost_lookup(matrix: CostMatrix | None) -> Callable[[int, int], float]:
     return cost_of
 
 
-def _nis_of(gated: Gated | None, track_ids: list[int], z_xy: np.ndarray) -> list[float | None]:
-    """(z - H m)^T S^-1 (z - H m) of detection k (z_xy: (P, 2)) for track_ids[k], from that track's gate
-    (its first row in ``gated``); None where the track has no gate."""
+def _pair_d2_lookup(gated: Gated | None) -> Callable[[int, int], float]:
+    """d2(meas index, track id): the squared Mahalanobis distance the tracker computed for that pair
+    (``Gated.d2``, the track's first row), NaN when there is none."""
     if gated is None:
-        return [None] * len(track_ids)
-    ids = np.asarray(gated.track_ids, dtype=np.int64).tolist()
-    first = dict(zip(reversed(ids), range(len(ids) - 1, -1, -1), strict=True))  # the first row of each id wins
-    hit = [k for k, t in enumerate(track_ids) if t in first]
-    out: list[float | None] = [None] * len(track_ids)
-    if not hit:
-        return out
-    rows = np.array([first[track_ids[k]] for k in hit], dtype=np.int64)
-    nu = np.asarray(z_xy, dtype=np.float64)[hit] - np.asarray(gated.center_xy, dtype=np.float64)[rows]
-    x = np.linalg.solve(np.asarray(gated.innovation_cov, dtype=np.float64)[rows], nu[:, :, None])[:, :, 0]
-    for k, value in zip(hit, np.vecdot(nu, x).tolist(), strict=True):  # the same dot kernel as nu @ x per pair
-        out[k] = value
-    return out
+        return lambda m, t: math.nan
+    row_of: dict[int, int] = {}
+    for k, t in enumerate(np.asarray(gated.track_ids, dtype=np.int64).tolist()):
+        row_of.setdefault(t, k)
+    col_of = {m: j for j, m in enumerate(np.asarray(gated.meas_indices, dtype=np.int64).tolist())}
+    d2 = np.asarray(gated.d2, dtype=np.float64)
+
+    def d2_of(m: int, t: int) -> float:
+        i, j = row_of.get(t), col_of.get(m)
+        return math.nan if i is None or j is None else float(d2[i, j])
+
+    return d2_of
 
 
 def _pair_lines(pred_xy: np.ndarray, pred_rows: list[int], xyz: np.ndarray, meas_rows: np.ndarray) -> np.ndarray:
@@ -1106,17 +844,6 @@ def _pair_lines(pred_xy: np.ndarray, pred_rows: list[int], xyz: np.ndarray, meas
     end = xyz[np.asarray(meas_rows, dtype=np.int64)]
     start = np.column_stack([pred_xy[np.asarray(pred_rows, dtype=np.int64)], end[:, 2]])
     return np.stack([start, end], axis=1)
-
-
-def _born_tracks(cf: _ClassFrame) -> dict[int, int]:
-    """Detection index -> the id of the track it started this frame."""
-    return {m: t for b in cf.born for t, m in zip(_ints(b.track_ids), _ints(b.meas_indices), strict=True)}
-
-
-def destination(column: AxisLabel, born_id: int | None) -> str:
-    """Where a detection went, in words: ``column_name``, with the id of the track a "new" detection started."""
-    name = column_name(column)
-    return f"new track {born_id}" if column.kind is AxisKind.NEW_TRACK and born_id is not None else name
 
 
 def _one_per_row(values: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -1128,8 +855,3 @@ def _labels(template: str, track_ids: np.ndarray, existence: np.ndarray) -> list
     """``template % (id, r)`` per track (Python scalars and %-formatting: formatting numpy scalars, or with
     ``str.format``, is several times slower)."""
     return [template % (t, r) for t, r in zip(track_ids.tolist(), existence.tolist(), strict=True)]
-
-
-def _ints(values: np.ndarray) -> list[int]:
-    """(N,) ids as Python ints (one ``tolist``: iterating a NumPy array makes a NumPy scalar per element)."""
-    return np.asarray(values, dtype=np.int64).tolist()

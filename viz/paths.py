@@ -74,6 +74,12 @@ def associations(tracker: str, class_name: str) -> str:
     return f"{tracker_world(tracker)}/associations/{_name(class_name)}"
 
 
+def weak_associations(tracker: str, class_name: str) -> str:
+    """LineStrips3D: dimmed lines for (track, detection) pairs a soft update used with a share below one half
+    (an association probability or PHD weight, in the label)."""
+    return f"{tracker_world(tracker)}/associations_weak/{_name(class_name)}"
+
+
 def gated_pairs(tracker: str, class_name: str) -> str:
     """LineStrips3D: dimmed lines for (track, detection) pairs inside the gate that the solver did not choose."""
     return f"{tracker_world(tracker)}/gated_pairs/{_name(class_name)}"

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gnnpmb.errors import DataError
+from gnnpmb.eval.evaluated import GtFrame, TrackEval, gt_frames, track_evals
 from gnnpmb.eval.nuscenes_eval import quiet_devkit, scene_sample_tokens, tracking_config
 
 if TYPE_CHECKING:
@@ -214,7 +215,8 @@ class FailureReport:
     """Every failure of one tracker on one scene; sample_tokens (F,) in keyframe order; classes: the evaluated
     classes (those with ground truth in the scene after the devkit's filters); track_scores: tracking id -> the
     score the evaluation compared with its class's threshold, the devkit's average of the track's box scores
-    (after its range filter), the same at every frame of the track."""
+    (after its range filter), the same at every frame of the track; gt_frames: instance token -> frame -> how the
+    evaluation saw the object there, track_evals: tracking id -> how it saw the track (``eval.evaluated``)."""
 
     scene_name: str
     tracker: str
@@ -223,6 +225,12 @@ class FailureReport:
     failures: tuple[Failure, ...]
     coalescence_radius_m: float = COALESCENCE_RADIUS_M
     track_scores: Mapping[str, float] = field(default_factory=dict)
+    gt_frames: Mapping[str, Mapping[int, GtFrame]] = field(default_factory=dict)
+    track_evals: Mapping[str, TrackEval] = field(default_factory=dict)
+
+    def gt_frame(self, gt_id: str, frame: int) -> GtFrame | None:
+        """How the evaluation saw object ``gt_id`` at ``frame`` (None: not annotated there)."""
+        return self.gt_frames.get(gt_id, {}).get(frame)
 
     def of_kind(self, kind: FailureKind) -> list[Failure]:
         return [f for f in self.failures if f.kind is kind]
@@ -285,6 +293,8 @@ class FailureReport:
             ],
             "totals": {kind.value: len(self.of_kind(kind)) for kind in FailureKind},
             "track_scores": dict(self.track_scores),
+            "gt_frames": {g: [v.to_json() for v in frames.values()] for g, frames in self.gt_frames.items()},
+            "track_evals": {t: v.to_json() for t, v in self.track_evals.items()},
             "failures": [f.to_json() for f in self.failures],
         }
 
@@ -307,6 +317,11 @@ class FailureReport:
             failures=tuple(Failure.from_json(f) for f in data["failures"]),
             coalescence_radius_m=float(data["coalescence_radius_m"]),
             track_scores={str(k): float(v) for k, v in data.get("track_scores", {}).items()},
+            gt_frames={
+                str(g): {(v := GtFrame.from_json(row)).frame: v for row in rows}
+                for g, rows in data.get("gt_frames", {}).items()
+            },
+            track_evals={str(t): TrackEval.from_json(v) for t, v in data.get("track_evals", {}).items()},
         )
 
 
@@ -347,14 +362,27 @@ def _split_with_scene(nusc: NuScenes, scene_name: str) -> str:
     )
 
 
-def _prepared(nusc: NuScenes, boxes: EvalBoxes, cfg: TrackingConfig) -> EvalBoxes:
-    """The devkit's box preparation: ego distances, then its class-range, point-count and bike-rack filter."""
+def _prepared(nusc: NuScenes, boxes: EvalBoxes, cfg: TrackingConfig) -> tuple[EvalBoxes, EvalBoxes, EvalBoxes]:
+    """The devkit's box preparation: ego distances, then its class-range, point-count and bike-rack filter.
+    Returns the boxes with ego distances before the filter, the boxes it kept, and a copy of the latter: the
+    devkit's ``create_tracks`` appends the boxes it interpolates to the lists it is given."""
     from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes
 
     boxes = add_center_dist(nusc, boxes)
+    raw = _copy(boxes)
     if any(boxes.boxes[t] for t in boxes.sample_tokens):  # the filter asserts at least one box exists
         boxes = filter_eval_boxes(nusc, boxes, cfg.class_range, verbose=False)
-    return boxes
+    return raw, boxes, _copy(boxes)
+
+
+def _copy(boxes: EvalBoxes) -> EvalBoxes:
+    """Another ``EvalBoxes`` with the same boxes in new lists."""
+    from nuscenes.eval.common.data_classes import EvalBoxes
+
+    out = EvalBoxes()
+    for token in boxes.sample_tokens:
+        out.add_boxes(token, list(boxes.boxes[token]))
+    return out
 
 
 @dataclass(slots=True)
@@ -567,8 +595,10 @@ def find_failures(
         except (AssertionError, KeyError, TypeError, ValueError) as exc:
             raise DataError(f"the tracking results of {scene_name} are not valid submission boxes: {exc}") from None
         gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
-        tracks_gt = create_tracks(_prepared(nusc, gt, cfg), nusc, split, gt=True)
-        tracks_pred = create_tracks(_prepared(nusc, pred, cfg), nusc, split, gt=False)
+        raw_gt, prepared_gt, kept_gt = _prepared(nusc, gt, cfg)
+        _, prepared_pred, kept_pred = _prepared(nusc, pred, cfg)
+        tracks_gt = create_tracks(prepared_gt, nusc, split, gt=True)
+        tracks_pred = create_tracks(prepared_pred, nusc, split, gt=False)
         scene_token = nusc.get("sample", tokens[0])["scene_token"]
         classes: list[ClassEvaluation] = []
         failures: list[Failure] = []
@@ -611,5 +641,13 @@ def find_failures(
         str(b.tracking_id): float(b.tracking_score) for boxes in tracks_pred[scene_token].values() for b in boxes
     }
     return FailureReport(
-        scene_name, tracker, tuple(tokens), tuple(classes), tuple(failures), coalescence_radius_m, track_scores
+        scene_name,
+        tracker,
+        tuple(tokens),
+        tuple(classes),
+        tuple(failures),
+        coalescence_radius_m,
+        track_scores,
+        gt_frames(raw_gt, kept_gt, tracks_gt[scene_token], frame_of_timestamp, tokens, cfg.class_range),
+        track_evals(results, kept_pred, tracks_pred[scene_token], track_scores, frame_of_timestamp, tokens),
     )

@@ -57,6 +57,7 @@ from gnnpmb.events import (
     Panel,
     Pruned,
     PruneReason,
+    UpdateWeights,
 )
 from gnnpmb.gating import gate
 from gnnpmb.kalman import (
@@ -222,11 +223,41 @@ class Selection:
 
 @dataclass(frozen=True, slots=True)
 class PhdPosterior:
-    """The reduced posterior intensity and, for the events, the extracted labels that vanished in the update
-    (every part got weight 0; only looked for when the sink is enabled)."""
+    """The reduced posterior intensity and, for the events (only when the sink is enabled), the extracted labels
+    that vanished in the update (every part got weight 0) and the update's weights (``UpdateSplit``)."""
 
     reduction: Reduction
     vanished: np.ndarray
+    split: UpdateSplit | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class UpdateSplit:
+    """The weights of one PHD update per predicted component, for the ``UpdateWeights`` event: labels (K + M,)
+    of the K persistent then M birth components (provisional labels negative), prior (K + M,), missed (K + M,)
+    and detected (K + M, M) weights; meas_indices (M,) source indices."""
+
+    labels: np.ndarray
+    prior: np.ndarray
+    missed: np.ndarray
+    detected: np.ndarray
+    n_persistent: int
+    meas_indices: np.ndarray
+
+    def event(self, class_name: str, relabelled: dict[int, int]) -> UpdateWeights:
+        """Summed per label of the persistent components (labels as this frame's track ids), births per
+        detection."""
+        k = self.n_persistent
+        labels = np.array([relabelled.get(t, t) for t in self.labels[:k].tolist()], dtype=np.int64)
+        unique, row = np.unique(labels, return_inverse=True)
+        prior = np.zeros(len(unique))
+        missed = np.zeros(len(unique))
+        detected = np.zeros((len(unique), self.detected.shape[1]))
+        np.add.at(prior, row, self.prior[:k])
+        np.add.at(missed, row, self.missed[:k])
+        np.add.at(detected, row, self.detected[:k])
+        birth = self.detected[k + np.arange(len(self.meas_indices)), np.arange(len(self.meas_indices))]
+        return UpdateWeights(class_name, unique, self.meas_indices, prior, missed, detected, birth)
 
 
 class GmPhdTracker(ClassFilter[Prediction, PhdPosterior]):
@@ -270,8 +301,18 @@ class GmPhdTracker(ClassFilter[Prediction, PhdPosterior]):
         posterior = posterior_mixture(prior, meas, log_missed, log_detected)
         reduction = reduce_mixture(posterior, p.prune_weight, p.merge_threshold, p.max_components)
         self.mixture = reduction.mixture
-        vanished = np.setdiff1d(prior.persistent.label, posterior.label) if sink.enabled else np.zeros(0, np.int64)
-        return PhdPosterior(reduction, vanished)
+        if not sink.enabled:
+            return PhdPosterior(reduction, np.zeros(0, np.int64))
+        vanished = np.setdiff1d(prior.persistent.label, posterior.label)
+        split = UpdateSplit(
+            prior.mixture.label,
+            prior.mixture.weight,
+            np.exp(log_missed),
+            np.exp(log_detected),
+            prior.n_persistent,
+            np.asarray(meas.source_index),
+        )
+        return PhdPosterior(reduction, vanished, split)
 
     def extract(self, posterior: PhdPosterior, sink: EventSink) -> tuple[list[TrackEstimate], float]:
         """Step 6 (``_select``) with the label bookkeeping of the module docstring (``_label``); emits ``Merged``,
@@ -348,8 +389,11 @@ class GmPhdTracker(ClassFilter[Prediction, PhdPosterior]):
     def _emit_reduction(
         self, posterior: PhdPosterior, relabelled: dict[int, int], born: np.ndarray, sink: EventSink
     ) -> None:
-        """``Merged`` (coalescence only), ``Pruned``, ``IntensityWeights`` and ``Born`` (module docstring)."""
+        """``UpdateWeights``, ``Merged`` (coalescence only), ``Pruned``, ``IntensityWeights`` and ``Born`` (module
+        docstring)."""
         reduction, vanished = posterior.reduction, posterior.vanished
+        if posterior.split is not None:
+            sink.emit(posterior.split.event(self.class_name, relabelled))
         for group in reduction.merges():
             into = relabelled.get(group.into_label, group.into_label)
             from_ids = tuple(relabelled.get(t, t) for t in group.from_labels)

@@ -177,7 +177,7 @@ class KBest:
             if best.parent >= COST_MATRIX_EVENTS:  # the matrix its assignment is explained over
                 ctx.sink.emit(local.cost_event(ctx.class_name, best.parent))
             own = _own_columns(best.col_of_row, members[best.parent], union.n_tracks)
-            _emit(best.total_cost, own, local, best.parent, posteriors, ctx)
+            _emit(best.total_cost, own, local, best.parent, posteriors, tuple(c.parent for c in kept), ctx)
         return posteriors
 
     def _select(self, children: list[_Child]) -> tuple[list[_Child], np.ndarray]:
@@ -579,11 +579,12 @@ def _emit(
     local: LocalHypotheses,
     parent: int,
     posteriors: list[GlobalHypothesis],
+    parents: tuple[int, ...],
     ctx: UpdateContext,
 ) -> None:
     """The best child's ``Assignment`` (``col_of_row`` over the ``local`` columns of its prior hypothesis
     ``parent``, whose ``CostMatrix`` has ``hypothesis=parent``) and the ``GlobalHypotheses`` as the core will keep
-    them (after pruning)."""
+    them (after pruning), with each one's prior hypothesis (``parents``)."""
     pairs, missed = assignment_pairs(local, col_of_row)
     ctx.sink.emit(Assignment(ctx.class_name, pairs, total_cost, missed, hypothesis=parent))
     alive = [h.without_existence_below(ctx.prune_existence) for h in posteriors]
@@ -593,5 +594,7 @@ def _emit(
             log_weights=np.array([h.log_weight for h in posteriors]),
             members=tuple(tuple(h.track_id.tolist()) for h in alive),
             local=tuple(tuple(h.local_key.tolist()) for h in alive),
+            existence=tuple(tuple(h.existence.tolist()) for h in alive),
+            parents=parents,
         )
     )

@@ -15,12 +15,15 @@ from rerun.chunk import RrdReader
 
 from cli.app import main
 from gnnpmb.eval.failures import FailureKind, short_id
-from gnnpmb.session import find_reports, prepare, rerun_runs
+from gnnpmb.session import explain_all, find_reports, gather_evidence, prepare, rerun_runs
+from gnnpmb.why.facts import Ending
+from gnnpmb.why.findings import Party, Rule
+from gnnpmb.why.words import column_name, whose_text, why_lines
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
 from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
-from viz.evaluated import evaluated_world, evaluation_range_world
+from viz.evaluated import evaluated_world
 from viz.focus import predicted_ghosts
 from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_legend
 
@@ -214,6 +217,14 @@ def test_the_summary_opens_with_the_decisions_that_made_the_switch(
     assert line.startswith(f"- frame {switch.frame_index}: m") and "over track " in line and "margin " in line
 
 
+def findings_of(demo_dataroot: Path, trackers: tuple[str, ...], detector: str = "pointpillars") -> dict:
+    """Per tracker, failure id -> its ``Finding`` (the data every sentence of the focus document is made from)."""
+    request = prepare(SCENE, list(trackers), dataroot=demo_dataroot, detector=detector)
+    evidence, _ = gather_evidence(request)
+    found = explain_all(request, evidence)
+    return {t: dict(zip(evidence[t].report.ids(), fs, strict=True)) for t, fs in found.items()}
+
+
 def test_a_failure_at_an_interpolated_gt_box_is_explained(
     demo_dataroot: Path, tmp_path: Path, failures_and_runs
 ) -> None:
@@ -230,17 +241,25 @@ def test_a_failure_at_an_interpolated_gt_box_is_explained(
         for i, f in zip(report.ids(), report.failures, strict=True)
         if f.kind is FailureKind.FRAGMENTATION and f.gt_interpolated
     )
+    finding = findings_of(demo_dataroot, ("gnnpmb",))["gnnpmb"][pick]
+    assert finding.parties[0] is Party.EVALUATION and finding.reach is not None
+    g = report.gt_frame(failure.gt_ids[0], failure.frame_index)
+    assert finding.reach.offset_m == pytest.approx(g.offset_m) and g.offset_m >= 0.5
     out, _ = record(demo_dataroot, tmp_path, pick)
     rows = read_rows(out)
     summary = rows[focus_doc()][0]["TextDocument:text"][0]
     gt = short_id(failure.gt_ids[0])
     # Right below the headline: where the evaluation put the object, how far from the annotation, and why.
-    verdict, note = summary.split("\n\n")[1:3]
-    assert verdict.startswith("**Verdict: the evaluation's doing.** gnnpmb track ")
-    assert note.startswith(f"**GT {gt} as evaluated**: at frame {failure.frame_index} it had no LiDAR or radar")
-    assert "nuscenes-devkit issue #1141" in note and " m** from the annotated one" in note
+    paragraphs = summary.split("\n\n")[1:3]
+    if finding.reach.near_annotated and not finding.reach.near_evaluated:
+        assert paragraphs[0].startswith("**Verdict: the evaluation's doing.** gnnpmb track")
+        note = paragraphs[1]
+    else:
+        note = paragraphs[0]
+    assert note.startswith(f"**GT {gt} as evaluated**: at frame {failure.frame_index} its annotated box was dropped")
+    assert " m** from the annotated one" in note
     # The frame table says which frames the evaluation did not score as annotated.
-    assert f"| {failure.frame_index} | 0: not scored as annotated (interpolated) |" in summary
+    assert f"| {failure.frame_index} | 0: interpolated by the evaluation ({g.offset_m:.1f} m off) |" in summary
     callouts = [r for r in rows[paths.focus_callouts("gnnpmb")] if r.get("frame") == failure.frame_index][0]
     assert any(label.startswith(f"GT {gt} as evaluated (") for label in callouts["Points3D:labels"])
     # The evaluated box is drawn at the failure frame with the 2 m match circle, and cleared at the others.
@@ -257,46 +276,33 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     report, _ = failures_and_runs
     pick = next(i for i in report.ids() if i.startswith("id_switch:"))
     failure = report.by_id(pick)
+    old, new = (int(t) for t in failure.track_ids)
+    finding = findings_of(demo_dataroot, ("gnnpmb", "pmbm"))["gnnpmb"][pick]
+    # The data: the lost and the new track, the choice that started the new one, the other tracker as evidence.
+    assert finding.lost.track_id == old and finding.taker.track_id == new
+    d = finding.decision
+    assert d is not None and d.went == new and d.born and d.frame <= failure.frame_index
+    assert d.choice.alternative is not None and d.choice.alternative_terms is not None
+    (other,) = finding.others
+    assert other.tracker == "pmbm"
     out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", "pmbm"))
     summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
-    # The cause in one line under the headline: detections of the object, the old track's existence, the choice.
-    old, new = failure.track_ids
-    why = summary.split("\n\n")[1]
-    last = failure.frame_index
-    assert re.match(
-        rf"\*\*Why\*\* \(gnnpmb, the tracker's doing\): in the \d+ recorded frames up to {last} \(\d+–{last}\), "
-        rf"GT {short_id(failure.gt_ids[0])} had a detection within 2 m at (?:frames? [\d, ]+|no frame)",
-        why,
-    ), why
-    assert f"track {old}'s existence went from " in why and f"→ **new track {new}** (cost " in why
-    # A track in between (neither the old nor the new one) is traced to the choice that started it.
-    between = re.search(rf"→ \*\*new track {new}\*\* \(cost [\d.]+\) over track (\d+) ", why)
-    if between and between.group(1) not in (str(old), str(new)):
-        assert re.search(rf"track {between.group(1)} had been started at frame \d+ by m\d+", why), why
+    why, because = summary.split("\n\n")[1:3]
+    assert why.startswith(f"**Why** (gnnpmb, {whose_text(finding)}): ")
+    assert f"→ **new track {new}** (cost {d.choice.chosen_cost:.2f}) over {column_name(d.choice.alternative)}" in why
     # Then the decisive choice's costs taken apart; the parts add up to the cost the decision table shows.
-    because = summary.split("\n\n")[2]
-    assert re.match(
-        rf"\*\*Because\*\* \(frame \d+\): m\d+ went to new track {new} \(cost [\d.]+\) rather than ", because
-    )
+    assert because.startswith(f"**Because** (frame {d.frame}): m{d.choice.meas.ref} went to new track {new} (cost ")
     lost = re.search(
         r"Track (\d+)'s ([-\d.]+) = (.*?)\. (?:With a predicted existence above|No predicted existence)", because
     )
     assert lost, because
     parts = [float(p.split(" for ")[0]) for p in lost.group(3).split(" + ")]
-    assert [" ".join(p.split(" for ")[1].split(" ")[:3]) for p in lost.group(3).split(" + ")] == [
-        "its predicted existence",
-        "the uncertainty of",
-        "the distance to",
-        re.search(r"for (m\d+'s score [\d.]+)", lost.group(3)).group(1),
-    ]
-    assert sum(parts) == pytest.approx(float(lost.group(2)), abs=0.03)
+    assert sum(parts) == pytest.approx(float(lost.group(2)), abs=0.005)
     # The track that had the object, when it was not the next best, gets its own cost (or: out of its gate).
-    if lost.group(1) != str(old):
-        had = re.search(rf"Track {old}, which had the object, would have cost ([-\d.]+) = (.*?)\. ", because)
-        assert had or f"was outside the gate of track {old}, which had the object" in because, because
-        if had:
-            total = sum(float(p.split(" for ")[0]) for p in had.group(2).split(" + "))
-            assert total == pytest.approx(float(had.group(1)), abs=0.03)
+    if d.lost is not None:
+        assert (d.lost_in_gate and f"Track {old}, which had the object, would have cost " in because) or (
+            not d.lost_in_gate and f"was outside the gate of track {old}, which had the object" in because
+        )
     # The disagreement log opens on the focused class's lines (the whole log is the next tab).
     rows = read_rows(out)
     assert stored_views(out)[f"disagreements ({failure.class_name})"] == ("TextLog", compare.focus_log_path())
@@ -306,34 +312,19 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     assert about == [line for line in everything if f": {failure.class_name} " in line] and len(everything) > len(about)
     # The picture says it too: the detection's label names where it went, in each tracker's view.
     for tracker in ("gnnpmb", "pmbm"):
-        callouts = [r for r in read_rows(out)[paths.focus_callouts(tracker)] if r.get("frame") == failure.frame_index]
+        callouts = [r for r in rows[paths.focus_callouts(tracker)] if r.get("frame") == failure.frame_index]
         went = [label.split(" → ")[1] for label in callouts[0]["Points3D:labels"] if re.match(r"m\d+ ", label)]
         assert went and all(re.fullmatch(r"(?:new )?track \d+", w) for w in went)
         if tracker == "gnnpmb":
             assert f"new track {new}" in went
-        # A track given a detection is labelled with the existence its detection was decided with, as the
-        # "Where the trackers part" line gives it (PMBM: the chosen hypothesis's, not the most likely prior's).
-        for label in callouts[0]["Points3D:labels"]:
-            given = re.fullmatch(r"(\d+) predicted r=([\d.]+) → (m\d+)", label)
-            if given and tracker == "pmbm":
-                track_id, r, meas = given.groups()
-                parting = summary.partition("**Where the trackers part**")[2]
-                assert f"pmbm: {meas} → **track {track_id}** (" in parting and f" at existence {r}, " in parting
-                # Its table gives the most likely prior hypothesis's existence and, if another, this one.
-                table = summary.partition("## pmbm")[2].partition(f"Track {track_id}, frame by frame:")[2]
-                row = next(line for line in table.splitlines() if line.startswith(f"| {failure.frame_index} | "))
-                before = row.split(" | ")[1]
-                assert before == r or before.endswith(f" ({r} in the hypothesis its detection was decided in)")
     # The decision view of that frame takes the same choice apart under its table.
-    decided, meas = re.match(r"\*\*Because\*\* \(frame (\d+)\): (m\d+) ", because).groups()
-    doc = next(r for r in read_rows(out)[paths.decisions("gnnpmb")] if r.get("frame") == int(decided))
-    assert f"- {meas} went to a new track (cost " in doc["TextDocument:text"][0]
+    doc = next(r for r in rows[paths.decisions("gnnpmb")] if r.get("frame") == d.frame)
+    assert f"- m{d.choice.meas.ref} went to a new track (cost " in doc["TextDocument:text"][0]
     head, _, rest = summary.partition(f"**Where the trackers part** at frame {failure.frame_index}")
     assert rest, "the two trackers sent a detection on the object to different places; the summary says where"
     assert "## gnnpmb" not in head  # it comes before the per-tracker sections
     lines = [line for line in rest.split("\n\n")[1].splitlines() if line.startswith("- ")]
-    new_track = f"new track {failure.track_ids[1]}"
-    assert any("gnnpmb: m" in line and new_track in line and " · pmbm: m" in line for line in lines)
+    assert any("gnnpmb: m" in line and f"new track {new}" in line and " · pmbm: m" in line for line in lines)
     for line in lines:
         gnnpmb, pmbm = line[2:].split(" · ")
         assert gnnpmb.split("→")[1].split("(")[0] != pmbm.split("→")[1].split("(")[0]  # different destinations
@@ -343,47 +334,31 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
     demo_dataroot: Path, tmp_path: Path, failures_and_runs
 ) -> None:
     report, _ = failures_and_runs
-    pick, failure = next(
-        (i, f) for i, f in zip(report.ids(), report.failures, strict=True) if f.kind is FailureKind.FALSE_TRACK
-    )
-    out, _ = record(demo_dataroot, tmp_path, pick)
-    summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
-    why = summary.split("\n\n")[1]
-    track = failure.track_ids[0]
-    # The object the false track sat on (if any) is involved: labelled in the views, with its frame table.
-    near = re.search(r"GT ([0-9a-f]{6}) (?:lies|does) \(?([\d.]+) m", why)
-    if near and float(near.group(2)) <= 2.0:
-        assert f"GT {near.group(1)}" in summary.split("**Involved**")[1].split("\n")[0]
-        assert f"**GT {near.group(1)}**, in the 1 frames of the table (0–0): a detection within 2 m in 1" in summary
-    doing = re.match(r"\*\*Why\*\* \(gnnpmb, the (detector|tracker|evaluation)'s doing\): ", why)
-    assert doing, why
-    assert why[doing.end() :].startswith(f"at frame {failure.frame_index} track {track} ({failure.class_name})")
-    # Whose doing it was follows from why no object matched the track.
-    if "the evaluation has no box for it" in why or "the evaluation has it" in why:
-        assert doing.group(1) == "evaluation"
-    elif "the detector gave it the wrong class" in why or "a detection of nothing" in why:
-        assert doing.group(1) == "detector"
-    average, threshold = report.track_scores[track], report.threshold_of(failure.class_name)
-    assert f"averaged over all its frames, {average:.3f}, is at least the {failure.class_name} threshold" in why
-    assert average >= threshold
-    # An object dropped for its range: the range is drawn around the ego vehicle and labelled beside the track.
-    if "beyond the evaluation's" in why:
-        rows = read_rows(out)
-        strips = [r for r in rows[evaluation_range_world()] if r.get("frame") == failure.frame_index]
-        assert strips and len(strips[0]["LineStrips3D:strips"]) == 1
-        callouts = [r for r in rows[paths.focus_callouts("gnnpmb")] if r.get("frame") == failure.frame_index][0]
-        assert f"evaluation range for {failure.class_name}: 50 m" in callouts["Points3D:labels"]
-    # Where the evaluation's ground truth was: the reason the track matched nothing.
-    assert any(
-        phrase in why
-        for phrase in (
-            "the evaluation has no box for it",
-            "the evaluation has it",
-            "matched it to another track",
-            "the detector gave it the wrong class",
-            "a detection of nothing",
-        )
-    )
+    findings = findings_of(demo_dataroot, ("gnnpmb",))["gnnpmb"]
+    checked = 0
+    for pick, failure in zip(report.ids(), report.failures, strict=True):
+        if failure.kind is not FailureKind.FALSE_TRACK:
+            continue
+        finding = findings[pick]
+        out = finding.false_output
+        assert out is not None and out.track_id == int(failure.track_ids[0])
+        # What it was output on is what the tracker output: the detection its box carries (or none).
+        box = next(b for b in failure.boxes if b.role == "false track")
+        assert out.output_xy_m == pytest.approx(box.translation_m[:2])
+        # The evaluation counted the track: the score it averaged over the frames it kept reaches the threshold.
+        assert out.evaluated.averaged_score == report.track_scores[failure.track_ids[0]]
+        assert out.evaluated.averaged_score >= report.threshold_of(failure.class_name)
+        (blame,) = finding.blame
+        if out.nearest_own is not None:
+            assert blame.rule in (Rule.NO_EVAL_BOX, Rule.INTERPOLATED, Rule.TWO_TRACKS)
+        else:
+            assert blame.rule in (Rule.OTHER_CLASS, Rule.DETECTION_OF_NOTHING, Rule.COASTED)
+        checked += 1
+    assert checked
+    pick = next(i for i, f in zip(report.ids(), report.failures, strict=True) if f.kind is FailureKind.FALSE_TRACK)
+    rec, _ = record(demo_dataroot, tmp_path, pick)
+    why = read_rows(rec)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
+    assert why == why_lines(findings[pick])[0]  # the document says what the finding holds
 
 
 def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(
@@ -406,26 +381,25 @@ def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(
         or "the detector gave it the wrong class" in why
         or re.search(rf"detection m\d+ \(score [\d.]+\) lay [\d.]+ m from {gt}", why)
     )
-    # Every track said to be on it was not counted: its averaged score is below the class threshold.
-    for track, average in re.findall(
-        r"track (\d+) was output on it \(score [\d.]+\), but its score averaged over all its "
-        r"frames, ([\d.]+)",
-        why,
-    ):
-        assert float(average) == pytest.approx(report.track_scores[track], abs=5e-4)
-        assert report.track_scores[track] < report.threshold_of(failure.class_name)
+    finding = findings_of(demo_dataroot, ("gnnpmb",))["gnnpmb"][pick]
+    for o in finding.sighting(failure.frame_index).on_it:  # tracks on it were not counted
+        assert not o.counted and o.evaluated.averaged_score < report.threshold_of(failure.class_name)
 
 
 def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(
     demo_dataroot: Path, tmp_path: Path
 ) -> None:
     """GNN on pointpillars: the old track ended while the object had no points; the new one was started later."""
-    request = prepare(SCENE, ["gnn"], dataroot=demo_dataroot, detector="pointpillars")
-    report = find_reports(request, rerun_runs(request))[0]["gnn"]
-    pick = next(i for i in report.ids() if i.startswith("id_switch:"))
-    old, new = report.by_id(pick).track_ids
+    findings = findings_of(demo_dataroot, ("gnn",))["gnn"]
+    pick = next(i for i in findings if i.startswith("id_switch:"))
+    finding = findings[pick]
+    ended = [s for s in finding.lost.steps if s.ended is not None]
+    assert ended and ended[0].ended.ending is Ending.DELETED and ended[0].ended.hits >= 0
+    assert finding.decision is None and finding.taker.meas >= 0  # no close call: where the new track came from
     out, _ = record(demo_dataroot, tmp_path, pick, ("gnn",))
     why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
     assert why.startswith("**Why** (gnn, ") and "existence" not in why  # GNN's tracks have none
-    assert re.search(rf"track {old} (was last given a detection at frame \d+|was given no detection)", why), why
-    assert re.search(rf"then, at frame \d+, m\d+ started track {new} \(not a close call\)[.;]", why), why
+    e = ended[0]
+    assert f"its track logic deleted it at frame {e.frame} ({e.ended.hits} of {e.ended.window} hits)" in why
+    o = finding.taker
+    assert f"track {o.track_id} had been started at frame {o.frame} by m{o.meas}" in why

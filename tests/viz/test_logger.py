@@ -36,7 +36,7 @@ from gnnpmb.types import TrackEstimate
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
 from viz.colors import INVOLVED_PALETTE, faded, pack_rgba, track_colors
-from viz.logger import DIMMED_KEEP, TrackerLogger, _nis_of
+from viz.logger import DIMMED_KEEP, TrackerLogger
 from viz.timeline import Clock
 
 T = "gnnpmb"
@@ -62,6 +62,10 @@ def new(j: int) -> AxisLabel:
     return AxisLabel(AxisKind.NEW_TRACK, j)
 
 
+def missed() -> AxisLabel:
+    return AxisLabel(AxisKind.MISSED, -1)
+
+
 def frame(i: int, tracker: str = T) -> FrameStarted:
     return FrameStarted(tracker, i, f"s{i}", T0_US + 500_000 * i, 0.0 if i == 0 else 0.5)
 
@@ -79,7 +83,7 @@ def scripted_events() -> list:
     (cost -5) over track 2 (-4) and m1 to track 2 (-4.5; m1 alone would rather go to track 1 at -5, but the swap
     totals -9 against -9.5: margin 0.5) -- a close call.
     Track 2 then drops to 1e-7 and is pruned; track 1 is reported. The bus class has nothing.
-    Frame 2: nothing; track 1 is pruned. Plus one event of every tracker-specific kind."""
+    Frame 2: nothing; track 1 is pruned; and one event of every other tracker-specific kind."""
     cov = np.tile(np.diag([1.0, 1.0, 2.0, 2.0]), (2, 1, 1))
     mean2 = np.array([[10.0, 2.0, 1.0, 0.0], [20.0, 5.0, 0.0, 0.0]])
     return [
@@ -103,6 +107,7 @@ def scripted_events() -> list:
             mean2[:, :2],
             cov[:, :2, :2],
             40.0,
+            np.array([[0.25, 1.0], [99.25, 101.25]]),
         ),
         CostMatrix(
             "car",
@@ -115,15 +120,15 @@ def scripted_events() -> list:
         Pruned("car", 2, PruneReason.LOW_EXISTENCE, 1e-7),
         Extracted("car", (est(1, 11.0, 0.99, 0),), 0.9),
         Extracted("bus", (), 0.9),
-        GlobalHypotheses("car", np.array([-0.1, -2.4]), ((1,), (1, 2)), ((0,), (0, 1))),
-        Marginals("car", np.array([[0.8, 0.2]]), (meas(0),), (track(1), new(0)), "lbp", 7),
+        GlobalHypotheses("car", np.array([-0.1, -2.4]), ((1,), (1, 2)), ((0,), (0, 1)), ((0.99,), (0.99, 0.5)), (0, 0)),
         Merged("car", 1, (1, 3), (0.7, 0.3)),
-        Cardinality("car", np.array([0.1, 0.6, 0.3])),
-        IntensityWeights("car", np.array([1, 3]), np.array([0.8, 0.3])),
         frame(2),
         Posterior("car", np.zeros(0, int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0)),
         Pruned("car", 1, PruneReason.LOW_EXISTENCE, 0.05),
         Extracted("car", (), 0.9),
+        Marginals("car", np.array([[0.8, 0.2]]), (track(5),), (missed(), meas(0)), "lbp", 7),
+        Cardinality("car", np.array([0.1, 0.6, 0.3])),
+        IntensityWeights("car", np.array([1, 3]), np.array([0.8, 0.3])),
     ]
 
 
@@ -181,8 +186,8 @@ def test_an_association_line_for_every_assigned_pair_and_dim_lines_for_gated_rej
     assert chosen["LineStrips3D:colors"] == [int(c) for c in pack_rgba(track_colors(np.array([1, 2])))]
     rejected = at_frame(rows[paths.gated_pairs(T, "car")], 1)[0]
     assert rejected["LineStrips3D:labels"] == [
-        "m1 in gate of 1, not chosen (cost -5.00)",
-        "m0 in gate of 2, not chosen (cost -4.00)",
+        "m1 in gate of 1, not used (cost -5.00)",
+        "m0 in gate of 2, not used (cost -4.00)",
     ]
     # Faint: the tracks' colours (1, 2) mixed towards the background, opaque (Rerun darkens see-through lines).
     assert rejected["LineStrips3D:colors"] == [int(c) for c in faded(pack_rgba(track_colors(np.array([1, 2]))), 0.45)]
@@ -265,10 +270,10 @@ def test_tracker_specific_plots(logged: tuple[dict, Path]) -> None:
     assert weights[0][:2] == pytest.approx([-0.1, -2.4]) and np.isnan(weights[0][2:]).all()
     names = [r for r in rows[paths.hypothesis_weights(T, "car")] if r["static"]][0]["SeriesLines:names"]
     assert names[:2] == ["car h0", "car h1"]
-    marg = at_frame(rows[paths.marginals(T, "car")], 1)[0]
+    marg = at_frame(rows[paths.marginals(T, "car")], 2)[0]
     assert marg["Tensor:data"][0]["buffer"] == pytest.approx([0.8, 0.2])
     assert marg["Tensor:value_range"][0] == [0.0, 1.0]
-    assert at_frame(rows[paths.cardinality_pmf(T, "car")], 1)[0]["BarChart:values"][0]["buffer"] == pytest.approx(
+    assert at_frame(rows[paths.cardinality_pmf(T, "car")], 2)[0]["BarChart:values"][0]["buffer"] == pytest.approx(
         [0.1, 0.6, 0.3]
     )
     mean = [r["Scalars:scalars"][0] for r in rows[paths.cardinality_mean(T, "car")] if not r["static"]]
@@ -293,9 +298,9 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     assert {r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 1)} == {1}
     assert {r.get("focus") for r in at_frame(rows[paths.track(T, "car", 1)], 2)} == {None}  # past the focus
     assert logger.has_gates  # the scripted tracker gates (greedy does not)
-    step = logger.track_steps[2][1]
-    assert (step.prior_existence, step.given, step.reported) == (pytest.approx(0.28), 1, False)
-    assert [m for m, _ in step.gated] == [0]
+    step = logger.facts.steps(2, "car")[1]  # what the focus document and callouts read of the focused track
+    assert (step.prior_existence, step.used, step.output) == (pytest.approx(0.28), (1,), None)
+    assert step.gated == ((0, 99.25),)
     focused = rows[paths.predicted_focus(T, "car")]
     assert at_frame(focused, 1)[0]["Points3D:labels"] == ["2 predicted r=0.28"]
     style = {k: v for r in rows[paths.existence(T, "car", 2)] if r["static"] for k, v in r.items()}
@@ -313,7 +318,7 @@ def test_events_outside_a_frame_and_unknown_events_are_rejected(saved_stream) ->
     with pytest.raises(RuntimeError, match="FrameStarted"):
         logger.emit(Extracted("car", (), 0.9))
     logger.emit(frame(0))
-    with pytest.raises(TypeError, match="cannot log"):
+    with pytest.raises(TypeError, match="cannot keep"):
         logger.emit("not an event")  # type: ignore[arg-type]
     stream.disconnect()
 
@@ -349,7 +354,12 @@ def test_pmbm_hypotheses_are_listed_with_what_tells_them_apart(saved_stream) -> 
     events = scripted_events()
     at = next(i for i, e in enumerate(events) if isinstance(e, GlobalHypotheses))
     events[at] = GlobalHypotheses(
-        "car", np.log(np.array([0.6, 0.3, 0.1])), ((1, 2), (1, 2), (1,)), ((0, 0), (0, 5), (0,))
+        "car",
+        np.log(np.array([0.6, 0.3, 0.1])),
+        ((1, 2), (1, 2), (1,)),
+        ((0, 0), (0, 5), (0,)),
+        ((0.99, 0.1), (0.99, 0.2), (0.99,)),
+        (0, 0, 0),
     )
     log_all(stream, events)
     stream.disconnect()
@@ -358,41 +368,6 @@ def test_pmbm_hypotheses_are_listed_with_what_tells_them_apart(saved_stream) -> 
     assert "| h0 | 0.600 | (the best, shown in the views) |" in doc
     assert "| h1 | 0.300 | other association for 1 candidate |" in doc
     assert "| h2 | 0.100 | without 1 candidate |" in doc
-
-
-def test_nis_of_many_pairs_at_once_equals_the_per_pair_formula_to_the_last_bit() -> None:
-    rng = np.random.default_rng(5)
-    k = 40
-    a = rng.normal(size=(k, 2, 2))
-    gated = Gated(
-        "car",
-        np.arange(100, 100 + k),
-        np.arange(3),
-        np.ones((k, 3), dtype=bool),
-        rng.normal(size=(k, 2)) * 10.0,
-        a @ a.transpose(0, 2, 1) + np.eye(2),
-        9.0,
-    )
-    tracks = [int(t) for t in rng.integers(95, 100 + k + 5, size=60)]
-    z = rng.normal(size=(60, 2)) * 10.0
-    got = _nis_of(gated, tracks, z)
-    for t, zk, value in zip(tracks, z, got, strict=True):
-        if not 100 <= t < 100 + k:
-            assert value is None
-            continue
-        nu = zk - gated.center_xy[t - 100]
-        assert value == float(nu @ np.linalg.solve(gated.innovation_cov[t - 100], nu))
-    assert _nis_of(None, [1, 2], z[:2]) == [None, None]
-
-
-def test_a_detection_that_started_a_track_is_named_with_that_tracks_id() -> None:
-    """Story lines and focus tables say "m2 -> new track 315", so a reader can follow the new track."""
-    from gnnpmb.events import AxisKind, AxisLabel
-    from viz.logger import destination
-
-    assert destination(AxisLabel(AxisKind.NEW_TRACK, 2), 315) == "new track 315"
-    assert destination(AxisLabel(AxisKind.NEW_TRACK, 2), None) == "new"  # clutter: no track started
-    assert destination(AxisLabel(AxisKind.TRACK, 61), None) == "track 61"
 
 
 def test_no_existence_series_or_story_existence_for_a_tracker_without_existence_but_the_rest_is_drawn(

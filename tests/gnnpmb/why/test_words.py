@@ -1,4 +1,4 @@
-"""The decision view's wording: conflict headings, and a choice's costs taken apart (hand-computed)."""
+"""The wording of decisions: conflict headings, and a choice's costs taken apart (hand-computed)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,8 @@ import numpy as np
 
 from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms
 from gnnpmb.explain import explain
-from viz.decisions import _tracks_phrase, choice_why, track_why
+from gnnpmb.why.words import choice_why, frames_text, track_why
+from viz.decisions import _tracks_phrase
 
 
 def test_conflict_headings_count_tracks_and_candidates() -> None:
@@ -116,10 +117,17 @@ def test_the_track_that_had_the_object_gets_its_own_cost_when_it_was_not_the_nex
 
 
 def test_the_parts_of_a_cost_are_rounded_so_that_they_add_up_to_the_cost_shown() -> None:
-    from viz.decisions import hundredths_summing_to
+    from gnnpmb.why.words import hundredths_summing_to
 
     parts = [3.014, 3.784, 0.054, 0.234]  # rounded one by one: 3.01 + 3.78 + 0.05 + 0.23 = 7.07, not 7.09
     shown = hundredths_summing_to(parts, sum(parts))
     assert round(sum(shown), 2) == round(sum(parts), 2) == 7.09
     assert all(abs(a - b) < 0.01 for a, b in zip(shown, parts, strict=True))  # each moved by under a hundredth
     assert hundredths_summing_to([-1.005, 2.004], 0.999) == [-1.0, 2.0]
+
+
+def test_frame_lists_join_consecutive_runs_of_three_or_more() -> None:
+    assert frames_text([7]) == "frame 7"
+    assert frames_text([13, 7]) == "frames 7, 13"
+    assert frames_text([12, 13, 14, 16]) == "frames 12–14, 16"
+    assert frames_text([9, 10, 15, 16]) == "frames 9, 10, 15, 16"

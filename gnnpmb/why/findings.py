@@ -1,0 +1,334 @@
+"""An explanation of one failure as data: ``Finding`` and its parts (frozen dataclasses, no text).
+
+A finding says whose doing the failure was by stated tests (``Blame``), what the tracker did to each track
+involved, frame by frame, in its own terms (``facts.TrackStep``: an assignment, association probabilities, PHD
+weights), the solver's deciding choice with its cost taken apart (``Deciding``), a PMBM hypothesis switch
+(``HypothesisSwitch``), what the evaluation did (``eval.evaluated``) and how other trackers on the same detections
+fared (``OtherRun``). ``reason.explain_failure`` builds it; ``words`` renders it; ``claims`` lists what it asserts
+so a test can check every assertion against independent facts.
+
+The tests of ``Blame`` (``Rule``) are stated once, here:
+
+* **the detector's**: in a frame that decided the failure, no detection of any class and score within
+  ``NEAR_M`` of the object (``NO_DETECTION``), only detections of another class (``OTHER_CLASS``), or the false
+  track was output on a detection that lies within ``NEAR_M`` of no object (``DETECTION_OF_NOTHING``);
+* **the tracker's**: a detection of the object's class was within ``NEAR_M`` and the update of the track that had
+  the object did not use it (``DETECTION_UNUSED``, naming where it went, or that preprocessing dropped it), or the
+  track that had the object (or took its detection) was not output (``NOT_OUTPUT``: over a gap in the
+  detections, the tracker could have carried it), or it was output
+  ``NEAR_M`` or more from the object (``OFF_OBJECT``), or a track on the object was output but not counted
+  (``NOT_COUNTED``), or two tracks were output on one object (``TWO_TRACKS``), or a track was output without a
+  detection on no object (``COASTED``), or one track was matched to an object while covering another
+  (``COVERED_TWO``);
+* **the evaluation's**: the box the object was scored against is an interpolation ``EVALUATED_OFFSET_M`` or more
+  from the annotation (``INTERPOLATED``), or the evaluation has no box of the object there, beyond its range or
+  for want of points (``NO_EVAL_BOX``).
+
+The frames that decide a failure: for a miss, a false track and a coalescence, the failure's frame; for a
+fragmentation, an ID switch and an identity theft, the frames from the one after the lost track last lay within
+``NEAR_M`` of the object to the failure's frame.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from gnnpmb.eval.evaluated import GtFrame, TrackEval
+from gnnpmb.eval.failures import FailureKind
+from gnnpmb.explain import PairChoice
+from gnnpmb.why.facts import Destination, TrackStep
+
+NEAR_M = 2.0
+"""A detection or track within this BEV distance of an object is on it: the devkit's match distance
+(``tracking_nips_2019`` dist_th_tp), which ``reason`` reads from the devkit config and checks against this."""
+EVALUATED_OFFSET_M = 0.5
+"""An interpolated box this far or farther from the annotation makes a failure the evaluation's doing."""
+
+
+class Party(enum.Enum):
+    """Whose doing (part of) a failure was."""
+
+    DETECTOR = "the detector"
+    TRACKER = "the tracker"
+    EVALUATION = "the evaluation"
+
+
+class Rule(enum.Enum):
+    """The stated tests of the module docstring; each held test is one ``Blame``."""
+
+    NO_DETECTION = "no detection"
+    OTHER_CLASS = "another class"
+    DETECTION_OF_NOTHING = "detection of nothing"
+    DETECTION_UNUSED = "detection unused"
+    NOT_OUTPUT = "not output"
+    OFF_OBJECT = "off the object"
+    NOT_COUNTED = "not counted"
+    TWO_TRACKS = "two tracks"
+    COASTED = "coasted"
+    COVERED_TWO = "covered two"
+    INTERPOLATED = "interpolated"
+    NO_EVAL_BOX = "no evaluated box"
+
+    @property
+    def party(self) -> Party:
+        return _PARTY[self]
+
+
+_PARTY = {
+    Rule.NO_DETECTION: Party.DETECTOR,
+    Rule.OTHER_CLASS: Party.DETECTOR,
+    Rule.DETECTION_OF_NOTHING: Party.DETECTOR,
+    Rule.DETECTION_UNUSED: Party.TRACKER,
+    Rule.NOT_OUTPUT: Party.TRACKER,
+    Rule.OFF_OBJECT: Party.TRACKER,
+    Rule.NOT_COUNTED: Party.TRACKER,
+    Rule.TWO_TRACKS: Party.TRACKER,
+    Rule.COASTED: Party.TRACKER,
+    Rule.COVERED_TWO: Party.TRACKER,
+    Rule.INTERPOLATED: Party.EVALUATION,
+    Rule.NO_EVAL_BOX: Party.EVALUATION,
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Blame:
+    """One stated test that held (``Rule``), at ``frames``."""
+
+    rule: Rule
+    frames: tuple[int, ...]
+
+    @property
+    def party(self) -> Party:
+        return self.rule.party
+
+
+@dataclass(frozen=True, slots=True)
+class Near:
+    """A detection near an object: its source index, class, score, BEV distance (m) and whether preprocessing
+    kept it (score threshold, NMS)."""
+
+    meas: int
+    class_name: str
+    score: float
+    distance_m: float
+    kept: bool
+
+
+@dataclass(frozen=True, slots=True)
+class OnObject:
+    """A track output within ``NEAR_M`` of an object: its id, distance, output score, the detection its box sits
+    on (-1: none this frame) and how the evaluation took it (``TrackEval``; None: not evaluated) against the
+    class's threshold (None: every box counts)."""
+
+    track_id: int
+    distance_m: float
+    score: float
+    meas: int
+    evaluated: TrackEval | None
+    threshold: float | None
+
+    @property
+    def counted(self) -> bool:
+        """Whether the evaluation counted the track (its averaged score reaches the threshold)."""
+        if self.evaluated is None or self.evaluated.averaged_score is None:
+            return False
+        return self.threshold is None or self.evaluated.averaged_score >= self.threshold
+
+
+@dataclass(frozen=True, slots=True)
+class Sighting:
+    """The object at one frame: its LiDAR + radar points, how the evaluation saw it, the nearest detection of any
+    class (within ``NEAR_M``, kept or not), the nearest kept detection of its class and where that went, and the
+    tracks of its class output on it."""
+
+    frame: int
+    points: int
+    evaluated: GtFrame | None
+    nearest_any: Near | None
+    nearest_own: Near | None
+    went: Destination | None
+    on_it: tuple[OnObject, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class OffObject:
+    """The lost track output ``NEAR_M`` or more from the object at the failure's frame: how far, on which
+    detection (-1: none), and the earlier frames whose detection it used lay that far from the object
+    ((frame, detection) pairs)."""
+
+    distance_m: float
+    meas: int
+    earlier: tuple[tuple[int, int], ...]
+
+
+@dataclass(frozen=True, slots=True)
+class LostTrack:
+    """The track that had the object: ``held_until`` the last frame it was output within ``NEAR_M`` of it (None:
+    never in the window); steps: its ``TrackStep`` per frame of the window; off: output away from the object at the
+    failure's frame; evaluated: how the evaluation took it; shown_min: the existence from which the viewer shows a
+    track (for a track never shown that the evaluation still counted)."""
+
+    track_id: int
+    held_until: int | None
+    steps: tuple[TrackStep, ...]
+    off: OffObject | None
+    evaluated: TrackEval | None
+    threshold: float | None
+
+    def step(self, frame: int) -> TrackStep | None:
+        return next((s for s in self.steps if s.frame == frame), None)
+
+    @property
+    def output_frames(self) -> tuple[int, ...]:
+        return tuple(s.frame for s in self.steps if s.output is not None)
+
+
+@dataclass(frozen=True, slots=True)
+class Origin:
+    """Where the track that took the object came from: born at ``frame`` from detection ``meas`` (frame -1: before
+    the window), and the frames it was a false track before the failure (identity theft)."""
+
+    track_id: int
+    frame: int
+    meas: int
+    false_frames: tuple[int, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class Deciding:
+    """A solver's choice that decided where the object's detection went: at ``frame``, ``choice`` (the chosen
+    column, its cost, the next best, the margin, and the cost terms when the tracker gives them); went: the id of
+    the track the detection went to (-1: none), or that it started (``born``); lost: the track that had the object
+    when it is neither of the compared columns, with its own cost for the detection (None: outside its gate or not
+    in the matrix) and whether the detection was in its gate."""
+
+    frame: int
+    choice: PairChoice
+    went: int
+    born: bool
+    lost: int | None = None
+    lost_in_gate: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class HypothesisSwitch:
+    """PMBM: at ``frame`` the best posterior hypothesis descends from prior hypothesis ``parent`` (not the previous
+    best, 0), of weight ``parent_weight`` against the previous best's ``best_weight`` (both as kept after the
+    previous frame); in it, each track of ``tracks`` has existed since a frame, with its existence in the chosen
+    hypothesis beside its marginal existence (``HypothesisTrack``)."""
+
+    frame: int
+    parent: int
+    parent_weight: float
+    best_weight: float
+    tracks: tuple[HypothesisTrack, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class HypothesisTrack:
+    """One track in a hypothesis switch: since: the first frame any kept hypothesis held it (None: never before);
+    decided: its predicted existence in the parent hypothesis (None: not there); predicted: in the previous best
+    (None: not there); chosen / marginal: after the update, in the chosen hypothesis and over all kept ones."""
+
+    track_id: int
+    since: int | None
+    decided: float | None
+    predicted: float | None
+    chosen: float | None
+    marginal: float | None
+
+
+@dataclass(frozen=True, slots=True)
+class KeyDecision:
+    """A choice up to the failure that sent a detection away from an involved track that was its next best, or
+    gave one to an involved track by a close call: the frame, the choice, and where the detection went
+    (track id, -1: none; born: it started that track)."""
+
+    frame: int
+    choice: PairChoice
+    went: int
+    born: bool
+
+
+@dataclass(frozen=True, slots=True)
+class FalseOutput:
+    """A false track's box at the failure frame: the detection it was output on (None: none, it was predicted),
+    the nearest object of its class (gt id, distance, how the evaluation saw it), the nearest of any class, and
+    the track the evaluation matched to that object instead (None: none)."""
+
+    track_id: int
+    on: Near | None
+    output_xy_m: tuple[float, float]
+    nearest_own: tuple[str, float, GtFrame | None] | None
+    nearest_any: tuple[str, str, float] | None
+    matched_instead: int | None
+    evaluated: TrackEval | None
+    threshold: float | None
+
+
+@dataclass(frozen=True, slots=True)
+class EvaluatedReach:
+    """Where the evaluation scored the object at the failure frame, against where it was annotated: the tracks
+    of the failure's tracker output within ``NEAR_M`` of the evaluated box and of the annotated box."""
+
+    offset_m: float
+    near_evaluated: tuple[int, ...]
+    near_annotated: tuple[int, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class OtherRun:
+    """Another tracker on the same detections at the failure: whether it has a failure of the same kind on the
+    same object at the same frame, and the tracks it output on the object there (counted or not)."""
+
+    tracker: str
+    failed_same: bool
+    on_it: tuple[OnObject, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Finding:
+    """The explanation of one failure (module docstring).
+
+    failure_id, kind, tracker, frame, class_name: the failure; gt_id: its object (a false track's nearest object
+    of its class within ``NEAR_M``, or None); track_ids: its own tracks; window: the frames looked at; deciding:
+    the frames that decided it; blame: the tests that held, in order (evaluation, detector, tracker); sightings:
+    the object per frame of the window; lost: the track that had it; taker: where the track that took it came
+    from; decision: the solver's deciding choice; switch: a PMBM hypothesis switch that decided it; false_output:
+    a false track's box; covered: a coalescence's other objects; key_decisions: choices that sent detections away
+    from involved tracks; others: other trackers on the same detections; reach: where the evaluation scored an
+    interpolated object against its annotation; mode: how the tracker's update uses detections (``facts.UseMode``
+    value), has_existence: whether its tracks have existences.
+    """
+
+    failure_id: str
+    kind: FailureKind
+    tracker: str
+    frame: int
+    class_name: str
+    gt_id: str | None
+    track_ids: tuple[int, ...]
+    window: tuple[int, int]
+    deciding: tuple[int, ...]
+    blame: tuple[Blame, ...]
+    sightings: tuple[Sighting, ...]
+    mode: str
+    has_existence: bool
+    lost: LostTrack | None = None
+    taker: Origin | None = None
+    decision: Deciding | None = None
+    switch: HypothesisSwitch | None = None
+    false_output: FalseOutput | None = None
+    covered: tuple[str, ...] = ()
+    key_decisions: tuple[KeyDecision, ...] = ()
+    others: tuple[OtherRun, ...] = ()
+    reach: EvaluatedReach | None = None
+
+    @property
+    def parties(self) -> tuple[Party, ...]:
+        """Whose doing, in order, each once."""
+        return tuple(dict.fromkeys(b.party for b in self.blame))
+
+    def sighting(self, frame: int) -> Sighting | None:
+        return next((s for s in self.sightings if s.frame == frame), None)

@@ -1,0 +1,591 @@
+"""From a failure to its ``Finding``: what happened to the object and the tracks around it, and whose doing it was.
+
+``explain_failure`` reads four independent sources and nothing else: the failure report (the devkit's matching
+and how it evaluated each object and track, ``eval.evaluated``), the tracker's facts (its events, ``facts``), its
+run (the detections it was given and the boxes it output) and the scene's annotations. The stated tests of
+``findings`` decide the ``Blame``; the finding keeps the facts each test used, so the text (``words``) and the
+checks (``claims``) read the same data.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from gnnpmb.data.scene import SceneData
+from gnnpmb.eval.evaluated import GtStatus
+from gnnpmb.eval.failures import Failure, FailureKind, FailureReport
+from gnnpmb.events import AxisKind
+from gnnpmb.focus import FRAMES_BEFORE
+from gnnpmb.pipeline import FrameResult, TrackingRun
+from gnnpmb.why.facts import TrackerFacts, UseMode
+from gnnpmb.why.findings import (
+    EVALUATED_OFFSET_M,
+    NEAR_M,
+    Blame,
+    Deciding,
+    EvaluatedReach,
+    FalseOutput,
+    Finding,
+    HypothesisSwitch,
+    HypothesisTrack,
+    KeyDecision,
+    LostTrack,
+    Near,
+    OffObject,
+    OnObject,
+    Origin,
+    OtherRun,
+    Rule,
+    Sighting,
+)
+
+LOST_AND_TAKER = {
+    FailureKind.ID_SWITCH: (0, 1),
+    FailureKind.IDENTITY_THEFT: (1, 0),
+    FailureKind.FRAGMENTATION: (0, None),
+}
+"""Per failure kind whose object a track lost: the positions in ``Failure.track_ids`` of that track and of the
+track that took the object over (None: none did)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Evidence:
+    """What ``explain_failure`` reads: a tracker's failure report, facts and run on one scene."""
+
+    report: FailureReport
+    facts: TrackerFacts
+    run: TrackingRun
+
+    @property
+    def tracker(self) -> str:
+        return self.run.tracker
+
+
+def explain_failure(
+    failure_id: str,
+    evidence: Evidence,
+    scene: SceneData,
+    others: Sequence[Evidence] = (),
+    first_frame: int | None = None,
+) -> Finding:
+    """The ``Finding`` of the failure ``failure_id`` of ``evidence`` (raises KeyError for an unknown id).
+
+    others: other trackers' evidence on the same detections (their failures at the same place become
+    ``OtherRun`` evidence); first_frame: the first frame to look at (default ``FRAMES_BEFORE`` before the
+    failure, within the run)."""
+    failure = evidence.report.by_id(failure_id)
+    if failure is None:
+        raise KeyError(failure_id)
+    start = first_frame if first_frame is not None else failure.frame_index - FRAMES_BEFORE
+    ctx = _Context(evidence, scene, failure.frame_index, failure.class_name, start, failure)
+    return ctx.finding(failure_id, others)
+
+
+class _Context:
+    """The failure, its sources and the frames looked at, with the lookups every part of a finding shares."""
+
+    def __init__(
+        self,
+        evidence: Evidence,
+        scene: SceneData,
+        frame: int,
+        class_name: str,
+        first_frame: int,
+        failure: Failure | None = None,
+    ) -> None:
+        self.evidence, self.scene = evidence, scene
+        self.failure: Failure = failure  # type: ignore[assignment]  # only the finding's parts read it
+        self.report, self.facts = evidence.report, evidence.facts
+        self.frames: dict[int, FrameResult] = {fr.keyframe.index: fr for fr in evidence.run.frames}
+        self.f = frame
+        self.class_name = class_name
+        self.window = range(max(min(self.frames), first_frame), frame + 1)
+        self.threshold = self.report.threshold_of(self.class_name)
+
+    # The object.
+    def gt_xy(self, gt_id: str, frame: int) -> np.ndarray | None:
+        """(2,) annotated BEV centre of ``gt_id`` at ``frame`` (None: not annotated there)."""
+        gt = self.scene.keyframes[frame].gt
+        hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id) if len(gt) else np.zeros(0, int)
+        return None if hit.size == 0 else np.asarray(gt.translation_m[hit[0], :2], dtype=np.float64)
+
+    def points(self, gt_id: str, frame: int) -> int:
+        gt = self.scene.keyframes[frame].gt
+        hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
+        return int(self.scene.keyframes[frame].gt_num_pts[hit[0]]) if hit.size else 0
+
+    def near(self, frame: int, xy: np.ndarray, *, own: bool) -> Near | None:
+        """The nearest detection within ``NEAR_M`` of ``xy`` at ``frame``: any class and score (own False), or a
+        kept one of the failure's class (own True)."""
+        fr = self.frames.get(frame)
+        if fr is None:
+            return None
+        boxes, kept = fr.detections.boxes, np.asarray(fr.detections.kept)
+        if not len(boxes):
+            return None
+        d = np.hypot(*(boxes.translation_m[:, :2] - xy).T)
+        ok = d < NEAR_M
+        if own:
+            ok &= kept & (boxes.class_name == self.class_name)
+        if not ok.any():
+            return None
+        m = int(np.flatnonzero(ok)[np.argmin(d[ok])])
+        return Near(m, str(boxes.class_name[m]), float(boxes.score[m]), float(d[m]), bool(kept[m]))
+
+    def on_object(self, report: FailureReport, fr: FrameResult | None, xy: np.ndarray) -> tuple[OnObject, ...]:
+        """The tracks of the failure's class output within ``NEAR_M`` of ``xy`` in ``fr``."""
+        if fr is None:
+            return ()
+        threshold = report.threshold_of(self.class_name)
+        out = []
+        for e in fr.estimates:
+            if e.class_name != self.class_name:
+                continue
+            d = float(np.hypot(e.translation_m[0] - xy[0], e.translation_m[1] - xy[1]))
+            if d < NEAR_M:
+                out.append(
+                    OnObject(e.track_id, d, e.score, e.meas_index, report.track_evals.get(str(e.track_id)), threshold)
+                )
+        return tuple(sorted(out, key=lambda o: o.distance_m))
+
+    def sightings(self, gt_id: str) -> tuple[Sighting, ...]:
+        out = []
+        for f in self.window:
+            xy = self.gt_xy(gt_id, f)
+            if xy is None or f not in self.frames:
+                continue
+            own = self.near(f, xy, own=True)
+            went = self.facts.destination(f, self.class_name, own.meas) if own is not None else None
+            out.append(
+                Sighting(
+                    f,
+                    self.points(gt_id, f),
+                    self.report.gt_frame(gt_id, f),
+                    self.near(f, xy, own=False),
+                    own,
+                    went,
+                    self.on_object(self.report, self.frames[f], xy),
+                )
+            )
+        return tuple(out)
+
+    # The finding.
+    def finding(self, failure_id: str, others: Sequence[Evidence]) -> Finding:
+        failure, kind = self.failure, self.failure.kind
+        gt_id = self.object_of()
+        sightings = self.sightings(gt_id) if gt_id is not None else ()
+        parts: dict = {}
+        if kind in LOST_AND_TAKER:
+            parts = self.lost_object(gt_id, sightings, self.involved(sightings))
+        elif kind is FailureKind.FALSE_TRACK:
+            parts = self.false_track()
+        elif kind is FailureKind.MISS:
+            parts = self.miss(sightings)
+        elif kind is FailureKind.COALESCENCE:
+            parts = self.coalescence(sightings)
+        else:
+            raise AssertionError(kind)
+        involved = self.involved(sightings)
+        return Finding(
+            failure_id=failure_id,
+            kind=kind,
+            tracker=self.evidence.tracker,
+            frame=self.f,
+            class_name=self.class_name,
+            gt_id=gt_id,
+            track_ids=tuple(int(t) for t in failure.track_ids),
+            window=(self.window.start, self.window.stop - 1),
+            sightings=sightings,
+            mode=_mode(self.facts, self.class_name, self.window).value,
+            has_existence=self.facts.has_existence,
+            key_decisions=self.key_decisions(involved),
+            others=self.others(others, gt_id),
+            reach=self.reach(gt_id, parts["blame"]),
+            **parts,
+        )
+
+    def reach(self, gt_id: str | None, blame: tuple[Blame, ...]) -> EvaluatedReach | None:
+        """With the blame ``INTERPOLATED``: the tracks within reach of the evaluated and of the annotated box."""
+        if gt_id is None or not any(b.rule is Rule.INTERPOLATED for b in blame):
+            return None
+        g = self.report.gt_frame(gt_id, self.f)
+        fr = self.frames.get(self.f)
+        if g is None or g.evaluated_xy_m is None:
+            return None
+        near = [self.on_object(self.report, fr, np.asarray(xy)) for xy in (g.evaluated_xy_m, g.annotated_xy_m)]
+        return EvaluatedReach(g.offset_m, *(tuple(o.track_id for o in n) for n in near))
+
+    def involved(self, sightings: tuple[Sighting, ...]) -> set[int]:
+        """The failure's own tracks and every track output on the object in the window."""
+        return {int(t) for t in self.failure.track_ids} | {o.track_id for s in sightings for o in s.on_it}
+
+    def object_of(self) -> str | None:
+        """The failure's object: the missed one of a coalescence, the object of the others, and for a false track
+        the object of its class nearest its box within ``NEAR_M`` (None if none)."""
+        failure = self.failure
+        if failure.kind is FailureKind.COALESCENCE:
+            return failure.gt_ids[1]
+        if failure.gt_ids:
+            return failure.gt_ids[0]
+        fr = self.frames.get(self.f)
+        e = self.estimate(int(failure.track_ids[0]), self.f)
+        if fr is None or e is None:
+            return None
+        gt = self.scene.keyframes[self.f].gt
+        mine = np.flatnonzero(gt.class_name == self.class_name) if len(gt) else np.zeros(0, int)
+        if not mine.size:
+            return None
+        d = np.hypot(*(gt.translation_m[mine, :2] - np.asarray(e.translation_m[:2])).T)
+        k = int(np.argmin(d))
+        return str(gt.instance_id[mine[k]]) if d[k] < NEAR_M else None
+
+    def estimate(self, track_id: int, frame: int):
+        fr = self.frames.get(frame)
+        return next((e for e in fr.estimates if e.track_id == track_id), None) if fr is not None else None
+
+    def held_until(self, track_id: int, gt_id: str) -> int | None:
+        """The last frame before the failure at which ``track_id`` was output within ``NEAR_M`` of the object."""
+        for f in sorted((f for f in self.frames if f < self.f), reverse=True):
+            e, xy = self.estimate(track_id, f), self.gt_xy(gt_id, f)
+            if e is not None and xy is not None and np.hypot(*(np.asarray(e.translation_m[:2]) - xy)) < NEAR_M:
+                return f
+        return None
+
+    def lost_object(self, gt_id: str, sightings: tuple[Sighting, ...], involved: set[int]) -> dict:
+        """ID switch, identity theft, fragmentation: the lost track, the taker, the deciding choice or hypothesis
+        switch, and the blame over the deciding frames."""
+        lost_at, took_at = LOST_AND_TAKER[self.failure.kind]
+        lost_id = int(self.failure.track_ids[lost_at])
+        taker_id = int(self.failure.track_ids[took_at]) if took_at is not None else None
+        held = self.held_until(lost_id, gt_id)
+        deciding = tuple(range((held + 1) if held is not None else self.f, self.f + 1))
+        lost = self.lost_track(lost_id, gt_id, held)
+        taker = self.origin(taker_id) if taker_id is not None else None
+        blame = self.blame_lost(sightings, deciding, lost)
+        decision = self.deciding(lost_id, taker_id, involved) if taker_id is not None else None
+        switch = self.switch({lost_id, *([taker_id] if taker_id is not None else [])}, deciding)
+        return {
+            "deciding": deciding,
+            "blame": blame,
+            "lost": lost,
+            "taker": taker,
+            "decision": decision,
+            "switch": switch,
+        }
+
+    def lost_track(self, track_id: int, gt_id: str, held: int | None) -> LostTrack:
+        steps = self.facts.steps(track_id, self.class_name)
+        in_window = tuple(steps[f] for f in self.window if f in steps)
+        off = None
+        e, xy = self.estimate(track_id, self.f), self.gt_xy(gt_id, self.f)
+        if e is not None and xy is not None:
+            gap = float(np.hypot(*(np.asarray(e.translation_m[:2]) - xy)))
+            if gap >= NEAR_M:
+                earlier = []
+                for s in in_window:
+                    at, fr = self.gt_xy(gt_id, s.frame), self.frames.get(s.frame)
+                    if s.frame >= self.f or at is None or fr is None:
+                        continue
+                    boxes = fr.detections.boxes
+                    earlier += [(s.frame, m) for m in s.used if np.hypot(*(boxes.translation_m[m, :2] - at)) >= NEAR_M]
+                off = OffObject(gap, e.meas_index, tuple(earlier))
+        return LostTrack(track_id, held, in_window, off, self.report.track_evals.get(str(track_id)), self.threshold)
+
+    def origin(self, track_id: int) -> Origin:
+        """Where ``track_id`` came from: the detection that started it and when; its false frames before the
+        failure (the evaluation matched it to no object)."""
+        steps = self.facts.steps(track_id, self.class_name)
+        born = next(((f, s.born_from) for f, s in sorted(steps.items()) if s.born_from is not None), None)
+        since = self.facts.existed_since(track_id, self.class_name, self.f)
+        if born is None or (since is not None and since < born[0]):
+            # started in a PMBM hypothesis other than the best (no Born event names it), or before the facts
+            born = (since if since is not None else min(steps, default=-1), -1)
+        false = tuple(
+            sorted(
+                {
+                    f.frame_index
+                    for f in self.report.of_kind(FailureKind.FALSE_TRACK)
+                    if str(track_id) in f.track_ids and f.frame_index < self.f
+                }
+            )
+        )
+        return Origin(track_id, born[0], born[1], false if self.failure.kind is FailureKind.IDENTITY_THEFT else ())
+
+    def blame_lost(self, sightings: tuple[Sighting, ...], deciding: tuple[int, ...], lost: LostTrack) -> tuple:
+        seen = {s.frame: s for s in sightings}
+        no_det, other_class, unused, not_output = [], [], [], []
+        for f in deciding:
+            s = seen.get(f)
+            if s is None:
+                continue
+            step = lost.step(f)
+            if s.nearest_any is None:
+                no_det.append(f)
+            elif s.nearest_own is None and s.nearest_any.class_name != self.class_name:
+                other_class.append(f)
+            own = s.nearest_own
+            if own is None and s.nearest_any is not None and s.nearest_any.class_name == self.class_name:
+                own = s.nearest_any  # of its class, dropped by preprocessing
+            if own is not None and (step is None or own.meas not in step.used):
+                unused.append(f)
+            if step is None or step.output is None:
+                not_output.append(f)
+        return self.evaluation_blame() + _blames(
+            (Rule.NO_DETECTION, no_det),
+            (Rule.OTHER_CLASS, other_class),
+            (Rule.DETECTION_UNUSED, unused),
+            (Rule.NOT_OUTPUT, not_output),
+            (Rule.OFF_OBJECT, [self.f] if lost.off is not None else []),
+        )
+
+    def evaluation_blame(self) -> tuple[Blame, ...]:
+        """The evaluation's tests at the failure frame for the failure's objects."""
+        out = []
+        for gt_id in self.failure.gt_ids:
+            g = self.report.gt_frame(gt_id, self.f)
+            if g is None:
+                continue
+            if g.status is GtStatus.INTERPOLATED and g.offset_m >= EVALUATED_OFFSET_M:
+                out.append(Blame(Rule.INTERPOLATED, (self.f,)))
+        return tuple(dict.fromkeys(out))
+
+    def deciding(self, lost_id: int, taker_id: int, involved: set[int]) -> Deciding | None:
+        """The solver's last choice up to the failure that sent a detection to the taker (or started it) while an
+        involved track (the lost one, or one in between) was the next best, or by a close call."""
+        best = None
+        for f in self.window:
+            d = self.facts.decisions(f, self.class_name)
+            if d is None:
+                continue
+            born = self.facts.frame(f, self.class_name).born_of()
+            for conflict in d.conflicts:
+                for c in conflict.choices:
+                    went, is_born = _went(c.chosen, born.get(int(c.meas.ref)))
+                    if went != taker_id or c.alternative is None or c.alternative.kind is not AxisKind.TRACK:
+                        continue
+                    if not (c.alternative.ref in involved or c.close_call):
+                        continue
+                    best = (f, c, went, is_born)
+        if best is None:
+            return None
+        f, c, went, is_born = best
+        compared = {label.ref for label in (c.chosen, c.alternative) if label is not None}
+        lost = None if lost_id in compared else lost_id
+        step = self.facts.steps(lost_id, self.class_name).get(f)
+        in_gate = step is not None and any(m == c.meas.ref for m, _ in step.gated)
+        return Deciding(f, c, went, is_born, lost, in_gate)
+
+    def switch(self, tracks: set[int], deciding: tuple[int, ...]) -> HypothesisSwitch | None:
+        """A PMBM hypothesis switch in the deciding frames: the best hypothesis descends from another prior
+        hypothesis than the previous best (the latest such frame)."""
+        for f in reversed(deciding):
+            h = self.facts.hypotheses(f, self.class_name)
+            if h is None or not h.switched:
+                continue
+            before = self.facts.hypotheses(f - 1, self.class_name)
+            weights = before.weights if before is not None else ()
+            parent_w = weights[h.best_parent] if h.best_parent < len(weights) else float("nan")
+            rows = []
+            for t in sorted(tracks):
+                step = self.facts.steps(t, self.class_name).get(f)
+                rows.append(
+                    HypothesisTrack(
+                        t,
+                        self.facts.existed_since(t, self.class_name, f),
+                        step.decided_existence if step is not None else None,
+                        step.prior_existence if step is not None else None,
+                        h.existence_in(0, t),
+                        step.marginal_existence if step is not None else None,
+                    )
+                )
+            return HypothesisSwitch(f, h.best_parent, parent_w, weights[0] if weights else float("nan"), tuple(rows))
+        return None
+
+    def false_track(self) -> dict:
+        t = int(self.failure.track_ids[0])
+        e = self.estimate(t, self.f)
+        xy = np.asarray(e.translation_m[:2]) if e is not None else np.zeros(2)
+        fr = self.frames.get(self.f)
+        on = None
+        if e is not None and e.meas_index >= 0 and fr is not None:
+            m, boxes = e.meas_index, fr.detections.boxes
+            on = Near(
+                m,
+                str(boxes.class_name[m]),
+                float(boxes.score[m]),
+                float(np.hypot(*(boxes.translation_m[m, :2] - xy))),
+                bool(fr.detections.kept[m]),
+            )
+        gt = self.scene.keyframes[self.f].gt
+        d = np.hypot(*(gt.translation_m[:, :2] - xy).T) if len(gt) else np.zeros(0)
+        mine = np.flatnonzero(gt.class_name == self.class_name) if len(gt) else np.zeros(0, int)
+        nearest_own = nearest_any = None
+        matched = None
+        if mine.size and d[mine].min() < NEAR_M:
+            k = int(mine[np.argmin(d[mine])])
+            gt_id = str(gt.instance_id[k])
+            nearest_own = (gt_id, float(d[k]), self.report.gt_frame(gt_id, self.f))
+            matched = self.matched_to(gt_id)
+        if d.size and d.min() < NEAR_M:
+            k = int(np.argmin(d))
+            nearest_any = (str(gt.instance_id[k]), str(gt.class_name[k]), float(d[k]))
+        blame: list[Blame] = []
+        if nearest_own is not None:
+            g = nearest_own[2]
+            if g is None or g.status in (GtStatus.NO_BOX, GtStatus.BEYOND_RANGE):
+                blame.append(Blame(Rule.NO_EVAL_BOX, (self.f,)))
+            elif g.status is GtStatus.INTERPOLATED and np.hypot(*(np.asarray(g.evaluated_xy_m) - xy)) >= NEAR_M:
+                blame.append(Blame(Rule.INTERPOLATED, (self.f,)))
+            else:
+                blame.append(Blame(Rule.TWO_TRACKS, (self.f,)))
+        elif on is None:
+            blame.append(Blame(Rule.COASTED, (self.f,)))
+        elif nearest_any is not None:
+            blame.append(Blame(Rule.OTHER_CLASS, (self.f,)))
+        else:
+            blame.append(Blame(Rule.DETECTION_OF_NOTHING, (self.f,)))
+        output = FalseOutput(
+            t,
+            on,
+            (float(xy[0]), float(xy[1])),
+            nearest_own,
+            nearest_any,
+            matched,
+            self.report.track_evals.get(str(t)),
+            self.threshold,
+        )
+        return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
+
+    def matched_to(self, gt_id: str) -> int | None:
+        """The track the evaluation matched object ``gt_id`` to at the failure frame: a counted track of the class
+        output within ``NEAR_M`` of its evaluated box, nearest first (None: none)."""
+        g = self.report.gt_frame(gt_id, self.f)
+        if g is None or g.evaluated_xy_m is None:
+            return None
+        others = [
+            o
+            for o in self.on_object(self.report, self.frames.get(self.f), np.asarray(g.evaluated_xy_m))
+            if o.counted and o.track_id != int(self.failure.track_ids[0])
+        ]
+        return others[0].track_id if others else None
+
+    def miss(self, sightings: tuple[Sighting, ...]) -> dict:
+        s = next((s for s in sightings if s.frame == self.f), None)
+        blame = list(self.evaluation_blame())
+        if s is not None:
+            blame += self.blame_uncovered(s)
+        return {"deciding": (self.f,), "blame": tuple(blame)}
+
+    def blame_uncovered(self, s: Sighting) -> list[Blame]:
+        """The tests for an object no counted track covered at frame ``s.frame`` (a miss, a coalescence's
+        missed object)."""
+        f = (s.frame,)
+        if s.nearest_any is None:
+            return [Blame(Rule.NO_DETECTION, f)]
+        out = []
+        if s.nearest_own is None and s.nearest_any.class_name != self.class_name:
+            out.append(Blame(Rule.OTHER_CLASS, f))
+        if any(not o.counted for o in s.on_it):
+            out.append(Blame(Rule.NOT_COUNTED, f))
+        own = s.nearest_own
+        if own is None and s.nearest_any.class_name == self.class_name:
+            out.append(Blame(Rule.DETECTION_UNUSED, f))  # preprocessing dropped it
+        elif own is not None:
+            on_ids = {o.track_id for o in s.on_it}
+            went = s.went
+            if went is None or went.track_id < 0:
+                out.append(Blame(Rule.DETECTION_UNUSED, f))
+            elif went.track_id not in on_ids:
+                out.append(Blame(Rule.NOT_OUTPUT, f))
+        return out
+
+    def coalescence(self, sightings: tuple[Sighting, ...]) -> dict:
+        s = next((s for s in sightings if s.frame == self.f), None)
+        blame = list(self.evaluation_blame())
+        if s is not None:
+            uncovered = self.blame_uncovered(s)
+            blame += [b for b in uncovered if b.rule is not Rule.NOT_COUNTED]
+            if s.went is not None and s.went.track_id == int(self.failure.track_ids[0]):
+                blame.append(Blame(Rule.COVERED_TWO, (self.f,)))
+        covered = tuple(g for g in self.failure.gt_ids if g != self.failure.gt_ids[1])
+        return {"deciding": (self.f,), "blame": tuple(dict.fromkeys(blame)), "covered": covered}
+
+    def key_decisions(self, involved: set[int]) -> tuple[KeyDecision, ...]:
+        """Choices up to the failure that sent a detection elsewhere while an involved track was its next best,
+        or gave one to an involved track by a close call (on the tracker's own cost scale)."""
+        out = []
+        for f in self.window:
+            d = self.facts.decisions(f, self.class_name)
+            if d is None:
+                continue
+            born = self.facts.frame(f, self.class_name).born_of()
+            for conflict in d.conflicts:
+                for c in conflict.choices:
+                    alt = c.alternative
+                    alt_involved = alt is not None and alt.kind is AxisKind.TRACK and alt.ref in involved
+                    chosen_involved = c.chosen.kind is AxisKind.TRACK and c.chosen.ref in involved
+                    if (alt_involved and not chosen_involved) or (chosen_involved and c.close_call):
+                        went, is_born = _went(c.chosen, born.get(int(c.meas.ref)))
+                        out.append(KeyDecision(f, c, went, is_born))
+        return tuple(out)
+
+    def others(self, others: Sequence[Evidence], gt_id: str | None) -> tuple[OtherRun, ...]:
+        """How other trackers fared at the same place: a failure of the same kind on the same object (or, for a
+        false track, at the same place) at the same frame, and their tracks output on the object."""
+        out = []
+        for ev in others:
+            if ev.tracker == self.evidence.tracker:
+                continue
+            fr = next((fr for fr in ev.run.frames if fr.keyframe.index == self.f), None)
+            xy = self.gt_xy(gt_id, self.f) if gt_id is not None else None
+            if xy is None:
+                e = self.estimate(int(self.failure.track_ids[0]), self.f) if self.failure.track_ids else None
+                xy = np.asarray(e.translation_m[:2]) if e is not None else None
+            failed = any(
+                f.kind is self.failure.kind and f.frame_index == self.f and (gt_id in f.gt_ids if gt_id else True)
+                for f in ev.report.failures
+            )
+            on_it = self.on_object(ev.report, fr, xy) if xy is not None else ()
+            out.append(OtherRun(ev.tracker, failed, on_it))
+        return tuple(out)
+
+
+def object_frames(
+    evidence: Evidence, scene: SceneData, class_name: str, gt_id: str, frames: range
+) -> tuple[Sighting, ...]:
+    """The object ``gt_id`` of ``class_name`` at each of ``frames`` as ``evidence``'s tracker saw it
+    (``Sighting``): the tables of a focus document, one per tracker."""
+    return _Context(evidence, scene, frames.stop - 1, class_name, frames.start).sightings(gt_id)
+
+
+def key_decisions(
+    evidence: Evidence, scene: SceneData, class_name: str, involved: set[int], frames: range
+) -> tuple[KeyDecision, ...]:
+    """Choices in ``frames`` that sent a detection away from one of ``involved`` while it was the next best, or
+    gave one to an involved track by a close call (``_Context.key_decisions``)."""
+    return _Context(evidence, scene, frames.stop - 1, class_name, frames.start).key_decisions(involved)
+
+
+def _went(chosen, born_id: int | None) -> tuple[int, bool]:
+    """(track id the detection went to or started (-1: none), whether it started it)."""
+    if chosen.kind is AxisKind.TRACK:
+        return int(chosen.ref), False
+    return (born_id, True) if born_id is not None else (-1, True)
+
+
+def _blames(*tests: tuple[Rule, list[int]]) -> tuple[Blame, ...]:
+    """The held tests (those with frames), detector's before tracker's."""
+    held = [Blame(t, tuple(frames)) for t, frames in tests if frames]
+    return tuple(sorted(held, key=lambda b: list(type(b.party)).index(b.party)))
+
+
+def _mode(facts: TrackerFacts, class_name: str, frames: range) -> UseMode:
+    """How the tracker's update used detections in ``frames`` (assignment without any update event)."""
+    for f in frames:
+        use = facts.use(f, class_name)
+        if use is not None and use.tracks:
+            return use.mode
+    return UseMode.ASSIGNED

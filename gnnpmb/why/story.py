@@ -1,0 +1,239 @@
+"""A run's story: typed lines per frame and class (confirmed, missed, no longer shown, ended, close calls).
+
+``Storyteller`` reads a tracker's facts frame by frame, in order, and keeps what a story needs to remember (the
+tracks shown so far, those shown the frame before). Each ``StoryLine`` names its tracks (``track_ids``), so a
+view picks the lines about some tracks without reading the text; the text is made here, once.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+import numpy as np
+
+from gnnpmb.events import AxisKind, TrackLogicAction
+from gnnpmb.why.facts import ClassFrame, TrackerFacts, Went
+from gnnpmb.why.words import (
+    SHOW_MIN_EXISTENCE,
+    column_name,
+    cost_value,
+    destination_text,
+    existence_text,
+    meas_name,
+    use_text,
+)
+
+MAX_NAMED = 12
+"""A line about new candidates names at most this many detections."""
+
+
+class StoryKind(enum.Enum):
+    CONFIRMED = "confirmed"  # first shown
+    MISSED = "missed"  # shown without a detection this frame
+    HIDDEN = "hidden"  # an involved track below the show floor, every frame
+    NO_LONGER_SHOWN = "no longer shown"
+    ENDED = "ended"
+    DELETED = "deleted"  # by track logic
+    MERGED = "merged"
+    CANDIDATES = "candidates"
+    SUMMARY = "summary"
+    CLOSE_CALL = "close call"
+    BUDGET = "budget"
+
+
+@dataclass(frozen=True, slots=True)
+class StoryLine:
+    """One line of the story: its frame, class, kind, level (``TextLog`` level), the tracks it is about and its
+    text."""
+
+    frame: int
+    class_name: str
+    kind: StoryKind
+    level: str
+    track_ids: tuple[int, ...]
+    text: str
+
+
+class Storyteller:
+    """Tells a run's story from its facts (module docstring). has_existence: whether tracks have existences
+    (else nothing is said of them); show_min: the existence from which a track counts as shown; involved: tracks
+    that get a line every frame even while not shown."""
+
+    def __init__(
+        self,
+        facts: TrackerFacts,
+        *,
+        show_min: float = SHOW_MIN_EXISTENCE,
+        involved: frozenset[int] = frozenset(),
+    ) -> None:
+        self.facts = facts
+        self.show_min = show_min
+        self.involved = involved
+        self.shown_ever: set[int] = set()
+        self._shown_before: dict[str, set[int]] = {}
+
+    @property
+    def has_existence(self) -> bool:
+        return self.facts.has_existence
+
+    def frame_lines(self, frame: int) -> list[StoryLine]:
+        """The lines of ``frame`` (call once per frame, in order): per class, then the frame's close calls."""
+        out: list[StoryLine] = []
+        for class_name, cf in self.facts.frames.get(frame, {}).items():
+            out += self._class_lines(frame, class_name, cf)
+        return out
+
+    def _class_lines(self, frame: int, class_name: str, cf: ClassFrame) -> list[StoryLine]:
+        lines: list[StoryLine] = []
+
+        def say(kind: StoryKind, level: str, ids: tuple[int, ...], text: str) -> None:
+            lines.append(StoryLine(frame, class_name, kind, level, ids, text))
+
+        extracted = cf.extracted.estimates if cf.extracted is not None else ()
+        now = {e.track_id: e for e in extracted if e.existence >= self.show_min}
+        known = self.shown_ever
+        hyp = self.facts.hypotheses(frame, class_name)
+        for t, e in now.items():
+            via = f"from {meas_name(e.meas_index)}" if e.meas_index >= 0 else "without a detection"
+            if t not in known:
+                since = self.facts.existed_since(t, class_name, frame) if hyp is not None else None
+                why = ""
+                if hyp is not None and hyp.switched and since is not None and since < frame:
+                    why = (
+                        f": the best hypothesis now descends from prior hypothesis {hyp.best_parent}, in which it "
+                        f"has existed since frame {since}"
+                    )
+                say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} confirmed ({self._r(e.existence)}{via}){why}")
+            elif e.meas_index < 0:
+                say(
+                    StoryKind.MISSED,
+                    "INFO",
+                    (t,),
+                    f"track {t} missed this frame, still reported{self._r_in(e.existence)}",
+                )
+        posterior_r: dict[int, float] = {}
+        if cf.posterior is not None:
+            posterior_r = dict(
+                zip(
+                    np.asarray(cf.posterior.track_ids).tolist(),
+                    np.asarray(cf.posterior.existence).tolist(),
+                    strict=True,
+                )
+            )
+        for t in sorted((self.involved & set(posterior_r)) - known - set(now)):
+            step = self.facts.steps(t, class_name).get(frame)
+            if step is None:
+                continue
+            via = f"started by {meas_name(step.born_from)}" if step.born_from is not None else use_text(step)
+            text = (
+                f"track {t} (not shown, r < {self.show_min:g}): {via}, r={existence_text(posterior_r[t])}"
+                if self.has_existence
+                else f"track {t} (not output): {via}"
+            )
+            say(StoryKind.HIDDEN, "INFO", (t,), text)
+        pruned_ids = {p.track_id for p in cf.pruned}
+        limit = max(cf.extracted.threshold if cf.extracted is not None else 0.0, self.show_min)
+        before = self._shown_before.get(class_name, set())
+        for t in sorted(before - set(now) - pruned_ids):
+            if t in posterior_r:
+                text = (
+                    f"track {t} no longer shown (r={posterior_r[t]:.2f} fell below {limit:.2f})"
+                    if self.has_existence
+                    else f"track {t} no longer shown (not output this frame)"
+                )
+                say(StoryKind.NO_LONGER_SHOWN, "WARN", (t,), text)
+        candidates_pruned = 0
+        for p in cf.pruned:
+            if p.track_id in known:
+                last = f" (last r={p.last_existence:.3g})" if self.has_existence else ""
+                say(StoryKind.ENDED, "WARN", (p.track_id,), f"track {p.track_id} ended: {p.reason.value}{last}")
+            else:
+                candidates_pruned += 1
+        born = cf.born_of()
+        if born or candidates_pruned:
+            named = ", ".join(meas_name(m) for m in list(born)[:MAX_NAMED]) + (" …" if len(born) > MAX_NAMED else "")
+            say(
+                StoryKind.CANDIDATES,
+                "DEBUG",
+                tuple(born.values()),
+                f"{len(born)} new candidates{' from ' + named if born else ''}; {candidates_pruned} candidates pruned",
+            )
+        for m in cf.merged:
+            if m.into_id in known or any(f in known for f in m.from_ids):
+                weights = ", ".join(f"{w:.3g}" for w in m.weights)
+                ids = ", ".join(str(i) for i in m.from_ids)
+                say(StoryKind.MERGED, "INFO", (m.into_id,), f"merged {ids} into track {m.into_id} (weights {weights})")
+        for ev in cf.logic:
+            if ev.action is TrackLogicAction.DELETED:
+                say(
+                    StoryKind.DELETED,
+                    "WARN",
+                    (ev.track_id,),
+                    f"track {ev.track_id} deleted ({ev.hits}/{ev.window} hits)",
+                )
+        use = self.facts.use(frame, class_name)
+        if use is not None and cf.meas is not None:
+            to_tracks = sum(1 for d in use.destinations.values() if d.went is Went.TRACK)
+            missed = [t for t, u in use.tracks.items() if t in known and not u.shares]
+            say(
+                StoryKind.SUMMARY,
+                "DEBUG",
+                tuple(missed),
+                f"{len(cf.meas.meas_indices)} detections: {to_tracks} updated tracks, "
+                f"{len(use.destinations) - to_tracks} new or clutter; reported tracks missed: "
+                f"{', '.join(map(str, missed)) or 'none'}",
+            )
+        for b in cf.budgets:
+            say(
+                StoryKind.BUDGET,
+                "WARN",
+                (),
+                f"budget {b.budget} = {b.limit} reached (this frame needed {b.needed}); work was cut",
+            )
+        lines += self._close_calls(frame, class_name, cf)
+        self.shown_ever |= set(now)
+        self._shown_before[class_name] = set(now)
+        return lines
+
+    def _close_calls(self, frame: int, class_name: str, cf: ClassFrame) -> list[StoryLine]:
+        """Close calls (on the tracker's own cost scale) that involve a shown track (between candidates they are
+        routine)."""
+        d = self.facts.decisions(frame, class_name)
+        if d is None:
+            return []
+        born = cf.born_of()
+        out = []
+        for conflict in d.conflicts:
+            for c in conflict.choices:
+                tracks = {
+                    label.ref
+                    for label in (c.chosen, c.alternative)
+                    if label is not None and label.kind is AxisKind.TRACK
+                }
+                if not c.close_call or not tracks & self.shown_ever:
+                    continue
+                b = born.get(int(c.meas.ref))
+                if c.chosen.kind is AxisKind.TRACK:
+                    went = column_name(c.chosen)
+                else:
+                    went = destination_text(b if b is not None else -1, True, c.chosen)
+                out.append(
+                    StoryLine(
+                        frame,
+                        class_name,
+                        StoryKind.CLOSE_CALL,
+                        "INFO",
+                        tuple(sorted(tracks | ({b} if b is not None else set()))),
+                        f"close call: {meas_name(c.meas.ref)} → {went} (cost {cost_value(c.chosen_cost, c)}) over "
+                        f"{column_name(c.alternative)} ({cost_value(c.alternative_cost, c)}), margin "
+                        f"{cost_value(c.margin, c)}",
+                    )
+                )
+        return out
+
+    def _r(self, existence: float) -> str:
+        return f"r={existence:.2f}, " if self.has_existence else ""
+
+    def _r_in(self, existence: float) -> str:
+        return f" (r={existence:.2f})" if self.has_existence else ""

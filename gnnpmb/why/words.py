@@ -1,0 +1,811 @@
+"""Findings in words: the one place an explanation becomes text (the focus document, ``gnnpmb failures --why``).
+
+Every sentence is rendered from a ``Finding`` (or a decision's ``PairChoice``) and never parsed back. Numbers are
+printed as the finding holds them; what a tracker's numbers mean follows its ``facts.UseMode`` (an assignment, an
+association probability, a PHD weight) and its cost's ``events.CostScale`` (nats, metres).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+
+from gnnpmb.eval.evaluated import GtFrame, GtStatus, TrackEval
+from gnnpmb.eval.failures import FailureKind, short_id
+from gnnpmb.events import AxisKind, AxisLabel, PairTerms
+from gnnpmb.explain import PairChoice
+from gnnpmb.why.facts import Destination, Ending, TrackStep, UseMode, Went
+from gnnpmb.why.findings import (
+    NEAR_M,
+    FalseOutput,
+    Finding,
+    KeyDecision,
+    LostTrack,
+    Near,
+    OnObject,
+    OtherRun,
+    Party,
+    Rule,
+    Sighting,
+)
+
+SHOW_MIN_EXISTENCE = 0.5
+"""Extracted tracks are drawn (and called shown) from this existence on: the submission may hold far less likely
+Bernoullis (a low extraction threshold with score = detection score x existence helps AMOTA)."""
+
+
+# Names.
+def meas_name(ref: int) -> str:
+    """How every view names detection ``ref`` (its source index): ``m<ref>``."""
+    return f"m{int(ref)}"
+
+
+def column_name(label: AxisLabel) -> str:
+    """``track 802``, ``new`` (start a track / clutter) or ``missed``."""
+    match label.kind:
+        case AxisKind.TRACK:
+            return f"track {label.ref}"
+        case AxisKind.NEW_TRACK:
+            return "new"
+        case AxisKind.MISSED:
+            return f"missed {label.ref}"
+        case AxisKind.MEASUREMENT:
+            return meas_name(label.ref)
+    raise AssertionError(label.kind)
+
+
+def existence_text(r: float) -> str:
+    """An existence probability with two decimals, or one significant digit below 0.01 (``0.004``, ``4e-05``),
+    so a small but non-zero existence does not read as 0.00."""
+    return f"{r:.2f}" if r >= 0.01 or r == 0 else f"{r:.1g}"
+
+
+def frames_text(frames: Iterable[int]) -> str:
+    """``frame 7``, ``frames 7, 13``, ``frames 12–14`` (consecutive runs joined)."""
+    fs = sorted(set(frames))
+    runs: list[list[int]] = []
+    for f in fs:
+        if runs and f == runs[-1][-1] + 1:
+            runs[-1].append(f)
+        else:
+            runs.append([f])
+    parts = [f"{r[0]}–{r[-1]}" if len(r) > 2 else ", ".join(map(str, r)) for r in runs]
+    return f"frame{'s' if len(fs) > 1 else ''} {', '.join(parts)}"
+
+
+def plural(n: int, word: str) -> str:
+    return f"{n} {word}{'s' if n != 1 else ''}"
+
+
+def _span(values: Sequence[float]) -> str:
+    lo, hi = min(values), max(values)
+    return f"{lo:,.0f}" if lo == hi else f"{lo:,.0f}–{hi:,.0f}"
+
+
+# Costs.
+def hundredths_summing_to(values: list[float], total: float) -> list[float]:
+    """``values`` rounded to hundredths so that they add up to ``total`` rounded to hundredths (largest
+    remainder: each is rounded down, then the ones with the largest remainders get a hundredth more), so a
+    reader adding the parts finds the total shown beside them."""
+    scaled = [100.0 * v for v in values]
+    down = [math.floor(x) for x in scaled]
+    missing = round(100.0 * total) - sum(down)
+    order = sorted(range(len(values)), key=lambda k: scaled[k] - down[k], reverse=True)
+    for k in order[: max(0, min(missing, len(values)))]:
+        down[k] += 1
+    return [d / 100.0 for d in down]
+
+
+def cost_breakdown(terms: PairTerms, meas: str) -> str:
+    """A track's cost for detection ``meas`` in words: the nats its predicted existence, the uncertainty of its
+    predicted position, the distance and the detection's score add, and the constant the tracker adds to every
+    pair (``events.PairTerms``; the parts a tracker's cost does not have are left out)."""
+    parts: list[tuple[float, str]] = []
+    if terms.offset_text:
+        parts.append((terms.offset_nats, f"for {terms.offset_text}"))
+    if terms.existence is not None:
+        parts.append((terms.existence_nats, f"for its predicted existence {existence_text(terms.existence)}"))
+    parts.append((terms.spread_nats, f"for the uncertainty of its predicted position (±{terms.spread_m:.1f} m)"))
+    parts.append((terms.distance_nats, f"for the distance to {meas} (d² {terms.d2:.1f})"))
+    if terms.score is not None:
+        parts.append((terms.score_nats, f"for {meas}'s score {terms.score:.2f}"))
+    shown = hundredths_summing_to([v for v, _ in parts], terms.total_nats)
+    return " + ".join(f"{v:.2f} {text}" for v, (_, text) in zip(shown, parts, strict=True))
+
+
+def cost_brief(terms: PairTerms | None) -> str:
+    """What a track's cost depended on, briefly: ``existence 0.62, ±1.2 m, d² 0.3`` ("" without terms)."""
+    if terms is None:
+        return ""
+    existence = f"existence {existence_text(terms.existence)}, " if terms.existence is not None else ""
+    return f"{existence}±{terms.spread_m:.1f} m, d² {terms.d2:.1f}"
+
+
+def _brief(terms: PairTerms | None) -> str:
+    return f" at {cost_brief(terms)}" if terms is not None else ""
+
+
+def cost_value(value: float, choice: PairChoice) -> str:
+    """A cost on its scale: ``6.76`` (nats) or ``1.20 m``."""
+    unit = choice.scale.unit
+    return f"{value:.2f}" if unit == "nats" else f"{value:.2f} {unit}"
+
+
+def destination_text(went: int, born: bool, chosen: AxisLabel | None = None) -> str:
+    """``new track 212``, ``track 26``, ``new`` (started nothing with an id, or clutter)."""
+    if went < 0:
+        return "new" if chosen is None else column_name(chosen)
+    return f"new track {went}" if born else f"track {went}"
+
+
+def choice_why(c: PairChoice, went: str | None = None) -> str | None:
+    """Why a detection went to its chosen column rather than the track that was its next best: both costs, each
+    track's taken apart (when the tracker's matrix says what they are made of), and the predicted existence at
+    which that track would have been the cheaper of the two. went: how to name the chosen column ("new track
+    212"; default ``column_name``). None when the next best is not a track or its terms are unknown."""
+    alt = c.alternative_terms
+    if alt is None or c.alternative is None:
+        return None
+    meas = meas_name(c.meas.ref)
+    other = column_name(c.alternative)
+    if c.chosen.kind is AxisKind.NEW_TRACK:
+        chosen = went if went and went.startswith("new track ") else "a new track"
+    else:
+        chosen = went or column_name(c.chosen)
+    lines = [
+        f"{meas} went to {chosen} (cost {c.chosen_cost:.2f}) rather than {other} (cost {c.alternative_cost:.2f}): "
+        "the lower cost wins"
+    ]
+    if c.chosen_terms is not None:
+        lines.append(
+            f"{column_name(c.chosen).capitalize()}'s {c.chosen_cost:.2f} = {cost_breakdown(c.chosen_terms, meas)}"
+        )
+    lines.append(f"{other.capitalize()}'s {c.alternative_cost:.2f} = {cost_breakdown(alt, meas)}")
+    lines.append(_would_have(alt, other, c.alternative_cost - c.chosen_cost, meas))
+    return ". ".join(lines)
+
+
+def track_why(c: PairChoice, track_id: int, role: str = "") -> str | None:
+    """What track ``track_id`` (neither the chosen nor the next best column of ``c``; ``role``: words after its
+    name, e.g. ", which had the object,") would have cost for c's detection, taken apart, and what would have made
+    it cheaper than the chosen column; None when the matrix does not say or has no such track."""
+    if c.terms is None or c.row < 0:
+        return None
+    col = c.terms.column_of(track_id)
+    if col is None:
+        return None
+    t = c.terms.pair(c.row, col)
+    meas, name = meas_name(c.meas.ref), f"track {track_id}"
+    cost = f"Track {track_id}{role} would have cost {t.total_nats:.2f} = {cost_breakdown(t, meas)}"
+    return f"{cost}. {_would_have(t, name, t.total_nats - c.chosen_cost, meas)}"
+
+
+def _would_have(t: PairTerms, name: str, gap: float, meas: str) -> str:
+    """What would have made track ``name`` (terms ``t``) ``gap`` nats cheaper: its predicted existence (PMB
+    family) or its distance (GNN)."""
+    if t.existence is not None:
+        needed = t.existence_for(gap)
+        if needed is None:
+            return f"No predicted existence would have given {meas} to {name}"
+        now, above = existence_text(t.existence), existence_text(needed)
+        return f"With a predicted existence above {above} (instead of {now}), {name} would have taken {meas}"
+    closer = t.d2_for(gap)
+    if closer is None:
+        return f"Even with {meas} right on its prediction (d² 0), {name} would have cost more"
+    return f"Within d² {closer:.1f} (instead of {t.d2:.1f}), {name} would have taken {meas}"
+
+
+def choice_text(frame: int, c: PairChoice, went: int, born: bool) -> str:
+    """One solver choice: ``frame 19: m2 (score 0.75) → **new track 315** (cost 6.75) over track 61 (7.06 at
+    existence 0.05, ±2.6 m, d² 0.1), margin 0.31`` (costs on the tracker's scale)."""
+    other = "(no other)"
+    if c.alternative is not None:
+        other = f"over {column_name(c.alternative)} ({cost_value(c.alternative_cost, c)}{_brief(c.alternative_terms)})"
+    terms = c.chosen_terms or c.alternative_terms
+    score = f" (score {terms.score:.2f})" if terms is not None and terms.score is not None else ""
+    return (
+        f"frame {frame}: {meas_name(c.meas.ref)}{score} → **{destination_text(went, born, c.chosen)}** "
+        f"(cost {cost_value(c.chosen_cost, c)}) {other}, margin {cost_value(c.margin, c)}"
+    )
+
+
+def key_text(k: KeyDecision) -> str:
+    return choice_text(k.frame, k.choice, k.went, k.born)
+
+
+# How an update used detections.
+def share_text(share: float, mode: UseMode) -> str:
+    """A detection's share of an update in the tracker's terms: nothing for an assignment, ``p 0.93`` for an
+    association probability, ``91 % of its weight`` for a PHD weight."""
+    if mode is UseMode.ASSIGNED:
+        return ""
+    if mode is UseMode.PROBABILITIES:
+        return f"p {share:.2f}"
+    return f"{100 * share:.0f} % of its weight"
+
+
+def use_text(step: TrackStep) -> str:
+    """``used m5``, ``used m5 (p 1.00)``, ``took 91 % of its weight from m2``, ``missed`` — what one update did."""
+    use = step.use
+    if use is None or not use.shares:
+        return "missed"
+    verb = "was given" if use.mode is UseMode.ASSIGNED else "used"
+    parts = []
+    for m, share in use.shares[:2]:
+        extra = share_text(share, use.mode)
+        parts.append(f"{meas_name(m)}" + (f" ({extra})" if extra else ""))
+    more = f" +{len(use.shares) - 2} more" if len(use.shares) > 2 else ""
+    if use.mode is UseMode.WEIGHTS:
+        m, share = use.shares[0]
+        return f"took {100 * share:.0f} % of its weight from {meas_name(m)}{more}"
+    return f"{verb} {', '.join(parts)}{more}"
+
+
+def went_text(d: Destination | None, mode: UseMode) -> str:
+    """Where a detection went: ``→ track 26``, ``→ track 62 (p 1.00)``, ``→ new track 348``, ``→ new (no
+    track)``; ``not received (dropped by preprocessing)``."""
+    if d is None or d.went is Went.NOT_RECEIVED:
+        return "not received (dropped by preprocessing)"
+    if d.went is Went.TRACK:
+        extra = share_text(d.share, mode)
+        return f"→ track {d.track_id}" + (f" ({extra.replace(' of its weight', '')})" if extra else "")
+    if d.went is Went.NEW_TRACK:
+        return f"→ new track {d.track_id}"
+    return "→ new (started no track: a candidate or clutter)"
+
+
+def _existence_word(mode: UseMode) -> str:
+    return "weight" if mode is UseMode.WEIGHTS else "existence"
+
+
+# A finding.
+def whose_text(f: Finding) -> str:
+    """``the tracker's doing``, ``the detector's and the tracker's doing``."""
+    names = [p.value + "'s" for p in f.parties]
+    if not names:
+        return "cause unknown"
+    joined = names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+    return f"{joined} doing"
+
+
+def why_lines(f: Finding) -> list[str]:
+    """The **Why** paragraph (and the **Because** one when a solver's choice decided it), as markdown lines."""
+    match f.kind:
+        case FailureKind.ID_SWITCH | FailureKind.IDENTITY_THEFT | FailureKind.FRAGMENTATION:
+            parts = _lost_object(f)
+        case FailureKind.FALSE_TRACK:
+            parts = _false_track(f)
+        case FailureKind.MISS:
+            parts = _miss(f)
+        case FailureKind.COALESCENCE:
+            parts = _coalescence(f)
+        case _:
+            raise AssertionError(f.kind)
+    parts += _others(f)
+    lines = [f"**Why** ({f.tracker}, {whose_text(f)}): " + "; ".join(p for p in parts if p) + ".", ""]
+    because = because_text(f)
+    if because:
+        lines += [because, ""]
+    return lines
+
+
+def evaluation_lines(f: Finding) -> list[str]:
+    """A paragraph per object the evaluation scored at an interpolated box ``EVALUATED_OFFSET_M`` or more from its
+    annotation (the blame ``INTERPOLATED``): where, why, and which tracks were within reach of each box."""
+    if not any(b.rule is Rule.INTERPOLATED for b in f.blame) or f.gt_id is None:
+        return []
+    s = f.sighting(f.frame)
+    g = s.evaluated if s is not None else None
+    if g is None or g.evaluated_xy_m is None:
+        return []
+    why = f"its annotated box was dropped ({g.dropped.value if g.dropped else 'dropped'}), so the evaluation "
+    why += "interpolated one" + _between(g)
+    out = []
+    r = f.reach
+    if r is not None:
+
+        def tracks(ids: tuple[int, ...]) -> str:
+            return f"{f.tracker} track{'s' if len(ids) > 1 else ''} {', '.join(map(str, ids))}" if ids else "no track"
+
+        if r.near_annotated and not r.near_evaluated:
+            out += [
+                f"**Verdict: the evaluation's doing.** {tracks(r.near_annotated)} followed the annotated object, but "
+                f"the evaluation scored it against a box {r.offset_m:.1f} m away.",
+                "",
+            ]
+        reach = (
+            f" Within {NEAR_M:.0f} m of the evaluated box: {tracks(r.near_evaluated)}. Within {NEAR_M:.0f} m of the "
+            f"annotated box: {tracks(r.near_annotated)}."
+        )
+    else:
+        reach = ""
+    return out + [
+        f"**GT {short_id(f.gt_id)} as evaluated**: at frame {f.frame} {why}; that box lies **{g.offset_m:.1f} m** "
+        f"from the annotated one (the column beside the views labels both).{reach}",
+        "",
+    ]
+
+
+def _between(g: GtFrame) -> str:
+    if g.between is None:
+        return ""
+    left, right = g.between
+    text = f" from frames {left} and {right}"
+    if g.unswapped_xy_m is not None and g.evaluated_xy_m is not None:
+        off = math.hypot(g.unswapped_xy_m[0] - g.evaluated_xy_m[0], g.unswapped_xy_m[1] - g.evaluated_xy_m[1])
+        if off >= 0.05:
+            right_way = math.hypot(g.unswapped_xy_m[0] - g.annotated_xy_m[0], g.unswapped_xy_m[1] - g.annotated_xy_m[1])
+            text += (
+                f", but it weights the two ends the wrong way round (nuscenes-devkit issue #1141): weighted the right "
+                f"way the box would lie {right_way:.1f} m from the annotation"
+            )
+    return text
+
+
+def because_text(f: Finding) -> str | None:
+    """The deciding choice's costs taken apart, and the lost track's own cost when it was neither of the compared
+    columns; None without a deciding choice whose next best was a track with known cost terms."""
+    d = f.decision
+    if d is None:
+        return None
+    why = choice_why(d.choice, destination_text(d.went, d.born, d.choice.chosen))
+    if why is None:
+        return None
+    if d.lost is not None:
+        if not d.lost_in_gate:
+            why += f". {meas_name(d.choice.meas.ref)} was outside the gate of track {d.lost}, which had the object"
+        elif (lost_why := track_why(d.choice, d.lost, ", which had the object,")) is not None:
+            why += f". {lost_why}"
+    back = f.frame - d.frame
+    where = f"; the views open at frame {f.frame}: step back {plural(back, 'frame')} to see it" if back > 0 else ""
+    return f"**Because** (frame {d.frame}{where}): {why}."
+
+
+def _presence(f: Finding) -> str:
+    """How often the object had a detection of its class within reach, over the window."""
+    seen = [s for s in f.sightings]
+    if not seen or f.gt_id is None:
+        return ""
+    detected = [s.frame for s in seen if s.nearest_own is not None]
+    at = frames_text(detected) if detected else "no frame"
+    only = " only" if 0 < len(detected) < len(seen) else ""
+    return (
+        f"in the {len(seen)} recorded frames up to {f.frame} ({seen[0].frame}–{seen[-1].frame}), GT "
+        f"{short_id(f.gt_id)} had a {f.class_name} detection within {NEAR_M:.0f} m at {at}{only}"
+    )
+
+
+def _detector_gaps(f: Finding) -> list[str]:
+    out = []
+    by = {s.frame: s for s in f.sightings}
+    for b in f.blame:
+        if b.rule is Rule.NO_DETECTION:
+            seen = [x for x in b.frames if x in by and by[x].points > 0]
+            hidden = [x for x in b.frames if x in by and by[x].points == 0]
+            if seen:
+                points = [by[x].points for x in seen]
+                out.append(
+                    f"at {frames_text(seen)} the detector gave no detection of any class within {NEAR_M:.0f} m, "
+                    f"though it had {_span(points)} LiDAR and radar points"
+                )
+            if hidden:
+                out.append(
+                    f"at {frames_text(hidden)} it had no LiDAR or radar points (no detector could see it) and had no "
+                    f"detection within {NEAR_M:.0f} m"
+                )
+        elif b.rule is Rule.OTHER_CLASS:
+            seen = [by[x].nearest_any for x in b.frames if x in by and by[x].nearest_any is not None]
+            what = ", ".join(f"{n.class_name} {meas_name(n.meas)} {n.distance_m:.2f} m away" for n in seen)
+            out.append(f"at {frames_text(b.frames)} the detector saw it only as another class ({what})")
+    return out
+
+
+def _lost_story(f: Finding, lost: LostTrack) -> str:
+    """What the lost track did over the window, in the tracker's terms."""
+    mode = UseMode(f.mode)
+    t = lost.track_id
+    steps = lost.steps
+    parts = []
+    if lost.held_until is not None:
+        parts.append(f"track {t} was last output on it at frame {lost.held_until}")
+    if f.has_existence and steps:
+        word = _existence_word(mode)
+        alive = [s for s in steps if s.posterior_existence is not None]
+        if alive:
+            peak = max(alive, key=lambda s: s.posterior_existence)
+            last = alive[-1]
+            if existence_text(peak.posterior_existence) == existence_text(last.posterior_existence):
+                span = f"frame {last.frame}" if peak.frame == last.frame else f"frames {alive[0].frame}–{last.frame}"
+                parts.append(f"its {word} was {existence_text(last.posterior_existence)} ({span})")
+            else:
+                parts.append(
+                    f"its {word} went from {existence_text(peak.posterior_existence)} (frame {peak.frame}) to "
+                    f"{existence_text(last.posterior_existence)} (frame {last.frame})"
+                )
+    deciding = [s for s in steps if s.frame in f.deciding]
+    used = [s for s in deciding if s.used]
+    if used and mode is not UseMode.ASSIGNED:
+        parts.append("; ".join(f"at frame {s.frame} it {use_text(s)}" for s in used))
+    not_output = [x for x in f.deciding if lost.step(x) is None or lost.step(x).output is None]
+    ended = next((s for s in steps if s.ended is not None), None)
+    if not_output:
+        parts.append(f"it was not output at {frames_text(not_output)}")
+    if ended is not None:
+        e = ended.ended
+        if e.ending is Ending.DELETED and e.hits >= 0:
+            parts.append(f"its track logic deleted it at frame {ended.frame} ({e.hits} of {e.window} hits)")
+        elif e.ending is Ending.DELETED:
+            parts.append(f"its track logic deleted it at frame {ended.frame}")
+        else:
+            parts.append(f"it was {e.ending.value} at frame {ended.frame} ({e.reason.value})")
+    return ", ".join(parts)
+
+
+def _unused(f: Finding) -> list[tuple[tuple[int, int], str]]:
+    """The deciding frames where a detection of the object was there and the lost track's update did not use it:
+    ((frame, detection), text)."""
+    mode = UseMode(f.mode)
+    out = []
+    for b in f.blame:
+        if b.rule is not Rule.DETECTION_UNUSED:
+            continue
+        for x in b.frames:
+            s = f.sighting(x)
+            if s is None:
+                continue
+            n = s.nearest_own
+            if n is None:
+                m = s.nearest_any
+                text = (
+                    f"at frame {x} {meas_name(m.meas)} ({f.class_name}, score {m.score:.2f}, {m.distance_m:.1f} m "
+                    "from it) was dropped by preprocessing (score threshold or NMS)"
+                )
+                out.append(((x, m.meas), text))
+                continue
+            gate = ""
+            if f.lost is not None:
+                step = f.lost.step(x)
+                nis = next((d2 for m, d2 in (step.gated if step is not None else ()) if m == n.meas), None)
+                if nis is not None:
+                    gate = f", in track {f.lost.track_id}'s gate at NIS {nis:.1f}"
+                elif step is None or step.ended is not None:
+                    gate = f"; track {f.lost.track_id} was gone"
+            text = (
+                f"at frame {x} {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m from it{gate}) "
+                f"{went_text(s.went, mode)}"
+            )
+            out.append(((x, n.meas), text))
+    return out
+
+
+def _lost_object(f: Finding) -> list[str]:
+    parts = [_presence(f)]
+    parts += _detector_gaps(f)
+    lost = f.lost
+    if lost is not None:
+        parts.append(_lost_story(f, lost))
+        parts += _counted_unshown(f, lost)
+    decided = (f.decision.frame, int(f.decision.choice.meas.ref)) if f.decision is not None else None
+    parts += [text for key, text in _unused(f) if key != decided]
+    if f.switch is not None:
+        parts.append(_switch_text(f))
+    if f.decision is not None:
+        parts.append(f"then, {choice_text(f.decision.frame, f.decision.choice, f.decision.went, f.decision.born)}")
+        parts += _where_from(f)
+    elif f.taker is not None and f.taker.frame >= 0:
+        o = f.taker
+        if o.meas >= 0:
+            parts.append(f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}")
+        elif f.switch is not None:
+            parts.append(f"track {o.track_id} had existed since frame {o.frame} in a hypothesis other than the best")
+    if lost is not None and lost.off is not None:
+        parts.append(_off_text(f, lost))
+    if f.taker is not None and f.taker.false_frames:
+        victim = f"track {lost.track_id}" if lost is not None else "another track"
+        parts.append(
+            f"track {f.taker.track_id} had been a false track at {frames_text(f.taker.false_frames)} (matched to no "
+            f"object: the evaluation still gave GT {short_id(f.gt_id or '')} to {victim}), so its taking the object "
+            "is an identity theft"
+        )
+    return parts
+
+
+def _where_from(f: Finding) -> list[str]:
+    """When the deciding choice's next best is a track between the two (neither lost nor taker), where it came
+    from: the earlier key decision that started it."""
+    d = f.decision
+    alt = d.choice.alternative
+    named = {f.lost.track_id if f.lost else None, f.taker.track_id if f.taker else None}
+    if alt is None or alt.kind is not AxisKind.TRACK or alt.ref in named:
+        return []
+    started = [k for k in f.key_decisions if k.frame < d.frame and k.born and k.went == alt.ref]
+    if not started:
+        return []
+    k = started[-1]
+    instead = f" instead of going to {column_name(k.choice.alternative)}" if k.choice.alternative is not None else ""
+    return [f"track {alt.ref} had been started at frame {k.frame} by {meas_name(k.choice.meas.ref)}{instead}"]
+
+
+def _switch_text(f: Finding) -> str:
+    s = f.switch
+    head = (
+        f"at frame {s.frame} the best hypothesis switched: it descends from prior hypothesis {s.parent} "
+        f"(probability {s.parent_weight:.2f} after frame {s.frame - 1}, against {s.best_weight:.2f} for the best), "
+        "not from a cost choice within the best"
+    )
+    rows = []
+    for t in s.tracks:
+        bits = []
+        if t.since is not None:
+            bits.append(f"held by a kept hypothesis since frame {t.since}")
+        if t.decided is not None:
+            bits.append(f"predicted existence {existence_text(t.decided)} in hypothesis {s.parent}")
+        if t.predicted is not None and (t.decided is None or existence_text(t.decided) != existence_text(t.predicted)):
+            bits.append(f"{existence_text(t.predicted)} in the previous best")
+        elif t.predicted is None:
+            bits.append("absent from the previous best")
+        if t.chosen is not None and t.marginal is not None:
+            bits.append(
+                f"after the update {existence_text(t.chosen)} in the chosen hypothesis, "
+                f"{existence_text(t.marginal)} over all kept ones"
+            )
+        rows.append(f"track {t.track_id}: " + ", ".join(bits))
+    return head + " (" + "; ".join(rows) + ")"
+
+
+def _off_text(f: Finding, lost: LostTrack) -> str:
+    off = lost.off
+    on = f", on {meas_name(off.meas)}" if off.meas >= 0 else ""
+    before = ""
+    if off.earlier:
+        away = ", ".join(f"{x} ({meas_name(m)})" for x, m in off.earlier)
+        before = (
+            f"; it had used detections {NEAR_M:.0f} m or more from the object at frame"
+            f"{'s' if len(off.earlier) > 1 else ''} {away}"
+        )
+    return (
+        f"at frame {f.frame} track {lost.track_id} was output {off.distance_m:.1f} m from GT "
+        f"{short_id(f.gt_id or '')}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the "
+        f"object{before}"
+    )
+
+
+def averaged_text(ev: TrackEval) -> str:
+    """``its score averaged over the 31 frames the evaluation kept (of 38 submitted), 0.660``."""
+    kept, submitted = len(ev.kept), len(ev.submitted)
+    over = (
+        f"over its {plural(kept, 'frame')}"
+        if kept == submitted
+        else f"over the {kept} of its {submitted} frames the evaluation kept (within the class range)"
+    )
+    return f"its score averaged {over}, {ev.averaged_score:.3f}"
+
+
+def _counted_unshown(f: Finding, lost: LostTrack) -> list[str]:
+    """Why a track never shown (existence below ``SHOW_MIN_EXISTENCE``) still counted for the evaluation."""
+    ev, threshold = lost.evaluated, lost.threshold
+    if not f.has_existence or ev is None or ev.averaged_score is None or threshold is None:
+        return []
+    if ev.averaged_score < threshold or any(
+        s.output is not None and s.output.existence >= SHOW_MIN_EXISTENCE for s in lost.steps
+    ):
+        return []
+    if math.isclose(ev.averaged_score, threshold, rel_tol=1e-9):
+        versus = f"is exactly the {f.class_name} threshold (the lowest score counted)"
+    else:
+        versus = f"is above the {f.class_name} threshold {threshold:.3f}"
+    return [
+        f"too low for track {lost.track_id} to be shown here (existence below {SHOW_MIN_EXISTENCE:g}), yet the "
+        f"evaluation counted it: {averaged_text(ev)}, {versus}"
+    ]
+
+
+def _near_text(n: Near) -> str:
+    return f"{meas_name(n.meas)} ({n.class_name}, score {n.score:.2f})"
+
+
+def _false_track(f: Finding) -> list[str]:
+    o: FalseOutput = f.false_output
+    head = f"at frame {f.frame} track {o.track_id} ({f.class_name}) was output on "
+    head += f"detection {_near_text(o.on)}" if o.on is not None else "no detection this frame (a predicted box)"
+    parts = [head]
+    tests = {b.rule for b in f.blame}
+    if o.nearest_own is not None:
+        gt_id, d, g = o.nearest_own
+        on = f"{f.class_name} GT {short_id(gt_id)} lies {d:.1f} m away"
+        if Rule.NO_EVAL_BOX in tests:
+            parts.append(
+                f"{on}, but the evaluation has no box for it here ({_no_box_reason(g)}): a track on it is false"
+            )
+        elif Rule.INTERPOLATED in tests:
+            parts.append(
+                f"{on}, but the evaluation has it interpolated {g.offset_m:.1f} m from the annotation, out of the "
+                "track's reach (see nuscenes-devkit issue #1141)"
+            )
+        else:
+            other = f" (track {o.matched_instead})" if o.matched_instead is not None else ""
+            parts.append(f"{on} and the evaluation matched it to another track{other}: two tracks on one object")
+    elif o.nearest_any is not None:
+        gt_id, cls, d = o.nearest_any
+        what = "the detector gave it the wrong class" if o.on is not None else "the track coasted onto it"
+        parts.append(
+            f"no {f.class_name} GT lies within {NEAR_M:.0f} m, but GT {cls} {short_id(gt_id)} does ({d:.1f} m): {what}"
+        )
+    elif o.on is not None:
+        parts.append(f"no object of any class lies within {NEAR_M:.0f} m: a detection of nothing")
+    else:
+        parts.append(f"no object of any class lies within {NEAR_M:.0f} m: the tracker output a box where nothing was")
+    ev = o.evaluated
+    if ev is not None and ev.averaged_score is not None and o.threshold is not None:
+        parts.append(
+            f"the evaluation counted the track: {averaged_text(ev)}, is at least the {f.class_name} threshold "
+            f"{o.threshold:.3f}"
+        )
+    return parts
+
+
+def _no_box_reason(g: GtFrame | None) -> str:
+    if g is None:
+        return "it is not annotated here"
+    if g.status is GtStatus.BEYOND_RANGE:
+        return (
+            f"it lies {g.ego_distance_m:.2f} m from the ego vehicle, beyond the evaluation's {g.range_m:g} m range, "
+            "and it keeps no box of it both before and after this frame"
+        )
+    return f"its box was dropped ({g.dropped.value if g.dropped else 'unknown'}) and could not be interpolated"
+
+
+def _miss(f: Finding) -> list[str]:
+    s = f.sighting(f.frame)
+    if s is None or f.gt_id is None:
+        return []
+    name = f"{f.class_name} GT {short_id(f.gt_id)}"
+    mode = UseMode(f.mode)
+    inside = f"{s.points} LiDAR and radar points in its box"
+    parts = []
+    if s.nearest_any is None:
+        parts.append(
+            f"at frame {f.frame} the detector gave no detection within {NEAR_M:.0f} m of {name} ({inside}): the "
+            "detector missed it"
+        )
+    elif s.nearest_own is None and s.nearest_any.class_name != f.class_name:
+        n = s.nearest_any
+        parts.append(
+            f"at frame {f.frame} the detector gave no {f.class_name} detection within {NEAR_M:.0f} m of {name} "
+            f"({inside}), but a {n.class_name} detection, {meas_name(n.meas)} (score {n.score:.2f}), "
+            f"{n.distance_m:.1f} m away: the detector gave it the wrong class"
+        )
+    elif s.nearest_own is None:
+        n = s.nearest_any
+        parts.append(
+            f"at frame {f.frame} detection {meas_name(n.meas)} (score {n.score:.2f}) lay {n.distance_m:.1f} m from "
+            f"{name} but was dropped by preprocessing (score threshold or NMS)"
+        )
+    else:
+        n = s.nearest_own
+        parts.append(
+            f"at frame {f.frame} detection {meas_name(n.meas)} (score {n.score:.2f}) lay {n.distance_m:.1f} m from "
+            f"{name} and went {went_text(s.went, mode).removeprefix('→ ')}"
+        )
+        if s.went is not None and s.went.track_id >= 0 and s.went.track_id not in {o.track_id for o in s.on_it}:
+            parts.append(f"track {s.went.track_id} was not output on it")
+    for o in s.on_it:
+        if not o.counted and o.evaluated is not None and o.evaluated.averaged_score is not None:
+            parts.append(
+                f"track {o.track_id} was output on it (score {o.score:.2f}), but {averaged_text(o.evaluated)}, is "
+                f"below the {f.class_name} threshold {o.threshold:.3f}: the evaluation did not count it"
+            )
+    if s.nearest_own is not None and not s.on_it:
+        parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
+    g = s.evaluated
+    if g is not None and g.status is GtStatus.INTERPOLATED and g.offset_m >= 0.05:
+        parts.append(
+            f"the evaluation scored it at a box it interpolated{_between(g)}, {g.offset_m:.1f} m from the annotation"
+        )
+    if g is not None and abs(g.ego_distance_m - g.range_m) <= 5.0:
+        side = "inside" if g.ego_distance_m < g.range_m else "beyond"
+        parts.append(
+            f"it lies {g.ego_distance_m:.1f} m from the ego vehicle, {side} the evaluation's {g.range_m:g} m range"
+        )
+    return parts
+
+
+def _coalescence(f: Finding) -> list[str]:
+    s = f.sighting(f.frame)
+    t = f.track_ids[0]
+    covered = ", ".join(f"GT {short_id(g)}" for g in f.covered)
+    parts = [
+        f"at frame {f.frame} track {t} was matched to {covered} and also lay within {NEAR_M:.0f} m of "
+        f"GT {short_id(f.gt_id or '')}, which no counted track covered"
+    ]
+    if s is None:
+        return parts
+    mode = UseMode(f.mode)
+    if s.nearest_any is None:
+        parts.append(
+            f"the detector gave GT {short_id(f.gt_id or '')} no detection of its own within {NEAR_M:.0f} m "
+            f"({s.points} LiDAR and radar points): one detection, or none, for two objects"
+        )
+    elif s.nearest_own is not None:
+        n = s.nearest_own
+        parts.append(
+            f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) went "
+            f"{went_text(s.went, mode).removeprefix('→ ')}"
+        )
+    return parts
+
+
+def _others(f: Finding) -> list[str]:
+    out = []
+    for o in f.others:
+        counted = [x for x in o.on_it if x.counted]
+        if o.failed_same:
+            out.append(f"{o.tracker} on the same detections failed here too")
+        elif counted:
+            ids = ", ".join(str(x.track_id) for x in counted)
+            out.append(
+                f"{o.tracker} on the same detections did not fail here: its track{'s' if len(counted) > 1 else ''} "
+                f"{ids} {'were' if len(counted) > 1 else 'was'} output on the object and counted"
+            )
+        else:
+            out.append(f"{o.tracker} on the same detections did not have this failure")
+    return out
+
+
+def summary_line(f: Finding) -> str:
+    """One line for ``gnnpmb failures --why``: whose doing and the tests that held."""
+    tests = "; ".join(f"{_RULE_WORDS[b.rule]} at {frames_text(b.frames)}" for b in f.blame)
+    return f"{whose_text(f)}: {tests}" if tests else whose_text(f)
+
+
+_RULE_WORDS = {
+    Rule.NO_DETECTION: "no detection of any class within 2 m",
+    Rule.OTHER_CLASS: "detected only as another class",
+    Rule.DETECTION_OF_NOTHING: "output on a detection of no object",
+    Rule.DETECTION_UNUSED: "a detection of it was there, not used by the track that had it",
+    Rule.NOT_OUTPUT: "the track on it was not output",
+    Rule.OFF_OBJECT: "the track was output 2 m or more from it",
+    Rule.NOT_COUNTED: "a track on it was output but not counted (averaged score below the threshold)",
+    Rule.TWO_TRACKS: "two tracks on one object",
+    Rule.COASTED: "output without a detection where nothing was",
+    Rule.COVERED_TWO: "one track covered two objects",
+    Rule.INTERPOLATED: "scored at an interpolated box 0.5 m or more from the annotation",
+    Rule.NO_EVAL_BOX: "the evaluation has no box of the object",
+}
+
+
+def on_object_text(o: OnObject) -> str:
+    """A track output on an object, for the object's table: ``62 (0.92; track average 0.69)``."""
+    if o.threshold is None:
+        return f"{o.track_id} ({o.score:.2f})"
+    ev = o.evaluated
+    if ev is None or ev.averaged_score is None:
+        return f"{o.track_id} ({o.score:.2f}; not evaluated: beyond the class range)"
+    return f"{o.track_id} ({o.score:.2f}; track average {ev.averaged_score:.2f}" + (
+        ", not counted)" if not o.counted else ")"
+    )
+
+
+def party_names() -> dict[Party, str]:
+    return {p: p.value for p in Party}
+
+
+def sighting_points(s: Sighting) -> str:
+    """The table's "points in box" cell: the count and how the evaluation scored the object there."""
+    g = s.evaluated
+    if g is None:
+        return f"{s.points}"
+    match g.status:
+        case GtStatus.SCORED:
+            return f"{s.points}"
+        case GtStatus.INTERPOLATED:
+            return f"{s.points}: interpolated by the evaluation ({g.offset_m:.1f} m off)"
+        case GtStatus.BEYOND_RANGE:
+            return f"{s.points}: beyond the {g.range_m:g} m range, not scored"
+        case GtStatus.NO_BOX:
+            return f"{s.points}: no box ({g.dropped.value if g.dropped else 'dropped'}), not scored"
+    raise AssertionError(g.status)
+
+
+def other_runs(others: Sequence[OtherRun]) -> list[str]:
+    return [f"{o.tracker}: {'failed too' if o.failed_same else 'no such failure'}" for o in others]

@@ -1,0 +1,135 @@
+"""Sentences of a finding (``why.words``) from hand-made findings: what each part says, exactly."""
+
+from __future__ import annotations
+
+from gnnpmb.eval.evaluated import TrackEval
+from gnnpmb.eval.failures import FailureKind
+from gnnpmb.events import PruneReason
+from gnnpmb.types import TrackEstimate
+from gnnpmb.why.facts import Destination, Ending, TrackEnd, TrackStep, Use, UseMode, Went
+from gnnpmb.why.findings import Blame, Finding, LostTrack, Near, OffObject, Origin, Rule, Sighting
+from gnnpmb.why.words import averaged_text, use_text, whose_text, why_lines
+
+GT = "bf3d85" + "0" * 26
+
+
+def estimate(track_id: int, existence: float) -> TrackEstimate:
+    return TrackEstimate(
+        track_id, "bicycle", (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (1.0, 0.0, 0.0, 0.0), (0.0, 0.0), 0.01, existence
+    )
+
+
+def step(
+    frame: int, *, used: int | None = None, output: TrackEstimate | None = None, r: float = 0.01, **kw
+) -> TrackStep:
+    use = Use(((used, 1.0),), 0.0, UseMode.ASSIGNED) if used is not None else Use((), 1.0, UseMode.ASSIGNED)
+    return TrackStep(frame, r, (0.0, 0.0), (), use, None, r, output, **kw)
+
+
+def finding(kind: FailureKind, lost: LostTrack | None = None, **kw) -> Finding:
+    base = dict(
+        failure_id=f"{kind.value}:1",
+        kind=kind,
+        tracker="gnnpmb",
+        frame=13,
+        class_name="bicycle",
+        gt_id=GT,
+        track_ids=(26, 212),
+        window=(5, 13),
+        deciding=(13,),
+        blame=(),
+        sightings=(),
+        mode="assigned",
+        has_existence=True,
+        lost=lost,
+    )
+    base.update(kw)
+    return Finding(**base)
+
+
+def test_a_track_never_shown_is_said_to_count_when_its_average_reaches_the_threshold() -> None:
+    evaluated = TrackEval((5, 6, 7), (5, 6, 7), (), 0.037, 0.037)
+    lost = LostTrack(26, 7, (step(7, output=estimate(26, 0.01)),), None, evaluated, 0.037)
+    (line, _) = why_lines(finding(FailureKind.ID_SWITCH, lost))
+    assert (
+        "too low for track 26 to be shown here (existence below 0.5), yet the evaluation counted it: its score "
+        "averaged over its 3 frames, 0.037, is exactly the bicycle threshold (the lowest score counted)" in line
+    )
+    shown = LostTrack(26, 7, (step(7, output=estimate(26, 0.9)),), None, evaluated, 0.037)
+    assert "too low" not in why_lines(finding(FailureKind.ID_SWITCH, shown))[0]  # it was shown: nothing to explain
+
+
+def test_the_averaged_score_names_the_frames_the_evaluation_kept_when_not_all() -> None:
+    assert averaged_text(TrackEval(tuple(range(38)), tuple(range(21)), (), 0.587, 0.660)) == (
+        "its score averaged over the 21 of its 38 frames the evaluation kept (within the class range), 0.660"
+    )
+    assert averaged_text(TrackEval((1, 2), (1, 2), (), 0.5, 0.5)) == "its score averaged over its 2 frames, 0.500"
+
+
+def test_an_identity_theft_names_the_frames_its_thief_was_a_false_track() -> None:
+    lost = LostTrack(61, 13, (), None, None, None)
+    f = finding(FailureKind.IDENTITY_THEFT, lost, taker=Origin(315, 12, 2, (12, 13)), frame=14)
+    assert (
+        "track 315 had been a false track at frames 12, 13 (matched to no object: the evaluation still gave GT bf3d85 "
+        "to track 61), so its taking the object is an identity theft" in why_lines(f)[0]
+    )
+
+
+def test_a_lost_track_output_away_from_its_object_is_traced_to_the_detections_that_led_it_off() -> None:
+    lost = LostTrack(25, 9, (), OffObject(5.4, 0, ((10, 0),)), None, None)
+    line = why_lines(finding(FailureKind.ID_SWITCH, lost, frame=11, has_existence=False))[0]
+    assert (
+        "at frame 11 track 25 was output 5.4 m from GT bf3d85, on m0: beyond the evaluation's 2 m, so it no longer "
+        "matched the object; it had used detections 2 m or more from the object at frame 10 (m0)" in line
+    )
+
+
+def test_a_soft_update_is_told_in_its_own_terms_never_as_no_detection() -> None:
+    jpda = TrackStep(
+        10, 1.0, (0.0, 0.0), ((0, 0.1),), Use(((0, 0.9999),), 0.0001, UseMode.PROBABILITIES), None, 1.0, None
+    )
+    assert use_text(jpda) == "used m0 (p 1.00)"
+    phd = TrackStep(8, 1.0, (0.0, 0.0), ((2, 0.4),), Use(((2, 0.91),), 0.09, UseMode.WEIGHTS), None, 1.0, None)
+    assert use_text(phd) == "took 91 % of its weight from m2"
+    hard = TrackStep(5, 0.9, (0.0, 0.0), (), Use(((8, 1.0),), 0.0, UseMode.ASSIGNED), None, 1.0, None)
+    assert use_text(hard) == "was given m8"
+    missed = TrackStep(6, 0.9, (0.0, 0.0), (), Use((), 1.0, UseMode.ASSIGNED), None, 0.5, None)
+    assert use_text(missed) == "missed"
+
+
+def test_whose_doing_names_every_party_whose_test_held_in_order() -> None:
+    f = finding(
+        FailureKind.ID_SWITCH,
+        blame=(Blame(Rule.NO_DETECTION, (12, 13, 14)), Blame(Rule.NOT_OUTPUT, (12, 13, 14, 15))),
+    )
+    assert whose_text(f) == "the detector's and the tracker's doing"
+    assert whose_text(finding(FailureKind.MISS, blame=(Blame(Rule.INTERPOLATED, (13,)),))) == "the evaluation's doing"
+
+
+def test_a_deleted_track_and_a_detection_that_started_another_are_both_said() -> None:
+    ended = TrackEnd(Ending.DELETED, PruneReason.TRACK_LOGIC, 1.0, 0, 3)
+    steps = (step(11, used=11, output=estimate(62, 1.0), r=1.0), step(14, r=1.0, ended=ended))
+    lost = LostTrack(62, 11, steps, None, None, None)
+    sighting = Sighting(
+        15,
+        1731,
+        None,
+        Near(0, "bicycle", 0.89, 0.1, True),
+        Near(0, "bicycle", 0.89, 0.1, True),
+        Destination(0, Went.NEW_TRACK, 348),
+        (),
+    )
+    f = finding(
+        FailureKind.ID_SWITCH,
+        lost,
+        frame=16,
+        deciding=(12, 13, 14, 15, 16),
+        sightings=(sighting,),
+        blame=(Blame(Rule.DETECTION_UNUSED, (15,)), Blame(Rule.NOT_OUTPUT, (12, 13, 14, 15, 16))),
+        mode="association probabilities",
+        has_existence=False,
+    )
+    line = why_lines(f)[0]
+    assert "its track logic deleted it at frame 14 (0 of 3 hits)" in line
+    assert "at frame 15 m0 (score 0.89, 0.1 m from it; track 62 was gone) → new track 348" in line
+    assert "given no detection" not in line and "?" not in line
