@@ -242,10 +242,17 @@ def failures(
     json_out: Annotated[
         Path | None, typer.Option("--json", metavar="FILE.json", help="Also write the report as JSON here.")
     ] = None,
+    why: Annotated[
+        bool,
+        typer.Option(
+            "--why", help="Explain each failure: whose doing, why and because (with --json: the typed findings)."
+        ),
+    ] = False,
 ) -> None:
     """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
     coalescence and cascading identity theft (scored with the devkit's own matching)."""
-    from gnnpmb.registry import check_tracker
+    from gnnpmb.registry import check_tracker, tracker_has_existence
+    from gnnpmb.why.facts import FactSink
 
     json_target = check_output_file(json_out, "--json") if json_out is not None else None
     check_tracker(tracker)
@@ -264,16 +271,47 @@ def failures(
     location = resolve_dataroot(dataroot, version, (scene,))
     nusc = open_nuscenes(location)
     scene_data = load_scene(nusc, location, scene)
-    run = run_tracker(scene_data, get_detections(scene_data, detections, preset, seed), tracker, config)
+    fact_sink = FactSink(tracker, has_existence=tracker_has_existence(tracker)) if why else None
+    run = run_tracker(
+        scene_data, get_detections(scene_data, detections, preset, seed), tracker, config, sink=fact_sink
+    )
     results = run_results(run)
     report = cached_report(
         cache_root(), location, scene, tracker, results, lambda: find_failures(nusc, scene, results, tracker)
     )
+    findings = []
+    if fact_sink is not None:
+        from gnnpmb.focus import FRAMES_BEFORE
+        from gnnpmb.why.reason import Evidence, explain_failure
+
+        evidence = Evidence(report, fact_sink.facts, run)
+        findings = [
+            explain_failure(fid, evidence, scene_data, first_frame=max(0, f.frame_index - FRAMES_BEFORE))
+            for fid, f in zip(report.ids(), report.failures, strict=True)
+        ]
     if json_target is not None:
-        write_json(json_target, report.to_json())
+        data = report.to_json()
+        if why:
+            from gnnpmb.why.serialize import finding_json
+
+            data["findings"] = [finding_json(f) for f in findings]
+        write_json(json_target, data)
     print_report(report, _stdout())
+    if why:
+        print_findings(findings, _stdout())
     if json_out is not None:
         typer.echo(f"report -> {json_out}")
+
+
+def print_findings(findings: list, console: Console) -> None:
+    """Each failure's finding: its id and whose doing, then its Why and Because lines (``why.words``)."""
+    from gnnpmb.why.words import plain, whose_text, why_lines
+
+    for f in findings:
+        console.print(f"{f.failure_id} (frame {f.frame}, {f.class_name}): {whose_text(f)}", highlight=False)
+        for line in why_lines(f):
+            if line:
+                console.print(f"  {plain(line)}", highlight=False, soft_wrap=True)
 
 
 def print_report(report: FailureReport, console: Console) -> None:

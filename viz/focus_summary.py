@@ -24,6 +24,7 @@ from gnnpmb.why.words import (
     column_name,
     cost_brief,
     cost_value,
+    destination_name,
     evaluation_lines,
     existence_text,
     frames_text,
@@ -148,7 +149,7 @@ def _parting(focus: FocusTarget, views: Mapping[str, TrackerView]) -> list[str]:
             ids = set(focus.track_ids.get(t, ()))
             d, ch = went[t], choices[t].get(m)
             touches |= d is not None and d.track_id in ids
-            text = went_text(d, uses[t].mode if uses[t] is not None else UseMode.ASSIGNED).removeprefix("→ ")
+            text = destination_name(d, uses[t].mode if uses[t] is not None else UseMode.ASSIGNED)
             if ch is None:
                 parts.append(f"{t}: {meas_name(m)} → **{text}**")
                 continue
@@ -250,7 +251,7 @@ def _gt_markdown(focus: FocusTarget, view: TrackerView, gt_id: str, seen: tuple[
         if s.nearest_own is not None:
             n = s.nearest_own
             nearest = f"m{n.meas} at {n.distance_m:.1f} m (score {n.score:.2f})"
-            sent = went_text(s.went, mode).removeprefix("→ ")
+            sent = destination_name(s.went, mode)
         elif s.nearest_any is not None:
             n = s.nearest_any
             why = "another class" if n.class_name != focus.class_name else "dropped by preprocessing"

@@ -10,7 +10,8 @@ so a test can check every assertion against independent facts.
 The tests of ``Blame`` (``Rule``) are stated once, here:
 
 * **the detector's**: in a frame that decided the failure, no detection of any class and score within
-  ``NEAR_M`` of the object (``NO_DETECTION``), only detections of another class (``OTHER_CLASS``), or the false
+  ``NEAR_M`` of the object while it had LiDAR or radar points (``NO_DETECTION``), only detections of another
+  class (``OTHER_CLASS``), or the false
   track was output on a detection that lies within ``NEAR_M`` of no object (``DETECTION_OF_NOTHING``);
 * **the tracker's**: a detection of the object's class was within ``NEAR_M`` and the update of the track that had
   the object did not use it (``DETECTION_UNUSED``, naming where it went, or that preprocessing dropped it), or the
@@ -19,10 +20,13 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   ``NEAR_M`` or more from the object (``OFF_OBJECT``), or a track on the object was output but not counted
   (``NOT_COUNTED``), or two tracks were output on one object (``TWO_TRACKS``), or a track was output without a
   detection on no object (``COASTED``), or one track was matched to an object while covering another
-  (``COVERED_TWO``);
+  (``COVERED_TWO``), or the object had no LiDAR or radar points, so no detector could see it, and no track carried
+  it (``UNSEEN``);
 * **the evaluation's**: the box the object was scored against is an interpolation ``EVALUATED_OFFSET_M`` or more
   from the annotation (``INTERPOLATED``), or the evaluation has no box of the object there, beyond its range or
-  for want of points (``NO_EVAL_BOX``).
+  for want of points (``NO_EVAL_BOX``), or the false track's box is one the evaluation interpolated between two of
+  the track's boxes, at a frame the tracker did not output it (``TRACK_INTERPOLATED``), or a track output on the
+  object was dropped there by the evaluation's range or bike-rack filter (``TRACK_DROPPED``).
 
 The frames that decide a failure: for a miss, a false track and a coalescence, the failure's frame; for a
 fragmentation, an ID switch and an identity theft, the frames from the one after the lost track last lay within
@@ -67,8 +71,11 @@ class Rule(enum.Enum):
     TWO_TRACKS = "two tracks"
     COASTED = "coasted"
     COVERED_TWO = "covered two"
+    UNSEEN = "unseen"
     INTERPOLATED = "interpolated"
     NO_EVAL_BOX = "no evaluated box"
+    TRACK_INTERPOLATED = "track interpolated"
+    TRACK_DROPPED = "track dropped"
 
     @property
     def party(self) -> Party:
@@ -86,8 +93,11 @@ _PARTY = {
     Rule.TWO_TRACKS: Party.TRACKER,
     Rule.COASTED: Party.TRACKER,
     Rule.COVERED_TWO: Party.TRACKER,
+    Rule.UNSEEN: Party.TRACKER,
     Rule.INTERPOLATED: Party.EVALUATION,
     Rule.NO_EVAL_BOX: Party.EVALUATION,
+    Rule.TRACK_INTERPOLATED: Party.EVALUATION,
+    Rule.TRACK_DROPPED: Party.EVALUATION,
 }
 
 
@@ -253,13 +263,15 @@ class KeyDecision:
 
 @dataclass(frozen=True, slots=True)
 class FalseOutput:
-    """A false track's box at the failure frame: the detection it was output on (None: none, it was predicted),
-    the nearest object of its class (gt id, distance, how the evaluation saw it), the nearest of any class, and
-    the track the evaluation matched to that object instead (None: none)."""
+    """A false track's box at the failure frame: the detection it was output on (None: none, it was predicted, or
+    not output at all), where the box lies, the frames of the track's own boxes the evaluation interpolated this
+    one between (None: the tracker output it), the nearest object of its class (gt id, distance, how the evaluation
+    saw it), the nearest of any class, and the track the evaluation matched to that object instead (None: none)."""
 
     track_id: int
     on: Near | None
     output_xy_m: tuple[float, float]
+    between: tuple[int, int] | None
     nearest_own: tuple[str, float, GtFrame | None] | None
     nearest_any: tuple[str, str, float] | None
     matched_instead: int | None
@@ -280,11 +292,13 @@ class EvaluatedReach:
 @dataclass(frozen=True, slots=True)
 class OtherRun:
     """Another tracker on the same detections at the failure: whether it has a failure of the same kind on the
-    same object at the same frame, and the tracks it output on the object there (counted or not)."""
+    same object (without an object: within ``NEAR_M`` of ``place_xy_m``) at the same frame, and the tracks it
+    output on the object there (counted or not)."""
 
     tracker: str
     failed_same: bool
     on_it: tuple[OnObject, ...]
+    place_xy_m: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True, slots=True)

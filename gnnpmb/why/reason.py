@@ -176,6 +176,10 @@ class _Context:
     def finding(self, failure_id: str, others: Sequence[Evidence]) -> Finding:
         failure, kind = self.failure, self.failure.kind
         gt_id = self.object_of()
+        if kind in LOST_AND_TAKER and gt_id is not None:  # look back to where the lost track last had the object
+            held = self.held_until(int(failure.track_ids[LOST_AND_TAKER[kind][0]]), gt_id)
+            if held is not None:
+                self.window = range(max(min(self.frames), min(self.window.start, held + 1)), self.window.stop)
         sightings = self.sightings(gt_id) if gt_id is not None else ()
         parts: dict = {}
         if kind in LOST_AND_TAKER:
@@ -224,21 +228,20 @@ class _Context:
 
     def object_of(self) -> str | None:
         """The failure's object: the missed one of a coalescence, the object of the others, and for a false track
-        the object of its class nearest its box within ``NEAR_M`` (None if none)."""
+        the object of its class nearest its box as evaluated within ``NEAR_M`` (None if none)."""
         failure = self.failure
         if failure.kind is FailureKind.COALESCENCE:
             return failure.gt_ids[1]
         if failure.gt_ids:
             return failure.gt_ids[0]
-        fr = self.frames.get(self.f)
-        e = self.estimate(int(failure.track_ids[0]), self.f)
-        if fr is None or e is None:
+        box = next((b for b in failure.boxes if b.role == "false track"), None)
+        if box is None:
             return None
         gt = self.scene.keyframes[self.f].gt
         mine = np.flatnonzero(gt.class_name == self.class_name) if len(gt) else np.zeros(0, int)
         if not mine.size:
             return None
-        d = np.hypot(*(gt.translation_m[mine, :2] - np.asarray(e.translation_m[:2])).T)
+        d = np.hypot(*(gt.translation_m[mine, :2] - np.asarray(box.translation_m[:2])).T)
         k = int(np.argmin(d))
         return str(gt.instance_id[mine[k]]) if d[k] < NEAR_M else None
 
@@ -323,7 +326,8 @@ class _Context:
                 continue
             step = lost.step(f)
             if s.nearest_any is None:
-                no_det.append(f)
+                if s.points > 0:
+                    no_det.append(f)
             elif s.nearest_own is None and s.nearest_any.class_name != self.class_name:
                 other_class.append(f)
             own = s.nearest_own
@@ -407,7 +411,16 @@ class _Context:
     def false_track(self) -> dict:
         t = int(self.failure.track_ids[0])
         e = self.estimate(t, self.f)
-        xy = np.asarray(e.translation_m[:2]) if e is not None else np.zeros(2)
+        between = None
+        if e is not None:
+            xy = np.asarray(e.translation_m[:2])
+        else:  # the tracker output no box here: the evaluation interpolated the track between two of its boxes
+            box = next(b for b in self.failure.boxes if b.role == "false track")
+            xy = np.asarray(box.translation_m[:2])
+            ev = self.report.track_evals.get(str(t))
+            kept = ev.kept if ev is not None else ()
+            before, after = [x for x in kept if x < self.f], [x for x in kept if x > self.f]
+            between = (before[-1], after[0]) if before and after else None
         fr = self.frames.get(self.f)
         on = None
         if e is not None and e.meas_index >= 0 and fr is not None:
@@ -433,6 +446,8 @@ class _Context:
             k = int(np.argmin(d))
             nearest_any = (str(gt.instance_id[k]), str(gt.class_name[k]), float(d[k]))
         blame: list[Blame] = []
+        if e is None:
+            blame.append(Blame(Rule.TRACK_INTERPOLATED, (self.f,)))
         if nearest_own is not None:
             g = nearest_own[2]
             if g is None or g.status in (GtStatus.NO_BOX, GtStatus.BEYOND_RANGE):
@@ -441,6 +456,8 @@ class _Context:
                 blame.append(Blame(Rule.INTERPOLATED, (self.f,)))
             else:
                 blame.append(Blame(Rule.TWO_TRACKS, (self.f,)))
+        elif e is None:
+            pass  # no box of the tracker's here
         elif on is None:
             blame.append(Blame(Rule.COASTED, (self.f,)))
         elif nearest_any is not None:
@@ -451,6 +468,7 @@ class _Context:
             t,
             on,
             (float(xy[0]), float(xy[1])),
+            between,
             nearest_own,
             nearest_any,
             matched,
@@ -484,11 +502,14 @@ class _Context:
         missed object)."""
         f = (s.frame,)
         if s.nearest_any is None:
-            return [Blame(Rule.NO_DETECTION, f)]
+            return [Blame(Rule.NO_DETECTION if s.points > 0 else Rule.UNSEEN, f)]
         out = []
         if s.nearest_own is None and s.nearest_any.class_name != self.class_name:
             out.append(Blame(Rule.OTHER_CLASS, f))
-        if any(not o.counted for o in s.on_it):
+        dropped = [o for o in s.on_it if o.evaluated is not None and s.frame not in o.evaluated.kept]
+        if dropped:
+            out.append(Blame(Rule.TRACK_DROPPED, f))
+        if any(not o.counted for o in s.on_it if o not in dropped):
             out.append(Blame(Rule.NOT_COUNTED, f))
         own = s.nearest_own
         if own is None and s.nearest_any.class_name == self.class_name:
@@ -541,15 +562,15 @@ class _Context:
                 continue
             fr = next((fr for fr in ev.run.frames if fr.keyframe.index == self.f), None)
             xy = self.gt_xy(gt_id, self.f) if gt_id is not None else None
-            if xy is None:
-                e = self.estimate(int(self.failure.track_ids[0]), self.f) if self.failure.track_ids else None
-                xy = np.asarray(e.translation_m[:2]) if e is not None else None
+            if xy is None and self.failure.boxes:
+                xy = np.asarray(self.failure.boxes[0].translation_m[:2])
             failed = any(
-                f.kind is self.failure.kind and f.frame_index == self.f and (gt_id in f.gt_ids if gt_id else True)
+                f.kind is self.failure.kind and f.frame_index == self.f and _same_place(f, gt_id, xy)
                 for f in ev.report.failures
             )
             on_it = self.on_object(ev.report, fr, xy) if xy is not None else ()
-            out.append(OtherRun(ev.tracker, failed, on_it))
+            place = (float(xy[0]), float(xy[1])) if xy is not None else None
+            out.append(OtherRun(ev.tracker, failed, on_it, place))
         return tuple(out)
 
 
@@ -567,6 +588,15 @@ def key_decisions(
     """Choices in ``frames`` that sent a detection away from one of ``involved`` while it was the next best, or
     gave one to an involved track by a close call (``_Context.key_decisions``)."""
     return _Context(evidence, scene, frames.stop - 1, class_name, frames.start).key_decisions(involved)
+
+
+def _same_place(f: Failure, gt_id: str | None, xy: np.ndarray | None) -> bool:
+    """Whether failure ``f`` is about the object ``gt_id``, or, without one, lies within ``NEAR_M`` of ``xy``."""
+    if gt_id is not None:
+        return gt_id in f.gt_ids
+    if xy is None:
+        return False
+    return any(np.hypot(*(np.asarray(b.translation_m[:2]) - xy)) < NEAR_M for b in f.boxes)
 
 
 def _went(chosen, born_id: int | None) -> tuple[int, bool]:

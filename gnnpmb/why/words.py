@@ -241,17 +241,35 @@ def use_text(step: TrackStep) -> str:
     return f"{verb} {', '.join(parts)}{more}"
 
 
-def went_text(d: Destination | None, mode: UseMode) -> str:
-    """Where a detection went: ``→ track 26``, ``→ track 62 (p 1.00)``, ``→ new track 348``, ``→ new (no
-    track)``; ``not received (dropped by preprocessing)``."""
+def destination_name(d: Destination | None, mode: UseMode) -> str:
+    """Where a detection went, as a table cell: ``track 26``, ``track 62 (p 1.00)``, ``new track 348``, ``new
+    (started no track: a candidate or clutter)``, ``not received (dropped by preprocessing)``."""
     if d is None or d.went is Went.NOT_RECEIVED:
         return "not received (dropped by preprocessing)"
     if d.went is Went.TRACK:
         extra = share_text(d.share, mode)
-        return f"→ track {d.track_id}" + (f" ({extra.replace(' of its weight', '')})" if extra else "")
+        return f"track {d.track_id}" + (f" ({extra.replace(' of its weight', '')})" if extra else "")
     if d.went is Went.NEW_TRACK:
-        return f"→ new track {d.track_id}"
-    return "→ new (started no track: a candidate or clutter)"
+        return f"new track {d.track_id}"
+    return "new (started no track: a candidate or clutter)"
+
+
+def went_text(d: Destination | None, mode: UseMode) -> str:
+    """Where a detection went, after its name: ``→ track 26``, ``→ new track 348``, ... (``destination_name``)."""
+    name = destination_name(d, mode)
+    return name if name.startswith("not received") else f"→ {name}"
+
+
+def went_phrase(d: Destination | None, mode: UseMode) -> str:
+    """Where a detection went, in a sentence: ``went to track 26``, ``started new track 348``, ``started no track
+    (a candidate or clutter)``, ``was dropped by preprocessing``."""
+    if d is None or d.went is Went.NOT_RECEIVED:
+        return "was dropped by preprocessing"
+    if d.went is Went.NEW_TRACK:
+        return f"started new track {d.track_id}"
+    if d.went is Went.NEW:
+        return "started no track (a candidate or clutter)"
+    return f"went to {destination_name(d, mode)}"
 
 
 def _existence_word(mode: UseMode) -> str:
@@ -327,6 +345,8 @@ def evaluation_lines(f: Finding) -> list[str]:
 
 
 def _between(g: GtFrame) -> str:
+    """`` from frames 14 and 20, weighting the two ends the wrong way round (...): weighted the right way the box
+    would lie 0.0 m from the annotation`` ("" without the ends)."""
     if g.between is None:
         return ""
     left, right = g.between
@@ -336,8 +356,8 @@ def _between(g: GtFrame) -> str:
         if off >= 0.05:
             right_way = math.hypot(g.unswapped_xy_m[0] - g.annotated_xy_m[0], g.unswapped_xy_m[1] - g.annotated_xy_m[1])
             text += (
-                f", but it weights the two ends the wrong way round (nuscenes-devkit issue #1141): weighted the right "
-                f"way the box would lie {right_way:.1f} m from the annotation"
+                f", weighting the two ends the wrong way round (nuscenes-devkit issue #1141): weighted the right way "
+                f"the box would lie {right_way:.1f} m from the annotation"
             )
     return text
 
@@ -380,24 +400,28 @@ def _detector_gaps(f: Finding) -> list[str]:
     by = {s.frame: s for s in f.sightings}
     for b in f.blame:
         if b.rule is Rule.NO_DETECTION:
-            seen = [x for x in b.frames if x in by and by[x].points > 0]
-            hidden = [x for x in b.frames if x in by and by[x].points == 0]
-            if seen:
-                points = [by[x].points for x in seen]
-                out.append(
-                    f"at {frames_text(seen)} the detector gave no detection of any class within {NEAR_M:.0f} m, "
-                    f"though it had {_span(points)} LiDAR and radar points"
-                )
-            if hidden:
-                out.append(
-                    f"at {frames_text(hidden)} it had no LiDAR or radar points (no detector could see it) and had no "
-                    f"detection within {NEAR_M:.0f} m"
-                )
+            points = [by[x].points for x in b.frames if x in by]
+            out.append(
+                f"at {frames_text(b.frames)} the detector gave no detection of any class within {NEAR_M:.0f} m, "
+                f"though it had {_span(points)} LiDAR and radar points"
+            )
         elif b.rule is Rule.OTHER_CLASS:
             seen = [by[x].nearest_any for x in b.frames if x in by and by[x].nearest_any is not None]
             what = ", ".join(f"{n.class_name} {meas_name(n.meas)} {n.distance_m:.2f} m away" for n in seen)
             out.append(f"at {frames_text(b.frames)} the detector saw it only as another class ({what})")
     return out
+
+
+def _hidden(f: Finding) -> list[str]:
+    """The deciding frames where the object had no LiDAR or radar points and no detection: no detector could see
+    it."""
+    hidden = [s.frame for s in f.sightings if s.frame in f.deciding and s.points == 0 and s.nearest_any is None]
+    if not hidden:
+        return []
+    return [
+        f"at {frames_text(hidden)} it had no LiDAR or radar points (no detector could see it) and no detection within "
+        f"{NEAR_M:.0f} m"
+    ]
 
 
 def _lost_story(f: Finding, lost: LostTrack) -> str:
@@ -481,6 +505,7 @@ def _unused(f: Finding) -> list[tuple[tuple[int, int], str]]:
 def _lost_object(f: Finding) -> list[str]:
     parts = [_presence(f)]
     parts += _detector_gaps(f)
+    parts += _hidden(f)
     lost = f.lost
     if lost is not None:
         parts.append(_lost_story(f, lost))
@@ -606,10 +631,17 @@ def _near_text(n: Near) -> str:
 
 def _false_track(f: Finding) -> list[str]:
     o: FalseOutput = f.false_output
-    head = f"at frame {f.frame} track {o.track_id} ({f.class_name}) was output on "
-    head += f"detection {_near_text(o.on)}" if o.on is not None else "no detection this frame (a predicted box)"
-    parts = [head]
     tests = {b.rule for b in f.blame}
+    if Rule.TRACK_INTERPOLATED in tests:
+        between = f" between its boxes at frames {o.between[0]} and {o.between[1]}" if o.between else ""
+        head = (
+            f"at frame {f.frame} track {o.track_id} ({f.class_name}) was not output: the evaluation interpolated it"
+            f"{between}, and that box matched no object"
+        )
+    else:
+        head = f"at frame {f.frame} track {o.track_id} ({f.class_name}) was output on "
+        head += f"detection {_near_text(o.on)}" if o.on is not None else "no detection this frame (a predicted box)"
+    parts = [head]
     if o.nearest_own is not None:
         gt_id, d, g = o.nearest_own
         on = f"{f.class_name} GT {short_id(gt_id)} lies {d:.1f} m away"
@@ -633,6 +665,8 @@ def _false_track(f: Finding) -> list[str]:
         )
     elif o.on is not None:
         parts.append(f"no object of any class lies within {NEAR_M:.0f} m: a detection of nothing")
+    elif Rule.TRACK_INTERPOLATED in tests:
+        parts.append(f"no object of any class lies within {NEAR_M:.0f} m of it")
     else:
         parts.append(f"no object of any class lies within {NEAR_M:.0f} m: the tracker output a box where nothing was")
     ev = o.evaluated
@@ -663,7 +697,12 @@ def _miss(f: Finding) -> list[str]:
     mode = UseMode(f.mode)
     inside = f"{s.points} LiDAR and radar points in its box"
     parts = []
-    if s.nearest_any is None:
+    if s.nearest_any is None and s.points == 0:
+        parts.append(
+            f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and no detection "
+            f"within {NEAR_M:.0f} m, and no track carried it through"
+        )
+    elif s.nearest_any is None:
         parts.append(
             f"at frame {f.frame} the detector gave no detection within {NEAR_M:.0f} m of {name} ({inside}): the "
             "detector missed it"
@@ -685,7 +724,7 @@ def _miss(f: Finding) -> list[str]:
         n = s.nearest_own
         parts.append(
             f"at frame {f.frame} detection {meas_name(n.meas)} (score {n.score:.2f}) lay {n.distance_m:.1f} m from "
-            f"{name} and went {went_text(s.went, mode).removeprefix('→ ')}"
+            f"{name} and {went_phrase(s.went, mode)}"
         )
         if s.went is not None and s.went.track_id >= 0 and s.went.track_id not in {o.track_id for o in s.on_it}:
             parts.append(f"track {s.went.track_id} was not output on it")
@@ -699,9 +738,14 @@ def _miss(f: Finding) -> list[str]:
         parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
     g = s.evaluated
     if g is not None and g.status is GtStatus.INTERPOLATED and g.offset_m >= 0.05:
-        parts.append(
-            f"the evaluation scored it at a box it interpolated{_between(g)}, {g.offset_m:.1f} m from the annotation"
-        )
+        parts.append(f"the evaluation scored it at a box it interpolated, {g.offset_m:.1f} m from the annotation")
+        parts.append(_between(g).removeprefix(" "))
+    for o in s.on_it:
+        if o.evaluated is not None and f.frame not in o.evaluated.kept and f.frame in o.evaluated.submitted:
+            parts.append(
+                f"track {o.track_id} was output on it, but its box lies beyond the evaluation's range for the class "
+                "(or in a bike rack): the evaluation dropped that box"
+            )
     if g is not None and abs(g.ego_distance_m - g.range_m) <= 5.0:
         side = "inside" if g.ego_distance_m < g.range_m else "beyond"
         parts.append(
@@ -729,8 +773,8 @@ def _coalescence(f: Finding) -> list[str]:
     elif s.nearest_own is not None:
         n = s.nearest_own
         parts.append(
-            f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) went "
-            f"{went_text(s.went, mode).removeprefix('→ ')}"
+            f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) "
+            f"{went_phrase(s.went, mode)}"
         )
     return parts
 
@@ -739,7 +783,10 @@ def _others(f: Finding) -> list[str]:
     out = []
     for o in f.others:
         counted = [x for x in o.on_it if x.counted]
-        if o.failed_same:
+        if f.gt_id is None:  # a false track on no object: the same mistake at the same place, or not
+            same = "had a false track here too" if o.failed_same else "had no false track here"
+            out.append(f"{o.tracker} on the same detections {same}")
+        elif o.failed_same:
             out.append(f"{o.tracker} on the same detections failed here too")
         elif counted:
             ids = ", ".join(str(x.track_id) for x in counted)
@@ -750,6 +797,11 @@ def _others(f: Finding) -> list[str]:
         else:
             out.append(f"{o.tracker} on the same detections did not have this failure")
     return out
+
+
+def plain(markdown: str) -> str:
+    """A rendered line without its markdown emphasis (``**Why**`` -> ``Why``), for a terminal."""
+    return markdown.replace("**", "")
 
 
 def summary_line(f: Finding) -> str:
@@ -769,8 +821,11 @@ _RULE_WORDS = {
     Rule.TWO_TRACKS: "two tracks on one object",
     Rule.COASTED: "output without a detection where nothing was",
     Rule.COVERED_TWO: "one track covered two objects",
+    Rule.UNSEEN: "no points, no detection, and no track carried it",
     Rule.INTERPOLATED: "scored at an interpolated box 0.5 m or more from the annotation",
     Rule.NO_EVAL_BOX: "the evaluation has no box of the object",
+    Rule.TRACK_INTERPOLATED: "a box the evaluation interpolated between two of the track's",
+    Rule.TRACK_DROPPED: "the track's box on it dropped by the evaluation (beyond the class range)",
 }
 
 
