@@ -272,9 +272,7 @@ def failures(
     nusc = open_nuscenes(location)
     scene_data = load_scene(nusc, location, scene)
     fact_sink = FactSink(tracker, has_existence=tracker_has_existence(tracker)) if why else None
-    run = run_tracker(
-        scene_data, get_detections(scene_data, detections, preset, seed), tracker, config, sink=fact_sink
-    )
+    run = run_tracker(scene_data, get_detections(scene_data, detections, preset, seed), tracker, config, sink=fact_sink)
     results = run_results(run)
     report = cached_report(
         cache_root(), location, scene, tracker, results, lambda: find_failures(nusc, scene, results, tracker)
