@@ -41,7 +41,7 @@ def main() -> None:
     parser.add_argument("--tracker", default="gnnpmb")
     parser.add_argument("--detector", default="centerpoint")
     parser.add_argument("--workers", type=int, default=None)
-    parser.add_argument("--out", type=Path, default=Path("table2_ablation"))
+    parser.add_argument("--out", type=Path, default=Path("docs/results/table2_ablation"))
     parser.add_argument("--figure", type=Path, default=Path("docs/table2_ablation.png"))
     args = parser.parse_args()
 

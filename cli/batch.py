@@ -357,16 +357,22 @@ def demo_data(
         str,
         typer.Option(
             metavar="SCENES",
-            help="Comma-separated scene names, or mini_val, mini_train or all (default mini_val).",
+            help="Comma-separated scene names, or mini_val, staged, mini_train or all (default mini_val,staged).",
         ),
-    ] = "mini_val",
+    ] = "mini_val,staged",
 ) -> None:
     """Write the synthetic nuScenes-format demo dataset (v1.0-mini; the mini_val scenes scene-0103 and
-    scene-0916 by default, the eight generated mini_train scenes on request)."""
+    scene-0916 and the staged scene-9001 by default, the eight generated mini_train scenes on request)."""
     from gnnpmb.data.demo import DEMO_SCENES, generate_demo_dataset
+    from gnnpmb.data.demo_staged import STAGED_SCENES
     from gnnpmb.data.demo_train import TRAIN_SCENES
 
-    groups = {"mini_val": DEMO_SCENES, "mini_train": TRAIN_SCENES, "all": DEMO_SCENES + TRAIN_SCENES}
+    groups = {
+        "mini_val": DEMO_SCENES,
+        "staged": STAGED_SCENES,
+        "mini_train": TRAIN_SCENES,
+        "all": DEMO_SCENES + STAGED_SCENES + TRAIN_SCENES,
+    }
     names = tuple(n for part in scenes.split(",") if part.strip() for n in groups.get(part.strip(), (part.strip(),)))
     path = generate_demo_dataset(check_output_dir(out, "--out"), seed=seed, scenes=names)
     typer.echo(f"demo dataset (v1.0-mini, seed {seed}, {len(set(names))} scenes) -> {path}")

@@ -48,7 +48,7 @@ COST_DESCRIPTION = "distance (m) from the detection's centre minus velocity x dt
 COST_SCALE = CostScale("distance", "m", 0.3, optimal=False)
 """Greedy's costs are metres and its matching is greedy, not optimal: a margin is the detection's next closest
 column minus its chosen one, and a close call one under 0.3 m, about the detectors' mean translation error
-(mATE 0.29-0.34 m on nuScenes val, README "Detector calibration")."""
+(mATE 0.29-0.34 m on nuScenes val, docs/demo-data.md "Simulated detectors")."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -302,6 +302,8 @@ def _check(c: Claim, f: Finding, src: Sources) -> str:  # noqa: C901 (one branch
             boxes = src.frames[x].detections.boxes
             if v[1] is None:  # output, on whatever
                 return ""
+            if v[1] >= len(boxes):
+                return f"the frame has no detection m{v[1]}"
             if v[1] >= 0:
                 return "" if _same_geometry(box, boxes, v[1]) else "its box does not carry that detection"
             same = [m for m in range(len(boxes)) if _same_geometry(box, boxes, m)]
@@ -482,6 +484,17 @@ def _check_blame(rule: Rule, frames: tuple[int, ...], f: Finding, src: Sources) 
                         dropped |= x not in kept
                 if not dropped:
                     return "no track box on it was dropped"
+            case Rule.COVERED_TWO if f.kind.value == "miss":
+                counted = [
+                    b
+                    for b in src.results.get(src.scene.keyframes[x].sample_token, ())
+                    if b["tracking_name"] == f.class_name
+                    and np.hypot(*(np.asarray(b["translation"][:2]) - xy)) < NEAR_M
+                    and x in src.devkit.tracks.get(b["tracking_id"], ((), None))[0]
+                    and src.devkit.tracks[b["tracking_id"]][1] >= (src.report.threshold_of(f.class_name) or 0.0)
+                ]
+                if not counted:
+                    return "no counted track lies within reach"
             case Rule.NO_EVAL_BOX:
                 gt_id = f.false_output.nearest_own[0] if f.false_output and f.false_output.nearest_own else f.gt_id
                 status, _ = src.devkit.gt.get((x, gt_id), (None, None))
@@ -606,6 +619,7 @@ def _views(evidence: Mapping[str, Any]) -> dict[str, Any]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     from gnnpmb.data.demo import DEMO_SCENES
+    from gnnpmb.data.demo_staged import STAGED_SCENES
     from gnnpmb.data.simdet_presets import PRESETS
     from gnnpmb.registry import TRACKER_NAMES
     from gnnpmb.session import prepare
@@ -618,7 +632,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     totals: dict[str, list[int]] = defaultdict(lambda: [0, 0, 0])
     shown: dict[str, list[str]] = defaultdict(list)
-    for scene in args.scene or list(DEMO_SCENES):
+    for scene in args.scene or list(DEMO_SCENES + STAGED_SCENES):
         for detector in args.detector or list(PRESETS):
             for tracker in args.tracker or list(TRACKER_NAMES):
                 request = prepare(scene, [tracker], detector=detector)

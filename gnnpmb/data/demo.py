@@ -2,8 +2,9 @@
 
 ``generate_demo_dataset`` writes ``v1.0-mini`` tables and LIDAR_TOP keyframe sweeps that the unmodified devkit
 (``nuscenes.nuscenes.NuScenes``) and the official tracking evaluation (``TrackingEval``, split ``mini_val``) accept.
-It holds the two ``mini_val`` scene names, 40 keyframes each at 2 Hz, and every scene description starts with
-``SYNTHETIC_MARKER`` so no one mistakes it for real data. It never substitutes for real data:
+It holds the two ``mini_val`` scene names and a staged scene, ``scene-9001``, in a custom split ``staged``
+(``demo_staged``: coalescence and identity theft), 40 keyframes each at 2 Hz, and every scene description starts
+with ``SYNTHETIC_MARKER`` so no one mistakes it for real data. It never substitutes for real data:
 ``gnnpmb.data.nuscenes.resolve_dataroot`` falls back to it only when no dataroot is given.
 
 The layout is fixed (the seed only drives the LiDAR noise). Each scene is laid out in *road coordinates*
@@ -53,6 +54,15 @@ from pathlib import Path
 import numpy as np
 
 from gnnpmb.data.demo_spec import SYNTHETIC_MARKER, Motion, ObjectSpec, SceneSpec, Segment
+from gnnpmb.data.demo_staged import (
+    HOTSPOT_FRAMES,
+    HOTSPOT_RADIUS_M,
+    STAGED_SCENES,
+    STAGED_SEED,
+    STAGED_SPLIT,
+    hotspot_sd,
+    staged_scene,
+)
 from gnnpmb.data.demo_train import LAYOUT_SEEDS, TRAIN_SCENES, train_scene
 from gnnpmb.data.raycast import LidarSpec, SceneBoxes, cast_scan
 from gnnpmb.errors import DataError
@@ -60,7 +70,7 @@ from gnnpmb.errors import DataError
 DEMO_VERSION = "v1.0-mini"
 DEMO_SCENES: tuple[str, ...] = ("scene-0103", "scene-0916")
 DEMO_SEED = 0
-GENERATOR_VERSION = 2
+GENERATOR_VERSION = 3
 """Bump when the generated data changes, so cached copies (``demo-v<N>``) are regenerated."""
 """Every demo scene description starts with this."""
 MARKER_FILE = "gnnpmb-demo.json"
@@ -320,7 +330,7 @@ def _scene_0916() -> SceneSpec:
     )
 
 
-SCENES: tuple[SceneSpec, ...] = (_scene_0103(), _scene_0916())
+SCENES: tuple[SceneSpec, ...] = (_scene_0103(), _scene_0916(), staged_scene())
 
 
 def keyframe_times_s() -> np.ndarray:
@@ -431,7 +441,21 @@ def _clutter_hotspots() -> tuple[ClutterHotspot, ...]:
     )
 
 
-CLUTTER_HOTSPOTS: tuple[ClutterHotspot, ...] = _clutter_hotspots() + _train_hotspots()
+def _staged_hotspots() -> tuple[ClutterHotspot, ...]:
+    """The false pedestrians just ahead of the staged scene's file of pedestrians (``demo_staged``)."""
+    spec = staged_scene()
+    centre = spec.to_global(np.array(hotspot_sd()[0]), np.array(hotspot_sd()[1]))
+    return (
+        ClutterHotspot(
+            scene_name=spec.name,
+            xy_global=(round(float(centre[0]), 3), round(float(centre[1]), 3)),
+            radius_m=HOTSPOT_RADIUS_M,
+            frames=HOTSPOT_FRAMES,
+        ),
+    )
+
+
+CLUTTER_HOTSPOTS: tuple[ClutterHotspot, ...] = _clutter_hotspots() + _train_hotspots() + _staged_hotspots()
 """Where and when the demo's bus passes the roadworks of scene-0916 (see the module docstring), and the roadworks
 of the generated train scenes (``demo_train``)."""
 
@@ -642,10 +666,11 @@ def _empty_mask_png() -> bytes:
 def _scene_seeds(seed: int, names: tuple[str, ...]) -> list[np.random.SeedSequence]:
     """LiDAR-noise seed of each scene: the val scenes keep their original streams, a train scene gets its own."""
     val = dict(zip(DEMO_SCENES, np.random.SeedSequence(seed).spawn(len(DEMO_SCENES)), strict=True))
-    return [val[n] if n in val else np.random.SeedSequence([seed, LAYOUT_SEEDS[n]]) for n in names]
+    layout = {**LAYOUT_SEEDS, **dict.fromkeys(STAGED_SCENES, STAGED_SEED)}
+    return [val[n] if n in val else np.random.SeedSequence([seed, layout[n]]) for n in names]
 
 
-def _write_dataset(dataroot: Path, seed: int, names: tuple[str, ...] = DEMO_SCENES) -> None:
+def _write_dataset(dataroot: Path, seed: int, names: tuple[str, ...]) -> None:
     """Write the demo scenes ``names`` into the (empty) folder ``dataroot``."""
     specs = [scene_spec(n) for n in names]
     (dataroot / DEMO_VERSION).mkdir(parents=True)
@@ -680,6 +705,10 @@ def _write_dataset(dataroot: Path, seed: int, names: tuple[str, ...] = DEMO_SCEN
         )
     for name, rows in tables.items():
         (dataroot / DEMO_VERSION / f"{name}.json").write_text(json.dumps(rows, indent=1) + "\n", encoding="utf-8")
+    staged = [n for n in names if n in STAGED_SCENES]
+    if staged:  # a custom split of the devkit (nuscenes-devkit 1.2.0 reads splits.json beside the tables)
+        splits = json.dumps({STAGED_SPLIT: staged}, indent=1) + "\n"
+        (dataroot / DEMO_VERSION / "splits.json").write_text(splits, encoding="utf-8")
     marker = {
         "generator": "gnnpmb-viz demo",
         "generator_version": GENERATOR_VERSION,
@@ -706,7 +735,7 @@ def is_demo_dataroot(path: Path, seed: int | None = None, scenes: tuple[str, ...
 def check_demo_scenes(names: tuple[str, ...]) -> tuple[str, ...]:
     """``names`` if every one is a demo scene (the ten ``v1.0-mini`` names), else a ``DataError`` naming the first
     unknown one."""
-    known = DEMO_SCENES + TRAIN_SCENES
+    known = DEMO_SCENES + STAGED_SCENES + TRAIN_SCENES
     for n in names:
         if n not in known:
             raise DataError(f"unknown demo scene '{n}'; the demo has: {', '.join(sorted(known))}")
@@ -715,9 +744,11 @@ def check_demo_scenes(names: tuple[str, ...]) -> tuple[str, ...]:
     return tuple(n for n in sorted(known) if n in names)
 
 
-def generate_demo_dataset(out_dir: Path, seed: int = DEMO_SEED, scenes: tuple[str, ...] = DEMO_SCENES) -> Path:
-    """Write the demo scenes ``scenes`` (default: the two mini_val ones) into ``out_dir`` (the dataroot) and
-    return it.
+def generate_demo_dataset(
+    out_dir: Path, seed: int = DEMO_SEED, scenes: tuple[str, ...] = DEMO_SCENES + STAGED_SCENES
+) -> Path:
+    """Write the demo scenes ``scenes`` (default: the two mini_val ones and the staged one) into ``out_dir`` (the
+    dataroot) and return it.
 
     The data is built in a sibling temp folder and renamed into place, so a reader never sees half a dataset.
     ``out_dir`` may be missing, empty or an earlier demo; anything else is refused with a ``DataError``.
@@ -759,7 +790,8 @@ def cache_root() -> Path:
 
 def demo_cache_dir(full: bool = False) -> Path:
     """Where ``ensure_demo_dataset`` keeps the demo: a ``demo-v<GENERATOR_VERSION>`` subfolder of ``cache_root``
-    (the two mini_val scenes) or ``demo-v<GENERATOR_VERSION>-all`` (all ten scenes, when ``full``)."""
+    (the two mini_val scenes and the staged one) or ``demo-v<GENERATOR_VERSION>-all`` (with the eight mini_train
+    scenes, when ``full``)."""
     return cache_root() / f"demo-v{GENERATOR_VERSION}{'-all' if full else ''}"
 
 
@@ -768,10 +800,12 @@ TRAIN_NEEDS = ("mini_train", "train")
 
 
 def demo_layout(needs: tuple[str, ...] = ()) -> tuple[Path, tuple[str, ...]]:
-    """The cached demo's dataroot and scenes for ``needs`` (split or scene names about to be used): the eight
-    train scenes are included (in a separate cached dataroot) only when one of them is a train split or scene."""
+    """The cached demo's dataroot and scenes for ``needs`` (split or scene names about to be used): the two
+    ``mini_val`` scenes and the staged one (``demo_staged``); the eight train scenes are included (in a separate
+    cached dataroot) only when one of them is a train split or scene."""
     full = any(n in TRAIN_NEEDS or n in TRAIN_SCENES for n in needs)
-    return demo_cache_dir(full), (DEMO_SCENES + TRAIN_SCENES if full else DEMO_SCENES)
+    scenes = DEMO_SCENES + STAGED_SCENES
+    return demo_cache_dir(full), (scenes + TRAIN_SCENES if full else scenes)
 
 
 def ensure_demo_dataset(needs: tuple[str, ...] = (), *, rebuild: bool = False) -> Path:

@@ -511,6 +511,8 @@ class _Context:
             out.append(Blame(Rule.TRACK_DROPPED, f))
         if any(not o.counted for o in s.on_it if o not in dropped):
             out.append(Blame(Rule.NOT_COUNTED, f))
+        if any(o.counted for o in s.on_it if o not in dropped):  # counted, yet matched to another object
+            out.append(Blame(Rule.COVERED_TWO, f))
         own = s.nearest_own
         if own is None and s.nearest_any.class_name == self.class_name:
             out.append(Blame(Rule.DETECTION_UNUSED, f))  # preprocessing dropped it

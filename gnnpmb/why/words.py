@@ -460,8 +460,10 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
             parts.append(f"its track logic deleted it at frame {ended.frame} ({e.hits} of {e.window} hits)")
         elif e.ending is Ending.DELETED:
             parts.append(f"its track logic deleted it at frame {ended.frame}")
+        elif e.ending is Ending.MERGED:
+            parts.append(f"it was merged into another component at frame {ended.frame}")
         else:
-            parts.append(f"it was {e.ending.value} at frame {ended.frame} ({e.reason.value})")
+            parts.append(f"it was pruned at frame {ended.frame} ({e.reason.value})")
     return ", ".join(parts)
 
 
@@ -736,6 +738,12 @@ def _miss(f: Finding) -> list[str]:
             )
     if s.nearest_own is not None and not s.on_it:
         parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
+    if any(b.rule is Rule.COVERED_TWO for b in f.blame):
+        covering = ", ".join(str(o.track_id) for o in s.on_it if o.counted)
+        parts.append(
+            f"track {covering} lay within {NEAR_M:.0f} m of it and was counted, but the evaluation matched it to "
+            "another object: one track for two objects"
+        )
     g = s.evaluated
     if g is not None and g.status is GtStatus.INTERPOLATED and g.offset_m >= 0.05:
         parts.append(f"the evaluation scored it at a box it interpolated, {g.offset_m:.1f} m from the annotation")
@@ -775,6 +783,17 @@ def _coalescence(f: Finding) -> list[str]:
         parts.append(
             f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) "
             f"{went_phrase(s.went, mode)}"
+        )
+    elif s.nearest_any.class_name != f.class_name:
+        n = s.nearest_any
+        parts.append(
+            f"the detector saw it only as another class ({n.class_name} {meas_name(n.meas)}, score {n.score:.2f})"
+        )
+    else:
+        n = s.nearest_any
+        parts.append(
+            f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) was dropped by "
+            "preprocessing (score threshold or NMS)"
         )
     return parts
 

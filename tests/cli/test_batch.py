@@ -121,8 +121,8 @@ def test_demo_data_calls_the_generator(monkeypatch, tmp_path: Path, capsys) -> N
 
     monkeypatch.setattr("gnnpmb.data.demo.generate_demo_dataset", fake)
     code, out, _ = run(["demo-data", "--out", str(tmp_path / "demo"), "--seed", "7"], capsys)
-    assert code == 0 and calls == [(tmp_path / "demo", 7, ("scene-0103", "scene-0916"))]
-    assert out == f"demo dataset (v1.0-mini, seed 7, 2 scenes) -> {tmp_path / 'demo'}\n"
+    assert code == 0 and calls == [(tmp_path / "demo", 7, ("scene-0103", "scene-0916", "scene-9001"))]
+    assert out == f"demo dataset (v1.0-mini, seed 7, 3 scenes) -> {tmp_path / 'demo'}\n"
     code, out, _ = run(["demo-data", "--out", str(tmp_path / "d2"), "--scenes", "mini_train,scene-0103"], capsys)
     assert code == 0 and len(calls[-1][2]) == 9 and calls[-1][2][-1] == "scene-0103"
 

@@ -29,6 +29,7 @@ from gnnpmb.data.demo import (
     ensure_demo_dataset,
     generate_demo_dataset,
 )
+from gnnpmb.data.demo_staged import STAGED_SCENES
 from gnnpmb.errors import DataError
 from gnnpmb.types import TRACKING_CLASSES
 
@@ -71,7 +72,7 @@ def _yaw(quat_wxyz: list[float]) -> float:
 
 
 def test_scenes_and_descriptions(nusc: NuScenes) -> None:
-    assert sorted(s["name"] for s in nusc.scene) == sorted(DEMO_SCENES)
+    assert sorted(s["name"] for s in nusc.scene) == sorted(DEMO_SCENES + STAGED_SCENES)
     for scene in nusc.scene:
         assert scene["description"].startswith(SYNTHETIC_MARKER)
         samples = _scene_samples(nusc, scene["name"])

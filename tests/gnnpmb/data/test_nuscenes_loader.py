@@ -11,6 +11,7 @@ import pytest
 
 from gnnpmb.data import nuscenes as loader
 from gnnpmb.data.demo import DEMO_SCENES, DEMO_VERSION, SYNTHETIC_MARKER
+from gnnpmb.data.demo_staged import STAGED_SCENES
 from gnnpmb.data.nuscenes import (
     DatasetLocation,
     check_dataroot,
@@ -121,11 +122,13 @@ def test_open_wraps_devkit_errors(tables_only: Path) -> None:
 
 def test_open_is_cached(location: DatasetLocation) -> None:
     assert open_nuscenes(location) is open_nuscenes(location)
-    assert list_scenes(open_nuscenes(location)) == list(DEMO_SCENES)
+    assert list_scenes(open_nuscenes(location)) == list(DEMO_SCENES + STAGED_SCENES)
 
 
 def test_unknown_scene_lists_available(location: DatasetLocation) -> None:
-    with pytest.raises(UnknownNameError, match=r"^unknown scene 'scene-0001'; available: scene-0103, scene-0916$"):
+    with pytest.raises(
+        UnknownNameError, match=r"^unknown scene 'scene-0001'; available: scene-0103, scene-0916, scene-9001$"
+    ):
         load_scene(open_nuscenes(location), location, "scene-0001")
 
 
@@ -191,7 +194,8 @@ def _with_path(keyframe, path: Path):
 def test_split_scenes(location: DatasetLocation, tables_only: Path) -> None:
     assert split_scenes("mini_val", location) == ["scene-0103", "scene-0916"]
     assert split_scenes("mini_train", location) == []
-    with pytest.raises(UnknownNameError, match=r"^unknown split 'minival'; known: mini_train, mini_val, test, train"):
+    assert split_scenes("staged", location) == ["scene-9001"]  # the demo's custom split
+    with pytest.raises(UnknownNameError, match=r"^unknown split 'minival'; known: mini_train, mini_val, staged, test"):
         split_scenes("minival", location)
 
     (tables_only / DEMO_VERSION / "splits.json").write_text(json.dumps({"hard": ["scene-0916", "scene-9999"]}))

@@ -1,5 +1,6 @@
 """The truth oracle (``tools.oracle``): every claim of every failure's finding, for every tracker on the demo's
-evaluation scenes and detector presets, holds against the submission, the raw events and the devkit."""
+evaluation scenes and staged scene and every detector preset, holds against the submission, the raw events and
+the devkit."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from gnnpmb.data.demo import DEMO_SCENES
+from gnnpmb.data.demo_staged import STAGED_SCENES
 from gnnpmb.data.simdet_presets import PRESETS
 from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.session import explain_all, gather_evidence, prepare
@@ -17,7 +19,7 @@ from tools import oracle
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("scene", DEMO_SCENES)
+@pytest.mark.parametrize("scene", DEMO_SCENES + STAGED_SCENES)
 @pytest.mark.parametrize("detector", list(PRESETS))
 def test_no_finding_of_any_tracker_contradicts_the_facts(demo_dataroot: Path, scene: str, detector: str) -> None:
     findings = 0
