@@ -128,16 +128,22 @@ def tracker_has_gates(name: str) -> bool:
     return _declared(name)[2]
 
 
+def tracker_has_costs(name: str) -> bool:
+    """Whether tracker ``name``'s update follows a chosen assignment (``skeleton.ClassFilter.has_costs``)."""
+    return _declared(name)[3]
+
+
 @functools.cache
-def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool]:
-    """What tracker ``name`` declares for the viewer (panels, has_existence, has_gates), read once from an instance
+def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool]:
+    """What tracker ``name`` declares for the viewer (panels, has_existence, has_gates, has_costs), read once from an
+    instance
     for the first class with the default configuration (building one costs a couple of milliseconds, and the
     blueprint asks several times per tracker)."""
     from gnnpmb.config import TrackerConfig
     from gnnpmb.types import IdAllocator
 
     sample = make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator())
-    return sample.panels, sample.has_existence, sample.has_gates
+    return sample.panels, sample.has_existence, sample.has_gates, sample.has_costs
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:

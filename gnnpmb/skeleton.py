@@ -104,11 +104,13 @@ class ClassFilter(ABC, Generic[PriorT, PosteriorT]):
     ``panels``: the tracker-specific viewer panels its events fill. ``has_existence``: False for trackers whose
     tracks have no existence probability (track logic instead; their events carry existence 1), so the viewer
     draws no existence plot for them. ``has_gates``: False for a tracker that matches without a Gaussian gate (no
-    ``Gated`` event, so no normalised innovation to plot)."""
+    ``Gated`` event, so no normalised innovation to plot). ``has_costs``: False for a tracker whose update follows no
+    chosen assignment of a cost matrix (JPDA, PHD, CPHD, TO-PMB: soft updates), so no chosen cost to plot."""
 
     panels: tuple[Panel, ...] = ()
     has_existence: bool = True
     has_gates: bool = True
+    has_costs: bool = True
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name

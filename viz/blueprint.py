@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import rerun.blueprint as rrb
 
 from gnnpmb.events import Panel
-from gnnpmb.registry import tracker_has_existence, tracker_has_gates, tracker_panels
+from gnnpmb.registry import tracker_has_costs, tracker_has_existence, tracker_has_gates, tracker_panels
 from viz import compare, paths
 from viz.failures import failure_log
 from viz.legend import LegendPlacement
@@ -198,10 +198,12 @@ def track_series_views(
     tracker: str, focus: FocusTarget | None = None, legends: Mapping[str, LegendPlacement] | None = None
 ) -> list[rrb.TimeSeriesView]:
     """Existence (for a tracker that has it, ``registry.tracker_has_existence``), normalised innovation (for a
-    tracker that gates, ``registry.tracker_has_gates``) and chosen cost per track; only the involved tracks when
+    tracker that gates, ``registry.tracker_has_gates``) and chosen cost (for a tracker that chooses an assignment,
+    ``registry.tracker_has_costs``) per track; only the involved tracks when
     focused, with a legend (placed by ``legends``, keyed by the view's origin)."""
     existence = [(paths.existence_root(tracker), "existence")] if tracker_has_existence(tracker) else []
     nis = [(paths.nis_root(tracker), "NIS (innovation²/S)")] if tracker_has_gates(tracker) else []
+    cost = [(paths.chosen_cost_root(tracker), "chosen cost")] if tracker_has_costs(tracker) else []
     return [
         rrb.TimeSeriesView(
             origin=root,
@@ -212,7 +214,7 @@ def track_series_views(
         for root, what in (
             *existence,
             *nis,
-            (paths.chosen_cost_root(tracker), "chosen cost"),
+            *cost,
         )
     ]
 

@@ -13,8 +13,10 @@ READING_GUIDE = f"""# How to read the views
 - **Ground truth**: translucent boxes.
 - **Tracks**: boxes labelled with their id; the trail behind a track shows its last positions.
 - **Gates**: the circles around each track's predicted position.
-- **Association lines**: a solid line joins a track's prediction to the detection it was given; a faint line, a
-  detection inside its gate that it was not given.
+- **Association lines**: a solid line joins a track's prediction to each detection its update used: the one it
+  was given (GNN-PMB, PMBM, GNN, greedy), or each with half or more of an association probability (JPDA, TO-PMB) or
+  of its PHD weight (PHD, CPHD), labelled with that share; a dimmed line, a detection it used with a smaller
+  share; a faint line, a detection inside its gate that its update did not use.
 - **Failures**: enlarged boxes: magenta ID switch, orange fragmentation, red false track, green coalescence,
   yellow identity theft, grey miss. This failure's box encloses the others on the same objects; failures of
   other objects at the same frame are pale.
@@ -24,8 +26,10 @@ READING_GUIDE = f"""# How to read the views
   an involved track below that is drawn here all the same, but counts as not shown in the comparison (and is
   not drawn in the full recording).
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
-  A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`); a track's predicted
-  position, its predicted existence and the detection it was given (`26 predicted r=0.40 → m2`) or `missed`.
+  A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`, `→ track 62 (p 1.00)`); a
+  track's predicted position, its predicted existence (for PMBM, in the hypothesis its detection was decided in
+  when that differs, with the best hypothesis's beside it) and the detection its update used most
+  (`26 predicted r=0.40 → m2`, `62 predicted → m0 (p 1.00)`) or `missed`.
   An involved track kept but not output this frame is a pale box at its predicted position, in the shape of its
   last output box: where the tracker expected the object.
   The involved tracks take distinct colours (blue, green, black, light blue, lime, … in order of their ids,
@@ -40,10 +44,12 @@ READING_GUIDE = f"""# How to read the views
 
 **Panels**
 
-- **focus**: the failure in words: **Why** (the cause: for a lost object, its detections and the lost track's
-  existence up to the choice that gave it away; for a false track, what it was output on and why no object
-  matched it; for a miss, whether the detector or the tracker missed it), **Because** (that choice's costs taken
-  apart), the key decisions, and per tracker what happened to each involved track.
+- **focus**: the failure in words: **Why** opens with whose doing it was (the detector's, the tracker's, the
+  evaluation's: each by a stated test, see *whose doing* below), then the facts: the object's detections, what
+  the lost track's update did with them in the tracker's terms, how it ended, the choice or the hypothesis switch
+  that gave the object away, where the new track came from; for a false track, what it was output on and why no
+  object matched it; for a miss, whether the detector or the tracker missed it. **Because** takes the deciding
+  choice's costs apart; then the key decisions, and per tracker what happened to each involved track.
 - **story**: each frame's events of the involved class (confirmed, missed, ended, close calls).
 - **decisions** and **cost grid**: per conflict the chosen pair, its cost, the next best and the margin (lower
   cost = more likely). When the next best was a track, the line under the table takes both costs apart (GNN-PMB,
@@ -53,8 +59,9 @@ READING_GUIDE = f"""# How to read the views
   detection. GNN has no existence or score in its cost, but a constant (a detection against clutter); it gives
   the distance at which the track would have won.
 - **existence**, **NIS**, **chosen cost**: the involved tracks' series up to the failure; the grey line is the
-  existence from which a Bernoulli is shown as a track. GNN, JPDA and greedy have no existence plot: their
-  tracks have no existence probability (track logic keeps a track or deletes it).
+  existence from which a Bernoulli is shown as a track (PHD, CPHD: a component's weight, capped at 1). The NIS is
+  that of the detection that dominated the update. GNN, JPDA and greedy have no existence plot: their tracks have
+  no existence probability (track logic keeps a track or deletes it); greedy has no gates, so no NIS.
 
 **Terms**
 
@@ -75,4 +82,12 @@ READING_GUIDE = f"""# How to read the views
   may steal the next one in turn.
 - **counted**: the evaluation keeps a track only if its score averaged over the whole track reaches the class's
   threshold (chosen for the best MOTA), at all its frames or at none.
+- **whose doing**: the detector's when, in a frame that decided the failure, no detection of any class lay within
+  2 m of an object that had LiDAR or radar points, or only one of another class, or a false track sat on a
+  detection of nothing; the tracker's when a detection was there and the update of the track that had the object
+  did not use it, the track was not output, output 2 m or more away, not counted, or covered two objects; the
+  evaluation's when it scored the object at an interpolated box 0.5 m or more from the annotation, had no box for
+  it, or made the false box up between two of the track's. Several can hold at once.
+- **p**, **% of its weight**: a JPDA or TO-PMB association probability; the share of a PHD component's weight the
+  update took from a detection.
 """

@@ -267,6 +267,7 @@ class GmPhdTracker(ClassFilter[Prediction, PhdPosterior]):
 
     name = "phd"
     panels: tuple[Panel, ...] = (Panel.INTENSITY,)
+    has_costs = False
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         super().__init__(class_name, config, ids)

@@ -211,10 +211,12 @@ class HypothesisLocals(Sequence[LocalHypotheses]):
 
 class HypothesisStrategy(Protocol):
     """Data-association hypothesis management: the only thing that differs across GNN-PMB, PMBM and TO-PMB.
-    ``panels``: the viewer panels its events fill."""
+    ``panels``: the viewer panels its events fill; ``chooses_assignment``: whether its update follows one chosen
+    assignment of the cost matrix (a soft update, TO-PMB's, has no chosen cost)."""
 
     name: str
     panels: tuple[Panel, ...]
+    chooses_assignment: bool
 
     def update(
         self, priors: list[GlobalHypothesis], locals_: Sequence[LocalHypotheses], ctx: UpdateContext
@@ -430,6 +432,11 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     def panels(self) -> tuple[Panel, ...]:
         """The viewer panels this tracker's events fill beyond the common ones: its strategy's."""
         return self.strategy.panels
+
+    @property
+    def has_costs(self) -> bool:  # type: ignore[override]
+        """Whether its update follows a chosen assignment (``HypothesisStrategy.chooses_assignment``)."""
+        return self.strategy.chooses_assignment
 
     def predict(self, meas: Measurements, dt_s: float) -> PmbPrior:
         """Steps 1-3 of the module docstring: the birth intensity at the M measurements, then every hypothesis'

@@ -20,6 +20,7 @@ class BestAssignment:
 
     name = "best-assignment"
     panels: tuple[Panel, ...] = ()
+    chooses_assignment = True
 
     def update(
         self, priors: list[GlobalHypothesis], locals_: list[LocalHypotheses], ctx: UpdateContext

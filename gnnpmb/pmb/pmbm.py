@@ -123,6 +123,7 @@ class KBest:
 
     name = "k-best"
     panels = (Panel.HYPOTHESES,)
+    chooses_assignment = True
 
     def __init__(
         self,

@@ -69,6 +69,7 @@ class MarginalMerge:
 
     name = "marginals"
     panels = (Panel.MARGINALS,)
+    chooses_assignment = False
 
     def __init__(self, params: LbpParams, max_bernoullis: int = MAX_BERNOULLIS):
         if max_bernoullis < 1:

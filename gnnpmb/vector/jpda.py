@@ -141,6 +141,7 @@ class JpdaTracker(VectorTracker):
     """One class's JPDA tracker (module docstring): ``tracks.VectorTracker`` with this ``_associate``."""
 
     panels = (Panel.MARGINALS,)
+    has_costs = False
 
     def _associate(self, prior: VectorTracks, gating: Gating, meas: Measurements, sink: EventSink) -> Association:
         inn = gating.inn
