@@ -501,10 +501,10 @@ class _Context:
         """The tests for an object no counted track covered at frame ``s.frame`` (a miss, a coalescence's
         missed object)."""
         f = (s.frame,)
-        if s.nearest_any is None:
-            return [Blame(Rule.NO_DETECTION if s.points > 0 else Rule.UNSEEN, f)]
         out = []
-        if s.nearest_own is None and s.nearest_any.class_name != self.class_name:
+        if s.nearest_any is None:
+            out.append(Blame(Rule.NO_DETECTION if s.points > 0 else Rule.UNSEEN, f))
+        elif s.nearest_own is None and s.nearest_any.class_name != self.class_name:
             out.append(Blame(Rule.OTHER_CLASS, f))
         dropped = [o for o in s.on_it if o.evaluated is not None and s.frame not in o.evaluated.kept]
         if dropped:
@@ -514,7 +514,7 @@ class _Context:
         if any(o.counted for o in s.on_it if o not in dropped):  # counted, yet matched to another object
             out.append(Blame(Rule.COVERED_TWO, f))
         own = s.nearest_own
-        if own is None and s.nearest_any.class_name == self.class_name:
+        if own is None and s.nearest_any is not None and s.nearest_any.class_name == self.class_name:
             out.append(Blame(Rule.DETECTION_UNUSED, f))  # preprocessing dropped it
         elif own is not None:
             on_ids = {o.track_id for o in s.on_it}
