@@ -112,6 +112,36 @@ def test_failures_lists_frames_and_writes_json(demo_dataroot: Path, tmp_path: Pa
     assert re.search(rf"│\s+{first['frame_index']} │ {first['kind']}", out)
 
 
+def test_failures_why_explains_each_failure_and_writes_the_typed_findings(
+    demo_dataroot: Path, tmp_path: Path, capsys
+) -> None:
+    report_path = tmp_path / "why.json"
+    argv = ["failures", "scene-0916", "--tracker", "jpda", "--dataroot", str(demo_dataroot), "--detector", "megvii"]
+    code, out, err = run([*argv, "--why", "--json", str(report_path)], capsys)
+    assert code == 0, err
+    report = json.loads(report_path.read_text())
+    findings = report["findings"]
+    assert [f["failure_id"] for f in findings] == [
+        f"{kind}:{n}" for kind, n in _numbered([f["kind"] for f in report["failures"]])
+    ]
+    switch = next(f for f in findings if f["failure_id"] == "id_switch:1")
+    assert switch["mode"] == "association probabilities" and {b["rule"] for b in switch["blame"]} >= {"not output"}
+    assert switch["lost"]["steps"] and switch["lost"]["track_id"] == int(switch["track_ids"][0])
+    lines = out.splitlines()
+    head = lines.index(next(x for x in lines if x.startswith("id_switch:1 (frame ")))
+    assert lines[head + 1].startswith("  Why (jpda, ") and "**" not in lines[head + 1]
+    assert "given no detection" not in out and "→ ?" not in out
+
+
+def _numbered(kinds: list[str]) -> list[tuple[str, int]]:
+    seen: dict[str, int] = {}
+    out = []
+    for k in kinds:
+        seen[k] = seen.get(k, 0) + 1
+        out.append((k, seen[k]))
+    return out
+
+
 def test_demo_data_calls_the_generator(monkeypatch, tmp_path: Path, capsys) -> None:
     calls = []
 

@@ -1,0 +1,184 @@
+"""``why.facts`` and ``why.story`` on hand-made events: what each family's update used, where detections went,
+how tracks ended, PMBM's hypotheses, and close calls on each tracker's own cost scale."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gnnpmb.events import (
+    Assignment,
+    AxisKind,
+    AxisLabel,
+    Born,
+    CostMatrix,
+    CostScale,
+    Extracted,
+    FrameStarted,
+    GlobalHypotheses,
+    Marginals,
+    MeasurementsReceived,
+    Posterior,
+    Predicted,
+    Pruned,
+    PruneReason,
+    TrackLogic,
+    TrackLogicAction,
+    UpdateWeights,
+)
+from gnnpmb.types import TrackEstimate
+from gnnpmb.why.facts import Ending, FactSink, UseMode, Went
+from gnnpmb.why.story import StoryKind, Storyteller
+
+
+def label(kind: AxisKind, ref: int) -> AxisLabel:
+    return AxisLabel(kind, ref)
+
+
+def frame(i: int) -> FrameStarted:
+    return FrameStarted("t", i, f"s{i}", 1_000_000 * i, 0.5)
+
+
+def received(refs: list[int]) -> MeasurementsReceived:
+    n = len(refs)
+    return MeasurementsReceived("car", np.array(refs), np.zeros((n, 3)), np.full(n, 0.8))
+
+
+def predicted(ids: list[int], existence: list[float]) -> Predicted:
+    k = len(ids)
+    return Predicted("car", np.array(ids), np.zeros((k, 4)), np.tile(np.eye(4), (k, 1, 1)), np.array(existence))
+
+
+def estimate(t: int, meas: int, existence: float = 1.0) -> TrackEstimate:
+    return TrackEstimate(t, "car", (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (1.0, 0, 0, 0), (0.0, 0.0), 0.8, existence, meas)
+
+
+def facts_of(events: list):
+    sink = FactSink("t")
+    for e in events:
+        sink.emit(e)
+    return sink.facts
+
+
+def test_a_jpda_update_is_a_mixture_over_detections_and_a_detection_goes_to_the_track_that_took_most_of_it() -> None:
+    probs = np.array([[0.05, 0.90, 0.05], [0.60, 0.395, 0.005]])  # rows: tracks 7, 8; cols: missed, m3, m4
+    cols = (label(AxisKind.MISSED, -1), label(AxisKind.MEASUREMENT, 3), label(AxisKind.MEASUREMENT, 4))
+    rows = (label(AxisKind.TRACK, 7), label(AxisKind.TRACK, 8))
+    facts = facts_of([frame(0), received([3, 4]), Marginals("car", probs, rows, cols, "exact")])
+    use = facts.use(0, "car")
+    assert use.mode is UseMode.PROBABILITIES
+    assert use.tracks[7].shares == ((3, 0.90), (4, 0.05)) and use.tracks[7].dominant == 3
+    assert use.tracks[8].shares == ((3, 0.395),) and use.tracks[8].dominant is None  # missed (0.60) outweighs
+    assert use.tracks[8].used == (3,)  # used all the same: "given no detection" would be false
+    m3 = facts.destination(0, "car", 3)
+    assert (m3.went, m3.track_id) == (Went.TRACK, 7) and m3.share == pytest.approx(0.9)
+    m4 = facts.destination(0, "car", 4)  # 0.055 claimed by tracks: a new track (or clutter) with p 0.945
+    assert (m4.went, m4.track_id) == (Went.NEW, -1) and m4.share == pytest.approx(0.945)
+
+
+def test_a_phd_update_gives_each_label_its_share_of_weight_per_detection() -> None:
+    weights = UpdateWeights(
+        "car",
+        labels=np.array([10, -3]),  # track 10 and a provisional label (a candidate)
+        meas_indices=np.array([5, 6]),
+        prior=np.array([1.0, 0.2]),
+        missed=np.array([0.1, 0.02]),
+        detected=np.array([[0.85, 0.05], [0.0, 0.1]]),
+        birth=np.array([0.1, 0.6]),
+    )
+    facts = facts_of([frame(0), received([5, 6]), weights])
+    use = facts.use(0, "car")
+    assert use.mode is UseMode.WEIGHTS and set(use.tracks) == {10}  # provisional labels are no track yet
+    (m5, s5), (m6, s6) = use.tracks[10].shares
+    assert (m5, m6) == (5, 6) and s5 == pytest.approx(0.85) and s6 == pytest.approx(0.05)
+    assert use.tracks[10].missed == pytest.approx(0.1)
+    assert facts.destination(0, "car", 5).track_id == 10
+    assert facts.destination(0, "car", 6).went is Went.NEW  # its birth component holds the most (0.6)
+
+
+def test_a_track_step_says_what_the_track_used_how_it_ended_and_whether_it_was_output() -> None:
+    a = Assignment("car", ((label(AxisKind.MEASUREMENT, 2), label(AxisKind.TRACK, 4)),), -1.0, missed_track_ids=(9,))
+    events = [
+        frame(0),
+        received([2]),
+        predicted([4, 9], [0.9, 0.4]),
+        a,
+        Posterior("car", np.array([4, 9]), np.zeros((2, 4)), np.tile(np.eye(4), (2, 1, 1)), np.array([1.0, 0.1])),
+        Extracted("car", (estimate(4, 2),), 0.5),
+        frame(1),
+        received([]),
+        predicted([4, 9], [0.9, 0.09]),
+        Assignment("car", (), 0.0, missed_track_ids=(4, 9)),
+        Pruned("car", 9, PruneReason.TRACK_LOGIC, 1.0),
+        TrackLogic("car", 9, TrackLogicAction.DELETED, 0, 3),
+    ]
+    facts = facts_of(events)
+    s = facts.steps(4, "car")
+    assert s[0].used == (2,) and s[0].output.meas_index == 2 and s[1].used == () and s[1].output is None
+    end = facts.steps(9, "car")[1].ended
+    assert (end.ending, end.hits, end.window) == (Ending.DELETED, 0, 3)
+
+
+def test_pmbm_hypotheses_say_where_the_best_came_from_and_since_when_a_track_was_held() -> None:
+    def hyps(members, existence, parents) -> GlobalHypotheses:
+        return GlobalHypotheses(
+            "car", np.log(np.array([0.7, 0.3])), members, tuple((0,) * len(m) for m in members), existence, parents
+        )
+
+    first = hyps(((4,), (4, 5)), ((0.9,), (0.9, 0.6)), (0, 0))
+    second = hyps(((4, 5), (4,)), ((0.95, 0.7), (0.95,)), (1, 0))  # the best now descends from prior h1
+    pick = Assignment("car", (), 0.0, (), hypothesis=1)
+    facts = facts_of([frame(0), first, frame(1), pick, second])
+    h = facts.hypotheses(1, "car")
+    assert h.switched and h.best_parent == 1 and h.weights == pytest.approx((0.7, 0.3))
+    assert facts.existed_since(5, "car", 1) == 0  # held by hypothesis 1 after frame 0, though not by the best
+    assert h.existence_in(0, 5) == 0.7
+
+
+def test_greedy_close_calls_are_in_metres_on_its_own_scale() -> None:
+    """A greedy match whose runner-up is 0.6 m farther is no close call (0.3 m); one 0.2 m farther is."""
+    metres = CostScale("distance", "m", 0.3, optimal=False)
+    rows = (label(AxisKind.MEASUREMENT, 0), label(AxisKind.MEASUREMENT, 1))
+    cols = (
+        label(AxisKind.TRACK, 1),
+        label(AxisKind.TRACK, 2),
+        label(AxisKind.NEW_TRACK, 0),
+        label(AxisKind.NEW_TRACK, 1),
+    )
+    cost = np.array([[0.5, 1.1, 2.0, np.inf], [3.0, 0.4, np.inf, 2.0]])
+    pairs = ((rows[0], cols[0]), (rows[1], cols[1]))
+    events = [
+        frame(0),
+        received([0, 1]),
+        predicted([1, 2], [1.0, 1.0]),
+        Extracted("car", (estimate(1, 0), estimate(2, 1)), 0.0),
+        frame(1),
+        received([0, 1]),
+        predicted([1, 2], [1.0, 1.0]),
+        CostMatrix("car", cost, rows, cols, scale=metres),
+        Assignment("car", pairs, 0.9, ()),
+        Extracted("car", (estimate(1, 0), estimate(2, 1)), 0.0),
+    ]
+    facts = facts_of(events)
+    teller = Storyteller(facts)
+    teller.frame_lines(0)
+    calls = [line for line in teller.frame_lines(1) if line.kind is StoryKind.CLOSE_CALL]
+    assert calls == []  # m0: 0.5 m against 1.1 m; m1: 0.4 m against 2.0 m (new)
+    near = np.array([[0.5, 0.7, 2.0, np.inf], [3.0, 0.4, np.inf, 2.0]])
+    events[7] = CostMatrix("car", near, rows, cols, scale=metres)
+    teller = Storyteller(facts_of(events))
+    teller.frame_lines(0)
+    (call,) = [line for line in teller.frame_lines(1) if line.kind is StoryKind.CLOSE_CALL]
+    assert call.text == "close call: m0 → track 1 (cost 0.50 m) over track 2 (0.70 m), margin 0.20 m"
+    assert call.track_ids == (1, 2)
+
+
+def test_a_tracker_that_emits_births_names_the_track_a_detection_started() -> None:
+    events = [
+        frame(0),
+        received([3]),
+        Assignment("car", ((label(AxisKind.MEASUREMENT, 3), label(AxisKind.NEW_TRACK, 3)),), 0.0, ()),
+        Born("car", np.array([17]), np.array([3]), np.zeros((1, 4)), np.array([0.3])),
+    ]
+    d = facts_of(events).destination(0, "car", 3)
+    assert (d.went, d.track_id) == (Went.NEW_TRACK, 17)
