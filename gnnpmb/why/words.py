@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 
-from gnnpmb.eval.evaluated import GtFrame, GtStatus, TrackEval
+from gnnpmb.eval.evaluated import Dropped, GtFrame, GtStatus, TrackEval
 from gnnpmb.eval.failures import FailureKind, short_id
 from gnnpmb.events import AxisKind, AxisLabel, PairTerms
 from gnnpmb.explain import PairChoice
@@ -688,7 +688,8 @@ def _no_box_reason(g: GtFrame | None) -> str:
             f"it lies {g.ego_distance_m:.2f} m from the ego vehicle, beyond the evaluation's {g.range_m:g} m range, "
             "and it keeps no box of it both before and after this frame"
         )
-    return f"its box was dropped ({g.dropped.value if g.dropped else 'unknown'}) and could not be interpolated"
+    why = f"it had {g.dropped.value}" if g.dropped is Dropped.NO_POINTS else f"it was {g.dropped.value}"
+    return f"{why}, so its box was dropped, and no box could be interpolated"
 
 
 def _miss(f: Finding) -> list[str]:
