@@ -23,8 +23,6 @@ from gnnpmb.why.findings import (
     LostTrack,
     Near,
     OnObject,
-    OtherRun,
-    Party,
     Rule,
     Sighting,
 )
@@ -824,31 +822,6 @@ def plain(markdown: str) -> str:
     return markdown.replace("**", "")
 
 
-def summary_line(f: Finding) -> str:
-    """One line for ``gnnpmb failures --why``: whose doing and the tests that held."""
-    tests = "; ".join(f"{_RULE_WORDS[b.rule]} at {frames_text(b.frames)}" for b in f.blame)
-    return f"{whose_text(f)}: {tests}" if tests else whose_text(f)
-
-
-_RULE_WORDS = {
-    Rule.NO_DETECTION: "no detection of any class within 2 m",
-    Rule.OTHER_CLASS: "detected only as another class",
-    Rule.DETECTION_OF_NOTHING: "output on a detection of no object",
-    Rule.DETECTION_UNUSED: "a detection of it was there, not used by the track that had it",
-    Rule.NOT_OUTPUT: "the track on it was not output",
-    Rule.OFF_OBJECT: "the track was output 2 m or more from it",
-    Rule.NOT_COUNTED: "a track on it was output but not counted (averaged score below the threshold)",
-    Rule.TWO_TRACKS: "two tracks on one object",
-    Rule.COASTED: "output without a detection where nothing was",
-    Rule.COVERED_TWO: "one track covered two objects",
-    Rule.UNSEEN: "no points, no detection, and no track carried it",
-    Rule.INTERPOLATED: "scored at an interpolated box 0.5 m or more from the annotation",
-    Rule.NO_EVAL_BOX: "the evaluation has no box of the object",
-    Rule.TRACK_INTERPOLATED: "a box the evaluation interpolated between two of the track's",
-    Rule.TRACK_DROPPED: "the track's box on it dropped by the evaluation (beyond the class range)",
-}
-
-
 def on_object_text(o: OnObject) -> str:
     """A track output on an object, for the object's table: ``62 (0.92; track average 0.69)``."""
     if o.threshold is None:
@@ -859,10 +832,6 @@ def on_object_text(o: OnObject) -> str:
     return f"{o.track_id} ({o.score:.2f}; track average {ev.averaged_score:.2f}" + (
         ", not counted)" if not o.counted else ")"
     )
-
-
-def party_names() -> dict[Party, str]:
-    return {p: p.value for p in Party}
 
 
 def sighting_points(s: Sighting) -> str:
@@ -880,7 +849,3 @@ def sighting_points(s: Sighting) -> str:
         case GtStatus.NO_BOX:
             return f"{s.points}: no box ({g.dropped.value if g.dropped else 'dropped'}), not scored"
     raise AssertionError(g.status)
-
-
-def other_runs(others: Sequence[OtherRun]) -> list[str]:
-    return [f"{o.tracker}: {'failed too' if o.failed_same else 'no such failure'}" for o in others]
