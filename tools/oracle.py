@@ -307,7 +307,14 @@ def _check(c: Claim, f: Finding, src: Sources) -> str:  # noqa: C901 (one branch
             if v[1] >= 0:
                 return "" if _same_geometry(box, boxes, v[1]) else "its box does not carry that detection"
             same = [m for m in range(len(boxes)) if _same_geometry(box, boxes, m)]
-            return "" if not same else f"its box carries detection {same[0]}"
+            if not same:
+                return ""
+            # A persistent false detection keeps its box from frame to frame: a track that kept that box while
+            # missed looks the same. It was on that detection only if its update used it.
+            cls = box["tracking_name"]
+            used = used_of(src, x, cls, v[0])
+            taken = [m for m in same if used is not None and m in [u for u, _ in used[0]]]
+            return f"its box carries detection {taken[0]}, which its update used" if taken else ""
         case "not output":
             return "" if src.box(x, v[0]) is None else "in the submission"
         case "output near":
@@ -474,6 +481,14 @@ def _check_blame(rule: Rule, frames: tuple[int, ...], f: Finding, src: Sources) 
                     nearest = min(own, key=lambda j: d[j])
                     if used is not None and nearest in [m for m, _ in used[0]]:
                         return f"track {f.lost.track_id} used m{nearest} at frame {x}"
+            case Rule.TRACK_DROPPED if f.false_output is not None:
+                kept, _ = src.devkit.tracks.get(str(f.false_output.track_id), ((), None))
+                if src.box(x, f.false_output.track_id) is None or x in kept:
+                    return "the track's box was not dropped there"
+            case Rule.TRACK_INTERPOLATED:
+                kept, _ = src.devkit.tracks.get(str(f.false_output.track_id), ((), None))
+                if x in kept:
+                    return "the evaluation kept the track's own box there"
             case Rule.TRACK_DROPPED:
                 dropped = False
                 for b in src.results.get(src.scene.keyframes[x].sample_token, ()):
@@ -484,7 +499,16 @@ def _check_blame(rule: Rule, frames: tuple[int, ...], f: Finding, src: Sources) 
                         dropped |= x not in kept
                 if not dropped:
                     return "no track box on it was dropped"
-            case Rule.COVERED_TWO if f.kind.value == "miss":
+            case Rule.TWO_TRACKS if f.lost is not None:
+                near = [
+                    b["tracking_id"]
+                    for b in src.results.get(src.scene.keyframes[x].sample_token, ())
+                    if b["tracking_name"] == f.class_name
+                    and np.hypot(*(np.asarray(b["translation"][:2]) - xy)) < NEAR_M
+                ]
+                if str(f.lost.track_id) not in near or len(near) < 2:
+                    return "not two tracks on the object"
+            case Rule.COVERED_TWO if f.kind.value in ("miss", "fragmentation"):
                 counted = [
                     b
                     for b in src.results.get(src.scene.keyframes[x].sample_token, ())

@@ -135,8 +135,10 @@ def claims(f: Finding) -> list[Claim]:
         add("parent", f.switch.frame, c, f.switch.parent)
     if f.false_output is not None:
         o = f.false_output
-        if o.between is not None or any(b.rule.name == "TRACK_INTERPOLATED" for b in f.blame):
-            add("not output", f.frame, o.track_id)
+        rules = {b.rule.name for b in f.blame}
+        if "TRACK_INTERPOLATED" in rules:
+            if "TRACK_DROPPED" not in rules:
+                add("not output", f.frame, o.track_id)
             if o.between is not None:
                 add("output", o.between[0], o.track_id, None)
                 add("output", o.between[1], o.track_id, None)
@@ -146,7 +148,7 @@ def claims(f: Finding) -> list[Claim]:
             add("averaged score", -1, o.track_id, o.evaluated.averaged_score, o.evaluated.kept)
         if o.nearest_own is not None:
             gt_id, d, g = o.nearest_own
-            if o.between is None:
+            if "TRACK_INTERPOLATED" not in rules:
                 add("output near", f.frame, o.track_id, gt_id, d)
             if g is not None:
                 add("evaluated", f.frame, gt_id, g.status, g.evaluated_xy_m)

@@ -42,6 +42,9 @@ from gnnpmb.why.findings import (
     Sighting,
 )
 
+_ON_IT_RULES = (Rule.TRACK_DROPPED, Rule.NOT_COUNTED, Rule.COVERED_TWO)
+"""The tests about tracks output on an object the evaluation still missed (``_Context.blame_uncovered``)."""
+
 LOST_AND_TAKER = {
     FailureKind.ID_SWITCH: (0, 1),
     FailureKind.IDENTITY_THEFT: (1, 0),
@@ -337,12 +340,22 @@ class _Context:
                 unused.append(f)
             if step is None or step.output is None:
                 not_output.append(f)
-        return self.evaluation_blame() + _blames(
-            (Rule.NO_DETECTION, no_det),
-            (Rule.OTHER_CLASS, other_class),
-            (Rule.DETECTION_UNUSED, unused),
-            (Rule.NOT_OUTPUT, not_output),
-            (Rule.OFF_OBJECT, [self.f] if lost.off is not None else []),
+        covering: list[Blame] = []
+        at = seen.get(self.f)
+        if self.failure.kind is FailureKind.FRAGMENTATION and at is not None:  # missed here though tracks were on it
+            covering = [b for b in self.blame_uncovered(at) if b.rule in _ON_IT_RULES]
+        elif at is not None and lost.off is None and any(o.track_id == lost.track_id for o in at.on_it):
+            covering = [Blame(Rule.TWO_TRACKS, (self.f,))]  # still on it, yet the evaluation took the other track
+        return (
+            self.evaluation_blame()
+            + _blames(
+                (Rule.NO_DETECTION, no_det),
+                (Rule.OTHER_CLASS, other_class),
+                (Rule.DETECTION_UNUSED, unused),
+                (Rule.NOT_OUTPUT, not_output),
+                (Rule.OFF_OBJECT, [self.f] if lost.off is not None else []),
+            )
+            + tuple(covering)
         )
 
     def evaluation_blame(self) -> tuple[Blame, ...]:
@@ -411,16 +424,18 @@ class _Context:
     def false_track(self) -> dict:
         t = int(self.failure.track_ids[0])
         e = self.estimate(t, self.f)
+        ev = self.report.track_evals.get(str(t))
+        interpolated = e is None or (ev is not None and self.f in ev.interpolated)
         between = None
-        if e is not None:
+        if not interpolated:
             xy = np.asarray(e.translation_m[:2])
-        else:  # the tracker output no box here: the evaluation interpolated the track between two of its boxes
+        else:  # no box of the tracker's was kept here: the evaluation interpolated the track between two of its
             box = next(b for b in self.failure.boxes if b.role == "false track")
             xy = np.asarray(box.translation_m[:2])
-            ev = self.report.track_evals.get(str(t))
             kept = ev.kept if ev is not None else ()
             before, after = [x for x in kept if x < self.f], [x for x in kept if x > self.f]
             between = (before[-1], after[0]) if before and after else None
+            e = None  # the box scored is not the tracker's
         fr = self.frames.get(self.f)
         on = None
         if e is not None and e.meas_index >= 0 and fr is not None:
@@ -446,8 +461,10 @@ class _Context:
             k = int(np.argmin(d))
             nearest_any = (str(gt.instance_id[k]), str(gt.class_name[k]), float(d[k]))
         blame: list[Blame] = []
-        if e is None:
+        if interpolated:
             blame.append(Blame(Rule.TRACK_INTERPOLATED, (self.f,)))
+            if self.estimate(t, self.f) is not None:
+                blame.append(Blame(Rule.TRACK_DROPPED, (self.f,)))  # output, but beyond the range: dropped
         if nearest_own is not None:
             g = nearest_own[2]
             if g is None or g.status in (GtStatus.NO_BOX, GtStatus.BEYOND_RANGE):
@@ -530,7 +547,7 @@ class _Context:
         blame = list(self.evaluation_blame())
         if s is not None:
             uncovered = self.blame_uncovered(s)
-            blame += [b for b in uncovered if b.rule is not Rule.NOT_COUNTED]
+            blame += uncovered
             if s.went is not None and s.went.track_id == int(self.failure.track_ids[0]):
                 blame.append(Blame(Rule.COVERED_TWO, (self.f,)))
         covered = tuple(g for g in self.failure.gt_ids if g != self.failure.gt_ids[1])

@@ -525,6 +525,34 @@ def _lost_object(f: Finding) -> list[str]:
             parts.append(f"track {o.track_id} had existed since frame {o.frame} in a hypothesis other than the best")
     if lost is not None and lost.off is not None:
         parts.append(_off_text(f, lost))
+    if lost is not None and any(b.rule is Rule.TWO_TRACKS for b in f.blame):
+        s = f.sighting(f.frame)
+        others = [o.track_id for o in (s.on_it if s else ()) if o.track_id != lost.track_id]
+        parts.append(
+            f"at frame {f.frame} track {lost.track_id} was still output on the object, but so was track "
+            f"{', '.join(map(str, others))}: two tracks on one object, and the evaluation matched the other"
+        )
+    if lost is not None and f.kind is FailureKind.FRAGMENTATION:
+        s = f.sighting(f.frame)
+        for b in f.blame:
+            if b.rule is Rule.COVERED_TWO and s is not None:
+                ids = ", ".join(str(o.track_id) for o in s.on_it if o.counted)
+                parts.append(
+                    f"at frame {f.frame} track {ids} lay within {NEAR_M:.0f} m of it and was counted, but the "
+                    "evaluation matched it to another object: one track for two objects"
+                )
+            elif b.rule is Rule.NOT_COUNTED and s is not None:
+                parts += [
+                    f"track {o.track_id} was output on it, but {averaged_text(o.evaluated)}, is below the "
+                    f"{f.class_name} threshold {o.threshold:.3f}: the evaluation did not count it"
+                    for o in s.on_it
+                    if not o.counted and o.evaluated is not None and o.evaluated.averaged_score is not None
+                ]
+            elif b.rule is Rule.TRACK_DROPPED:
+                parts.append(
+                    f"at frame {f.frame} a track's box on it lies beyond the evaluation's range for the class: the "
+                    "evaluation dropped that box"
+                )
     if f.taker is not None and f.taker.false_frames:
         victim = f"track {lost.track_id}" if lost is not None else "another track"
         parts.append(
@@ -634,9 +662,14 @@ def _false_track(f: Finding) -> list[str]:
     tests = {b.rule for b in f.blame}
     if Rule.TRACK_INTERPOLATED in tests:
         between = f" between its boxes at frames {o.between[0]} and {o.between[1]}" if o.between else ""
+        why = (
+            "was output, but its box lay beyond the evaluation's range for the class and was dropped"
+            if Rule.TRACK_DROPPED in tests
+            else "was not output"
+        )
         head = (
-            f"at frame {f.frame} track {o.track_id} ({f.class_name}) was not output: the evaluation interpolated it"
-            f"{between}, and that box matched no object"
+            f"at frame {f.frame} track {o.track_id} ({f.class_name}) {why}: the evaluation interpolated it{between}, "
+            "and that box matched no object"
         )
     else:
         head = f"at frame {f.frame} track {o.track_id} ({f.class_name}) was output on "
