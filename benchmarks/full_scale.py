@@ -428,7 +428,7 @@ def main() -> None:
     m.add_argument("--detections", type=Path, required=True)
     m.add_argument("--nuscenes-version", dest="version", default=VERSION)
     m.add_argument("--scene", default="scene-0003")
-    m.add_argument("--focus", default="false_track:1", help="the failure --focus opens")
+    m.add_argument("--focus", default="id_switch:1", help="the failure --focus opens")
     m.add_argument("--commands", nargs="+", choices=COMMANDS, default=list(COMMANDS))
     m.add_argument("--warm-only", action="store_true", help="skip the cold runs")
     args = parser.parse_args()
