@@ -90,3 +90,30 @@ def test_bad_table_is_one_line(dataroot: Path) -> None:
     table.write_text(json.dumps([{"token": "a", "sample_token": "nowhere"}]))
     with pytest.raises(DataError, match="sample_annotation.json cannot be read .*field"):
         load_scene(check_dataroot(dataroot, None), SCENE)
+
+
+def test_cli_reads_a_damaged_index_and_refuses_a_garbled_table(
+    dataroot: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import functools
+
+    from cli.batch import app
+    from cli.errors import run_app
+    from tests.inprocess import run_main
+
+    def failures() -> tuple[int, str, str]:
+        loader._INDEXES.clear()
+        argv = ["failures", SCENE, "--dataroot", str(dataroot), "--detector", "pointpillars"]
+        return run_main(functools.partial(run_app, app), argv, capsys)
+
+    code, first, _ = failures()
+    assert code == 0 and "false_track" in first
+    (folder,) = (dataroot.parent / "cache" / "index").glob("dataset-*")
+    (folder / "samples.arrow").write_bytes(b"garbage")
+    assert failures()[:2] == (0, first)
+    table = dataroot / "v1.0-mini" / "sample.json"
+    table.write_text(table.read_text()[:-200])
+    code, _, err = failures()
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and lines[0].startswith("error: ")
+    assert "v1.0-mini/sample.json cannot be read" in lines[0] and "line" in lines[0]
