@@ -7,8 +7,10 @@ with ``--boxes-per-sample`` boxes per sample (the demo's annotated objects with 
 up with low-scoring boxes as a real detector's are). ``--pad-sample-data`` adds non-keyframe LIDAR_TOP sweeps
 (and their ego poses) until sample_data has the real trainval's 2.6M rows.
 
-``measure`` runs each command as a user types it, in a fresh cache (cold: the index is built) and again in the
-same cache (warm), and prints a markdown table: wall seconds, CPU seconds (every process of the command,
+``measure`` runs each command as a user types it, in a fresh cache (cold: the indexes are built), again in the
+same cache with its failure reports removed (warm: indexes built, the evaluation runs) and once more as is
+(warm + report: the failure report of the same tracks is stored, as when ``--focus`` follows ``gnnpmb
+failures``), and prints a markdown table: wall seconds, CPU seconds (every process of the command,
 Ray's included) and peak resident memory (the command's process; for ``--workers`` also the largest worker and
 all processes together), sampled every 0.1 s with psutil. With ``--dataroot`` and ``--detections`` it measures
 real data the same way::
@@ -42,6 +44,7 @@ VERSION = "v1.0-trainval"
 REAL_SAMPLE_DATA_ROWS = 2_600_000
 SHARED_TABLES = ("category", "attribute", "visibility", "sensor", "calibrated_sensor")
 COMMANDS = ("viz", "failures", "focus", "track1", "track2")
+SINGLE_SCENE = ("viz", "failures", "focus")
 SAMPLE_INTERVAL_S = 0.1
 
 
@@ -339,9 +342,12 @@ def run_measured(argv: Sequence[str], env: dict[str, str]) -> Measured:
     return Measured(wall, sum(cpu.values()), main_peak, max(others, default=0.0), total_peak, proc.returncode)
 
 
-def command_lines(dataroot: Path, detections: Path, version: str, scene: str, focus: str, out: Path) -> dict:
+def command_lines(
+    dataroot: Path, detections: Path, version: str, scene: str, focus: str, out: Path, tracker: str
+) -> dict:
     """The measured commands by key."""
     common = ["--dataroot", str(dataroot), "--nuscenes-version", version, "--detections", str(detections)]
+    common += ["--tracker", tracker]
     scripts = Path(sys.executable).parent  # the console scripts themselves, so the command is the measured process
     viz = [str(scripts / "gnnpmb-viz"), scene, *common, "--no-progress"]
     batch = [str(scripts / "gnnpmb")]
@@ -395,14 +401,17 @@ def measure(args: argparse.Namespace) -> None:
     out = Path(tempfile.mkdtemp(prefix="gnnpmb-full-scale-"))
     cache = out / "cache"
     env = {**os.environ, "GNNPMB_CACHE_DIR": str(cache), "PYTHONUNBUFFERED": "1"}
-    lines = command_lines(args.dataroot, args.detections, args.version, args.scene, args.focus, out)
+    lines = command_lines(args.dataroot, args.detections, args.version, args.scene, args.focus, out, args.tracker)
     print("| command | run | wall s | CPU s | peak RSS GB (command / largest worker / all) | exit |")
     print("|---|---|---|---|---|---|")
     try:
         for key in args.commands:
-            for run in ("cold", "warm") if not args.warm_only else ("warm",):
+            runs = ["cold", "warm", "warm + report"] if key in SINGLE_SCENE else ["cold", "warm"]
+            for run in runs[1:] if args.warm_only else runs:
                 if run == "cold" and cache.exists():
                     shutil.rmtree(cache)
+                if run == "warm":
+                    shutil.rmtree(cache / "failures", ignore_errors=True)
                 m = run_measured(lines[key], env)
                 rss = f"{m.main_gb:.2f}" + (f" / {m.worker_gb:.2f} / {m.total_gb:.2f}" if key == "track2" else "")
                 print(f"| {LABELS[key]} | {run} | {m.wall_s:.1f} | {m.cpu_s:.1f} | {rss} | {m.code} |", flush=True)
@@ -431,6 +440,7 @@ def main() -> None:
     m.add_argument("--focus", default="id_switch:1", help="the failure --focus opens")
     m.add_argument("--commands", nargs="+", choices=COMMANDS, default=list(COMMANDS))
     m.add_argument("--warm-only", action="store_true", help="skip the cold runs")
+    m.add_argument("--tracker", default="gnnpmb", help="the tracker every command runs")
     args = parser.parse_args()
     if args.step == "build":
         build(args.out, args.pad_sample_data, args.boxes_per_sample, args.barriers, args.seed)

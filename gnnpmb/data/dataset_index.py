@@ -384,12 +384,13 @@ def _annotations(
     except (KeyError, TypeError, ValueError) as exc:
         raise tables.field_error("sample_annotation", exc) from None
     table = pa.concat_tables(chunks)
+    del chunks, rows
     info = np.column_stack([np.frombuffer(column, dtype=np.int64) for column in meta]).reshape(-1, 4)
     table = _with_velocity(table, info[:, 3])
     order = np.lexsort((info[:, 2], info[:, 1], info[:, 0]))
     table = table.append_column("sample_index", pa.array(info[:, 1].astype(np.int32)))
     table = table.append_column("table_pos", pa.array(info[:, 2])).take(pa.array(order))
-    table = table.select([f.name for f in _ANN_SCHEMA]).cast(_ANN_SCHEMA)
+    table = table.select([f.name for f in _ANN_SCHEMA]).cast(_ANN_SCHEMA).combine_chunks()
     scene_of = info[order, 0]
     bounds = np.searchsorted(scene_of, np.arange(n_scenes + 1))
     batches = [_slice_batch(table, int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
@@ -401,7 +402,8 @@ def _annotations(
 
 
 def _slice_batch(table: pa.Table, start: int, stop: int) -> pa.RecordBatch:
-    part = table.slice(start, stop - start).combine_chunks()
+    """Rows ``start:stop`` of a single-chunk table as one record batch (no copy)."""
+    part = table.slice(start, stop - start)
     return part.to_batches()[0] if part.num_rows else pa.RecordBatch.from_pylist([], table.schema)
 
 

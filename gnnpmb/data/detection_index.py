@@ -21,8 +21,8 @@ import pyarrow as pa
 
 from gnnpmb.data.index_store import (
     Store,
-    batch_crc,
     build_progress,
+    file_crcs,
     open_or_build,
     source_identity,
     write_json_file,
@@ -121,7 +121,7 @@ def _build(
 
     batch_of: dict[str, int] = {}
     problems: dict[str, str] = {}
-    crcs: list[int] = []
+    written = 0
     try:
         with (
             open(path, "rb") as f,
@@ -135,14 +135,13 @@ def _build(
                 if isinstance(converted, str):
                     problems[token] = converted
                     continue
-                batch = _batch(converted)
-                writer.write_batch(batch)
-                crcs.append(batch_crc(batch))
-                batch_of[token] = len(crcs) - 1
+                writer.write_batch(_batch(converted))
+                batch_of[token] = written
+                written += 1
     except (JsonStreamError, NotUtf8Error, KeyError, TypeError, OSError) as exc:
         raise describe(exc) from None
     files = {
-        "boxes.arrow": {"size": (tmp / "boxes.arrow").stat().st_size, "crc": crcs},
+        "boxes.arrow": {"size": (tmp / "boxes.arrow").stat().st_size, "crc": file_crcs(tmp / "boxes.arrow")},
         "samples.json": write_json_file(tmp / "samples.json", {"batch": batch_of, "problems": problems}),
     }
     manifest = {"format": FORMAT, "sources": sources, "sha256": digest.hexdigest(), "files": files}

@@ -18,7 +18,7 @@ import os
 import shutil
 import tempfile
 import zlib
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -53,12 +53,19 @@ def batch_crc(batch: pa.RecordBatch) -> int:
     return zlib.crc32(batch.serialize())
 
 
-def write_batches(path: Path, schema: pa.Schema, batches: Sequence[pa.RecordBatch]) -> dict[str, Any]:
-    """Write ``batches`` (one per scene or sample) to an Arrow IPC file; its manifest entry (size, CRCs)."""
+def write_batches(path: Path, schema: pa.Schema, batches: Iterable[pa.RecordBatch]) -> dict[str, Any]:
+    """Write ``batches`` (one per scene or sample) to an Arrow IPC file; its manifest entry (size, and the CRC
+    of each batch as it reads back, whatever slicing or padding the writer applied)."""
     with pa.OSFile(str(path), "wb") as sink, pa.ipc.new_file(sink, schema) as writer:
         for batch in batches:
             writer.write_batch(batch)
-    return {"size": path.stat().st_size, "crc": [batch_crc(b) for b in batches]}
+    return {"size": path.stat().st_size, "crc": file_crcs(path)}
+
+
+def file_crcs(path: Path) -> list[int]:
+    """The CRC of every record batch of an Arrow IPC file, read back from disk."""
+    reader = pa.ipc.open_file(pa.memory_map(str(path)))
+    return [batch_crc(reader.get_batch(i)) for i in range(reader.num_record_batches)]
 
 
 def write_json_file(path: Path, data: Any) -> dict[str, Any]:

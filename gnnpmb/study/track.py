@@ -3,8 +3,9 @@ and of the per-scene step of ``gnnpmb failures`` (``scene_failures``); ``sweep``
 same ``gnnpmb.study.data`` steps.
 
 In this process each scene is read from the indexes and tracked in turn. On Ray this process reads each scene's
-inputs (the scene and its detections, from the indexes) and sends them with the task, one scene per task, so a
-worker holds only its scenes and loads nothing. Every scene is tracked by the same deterministic code either
+inputs (the scene and its detections, from the indexes) and sends them with the task, a few consecutive scenes
+per task (``TASKS_PER_WORKER`` tasks per worker: fewer tasks, less of Ray's per-task cost on a small machine), so
+a worker holds only its scenes and loads nothing. Every scene is tracked by the same deterministic code either
 way and the runs are put back in split order, so the submission equals a one-worker run's byte for byte.
 """
 
@@ -26,21 +27,23 @@ if TYPE_CHECKING:
     from gnnpmb.pipeline import TrackingRun
 
 IN_PROCESS = Execution(workers=1)
+TASKS_PER_WORKER = 4
+"""Ray tasks per worker when the scenes are split among ``workers`` (one scene per task without a cap)."""
 
 
 @dataclass(frozen=True, slots=True)
-class SceneTask:
-    """One scene to track, with its inputs."""
+class ScenesTask:
+    """Consecutive scenes of the split to track, with their inputs."""
 
-    inputs: SceneInputs
+    inputs: tuple[SceneInputs, ...]
     tracker: str
     config: TrackerConfig
     detector: str
     seed: int
 
 
-def _track(task: SceneTask) -> SceneRun:
-    return track_inputs(task.inputs, task.tracker, task.config, task.detector, task.seed)
+def _track(task: ScenesTask) -> list[SceneRun]:
+    return [track_inputs(i, task.tracker, task.config, task.detector, task.seed) for i in task.inputs]
 
 
 def track_split(
@@ -60,14 +63,21 @@ def track_split(
             if on_scene is not None:
                 on_scene(runs[-1])
         return runs
-    tasks = (SceneTask(load_inputs(data, name), tracker, config, data.detector, data.seed) for name in data.scene_names)
-    done: dict[int, SceneRun] = {}
+    names = data.scene_names
+    size = 1 if run.workers is None else -(-len(names) // (run.workers * TASKS_PER_WORKER))
+    chunks = [names[i : i + size] for i in range(0, len(names), size)]
+    tasks = (
+        ScenesTask(tuple(load_inputs(data, n) for n in chunk), tracker, config, data.detector, data.seed)
+        for chunk in chunks
+    )
+    done: dict[int, list[SceneRun]] = {}
     with session(run):
-        for i, scene_run in run_tasks(_track, tasks, run):
-            done[i] = scene_run
+        for i, scene_runs in run_tasks(_track, tasks, run):
+            done[i] = scene_runs
             if on_scene is not None:
-                on_scene(scene_run)
-    return [done[i] for i in range(len(data.scene_names))]
+                for scene_run in scene_runs:
+                    on_scene(scene_run)
+    return [r for i in range(len(chunks)) for r in done[i]]
 
 
 @dataclass(frozen=True, slots=True)
