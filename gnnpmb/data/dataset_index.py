@@ -274,7 +274,15 @@ def _chain(scene: dict[str, Any], samples: dict[str, tuple[int, dict]]) -> list[
     return chain
 
 
-def _sample_batches(chains, samples, lidar, poses, calibrated, tables: _Tables) -> list[pa.RecordBatch]:
+_Rows = dict[str, tuple[int, dict[str, Any]]]
+"""token -> (table position, row)."""
+
+
+def _sample_batches(
+    chains: list[list[str]], samples: _Rows, lidar: _Rows, poses: _Rows, calibrated: _Rows, tables: _Tables
+) -> list[pa.RecordBatch]:
+    """Per scene, its keyframes in time order with their LIDAR_TOP sample_data, ego pose and calibration (NaN
+    poses where a sample has no LIDAR_TOP keyframe: ``has_lidar`` False)."""
     out = []
     missing_pose = {"translation": [np.nan] * 3, "rotation": [np.nan] * 4, "timestamp": -1}
     for chain in chains:

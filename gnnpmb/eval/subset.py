@@ -8,8 +8,9 @@ index, sensors, logs and maps. ``eval_location`` writes exactly those rows, in t
 with the original values (floats written with ``repr`` read back bit for bit), into
 ``<cache root>/evalroot/<key>/<version>/`` beside the version's ``splits.json``; the metrics are those of a full
 load (``tests/gnnpmb/eval/test_subset.py``). Map masks are empty placeholder files: the devkit checks that they
-exist and the evaluation never opens them. The folder is built in a temporary folder and renamed into place;
-the newest ``KEEP_FOLDERS`` are kept.
+exist and the evaluation never opens them. The folder is built in a temporary folder and renamed into place,
+with ``sizes.json`` written last; one whose files do not have their recorded sizes is built again. The newest
+``KEEP_FOLDERS`` are kept.
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ from gnnpmb.data.dataset_index import SMALL_TABLES, DatasetIndex, SceneSlice
 from gnnpmb.data.nuscenes import DatasetLocation, dataset_index
 
 EVALROOT_FOLDER = "evalroot"
+SIZES = "sizes.json"
+"""Written last in an eval folder: each file's size, so a damaged or partial folder is built again."""
 KEEP_FOLDERS = 50
 """Eval folders kept in the cache (a one-scene folder is tens of kB, a val split one tens of MB)."""
 
@@ -42,10 +45,20 @@ def eval_location(location: DatasetLocation, scene_names: Sequence[str]) -> Data
     custom = splits.read_bytes() if splits.is_file() else b""
     key = hashlib.sha256(json.dumps([index.key, list(scene_names), custom.decode(errors="replace")]).encode())
     folder = cache_root() / EVALROOT_FOLDER / key.hexdigest()[:24]
-    if not (folder / location.version / "scene.json").is_file():
+    if not _complete(folder):
+        shutil.rmtree(folder, ignore_errors=True)
         _write(folder, location.version, subset_tables(index, scene_names), custom)
         _drop_oldest(folder.parent, KEEP_FOLDERS)
     return DatasetLocation(dataroot=folder, version=location.version, synthetic=location.synthetic)
+
+
+def _complete(folder: Path) -> bool:
+    """Whether every file listed in the folder's ``sizes.json`` (written last) has its recorded size."""
+    try:
+        sizes = json.loads((folder / SIZES).read_text(encoding="utf-8"))
+        return all((folder / name).stat().st_size == size for name, size in sizes.items())
+    except (OSError, ValueError, AttributeError):
+        return False
 
 
 def _write(folder: Path, version: str, tables: dict[str, list[dict[str, Any]]], custom: bytes) -> None:
@@ -61,10 +74,12 @@ def _write(folder: Path, version: str, tables: dict[str, list[dict[str, Any]]], 
             path = tmp / row["filename"]
             path.parent.mkdir(parents=True, exist_ok=True)
             path.touch()
+        sizes = {p.relative_to(tmp).as_posix(): p.stat().st_size for p in tmp.rglob("*") if p.is_file()}
+        (tmp / SIZES).write_text(json.dumps(sizes), encoding="utf-8")
         try:
             os.replace(tmp, folder)
         except OSError:  # another process wrote the same folder first
-            if not (folder / version / "scene.json").is_file():
+            if not _complete(folder):
                 raise
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -84,3 +84,12 @@ def test_subset_holds_only_its_scenes(dataroot: Path) -> None:
     samples = json.loads((tables / "sample.json").read_text())
     assert {s["token"] for s in samples} == set(sample_tokens(location, ["scene-0916"]))
     assert eval_location(location, ["scene-0916"]) == subset
+
+
+def test_damaged_subset_is_built_again(dataroot: Path) -> None:
+    location = check_dataroot(dataroot, None)
+    subset = eval_location(location, ["scene-0103"])
+    table = subset.dataroot / subset.version / "sample_annotation.json"
+    expected = table.read_text()
+    table.write_text(expected[:100])
+    assert eval_location(location, ["scene-0103"]) == subset and table.read_text() == expected
