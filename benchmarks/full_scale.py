@@ -12,7 +12,8 @@ same cache with its failure reports removed (warm: indexes built, the evaluation
 (warm + report: the failure report of the same tracks is stored, as when ``--focus`` follows ``gnnpmb
 failures``), and prints a markdown table: wall seconds, CPU seconds (every process of the command,
 Ray's included) and peak resident memory (the command's process; for ``--workers`` also the largest worker and
-all processes together), sampled every 0.1 s with psutil. With ``--dataroot`` and ``--detections`` it measures
+all processes together), sampled every 0.1 s with psutil, and the 1-minute load average before the command
+(anything else running on the machine shows there). With ``--dataroot`` and ``--detections`` it measures
 real data the same way::
 
     uv run python benchmarks/full_scale.py build --out /work/bigdata/fullsize
@@ -402,8 +403,8 @@ def measure(args: argparse.Namespace) -> None:
     cache = out / "cache"
     env = {**os.environ, "GNNPMB_CACHE_DIR": str(cache), "PYTHONUNBUFFERED": "1"}
     lines = command_lines(args.dataroot, args.detections, args.version, args.scene, args.focus, out, args.tracker)
-    print("| command | run | wall s | CPU s | peak RSS GB (command / largest worker / all) | exit |")
-    print("|---|---|---|---|---|---|")
+    print("| command | run | wall s | CPU s | peak RSS GB (command / largest worker / all) | load before | exit |")
+    print("|---|---|---|---|---|---|---|")
     try:
         for key in args.commands:
             runs = ["cold", "warm", "warm + report"] if key in SINGLE_SCENE else ["cold", "warm"]
@@ -412,9 +413,11 @@ def measure(args: argparse.Namespace) -> None:
                     shutil.rmtree(cache)
                 if run == "warm":
                     shutil.rmtree(cache / "failures", ignore_errors=True)
+                load = os.getloadavg()[0]
                 m = run_measured(lines[key], env)
                 rss = f"{m.main_gb:.2f}" + (f" / {m.worker_gb:.2f} / {m.total_gb:.2f}" if key == "track2" else "")
-                print(f"| {LABELS[key]} | {run} | {m.wall_s:.1f} | {m.cpu_s:.1f} | {rss} | {m.code} |", flush=True)
+                cells = f"{m.wall_s:.1f} | {m.cpu_s:.1f} | {rss} | {load:.1f} | {m.code}"
+                print(f"| {LABELS[key]} | {run} | {cells} |", flush=True)
         same = [out / "track1.json", out / "track2.json"]
         if all(p.is_file() for p in same):
             digests = {hashlib.sha256(p.read_bytes()).hexdigest()[:12] for p in same}

@@ -148,10 +148,23 @@ def open_or_build(folder: Path, fmt: int, sources: list[list[Any]], build: Calla
             os.replace(tmp, folder)
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
+        drop_orphans(folder.parent)
     store = open_store(folder, fmt, sources)
     if store is None:
         raise IndexDamaged(f"the index just built in {folder} cannot be opened")
     return store
+
+
+def drop_orphans(root: Path) -> None:
+    """Delete the indexes in ``root`` whose source files are all gone (e.g. a deleted dataroot or detection
+    file), so the cache does not grow with every temporary dataset."""
+    for folder in root.iterdir():
+        try:
+            sources = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))["sources"]
+        except (OSError, ValueError, KeyError, TypeError):
+            continue
+        if sources and not any(Path(source[0]).exists() for source in sources):
+            shutil.rmtree(folder, ignore_errors=True)
 
 
 def write_manifest(folder: Path, manifest: Mapping[str, Any]) -> None:
