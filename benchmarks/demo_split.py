@@ -32,7 +32,7 @@ class DemoSplit:
         location = resolve_dataroot(None, None, (split,))
         nusc = open_nuscenes(location)
         names = split_scenes(split, location)
-        scenes = tuple(load_scene(nusc, location, n) for n in names)
+        scenes = tuple(load_scene(location, n) for n in names)
         return DemoSplit(split, location, scenes, tuple(split_sample_tokens(nusc, names)))
 
     def detections(self, preset: str, seed: int) -> list[dict[str, Boxes]]:

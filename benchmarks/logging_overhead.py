@@ -28,7 +28,7 @@ from rerun.chunk import RrdReader
 
 from gnnpmb.config import TrackerConfig
 from gnnpmb.data.demo import ensure_demo_dataset
-from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
 from gnnpmb.events import ListSink
 from gnnpmb.pipeline import get_detections, preprocess_frames, run_tracker
 from gnnpmb.registry import tracker_has_existence
@@ -83,7 +83,7 @@ def main() -> None:
     args = parser.parse_args()
     ensure_demo_dataset()
     location = resolve_dataroot(None, None)
-    scene = load_scene(open_nuscenes(location), location, args.scene)
+    scene = load_scene(location, args.scene)
     config = TrackerConfig()
     detections = get_detections(scene, None, args.detector, 0)
     frames = preprocess_frames(scene, detections, config, TRACKING_CLASSES)

@@ -21,7 +21,7 @@ import numpy as np
 from tracker_speed import stress_frames
 
 from gnnpmb.config import PmbmParams, TrackerConfig
-from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot, split_scenes
+from gnnpmb.data.nuscenes import load_scene, resolve_dataroot, split_scenes
 from gnnpmb.data.preprocess import preprocess
 from gnnpmb.data.simdet import PRESETS
 from gnnpmb.events import EventSink, ListSink, NullSink
@@ -80,8 +80,7 @@ def digests(frames: Sequence[FrameDetections], config: TrackerConfig, with_event
 
 def main() -> None:
     location = resolve_dataroot(None, None)
-    nusc = open_nuscenes(location)
-    scenes = [load_scene(nusc, location, name) for name in split_scenes("mini_val", location)]
+    scenes = [load_scene(location, name) for name in split_scenes("mini_val", location)]
     for n_hypotheses in (100, 20):
         config = TrackerConfig().replace(pmbm=PmbmParams(n_hypotheses=n_hypotheses))
         for preset in PRESETS:

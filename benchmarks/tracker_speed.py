@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from gnnpmb.config import TrackerConfig, load_config
-from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot, split_scenes
+from gnnpmb.data.nuscenes import load_scene, resolve_dataroot, split_scenes
 from gnnpmb.data.preprocess import preprocess
 from gnnpmb.events import NullSink
 from gnnpmb.pipeline import get_detections, preprocess_frames, run_tracker
@@ -84,8 +84,7 @@ def main() -> None:
     args = parser.parse_args()
     config = load_config(args.params)
     location = resolve_dataroot(None, None)
-    nusc = open_nuscenes(location)
-    scenes = [load_scene(nusc, location, name) for name in split_scenes("mini_val", location)]
+    scenes = [load_scene(location, name) for name in split_scenes("mini_val", location)]
     inputs = []
     for scene in scenes:
         dets = get_detections(scene, None, args.preset, seed=0)

@@ -15,21 +15,31 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from cli.errors import entry_point
-from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
-from cli.study import AddressOption, register
-from gnnpmb.errors import GnnpmbError
+from cli.options import (
+    DEFAULT_DETECTOR,
+    DEFAULT_TRACKER,
+    AddressOption,
+    DatarootOption,
+    DetectionsOption,
+    DetectorOption,
+    ParamsOption,
+    SeedOption,
+    SplitOption,
+    TrackerOption,
+    VersionOption,
+    stdout_console,
+    tidy_help,
+)
+from cli.study import register
+from gnnpmb.eval.nuscenes_eval import default_split
 from gnnpmb.outputs import check_output_dir, check_output_file
-from gnnpmb.registry import TRACKER_NAMES
 
 if TYPE_CHECKING:  # rich, numpy and the devkit load only on the paths that use them (fast --help)
     from rich.console import Console
 
     from gnnpmb.eval.failures import FailureReport
 
-DEFAULT_DETECTOR = "centerpoint"
-DEFAULT_TRACKER = "gnnpmb"
-_TABLE_WIDTH = 160
-"""Console width when stdout is not a terminal (pipes, tests), so tables are not squeezed to 80 columns."""
+__all__ = ["app", "default_split", "main"]
 
 app = typer.Typer(
     add_completion=False,
@@ -39,59 +49,6 @@ app = typer.Typer(
 )
 
 tidy_help()
-
-SplitOption = Annotated[
-    str | None,
-    typer.Option(
-        metavar="NAME",
-        help="Split: mini_val, val, ... or one in <version>/splits.json (default: from --nuscenes-version).",
-    ),
-]
-DetectorOption = Annotated[
-    str | None,
-    typer.Option(
-        metavar="PRESET",
-        help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR}).",
-    ),
-]
-TrackerOption = Annotated[
-    str, typer.Option("--tracker", "-t", metavar="NAME", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")
-]
-
-
-def _stdout() -> Console:
-    from rich.console import Console
-
-    console = Console()
-    return console if console.is_terminal else Console(width=_TABLE_WIDTH)
-
-
-def default_split(version: str) -> str:
-    """The evaluation split of a version: mini_val for *mini, test for *test, else val."""
-    if version.endswith("mini"):
-        return "mini_val"
-    if version.endswith("test"):
-        return "test"
-    return "val"
-
-
-def _detector(detections: Path | None, detector: str | None) -> str:
-    """The simulated detector preset to use (checked), refusing --detections together with --detector."""
-    if detections is not None and detector is not None:
-        raise GnnpmbError("pass either --detections FILE or --detector PRESET, not both")
-    from gnnpmb.data.simdet import get_preset
-
-    name = detector or DEFAULT_DETECTOR
-    get_preset(name)
-    return name
-
-
-def _check_detections(detections: Path | None) -> None:
-    """Read a --detections file before any dataset is loaded, so a bad file fails in a second."""
-    if detections is not None:
-        from gnnpmb.data.detections import check_detection_file
-
-        check_detection_file(detections)
 
 
 @app.command(short_help="Track a split into a nuScenes tracking submission.")
@@ -112,74 +69,48 @@ def track(
     address: AddressOption = None,
 ) -> None:
     """Track every scene of a split (all 7 classes) and write a nuScenes tracking submission."""
+    from gnnpmb.data.simdet_presets import detector_choice
     from gnnpmb.registry import check_tracker
 
     target = check_output_file(out, "--out")
     check_tracker(tracker)
-    preset = _detector(detections, detector)
+    preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
 
     from cli.progress import progress_bar
     from gnnpmb.config import load_config
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot, split_scenes
-    from gnnpmb.eval.nuscenes_eval import check_split_version, split_sample_tokens
-    from gnnpmb.eval.submission import build_submission, run_results, write_submission
-    from gnnpmb.pipeline import get_detections, run_tracker
+    from gnnpmb.data.detections import check_detection_file
+    from gnnpmb.data.nuscenes import resolve_dataroot
+    from gnnpmb.study.data import resolve_study_data
     from gnnpmb.study.runner import execution
+    from gnnpmb.study.track import track_to_file
 
     config = load_config(params)
     run = execution(workers, address)
-    _check_detections(detections)
+    if detections is not None:  # a bad file fails before a dataset is looked for
+        check_detection_file(detections)
     location = resolve_dataroot(dataroot, version, (split,) if split else ())
-    split = split or default_split(location.version)
-    check_split_version(split, location.version)
-    scene_names = split_scenes(split, location)
-    if not scene_names:
-        raise GnnpmbError(f"split {split} has no scenes in {location.dataroot / location.version}")
-    nusc = open_nuscenes(location)
-    tokens = split_sample_tokens(nusc, scene_names)
-
-    if run.uses_ray:
-        from gnnpmb.study.data import StudyData
-        from gnnpmb.study.track import track_scenes
-
-        detections_path = None if detections is None else detections.resolve()  # workers may run elsewhere
-        data = StudyData(location, split, tuple(scene_names), tuple(tokens), detections_path, preset, seed)
-        runs = track_scenes(data, tracker, config, run)
-        parts = [r.results for r in runs]
-        n_frames = sum(r.n_frames for r in runs)
-        n_boxes = sum(len(boxes) for r in runs for boxes in r.results.values())
-        step_s = sum(r.step_time_s for r in runs)
-    else:
-        parts = []
-        n_frames = n_boxes = 0
-        step_s = 0.0
-        with progress_bar(progress, transient=True) as bar:
-            scenes_task = bar.add_task("scenes", total=len(scene_names))
-            frames_task = bar.add_task("frames", total=None)
-            for name in scene_names:
-                scene = load_scene(nusc, location, name)
-                bar.update(frames_task, description=f"{name} frames", total=len(scene.keyframes), completed=0)
-                scene_detections = get_detections(scene, detections, preset, seed)
-                scene_run = run_tracker(
-                    scene, scene_detections, tracker, config, on_frame=lambda: bar.advance(frames_task)
-                )
-                results = run_results(scene_run)
-                parts.append(results)
-                n_frames += len(scene_run.frames)
-                n_boxes += sum(len(boxes) for boxes in results.values())
-                step_s += sum(f.step_time_s for f in scene_run.frames)
-                bar.advance(scenes_task)
-    write_submission(target, build_submission(parts, tokens))
-    ms = 1e3 * step_s / max(n_frames, 1)
-    if n_boxes == 0:
+    data = resolve_study_data(location, split or default_split(location.version), detections, preset, seed)
+    with progress_bar(progress, transient=True) as bar:
+        scenes_task = bar.add_task("scenes", total=len(data.scene_names))
+        frames_task = bar.add_task("frames", total=None, visible=not run.uses_ray)
+        summary = track_to_file(
+            data,
+            tracker,
+            config,
+            target,
+            run,
+            on_scene=lambda _run: bar.advance(scenes_task),
+            on_frame=lambda: bar.advance(frames_task),
+        )
+    if summary.boxes == 0:
         typer.echo(
             "note: no tracks were output; 'gnnpmb eval' cannot score an empty submission (check the detections "
             "and score_threshold)",
             err=True,
         )
     typer.echo(
-        f"{tracker}: {len(scene_names)} scenes of {split}, {n_frames} frames, {n_boxes} boxes, "
-        f"{ms:.1f} ms/frame -> {out}"
+        f"{tracker}: {summary.scenes} scenes of {data.split}, {summary.frames} frames, {summary.boxes} boxes, "
+        f"{summary.ms_per_frame:.1f} ms/frame -> {out}"
     )
 
 
@@ -219,7 +150,7 @@ def evaluate(
         table.add_row(class_name, *(format_metric(m, metrics[m]) for m in TABLE_METRICS))
     table.add_section()
     table.add_row("overall", *(format_metric(m, scores.overall[m]) for m in TABLE_METRICS), style="bold")
-    console = _stdout()
+    console = stdout_console()
     console.print(table)
     console.print(
         f"AMOTA {scores.overall['amota']:.3f}; evaluated in {time.perf_counter() - start:.1f} s; "
@@ -251,6 +182,7 @@ def failures(
 ) -> None:
     """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
     coalescence and cascading identity theft (scored with the devkit's own matching)."""
+    from gnnpmb.data.simdet_presets import detector_choice
     from gnnpmb.registry import check_tracker, tracker_has_existence
     from gnnpmb.why.facts import FactSink
 
@@ -258,33 +190,27 @@ def failures(
     check_tracker(tracker)
 
     from gnnpmb.config import load_config
-    from gnnpmb.data.demo import cache_root
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
-    from gnnpmb.eval.failure_cache import cached_report
-    from gnnpmb.eval.failures import find_failures
-    from gnnpmb.eval.submission import run_results, write_json
-    from gnnpmb.pipeline import get_detections, run_tracker
+    from gnnpmb.data.detections import check_detection_file
+    from gnnpmb.data.nuscenes import resolve_dataroot
+    from gnnpmb.eval.submission import write_json
+    from gnnpmb.study.track import scene_failures
 
-    preset = _detector(detections, detector)
+    preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
     config = load_config(params)
-    _check_detections(detections)
+    if detections is not None:
+        check_detection_file(detections)
     location = resolve_dataroot(dataroot, version, (scene,))
-    nusc = open_nuscenes(location)
-    scene_data = load_scene(nusc, location, scene)
     fact_sink = FactSink(tracker, has_existence=tracker_has_existence(tracker)) if why else None
-    run = run_tracker(scene_data, get_detections(scene_data, detections, preset, seed), tracker, config, sink=fact_sink)
-    results = run_results(run)
-    report = cached_report(
-        cache_root(), location, scene, tracker, results, lambda: find_failures(nusc, scene, results, tracker)
-    )
+    found = scene_failures(location, scene, tracker, config, detections, preset, seed, sink=fact_sink)
+    report = found.report
     findings = []
     if fact_sink is not None:
         from gnnpmb.focus import FRAMES_BEFORE
         from gnnpmb.why.reason import Evidence, explain_failure
 
-        evidence = Evidence(report, fact_sink.facts, run)
+        evidence = Evidence(report, fact_sink.facts, found.run)
         findings = [
-            explain_failure(fid, evidence, scene_data, first_frame=max(0, f.frame_index - FRAMES_BEFORE))
+            explain_failure(fid, evidence, found.run.scene, first_frame=max(0, f.frame_index - FRAMES_BEFORE))
             for fid, f in zip(report.ids(), report.failures, strict=True)
         ]
     if json_target is not None:
@@ -294,9 +220,9 @@ def failures(
 
             data["findings"] = [finding_json(f) for f in findings]
         write_json(json_target, data)
-    print_report(report, _stdout())
+    print_report(report, stdout_console())
     if why:
-        print_findings(findings, _stdout())
+        print_findings(findings, stdout_console())
     if json_out is not None:
         typer.echo(f"report -> {json_out}")
 

@@ -1,11 +1,22 @@
-"""Command-line options shared by ``gnnpmb-viz`` and ``gnnpmb``: one spelling and help text each."""
+"""Command-line options shared by ``gnnpmb-viz`` and ``gnnpmb`` (``cli.batch`` and ``cli.study``): one spelling
+and help text each, and the console tables are printed on."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
+
+from gnnpmb.registry import TRACKER_NAMES
+
+if TYPE_CHECKING:
+    from rich.console import Console
+
+DEFAULT_TRACKER = "gnnpmb"
+DEFAULT_DETECTOR = "centerpoint"
+_TABLE_WIDTH = 160
+"""Console width when stdout is not a terminal (pipes, tests), so tables are not squeezed to 80 columns."""
 
 DatarootOption = Annotated[
     Path | None,
@@ -28,6 +39,40 @@ ParamsOption = Annotated[
     Path | None,
     typer.Option(metavar="FILE.toml", help="Tracker parameter file (.toml) overriding the paper's."),
 ]
+
+
+SplitOption = Annotated[
+    str | None,
+    typer.Option(
+        metavar="NAME",
+        help="Split: mini_val, val, ... or one in <version>/splits.json (default: from --nuscenes-version).",
+    ),
+]
+DetectorOption = Annotated[
+    str | None,
+    typer.Option(
+        metavar="PRESET",
+        help=f"Simulated detector preset: centerpoint, megvii, pointpillars (default {DEFAULT_DETECTOR}).",
+    ),
+]
+TrackerOption = Annotated[
+    str, typer.Option("--tracker", "-t", metavar="NAME", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")
+]
+AddressOption = Annotated[
+    str | None,
+    typer.Option(
+        metavar="ADDR",
+        help="Join the Ray cluster at HOST:PORT (default: $RAY_ADDRESS, else a local Ray instance).",
+    ),
+]
+
+
+def stdout_console() -> Console:
+    """The console tables are printed on: the terminal's width, or ``_TABLE_WIDTH`` columns in a pipe."""
+    from rich.console import Console
+
+    console = Console()
+    return console if console.is_terminal else Console(width=_TABLE_WIDTH)
 
 
 def tidy_help() -> None:

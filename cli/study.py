@@ -1,6 +1,7 @@
 """``gnnpmb sweep`` and ``gnnpmb tune``: parameter studies scored with the official evaluation, on Ray.
 
-Registered on the ``gnnpmb`` app by ``cli.batch`` (``register``); the work is in ``gnnpmb.study``. No
+Registered on the ``gnnpmb`` app by ``cli.batch`` (``register``; this module imports nothing of ``cli.batch``);
+the work is in ``gnnpmb.study``. No
 ``from __future__ import annotations`` here: typer must evaluate the option annotations inside ``register``.
 """
 
@@ -14,7 +15,20 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
-from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
+from cli.options import (
+    DEFAULT_DETECTOR,
+    DEFAULT_TRACKER,
+    AddressOption,
+    DatarootOption,
+    DetectionsOption,
+    DetectorOption,
+    ParamsOption,
+    SeedOption,
+    SplitOption,
+    TrackerOption,
+    VersionOption,
+    stdout_console,
+)
 from cli.progress import progress_bar
 from gnnpmb.errors import GnnpmbError
 
@@ -28,13 +42,6 @@ WorkersOption = Annotated[
     typer.Option(
         metavar="N",
         help="Parallel tasks (default: the CPU count; on a cluster, all its CPUs); 1 runs in this process without Ray.",
-    ),
-]
-AddressOption = Annotated[
-    str | None,
-    typer.Option(
-        metavar="ADDR",
-        help="Join the Ray cluster at HOST:PORT (default: $RAY_ADDRESS, else a local Ray instance).",
     ),
 ]
 ProgressOption = Annotated[bool, typer.Option(help="Show a progress bar on stderr.")]
@@ -112,8 +119,7 @@ def best_table(rows: list[dict[str, Any]], keys: tuple[str, ...], title: str) ->
 
 
 def register(app: typer.Typer) -> None:
-    """Add ``sweep`` and ``tune`` to the ``gnnpmb`` app (its shared option types come from ``cli.batch``)."""
-    from cli.batch import DEFAULT_TRACKER, DetectorOption, SplitOption, TrackerOption
+    """Add ``sweep`` and ``tune`` to the ``gnnpmb`` app."""
 
     @app.command()
     def sweep(
@@ -143,8 +149,9 @@ def register(app: typer.Typer) -> None:
         progress: ProgressOption = True,
     ) -> None:
         """Score every configuration of a parameter grid with the official evaluation (cached, resumable)."""
-        from cli.batch import _detector, _stdout, default_split
         from gnnpmb.data.nuscenes import resolve_dataroot
+        from gnnpmb.data.simdet_presets import detector_choice
+        from gnnpmb.eval.nuscenes_eval import default_split
         from gnnpmb.registry import check_tracker
         from gnnpmb.study.cache import CACHE_FOLDER, ResultCache
         from gnnpmb.study.data import resolve_study_data
@@ -156,7 +163,7 @@ def register(app: typer.Typer) -> None:
 
         check_tracker(tracker)
         check_out_dir(out)
-        preset = _detector(detections, detector)
+        preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
         swept = [parse_param(p) for p in param or []]
         base = base_params(params)
         run = execution(workers, address)
@@ -194,7 +201,7 @@ def register(app: typer.Typer) -> None:
             write_results(out, plan.keys, rows, meta)
             title = f"{tracker} on {data.split} ({len(data.scene_names)} scenes, {meta['detector'] or 'file'})"
             plot_sweep(out, plan.keys, rows, plan.base_values, plan.one_at_a_time, title)
-            console = _stdout()
+            console = stdout_console()
             console.print(best_table(best_rows(rows, top), plan.keys, f"best of {len(rows)} configurations"))
         ran = len(rows) - outcome.from_cache
         best = best_amota(rows)
@@ -240,8 +247,8 @@ def register(app: typer.Typer) -> None:
         progress: ProgressOption = True,
     ) -> None:
         """Search per-class parameters (Optuna TPE on Ray Tune) and write the best as a --params TOML."""
-        from cli.batch import _detector, _stdout
         from gnnpmb.data.nuscenes import resolve_dataroot
+        from gnnpmb.data.simdet_presets import detector_choice
         from gnnpmb.registry import check_tracker
         from gnnpmb.study.data import resolve_study_data
         from gnnpmb.study.grid import config_toml
@@ -251,7 +258,7 @@ def register(app: typer.Typer) -> None:
 
         check_tracker(tracker)
         check_out_file(out)
-        preset = _detector(detections, detector)
+        preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
         base = base_params(params)
         class_names = TRACKING_CLASSES if classes is None else tuple(c.strip() for c in classes.split(",") if c)
         unknown = [c for c in class_names if c not in TRACKING_CLASSES]
@@ -278,7 +285,7 @@ def register(app: typer.Typer) -> None:
         final = result.final_row
         header = _provenance(tracker, data, dims, trials, seed, run, result, params)
         write_params(out, config_toml(base, result.best), header)
-        _print_tune(_stdout(), result, class_names, dims)
+        _print_tune(stdout_console(), result, class_names, dims)
         typer.echo(
             f"tune: {len(result.trials)} trials on {data.split}, combined AMOTA {_metric(final['amota'])} -> {out}"
         )

@@ -11,7 +11,7 @@ import sys
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
 from gnnpmb.pipeline import get_detections, preprocess_frames, run_tracker
 from gnnpmb.types import TRACKING_CLASSES
 
@@ -21,7 +21,7 @@ def main() -> None:
     preset = sys.argv[2] if len(sys.argv) > 2 else "pointpillars"
     config = TrackerConfig()
     location = resolve_dataroot(None, None)
-    scene = load_scene(open_nuscenes(location), location, scene_name)
+    scene = load_scene(location, scene_name)
     detections = get_detections(scene, None, preset, seed=0)
     frames = preprocess_frames(scene, detections, config, TRACKING_CLASSES)
     print(f"{scene_name}, simulated {preset} detections, {len(frames)} keyframes")

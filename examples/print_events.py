@@ -8,7 +8,7 @@ from __future__ import annotations
 import sys
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
 from gnnpmb.events import Assignment, AxisKind, Born, Event, FrameStarted, Pruned
 from gnnpmb.pipeline import get_detections, run_tracker
 
@@ -37,7 +37,7 @@ def main() -> None:
     scene_name = sys.argv[1] if len(sys.argv) > 1 else "scene-0103"
     tracker = sys.argv[2] if len(sys.argv) > 2 else "gnnpmb"
     location = resolve_dataroot(None, None)
-    scene = load_scene(open_nuscenes(location), location, scene_name)
+    scene = load_scene(location, scene_name)
     detections = get_detections(scene, None, "centerpoint", seed=0)
     run_tracker(scene, detections, tracker, TrackerConfig(), sink=PrintingSink(), frame_range=range(0, 6))
 

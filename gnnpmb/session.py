@@ -164,11 +164,12 @@ def detections_source(
     scene: SceneData, detections: dict[str, Boxes], detections_file: Path | None, detector: str, seed: int
 ) -> DetectionsSource:
     """Where ``detections`` came from, with the SHA-256 of the file, or of the simulated boxes."""
-    from gnnpmb.provenance import DetectionsSource, boxes_sha256, file_sha256
+    from gnnpmb.data.detections import detection_file_sha256
+    from gnnpmb.provenance import DetectionsSource, boxes_sha256
 
     if detections_file is not None:
         path = Path(detections_file).expanduser().absolute()
-        return DetectionsSource("file", file_sha256(path), path=str(path))
+        return DetectionsSource("file", detection_file_sha256(path), path=str(path))
     return DetectionsSource("simulated", boxes_sha256(detections, scene.sample_tokens), preset=detector, seed=int(seed))
 
 
@@ -212,7 +213,7 @@ def prepare(
 
     from gnnpmb.config import load_config
     from gnnpmb.data.detections import check_detection_file
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
     from gnnpmb.data.simdet import get_preset
     from gnnpmb.pipeline import get_detections, preprocess_frames
 
@@ -221,7 +222,7 @@ def prepare(
     if detections_file is not None:
         check_detection_file(detections_file)
     location = resolve_dataroot(dataroot, version, (scene_name,))
-    scene = load_scene(open_nuscenes(location), location, scene_name)
+    scene = load_scene(location, scene_name)
     frame_range = frame_range_of(bounds, scene)
     detections = get_detections(scene, detections_file, detector, seed)
     source = detections_source(scene, detections, detections_file, detector, seed)
@@ -267,7 +268,7 @@ def prepare_reproduction(
     recorded paths (e.g. on another machine). Raises a DataError naming the input that is missing or
     changed."""
     from gnnpmb.config import config_from_dict
-    from gnnpmb.data.nuscenes import check_dataroot, load_scene, open_nuscenes
+    from gnnpmb.data.nuscenes import check_dataroot, load_scene
     from gnnpmb.pipeline import get_detections, preprocess_frames
 
     p = provenance
@@ -276,7 +277,7 @@ def prepare_reproduction(
     if not root.exists():
         raise DataError(f"the recorded dataroot {root} does not exist; pass --dataroot DIR with a copy of it")
     location = check_dataroot(root, p.version, "--dataroot" if dataroot is not None else "the recording")
-    scene = load_scene(open_nuscenes(location), location, p.scene_name)
+    scene = load_scene(location, p.scene_name)
     if scene.token != p.scene_token:
         raise DataError(
             f"{p.scene_name} in {location.dataroot} has token {scene.token}, the recorded one "
@@ -388,10 +389,7 @@ def find_reports(
     """Each run's failures found with the devkit's matching (or stored from an earlier run of the same tracks,
     ``eval.failure_cache``), and notices: a scene without ground truth, or one the devkit cannot evaluate, gives
     no reports."""
-    from gnnpmb.data.demo import cache_root
-    from gnnpmb.data.nuscenes import open_nuscenes
-    from gnnpmb.eval.failure_cache import cached_report
-    from gnnpmb.eval.failures import find_failures
+    from gnnpmb.eval.failure_cache import scene_report
     from gnnpmb.eval.submission import run_results
 
     scene = request.scene
@@ -399,18 +397,8 @@ def find_reports(
         return {}, [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
     reports = {}
     for run in runs:
-        results = run_results(run)
         try:
-            reports[run.tracker] = cached_report(
-                cache_root(),
-                request.location,
-                scene.name,
-                run.tracker,
-                results,
-                lambda results=results, tracker=run.tracker: find_failures(
-                    open_nuscenes(request.location), scene.name, results, tracker
-                ),
-            )
+            reports[run.tracker] = scene_report(request.location, scene.name, run.tracker, run_results(run))
         except DataError as exc:
             return {}, [f"failure markers skipped: {exc}"]
         on_done()

@@ -8,27 +8,30 @@ per-box ``sample_token``. A NaN velocity (allowed by the devkit for detectors wi
 and becomes 0. Only the 7 tracking classes are kept (barrier, traffic_cone and construction_vehicle
 boxes are dropped).
 
-Result files of the full val split are 100-400 MB, so a file is parsed once per process and kept as compact
-arrays per sample, keyed by (path, inode, mtime, size): loading another scene from the same file is instant,
-and a rewritten file is parsed again. A malformed box is reported only when a sample that contains it is
-requested.
+Result files of the full val split are 300-700 MB, so a file is read once, streamed, into a persistent index
+in the user cache (``gnnpmb.data.detection_index``: each sample's converted boxes, or its first problem) and
+every later command reads only the samples it needs; a rewritten file is indexed again. A malformed box is
+reported only when a sample that contains it is requested.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import shutil
 import tempfile
-from collections import OrderedDict
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from gnnpmb.data.json_stream import JsonStreamError, NotUtf8Error
 from gnnpmb.errors import DataError
 from gnnpmb.types import TRACKING_CLASSES, Boxes
+
+if TYPE_CHECKING:
+    from gnnpmb.data.detection_index import DetectionIndex
 
 DETECTION_CLASSES: tuple[str, ...] = (
     "barrier",
@@ -58,19 +61,10 @@ MAX_SPEED_MPS = 200.0
 """Largest accepted |vx|, |vy| of a box (NaN is allowed: unknown velocity, read as 0)."""
 MIN_QUAT_NORM = 1e-6
 """A rotation quaternion shorter than this has no direction (e.g. all zeros)."""
-_CACHE_FILES = 2
-"""Parsed files kept in memory (each full-val file takes a few hundred MB as arrays)."""
 
 
-@dataclass(frozen=True, slots=True)
-class _ParsedFile:
-    """One parsed detection file: tracking-class boxes per sample, or the sample's first problem."""
-
-    boxes: dict[str, Boxes]
-    problems: dict[str, str]
-
-
-_cache: OrderedDict[tuple[str, int, int, int], _ParsedFile] = OrderedDict()
+_opened: dict[tuple[str, int, int, int], DetectionIndex] = {}
+"""The index of the detection file last used in this process, keyed by the file's identity."""
 
 
 def _as_floats(value: Any) -> np.ndarray | None:
@@ -151,7 +145,7 @@ def _diagnose(token: str, entries: Any) -> str:
     return f"the boxes of sample {token} could not be read"
 
 
-def _convert_sample(token: str, entries: Any) -> Boxes | str:
+def convert_sample(token: str, entries: Any) -> Boxes | str:
     """The tracking-class boxes of one sample's entries, or a problem description (checked fully only on the
     slow path, when the fast vectorised conversion finds something wrong)."""
     if not isinstance(entries, list):
@@ -194,42 +188,33 @@ def _convert_sample(token: str, entries: Any) -> Boxes | str:
     )
 
 
-def _parse(path: Path) -> _ParsedFile:
-    try:
-        data = json.loads(path.read_bytes())
-    except json.JSONDecodeError as exc:
-        raise DataError(
-            f"detections file {path} is not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno} "
-            f"(character {exc.pos}); is it truncated? Download or generate it again"
-        ) from None
-    except UnicodeDecodeError as exc:
-        raise DataError(
-            f"detections file {path} is not UTF-8 JSON text (bad byte at position {exc.start}); "
+def _read_error(path: Path, exc: Exception) -> DataError:
+    """The one line for a detection file that cannot be read as a submission."""
+    if isinstance(exc, JsonStreamError):
+        return DataError(
+            f"detections file {path} is not valid JSON: {exc}; is it truncated? Download or generate it again"
+        )
+    if isinstance(exc, NotUtf8Error):
+        return DataError(
+            f"detections file {path} is not UTF-8 JSON text (bad byte at position {exc.byte}); "
             "pass a nuScenes detection results .json file"
-        ) from None
-    if not isinstance(data, dict) or "results" not in data:
-        raise DataError(
+        )
+    if isinstance(exc, TypeError) and len(exc.args) == 2 and exc.args[1] is not None:
+        return DataError(f"'results' in detections file {path} is a {exc.args[0]}, not an object keyed by sample token")
+    if isinstance(exc, KeyError | TypeError):
+        return DataError(
             f"detections file {path} has no 'results' object; "
             "expected a nuScenes detection submission {'meta': ..., 'results': {sample_token: [boxes]}}"
         )
-    results = data["results"]
-    if not isinstance(results, dict):
-        raise DataError(
-            f"'results' in detections file {path} is a {type(results).__name__}, not an object keyed by sample token"
-        )
-    boxes: dict[str, Boxes] = {}
-    problems: dict[str, str] = {}
-    for token in list(results):
-        converted = _convert_sample(token, results.pop(token))
-        if isinstance(converted, Boxes):
-            boxes[token] = converted
-        else:
-            problems[token] = converted
-    return _ParsedFile(boxes=boxes, problems=problems)
+    return DataError(f"cannot read detections file {path}: {getattr(exc, 'strerror', None) or exc}")
 
 
-def _parsed(path: Path) -> _ParsedFile:
-    """The parsed file, from the in-process cache when the file has not changed."""
+def _index(path: Path) -> DetectionIndex:
+    """The file's index (``gnnpmb.data.detection_index``: parsed once per file and kept in the user cache),
+    opened once per process while the file is unchanged."""
+    from gnnpmb.data.demo import cache_root
+    from gnnpmb.data.detection_index import open_detection_index
+
     try:
         st = path.stat()
     except FileNotFoundError:
@@ -240,21 +225,24 @@ def _parsed(path: Path) -> _ParsedFile:
         raise DataError(f"detections path {path} is a folder; pass a nuScenes detection results .json file")
     if not path.is_file():
         raise DataError(f"detections path {path} is not a file; pass a nuScenes detection results .json file")
-    key = (str(path.resolve()), st.st_ino, st.st_mtime_ns, st.st_size)
-    if key in _cache:
-        _cache.move_to_end(key)
-        return _cache[key]
-    parsed = _parse(path)
-    _cache[key] = parsed
-    while len(_cache) > _CACHE_FILES:
-        _cache.popitem(last=False)
-    return parsed
+    resolved = path.resolve()
+    key = (str(resolved), st.st_ino, st.st_mtime_ns, st.st_size)
+    if key not in _opened:
+        _opened.clear()
+        _opened[key] = open_detection_index(cache_root(), resolved, convert_sample, lambda exc: _read_error(path, exc))
+    return _opened[key]
 
 
 def check_detection_file(path: Path) -> None:
-    """Parse (and cache) a detection file now, so a missing, non-JSON or malformed file fails before a
-    dataset is loaded; problems inside one sample's boxes are still reported when that sample is loaded."""
-    _parsed(Path(path))
+    """Index (once) or open the index of a detection file now, so a missing, non-JSON or malformed file fails
+    before a dataset is loaded; problems inside one sample's boxes are still reported when that sample is
+    loaded."""
+    _index(Path(path))
+
+
+def detection_file_sha256(path: Path) -> str:
+    """SHA-256 (hex) of a detection file's bytes, computed when it was indexed."""
+    return _index(Path(path)).sha256
 
 
 def load_detection_file(path: Path, sample_tokens: Sequence[str], scene_name: str | None = None) -> dict[str, Boxes]:
@@ -263,9 +251,11 @@ def load_detection_file(path: Path, sample_tokens: Sequence[str], scene_name: st
     scene_name only makes error messages clearer. Raises ``DataError`` when the file is missing or malformed,
     a requested sample has a malformed box, or some requested samples have no entry (an empty list is fine).
     """
+    from gnnpmb.data.index_store import IndexDamaged
+
     path = Path(path)
-    parsed = _parsed(path)
-    missing = [t for t in sample_tokens if t not in parsed.boxes and t not in parsed.problems]
+    index = _index(path)
+    missing = [t for t in sample_tokens if t not in index]
     if missing:
         where = f"the {len(sample_tokens)} " + (f"samples of {scene_name}" if scene_name else "requested samples")
         raise DataError(
@@ -273,9 +263,14 @@ def load_detection_file(path: Path, sample_tokens: Sequence[str], scene_name: st
             f"(first missing: {missing[0]}); is it for another split or version?"
         )
     for token in sample_tokens:
-        if token in parsed.problems:
-            raise DataError(f"detections file {path.name}: {parsed.problems[token]}")
-    return {token: parsed.boxes[token] for token in sample_tokens}
+        if token in index.problems:
+            raise DataError(f"detections file {path.name}: {index.problems[token]}")
+    try:
+        return {token: index.boxes(token) for token in sample_tokens}
+    except IndexDamaged:
+        _opened.clear()
+        shutil.rmtree(index.store.folder, ignore_errors=True)
+        return load_detection_file(path, sample_tokens, scene_name)
 
 
 def write_detection_file(path: Path, submission: dict[str, Any]) -> None:

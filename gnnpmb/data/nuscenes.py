@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -30,7 +32,10 @@ from gnnpmb.errors import DataError, UnknownNameError
 from gnnpmb.types import Boxes
 
 if TYPE_CHECKING:
+    import pyarrow as pa
     from nuscenes.nuscenes import NuScenes
+
+    from gnnpmb.data.dataset_index import DatasetIndex, SceneSlice
 
 DATAROOT_ENV = "NUSCENES_DATAROOT"
 LIDAR_CHANNEL = "LIDAR_TOP"
@@ -176,82 +181,148 @@ def list_scenes(nusc: NuScenes) -> list[str]:
     return [s["name"] for s in nusc.scene]
 
 
-def _scene_record(nusc: NuScenes, scene_name: str) -> dict:
-    for record in nusc.scene:
-        if record["name"] == scene_name:
-            return record
-    raise UnknownNameError(f"unknown scene '{scene_name}'; available: {', '.join(sorted(list_scenes(nusc)))}")
+_INDEXES: dict[tuple[Path, str], DatasetIndex] = {}
 
 
-def _pose(record: dict) -> Pose:
-    return Pose(
-        translation_m=np.asarray(record["translation"], dtype=float),
-        quat_wxyz=np.asarray(record["rotation"], dtype=float),
-    )
+def dataset_index(location: DatasetLocation, *, fresh: bool = False) -> DatasetIndex:
+    """The persistent index of ``location`` (``gnnpmb.data.dataset_index``), opened once per process; built on
+    first use (a damaged cached demo is generated again first). ``fresh`` drops the index and builds it again
+    (it was found damaged)."""
+    from gnnpmb.data.dataset_index import index_folder, open_dataset_index
+    from gnnpmb.data.demo import cache_root
+
+    key = (location.dataroot, location.version)
+    if fresh:
+        _INDEXES.pop(key, None)
+        shutil.rmtree(index_folder(cache_root(), *key), ignore_errors=True)
+    if key not in _INDEXES:
+        try:
+            _INDEXES[key] = open_dataset_index(cache_root(), location.dataroot, location.version)
+        except DataError:
+            needs = _demo_needs(location)
+            if needs is None or key in _REBUILT:
+                raise
+            _REBUILT.add(key)
+            _rebuild_demo(needs)
+            return dataset_index(location)
+    return _INDEXES[key]
 
 
-def _gt_boxes(nusc: NuScenes, sample: dict) -> tuple[Boxes, np.ndarray]:
-    """Ground truth of the 7 tracking classes in one sample (global frame) and each box's LiDAR + radar points."""
-    from nuscenes.eval.tracking.utils import category_to_tracking_name
+def _check_scene(index: DatasetIndex, scene_name: str) -> None:
+    if index.scene(scene_name) is None:
+        names = sorted(s.name for s in index.scenes)
+        raise UnknownNameError(f"unknown scene '{scene_name}'; available: {', '.join(names)}")
 
-    rows = []
-    for ann_token in sample["anns"]:
-        ann = nusc.get("sample_annotation", ann_token)
-        name = category_to_tracking_name(ann["category_name"])
-        if name is not None:
-            rows.append((ann, name))
-    if not rows:
+
+def sample_tokens(location: DatasetLocation, scene_names: Sequence[str]) -> list[str]:
+    """Every sample token of the given scenes, scene by scene in time order (from the index)."""
+    from gnnpmb.data.index_store import IndexDamaged
+
+    index = dataset_index(location)
+    for name in scene_names:
+        _check_scene(index, name)
+    try:
+        return [t for name in scene_names for t in index.sample_tokens(name)]
+    except IndexDamaged:
+        index = dataset_index(location, fresh=True)
+        return [t for name in scene_names for t in index.sample_tokens(name)]
+
+
+def all_sample_tokens(location: DatasetLocation) -> set[str]:
+    """Every sample token of the dataset (every scene's samples, from the index)."""
+    index = dataset_index(location)
+    return {t for scene in index.scenes for t in index.sample_tokens(scene.name)}
+
+
+def _pose(translation: np.ndarray, quat: np.ndarray) -> Pose:
+    return Pose(translation_m=np.array(translation, dtype=float), quat_wxyz=np.array(quat, dtype=float))
+
+
+def _columns(batch: pa.RecordBatch, prefix: str, n: int) -> np.ndarray:
+    """(rows, n) float64 of the columns ``prefix_0`` ... ``prefix_{n-1}``."""
+    return np.column_stack([batch.column(f"{prefix}_{i}").to_numpy() for i in range(n)]).reshape(-1, n)
+
+
+def _gt_boxes(anns: pa.RecordBatch, rows: np.ndarray, fields: dict[str, np.ndarray]) -> tuple[Boxes, np.ndarray]:
+    """Ground truth of the 7 tracking classes among annotation ``rows`` (global frame) and each box's LiDAR +
+    radar points."""
+    if rows.size == 0:
         return Boxes.empty(), np.zeros(0, dtype=np.int64)
-    velocity = np.array([nusc.box_velocity(ann["token"])[:2] for ann, _ in rows], dtype=float)
     boxes = Boxes(
-        translation_m=np.array([ann["translation"] for ann, _ in rows], dtype=float),
-        size_wlh_m=np.array([ann["size"] for ann, _ in rows], dtype=float),
-        quat_wxyz=np.array([ann["rotation"] for ann, _ in rows], dtype=float),
-        velocity_mps=np.nan_to_num(velocity, nan=0.0),
-        score=np.ones(len(rows)),
-        class_name=np.array([name for _, name in rows], dtype=object),
-        instance_id=np.array([ann["instance_token"] for ann, _ in rows], dtype=object),
+        translation_m=fields["translation"][rows],
+        size_wlh_m=fields["size"][rows],
+        quat_wxyz=fields["rotation"][rows],
+        velocity_mps=np.nan_to_num(fields["velocity"][rows], nan=0.0),
+        score=np.ones(rows.size),
+        class_name=np.array(fields["tracking_name"][rows], dtype=object),
+        instance_id=np.array(fields["instance_token"][rows], dtype=object),
     )
-    num_pts = np.array([ann["num_lidar_pts"] + ann["num_radar_pts"] for ann, _ in rows], dtype=np.int64)
-    return boxes, num_pts
+    return boxes, fields["num_pts"][rows]
 
 
-def load_scene(nusc: NuScenes, location: DatasetLocation, scene_name: str) -> SceneData:
-    """One scene's keyframes in time order with LIDAR_TOP pose, calibration, sweep path and tracking-class GT."""
-    scene = _scene_record(nusc, scene_name)
-    keyframes: list[Keyframe] = []
-    sample_token = scene["first_sample_token"]
-    while sample_token:
-        sample = nusc.get("sample", sample_token)
-        if LIDAR_CHANNEL not in sample["data"]:
-            raise DataError(
-                f"sample {sample_token} of {scene_name} has no {LIDAR_CHANNEL} data; the dataset is incomplete"
-            )
-        sweep = nusc.get("sample_data", sample["data"][LIDAR_CHANNEL])
-        gt, gt_num_pts = _gt_boxes(nusc, sample)
+def load_scene(location: DatasetLocation, scene_name: str) -> SceneData:
+    """One scene's keyframes in time order with LIDAR_TOP pose, calibration, sweep path and tracking-class GT,
+    read from the dataset's index (only this scene's rows)."""
+    from gnnpmb.data.index_store import IndexDamaged
+
+    index = dataset_index(location)
+    _check_scene(index, scene_name)
+    try:
+        part = index.read(scene_name)
+    except IndexDamaged:
+        part = dataset_index(location, fresh=True).read(scene_name)
+    return _scene_data(location, part)
+
+
+def _scene_data(location: DatasetLocation, part: SceneSlice) -> SceneData:
+    samples, anns = part.samples, part.annotations
+    name, tokens = part.scene.name, samples.column("token").to_pylist()
+    has_lidar = samples.column("has_lidar").to_numpy(zero_copy_only=False)
+    if not has_lidar.all():
+        missing = tokens[int(np.flatnonzero(~has_lidar)[0])]
+        raise DataError(f"sample {missing} of {name} has no {LIDAR_CHANNEL} data; the dataset is incomplete")
+    tracking = anns.column("tracking_name")
+    fields = {
+        "translation": _columns(anns, "translation", 3),
+        "size": _columns(anns, "size", 3),
+        "rotation": _columns(anns, "rotation", 4),
+        "velocity": _columns(anns, "velocity", 2),
+        "tracking_name": np.array(tracking.to_pylist(), dtype=object),
+        "instance_token": np.array(anns.column("instance_token").to_pylist(), dtype=object),
+        "num_pts": anns.column("num_lidar_pts").to_numpy() + anns.column("num_radar_pts").to_numpy(),
+    }
+    kept = tracking.is_valid().to_numpy(zero_copy_only=False)
+    sample_index = part.ann_sample_index()
+    ego_t, ego_q = _columns(samples, "ego_t", 3), _columns(samples, "ego_q", 4)
+    calib_t, calib_q = _columns(samples, "calib_t", 3), _columns(samples, "calib_q", 4)
+    filenames = samples.column("sd_filename").to_pylist()
+    timestamps = samples.column("timestamp").to_pylist()
+    keyframes = []
+    for k, token in enumerate(tokens):
+        gt, gt_num_pts = _gt_boxes(anns, np.flatnonzero((sample_index == k) & kept), fields)
         keyframes.append(
             Keyframe(
-                index=len(keyframes),
-                sample_token=sample_token,
-                timestamp_us=int(sample["timestamp"]),
-                ego_pose=_pose(nusc.get("ego_pose", sweep["ego_pose_token"])),
-                lidar_calib=_pose(nusc.get("calibrated_sensor", sweep["calibrated_sensor_token"])),
-                lidar_path=location.dataroot / sweep["filename"],
+                index=k,
+                sample_token=token,
+                timestamp_us=int(timestamps[k]),
+                ego_pose=_pose(ego_t[k], ego_q[k]),
+                lidar_calib=_pose(calib_t[k], calib_q[k]),
+                lidar_path=location.dataroot / filenames[k],
                 gt=gt,
                 gt_num_pts=gt_num_pts,
             )
         )
-        sample_token = sample["next"]
-    synthetic = is_synthetic_description(scene["description"])
+    description = str(part.scene.row["description"])
+    synthetic = is_synthetic_description(description)
     return SceneData(
-        name=scene_name,
-        token=scene["token"],
-        description=scene["description"],
+        name=name,
+        token=str(part.scene.row["token"]),
+        description=description,
         dataroot=location.dataroot,
         version=location.version,
         synthetic=synthetic,
         keyframes=tuple(keyframes),
-        clutter_hotspots=_demo_hotspots(scene_name) if synthetic else (),
+        clutter_hotspots=_demo_hotspots(name) if synthetic else (),
     )
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from gnnpmb.errors import UnknownNameError
+from gnnpmb.errors import GnnpmbError, UnknownNameError
 
 
 @dataclass(frozen=True, slots=True)
@@ -240,3 +240,11 @@ def get_preset(preset: str | DetectorPreset) -> DetectorPreset:
         return PRESETS[preset]
     except KeyError:
         raise UnknownNameError(f"unknown detector preset '{preset}' (choose one of: {', '.join(PRESETS)})") from None
+
+
+def detector_choice(detections_file: object | None, detector: str | None, default: str = "centerpoint") -> str:
+    """The simulated preset a command uses (checked), refusing a detection file together with a preset."""
+    if detections_file is not None and detector is not None:
+        raise GnnpmbError("pass either --detections FILE or --detector PRESET, not both")
+    get_preset(detector or default)
+    return detector or default

@@ -72,6 +72,23 @@ def cached_report(
     return report
 
 
+def scene_report(
+    location: DatasetLocation, scene_name: str, tracker: str, results: Mapping[str, Sequence[Mapping[str, Any]]]
+) -> FailureReport:
+    """The failure report of one scene's tracking results: stored, else found by the devkit's evaluation on a
+    version folder holding only that scene (``gnnpmb.eval.subset``)."""
+    from gnnpmb.data.demo import cache_root
+    from gnnpmb.data.nuscenes import open_nuscenes
+    from gnnpmb.eval.failures import find_failures
+    from gnnpmb.eval.subset import eval_location
+
+    def find() -> FailureReport:
+        nusc = open_nuscenes(eval_location(location, [scene_name]))
+        return find_failures(nusc, scene_name, results, tracker)
+
+    return cached_report(cache_root(), location, scene_name, tracker, results, find)
+
+
 def _drop_oldest(folder: Path, keep: int) -> None:
     """Delete all but the ``keep`` most recently modified reports in ``folder``."""
     files = sorted(folder.glob("*.json"), key=lambda p: p.stat().st_mtime_ns, reverse=True)

@@ -18,7 +18,7 @@ import os
 import shutil
 import tempfile
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Collection, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -85,6 +85,15 @@ def tracking_config() -> TrackingConfig:
     from nuscenes.eval.common.config import config_factory
 
     return config_factory(EVAL_CONFIG)
+
+
+def default_split(version: str) -> str:
+    """The evaluation split of a version: mini_val for *mini, test for *test, else val."""
+    if version.endswith("mini"):
+        return "mini_val"
+    if version.endswith("test"):
+        return "test"
+    return "val"
 
 
 def check_split_version(split: str, version: str) -> None:
@@ -185,8 +194,10 @@ def evaluate_submission(
     results_path: Path, location: DatasetLocation, split: str, out_dir: Path | None = None
 ) -> TrackingScores:
     """Check ``results_path`` against ``split`` of the dataset at ``location``, then score it with the
-    official evaluation; the devkit's files go to ``out_dir`` (default ``default_eval_dir(results_path)``)."""
-    from gnnpmb.data.nuscenes import open_nuscenes, split_scenes
+    official evaluation, on a version folder holding only the split's evaluation tables
+    (``gnnpmb.eval.subset``); the devkit's files go to ``out_dir`` (default ``default_eval_dir(results_path)``)."""
+    from gnnpmb.data.nuscenes import all_sample_tokens, sample_tokens, split_scenes
+    from gnnpmb.eval.subset import eval_location
 
     results_path = Path(results_path)
     check_split_version(split, location.version)
@@ -194,18 +205,40 @@ def evaluate_submission(
     scene_names = split_scenes(split, location)
     if not scene_names:
         raise DataError(f"split {split} has no scenes in {location.dataroot / location.version}; pick another split")
-    nusc = open_nuscenes(location)
     check_submission(
         data,
         results_path.name,
         split,
-        split_sample_tokens(nusc, scene_names),
-        {s["token"] for s in nusc.sample},
+        sample_tokens(location, scene_names),
+        _LazyTokens(lambda: all_sample_tokens(location)),
     )
     del data
+    evaluated = eval_location(location, scene_names)
     return run_tracking_eval(
-        results_path, location.dataroot, location.version, split, out_dir or default_eval_dir(results_path)
+        results_path, evaluated.dataroot, evaluated.version, split, out_dir or default_eval_dir(results_path)
     )
+
+
+class _LazyTokens(Collection[str]):
+    """Every sample token of the dataset, read only when asked (a submission with samples of other splits)."""
+
+    def __init__(self, load: Callable[[], set[str]]) -> None:
+        self._load = load
+        self._tokens: set[str] | None = None
+
+    def _get(self) -> set[str]:
+        if self._tokens is None:
+            self._tokens = self._load()
+        return self._tokens
+
+    def __contains__(self, token: object) -> bool:
+        return token in self._get()
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._get())
+
+    def __len__(self) -> int:
+        return len(self._get())
 
 
 def format_metric(metric: str, value: float) -> str:

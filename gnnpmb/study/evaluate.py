@@ -74,8 +74,9 @@ def score_config(job: ConfigJob) -> dict[str, Any]:
         results_path = scratch / "results.json"
         write_submission(results_path, build_submission(parts, job.data.sample_tokens))
         eval_start = time.perf_counter()
+        evaluated = job.data.evaluation or job.data.location
         scores = run_tracking_eval(
-            results_path, job.data.location.dataroot, job.data.location.version, job.data.split, scratch / "eval"
+            results_path, evaluated.dataroot, evaluated.version, job.data.split, scratch / "eval"
         )
         eval_s = time.perf_counter() - eval_start
     finally:

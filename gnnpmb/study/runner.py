@@ -13,7 +13,7 @@ import contextlib
 import logging
 import os
 import socket
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, TypeVar
@@ -26,6 +26,8 @@ R = TypeVar("R")
 ADDRESS_ENV = "RAY_ADDRESS"
 CONNECT_TIMEOUT_S = 5.0
 _UV_HOOK_ENV = "RAY_ENABLE_UV_RUN_RUNTIME_ENV"
+_UNCAPPED = 1 << 16
+"""Tasks in flight when no cap is given (a cluster): Ray queues what its CPUs cannot start yet."""
 
 
 def import_ray() -> ModuleType:
@@ -120,9 +122,10 @@ def _unwrap(exc: BaseException) -> BaseException:
     return cause if isinstance(cause, GnnpmbError) else exc
 
 
-def run_tasks(fn: Callable[[T], R], items: Sequence[T], run: Execution) -> Iterator[tuple[int, R]]:
+def run_tasks(fn: Callable[[T], R], items: Iterable[T], run: Execution) -> Iterator[tuple[int, R]]:
     """``(index, fn(item))`` for every item, in finishing order; in this process when ``run.workers == 1``
-    without an address, else as Ray tasks with at most ``run.workers`` in flight (one CPU each).
+    without an address, else as Ray tasks with at most ``run.workers`` in flight (one CPU each). ``items`` is
+    consumed lazily, one item per task submitted (a task's inputs are read just before it is sent).
 
     Must be iterated inside ``ray_session(run)`` when ``run.uses_ray``. Closing the iterator early (or Ctrl-C)
     cancels the tasks still running.
@@ -133,15 +136,21 @@ def run_tasks(fn: Callable[[T], R], items: Sequence[T], run: Execution) -> Itera
         return
     ray = import_ray()
     remote = ray.remote(num_cpus=1, max_retries=0)(fn)
-    cap = run.workers or len(items)
+    cap = run.workers or _UNCAPPED
     pending: dict[Any, int] = {}
-    queue = list(enumerate(items))
-    queue.reverse()
+    queue = enumerate(items)
+    left = True
     try:
-        while queue or pending:
-            while queue and len(pending) < cap:
-                i, item = queue.pop()
+        while left or pending:
+            while left and len(pending) < cap:
+                nxt = next(queue, None)
+                if nxt is None:
+                    left = False
+                    break
+                i, item = nxt
                 pending[remote.remote(item)] = i
+            if not pending:
+                break
             done, _ = ray.wait(list(pending), num_returns=1)
             ref = done[0]
             i = pending.pop(ref)

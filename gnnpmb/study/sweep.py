@@ -12,7 +12,7 @@ from typing import Any
 
 from gnnpmb.provenance import code_version
 from gnnpmb.study.cache import ResultCache, config_key
-from gnnpmb.study.data import StudyData, inputs_fingerprint
+from gnnpmb.study.data import StudyData, for_scoring, inputs_fingerprint
 from gnnpmb.study.evaluate import ConfigJob, score_config
 from gnnpmb.study.grid import (
     Assignment,
@@ -106,8 +106,9 @@ def run_sweep(
             if on_row is not None:
                 on_row(rows[i], True)
     from_cache = len(rows)
+    data = for_scoring(plan.data, run.uses_ray) if len(rows) < len(keys) else plan.data
     jobs = [
-        ConfigJob(i, a, build_config(config_toml(plan.base_toml, a)), plan.tracker, plan.data)
+        ConfigJob(i, a, build_config(config_toml(plan.base_toml, a)), plan.tracker, data)
         for i, a in enumerate(plan.assignments)
         if i not in rows
     ]

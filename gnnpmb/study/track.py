@@ -1,46 +1,139 @@
-"""``gnnpmb track --workers N``: the scenes of a split tracked as parallel Ray tasks, one scene per task.
+"""Tracking a split, in this process or as Ray tasks: the one entry point of ``gnnpmb track`` (``track_to_file``)
+and of the per-scene step of ``gnnpmb failures`` (``scene_failures``); ``sweep`` and ``tune`` track through the
+same ``gnnpmb.study.data`` steps.
 
-Every scene is tracked by the same deterministic code as in one process, and the runs are put back in split
-order, so the submission equals a one-worker run's byte for byte.
+In this process each scene is read from the indexes and tracked in turn. On Ray this process reads each scene's
+inputs (the scene and its detections, from the indexes) and sends them with the task, a few consecutive scenes
+per task (``TASKS_PER_WORKER`` tasks per worker: fewer tasks, less of Ray's per-task cost on a small machine), so
+a worker holds only its scenes and loads nothing. Every scene is tracked by the same deterministic code either
+way and the runs are put back in split order, so the submission equals a one-worker run's byte for byte.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.study.data import SceneRun, StudyData, track_scene
+from gnnpmb.study.data import SceneInputs, SceneRun, StudyData, load_inputs, run_inputs, track_inputs
 from gnnpmb.study.runner import Execution, run_tasks, session
+
+if TYPE_CHECKING:
+    from gnnpmb.data.nuscenes import DatasetLocation
+    from gnnpmb.eval.failures import FailureReport
+    from gnnpmb.events import EventSink
+    from gnnpmb.pipeline import TrackingRun
+
+IN_PROCESS = Execution(workers=1)
+TASKS_PER_WORKER = 4
+"""Ray tasks per worker when the scenes are split among ``workers`` (one scene per task without a cap)."""
 
 
 @dataclass(frozen=True, slots=True)
-class SceneTask:
-    """One scene of the split to track."""
+class ScenesTask:
+    """Consecutive scenes of the split to track, with their inputs."""
 
-    data: StudyData
-    scene_name: str
+    inputs: tuple[SceneInputs, ...]
     tracker: str
     config: TrackerConfig
+    detector: str
+    seed: int
 
 
-def _track(task: SceneTask) -> SceneRun:
-    return track_scene(task.data, task.scene_name, task.tracker, task.config)
+def _track(task: ScenesTask) -> list[SceneRun]:
+    return [track_inputs(i, task.tracker, task.config, task.detector, task.seed) for i in task.inputs]
 
 
-def track_scenes(
+def track_split(
     data: StudyData,
     tracker: str,
     config: TrackerConfig,
-    run: Execution,
+    run: Execution = IN_PROCESS,
     on_scene: Callable[[SceneRun], None] | None = None,
+    on_frame: Callable[[], None] | None = None,
 ) -> list[SceneRun]:
-    """Track every scene of ``data`` on ``run`` (Ray unless one worker); runs in split order."""
-    tasks = [SceneTask(data, name, tracker, config) for name in data.scene_names]
-    runs: dict[int, SceneRun] = {}
-    with session(run):
-        for i, scene_run in run_tasks(_track, tasks, run):
-            runs[i] = scene_run
+    """Track every scene of ``data`` on ``run`` (Ray unless one worker); runs in split order. ``on_frame`` is
+    called after each keyframe tracked in this process (not on Ray), ``on_scene`` after each scene."""
+    if not run.uses_ray:
+        runs = []
+        for name in data.scene_names:
+            runs.append(track_inputs(load_inputs(data, name), tracker, config, data.detector, data.seed, on_frame))
             if on_scene is not None:
-                on_scene(scene_run)
-    return [runs[i] for i in range(len(tasks))]
+                on_scene(runs[-1])
+        return runs
+    names = data.scene_names
+    size = 1 if run.workers is None else -(-len(names) // (run.workers * TASKS_PER_WORKER))
+    chunks = [names[i : i + size] for i in range(0, len(names), size)]
+    tasks = (
+        ScenesTask(tuple(load_inputs(data, n) for n in chunk), tracker, config, data.detector, data.seed)
+        for chunk in chunks
+    )
+    done: dict[int, list[SceneRun]] = {}
+    with session(run):
+        for i, scene_runs in run_tasks(_track, tasks, run):
+            done[i] = scene_runs
+            if on_scene is not None:
+                for scene_run in scene_runs:
+                    on_scene(scene_run)
+    return [r for i in range(len(chunks)) for r in done[i]]
+
+
+@dataclass(frozen=True, slots=True)
+class TrackSummary:
+    """What ``track_to_file`` did: scenes, keyframes and boxes written, and the trackers' mean ms per frame."""
+
+    scenes: int
+    frames: int
+    boxes: int
+    ms_per_frame: float
+
+
+def track_to_file(
+    data: StudyData,
+    tracker: str,
+    config: TrackerConfig,
+    out: Path,
+    run: Execution = IN_PROCESS,
+    on_scene: Callable[[SceneRun], None] | None = None,
+    on_frame: Callable[[], None] | None = None,
+) -> TrackSummary:
+    """Track the split of ``data`` and write its nuScenes tracking submission to ``out`` (atomically)."""
+    from gnnpmb.eval.submission import build_submission, write_submission
+
+    runs = track_split(data, tracker, config, run, on_scene, on_frame)
+    write_submission(out, build_submission([r.results for r in runs], data.sample_tokens))
+    frames = sum(r.n_frames for r in runs)
+    boxes = sum(len(b) for r in runs for b in r.results.values())
+    step_s = sum(r.step_time_s for r in runs)
+    return TrackSummary(len(runs), frames, boxes, 1e3 * step_s / max(frames, 1))
+
+
+@dataclass(frozen=True, slots=True)
+class SceneFailures:
+    """One scene tracked (the run, with its scene) and its failure report."""
+
+    run: TrackingRun
+    report: FailureReport
+
+
+def scene_failures(
+    location: DatasetLocation,
+    scene_name: str,
+    tracker: str,
+    config: TrackerConfig,
+    detections: Path | None,
+    detector: str,
+    seed: int,
+    sink: EventSink | None = None,
+) -> SceneFailures:
+    """Track one scene (its events to ``sink``) and find its failures (``gnnpmb failures``), the report stored
+    for the next time."""
+    from gnnpmb.eval.failure_cache import scene_report
+    from gnnpmb.eval.submission import run_results
+    from gnnpmb.study.data import scene_study
+
+    data = scene_study(location, scene_name, detections, detector, seed)
+    run = run_inputs(load_inputs(data, scene_name), tracker, config, detector, seed, sink=sink)
+    return SceneFailures(run, scene_report(location, scene_name, tracker, run_results(run)))

@@ -28,7 +28,7 @@ from typing import Any
 
 from gnnpmb.config import config_from_dict, load_config
 from gnnpmb.errors import GnnpmbError
-from gnnpmb.study.data import StudyData
+from gnnpmb.study.data import StudyData, for_scoring
 from gnnpmb.study.evaluate import ConfigJob, class_column, score_config
 from gnnpmb.study.grid import (
     Assignment,
@@ -333,6 +333,7 @@ def run_tune(
     """
     if trials < 1:
         raise StudyError(f"--trials must be at least 1, got {trials}")
+    data = for_scoring(data, run.uses_ray)
     base = dict(base_toml)
     if run.uses_ray:
         context = _TrialContext(tuple(dims), base, tracker, data)

@@ -151,10 +151,10 @@ def test_reproduce_reports_identical_tracks(full_run: tuple[Path, str], capsys: 
 def test_installed_script_with_a_detections_file_and_frame_range(demo_dataroot: Path, tmp_path: Path) -> None:
     """A real process through the console script: --detections (GT boxes as a submission), --frames,
     --classes."""
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
 
     location = resolve_dataroot(demo_dataroot, None)
-    scene = load_scene(open_nuscenes(location), location, SCENE)
+    scene = load_scene(location, SCENE)
     results = {}
     for k in scene.keyframes:
         g = k.gt

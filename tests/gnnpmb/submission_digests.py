@@ -22,10 +22,9 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+from gnnpmb.data.nuscenes import load_scene, resolve_dataroot, sample_tokens
 from gnnpmb.data.scene import SceneData
 from gnnpmb.data.simdet import PRESETS
-from gnnpmb.eval.nuscenes_eval import split_sample_tokens
 from gnnpmb.eval.submission import build_submission, run_results
 from gnnpmb.pipeline import get_detections, run_tracker
 from gnnpmb.registry import TRACKER_NAMES
@@ -38,8 +37,7 @@ SEED = 0
 def load_demo_scenes(dataroot: Path) -> tuple[list[SceneData], list[str]]:
     """The demo mini_val scenes and their sample tokens (the submission's sample list)."""
     location = resolve_dataroot(dataroot, "v1.0-mini")
-    nusc = open_nuscenes(location)
-    return [load_scene(nusc, location, name) for name in SCENE_NAMES], split_sample_tokens(nusc, SCENE_NAMES)
+    return [load_scene(location, name) for name in SCENE_NAMES], sample_tokens(location, SCENE_NAMES)
 
 
 def submission_bytes(scenes: Sequence[SceneData], tokens: Sequence[str], tracker: str, preset: str) -> bytes:

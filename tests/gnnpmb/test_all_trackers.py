@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
 from gnnpmb.events import (
     Cardinality,
     Extracted,
@@ -32,8 +32,7 @@ PRESETS = ("centerpoint", "megvii", "pointpillars")
 @pytest.fixture(scope="module")
 def scenes(demo_dataroot):
     location = resolve_dataroot(demo_dataroot, "v1.0-mini")
-    nusc = open_nuscenes(location)
-    return [load_scene(nusc, location, name) for name in ("scene-0103", "scene-0916")]
+    return [load_scene(location, name) for name in ("scene-0103", "scene-0916")]
 
 
 def assert_spd(cov: np.ndarray, what: str) -> None:

@@ -7,7 +7,7 @@ import pytest
 
 from gnnpmb.config import TrackerConfig
 from gnnpmb.data.demo import CLUTTER_HOTSPOTS
-from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
 from gnnpmb.pipeline import get_detections, preprocess_frames, run_tracker
 from gnnpmb.types import TRACKING_CLASSES
 
@@ -15,7 +15,7 @@ from gnnpmb.types import TRACKING_CLASSES
 @pytest.fixture(scope="module")
 def scene(demo_dataroot):
     location = resolve_dataroot(demo_dataroot, "v1.0-mini")
-    return load_scene(open_nuscenes(location), location, "scene-0103")
+    return load_scene(location, "scene-0103")
 
 
 def test_the_demo_scene_carries_its_hotspots_and_ground_height(scene):

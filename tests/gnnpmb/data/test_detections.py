@@ -54,13 +54,37 @@ def test_loads_requested_samples_and_tracking_classes(det_file):
     assert list(out["s2"].class_name) == ["truck"]
 
 
-def test_parsed_once_and_reparsed_when_rewritten(det_file):
+def test_indexed_once_and_again_when_rewritten(det_file, tmp_path, monkeypatch):
+    from gnnpmb.data import detection_index, detections
+
+    monkeypatch.setenv("GNNPMB_CACHE_DIR", str(tmp_path / "cache"))
+    builds = []
+    build = detection_index._build
+    monkeypatch.setattr(detection_index, "_build", lambda *a: builds.append(1) or build(*a))
     first = load_detection_file(det_file, ["s0"])
+    detections._opened.clear()  # a new process: the index on disk is reused
     again = load_detection_file(det_file, ["s0", "s1"])
-    assert again["s0"] is first["s0"]
+    assert len(builds) == 1 and np.array_equal(again["s0"].translation_m, first["s0"].translation_m)
     write_detection_file(det_file, submission({"s0": [box("s0", "bicycle", 0.5)]}))
     fresh = load_detection_file(det_file, ["s0"])
-    assert list(fresh["s0"].class_name) == ["bicycle"]
+    assert list(fresh["s0"].class_name) == ["bicycle"] and len(builds) == 2
+
+
+def test_damaged_index_is_rebuilt(det_file, tmp_path, monkeypatch):
+    from gnnpmb.data import detections
+
+    monkeypatch.setenv("GNNPMB_CACHE_DIR", str(tmp_path / "cache"))
+    expected = load_detection_file(det_file, ["s0", "s2"])
+    (boxes,) = (tmp_path / "cache" / "index").glob("detections-*/boxes.arrow")
+    raw = bytearray(boxes.read_bytes())
+    raw[300] ^= 0xFF  # a flipped bit inside the first sample's values: the size still matches
+    boxes.write_bytes(bytes(raw))
+    got = load_detection_file(det_file, ["s0", "s2"])
+    assert np.array_equal(got["s0"].translation_m, expected["s0"].translation_m)
+    detections._opened.clear()
+    boxes.write_bytes(bytes(raw[:-10]))  # truncated: not trusted when opened
+    got = load_detection_file(det_file, ["s0"])
+    assert np.array_equal(got["s0"].score, expected["s0"].score)
 
 
 def test_missing_file(tmp_path):

@@ -129,12 +129,12 @@ def test_unknown_scene_lists_available(location: DatasetLocation) -> None:
     with pytest.raises(
         UnknownNameError, match=r"^unknown scene 'scene-0001'; available: scene-0103, scene-0916, scene-9001$"
     ):
-        load_scene(open_nuscenes(location), location, "scene-0001")
+        load_scene(location, "scene-0001")
 
 
 def test_load_scene(location: DatasetLocation) -> None:
     nusc = open_nuscenes(location)
-    scene = load_scene(nusc, location, "scene-0916")
+    scene = load_scene(location, "scene-0916")
     assert scene.name == "scene-0916" and scene.synthetic and scene.description.startswith(SYNTHETIC_MARKER)
     assert scene.version == DEMO_VERSION and scene.dataroot == location.dataroot
     assert len(scene.keyframes) == 40
@@ -171,7 +171,7 @@ def test_load_scene(location: DatasetLocation) -> None:
 
 
 def test_load_lidar_points(location: DatasetLocation, tmp_path: Path) -> None:
-    keyframe = load_scene(open_nuscenes(location), location, "scene-0103").keyframes[5]
+    keyframe = load_scene(location, "scene-0103").keyframes[5]
     points = load_lidar_points(keyframe)
     raw = np.fromfile(keyframe.lidar_path, dtype=np.float32).reshape(-1, 5)
     assert points.dtype == np.float32 and points.shape == (raw.shape[0], 4)

@@ -31,7 +31,7 @@ def nusc(location: DatasetLocation):
 @pytest.fixture(scope="module")
 def switched(nusc, location: DatasetLocation) -> dict[str, list[dict]]:
     """The ground truth with one visible object's id changed from SWITCH_FRAME on: one ID switch."""
-    scene = load_scene(nusc, location, SCENE)
+    scene = load_scene(location, SCENE)
     results = gt_results(scene)
     instance = sorted(visible_throughout(scene, range(SWITCH_FRAME - 1, SWITCH_FRAME + 1)))[0]
     relabel(results, range(SWITCH_FRAME, len(results)), instance, "switched")

@@ -33,7 +33,7 @@ def nusc(demo_dataroot: Path):
 
 @pytest.fixture(scope="module")
 def scene(nusc, demo_dataroot: Path) -> SceneData:
-    return load_scene(nusc, check_dataroot(demo_dataroot, "v1.0-mini"), SCENE)
+    return load_scene(check_dataroot(demo_dataroot, "v1.0-mini"), SCENE)
 
 
 @pytest.fixture(scope="module")

@@ -50,8 +50,7 @@ def split_tokens(location: DatasetLocation) -> list[str]:
 
 @pytest.fixture(scope="module")
 def gt_submission(location: DatasetLocation, split_tokens: list[str]) -> dict:
-    nusc = open_nuscenes(location)
-    return build_submission([gt_results(load_scene(nusc, location, name)) for name in SCENES], split_tokens)
+    return build_submission([gt_results(load_scene(location, name)) for name in SCENES], split_tokens)
 
 
 @pytest.fixture(scope="module")
@@ -90,7 +89,7 @@ def test_tracker_submission_passes_the_devkits_own_checks(
     nusc = open_nuscenes(location)
     parts = []
     for name in SCENES:
-        scene = load_scene(nusc, location, name)
+        scene = load_scene(location, name)
         parts.append(
             run_results(run_tracker(scene, get_detections(scene, None, "megvii", 3), "gnnpmb", TrackerConfig()))
         )

@@ -117,12 +117,12 @@ def test_n_h_one_equals_gnnpmb_on_a_multi_target_sequence():
 
 
 def test_n_h_one_equals_gnnpmb_on_a_demo_scene(demo_dataroot):
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
     from gnnpmb.pipeline import get_detections, preprocess_frames, run_tracker
     from gnnpmb.types import TRACKING_CLASSES
 
     location = resolve_dataroot(demo_dataroot, "v1.0-mini")
-    scene = load_scene(open_nuscenes(location), location, "scene-0103")
+    scene = load_scene(location, "scene-0103")
     detections = get_detections(scene, None, "centerpoint", seed=0)
     config = CFG.replace(pmbm=PmbmParams(n_hypotheses=1))
     frames = preprocess_frames(scene, detections, config, TRACKING_CLASSES)

@@ -225,12 +225,11 @@ def test_deterministic_and_sink_independent():
 
 
 def test_demo_scene_runs_without_nan(demo_dataroot):
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
     from gnnpmb.pipeline import get_detections, run_tracker
 
     loc = resolve_dataroot(demo_dataroot, None)
-    nusc = open_nuscenes(loc)
-    scene = load_scene(nusc, loc, "scene-0103")
+    scene = load_scene(loc, "scene-0103")
     run = run_tracker(scene, get_detections(scene, None, "centerpoint", seed=0), "topmb", TrackerConfig())
     estimates = [e for f in run.frames for e in f.estimates]
     assert estimates

@@ -68,7 +68,7 @@ def test_a_lower_extraction_threshold_reports_at_least_as_many_boxes(
     Checked on the tracker's output: the devkit's tp + fp in the sweep rows are counted at each run's best-MOTA
     score threshold and need not grow when more boxes are reported."""
     from gnnpmb.config import TrackerConfig, with_params
-    from gnnpmb.data.nuscenes import load_scene, open_nuscenes, resolve_dataroot
+    from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
     from gnnpmb.pipeline import get_detections, run_tracker
 
     out = tmp_path / "sweep"
@@ -77,7 +77,7 @@ def test_a_lower_extraction_threshold_reports_at_least_as_many_boxes(
     low, high = json.loads((out / "results.json").read_text())["rows"]
     assert low["tp"] + low["fn"] == high["tp"] + high["fn"]  # the same ground truth
     location = resolve_dataroot(tiny_dataroot, None)
-    scene = load_scene(open_nuscenes(location), location, "scene-0103")
+    scene = load_scene(location, "scene-0103")
     detections = get_detections(scene, None, "pointpillars", 0)
     reported = {}
     for threshold in (0.5, 0.9):

@@ -1,0 +1,27 @@
+"""The command-line modules only parse and print: ``cli.study`` does not import ``cli.batch`` (no cycle), and the
+tracking entry point lives in ``gnnpmb``."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+
+def _modules_after(statement: str) -> set[str]:
+    code = f"import sys; {statement}; print(' '.join(sorted(sys.modules)))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    return set(out.split())
+
+
+def test_cli_study_does_not_import_cli_batch() -> None:
+    assert "cli.batch" not in _modules_after("import cli.study")
+
+
+def test_track_and_failures_use_the_gnnpmb_entry_point() -> None:
+    import inspect
+
+    import cli.batch
+
+    source = inspect.getsource(cli.batch)
+    assert "track_to_file(" in source and "scene_failures(" in source
+    assert "run_tracker(" not in source and "load_scene(" not in source

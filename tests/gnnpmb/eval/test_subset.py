@@ -1,0 +1,95 @@
+"""The evaluation on a version folder built from the index for some scenes equals the evaluation on the whole
+dataset: the same metrics files, the same failure reports."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from gnnpmb.data.nuscenes import check_dataroot, load_scene, open_nuscenes, sample_tokens
+from gnnpmb.eval.failures import find_failures
+from gnnpmb.eval.nuscenes_eval import run_tracking_eval
+from gnnpmb.eval.submission import build_submission, run_results, write_submission
+from gnnpmb.eval.subset import eval_location
+from gnnpmb.pipeline import get_detections, run_tracker
+
+SCENES = ("scene-0103", "scene-0916")
+
+
+@pytest.fixture(scope="module")
+def dataroot(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The demo with a custom split holding one scene, so a subset evaluation leaves a scene out."""
+    root = tmp_path_factory.mktemp("subset") / "nuscenes"
+    (root / "v1.0-mini").mkdir(parents=True)
+    for table in (demo_dataroot / "v1.0-mini").glob("*.json"):
+        shutil.copy(table, root / "v1.0-mini" / table.name)
+    (root / "v1.0-mini" / "splits.json").write_text(json.dumps({"one": ["scene-0916"]}))
+    for folder in ("samples", "maps"):
+        (root / folder).symlink_to(demo_dataroot / folder)
+    return root
+
+
+@pytest.fixture(scope="module")
+def results(dataroot: Path) -> dict[str, dict]:
+    location = check_dataroot(dataroot, None)
+    out = {}
+    for name in SCENES:
+        scene = load_scene(location, name)
+        run = run_tracker(scene, get_detections(scene, None, "pointpillars", 0), "gnnpmb", _config())
+        out[name] = run_results(run)
+    return out
+
+
+def _config():
+    from gnnpmb.config import TrackerConfig
+
+    return TrackerConfig()
+
+
+def _metrics(folder: Path) -> dict:
+    summary = json.loads((folder / "metrics_summary.json").read_text())
+    summary.pop("eval_time")
+    details = json.loads((folder / "metrics_details.json").read_text())
+    return {"summary": summary, "details": details}
+
+
+@pytest.mark.parametrize(("split", "scenes"), [("mini_val", SCENES), ("one", ("scene-0916",))])
+def test_split_metrics_equal_a_full_load(dataroot: Path, results: dict, tmp_path: Path, split: str, scenes) -> None:
+    location = check_dataroot(dataroot, None)
+    path = tmp_path / "results.json"
+    write_submission(path, build_submission([results[n] for n in scenes], sample_tokens(location, scenes)))
+    run_tracking_eval(path, location.dataroot, location.version, split, tmp_path / "full")
+    subset = eval_location(location, scenes)
+    assert subset.dataroot != location.dataroot
+    run_tracking_eval(path, subset.dataroot, subset.version, split, tmp_path / "subset")
+    assert _metrics(tmp_path / "subset") == _metrics(tmp_path / "full")
+
+
+def test_failure_report_equals_a_full_load(dataroot: Path, results: dict) -> None:
+    location = check_dataroot(dataroot, None)
+    name = "scene-0103"
+    full = find_failures(open_nuscenes(location), name, results[name], "gnnpmb")
+    subset = find_failures(open_nuscenes(eval_location(location, [name])), name, results[name], "gnnpmb")
+    assert subset.to_json() == full.to_json() and full.failures
+
+
+def test_subset_holds_only_its_scenes(dataroot: Path) -> None:
+    location = check_dataroot(dataroot, None)
+    subset = eval_location(location, ["scene-0916"])
+    tables = subset.dataroot / subset.version
+    assert [s["name"] for s in json.loads((tables / "scene.json").read_text())] == ["scene-0916"]
+    samples = json.loads((tables / "sample.json").read_text())
+    assert {s["token"] for s in samples} == set(sample_tokens(location, ["scene-0916"]))
+    assert eval_location(location, ["scene-0916"]) == subset
+
+
+def test_damaged_subset_is_built_again(dataroot: Path) -> None:
+    location = check_dataroot(dataroot, None)
+    subset = eval_location(location, ["scene-0103"])
+    table = subset.dataroot / subset.version / "sample_annotation.json"
+    expected = table.read_text()
+    table.write_text(expected[:100])
+    assert eval_location(location, ["scene-0103"]) == subset and table.read_text() == expected
