@@ -20,6 +20,7 @@ from gnnpmb.eval.failures import Failure, FailureKind, FailureReport
 from gnnpmb.events import AxisKind
 from gnnpmb.focus import FRAMES_BEFORE
 from gnnpmb.pipeline import FrameResult, TrackingRun
+from gnnpmb.types import TrackEstimate
 from gnnpmb.why.facts import TrackerFacts, UseMode
 from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
@@ -248,7 +249,7 @@ class _Context:
         k = int(np.argmin(d))
         return str(gt.instance_id[mine[k]]) if d[k] < NEAR_M else None
 
-    def estimate(self, track_id: int, frame: int):
+    def estimate(self, track_id: int, frame: int) -> TrackEstimate | None:
         fr = self.frames.get(frame)
         return next((e for e in fr.estimates if e.track_id == track_id), None) if fr is not None else None
 
