@@ -30,6 +30,8 @@ ADDRESS_ENV = "RAY_ADDRESS"
 _UV_HOOK_ENV = "RAY_ENABLE_UV_RUN_RUNTIME_ENV"
 _UNCAPPED = 1 << 16
 """Tasks in flight when no cap is given (a cluster): Ray queues what its CPUs cannot start yet."""
+_WAIT_S = 0.5
+"""How long one wait for a finished task lasts before a SIGTERM is looked at."""
 
 
 def import_ray() -> ModuleType:
@@ -109,7 +111,9 @@ def ray_session(run: Execution) -> Iterator[None]:
         try:
             yield
         finally:
-            ray.shutdown()
+            with signals.deferred():  # a SIGTERM during the shutdown stops the run once it is done
+                ray.shutdown()
+            signals.check()
 
 
 def session(run: Execution) -> contextlib.AbstractContextManager[None]:
@@ -152,7 +156,11 @@ def run_tasks(fn: Callable[[T], R], items: Iterable[T], run: Execution) -> Itera
                 pending[remote.remote(item)] = i
             if not pending:
                 break
-            done, _ = ray.wait(list(pending), num_returns=1)
+            with signals.deferred():  # SIGTERM stops the run here, not inside Ray's wait
+                done, _ = ray.wait(list(pending), num_returns=1, timeout=_WAIT_S)
+            signals.check()
+            if not done:
+                continue
             ref = done[0]
             i = pending.pop(ref)
             try:
