@@ -196,9 +196,9 @@ def view(
                 else ""
             )
             typer.echo(
-                f"{name} failures: {report.totals_text()}{at_interpolated}. To open {first} at its frame, {how} to "
-                f"this command; to list them all: gnnpmb failures {request.scene.name} --tracker {name} (same "
-                "options)."
+                f"{name} failures{report.scope_text()}: {report.totals_text()}{at_interpolated}. To open {first} at "
+                f"its frame, {how} to this command; to list them all: gnnpmb failures {request.scene.name} "
+                f"--tracker {name} (same options)."
             )
     if request.serve is not None:
         from viz.serving import wait_for_ctrl_c
@@ -226,9 +226,12 @@ def reproduce(
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr (with --save).")] = True,
 ) -> None:
     """Re-run a recording's trackers and compare their track digests (``REPRODUCE_HELP``)."""
+    from gnnpmb.outputs import check_output_file
     from viz.provenance import read_provenance
     from viz.view import run_view
 
+    if save is not None:  # the recording read must not be the one written
+        check_output_file(save, "--save", ".rrd", inputs=(("FILE.rrd", recording_file), ("--detections", detections)))
     provenance = read_provenance(recording_file)
     request = prepare_reproduction(
         provenance, dataroot=dataroot, detections_file=detections, save=save, argv=command_line()

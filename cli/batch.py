@@ -30,7 +30,7 @@ from cli.options import (
     stdout_console,
     tidy_help,
 )
-from cli.study import register
+from cli.study import VerboseOption, register
 from gnnpmb.eval.nuscenes_eval import default_split
 from gnnpmb.outputs import check_output_dir, check_output_file
 
@@ -67,12 +67,13 @@ def track(
         int, typer.Option(metavar="N", help="Scenes tracked in parallel on Ray; 1 (default) runs in this process.")
     ] = 1,
     address: AddressOption = None,
+    verbose: VerboseOption = False,
 ) -> None:
     """Track every scene of a split (all 7 classes) and write a nuScenes tracking submission."""
     from gnnpmb.data.simdet_presets import detector_choice
     from gnnpmb.registry import check_tracker
 
-    target = check_output_file(out, "--out")
+    target = check_output_file(out, "--out", inputs=(("--detections", detections), ("--params", params)))
     check_tracker(tracker)
     preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
 
@@ -85,7 +86,7 @@ def track(
     from gnnpmb.study.track import track_to_file
 
     config = load_config(params)
-    run = execution(workers, address)
+    run = execution(workers, address, verbose)
     if detections is not None:  # a bad file fails before a dataset is looked for
         check_detection_file(detections)
     location = resolve_dataroot(dataroot, version, (split,) if split else ())
@@ -133,11 +134,22 @@ def evaluate(
     from rich.table import Table
 
     from gnnpmb.data.nuscenes import resolve_dataroot
-    from gnnpmb.eval.nuscenes_eval import TABLE_METRICS, default_eval_dir, evaluate_submission, format_metric
+    from gnnpmb.eval.nuscenes_eval import (
+        DEVKIT_FILES,
+        TABLE_METRICS,
+        default_eval_dir,
+        evaluate_submission,
+        format_metric,
+    )
     from gnnpmb.eval.submission import check_results_file
 
     check_results_file(results)
-    out = check_output_dir(out if out is not None else default_eval_dir(results), "--out")
+    out = check_output_dir(
+        out if out is not None else default_eval_dir(results),
+        "--out",
+        files=DEVKIT_FILES,
+        inputs=(("RESULTS.json", results),),
+    )
     location = resolve_dataroot(dataroot, version, (split,) if split else ())
     split = split or default_split(location.version)
     start = time.perf_counter()
@@ -179,15 +191,26 @@ def failures(
             "--why", help="Explain each failure: whose doing, why and because (with --json: the typed findings)."
         ),
     ] = False,
+    frames: Annotated[
+        str | None,
+        typer.Option(
+            metavar="START:END",
+            help="Track and evaluate only keyframes START:END (END exclusive), as gnnpmb-viz --frames does; the "
+            "ids are those gnnpmb-viz --frames START:END --focus takes.",
+        ),
+    ] = None,
 ) -> None:
     """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
     coalescence and cascading identity theft (scored with the devkit's own matching)."""
     from gnnpmb.data.simdet_presets import detector_choice
     from gnnpmb.registry import check_tracker, tracker_has_existence
+    from gnnpmb.session import parse_frames
     from gnnpmb.why.facts import FactSink
 
-    json_target = check_output_file(json_out, "--json") if json_out is not None else None
+    inputs = (("--detections", detections), ("--params", params))
+    json_target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
     check_tracker(tracker)
+    bounds = parse_frames(frames)
 
     from gnnpmb.config import load_config
     from gnnpmb.data.detections import check_detection_file
@@ -201,7 +224,7 @@ def failures(
         check_detection_file(detections)
     location = resolve_dataroot(dataroot, version, (scene,))
     fact_sink = FactSink(tracker, has_existence=tracker_has_existence(tracker)) if why else None
-    found = scene_failures(location, scene, tracker, config, detections, preset, seed, sink=fact_sink)
+    found = scene_failures(location, scene, tracker, config, detections, preset, seed, sink=fact_sink, bounds=bounds)
     report = found.report
     findings = []
     if fact_sink is not None:
@@ -210,7 +233,9 @@ def failures(
 
         evidence = Evidence(report, fact_sink.facts, found.run)
         findings = [
-            explain_failure(fid, evidence, found.run.scene, first_frame=max(0, f.frame_index - FRAMES_BEFORE))
+            explain_failure(
+                fid, evidence, found.run.scene, first_frame=max(bounds[0] or 0, f.frame_index - FRAMES_BEFORE)
+            )
             for fid, f in zip(report.ids(), report.failures, strict=True)
         ]
     if json_target is not None:
@@ -264,7 +289,8 @@ def print_report(report: FailureReport, console: Console) -> None:
     for (frame, _kind), entries in grouped.items():
         rows.add_row(str(frame), _id_span([i for i, _ in entries]), "; ".join(text for _, text in entries))
     console.print(rows)
-    console.print(f"{report.scene_name}, {report.tracker}: {report.totals_text()}", highlight=False, soft_wrap=True)
+    totals = f"{report.scene_name}, {report.tracker}{report.scope_text()}: {report.totals_text()}"
+    console.print(totals, highlight=False, soft_wrap=True)
 
 
 def _id_span(ids: list[str]) -> str:
@@ -278,7 +304,7 @@ def demo_data(
         Path,
         typer.Option(metavar="DIR", help="Folder to write the demo dataroot into (new, empty or an old demo)."),
     ],
-    seed: Annotated[int, typer.Option(metavar="N", help="Seed of the LiDAR noise.")] = 0,
+    seed: Annotated[int, typer.Option(metavar="N", min=0, help="Seed of the LiDAR noise (0 or more).")] = 0,
     scenes: Annotated[
         str,
         typer.Option(

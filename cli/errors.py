@@ -15,6 +15,7 @@ from collections.abc import Callable, Sequence
 
 import typer
 
+from gnnpmb import signals
 from gnnpmb.errors import GnnpmbError
 
 EXIT_USER_ERROR = 2
@@ -94,16 +95,31 @@ def os_error_line(exc: OSError) -> str:
     return reason
 
 
+_ANNOUNCED: list[str] = []
+"""The stop line printed by this run, if any (``announce_stop``)."""
+
+
+def announce_stop(what: str = "unfinished outputs were not written") -> None:
+    """Print the one line of a run stopped by Ctrl-C or SIGTERM (``gnnpmb.signals``), saying ``what`` became of
+    its work; only the first call of a run prints."""
+    if _ANNOUNCED:
+        return
+    verb = "terminated" if signals.terminated() else "interrupted"
+    _ANNOUNCED.append(f"{verb} by {signals.stop_reason()}: {what}")
+    print(_ANNOUNCED[-1], file=sys.stderr)
+
+
 def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
     """Run a typer app (or a partial of one); user mistakes end the process with one ``error:`` line and exit
-    code 2, Ctrl-C exits 130 quietly, a closed stdout pipe exits quietly."""
+    code 2, Ctrl-C (or SIGTERM, ``gnnpmb.signals``) with one line and exit 130 (143), a closed stdout pipe
+    quietly."""
+    _ANNOUNCED.clear()
     try:
         code = app(args=argv, standalone_mode=False)
     except GnnpmbError as exc:
         _fail(str(exc))
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
-        sys.exit(EXIT_INTERRUPTED)
+        _stopped()
     except typer.Exit as exc:
         sys.exit(exc.exit_code)
     except typer.Abort:
@@ -118,6 +134,8 @@ def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
         if getattr(exc, "exit_code", EXIT_USER_ERROR) == 0:
             sys.exit(0)
         _fail(usage_line(exc))
+    if code == EXIT_INTERRUPTED:  # typer returns Ctrl-C as 130, silently, like a command's own Exit(130)
+        _stopped()
     if isinstance(code, int) and code:
         sys.exit(code)
 
@@ -129,17 +147,27 @@ def _quiet_broken_pipe() -> None:
     sys.exit(1)
 
 
+def _stopped() -> None:
+    announce_stop()
+    sys.exit(signals.exit_code())
+
+
 def _fail(message: str) -> None:
     print(f"error: {message}", file=sys.stderr)
     sys.exit(EXIT_USER_ERROR)
 
 
 def exit_now_on_failure(run: Callable[[], None]) -> None:
-    """Run a console script's body; a failed run (SystemExit with a non-zero code) ends the process at once,
-    after flushing stdout and stderr, skipping interpreter shutdown: Rerun's exit hook can wait forever on a
-    recording whose file writer died (disk full). Every output was already finished or removed."""
+    """Run a console script's body with SIGTERM handled like Ctrl-C (``gnnpmb.signals``); a failed run
+    (SystemExit with a non-zero code) ends the process at once, after flushing stdout and stderr, skipping
+    interpreter shutdown: Rerun's exit hook can wait forever on a recording whose file writer died (disk full).
+    Every output was already finished or removed."""
+    signals.install()
     try:
-        run()
+        try:
+            run()
+        except KeyboardInterrupt:  # before or after the app ran (e.g. while importing)
+            _stopped()
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
         if code == 0:

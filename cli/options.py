@@ -34,7 +34,7 @@ DetectionsOption = Annotated[
     Path | None,
     typer.Option(metavar="FILE.json", help="nuScenes detection results .json (default: a simulated detector)."),
 ]
-SeedOption = Annotated[int, typer.Option(metavar="N", help="Seed of the simulated detector.")]
+SeedOption = Annotated[int, typer.Option(metavar="N", min=0, help="Seed of the simulated detector (0 or more).")]
 ParamsOption = Annotated[
     Path | None,
     typer.Option(metavar="FILE.toml", help="Tracker parameter file (.toml) overriding the paper's."),

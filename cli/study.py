@@ -5,7 +5,6 @@ the work is in ``gnnpmb.study``. No
 ``from __future__ import annotations`` here: typer must evaluate the option annotations inside ``register``.
 """
 
-import sys
 import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -15,6 +14,7 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
+from cli.errors import announce_stop
 from cli.options import (
     DEFAULT_DETECTOR,
     DEFAULT_TRACKER,
@@ -45,6 +45,7 @@ WorkersOption = Annotated[
     ),
 ]
 ProgressOption = Annotated[bool, typer.Option(help="Show a progress bar on stderr.")]
+VerboseOption = Annotated[bool, typer.Option("--verbose", help="Show Ray's own log lines (hidden by default).")]
 
 
 def base_params(params: Path | None) -> dict[str, Any]:
@@ -60,18 +61,6 @@ def base_params(params: Path | None) -> dict[str, Any]:
 def train_split(version: str) -> str:
     """The split parameters are tuned on by default: mini_train for *mini versions, else train."""
     return "mini_train" if version.endswith("mini") else "train"
-
-
-def check_out_dir(out: Path) -> None:
-    """A sweep's output folder must be a folder (new or existing)."""
-    if out.exists() and not out.is_dir():
-        raise GnnpmbError(f"--out {out} is a file; give a folder for the sweep's results")
-
-
-def check_out_file(out: Path) -> None:
-    """The tuned parameter file must be a file path in a folder."""
-    if out.is_dir():
-        raise GnnpmbError(f"--out {out} is a folder; give a file name such as tuned.toml")
 
 
 def _progress(enabled: bool, total: int, what: str) -> Progress:
@@ -147,6 +136,7 @@ def register(app: typer.Typer) -> None:
         address: AddressOption = None,
         top: Annotated[int, typer.Option(metavar="N", help="Rows in the table of best configurations.")] = 10,
         progress: ProgressOption = True,
+        verbose: VerboseOption = False,
     ) -> None:
         """Score every configuration of a parameter grid with the official evaluation (cached, resumable)."""
         from gnnpmb.data.nuscenes import resolve_dataroot
@@ -155,6 +145,7 @@ def register(app: typer.Typer) -> None:
         from gnnpmb.registry import check_tracker
         from gnnpmb.study.cache import CACHE_FOLDER, ResultCache
         from gnnpmb.study.data import resolve_study_data
+        from gnnpmb.study.folder import check_study_dir, drop_stale_plots, identity, merge_study, read_study
         from gnnpmb.study.grid import parse_param
         from gnnpmb.study.plots import plot_sweep
         from gnnpmb.study.results import best_amota, best_rows, write_results
@@ -162,35 +153,28 @@ def register(app: typer.Typer) -> None:
         from gnnpmb.study.sweep import plan_sweep, run_sweep
 
         check_tracker(tracker)
-        check_out_dir(out)
         preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
         swept = [parse_param(p) for p in param or []]
         base = base_params(params)
-        run = execution(workers, address)
+        folder = check_study_dir(out, [p.key for p in swept], (("--detections", detections), ("--params", params)))
+        run = execution(workers, address, verbose)
         location = resolve_dataroot(dataroot, version, (split,) if split else ())
         data = resolve_study_data(location, split or default_split(location.version), detections, preset, seed)
-        plan = plan_sweep(tracker, data, base, swept, one_at_a_time)
+        plan, note = merge_study(plan_sweep(tracker, data, base, swept, one_at_a_time), read_study(folder), out, params)
+        if note is not None:
+            typer.echo(note, err=True)
         n = len(plan.assignments)
         rows_seen: list[dict[str, Any]] = []
-        with _progress(progress, n, "configurations") as bar:
+        with session(run), _progress(progress, n, "configurations") as bar:  # the bar once Ray is up
 
             def on_row(row: dict[str, Any], from_cache: bool) -> None:
                 rows_seen.append(row)
                 task = bar.task_ids[0]
                 bar.update(task, advance=1, description=_best_label("configurations", best_amota(rows_seen)))
 
-            with session(run):
-                outcome = run_sweep(plan, ResultCache(out / CACHE_FOLDER), run, on_row)
+            outcome = run_sweep(plan, ResultCache(folder / CACHE_FOLDER), run, on_row)
         meta = {
-            "tracker": tracker,
-            "dataroot": str(data.location.dataroot),
-            "version": data.location.version,
-            "split": data.split,
-            "scenes": list(data.scene_names),
-            "detections": str(data.detections) if data.detections else None,
-            "detector": None if data.detections else data.detector,
-            "seed": seed,
-            "params": str(params) if params else None,
+            **identity(plan, params),
             "keys": list(plan.keys),
             "one_at_a_time": plan.one_at_a_time,
             "base_values": plan.base_values,
@@ -198,9 +182,10 @@ def register(app: typer.Typer) -> None:
         }
         rows = outcome.rows
         if rows:
-            write_results(out, plan.keys, rows, meta)
+            write_results(folder, plan.keys, rows, meta)
             title = f"{tracker} on {data.split} ({len(data.scene_names)} scenes, {meta['detector'] or 'file'})"
-            plot_sweep(out, plan.keys, rows, plan.base_values, plan.one_at_a_time, title)
+            plot_sweep(folder, plan.keys, rows, plan.base_values, plan.one_at_a_time, title)
+            drop_stale_plots(folder, plan.keys)
             console = stdout_console()
             console.print(best_table(best_rows(rows, top), plan.keys, f"best of {len(rows)} configurations"))
         ran = len(rows) - outcome.from_cache
@@ -210,10 +195,8 @@ def register(app: typer.Typer) -> None:
             f"best AMOTA {'-' if best is None else f'{best:.3f}'} -> {out}"
         )
         if outcome.interrupted:
-            print(
-                f"interrupted: {n - len(rows)} configurations left; run the same command again to resume",
-                file=sys.stderr,
-            )
+            left = f"{n - len(rows)} configurations left; run the same command again to resume"
+            announce_stop(left)
             raise typer.Exit(130)
 
     @app.command()
@@ -240,15 +223,19 @@ def register(app: typer.Typer) -> None:
         ] = None,
         detections: DetectionsOption = None,
         detector: DetectorOption = None,
-        seed: Annotated[int, typer.Option(metavar="N", help="Seed of the simulated detector and the sampler.")] = 0,
+        seed: Annotated[
+            int, typer.Option(metavar="N", min=0, help="Seed of the simulated detector and the sampler (0 or more).")
+        ] = 0,
         params: ParamsOption = None,
         workers: WorkersOption = None,
         address: AddressOption = None,
         progress: ProgressOption = True,
+        verbose: VerboseOption = False,
     ) -> None:
         """Search per-class parameters (Optuna TPE on Ray Tune) and write the best as a --params TOML."""
         from gnnpmb.data.nuscenes import resolve_dataroot
         from gnnpmb.data.simdet_presets import detector_choice
+        from gnnpmb.outputs import check_output_file
         from gnnpmb.registry import check_tracker
         from gnnpmb.study.data import resolve_study_data
         from gnnpmb.study.grid import config_toml
@@ -257,7 +244,7 @@ def register(app: typer.Typer) -> None:
         from gnnpmb.types import TRACKING_CLASSES
 
         check_tracker(tracker)
-        check_out_file(out)
+        target = check_output_file(out, "--out", inputs=(("--detections", detections), ("--params", params)))
         preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
         base = base_params(params)
         class_names = TRACKING_CLASSES if classes is None else tuple(c.strip() for c in classes.split(",") if c)
@@ -268,29 +255,28 @@ def register(app: typer.Typer) -> None:
         check_space(dims, base)
         if trials < 1:
             raise GnnpmbError(f"--trials must be at least 1, got {trials}")
-        run = execution(workers, address)
+        run = execution(workers, address, verbose)
         # the demo generates its train scenes only when asked for them; tuning defaults to a train split
         location = resolve_dataroot(dataroot, version, (split or "mini_train",))
         data = resolve_study_data(location, split or train_split(location.version), detections, preset, seed)
         seen: list[float] = []
-        with _progress(progress, trials, "trials") as bar:
+        with session(run), _progress(progress, trials, "trials") as bar:  # the bar once Ray is up
 
             def on_trial(trial: Any) -> None:
                 if trial.row.get("amota") is not None:
                     seen.append(trial.row["amota"])
                 bar.update(bar.task_ids[0], advance=1, description=_best_label("trials", max(seen, default=None)))
 
-            with session(run):
-                result = run_tune(tracker, data, base, dims, trials, seed, run, on_trial)
+            result = run_tune(tracker, data, base, dims, trials, seed, run, on_trial)
         final = result.final_row
         header = _provenance(tracker, data, dims, trials, seed, run, result, params)
-        write_params(out, config_toml(base, result.best), header)
+        write_params(target, config_toml(base, result.best), header)
         _print_tune(stdout_console(), result, class_names, dims)
         typer.echo(
             f"tune: {len(result.trials)} trials on {data.split}, combined AMOTA {_metric(final['amota'])} -> {out}"
         )
         if result.interrupted:
-            print("interrupted: wrote the best of the finished trials", file=sys.stderr)
+            announce_stop("wrote the best of the finished trials")
             raise typer.Exit(130)
 
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -520,7 +521,10 @@ def config_from_dict(data: Mapping[str, Any], base: TrackerConfig | None = None)
             raise ConfigError(f"unknown section [{key}] (known: classes, {', '.join(_SECTIONS)})")
     out = cfg.replace(**changes)
     for name in out.class_overrides:
-        out.resolved(name)  # cross-field checks (e.g. confirm_m <= confirm_n) of every class's view
+        try:
+            out.resolved(name)  # cross-field checks (e.g. confirm_m <= confirm_n) of every class's view
+        except ConfigError as exc:  # found in the class's view: name its section, not the shared one
+            raise ConfigError(re.sub(r"^\[\w+\]", f"[classes.{name}]", str(exc))) from None
     return out
 
 

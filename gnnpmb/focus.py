@@ -119,9 +119,11 @@ def resolve_focus(
     if failure is None or failure.frame_index not in frames:
         ids = [i for i in reports[first].ids() if i.startswith(kind + ":")]
         known = f"it has {ids[0]} to {ids[-1]}" if ids else f"it has no {kind.replace('_', ' ')}"
+        window = reports[first].frames
+        same = f" --frames {window[0]}:{window[1]}" if window is not None else ""
         raise GnnpmbError(
             f"--focus {spec}: no such failure of {first} on {scene.name} in the tracked frames ({known}); "
-            f"gnnpmb failures {scene.name} --tracker {first} lists them"
+            f"gnnpmb failures {scene.name} --tracker {first}{same} lists them"
         )
     return _from_failure(failure, first, spec.strip(), scene, estimates, frames)
 

@@ -152,6 +152,11 @@ def frame_range_of(bounds: tuple[int | None, int | None], scene: SceneData) -> r
     return range(start, end)
 
 
+def evaluated_keyframes(frame_range: range, scene: SceneData) -> range | None:
+    """The keyframes failures are found in: those tracked (``--frames``), None when that is the whole scene."""
+    return None if len(frame_range) == len(scene.keyframes) else frame_range
+
+
 def parse_classes(text: str | None) -> tuple[str, ...]:
     """``car,bus`` -> ("car", "bus"), checked; None -> all seven tracking classes."""
     if text is None:
@@ -203,7 +208,8 @@ def prepare(
     names = tuple(dict.fromkeys(check_tracker(t) for t in (trackers or [DEFAULT_TRACKER])))
     class_names = parse_classes(classes)
     bounds = parse_frames(frames)
-    target = check_output_file(save, "--save", ".rrd") if save is not None else None
+    inputs = (("--detections", detections_file), ("--params", params))
+    target = check_output_file(save, "--save", ".rrd", inputs=inputs) if save is not None else None
     if serve is not None:
         check_serve_ports(serve)
     if focus is not None:
@@ -386,9 +392,9 @@ def compare_runs(runs: Sequence[TrackingRun]) -> Comparison:
 def find_reports(
     request: ViewRequest, runs: Sequence[TrackingRun], on_done: Callable[[], None] = lambda: None
 ) -> tuple[dict[str, FailureReport], list[str]]:
-    """Each run's failures found with the devkit's matching (or stored from an earlier run of the same tracks,
-    ``eval.failure_cache``), and notices: a scene without ground truth, or one the devkit cannot evaluate, gives
-    no reports."""
+    """Each run's failures found with the devkit's matching in the tracked keyframes (or stored from an earlier
+    run of the same tracks, ``eval.failure_cache``), and notices: a scene without ground truth, or one the
+    devkit cannot evaluate, gives no reports."""
     from gnnpmb.eval.failure_cache import scene_report
     from gnnpmb.eval.submission import run_results
 
@@ -396,9 +402,10 @@ def find_reports(
     if not any(len(k.gt) for k in scene.keyframes):
         return {}, [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
     reports = {}
+    keyframes = evaluated_keyframes(request.frame_range, scene)
     for run in runs:
         try:
-            reports[run.tracker] = scene_report(request.location, scene.name, run.tracker, run_results(run))
+            reports[run.tracker] = scene_report(request.location, scene.name, run.tracker, run_results(run), keyframes)
         except DataError as exc:
             return {}, [f"failure markers skipped: {exc}"]
         on_done()

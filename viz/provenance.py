@@ -9,6 +9,7 @@ main fields (command, versions, data source, detections, seed, frames, classes, 
 from __future__ import annotations
 
 import shlex
+import warnings
 from pathlib import Path
 
 import rerun as rr
@@ -48,12 +49,16 @@ def log_provenance(stream: rr.RecordingStream, provenance: Provenance) -> None:
 def read_provenance(path: Path) -> Provenance:
     """The provenance stored in the saved recording ``path``; a DataError says why there is none."""
     from rerun.chunk import RrdReader
+    from rerun.error_utils import RerunWarning
 
     path = Path(path)
     if not path.is_file():
         raise DataError(f"recording {path} does not exist")
     try:
-        chunks = RrdReader(path).store().stream().filter(content=PROPERTY_ENTITY, is_static=True)
+        with warnings.catch_warnings():  # e.g. "no footer" before the error of a truncated file
+            warnings.simplefilter("ignore", RerunWarning)
+            store = RrdReader(path).store()
+        chunks = store.stream().filter(content=PROPERTY_ENTITY, is_static=True)
         texts = [
             value
             for chunk in chunks

@@ -1,8 +1,10 @@
 """Opening and closing the Rerun recording: a spawned viewer, or an ``.rrd`` file written atomically.
 
-A saved recording streams into a hidden temp file next to the target; ``close_recording`` finalises it
-(``disconnect`` writes the footer) and renames it into place, and ``abort_recording`` deletes it, so an error
-midway never leaves a half-written ``.rrd``. ``recording(...)`` wraps both in a context manager.
+A saved recording streams into a hidden temp file next to the target (named as ``gnnpmb.atomic`` names them, so
+the leftover of a killed run is swept by the next one); ``close_recording`` finalises it (``disconnect`` writes
+the footer) and renames it into place with the one output file mode, and ``abort_recording`` deletes it, so an
+error midway never leaves a half-written ``.rrd``. A live viewer is started and checked by ``viz.viewer``, and
+checked again before the recording counts as sent. ``recording(...)`` wraps both in a context manager.
 """
 
 from __future__ import annotations
@@ -16,7 +18,9 @@ from pathlib import Path
 import rerun as rr
 import rerun.blueprint as rrb
 
+from gnnpmb.atomic import finish, sweep_leftovers, temp_prefix
 from gnnpmb.errors import DataError
+from viz.viewer import Viewer, ViewerError, check_alive, start_viewer
 
 APPLICATION_ID = "gnnpmb-viz"
 BATCHER = rr.ChunkBatcherConfig(flush_tick=1.0, flush_num_bytes=8 * 1024 * 1024)
@@ -30,6 +34,8 @@ FLUSH_STALL_S = 5.0
 died (disk full), Rerun 0.41's flush, and its disconnect, can wait forever."""
 _PENDING: dict[str, Path] = {}
 """Recording id -> the temp file a saved recording is being written to."""
+_VIEWERS: dict[str, Viewer] = {}
+"""Recording id -> the native viewer a live recording streams to."""
 
 
 def check_save_path(save: Path) -> Path:
@@ -62,9 +68,12 @@ def open_recording(
     stream.set_log_time_enabled(False)
     stream.send_recording_name(name)
     if target is None:
-        stream.spawn(default_blueprint=blueprint)
+        viewer = start_viewer()
+        stream.connect_grpc(viewer.url, default_blueprint=blueprint)
+        _VIEWERS[stream.get_recording_id()] = viewer
         return stream
-    tmp = target.parent / f".{target.name}.{uuid.uuid4().hex[:12]}.partial"
+    sweep_leftovers(target.parent)
+    tmp = target.parent / f"{temp_prefix(target)}{uuid.uuid4().hex[:12]}.partial"
     _PENDING[stream.get_recording_id()] = tmp
     try:
         stream.save(tmp, default_blueprint=blueprint)
@@ -76,10 +85,18 @@ def open_recording(
 
 def _flush(stream: rr.RecordingStream, tmp: Path | None) -> None:
     """``stream.flush()``, in 1 s steps while ``tmp`` (the file being written, if any) keeps growing; a
-    RuntimeError once it stalls for ``FLUSH_STALL_S``."""
+    RuntimeError once it stalls for ``FLUSH_STALL_S``. A live recording flushes while its viewer runs (a
+    ViewerError once it has exited)."""
     if tmp is None:
-        stream.flush()
-        return
+        viewer = _VIEWERS.get(stream.get_recording_id())
+        if viewer is None:
+            stream.flush()
+            return
+        while True:
+            check_alive(viewer)
+            with contextlib.suppress(RuntimeError):  # not yet sent: ask the viewer again
+                stream.flush(timeout_sec=1.0)
+                return
     last_size, stalled_s = -1, 0.0
     while True:
         try:
@@ -98,6 +115,9 @@ def close_recording(stream: rr.RecordingStream, save: Path | None) -> None:
     tmp = _PENDING.get(stream.get_recording_id())
     _flush(stream, tmp)
     stream.disconnect()
+    viewer = _VIEWERS.pop(stream.get_recording_id(), None)
+    if viewer is not None:
+        check_alive(viewer)
     if save is None:
         if tmp is not None:
             tmp.unlink(missing_ok=True)
@@ -105,7 +125,7 @@ def close_recording(stream: rr.RecordingStream, save: Path | None) -> None:
         return
     if tmp is None:
         raise ValueError("close_recording(save=...) on a stream that open_recording did not open for saving")
-    os.replace(tmp, check_save_path(save))
+    finish(tmp, check_save_path(save))
     _PENDING.pop(stream.get_recording_id(), None)
 
 
@@ -116,12 +136,16 @@ def abort_recording(stream: rr.RecordingStream) -> None:
 
 def _forget(stream: rr.RecordingStream) -> None:
     """Delete a saved recording's temp file without touching the stream."""
+    _VIEWERS.pop(stream.get_recording_id(), None)
     tmp = _PENDING.pop(stream.get_recording_id(), None)
     if tmp is not None:
         tmp.unlink(missing_ok=True)
 
 
 def _discard(stream: rr.RecordingStream) -> None:
+    viewer = _VIEWERS.pop(stream.get_recording_id(), None)
+    if viewer is not None and not viewer.alive():
+        return  # with its viewer gone, disconnect can wait forever
     try:
         stream.disconnect()
     finally:
@@ -144,6 +168,9 @@ def recording(
         raise
     try:
         close_recording(stream, save)
+    except ViewerError:
+        _forget(stream)  # no disconnect: with its viewer gone it can wait forever
+        raise
     except RuntimeError as exc:  # Rerun's file writer failed, e.g. "File-writer thread shut down prematurely"
         _forget(stream)  # no disconnect: with a dead file writer it can wait forever
         raise DataError(

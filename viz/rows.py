@@ -207,6 +207,15 @@ class RowBuffer:
             send_entities(self.stream, self.clock, archetype, entities)
 
 
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def _float32(values: Any) -> np.ndarray:
+    """``values`` as float32, clipped to float32's range (a gate of ``gate_chi2 = 1e308`` is drawn at the
+    largest float32 instead of overflowing to infinity with a numpy warning)."""
+    return np.clip(np.asarray(values, dtype=np.float64), -_FLOAT32_MAX, _FLOAT32_MAX).astype(np.float32)
+
+
 def _strips_array(strips: list[Any] | np.ndarray) -> pa.Array:
     """The Arrow ``LineStrip3D`` array of ``strips`` (each a (k_i, 3) array or list of points; an (n, k, 3) array
     counts as n strips), built from one concatenated point array: Rerun's own conversion handles strips one at a
@@ -214,9 +223,9 @@ def _strips_array(strips: list[Any] | np.ndarray) -> pa.Array:
     if isinstance(strips, np.ndarray) and strips.ndim == 3:  # N strips of k points each
         n, k = strips.shape[:2]
         offsets = np.arange(0, (n + 1) * k, k, dtype=np.int32)
-        points = np.asarray(strips, dtype=np.float32).reshape(-1, 3)
+        points = _float32(strips).reshape(-1, 3)
     else:
-        strips = [np.asarray(strip, dtype=np.float32).reshape(-1, 3) for strip in strips]
+        strips = [_float32(strip).reshape(-1, 3) for strip in strips]
         lengths = np.fromiter((s.shape[0] for s in strips), dtype=np.int32, count=len(strips))
         offsets = np.zeros(len(strips) + 1, dtype=np.int32)
         np.cumsum(lengths, out=offsets[1:])

@@ -53,6 +53,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gnnpmb.atomic import sweep_leftovers, temp_prefix
 from gnnpmb.data.demo_spec import SYNTHETIC_MARKER, Motion, ObjectSpec, SceneSpec, Segment
 from gnnpmb.data.demo_staged import (
     HOTSPOT_FRAMES,
@@ -763,11 +764,12 @@ def generate_demo_dataset(
             "demo; choose a new or empty folder"
         )
     out_dir.parent.mkdir(parents=True, exist_ok=True)
-    build = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.build-", dir=out_dir.parent))
+    sweep_leftovers(out_dir.parent)  # builds of killed runs
+    build = Path(tempfile.mkdtemp(prefix=temp_prefix(out_dir, "build"), dir=out_dir.parent))
     try:
         _write_dataset(build / "data", seed, check_demo_scenes(tuple(scenes)))
         if out_dir.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.old-", dir=out_dir.parent))
+            old = Path(tempfile.mkdtemp(prefix=temp_prefix(out_dir, "old"), dir=out_dir.parent))
             os.replace(out_dir, old / "data")
             os.replace(build / "data", out_dir)
             shutil.rmtree(old, ignore_errors=True)
@@ -812,6 +814,7 @@ def ensure_demo_dataset(needs: tuple[str, ...] = (), *, rebuild: bool = False) -
     """The dataroot of the cached demo (seed ``DEMO_SEED``) for ``needs`` (``demo_layout``), generated on first
     use, so the default val demo stays quick to build; ``rebuild`` generates it again (a damaged cache)."""
     dataroot, scenes = demo_layout(needs)
+    sweep_leftovers(dataroot.parent)  # builds of killed runs
     if not rebuild and is_demo_dataroot(dataroot, DEMO_SEED, scenes):
         return dataroot
     try:

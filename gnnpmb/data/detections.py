@@ -17,9 +17,7 @@ reported only when a sample that contains it is requested.
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -274,14 +272,7 @@ def load_detection_file(path: Path, sample_tokens: Sequence[str], scene_name: st
 
 
 def write_detection_file(path: Path, submission: dict[str, Any]) -> None:
-    """Write a detection submission as JSON, atomically (temporary file in the same folder, then rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(json.dumps(submission, allow_nan=False, separators=(",", ":")))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """Write a detection submission as JSON, atomically (``gnnpmb.atomic``)."""
+    from gnnpmb.atomic import write_text
+
+    write_text(Path(path), json.dumps(submission, allow_nan=False, separators=(",", ":")))

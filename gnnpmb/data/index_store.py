@@ -25,6 +25,8 @@ from typing import Any
 
 import pyarrow as pa
 
+from gnnpmb.atomic import sweep_leftovers, temp_prefix
+
 MANIFEST = "manifest.json"
 NOTE_MIN_BYTES = 50_000_000
 """Sources from this size on take seconds to index: say so even when stderr is not a terminal."""
@@ -138,11 +140,12 @@ def open_or_build(folder: Path, fmt: int, sources: list[list[Any]], build: Calla
         store = open_store(folder, fmt, sources)
         if store is not None:
             return store
-        tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.build-", dir=folder.parent))
+        sweep_leftovers(folder.parent)  # builds of killed runs (gnnpmb.atomic)
+        tmp = Path(tempfile.mkdtemp(prefix=temp_prefix(folder, "build"), dir=folder.parent))
         try:
             build(tmp)
             if folder.exists():
-                old = Path(tempfile.mkdtemp(prefix=f".{folder.name}.old-", dir=folder.parent))
+                old = Path(tempfile.mkdtemp(prefix=temp_prefix(folder, "old"), dir=folder.parent))
                 os.replace(folder, old / "index")
                 shutil.rmtree(old, ignore_errors=True)
             os.replace(tmp, folder)

@@ -19,6 +19,7 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from gnnpmb.errors import DataError
 from gnnpmb.eval.failures import FailureReport
 from gnnpmb.study.cache import ResultCache
 
@@ -31,9 +32,14 @@ MAX_REPORTS = 500
 
 
 def report_key(
-    location: DatasetLocation, scene_name: str, tracker: str, results: Mapping[str, Sequence[Mapping[str, Any]]]
+    location: DatasetLocation,
+    scene_name: str,
+    tracker: str,
+    results: Mapping[str, Sequence[Mapping[str, Any]]],
+    keyframes: range | None = None,
 ) -> str:
-    """Cache key (hex SHA-256) of the failure report of ``results`` (submission boxes by sample token)."""
+    """Cache key (hex SHA-256) of the failure report of ``results`` (submission boxes by sample token), evaluated
+    on ``keyframes`` only (None: the whole scene)."""
     from gnnpmb.provenance import code_version, tables_fingerprint
 
     blob = {
@@ -45,6 +51,8 @@ def report_key(
         "results": results,
         "code": code_version(),
     }
+    if keyframes is not None:
+        blob["keyframes"] = [keyframes.start, keyframes.stop]
     return hashlib.sha256(json.dumps(blob, sort_keys=True, allow_nan=True).encode()).hexdigest()
 
 
@@ -55,10 +63,12 @@ def cached_report(
     tracker: str,
     results: Mapping[str, Sequence[Mapping[str, Any]]],
     find: Callable[[], FailureReport],
+    keyframes: range | None = None,
 ) -> FailureReport:
-    """The stored report for these inputs, else ``find()``'s, stored under ``root/failures``."""
+    """The stored report for these inputs (evaluated on ``keyframes``, None: all), else ``find()``'s, stored under
+    ``root/failures``."""
     cache = ResultCache(root / FAILURES_FOLDER)
-    key = report_key(location, scene_name, tracker, results)
+    key = report_key(location, scene_name, tracker, results, keyframes)
     stored = cache.get(key)
     if stored is not None:
         try:
@@ -66,17 +76,21 @@ def cached_report(
         except (KeyError, TypeError, ValueError):
             pass  # written by an incompatible version: evaluate again and overwrite
     report = find()
-    with contextlib.suppress(OSError):  # a read-only or full cache only costs the next run the evaluation
+    with contextlib.suppress(OSError, DataError):  # a read-only or full cache only costs the next run the evaluation
         cache.put(key, report.to_json())
         _drop_oldest(root / FAILURES_FOLDER, MAX_REPORTS)
     return report
 
 
 def scene_report(
-    location: DatasetLocation, scene_name: str, tracker: str, results: Mapping[str, Sequence[Mapping[str, Any]]]
+    location: DatasetLocation,
+    scene_name: str,
+    tracker: str,
+    results: Mapping[str, Sequence[Mapping[str, Any]]],
+    keyframes: range | None = None,
 ) -> FailureReport:
-    """The failure report of one scene's tracking results: stored, else found by the devkit's evaluation on a
-    version folder holding only that scene (``gnnpmb.eval.subset``)."""
+    """The failure report of one scene's tracking results (on ``keyframes`` only, None: all): stored, else found by
+    the devkit's evaluation on a version folder holding only that scene (``gnnpmb.eval.subset``)."""
     from gnnpmb.data.demo import cache_root
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.failures import find_failures
@@ -84,9 +98,9 @@ def scene_report(
 
     def find() -> FailureReport:
         nusc = open_nuscenes(eval_location(location, [scene_name]))
-        return find_failures(nusc, scene_name, results, tracker)
+        return find_failures(nusc, scene_name, results, tracker, keyframes=keyframes)
 
-    return cached_report(cache_root(), location, scene_name, tracker, results, find)
+    return cached_report(cache_root(), location, scene_name, tracker, results, find, keyframes)
 
 
 def _drop_oldest(folder: Path, keep: int) -> None:

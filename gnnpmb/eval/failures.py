@@ -216,7 +216,10 @@ class FailureReport:
     classes (those with ground truth in the scene after the devkit's filters); track_scores: tracking id -> the
     score the evaluation compared with its class's threshold, the devkit's average of the track's box scores
     (after its range filter), the same at every frame of the track; gt_frames: instance token -> frame -> how the
-    evaluation saw the object there, track_evals: tracking id -> how it saw the track (``eval.evaluated``)."""
+    evaluation saw the object there, track_evals: tracking id -> how it saw the track (``eval.evaluated``);
+    frames: the keyframes (start, end exclusive) evaluated when only those were tracked (``--frames``), None for
+    the whole scene; failure frame indices are always the scene's keyframe indices, and ids number the failures
+    of the evaluated keyframes."""
 
     scene_name: str
     tracker: str
@@ -227,6 +230,7 @@ class FailureReport:
     track_scores: Mapping[str, float] = field(default_factory=dict)
     gt_frames: Mapping[str, Mapping[int, GtFrame]] = field(default_factory=dict)
     track_evals: Mapping[str, TrackEval] = field(default_factory=dict)
+    frames: tuple[int, int] | None = None
 
     def gt_frame(self, gt_id: str, frame: int) -> GtFrame | None:
         """How the evaluation saw object ``gt_id`` at ``frame`` (None: not annotated there)."""
@@ -252,6 +256,13 @@ class FailureReport:
     def totals_text(self) -> str:
         """E.g. "3 id_switch, 4 fragmentation, 38 false_track, 27 miss, 0 coalescence, 1 identity_theft"."""
         return ", ".join(f"{len(self.of_kind(k))} {k.value}" for k in FailureKind)
+
+    def scope_text(self) -> str:
+        """What was evaluated: "" for the whole scene, else e.g. " in keyframes 0:6 (only those were tracked and
+        evaluated)"."""
+        if self.frames is None:
+            return ""
+        return f" in keyframes {self.frames[0]}:{self.frames[1]} (only those were tracked and evaluated)"
 
     def first_worth_opening(self) -> str | None:
         """The id of the first failure of the first kind in ``OPEN_FIRST`` that occurred, preferring failures
@@ -295,6 +306,7 @@ class FailureReport:
             "track_scores": dict(self.track_scores),
             "gt_frames": {g: [v.to_json() for v in frames.values()] for g, frames in self.gt_frames.items()},
             "track_evals": {t: v.to_json() for t, v in self.track_evals.items()},
+            "frames": None if self.frames is None else list(self.frames),
             "failures": [f.to_json() for f in self.failures],
         }
 
@@ -322,6 +334,7 @@ class FailureReport:
                 for g, rows in data.get("gt_frames", {}).items()
             },
             track_evals={str(t): TrackEval.from_json(v) for t, v in data.get("track_evals", {}).items()},
+            frames=None if data.get("frames") is None else (int(data["frames"][0]), int(data["frames"][1])),
         )
 
 
@@ -573,11 +586,13 @@ def find_failures(
     results: Mapping[str, Sequence[Mapping[str, Any]]],
     tracker: str,
     coalescence_radius_m: float = COALESCENCE_RADIUS_M,
+    keyframes: range | None = None,
 ) -> FailureReport:
     """Evaluate one scene of a tracking submission with the devkit and list its failures.
 
     results: submission boxes keyed by sample token (``submission.run_results``); samples of the scene without
-    an entry count as empty. Failures are sorted by frame, then kind, class and ids.
+    an entry count as empty. keyframes: evaluate only these (those a ``--frames`` run tracked), as if the
+    scene held no others; None or the whole scene: all. Failures are sorted by frame, then kind, class and ids.
     """
     from nuscenes.eval.common.data_classes import EvalBoxes
     from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
@@ -586,20 +601,24 @@ def find_failures(
     from nuscenes.eval.tracking.loaders import create_tracks
 
     tokens = scene_sample_tokens(nusc, scene_name)
+    window = range(len(tokens))
+    if keyframes is not None:
+        window = range(max(keyframes.start, 0), min(keyframes.stop, len(tokens)))
+    evaluated = tokens[window.start : window.stop]
     frame_of_timestamp = {nusc.get("sample", t)["timestamp"]: i for i, t in enumerate(tokens)}
     split = _split_with_scene(nusc, scene_name)
     cfg = tracking_config()
     with quiet_devkit():
         try:
-            pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in tokens}, TrackingBox)
+            pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in evaluated}, TrackingBox)
         except (AssertionError, KeyError, TypeError, ValueError) as exc:
             raise DataError(f"the tracking results of {scene_name} are not valid submission boxes: {exc}") from None
-        gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
+        gt = load_gt_of_sample_tokens(nusc, evaluated, TrackingBox, verbose=False)
         raw_gt, prepared_gt, kept_gt = _prepared(nusc, gt, cfg)
         _, prepared_pred, kept_pred = _prepared(nusc, pred, cfg)
         tracks_gt = create_tracks(prepared_gt, nusc, split, gt=True)
         tracks_pred = create_tracks(prepared_pred, nusc, split, gt=False)
-        scene_token = nusc.get("sample", tokens[0])["scene_token"]
+        scene_token = nusc.get("sample", evaluated[0])["scene_token"]
         classes: list[ClassEvaluation] = []
         failures: list[Failure] = []
         for class_name in cfg.class_names:
@@ -640,6 +659,7 @@ def find_failures(
     track_scores = {
         str(b.tracking_id): float(b.tracking_score) for boxes in tracks_pred[scene_token].values() for b in boxes
     }
+    whole = len(window) == len(tokens)
     return FailureReport(
         scene_name,
         tracker,
@@ -650,4 +670,5 @@ def find_failures(
         track_scores,
         gt_frames(raw_gt, kept_gt, tracks_gt[scene_token], frame_of_timestamp, tokens, cfg.class_range),
         track_evals(results, kept_pred, tracks_pred[scene_token], track_scores, frame_of_timestamp, tokens),
+        None if whole else (window.start, window.stop),
     )

@@ -14,7 +14,6 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-import os
 import shutil
 import tempfile
 import warnings
@@ -23,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from gnnpmb.atomic import finish
 from gnnpmb.errors import DataError
 from gnnpmb.eval.submission import check_submission, read_submission
 
@@ -184,7 +184,7 @@ def run_tracking_eval(results_path: Path, dataroot: Path, version: str, split: s
                 raise DataError(f"the nuScenes evaluation rejected {Path(results_path).name}: {exc}") from None
         out_dir.mkdir(parents=True, exist_ok=True)
         for name in DEVKIT_FILES:
-            os.replace(tmp / name, out_dir / name)
+            finish(tmp / name, out_dir / name)  # the one output file mode (gnnpmb.atomic)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     return TrackingScores.from_summary(summary, out_dir / DEVKIT_FILES[0])

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from collections.abc import Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -143,36 +141,19 @@ def build_submission(
 
 
 def write_json(path: Path, data: Any) -> None:
-    """Write ``data`` as JSON atomically: a temporary file in the same folder, then ``os.replace``.
+    """Write ``data`` as JSON atomically (``gnnpmb.atomic``: a temporary file in the same folder, then
+    ``os.replace``, with the one output file mode).
 
-    NaN or infinite numbers are refused (they are not JSON); nothing is left behind on failure. The file gets
-    the mode a plain ``open`` would give (0666 minus the umask); a symlink at ``path`` is kept and its target
-    written.
+    NaN or infinite numbers are refused (they are not JSON); nothing is left behind on failure. A symlink at
+    ``path`` is kept and its target written.
     """
-    path = Path(path)
-    if path.is_symlink():
-        path = path.resolve()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    from gnnpmb.atomic import write_text
+
+    text = json.dumps(data, allow_nan=False, separators=(",", ":"))  # the C encoder; json.dump is pure Python
     try:
-        os.fchmod(fd, _new_file_mode())
-        text = json.dumps(data, allow_nan=False, separators=(",", ":"))  # the C encoder; json.dump is pure Python
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
+        write_text(Path(path), text)
     except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
         raise DataError(f"cannot write {path}: {exc.strerror or exc}; free space or write elsewhere") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _new_file_mode() -> int:
-    """0o666 minus the process umask (``mkstemp`` alone gives 0o600)."""
-    umask = os.umask(0o022)
-    os.umask(umask)
-    return 0o666 & ~umask
 
 
 def write_submission(path: Path, submission: Mapping[str, Any]) -> None:

@@ -26,6 +26,7 @@ from typing import Any
 
 import pyarrow as pa
 
+from gnnpmb.atomic import sweep_leftovers, temp_prefix
 from gnnpmb.data.dataset_index import SMALL_TABLES, DatasetIndex, SceneSlice
 from gnnpmb.data.nuscenes import DatasetLocation, dataset_index
 
@@ -63,7 +64,8 @@ def _complete(folder: Path) -> bool:
 
 def _write(folder: Path, version: str, tables: dict[str, list[dict[str, Any]]], custom: bytes) -> None:
     folder.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=folder.parent))
+    sweep_leftovers(folder.parent)  # folders of killed runs (gnnpmb.atomic)
+    tmp = Path(tempfile.mkdtemp(prefix=temp_prefix(folder, "build"), dir=folder.parent))
     try:
         (tmp / version).mkdir()
         for name, rows in tables.items():

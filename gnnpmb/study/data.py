@@ -145,14 +145,16 @@ def run_inputs(
     seed: int,
     sink: EventSink | None = None,
     on_frame: Callable[[], None] | None = None,
+    frame_range: range | None = None,
 ) -> TrackingRun:
-    """Track every keyframe of one scene (all 7 classes), the tracker's events to ``sink``."""
+    """Track every keyframe of one scene (all 7 classes; ``frame_range``: only those), the tracker's events to
+    ``sink``."""
     from gnnpmb.pipeline import get_detections, run_tracker
 
     detections = inputs.detections
     if detections is None:
         detections = get_detections(inputs.scene, None, detector, seed)
-    return run_tracker(inputs.scene, detections, tracker, config, sink=sink, on_frame=on_frame)
+    return run_tracker(inputs.scene, detections, tracker, config, sink=sink, on_frame=on_frame, frame_range=frame_range)
 
 
 def track_inputs(

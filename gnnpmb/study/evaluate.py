@@ -48,6 +48,20 @@ def _number(value: float, count: bool = False) -> float | int | None:
     return int(round(value)) if count else float(value)
 
 
+TIME_COLUMNS: tuple[str, ...] = ("wall_time_s", "track_time_s", "eval_time_s")
+"""Seconds a configuration took: in all, tracking, evaluating."""
+
+
+def is_complete_row(row: Any) -> bool:
+    """Whether ``row`` (e.g. read back from a study's cache) has every metric ``score_config`` writes, each a
+    number or None (an entry written by another version, or edited, is not: it is scored again)."""
+    if not isinstance(row, dict):
+        return False
+    names = [*OVERALL_METRICS, *(class_column(c) for c in TRACKING_CLASSES), *TIME_COLUMNS]
+    values = [row.get(n, row) for n in names]  # a missing name gives the row itself: not a number
+    return all(v is None or (isinstance(v, int | float) and not isinstance(v, bool)) for v in values)
+
+
 def _empty_row(track_s: float, wall_s: float) -> dict[str, Any]:
     """The row of a configuration that tracked nothing: the devkit refuses an empty submission, and with no
     output every recall threshold is unreached, so AMOTA is 0 and TP = FP = IDS = FRAG = 0; the other metrics

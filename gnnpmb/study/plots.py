@@ -8,8 +8,6 @@ else on a categorical one.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -41,8 +39,10 @@ def series(
                 continue
             value = base_value if value is None else value
             points[value] = score
-        else:
-            value = row[key]
+        else:  # a row of a table that grew by another grid leaves this key at its base value (empty cell)
+            value = base_value if row.get(key) is None else row[key]
+            if value is None:
+                continue
             points[value] = max(score, points.get(value, score))
     try:
         return sorted(points.items())
@@ -61,14 +61,10 @@ def _numeric(values: Sequence[Any]) -> bool:
 
 
 def _save(fig: Any, path: Path) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
+    from gnnpmb.atomic import atomic_path
+
+    with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, dpi=110)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def plot_file_name(key: str) -> str:

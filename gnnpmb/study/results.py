@@ -4,36 +4,19 @@ from __future__ import annotations
 
 import csv
 import io
-import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from gnnpmb.atomic import write_text
 from gnnpmb.eval.submission import write_json
-from gnnpmb.study.evaluate import OVERALL_METRICS, class_column
+from gnnpmb.study.evaluate import OVERALL_METRICS, TIME_COLUMNS, class_column
 from gnnpmb.types import TRACKING_CLASSES
-
-TIME_COLUMNS: tuple[str, ...] = ("wall_time_s", "track_time_s", "eval_time_s")
 
 
 def columns(keys: Sequence[str]) -> list[str]:
     """Column order: config index and id, the swept keys, the overall metrics, AMOTA per class, times."""
     return ["config", "id", *keys, *OVERALL_METRICS, *(class_column(c) for c in TRACKING_CLASSES), *TIME_COLUMNS]
-
-
-def write_text(path: Path, text: str) -> None:
-    """Write text atomically: a temporary file in the same folder, then ``os.replace``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def write_results(out_dir: Path, keys: Sequence[str], rows: Sequence[dict[str, Any]], meta: dict[str, Any]) -> None:

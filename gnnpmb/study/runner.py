@@ -2,9 +2,11 @@
 
 Ray runs locally by default (``ray.init(num_cpus=workers)``, no dashboard, quiet logs); with an address (or
 ``RAY_ADDRESS``) it joins an existing cluster, and ``workers`` caps how many tasks are in flight. An address
-that does not accept a TCP connection within ``CONNECT_TIMEOUT_S`` is refused before Ray is asked (Ray itself
-retries an unreachable GCS for minutes). Results are yielded as tasks finish; Ctrl-C cancels the tasks still
-running and re-raises, so the caller keeps whatever already finished.
+that does not answer like a Ray head within ``connect.PROBE_TIMEOUT_S`` is refused before Ray is asked (Ray
+itself retries an unreachable head for minutes), and joining is bounded by ``connect.JOIN_DEADLINE_S``; Ray's
+own log lines stay out of the terminal unless ``verbose`` (``connect``). Results are yielded as tasks finish;
+Ctrl-C (or SIGTERM, ``gnnpmb.signals``) cancels the tasks still running and re-raises, so the caller keeps
+whatever already finished.
 """
 
 from __future__ import annotations
@@ -12,22 +14,24 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-import socket
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, TypeVar
 
+from gnnpmb import signals
 from gnnpmb.errors import GnnpmbError
+from gnnpmb.study.connect import init_within, probe_head, quiet_stderr
 
 T = TypeVar("T")
 R = TypeVar("R")
 
 ADDRESS_ENV = "RAY_ADDRESS"
-CONNECT_TIMEOUT_S = 5.0
 _UV_HOOK_ENV = "RAY_ENABLE_UV_RUN_RUNTIME_ENV"
 _UNCAPPED = 1 << 16
 """Tasks in flight when no cap is given (a cluster): Ray queues what its CPUs cannot start yet."""
+_WAIT_S = 0.5
+"""How long one wait for a finished task lasts before a SIGTERM is looked at."""
 
 
 def import_ray() -> ModuleType:
@@ -45,18 +49,20 @@ def import_ray() -> ModuleType:
 class Execution:
     """How to run: ``workers`` parallel tasks (1 = in this process, no Ray) and an optional cluster address.
 
-    workers None (only with an address): no cap of our own, Ray fills the cluster's CPUs.
+    workers None (only with an address): no cap of our own, Ray fills the cluster's CPUs. verbose: let Ray's
+    own log lines through to the terminal.
     """
 
     workers: int | None
     address: str | None = None
+    verbose: bool = False
 
     @property
     def uses_ray(self) -> bool:
         return self.address is not None or (self.workers or 0) > 1
 
 
-def execution(workers: int | None, address: str | None) -> Execution:
+def execution(workers: int | None, address: str | None, verbose: bool = False) -> Execution:
     """Check ``--workers`` / ``--address`` (falling back to ``RAY_ADDRESS``). Default workers: the CPU count
     locally, no cap on a cluster."""
     address = address or os.environ.get(ADDRESS_ENV) or None
@@ -66,7 +72,7 @@ def execution(workers: int | None, address: str | None) -> Execution:
         check_address(address)
     elif workers is None:
         workers = os.cpu_count() or 1
-    return Execution(workers=workers, address=address)
+    return Execution(workers=workers, address=address, verbose=verbose)
 
 
 def check_address(address: str) -> None:
@@ -78,37 +84,36 @@ def check_address(address: str) -> None:
     host, sep, port = hostport.rpartition(":")
     if not sep or not port.isdigit() or not host:
         raise GnnpmbError(f"Ray address '{address}' must look like HOST:PORT (e.g. 10.0.0.1:6379)")
-    try:
-        with socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT_S):
-            pass
-    except OSError as exc:
-        raise GnnpmbError(
-            f"cannot reach the Ray cluster at {address} ({exc.strerror or type(exc).__name__}); start it with "
-            "'ray start --head' on the head node, or drop --address / RAY_ADDRESS to run locally"
-        ) from None
+    probe_head(address, host, int(port))
 
 
 @contextlib.contextmanager
 def ray_session(run: Execution) -> Iterator[None]:
     """A Ray connection for the duration of the block: reuse one that is already up (tests), else start a
-    local instance with ``run.workers`` CPUs or join ``run.address``; shut down only what was started here."""
+    local instance with ``run.workers`` CPUs or join ``run.address`` (within ``connect.JOIN_DEADLINE_S``); shut
+    down only what was started here. Ray's log lines go to a temporary file unless ``run.verbose``."""
     ray = import_ray()
 
     if ray.is_initialized():
         yield
         return
     quiet = {"include_dashboard": False, "logging_level": logging.ERROR, "log_to_driver": False}
-    if run.address is None:
-        ray.init(num_cpus=run.workers, **quiet)
-    else:
+    with quiet_stderr(run.verbose):
+        if run.address is None:
+            ray.init(num_cpus=run.workers, **quiet)
+        else:
+            try:
+                init_within(ray.init, run.address, **quiet)
+            except (ConnectionError, RuntimeError) as exc:
+                detail = str(exc).splitlines()[0]
+                raise GnnpmbError(f"cannot join the Ray cluster at {run.address}: {detail}") from None
+        signals.reinstall()  # Ray sets its own SIGTERM handler, which exits without cleaning up
         try:
-            ray.init(address=run.address, **quiet)
-        except (ConnectionError, RuntimeError) as exc:
-            raise GnnpmbError(f"cannot join the Ray cluster at {run.address}: {str(exc).splitlines()[0]}") from None
-    try:
-        yield
-    finally:
-        ray.shutdown()
+            yield
+        finally:
+            with signals.deferred():  # a SIGTERM during the shutdown stops the run once it is done
+                ray.shutdown()
+            signals.check()
 
 
 def session(run: Execution) -> contextlib.AbstractContextManager[None]:
@@ -151,7 +156,11 @@ def run_tasks(fn: Callable[[T], R], items: Iterable[T], run: Execution) -> Itera
                 pending[remote.remote(item)] = i
             if not pending:
                 break
-            done, _ = ray.wait(list(pending), num_returns=1)
+            with signals.deferred():  # SIGTERM stops the run here, not inside Ray's wait
+                done, _ = ray.wait(list(pending), num_returns=1, timeout=_WAIT_S)
+            signals.check()
+            if not done:
+                continue
             ref = done[0]
             i = pending.pop(ref)
             try:

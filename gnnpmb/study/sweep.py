@@ -13,7 +13,7 @@ from typing import Any
 from gnnpmb.provenance import code_version
 from gnnpmb.study.cache import ResultCache, config_key
 from gnnpmb.study.data import StudyData, for_scoring, inputs_fingerprint
-from gnnpmb.study.evaluate import ConfigJob, score_config
+from gnnpmb.study.evaluate import ConfigJob, is_complete_row, score_config
 from gnnpmb.study.grid import (
     Assignment,
     Scalar,
@@ -101,7 +101,7 @@ def run_sweep(
     rows: dict[int, dict[str, Any]] = {}
     for i, key in enumerate(keys):
         cached = cache.get(key)
-        if cached is not None:
+        if cached is not None and is_complete_row(cached):  # an incomplete entry is scored again
             rows[i] = {**_row_head(plan, i, key), **cached}
             if on_row is not None:
                 on_row(rows[i], True)

@@ -127,13 +127,18 @@ def scene_failures(
     detector: str,
     seed: int,
     sink: EventSink | None = None,
+    bounds: tuple[int | None, int | None] = (None, None),
 ) -> SceneFailures:
-    """Track one scene (its events to ``sink``) and find its failures (``gnnpmb failures``), the report stored
-    for the next time."""
+    """Track one scene (its events to ``sink``; ``bounds``: only those keyframes, as ``--frames`` gives them) and
+    find its failures (``gnnpmb failures``) in the keyframes tracked, the report stored for the next time."""
     from gnnpmb.eval.failure_cache import scene_report
     from gnnpmb.eval.submission import run_results
+    from gnnpmb.session import evaluated_keyframes, frame_range_of
     from gnnpmb.study.data import scene_study
 
     data = scene_study(location, scene_name, detections, detector, seed)
-    run = run_inputs(load_inputs(data, scene_name), tracker, config, detector, seed, sink=sink)
-    return SceneFailures(run, scene_report(location, scene_name, tracker, run_results(run)))
+    inputs = load_inputs(data, scene_name)
+    frames = frame_range_of(bounds, inputs.scene)
+    run = run_inputs(inputs, tracker, config, detector, seed, sink=sink, frame_range=frames)
+    keyframes = evaluated_keyframes(frames, inputs.scene)
+    return SceneFailures(run, scene_report(location, scene_name, tracker, run_results(run), keyframes))

@@ -43,6 +43,7 @@ def _case(name: str, command: str, expected: str) -> Case:
 
 VIZ = "gnnpmb-viz"
 SAVE = "--save {w}/good.rrd"
+IS_INPUT = "is the --detections file"
 CASES_BEFORE_DATA: tuple[Case, ...] = (
     # usage errors of gnnpmb-viz (typer's bundled click)
     _case("viz typo option", f"{VIZ} scene-0103 --frame 1", "no such option: --frame"),
@@ -94,7 +95,7 @@ CASES_BEFORE_DATA: tuple[Case, ...] = (
     _case("track out missing folder", "gnnpmb track --out {w}/no/r.json", "does not exist"),
     _case(
         "track detections and detector",
-        "gnnpmb track --out {w}/good.json --detections {w}/good.json --detector megvii",
+        "gnnpmb track --out {w}/good.json --detections {w}/trunc.json --detector megvii",
         "not both",
     ),
     _case("track detections folder", "gnnpmb track --out {w}/good.json --detections {w}", "is a folder"),
@@ -114,6 +115,33 @@ CASES_BEFORE_DATA: tuple[Case, ...] = (
     _case("demo-data out device", "gnnpmb demo-data --out /dev/null", "is a file, not a folder"),
     _case("demo-data out not empty", "gnnpmb demo-data --out {w}", "not empty"),
     _case("demo-data seed not int", "gnnpmb demo-data --out {w}/new --seed x", "'--seed'"),
+    # issue 22: negative seeds, outputs that are inputs (however spelled), a parameter under its real section
+    _case("viz seed negative", f"{VIZ} scene-0103 --seed -1 {SAVE}", "'--seed'"),
+    _case("track seed negative", "gnnpmb track --out {w}/good.json --seed -1", "'--seed'"),
+    _case("failures seed negative", "gnnpmb failures scene-0103 --seed -1", "'--seed'"),
+    _case("demo-data seed negative", "gnnpmb demo-data --out {w}/new --seed -1", "'--seed'"),
+    _case("tune seed negative", "gnnpmb tune --out {w}/t.toml --seed -1", "'--seed'"),
+    _case("track out is detections", "gnnpmb track --out {w}/good.json --detections {w}/good.json", IS_INPUT),
+    _case("track out relative", "gnnpmb track --out good.json --detections ./sub/../good.json", IS_INPUT),
+    _case("track out hard link", "gnnpmb track --out {w}/hard.json --detections {w}/good.json", IS_INPUT),
+    _case("track out symlink", "gnnpmb track --out {w}/good.json --detections {w}/link.json", IS_INPUT),
+    _case("track out is params", "gnnpmb track --out {w}/good.json --params {w}/hard.json", "the --params file"),
+    _case(
+        "failures json is detections",
+        "gnnpmb failures scene-0103 --json {w}/link.json --detections {w}/good.json",
+        IS_INPUT,
+    ),
+    _case("viz save is params", f"{VIZ} scene-0103 --params {{w}}/good.rrd {SAVE}", "the --params file"),
+    _case("reproduce save is file", f"{VIZ} reproduce {{w}}/good.rrd {SAVE}", "the FILE.rrd file"),
+    _case("tune out is params", "gnnpmb tune --out {w}/good.toml --params {w}/good.toml", "the --params file"),
+    _case(
+        "sweep writes detections",
+        "gnnpmb sweep --out {w} --param models.gate_chi2=20 --detections {w}/results.json",
+        IS_INPUT,
+    ),
+    _case(
+        "params class section", f"{VIZ} scene-0103 --params {{w}}/confirm.toml {SAVE}", "[classes.car] need confirm_m"
+    ),
 )
 
 
@@ -192,10 +220,14 @@ def _snapshot(folder: Path) -> dict[str, bytes | None]:
 def _work_folder(root: Path) -> Path:
     work = root
     work.mkdir(parents=True, exist_ok=True)
-    for name in ("good.rrd", "good.json"):
+    for name in ("good.rrd", "good.json", "good.toml"):
         (work / name).write_bytes(GOOD)
     (work / "trunc.json").write_text('{"meta": {}, "results": {"abc": [')
     (work / "dir.rrd").mkdir()
+    (work / "sub").mkdir()
+    os.link(work / "good.json", work / "hard.json")
+    (work / "link.json").symlink_to("good.json")
+    (work / "confirm.toml").write_text("[classes.car]\nconfirm_m = 5\n")
     return work
 
 
@@ -310,5 +342,5 @@ def test_ctrl_c_while_saving_leaves_no_partial_file(demo_dataroot: Path, tmp_pat
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err
-    assert "Traceback" not in err
+    assert err == "interrupted by Ctrl-C: unfinished outputs were not written\n"
     assert _snapshot(work) == before

@@ -235,15 +235,21 @@ def test_duplicate_tracking_id_in_one_sample_is_refused() -> None:
     check(submission(**{token: [box(token, "7"), box(token, "7", name="pedestrian")]}))
 
 
-def test_json_output_follows_the_umask_and_keeps_a_symlink(tmp_path: Path) -> None:
+def test_json_output_follows_the_umask_and_keeps_a_symlink_and_a_mode(tmp_path: Path) -> None:
+    """One file-mode policy for every output (``gnnpmb.atomic``): a new file gets 0666 minus the umask, a file
+    written over keeps its mode."""
     target = tmp_path / "real.json"
     link = tmp_path / "link.json"
     target.write_text("{}")
+    target.chmod(0o604)
     link.symlink_to(target)
+    new = tmp_path / "new.json"
     old = os.umask(0o027)
     try:
         write_submission(link, submission())
+        write_submission(new, submission())
     finally:
         os.umask(old)
     assert link.is_symlink() and read_submission(target) == submission()
-    assert stat.S_IMODE(target.stat().st_mode) == 0o640
+    assert stat.S_IMODE(target.stat().st_mode) == 0o604
+    assert stat.S_IMODE(new.stat().st_mode) == 0o640
