@@ -73,6 +73,36 @@ def _greedy(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFi
     return GreedyTracker(class_name, config, ids)
 
 
+def _ab3dmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.box.ab3dmot import make
+
+    return make(class_name, config, ids)
+
+
+def _prob3dmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.box.prob3dmot import make
+
+    return make(class_name, config, ids)
+
+
+def _simpletrack(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.box.simpletrack import make_simpletrack
+
+    return make_simpletrack(class_name, config, ids)
+
+
+def _immortal(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.box.simpletrack import make_immortal
+
+    return make_immortal(class_name, config, ids)
+
+
+def _cbmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.cbmot import CbmotTracker
+
+    return CbmotTracker(class_name, config, ids)
+
+
 _FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassFilter]] = {
     "gnnpmb": _gnnpmb,
     "pmbm": _pmbm,
@@ -82,6 +112,11 @@ _FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassFilter]] 
     "jpda": _jpda,
     "gnn": _gnn,
     "greedy": _greedy,
+    "ab3dmot": _ab3dmot,
+    "prob3dmot": _prob3dmot,
+    "simpletrack": _simpletrack,
+    "immortal": _immortal,
+    "cbmot": _cbmot,
 }
 
 TRACKER_NAMES: tuple[str, ...] = tuple(_FACTORIES)
@@ -95,6 +130,11 @@ TRACKER_DESCRIPTIONS: dict[str, str] = {
     "jpda": "JPDA: joint probabilistic data association with M/N track logic",
     "gnn": "GNN: global nearest neighbour Kalman trackers with M/N track logic",
     "greedy": "greedy: CenterPoint's closest-pair matching of velocity-projected detection centres",
+    "ab3dmot": "AB3DMOT: 3D IoU, Hungarian, 10-D box Kalman filter, birth and death by hits and misses",
+    "prob3dmot": "Probabilistic 3D MOT: Mahalanobis distance, greedy matching, noise learned per class",
+    "simpletrack": "SimpleTrack: 3D GIoU, Hungarian, prediction from the last update, score decay",
+    "immortal": "ImmortalTracker: SimpleTrack whose tracks are never deleted, predicted while unseen",
+    "cbmot": "CBMOT: CenterPoint's greedy tracker with confidence-based score refinement",
 }
 
 

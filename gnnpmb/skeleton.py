@@ -30,7 +30,7 @@ from typing import Generic, TypeVar
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.events import EventSink, Extracted, Gated, Panel, Posterior, Predicted
+from gnnpmb.events import EventSink, Extracted, Gated, Panel, Posterior, Predicted, ScoreRule
 from gnnpmb.gating import gate
 from gnnpmb.kalman import Innovation, innovation, mahalanobis2
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
@@ -42,12 +42,15 @@ PosteriorT = TypeVar("PosteriorT")
 @dataclass(frozen=True, slots=True)
 class TrackView:
     """K tracks as ``Predicted`` and ``Posterior`` show them: track_id (K,) int64, mean (K, 4) [x, y, vx, vy],
-    cov (K, 4, 4), existence (K,) (1 for trackers without one)."""
+    cov (K, 4, 4), existence (K,) (1 for trackers without one); score (K,) and score_rule: the track scores of a
+    tracker that keeps them (``events.ScoreRule``), else None."""
 
     track_id: np.ndarray
     mean: np.ndarray
     cov: np.ndarray
     existence: np.ndarray
+    score: np.ndarray | None = None
+    score_rule: ScoreRule | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,7 +97,7 @@ def emit_posterior(
     sink: EventSink, class_name: str, t: TrackView, estimates: Sequence[TrackEstimate], threshold: float
 ) -> None:
     """``Posterior`` of the K updated tracks and ``Extracted`` with the estimates and the extraction threshold."""
-    sink.emit(Posterior(class_name, t.track_id, t.mean, t.cov, t.existence))
+    sink.emit(Posterior(class_name, t.track_id, t.mean, t.cov, t.existence, t.score, t.score_rule))
     sink.emit(Extracted(class_name, tuple(estimates), threshold))
 
 
@@ -125,12 +128,18 @@ class ClassFilter(ABC, Generic[PriorT, PosteriorT]):
         prior = self.predict(meas, dt_s)
         if sink.enabled:
             t, gating = self.prior_view(prior)
-            emit_prior(sink, self.class_name, t, gating, meas.source_index, self.config.models.gate_chi2)
+            emit_prior(sink, self.class_name, t, gating, meas.source_index, self.gate_threshold)
         posterior = self.update(prior, meas, sink)
         estimates, threshold = self.extract(posterior, sink)
         if sink.enabled:
             emit_posterior(sink, self.class_name, self.posterior_view(posterior), estimates, threshold)
         return estimates
+
+    @property
+    def gate_threshold(self) -> float:
+        """The squared Mahalanobis gate ``Gated`` reports (``[models] gate_chi2``; a family with its own gate
+        says so)."""
+        return self.config.models.gate_chi2
 
     def idle(self) -> bool:
         """True when a frame without measurements would leave the filter unchanged and extract nothing, so
