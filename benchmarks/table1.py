@@ -9,19 +9,15 @@ The parameters come from ``--params`` (repeatable, each file on top of the ones 
 read by ``prob3dmot`` only); ``--params default`` uses the built-in defaults. Every tracker reads the same
 parameters (the shared sections apply to all of them).
 
-``--per-class`` adds one line per tracker with each class's AMOTA (mean ± std over the seeds). ``--original
-NAME=DIR`` prints beside tracker NAME the scores of its original implementation, read from
-``DIR/<preset>_s<seed>_eval/metrics_summary.json`` (the devkit's evaluation of the original's submission on the
-same detections; ``/work/baselines`` has the runs of the report).
+``--per-class`` adds one line per tracker with each class's AMOTA (mean ± std over the seeds).
 
 Usage: uv run python benchmarks/table1.py [--tracker NAME ...] [--preset NAME ...] [--seeds 0,1,2]
-       [--params FILE|default ...] [--split mini_val] [--per-class] [--original NAME=DIR ...] [--out DIR]
+       [--params FILE|default ...] [--split mini_val] [--per-class] [--out DIR]
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import tempfile
 import tomllib
 from pathlib import Path
@@ -60,12 +56,6 @@ def layered_config(files: list[str]) -> TrackerConfig:
     return config
 
 
-def original_scores(directory: Path, preset: str, seeds: list[int]) -> list[dict]:
-    """The original implementation's metric summaries for ``preset`` and ``seeds`` (missing runs skipped)."""
-    paths = [directory / f"{preset}_s{seed}_eval" / "metrics_summary.json" for seed in seeds]
-    return [json.loads(p.read_text()) for p in paths if p.exists()]
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tracker", action="append", choices=TRACKER_NAMES)
@@ -74,13 +64,11 @@ def main() -> None:
     parser.add_argument("--params", action="append", help="parameter TOML (repeatable, later on top), or 'default'")
     parser.add_argument("--split", default="mini_val")
     parser.add_argument("--per-class", action="store_true", help="also print each class's AMOTA")
-    parser.add_argument("--original", action="append", default=[], help="NAME=DIR: the original's scores beside")
     parser.add_argument("--out", type=Path, help="keep submissions and metric files here")
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="gnnpmb-table1-"))
     params = args.params or [str(TUNED), str(BOX_NOISE)]
     config = layered_config(params)
-    originals = dict(o.split("=", 1) for o in args.original)
     seeds = [int(s) for s in args.seeds.split(",")]
     split = DemoSplit.load(args.split)
     print(f"split {args.split}, params {' + '.join(params)}, detector seeds {seeds}")
@@ -103,12 +91,6 @@ def main() -> None:
                     f"{'':13s} {'':11s} "
                     + " ".join(f"{c} {cell('amota', v)}" for c, v in zip(classes, per_class, strict=True))
                 )
-            if tracker in originals:
-                summaries = original_scores(Path(originals[tracker]), preset, seeds)
-                if summaries:
-                    amota = cell("amota", [m["amota"] for m in summaries])
-                    ids = cell("ids", [m["ids"] for m in summaries])
-                    print(f"{'':13s} {'original':11s} AMOTA {amota} IDS {ids} ({len(summaries)} seeds)", flush=True)
     print(f"submissions and metric files: {out}")
 
 
