@@ -29,7 +29,7 @@ EXACT_PAIRS = 256
 overhead, not the pairs, sets the time of such a matrix)."""
 
 
-ROW_CANDIDATES = 3
+ROW_CANDIDATES = 6
 """Per detection, this many of its cheapest bounded pairs are made exact before the solve."""
 
 
@@ -119,8 +119,9 @@ class OneMinusGiou3d(BoxCost):
     def matrix(self, z_pred: np.ndarray, inn: Innovation | None, z: np.ndarray, limit: float) -> BoundedCosts:
         """Exact for every pair of a small matrix (up to ``EXACT_PAIRS``: one vectorised call costs about the
         same); else exact where the cheap bound (``overlap.giou_3d_bound_pairs``) allows a cost <= ``limit``, for
-        each detection's ``ROW_CANDIDATES`` and each track's cheapest bounds (what a solver takes first, so the
-        certified solve seldom needs a second round), the bound elsewhere."""
+        each detection's ``ROW_CANDIDATES`` cheapest bounds and, when there are no more tracks than detections,
+        each track's cheapest (what a solver takes first, so the certified solve seldom needs a second round),
+        the bound elsewhere."""
         m, k = len(z), len(z_pred)
         dets, preds = _upright(z), _upright(z_pred)
         if m * k <= EXACT_PAIRS:
@@ -130,7 +131,8 @@ class OneMinusGiou3d(BoxCost):
         first = bound <= limit
         n = min(k, ROW_CANDIDATES)
         first[np.arange(m)[:, None], np.argpartition(bound, n - 1, axis=1)[:, :n]] = True
-        first[bound.argmin(axis=0), np.arange(k)] = True
+        if k <= m:  # every track takes a detection: each track's cheapest too
+            first[bound.argmin(axis=0), np.arange(k)] = True
         costs.refine(*np.nonzero(first))
         return costs
 
