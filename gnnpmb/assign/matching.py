@@ -91,9 +91,10 @@ def solve_then_threshold(cost: BoundedCosts, max_cost: float, solver: Solver) ->
     if solver is Solver.HUNGARIAN:
         while True:
             rows, cols = linear_sum_assignment(cost.value)
-            if cost.exact[rows, cols].all():
+            bounded = ~cost.exact[rows, cols]
+            if not bounded.any():
                 break
-            cost.refine(rows, cols)
+            cost.refine(*_next_candidates(cost, rows[bounded], cols[bounded]))
     elif solver is Solver.GREEDY:
         cost.refine(*np.nonzero(cost.value <= max_cost))
         pairs = greedy_pairs(np.where(cost.value <= max_cost, cost.value, np.inf))
@@ -103,6 +104,23 @@ def solve_then_threshold(cost: BoundedCosts, max_cost: float, solver: Solver) ->
     keep = cost.value[rows, cols] <= max_cost
     col_of_row[rows[keep]] = cols[keep]
     return col_of_row
+
+
+CERTIFY_ROW_PAIRS = 16
+"""When a certified solve picks a bounded pair, that row's this many cheapest bounded pairs are resolved with it
+(one resolution per round: fewer rounds, each about as costly)."""
+
+
+def _next_candidates(cost: BoundedCosts, rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The bounded pairs (rows[p], cols[p]) the solve picked and, in each of those rows, the
+    ``CERTIFY_ROW_PAIRS`` cheapest bounded pairs (the row's next candidates once its pick turns out dearer)."""
+    values = np.where(cost.exact[rows], np.inf, cost.value[rows])  # (R, C): bounded pairs of those rows
+    n = min(CERTIFY_ROW_PAIRS, values.shape[1])
+    cheapest = np.argpartition(values, n - 1, axis=1)[:, :n]
+    keep = np.isfinite(np.take_along_axis(values, cheapest, axis=1))
+    r = np.concatenate([rows, np.repeat(rows, n)[keep.ravel()]])
+    c = np.concatenate([cols, cheapest.ravel()[keep.ravel()]])
+    return r, c
 
 
 @dataclass(frozen=True, slots=True)

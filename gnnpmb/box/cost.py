@@ -20,7 +20,14 @@ import numpy as np
 
 from gnnpmb.assign.matching import BoundedCosts
 from gnnpmb.box import kalman
-from gnnpmb.box.overlap import UprightBoxes, all_pairs, giou_3d_bound_pairs, giou_3d_pairs, iou_3d_pairs
+from gnnpmb.box.overlap import (
+    UprightBoxes,
+    all_pairs,
+    giou_3d_bound_matrix,
+    giou_3d_bound_pairs,
+    giou_3d_pairs,
+    iou_3d_pairs,
+)
 from gnnpmb.events import CostScale
 from gnnpmb.kalman import Innovation
 
@@ -118,7 +125,8 @@ class OneMinusGiou3d(BoxCost):
 
     def matrix(self, z_pred: np.ndarray, inn: Innovation | None, z: np.ndarray, limit: float) -> BoundedCosts:
         """Exact for every pair of a small matrix (up to ``EXACT_PAIRS``: one vectorised call costs about the
-        same); else exact where the cheap bound (``overlap.giou_3d_bound_pairs``) allows a cost <= ``limit``, for
+        same); else exact where the cheap bounds (``overlap.giou_3d_bound_matrix``, then ``giou_3d_bound_pairs``
+        where the first allows it) allow a cost <= ``limit``, for
         each detection's ``ROW_CANDIDATES`` cheapest bounds and, when there are no more tracks than detections,
         each track's cheapest (what a solver takes first, so the certified solve seldom needs a second round),
         the bound elsewhere."""
@@ -126,7 +134,9 @@ class OneMinusGiou3d(BoxCost):
         dets, preds = _upright(z), _upright(z_pred)
         if m * k <= EXACT_PAIRS:
             return BoundedCosts.of(1.0 - giou_3d_pairs(dets, preds, *all_pairs(m, k)).reshape(m, k))
-        bound = 1.0 - giou_3d_bound_pairs(dets, preds, *all_pairs(m, k)).reshape(m, k)
+        bound = 1.0 - giou_3d_bound_matrix(dets, preds)
+        close = np.nonzero(bound <= limit)  # the crude bound allows a match: try the tighter one
+        bound[close] = 1.0 - giou_3d_bound_pairs(dets, preds, *close)
         costs = BoundedCosts(bound, np.zeros((m, k), dtype=bool), lambda j, t: 1.0 - giou_3d_pairs(dets, preds, j, t))
         first = bound <= limit
         n = min(k, ROW_CANDIDATES)

@@ -192,6 +192,25 @@ def giou_3d_bound_pairs(a: UprightBoxes, b: UprightBoxes, ia: np.ndarray, ib: np
     return np.where(apart(a, b, ia, ib), bound, 1.0)
 
 
+def giou_3d_bound_matrix(a: UprightBoxes, b: UprightBoxes) -> np.ndarray:
+    """(M, K) cruder upper bounds of the 3D GIoU of every pair, by broadcasting (no corners): 1 for pairs whose
+    bounding circles meet; else |C| >= d (r_A + r_B) h_ext, the trapezoid between the boxes' inscribed circles
+    (radii half their shorter sides) at centre distance d, or |A| + |B| if larger."""
+    d = np.hypot(a.centre[:, None, 0] - b.centre[None, :, 0], a.centre[:, None, 1] - b.centre[None, :, 1])
+    inner_a, inner_b = 0.5 * a.size_wlh[:, :2].min(axis=1), 0.5 * b.size_wlh[:, :2].min(axis=1)
+    area = np.maximum(d * (inner_a[:, None] + inner_b[None, :]), a.area[:, None] + b.area[None, :])
+    top = np.maximum(
+        a.centre[:, None, 2] + 0.5 * a.size_wlh[:, None, 2], b.centre[None, :, 2] + 0.5 * b.size_wlh[None, :, 2]
+    )
+    bottom = np.minimum(
+        a.centre[:, None, 2] - 0.5 * a.size_wlh[:, None, 2], b.centre[None, :, 2] - 0.5 * b.size_wlh[None, :, 2]
+    )
+    volume = (a.area * a.size_wlh[:, 2])[:, None] + (b.area * b.size_wlh[:, 2])[None, :]
+    enclosing = area * (top - bottom)
+    bound = volume / np.where(enclosing > 0.0, enclosing, np.inf) - 1.0
+    return np.where(d > a.radius[:, None] + b.radius[None, :], bound, 1.0)
+
+
 def _pairs_of(
     fn, translation_a: np.ndarray, size_a: np.ndarray, yaw_a: np.ndarray, translation_b, size_b, yaw_b
 ) -> np.ndarray:
@@ -250,6 +269,7 @@ __all__ = [
     "apart",
     "convex_hull_area",
     "giou_3d",
+    "giou_3d_bound_matrix",
     "giou_3d_bound_pairs",
     "giou_3d_pairs",
     "giou_bev",

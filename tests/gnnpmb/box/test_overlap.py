@@ -12,6 +12,7 @@ from gnnpmb.box.overlap import (
     all_pairs,
     convex_hull_area,
     giou_3d,
+    giou_3d_bound_matrix,
     giou_3d_bound_pairs,
     giou_3d_pairs,
     giou_bev,
@@ -148,3 +149,13 @@ def test_the_far_pair_bound_is_an_upper_bound_of_giou():
     assert (exact <= bound + 1e-12).all()
     apart = bound < 1.0
     assert apart.mean() > 0.8 and np.median(bound[apart] - exact[apart]) < 0.05  # tight enough to skip most pairs
+
+
+def test_the_crude_matrix_bound_is_an_upper_bound_too():
+    rng = np.random.default_rng(5)
+    a, b = UprightBoxes.of(*_random_boxes(rng, 60, 30.0)), UprightBoxes.of(*_random_boxes(rng, 70, 30.0))
+    exact = giou_3d_pairs(a, b, *all_pairs(60, 70)).reshape(60, 70)
+    crude = giou_3d_bound_matrix(a, b)
+    tight = giou_3d_bound_pairs(a, b, *all_pairs(60, 70)).reshape(60, 70)
+    assert (exact <= crude + 1e-12).all() and (exact <= tight + 1e-12).all()
+    assert (tight <= crude + 1e-12).mean() > 0.95  # the corner bound is the tighter one, nearly always
