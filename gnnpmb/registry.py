@@ -132,7 +132,7 @@ TRACKER_DESCRIPTIONS: dict[str, str] = {
     "greedy": "greedy: CenterPoint's closest-pair matching of velocity-projected detection centres",
     "ab3dmot": "AB3DMOT: 3D IoU, Hungarian, 10-D box Kalman filter, birth and death by hits and misses",
     "prob3dmot": "Probabilistic 3D MOT: Mahalanobis distance, greedy matching, noise learned per class",
-    "simpletrack": "SimpleTrack: 3D GIoU, Hungarian, prediction from the last update, score decay",
+    "simpletrack": "SimpleTrack: 3D GIoU, Hungarian, NMS, detector-velocity motion model, score decay",
     "immortal": "ImmortalTracker: SimpleTrack whose tracks are never deleted, predicted while unseen",
     "cbmot": "CBMOT: CenterPoint's greedy tracker with confidence-based score refinement",
 }

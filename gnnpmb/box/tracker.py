@@ -201,9 +201,10 @@ class BoxTracker(ClassFilter[BoxPrior, BoxTracks]):
         alive_k = np.flatnonzero(matches.kept_alive)
         mean, cov = t.mean.copy(), t.cov.copy()
         if spec.prediction is Prediction.DETECTOR_VELOCITY:
-            mean[hit_k], cov[hit_k] = kalman.box_with_velocity(
-                prior.z[meas_of_track[hit_k]], meas.boxes.velocity_mps[meas_of_track[hit_k]]
-            )
+            if len(hit_k):
+                mean[hit_k], cov[hit_k] = kalman.box_with_velocity(
+                    prior.z[meas_of_track[hit_k]], meas.boxes.velocity_mps[meas_of_track[hit_k]]
+                )
         else:
             for rows, z in ((hit_k, prior.z[meas_of_track[hit_k]]), (alive_k, t.mean[alive_k, : kalman.MEAS_DIM])):
                 if len(rows):
