@@ -86,7 +86,7 @@ def solve_then_threshold(cost: BoundedCosts, max_cost: float, solver: Solver) ->
     the Hungarian assignment is certified, or every pair the greedy solver may take is exact)."""
     n_rows, n_cols = cost.shape
     col_of_row = np.full(n_rows, -1, dtype=np.int64)
-    if n_rows == 0 or n_cols == 0:
+    if n_rows == 0 or n_cols == 0 or not (cost.value <= max_cost).any():  # every pair past the threshold
         return col_of_row
     if solver is Solver.HUNGARIAN:
         while True:

@@ -124,20 +124,27 @@ class OneMinusGiou3d(BoxCost):
         )
 
     def matrix(self, z_pred: np.ndarray, inn: Innovation | None, z: np.ndarray, limit: float) -> BoundedCosts:
-        """Exact for every pair of a small matrix (up to ``EXACT_PAIRS``: one vectorised call costs about the
-        same); else exact where the cheap bounds (``overlap.giou_3d_bound_matrix``, then ``giou_3d_bound_pairs``
+        """Only bounds when the cheap bound rules out every pair (``overlap.giou_3d_bound_matrix``); else exact
+        for every pair of a small matrix (up to ``EXACT_PAIRS``: one vectorised call costs about the same); else
+        exact where the cheap bounds (``overlap.giou_3d_bound_matrix``, then ``giou_3d_bound_pairs``
         where the first allows it) allow a cost <= ``limit``, for
         each detection's ``ROW_CANDIDATES`` cheapest bounds and, when there are no more tracks than detections,
         each track's cheapest (what a solver takes first, so the certified solve seldom needs a second round),
         the bound elsewhere."""
         m, k = len(z), len(z_pred)
         dets, preds = _upright(z), _upright(z_pred)
+        bound = 1.0 - giou_3d_bound_matrix(dets, preds)
+
+        def resolve(j: np.ndarray, t: np.ndarray) -> np.ndarray:
+            return 1.0 - giou_3d_pairs(dets, preds, j, t)
+
+        if (bound > limit).all():  # no pair can be matched: no solver needs an exact cost
+            return BoundedCosts(bound, np.zeros((m, k), dtype=bool), resolve)
         if m * k <= EXACT_PAIRS:
             return BoundedCosts.of(1.0 - giou_3d_pairs(dets, preds, *all_pairs(m, k)).reshape(m, k))
-        bound = 1.0 - giou_3d_bound_matrix(dets, preds)
         close = np.nonzero(bound <= limit)  # the crude bound allows a match: try the tighter one
         bound[close] = 1.0 - giou_3d_bound_pairs(dets, preds, *close)
-        costs = BoundedCosts(bound, np.zeros((m, k), dtype=bool), lambda j, t: 1.0 - giou_3d_pairs(dets, preds, j, t))
+        costs = BoundedCosts(bound, np.zeros((m, k), dtype=bool), resolve)
         first = bound <= limit
         n = min(k, ROW_CANDIDATES)
         first[np.arange(m)[:, None], np.argpartition(bound, n - 1, axis=1)[:, :n]] = True
