@@ -173,17 +173,22 @@ def tracker_has_costs(name: str) -> bool:
     return _declared(name)[3]
 
 
+def tracker_keeps_detection_box(name: str) -> bool:
+    """Whether tracker ``name``'s output boxes carry their detections' size and heading
+    (``skeleton.ClassFilter.keeps_detection_box``)."""
+    return _declared(name)[4]
+
+
 @functools.cache
-def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool]:
-    """What tracker ``name`` declares for the viewer (panels, has_existence, has_gates, has_costs), read once from an
-    instance
-    for the first class with the default configuration (building one costs a couple of milliseconds, and the
-    blueprint asks several times per tracker)."""
+def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool, bool]:
+    """What tracker ``name`` declares (panels, has_existence, has_gates, has_costs, keeps_detection_box), read
+    once from an instance for the first class with the default configuration (building one costs a couple of
+    milliseconds, and the blueprint asks several times per tracker)."""
     from gnnpmb.config import TrackerConfig
     from gnnpmb.types import IdAllocator
 
     sample = make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator())
-    return sample.panels, sample.has_existence, sample.has_gates, sample.has_costs
+    return sample.panels, sample.has_existence, sample.has_gates, sample.has_costs, sample.keeps_detection_box
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:

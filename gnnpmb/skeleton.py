@@ -108,12 +108,15 @@ class ClassFilter(ABC, Generic[PriorT, PosteriorT]):
     tracks have no existence probability (track logic instead; their events carry existence 1), so the viewer
     draws no existence plot for them. ``has_gates``: False for a tracker that matches without a Gaussian gate (no
     ``Gated`` event, so no normalised innovation to plot). ``has_costs``: False for a tracker whose update follows no
-    chosen assignment of a cost matrix (JPDA, PHD, CPHD, TO-PMB: soft updates), so no chosen cost to plot."""
+    chosen assignment of a cost matrix (JPDA, PHD, CPHD, TO-PMB: soft updates), so no chosen cost to plot.
+    ``keeps_detection_box``: an output box has the size, heading and height of the detection that last updated its
+    track; False for a tracker that filters the whole box (``gnnpmb.box``), whose box only nears the detection's."""
 
     panels: tuple[Panel, ...] = ()
     has_existence: bool = True
     has_gates: bool = True
     has_costs: bool = True
+    keeps_detection_box: bool = True
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name

@@ -141,6 +141,7 @@ class BoxTracker(ClassFilter[BoxPrior, BoxTracks]):
     """One class's box tracker (module docstring); the frame loop is ``skeleton.ClassFilter.step``."""
 
     has_existence = False  # hits / misses life cycle
+    keeps_detection_box = False  # the 10-D Kalman filter smooths size and heading too
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator, spec: BoxTrackerSpec):
         super().__init__(class_name, config, ids)
