@@ -3,28 +3,35 @@
 (the layout of the GNN-PMB paper's Table I: AMOTA, AMOTP, recall, MT, ML, FP, FN, IDS, FRAG), plus the median
 per-frame tracker time.
 
-The parameters come from ``--params`` (default ``gnnpmb/params/tuned_mini_train.toml``, written by
-``benchmarks/tune_mini_train.py`` from mini_train alone); ``--params default`` uses the built-in defaults.
-Every tracker reads the same file (the shared sections apply to all of them).
+The parameters come from ``--params`` (repeatable, each file on top of the ones before; default
+``gnnpmb/params/tuned_mini_train.toml``, written by ``benchmarks/tune_mini_train.py`` from mini_train alone, then
+``gnnpmb/params/box_noise_mini_train.toml``, written by ``benchmarks/learn_box_noise.py`` from mini_train alone and
+read by ``prob3dmot`` only); ``--params default`` uses the built-in defaults. Every tracker reads the same
+parameters (the shared sections apply to all of them).
+
+``--per-class`` adds one line per tracker with each class's AMOTA (mean ± std over the seeds).
 
 Usage: uv run python benchmarks/table1.py [--tracker NAME ...] [--preset NAME ...] [--seeds 0,1,2]
-       [--params FILE|default] [--split mini_val] [--out DIR]
+       [--params FILE|default ...] [--split mini_val] [--per-class] [--out DIR]
 """
 
 from __future__ import annotations
 
 import argparse
 import tempfile
+import tomllib
 from pathlib import Path
 
 import numpy as np
 from demo_split import DemoSplit, score
 
-from gnnpmb.config import TrackerConfig, load_config
+from gnnpmb.config import TrackerConfig, config_from_dict
 from gnnpmb.data.simdet import PRESETS
 from gnnpmb.registry import TRACKER_NAMES
 
-TUNED = Path(__file__).resolve().parents[1] / "gnnpmb" / "params" / "tuned_mini_train.toml"
+PARAMS = Path(__file__).resolve().parents[1] / "gnnpmb" / "params"
+TUNED = PARAMS / "tuned_mini_train.toml"
+BOX_NOISE = PARAMS / "box_noise_mini_train.toml"
 WITH_STD = ("amota", "amotp", "ids")
 COLUMNS = ("amota", "amotp", "recall", "mt", "ml", "fp", "fn", "ids", "frag")
 
@@ -40,22 +47,33 @@ def cell(metric: str, values: list[float]) -> str:
     return f"{mean:.1f}"
 
 
+def layered_config(files: list[str]) -> TrackerConfig:
+    """The defaults with each parameter file applied in turn (``default`` alone: the defaults)."""
+    config = TrackerConfig()
+    for f in files:
+        if f != "default":
+            config = config_from_dict(tomllib.loads(Path(f).read_text()), config)
+    return config
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tracker", action="append", choices=TRACKER_NAMES)
     parser.add_argument("--preset", action="append", choices=sorted(PRESETS))
     parser.add_argument("--seeds", default="0,1,2", help="comma-separated detector seeds")
-    parser.add_argument("--params", default=str(TUNED), help="parameter TOML, or 'default'")
+    parser.add_argument("--params", action="append", help="parameter TOML (repeatable, later on top), or 'default'")
     parser.add_argument("--split", default="mini_val")
+    parser.add_argument("--per-class", action="store_true", help="also print each class's AMOTA")
     parser.add_argument("--out", type=Path, help="keep submissions and metric files here")
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="gnnpmb-table1-"))
-    config = TrackerConfig() if args.params == "default" else load_config(Path(args.params))
+    params = args.params or [str(TUNED), str(BOX_NOISE)]
+    config = layered_config(params)
     seeds = [int(s) for s in args.seeds.split(",")]
     split = DemoSplit.load(args.split)
-    print(f"split {args.split}, params {args.params}, detector seeds {seeds}")
+    print(f"split {args.split}, params {' + '.join(params)}, detector seeds {seeds}")
     widths = {c: 12 if c in ("amota", "amotp") else 10 if c in WITH_STD else 6 for c in COLUMNS}
-    header = f"{'preset':13s} {'tracker':8s} " + " ".join(f"{c.upper():>{widths[c]}s}" for c in COLUMNS)
+    header = f"{'preset':13s} {'tracker':11s} " + " ".join(f"{c.upper():>{widths[c]}s}" for c in COLUMNS)
     print(header + f" {'med ms':>7s}", flush=True)
     for preset in args.preset or ("centerpoint", "megvii", "pointpillars"):
         detections = {seed: split.detections(preset, seed) for seed in seeds}
@@ -65,7 +83,14 @@ def main() -> None:
             ]
             cells = [f"{cell(c, [r.scores.overall[c] for r in runs]):>{widths[c]}s}" for c in COLUMNS]
             ms = float(np.median(np.concatenate([r.step_ms for r in runs])))
-            print(f"{preset:13s} {tracker:8s} " + " ".join(cells) + f" {ms:7.2f}", flush=True)
+            print(f"{preset:13s} {tracker:11s} " + " ".join(cells) + f" {ms:7.2f}", flush=True)
+            if args.per_class:
+                classes = sorted(runs[0].scores.per_class)
+                per_class = [[r.scores.per_class[c]["amota"] for r in runs] for c in classes]
+                print(
+                    f"{'':13s} {'':11s} "
+                    + " ".join(f"{c} {cell('amota', v)}" for c, v in zip(classes, per_class, strict=True))
+                )
     print(f"submissions and metric files: {out}")
 
 

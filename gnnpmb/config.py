@@ -98,15 +98,39 @@ RULES: dict[str, Range] = {
     "vector.delete_misses": _at_least(1),
     "vector.exact_cluster_max": _at_least(1),
     "greedy.max_age": _at_least(1),
+    "ab3dmot.iou_threshold": Range(0.0, 1.0, True, False),
+    "ab3dmot.min_hits": _at_least(0),
+    "ab3dmot.max_misses": _at_least(1),
+    "prob3dmot.distance_threshold": _POSITIVE,
+    "prob3dmot.min_hits": _at_least(0),
+    "prob3dmot.max_misses": _at_least(1),
+    "simpletrack.giou_threshold": Range(-1.0, 1.0, True, True),
+    "simpletrack.first_stage_score": _PROB,
+    "simpletrack.min_hits": _at_least(0),
+    "simpletrack.max_misses": _at_least(1),
+    "simpletrack.miss_score_factor": _PROB,
+    "simpletrack.two_stage": Range(0.0, 1.0, True, True),
+    "simpletrack.detector_velocity": Range(0.0, 1.0, True, True),
+    "simpletrack.second_stage_score": _PROB,
+    "simpletrack.second_stage_giou": Range(-1.0, 1.0, True, True),
+    "immortal.min_hits": _at_least(0),
+    "immortal.output_max_misses": _at_least(0),
+    "cbmot.score_decay": _PROB,
+    "cbmot.max_misses": _at_least(1),
+    "cbmot.delete_score": Range(0.0, 1.0, True, False),
     "classes.q_x": _NON_NEGATIVE,
     "classes.q_y": _NON_NEGATIVE,
     "classes.r_x": _POSITIVE,
     "classes.r_y": _POSITIVE,
     "classes.match_distance_m": _POSITIVE,
+    "classes.cbmot_distance_m": _POSITIVE,
     "classes.r_vx": _POSITIVE,
     "classes.r_vy": _POSITIVE,
     "pmb.measure_velocity": Range(0.0, 1.0, True, True),
     "pmb.clutter_velocity_density": _POSITIVE,
+    **{f"box_noise.{k}": _POSITIVE for k in ("r_x", "r_y", "r_z", "r_yaw", "r_l", "r_w", "r_h")},
+    **{f"box_noise.{k}": _NON_NEGATIVE for k in ("q_x", "q_y", "q_z", "q_yaw", "q_size", "q_vx", "q_vy", "q_vz")},
+    **{f"box_noise.{k}": _POSITIVE for k in ("p_vx", "p_vy", "p_vz", "p_scale")},
 }
 """Allowed range of every parameter, by ``section.key`` (``classes.key`` for the per-class models). Covariance
 entries: Q may be 0 (no process noise), R must be > 0 (a zero R makes a perfect sensor and a singular S)."""
@@ -130,8 +154,9 @@ def validate_section(params: Any, section: str) -> None:
 @dataclass(frozen=True, slots=True)
 class ClassParams:
     """Per-class models: process noise Q = diag(q_x, q_y, q_x, q_y), measurement noise R = diag(r_x, r_y), and
-    the greedy tracker's matching distance (``gnnpmb.greedy``; CenterPoint's per-class values), and the velocity
-    measurement noise r_vx, r_vy ((m/s)^2) used only by the opt-in ``[pmb] measure_velocity = 1`` variant."""
+    the greedy tracker's matching distance (``gnnpmb.greedy``; CenterPoint's per-class values), the velocity
+    measurement noise r_vx, r_vy ((m/s)^2) used only by the opt-in ``[pmb] measure_velocity = 1`` variant, and
+    CBMOT's matching distance (``gnnpmb.cbmot``: the earlier CenterPoint values its code ships)."""
 
     q_x: float
     q_y: float
@@ -140,22 +165,115 @@ class ClassParams:
     match_distance_m: float = 4.0
     r_vx: float = 0.5
     r_vy: float = 0.5
+    cbmot_distance_m: float = 3.0
 
     def __post_init__(self) -> None:
         validate_section(self, "classes")
 
 
 PAPER_CLASS_PARAMS: dict[str, ClassParams] = {
-    "car": ClassParams(0.1589, 0.1249, 0.0890, 0.0941, 4.0),
-    "truck": ClassParams(0.0945, 0.0946, 0.1486, 0.1445, 4.0),
-    "bus": ClassParams(0.1177, 0.0885, 0.1755, 0.1382, 5.5),
-    "trailer": ClassParams(0.0420, 0.0369, 0.2323, 0.2223, 3.0),
-    "pedestrian": ClassParams(0.0335, 0.0247, 0.0386, 0.0377, 1.0),
-    "bicycle": ClassParams(0.0199, 0.0137, 0.0539, 0.0504, 3.0),
-    "motorcycle": ClassParams(0.0324, 0.0387, 0.0405, 0.0399, 13.0),
+    "car": ClassParams(0.1589, 0.1249, 0.0890, 0.0941, 4.0, cbmot_distance_m=3.0),
+    "truck": ClassParams(0.0945, 0.0946, 0.1486, 0.1445, 4.0, cbmot_distance_m=4.0),
+    "bus": ClassParams(0.1177, 0.0885, 0.1755, 0.1382, 5.5, cbmot_distance_m=5.5),
+    "trailer": ClassParams(0.0420, 0.0369, 0.2323, 0.2223, 3.0, cbmot_distance_m=2.0),
+    "pedestrian": ClassParams(0.0335, 0.0247, 0.0386, 0.0377, 1.0, cbmot_distance_m=1.0),
+    "bicycle": ClassParams(0.0199, 0.0137, 0.0539, 0.0504, 3.0, cbmot_distance_m=2.5),
+    "motorcycle": ClassParams(0.0324, 0.0387, 0.0405, 0.0399, 13.0, cbmot_distance_m=4.0),
 }
 """Q and R: the authors' GNN-PMB code; match_distance_m: CenterPoint's ``NUSCENE_CLS_VELOCITY_ERROR`` (Yin et al.
-2021, ``det3d/.../pub_tracker.py``)."""
+2021, ``det3d/.../pub_tracker.py``); cbmot_distance_m: the same table as CBMOT's ``tracker.py`` ships it (Benbarka
+et al. 2021; an earlier CenterPoint version: car 3, trailer 2, motorcycle 4, bicycle 2.5 m)."""
+
+
+@dataclass(frozen=True, slots=True)
+class BoxNoise:
+    """Diagonal noise of one class's 10-D box Kalman filter (``gnnpmb.box.kalman``), state [x, y, z, yaw, l, w,
+    h, vx, vy, vz], measurement the first 7, in SI units per keyframe step.
+
+    r_*: measurement noise R (m^2; r_yaw rad^2); q_x, q_y, q_z, q_yaw: process noise of the position and heading
+    per step; q_size: of l, w, h; q_vx, q_vy, q_vz: of the velocity ((m/s)^2 per step); p_vx, p_vy, p_vz: the
+    initial velocity variance ((m/s)^2); p_scale: the initial variance of the 7 measured components is p_scale R.
+
+    The defaults (``NUSCENES_BOX_NOISE``) are Probabilistic 3D MOT's statistics of nuScenes train (Chiu et al.
+    2020, sec. IV-C, its ``covariance.py`` ``NuScenesCovariance``); its velocities are per 0.5 s keyframe, so its
+    velocity entries are divided by 0.5^2 here. ``benchmarks/learn_box_noise.py`` learns them from a split.
+    """
+
+    r_x: float
+    r_y: float
+    r_z: float
+    r_yaw: float
+    r_l: float
+    r_w: float
+    r_h: float
+    q_x: float
+    q_y: float
+    q_z: float
+    q_yaw: float
+    q_size: float
+    q_vx: float
+    q_vy: float
+    q_vz: float
+    p_vx: float
+    p_vy: float
+    p_vz: float
+    p_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        validate_section(self, "box_noise")
+
+    @staticmethod
+    def uniform(r: float, q: float, q_size: float, q_velocity: float, p_velocity: float, p_scale: float) -> BoxNoise:
+        """The same variance for every measured component (r), position and heading (q), ... (AB3DMOT's and
+        SimpleTrack's hand-set covariances)."""
+        return BoxNoise(*([r] * 7), *([q] * 4), q_size, *([q_velocity] * 3), *([p_velocity] * 3), p_scale=p_scale)
+
+
+def _prob3dmot_nuscenes(r: tuple[float, ...], q: tuple[float, float, float, float], p_v: tuple[float, ...]) -> BoxNoise:
+    """``BoxNoise`` from Probabilistic 3D MOT's published R (x, y, z, yaw, l, w, h), Q (x, y, z, yaw; its
+    velocity noise equals the position noise per frame) and initial velocity variance, per 0.5 s frame."""
+    per_s2 = 1.0 / 0.5**2
+    return BoxNoise(*r, *q, 0.0, *(v * per_s2 for v in q[:3]), *(v * per_s2 for v in p_v), p_scale=1.0)
+
+
+NUSCENES_BOX_NOISE: dict[str, BoxNoise] = {
+    "car": _prob3dmot_nuscenes(
+        (0.08900372, 0.09412005, 0.03265469, 1.00535696, 0.10912802, 0.02359175, 0.02455134),
+        (0.158918523, 0.124935318, 0.00535573165, 0.0922800791),
+        (0.08120681, 0.08224643, 0.02266425),
+    ),
+    "truck": _prob3dmot_nuscenes(
+        (0.14862173, 0.1444596, 0.05417157, 0.73122169, 0.69387238, 0.05484365, 0.07748085),
+        (0.0945275998, 0.0945620374, 0.00838061721, 0.14168046),
+        (0.10683797, 0.10248689, 0.0378078),
+    ),
+    "bus": _prob3dmot_nuscenes(
+        (0.17546469, 0.13818929, 0.05947248, 0.1979503, 0.78867322, 0.05507407, 0.06684149),
+        (0.117729925, 0.0884659079, 0.011761644, 0.209050032),
+        (0.13263319, 0.11508148, 0.05033665),
+    ),
+    "trailer": _prob3dmot_nuscenes(
+        (0.23228021, 0.22229261, 0.07006275, 1.05163481, 1.37451601, 0.06354783, 0.10500918),
+        (0.0419985099, 0.0368661552, 0.011941505, 0.056316624),
+        (0.2138643, 0.19625241, 0.05231335),
+    ),
+    "pedestrian": _prob3dmot_nuscenes(
+        (0.03855275, 0.0377111, 0.02482115, 2.0751833, 0.02286483, 0.0136347, 0.0203149),
+        (0.0334814566, 0.0247354921, 0.00594592529, 0.424962535),
+        (0.04237008, 0.04092393, 0.01482923),
+    ),
+    "bicycle": _prob3dmot_nuscenes(
+        (0.05390982, 0.05039431, 0.01863044, 1.29464435, 0.02713823, 0.01169572, 0.01295084),
+        (0.0198881347, 0.0136552276, 0.00510175742, 0.133430252),
+        (0.04560422, 0.04097244, 0.01725477),
+    ),
+    "motorcycle": _prob3dmot_nuscenes(
+        (0.04052819, 0.0398904, 0.01511711, 1.06442726, 0.03291016, 0.00957574, 0.0111605),
+        (0.032364759, 0.0386650974, 0.00547421635, 0.234967407),
+        (0.0437039, 0.04327734, 0.01465631),
+    ),
+}
+"""Per-class box noise of nuScenes train as Probabilistic 3D MOT publishes it (``BoxNoise``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -334,6 +452,114 @@ class GreedyParams:
         validate_section(self, "greedy")
 
 
+@dataclass(frozen=True, slots=True)
+class Ab3dmotParams:
+    """AB3DMOT (Weng, Wang, Held & Kitani, IROS 2020) as it runs on nuScenes (the configuration Probabilistic 3D
+    MOT published for it, ``config/AB3DMOT.yaml``; ``gnnpmb.box.ab3dmot``).
+
+    iou_threshold: a detection and a predicted box are matched only if their 3D IoU exceeds this (after the
+    Hungarian solve over all pairs). min_hits: a track is output from its min_hits-th hit on (and every track
+    in the first min_hits frames). max_misses: a track missed this many frames in a row is deleted; a track
+    missed fewer is output at its prediction (AB3DMOT's max_age).
+    """
+
+    iou_threshold: float = 0.1
+    min_hits: int = 3
+    max_misses: int = 2
+
+    def __post_init__(self) -> None:
+        validate_section(self, "ab3dmot")
+
+
+@dataclass(frozen=True, slots=True)
+class Prob3dmotParams:
+    """Probabilistic 3D MOT (Chiu, Prioletti, Li & Bohg, 2020; ``gnnpmb.box.prob3dmot``); its per-class noise is
+    ``[box_noise.<class>]``.
+
+    distance_threshold: a pair is matched only if the Mahalanobis distance sqrt(nu^T S^-1 nu) of the 7-D box
+    residual is below this (11). min_hits, max_misses: as ``[ab3dmot]`` (AB3DMOT's 3 and 2).
+    """
+
+    distance_threshold: float = 11.0
+    min_hits: int = 3
+    max_misses: int = 2
+
+    def __post_init__(self) -> None:
+        validate_section(self, "prob3dmot")
+
+
+@dataclass(frozen=True, slots=True)
+class SimpleTrackParams:
+    """SimpleTrack (Pang, Li & Wang, 2021; ``gnnpmb.box.simpletrack``), its nuScenes 2 Hz configurations
+    (``configs/nu_configs/giou.yaml`` and ``velo_giou.yaml``); ImmortalTracker reads them too.
+
+    giou_threshold: a pair is matched only if the 3D GIoU of the detection and the track's box is at least this
+    (its 1 - GIoU <= 1.5). first_stage_score: detections scoring below it take no part in the first stage and
+    start no track (its score_threshold 0.01, below the preprocessing threshold, so by default every kept
+    detection does). min_hits: a track is output from its min_hits-th hit on (0: at once). max_misses: a track
+    missed this many frames in a row is deleted (its max_age_since_update). miss_score_factor: a missed track's
+    score is multiplied by this each missed frame (0.01). two_stage: 1 = the second association stage (its "mm"
+    redundancy mode; off in both nuScenes 2 Hz configurations): a track the first stage left unmatched stays
+    alive, not updated by the detection, when a detection scoring above second_stage_score has GIoU >=
+    second_stage_giou with it. detector_velocity: the motion model, 1 = its "velo" model (``velo_giou.yaml``: a
+    track is its last detection moved by that detection's velocity, and detections are stepped back by their own
+    velocity to meet the tracks; the SimpleTrack paper finds this the more robust model at low frame rates), 0 =
+    its Kalman filter (``giou.yaml``). 1 was chosen on the demo mini_train split (centerpoint / pointpillars
+    presets, seed 0: simpletrack AMOTA 0.753 / 0.602 against 0.697 / 0.522 with the Kalman filter; immortal 0.822
+    / 0.682 against 0.771 / 0.659): at 2 Hz a new Kalman track has no velocity, so a fast, small object (a
+    motorcycle moving 5 m per keyframe) misses its second detection's GIoU gate.
+    """
+
+    giou_threshold: float = -0.5
+    first_stage_score: float = 0.01
+    min_hits: int = 0
+    max_misses: int = 2
+    miss_score_factor: float = 0.01
+    two_stage: int = 0
+    second_stage_score: float = 0.1
+    second_stage_giou: float = -0.5
+    detector_velocity: int = 1
+
+    def __post_init__(self) -> None:
+        validate_section(self, "simpletrack")
+
+
+@dataclass(frozen=True, slots=True)
+class ImmortalParams:
+    """ImmortalTracker (Wang, Chen, Pang, Wang & Zhang, 2021; ``gnnpmb.box.simpletrack``): SimpleTrack
+    (``[simpletrack]``, its motion model included: ImmortalTracker's own code has only the Kalman filter,
+    ``[simpletrack] detector_velocity = 0``) whose tracks are never deleted (its ``configs/nu_configs/
+    immortal.yaml``).
+
+    min_hits: as SimpleTrack's (1). output_max_misses: a track is output while it has been missed at most this
+    many frames in a row (1: its nuScenes result creation keeps tracks updated at most one frame ago).
+    """
+
+    min_hits: int = 1
+    output_max_misses: int = 1
+
+    def __post_init__(self) -> None:
+        validate_section(self, "immortal")
+
+
+@dataclass(frozen=True, slots=True)
+class CbmotParams:
+    """CBMOT (Benbarka, Schröder & Zell, "Score refinement for confidence-based 3D multi-object tracking", IROS
+    2021; ``gnnpmb.cbmot``), its LiDAR-only configuration (multiplication score update, score decay 0.2).
+
+    score_decay: subtracted from a track's score every frame before the update. max_misses: a track missed this
+    many frames in a row is deleted (its max_age, 40). delete_score: a missed track whose score falls to or below
+    this is deleted (0).
+    """
+
+    score_decay: float = 0.2
+    max_misses: int = 40
+    delete_score: float = 0.0
+
+    def __post_init__(self) -> None:
+        validate_section(self, "cbmot")
+
+
 PAPER_MODELS = ModelParams(p_survive=0.7, birth_weight=0.1)
 PAPER_PMB = PmbParams(extraction_threshold=0.9, miss_p_detect_max=1.0)
 PAPER_PMBM = PmbmParams(n_hypotheses=100)
@@ -357,7 +583,13 @@ class TrackerConfig:
     phd: PhdParams = PhdParams()
     vector: VectorParams = VectorParams()
     greedy: GreedyParams = GreedyParams()
+    ab3dmot: Ab3dmotParams = Ab3dmotParams()
+    prob3dmot: Prob3dmotParams = Prob3dmotParams()
+    simpletrack: SimpleTrackParams = SimpleTrackParams()
+    immortal: ImmortalParams = ImmortalParams()
+    cbmot: CbmotParams = CbmotParams()
     class_overrides: Overrides = field(default_factory=dict)
+    box_noise: dict[str, BoxNoise] = field(default_factory=lambda: dict(NUSCENES_BOX_NOISE))
 
     def for_class(self, class_name: str) -> ClassParams:
         return self.classes[class_name]
@@ -392,6 +624,7 @@ class TrackerConfig:
                         entry.setdefault(section, {})[key] = value
             classes[name] = entry
         out["classes"] = classes
+        out["box_noise"] = {name: dataclasses.asdict(n) for name, n in self.box_noise.items()}
         return out
 
 
@@ -410,6 +643,11 @@ _SECTIONS: dict[str, type] = {
     "phd": PhdParams,
     "vector": VectorParams,
     "greedy": GreedyParams,
+    "ab3dmot": Ab3dmotParams,
+    "prob3dmot": Prob3dmotParams,
+    "simpletrack": SimpleTrackParams,
+    "immortal": ImmortalParams,
+    "cbmot": CbmotParams,
 }
 
 MOVED_KEYS: dict[tuple[str, str], str] = {("pmb", f.name): "models" for f in dataclasses.fields(ModelParams)}
@@ -483,6 +721,18 @@ def _class_table(name: str, values: Any, params: ClassParams, overrides: dict[st
     return _typed_section(ClassParams, "classes", model, where, params)
 
 
+def _box_noise_tables(values: Any, base: dict[str, BoxNoise]) -> dict[str, BoxNoise]:
+    """Read ``[box_noise.<class>]`` tables on top of ``base`` (class name -> ``BoxNoise``)."""
+    if not isinstance(values, dict):
+        raise ConfigError("[box_noise] must be a table of per-class tables")
+    out = dict(base)
+    for name, table in values.items():
+        if name not in TRACKING_CLASSES:
+            raise ConfigError(f"[box_noise.{name}]: unknown class (known: {', '.join(TRACKING_CLASSES)})")
+        out[name] = _typed_section(BoxNoise, "box_noise", table, f"[box_noise.{name}]", out[name])
+    return out
+
+
 def config_from_dict(data: Mapping[str, Any], base: TrackerConfig | None = None) -> TrackerConfig:
     """Apply a nested dict of overrides (the TOML layout) to ``base`` (paper defaults if None)."""
     cfg = base or TrackerConfig()
@@ -502,6 +752,8 @@ def config_from_dict(data: Mapping[str, Any], base: TrackerConfig | None = None)
                     del overrides[name]
             changes["classes"] = classes
             changes["class_overrides"] = overrides
+        elif key == "box_noise":
+            changes["box_noise"] = _box_noise_tables(values, changes.get("box_noise", cfg.box_noise))
         elif key in _SECTIONS:
             if not isinstance(values, dict):
                 raise ConfigError(f"[{key}] must be a table")
@@ -518,7 +770,7 @@ def config_from_dict(data: Mapping[str, Any], base: TrackerConfig | None = None)
                 base_section = changes.get(section, getattr(cfg, section))
                 changes[section] = _typed_section(_SECTIONS[section], section, section_values, f"[{key}]", base_section)
         else:
-            raise ConfigError(f"unknown section [{key}] (known: classes, {', '.join(_SECTIONS)})")
+            raise ConfigError(f"unknown section [{key}] (known: classes, box_noise, {', '.join(_SECTIONS)})")
     out = cfg.replace(**changes)
     for name in out.class_overrides:
         try:
@@ -557,6 +809,9 @@ def get_param(cfg: TrackerConfig, dotted: str) -> float | int:
         sections = (current_section(parts[2], key),) if len(parts) == 4 else _SECTIONS_OF_KEY.get(key, ())
         if len(sections) == 1 and sections[0] in _SECTIONS and hasattr(getattr(cfg, sections[0]), key):
             return getattr(getattr(cfg.resolved(name), sections[0]), key)
+    elif parts[0] == "box_noise" and len(parts) == 3 and parts[1] in cfg.box_noise:
+        if hasattr(cfg.box_noise[parts[1]], parts[2]):
+            return getattr(cfg.box_noise[parts[1]], parts[2])
     elif len(parts) == 2 and parts[0] in _SECTIONS:
         section = current_section(parts[0], parts[1])
         if hasattr(getattr(cfg, section), parts[1]):
@@ -603,4 +858,8 @@ def dump_config(cfg: TrackerConfig) -> str:
                 out.append(f"[classes.{name}.{section}]")
                 out.extend(f"{k} = {_toml_value(v)}" for k, v in sub.items())
                 out.append("")
+    for name, values in d["box_noise"].items():
+        out.append(f"[box_noise.{name}]")
+        out.extend(f"{k} = {_toml_value(v)}" for k, v in values.items())
+        out.append("")
     return "\n".join(out)

@@ -96,6 +96,7 @@ class PruneReason(enum.Enum):
     LOW_WEIGHT = "mixture weight below pruning threshold"
     CAPPED = "over the component cap"
     TRACK_LOGIC = "deleted by track logic"
+    LOW_SCORE = "track score fell to the deletion threshold"
 
 
 class Panel(enum.Enum):
@@ -280,13 +281,18 @@ class CostScale:
     name: what a cost is ("negative log-likelihood ratio", "distance"); unit: "nats", "m", ...; close_call: a
     choice whose margin is below this is a close call (in ``unit``); optimal: the assignment minimises the total
     cost (Hungarian / Murty), so a margin is how much the best total rises without a pair; False for a greedy
-    matcher, whose margin is the row's next cheapest entry minus the chosen one.
+    matcher, whose margin is the row's next cheapest entry minus the chosen one. For the model-based baselines
+    (``gnnpmb.box``, ``gnnpmb.cbmot``) also threshold: a pair costlier than this is never matched (its entry is
+    +inf; every new-track column holds it); similarity: when set (e.g. "GIoU"), cost = 1 - similarity, so a text
+    may give the similarity instead (GIoU = 1 - cost). None for the others.
     """
 
     name: str
     unit: str
     close_call: float
     optimal: bool = True
+    threshold: float | None = None
+    similarity: str | None = None
 
 
 NATS = CostScale("negative log-likelihood ratio", "nats", 1.0)
@@ -345,20 +351,51 @@ class Born:
     existence: np.ndarray
 
 
+class ScoreOnHit(enum.Enum):
+    """What a track-score tracker's track takes as its score when a detection updates it (``ScoreRule``)."""
+
+    DETECTION = "the detection's score"
+    FUSED = "1 - (1 - track score)(1 - detection score)"  # CBMOT's multiplication update
+
+
+@dataclass(frozen=True, slots=True)
+class ScoreRule:
+    """How the scores of a tracker without existence probabilities move (``Posterior.score``; they are its
+    tracking scores: confidences, not probabilities that the object exists).
+
+    on_hit: the score a detection gives its track; miss_factor: multiplies a missed track's score every missed
+    frame (1: kept; SimpleTrack 0.01); decay_step: subtracted from every track's score each frame before the
+    update (0: none; CBMOT 0.2); delete_at: a missed track whose score falls to or below this is deleted (None:
+    the score deletes nothing).
+    """
+
+    on_hit: ScoreOnHit
+    miss_factor: float = 1.0
+    decay_step: float = 0.0
+    delete_at: float | None = None
+
+
 @dataclass(frozen=True, slots=True)
 class Posterior:
-    """Every track after the update: mean (K, 4), cov (K, 4, 4), existence (K,) in [0, 1]."""
+    """Every track after the update: mean (K, 4), cov (K, 4, 4), existence (K,) in [0, 1].
+
+    score: (K,) the track scores of a tracker whose tracks have none of existence (the model-based baselines),
+    moved by ``score_rule``; None for the others.
+    """
 
     class_name: str
     track_ids: np.ndarray
     mean: np.ndarray
     cov: np.ndarray
     existence: np.ndarray
+    score: np.ndarray | None = None
+    score_rule: ScoreRule | None = None
 
 
 @dataclass(frozen=True, slots=True)
 class Pruned:
-    """A track or component removed: why, and the existence (or weight) it last had."""
+    """A track or component removed: why, and the existence (or weight; the track score for a tracker whose
+    ``Posterior`` carries scores) it last had."""
 
     class_name: str
     track_id: int

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gnnpmb.assign.greedy import greedy_pairs
 from gnnpmb.config import TrackerConfig
 from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
@@ -77,21 +78,6 @@ def distance_matrix(
     back = det_xy - det_velocity_mps * dt_s
     dist = np.linalg.norm(back[:, None, :] - track_xy[None, :, :], axis=2)
     return np.where(dist <= max_distance_m, dist, np.inf)
-
-
-def greedy_pairs(dist: np.ndarray) -> np.ndarray:
-    """(P, 2) pairs [j, k] taken by increasing finite distance, each row and column at most once; ties are
-    broken by row, then column index, so the result is deterministic."""
-    rows, cols = np.nonzero(np.isfinite(dist))
-    order = np.lexsort((cols, rows, dist[rows, cols]))
-    used_r, used_c = set(), set()
-    pairs = []
-    for j, k in zip(rows[order].tolist(), cols[order].tolist(), strict=True):
-        if j not in used_r and k not in used_c:
-            used_r.add(j)
-            used_c.add(k)
-            pairs.append((j, k))
-    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
 
 
 @dataclass(frozen=True, slots=True)

@@ -35,8 +35,11 @@ def symmetrize(P: np.ndarray) -> np.ndarray:
 
 
 def predict(mean: np.ndarray, cov: np.ndarray, model: MotionModel) -> tuple[np.ndarray, np.ndarray]:
-    """Kalman predict of (K, 4) means and (K, 4, 4) covariances: m' = F m, P' = F P F^T + Q."""
+    """Kalman predict of (K, n) means and (K, n, n) covariances: m' = F m, P' = F P F^T + Q; F is (n, n), or
+    (K, n, n) for one transition per track (tracks predicted over different times)."""
     F = model.F
+    if F.ndim == 3:
+        return np.einsum("kij,kj->ki", F, mean), symmetrize(F @ cov @ F.swapaxes(-1, -2) + model.Q)
     return mean @ F.T, symmetrize(F @ cov @ F.T + model.Q)
 
 

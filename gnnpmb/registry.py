@@ -73,6 +73,36 @@ def _greedy(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFi
     return GreedyTracker(class_name, config, ids)
 
 
+def _ab3dmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.box.ab3dmot import make
+
+    return make(class_name, config, ids)
+
+
+def _prob3dmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.box.prob3dmot import make
+
+    return make(class_name, config, ids)
+
+
+def _simpletrack(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.box.simpletrack import make_simpletrack
+
+    return make_simpletrack(class_name, config, ids)
+
+
+def _immortal(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.box.simpletrack import make_immortal
+
+    return make_immortal(class_name, config, ids)
+
+
+def _cbmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    from gnnpmb.cbmot import CbmotTracker
+
+    return CbmotTracker(class_name, config, ids)
+
+
 _FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassFilter]] = {
     "gnnpmb": _gnnpmb,
     "pmbm": _pmbm,
@@ -82,6 +112,11 @@ _FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassFilter]] 
     "jpda": _jpda,
     "gnn": _gnn,
     "greedy": _greedy,
+    "ab3dmot": _ab3dmot,
+    "prob3dmot": _prob3dmot,
+    "simpletrack": _simpletrack,
+    "immortal": _immortal,
+    "cbmot": _cbmot,
 }
 
 TRACKER_NAMES: tuple[str, ...] = tuple(_FACTORIES)
@@ -95,6 +130,11 @@ TRACKER_DESCRIPTIONS: dict[str, str] = {
     "jpda": "JPDA: joint probabilistic data association with M/N track logic",
     "gnn": "GNN: global nearest neighbour Kalman trackers with M/N track logic",
     "greedy": "greedy: CenterPoint's closest-pair matching of velocity-projected detection centres",
+    "ab3dmot": "AB3DMOT: 3D IoU, Hungarian, 10-D box Kalman filter, birth and death by hits and misses",
+    "prob3dmot": "Probabilistic 3D MOT: Mahalanobis distance, greedy matching, noise learned per class",
+    "simpletrack": "SimpleTrack: 3D GIoU, Hungarian, NMS, detector-velocity motion model, score decay",
+    "immortal": "ImmortalTracker: SimpleTrack whose tracks are never deleted, predicted while unseen",
+    "cbmot": "CBMOT: CenterPoint's greedy tracker with confidence-based score refinement",
 }
 
 
@@ -133,17 +173,22 @@ def tracker_has_costs(name: str) -> bool:
     return _declared(name)[3]
 
 
+def tracker_keeps_detection_box(name: str) -> bool:
+    """Whether tracker ``name``'s output boxes carry their detections' size and heading
+    (``skeleton.ClassFilter.keeps_detection_box``)."""
+    return _declared(name)[4]
+
+
 @functools.cache
-def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool]:
-    """What tracker ``name`` declares for the viewer (panels, has_existence, has_gates, has_costs), read once from an
-    instance
-    for the first class with the default configuration (building one costs a couple of milliseconds, and the
-    blueprint asks several times per tracker)."""
+def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool, bool]:
+    """What tracker ``name`` declares (panels, has_existence, has_gates, has_costs, keeps_detection_box), read
+    once from an instance for the first class with the default configuration (building one costs a couple of
+    milliseconds, and the blueprint asks several times per tracker)."""
     from gnnpmb.config import TrackerConfig
     from gnnpmb.types import IdAllocator
 
     sample = make_class_tracker(name, TRACKING_CLASSES[0], TrackerConfig(), IdAllocator())
-    return sample.panels, sample.has_existence, sample.has_gates, sample.has_costs
+    return sample.panels, sample.has_existence, sample.has_gates, sample.has_costs, sample.keeps_detection_box
 
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:

@@ -30,7 +30,7 @@ from typing import Generic, TypeVar
 import numpy as np
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.events import EventSink, Extracted, Gated, Panel, Posterior, Predicted
+from gnnpmb.events import EventSink, Extracted, Gated, Panel, Posterior, Predicted, ScoreRule
 from gnnpmb.gating import gate
 from gnnpmb.kalman import Innovation, innovation, mahalanobis2
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
@@ -42,12 +42,15 @@ PosteriorT = TypeVar("PosteriorT")
 @dataclass(frozen=True, slots=True)
 class TrackView:
     """K tracks as ``Predicted`` and ``Posterior`` show them: track_id (K,) int64, mean (K, 4) [x, y, vx, vy],
-    cov (K, 4, 4), existence (K,) (1 for trackers without one)."""
+    cov (K, 4, 4), existence (K,) (1 for trackers without one); score (K,) and score_rule: the track scores of a
+    tracker that keeps them (``events.ScoreRule``), else None."""
 
     track_id: np.ndarray
     mean: np.ndarray
     cov: np.ndarray
     existence: np.ndarray
+    score: np.ndarray | None = None
+    score_rule: ScoreRule | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -94,7 +97,7 @@ def emit_posterior(
     sink: EventSink, class_name: str, t: TrackView, estimates: Sequence[TrackEstimate], threshold: float
 ) -> None:
     """``Posterior`` of the K updated tracks and ``Extracted`` with the estimates and the extraction threshold."""
-    sink.emit(Posterior(class_name, t.track_id, t.mean, t.cov, t.existence))
+    sink.emit(Posterior(class_name, t.track_id, t.mean, t.cov, t.existence, t.score, t.score_rule))
     sink.emit(Extracted(class_name, tuple(estimates), threshold))
 
 
@@ -105,12 +108,15 @@ class ClassFilter(ABC, Generic[PriorT, PosteriorT]):
     tracks have no existence probability (track logic instead; their events carry existence 1), so the viewer
     draws no existence plot for them. ``has_gates``: False for a tracker that matches without a Gaussian gate (no
     ``Gated`` event, so no normalised innovation to plot). ``has_costs``: False for a tracker whose update follows no
-    chosen assignment of a cost matrix (JPDA, PHD, CPHD, TO-PMB: soft updates), so no chosen cost to plot."""
+    chosen assignment of a cost matrix (JPDA, PHD, CPHD, TO-PMB: soft updates), so no chosen cost to plot.
+    ``keeps_detection_box``: an output box has the size, heading and height of the detection that last updated its
+    track; False for a tracker that filters the whole box (``gnnpmb.box``), whose box only nears the detection's."""
 
     panels: tuple[Panel, ...] = ()
     has_existence: bool = True
     has_gates: bool = True
     has_costs: bool = True
+    keeps_detection_box: bool = True
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         self.class_name = class_name
@@ -125,12 +131,18 @@ class ClassFilter(ABC, Generic[PriorT, PosteriorT]):
         prior = self.predict(meas, dt_s)
         if sink.enabled:
             t, gating = self.prior_view(prior)
-            emit_prior(sink, self.class_name, t, gating, meas.source_index, self.config.models.gate_chi2)
+            emit_prior(sink, self.class_name, t, gating, meas.source_index, self.gate_threshold)
         posterior = self.update(prior, meas, sink)
         estimates, threshold = self.extract(posterior, sink)
         if sink.enabled:
             emit_posterior(sink, self.class_name, self.posterior_view(posterior), estimates, threshold)
         return estimates
+
+    @property
+    def gate_threshold(self) -> float:
+        """The squared Mahalanobis gate ``Gated`` reports (``[models] gate_chi2``; a family with its own gate
+        says so)."""
+        return self.config.models.gate_chi2
 
     def idle(self) -> bool:
         """True when a frame without measurements would leave the filter unchanged and extract nothing, so

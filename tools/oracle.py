@@ -57,7 +57,9 @@ USED_SHARE = 0.01
 class Sources:
     """What the oracle checks against, for one tracker run on one scene: frames (index -> FrameResult), results
     (submission boxes by sample token), events by (frame, class) and kind, the report, the devkit's evaluation
-    recomputed (``Devkit``), the scene, and other trackers' reports by name."""
+    recomputed (``Devkit``), the scene, and other trackers' reports by name. keeps_detection_box: the tracker's output
+    boxes carry their detections' size, heading and height (False for a box-filtering tracker, whose box can only
+    be tied to a detection through its raw events)."""
 
     scene: Any
     frames: Mapping[int, Any]
@@ -66,6 +68,7 @@ class Sources:
     report: Any
     devkit: Devkit
     others: Mapping[str, Any] = field(default_factory=dict)
+    keeps_detection_box: bool = True
 
     def box(self, frame: int, track: int) -> Mapping[str, Any] | None:
         token = self.scene.keyframes[frame].sample_token
@@ -151,6 +154,17 @@ def recompute_devkit(nusc, scene, results, cfg) -> Devkit:
 
 
 # The oracle's own reading of the raw events.
+def _box_update_of(src: Sources, frame: int, class_name: str, track: int) -> int | None:
+    """The detection a box-filtering tracker's ``track`` was born from or updated with at ``frame`` (raw ``Born``
+    and ``Assignment`` events), None if neither."""
+    for born in src.events.get((frame, class_name), {}).get(Born, ()):
+        hit = np.flatnonzero(np.asarray(born.track_ids) == track)
+        if hit.size:
+            return int(np.asarray(born.meas_indices)[hit[0]])
+    used = used_of(src, frame, class_name, track)
+    return used[0][0][0] if used is not None and used[0] else None
+
+
 def used_of(
     src: Sources, frame: int, class_name: str, track: int
 ) -> tuple[tuple[tuple[int, float], ...], float] | None:
@@ -304,6 +318,11 @@ def _check(c: Claim, f: Finding, src: Sources) -> str:  # noqa: C901 (one branch
                 return ""
             if v[1] >= len(boxes):
                 return f"the frame has no detection m{v[1]}"
+            if not src.keeps_detection_box:
+                took = _box_update_of(src, x, box["tracking_name"], v[0])
+                if v[1] >= 0:
+                    return "" if took == v[1] else f"its update took {took}, not that detection"
+                return "" if took is None else f"its update took detection {took}"
             if v[1] >= 0:
                 return "" if _same_geometry(box, boxes, v[1]) else "its box does not carry that detection"
             same = [m for m in range(len(boxes)) if _same_geometry(box, boxes, m)]
@@ -549,6 +568,7 @@ def sources(request, tracker: str, evidence: Mapping[str, Any], events: Sequence
     from gnnpmb.eval.nuscenes_eval import tracking_config
     from gnnpmb.eval.submission import run_results
     from gnnpmb.pipeline import run_tracker
+    from gnnpmb.registry import tracker_keeps_detection_box
 
     run = evidence[tracker].run
     if events is None:
@@ -579,6 +599,7 @@ def sources(request, tracker: str, evidence: Mapping[str, Any], events: Sequence
         evidence[tracker].report,
         recompute_devkit(open_nuscenes(request.location), request.scene, results, tracking_config()),
         {t: ev.report for t, ev in evidence.items() if t != tracker},
+        tracker_keeps_detection_box(tracker),
     )
 
 

@@ -150,6 +150,17 @@ def _scale_notes(decisions: Sequence[Decisions]) -> list[str]:
                 "detection starts a track or is clutter). margin = how much worse the best assignment gets without "
                 f"that pair (a close call below {scale.close_call:g})."
             )
+        elif scale.similarity is not None:
+            how = "the best assignment gets" if scale.optimal else "the detection's next closest column is"
+            never = (
+                f" a pair with {scale.similarity} below {1 - scale.threshold:g} is never matched;"
+                if (scale.threshold is not None)
+                else ""
+            )
+            out.append(
+                f"cost = 1 − {scale.similarity} (lower = more overlap;{never} **new** = the detection starts a track). "
+                f"margin = how much worse {how}, in {scale.similarity} (a close call below {scale.close_call:g})."
+            )
         else:
             how = "the best assignment gets" if scale.optimal else "the detection's next closest column is"
             out.append(

@@ -17,9 +17,11 @@ from gnnpmb.why.facts import ClassFrame, TrackerFacts, Went
 from gnnpmb.why.words import (
     SHOW_MIN_EXISTENCE,
     column_name,
+    cost_named,
     cost_value,
     destination_text,
     existence_text,
+    margin_value,
     meas_name,
     use_text,
 )
@@ -225,9 +227,9 @@ class Storyteller:
                         StoryKind.CLOSE_CALL,
                         "INFO",
                         tuple(sorted(tracks | ({b} if b is not None else set()))),
-                        f"close call: {meas_name(c.meas.ref)} → {went} (cost {cost_value(c.chosen_cost, c)}) over "
+                        f"close call: {meas_name(c.meas.ref)} → {went} ({cost_named(c.chosen_cost, c)}) over "
                         f"{column_name(c.alternative)} ({cost_value(c.alternative_cost, c)}), margin "
-                        f"{cost_value(c.margin, c)}",
+                        f"{margin_value(c.margin, c)}",
                     )
                 )
         return out

@@ -124,9 +124,21 @@ def _brief(terms: PairTerms | None) -> str:
 
 
 def cost_value(value: float, choice: PairChoice) -> str:
-    """A cost on its scale: ``6.76`` (nats) or ``1.20 m``."""
-    unit = choice.scale.unit
-    return f"{value:.2f}" if unit == "nats" else f"{value:.2f} {unit}"
+    """A cost in the tracker's own terms: ``6.76`` (nats), ``1.20 m``, or for a cost that is 1 - a similarity
+    ``GIoU -0.21``."""
+    scale = choice.scale
+    if scale.similarity is not None:
+        return f"{scale.similarity} {1.0 - value:.2f}"
+    return f"{value:.2f}" if scale.unit == "nats" else f"{value:.2f} {scale.unit}"
+
+
+def margin_value(value: float, choice: PairChoice) -> str:
+    """A margin (a difference of costs) in the tracker's own terms: ``0.31`` (nats), ``0.20 m``, ``0.29 of
+    GIoU``."""
+    scale = choice.scale
+    if scale.similarity is not None:
+        return f"{value:.2f} of {scale.similarity}"
+    return f"{value:.2f}" if scale.unit == "nats" else f"{value:.2f} {scale.unit}"
 
 
 def destination_text(went: int, born: bool, chosen: AxisLabel | None = None) -> str:
@@ -203,8 +215,14 @@ def choice_text(frame: int, c: PairChoice, went: int, born: bool) -> str:
     score = f" (score {terms.score:.2f})" if terms is not None and terms.score is not None else ""
     return (
         f"frame {frame}: {meas_name(c.meas.ref)}{score} → **{destination_text(went, born, c.chosen)}** "
-        f"(cost {cost_value(c.chosen_cost, c)}) {other}, margin {cost_value(c.margin, c)}"
+        f"({cost_named(c.chosen_cost, c)}) {other}, margin {margin_value(c.margin, c)}"
     )
+
+
+def cost_named(value: float, c: PairChoice) -> str:
+    """``cost 6.75`` / ``cost 1.20 m``; a similarity needs no word (``GIoU -0.21``)."""
+    text = cost_value(value, c)
+    return text if c.scale.similarity is not None else f"cost {text}"
 
 
 def key_text(k: KeyDecision) -> str:
@@ -455,7 +473,8 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     if ended is not None:
         e = ended.ended
         if e.ending is Ending.DELETED and e.hits >= 0:
-            parts.append(f"its track logic deleted it at frame {ended.frame} ({e.hits} of {e.window} hits)")
+            hits = f"no hit in its last {e.window} frames" if e.hits == 0 else f"{e.hits} of {e.window} hits"
+            parts.append(f"its track logic deleted it at frame {ended.frame} ({hits})")
         elif e.ending is Ending.DELETED:
             parts.append(f"its track logic deleted it at frame {ended.frame}")
         elif e.ending is Ending.MERGED:

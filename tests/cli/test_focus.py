@@ -397,6 +397,7 @@ def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(
     why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
     assert why.startswith("**Why** (gnn, ") and "existence" not in why  # GNN's tracks have none
     e = ended[0]
-    assert f"its track logic deleted it at frame {e.frame} ({e.ended.hits} of {e.ended.window} hits)" in why
+    hits = f"{e.ended.hits} of {e.ended.window} hits" if e.ended.hits else f"no hit in its last {e.ended.window} frames"
+    assert f"its track logic deleted it at frame {e.frame} ({hits})" in why
     o = finding.taker
     assert f"track {o.track_id} had been started at frame {o.frame} by m{o.meas}" in why

@@ -155,3 +155,45 @@ def test_a_model_key_given_in_both_sections_is_an_error_naming_it(tmp_path):
     path.write_text("[models]\np_survive = 1.5\n")
     with pytest.raises(ConfigError, match=r"\[models\] p_survive must be in \(0, 1\], got 1.5"):
         load_config(path)
+
+
+def test_box_noise_tables_read_check_and_round_trip(tmp_path):
+    path = tmp_path / "p.toml"
+    path.write_text("[box_noise.car]\nr_yaw = 0.25\nq_size = 0.0\n")
+    cfg = load_config(path)
+    assert cfg.box_noise["car"].r_yaw == 0.25 and cfg.box_noise["bus"] == TrackerConfig().box_noise["bus"]
+    assert get_param(cfg, "box_noise.car.r_yaw") == 0.25
+    assert get_param(with_params(cfg, {"box_noise.truck.p_vx": 2.0}), "box_noise.truck.p_vx") == 2.0
+    again = tmp_path / "again.toml"
+    again.write_text(dump_config(cfg))
+    assert load_config(again) == cfg
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[box_noise.boat]\nr_x = 1\n", r"\[box_noise.boat\]: unknown class"),
+        ("[box_noise.car]\nr_x = 0\n", r"\[box_noise.car\] r_x must be > 0, got 0"),
+        ("[box_noise.car]\nr_xx = 1\n", "unknown parameter 'r_xx'"),
+        ("[ab3dmot]\niou_threshold = 1.0\n", r"\[ab3dmot\] iou_threshold must be in \[0, 1\), got 1.0"),
+        ("[simpletrack]\ndetector_velocity = 2\n", r"\[simpletrack\] detector_velocity must be in \[0, 1\], got 2"),
+        ("[classes.car]\nmin_hits = 2\n", r"'min_hits' is a parameter of several sections"),
+    ],
+)
+def test_bad_baseline_parameters_give_one_clear_error(tmp_path, text, message):
+    path = tmp_path / "p.toml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=message):
+        load_config(path)
+
+
+def test_a_baseline_key_per_class_goes_in_its_section_sub_table(tmp_path):
+    path = tmp_path / "p.toml"
+    path.write_text("[classes.pedestrian.ab3dmot]\nmin_hits = 1\n")
+    cfg = load_config(path)
+    assert cfg.resolved("pedestrian").ab3dmot.min_hits == 1 and cfg.resolved("car").ab3dmot.min_hits == 3
+
+
+def test_shipped_box_noise_file_is_a_parameter_file():
+    cfg = load_config(DEFAULT_FILE.parent / "params" / "box_noise_mini_train.toml")
+    assert cfg.box_noise != TrackerConfig().box_noise and cfg.classes == TrackerConfig().classes

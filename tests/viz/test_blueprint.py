@@ -143,7 +143,8 @@ def test_an_existence_plot_only_for_trackers_whose_tracks_have_an_existence_prob
     from gnnpmb.registry import TRACKER_NAMES, tracker_has_existence
 
     without = {name for name in TRACKER_NAMES if not tracker_has_existence(name)}
-    assert without == {"gnn", "jpda", "greedy"}  # track logic: a track exists or not
+    # track logic (a track exists or not) and the model-based baselines' hits and misses or track scores
+    assert without == {"gnn", "jpda", "greedy", "ab3dmot", "prob3dmot", "simpletrack", "immortal", "cbmot"}
     origins = {v.origin for v in views(default_blueprint(["gnnpmb", "gnn"], ["car"]))}
     assert paths.existence_root("gnnpmb") in origins and paths.existence_root("gnn") not in origins
     assert paths.nis_root("gnn") in origins and paths.chosen_cost_root("gnn") in origins
@@ -153,7 +154,9 @@ def test_an_existence_plot_only_for_trackers_whose_tracks_have_an_existence_prob
 def test_no_innovation_plot_for_a_tracker_without_gates() -> None:
     from gnnpmb.registry import TRACKER_NAMES, tracker_has_gates
 
-    assert {name for name in TRACKER_NAMES if not tracker_has_gates(name)} == {"greedy"}
+    # distances and box overlaps; prob3dmot's Mahalanobis distance is a Gaussian gate
+    ungated = {"greedy", "cbmot", "ab3dmot", "simpletrack", "immortal"}
+    assert {name for name in TRACKER_NAMES if not tracker_has_gates(name)} == ungated
     origins = {v.origin for v in views(default_blueprint(["gnn", "greedy"], ["car"]))}
     assert paths.nis_root("gnn") in origins and paths.nis_root("greedy") not in origins
     assert paths.chosen_cost_root("greedy") in origins

@@ -130,6 +130,6 @@ def test_a_deleted_track_and_a_detection_that_started_another_are_both_said() ->
         has_existence=False,
     )
     line = why_lines(f)[0]
-    assert "its track logic deleted it at frame 14 (0 of 3 hits)" in line
+    assert "its track logic deleted it at frame 14 (no hit in its last 3 frames)" in line
     assert "at frame 15 m0 (score 0.89, 0.1 m from it; track 62 was gone) → new track 348" in line
     assert "given no detection" not in line and "?" not in line
