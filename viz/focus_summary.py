@@ -28,6 +28,7 @@ from gnnpmb.why.words import (
     evaluation_lines,
     existence_text,
     frames_text,
+    hits_text,
     key_text,
     meas_name,
     on_object_text,
@@ -209,7 +210,7 @@ def _diagnosis(view: TrackerView, class_name: str, track_ids: list[int], frames:
         if ended is not None:
             e = ended.ended
             if e.hits >= 0:
-                parts.append(f"{e.ending.value} at frame {ended.frame} ({e.hits} of {e.window} hits)")
+                parts.append(f"{e.ending.value} at frame {ended.frame} ({hits_text(e.hits, e.window)})")
             elif e.ending is Ending.DELETED:
                 parts.append(f"{e.ending.value} at frame {ended.frame}")
             else:

@@ -21,6 +21,7 @@ from gnnpmb.why.words import (
     cost_value,
     destination_text,
     existence_text,
+    hits_text,
     margin_value,
     meas_name,
     use_text,
@@ -172,7 +173,7 @@ class Storyteller:
                     StoryKind.DELETED,
                     "WARN",
                     (ev.track_id,),
-                    f"track {ev.track_id} deleted ({ev.hits}/{ev.window} hits)",
+                    f"track {ev.track_id} deleted ({hits_text(ev.hits, ev.window)})",
                 )
         use = self.facts.use(frame, class_name)
         if use is not None and cf.meas is not None:

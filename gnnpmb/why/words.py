@@ -123,6 +123,11 @@ def _brief(terms: PairTerms | None) -> str:
     return f" at {cost_brief(terms)}" if terms is not None else ""
 
 
+def hits_text(hits: int, window: int) -> str:
+    """A track-logic count: ``2 of 3 hits``, or ``no hit in its last 2 frames`` (a deletion by misses)."""
+    return f"no hit in its last {window} frames" if hits == 0 else f"{hits} of {window} hits"
+
+
 def cost_value(value: float, choice: PairChoice) -> str:
     """A cost in the tracker's own terms: ``6.76`` (nats), ``1.20 m``, or for a cost that is 1 - a similarity
     ``GIoU -0.21``."""
@@ -473,8 +478,7 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     if ended is not None:
         e = ended.ended
         if e.ending is Ending.DELETED and e.hits >= 0:
-            hits = f"no hit in its last {e.window} frames" if e.hits == 0 else f"{e.hits} of {e.window} hits"
-            parts.append(f"its track logic deleted it at frame {ended.frame} ({hits})")
+            parts.append(f"its track logic deleted it at frame {ended.frame} ({hits_text(e.hits, e.window)})")
         elif e.ending is Ending.DELETED:
             parts.append(f"its track logic deleted it at frame {ended.frame}")
         elif e.ending is Ending.MERGED:

@@ -235,7 +235,7 @@ def test_story_log_tells_each_reported_track_and_aggregates_candidates(logged: t
     frame0 = lines(rows, 0)
     assert ("track 1 confirmed (r=0.97, from m0)", "INFO") in frame0
     assert ("2 new candidates from m0, m1; 0 candidates pruned", "DEBUG") in frame0
-    assert ("track 1 deleted (0/4 hits)", "WARN") in frame0
+    assert ("track 1 deleted (no hit in its last 4 frames)", "WARN") in frame0
     frame1 = lines(rows, 1)
     assert ("close call: m1 → track 2 (cost -4.50) over track 1 (-5.00), margin 0.50", "INFO") in frame1
     assert ("0 new candidates; 1 candidates pruned", "DEBUG") in frame1
