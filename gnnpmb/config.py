@@ -82,6 +82,14 @@ RULES: dict[str, Range] = {
     "pmb.prune_existence": Range(0.0, 1.0, True, False),
     "pmb.extraction_threshold": _PROB,
     "pmb.miss_p_detect_max": Range(0.0, 1.0, False, True),
+    "pmb.miss_score_decay": Range(0.0, 1.0, False, True),
+    "pmb.heading_std_rad": Range(0.0, 1.5, True, True),
+    "pmb.size_log_std": Range(0.0, 2.0, True, True),
+    "pmb.size_log_spread": _POSITIVE,
+    "pmb.box_outlier_prob": Range(0.0, 1.0, False, False),
+    "models.motion_model": Range(0.0, 1.0, True, True),
+    "models.turn_rate_std_rps": _NON_NEGATIVE,
+    "models.birth_turn_rate_std_rps": _POSITIVE,
     "pmbm.n_hypotheses": _at_least(1),
     "pmbm.hypothesis_prune": Range(0.0, 1.0, True, False),
     "lbp.max_iterations": _at_least(1),
@@ -302,6 +310,11 @@ class ModelParams:
       few frames decays so far that its object comes back under a new id.
     - birth_weight 0.3 (paper 0.1): the prior rate of new objects per detection; a larger one makes a detection's
       first Bernoulli more likely (r_new = w s N / (c + w s N)), so a new object's first box is scored higher.
+
+    motion_model: 0 = constant velocity (the paper's), 1 = coordinated turn (constant turn rate and velocity,
+    state [x, y, vx, vy, omega], extended Kalman predict; ``gnnpmb.models.ct_model``), read by the PMB family;
+    turn_rate_std_rps: the turn rate's process noise per keyframe (rad/s); birth_turn_rate_std_rps: a new track's
+    turn-rate standard deviation (its turn rate starts at 0).
     """
 
     p_survive: float = 0.95
@@ -310,6 +323,9 @@ class ModelParams:
     birth_weight: float = 0.3
     birth_pos_std_m: float = 15.0
     birth_vel_std_mps: float = 1.0
+    motion_model: int = 0
+    turn_rate_std_rps: float = 0.2
+    birth_turn_rate_std_rps: float = 0.5
 
     def __post_init__(self) -> None:
         validate_section(self, "models")
@@ -336,6 +352,12 @@ class PmbParams:
     clutter_velocity_density: with measure_velocity = 1 the clutter intensity is per m^2 per (m/s)^2, so it is
     clutter_intensity x this density of a clutter detection's velocity (default: uniform over a 20 x 20 m/s
     square, 1/400); unused otherwise.
+    miss_score_decay: a Bernoulli missed for n frames in a row is output with tracking score s r d^n (d = this;
+    1: no decay, the paper's s r). Its predicted box stays in the output while r >= the extraction threshold,
+    ranked below the boxes of detected tracks (Poly-MOT's score decay of unmatched tracks, Li et al. 2023).
+    heading_std_rad, size_log_std, size_log_spread, box_outlier_prob: the heading and size measurement model
+    (``gnnpmb.box_likelihood``): sigma_psi of a detection's heading, sigma_s of its log width and length, sigma_c
+    the spread of the class's log sizes, eps the outlier share; a sigma of 0 leaves that part out (the paper).
     """
 
     prune_existence: float = 1e-6
@@ -343,6 +365,11 @@ class PmbParams:
     miss_p_detect_max: float = 0.3
     measure_velocity: int = 0
     clutter_velocity_density: float = 1.0 / 400.0
+    miss_score_decay: float = 1.0
+    heading_std_rad: float = 0.0
+    size_log_std: float = 0.0
+    size_log_spread: float = 0.2
+    box_outlier_prob: float = 0.1
 
     def __post_init__(self) -> None:
         validate_section(self, "pmb")

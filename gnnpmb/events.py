@@ -183,7 +183,9 @@ class PairTerms:
     tracker without existences or score-based P_D); d2: squared Mahalanobis distance; distance_nats: d2 / 2;
     spread_m: the predicted measurement's spread |S_k|^(1 / 2D) (the geometric mean of its standard deviations,
     metres); spread_nats: (log|S_k| + D log 2 pi) / 2 (with distance_nats, -log N(z_j; H m_k, S_k));
-    offset_nats: a constant every pair of the matrix shares, named by offset_text (GNN: detection against clutter).
+    offset_nats: a constant every pair of the matrix shares, named by offset_text (GNN: detection against clutter);
+    box_nats: minus the log-likelihood ratio of the detection's heading and size against the track's last box
+    (``gnnpmb.box_likelihood``; 0 for a tracker that measures the centre only).
     """
 
     existence: float | None
@@ -197,10 +199,18 @@ class PairTerms:
     spread_nats: float
     offset_nats: float = 0.0
     offset_text: str = ""
+    box_nats: float = 0.0
 
     @property
     def total_nats(self) -> float:
-        return self.offset_nats + self.existence_nats + self.score_nats + self.distance_nats + self.spread_nats
+        return (
+            self.offset_nats
+            + self.existence_nats
+            + self.score_nats
+            + self.distance_nats
+            + self.spread_nats
+            + self.box_nats
+        )
 
     def existence_for(self, cheaper_by_nats: float) -> float | None:
         """The predicted existence at which this cost would be ``cheaper_by_nats`` lower, all else equal: solves
@@ -223,12 +233,14 @@ class PairTerms:
 @dataclass(frozen=True, slots=True)
 class CostTerms:
     """The track entries of a cost matrix taken apart: C[j, k] = offset_nats + existence_nats[k] + score_nats[j] +
-    distance_nats[j, k] + spread_nats[k] on every gated entry (``PairTerms``).
+    distance_nats[j, k] + spread_nats[k] + box_nats[j, k] on every gated entry (``PairTerms``).
 
     PMB family (``gnnpmb.pmb.cost``, García-Fernández et al. 2018, eq. 12-13): existence r (K,), miss_log_lik
     log(1 - r P_D) (K,), score s (M,), offset 0. GNN (``gnnpmb.vector.gnn``): no existence or score (None), the
     offset -log(P_D / ((1 - P_D) kappa)). Both: d2 (K, M) squared Mahalanobis distances, log_det_S (K,), dim D of
-    the measurement; track_ids (K,) of the columns. Holds the arrays the tracker computed anyway (no copies)."""
+    the measurement; track_ids (K,) of the columns; box_nats (K, M): minus the heading and size log-likelihood
+    ratio (``gnnpmb.box_likelihood``), None when the tracker measures the centre only. Holds the arrays the
+    tracker computed anyway (no copies)."""
 
     existence: np.ndarray | None
     miss_log_lik: np.ndarray | None
@@ -239,6 +251,7 @@ class CostTerms:
     offset_nats: float = 0.0
     offset_text: str = ""
     track_ids: np.ndarray | None = None
+    box_nats: np.ndarray | None = None
 
     def column_of(self, track_id: int) -> int | None:
         """The track column of ``track_id``, None if the matrix has no such track (or no ids)."""
@@ -271,6 +284,7 @@ class CostTerms:
             spread_nats=0.5 * (log_det_S + self.dim * math.log(2.0 * math.pi)),
             offset_nats=self.offset_nats,
             offset_text=self.offset_text,
+            box_nats=0.0 if self.box_nats is None else float(self.box_nats[k, j]),
         )
 
 
