@@ -18,10 +18,10 @@ from gnnpmb.data.simdet import (
     to_submission,
 )
 from gnnpmb.data.simdet_presets import CLASS_MODELS, VARIANTS
-
-VARIANTS_RUNS = VARIANTS["runs"]
 from gnnpmb.errors import UnknownNameError
 from gnnpmb.types import TRACKING_CLASSES, Boxes
+
+VARIANTS_RUNS = VARIANTS["runs"]
 
 SIZES = {
     "car": (1.9, 4.5, 1.6),
