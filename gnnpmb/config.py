@@ -87,6 +87,7 @@ RULES: dict[str, Range] = {
     "pmb.size_log_std": Range(0.0, 2.0, True, True),
     "pmb.size_log_spread": _POSITIVE,
     "pmb.box_outlier_prob": Range(0.0, 1.0, False, False),
+    "pmb.gate_giou_min": Range(-1.0, 1.0, True, True),
     "models.motion_model": Range(0.0, 1.0, True, True),
     "models.turn_rate_std_rps": _NON_NEGATIVE,
     "models.birth_turn_rate_std_rps": _POSITIVE,
@@ -358,6 +359,9 @@ class PmbParams:
     heading_std_rad, size_log_std, size_log_spread, box_outlier_prob: the heading and size measurement model
     (``gnnpmb.box_likelihood``): sigma_psi of a detection's heading, sigma_s of its log width and length, sigma_c
     the spread of the class's log sizes, eps the outlier share; a sigma of 0 leaves that part out (the paper).
+    gate_giou_min: a pair inside the Mahalanobis gate is also required to have a bird's-eye GIoU of at least this
+    between the detection and the track's predicted box (its filtered centre, its last detection's size and
+    heading); -1 (GIoU > -1 always): no overlap gate, the paper's. Poly-MOT and SimpleTrack gate on GIoU alone.
     """
 
     prune_existence: float = 1e-6
@@ -370,6 +374,7 @@ class PmbParams:
     size_log_std: float = 0.0
     size_log_spread: float = 0.2
     box_outlier_prob: float = 0.1
+    gate_giou_min: float = -1.0
 
     def __post_init__(self) -> None:
         validate_section(self, "pmb")

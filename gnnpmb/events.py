@@ -161,7 +161,9 @@ class Gated:
     track_ids: (K,); meas_indices: (M,) source indices; inside: (K, M) bool; center_xy: (K, 2) predicted
     measurement H m_k; innovation_cov: (K, 2, 2) S_k; threshold: squared Mahalanobis gate (chi-square value);
     d2: (K, M) the squared Mahalanobis distances the tracker computed (over its full measurement vector, which can
-    hold more than x, y), the NIS every explanation quotes.
+    hold more than x, y), the NIS every explanation quotes. giou / giou_min: with an overlap gate as well (PMB
+    family, ``[pmb] gate_giou_min``), the bird's-eye GIoU (K, M) of every pair inside the Mahalanobis gate (NaN
+    elsewhere) and its minimum: inside = (d2 < threshold) & (giou >= giou_min); None without one.
     """
 
     class_name: str
@@ -172,6 +174,8 @@ class Gated:
     innovation_cov: np.ndarray
     threshold: float
     d2: np.ndarray
+    giou: np.ndarray | None = None
+    giou_min: float | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -466,7 +466,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         """The K Bernoullis of the most likely prior hypothesis and their gate."""
         local = prior.locals_[0]
         b = local.prior
-        return _view(b), Gating(local.inn, local.d2, local.inside)
+        return _view(b), Gating(local.inn, local.d2, local.inside, local.giou, local.gate_giou_min)
 
     def update(self, prior: PmbPrior, meas: Measurements, sink: EventSink) -> Bernoullis:
         """Steps 4-5: the strategy's posterior hypotheses, pruned, become the state; returns the Bernoullis of the
@@ -516,7 +516,16 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         if len(self.hypotheses) == 1:
             h = self.hypotheses[0]
             prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
-            local = local_hypotheses(prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max, self.box)
+            local = local_hypotheses(
+                prior,
+                meas,
+                new,
+                model.R,
+                p.gate_chi2,
+                self.params.miss_p_detect_max,
+                self.box,
+                self.params.gate_giou_min,
+            )
             return PmbPrior([GlobalHypothesis(h.log_weight, prior)], [local])
         union, members = hypothesis_union(self.hypotheses)
         union_prior = predict_bernoullis(union, model, p.p_survive)

@@ -21,7 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gnnpmb.box.overlap import giou_bev
 from gnnpmb.box_likelihood import BoxShapeModel, box_log_ratio
+from gnnpmb.data.boxes3d import yaw_from_quat_wxyz
 from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, CostTerms, axis_labels
 from gnnpmb.kalman import Innovation, log_likelihood, paired_updated_means
 from gnnpmb.pmb.bernoulli import Bernoullis, missed_update
@@ -37,7 +39,9 @@ class LocalHypotheses:
     prior: K predicted Bernoullis; meas: M measurements; inn: innovation quantities (K);
     d2: (K, M) squared Mahalanobis distances; inside: (K, M) gate; miss_log_lik / miss_existence: (K,);
     det_log_lik: (K, M), -inf outside the gate; new: the M new-track hypotheses; box_log_ratio: (K, M) the
-    heading and size log-likelihood ratio in det_log_lik (``box_likelihood``), None when not used.
+    heading and size log-likelihood ratio in det_log_lik (``box_likelihood``), None when not used; giou: (K, M)
+    the bird's-eye GIoU of the pairs inside the Mahalanobis gate (NaN elsewhere) when the overlap gate
+    (``gate_giou_min``) applies, else None.
     """
 
     prior: Bernoullis
@@ -50,6 +54,8 @@ class LocalHypotheses:
     det_log_lik: np.ndarray
     new: NewTrackHypotheses
     box_log_ratio: np.ndarray | None = None
+    giou: np.ndarray | None = None
+    gate_giou_min: float | None = None
 
     @property
     def n_tracks(self) -> int:
@@ -113,6 +119,8 @@ class LocalHypotheses:
             det_log_lik=self.det_log_lik[index],
             new=self.new,
             box_log_ratio=None if self.box_log_ratio is None else self.box_log_ratio[index],
+            giou=None if self.giou is None else self.giou[index],
+            gate_giou_min=self.gate_giou_min,
         )
 
     def row_labels(self) -> tuple[AxisLabel, ...]:
@@ -131,12 +139,18 @@ def local_hypotheses(
     gate_chi2: float,
     miss_p_detect_max: float = 1.0,
     box: BoxShapeModel | None = None,
+    gate_giou_min: float = -1.0,
 ) -> LocalHypotheses:
     """Gate every (track, measurement) pair and compute the local hypothesis likelihoods (module docstring); a
     missed track's P_D is its last detection score capped at ``miss_p_detect_max`` (``PmbParams``); ``box``: the
-    heading and size model (None or disabled: position only)."""
+    heading and size model (None or disabled: position only); ``gate_giou_min`` > -1: a pair must also overlap
+    with bird's-eye GIoU >= it (``overlap_gate``)."""
     gating = gate_tracks(prior.mean, prior.cov, R, meas.z, gate_chi2)
     inn, d2, inside = gating.inn, gating.d2, gating.inside
+    giou = None
+    if gate_giou_min > -1.0:
+        giou = overlap_gate(prior, meas, inside)
+        inside = inside & (giou >= gate_giou_min)
     # missed_update caps P_D below 1 itself: a cap at or above 1 changes nothing
     p_detect = prior.score if miss_p_detect_max >= 1.0 else np.minimum(prior.score, miss_p_detect_max)
     miss_log_lik, miss_existence = missed_update(prior.existence, p_detect)
@@ -160,7 +174,28 @@ def local_hypotheses(
         det_log_lik=det_log_lik,
         new=new,
         box_log_ratio=ratio,
+        giou=giou,
+        gate_giou_min=None if giou is None else gate_giou_min,
     )
+
+
+def overlap_gate(prior: Bernoullis, meas: Measurements, inside: np.ndarray) -> np.ndarray:
+    """(K, M) bird's-eye GIoU (``box.overlap.giou_bev``) of every pair inside the Mahalanobis gate: the
+    detection's box against the track's predicted box (predicted centre, last detection's width, length and
+    heading); NaN for the pairs outside."""
+    out = np.full(inside.shape, np.nan)
+    k, j = np.nonzero(inside)
+    if len(k):
+        tracks, boxes = prior.size_wlh_m, meas.boxes
+        out[k, j] = giou_bev(
+            prior.mean[k, :2],
+            tracks[k, :2],
+            yaw_from_quat_wxyz(prior.quat_wxyz[k]),
+            boxes.xy[j],
+            boxes.size_wlh_m[j, :2],
+            yaw_from_quat_wxyz(boxes.quat_wxyz[j]),
+        )
+    return out
 
 
 def detected_means(local: LocalHypotheses, track_index: np.ndarray, meas_index: np.ndarray) -> np.ndarray:

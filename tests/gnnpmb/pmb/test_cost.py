@@ -111,3 +111,24 @@ def test_cost_terms_add_up_with_the_heading_and_size_model():
         t = terms.pair(j, i)
         assert t.box_nats != 0.0
         assert np.isclose(t.total_nats, cost[j, i], rtol=0, atol=1e-12)
+
+
+def test_overlap_gate_keeps_only_pairs_that_overlap_enough():
+    """Two detections inside the Mahalanobis gate of a track at the origin (2 x 4.5 m car, heading 0): one 0.5 m
+    ahead (GIoU ~0.8), one turned by 90 degrees (GIoU < 0.5); a GIoU gate of 0.5 keeps the first only."""
+    meas = make_measurements([(0.5, 0.0), (0.0, 0.3)], 0.7)
+    meas = Measurements(
+        replace(meas.boxes, quat_wxyz=quat_wxyz_from_yaw(np.array([0.0, np.pi / 2]))), meas.source_index
+    )
+    new = new_track_hypotheses(measurement_birth(meas, CFG.models), meas, R, CFG.models.clutter_intensity)
+    track = bernoullis([(0.0, 0.0)])
+    track = replace(
+        track, det=replace(track.det, size_wlh_m=np.array([[2.0, 4.5, 1.6]]), quat_wxyz=np.array([[1.0, 0, 0, 0]]))
+    )
+    plain = local_hypotheses(track, meas, new, R, CFG.models.gate_chi2)
+    gated = local_hypotheses(track, meas, new, R, CFG.models.gate_chi2, gate_giou_min=0.5)
+    assert plain.inside.tolist() == [[True, True]] and plain.giou is None
+    assert gated.inside.tolist() == [[True, False]]
+    expected = (2.0 * 4.0) / (2.0 * 5.0)  # I / U with |C| = U: two aligned boxes 0.5 m apart along their length
+    assert np.isclose(gated.giou[0, 0], expected, rtol=0, atol=1e-12) and gated.giou[0, 1] < 0.5
+    assert np.isinf(gated.cost_matrix()[1, 0]) and np.isfinite(gated.cost_matrix()[0, 0])
