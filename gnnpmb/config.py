@@ -592,8 +592,16 @@ class CbmotParams:
         validate_section(self, "cbmot")
 
 
-PAPER_MODELS = ModelParams(p_survive=0.7, birth_weight=0.1)
-PAPER_PMB = PmbParams(extraction_threshold=0.9, miss_p_detect_max=1.0)
+PAPER_MODELS = ModelParams(p_survive=0.7, birth_weight=0.1, motion_model=0)
+PAPER_PMB = PmbParams(
+    extraction_threshold=0.9,
+    miss_p_detect_max=1.0,
+    measure_velocity=0,
+    miss_score_decay=1.0,
+    heading_std_rad=0.0,
+    size_log_std=0.0,
+    gate_giou_min=-1.0,
+)
 PAPER_PMBM = PmbmParams(n_hypotheses=100)
 """The paper's ``[models]``, ``[pmb]`` and ``[pmbm]`` values (sec. V-B, Table II), where the defaults differ
 (``gnnpmb/params/paper.toml``)."""
