@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gnnpmb.config import TrackerConfig, with_params
+from gnnpmb.config import TrackerConfig, paper_config, with_params
 from gnnpmb.events import Gated, ListSink, NullSink
 from gnnpmb.kalman import _innovation_general, innovation
 from gnnpmb.models import cv_model
@@ -71,6 +71,8 @@ def test_birth_then_update_with_velocity_measurement_match_hand_computation():
     np.testing.assert_allclose(gated.innovation_cov[0], S[:2, :2], rtol=1e-9)
 
 
-def test_default_is_the_position_only_paper_model():
-    assert TrackerConfig().pmb.measure_velocity == 0
+def test_default_measures_velocity_and_the_paper_model_does_not():
+    """Chosen on mini_train (``config.PmbParams``); ``params/paper.toml`` keeps the paper's position-only model."""
+    assert TrackerConfig().pmb.measure_velocity == 1 and paper_config().pmb.measure_velocity == 0
     assert cv_model(0.5, TrackerConfig().for_class("car")).R.shape == (2, 2)
+    assert cv_model(0.5, TrackerConfig().for_class("car"), measure_velocity=True).R.shape == (4, 4)
