@@ -350,11 +350,10 @@ class PmbParams:
     ``mini_train`` split among 1.0 / 0.7 / 0.5 / 0.3 (gnnpmb AMOTA centerpoint 0.878 / 0.912 / 0.926 / 0.925,
     pointpillars 0.799 / 0.803 / 0.802 / 0.828; IDS 27 -> 4 and 18 -> 4).
     measure_velocity: 1 = measure [x, y, vx, vy] (``kalman``; R adds r_vx = r_vy = 0.5 (m/s)^2), 0 = the paper's
-    [x, y]. 1 is the default since it was chosen on the demo ``mini_train`` split over the three presets and
-    detector seeds 0, 1, 2 (gnnpmb mean AMOTA 0.8695 -> 0.8883, better on every preset, IDS 4.2 -> 2.7, AMOTP
-    0.428 -> 0.378 m; ``benchmarks/tune_models.py``): every detector the paper tracks with regresses velocity, and
-    the filter's velocity otherwise needs two or three frames to settle, which shows as late, misplaced boxes
-    of vehicles (the issue's worse vehicle AMOTP).
+    [x, y]. 1 was chosen on the demo ``mini_train`` split over the three presets and detector seeds 0, 1, 2
+    (gnnpmb mean AMOTA 0.8695 -> 0.8883, better on every preset, IDS 4.2 -> 2.7, AMOTP 0.428 -> 0.378 m;
+    ``benchmarks/tune_models.py``) and is ``params/velocity.toml``; it is not the default yet because it about
+    doubles the low-score boxes output and so the entities of a recording (``docs/results.md``).
     clutter_velocity_density: with measure_velocity = 1 the clutter intensity is per m^2 per (m/s)^2, so it is
     clutter_intensity x this density of a clutter detection's velocity (default: uniform over a 20 x 20 m/s
     square, 1/400); unused otherwise.
@@ -372,7 +371,7 @@ class PmbParams:
     prune_existence: float = 1e-6
     extraction_threshold: float = 0.01
     miss_p_detect_max: float = 0.3
-    measure_velocity: int = 1
+    measure_velocity: int = 0
     clutter_velocity_density: float = 1.0 / 400.0
     miss_score_decay: float = 1.0
     heading_std_rad: float = 0.0
@@ -390,15 +389,15 @@ class PmbmParams:
     """PMBM hypothesis management (``gnnpmb.pmb.pmbm``; García-Fernández et al. 2018, sec. V).
 
     n_hypotheses: N_h, the most global hypotheses kept; prior hypothesis h of weight w_h gets its
-    ceil(N_h w_h) best assignments (Murty). Default N_h = 10, the per-frame hypothesis budget: on the demo
-    mini_train scenes N_h = 20 gave the AMOTA of the paper's N_h = 100 (``params/paper.toml``) to 4 decimals at
-    less than half the time per frame, and with the velocity measured N_h = 10 gave that of N_h = 20 (mean over
-    3 presets x 3 seeds 0.8881 vs 0.8878) in 16 % less time. N_h = 1 is exactly GNN-PMB.
+    ceil(N_h w_h) best assignments (Murty). Default N_h = 20, the per-frame hypothesis budget: on the demo
+    mini_train scenes it gave the AMOTA of the paper's N_h = 100 (``params/paper.toml``) to 4 decimals at less
+    than half the time per frame; with the velocity measured (``params/velocity.toml``) N_h = 10 gave that of
+    N_h = 20 (mean over 3 presets x 3 seeds 0.8881 vs 0.8878) in 16 % less time. N_h = 1 is exactly GNN-PMB.
     hypothesis_prune: global hypotheses whose normalised weight falls below it are dropped (the most likely one
     always stays).
     """
 
-    n_hypotheses: int = 10
+    n_hypotheses: int = 20
     hypothesis_prune: float = 1e-4
 
     def __post_init__(self) -> None:
