@@ -9,28 +9,38 @@ The parameters come from ``--params`` (repeatable, each file on top of the ones 
 read by ``prob3dmot`` only); ``--params default`` uses the built-in defaults. Every tracker reads the same
 parameters (the shared sections apply to all of them).
 
-``--per-class`` adds one line per tracker with each class's AMOTA (mean ± std over the seeds).
+Under each row, each class's AMOTA (mean ± std over the seeds; ``--no-per-class`` leaves them out). The PMB
+trackers (gnnpmb, pmbm, topmb) also get a row with the paper's configuration (``gnnpmb/params/paper.toml`` on top
+of the same files; ``--no-paper`` leaves it out). ``--external NAME=PATTERN`` adds a row for another tracker's
+submissions, one file per preset and seed (``{split}``, ``{preset}`` and ``{seed}`` in PATTERN are filled in),
+e.g. Poly-MOT run outside this project on the same simulated detections; its per-frame time is read from
+``<file>_time.json`` (``track_cpu_ms``) when there is one.
 
 Usage: uv run python benchmarks/table1.py [--tracker NAME ...] [--preset NAME ...] [--seeds 0,1,2]
-       [--params FILE|default ...] [--split mini_val] [--per-class] [--out DIR]
+       [--params FILE|default ...] [--split mini_val] [--no-per-class] [--no-paper] [--external NAME=PATTERN ...]
+       [--out DIR]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import tempfile
 import tomllib
 from pathlib import Path
 
 import numpy as np
-from demo_split import DemoSplit, score
+from demo_split import DemoSplit, RunScores, score
 
 from gnnpmb.config import TrackerConfig, config_from_dict
 from gnnpmb.data.simdet import PRESETS
+from gnnpmb.eval.nuscenes_eval import evaluate_submission
 from gnnpmb.registry import TRACKER_NAMES
 
 PARAMS = Path(__file__).resolve().parents[1] / "gnnpmb" / "params"
 TUNED = PARAMS / "tuned_mini_train.toml"
+PAPER = PARAMS / "paper.toml"
+PMB_TRACKERS = ("gnnpmb", "pmbm", "topmb")
 BOX_NOISE = PARAMS / "box_noise_mini_train.toml"
 WITH_STD = ("amota", "amotp", "ids")
 COLUMNS = ("amota", "amotp", "recall", "mt", "ml", "fp", "fn", "ids", "frag")
@@ -56,6 +66,28 @@ def layered_config(files: list[str]) -> TrackerConfig:
     return config
 
 
+def external_runs(split: DemoSplit, pattern: str, preset: str, seeds: list[int], out: Path) -> list[RunScores]:
+    """Score another tracker's submission files (``--external``) like the trackers' own runs."""
+    runs = []
+    for seed in seeds:
+        path = Path(pattern.format(split=split.split, preset=preset, seed=seed))
+        scores = evaluate_submission(path, split.location, split.split, out / f"{path.stem}_eval")
+        timing = path.with_name(path.stem + "_time.json")
+        ms = json.loads(timing.read_text())["track_cpu_ms"] if timing.exists() else [float("nan")]
+        runs.append(RunScores(scores, np.asarray(ms, dtype=float)))
+    return runs
+
+
+def print_row(preset: str, label: str, runs: list[RunScores], widths: dict[str, int], per_class: bool) -> None:
+    cells = [f"{cell(c, [r.scores.overall[c] for r in runs]):>{widths[c]}s}" for c in COLUMNS]
+    ms = float(np.median(np.concatenate([r.step_ms for r in runs])))
+    print(f"{preset:13s} {label:16s} " + " ".join(cells) + f" {ms:7.2f}", flush=True)
+    if per_class:
+        classes = sorted(runs[0].scores.per_class)
+        values = [[r.scores.per_class[c]["amota"] for r in runs] for c in classes]
+        print(f"{'':13s} {'':16s} " + " ".join(f"{c} {cell('amota', v)}" for c, v in zip(classes, values, strict=True)))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tracker", action="append", choices=TRACKER_NAMES)
@@ -63,34 +95,36 @@ def main() -> None:
     parser.add_argument("--seeds", default="0,1,2", help="comma-separated detector seeds")
     parser.add_argument("--params", action="append", help="parameter TOML (repeatable, later on top), or 'default'")
     parser.add_argument("--split", default="mini_val")
-    parser.add_argument("--per-class", action="store_true", help="also print each class's AMOTA")
+    parser.add_argument("--no-per-class", dest="per_class", action="store_false", help="overall rows only")
+    parser.add_argument("--no-paper", dest="paper", action="store_false", help="no paper-configuration rows")
+    parser.add_argument("--external", action="append", default=[], help="NAME=PATTERN of submission files")
     parser.add_argument("--out", type=Path, help="keep submissions and metric files here")
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="gnnpmb-table1-"))
     params = args.params or [str(TUNED), str(BOX_NOISE)]
     config = layered_config(params)
+    paper = layered_config([*params, str(PAPER)])
     seeds = [int(s) for s in args.seeds.split(",")]
     split = DemoSplit.load(args.split)
     print(f"split {args.split}, params {' + '.join(params)}, detector seeds {seeds}")
     widths = {c: 12 if c in ("amota", "amotp") else 10 if c in WITH_STD else 6 for c in COLUMNS}
-    header = f"{'preset':13s} {'tracker':11s} " + " ".join(f"{c.upper():>{widths[c]}s}" for c in COLUMNS)
+    header = f"{'preset':13s} {'tracker':16s} " + " ".join(f"{c.upper():>{widths[c]}s}" for c in COLUMNS)
     print(header + f" {'med ms':>7s}", flush=True)
     for preset in args.preset or ("centerpoint", "megvii", "pointpillars"):
         detections = {seed: split.detections(preset, seed) for seed in seeds}
         for tracker in args.tracker or TRACKER_NAMES:
-            runs = [
-                score(split, detections[seed], tracker, config, out / f"{preset}_{tracker}_s{seed}") for seed in seeds
-            ]
-            cells = [f"{cell(c, [r.scores.overall[c] for r in runs]):>{widths[c]}s}" for c in COLUMNS]
-            ms = float(np.median(np.concatenate([r.step_ms for r in runs])))
-            print(f"{preset:13s} {tracker:11s} " + " ".join(cells) + f" {ms:7.2f}", flush=True)
-            if args.per_class:
-                classes = sorted(runs[0].scores.per_class)
-                per_class = [[r.scores.per_class[c]["amota"] for r in runs] for c in classes]
-                print(
-                    f"{'':13s} {'':11s} "
-                    + " ".join(f"{c} {cell('amota', v)}" for c, v in zip(classes, per_class, strict=True))
-                )
+            configs = [(tracker, config)]
+            if args.paper and tracker in PMB_TRACKERS:
+                configs.append((f"{tracker} (paper)", paper))
+            for label, cfg in configs:
+                name = label.replace(" (paper)", "_paper")
+                runs = [
+                    score(split, detections[seed], tracker, cfg, out / f"{preset}_{name}_s{seed}") for seed in seeds
+                ]
+                print_row(preset, label, runs, widths, args.per_class)
+        for item in args.external:
+            label, _, pattern = item.partition("=")
+            print_row(preset, label, external_runs(split, pattern, preset, seeds, out), widths, args.per_class)
     print(f"submissions and metric files: {out}")
 
 

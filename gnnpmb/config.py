@@ -82,6 +82,15 @@ RULES: dict[str, Range] = {
     "pmb.prune_existence": Range(0.0, 1.0, True, False),
     "pmb.extraction_threshold": _PROB,
     "pmb.miss_p_detect_max": Range(0.0, 1.0, False, True),
+    "pmb.miss_score_decay": Range(0.0, 1.0, False, True),
+    "pmb.heading_std_rad": Range(0.0, 1.5, True, True),
+    "pmb.size_log_std": Range(0.0, 2.0, True, True),
+    "pmb.size_log_spread": _POSITIVE,
+    "pmb.box_outlier_prob": Range(0.0, 1.0, False, False),
+    "pmb.gate_giou_min": Range(-1.0, 1.0, True, True),
+    "models.motion_model": Range(0.0, 1.0, True, True),
+    "models.turn_rate_std_rps": _NON_NEGATIVE,
+    "models.birth_turn_rate_std_rps": _POSITIVE,
     "pmbm.n_hypotheses": _at_least(1),
     "pmbm.hypothesis_prune": Range(0.0, 1.0, True, False),
     "lbp.max_iterations": _at_least(1),
@@ -302,6 +311,11 @@ class ModelParams:
       few frames decays so far that its object comes back under a new id.
     - birth_weight 0.3 (paper 0.1): the prior rate of new objects per detection; a larger one makes a detection's
       first Bernoulli more likely (r_new = w s N / (c + w s N)), so a new object's first box is scored higher.
+
+    motion_model: 0 = constant velocity (the paper's), 1 = coordinated turn (constant turn rate and velocity,
+    state [x, y, vx, vy, omega], extended Kalman predict; ``gnnpmb.models.ct_model``), read by the PMB family;
+    turn_rate_std_rps: the turn rate's process noise per keyframe (rad/s); birth_turn_rate_std_rps: a new track's
+    turn-rate standard deviation (its turn rate starts at 0).
     """
 
     p_survive: float = 0.95
@@ -310,6 +324,9 @@ class ModelParams:
     birth_weight: float = 0.3
     birth_pos_std_m: float = 15.0
     birth_vel_std_mps: float = 1.0
+    motion_model: int = 0
+    turn_rate_std_rps: float = 0.2
+    birth_turn_rate_std_rps: float = 0.5
 
     def __post_init__(self) -> None:
         validate_section(self, "models")
@@ -332,10 +349,23 @@ class PmbParams:
     0.3 was chosen on the demo
     ``mini_train`` split among 1.0 / 0.7 / 0.5 / 0.3 (gnnpmb AMOTA centerpoint 0.878 / 0.912 / 0.926 / 0.925,
     pointpillars 0.799 / 0.803 / 0.802 / 0.828; IDS 27 -> 4 and 18 -> 4).
-    measure_velocity: 1 = measure [x, y, vx, vy] (opt-in variant, ``kalman``), 0 = the paper's [x, y].
+    measure_velocity: 1 = measure [x, y, vx, vy] (``kalman``; R adds r_vx = r_vy = 0.5 (m/s)^2), 0 = the paper's
+    [x, y]. 1 was chosen on the demo ``mini_train`` split over the three presets and detector seeds 0, 1, 2
+    (gnnpmb mean AMOTA 0.8695 -> 0.8883, better on every preset, IDS 4.2 -> 2.7, AMOTP 0.428 -> 0.378 m;
+    ``benchmarks/tune_models.py``) and is ``params/velocity.toml``; it is not the default yet because it about
+    doubles the low-score boxes output and so the entities of a recording (``docs/results.md``).
     clutter_velocity_density: with measure_velocity = 1 the clutter intensity is per m^2 per (m/s)^2, so it is
     clutter_intensity x this density of a clutter detection's velocity (default: uniform over a 20 x 20 m/s
     square, 1/400); unused otherwise.
+    miss_score_decay: a Bernoulli missed for n frames in a row is output with tracking score s r d^n (d = this;
+    1: no decay, the paper's s r). Its predicted box stays in the output while r >= the extraction threshold,
+    ranked below the boxes of detected tracks (Poly-MOT's score decay of unmatched tracks, Li et al. 2023).
+    heading_std_rad, size_log_std, size_log_spread, box_outlier_prob: the heading and size measurement model
+    (``gnnpmb.box_likelihood``): sigma_psi of a detection's heading, sigma_s of its log width and length, sigma_c
+    the spread of the class's log sizes, eps the outlier share; a sigma of 0 leaves that part out (the paper).
+    gate_giou_min: a pair inside the Mahalanobis gate is also required to have a bird's-eye GIoU of at least this
+    between the detection and the track's predicted box (its filtered centre, its last detection's size and
+    heading); -1 (GIoU > -1 always): no overlap gate, the paper's. Poly-MOT and SimpleTrack gate on GIoU alone.
     """
 
     prune_existence: float = 1e-6
@@ -343,6 +373,12 @@ class PmbParams:
     miss_p_detect_max: float = 0.3
     measure_velocity: int = 0
     clutter_velocity_density: float = 1.0 / 400.0
+    miss_score_decay: float = 1.0
+    heading_std_rad: float = 0.0
+    size_log_std: float = 0.0
+    size_log_spread: float = 0.2
+    box_outlier_prob: float = 0.1
+    gate_giou_min: float = -1.0
 
     def __post_init__(self) -> None:
         validate_section(self, "pmb")
@@ -355,7 +391,8 @@ class PmbmParams:
     n_hypotheses: N_h, the most global hypotheses kept; prior hypothesis h of weight w_h gets its
     ceil(N_h w_h) best assignments (Murty). Default N_h = 20, the per-frame hypothesis budget: on the demo
     mini_train scenes it gave the AMOTA of the paper's N_h = 100 (``params/paper.toml``) to 4 decimals at less
-    than half the time per frame. N_h = 1 is exactly GNN-PMB.
+    than half the time per frame; with the velocity measured (``params/velocity.toml``) N_h = 10 gave that of
+    N_h = 20 (mean over 3 presets x 3 seeds 0.8881 vs 0.8878) in 16 % less time. N_h = 1 is exactly GNN-PMB.
     hypothesis_prune: global hypotheses whose normalised weight falls below it are dropped (the most likely one
     always stays).
     """
@@ -560,8 +597,16 @@ class CbmotParams:
         validate_section(self, "cbmot")
 
 
-PAPER_MODELS = ModelParams(p_survive=0.7, birth_weight=0.1)
-PAPER_PMB = PmbParams(extraction_threshold=0.9, miss_p_detect_max=1.0)
+PAPER_MODELS = ModelParams(p_survive=0.7, birth_weight=0.1, motion_model=0)
+PAPER_PMB = PmbParams(
+    extraction_threshold=0.9,
+    miss_p_detect_max=1.0,
+    measure_velocity=0,
+    miss_score_decay=1.0,
+    heading_std_rad=0.0,
+    size_log_std=0.0,
+    gate_giou_min=-1.0,
+)
 PAPER_PMBM = PmbmParams(n_hypotheses=100)
 """The paper's ``[models]``, ``[pmb]`` and ``[pmbm]`` values (sec. V-B, Table II), where the defaults differ
 (``gnnpmb/params/paper.toml``)."""

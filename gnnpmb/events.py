@@ -161,7 +161,9 @@ class Gated:
     track_ids: (K,); meas_indices: (M,) source indices; inside: (K, M) bool; center_xy: (K, 2) predicted
     measurement H m_k; innovation_cov: (K, 2, 2) S_k; threshold: squared Mahalanobis gate (chi-square value);
     d2: (K, M) the squared Mahalanobis distances the tracker computed (over its full measurement vector, which can
-    hold more than x, y), the NIS every explanation quotes.
+    hold more than x, y), the NIS every explanation quotes. giou / giou_min: with an overlap gate as well (PMB
+    family, ``[pmb] gate_giou_min``), the bird's-eye GIoU (K, M) of every pair inside the Mahalanobis gate (NaN
+    elsewhere) and its minimum: inside = (d2 < threshold) & (giou >= giou_min); None without one.
     """
 
     class_name: str
@@ -172,6 +174,8 @@ class Gated:
     innovation_cov: np.ndarray
     threshold: float
     d2: np.ndarray
+    giou: np.ndarray | None = None
+    giou_min: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -183,7 +187,9 @@ class PairTerms:
     tracker without existences or score-based P_D); d2: squared Mahalanobis distance; distance_nats: d2 / 2;
     spread_m: the predicted measurement's spread |S_k|^(1 / 2D) (the geometric mean of its standard deviations,
     metres); spread_nats: (log|S_k| + D log 2 pi) / 2 (with distance_nats, -log N(z_j; H m_k, S_k));
-    offset_nats: a constant every pair of the matrix shares, named by offset_text (GNN: detection against clutter).
+    offset_nats: a constant every pair of the matrix shares, named by offset_text (GNN: detection against clutter);
+    box_nats: minus the log-likelihood ratio of the detection's heading and size against the track's last box
+    (``gnnpmb.box_likelihood``; 0 for a tracker that measures the centre only).
     """
 
     existence: float | None
@@ -197,10 +203,18 @@ class PairTerms:
     spread_nats: float
     offset_nats: float = 0.0
     offset_text: str = ""
+    box_nats: float = 0.0
 
     @property
     def total_nats(self) -> float:
-        return self.offset_nats + self.existence_nats + self.score_nats + self.distance_nats + self.spread_nats
+        return (
+            self.offset_nats
+            + self.existence_nats
+            + self.score_nats
+            + self.distance_nats
+            + self.spread_nats
+            + self.box_nats
+        )
 
     def existence_for(self, cheaper_by_nats: float) -> float | None:
         """The predicted existence at which this cost would be ``cheaper_by_nats`` lower, all else equal: solves
@@ -223,12 +237,14 @@ class PairTerms:
 @dataclass(frozen=True, slots=True)
 class CostTerms:
     """The track entries of a cost matrix taken apart: C[j, k] = offset_nats + existence_nats[k] + score_nats[j] +
-    distance_nats[j, k] + spread_nats[k] on every gated entry (``PairTerms``).
+    distance_nats[j, k] + spread_nats[k] + box_nats[j, k] on every gated entry (``PairTerms``).
 
     PMB family (``gnnpmb.pmb.cost``, García-Fernández et al. 2018, eq. 12-13): existence r (K,), miss_log_lik
     log(1 - r P_D) (K,), score s (M,), offset 0. GNN (``gnnpmb.vector.gnn``): no existence or score (None), the
     offset -log(P_D / ((1 - P_D) kappa)). Both: d2 (K, M) squared Mahalanobis distances, log_det_S (K,), dim D of
-    the measurement; track_ids (K,) of the columns. Holds the arrays the tracker computed anyway (no copies)."""
+    the measurement; track_ids (K,) of the columns; box_nats (K, M): minus the heading and size log-likelihood
+    ratio (``gnnpmb.box_likelihood``), None when the tracker measures the centre only. Holds the arrays the
+    tracker computed anyway (no copies)."""
 
     existence: np.ndarray | None
     miss_log_lik: np.ndarray | None
@@ -239,6 +255,7 @@ class CostTerms:
     offset_nats: float = 0.0
     offset_text: str = ""
     track_ids: np.ndarray | None = None
+    box_nats: np.ndarray | None = None
 
     def column_of(self, track_id: int) -> int | None:
         """The track column of ``track_id``, None if the matrix has no such track (or no ids)."""
@@ -271,6 +288,7 @@ class CostTerms:
             spread_nats=0.5 * (log_det_S + self.dim * math.log(2.0 * math.pi)),
             offset_nats=self.offset_nats,
             offset_text=self.offset_text,
+            box_nats=0.0 if self.box_nats is None else float(self.box_nats[k, j]),
         )
 
 

@@ -1,4 +1,5 @@
-"""Linear Kalman filter for the constant-velocity model, vectorised over K tracks.
+"""Kalman filter for the constant-velocity model (and the extended Kalman predict of a non-linear one),
+vectorised over K tracks.
 
 State m = [x, y, vx, vy]; measurement z = H m = [x, y] (D = 2), or [x, y, vx, vy] (D = 4, H = I) for the opt-in
 variant that also measures the detector's velocity (``[pmb] measure_velocity = 1``).
@@ -36,7 +37,12 @@ def symmetrize(P: np.ndarray) -> np.ndarray:
 
 def predict(mean: np.ndarray, cov: np.ndarray, model: MotionModel) -> tuple[np.ndarray, np.ndarray]:
     """Kalman predict of (K, n) means and (K, n, n) covariances: m' = F m, P' = F P F^T + Q; F is (n, n), or
-    (K, n, n) for one transition per track (tracks predicted over different times)."""
+    (K, n, n) for one transition per track (tracks predicted over different times). For a non-linear model
+    (``model.transition``) the extended Kalman predict: m' = f(m), P' = J P J^T + Q with J the Jacobian of f at m
+    (Bar-Shalom, Li & Kirubarajan 2001, sec. 10.3); with a linear f it is the Kalman predict."""
+    if model.transition is not None:
+        out, J = model.transition(mean)
+        return out, symmetrize(J @ cov @ J.swapaxes(-1, -2) + model.Q)
     F = model.F
     if F.ndim == 3:
         return np.einsum("kij,kj->ki", F, mean), symmetrize(F @ cov @ F.swapaxes(-1, -2) + model.Q)
@@ -59,19 +65,21 @@ class Innovation(StructOfArrays):
     cov_post: np.ndarray
 
     @staticmethod
-    def empty() -> Innovation:
+    def empty(state_dim: int = 4, meas_dim: int = 2) -> Innovation:
+        n, d = state_dim, meas_dim
         return Innovation(
-            z_pred=np.zeros((0, 2)),
-            S=np.zeros((0, 2, 2)),
-            S_inv=np.zeros((0, 2, 2)),
+            z_pred=np.zeros((0, d)),
+            S=np.zeros((0, d, d)),
+            S_inv=np.zeros((0, d, d)),
             log_det_S=np.zeros(0),
-            gain=np.zeros((0, 4, 2)),
-            cov_post=np.zeros((0, 4, 4)),
+            gain=np.zeros((0, n, d)),
+            cov_post=np.zeros((0, n, n)),
         )
 
 
 def innovation(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:
-    """S, S^-1, gain and posterior covariance for (K, 4) means and (K, 4, 4) covariances.
+    """S, S^-1, gain and posterior covariance for (K, n) means and (K, n, n) covariances (n = 4, or 5 with a
+    turn rate).
 
     The measurement dimension D is R's (2 or 4; H picks the first D state entries). For D = 2, S's inverse and
     determinant are written out (much faster than batched LAPACK calls for the few tracks of one class).
@@ -80,7 +88,7 @@ def innovation(mean: np.ndarray, cov: np.ndarray, R: np.ndarray) -> Innovation:
     if R.shape[0] != 2:
         return _innovation_general(mean, cov, R)
     if not len(mean):
-        return Innovation.empty()
+        return Innovation.empty(mean.shape[1])
     PHt = cov[:, :, :2]  # P H^T, (K, 4, 2)
     S = symmetrize(cov[:, :2, :2] + R)  # the diagonal is exact: (s + s) / 2 = s
     s00, s11, s01 = S[:, 0, 0], S[:, 1, 1], S[:, 0, 1]

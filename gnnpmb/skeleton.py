@@ -56,11 +56,14 @@ class TrackView:
 @dataclass(frozen=True, slots=True)
 class Gating:
     """The gate step's result for K tracks and M measurements: inn (K) innovation quantities, d2 (K, M) squared
-    Mahalanobis distances, inside (K, M) bool."""
+    Mahalanobis distances, inside (K, M) bool; giou (K, M) the bird's-eye GIoU of the pairs inside the
+    Mahalanobis gate (NaN elsewhere) and giou_min when an overlap gate also applied (``Gated``), else None."""
 
     inn: Innovation
     d2: np.ndarray
     inside: np.ndarray
+    giou: np.ndarray | None = None
+    giou_min: float | None = None
 
 
 def gate_tracks(mean: np.ndarray, cov: np.ndarray, R: np.ndarray, z: np.ndarray, gate_chi2: float) -> Gating:
@@ -89,6 +92,8 @@ def emit_prior(
             innovation_cov=gating.inn.S[:, :2, :2],
             threshold=gate_chi2,
             d2=gating.d2,
+            giou=gating.giou,
+            giou_min=gating.giou_min,
         )
     )
 

@@ -27,10 +27,16 @@ Poisson number over the area the ego sees (``ghost_rate`` within range on averag
 box and stable score ``~ Beta(ghost_score_beta)``; a ghost within ``fp_range_m`` of the ego is reported in a
 frame with probability ``ghost_presence``, with small jitter, like a real detector's repeated false alarm.
 
+Detector realism (``DetectorPreset.realism``, off in the calibrated presets, on in the named variants
+``"<preset>+runs"``, ``+near``, ``+tails``, ``+real``; ``simdet_presets.DetectorRealism``): a latent per-object
+hardness, an AR(1) sequence over keyframes, lowers the detection probability's logit and the score (misses in
+runs, low scores for several frames); false boxes beside true objects; heavy-tailed velocity errors.
+
 Randomness: each frame draws from its own generator seeded by (seed, scene token, keyframe index), each
-instance's persistent offset from (seed, scene token, instance token) and the scene's ghost places from
-(seed, scene token), so one frame's draws never depend on another frame. Boxes of a frame are returned sorted
-by score, highest first, like a real detector's output.
+instance's persistent offset and hardness sequence from (seed, scene token, instance token) and the scene's ghost
+places from (seed, scene token), so one frame's draws never depend on another frame; the realism options draw
+only when on, so with them off a frame's detections are what they always were. Boxes of a frame are returned
+sorted by score, highest first, like a real detector's output.
 """
 
 from __future__ import annotations
@@ -52,6 +58,7 @@ from gnnpmb.data.simdet_presets import (
     PRESETS,
     TYPICAL_SIZE_WLH_M,
     DetectorPreset,
+    DetectorRealism,
     get_preset,
 )
 from gnnpmb.types import Boxes
@@ -60,6 +67,7 @@ __all__ = [
     "CONFUSABLE",
     "PRESETS",
     "DetectorPreset",
+    "DetectorRealism",
     "GhostSites",
     "Hotspot",
     "get_preset",
@@ -81,6 +89,8 @@ _FP_SPEED_STD_MPS = 0.5
 _TAG_FRAME = 1
 _TAG_INSTANCE = 2
 _TAG_GHOST = 3
+_TAG_HARDNESS = 4
+_NEAR_FP_SCORE_FACTOR = 0.8
 _CONFUSED_SCORE_FACTOR = 0.75
 _HIGH_FP_SCORE_FACTOR = 0.8
 _GHOST_JITTER_M = 0.1
@@ -123,6 +133,24 @@ def _instance_offsets(seed: int, scene_token: str, instance_ids: Sequence[str]) 
     for k, token in enumerate(instance_ids):
         seq = np.random.SeedSequence([seed, _TAG_INSTANCE, _hash64(scene_token), _hash64(token)])
         out[k] = np.random.default_rng(seq).standard_normal(3)
+    return out
+
+
+def _instance_hardness(
+    seed: int, scene_token: str, instance_ids: Sequence[str], n_frames: int, corr: float
+) -> np.ndarray:
+    """(N, n_frames) stationary AR(1) sequences a_t = corr a_{t-1} + sqrt(1 - corr^2) e_t, a_0 ~ N(0, 1), one per
+    instance token (the same token gives the same row)."""
+    out = np.empty((len(instance_ids), n_frames))
+    innovation_std = np.sqrt(1.0 - corr**2)
+    for k, token in enumerate(instance_ids):
+        seq = np.random.SeedSequence([seed, _TAG_HARDNESS, _hash64(scene_token), _hash64(token)])
+        e = np.random.default_rng(seq).standard_normal(n_frames)
+        a = np.empty(n_frames)
+        a[0] = e[0]
+        for t in range(1, n_frames):
+            a[t] = corr * a[t - 1] + innovation_std * e[t]
+        out[k] = a
     return out
 
 
@@ -191,10 +219,11 @@ def _confused_classes(
 
 
 def _true_detections(
-    kf: Keyframe, p: DetectorPreset, rng: np.random.Generator, offsets: np.ndarray
+    kf: Keyframe, p: DetectorPreset, rng: np.random.Generator, offsets: np.ndarray, hardness: np.ndarray | None
 ) -> tuple[Boxes, Boxes]:
     """Detections of ground-truth boxes and their duplicates. Every draw is made for every GT box, whatever
-    happens to it, so the stream of draws does not depend on earlier outcomes."""
+    happens to it, so the stream of draws does not depend on earlier outcomes. ``hardness``: (N,) the objects'
+    latent hardness this keyframe (None: realism off)."""
     gt = kf.gt
     n = len(gt)
     classes = gt.class_name
@@ -218,6 +247,13 @@ def _true_detections(
     dup_score = rng.uniform(0.3, 0.9, size=n)
     u_confuse = rng.random(n)
     u_target = rng.random(n)
+    real = p.realism
+    if hardness is not None and real.hardness_std_logit > 0.0:
+        logit = np.log(np.clip(p_detect, 1e-6, 1 - 1e-6)) - np.log1p(-np.clip(p_detect, 1e-6, 1 - 1e-6))
+        p_detect = 1.0 / (1.0 + np.exp(-(logit - real.hardness_std_logit * hardness)))
+    if real.velocity_outlier_prob > 0.0:
+        outlier = rng.random(n) < real.velocity_outlier_prob
+        vel_noise = vel_noise * np.where(outlier, real.velocity_outlier_scale, 1.0)[:, None]
 
     noise_scale = _class_field("noise_scale", classes)
     range_growth = 1.0 + dist / _NOISE_RANGE_M
@@ -231,6 +267,8 @@ def _true_detections(
     yaw = yaw_from_quat_wxyz(gt.quat_wxyz) + yaw_std * yaw_noise + np.pi * flip
     velocity = np.nan_to_num(gt.velocity_mps.astype(float)) + (p.vel_noise_std_mps * range_growth)[:, None] * vel_noise
     score = score_beta * (_SCORE_FLOOR + (1.0 - _SCORE_FLOOR) * f_range * f_vis)
+    if hardness is not None and real.score_hardness > 0.0:
+        score = np.clip(score * np.exp(-real.score_hardness * hardness), _SCORE_MIN, _SCORE_MAX)
     reported = _confused_classes(classes, p, u_confuse, u_target)
     score = np.where(reported != classes, _CONFUSED_SCORE_FACTOR * score, score)
 
@@ -344,6 +382,33 @@ def _hotspot_clutter(kf: Keyframe, p: DetectorPreset, rng: np.random.Generator, 
     return Boxes.concatenate(parts)
 
 
+def _near_object_fps(kf: Keyframe, p: DetectorPreset, rng: np.random.Generator) -> Boxes:
+    """False boxes beside true objects (``DetectorRealism.near_fp_prob``): along the heading of a vehicle, one to
+    one and a half lengths from its centre (a split-off box), beside a pedestrian or cyclist one to two widths
+    away; of the object's class, its size, score ~ 0.8 Beta(hotspot_score_beta). Draws for every GT box."""
+    gt, n = kf.gt, len(kf.gt)
+    u = rng.random(n)
+    side = rng.choice([-1.0, 1.0], size=n)
+    reach = rng.uniform(1.0, 1.5, size=n)
+    score = _NEAR_FP_SCORE_FACTOR * rng.beta(*p.hotspot_score_beta, size=n)
+    chosen = np.flatnonzero(u < p.realism.near_fp_prob)
+    if not len(chosen):
+        return Boxes.empty()
+    yaw = yaw_from_quat_wxyz(gt.quat_wxyz[chosen])
+    classes = gt.class_name[chosen]
+    size = gt.size_wlh_m[chosen].astype(float)
+    small = np.isin(classes.astype(str), ["pedestrian", "bicycle", "motorcycle"])
+    along = np.where(small, 0.0, reach[chosen] * size[:, 1])
+    across = np.where(small, 2.0 * reach[chosen] * size[:, 0], 0.0)
+    c, s = np.cos(yaw), np.sin(yaw)
+    d = side[chosen]
+    translation = gt.translation_m[chosen].astype(float).copy()
+    translation[:, 0] += d * (along * c - across * s)
+    translation[:, 1] += d * (along * s + across * c)
+    velocity = np.nan_to_num(gt.velocity_mps[chosen].astype(float))
+    return _make_boxes(translation, size, yaw, velocity, score[chosen], classes)
+
+
 def simulate_frame(
     kf: Keyframe,
     preset: DetectorPreset,
@@ -351,17 +416,22 @@ def simulate_frame(
     offsets: np.ndarray,
     hotspots: Sequence[Hotspot] = (),
     ghosts: GhostSites | None = None,
+    hardness: np.ndarray | None = None,
 ) -> Boxes:
     """Detections of one keyframe, sorted by score (highest first; ties keep generation order).
 
     offsets: (N, 3) standard-normal persistent offsets of the keyframe's N GT boxes; ghosts: the scene's
-    persistent false positives (``scene_ghosts``), none if not given.
+    persistent false positives (``scene_ghosts``), none if not given; hardness: (N,) the GT boxes' latent
+    hardness this keyframe (``DetectorRealism``; None: not modelled).
     """
-    true_boxes, dup_boxes = _true_detections(kf, preset, rng, offsets)
+    true_boxes, dup_boxes = _true_detections(kf, preset, rng, offsets, hardness)
     fp_boxes = _false_positives(kf, preset, rng)
     hot_boxes = _hotspot_clutter(kf, preset, rng, hotspots)
     ghost_boxes = _ghost_detections(kf, preset, rng, GhostSites.none() if ghosts is None else ghosts)
-    boxes = Boxes.concatenate([true_boxes, dup_boxes, fp_boxes, hot_boxes, ghost_boxes])
+    parts = [true_boxes, dup_boxes, fp_boxes, hot_boxes, ghost_boxes]
+    if preset.realism.near_fp_prob > 0.0:
+        parts.append(_near_object_fps(kf, preset, rng))
+    boxes = Boxes.concatenate(parts)
     return boxes.subset(np.argsort(-boxes.score, kind="stable"))
 
 
@@ -379,15 +449,24 @@ def simulate_detections(
     """
     p = get_preset(preset)
     ghosts = scene_ghosts(scene, p, seed)
+    real = p.realism
+    with_hardness = real.hardness_std_logit > 0.0 or real.score_hardness > 0.0
+    n_frames = 1 + max((kf.index for kf in scene.keyframes), default=0)
     cache: dict[str, np.ndarray] = {}
+    hard_cache: dict[str, np.ndarray] = {}
     out: dict[str, Boxes] = {}
     for kf in scene.keyframes:
         ids = [str(i) for i in kf.gt.instance_id]
         new = sorted({i for i in ids if i not in cache})
         cache.update(zip(new, _instance_offsets(seed, scene.token, new), strict=True))
         offsets = np.array([cache[i] for i in ids]).reshape(len(ids), 3)
+        hardness = None
+        if with_hardness:
+            sequences = _instance_hardness(seed, scene.token, new, n_frames, real.hardness_corr)
+            hard_cache.update(zip(new, sequences, strict=True))
+            hardness = np.array([hard_cache[i][kf.index] for i in ids], dtype=float)
         rng = _frame_rng(seed, scene.token, kf.index)
-        out[kf.sample_token] = simulate_frame(kf, p, rng, offsets, hotspots, ghosts)
+        out[kf.sample_token] = simulate_frame(kf, p, rng, offsets, hotspots, ghosts, hardness)
     return out
 
 

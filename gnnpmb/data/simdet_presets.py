@@ -8,10 +8,50 @@ figures, their splits and sources are in that script). The other knobs are set b
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 from gnnpmb.errors import GnnpmbError, UnknownNameError
+
+
+@dataclass(frozen=True, slots=True)
+class DetectorRealism:
+    """Error properties of real detectors that the calibration figures (``DetectionEval``) do not measure: how
+    errors are spread over time and where false positives sit. All off (0) in the calibrated presets; the named
+    variants (``VARIANTS``, ``"<preset>+<variant>"``) switch some on, so tracker defaults can be chosen to win
+    across a family of detector models rather than on one.
+
+    hardness_std_logit: each object has a latent "hardness" a_k, a stationary AR(1) sequence over keyframes
+    (standard normal, correlation ``hardness_corr`` from one keyframe to the next); its detection probability's
+    logit falls by hardness_std_logit a_k and its score is multiplied by exp(-score_hardness a_k). Misses then
+    come in runs and a hard object's detections score low for several frames (real detectors miss the same hard
+    object repeatedly: occlusion, sparse points, unusual shape; Hoiem, Chodpathumwan & Dai, "Diagnosing Error in
+    Object Detectors", ECCV 2012, sec. 4; Weng et al., AB3DMOT 2020, sec. 4.4, on consecutive misses).
+    near_fp_prob: per object and keyframe, the probability of a false box beside it (a box split off a long
+    vehicle along its heading, or a neighbour beside a pedestrian or cyclist), of its class, score ~
+    Beta(hotspot_score_beta) (most nuScenes false positives of good detectors are localisation and duplicate
+    errors next to true objects: Caesar et al., "nuScenes", CVPR 2020, sec. 4.2, and the TIDE breakdown, Bolya et
+    al., ECCV 2020). velocity_outlier_prob: the probability that a detection's velocity error is
+    ``velocity_outlier_scale`` times its usual spread (heavy tails of regressed velocities, e.g. for objects just
+    appearing, which have no motion history in the swept points).
+    """
+
+    hardness_std_logit: float = 0.0
+    hardness_corr: float = 0.8
+    score_hardness: float = 0.0
+    near_fp_prob: float = 0.0
+    velocity_outlier_prob: float = 0.0
+    velocity_outlier_scale: float = 6.0
+
+
+VARIANTS: dict[str, DetectorRealism] = {
+    "runs": DetectorRealism(hardness_std_logit=1.5, score_hardness=0.15),
+    "near": DetectorRealism(near_fp_prob=0.04),
+    "tails": DetectorRealism(velocity_outlier_prob=0.05),
+    "real": DetectorRealism(hardness_std_logit=1.5, score_hardness=0.15, near_fp_prob=0.04, velocity_outlier_prob=0.05),
+}
+"""The detector-model family: each calibrated preset may be named with one of these (``"pointpillars+runs"``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,6 +93,7 @@ class DetectorPreset:
     ghost_score_beta: tuple[float, float]
     fp_high_score_frac: float
     class_recall: Mapping[str, float]
+    realism: DetectorRealism = DetectorRealism()
 
 
 @dataclass(frozen=True, slots=True)
@@ -233,13 +274,20 @@ PRESETS: dict[str, DetectorPreset] = {
 
 
 def get_preset(preset: str | DetectorPreset) -> DetectorPreset:
-    """The preset itself, or the one named ``preset``; an unknown name raises ``UnknownNameError``."""
+    """The preset itself, or the one named ``preset`` (``"<preset>"`` or ``"<preset>+<variant>"``, a variant of
+    ``VARIANTS``); an unknown name raises ``UnknownNameError``."""
     if isinstance(preset, DetectorPreset):
         return preset
-    try:
-        return PRESETS[preset]
-    except KeyError:
-        raise UnknownNameError(f"unknown detector preset '{preset}' (choose one of: {', '.join(PRESETS)})") from None
+    name, _, variant = preset.partition("+")
+    if name not in PRESETS or (variant and variant not in VARIANTS):
+        raise UnknownNameError(
+            f"unknown detector preset '{preset}' (choose one of: {', '.join(PRESETS)}, optionally followed by "
+            f"+{' / +'.join(VARIANTS)})"
+        )
+    base = PRESETS[name]
+    if not variant:
+        return base
+    return dataclasses.replace(base, name=preset, realism=VARIANTS[variant])
 
 
 def detector_choice(detections_file: object | None, detector: str | None, default: str = "centerpoint") -> str:

@@ -24,8 +24,10 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
 
     track_id: (K,) int, the track label (metadata, kept through updates);
     local_key: (K,) int64, identifies the single-target hypothesis (equal keys = identical component; PMBM);
-    existence: (K,) r in [0, 1]; mean: (K, 4); cov: (K, 4, 4);
-    det: the last associated detection's fields (``score``, ``z_m``, ... read through as the Bernoullis' own).
+    existence: (K,) r in [0, 1]; mean: (K, n) ([x, y, vx, vy], or with the turn rate omega); cov: (K, n, n);
+    det: the last associated detection's fields (``score``, ``z_m``, ... read through as the Bernoullis' own);
+    misses: (K,) int64, frames since the last detection (0 for a Bernoulli detected this frame; the prediction
+    adds 1), which sets the decayed output score of a missed track (``PmbParams.miss_score_decay``).
     """
 
     track_id: np.ndarray
@@ -34,28 +36,31 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
     mean: np.ndarray
     cov: np.ndarray
     det: DetectionFields
+    misses: np.ndarray
 
     def __len__(self) -> int:
         return len(self.track_id)
 
     @staticmethod
-    def empty() -> Bernoullis:
+    def empty(state_dim: int = 4) -> Bernoullis:
         return Bernoullis(
             track_id=np.zeros(0, dtype=np.int64),
             local_key=np.zeros(0, dtype=np.int64),
             existence=np.zeros(0),
-            mean=np.zeros((0, 4)),
-            cov=np.zeros((0, 4, 4)),
+            mean=np.zeros((0, state_dim)),
+            cov=np.zeros((0, state_dim, state_dim)),
             det=DetectionFields.empty(),
+            misses=np.zeros(0, dtype=np.int64),
         )
 
 
 def predict_bernoullis(b: Bernoullis, model: MotionModel, p_survive: float) -> Bernoullis:
-    """Prediction: r' = P_S r, (m', P') = Kalman predict (García-Fernández et al. 2018, eq. 8-9)."""
+    """Prediction: r' = P_S r, (m', P') = Kalman predict (García-Fernández et al. 2018, eq. 8-9); one more
+    frame since the last detection."""
     if not len(b):
         return b
     mean, cov = predict(b.mean, b.cov, model)
-    return Bernoullis(b.track_id, b.local_key, p_survive * b.existence, mean, cov, b.det.undetected())
+    return Bernoullis(b.track_id, b.local_key, p_survive * b.existence, mean, cov, b.det.undetected(), b.misses + 1)
 
 
 def missed_update(existence: np.ndarray, p_detect: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -21,6 +21,7 @@ from typing import Protocol, overload
 
 import numpy as np
 
+from gnnpmb.box_likelihood import BoxShapeModel
 from gnnpmb.config import TrackerConfig
 from gnnpmb.events import (
     AxisLabel,
@@ -30,12 +31,12 @@ from gnnpmb.events import (
     Pruned,
     PruneReason,
 )
-from gnnpmb.models import MotionModel, birth_covariance, clutter_intensity, cv_model, measurement_birth
+from gnnpmb.models import MotionModel, birth_covariance, clutter_intensity, measurement_birth, motion_model
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
 from gnnpmb.pmb.poisson import NewTrackHypotheses, birth_update, new_track_hypotheses
 from gnnpmb.skeleton import ClassFilter, Gating, TrackView
-from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
+from gnnpmb.types import STATE_DIM, IdAllocator, Measurements, TrackEstimate
 
 
 @dataclass(frozen=True, slots=True)
@@ -324,6 +325,8 @@ def updated_bernoullis(
     else:
         fields = prior.det.subset(rows)
     track_id, parent, outcome = prior.track_id[rows], prior.local_key[rows], outcome
+    misses = _gather(prior.misses, np.zeros(len(new.existence), dtype=np.int64), source, n_new)
+    misses[det] = 0
     if n_new:
         births = np.array([ctx.birth_id(j) for j in new_j.tolist()], dtype=np.int64)
         track_id = np.concatenate([track_id, births])
@@ -336,12 +339,16 @@ def updated_bernoullis(
         mean=mean,
         cov=cov,
         det=fields,
+        misses=misses,
     )
 
 
 def _gather(own: np.ndarray, born: np.ndarray, source: np.ndarray, n_new: int) -> np.ndarray:
-    """Rows ``source`` of ``own`` followed by ``born`` (of ``own`` alone when no row is born: ``n_new`` 0)."""
-    return np.concatenate([own, born])[source] if n_new else own[source]
+    """Rows ``source`` of ``own`` followed by ``born`` (of ``own`` alone when no row is born: ``n_new`` 0; of
+    ``born`` alone when ``own`` has no rows, whose trailing shape may then be a default one)."""
+    if not n_new:
+        return own[source]
+    return (np.concatenate([own, born]) if len(own) else born)[source]
 
 
 def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext) -> Bernoullis:
@@ -423,10 +430,14 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         self.params = config.pmb
         self.models = config.models
         self.strategy = strategy
-        self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty())]
+        self.turn_rate = self.models.motion_model == 1
+        p = self.params
+        box = BoxShapeModel(p.heading_std_rad, p.size_log_std, p.size_log_spread, p.box_outlier_prob)
+        self.box = box if box.enabled else None
+        model = motion_model(0.0, self.class_params, self.models, self.params.measure_velocity == 1)
+        self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty(model.state_dim))]
         self.frame_serial = 0
-        R = cv_model(0.0, self.class_params, self.params.measure_velocity == 1).R
-        self.birth_update = birth_update(birth_covariance(self.models), R)
+        self.birth_update = birth_update(birth_covariance(self.models, self.turn_rate), model.R)
 
     @property
     def panels(self) -> tuple[Panel, ...]:
@@ -443,11 +454,11 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         Bernoullis predicted and gated (z = [x, y], or [x, y, vx, vy] with ``[pmb] measure_velocity = 1``)."""
         p = self.params
         self.frame_serial += 1
-        model = cv_model(dt_s, self.class_params, p.measure_velocity == 1)
+        model = motion_model(dt_s, self.class_params, self.models, p.measure_velocity == 1)
         if p.measure_velocity == 1:
             meas = VelocityMeasurements(meas.boxes, meas.source_index)
         clutter = clutter_intensity(self.models, p)
-        birth = measurement_birth(meas, self.models)
+        birth = measurement_birth(meas, self.models, self.turn_rate)
         new = new_track_hypotheses(birth, meas, model.R, clutter, self.birth_update)
         return self._predict_and_localise(meas, model, new)
 
@@ -455,7 +466,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         """The K Bernoullis of the most likely prior hypothesis and their gate."""
         local = prior.locals_[0]
         b = local.prior
-        return TrackView(b.track_id, b.mean, b.cov, b.existence), Gating(local.inn, local.d2, local.inside)
+        return _view(b), Gating(local.inn, local.d2, local.inside, local.giou, local.gate_giou_min)
 
     def update(self, prior: PmbPrior, meas: Measurements, sink: EventSink) -> Bernoullis:
         """Steps 4-5: the strategy's posterior hypotheses, pruned, become the state; returns the Bernoullis of the
@@ -472,19 +483,29 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         return best
 
     def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
-        """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r."""
+        """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r, times
+        d^n for a Bernoulli missed n frames in a row (``[pmb] miss_score_decay`` d)."""
         threshold = self.params.extraction_threshold
         b, keep = posterior, posterior.existence >= threshold
-        det, track_id, mean, existence = b.det, b.track_id, b.mean, b.existence
+        det, track_id, mean, existence, misses = b.det, b.track_id, b.mean, b.existence, b.misses
         if not keep.all():
             sel = keep.nonzero()[0]
-            det, track_id, mean, existence = det.subset(sel), track_id[sel], mean[sel], existence[sel]
-        estimates = det.to_estimates(self.class_name, track_id, mean, det.score * existence, existence)
+            det, track_id, mean, existence, misses = (
+                det.subset(sel),
+                track_id[sel],
+                mean[sel],
+                existence[sel],
+                misses[sel],
+            )
+        score = det.score * existence
+        decay = self.params.miss_score_decay
+        if decay < 1.0:
+            score = score * decay ** misses.astype(float)
+        estimates = det.to_estimates(self.class_name, track_id, mean, score, existence)
         return estimates, threshold
 
     def posterior_view(self, posterior: Bernoullis) -> TrackView:
-        b = posterior
-        return TrackView(b.track_id, b.mean, b.cov, b.existence)
+        return _view(posterior)
 
     def _predict_and_localise(self, meas: Measurements, model: MotionModel, new: NewTrackHypotheses) -> PmbPrior:
         """Predicted prior hypotheses and their local hypotheses. Global hypotheses share most Bernoullis
@@ -495,11 +516,22 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         if len(self.hypotheses) == 1:
             h = self.hypotheses[0]
             prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
-            local = local_hypotheses(prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max)
+            local = local_hypotheses(
+                prior,
+                meas,
+                new,
+                model.R,
+                p.gate_chi2,
+                self.params.miss_p_detect_max,
+                self.box,
+                self.params.gate_giou_min,
+            )
             return PmbPrior([GlobalHypothesis(h.log_weight, prior)], [local])
         union, members = hypothesis_union(self.hypotheses)
         union_prior = predict_bernoullis(union, model, p.p_survive)
-        union_local = local_hypotheses(union_prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max)
+        union_local = local_hypotheses(
+            union_prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max, self.box
+        )
         priors = [GlobalHypothesis(h.log_weight, union_prior, i) for h, i in zip(self.hypotheses, members, strict=True)]
         return PmbPrior(priors, HypothesisLocals(union_local, members))
 
@@ -528,5 +560,19 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         sel = np.array([k for k, t in enumerate(best.track_id.tolist()) if t in born], dtype=np.intp)
         if len(sel):
             sink.emit(
-                Born(self.class_name, best.track_id[sel], best.meas_index[sel], best.mean[sel], best.existence[sel])
+                Born(
+                    self.class_name,
+                    best.track_id[sel],
+                    best.meas_index[sel],
+                    best.mean[sel, :STATE_DIM],
+                    best.existence[sel],
+                )
             )
+
+
+def _view(b: Bernoullis) -> TrackView:
+    """K Bernoullis as events show them: [x, y, vx, vy] (K, 4) and its covariance (K, 4, 4) (a turn rate left
+    out)."""
+    if b.mean.shape[1] == STATE_DIM:
+        return TrackView(b.track_id, b.mean, b.cov, b.existence)
+    return TrackView(b.track_id, b.mean[:, :STATE_DIM], b.cov[:, :STATE_DIM, :STATE_DIM], b.existence)

@@ -3,7 +3,9 @@
 For Bernoulli k with prior (r_k, m_k, P_k) and measurement j (García-Fernández et al. 2018, eq. 12-13):
   missed:    l_k0 = 1 - r_k P_D,k                 r = r_k (1 - P_D,k) / l_k0, state unchanged
   detected:  l_kj = r_k P_D,j N(z_j; H m_k, S_k)   r = 1, state = Kalman update with z_j (only inside the gate)
-with P_D,j the score of detection j and P_D,k the score of the track's last detection (paper sec. V-B).
+with P_D,j the score of detection j and P_D,k the score of the track's last detection (paper sec. V-B). With the
+heading and size measurement model (``gnnpmb.box_likelihood``) l_kj is also multiplied by the likelihood ratio
+of the detection's heading and size against the track's last box (1 without it, the paper's model).
 New-track hypotheses l_j come from ``poisson.new_track_hypotheses``.
 
 Cost matrix (M rows = measurements, K + M columns = [tracks | new track per measurement]):
@@ -19,6 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gnnpmb.box.overlap import giou_bev
+from gnnpmb.box_likelihood import BoxShapeModel, box_log_ratio
+from gnnpmb.data.boxes3d import yaw_from_quat_wxyz
 from gnnpmb.events import AxisKind, AxisLabel, CostMatrix, CostTerms, axis_labels
 from gnnpmb.kalman import Innovation, log_likelihood, paired_updated_means
 from gnnpmb.pmb.bernoulli import Bernoullis, missed_update
@@ -33,7 +38,10 @@ class LocalHypotheses:
 
     prior: K predicted Bernoullis; meas: M measurements; inn: innovation quantities (K);
     d2: (K, M) squared Mahalanobis distances; inside: (K, M) gate; miss_log_lik / miss_existence: (K,);
-    det_log_lik: (K, M), -inf outside the gate; new: the M new-track hypotheses.
+    det_log_lik: (K, M), -inf outside the gate; new: the M new-track hypotheses; box_log_ratio: (K, M) the
+    heading and size log-likelihood ratio in det_log_lik (``box_likelihood``), None when not used; giou: (K, M)
+    the bird's-eye GIoU of the pairs inside the Mahalanobis gate (NaN elsewhere) when the overlap gate
+    (``gate_giou_min``) applies, else None.
     """
 
     prior: Bernoullis
@@ -45,6 +53,9 @@ class LocalHypotheses:
     miss_existence: np.ndarray
     det_log_lik: np.ndarray
     new: NewTrackHypotheses
+    box_log_ratio: np.ndarray | None = None
+    giou: np.ndarray | None = None
+    gate_giou_min: float | None = None
 
     @property
     def n_tracks(self) -> int:
@@ -65,8 +76,10 @@ class LocalHypotheses:
 
     def cost_terms(self) -> CostTerms:
         """The track entries of ``cost_matrix`` taken apart: C[j, k] = (log l_k0 - log r_k) - log P_D,j
-        - log N(z_j; H m_k, S_k) (``events.CostTerms``), from the arrays already computed."""
+        - log N(z_j; H m_k, S_k) - box log-likelihood ratio (``events.CostTerms``), from the arrays already
+        computed."""
         return CostTerms(
+            box_nats=None if self.box_log_ratio is None else -self.box_log_ratio,
             existence=self.prior.existence,
             miss_log_lik=self.miss_log_lik,
             score=self.meas.boxes.score,
@@ -105,6 +118,9 @@ class LocalHypotheses:
             miss_existence=self.miss_existence[index],
             det_log_lik=self.det_log_lik[index],
             new=self.new,
+            box_log_ratio=None if self.box_log_ratio is None else self.box_log_ratio[index],
+            giou=None if self.giou is None else self.giou[index],
+            gate_giou_min=self.gate_giou_min,
         )
 
     def row_labels(self) -> tuple[AxisLabel, ...]:
@@ -122,16 +138,30 @@ def local_hypotheses(
     R: np.ndarray,
     gate_chi2: float,
     miss_p_detect_max: float = 1.0,
+    box: BoxShapeModel | None = None,
+    gate_giou_min: float = -1.0,
 ) -> LocalHypotheses:
     """Gate every (track, measurement) pair and compute the local hypothesis likelihoods (module docstring); a
-    missed track's P_D is its last detection score capped at ``miss_p_detect_max`` (``PmbParams``)."""
+    missed track's P_D is its last detection score capped at ``miss_p_detect_max`` (``PmbParams``); ``box``: the
+    heading and size model (None or disabled: position only); ``gate_giou_min`` > -1: a pair must also overlap
+    with bird's-eye GIoU >= it (``overlap_gate``)."""
     gating = gate_tracks(prior.mean, prior.cov, R, meas.z, gate_chi2)
     inn, d2, inside = gating.inn, gating.d2, gating.inside
+    giou = None
+    if gate_giou_min > -1.0:
+        giou = overlap_gate(prior, meas, inside)
+        inside = inside & (giou >= gate_giou_min)
     # missed_update caps P_D below 1 itself: a cap at or above 1 changes nothing
     p_detect = prior.score if miss_p_detect_max >= 1.0 else np.minimum(prior.score, miss_p_detect_max)
     miss_log_lik, miss_existence = missed_update(prior.existence, p_detect)
     with np.errstate(divide="ignore"):
         det = np.log(prior.existence)[:, None] + np.log(meas.boxes.score)[None, :] + log_likelihood(inn, d2)
+    ratio = None
+    if box is not None and len(prior) and len(meas):
+        boxes = meas.boxes
+        ratio = box_log_ratio(prior.quat_wxyz, prior.size_wlh_m, boxes.quat_wxyz, boxes.size_wlh_m, box)
+        if ratio is not None:
+            det = det + ratio
     det_log_lik = np.where(inside, det, -np.inf)
     return LocalHypotheses(
         prior=prior,
@@ -143,11 +173,33 @@ def local_hypotheses(
         miss_existence=miss_existence,
         det_log_lik=det_log_lik,
         new=new,
+        box_log_ratio=ratio,
+        giou=giou,
+        gate_giou_min=None if giou is None else gate_giou_min,
     )
+
+
+def overlap_gate(prior: Bernoullis, meas: Measurements, inside: np.ndarray) -> np.ndarray:
+    """(K, M) bird's-eye GIoU (``box.overlap.giou_bev``) of every pair inside the Mahalanobis gate: the
+    detection's box against the track's predicted box (predicted centre, last detection's width, length and
+    heading); NaN for the pairs outside."""
+    out = np.full(inside.shape, np.nan)
+    k, j = np.nonzero(inside)
+    if len(k):
+        tracks, boxes = prior.size_wlh_m, meas.boxes
+        out[k, j] = giou_bev(
+            prior.mean[k, :2],
+            tracks[k, :2],
+            yaw_from_quat_wxyz(prior.quat_wxyz[k]),
+            boxes.xy[j],
+            boxes.size_wlh_m[j, :2],
+            yaw_from_quat_wxyz(boxes.quat_wxyz[j]),
+        )
+    return out
 
 
 def detected_means(local: LocalHypotheses, track_index: np.ndarray, meas_index: np.ndarray) -> np.ndarray:
     """(P, 4) Kalman-updated means for P (track, measurement) pairs given as local row/column indices."""
     if len(track_index) == 0:
-        return np.zeros((0, 4))
+        return np.zeros((0, local.prior.mean.shape[1]))
     return paired_updated_means(local.prior.mean, local.inn, local.meas.z, track_index, meas_index)

@@ -51,10 +51,12 @@ def birth_update(birth_cov: np.ndarray, R: np.ndarray) -> BirthUpdate:
     ``new_track_hypotheses`` on one component with a zero innovation, so each quantity has the bits the
     per-component computation gives."""
     d = R.shape[0]
-    inn = innovation(np.zeros((1, 4)), birth_cov[None], R)
+    inn = innovation(np.zeros((1, birth_cov.shape[0])), birth_cov[None], R)
     nu = np.zeros((1, d))
     log_density = gaussian_log_density(paired_mahalanobis2(inn.S_inv, nu), inn.log_det_S, d)
-    increment = mean_update(np.full((1, 4), -0.0), inn.gain, nu)[0]  # -0 + x = x, signed zeros included
+    increment = mean_update(np.full((1, birth_cov.shape[0]), -0.0), inn.gain, nu)[
+        0
+    ]  # -0 + x = x, signed zeros included
     cov = inn.cov_post[0]
     increment.flags.writeable = cov.flags.writeable = False
     return BirthUpdate(log_density=float(log_density[0]), mean_increment=increment, cov=cov)
@@ -73,7 +75,8 @@ def new_track_hypotheses(
     per class), used instead of a Kalman update per component."""
     m = len(meas)
     if m == 0:
-        return NewTrackHypotheses(np.zeros(0), np.zeros(0), np.zeros((0, 4)), np.zeros((0, 4, 4)))
+        n = birth.mean.shape[1]
+        return NewTrackHypotheses(np.zeros(0), np.zeros(0), np.zeros((0, n)), np.zeros((0, n, n)))
     if shared is None:
         inn = innovation(birth.mean, birth.cov, R)
         nu = meas.z - inn.z_pred  # (M, D): component j explains measurement j only

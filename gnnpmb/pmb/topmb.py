@@ -159,6 +159,7 @@ def merged_bernoullis(local: LocalHypotheses, marg: AssociationMarginals) -> tup
         mean=mean,
         cov=symmetrize(cov),
         det=prior.det.undetected().take(hit, DetectionFields.from_measurements(meas, hit_j)),
+        misses=np.where(best > 0, 0, prior.misses),
     )
     return tracks, comp
 

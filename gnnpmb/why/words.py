@@ -107,6 +107,8 @@ def cost_breakdown(terms: PairTerms, meas: str) -> str:
     parts.append((terms.distance_nats, f"for the distance to {meas} (d² {terms.d2:.1f})"))
     if terms.score is not None:
         parts.append((terms.score_nats, f"for {meas}'s score {terms.score:.2f}"))
+    if terms.box_nats:
+        parts.append((terms.box_nats, f"for {meas}'s heading and size against its last box"))
     shown = hundredths_summing_to([v for v, _ in parts], terms.total_nats)
     return " + ".join(f"{v:.2f} {text}" for v, (_, text) in zip(shown, parts, strict=True))
 

@@ -21,7 +21,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from gnnpmb.config import TrackerConfig
+from gnnpmb.config import TrackerConfig, paper_config
 from gnnpmb.data.nuscenes import load_scene, resolve_dataroot, sample_tokens
 from gnnpmb.data.scene import SceneData
 from gnnpmb.data.simdet import PRESETS
@@ -40,9 +40,17 @@ def load_demo_scenes(dataroot: Path) -> tuple[list[SceneData], list[str]]:
     return [load_scene(location, name) for name in SCENE_NAMES], sample_tokens(location, SCENE_NAMES)
 
 
-def submission_bytes(scenes: Sequence[SceneData], tokens: Sequence[str], tracker: str, preset: str) -> bytes:
-    """The submission ``gnnpmb track --tracker TRACKER --detector PRESET --seed 0`` writes for ``scenes``."""
-    config = TrackerConfig()
+PAPER_TRACKERS: tuple[str, ...] = ("gnnpmb", "pmbm", "topmb")
+"""The trackers whose submissions with ``gnnpmb/params/paper.toml`` are digested too (``paper:`` keys): the
+paper's configuration must keep giving the paper's tracker whatever the defaults become."""
+
+
+def submission_bytes(
+    scenes: Sequence[SceneData], tokens: Sequence[str], tracker: str, preset: str, paper: bool = False
+) -> bytes:
+    """The submission ``gnnpmb track --tracker TRACKER --detector PRESET --seed 0`` writes for ``scenes`` (with
+    ``--params gnnpmb/params/paper.toml`` when ``paper``)."""
+    config = paper_config() if paper else TrackerConfig()
     parts = [
         run_results(run_tracker(scene, get_detections(scene, None, preset, SEED), tracker, config)) for scene in scenes
     ]
@@ -50,21 +58,27 @@ def submission_bytes(scenes: Sequence[SceneData], tokens: Sequence[str], tracker
     return text.encode("utf-8")
 
 
-def digest_key(tracker: str, preset: str) -> str:
-    return f"{tracker}/{preset}"
+def digest_key(tracker: str, preset: str, paper: bool = False) -> str:
+    return f"{'paper:' if paper else ''}{tracker}/{preset}"
+
+
+def all_keys() -> list[tuple[str, str, bool]]:
+    """(tracker, preset, paper) of every committed digest."""
+    defaults = [(t, p, False) for t in TRACKER_NAMES for p in PRESETS]
+    return defaults + [(t, p, True) for t in PAPER_TRACKERS for p in PRESETS]
 
 
 def compute_digests(dataroot: Path, trackers: Sequence[str] = TRACKER_NAMES) -> dict[str, str]:
     """``{"tracker/preset": sha256 hex}`` for ``trackers`` x every preset; prints each run's wall time."""
     scenes, tokens = load_demo_scenes(dataroot)
     digests: dict[str, str] = {}
-    for tracker in trackers:
-        for preset in PRESETS:
-            start = time.perf_counter()
-            digests[digest_key(tracker, preset)] = hashlib.sha256(
-                submission_bytes(scenes, tokens, tracker, preset)
-            ).hexdigest()
-            print(f"{tracker:8s} {preset:13s} {time.perf_counter() - start:6.2f} s", file=sys.stderr)
+    for tracker, preset, paper in all_keys():
+        if tracker not in trackers:
+            continue
+        start = time.perf_counter()
+        key = digest_key(tracker, preset, paper)
+        digests[key] = hashlib.sha256(submission_bytes(scenes, tokens, tracker, preset, paper)).hexdigest()
+        print(f"{key:28s} {time.perf_counter() - start:6.2f} s", file=sys.stderr)
     return digests
 
 

@@ -17,9 +17,11 @@ from gnnpmb.data.simdet import (
     simulate_detections,
     to_submission,
 )
-from gnnpmb.data.simdet_presets import CLASS_MODELS
+from gnnpmb.data.simdet_presets import CLASS_MODELS, VARIANTS
 from gnnpmb.errors import UnknownNameError
 from gnnpmb.types import TRACKING_CLASSES, Boxes
+
+VARIANTS_RUNS = VARIANTS["runs"]
 
 SIZES = {
     "car": (1.9, 4.5, 1.6),
@@ -400,3 +402,47 @@ def test_submission_round_trips_through_the_loader(tmp_path):
         for field in ("translation_m", "size_wlh_m", "quat_wxyz", "velocity_mps", "score"):
             np.testing.assert_allclose(getattr(loaded[token], field), getattr(dets[token], field), rtol=1e-15)
         np.testing.assert_array_equal(loaded[token].class_name, dets[token].class_name)
+
+
+def test_variant_names_and_realism_off_leaves_the_preset_unchanged():
+    from gnnpmb.data.simdet_presets import get_preset
+
+    assert get_preset("megvii+runs").realism == VARIANTS["runs"] and get_preset("megvii").realism.near_fp_prob == 0
+    with pytest.raises(UnknownNameError, match=r"\+runs"):
+        get_preset("megvii+sunny")
+    scene = make_scene(street())
+    off = dataclasses.replace(PRESETS["pointpillars"], realism=dataclasses.replace(VARIANTS["real"], **OFF))
+    a, b = simulate_detections(scene, "pointpillars", seed=2), simulate_detections(scene, off, seed=2)
+    for token in scene.sample_tokens:
+        assert_boxes_equal(a[token], b[token])
+
+
+OFF = {"hardness_std_logit": 0.0, "score_hardness": 0.0, "near_fp_prob": 0.0, "velocity_outlier_prob": 0.0}
+
+
+def test_hardness_makes_misses_come_in_runs():
+    """With the latent hardness, a missed object is missed again next frame more often than its miss rate."""
+    objects = [(f"car-{i}", "car", 5.0 + 3 * (i % 10), -20.0 + 4 * (i // 10), 0.0, 0.0, 0.0) for i in range(40)]
+    frames = [list(objects) for _ in range(40)]
+    scene = make_scene(frames, num_pts=[np.full(40, 10)] * 40)  # few points: some misses
+    runs = dataclasses.replace(quiet("pointpillars"), realism=dataclasses.replace(VARIANTS_RUNS, score_hardness=0.0))
+    hits = []
+    for preset in (quiet("pointpillars"), runs):
+        dets = simulate_detections(scene, preset, seed=7)
+        seen = np.array(
+            [
+                [nearest_detection(dets[k.sample_token], k.gt.xy[i], 0.8) is not None for i in range(40)]
+                for k in scene.keyframes
+            ]
+        )
+        miss = ~seen
+        hits.append((miss[1:] & miss[:-1]).sum() / max(miss[:-1].sum(), 1) / max(miss.mean(), 1e-9))
+    assert hits[1] > 1.5 * hits[0]
+
+
+def test_near_object_false_boxes_sit_beside_objects():
+    scene = make_scene(street(20))
+    near = dataclasses.replace(quiet(), realism=dataclasses.replace(VARIANTS_RUNS, **{**OFF, "near_fp_prob": 1.0}))
+    dets = simulate_detections(scene, near, seed=1)
+    first = dets[scene.sample_tokens[0]]
+    assert len(first) >= 2 * len(scene.keyframes[0].gt) - 1

@@ -1,11 +1,16 @@
+from dataclasses import replace
+
 import numpy as np
 
+from gnnpmb.box_likelihood import BoxShapeModel
 from gnnpmb.config import paper_config
+from gnnpmb.data.boxes3d import quat_wxyz_from_yaw
 from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.models import measurement_birth
 from gnnpmb.pmb.bernoulli import Bernoullis
 from gnnpmb.pmb.cost import local_hypotheses
 from gnnpmb.pmb.poisson import new_track_hypotheses
+from gnnpmb.types import Measurements
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = paper_config()
@@ -22,6 +27,7 @@ def bernoullis(xy: list[tuple[float, float]]) -> Bernoullis:
         mean=np.column_stack([np.asarray(xy, dtype=float).reshape(k, 2), np.zeros((k, 2))]),
         cov=np.broadcast_to(np.eye(4), (k, 4, 4)).copy(),
         det=DetectionFields(np.full(k, 0.8), np.zeros(k), np.ones((k, 3)), np.zeros((k, 4)), np.full(k, -1)),
+        misses=np.zeros(k, dtype=np.int64),
     )
 
 
@@ -82,3 +88,47 @@ def test_existence_for_a_cheaper_cost():
     assert np.isclose(np.log(1 - r * t.p_detect) - np.log(r), t.existence_nats - 0.3)
     assert t.existence_for(-0.3) < 0.5
     assert t.existence_for(t.existence_nats - np.log(1 - t.p_detect) + 0.01) is None  # beyond r = 1
+
+
+def test_cost_terms_add_up_with_the_heading_and_size_model():
+    """The box log-likelihood ratio enters C[j, k] as its own term (``CostTerms.box_nats``), and the terms still
+    add up to every gated entry; the new-track column does not change."""
+    box = BoxShapeModel(heading_std_rad=0.1, size_log_std=0.1, size_log_spread=0.2, outlier_prob=0.1)
+    meas = make_measurements([(0.2, 0.1), (5.5, -0.3), (0.9, 0.4)], 0.7)
+    meas = Measurements(
+        replace(meas.boxes, quat_wxyz=quat_wxyz_from_yaw(np.array([0.05, 1.2, -0.1]))), meas.source_index
+    )
+    new = new_track_hypotheses(measurement_birth(meas, CFG.models), meas, R, CFG.models.clutter_intensity)
+    tracks = bernoullis([(0.0, 0.0), (5.0, 0.0), (1.0, 1.0)])
+    plain = local_hypotheses(tracks, meas, new, R, CFG.models.gate_chi2)
+    local = local_hypotheses(tracks, meas, new, R, CFG.models.gate_chi2, box=box)
+    cost, terms = local.cost_matrix(), local.cost_terms()
+    k = local.n_tracks
+    assert np.array_equal(cost[:, k:], plain.cost_matrix()[:, k:])
+    gated = np.argwhere(np.isfinite(cost[:, :k]))
+    assert len(gated) >= 4
+    for j, i in gated.tolist():
+        t = terms.pair(j, i)
+        assert t.box_nats != 0.0
+        assert np.isclose(t.total_nats, cost[j, i], rtol=0, atol=1e-12)
+
+
+def test_overlap_gate_keeps_only_pairs_that_overlap_enough():
+    """Two detections inside the Mahalanobis gate of a track at the origin (2 x 4.5 m car, heading 0): one 0.5 m
+    ahead (GIoU ~0.8), one turned by 90 degrees (GIoU < 0.5); a GIoU gate of 0.5 keeps the first only."""
+    meas = make_measurements([(0.5, 0.0), (0.0, 0.3)], 0.7)
+    meas = Measurements(
+        replace(meas.boxes, quat_wxyz=quat_wxyz_from_yaw(np.array([0.0, np.pi / 2]))), meas.source_index
+    )
+    new = new_track_hypotheses(measurement_birth(meas, CFG.models), meas, R, CFG.models.clutter_intensity)
+    track = bernoullis([(0.0, 0.0)])
+    track = replace(
+        track, det=replace(track.det, size_wlh_m=np.array([[2.0, 4.5, 1.6]]), quat_wxyz=np.array([[1.0, 0, 0, 0]]))
+    )
+    plain = local_hypotheses(track, meas, new, R, CFG.models.gate_chi2)
+    gated = local_hypotheses(track, meas, new, R, CFG.models.gate_chi2, gate_giou_min=0.5)
+    assert plain.inside.tolist() == [[True, True]] and plain.giou is None
+    assert gated.inside.tolist() == [[True, False]]
+    expected = (2.0 * 4.0) / (2.0 * 5.0)  # I / U with |C| = U: two aligned boxes 0.5 m apart along their length
+    assert np.isclose(gated.giou[0, 0], expected, rtol=0, atol=1e-12) and gated.giou[0, 1] < 0.5
+    assert np.isinf(gated.cost_matrix()[1, 0]) and np.isfinite(gated.cost_matrix()[0, 0])

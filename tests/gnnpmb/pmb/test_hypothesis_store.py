@@ -27,6 +27,7 @@ def random_store(rng: np.random.Generator, n: int, keys: np.ndarray) -> Bernoull
             quat_wxyz=rng.random((n, 4)),
             meas_index=rng.integers(-1, 5, size=n),
         ),
+        misses=np.zeros(n, dtype=np.int64),
     )
 
 

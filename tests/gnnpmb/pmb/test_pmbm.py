@@ -51,6 +51,7 @@ def one_track(score: float = 0.9, pos_var: float = 0.1, vel_var: float = 0.5) ->
             quat_wxyz=np.array([[1.0, 0.0, 0.0, 0.0]]),
             meas_index=np.array([-1]),
         ),
+        misses=np.zeros(1, dtype=np.int64),
     )
 
 

@@ -44,6 +44,7 @@ def make_prior(means, existence, cov_diag=(0.5, 0.5, 1.0, 1.0), score=0.8) -> Be
             quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (k, 1)),
             meas_index=np.full(k, -1),
         ),
+        misses=np.zeros(k, dtype=np.int64),
     )
 
 
