@@ -211,24 +211,18 @@ def failures(
     from gnnpmb.runs import parse_runs, run_inputs
     from gnnpmb.session import parse_frames
 
-    specs = parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)
-    inputs = (("--detections", detections), ("--params", params), *run_inputs(specs))
+    runs = parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)
+    inputs = (("--detections", detections), ("--params", params), *run_inputs(runs))
     json_target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
-    parse_frames(frames)  # a malformed --frames: one line before any work
-    detector_choice(detections, detector, DEFAULT_DETECTOR)  # --detections and --detector: one line
-    reports, findings, request = failure_reports(
-        scene,
-        tracker or [],
-        results or [],
-        dataroot=dataroot,
-        version=version,
-        detections=detections,
-        detector=detector,
-        seed=seed,
-        params=params,
-        why=why,
-        frames=frames,
-    )
+    bounds = parse_frames(frames)
+    preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
+    foreign: dict = {}
+    if len(runs) == 1 and runs[0].tracker is not None and runs[0].params is None:  # one built-in tracker
+        reports, findings = _one_tracker(
+            scene, runs[0].tracker, dataroot, version, detections, preset, seed, params, why, bounds
+        )
+    else:  # several runs, a results file or a tracker's own parameters (gnnpmb.session)
+        from cli.failures import failure_reports
 
         reports, findings, request = failure_reports(
             scene,
@@ -241,6 +235,7 @@ def failures(
             seed=seed,
             params=params,
             why=why,
+            frames=frames,
         )
         foreign = {name: r.original_ids for name, r in request.foreign.items() if r.original_ids}
     if json_target is not None:
@@ -256,8 +251,11 @@ def failures(
         typer.echo(f"report -> {json_out}")
 
 
-def _one_tracker(scene: str, tracker: str, dataroot, version, detections, preset: str, seed: int, params, why: bool):
-    """One built-in tracker's report (and findings, with ``why``) on ``scene``, keyed by its name."""
+def _one_tracker(
+    scene: str, tracker: str, dataroot, version, detections, preset: str, seed: int, params, why: bool, bounds
+):
+    """One built-in tracker's report (and findings, with ``why``) on ``scene``, keyed by its name; bounds: the
+    ``--frames`` keyframes (``session.parse_frames``)."""
     from gnnpmb.config import load_config
     from gnnpmb.data.detections import check_detection_file
     from gnnpmb.data.nuscenes import resolve_dataroot
