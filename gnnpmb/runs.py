@@ -196,7 +196,7 @@ def run_inputs(specs: Sequence[RunSpec]) -> tuple[tuple[str, Path], ...]:
     out: list[tuple[str, Path]] = []
     for spec in specs:
         if spec.results is not None:
-            out.append((f"results {spec.name}", spec.results))
+            out.append((f"--results {spec.name}", spec.results))
         if spec.params is not None:
-            out.append((f"parameters of {spec.name}", spec.params))
+            out.append((f"--tracker {spec.name} parameters", spec.params))
     return tuple(out)
