@@ -28,7 +28,15 @@ from typing import Annotated
 import typer
 
 from cli.errors import check_version_flag, exit_now_on_failure, run_app
-from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption, tidy_help
+from cli.options import (
+    DatarootOption,
+    DetectionsOption,
+    ParamsOption,
+    ResultsOption,
+    SeedOption,
+    VersionOption,
+    tidy_help,
+)
 from cli.progress import progress_bar
 from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.registry import TRACKER_NAMES
@@ -92,9 +100,11 @@ def view(
             "--tracker",
             "-t",
             metavar="NAME",
-            help=f"Tracker to run; repeat to compare several side by side ({', '.join(TRACKER_NAMES)}).",
+            help=f"Tracker to run; repeat to compare several side by side ({', '.join(TRACKER_NAMES)}); "
+            "TRACKER:PARAMS.toml runs it with its own parameters, NAME=FILE.json is a results file.",
         ),
     ] = None,
+    results: ResultsOption = None,
     dataroot: DatarootOption = None,
     version: VersionOption = None,
     detections: DetectionsOption = None,
@@ -155,6 +165,7 @@ def view(
     request = prepare(
         scene,
         tracker or [],
+        results=results or [],
         dataroot=dataroot,
         version=version,
         detections_file=detections,
@@ -183,12 +194,13 @@ def view(
     if request.serve is not None:
         output = f"served at {request.serve.url}"
     typer.echo(f"{request.scene.name}: {len(request.frame_range)} frames, {timing}{compared}; {output}")
-    if result.focus is None:  # where to look next: --focus ids name the first tracker's failures
+    if result.focus is None:  # where to look next: --focus ids name the first run's failures
         for k, (name, report) in enumerate(result.reports.items()):
             first = report.first_worth_opening()
             if first is None:
                 continue
-            how = f"add --focus {first}" if k == 0 else f"give --tracker {name} first and add --focus {first}"
+            spec = request.spec(name).text()
+            how = f"add --focus {first}" if k == 0 else f"give --tracker {spec} first and add --focus {first}"
             interpolated = sum(f.gt_interpolated for f in report.failures)
             at_interpolated = (
                 f" ({interpolated} at a GT box the evaluation interpolated: the object had no points)"
@@ -198,7 +210,7 @@ def view(
             typer.echo(
                 f"{name} failures{report.scope_text()}: {report.totals_text()}{at_interpolated}. To open {first} at "
                 f"its frame, {how} to this command; to list them all: gnnpmb failures {request.scene.name} "
-                f"--tracker {name} (same options)."
+                f"--tracker {spec} (same options)."
             )
     if request.serve is not None:
         from viz.serving import wait_for_ctrl_c

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from cli.diff import register as register_diff
 from cli.errors import entry_point
 from cli.options import (
     DEFAULT_DETECTOR,
@@ -23,6 +24,8 @@ from cli.options import (
     DetectionsOption,
     DetectorOption,
     ParamsOption,
+    ResultsOption,
+    RunsOption,
     SeedOption,
     SplitOption,
     TrackerOption,
@@ -175,7 +178,8 @@ def evaluate(
 @app.command(short_help="List one scene's tracking failures per frame.")
 def failures(
     scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
-    tracker: TrackerOption = DEFAULT_TRACKER,
+    tracker: RunsOption = None,
+    results: ResultsOption = None,
     dataroot: DatarootOption = None,
     version: VersionOption = None,
     detections: DetectionsOption = None,
@@ -201,24 +205,64 @@ def failures(
     ] = None,
 ) -> None:
     """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
-    coalescence and cascading identity theft (scored with the devkit's own matching)."""
+    coalescence and cascading identity theft (scored with the devkit's own matching). With several runs (--tracker,
+    --results) each is listed in turn; --why explains each failure beside the others."""
     from gnnpmb.data.simdet_presets import detector_choice
-    from gnnpmb.registry import check_tracker, tracker_has_existence
+    from gnnpmb.runs import parse_runs, run_inputs
     from gnnpmb.session import parse_frames
-    from gnnpmb.why.facts import FactSink
 
-    inputs = (("--detections", detections), ("--params", params))
+    runs = parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)
+    inputs = (("--detections", detections), ("--params", params), *run_inputs(runs))
     json_target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
-    check_tracker(tracker)
     bounds = parse_frames(frames)
+    preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
+    foreign: dict = {}
+    if len(runs) == 1 and runs[0].tracker is not None and runs[0].params is None:  # one built-in tracker
+        reports, findings = _one_tracker(
+            scene, runs[0].tracker, dataroot, version, detections, preset, seed, params, why, bounds
+        )
+    else:  # several runs, a results file or a tracker's own parameters (gnnpmb.session)
+        from cli.failures import failure_reports
 
+        reports, findings, request = failure_reports(
+            scene,
+            tracker or [],
+            results or [],
+            dataroot=dataroot,
+            version=version,
+            detections=detections,
+            detector=detector,
+            seed=seed,
+            params=params,
+            why=why,
+            frames=frames,
+        )
+        foreign = {name: r.original_ids for name, r in request.foreign.items() if r.original_ids}
+    if json_target is not None:
+        from gnnpmb.eval.submission import write_json
+
+        write_json(json_target, _report_json(reports, findings, foreign))
+    console = stdout_console()
+    for name, report in reports.items():
+        print_report(report, console)
+        if why:
+            print_findings(findings[name], console)
+    if json_out is not None:
+        typer.echo(f"report -> {json_out}")
+
+
+def _one_tracker(
+    scene: str, tracker: str, dataroot, version, detections, preset: str, seed: int, params, why: bool, bounds
+):
+    """One built-in tracker's report (and findings, with ``why``) on ``scene``, keyed by its name; bounds: the
+    ``--frames`` keyframes (``session.parse_frames``)."""
     from gnnpmb.config import load_config
     from gnnpmb.data.detections import check_detection_file
     from gnnpmb.data.nuscenes import resolve_dataroot
-    from gnnpmb.eval.submission import write_json
+    from gnnpmb.registry import tracker_has_existence
     from gnnpmb.study.track import scene_failures
+    from gnnpmb.why.facts import FactSink
 
-    preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
     config = load_config(params)
     if detections is not None:
         check_detection_file(detections)
@@ -238,18 +282,27 @@ def failures(
             )
             for fid, f in zip(report.ids(), report.failures, strict=True)
         ]
-    if json_target is not None:
-        data = report.to_json()
-        if why:
-            from gnnpmb.why.serialize import finding_json
+    return {tracker: report}, ({tracker: findings} if why else {})
 
-            data["findings"] = [finding_json(f) for f in findings]
-        write_json(json_target, data)
-    print_report(report, stdout_console())
-    if why:
-        print_findings(findings, stdout_console())
-    if json_out is not None:
-        typer.echo(f"report -> {json_out}")
+
+def _report_json(reports: dict, findings: dict, track_names: dict) -> dict:
+    """The first run's report (and findings), the other runs' under ``other_runs``; a results file's renumbered
+    ids under ``track_names`` (``track_names``: run -> track id -> the file's id)."""
+    from gnnpmb.why.serialize import finding_json
+
+    def one(name: str) -> dict:
+        data = reports[name].to_json()
+        if name in findings:
+            data["findings"] = [finding_json(f) for f in findings[name]]
+        if name in track_names:
+            data["track_names"] = {str(t): i for t, i in track_names[name].items()}
+        return data
+
+    first, *rest = reports
+    data = one(first)
+    if rest:
+        data["other_runs"] = [one(name) for name in rest]
+    return data
 
 
 def print_findings(findings: list, console: Console) -> None:
@@ -331,4 +384,5 @@ def demo_data(
 
 
 register(app)
+register_diff(app)
 main = entry_point(app, "gnnpmb")

@@ -35,6 +35,25 @@ DetectionsOption = Annotated[
     typer.Option(metavar="FILE.json", help="nuScenes detection results .json (default: a simulated detector)."),
 ]
 SeedOption = Annotated[int, typer.Option(metavar="N", min=0, help="Seed of the simulated detector (0 or more).")]
+RunsOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--tracker",
+        "-t",
+        metavar="NAME",
+        help=f"Tracker to run (repeatable): {', '.join(TRACKER_NAMES)}; TRACKER:PARAMS.toml with its own "
+        "parameters; NAME=FILE.json a results file (default gnnpmb).",
+    ),
+]
+ResultsOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--results",
+        metavar="NAME=FILE.json",
+        help="Another tracker's results (a nuScenes tracking submission) as a run named NAME; repeatable. "
+        "Results runs come first (to order them among trackers, give --tracker NAME=FILE.json instead).",
+    ),
+]
 ParamsOption = Annotated[
     Path | None,
     typer.Option(metavar="FILE.toml", help="Tracker parameter file (.toml) overriding the paper's."),

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -35,6 +35,7 @@ NEAR_FRAMES = 4
 """... and so are tracks that were that close to it in this many keyframes before the failure (a track that
 followed the object with too low a score to be counted is often the failure's cause)."""
 _SPEC = re.compile(r"^(?P<kind>[a-z_]+):(?P<ref>\S+)$")
+_DIFF_REF = re.compile(r"^(fixed|introduced|kept):[1-9][0-9]*$")
 _KIND_ORDER = (
     FailureKind.IDENTITY_THEFT,
     FailureKind.ID_SWITCH,
@@ -86,13 +87,15 @@ def parse_focus(spec: str) -> tuple[str, str]:
     """``kind:ref`` -> (kind, ref), checked; raises GnnpmbError naming the accepted forms."""
     match = _SPEC.match(spec.strip())
     kinds = {k.value for k in FailureKind}
-    if match is None or (match["kind"] not in kinds | {"track", "gt"}):
+    if match is None or (match["kind"] not in kinds | {"track", "gt", "diff"}):
         raise GnnpmbError(
-            f"bad --focus '{spec}': use track:ID, gt:TOKEN or a failure id such as id_switch:1 "
-            f"(gnnpmb failures SCENE --tracker T lists them)"
+            f"bad --focus '{spec}': use track:ID, gt:TOKEN, a failure id such as id_switch:1 "
+            f"(gnnpmb failures SCENE --tracker T lists them) or a change such as diff:introduced:1 (gnnpmb diff A B)"
         )
     if match["kind"] == "track" and not match["ref"].isdigit():
         raise GnnpmbError(f"bad --focus '{spec}': track:ID takes a track number, e.g. track:802")
+    if match["kind"] == "diff" and not _DIFF_REF.match(match["ref"]):
+        raise GnnpmbError(f"bad --focus '{spec}': use diff:fixed:N, diff:introduced:N or diff:kept:N")
     return match["kind"], match["ref"]
 
 
@@ -114,6 +117,16 @@ def resolve_focus(
         return _track_focus(int(ref), scene, reports, estimates, frames)
     if kind == "gt":
         return _gt_focus(ref, scene, reports, estimates, frames)
+    if kind == "diff":
+        from gnnpmb.diff import diff_failure
+
+        failure, run, fid, entry = diff_failure(ref, reports)
+        if failure.frame_index not in frames:
+            raise GnnpmbError(f"--focus {spec}: {entry.diff_id} is at frame {failure.frame_index}, outside --frames")
+        target = _from_failure(failure, run, fid, scene, estimates, frames)
+        a, b = list(reports)[:2]
+        title = f"{entry.diff_id} ({entry.change.value} from {a} to {b}): {target.title}"
+        return replace(target, title=title)
     first = trackers[0]
     failure = reports[first].by_id(spec.strip())
     if failure is None or failure.frame_index not in frames:

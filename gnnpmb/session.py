@@ -31,7 +31,8 @@ from typing import TYPE_CHECKING, Any, Protocol
 from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.errors import DataError, GnnpmbError
 from gnnpmb.outputs import check_output_file
-from gnnpmb.registry import check_classes, check_tracker, tracker_has_existence
+from gnnpmb.registry import check_classes
+from gnnpmb.runs import Capabilities, RunSpec, capabilities, parse_run, parse_runs, run_inputs
 from gnnpmb.serve import ServeTarget, check_serve_ports
 
 if TYPE_CHECKING:
@@ -40,10 +41,13 @@ if TYPE_CHECKING:
     from gnnpmb.data.nuscenes import DatasetLocation
     from gnnpmb.data.scene import SceneData
     from gnnpmb.eval.failures import FailureReport
+    from gnnpmb.events import EventSink
     from gnnpmb.focus import FocusTarget
+    from gnnpmb.foreign import ForeignResults
     from gnnpmb.pipeline import TrackingRun
     from gnnpmb.provenance import DetectionsSource, Provenance, TrackDigest
     from gnnpmb.types import Boxes, FrameDetections
+    from gnnpmb.why.facts import FactSink, TrackerFacts
     from gnnpmb.why.findings import Finding
     from gnnpmb.why.reason import Evidence
 
@@ -89,8 +93,12 @@ class SilentProgress:
 class ViewRequest:
     """Everything one ``gnnpmb-viz`` run needs, checked: no recording is opened before this exists.
 
-    source: where the detections came from, with their hash; seed: the simulated detector's seed;
-    argv: the command line, for the provenance; serve: the ports of the web viewer (None: save or spawn).
+    trackers: the names of the runs (``gnnpmb.runs``), in order; runs: each one's spec (built-in tracker or
+    results file; empty: every name is a registry tracker with ``config``); foreign: the loaded results of each
+    results run; configs: the parameters of each run with a file of its own; own_frames: the detections of a run
+    whose parameters preprocess them otherwise; source: where the detections came from, with their hash; seed:
+    the simulated detector's seed; argv: the command line, for the provenance; serve: the ports of the web viewer
+    (None: save or spawn); notices: what the user should know (e.g. boxes of a results file left out).
     """
 
     scene: SceneData
@@ -107,6 +115,19 @@ class ViewRequest:
     argv: tuple[str, ...]
     focus: str | None = None
     serve: ServeTarget | None = None
+    runs: tuple[RunSpec, ...] = ()
+    foreign: Mapping[str, ForeignResults] = field(default_factory=dict)
+    configs: Mapping[str, TrackerConfig] = field(default_factory=dict)
+    own_frames: Mapping[str, list[FrameDetections]] = field(default_factory=dict)
+    notices: tuple[str, ...] = ()
+
+    def spec(self, name: str) -> RunSpec:
+        """The spec of run ``name`` (a registry tracker of that name when ``runs`` does not list it)."""
+        return next((s for s in self.runs if s.name == name), RunSpec(name, tracker=name))
+
+    def capabilities(self, name: str) -> Capabilities:
+        """What run ``name`` can show (``runs.capabilities``)."""
+        return capabilities(self.spec(name))
 
 
 @dataclass(frozen=True, slots=True)
@@ -182,6 +203,7 @@ def prepare(
     scene_name: str,
     trackers: Sequence[str],
     *,
+    results: Sequence[str] = (),
     dataroot: Path | None = None,
     version: str | None = None,
     detections_file: Path | None = None,
@@ -197,18 +219,20 @@ def prepare(
 ) -> ViewRequest:
     """Check every argument and load the scene and detections; raises GnnpmbError with a one-line message.
 
-    The cheap checks (names, --frames, output path, ports, the --detections file) run before the dataset is
-    loaded. detector None means the default preset; it cannot be combined with ``detections_file``.
+    trackers: run spellings (``runs.parse_run``: ``gnnpmb``, ``gnnpmb:paper.toml``, ``NAME=FILE.json``);
+    results: ``NAME=FILE.json`` runs, placed first (the default tracker runs when neither is given). The cheap
+    checks (names, files, --frames, output path, ports, the --detections file) run before the dataset is loaded.
+    detector None means the default preset; it cannot be combined with ``detections_file``.
     """
     if detections_file is not None and detector is not None:
         raise GnnpmbError("pass either --detections FILE.json or --detector PRESET, not both")
     if save is not None and serve is not None:
         raise GnnpmbError("pass either --save OUT.rrd or --serve, not both")
     detector = detector or DEFAULT_DETECTOR
-    names = tuple(dict.fromkeys(check_tracker(t) for t in (trackers or [DEFAULT_TRACKER])))
+    specs = parse_runs(trackers, results, default=DEFAULT_TRACKER)
     class_names = parse_classes(classes)
     bounds = parse_frames(frames)
-    inputs = (("--detections", detections_file), ("--params", params))
+    inputs = (("--detections", detections_file), ("--params", params), *run_inputs(specs))
     target = check_output_file(save, "--save", ".rrd", inputs=inputs) if save is not None else None
     if serve is not None:
         check_serve_ports(serve)
@@ -233,11 +257,12 @@ def prepare(
     detections = get_detections(scene, detections_file, detector, seed)
     source = detections_source(scene, detections, detections_file, detector, seed)
     frame_detections = preprocess_frames(scene, detections, config, class_names)
+    own = load_runs(specs, scene, location, config, detections, frame_detections, class_names)
     freeze_loaded()
     return ViewRequest(
         scene,
         location,
-        names,
+        tuple(s.name for s in specs),
         class_names,
         frame_range,
         config,
@@ -249,7 +274,41 @@ def prepare(
         tuple(argv),
         focus=focus,
         serve=serve,
+        runs=specs,
+        **own,
     )
+
+
+def load_runs(
+    specs: Sequence[RunSpec],
+    scene: SceneData,
+    location: DatasetLocation,
+    config: TrackerConfig,
+    detections: Mapping[str, Boxes],
+    frames: list[FrameDetections],
+    classes: Sequence[str],
+) -> dict[str, Any]:
+    """What the runs bring of their own (the ``ViewRequest`` fields ``foreign``, ``configs``, ``own_frames`` and
+    ``notices``): each results file read and checked for ``scene`` (``gnnpmb.foreign``), each parameter file."""
+    from gnnpmb.config import load_config
+    from gnnpmb.data.nuscenes import all_sample_tokens
+    from gnnpmb.foreign import read_results, scene_results
+    from gnnpmb.pipeline import preprocess_frames
+
+    foreign, configs, own_frames, notices = {}, {}, {}, []
+    dataset_tokens: set[str] | None = None
+    for spec in specs:
+        if spec.results is not None:
+            if dataset_tokens is None:
+                dataset_tokens = all_sample_tokens(location)
+            data = read_results(spec.results)
+            foreign[spec.name] = scene_results(spec.name, spec.results, data, scene, frames, classes, dataset_tokens)
+            notices += foreign[spec.name].notices
+        elif spec.params is not None:
+            own = configs[spec.name] = load_config(spec.params)
+            if own.preprocess_by_class() != config.preprocess_by_class():
+                own_frames[spec.name] = preprocess_frames(scene, detections, own, classes)
+    return {"foreign": foreign, "configs": configs, "own_frames": own_frames, "notices": tuple(notices)}
 
 
 def freeze_loaded() -> None:
@@ -291,7 +350,7 @@ def prepare_reproduction(
         )
     config = config_from_dict(p.config)
     classes = tuple(check_classes(list(p.classes)))
-    trackers = tuple(check_tracker(t) for t in p.trackers)
+    specs = tuple(parse_run(t, "recorded run") for t in p.trackers)
     frame_range = frame_range_of((p.frame_start, p.frame_end), scene)
     recorded = p.detections
     if recorded.kind == "file":
@@ -316,11 +375,12 @@ def prepare_reproduction(
                 f"recorded (sha256 {source.sha256[:12]}, recorded {recorded.sha256[:12]})"
             )
     frame_detections = preprocess_frames(scene, detections, config, classes)
+    own = load_runs(specs, scene, location, config, detections, frame_detections, classes)
     freeze_loaded()
     return ViewRequest(
         scene,
         location,
-        trackers,
+        tuple(s.name for s in specs),
         classes,
         frame_range,
         config,
@@ -330,6 +390,8 @@ def prepare_reproduction(
         source,
         p.seed,
         tuple(argv),
+        runs=specs,
+        **own,
     )
 
 
@@ -360,9 +422,17 @@ def provenance_of(request: ViewRequest, digests: dict[str, TrackDigest]) -> Prov
         frame_start=request.frame_range.start,
         frame_end=request.frame_range.stop,
         classes=request.classes,
-        trackers=request.trackers,
+        trackers=tuple(_recorded(request.spec(t)) for t in request.trackers),
         track_digests=digests,
     )
+
+
+def _recorded(spec: RunSpec) -> str:
+    """A run's spelling in the provenance, with absolute paths (``runs.parse_run`` reads it back)."""
+    from dataclasses import replace
+
+    absolute = {k: Path(v).absolute() for k in ("params", "results") if (v := getattr(spec, k)) is not None}
+    return replace(spec, **absolute).text()
 
 
 def run_digest(run: TrackingRun) -> TrackDigest:
@@ -427,49 +497,88 @@ def resolve_request_focus(request: ViewRequest) -> tuple[FocusTarget, dict[str, 
     return resolve_focus(request.focus, request.scene, reports, estimates, request.frame_range), reports, notices
 
 
+def resolve_opening(request: ViewRequest) -> tuple[FocusTarget | None, dict[str, FailureReport], list[str]]:
+    """Where a full recording opens: run every tracker without logging, find their failures and take the first
+    failure worth a look of the first run (``FailureReport.first_worth_opening``) as a focus target (None: no
+    failure, or no ground truth); returns it, the failure reports and notices."""
+    from gnnpmb.focus import resolve_focus
+
+    runs = rerun_runs(request)
+    reports, notices = find_reports(request, runs)
+    report = reports.get(request.trackers[0])
+    first = report.first_worth_opening(request.frame_range) if report is not None else None
+    if first is None:
+        return None, reports, notices
+    estimates = {run.tracker: [f.estimates for f in run.frames] for run in runs}
+    return resolve_focus(first, request.scene, reports, estimates, request.frame_range), reports, notices
+
+
 def rerun_runs(request: ViewRequest) -> list[TrackingRun]:
     """Run every tracker of ``request`` without logging."""
+    return [track_run(request, name) for name in request.trackers]
+
+
+def track_run(
+    request: ViewRequest, name: str, sink: EventSink | None = None, on_frame: Callable[[], None] | None = None
+) -> TrackingRun:
+    """Run ``name`` of ``request`` over its frames, its events to ``sink``: a built-in tracker tracks (with its own
+    parameters and detections when it has them), a results file is replayed (``gnnpmb.foreign.replay``); the run
+    is named ``name``."""
+    from dataclasses import replace
+
+    from gnnpmb.foreign import replay
     from gnnpmb.pipeline import run_tracker
 
-    return [
-        run_tracker(
-            request.scene,
-            request.frame_detections,
-            tracker,
-            request.config,
-            classes=request.classes,
-            frame_range=request.frame_range,
+    foreign = request.foreign.get(name)
+    if foreign is not None:
+        return replay(
+            foreign, request.scene, request.frame_detections, request.classes, request.frame_range, sink, on_frame
         )
-        for tracker in request.trackers
-    ]
+    spec = request.spec(name)
+    run = run_tracker(
+        request.scene,
+        request.own_frames.get(name, request.frame_detections),
+        str(spec.tracker),
+        request.configs.get(name, request.config),
+        sink=sink,
+        classes=request.classes,
+        frame_range=request.frame_range,
+        on_frame=on_frame,
+    )
+    return run if run.tracker == name else replace(run, tracker=name)
+
+
+def fact_sink(request: ViewRequest, name: str) -> FactSink:
+    """A ``why.facts.FactSink`` for run ``name`` (output only for a results file)."""
+    from gnnpmb.why.facts import FactSink
+
+    caps = request.capabilities(name)
+    return FactSink(name, has_existence=caps.has_existence, output_only=caps.output_only)
+
+
+def evidence_of(request: ViewRequest, report: FailureReport, facts: TrackerFacts, run: TrackingRun) -> Evidence:
+    """The ``why.reason.Evidence`` of one run: with a results file, how each box was placed on a detection."""
+    from gnnpmb.why.reason import Evidence
+
+    foreign = request.foreign.get(run.tracker)
+    return Evidence(report, facts, run, foreign.boxes_on if foreign is not None else {})
 
 
 def gather_evidence(request: ViewRequest) -> tuple[dict[str, Evidence], list[str]]:
     """Every tracker of ``request`` run with a ``why.facts.FactSink``, its failures found: the evidence a finding
     is explained from (``why.reason.explain_failure``), per tracker, and notices (as ``find_reports``)."""
     from gnnpmb.events import TeeSink
-    from gnnpmb.pipeline import run_tracker
-    from gnnpmb.why.facts import FactSink
-    from gnnpmb.why.reason import Evidence
 
     runs, facts = [], {}
-    for tracker in request.trackers:
-        sink = FactSink(tracker, has_existence=tracker_has_existence(tracker))
-        facts[tracker] = sink.facts
-        runs.append(
-            run_tracker(
-                request.scene,
-                request.frame_detections,
-                tracker,
-                request.config,
-                sink=TeeSink(sink),
-                classes=request.classes,
-                frame_range=request.frame_range,
-            )
-        )
+    for name in request.trackers:
+        sink = fact_sink(request, name)
+        facts[name] = sink.facts
+        runs.append(track_run(request, name, TeeSink(sink)))
     reports, notices = find_reports(request, runs)
     return {
-        run.tracker: Evidence(reports[run.tracker], facts[run.tracker], run) for run in runs if run.tracker in reports
+        run.tracker: evidence_of(request, reports[run.tracker], facts[run.tracker], run)
+        for run in runs
+        if run.tracker in reports
     }, notices
 
 

@@ -16,3 +16,17 @@ def demo_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
     from gnnpmb.data.demo import DEMO_SEED, generate_demo_dataset
 
     return generate_demo_dataset(tmp_path_factory.mktemp("demo") / "nuscenes", seed=DEMO_SEED)
+
+
+@pytest.fixture(scope="session")
+def cv_results(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Another tracker's results on the demo's ``mini_val`` scenes (a tracking submission written by
+    ``examples/cv_tracker.py``, a constant-velocity tracker outside the registry, on the centerpoint preset)."""
+    from examples.cv_tracker import track_scenes
+    from gnnpmb.data.demo import DEMO_SCENES
+    from gnnpmb.eval.submission import SUBMISSION_META, write_json
+
+    path = tmp_path_factory.mktemp("cv") / "cv.json"
+    results = track_scenes(list(DEMO_SCENES), demo_dataroot, None, "centerpoint")
+    write_json(path, {"meta": dict(SUBMISSION_META), "results": results})
+    return path

@@ -15,6 +15,10 @@ plus the scene's annotations and the detections. A rendered sentence with a ``?`
 too. ``uv run python -m tools.oracle`` checks every tracker on every demo scene and preset and prints the count of
 claims checked and contradictions found per tracker; ``tests/gnnpmb/why/test_oracle.py`` runs it on the
 evaluation split.
+
+A results file of another tracker (``--results NAME=FILE.json``) has no events: its findings are checked against
+the file itself, read here (its boxes, the detection each sits on by the rule of ``gnnpmb.foreign``, re-applied
+with code of its own), the detections and the devkit.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ import sys
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -69,6 +74,8 @@ class Sources:
     devkit: Devkit
     others: Mapping[str, Any] = field(default_factory=dict)
     keeps_detection_box: bool = True
+    output_only: bool = False
+    """A results file: ``results`` is the file's, and what an update used is where its boxes sit."""
 
     def box(self, frame: int, track: int) -> Mapping[str, Any] | None:
         token = self.scene.keyframes[frame].sample_token
@@ -168,7 +175,14 @@ def _box_update_of(src: Sources, frame: int, class_name: str, track: int) -> int
 def used_of(
     src: Sources, frame: int, class_name: str, track: int
 ) -> tuple[tuple[tuple[int, float], ...], float] | None:
-    """(detection, share) >= USED_SHARE and the missed share of ``track``'s update, from the raw events."""
+    """(detection, share) >= USED_SHARE and the missed share of ``track``'s update, from the raw events (a results
+    file: the detection its box sits on)."""
+    if src.output_only:
+        box = src.box(frame, track)
+        if box is None:
+            return None
+        placed = placed_on(src, frame, box)
+        return (((placed[0], 1.0),), 0.0) if placed is not None else ((), 1.0)
     marg = src.one(frame, class_name, Marginals)
     if marg is not None:
         rows = [i for i, r in enumerate(marg.rows) if r.ref == track]
@@ -197,7 +211,16 @@ def used_of(
 
 
 def went_of(src: Sources, frame: int, class_name: str, meas: int) -> tuple[str, int, float] | None:
-    """Where a detection went, from the raw events: (went, track, share)."""
+    """Where a detection went, from the raw events: (went, track, share); a results file: the track whose box sits
+    on it (the lowest id), else under no output box."""
+    if src.output_only:
+        token = src.scene.keyframes[frame].sample_token
+        on = sorted(
+            int(b["tracking_id"])
+            for b in src.results.get(token, ())
+            if b["tracking_name"] == class_name and (p := placed_on(src, frame, b)) is not None and p[0] == meas
+        )
+        return ("track", on[0], 1.0) if on else ("under no output box", -1, 1.0)
     born = {
         int(m): int(t)
         for b in src.of(frame, class_name, Born)
@@ -236,6 +259,33 @@ def went_of(src: Sources, frame: int, class_name: str, meas: int) -> tuple[str, 
             if row.ref == meas:
                 return ("track", int(col.ref), 1.0) if col.kind is AxisKind.TRACK else new(1.0)
     return new(1.0)
+
+
+def placed_on(src: Sources, frame: int, box: Mapping[str, Any]) -> tuple[int, str, float] | None:
+    """The detection a results file's box sits on, recomputed here: (index, how, BEV distance) of the detection of
+    its class whose size, heading and height it carries (within ``foreign.SAME_BOX_TOL``; the nearest such), else
+    the nearest of its class within ``foreign.NEAREST_M``; None: none."""
+    from gnnpmb.foreign import NEAREST_M, SAME_BOX_TOL
+
+    det = src.frames[frame].detections.boxes
+    best: tuple[float, int, str] | None = None
+    for m in range(len(det)):
+        if det.class_name[m] != box["tracking_name"]:
+            continue
+        d = float(
+            np.hypot(box["translation"][0] - det.translation_m[m, 0], box["translation"][1] - det.translation_m[m, 1])
+        )
+        same = (
+            np.all(np.abs(np.asarray(box["size"]) - det.size_wlh_m[m]) <= SAME_BOX_TOL)
+            and np.all(np.abs(np.asarray(box["rotation"]) - det.quat_wxyz[m]) <= SAME_BOX_TOL)
+            and abs(box["translation"][2] - det.translation_m[m, 2]) <= SAME_BOX_TOL
+        )
+        rank = (0 if same else 1, d)
+        if (same or d < NEAREST_M) and (best is None or rank < (best[0], best[1])):
+            best = (rank[0], d, m)
+    if best is None:
+        return None
+    return best[2], ("same box" if best[0] == 0 else "nearest"), best[1]
 
 
 def _same_geometry(box: Mapping[str, Any], boxes, m: int) -> bool:
@@ -316,6 +366,10 @@ def _check(c: Claim, f: Finding, src: Sources) -> str:  # noqa: C901 (one branch
             boxes = src.frames[x].detections.boxes
             if v[1] is None:  # output, on whatever
                 return ""
+            if src.output_only:
+                placed = placed_on(src, x, box)
+                on = placed[0] if placed is not None else -1
+                return "" if on == v[1] else f"its box sits on detection {on}"
             if v[1] >= len(boxes):
                 return f"the frame has no detection m{v[1]}"
             if not src.keeps_detection_box:
@@ -458,6 +512,16 @@ def _check(c: Claim, f: Finding, src: Sources) -> str:  # noqa: C901 (one branch
             return "" if expected == tuple(v[2]) else f"the submission gives {expected}"
         case "blame":
             return _check_blame(v[0], v[1], f, src)
+        case "output on":
+            box = src.box(x, v[0])
+            placed = placed_on(src, x, box) if box is not None else None
+            if placed is None:
+                return "its box sits on no detection"
+            ok = placed[0] == v[1] and placed[1] == v[2] and abs(placed[2] - v[3]) < ATOL
+            return "" if ok else f"its box sits on {placed}"
+        case "first output":
+            earlier = [y for y in range(x) if src.box(y, v[0]) is not None]
+            return "" if src.box(x, v[0]) is not None and not earlier else f"output at frames {earlier} before"
     return f"unknown claim {c.what}"
 
 
@@ -561,29 +625,26 @@ def _check_blame(rule: Rule, frames: tuple[int, ...], f: Finding, src: Sources) 
 
 # Running it.
 def sources(request, tracker: str, evidence: Mapping[str, Any], events: Sequence | None = None) -> Sources:
-    """The independent sources of ``tracker``'s findings on ``request``'s scene: its submission, its raw events
-    (``events``: the ones it emitted, e.g. a ``ListSink``'s; None: run it again to record them), the devkit's
-    evaluation recomputed, the other trackers' reports."""
+    """The independent sources of ``tracker``'s findings on ``request``'s scene: its submission (a results file:
+    the file, read here), its raw events (``events``: the ones it emitted, e.g. a ``ListSink``'s; None: run it again
+    to record them), the devkit's evaluation recomputed, the other trackers' reports."""
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.nuscenes_eval import tracking_config
     from gnnpmb.eval.submission import run_results
-    from gnnpmb.pipeline import run_tracker
     from gnnpmb.registry import tracker_keeps_detection_box
+    from gnnpmb.session import track_run
 
     run = evidence[tracker].run
-    if events is None:
-        listed = ListSink()
-        run_tracker(
-            request.scene,
-            request.frame_detections,
-            tracker,
-            request.config,
-            sink=listed,
-            classes=request.classes,
-            frame_range=request.frame_range,
-        )
-        events = listed.events
-    results = run_results(run)
+    spec = request.spec(tracker)
+    if spec.results is not None:
+        results = file_results(spec.results, request.scene, request.classes)
+        events = []
+    else:
+        if events is None:
+            listed = ListSink()
+            track_run(request, tracker, listed)
+            events = listed.events
+        results = run_results(run)
     by: dict[tuple[int, str], dict[type, list]] = defaultdict(lambda: defaultdict(list))
     frame = -1
     for e in events:
@@ -599,42 +660,51 @@ def sources(request, tracker: str, evidence: Mapping[str, Any], events: Sequence
         evidence[tracker].report,
         recompute_devkit(open_nuscenes(request.location), request.scene, results, tracking_config()),
         {t: ev.report for t, ev in evidence.items() if t != tracker},
-        tracker_keeps_detection_box(tracker),
+        keeps_detection_box=spec.results is not None or tracker_keeps_detection_box(str(spec.tracker)),
+        output_only=spec.results is not None,
     )
 
 
+def file_results(path, scene, classes: Sequence[str]) -> dict[str, list[dict[str, Any]]]:
+    """A results file's boxes of ``scene``'s samples and ``classes``, read here; ids that are not plain integers
+    unique across classes numbered 1, 2, ... in order of appearance (as the run names them)."""
+    import json
+    import re
+
+    data = json.loads(Path(path).read_bytes())["results"]
+    tokens = [k.sample_token for k in scene.keyframes]
+    boxes = {t: [dict(b) for b in data[t] if b["tracking_name"] in classes] for t in tokens}
+    keys = list(dict.fromkeys((str(b["tracking_id"]), b["tracking_name"]) for t in tokens for b in boxes[t]))
+    plain = all(re.fullmatch(r"0|[1-9][0-9]{0,14}", i) for i, _ in keys) and len({i for i, _ in keys}) == len(keys)
+    number = {key: (key[0] if plain else str(k + 1)) for k, key in enumerate(keys)}
+    for t in tokens:
+        for b in boxes[t]:
+            b["tracking_id"] = number[(str(b["tracking_id"]), b["tracking_name"])]
+    return boxes
+
+
 def run_one(request, tracker: str, others: Sequence[str] = ()) -> tuple[Verdict, int]:
-    """Check every finding of ``tracker`` on ``request``'s scene; returns the verdict and the number of findings."""
+    """Check every finding of ``tracker`` (a run of ``request``: a tracker or a results file) on ``request``'s scene;
+    returns the verdict and the number of findings."""
     from gnnpmb.events import TeeSink
     from gnnpmb.focus import FRAMES_BEFORE, resolve_focus
-    from gnnpmb.pipeline import run_tracker
-    from gnnpmb.registry import tracker_has_existence
-    from gnnpmb.session import find_reports
-    from gnnpmb.why.facts import FactSink
-    from gnnpmb.why.reason import Evidence, explain_failure
+    from gnnpmb.session import evidence_of, fact_sink, find_reports, track_run
+    from gnnpmb.why.reason import explain_failure
     from viz.focus_summary import focus_markdown
 
     raw, evidence = {}, {}
     for name in (tracker, *others):
-        sink, listed = FactSink(name, has_existence=tracker_has_existence(name)), ListSink()
-        run = run_tracker(
-            request.scene,
-            request.frame_detections,
-            name,
-            request.config,
-            sink=TeeSink(sink, listed),
-            classes=request.classes,
-            frame_range=request.frame_range,
-        )
+        sink, listed = fact_sink(request, name), ListSink()
+        run = track_run(request, name, TeeSink(sink, listed))
         raw[name] = (run, listed.events, sink.facts)
     reports, _ = find_reports(request, [r for r, _, _ in raw.values()])
     for name, (run, _, facts) in raw.items():
-        evidence[name] = Evidence(reports[name], facts, run)
+        evidence[name] = evidence_of(request, reports[name], facts, run)
     src = sources(request, tracker, evidence, raw[tracker][1])
     verdict = Verdict()
     report = reports[tracker]
     rest = [evidence[t] for t in others]
-    views = _views(evidence)
+    views = _views(request, evidence)
     estimates = {t: [fr.estimates for fr in ev.run.frames] for t, ev in evidence.items()}
     for fid, failure in zip(report.ids(), report.failures, strict=True):
         start = max(request.frame_range.start, failure.frame_index - FRAMES_BEFORE)
@@ -648,9 +718,8 @@ def run_one(request, tracker: str, others: Sequence[str] = ()) -> tuple[Verdict,
     return verdict, len(report.failures)
 
 
-def _views(evidence: Mapping[str, Any]) -> dict[str, Any]:
+def _views(request, evidence: Mapping[str, Any]) -> dict[str, Any]:
     """What the focus document shows of each tracker, as a recording would (its story told from its facts)."""
-    from gnnpmb.registry import tracker_has_gates
     from gnnpmb.why.story import Storyteller
     from viz.focus_summary import TrackerView
 
@@ -658,7 +727,7 @@ def _views(evidence: Mapping[str, Any]) -> dict[str, Any]:
     for t, ev in evidence.items():
         teller = Storyteller(ev.facts)
         story = tuple(line for f in ev.facts.frame_indices for line in teller.frame_lines(f))
-        out[t] = TrackerView(ev, tracker_has_gates(t), story, frozenset(teller.shown_ever))
+        out[t] = TrackerView(ev, request.capabilities(t).has_gates, story, frozenset(teller.shown_ever))
     return out
 
 
@@ -671,28 +740,62 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", action="append", help="demo scenes (default: all)")
-    parser.add_argument("--detector", action="append", help="presets (default: all)")
-    parser.add_argument("--tracker", action="append", help="trackers (default: all)")
+    parser.add_argument("--detector", action="append", help="presets (default: all; centerpoint with --results)")
+    parser.add_argument("--tracker", action="append", help="trackers (default: all; none with --results)")
+    parser.add_argument(
+        "--results",
+        action="append",
+        metavar="NAME=FILE.json",
+        help="check a results file's findings instead, on the scenes it covers (made on the given detections)",
+    )
     parser.add_argument("--show", type=int, default=5, help="contradictions printed per tracker")
     args = parser.parse_args(argv)
     totals: dict[str, list[int]] = defaultdict(lambda: [0, 0, 0])
     shown: dict[str, list[str]] = defaultdict(list)
-    for scene in args.scene or list(DEMO_SCENES + STAGED_SCENES):
-        for detector in args.detector or list(PRESETS):
-            for tracker in args.tracker or list(TRACKER_NAMES):
-                request = prepare(scene, [tracker], detector=detector)
-                verdict, n = run_one(request, tracker)
-                t = totals[tracker]
-                t[0] += n
-                t[1] += verdict.checked
-                t[2] += len(verdict.contradictions)
-                shown[tracker] += verdict.contradictions
+    jobs: list[tuple[str, str, list[str], list[str]]] = []  # (scene, detector, trackers, results)
+    if args.results:
+        covered = _covered_scenes(args.results, args.scene or list(DEMO_SCENES + STAGED_SCENES))
+        jobs = [
+            (scene, d, [], [r]) for r in args.results for scene in covered[r] for d in args.detector or ["centerpoint"]
+        ]
+    else:
+        scenes = args.scene or list(DEMO_SCENES + STAGED_SCENES)
+        jobs = [
+            (s, d, [t], [])
+            for s in scenes
+            for d in args.detector or list(PRESETS)
+            for t in args.tracker or TRACKER_NAMES
+        ]
+    for scene, detector, trackers, results in jobs:
+        request = prepare(scene, trackers, results=results, detector=detector)
+        name = request.trackers[0]
+        verdict, n = run_one(request, name)
+        t = totals[name]
+        t[0] += n
+        t[1] += verdict.checked
+        t[2] += len(verdict.contradictions)
+        shown[name] += verdict.contradictions
     print(f"{'tracker':8} {'findings':>9} {'claims':>8} {'contradictions':>15}")
     for tracker, (n, checked, bad) in totals.items():
         print(f"{tracker:8} {n:9d} {checked:8d} {bad:15d}")
         for line in shown[tracker][: args.show]:
             print(f"    {line}")
     return 1 if any(t[2] for t in totals.values()) else 0
+
+
+def _covered_scenes(results: Sequence[str], scenes: Sequence[str]) -> dict[str, list[str]]:
+    """Per ``NAME=FILE.json``, the ``scenes`` whose first sample the file holds."""
+    import json
+
+    from gnnpmb.data.nuscenes import resolve_dataroot, sample_tokens
+
+    location = resolve_dataroot(None, None, tuple(scenes))
+    first = {s: sample_tokens(location, [s])[0] for s in scenes}
+    out = {}
+    for spec in results:
+        held = json.loads(Path(spec.split("=", 1)[1]).read_bytes())["results"]
+        out[spec] = [s for s in scenes if first[s] in held]
+    return out
 
 
 if __name__ == "__main__":

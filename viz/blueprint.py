@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import rerun.blueprint as rrb
 
 from gnnpmb.events import Panel
-from gnnpmb.registry import tracker_has_costs, tracker_has_existence, tracker_has_gates, tracker_panels
+from gnnpmb.runs import Capabilities, tracker_capabilities
 from viz import compare, paths
 from viz.failures import failure_log
 from viz.legend import LegendPlacement
@@ -59,6 +59,11 @@ STORY_LEVELS = ("INFO", "WARN", "ERROR", "CRITICAL")
 def failures_root(tracker: str) -> str:
     """Parent of one tracker's failure-count series (``paths.failure_count``)."""
     return f"{paths.tracker_root(tracker)}/failures"
+
+
+def failure_index_doc(tracker: str) -> str:
+    """TextDocument: a run's failures with their ``--focus`` ids (``viz.opening``; static)."""
+    return f"{paths.tracker_root(tracker)}/failure_index"
 
 
 def focus_doc() -> str:
@@ -172,8 +177,14 @@ PANEL_VIEWS: dict[Panel, Callable[[str, Sequence[str]], rrb.View | rrb.Container
 """The view of each tracker-specific panel; which panels a tracker gets, it declares (``registry.tracker_panels``)."""
 
 
-def _extra_views(tracker: str, classes: Sequence[str]) -> list[rrb.View | rrb.Container]:
-    return [PANEL_VIEWS[panel](tracker, classes) for panel in tracker_panels(tracker)]
+def _extra_views(tracker: str, classes: Sequence[str], caps: Capabilities) -> list[rrb.View | rrb.Container]:
+    return [PANEL_VIEWS[panel](tracker, classes) for panel in caps.panels]
+
+
+def _caps(tracker: str, caps: Mapping[str, Capabilities] | None) -> Capabilities:
+    """What run ``tracker`` can show: as given, else the registry's tracker of that name."""
+    given = (caps or {}).get(tracker)
+    return given if given is not None else tracker_capabilities(tracker)
 
 
 def failure_counts_view(tracker: str) -> rrb.TimeSeriesView:
@@ -195,21 +206,30 @@ def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visib
 
 
 def track_series_views(
-    tracker: str, focus: FocusTarget | None = None, legends: Mapping[str, LegendPlacement] | None = None
+    tracker: str,
+    focus: FocusTarget | None = None,
+    legends: Mapping[str, LegendPlacement] | None = None,
+    caps: Capabilities | None = None,
+    opening: FocusTarget | None = None,
 ) -> list[rrb.TimeSeriesView]:
     """Existence (for a tracker that has it, ``registry.tracker_has_existence``), normalised innovation (for a
     tracker that gates, ``registry.tracker_has_gates``) and chosen cost (for a tracker that chooses an assignment,
-    ``registry.tracker_has_costs``) per track; only the involved tracks when
-    focused, with a legend (placed by ``legends``, keyed by the view's origin)."""
-    existence = [(paths.existence_root(tracker), "existence")] if tracker_has_existence(tracker) else []
-    nis = [(paths.nis_root(tracker), "NIS (innovation²/S)")] if tracker_has_gates(tracker) else []
-    cost = [(paths.chosen_cost_root(tracker), "chosen cost")] if tracker_has_costs(tracker) else []
+    ``registry.tracker_has_costs``) per track; only the involved tracks when focused, or in a full recording the
+    tracks at the failure it opens at (``opening``), with a legend naming them (placed by ``legends``, keyed by
+    the view's origin). caps: what the run can show (default: the registry's)."""
+    caps = caps or tracker_capabilities(tracker)
+    existence = [(paths.existence_root(tracker), "existence")] if caps.has_existence else []
+    nis = [(paths.nis_root(tracker), "NIS (innovation²/S)")] if caps.has_gates else []
+    cost = [(paths.chosen_cost_root(tracker), "chosen cost")] if caps.has_costs else []
+    near = focus or opening
+    few = near is not None and bool(near.track_ids.get(tracker))
+    at = f" · tracks at {opening.failure_id}" if focus is None and opening is not None and few else ""
     return [
         rrb.TimeSeriesView(
             origin=root,
-            contents=_series_contents(root, focus, tracker),
-            name=f"{tracker} {what}",
-            **_legend_args(root, legends, focus is not None),
+            contents=_series_contents(root, near, tracker),
+            name=f"{tracker} {what}{at}",
+            **_legend_args(root, legends, few or focus is not None),
         )
         for root, what in (
             *existence,
@@ -251,38 +271,53 @@ def tracker_panel(
     classes: Sequence[str],
     focus: FocusTarget | None = None,
     legends: Mapping[str, LegendPlacement] | None = None,
+    caps: Capabilities | None = None,
+    opening: FocusTarget | None = None,
+    failure_index: bool = False,
 ) -> rrb.Vertical:
     """Decision view, story and failure logs, and series (per-track, candidates, failures, extra plots); with a
     focus the summary of the failure comes first (beside a tab on how to read the views) and the decision
     document goes to a tab beside the story. Candidates (Bernoullis too unlikely to be drawn as tracks) only for
-    a tracker with existences."""
+    a tracker with existences. caps: what the run can show (default: the registry's): the decision view only for a
+    tracker that chooses an assignment. A full recording whose failures were found (``failure_index``) opens on its
+    failure index; its per-track plots show the tracks at the failure it opens at (``opening``)."""
+    caps = caps or tracker_capabilities(tracker)
     candidates = []
-    if tracker_has_existence(tracker):
+    if caps.has_existence:
         candidates = [rrb.TimeSeriesView(origin=paths.candidates_root(tracker), name=f"{tracker} candidates")]
     series = rrb.Tabs(
-        *track_series_views(tracker, focus, legends),
+        *track_series_views(tracker, focus, legends, caps, opening),
         *candidates,
         failure_counts_view(tracker),
-        *_extra_views(tracker, classes),
+        *_extra_views(tracker, classes, caps),
     )
     logs = rrb.Tabs(
         story_view(tracker, focus),
-        rrb.TextLogView(origin=failure_log(tracker), name=f"{tracker} failures", columns=STORY_COLUMNS),
+        rrb.TextLogView(origin=failure_log(tracker), name=f"{tracker} failure log", columns=STORY_COLUMNS),
     )
     if focus is not None:
+        decisions = []
+        if caps.has_costs:
+            decisions = [
+                rrb.TextDocumentView(origin=paths.decisions(tracker), name=f"{tracker} decisions"),
+                rrb.Spatial2DView(origin=paths.decision_matrix(tracker), name=f"{tracker} cost grid"),
+            ]
         logs = rrb.Tabs(
             story_view(tracker, focus, involved=True),
             story_view(tracker, focus),
-            rrb.TextDocumentView(origin=paths.decisions(tracker), name=f"{tracker} decisions"),
-            rrb.Spatial2DView(origin=paths.decision_matrix(tracker), name=f"{tracker} cost grid"),
-            rrb.TextLogView(origin=failure_log(tracker), name=f"{tracker} failures", columns=STORY_COLUMNS),
+            *decisions,
+            rrb.TextLogView(origin=failure_log(tracker), name=f"{tracker} failure log", columns=STORY_COLUMNS),
         )
         summary = rrb.Tabs(
             rrb.TextDocumentView(origin=focus_doc(), name="focus"),
             rrb.TextDocumentView(origin=reading_guide_doc(), name="how to read the views"),
         )
         return rrb.Vertical(summary, logs, series, row_shares=[6, 3, 3], name=tracker)
-    return rrb.Vertical(decision_views(tracker), logs, series, row_shares=[5, 3, 2], name=tracker)
+    top = [rrb.TextDocumentView(origin=failure_index_doc(tracker), name=f"{tracker} failures")] if failure_index else []
+    top += [decision_views(tracker)] if caps.has_costs else []
+    if not top:
+        return rrb.Vertical(logs, series, row_shares=[3, 2], name=tracker)
+    return rrb.Vertical(rrb.Tabs(*top, active_tab=0), logs, series, row_shares=[5, 3, 2], name=tracker)
 
 
 def comparison_panel(
@@ -309,11 +344,23 @@ def comparison_panel(
     return rrb.Horizontal(counts, log, column_shares=[2, 3], name="comparison")
 
 
-def _tracker_views(tracker: str, focus: FocusTarget | None) -> rrb.Container:
+def _tracker_views(tracker: str, focus: FocusTarget | None, strip: range | None = None, rows: int = 1) -> rrb.Container:
     """The bird's-eye view above the perspective view; with a focus the bird's-eye view, where the failure is
-    read, takes more of the height."""
-    shares = [3, 2] if focus is None else [7, 3]
-    return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=shares)
+    read, takes more of the height; with ``strip`` (a full recording whose failures were found: its frames) the
+    failures over those frames below them, in ``rows`` rows (``viz.opening.log_failure_timeline``)."""
+    if focus is not None:
+        return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[7, 3])
+    if strip is not None:
+        from viz.opening import failure_timeline, timeline_bounds
+
+        x_range, y_range = timeline_bounds(strip, rows)
+        strip_view = rrb.Spatial2DView(
+            origin=failure_timeline(tracker),
+            name=f"{tracker} failures over time",
+            visual_bounds=rrb.VisualBounds2D(x_range=x_range, y_range=y_range),
+        )
+        return rrb.Vertical(bev_view(tracker), spatial_view(tracker), strip_view, row_shares=[6, 4, 2])
+    return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[3, 2])
 
 
 def default_blueprint(
@@ -321,20 +368,31 @@ def default_blueprint(
     classes: Sequence[str],
     focus: FocusTarget | None = None,
     legends: Mapping[str, LegendPlacement] | None = None,
+    caps: Mapping[str, Capabilities] | None = None,
+    opening: FocusTarget | None = None,
+    failure_index: bool = False,
+    frames: range | None = None,
+    timeline_rows: Mapping[str, int] | None = None,
 ) -> rrb.Blueprint:
-    """The layout for a recording of ``trackers`` (one or more, side by side) over ``classes``; with ``focus``
+    """The layout for a recording of ``trackers`` (one or more runs, side by side) over ``classes``; with ``focus``
     the layout opens at and looks at the failure. ``legends``: where the legends of series views go, keyed by
-    the view's origin (``viz.legend.place_legend``; default: Rerun's corner)."""
+    the view's origin (``viz.legend.place_legend``; default: Rerun's corner); caps: what each run can show
+    (``gnnpmb.runs.Capabilities``; default: the registry's tracker of that name). A full recording whose failures
+    were found (``failure_index``) shows each run's failure index and its failures over ``frames`` (in
+    ``timeline_rows`` rows per run), and opens at the failure ``opening`` (``viz.opening``): its ``focus`` timeline
+    ends there."""
     if not trackers:
         raise ValueError("default_blueprint needs at least one tracker")
-    panels = [tracker_panel(t, classes, focus, legends) for t in trackers]
-    scene = rrb.Horizontal(*[_tracker_views(t, focus) for t in trackers])
+    strips = frames if focus is None and failure_index and frames is not None else None
+    panels = [tracker_panel(t, classes, focus, legends, _caps(t, caps), opening, failure_index) for t in trackers]
+    rows = timeline_rows or {}
+    scene = rrb.Horizontal(*[_tracker_views(t, focus, strips, rows.get(t, 1)) for t in trackers])
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:
         left = rrb.Vertical(scene, comparison_panel(trackers, legends, focus), row_shares=[4, 1])
         layout = rrb.Horizontal(left, rrb.Tabs(*panels), column_shares=[3, 2])
-    if focus is None:
+    if focus is None and opening is None:
         time_panel = rrb.TimePanel(state="collapsed", timeline="frame", play_state="paused")
     else:
         time_panel = rrb.TimePanel(state="collapsed", timeline=FOCUS_TIMELINE, play_state="following")

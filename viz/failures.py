@@ -9,6 +9,9 @@ however many failures there are.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
 import numpy as np
 import rerun as rr
 
@@ -17,6 +20,9 @@ from gnnpmb.eval.failures import Failure, FailureBox, FailureKind, FailureReport
 from viz import paths
 from viz.markers import send_counts, send_marker_boxes, send_text_lines
 from viz.timeline import PLAIN_CLOCK, Clock
+
+if TYPE_CHECKING:
+    from viz.opening import LabelNotes
 
 KIND_COLORS: dict[FailureKind, tuple[int, int, int]] = {
     FailureKind.ID_SWITCH: (255, 0, 255),
@@ -74,21 +80,25 @@ def _label(kind: FailureKind, box: FailureBox) -> str:
     return f"{KIND_LABELS[kind]}: {box.role} {name}"
 
 
-def _frame_boxes(failures: list[Failure], n_frames: int) -> tuple[list[FailureBox], list[str], np.ndarray]:
+def _frame_boxes(
+    failures: list[Failure], n_frames: int, merged: Mapping[int, set[tuple[str, str]]] | None = None
+) -> tuple[list[FailureBox], list[str], np.ndarray]:
     """The distinct boxes per frame (a box in several failures of one kind and frame is drawn once), their
-    labels and (F,) boxes per frame."""
+    labels ("" for a box whose words a track's own label carries: ``merged``, per failure, (role, id)) and (F,)
+    boxes per frame."""
     boxes: list[FailureBox] = []
     labels: list[str] = []
     lengths = np.zeros(n_frames, dtype=np.int64)
     seen: set[tuple[int, str, str]] = set()
     for failure in sorted(failures, key=lambda f: f.frame_index):
+        carried = (merged or {}).get(id(failure), set())
         for box in failure.boxes:
             key = (failure.frame_index, box.role, box.object_id)
             if key in seen:
                 continue
             seen.add(key)
             boxes.append(box)
-            labels.append(_label(failure.kind, box))
+            labels.append("" if (box.role, box.object_id) in carried else _label(failure.kind, box))
             lengths[failure.frame_index] += 1
     return boxes, labels, lengths
 
@@ -104,6 +114,7 @@ def log_failures(
     show_labels: bool = True,
     involved: set[str] | None = None,
     focus_kind: FailureKind | None = None,
+    notes: LabelNotes | None = None,
 ) -> None:
     """Log ``report`` (failures of ``tracker`` on ``scene``) on the recording's timelines (``clock``).
 
@@ -111,7 +122,8 @@ def log_failures(
     involved: in a focus recording, the ids (instance tokens, track ids) of the objects the focus is about: the
     markers of other objects are drawn pale, so that another failure at the same frame does not read as this one;
     focus_kind: the focused failure's kind, whose markers are drawn around the others of the same objects
-    (``FOCUS_MARGIN_M`` wider) instead of under them.
+    (``FOCUS_MARGIN_M`` wider) instead of under them. notes: a full recording's ``viz.opening.LabelNotes``: what a
+    failure says about a drawn track goes into the track's label, and the marker's label stays empty.
     Boxes of a kind show only at their frame (other frames get an empty batch); the count series has a value
     at every keyframe of ``frame_range`` (default: the whole scene; 0 when nothing failed). Failures outside the
     range are left out.
@@ -122,6 +134,15 @@ def log_failures(
     stamps = np.array([k.timestamp_us for k in scene.keyframes], dtype=np.int64)
     every_frame = np.arange(n) if frame_range is None else np.array(frame_range, dtype=np.int64)
     in_range = set(every_frame.tolist())
+    merged: dict[int, set[tuple[str, str]]] = {}
+    if notes is not None:
+        from viz.opening import failure_notes
+
+        thefts = {(f.frame_index, f.gt_ids) for f in report.of_kind(FailureKind.IDENTITY_THEFT)}
+        for f in report.failures:
+            if f.frame_index in in_range:
+                quiet = f.kind is FailureKind.ID_SWITCH and (f.frame_index, f.gt_ids) in thefts
+                merged[id(f)] = failure_notes(tracker, f, notes, quiet=quiet)
     for kind in FailureKind:
         color = KIND_COLORS[kind]
         send_counts(
@@ -137,7 +158,7 @@ def log_failures(
         failures = [f for f in report.of_kind(kind) if f.frame_index in in_range]
         if not failures:
             continue
-        boxes, labels, lengths = _frame_boxes(failures, n)
+        boxes, labels, lengths = _frame_boxes(failures, n, merged)
         send_marker_boxes(
             stream,
             clock,

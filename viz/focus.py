@@ -148,7 +148,9 @@ def log_focus(
             )
             facts = views[tracker].facts
             steps = {t: facts.steps(t, focus.class_name).get(i) for t in sorted(ids)}
-            _log_ghosts(stream, tracker, frames[tracker], i, steps, {e.track_id for e in chosen}, palette)
+            ghosts = _log_ghosts(
+                stream, tracker, frames[tracker], i, steps, {e.track_id for e in chosen}, palette, facts.output_only
+            )
             given = {e.meas_index for e in chosen if e.meas_index >= 0}
             given |= {m for s in steps.values() if s is not None for m in s.used}
             # and, for a track that used none, the detection nearest it (by NIS) in its gate: where that one went
@@ -162,7 +164,8 @@ def log_focus(
                 paths.focus_callouts(tracker),
                 gt_callouts
                 + _detection_callouts(detections, sorted(given), facts, i, focus.class_name, mode)
-                + _prediction_callouts(steps, z_m, palette, facts.has_existence),
+                + _prediction_callouts(steps, z_m, palette, facts.has_existence)
+                + ghosts,
                 height_m,
             )
         if meas and detections is not None:
@@ -292,26 +295,37 @@ def _log_ghosts(
     steps: Mapping[int, TrackStep | None],
     output: set[int],
     palette: Mapping[int, tuple[int, int, int]],
-) -> None:
+    output_only: bool = False,
+) -> list[Callout]:
     """A pale box at the predicted position of each involved track the tracker kept but did not output at frame
     ``i``, with the size and heading of its last output box (within ``GHOST_LOOKBACK`` frames): where the
     tracker expected the object, so a label "61 predicted …, missed" points at a track's shape, not at bare
-    ground. An empty batch when there is none."""
-    ghosts = []
+    ground. A run known by its output only (``output_only``) predicts nothing we know of: its involved tracks not
+    output are drawn pale at their last output box instead, with a callout ("5 last output at frame 8", returned
+    for the callout column). An empty batch when there is none."""
+    ghosts, labels, callouts = [], [], []
     for t, step in steps.items():
-        if step is None or step.predicted_xy_m is None or t in output:
+        if t in output or (not output_only and (step is None or step.predicted_xy_m is None)):
             continue
-        last = next(
+        found = next(
             (
-                e
+                (j, e)
                 for j in range(i - 1, max(-1, i - 1 - GHOST_LOOKBACK), -1)
                 for e in (frames[j].estimates if j in frames else ())
                 if e.track_id == t
             ),
             None,
         )
-        if last is not None:
+        if found is None:
+            continue
+        at, last = found
+        if output_only:
+            ghosts.append((t, (float(last.translation_m[0]), float(last.translation_m[1])), last))
+            labels.append(f"{t} (last output at frame {at})")
+            callouts.append(Callout(tuple(last.translation_m), f"{t} last output at frame {at}", palette[t]))
+        else:
             ghosts.append((t, step.predicted_xy_m, last))
+            labels.append(f"{t} (predicted)")
     boxes = estimate_boxes([e for *_, e in ghosts])
     centers = boxes.centers_m.copy()
     if ghosts:
@@ -325,10 +339,11 @@ def _log_ghosts(
             quaternions=boxes.quat_xyzw,
             colors=faded(colors, GHOST_KEEP),
             radii=GHOST_LINE_RADIUS_M,
-            labels=[f"{t} (predicted)" for t, *_ in ghosts],
+            labels=labels,
             show_labels=False,
         ),
     )
+    return callouts
 
 
 def _prediction_callouts(

@@ -150,9 +150,11 @@ def _parting(focus: FocusTarget, views: Mapping[str, TrackerView]) -> list[str]:
             ids = set(focus.track_ids.get(t, ()))
             d, ch = went[t], choices[t].get(m)
             touches |= d is not None and d.track_id in ids
-            text = destination_name(d, uses[t].mode if uses[t] is not None else UseMode.ASSIGNED)
+            mode = uses[t].mode if uses[t] is not None else UseMode.ASSIGNED
+            text = destination_name(d, mode)
             if ch is None:
-                parts.append(f"{t}: {meas_name(m)} → **{text}**")
+                arrow = "" if mode is UseMode.OUTPUT else " →"  # a results run: where its boxes are, not where it went
+                parts.append(f"{t}: {meas_name(m)}{arrow} **{text}**")
                 continue
             labels = [ch.chosen] if ch.alternative is None else [ch.chosen, ch.alternative]
             touches |= any(label.kind is AxisKind.TRACK and label.ref in ids for label in labels)
@@ -186,6 +188,8 @@ def _diagnosis(view: TrackerView, class_name: str, track_ids: list[int], frames:
         used = [s for s in steps if s.used]
         if used:
             parts.append(f"last {use_text(used[-1])} at frame {used[-1].frame}")
+        elif facts.output_only:
+            parts.append(f"output on no detection at {frames_text([s.frame for s in steps])}")
         elif born is None or len(steps) > 1:
             parts.append(f"used no detection in {frames_text([s.frame for s in steps if s is not born])}")
         since = [s for s in steps if (not used or s.frame > used[-1].frame) and s is not born]
@@ -227,12 +231,15 @@ def _diagnosis(view: TrackerView, class_name: str, track_ids: list[int], frames:
                     f"{word} after update {existence_text(peak.posterior_existence)} at frame {peak.frame} -> "
                     f"{existence_text(last.posterior_existence)} at frame {last.frame}"
                 )
-        parts.append("output at the last frame" if steps[-1].output is not None else "not output at the last frame")
+        at_last = steps[-1].frame == frames.stop - 1 and steps[-1].output is not None
+        parts.append("output at the last frame" if at_last else "not output at the last frame")
         out.append(f"**track {t}**: " + "; ".join(parts) + ".")
     return out
 
 
 def _mode(facts: TrackerFacts, class_name: str, frames: range) -> UseMode:
+    if facts.output_only:
+        return UseMode.OUTPUT
     for f in frames:
         use = facts.use(f, class_name)
         if use is not None and use.tracks:
@@ -271,6 +278,7 @@ def _gt_markdown(focus: FocusTarget, view: TrackerView, gt_id: str, seen: tuple[
         " (its best-MOTA threshold)"
     )
     detected = [s.frame for s in seen if s.nearest_own is not None]
+    sent_to = "output box on its detection" if mode is UseMode.OUTPUT else "sent to"
     return [
         f"**GT {short_id(gt_id)}**, in the {len(seen)} frames of the table ({seen[0].frame}–{seen[-1].frame}): a "
         f"{focus.class_name} detection within {NEAR_M:.0f} m at "
@@ -278,7 +286,7 @@ def _gt_markdown(focus: FocusTarget, view: TrackerView, gt_id: str, seen: tuple[
         "",
         f"GT {short_id(gt_id)}, frame by frame (the evaluation counted {counted}):",
         "",
-        "| frame | points in box | nearest detection | sent to | tracks output on it (score) |",
+        f"| frame | points in box | nearest detection | {sent_to} | tracks output on it (score) |",
         "|---|---|---|---|---|",
         *rows,
         "",
@@ -291,7 +299,7 @@ def _used_cell(s: TrackStep) -> str:
     if s.use is None or not s.use.shares:
         return "—"
     return ", ".join(
-        meas_name(m) + (f" ({share_text(share, s.use.mode)})" if s.use.mode is not UseMode.ASSIGNED else "")
+        meas_name(m) + (f" ({text})" if (text := share_text(share, s.use.mode)) else "")
         for m, share in s.use.shares[:3]
     )
 
@@ -307,7 +315,9 @@ def _steps_markdown(view: TrackerView, class_name: str, track_ids: list[int], fr
         if not steps:
             continue
         out += [f"Track {t}, frame by frame:", ""]
-        if not view.has_gates:
+        if facts.output_only:
+            out += ["| frame | detection under its box | output |", "|---|---|---|"]
+        elif not view.has_gates:
             out += ["| frame | used | output |", "|---|---|---|"]
         elif not facts.has_existence:
             out += ["| frame | in gate (NIS) | used | output |", "|---|---|---|---|"]
@@ -339,6 +349,8 @@ def _update_markdown(view: TrackerView, class_name: str, ids: set[int], frame: i
     """The update at the focus frame about the involved tracks: the solver's conflicts (a tracker that chooses an
     assignment), or each track's association probabilities or weights (a soft update)."""
     facts = view.facts
+    if facts.output_only:
+        return []  # nothing is known of its update
     d = facts.decisions(frame, class_name)
     if d is not None:
         decided = [c for c in d.conflicts if c.involves(ids)]

@@ -396,6 +396,8 @@ class TrackerLogger:
         worthy = self._draw_prior(class_name, cf)
         self._draw_associations(class_name, cf, worthy)
         self._record_posterior(class_name, cf)
+        if self.facts.output_only:  # no posterior: the trail follows the output boxes
+            self._record_output(drawn)
         for p in cf.pruned:
             self._trails.pop(p.track_id, None)
         self._draw_tracks(class_name, drawn, {e.track_id for e in estimates})
@@ -634,6 +636,14 @@ class TrackerLogger:
             if trail is None:
                 trail = self._trails[t] = deque(maxlen=TRAIL_FRAMES)
             trail.append((x, y, self._track_z.get(t, self.gate_z_m)))
+
+    def _record_output(self, estimates: tuple[TrackEstimate, ...]) -> None:
+        """Trail points of a run known by its output only: its box centres."""
+        for e in estimates:
+            trail = self._trails.get(e.track_id)
+            if trail is None:
+                trail = self._trails[e.track_id] = deque(maxlen=TRAIL_FRAMES)
+            trail.append(tuple(float(v) for v in e.translation_m))
 
     def _track_colors(self, track_ids: np.ndarray, keep: float = 1.0) -> np.ndarray:
         """(N,) packed colours of (N,) track ids, ``keep`` of each colour (``colors.faded``); with focus tracks,

@@ -7,19 +7,22 @@ from those facts; a focus recording then explains its failure from them (``gnnpm
 
 from __future__ import annotations
 
-from gnnpmb.registry import tracker_has_existence
 from gnnpmb.session import (
     ProgressBar,
     SilentProgress,
     ViewRequest,
     ViewResult,
     compare_runs,
-    find_reports,
+    evidence_of,
+    fact_sink,
     provenance_of,
     recording_name,
+    resolve_opening,
     resolve_request_focus,
     run_digest,
+    track_run,
 )
+from viz.opening import timeline_rows
 
 
 def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failures: bool = True) -> ViewResult:
@@ -31,28 +34,50 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
 
     from gnnpmb.data.nuscenes import load_lidar_points
     from gnnpmb.events import TeeSink
-    from gnnpmb.pipeline import TrackingRun, run_tracker
-    from gnnpmb.why.facts import FactSink
-    from gnnpmb.why.reason import Evidence, explain_failure
+    from gnnpmb.pipeline import TrackingRun
+    from gnnpmb.why.reason import explain_failure
     from viz.blueprint import default_blueprint
     from viz.compare import log_comparison
     from viz.failures import log_failures
     from viz.focus import focus_legends, log_focus, tracker_views
     from viz.logger import FLUSH_FRAMES, TrackerLogger
+    from viz.opening import (
+        LabelNotes,
+        drawn_tracks,
+        log_failure_index,
+        log_failure_timeline,
+        log_lost_tracks,
+        lost_ghosts,
+    )
     from viz.provenance import log_provenance
     from viz.recording import recording
     from viz.scene import log_scene
     from viz.timeline import PLAIN_CLOCK, Clock
 
     scene, frame_range = request.scene, request.frame_range
-    focus, reports, notices = None, {}, []
-    if request.focus is not None:  # the logged runs below give the same tracks (deterministic): reuse the reports
+    focus, opening, reports, notices = None, None, {}, []
+    # The logged runs below give the same tracks (deterministic): the reports found first are reused.
+    if request.focus is not None:
         focus, reports, notices = resolve_request_focus(request)
+    elif failures:  # a full recording opens at its first failure worth a look (viz.opening)
+        opening, reports, notices = resolve_opening(request)
     shown = focus.window(frame_range) if focus is not None else frame_range
-    clock = Clock(focus_end=focus.frame_index) if focus is not None else PLAIN_CLOCK
+    start = focus or opening
+    clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
     n = len(shown)
     # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
-    blueprint = default_blueprint(request.trackers, request.classes) if focus is None else None
+    caps = {t: request.capabilities(t) for t in request.trackers}
+    blueprint = None
+    if focus is None:
+        blueprint = default_blueprint(
+            request.trackers,
+            request.classes,
+            caps=caps,
+            opening=opening,
+            failure_index=bool(reports),
+            frames=shown,
+            timeline_rows={t: len(timeline_rows(r, shown)) for t, r in reports.items()},
+        )
     bar = progress if progress is not None else SilentProgress()
     runs: list[TrackingRun] = []
     loggers: dict[str, TrackerLogger] = {}
@@ -77,8 +102,8 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
         )
         for tracker in request.trackers:
             task = bar.add_task(f"{scene.name} {tracker}", total=len(frame_range))
-            fact_sink = FactSink(tracker, has_existence=tracker_has_existence(tracker))
-            facts[tracker] = fact_sink.facts
+            sink = fact_sink(request, tracker)
+            facts[tracker] = sink.facts
             logger = loggers[tracker] = TrackerLogger(
                 stream,
                 tracker,
@@ -87,23 +112,16 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                 log_frames=shown if focus is not None else None,
                 focus_tracks=set(focus.track_ids.get(tracker, ())) if focus is not None else None,
                 flush_frames=None if request.save is not None else FLUSH_FRAMES,
-                has_existence=tracker_has_existence(tracker),
+                has_existence=caps[tracker].has_existence,
                 focus_class=focus.class_name if focus is not None else None,
-                facts=fact_sink.facts,
+                facts=sink.facts,
             )
-            runs.append(
-                run_tracker(
-                    scene,
-                    request.frame_detections,
-                    tracker,
-                    request.config,
-                    sink=TeeSink(fact_sink, logger),
-                    classes=request.classes,
-                    frame_range=frame_range,
-                    on_frame=lambda task=task: bar.advance(task),
-                )
-            )
+            runs.append(track_run(request, tracker, TeeSink(sink, logger), lambda task=task: bar.advance(task)))
             logger.finish()
+        notes = None
+        if focus is None and reports:  # a full recording: one label per box, the lost tracks drawn (viz.opening)
+            ghosts = {run.tracker: lost_ghosts(reports[run.tracker], run, facts[run.tracker], shown) for run in runs}
+            notes = LabelNotes({run.tracker: drawn_tracks(run) for run in runs}, ghosts)
         if len(runs) > 1:
             comparison = compare_runs(runs)
             log_comparison(
@@ -113,12 +131,10 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                 clock,
                 show_labels=focus is None,
                 focus_class=focus.class_name if focus is not None else None,
+                notes=notes,
             )
-        if failures and focus is None:
-            task = bar.add_task(f"{scene.name} failures", total=len(runs))
-            reports, notices = find_reports(request, runs, lambda: bar.advance(task))
         if failures or focus is not None:
-            for name, report in reports.items():
+            for k, (name, report) in enumerate(reports.items()):
                 log_failures(
                     stream,
                     name,
@@ -129,9 +145,19 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                     show_labels=focus is None,
                     involved=focus.object_ids(name) if focus is not None else None,
                     focus_kind=focus.failure_kind if focus is not None else None,
+                    notes=notes,
                 )
+                if notes is not None:
+                    opened = opening.failure_id if opening is not None else None
+                    log_failure_index(stream, name, report, opened, k == 0, shown)
+                    log_lost_tracks(stream, name, ghosts[name], notes, scene, clock, shown)
+                    log_failure_timeline(stream, name, report, scene, clock, shown, opened if k == 0 else None)
+        if notes is not None:
+            notes.send(stream, clock, scene)
         if focus is not None:
-            evidence = {run.tracker: Evidence(reports[run.tracker], facts[run.tracker], run) for run in runs}
+            evidence = {
+                run.tracker: evidence_of(request, reports[run.tracker], facts[run.tracker], run) for run in runs
+            }
             finding = None
             if focus.failure_id is not None and focus.failure_tracker in evidence:
                 owner = evidence[focus.failure_tracker]
@@ -140,11 +166,11 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
             log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding)
             legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
             stream.send_blueprint(
-                default_blueprint(request.trackers, request.classes, focus, legends),
+                default_blueprint(request.trackers, request.classes, focus, legends, caps),
                 make_active=True,
                 make_default=True,
             )
         digests = {run.tracker: run_digest(run) for run in runs}
         log_provenance(stream, provenance_of(request, digests))
     ms = {run.tracker: 1000.0 * float(np.mean([f.step_time_s for f in run.frames])) for run in runs}
-    return ViewResult(ms, digests, comparison, tuple(notices), focus, reports)
+    return ViewResult(ms, digests, comparison, (*request.notices, *notices), focus, reports)

@@ -264,12 +264,14 @@ class FailureReport:
             return ""
         return f" in keyframes {self.frames[0]}:{self.frames[1]} (only those were tracked and evaluated)"
 
-    def first_worth_opening(self) -> str | None:
-        """The id of the first failure of the first kind in ``OPEN_FIRST`` that occurred, preferring failures
-        whose ground truth the evaluation did not interpolate (those are often the devkit's doing, see
-        ``FailureBox``), and, within a kind, one after the first keyframe (a failure there has no history to
-        show); None: no failure."""
-        ids = list(zip(self.ids(), self.failures, strict=True))
+    def first_worth_opening(self, frames: range | None = None) -> str | None:
+        """The id of the first failure of the first kind in ``OPEN_FIRST`` that occurred (at ``frames``, default
+        all), preferring failures whose ground truth the evaluation did not interpolate (those are often the
+        devkit's doing, see ``FailureBox``), and, within a kind, one after the first keyframe (a failure there has
+        no history to show); None: no failure."""
+        ids = [
+            (i, f) for i, f in zip(self.ids(), self.failures, strict=True) if frames is None or f.frame_index in frames
+        ]
         for allow_interpolated in (False, True):
             for kind in OPEN_FIRST:
                 hits = [(i, f) for i, f in ids if f.kind is kind and (allow_interpolated or not f.gt_interpolated)]

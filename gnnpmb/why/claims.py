@@ -46,6 +46,8 @@ CLAIM_KINDS = (
     "other failed",  # (tracker, kind, gt, place xy, failed): at the object (or, without one, the place)
     "blame",  # (rule, frames): the stated test held at each frame
     "deciding",  # (track, gt, frames): the frames after the track was last output on the object, up to the failure
+    "output on",  # (track, meas, how, distance_m): a results file's box sits on that detection by ``foreign.box_on``
+    "first output",  # (track,): a results file's track has its first box at this frame
 )
 
 
@@ -106,7 +108,9 @@ def claims(f: Finding) -> list[Claim]:
             add("averaged score", -1, t, lost.evaluated.averaged_score, lost.evaluated.kept)
     if f.taker is not None:
         o = f.taker
-        if o.meas >= 0:
+        if f.output_only:
+            add("first output", o.frame, o.track_id)
+        elif o.meas >= 0:
             add("born", o.frame, c, o.track_id, o.meas)
         elif f.switch is not None:
             add("held since", o.frame, c, o.track_id)
@@ -154,6 +158,8 @@ def claims(f: Finding) -> list[Claim]:
                 add("evaluated", f.frame, gt_id, g.status, g.evaluated_xy_m)
     for other in f.others:
         add("other failed", f.frame, other.tracker, f.kind.value, f.gt_id, other.place_xy_m, other.failed_same)
+    for frame, track, on in f.boxes_on:
+        add("output on", frame, track, on.meas, on.how.value, on.distance_m)
     for b in f.blame:
         add("blame", -1, b.rule, b.frames)
     return out

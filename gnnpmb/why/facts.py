@@ -62,6 +62,7 @@ class UseMode(enum.Enum):
     ASSIGNED = "assigned"  # one detection or none per track (GNN-PMB, PMBM's chosen hypothesis, GNN, greedy)
     PROBABILITIES = "association probabilities"  # a mixture over detections (JPDA, TO-PMB)
     WEIGHTS = "update weights"  # the PHD intensity split over detections (GM-PHD, CPHD)
+    OUTPUT = "output only"  # a results file: only the detection each output box sits on is known
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,6 +101,7 @@ class Went(enum.Enum):
     NEW_TRACK = "new track"  # it started a track (or a candidate Bernoulli) of its own
     NEW = "new"  # it started nothing that got an id this frame, or was clutter
     NOT_RECEIVED = "not received"  # below the score threshold or suppressed by NMS: the tracker never saw it
+    NO_OUTPUT = "under no output box"  # output only: no box of the run sits on it (what its update did is unknown)
 
 
 @dataclass(frozen=True, slots=True)
@@ -256,13 +258,14 @@ class FactSink:
     """Keeps every event of one tracker's run by frame and class (``TrackerFacts`` reads them).
 
     Put it before the viewer's logger in a ``TeeSink``: the logger reads the facts of a frame when it closes it.
-    has_existence: False for a tracker whose tracks have no existence probability (its events carry 1).
+    has_existence: False for a tracker whose tracks have no existence probability (its events carry 1);
+    output_only: the run is known by its output alone (a results file, ``gnnpmb.foreign``).
     """
 
     enabled = True
 
-    def __init__(self, tracker: str, *, has_existence: bool = True) -> None:
-        self.facts = TrackerFacts(tracker, has_existence=has_existence)
+    def __init__(self, tracker: str, *, has_existence: bool = True, output_only: bool = False) -> None:
+        self.facts = TrackerFacts(tracker, has_existence=has_existence and not output_only, output_only=output_only)
 
     def emit(self, event: Event) -> None:
         self.facts.add(event)
@@ -271,9 +274,11 @@ class FactSink:
 class TrackerFacts:
     """The facts of one tracker run (module docstring): events by frame and class, and what follows from them."""
 
-    def __init__(self, tracker: str, *, has_existence: bool = True) -> None:
+    def __init__(self, tracker: str, *, has_existence: bool = True, output_only: bool = False) -> None:
         self.tracker = tracker
         self.has_existence = has_existence
+        self.output_only = output_only
+        """Only the run's output is known (``UseMode.OUTPUT``): nothing here speaks of its update."""
         self.frames: dict[int, dict[str, ClassFrame]] = {}
         """Frame index -> class -> its events."""
         self.started: dict[int, FrameStarted] = {}
@@ -330,7 +335,8 @@ class TrackerFacts:
         known = self._use.setdefault(frame, {})
         if class_name not in known:
             cf = self.frame(frame, class_name)
-            known[class_name] = None if cf is None else frame_use(cf)
+            read = output_use if self.output_only else frame_use
+            known[class_name] = None if cf is None else read(cf)
         return known[class_name]
 
     def destination(self, frame: int, class_name: str, meas: int) -> Destination | None:
@@ -509,6 +515,25 @@ def frame_use(cf: ClassFrame) -> FrameUse | None:
     if not received:
         return None
     return FrameUse(UseMode.ASSIGNED, {}, {m: _new(m, born) for m in received})
+
+
+def output_use(cf: ClassFrame) -> FrameUse | None:
+    """An output-only run (``UseMode.OUTPUT``): each output track "used" the detection its box sits on
+    (``TrackEstimate.meas_index``; share 1, none: missed 1); a detection went to the track whose box sits on it
+    (the lowest id when several do), else under no output box."""
+    if cf.extracted is None:
+        return None
+    tracks: dict[int, Use] = {}
+    destinations: dict[int, Destination] = {}
+    for e in sorted(cf.extracted.estimates, key=lambda e: e.track_id):
+        on = e.meas_index >= 0
+        tracks[e.track_id] = Use(((e.meas_index, 1.0),) if on else (), 0.0 if on else 1.0, UseMode.OUTPUT)
+        if on:
+            destinations.setdefault(e.meas_index, Destination(e.meas_index, Went.TRACK, e.track_id))
+    received = np.asarray(cf.meas.meas_indices).tolist() if cf.meas is not None else []
+    for m in received:
+        destinations.setdefault(m, Destination(m, Went.NO_OUTPUT))
+    return FrameUse(UseMode.OUTPUT, tracks, destinations)
 
 
 def _new(m: int, born: Mapping[int, int], share: float = 1.0) -> Destination:

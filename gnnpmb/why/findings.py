@@ -41,6 +41,7 @@ from dataclasses import dataclass
 from gnnpmb.eval.evaluated import GtFrame, TrackEval
 from gnnpmb.eval.failures import FailureKind
 from gnnpmb.explain import PairChoice
+from gnnpmb.foreign import BoxOn
 from gnnpmb.why.facts import Destination, TrackStep
 
 NEAR_M = 2.0
@@ -293,12 +294,14 @@ class EvaluatedReach:
 class OtherRun:
     """Another tracker on the same detections at the failure: whether it has a failure of the same kind on the
     same object (without an object: within ``NEAR_M`` of ``place_xy_m``) at the same frame, and the tracks it
-    output on the object there (counted or not)."""
+    output on the object there (counted or not); output_only: it is a results file (what detections it was given is
+    not known)."""
 
     tracker: str
     failed_same: bool
     on_it: tuple[OnObject, ...]
     place_xy_m: tuple[float, float] | None = None
+    output_only: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -313,7 +316,9 @@ class Finding:
     a false track's box; covered: a coalescence's other objects; key_decisions: choices that sent detections away
     from involved tracks; others: other trackers on the same detections; reach: where the evaluation scored an
     interpolated object against its annotation; mode: how the tracker's update uses detections (``facts.UseMode``
-    value), has_existence: whether its tracks have existences.
+    value; "output only" for a results file: nothing is said of its update), has_existence: whether its tracks have
+    existences; boxes_on: for a results file, how each output box named was placed on a detection (frame, track
+    id, ``foreign.BoxOn``).
     """
 
     failure_id: str
@@ -338,6 +343,16 @@ class Finding:
     key_decisions: tuple[KeyDecision, ...] = ()
     others: tuple[OtherRun, ...] = ()
     reach: EvaluatedReach | None = None
+    boxes_on: tuple[tuple[int, int, BoxOn], ...] = ()
+
+    @property
+    def output_only(self) -> bool:
+        """Whether only the run's output is known (a results file)."""
+        return self.mode == "output only"
+
+    def box_on(self, frame: int, track_id: int) -> BoxOn | None:
+        """How track ``track_id``'s box at ``frame`` was placed on a detection (a results file; else None)."""
+        return next((b for f, t, b in self.boxes_on if (f, t) == (frame, track_id)), None)
 
     @property
     def parties(self) -> tuple[Party, ...]:

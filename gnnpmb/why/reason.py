@@ -9,8 +9,8 @@ checks (``claims``) read the same data.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from gnnpmb.eval.evaluated import GtStatus
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport
 from gnnpmb.events import AxisKind
 from gnnpmb.focus import FRAMES_BEFORE
+from gnnpmb.foreign import BoxOn
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.facts import TrackerFacts, UseMode
@@ -57,11 +58,14 @@ track that took the object over (None: none did)."""
 
 @dataclass(frozen=True, slots=True)
 class Evidence:
-    """What ``explain_failure`` reads: a tracker's failure report, facts and run on one scene."""
+    """What ``explain_failure`` reads: a tracker's failure report, facts and run on one scene; for a run known by
+    its output only (a results file), how each of its boxes was placed on a detection, by (frame, track id)
+    (``gnnpmb.foreign.box_on``)."""
 
     report: FailureReport
     facts: TrackerFacts
     run: TrackingRun
+    boxes_on: Mapping[tuple[int, int], BoxOn] = field(default_factory=dict)
 
     @property
     def tracker(self) -> str:
@@ -197,6 +201,7 @@ class _Context:
         else:
             raise AssertionError(kind)
         involved = self.involved(sightings)
+        boxes_on = self.boxes_on(sightings, parts) if self.facts.output_only else ()
         return Finding(
             failure_id=failure_id,
             kind=kind,
@@ -212,8 +217,22 @@ class _Context:
             key_decisions=self.key_decisions(involved),
             others=self.others(others, gt_id),
             reach=self.reach(gt_id, parts["blame"]),
+            boxes_on=boxes_on,
             **parts,
         )
+
+    def boxes_on(self, sightings: tuple[Sighting, ...], parts: dict) -> tuple[tuple[int, int, BoxOn], ...]:
+        """For a run known by its output only: how each output box the finding names was placed on a detection,
+        as (frame, track id, ``BoxOn``)."""
+        named = {(s.frame, o.track_id) for s in sightings for o in s.on_it}
+        lost: LostTrack | None = parts.get("lost")
+        if lost is not None:
+            named |= {(s.frame, lost.track_id) for s in lost.steps if s.output is not None}
+        false: FalseOutput | None = parts.get("false_output")
+        if false is not None and false.between is None:
+            named.add((self.f, false.track_id))
+        known = self.evidence.boxes_on
+        return tuple((f, t, known[(f, t)]) for f, t in sorted(named) if (f, t) in known)
 
     def reach(self, gt_id: str | None, blame: tuple[Blame, ...]) -> EvaluatedReach | None:
         """With the blame ``INTERPOLATED``: the tracks within reach of the evaluated and of the annotated box."""
@@ -590,7 +609,7 @@ class _Context:
             )
             on_it = self.on_object(ev.report, fr, xy) if xy is not None else ()
             place = (float(xy[0]), float(xy[1])) if xy is not None else None
-            out.append(OtherRun(ev.tracker, failed, on_it, place))
+            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only))
         return tuple(out)
 
 
@@ -633,7 +652,10 @@ def _blames(*tests: tuple[Rule, list[int]]) -> tuple[Blame, ...]:
 
 
 def _mode(facts: TrackerFacts, class_name: str, frames: range) -> UseMode:
-    """How the tracker's update used detections in ``frames`` (assignment without any update event)."""
+    """How the tracker's update used detections in ``frames`` (assignment without any update event; output only
+    for a run known by its output)."""
+    if facts.output_only:
+        return UseMode.OUTPUT
     for f in frames:
         use = facts.use(f, class_name)
         if use is not None and use.tracks:

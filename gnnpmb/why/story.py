@@ -97,8 +97,16 @@ class Storyteller:
         now = {e.track_id: e for e in extracted if e.existence >= self.show_min}
         known = self.shown_ever
         hyp = self.facts.hypotheses(frame, class_name)
+        output_only = self.facts.output_only
         for t, e in now.items():
             via = f"from {meas_name(e.meas_index)}" if e.meas_index >= 0 else "without a detection"
+            if output_only:  # a results file: only where its boxes were is known
+                if t not in known:
+                    on = f"on {meas_name(e.meas_index)}" if e.meas_index >= 0 else "on no detection"
+                    say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} first output ({on})")
+                elif e.meas_index < 0:
+                    say(StoryKind.MISSED, "INFO", (t,), f"track {t} output with no detection under its box")
+                continue
             if t not in known:
                 since = self.facts.existed_since(t, class_name, frame) if hyp is not None else None
                 why = ""
@@ -139,7 +147,9 @@ class Storyteller:
         limit = max(cf.extracted.threshold if cf.extracted is not None else 0.0, self.show_min)
         before = self._shown_before.get(class_name, set())
         for t in sorted(before - set(now) - pruned_ids):
-            if t in posterior_r:
+            if output_only:
+                say(StoryKind.NO_LONGER_SHOWN, "WARN", (t,), f"track {t} no longer output")
+            elif t in posterior_r:
                 text = (
                     f"track {t} no longer shown (r={posterior_r[t]:.2f} fell below {limit:.2f})"
                     if self.has_existence
@@ -176,7 +186,15 @@ class Storyteller:
                     f"track {ev.track_id} deleted ({hits_text(ev.hits, ev.window)})",
                 )
         use = self.facts.use(frame, class_name)
-        if use is not None and cf.meas is not None:
+        if use is not None and cf.meas is not None and output_only:
+            under = sum(1 for d in use.destinations.values() if d.went is Went.TRACK)
+            say(
+                StoryKind.SUMMARY,
+                "DEBUG",
+                (),
+                f"{len(cf.meas.meas_indices)} detections: {under} under an output box",
+            )
+        elif use is not None and cf.meas is not None:
             to_tracks = sum(1 for d in use.destinations.values() if d.went is Went.TRACK)
             missed = [t for t, u in use.tracks.items() if t in known and not u.shares]
             say(

@@ -14,6 +14,7 @@ from gnnpmb.eval.evaluated import Dropped, GtFrame, GtStatus, TrackEval
 from gnnpmb.eval.failures import FailureKind, short_id
 from gnnpmb.events import AxisKind, AxisLabel, PairTerms
 from gnnpmb.explain import PairChoice
+from gnnpmb.foreign import NEAREST_M, BoxOn, OnHow
 from gnnpmb.why.facts import Destination, Ending, TrackStep, UseMode, Went
 from gnnpmb.why.findings import (
     NEAR_M,
@@ -23,6 +24,7 @@ from gnnpmb.why.findings import (
     LostTrack,
     Near,
     OnObject,
+    OtherRun,
     Rule,
     Sighting,
 )
@@ -238,9 +240,9 @@ def key_text(k: KeyDecision) -> str:
 
 # How an update used detections.
 def share_text(share: float, mode: UseMode) -> str:
-    """A detection's share of an update in the tracker's terms: nothing for an assignment, ``p 0.93`` for an
-    association probability, ``91 % of its weight`` for a PHD weight."""
-    if mode is UseMode.ASSIGNED:
+    """A detection's share of an update in the tracker's terms: nothing for an assignment (or a run known by its
+    output only), ``p 0.93`` for an association probability, ``91 % of its weight`` for a PHD weight."""
+    if mode in (UseMode.ASSIGNED, UseMode.OUTPUT):
         return ""
     if mode is UseMode.PROBABILITIES:
         return f"p {share:.2f}"
@@ -248,8 +250,11 @@ def share_text(share: float, mode: UseMode) -> str:
 
 
 def use_text(step: TrackStep) -> str:
-    """``used m5``, ``used m5 (p 1.00)``, ``took 91 % of its weight from m2``, ``missed`` — what one update did."""
+    """``used m5``, ``used m5 (p 1.00)``, ``took 91 % of its weight from m2``, ``missed`` — what one update did;
+    for a run known by its output only, where its box was: ``was output on m5``, ``was output on no detection``."""
     use = step.use
+    if use is not None and use.mode is UseMode.OUTPUT:
+        return f"was output on {meas_name(use.shares[0][0])}" if use.shares else "was output on no detection"
     if use is None or not use.shares:
         return "missed"
     verb = "was given" if use.mode is UseMode.ASSIGNED else "used"
@@ -266,7 +271,12 @@ def use_text(step: TrackStep) -> str:
 
 def destination_name(d: Destination | None, mode: UseMode) -> str:
     """Where a detection went, as a table cell: ``track 26``, ``track 62 (p 1.00)``, ``new track 348``, ``new
-    (started no track: a candidate or clutter)``, ``not received (dropped by preprocessing)``."""
+    (started no track: a candidate or clutter)``, ``not received (dropped by preprocessing)``; for a run known by its
+    output only, the box on it: ``under track 26's box``, ``under no output box``."""
+    if mode is UseMode.OUTPUT:
+        if d is None or d.went is not Went.TRACK:
+            return "under no output box"
+        return f"under track {d.track_id}'s box"
     if d is None or d.went is Went.NOT_RECEIVED:
         return "not received (dropped by preprocessing)"
     if d.went is Went.TRACK:
@@ -280,12 +290,14 @@ def destination_name(d: Destination | None, mode: UseMode) -> str:
 def went_text(d: Destination | None, mode: UseMode) -> str:
     """Where a detection went, after its name: ``→ track 26``, ``→ new track 348``, ... (``destination_name``)."""
     name = destination_name(d, mode)
-    return name if name.startswith("not received") else f"→ {name}"
+    return name if name.startswith(("not received", "under ")) else f"→ {name}"
 
 
 def went_phrase(d: Destination | None, mode: UseMode) -> str:
     """Where a detection went, in a sentence: ``went to track 26``, ``started new track 348``, ``started no track
-    (a candidate or clutter)``, ``was dropped by preprocessing``."""
+    (a candidate or clutter)``, ``was dropped by preprocessing``; output only: ``lay under track 26's box``."""
+    if mode is UseMode.OUTPUT:
+        return f"lay {destination_name(d, mode)}"
     if d is None or d.went is Went.NOT_RECEIVED:
         return "was dropped by preprocessing"
     if d.went is Went.NEW_TRACK:
@@ -517,12 +529,12 @@ def _unused(f: Finding) -> list[tuple[tuple[int, int], str]]:
                 nis = next((d2 for m, d2 in (step.gated if step is not None else ()) if m == n.meas), None)
                 if nis is not None:
                     gate = f", in track {f.lost.track_id}'s gate at NIS {nis:.1f}"
+                elif f.output_only and step is None:
+                    gate = f"; track {f.lost.track_id} was not output"
                 elif step is None or step.ended is not None:
                     gate = f"; track {f.lost.track_id} was gone"
-            text = (
-                f"at frame {x} {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m from it{gate}) "
-                f"{went_text(s.went, mode)}"
-            )
+            went = went_phrase(s.went, mode) if mode is UseMode.OUTPUT else went_text(s.went, mode)
+            text = f"at frame {x} {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m from it{gate}) {went}"
             out.append(((x, n.meas), text))
     return out
 
@@ -544,7 +556,9 @@ def _lost_object(f: Finding) -> list[str]:
         parts += _where_from(f)
     elif f.taker is not None and f.taker.frame >= 0:
         o = f.taker
-        if o.meas >= 0:
+        if f.output_only:
+            parts.append(f"track {o.track_id} was first output at frame {o.frame}")
+        elif o.meas >= 0:
             parts.append(f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}")
         elif f.switch is not None:
             parts.append(f"track {o.track_id} had existed since frame {o.frame} in a hypothesis other than the best")
@@ -637,8 +651,9 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
     before = ""
     if off.earlier:
         away = ", ".join(f"{x} ({meas_name(m)})" for x, m in off.earlier)
+        verb = "its box had sat on" if f.output_only else "it had used"
         before = (
-            f"; it had used detections {NEAR_M:.0f} m or more from the object at frame"
+            f"; {verb} detections {NEAR_M:.0f} m or more from the object at frame"
             f"{'s' if len(off.earlier) > 1 else ''} {away}"
         )
     return (
@@ -698,7 +713,10 @@ def _false_track(f: Finding) -> list[str]:
         )
     else:
         head = f"at frame {f.frame} track {o.track_id} ({f.class_name}) was output on "
-        head += f"detection {_near_text(o.on)}" if o.on is not None else "no detection this frame (a predicted box)"
+        if f.output_only:
+            head += _output_on_text(f, f.frame, o.track_id, o.on)
+        else:
+            head += f"detection {_near_text(o.on)}" if o.on is not None else "no detection this frame (a predicted box)"
     parts = [head]
     if o.nearest_own is not None:
         gt_id, d, g = o.nearest_own
@@ -718,6 +736,8 @@ def _false_track(f: Finding) -> list[str]:
     elif o.nearest_any is not None:
         gt_id, cls, d = o.nearest_any
         what = "the detector gave it the wrong class" if o.on is not None else "the track coasted onto it"
+        if f.output_only and o.on is None:
+            what = "the tracker output a box there without a detection of its class under it"
         parts.append(
             f"no {f.class_name} GT lies within {NEAR_M:.0f} m, but GT {cls} {short_id(gt_id)} does ({d:.1f} m): {what}"
         )
@@ -734,6 +754,32 @@ def _false_track(f: Finding) -> list[str]:
             f"{o.threshold:.3f}"
         )
     return parts
+
+
+def box_on_text(on: BoxOn, class_name: str) -> str:
+    """How a results file's box was placed on its detection: ``its box carries m3's size, heading and height`` or
+    ``m3 is the nearest car detection, 0.31 m from its box (none carries its size, heading and height)``."""
+    m = meas_name(on.meas)
+    if on.how is OnHow.SAME_BOX:
+        return f"its box carries {m}'s size, heading and height"
+    return (
+        f"{m} is the nearest {class_name} detection, {on.distance_m:.2f} m from its box (none carries its size, "
+        "heading and height)"
+    )
+
+
+def _output_on_text(f: Finding, frame: int, track_id: int, on: Near | None) -> str:
+    """Where a results file's box was, in words: ``detection m3 (car, score 0.80; its box carries ...)`` or ``no
+    detection (...)``."""
+    placed = f.box_on(frame, track_id)
+    if on is None or placed is None:
+        return (
+            f"no detection (none of its class carries its box's size, heading and height or lies within "
+            f"{NEAREST_M:g} m of it)"
+        )
+    return (
+        f"detection {meas_name(on.meas)} ({on.class_name}, score {on.score:.2f}; {box_on_text(placed, f.class_name)})"
+    )
 
 
 def _no_box_reason(g: GtFrame | None) -> str:
@@ -859,20 +905,29 @@ def _others(f: Finding) -> list[str]:
     out = []
     for o in f.others:
         counted = [x for x in o.on_it if x.counted]
+        who = _other_name(f, o)
         if f.gt_id is None:  # a false track on no object: the same mistake at the same place, or not
             same = "had a false track here too" if o.failed_same else "had no false track here"
-            out.append(f"{o.tracker} on the same detections {same}")
+            out.append(f"{who} {same}")
         elif o.failed_same:
-            out.append(f"{o.tracker} on the same detections failed here too")
+            out.append(f"{who} failed here too")
         elif counted:
             ids = ", ".join(str(x.track_id) for x in counted)
             out.append(
-                f"{o.tracker} on the same detections did not fail here: its track{'s' if len(counted) > 1 else ''} "
+                f"{who} did not fail here: its track{'s' if len(counted) > 1 else ''} "
                 f"{ids} {'were' if len(counted) > 1 else 'was'} output on the object and counted"
             )
         else:
-            out.append(f"{o.tracker} on the same detections did not have this failure")
+            out.append(f"{who} did not have this failure")
     return out
+
+
+def _other_name(f: Finding, o: OtherRun) -> str:
+    """``pmbm on the same detections``; what a results file was given is not known: ``cv's results``, and beside
+    one, ``gnnpmb on the given detections``."""
+    if o.output_only:
+        return f"{o.tracker}'s results"
+    return f"{o.tracker} on the given detections" if f.output_only else f"{o.tracker} on the same detections"
 
 
 def plain(markdown: str) -> str:

@@ -180,7 +180,7 @@ def test_focus_in_a_comparison_highlights_each_trackers_tracks(
 @pytest.mark.parametrize(
     ("focus", "message"),
     [
-        ("switch", "bad --focus 'switch': use track:ID, gt:TOKEN or a failure id such as id_switch:1"),
+        ("switch", "bad --focus 'switch': use track:ID, gt:TOKEN, a failure id such as id_switch:1"),
         ("track:abc", "bad --focus 'track:abc': track:ID takes a track number"),
         ("id_switch:999", "--focus id_switch:999: no such failure of gnnpmb on scene-0103"),
         ("gt:zzzz", "--focus gt:zzzz: no ground-truth object of scene-0103 has an id starting so"),

@@ -83,7 +83,7 @@ CASES_BEFORE_DATA: tuple[Case, ...] = (
     _case("viz save folder", f"{VIZ} scene-0103 --save {{w}}/dir.rrd", "is a folder"),
     _case("viz save missing folder", f"{VIZ} scene-0103 --save {{w}}/no/x.rrd", "does not exist"),
     # gnnpmb
-    _case("batch no command", "gnnpmb", "missing a command (track, eval, failures, demo-data, sweep, tune)"),
+    _case("batch no command", "gnnpmb", "missing a command (track, eval, failures, demo-data, sweep, tune, diff)"),
     _case("batch unknown command", "gnnpmb trak", "no such command 'trak'"),
     _case("batch old --version V", "gnnpmb track --version v1.0-mini", "--nuscenes-version"),
     _case("track no out", "gnnpmb track", "missing option '--out'"),
@@ -125,6 +125,16 @@ CASES_BEFORE_DATA: tuple[Case, ...] = (
     _case("track out relative", "gnnpmb track --out good.json --detections ./sub/../good.json", IS_INPUT),
     _case("track out hard link", "gnnpmb track --out {w}/hard.json --detections {w}/good.json", IS_INPUT),
     _case("track out symlink", "gnnpmb track --out {w}/good.json --detections {w}/link.json", IS_INPUT),
+    _case(
+        "failures json is a results file",
+        "gnnpmb failures scene-0103 --results mine={w}/good.json --json {w}/good.json",
+        "is the --results mine file",
+    ),
+    _case(
+        "diff json is a results file",
+        "gnnpmb diff gnnpmb mine={w}/good.json --json {w}/link.json",
+        "is the --results mine file",
+    ),
     _case("track out is params", "gnnpmb track --out {w}/good.json --params {w}/hard.json", "the --params file"),
     _case(
         "failures json is detections",

@@ -85,8 +85,7 @@ def test_comparison_panel_only_with_several_trackers() -> None:
     assert ("TimeSeriesView", compare.counts_root()) not in single
     assert ("TextLogView", compare.log_path()) not in single
     assert ("Spatial3DView", paths.EGO) in single
-    assert compare.markers_path(compare.DisagreementKind.ID_CHANGE).startswith(f"{paths.WORLD}/")
-    assert not compare.markers_path(compare.DisagreementKind.ID_CHANGE).startswith(paths.WORLD_TRACKERS)
+    assert compare.markers_path(compare.DisagreementKind.ID_CHANGE, "jpda").startswith(paths.tracker_world("jpda"))
 
 
 def test_tracker_specific_views() -> None:

@@ -71,3 +71,32 @@ def test_the_oracle_catches_a_false_claim(demo_dataroot: Path) -> None:
     assert oracle.check(lie, src).contradictions
     assert oracle.check(finding, src, "m5 → ?").contradictions  # a placeholder in the text
     assert fid
+
+
+def test_no_finding_of_a_results_file_contradicts_the_file(demo_dataroot: Path, cv_results: Path) -> None:
+    """Another tracker's results (a constant-velocity tracker outside the registry): every claim of every finding
+    holds against the file itself, the detections and the devkit; the claims name only what its output shows."""
+    request = prepare("scene-0103", ["gnnpmb"], results=[f"cv={cv_results}"], dataroot=demo_dataroot)
+    verdict, n = oracle.run_one(request, "cv", ("gnnpmb",))
+    assert verdict.contradictions == [], verdict.contradictions[:5]
+    assert n > 50 and verdict.checked > 10 * n
+
+
+def test_the_oracle_catches_a_false_claim_about_a_results_file(demo_dataroot: Path, cv_results: Path) -> None:
+    from gnnpmb.foreign import OnHow
+    from gnnpmb.why.claims import claims
+
+    request = prepare("scene-0103", [], results=[f"cv={cv_results}"], dataroot=demo_dataroot)
+    evidence, _ = gather_evidence(request)
+    findings = explain_all(request, evidence)["cv"]
+    src = oracle.sources(request, "cv", evidence)
+    finding = next(f for f in findings if f.boxes_on)
+    assert oracle.check(finding, src).contradictions == []
+    assert {c.what for f in findings for c in claims(f)} >= {"output on", "first output"}
+    frame, track, on = finding.boxes_on[0]
+    how = OnHow.NEAREST if on.how is OnHow.SAME_BOX else OnHow.SAME_BOX
+    lie = dataclasses.replace(finding, boxes_on=((frame, track, dataclasses.replace(on, how=how)),))
+    assert any("output on" in c for c in oracle.check(lie, src).contradictions)
+    moved = dataclasses.replace(on, meas=on.meas + 1)
+    lie = dataclasses.replace(finding, boxes_on=((frame, track, moved),))
+    assert oracle.check(lie, src).contradictions

@@ -1,0 +1,125 @@
+"""Another tracker's results file in the debugger (``--results NAME=FILE.json``): its failures listed and explained
+in real processes, a focus recording read back, and its one-line errors."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from cli.app import main as viz_main
+from tests.viz.rrd import read_rows
+from tests.viz.test_blueprint import stored_views
+from viz import paths
+from viz.blueprint import focus_doc
+
+SCENE = "scene-0103"
+BIN = Path(sys.executable).parent
+
+
+def test_failures_of_a_results_file_in_a_real_process(demo_dataroot: Path, cv_results: Path, tmp_path: Path) -> None:
+    report = tmp_path / "cv_failures.json"
+    argv = [str(BIN / "gnnpmb"), "failures", SCENE, "--results", f"cv={cv_results}", "--tracker", "gnnpmb"]
+    proc = subprocess.run(
+        [*argv, "--dataroot", str(demo_dataroot), "--why", "--json", str(report)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "note: cv.json: " in proc.stderr and "samples outside scene-0103 left out" in proc.stderr
+    out = proc.stdout
+    assert f"{SCENE}, cv: " in out and f"{SCENE}, gnnpmb: " in out  # both runs, the results first
+    assert out.index(f"{SCENE}, cv: ") < out.index(f"{SCENE}, gnnpmb: ")
+    data = json.loads(report.read_text())
+    assert data["tracker"] == "cv" and [r["tracker"] for r in data["other_runs"]] == ["gnnpmb"]
+    findings = data["findings"]
+    assert findings and all(f["mode"] == "output only" for f in findings)
+    why = [line for line in out.splitlines() if line.startswith("  Why (cv, ")]
+    assert len(why) == len(findings)
+    text = "\n".join(why)
+    # Nothing about its update: no gates, existences, costs or births, only where its boxes were.
+    for word in ("gate", "existence", "cost", "NIS", "started by", "was given", "(p "):
+        assert word not in text, word
+    assert "its box carries m" in text and "gnnpmb on the given detections" in text
+
+
+def test_a_focus_recording_of_a_results_run(demo_dataroot: Path, cv_results: Path, tmp_path: Path) -> None:
+    report = json.loads(
+        subprocess.run(
+            [
+                str(BIN / "gnnpmb"),
+                "failures",
+                SCENE,
+                "--results",
+                f"cv={cv_results}",
+                "--dataroot",
+                str(demo_dataroot),
+                "--json",
+                str(tmp_path / "r.json"),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        ).returncode
+        == 0
+        and (tmp_path / "r.json").read_text()
+    )
+    pick = next(f"id_switch:{n}" for n, _ in enumerate([f for f in report["failures"] if f["kind"] == "id_switch"], 1))
+    out = tmp_path / "cv.rrd"
+    argv = [SCENE, "--results", f"cv={cv_results}", "-t", "gnnpmb", "--dataroot", str(demo_dataroot)]
+    with contextlib.redirect_stdout(io.StringIO()) as stdout, contextlib.redirect_stderr(io.StringIO()):
+        viz_main([*argv, "--focus", pick, "--save", str(out), "--no-progress"])
+    assert f"focus: {pick} at frame" in stdout.getvalue() and "(cv)" in stdout.getvalue()
+    rows = read_rows(out)
+    doc = rows[focus_doc()][0]["TextDocument:text"][0]
+    assert "**Why** (cv, " in doc and "| detection under its box | output |" in doc
+    assert not any(p.startswith(f"{paths.tracker_world('cv')}/gates") for p in rows)  # drawn without introspection
+    assert not any(p.startswith(paths.existence_root("cv")) for p in rows)
+    assert any(p.startswith(paths.tracks("cv", "car") + "/") for p in rows)
+    views = stored_views(out)
+    assert {"cv bird's-eye", "cv 3D", "gnnpmb bird's-eye"} <= set(views)
+    assert not any(
+        name.startswith("cv ") and ("existence" in name or "cost" in name or "NIS" in name) for name in views
+    )
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--results", "gnnpmb={f}"], "results name 'gnnpmb' is a built-in tracker's"),
+        (["--results", "mine={missing}"], "results file not found"),
+        (["--results", "mine"], "bad --results 'mine': use NAME=FILE.json"),
+        (["--results", "a={f}", "--tracker", "a={f}"], ""),  # the same run twice is one run
+        (["--results", "a={f}", "--tracker", "a=gnnpmb"], "two runs are named 'a'"),
+    ],
+)
+def test_results_errors_are_one_line(
+    demo_dataroot: Path, cv_results: Path, tmp_path: Path, args: list[str], message: str
+) -> None:
+    args = [a.format(f=cv_results, missing=tmp_path / "missing.json") for a in args]
+    argv = [str(BIN / "gnnpmb"), "failures", SCENE, *args, "--dataroot", str(demo_dataroot)]
+    proc = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    if not message:
+        assert proc.returncode == 0, proc.stderr
+        return
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and lines[0].startswith("error: ") and message in lines[0], lines
+
+
+def test_a_recording_of_a_results_file_and_a_tracker_with_its_own_parameters_reproduces(
+    demo_dataroot: Path, cv_results: Path, tmp_path: Path
+) -> None:
+    rec = tmp_path / "rep.rrd"
+    argv = [SCENE, "--results", f"cv={cv_results}", "-t", "gnnpmb:gnnpmb/params/paper.toml", "--frames", "0:6"]
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        viz_main([*argv, "--dataroot", str(demo_dataroot), "--no-failures", "--save", str(rec), "--no-progress"])
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        viz_main(["reproduce", str(rec)])
+    assert "cv: identical (6 frames)" in out.getvalue() and "gnnpmb-paper: identical (6 frames)" in out.getvalue()

@@ -1,0 +1,105 @@
+"""A full recording (no ``--focus``) as a way in (``viz.opening``): it opens at the first failure worth a look, its
+failure index is the first tab, failures are over time below the views, one label per box, the lost track drawn
+pale, and panels a run cannot fill are left out."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from pathlib import Path
+
+import pytest
+from rerun.chunk import RrdReader
+
+from cli.app import main
+from gnnpmb.session import find_reports, prepare, rerun_runs
+from tests.viz.rrd import at_frame, read_rows
+from tests.viz.test_blueprint import stored_views
+from viz import compare, paths
+from viz.blueprint import failure_index_doc
+from viz.opening import TIMELINE_KINDS, failure_timeline, lost_tracks, timeline_rows
+
+SCENE = "scene-0103"
+
+
+@pytest.fixture(scope="module")
+def recorded(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict, dict]:
+    """GNN-PMB beside JPDA on the pointpillars preset (ID switches and an identity theft), its rows and reports."""
+    out = tmp_path_factory.mktemp("full") / "full.rrd"
+    argv = [SCENE, "-t", "gnnpmb", "-t", "jpda", "--detector", "pointpillars", "--dataroot", str(demo_dataroot)]
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        main([*argv, "--save", str(out), "--no-progress"])
+    request = prepare(SCENE, ["gnnpmb", "jpda"], dataroot=demo_dataroot, detector="pointpillars")
+    reports, _ = find_reports(request, rerun_runs(request))
+    return out, read_rows(out), reports
+
+
+def _focus_max(path: Path) -> int:
+    top = -1
+    for chunk in RrdReader(path).store().stream():
+        batch = chunk.to_record_batch()
+        if not chunk.is_static and "focus" in batch.schema.names and batch.num_rows:
+            top = max(top, max(v for v in batch.column("focus").to_pylist() if v is not None))
+    return top
+
+
+def test_it_opens_at_the_first_failure_worth_a_look_with_its_index_first(recorded) -> None:
+    path, rows, reports = recorded
+    first = reports["gnnpmb"].first_worth_opening()
+    assert first.startswith("id_switch:")  # association errors come first
+    opened = reports["gnnpmb"].by_id(first)
+    assert _focus_max(path) == opened.frame_index  # the focus timeline ends there: the viewer opens there
+    index = rows[failure_index_doc("gnnpmb")][0]["TextDocument:text"][0]
+    assert f"Opened at frame **{opened.frame_index}** on **{first}**" in index
+    assert f"| **{first}** (opened) | {opened.frame_index} | ID switch |" in index
+    other = rows[failure_index_doc("jpda")][0]["TextDocument:text"][0]
+    assert "give `--tracker jpda` first and add `--focus ID`" in other and "Opened at" not in other
+    body = [line for line in index.splitlines() if line.startswith("| ") and "---" not in line][1:]
+    kinds = [line.split(" | ")[2] for line in body]
+    assert kinds.index("ID switch") < kinds.index("false track") < kinds.index("miss")  # association errors first
+
+
+def test_layout_index_tab_failures_over_time_and_only_fillable_panels(recorded) -> None:
+    path, _, reports = recorded
+    views = stored_views(path)
+    assert views["gnnpmb failures"][1] == failure_index_doc("gnnpmb")
+    assert views["gnnpmb failures over time"] == ("2D", failure_timeline("gnnpmb"))
+    assert "gnnpmb decisions" in views and "gnnpmb cost grid" in views
+    assert "jpda decisions" not in views and "jpda cost grid" not in views  # JPDA chooses no assignment
+    opened = reports["gnnpmb"].by_id(reports["gnnpmb"].first_worth_opening())
+    existence = next(name for name in views if name.startswith("gnnpmb existence"))
+    assert existence.endswith(f" · tracks at {reports['gnnpmb'].first_worth_opening()}")
+    assert opened.class_name  # the plots hold that failure's tracks (its class), with a legend naming them
+
+
+def test_one_label_per_box_and_the_lost_track_drawn(recorded) -> None:
+    _, rows, reports = recorded
+    report = reports["gnnpmb"]
+    false = next(f for f in report.failures if f.kind.value == "false_track")
+    track = paths.track("gnnpmb", false.class_name, int(false.track_ids[0]))
+    labels = [r["Boxes3D:labels"] for r in at_frame(rows[track], false.frame_index) if r.get("Boxes3D:labels")]
+    if labels:  # the false track is drawn there (shown): the words are on its own label, not on the marker
+        assert labels[-1][0].startswith(f"{false.track_ids[0]} · ") and "false track" in labels[-1][0]
+        marker = at_frame(rows[paths.failures_world("gnnpmb", "false_track")], false.frame_index)[0]
+        assert f"false track {false.track_ids[0]}" not in marker["Boxes3D:labels"]
+    switch = next(f for f in report.failures if f.kind.value == "id_switch")
+    lost = at_frame(rows[lost_tracks("gnnpmb")], switch.frame_index)[0]["Boxes3D:labels"]
+    assert any(label.startswith(f"{switch.track_ids[0]} (lost)") for label in lost)
+    for viewer in ("gnnpmb", "jpda"):  # comparison markers per tracker's views
+        assert compare.markers_path(compare.DisagreementKind.MISSED_BY_ONE, viewer) in rows
+
+
+def test_failures_over_the_whole_scene_whatever_the_timeline(recorded) -> None:
+    _, rows, reports = recorded
+    report = reports["gnnpmb"]
+    root = failure_timeline("gnnpmb")
+    dots = rows[f"{root}/failures"][0]  # static: seen on the focus timeline too, which ends at the opening
+    kinds = timeline_rows(report, range(40))
+    expected = {(f.frame_index, kinds.index(f.kind)) for f in report.failures}
+    assert {tuple(map(int, p)) for p in dots["Points2D:positions"]} == expected
+    names = rows[f"{root}/kinds"][0]["Points2D:labels"]
+    assert names[0].startswith("ID switch (") and names[-1].startswith("miss (")  # the kinds that occurred
+    assert [k for k in TIMELINE_KINDS if k in kinds] == kinds and len(names) == len(kinds)
+    opened = report.by_id(report.first_worth_opening())
+    assert rows[f"{root}/opened"][0]["Boxes2D:centers"] == [[opened.frame_index, kinds.index(opened.kind)]]
+    assert sorted({r["frame"] for r in rows[f"{root}/now"] if not r["static"]}) == list(range(40))

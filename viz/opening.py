@@ -1,0 +1,409 @@
+"""The way into a full recording (no ``--focus``): where it opens, the failure index, lost tracks and one label per
+box.
+
+* the **opening**: the first failure worth a look of the first run (``FailureReport.first_worth_opening``, found
+  before anything is logged, ``gnnpmb.session.resolve_opening``); the recording opens at its frame (its ``focus``
+  timeline ends there, ``viz.timeline.Clock``) and its per-track plots show the tracks around it
+  (``viz.blueprint``);
+* ``trackers/<run>/failure_index`` (static TextDocument, ``log_failure_index``): every failure with its ``--focus``
+  id, association errors first, one object's misses (or one track's false boxes) over consecutive frames on one row;
+* ``world/trackers/<run>/lost`` (``log_lost_tracks``): at the frame of an ID switch, identity theft or
+  fragmentation, the track that lost the object drawn pale when it is not drawn there itself (often it never was:
+  output with too low an existence to be drawn, yet counted by the evaluation): its output box there, else its
+  last one where the tracker predicted it (``lost_ghosts``);
+* ``LabelNotes``: what a failure or a disagreement says about a drawn track goes into the track's own label at
+  that frame (``203 · false track``) and the marker's label stays empty, so two labels never sit on one box.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Collection, Mapping, Sequence
+
+import numpy as np
+import rerun as rr
+
+from gnnpmb.data.scene import SceneData
+from gnnpmb.eval.failures import OPEN_FIRST, Failure, FailureKind, FailureReport, short_id
+from gnnpmb.pipeline import TrackingRun
+from gnnpmb.types import TrackEstimate
+from gnnpmb.why.facts import TrackerFacts
+from gnnpmb.why.words import SHOW_MIN_EXISTENCE, frames_text
+from viz import paths
+from viz.blueprint import failure_index_doc
+from viz.colors import faded, packed_track_colors
+from viz.failures import KIND_LABELS
+from viz.geometry import estimate_boxes
+from viz.timeline import FOCUS, FRAME, Clock
+
+LOST_LOOKBACK = 20
+"""A lost track is drawn with its last output box of at most this many frames back."""
+LOST_KEEP = 0.4
+"""A lost track keeps this share of its colour (``colors.faded``)."""
+LOST_LINE_RADIUS_M = 0.05
+LOST_KINDS = {FailureKind.ID_SWITCH: 0, FailureKind.IDENTITY_THEFT: 1, FailureKind.FRAGMENTATION: 0}
+"""The failures that lose a track, and the position of the lost track in ``Failure.track_ids``."""
+
+
+def lost_tracks(tracker: str) -> str:
+    """Boxes3D: the tracks that lost their object, pale, at the failure frames."""
+    return f"{paths.tracker_world(tracker)}/lost"
+
+
+def drawn_tracks(run: TrackingRun) -> dict[tuple[int, int], TrackEstimate]:
+    """(frame, track id) -> the estimate the viewer draws as a track (existence at least ``SHOW_MIN_EXISTENCE``)."""
+    return {
+        (fr.keyframe.index, e.track_id): e
+        for fr in run.frames
+        for e in fr.estimates
+        if e.existence >= SHOW_MIN_EXISTENCE
+    }
+
+
+class LabelNotes:
+    """Notes to add to the labels of drawn tracks (and of lost tracks drawn pale, ``lost_ghosts``), per run, frame
+    and track (module docstring); ``note`` says whether a note could be placed (the track is drawn there), so the
+    caller leaves its own label empty. drawn: per run, ``drawn_tracks``; ghosts: per run, the (frame, track id) of
+    its lost tracks drawn pale."""
+
+    def __init__(
+        self,
+        drawn: Mapping[str, Mapping[tuple[int, int], TrackEstimate]],
+        ghosts: Mapping[str, Collection[tuple[int, int]]] | None = None,
+    ) -> None:
+        self.drawn = drawn
+        self.ghosts = ghosts or {}
+        self.notes: dict[str, dict[tuple[int, int], list[str]]] = defaultdict(dict)
+        self.ghost_notes: dict[str, dict[tuple[int, int], list[str]]] = defaultdict(dict)
+
+    def note(self, tracker: str, frame: int, track_id: int, text: str) -> bool:
+        key = (frame, track_id)
+        if key in self.drawn.get(tracker, {}):
+            into = self.notes[tracker]
+        elif key in self.ghosts.get(tracker, ()):
+            into = self.ghost_notes[tracker]
+        else:
+            return False
+        texts = into.setdefault(key, [])
+        if text not in texts:
+            texts.append(text)
+        return True
+
+    def has(self, tracker: str, frame: int, track_id: int) -> bool:
+        """Whether track ``track_id`` of ``tracker`` is drawn (or drawn pale as lost) at ``frame``."""
+        key = (frame, track_id)
+        return key in self.drawn.get(tracker, {}) or key in self.ghosts.get(tracker, ())
+
+    def send(self, stream: rr.RecordingStream, clock: Clock, scene: SceneData) -> None:
+        """Each noted track's label at its noted frames: ``<id> · <note>; <note>`` (one call per track entity)."""
+        for tracker, notes in self.notes.items():
+            by_track: dict[tuple[str, int], list[tuple[int, str]]] = defaultdict(list)
+            for (frame, t), texts in sorted(notes.items()):
+                e = self.drawn[tracker][(frame, t)]
+                by_track[(e.class_name, t)].append((frame, f"{t} · {'; '.join(texts)}"))
+            for (class_name, t), rows in by_track.items():
+                frames = np.array([f for f, _ in rows], dtype=np.int64)
+                stamps = np.array([scene.keyframes[f].timestamp_us for f in frames.tolist()], dtype=np.int64)
+                labels = [text for _, text in rows]
+                clock.send(
+                    stream,
+                    paths.track(tracker, class_name, t),
+                    frames,
+                    stamps,
+                    lambda sel, labels=labels: rr.Boxes3D.columns(labels=[labels[i] for i in sel]),
+                )
+
+
+def failure_notes(tracker: str, failure: Failure, notes: LabelNotes, *, quiet: bool = False) -> set[tuple[str, str]]:
+    """Note ``failure`` on the labels of its drawn tracks; returns the (role, id) of its marker boxes whose label is
+    then carried by a track (left empty on the marker). quiet: only say which (another failure's note says it, as an
+    identity theft does for the ID switch it is)."""
+    f, ids = failure.frame_index, failure.track_ids
+    gt = short_id(failure.gt_ids[0]) if failure.gt_ids else ""
+    merged: set[tuple[str, str]] = set()
+
+    def put(role: str, track: str, text: str) -> bool:
+        if notes.has(tracker, f, int(track)) if quiet else notes.note(tracker, f, int(track), text):
+            merged.add((role, track))
+            return True
+        return False
+
+    match failure.kind:
+        case FailureKind.FALSE_TRACK:
+            put("false track", ids[0], "false track")
+        case FailureKind.ID_SWITCH:
+            if put("new track", ids[1], f"ID switch: took GT {gt} from {ids[0]}"):
+                merged.add(("gt", failure.gt_ids[0]))
+            put("old track", ids[0], f"ID switch: lost GT {gt}")
+        case FailureKind.IDENTITY_THEFT:
+            if put("thief track", ids[0], f"identity theft: took GT {gt} from {ids[1]}"):
+                merged.add(("gt", failure.gt_ids[0]))
+            put("victim track", ids[1], f"identity theft: lost GT {gt}")
+        case FailureKind.COALESCENCE:
+            covers = " and ".join(f"GT {short_id(g)}" for g in failure.gt_ids)
+            if put("track", ids[0], f"coalescence: covers {covers}"):
+                merged |= {("matched gt", failure.gt_ids[0])} | {("missed gt", g) for g in failure.gt_ids[1:]}
+        case FailureKind.FRAGMENTATION:
+            put("track", ids[0], f"fragmentation: lost GT {gt}")
+        case FailureKind.MISS:
+            pass
+    return merged
+
+
+def _subject(f: Failure) -> tuple:
+    return OPEN_FIRST.index(f.kind), f.class_name, f.gt_ids, f.track_ids
+
+
+def log_failure_index(
+    stream: rr.RecordingStream,
+    tracker: str,
+    report: FailureReport,
+    opening: str | None,
+    first_run: bool,
+    frames: range | None = None,
+) -> None:
+    """The failure index of one run (module docstring) over ``frames`` (default all); ``opening``: the failure
+    the recording opens at (of the first run; ``first_run``: whether this is it, so its ids open with ``--focus``
+    as they are)."""
+    stream.log(
+        failure_index_doc(tracker),
+        rr.TextDocument(index_markdown(tracker, report, opening, first_run, frames), media_type="text/markdown"),
+        static=True,
+    )
+
+
+def index_markdown(
+    tracker: str, report: FailureReport, opening: str | None, first_run: bool, frames: range | None = None
+) -> str:
+    """The failure index as markdown (``log_failure_index``)."""
+    ids = dict(zip(map(id, report.failures), report.ids(), strict=True))
+    kept = [f for f in report.failures if frames is None or f.frame_index in frames]
+    total = len(kept)
+    within = (
+        ""
+        if frames is None or len(frames) == len(report.sample_tokens)
+        else f", frames {frames.start}–{frames.stop - 1}"
+    )
+    lines = [f"# {tracker}: {total} failure{'s' if total != 1 else ''} on {report.scene_name}{within}", ""]
+    if opening is not None and first_run:
+        f = report.by_id(opening)
+        lines += [
+            f"Opened at frame **{f.frame_index}** on **{opening}**, the first failure worth a look (association "
+            f"errors first). The `{FOCUS}` timeline ends there: choose `{FRAME}` in the time panel to step through "
+            "the whole scene.",
+            "",
+        ]
+    how = "add `--focus ID` to the command" if first_run else f"give `--tracker {tracker}` first and add `--focus ID`"
+    lines += [
+        f"To open one with its explanation, {how} that made this recording. Where they are over the scene: the "
+        "strip below the views. *interpolated*: the evaluation scored the object at a box it interpolated (it had no "
+        "LiDAR or radar points there), often the evaluation's doing.",
+        "",
+        "| --focus ID | frames | kind | class | tracks | objects |",
+        "|---|---|---|---|---|---|",
+    ]
+    for group in _groups(kept):
+        first, last = group[0], group[-1]
+        span = ids[id(first)] if len(group) == 1 else f"{ids[id(first)]} … {ids[id(last)]}"
+        if ids[id(first)] == opening and first_run:
+            span = f"**{span}** (opened)"
+        frames = frames_text(f.frame_index for f in group).split(" ", 1)[1]
+        tracks = ", ".join(dict.fromkeys(t for f in group for t in f.track_ids)) or "—"
+        objects = ", ".join(f"GT {short_id(g)}" for g in dict.fromkeys(g for f in group for g in f.gt_ids)) or "—"
+        if any(f.gt_interpolated for f in group):
+            objects += " (interpolated)"
+        lines.append(f"| {span} | {frames} | {KIND_LABELS[first.kind]} | {first.class_name} | {tracks} | {objects} |")
+    return "\n".join(lines) + "\n"
+
+
+def _groups(failures: Sequence[Failure]) -> list[list[Failure]]:
+    """The failures in rows, by ``OPEN_FIRST`` kind, then frame: a miss of one object or a false box of one track
+    at consecutive frames joins the row of the frame before."""
+    order = sorted(failures, key=lambda f: (_subject(f), f.frame_index))
+    rows: list[list[Failure]] = []
+    for f in order:
+        last = rows[-1][-1] if rows else None
+        joins = (
+            last is not None
+            and f.kind in (FailureKind.MISS, FailureKind.FALSE_TRACK)
+            and _subject(last) == _subject(f)
+            and f.frame_index == last.frame_index + 1
+        )
+        if joins:
+            rows[-1].append(f)
+        else:
+            rows.append([f])
+    return sorted(rows, key=lambda r: (OPEN_FIRST.index(r[0].kind), r[0].frame_index, r[0].class_name))
+
+
+def lost_ghosts(
+    report: FailureReport, run: TrackingRun, facts: TrackerFacts, frames: Sequence[int]
+) -> dict[tuple[int, int], tuple[TrackEstimate, tuple[float, float]]]:
+    """(frame, track id) -> (a box of it, BEV centre to draw it at) for the track each ID switch, identity theft
+    and fragmentation in ``frames`` lost, when it is not drawn at that frame: its output box there (output with an
+    existence too low to be drawn), else its last output box of at most ``LOST_LOOKBACK`` frames back, where the
+    tracker predicted it or else where that box was (module docstring)."""
+    drawn = drawn_tracks(run)
+    output = {(fr.keyframe.index, e.track_id): e for fr in run.frames for e in fr.estimates}
+    out: dict[tuple[int, int], tuple[TrackEstimate, tuple[float, float]]] = {}
+    for failure in report.failures:
+        at = LOST_KINDS.get(failure.kind)
+        if at is None or failure.frame_index not in frames:
+            continue
+        f, t = failure.frame_index, int(failure.track_ids[at])
+        if (f, t) in drawn or (f, t) in out:
+            continue
+        back = range(f, max(-1, f - 1 - LOST_LOOKBACK), -1)
+        last = next((output[(j, t)] for j in back if (j, t) in output), None)
+        if last is None:
+            continue
+        xy = (float(last.translation_m[0]), float(last.translation_m[1]))
+        step = facts.steps(t, failure.class_name).get(f)
+        if (f, t) not in output and step is not None and step.predicted_xy_m is not None:
+            xy = step.predicted_xy_m
+        out[(f, t)] = (last, xy)
+    return out
+
+
+def log_lost_tracks(
+    stream: rr.RecordingStream,
+    tracker: str,
+    ghosts: Mapping[tuple[int, int], tuple[TrackEstimate, tuple[float, float]]],
+    notes: LabelNotes,
+    scene: SceneData,
+    clock: Clock,
+    frames: Sequence[int],
+) -> None:
+    """The lost tracks (``lost_ghosts``) pale at their failure frames, labelled ``26 (lost) · <notes>``; an empty
+    batch at the other keyframes of ``frames`` (nothing when there is none at all)."""
+    if not ghosts:
+        return
+    every = np.array(list(frames), dtype=np.int64)
+    stamps = np.array([scene.keyframes[i].timestamp_us for i in every.tolist()], dtype=np.int64)
+    rows = [sorted((t, *ghosts[(i, t)]) for (j, t) in ghosts if j == i) for i in every.tolist()]
+    flat = [(i, g) for i, row in zip(every.tolist(), rows, strict=True) for g in row]
+    boxes = estimate_boxes([e for _, (_, e, _) in flat])
+    centers = boxes.centers_m.copy()
+    centers[:, :2] = np.array([xy for _, (*_, xy) in flat], dtype=np.float64)
+    colors = faded(packed_track_colors(np.array([t for _, (t, *_) in flat], dtype=np.int64)), LOST_KEEP)
+    labels = []
+    for i, (t, *_) in flat:
+        said = notes.ghost_notes.get(tracker, {}).get((i, t), [])
+        labels.append(f"{t} (lost)" + (f" · {'; '.join(said)}" if said else ""))
+    lengths = np.array([len(r) for r in rows], dtype=np.int64)
+    starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+
+    def columns(sel: np.ndarray) -> rr.ComponentColumnList:
+        idx = np.concatenate([np.arange(starts[r], starts[r] + lengths[r]) for r in sel]).astype(np.int64)
+        return rr.Boxes3D.columns(
+            centers=centers[idx],
+            half_sizes=0.5 * boxes.sizes_xyz_m[idx],
+            quaternions=boxes.quat_xyzw[idx],
+            colors=colors[idx],
+            radii=np.full(idx.size, LOST_LINE_RADIUS_M, dtype=np.float32),
+            labels=[labels[i] for i in idx.tolist()],
+        ).partition(lengths[sel])
+
+    clock.send(stream, lost_tracks(tracker), every, stamps, columns)
+
+
+TIMELINE_KINDS: tuple[FailureKind, ...] = OPEN_FIRST
+"""The order of the failure timeline's rows, top to bottom: association errors first (a kind that did not occur
+gets no row)."""
+TICK_EVERY = 5
+"""Frame numbers are written under the failure timeline every this many keyframes."""
+LABEL_SPAN = 7.0
+"""Keyframes' worth of room on the left of the failure timeline for the row names."""
+
+
+def failure_timeline(tracker: str) -> str:
+    """2D chart of one run's failures over the scene (``log_failure_timeline``)."""
+    return f"{paths.tracker_root(tracker)}/failure_timeline"
+
+
+def timeline_rows(report: FailureReport, frames: range) -> list[FailureKind]:
+    """The kinds with a failure in ``frames``, in ``TIMELINE_KINDS`` order (at least one row)."""
+    rows = [k for k in TIMELINE_KINDS if any(f.frame_index in frames for f in report.of_kind(k))]
+    return rows or [TIMELINE_KINDS[0]]
+
+
+def timeline_bounds(frames: range, rows: int) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(x range, y range) the failure timeline's view shows: every frame and row, the row names on the left and
+    the frame numbers below."""
+    return (frames.start - LABEL_SPAN, frames.stop + 0.5), (-1.0, rows + 0.4)
+
+
+def log_failure_timeline(
+    stream: rr.RecordingStream,
+    tracker: str,
+    report: FailureReport,
+    scene: SceneData,
+    clock: Clock,
+    frames: range,
+    opening: str | None = None,
+) -> None:
+    """Where a run's failures are over the whole scene, whatever timeline the viewer is on: one row per kind that
+    occurred (``timeline_rows``), a dot in the kind's colour at each frame with failures of that kind (larger for
+    more), the frame numbers below, the failure the recording opens at boxed, and a cursor at the current frame
+    (the only part that moves with time). A time series would show only the frames of the timeline it is on, and
+    the one a full recording opens on ends at its opening failure."""
+    from viz.failures import KIND_COLORS
+
+    root = failure_timeline(tracker)
+    kinds = timeline_rows(report, frames)
+    xs, ys, colors, radii = [], [], [], []
+    for row, kind in enumerate(kinds):
+        counts = report.counts(kind)
+        for f in frames:
+            if counts[f]:
+                xs.append(f)
+                ys.append(row)
+                colors.append(KIND_COLORS[kind])
+                radii.append(0.2 + 0.05 * min(int(counts[f]), 4))
+    stream.log(
+        f"{root}/failures",
+        rr.Points2D(
+            np.column_stack([xs, ys]).reshape(-1, 2), colors=np.array(colors, np.uint8).reshape(-1, 3), radii=radii
+        ),
+        static=True,
+    )
+    n_of = {k: sum(f.frame_index in frames for f in report.of_kind(k)) for k in kinds}
+    stream.log(
+        f"{root}/kinds",
+        rr.Points2D(
+            np.column_stack([np.full(len(kinds), frames.start - LABEL_SPAN / 2), np.arange(len(kinds))]),
+            colors=[KIND_COLORS[k] for k in kinds],
+            radii=0.01,
+            labels=[f"{KIND_LABELS[k]} ({n_of[k]})" for k in kinds],
+            show_labels=True,
+        ),
+        static=True,
+    )
+    ticks = [f for f in frames if (f - frames.start) % TICK_EVERY == 0]
+    stream.log(
+        f"{root}/frames",
+        rr.Points2D(
+            np.column_stack([ticks, np.full(len(ticks), len(kinds) - 0.2)]),
+            colors=[(120, 120, 120)],
+            radii=0.01,
+            labels=[str(f) for f in ticks],
+            show_labels=True,
+        ),
+        static=True,
+    )
+    if opening is not None and report.by_id(opening).kind in kinds:
+        f = report.by_id(opening)
+        stream.log(
+            f"{root}/opened",
+            rr.Boxes2D(centers=[(f.frame_index, kinds.index(f.kind))], half_sizes=[(0.5, 0.45)], colors=[(40, 40, 40)]),
+            static=True,
+        )
+    every = np.array(list(frames), dtype=np.int64)
+    stamps = np.array([scene.keyframes[i].timestamp_us for i in every.tolist()], dtype=np.int64)
+    top, bottom = -0.6, len(kinds) - 0.5
+    strips = np.stack(
+        [np.column_stack([every, np.full(every.size, top)]), np.column_stack([every, np.full(every.size, bottom)])],
+        axis=1,
+    )
+    stream.log(f"{root}/now", rr.LineStrips2D.from_fields(colors=[(90, 90, 90)], radii=[0.04]), static=True)
+    clock.send(stream, f"{root}/now", every, stamps, lambda sel: rr.LineStrips2D.columns(strips=strips[sel]))
