@@ -29,19 +29,14 @@ from gnnpmb.assign.greedy import greedy_rows
 from gnnpmb.config import TrackerConfig
 from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
-    Assignment,
-    AxisKind,
-    Born,
-    CostMatrix,
     CostScale,
     EventSink,
     Pruned,
     PruneReason,
     ScoreOnHit,
     ScoreRule,
-    axis_labels,
 )
-from gnnpmb.greedy import distance_matrix
+from gnnpmb.greedy import distance_matrix, emit_distance_choices
 from gnnpmb.skeleton import ClassFilter, TrackView
 from gnnpmb.soa import StructOfArrays
 from gnnpmb.track_scores import fuse_confidence, step_down
@@ -176,29 +171,24 @@ class CbmotTracker(ClassFilter[CbmotPrior, tuple[CbmotTracks, Measurements]]):
         sink: EventSink,
     ) -> None:
         """``CostMatrix`` (distances, new-track column = d_class), ``Assignment``, ``Born``, ``Pruned``."""
-        dist = prior.dist
-        m, k = dist.shape
-        full = np.full((m, k + m), np.inf)
-        full[:, :k] = dist
-        full[np.arange(m), k + np.arange(m)] = self.max_distance_m
-        rows = axis_labels(AxisKind.MEASUREMENT, meas.source_index)
-        track_cols = axis_labels(AxisKind.TRACK, prior.tracks.track_id)
-        new_cols = axis_labels(AxisKind.NEW_TRACK, meas.source_index)
         description = (
             f"distance (m) from the detection's centre minus velocity x dt to the track's centre; pairs beyond "
             f"{self.max_distance_m:g} m cannot match; detections take their nearest free track in file order; "
             f"new-track column = {self.max_distance_m:g}"
         )
-        sink.emit(
-            CostMatrix(self.class_name, full, rows, track_cols + new_cols, description=description, scale=self.scale)
+        emit_distance_choices(
+            self.class_name,
+            prior.dist,
+            self.max_distance_m,
+            meas,
+            prior.tracks.track_id,
+            track_of_meas,
+            (new_j, new_ids),
+            tuple(int(i) for i in missed_ids),
+            description,
+            self.scale,
+            sink,
         )
-        chosen = track_of_meas.tolist()
-        pairs = tuple((rows[j], track_cols[c] if c >= 0 else new_cols[j]) for j, c in enumerate(chosen))
-        total = float(sum(full[j, c] if c >= 0 else full[j, k + j] for j, c in enumerate(chosen)))
-        sink.emit(Assignment(self.class_name, pairs, total, tuple(int(i) for i in missed_ids)))
-        if len(new_j):
-            born_state = np.concatenate([meas.z[new_j], meas.boxes.velocity_mps[new_j]], axis=1)
-            sink.emit(Born(self.class_name, new_ids, meas.source_index[new_j], born_state, np.ones(len(new_j))))
         for i in np.flatnonzero(low | old).tolist():
             reason = PruneReason.LOW_SCORE if low[i] else PruneReason.TRACK_LOGIC
             sink.emit(Pruned(self.class_name, int(missed_ids[i]), reason, float(missed_scores[i])))

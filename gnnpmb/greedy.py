@@ -80,6 +80,40 @@ def distance_matrix(
     return np.where(dist <= max_distance_m, dist, np.inf)
 
 
+def emit_distance_choices(
+    class_name: str,
+    dist: np.ndarray,
+    max_distance_m: float,
+    meas: Measurements,
+    track_ids: np.ndarray,
+    track_of_meas: np.ndarray,
+    born: tuple[np.ndarray, np.ndarray],
+    missed_ids: tuple[int, ...],
+    description: str,
+    scale: CostScale,
+    sink: EventSink,
+) -> None:
+    """The ``CostMatrix`` (M, K + M) of a distance-matching tracker (greedy, CBMOT: the distances, each
+    detection's new-track column = ``max_distance_m``), its ``Assignment`` (``track_of_meas`` (M,): the chosen
+    track's row index or -1) and the ``Born`` tracks (``born``: the detections' indices and the new ids)."""
+    m, k = dist.shape
+    full = np.full((m, k + m), np.inf)
+    full[:, :k] = dist
+    full[np.arange(m), k + np.arange(m)] = max_distance_m
+    rows = axis_labels(AxisKind.MEASUREMENT, meas.source_index)
+    track_cols = axis_labels(AxisKind.TRACK, track_ids)
+    new_cols = axis_labels(AxisKind.NEW_TRACK, meas.source_index)
+    sink.emit(CostMatrix(class_name, full, rows, track_cols + new_cols, description=description, scale=scale))
+    chosen = track_of_meas.tolist()
+    pairs = tuple((rows[j], track_cols[c] if c >= 0 else new_cols[j]) for j, c in enumerate(chosen))
+    total = float(sum(full[j, c] if c >= 0 else full[j, k + j] for j, c in enumerate(chosen)))
+    sink.emit(Assignment(class_name, pairs, total, missed_ids))
+    new_j, new_ids = born
+    if len(new_j):
+        born_state = np.concatenate([meas.z[new_j], meas.boxes.velocity_mps[new_j]], axis=1)
+        sink.emit(Born(class_name, new_ids, meas.source_index[new_j], born_state, np.ones(len(new_j))))
+
+
 @dataclass(frozen=True, slots=True)
 class GreedyPrior:
     """The K live tracks as the last frame left them, their centres coasted to this frame t_k + v_k dt (K, 2),
@@ -171,26 +205,20 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
         sink: EventSink,
     ) -> None:
         """``CostMatrix`` (distances, new-track column = the threshold), ``Assignment``, ``Born``, ``Pruned``."""
-        dist = prior.dist
-        m, k = dist.shape
-        full = np.full((m, k + m), np.inf)
-        full[:, :k] = dist
-        full[np.arange(m), k + np.arange(m)] = self.max_distance_m
-        rows = axis_labels(AxisKind.MEASUREMENT, meas.source_index)
-        track_cols = axis_labels(AxisKind.TRACK, prior.tracks.track_id)
-        new_cols = axis_labels(AxisKind.NEW_TRACK, meas.source_index)
-        sink.emit(
-            CostMatrix(
-                self.class_name, full, rows, track_cols + new_cols, description=COST_DESCRIPTION, scale=COST_SCALE
-            )
-        )
-        pairs = tuple((rows[j], track_cols[t] if t >= 0 else new_cols[j]) for j, t in enumerate(track_of_meas.tolist()))
-        total = float(sum(full[j, t] if t >= 0 else full[j, k + j] for j, t in enumerate(track_of_meas.tolist())))
         detected = set(track_of_meas[track_of_meas >= 0].tolist())
         missed = tuple(int(t) for i, t in enumerate(prior.tracks.track_id.tolist()) if i not in detected)
-        sink.emit(Assignment(self.class_name, pairs, total, missed))
-        if len(new_j):
-            born_state = np.concatenate([meas.z[new_j], meas.boxes.velocity_mps[new_j]], axis=1)
-            sink.emit(Born(self.class_name, new_ids, meas.source_index[new_j], born_state, np.ones(len(new_j))))
+        emit_distance_choices(
+            self.class_name,
+            prior.dist,
+            self.max_distance_m,
+            meas,
+            prior.tracks.track_id,
+            track_of_meas,
+            (new_j, new_ids),
+            missed,
+            COST_DESCRIPTION,
+            COST_SCALE,
+            sink,
+        )
         for t in deleted_ids.tolist():
             sink.emit(Pruned(self.class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))

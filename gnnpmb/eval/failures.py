@@ -39,7 +39,7 @@ import numpy as np
 
 from gnnpmb.errors import DataError
 from gnnpmb.eval.evaluated import GtFrame, TrackEval, gt_frames, track_evals
-from gnnpmb.eval.nuscenes_eval import quiet_devkit, scene_sample_tokens, tracking_config
+from gnnpmb.eval.nuscenes_eval import class_evaluation, quiet_devkit, scene_sample_tokens, tracking_config
 
 if TYPE_CHECKING:
     from nuscenes import NuScenes
@@ -598,8 +598,7 @@ def find_failures(
     """
     from nuscenes.eval.common.data_classes import EvalBoxes
     from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
-    from nuscenes.eval.tracking.algo import TrackingEvaluation
-    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetricData
+    from nuscenes.eval.tracking.data_classes import TrackingBox
     from nuscenes.eval.tracking.loaders import create_tracks
 
     tokens = scene_sample_tokens(nusc, scene_name)
@@ -624,17 +623,7 @@ def find_failures(
         classes: list[ClassEvaluation] = []
         failures: list[Failure] = []
         for class_name in cfg.class_names:
-            evaluation = TrackingEvaluation(
-                tracks_gt,
-                tracks_pred,
-                class_name,
-                cfg.dist_fcn_callable,
-                cfg.dist_th_tp,
-                cfg.min_recall,
-                num_thresholds=TrackingMetricData.nelem,
-                metric_worst=cfg.metric_worst,
-                verbose=False,
-            )
+            evaluation = class_evaluation(tracks_gt, tracks_pred, class_name, cfg)
             md = evaluation.accumulate()
             if np.all(np.isnan(md.mota)):
                 continue  # no ground truth of this class: the devkit does not score it

@@ -87,6 +87,25 @@ def tracking_config() -> TrackingConfig:
     return config_factory(EVAL_CONFIG)
 
 
+def class_evaluation(tracks_gt: Any, tracks_pred: Any, class_name: str, cfg: TrackingConfig) -> Any:
+    """The devkit's ``TrackingEvaluation`` of one class with the config's settings, exactly as ``TrackingEval``
+    builds it (40 recall thresholds, the official distance function and thresholds), quiet."""
+    from nuscenes.eval.tracking.algo import TrackingEvaluation
+    from nuscenes.eval.tracking.data_classes import TrackingMetricData
+
+    return TrackingEvaluation(
+        tracks_gt,
+        tracks_pred,
+        class_name,
+        cfg.dist_fcn_callable,
+        cfg.dist_th_tp,
+        cfg.min_recall,
+        num_thresholds=TrackingMetricData.nelem,
+        metric_worst=cfg.metric_worst,
+        verbose=False,
+    )
+
+
 def default_split(version: str) -> str:
     """The evaluation split of a version: mini_val for *mini, test for *test, else val."""
     if version.endswith("mini"):

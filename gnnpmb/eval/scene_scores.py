@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gnnpmb.errors import DataError
-from gnnpmb.eval.nuscenes_eval import quiet_devkit, scene_sample_tokens, tracking_config
+from gnnpmb.eval.nuscenes_eval import class_evaluation, quiet_devkit, scene_sample_tokens, tracking_config
 
 if TYPE_CHECKING:
     from nuscenes import NuScenes
@@ -32,9 +32,8 @@ def scene_scores(
     the devkit's ``metrics_summary.json``; NaN where a class has no ground truth."""
     from nuscenes.eval.common.data_classes import EvalBoxes
     from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes, load_gt_of_sample_tokens
-    from nuscenes.eval.tracking.algo import TrackingEvaluation
     from nuscenes.eval.tracking.constants import AVG_METRIC_MAP, MOT_METRIC_MAP
-    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetricData, TrackingMetrics
+    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetrics
     from nuscenes.eval.tracking.loaders import create_tracks
 
     from gnnpmb.eval.failures import _split_with_scene
@@ -61,17 +60,7 @@ def scene_scores(
         tracks_pred = create_tracks(prepared[1], nusc, split, gt=False)
         metrics = TrackingMetrics(cfg)
         for class_name in cfg.class_names:
-            md = TrackingEvaluation(
-                tracks_gt,
-                tracks_pred,
-                class_name,
-                cfg.dist_fcn_callable,
-                cfg.dist_th_tp,
-                cfg.min_recall,
-                num_thresholds=TrackingMetricData.nelem,
-                metric_worst=cfg.metric_worst,
-                verbose=False,
-            ).accumulate()
+            md = class_evaluation(tracks_gt, tracks_pred, class_name, cfg).accumulate()
             if not np.all(np.isnan(md.mota)):
                 best = int(np.nanargmax(md.mota))
                 for metric in MOT_METRIC_MAP.values():
