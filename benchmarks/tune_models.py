@@ -5,7 +5,7 @@ Each candidate is a name and dotted parameters on top of the defaults (``--param
 ``--candidate decay=pmb.miss_score_decay=0.3`` or ``--candidate both=pmb.miss_score_decay=0.3,pmb.heading_std_rad=0.1``;
 ``base`` (no change) is always scored. Prints, per candidate, the mean AMOTA per detector model and over all of
 them, with mean FP, IDS and AMOTP, and the number of detector models on which it beats ``base``. Runs two
-evaluations at a time (``--workers``).
+evaluations at a time (``--workers``) as Ray tasks (``gnnpmb.study.runner``; ``--workers 1``: in this process).
 
 Usage: uv run python benchmarks/tune_models.py [--tracker gnnpmb] [--split mini_train] [--preset NAME ...]
        [--seeds 0,1,2] [--candidate NAME=KEY=VALUE,... ...] [--params FILE ...] [--workers 2] [--out DIR]
@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import multiprocessing
+import os
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -24,8 +25,8 @@ from demo_split import DemoSplit, score
 from table1 import layered_config
 
 from gnnpmb.config import TrackerConfig, with_params
-
-_STATE: dict = {}
+from gnnpmb.study.runner import execution, run_tasks, session
+from gnnpmb.types import Boxes
 
 
 def parse_candidate(text: str) -> tuple[str, dict[str, float]]:
@@ -37,16 +38,26 @@ def parse_candidate(text: str) -> tuple[str, dict[str, float]]:
     return name, values
 
 
-def _run(job: tuple[str, str, int]) -> tuple[str, str, int, dict[str, float]]:
-    name, preset, seed = job
-    split: DemoSplit = _STATE["split"]
-    config: TrackerConfig = _STATE["configs"][name]
-    out: Path = _STATE["out"] / f"{name}_{preset}_s{seed}"
-    run = score(split, _STATE["detections"][(preset, seed)], _STATE["tracker"], config, out)
+@dataclass(frozen=True)
+class Job:
+    """One candidate on one detector model and seed, with everything a Ray worker needs to score it."""
+
+    name: str
+    preset: str
+    seed: int
+    split: DemoSplit
+    detections: list[dict[str, Boxes]]
+    tracker: str
+    config: TrackerConfig
+    out: Path
+
+
+def _run(job: Job) -> tuple[str, str, int, dict[str, float]]:
+    run = score(job.split, job.detections, job.tracker, job.config, job.out / f"{job.name}_{job.preset}_s{job.seed}")
     overall = run.scores.overall
     metrics = {k: float(overall[k]) for k in ("amota", "amotp", "recall", "fp", "fn", "ids")}
     metrics["ms"] = float(np.median(run.step_ms))
-    return name, preset, seed, metrics
+    return job.name, job.preset, job.seed, metrics
 
 
 def main() -> None:
@@ -68,17 +79,21 @@ def main() -> None:
     presets = args.preset or ["centerpoint", "megvii", "pointpillars"]
     seeds = [int(s) for s in args.seeds.split(",")]
     split = DemoSplit.load(args.split)
-    _STATE.update(
-        split=split,
-        tracker=args.tracker,
-        out=out,
-        configs={name: with_params(base, values) for name, values in candidates.items()},
-        detections={(p, s): split.detections(p, s) for p in presets for s in seeds},
-    )
-    jobs = [(name, p, s) for name in candidates for p in presets for s in seeds]
+    configs = {name: with_params(base, values) for name, values in candidates.items()}
+    detections = {(p, s): split.detections(p, s) for p in presets for s in seeds}
+    jobs = [
+        Job(name, p, s, split, detections[(p, s)], args.tracker, configs[name], out)
+        for name in candidates
+        for p in presets
+        for s in seeds
+    ]
+    # Ray workers import this folder's modules (demo_split, table1) as the driver does.
+    here = str(Path(__file__).resolve().parent)
+    os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [here, os.environ.get("PYTHONPATH")]))
     results: dict[tuple[str, str, int], dict[str, float]] = {}
-    with multiprocessing.get_context("fork").Pool(args.workers) as pool:
-        for name, preset, seed, metrics in pool.imap_unordered(_run, jobs):
+    run = execution(args.workers, None)
+    with session(run):
+        for _, (name, preset, seed, metrics) in run_tasks(_run, jobs, run):
             results[(name, preset, seed)] = metrics
             print(f"  {name} {preset} s{seed}: AMOTA {metrics['amota']:.4f} IDS {metrics['ids']:.0f}", flush=True)
     print(f"split {args.split}, tracker {args.tracker}, seeds {seeds}; mean over seeds")
