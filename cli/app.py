@@ -40,9 +40,11 @@ from cli.options import (
 from cli.progress import progress_bar
 from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.registry import TRACKER_NAMES
+from gnnpmb.runs import parse_runs
 from gnnpmb.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, ServeTarget, check_display
 from gnnpmb.session import (
     DEFAULT_DETECTOR,
+    DEFAULT_TRACKER,
     digest_report,
     prepare,
     prepare_reproduction,
@@ -161,6 +163,7 @@ def view(
 ) -> None:
     """Track SCENE into one recording and show or save it (``VIEW_HELP``)."""
     if save is None and not serve:
+        parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)  # a mistyped run first, then the display
         check_display()
     request = prepare(
         scene,

@@ -58,6 +58,7 @@ CASES_BEFORE_DATA: tuple[Case, ...] = (
     _case("reproduce not a recording", f"{VIZ} reproduce {{w}}/good.json", "good.json"),
     # names, ranges, conflicts
     _case("viz unknown tracker", f"{VIZ} scene-0103 --tracker nope {SAVE}", "unknown tracker"),
+    _case("viz unknown tracker, no --save", f"{VIZ} scene-0103 --tracker simpletrak", "unknown tracker 'simpletrak'"),
     _case("viz unknown class", f"{VIZ} scene-0103 --classes car,tree {SAVE}", "unknown class"),
     _case("viz unknown preset", f"{VIZ} scene-0103 --detector yolo {SAVE}", "preset 'yolo'"),
     _case("viz bad frames", f"{VIZ} scene-0103 --frames 5:2 {SAVE}", "END must be greater"),
