@@ -31,12 +31,12 @@ def scene_scores(
     sample without an entry counts as empty) on ``scene_names`` (all in one devkit or custom split), as named in
     the devkit's ``metrics_summary.json``; NaN where a class has no ground truth."""
     from nuscenes.eval.common.data_classes import EvalBoxes
-    from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes, load_gt_of_sample_tokens
+    from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
     from nuscenes.eval.tracking.constants import AVG_METRIC_MAP, MOT_METRIC_MAP
     from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetrics
     from nuscenes.eval.tracking.loaders import create_tracks
 
-    from gnnpmb.eval.failures import _split_with_scene
+    from gnnpmb.eval.failures import _prepared, _split_with_scene
 
     if not scene_names:
         raise DataError("no scenes to score")
@@ -50,12 +50,7 @@ def scene_scores(
         except (AssertionError, KeyError, TypeError, ValueError) as exc:
             raise DataError(f"the tracking results are not valid submission boxes: {exc}") from None
         gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
-        prepared = []
-        for boxes in (gt, pred):
-            boxes = add_center_dist(nusc, boxes)
-            if any(boxes.boxes[t] for t in boxes.sample_tokens):  # the filter asserts at least one box exists
-                boxes = filter_eval_boxes(nusc, boxes, cfg.class_range, verbose=False)
-            prepared.append(boxes)
+        prepared = [_prepared(nusc, boxes, cfg)[1] for boxes in (gt, pred)]  # the devkit's filters
         tracks_gt = create_tracks(prepared[0], nusc, split, gt=True)
         tracks_pred = create_tracks(prepared[1], nusc, split, gt=False)
         metrics = TrackingMetrics(cfg)
