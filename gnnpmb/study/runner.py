@@ -163,10 +163,12 @@ def run_tasks(fn: Callable[[T], R], items: Iterable[T], run: Execution) -> Itera
                 continue
             ref = done[0]
             i = pending.pop(ref)
-            try:
-                result = ray.get(ref)
-            except ray.exceptions.RayTaskError as exc:
-                raise _unwrap(exc) from None
+            with signals.deferred():  # nor inside Ray's get
+                try:
+                    result = ray.get(ref)
+                except ray.exceptions.RayTaskError as exc:
+                    raise _unwrap(exc) from None
+            signals.check()
             yield i, result
     finally:
         for ref in pending:
