@@ -9,7 +9,7 @@ machine) per mode are printed as ms per frame with the ratios to the tracker alo
 count. "sending" is the wall time per frame of the logger's ``finish`` and closing the recording alone (no
 drawing; with ``--live`` only the last rows), "budget" what the logger may take per frame on top of the events
 for tracker + logger <= 1.5x the tracker alone (wall). Everything loaded before the runs is frozen out of the
-garbage collector's reach, as ``gnnpmb-viz`` does (``gnnpmb.session.freeze_loaded``).
+garbage collector's reach, as ``gnnpmb-viz`` does (``gnnpmb.stages.inputs.freeze_loaded``).
 
     uv run python benchmarks/logging_overhead.py [--scene scene-0103] [--detector centerpoint] [--tracker gnnpmb]
         [--live]
@@ -88,7 +88,7 @@ def main() -> None:
     detections = get_detections(scene, None, args.detector, 0)
     frames = preprocess_frames(scene, detections, config, TRACKING_CLASSES)
     gc.collect()
-    gc.freeze()  # as gnnpmb.session.prepare does: no full collection walks the devkit's tables mid-run
+    gc.freeze()  # as gnnpmb.stages.inputs.load_inputs does: no full collection walks the devkit's tables mid-run
     n = len(scene.keyframes)
     flush_frames = FLUSH_FRAMES if args.live else None
     mode = f"rows sent every {FLUSH_FRAMES} frames (live)" if args.live else "rows sent at the end (--save)"

@@ -8,8 +8,9 @@ provenance of the run (command line, versions, parameters, inputs and their hash
 whether the tracks are identical. Typer cannot mix a positional SCENE with a subcommand, so ``main``
 dispatches on the first argument being ``reproduce``.
 
-This module only parses and prints: the work is ``gnnpmb.session`` (``prepare``, ...) and ``viz.view.run_view``, which a
-notebook can call the same way (``examples/notebook_session.py``). Everything the user typed is checked before a
+This module only parses and prints: the work is the stages of ``gnnpmb.stages`` (``check_request``,
+``load_inputs``) and ``viz.view.run_view``, which a notebook can call the same way
+(``examples/notebook_session.py``). Everything the user typed is checked before a
 recording is opened (names, --frames, files, the dataset), so a
 mistake costs one line on stderr and leaves no ``.rrd`` behind. Without ``--save`` or ``--serve`` the run needs
 a display for the spawned viewer; without one it stops at once with a hint instead of hanging.
@@ -17,7 +18,6 @@ a display for the spawned viewer; without one it stops at once with a hint inste
 
 from __future__ import annotations
 
-import contextvars
 import functools
 import os
 import sys
@@ -38,24 +38,12 @@ from cli.options import (
     tidy_help,
 )
 from cli.progress import progress_bar
+from cli.reproduce import COMMAND_LINE, PROG, command_line, reproduce_app
 from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.runs import parse_runs
 from gnnpmb.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, ServeTarget, check_display
-from gnnpmb.session import (
-    DEFAULT_DETECTOR,
-    DEFAULT_TRACKER,
-    digest_report,
-    prepare,
-    prepare_reproduction,
-    rerun_digests,
-    version_notes,
-)
-
-PROG = "gnnpmb-viz"
-EXIT_DIFFERENT = 1
-_COMMAND_LINE: contextvars.ContextVar[tuple[str, ...] | None] = contextvars.ContextVar("command_line", default=None)
-"""The command line ``main`` was given, recorded in the provenance (else ``sys.argv`` is used)."""
+from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER, check_request
 
 tidy_help()
 app = typer.Typer(
@@ -64,18 +52,6 @@ app = typer.Typer(
     help="Track a nuScenes scene and inspect every step of the tracker(s) in the Rerun viewer.",
     pretty_exceptions_enable=False,
 )
-reproduce_app = typer.Typer(
-    add_completion=False,
-    rich_markup_mode=None,
-    help="Re-run the trackers of a recording saved by gnnpmb-viz and check its tracks.",
-    pretty_exceptions_enable=False,
-)
-
-
-def command_line() -> tuple[str, ...]:
-    """The command line of this run: what ``main`` was given, else this process's arguments."""
-    given = _COMMAND_LINE.get()
-    return given if given is not None else (PROG, *sys.argv[1:])
 
 
 VIEW_HELP = (
@@ -84,12 +60,6 @@ VIEW_HELP = (
     "side with where they disagree.\n\n"
     f"To re-run the trackers of a saved recording and check that its tracks are identical: {PROG} reproduce "
     f"FILE.rrd (see {PROG} reproduce --help)."
-)
-REPRODUCE_HELP = (
-    "Re-run the trackers of FILE.rrd (saved by gnnpmb-viz SCENE --save FILE.rrd) on the same inputs, checked "
-    "by hash, and report per tracker whether the tracks are identical or the first keyframe where they "
-    "differ.\n\n"
-    "Exit code 0: all identical; 1: some differ; 2: an input is missing or changed."
 )
 
 
@@ -165,7 +135,7 @@ def view(
     if save is None and not serve:
         parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)  # a mistyped run first, then the display
         check_display()
-    request = prepare(
+    request = check_request(
         scene,
         tracker or [],
         results=results or [],
@@ -182,9 +152,11 @@ def view(
         argv=command_line(),
         focus=focus,
     )
+    from gnnpmb.stages.inputs import load_inputs
     from viz.view import run_view
 
-    result = run_view(request, progress=progress_bar(progress), failures=failures)
+    inputs = load_inputs(request)
+    result = run_view(inputs, progress=progress_bar(progress), failures=failures)
     if result.focus is not None:
         typer.echo(f"focus: {result.focus.title}")
     for notice in result.notices:
@@ -196,13 +168,13 @@ def view(
     output = f"saved {request.save}" if request.save is not None else "streamed to the Rerun viewer"
     if request.serve is not None:
         output = f"served at {request.serve.url}"
-    typer.echo(f"{request.scene.name}: {len(request.frame_range)} frames, {timing}{compared}; {output}")
+    typer.echo(f"{inputs.scene.name}: {len(inputs.frame_range)} frames, {timing}{compared}; {output}")
     if result.focus is None:  # where to look next: --focus ids name the first run's failures
         for k, (name, report) in enumerate(result.reports.items()):
             first = report.first_worth_opening()
             if first is None:
                 continue
-            spec = request.spec(name).text()
+            spec = inputs.spec(name).text()
             how = f"add --focus {first}" if k == 0 else f"give --tracker {spec} first and add --focus {first}"
             interpolated = sum(f.gt_interpolated for f in report.failures)
             at_interpolated = (
@@ -212,60 +184,13 @@ def view(
             )
             typer.echo(
                 f"{name} failures{report.scope_text()}: {report.totals_text()}{at_interpolated}. To open {first} at "
-                f"its frame, {how} to this command; to list them all: gnnpmb failures {request.scene.name} "
+                f"its frame, {how} to this command; to list them all: gnnpmb failures {inputs.scene.name} "
                 f"--tracker {spec} (same options)."
             )
     if request.serve is not None:
         from viz.serving import wait_for_ctrl_c
 
         wait_for_ctrl_c(request.serve)
-
-
-@reproduce_app.command(help=REPRODUCE_HELP)
-def reproduce(
-    recording_file: Annotated[
-        Path,
-        typer.Argument(metavar="FILE.rrd", help="A recording saved by gnnpmb-viz SCENE --save FILE.rrd."),
-    ],
-    dataroot: Annotated[
-        Path | None,
-        typer.Option(metavar="DIR", help="Use this dataroot instead of the recorded one (a copy)."),
-    ] = None,
-    detections: Annotated[
-        Path | None,
-        typer.Option(metavar="FILE.json", help="Use this detections file instead of the recorded path (a copy)."),
-    ] = None,
-    save: Annotated[
-        Path | None, typer.Option(metavar="OUT.rrd", help="Also write the re-run as a new recording.")
-    ] = None,
-    progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr (with --save).")] = True,
-) -> None:
-    """Re-run a recording's trackers and compare their track digests (``REPRODUCE_HELP``)."""
-    from gnnpmb.outputs import check_output_file
-    from viz.provenance import read_provenance
-    from viz.view import run_view
-
-    if save is not None:  # the recording read must not be the one written
-        check_output_file(save, "--save", ".rrd", inputs=(("FILE.rrd", recording_file), ("--detections", detections)))
-    provenance = read_provenance(recording_file)
-    request = prepare_reproduction(
-        provenance, dataroot=dataroot, detections_file=detections, save=save, argv=command_line()
-    )
-    for note in version_notes(provenance.versions):
-        typer.echo(note, err=True)
-    typer.echo(
-        f"{provenance.scene_name} ({provenance.data_source}), keyframes {provenance.frame_start}:"
-        f"{provenance.frame_end}, detections: {request.source.describe()} (same as recorded)"
-    )
-    rerun = run_view(request, progress=progress_bar(progress)) if save is not None else None
-    digests = rerun.digests if rerun is not None else rerun_digests(request)
-    lines, same = digest_report(provenance.track_digests, digests)
-    for line in lines:
-        typer.echo(line)
-    if save is not None:
-        typer.echo(f"saved {request.save}")
-    if not same:
-        raise typer.Exit(EXIT_DIFFERENT)
 
 
 def main(argv: Sequence[str] | None = None) -> None:
@@ -282,11 +207,11 @@ def _main(args: list[str]) -> None:
     """``main`` on the arguments after the program name."""
     check_version_flag(args, PROG)
     os.environ.setdefault("RUST_LOG", "off")  # Rerun's own log lines; our errors say what went wrong
-    token = _COMMAND_LINE.set((PROG, *args))
+    token = COMMAND_LINE.set((PROG, *args))
     try:
         if args and args[0] == "reproduce":
             run_app(functools.partial(reproduce_app, prog_name=f"{PROG} reproduce"), args[1:])
         else:
             run_app(functools.partial(app, prog_name=PROG), args)
     finally:
-        _COMMAND_LINE.reset(token)
+        COMMAND_LINE.reset(token)

@@ -8,7 +8,6 @@ on a submission, with our own table), ``failures`` (one scene: which frames and 
 from __future__ import annotations
 
 import time
-from collections import defaultdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -16,6 +15,7 @@ import typer
 
 from cli.diff import register as register_diff
 from cli.errors import entry_point
+from cli.failures import register as register_failures
 from cli.options import (
     DEFAULT_DETECTOR,
     DEFAULT_TRACKER,
@@ -24,8 +24,6 @@ from cli.options import (
     DetectionsOption,
     DetectorOption,
     ParamsOption,
-    ResultsOption,
-    RunsOption,
     SeedOption,
     SplitOption,
     TrackerOption,
@@ -34,13 +32,12 @@ from cli.options import (
     tidy_help,
 )
 from cli.study import VerboseOption, register
+from cli.tune import register as register_tune
 from gnnpmb.eval.nuscenes_eval import default_split
 from gnnpmb.outputs import check_output_dir, check_output_file
 
 if TYPE_CHECKING:  # rich, numpy and the devkit load only on the paths that use them (fast --help)
-    from rich.console import Console
-
-    from gnnpmb.eval.failures import FailureReport
+    pass
 
 __all__ = ["app", "default_split", "main"]
 
@@ -175,180 +172,7 @@ def evaluate(
     )
 
 
-@app.command(short_help="List one scene's tracking failures per frame.")
-def failures(
-    scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
-    tracker: RunsOption = None,
-    results: ResultsOption = None,
-    dataroot: DatarootOption = None,
-    version: VersionOption = None,
-    detections: DetectionsOption = None,
-    detector: DetectorOption = None,
-    seed: SeedOption = 0,
-    params: ParamsOption = None,
-    json_out: Annotated[
-        Path | None, typer.Option("--json", metavar="FILE.json", help="Also write the report as JSON here.")
-    ] = None,
-    why: Annotated[
-        bool,
-        typer.Option(
-            "--why", help="Explain each failure: whose doing, why and because (with --json: the typed findings)."
-        ),
-    ] = False,
-    frames: Annotated[
-        str | None,
-        typer.Option(
-            metavar="START:END",
-            help="Track and evaluate only keyframes START:END (END exclusive), as gnnpmb-viz --frames does; the "
-            "ids are those gnnpmb-viz --frames START:END --focus takes.",
-        ),
-    ] = None,
-) -> None:
-    """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
-    coalescence and cascading identity theft (scored with the devkit's own matching). With several runs (--tracker,
-    --results) each is listed in turn; --why explains each failure beside the others."""
-    from gnnpmb.data.simdet_presets import detector_choice
-    from gnnpmb.runs import parse_runs, run_inputs
-    from gnnpmb.session import parse_frames
-
-    runs = parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)
-    inputs = (("--detections", detections), ("--params", params), *run_inputs(runs))
-    json_target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
-    bounds = parse_frames(frames)
-    preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
-    foreign: dict = {}
-    if len(runs) == 1 and runs[0].tracker is not None and runs[0].params is None:  # one built-in tracker
-        reports, findings = _one_tracker(
-            scene, runs[0].tracker, dataroot, version, detections, preset, seed, params, why, bounds
-        )
-    else:  # several runs, a results file or a tracker's own parameters (gnnpmb.session)
-        from cli.failures import failure_reports
-
-        reports, findings, request = failure_reports(
-            scene,
-            tracker or [],
-            results or [],
-            dataroot=dataroot,
-            version=version,
-            detections=detections,
-            detector=detector,
-            seed=seed,
-            params=params,
-            why=why,
-            frames=frames,
-        )
-        foreign = {name: r.original_ids for name, r in request.foreign.items() if r.original_ids}
-    if json_target is not None:
-        from gnnpmb.eval.submission import write_json
-
-        write_json(json_target, _report_json(reports, findings, foreign))
-    console = stdout_console()
-    for name, report in reports.items():
-        print_report(report, console)
-        if why:
-            print_findings(findings[name], console)
-    if json_out is not None:
-        typer.echo(f"report -> {json_out}")
-
-
-def _one_tracker(
-    scene: str, tracker: str, dataroot, version, detections, preset: str, seed: int, params, why: bool, bounds
-):
-    """One built-in tracker's report (and findings, with ``why``) on ``scene``, keyed by its name; bounds: the
-    ``--frames`` keyframes (``session.parse_frames``)."""
-    from gnnpmb.config import load_config
-    from gnnpmb.data.detections import check_detection_file
-    from gnnpmb.data.nuscenes import resolve_dataroot
-    from gnnpmb.registry import tracker_has_existence
-    from gnnpmb.study.track import scene_failures
-    from gnnpmb.why.facts import FactSink
-
-    config = load_config(params)
-    if detections is not None:
-        check_detection_file(detections)
-    location = resolve_dataroot(dataroot, version, (scene,))
-    fact_sink = FactSink(tracker, has_existence=tracker_has_existence(tracker)) if why else None
-    found = scene_failures(location, scene, tracker, config, detections, preset, seed, sink=fact_sink, bounds=bounds)
-    report = found.report
-    findings = []
-    if fact_sink is not None:
-        from gnnpmb.focus import FRAMES_BEFORE
-        from gnnpmb.why.reason import Evidence, explain_failure
-
-        evidence = Evidence(report, fact_sink.facts, found.run)
-        findings = [
-            explain_failure(
-                fid, evidence, found.run.scene, first_frame=max(bounds[0] or 0, f.frame_index - FRAMES_BEFORE)
-            )
-            for fid, f in zip(report.ids(), report.failures, strict=True)
-        ]
-    return {tracker: report}, ({tracker: findings} if why else {})
-
-
-def _report_json(reports: dict, findings: dict, track_names: dict) -> dict:
-    """The first run's report (and findings), the other runs' under ``other_runs``; a results file's renumbered
-    ids under ``track_names`` (``track_names``: run -> track id -> the file's id)."""
-    from gnnpmb.why.serialize import finding_json
-
-    def one(name: str) -> dict:
-        data = reports[name].to_json()
-        if name in findings:
-            data["findings"] = [finding_json(f) for f in findings[name]]
-        if name in track_names:
-            data["track_names"] = {str(t): i for t, i in track_names[name].items()}
-        return data
-
-    first, *rest = reports
-    data = one(first)
-    if rest:
-        data["other_runs"] = [one(name) for name in rest]
-    return data
-
-
-def print_findings(findings: list, console: Console) -> None:
-    """Each failure's finding: its id and whose doing, then its Why and Because lines (``why.words``)."""
-    from gnnpmb.why.words import plain, whose_text, why_lines
-
-    for f in findings:
-        console.print(f"{f.failure_id} (frame {f.frame}, {f.class_name}): {whose_text(f)}", highlight=False)
-        for line in why_lines(f):
-            if line:
-                console.print(f"  {plain(line)}", highlight=False, soft_wrap=True)
-
-
-def print_report(report: FailureReport, console: Console) -> None:
-    """The failure report as two tables: per class at its best-MOTA threshold, then failures per frame."""
-    from rich.table import Table
-
-    from gnnpmb.eval.failures import FailureKind
-    from gnnpmb.eval.nuscenes_eval import format_metric
-
-    classes = Table(title=f"{report.tracker} on {report.scene_name}: devkit counts at the best-MOTA threshold")
-    for name in ("class", "threshold", "MOTA", "TP", "FP", "FN", "IDS", "FRAG"):
-        classes.add_column(name, justify="left" if name == "class" else "right")
-    for c in report.classes:
-        threshold = "all" if c.threshold is None else f"{c.threshold:.3f}"
-        counts = (format_metric(m, getattr(c, m)) for m in ("tp", "fp", "fn", "ids", "frag"))
-        classes.add_row(c.class_name, threshold, format_metric("mota", c.mota), *counts)
-    console.print(classes)
-
-    grouped: dict[tuple[int, FailureKind], list[tuple[str, str]]] = defaultdict(list)
-    for failure_id, f in zip(report.ids(), report.failures, strict=True):
-        grouped[(f.frame_index, f.kind)].append((failure_id, f.describe()))
-    rows = Table(title="failures per frame (open one: gnnpmb-viz SCENE --tracker T --focus ID)")
-    rows.add_column("frame", justify="right")
-    rows.add_column("id")
-    rows.add_column("what (GT ids shortened to 6 characters)")
-    for (frame, _kind), entries in grouped.items():
-        rows.add_row(str(frame), _id_span([i for i, _ in entries]), "; ".join(text for _, text in entries))
-    console.print(rows)
-    totals = f"{report.scene_name}, {report.tracker}{report.scope_text()}: {report.totals_text()}"
-    console.print(totals, highlight=False, soft_wrap=True)
-
-
-def _id_span(ids: list[str]) -> str:
-    """``miss:3`` or ``miss:3-7`` for the ids of one kind in one frame (numbered consecutively)."""
-    return ids[0] if len(ids) == 1 else f"{ids[0]}-{ids[-1].split(':')[1]}"
+register_failures(app)  # after eval in --help, as before
 
 
 @app.command("demo-data", short_help="Write the synthetic demo dataset.")
@@ -384,5 +208,6 @@ def demo_data(
 
 
 register(app)
+register_tune(app)
 register_diff(app)
 main = entry_point(app, "gnnpmb")

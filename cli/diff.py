@@ -63,10 +63,11 @@ def diff(
     """``DIFF_HELP``."""
     from cli.options import stdout_console
     from gnnpmb.data.nuscenes import all_sample_tokens, resolve_dataroot, sample_tokens, split_scenes
-    from gnnpmb.diff import diff_runs
     from gnnpmb.eval.nuscenes_eval import default_split
     from gnnpmb.runs import parse_run, run_inputs
-    from gnnpmb.session import prepare
+    from gnnpmb.stages.diff import diff_runs
+    from gnnpmb.stages.inputs import load_inputs
+    from gnnpmb.stages.request import check_request
 
     inputs = (("--detections", detections), ("--params", params), *run_inputs([parse_run(a), parse_run(b)]))
     target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
@@ -95,7 +96,7 @@ def diff(
         b,
         scenes,
         where,
-        prepare_scene=lambda name, runs: prepare(name, runs, **data_options),
+        scene_inputs=lambda name, runs: load_inputs(check_request(name, runs, **data_options)),
         split_tokens=sample_tokens(location, scenes),  # an unknown scene is one line here
         dataset_tokens=all_sample_tokens(location),
     )

@@ -1,17 +1,103 @@
-"""``gnnpmb failures``: the failure reports (and, with --why, the findings) of one scene's runs, for the printer."""
+"""``gnnpmb failures``: one scene's failure reports (and, with --why, the findings), through the stages of
+``gnnpmb.stages`` (request → inputs → runs → evaluation → findings), printed as tables or written as JSON.
+Registered on the ``gnnpmb`` app by ``cli.batch``. No ``from __future__ import annotations`` here: typer must
+evaluate the option annotations inside ``register``."""
 
-from __future__ import annotations
-
+from collections import defaultdict
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Annotated
 
+import typer
+
+from cli.options import (
+    DatarootOption,
+    DetectionsOption,
+    DetectorOption,
+    ParamsOption,
+    ResultsOption,
+    RunsOption,
+    SeedOption,
+    VersionOption,
+    stdout_console,
+)
 from gnnpmb.errors import GnnpmbError
+from gnnpmb.outputs import check_output_file
+from gnnpmb.stages.request import DEFAULT_TRACKER
 
 if TYPE_CHECKING:
+    from rich.console import Console
+
     from gnnpmb.eval.failures import FailureReport
-    from gnnpmb.session import ViewRequest
+    from gnnpmb.stages.inputs import Inputs
     from gnnpmb.why.findings import Finding
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``failures`` command to ``app``."""
+
+    @app.command(short_help="List one scene's tracking failures per frame.")
+    def failures(
+        scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
+        tracker: RunsOption = None,
+        results: ResultsOption = None,
+        dataroot: DatarootOption = None,
+        version: VersionOption = None,
+        detections: DetectionsOption = None,
+        detector: DetectorOption = None,
+        seed: SeedOption = 0,
+        params: ParamsOption = None,
+        json_out: Annotated[
+            Path | None, typer.Option("--json", metavar="FILE.json", help="Also write the report as JSON here.")
+        ] = None,
+        why: Annotated[
+            bool,
+            typer.Option(
+                "--why", help="Explain each failure: whose doing, why and because (with --json: the typed findings)."
+            ),
+        ] = False,
+        frames: Annotated[
+            str | None,
+            typer.Option(
+                metavar="START:END",
+                help="Track and evaluate only keyframes START:END (END exclusive), as gnnpmb-viz --frames does; the "
+                "ids are those gnnpmb-viz --frames START:END --focus takes.",
+            ),
+        ] = None,
+    ) -> None:
+        """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
+        coalescence and cascading identity theft (scored with the devkit's own matching). With several runs (--tracker,
+        --results) each is listed in turn; --why explains each failure beside the others."""
+        from gnnpmb.runs import parse_runs, run_inputs
+
+        runs = parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)
+        inputs = (("--detections", detections), ("--params", params), *run_inputs(runs))
+        json_target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
+        reports, findings, loaded = failure_reports(
+            scene,
+            tracker or [],
+            results or [],
+            dataroot=dataroot,
+            version=version,
+            detections=detections,
+            detector=detector,
+            seed=seed,
+            params=params,
+            why=why,
+            frames=frames,
+        )
+        foreign = {name: r.original_ids for name, r in loaded.foreign.items() if r.original_ids}
+        if json_target is not None:
+            from gnnpmb.eval.submission import write_json
+
+            write_json(json_target, _report_json(reports, findings, foreign))
+        console = stdout_console()
+        for name, report in reports.items():
+            print_report(report, console)
+            if why:
+                print_findings(findings[name], console)
+        if json_out is not None:
+            typer.echo(f"report -> {json_out}")
 
 
 def failure_reports(
@@ -27,16 +113,20 @@ def failure_reports(
     params: Path | None,
     why: bool,
     frames: str | None = None,
-) -> tuple[dict[str, FailureReport], dict[str, list[Finding]], ViewRequest]:
+) -> "tuple[dict[str, FailureReport], dict[str, list[Finding]], Inputs]":
     """Every run's failure report on ``scene`` in order, its findings (with ``why``; each explained with the
-    other runs' evidence beside it) and the checked request; notices go to stderr. Raises a one-line error when
+    other runs' evidence beside it) and the loaded inputs; notices go to stderr. Raises a one-line error when
     the scene cannot be evaluated (no ground truth, in no split). frames: ``--frames START:END``, the keyframes
     tracked and evaluated."""
     import typer
 
-    from gnnpmb.session import explain_all, find_reports, gather_evidence, prepare, rerun_runs
+    from gnnpmb.stages.evaluation import find_reports
+    from gnnpmb.stages.findings import all_evidence, explain_all
+    from gnnpmb.stages.inputs import load_inputs
+    from gnnpmb.stages.request import check_request
+    from gnnpmb.stages.runs import run_all
 
-    request = prepare(
+    request = check_request(
         scene,
         trackers,
         results=results,
@@ -48,15 +138,78 @@ def failure_reports(
         params=params,
         frames=frames,
     )
-    for notice in request.notices:
+    inputs = load_inputs(request)
+    for notice in inputs.notices:
         typer.echo(f"note: {notice}", err=True)
-    if why:
-        evidence, notices = gather_evidence(request)
-        reports = {name: ev.report for name, ev in evidence.items()}
-        findings = explain_all(request, evidence)
-    else:
-        reports, notices = find_reports(request, rerun_runs(request))
-        findings = {}
+    runs = run_all(inputs, record=why)
+    reports, notices = find_reports(inputs, runs)
     if not reports:
         raise GnnpmbError("; ".join(notices) or f"{scene} cannot be evaluated")
-    return reports, findings, request
+    findings = explain_all(inputs, all_evidence(inputs, runs, reports)) if why else {}
+    return reports, findings, inputs
+
+
+def _report_json(reports: dict, findings: dict, track_names: dict) -> dict:
+    """The first run's report (and findings), the other runs' under ``other_runs``; a results file's renumbered
+    ids under ``track_names`` (``track_names``: run -> track id -> the file's id)."""
+    from gnnpmb.why.serialize import finding_json
+
+    def one(name: str) -> dict:
+        data = reports[name].to_json()
+        if name in findings:
+            data["findings"] = [finding_json(f) for f in findings[name]]
+        if name in track_names:
+            data["track_names"] = {str(t): i for t, i in track_names[name].items()}
+        return data
+
+    first, *rest = reports
+    data = one(first)
+    if rest:
+        data["other_runs"] = [one(name) for name in rest]
+    return data
+
+
+def print_findings(findings: list, console: "Console") -> None:
+    """Each failure's finding: its id and whose doing, then its Why and Because lines (``why.words``)."""
+    from gnnpmb.why.words import plain, whose_text, why_lines
+
+    for f in findings:
+        console.print(f"{f.failure_id} (frame {f.frame}, {f.class_name}): {whose_text(f)}", highlight=False)
+        for line in why_lines(f):
+            if line:
+                console.print(f"  {plain(line)}", highlight=False, soft_wrap=True)
+
+
+def print_report(report: "FailureReport", console: "Console") -> None:
+    """The failure report as two tables: per class at its best-MOTA threshold, then failures per frame."""
+    from rich.table import Table
+
+    from gnnpmb.eval.failures import FailureKind
+    from gnnpmb.eval.nuscenes_eval import format_metric
+
+    classes = Table(title=f"{report.tracker} on {report.scene_name}: devkit counts at the best-MOTA threshold")
+    for name in ("class", "threshold", "MOTA", "TP", "FP", "FN", "IDS", "FRAG"):
+        classes.add_column(name, justify="left" if name == "class" else "right")
+    for c in report.classes:
+        threshold = "all" if c.threshold is None else f"{c.threshold:.3f}"
+        counts = (format_metric(m, getattr(c, m)) for m in ("tp", "fp", "fn", "ids", "frag"))
+        classes.add_row(c.class_name, threshold, format_metric("mota", c.mota), *counts)
+    console.print(classes)
+
+    grouped: dict[tuple[int, FailureKind], list[tuple[str, str]]] = defaultdict(list)
+    for failure_id, f in zip(report.ids(), report.failures, strict=True):
+        grouped[(f.frame_index, f.kind)].append((failure_id, f.describe()))
+    rows = Table(title="failures per frame (open one: gnnpmb-viz SCENE --tracker T --focus ID)")
+    rows.add_column("frame", justify="right")
+    rows.add_column("id")
+    rows.add_column("what (GT ids shortened to 6 characters)")
+    for (frame, _kind), entries in grouped.items():
+        rows.add_row(str(frame), _id_span([i for i, _ in entries]), "; ".join(text for _, text in entries))
+    console.print(rows)
+    totals = f"{report.scene_name}, {report.tracker}{report.scope_text()}: {report.totals_text()}"
+    console.print(totals, highlight=False, soft_wrap=True)
+
+
+def _id_span(ids: list[str]) -> str:
+    """``miss:3`` or ``miss:3-7`` for the ids of one kind in one frame (numbered consecutively)."""
+    return ids[0] if len(ids) == 1 else f"{ids[0]}-{ids[-1].split(':')[1]}"

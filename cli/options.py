@@ -9,12 +9,11 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from gnnpmb.registry import TRACKER_NAMES
+from gnnpmb.stages.request import DEFAULT_DETECTOR
 
 if TYPE_CHECKING:
     from rich.console import Console
 
-DEFAULT_TRACKER = "gnnpmb"
-DEFAULT_DETECTOR = "centerpoint"
 _TABLE_WIDTH = 160
 """Console width when stdout is not a terminal (pipes, tests), so tables are not squeezed to 80 columns."""
 

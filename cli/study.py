@@ -1,4 +1,5 @@
-"""``gnnpmb sweep`` and ``gnnpmb tune``: parameter studies scored with the official evaluation, on Ray.
+"""``gnnpmb sweep``: a parameter grid scored with the official evaluation, on Ray, and what ``gnnpmb tune``
+(``cli.tune``) shares with it.
 
 Registered on the ``gnnpmb`` app by ``cli.batch`` (``register``; this module imports nothing of ``cli.batch``);
 the work is in ``gnnpmb.study``. No
@@ -10,7 +11,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
@@ -30,12 +30,9 @@ from cli.options import (
     stdout_console,
 )
 from cli.progress import progress_bar
-from gnnpmb.errors import GnnpmbError
 
 if TYPE_CHECKING:
-    from gnnpmb.study.data import StudyData
-    from gnnpmb.study.runner import Execution
-    from gnnpmb.study.tune import SearchDim, TuneResult
+    pass
 
 WorkersOption = Annotated[
     int | None,
@@ -63,17 +60,17 @@ def train_split(version: str) -> str:
     return "mini_train" if version.endswith("mini") else "train"
 
 
-def _progress(enabled: bool, total: int, what: str) -> Progress:
+def study_progress(enabled: bool, total: int, what: str) -> Progress:
     bar = progress_bar(enabled, transient=True)
     bar.add_task(f"{what}, best AMOTA -", total=total)
     return bar
 
 
-def _best_label(what: str, best: float | None) -> str:
+def best_label(what: str, best: float | None) -> str:
     return f"{what}, best AMOTA {'-' if best is None else f'{best:.3f}'}"
 
 
-def _metric(value: Any, digits: int = 3) -> str:
+def metric_text(value: Any, digits: int = 3) -> str:
     if value is None:
         return "-"
     if isinstance(value, float) and not value.is_integer():
@@ -102,13 +99,13 @@ def best_table(rows: list[dict[str, Any]], keys: tuple[str, ...], title: str) ->
     for row in rows:
         values = [_value(row[k]) for k in keys]
         table.add_row(
-            str(row["config"]), *values, *(_metric(row[m]) for m in OVERALL_METRICS), f"{row['wall_time_s']:.1f}"
+            str(row["config"]), *values, *(metric_text(row[m]) for m in OVERALL_METRICS), f"{row['wall_time_s']:.1f}"
         )
     return table
 
 
 def register(app: typer.Typer) -> None:
-    """Add ``sweep`` and ``tune`` to the ``gnnpmb`` app."""
+    """Add ``sweep`` to the ``gnnpmb`` app."""
 
     @app.command()
     def sweep(
@@ -165,12 +162,12 @@ def register(app: typer.Typer) -> None:
             typer.echo(note, err=True)
         n = len(plan.assignments)
         rows_seen: list[dict[str, Any]] = []
-        with session(run), _progress(progress, n, "configurations") as bar:  # the bar once Ray is up
+        with session(run), study_progress(progress, n, "configurations") as bar:  # the bar once Ray is up
 
             def on_row(row: dict[str, Any], from_cache: bool) -> None:
                 rows_seen.append(row)
                 task = bar.task_ids[0]
-                bar.update(task, advance=1, description=_best_label("configurations", best_amota(rows_seen)))
+                bar.update(task, advance=1, description=best_label("configurations", best_amota(rows_seen)))
 
             outcome = run_sweep(plan, ResultCache(folder / CACHE_FOLDER), run, on_row)
         meta = {
@@ -198,133 +195,3 @@ def register(app: typer.Typer) -> None:
             left = f"{n - len(rows)} configurations left; run the same command again to resume"
             announce_stop(left)
             raise typer.Exit(130)
-
-    @app.command()
-    def tune(
-        out: Annotated[Path, typer.Option(metavar="FILE.toml", help="Where to write the best parameters.")],
-        tracker: TrackerOption = DEFAULT_TRACKER,
-        trials: Annotated[int, typer.Option(metavar="N", help="Number of trials.")] = 20,
-        classes: Annotated[
-            str | None,
-            typer.Option(metavar="a,b", help="Classes whose per-class parameters are searched (default: all 7)."),
-        ] = None,
-        space: Annotated[
-            list[str] | None,
-            typer.Option(
-                metavar="KEY=LOW:HIGH[:log]",
-                help="Searched key and range (repeatable); replaces the default per-class space.",
-            ),
-        ] = None,
-        dataroot: DatarootOption = None,
-        version: VersionOption = None,
-        split: Annotated[
-            str | None,
-            typer.Option(help="Split to tune on (default: mini_train for *mini versions, else train)."),
-        ] = None,
-        detections: DetectionsOption = None,
-        detector: DetectorOption = None,
-        seed: Annotated[
-            int, typer.Option(metavar="N", min=0, help="Seed of the simulated detector and the sampler (0 or more).")
-        ] = 0,
-        params: ParamsOption = None,
-        workers: WorkersOption = None,
-        address: AddressOption = None,
-        progress: ProgressOption = True,
-        verbose: VerboseOption = False,
-    ) -> None:
-        """Search per-class parameters (Optuna TPE on Ray Tune) and write the best as a --params TOML."""
-        from gnnpmb.data.nuscenes import resolve_dataroot
-        from gnnpmb.data.simdet_presets import detector_choice
-        from gnnpmb.outputs import check_output_file
-        from gnnpmb.registry import check_tracker
-        from gnnpmb.study.data import resolve_study_data
-        from gnnpmb.study.grid import config_toml
-        from gnnpmb.study.runner import execution, session
-        from gnnpmb.study.tune import check_space, default_space, parse_space, run_tune, write_params
-        from gnnpmb.types import TRACKING_CLASSES
-
-        check_tracker(tracker)
-        target = check_output_file(out, "--out", inputs=(("--detections", detections), ("--params", params)))
-        preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
-        base = base_params(params)
-        class_names = TRACKING_CLASSES if classes is None else tuple(c.strip() for c in classes.split(",") if c)
-        unknown = [c for c in class_names if c not in TRACKING_CLASSES]
-        if unknown or not class_names:
-            raise GnnpmbError(f"unknown class {', '.join(unknown) or '(none)'}; known: {', '.join(TRACKING_CLASSES)}")
-        dims = [parse_space(s) for s in space] if space else default_space(class_names, base)
-        check_space(dims, base)
-        if trials < 1:
-            raise GnnpmbError(f"--trials must be at least 1, got {trials}")
-        run = execution(workers, address, verbose)
-        # the demo generates its train scenes only when asked for them; tuning defaults to a train split
-        location = resolve_dataroot(dataroot, version, (split or "mini_train",))
-        data = resolve_study_data(location, split or train_split(location.version), detections, preset, seed)
-        seen: list[float] = []
-        with session(run), _progress(progress, trials, "trials") as bar:  # the bar once Ray is up
-
-            def on_trial(trial: Any) -> None:
-                if trial.row.get("amota") is not None:
-                    seen.append(trial.row["amota"])
-                bar.update(bar.task_ids[0], advance=1, description=_best_label("trials", max(seen, default=None)))
-
-            result = run_tune(tracker, data, base, dims, trials, seed, run, on_trial)
-        final = result.final_row
-        header = _provenance(tracker, data, dims, trials, seed, run, result, params)
-        write_params(target, config_toml(base, result.best), header)
-        _print_tune(stdout_console(), result, class_names, dims)
-        typer.echo(
-            f"tune: {len(result.trials)} trials on {data.split}, combined AMOTA {_metric(final['amota'])} -> {out}"
-        )
-        if result.interrupted:
-            announce_stop("wrote the best of the finished trials")
-            raise typer.Exit(130)
-
-
-def _provenance(
-    tracker: str,
-    data: "StudyData",
-    dims: "list[SearchDim]",
-    trials: int,
-    seed: int,
-    run: "Execution",
-    result: "TuneResult",
-    params: Path | None,
-) -> list[str]:
-    """Comment header of a tuned parameter file: search space, trials, data, versions, scores."""
-    from gnnpmb.provenance import code_version, package_versions
-    from gnnpmb.study.evaluate import class_column
-    from gnnpmb.types import TRACKING_CLASSES
-
-    versions = package_versions(("gnnpmb-viz", "nuscenes-devkit", "ray", "optuna", "numpy"))
-    detections = f"file {data.detections}" if data.detections else f"simulated preset {data.detector}, seed {seed}"
-    where = "in process" if not run.uses_ray else f"Ray Tune, {run.workers or 'all cluster CPUs'} concurrent"
-    per_class = ", ".join(f"{c} {_metric(result.final_row[class_column(c)])}" for c in TRACKING_CLASSES)
-    return [
-        f"gnnpmb tune: per-class parameters for tracker {tracker}; pass this file with --params",
-        "search space: " + "; ".join(d.describe() for d in dims),
-        f"trials: {len(result.trials)} of {trials} (Optuna TPE sampler, seed {seed}, {where})",
-        "choice: per class, the values of the trial with that class's highest AMOTA",
-        f"data: {data.location.dataroot} {data.location.version}, split {data.split} "
-        f"({', '.join(data.scene_names)}); detections: {detections}",
-        f"base parameters: {params or 'paper defaults'}",
-        f"combined on {data.split}: AMOTA {_metric(result.final_row['amota'])}; per class: {per_class}",
-        "versions: " + ", ".join(f"{k} {v}" for k, v in versions.items()) + f"; code {code_version()[:12]}",
-        "score it on held-out data: gnnpmb track --params THIS.toml ... then gnnpmb eval",
-    ]
-
-
-def _print_tune(console: Console, result: "TuneResult", class_names: tuple[str, ...], dims: "list[SearchDim]") -> None:
-    """Per class: the best AMOTA seen in a trial, the combined evaluation's AMOTA, and the chosen values."""
-    from gnnpmb.study.evaluate import class_column
-    from gnnpmb.study.tune import class_of
-
-    chosen = dict(result.best)
-    table = Table(title="best per class")
-    for name in ("class", "best trial AMOTA", "combined AMOTA", "values"):
-        table.add_column(name, justify="left" if name in ("class", "values") else "right")
-    for c in class_names:
-        column = class_column(c)
-        scores = [t.row[column] for t in result.trials if t.row.get(column) is not None]
-        values = ", ".join(f"{d.key.split('.', 1)[1]}={chosen[d.key]:.4g}" for d in dims if class_of(d.key) == c)
-        table.add_row(c, _metric(max(scores, default=None)), _metric(result.final_row[column]), values or "-")
-    console.print(table)

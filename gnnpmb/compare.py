@@ -1,7 +1,7 @@
 """Where two or more trackers disagree, frame by frame, judged against the ground truth.
 
-The estimates compared are the tracks each tracker shows (``gnnpmb.session.compare_runs``: existence at least the
-viewer's show floor), so the lines say "shown". Per tracker and keyframe, the estimates are matched to the
+The estimates compared are the tracks each tracker shows (``gnnpmb.stages.findings.compare_runs``: existence at
+least the viewer's show floor), so the lines say "shown". Per tracker and keyframe, the estimates are matched to the
 ground-truth boxes with the nuScenes tracking criterion: BEV centre distance below ``MATCH_DISTANCE_M`` (2 m,
 ``dist_th_tp`` of ``tracking_nips_2019``), same class, one-to-one, the pairing found by the Hungarian method (most
 pairs, then least summed distance).

@@ -325,3 +325,30 @@ def code_version() -> str:
             digest.update(str(path.relative_to(root)).encode() + b"\0" + path.read_bytes() + b"\0")
     digest.update(json.dumps(package_versions(("nuscenes-devkit", "motmetrics", "numpy")), sort_keys=True).encode())
     return digest.hexdigest()
+
+
+def digest_report(recorded: dict[str, TrackDigest], now: dict[str, TrackDigest]) -> tuple[list[str], bool]:
+    """One line per tracker ("identical" or its first differing keyframe) and whether all are identical."""
+    lines, same = [], True
+    for tracker, digest in now.items():
+        before = recorded.get(tracker)
+        if before is None:
+            lines.append(f"{tracker}: no recorded track digest to compare with")
+            same = False
+            continue
+        first = before.first_difference(digest)
+        if first is None:
+            lines.append(f"{tracker}: identical ({len(digest.frames)} frames)")
+        else:
+            lines.append(
+                f"{tracker}: DIFFERENT from keyframe {first} on "
+                f"({before.differing_frames(digest)} of {len(digest.frames)} frames differ)"
+            )
+            same = False
+    return lines, same
+
+
+def version_notes(recorded: dict[str, str]) -> list[str]:
+    """A note for each package whose version differs from the recorded one."""
+    now = package_versions(tuple(recorded))
+    return [f"note: recorded with {k} {v}, now {now[k]}" for k, v in recorded.items() if now.get(k) != v]

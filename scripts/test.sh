@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's test command: installs what the suite needs (uv; Chromium for the browser check when running as
-# root with apt-get), checks lint and formatting (ruff), then runs pytest. Extra arguments go to pytest.
+# root with apt-get), checks lint and formatting (ruff), then runs pytest on every core (pytest-xdist; a module's
+# tests stay on one worker so its shared runs are made once). Extra arguments go to pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if command -v uv >/dev/null 2>&1; then
@@ -20,4 +21,4 @@ if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
 fi
 "${UV[@]}" run ruff check .
 "${UV[@]}" run ruff format --check .
-exec "${UV[@]}" run pytest "$@"
+exec "${UV[@]}" run pytest -n auto --dist loadscope "$@"

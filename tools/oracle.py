@@ -632,7 +632,7 @@ def sources(request, tracker: str, evidence: Mapping[str, Any], events: Sequence
     from gnnpmb.eval.nuscenes_eval import tracking_config
     from gnnpmb.eval.submission import run_results
     from gnnpmb.registry import tracker_keeps_detection_box
-    from gnnpmb.session import track_run
+    from gnnpmb.stages.runs import track_run
 
     run = evidence[tracker].run
     spec = request.spec(tracker)
@@ -686,21 +686,18 @@ def file_results(path, scene, classes: Sequence[str]) -> dict[str, list[dict[str
 def run_one(request, tracker: str, others: Sequence[str] = ()) -> tuple[Verdict, int]:
     """Check every finding of ``tracker`` (a run of ``request``: a tracker or a results file) on ``request``'s scene;
     returns the verdict and the number of findings."""
-    from gnnpmb.events import TeeSink
-    from gnnpmb.focus import FRAMES_BEFORE, resolve_focus
-    from gnnpmb.session import evidence_of, fact_sink, find_reports, track_run
+    from gnnpmb.focus import resolve_focus
+    from gnnpmb.stages.evaluation import find_reports
+    from gnnpmb.stages.findings import all_evidence
+    from gnnpmb.stages.runs import run_all
+    from gnnpmb.why.findings import FRAMES_BEFORE
     from gnnpmb.why.reason import explain_failure
     from viz.focus_summary import focus_markdown
 
-    raw, evidence = {}, {}
-    for name in (tracker, *others):
-        sink, listed = fact_sink(request, name), ListSink()
-        run = track_run(request, name, TeeSink(sink, listed))
-        raw[name] = (run, listed.events, sink.facts)
-    reports, _ = find_reports(request, [r for r, _, _ in raw.values()])
-    for name, (run, _, facts) in raw.items():
-        evidence[name] = evidence_of(request, reports[name], facts, run)
-    src = sources(request, tracker, evidence, raw[tracker][1])
+    runs = [r for r in run_all(request, record=True) if r.name in (tracker, *others)]
+    reports, _ = find_reports(request, runs)
+    evidence = all_evidence(request, runs, reports)
+    src = sources(request, tracker, evidence, next(r for r in runs if r.name == tracker).events)
     verdict = Verdict()
     report = reports[tracker]
     rest = [evidence[t] for t in others]
@@ -736,7 +733,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     from gnnpmb.data.demo_staged import STAGED_SCENES
     from gnnpmb.data.simdet_presets import PRESETS
     from gnnpmb.registry import TRACKER_NAMES
-    from gnnpmb.session import prepare
+    from gnnpmb.stages.inputs import load_inputs
+    from gnnpmb.stages.request import check_request
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", action="append", help="demo scenes (default: all)")
@@ -767,7 +765,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             for t in args.tracker or TRACKER_NAMES
         ]
     for scene, detector, trackers, results in jobs:
-        request = prepare(scene, trackers, results=results, detector=detector)
+        request = load_inputs(check_request(scene, trackers, results=results, detector=detector))
         name = request.trackers[0]
         verdict, n = run_one(request, name)
         t = totals[name]

@@ -61,11 +61,6 @@ def failures_root(tracker: str) -> str:
     return f"{paths.tracker_root(tracker)}/failures"
 
 
-def failure_index_doc(tracker: str) -> str:
-    """TextDocument: a run's failures with their ``--focus`` ids (``viz.opening``; static)."""
-    return f"{paths.tracker_root(tracker)}/failure_index"
-
-
 def focus_doc() -> str:
     """TextDocument describing the focused failure (static)."""
     return "focus/summary"
@@ -313,7 +308,11 @@ def tracker_panel(
             rrb.TextDocumentView(origin=reading_guide_doc(), name="how to read the views"),
         )
         return rrb.Vertical(summary, logs, series, row_shares=[6, 3, 3], name=tracker)
-    top = [rrb.TextDocumentView(origin=failure_index_doc(tracker), name=f"{tracker} failures")] if failure_index else []
+    top = (
+        [rrb.TextDocumentView(origin=paths.failure_index_doc(tracker), name=f"{tracker} failures")]
+        if failure_index
+        else []
+    )
     top += [decision_views(tracker)] if caps.has_costs else []
     if not top:
         return rrb.Vertical(logs, series, row_shares=[3, 2], name=tracker)

@@ -31,7 +31,7 @@ KIND_COLORS: dict[DisagreementKind, tuple[int, int, int]] = {
     DisagreementKind.ID_CHANGE: (170, 80, 255),
     DisagreementKind.ONLY_IN_ONE: (255, 120, 200),
 }
-"""Colours apart from the class colours and from the failure markers' (``viz.failures.KIND_COLORS``)."""
+"""Colours apart from the class colours and from the failure markers' (``viz.failure_style.KIND_COLORS``)."""
 KIND_LABELS: dict[DisagreementKind, str] = {
     DisagreementKind.MISSED_BY_ONE: "tracked by one only",
     DisagreementKind.ID_CHANGE: "id changed in one only",

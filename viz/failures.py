@@ -18,41 +18,12 @@ import rerun as rr
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import Failure, FailureBox, FailureKind, FailureReport, short_id
 from viz import paths
+from viz.failure_style import KIND_COLORS, KIND_LABELS, KIND_LEVELS
 from viz.markers import send_counts, send_marker_boxes, send_text_lines
 from viz.timeline import PLAIN_CLOCK, Clock
 
 if TYPE_CHECKING:
     from viz.opening import LabelNotes
-
-KIND_COLORS: dict[FailureKind, tuple[int, int, int]] = {
-    FailureKind.ID_SWITCH: (255, 0, 255),
-    FailureKind.FRAGMENTATION: (255, 160, 0),
-    FailureKind.FALSE_TRACK: (255, 0, 0),
-    FailureKind.MISS: (150, 150, 150),
-    FailureKind.COALESCENCE: (0, 255, 140),
-    FailureKind.IDENTITY_THEFT: (255, 255, 0),
-}
-"""One colour per failure kind, outside the hues tracks may take (``viz.colors.TRACK_HUE_BANDS``); "miss", the
-most frequent kind, is a mid grey that shows on the dark and the light theme alike."""
-
-KIND_LABELS: dict[FailureKind, str] = {
-    FailureKind.ID_SWITCH: "ID switch",
-    FailureKind.FRAGMENTATION: "fragmentation",
-    FailureKind.FALSE_TRACK: "false track",
-    FailureKind.MISS: "miss",
-    FailureKind.COALESCENCE: "coalescence",
-    FailureKind.IDENTITY_THEFT: "identity theft",
-}
-
-KIND_LEVELS: dict[FailureKind, str] = {
-    FailureKind.ID_SWITCH: "WARN",
-    FailureKind.FRAGMENTATION: "WARN",
-    FailureKind.FALSE_TRACK: "INFO",
-    FailureKind.MISS: "INFO",
-    FailureKind.COALESCENCE: "WARN",
-    FailureKind.IDENTITY_THEFT: "ERROR",
-}
-"""TextLog levels: the paper's failure patterns stand out, plain misses and false tracks stay quiet."""
 
 MARKER_SCALE = 1.1
 MARKER_MARGIN_M = 0.3

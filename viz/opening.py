@@ -2,7 +2,7 @@
 box.
 
 * the **opening**: the first failure worth a look of the first run (``FailureReport.first_worth_opening``, found
-  before anything is logged, ``gnnpmb.session.resolve_opening``); the recording opens at its frame (its ``focus``
+  before anything is logged, ``gnnpmb.stages.findings.opening_focus``); the recording opens at its frame (its ``focus``
   timeline ends there, ``viz.timeline.Clock``) and its per-track plots show the tracks around it
   (``viz.blueprint``);
 * ``trackers/<run>/failure_index`` (static TextDocument, ``log_failure_index``): every failure with its ``--focus``
@@ -30,9 +30,8 @@ from gnnpmb.types import TrackEstimate
 from gnnpmb.why.facts import TrackerFacts
 from gnnpmb.why.words import SHOW_MIN_EXISTENCE, frames_text
 from viz import paths
-from viz.blueprint import failure_index_doc
 from viz.colors import faded, packed_track_colors
-from viz.failures import KIND_LABELS
+from viz.failure_style import KIND_COLORS, KIND_LABELS
 from viz.geometry import estimate_boxes
 from viz.timeline import FOCUS, FRAME, Clock
 
@@ -166,7 +165,7 @@ def log_failure_index(
     the recording opens at (of the first run; ``first_run``: whether this is it, so its ids open with ``--focus``
     as they are)."""
     stream.log(
-        failure_index_doc(tracker),
+        paths.failure_index_doc(tracker),
         rr.TextDocument(index_markdown(tracker, report, opening, first_run, frames), media_type="text/markdown"),
         static=True,
     )
@@ -347,8 +346,6 @@ def log_failure_timeline(
     more), the frame numbers below, the failure the recording opens at boxed, and a cursor at the current frame
     (the only part that moves with time). A time series would show only the frames of the timeline it is on, and
     the one a full recording opens on ends at its opening failure."""
-    from viz.failures import KIND_COLORS
-
     root = failure_timeline(tracker)
     kinds = timeline_rows(report, frames)
     xs, ys, colors, radii = [], [], [], []

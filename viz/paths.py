@@ -100,6 +100,11 @@ def tracker_root(tracker: str) -> str:
     return f"{TRACKERS}/{_name(tracker)}"
 
 
+def failure_index_doc(tracker: str) -> str:
+    """TextDocument: a run's failures with their ``--focus`` ids (``viz.opening``; static)."""
+    return f"{tracker_root(tracker)}/failure_index"
+
+
 def decisions(tracker: str) -> str:
     """TextDocument: the frame's conflicts per class, chosen pairs, best alternatives and margins."""
     return f"{tracker_root(tracker)}/decisions"

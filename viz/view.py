@@ -1,41 +1,101 @@
-"""One ``gnnpmb-viz`` recording: the scene, every tracker's events drawn, their comparison, failures and focus.
+"""Stage 6, the recording: the scene, every run's events drawn, their comparison, failures and focus.
 
-``run_view`` is what ``gnnpmb-viz`` runs after ``gnnpmb.session.prepare`` checked the request. Each tracker's
-events go through a ``TeeSink`` to its facts (``gnnpmb.why.facts.FactSink``) and then to its logger, which draws
-from those facts; a focus recording then explains its failure from them (``gnnpmb.why.reason``).
+``run_view`` takes the loaded inputs (``gnnpmb.stages.inputs``), runs every tracker once with its events recorded
+(``gnnpmb.stages.runs``), finds their failures (``stages.evaluation``), the focus or the opening failure and the
+comparison (``stages.findings``), and only then opens the recording: each run's recorded events are replayed into
+its logger, which draws from the run's facts (``gnnpmb.why.facts``); a focus recording explains its failure.
 """
 
 from __future__ import annotations
 
-from gnnpmb.session import (
-    ProgressBar,
-    SilentProgress,
-    ViewRequest,
-    ViewResult,
+from dataclasses import dataclass, field
+from types import TracebackType
+from typing import TYPE_CHECKING, Any, Protocol
+
+from gnnpmb.stages.evaluation import find_reports
+from gnnpmb.stages.findings import (
+    all_evidence,
     compare_runs,
-    evidence_of,
-    fact_sink,
-    provenance_of,
-    recording_name,
-    resolve_opening,
-    resolve_request_focus,
-    run_digest,
-    track_run,
+    explain_focus,
+    opening_focus,
+    request_focus,
 )
+from gnnpmb.stages.inputs import Inputs
+from gnnpmb.stages.runs import provenance_of, run_all, run_digests
 from viz.opening import timeline_rows
 
+if TYPE_CHECKING:
+    from gnnpmb.compare import Comparison
+    from gnnpmb.eval.failures import FailureReport
+    from gnnpmb.focus import FocusTarget
+    from gnnpmb.provenance import TrackDigest
 
-def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failures: bool = True) -> ViewResult:
-    """Log the scene, run every tracker into one recording (sharing the preprocessed detections), compare them
-    and log failures and provenance. With ``request.focus`` the trackers first run without logging to find the
-    focus (``resolve_request_focus``); the recording then holds the keyframes around it, opens on it and explains
-    it (``focus/summary``). ``progress``: a progress display (e.g. a rich ``Progress``; none by default)."""
+
+class ProgressBar(Protocol):
+    """What ``run_view`` needs of a progress display (a rich ``Progress`` has it): a context manager with
+    tasks that advance."""
+
+    def __enter__(self) -> Any: ...
+
+    def __exit__(
+        self, kind: type[BaseException] | None, value: BaseException | None, traceback: TracebackType | None
+    ) -> Any: ...
+
+    def add_task(self, description: str, total: float | None = ...) -> Any: ...
+
+    def advance(self, task_id: Any, advance: float = ...) -> None: ...
+
+
+class SilentProgress:
+    """A progress display that shows nothing."""
+
+    def __enter__(self) -> SilentProgress:
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, value: BaseException | None, traceback: TracebackType | None
+    ) -> None:
+        return None
+
+    def add_task(self, description: str, total: float | None = None) -> int:
+        return 0
+
+    def advance(self, task_id: Any, advance: float = 1) -> None:
+        return None
+
+
+@dataclass(frozen=True, slots=True)
+class ViewResult:
+    """What ``run_view`` did: mean tracker ms per frame and track digest per tracker, the comparison (None
+    with one tracker), notices for the user (e.g. failures skipped), the focus and each tracker's failures
+    (empty when not looked for)."""
+
+    ms_per_frame: dict[str, float]
+    digests: dict[str, TrackDigest]
+    comparison: Comparison | None
+    notices: tuple[str, ...]
+    focus: FocusTarget | None = None
+    reports: dict[str, FailureReport] = field(default_factory=dict)
+
+
+def recording_name(inputs: Inputs, focus: FocusTarget | None = None) -> str:
+    """E.g. "scene-0103 · gnnpmb vs pmbm · synthetic demo", with "· focus id_switch:1" for a focus."""
+    data = "synthetic demo" if inputs.scene.synthetic else f"nuScenes {inputs.location.version}"
+    name = f"{inputs.scene.name} · {' vs '.join(inputs.trackers)} · {data}"
+    if focus is not None:
+        name += f" · focus {focus.failure_id or inputs.focus}"
+    return name
+
+
+def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: bool = True) -> ViewResult:
+    """Run every tracker once with its events recorded, find the failures (with ``failures``, or for a focus), the
+    focus or the opening failure and the comparison, then log the scene, replay each run's events into its logger
+    and log failures and provenance. With ``inputs.focus`` the recording holds the keyframes around the focus,
+    opens on it and explains it (``focus/summary``). ``progress``: a progress display (e.g. a rich ``Progress``;
+    none by default)."""
     import numpy as np
 
     from gnnpmb.data.nuscenes import load_lidar_points
-    from gnnpmb.events import TeeSink
-    from gnnpmb.pipeline import TrackingRun
-    from gnnpmb.why.reason import explain_failure
     from viz.blueprint import default_blueprint
     from viz.compare import log_comparison
     from viz.failures import log_failures
@@ -54,123 +114,115 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
     from viz.scene import log_scene
     from viz.timeline import PLAIN_CLOCK, Clock
 
-    scene, frame_range = request.scene, request.frame_range
-    focus, opening, reports, notices = None, None, {}, []
-    # The logged runs below give the same tracks (deterministic): the reports found first are reused.
-    if request.focus is not None:
-        focus, reports, notices = resolve_request_focus(request)
-    elif failures:  # a full recording opens at its first failure worth a look (viz.opening)
-        opening, reports, notices = resolve_opening(request)
-    shown = focus.window(frame_range) if focus is not None else frame_range
-    start = focus or opening
-    clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
-    n = len(shown)
-    # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
-    caps = {t: request.capabilities(t) for t in request.trackers}
-    blueprint = None
-    if focus is None:
-        blueprint = default_blueprint(
-            request.trackers,
-            request.classes,
-            caps=caps,
-            opening=opening,
-            failure_index=bool(reports),
-            frames=shown,
-            timeline_rows={t: len(timeline_rows(r, shown)) for t, r in reports.items()},
-        )
+    scene, frame_range = inputs.scene, inputs.frame_range
     bar = progress if progress is not None else SilentProgress()
-    runs: list[TrackingRun] = []
-    loggers: dict[str, TrackerLogger] = {}
-    facts = {}
-    comparison = None
-    if request.serve is not None:
-        from viz.serving import serving
+    with bar:
+        tasks = {t: bar.add_task(f"{scene.name} {t}", total=len(frame_range)) for t in inputs.trackers}
+        runs = run_all(inputs, record=True, on_frame=lambda t: lambda: bar.advance(tasks[t]))
+        focus, opening, reports, notices = None, None, {}, []
+        if inputs.focus is not None:
+            reports, notices = find_reports(inputs, runs)
+            focus = request_focus(inputs, runs, reports, notices)
+        elif failures:  # a full recording opens at its first failure worth a look (viz.opening)
+            reports, notices = find_reports(inputs, runs)
+            opening = opening_focus(inputs, runs, reports)
+        shown = focus.window(frame_range) if focus is not None else frame_range
+        start = focus or opening
+        clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
+        # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
+        caps = {t: inputs.capabilities(t) for t in inputs.trackers}
+        blueprint = None
+        if focus is None:
+            blueprint = default_blueprint(
+                inputs.trackers,
+                inputs.classes,
+                caps=caps,
+                opening=opening,
+                failure_index=bool(reports),
+                frames=shown,
+                timeline_rows={t: len(timeline_rows(r, shown)) for t, r in reports.items()},
+            )
+        loggers: dict[str, TrackerLogger] = {}
+        comparison = None
+        if inputs.serve is not None:
+            from viz.serving import serving
 
-        opened = serving(recording_name(request, focus), request.serve, blueprint)
-    else:
-        opened = recording(recording_name(request, focus), request.save, blueprint)
-    with opened as stream, bar:
-        sensors = bar.add_task(f"{scene.name} sensors", total=n)
-        log_scene(
-            stream,
-            scene,
-            [request.frame_detections[i] for i in shown],
-            shown,
-            points_loader=load_lidar_points,
-            on_frame=lambda: bar.advance(sensors),
-            clock=clock,
-        )
-        for tracker in request.trackers:
-            task = bar.add_task(f"{scene.name} {tracker}", total=len(frame_range))
-            sink = fact_sink(request, tracker)
-            facts[tracker] = sink.facts
-            logger = loggers[tracker] = TrackerLogger(
+            opened = serving(recording_name(inputs, focus), inputs.serve, blueprint)
+        else:
+            opened = recording(recording_name(inputs, focus), inputs.save, blueprint)
+        with opened as stream:
+            sensors = bar.add_task(f"{scene.name} sensors", total=len(shown))
+            log_scene(
                 stream,
-                tracker,
-                gate_z_m=scene.ground_z_m,
-                clock=clock,
-                log_frames=shown if focus is not None else None,
-                focus_tracks=set(focus.track_ids.get(tracker, ())) if focus is not None else None,
-                flush_frames=None if request.save is not None else FLUSH_FRAMES,
-                has_existence=caps[tracker].has_existence,
-                focus_class=focus.class_name if focus is not None else None,
-                facts=sink.facts,
-            )
-            runs.append(track_run(request, tracker, TeeSink(sink, logger), lambda task=task: bar.advance(task)))
-            logger.finish()
-        notes = None
-        if focus is None and reports:  # a full recording: one label per box, the lost tracks drawn (viz.opening)
-            ghosts = {run.tracker: lost_ghosts(reports[run.tracker], run, facts[run.tracker], shown) for run in runs}
-            notes = LabelNotes({run.tracker: drawn_tracks(run) for run in runs}, ghosts)
-        if len(runs) > 1:
-            comparison = compare_runs(runs)
-            log_comparison(
-                stream,
-                comparison.within(shown),
                 scene,
-                clock,
-                show_labels=focus is None,
-                focus_class=focus.class_name if focus is not None else None,
-                notes=notes,
+                [inputs.frame_detections[i] for i in shown],
+                shown,
+                points_loader=load_lidar_points,
+                on_frame=lambda: bar.advance(sensors),
+                clock=clock,
             )
-        if failures or focus is not None:
-            for k, (name, report) in enumerate(reports.items()):
-                log_failures(
+            for run in runs:
+                logger = loggers[run.name] = TrackerLogger(
                     stream,
-                    name,
-                    report,
+                    run.name,
+                    gate_z_m=scene.ground_z_m,
+                    clock=clock,
+                    log_frames=shown if focus is not None else None,
+                    focus_tracks=set(focus.track_ids.get(run.name, ())) if focus is not None else None,
+                    flush_frames=None if inputs.save is not None else FLUSH_FRAMES,
+                    has_existence=caps[run.name].has_existence,
+                    focus_class=focus.class_name if focus is not None else None,
+                    facts=run.facts,
+                )
+                run.replay(logger)
+                logger.finish()
+            notes = None
+            if focus is None and reports:  # a full recording: one label per box, the lost tracks drawn (viz.opening)
+                ghosts = {run.name: lost_ghosts(reports[run.name], run.tracking, run.facts, shown) for run in runs}
+                notes = LabelNotes({run.name: drawn_tracks(run.tracking) for run in runs}, ghosts)
+            if len(runs) > 1:
+                comparison = compare_runs(runs)
+                log_comparison(
+                    stream,
+                    comparison.within(shown),
                     scene,
-                    shown,
                     clock,
                     show_labels=focus is None,
-                    involved=focus.object_ids(name) if focus is not None else None,
-                    focus_kind=focus.failure_kind if focus is not None else None,
+                    focus_class=focus.class_name if focus is not None else None,
                     notes=notes,
                 )
-                if notes is not None:
-                    opened = opening.failure_id if opening is not None else None
-                    log_failure_index(stream, name, report, opened, k == 0, shown)
-                    log_lost_tracks(stream, name, ghosts[name], notes, scene, clock, shown)
-                    log_failure_timeline(stream, name, report, scene, clock, shown, opened if k == 0 else None)
-        if notes is not None:
-            notes.send(stream, clock, scene)
-        if focus is not None:
-            evidence = {
-                run.tracker: evidence_of(request, reports[run.tracker], facts[run.tracker], run) for run in runs
-            }
-            finding = None
-            if focus.failure_id is not None and focus.failure_tracker in evidence:
-                owner = evidence[focus.failure_tracker]
-                others = [ev for t, ev in evidence.items() if t != focus.failure_tracker]
-                finding = explain_failure(focus.failure_id, owner, scene, others, first_frame=shown.start)
-            log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding)
-            legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
-            stream.send_blueprint(
-                default_blueprint(request.trackers, request.classes, focus, legends, caps),
-                make_active=True,
-                make_default=True,
-            )
-        digests = {run.tracker: run_digest(run) for run in runs}
-        log_provenance(stream, provenance_of(request, digests))
-    ms = {run.tracker: 1000.0 * float(np.mean([f.step_time_s for f in run.frames])) for run in runs}
-    return ViewResult(ms, digests, comparison, (*request.notices, *notices), focus, reports)
+            if failures or focus is not None:
+                for k, (name, report) in enumerate(reports.items()):
+                    log_failures(
+                        stream,
+                        name,
+                        report,
+                        scene,
+                        shown,
+                        clock,
+                        show_labels=focus is None,
+                        involved=focus.object_ids(name) if focus is not None else None,
+                        focus_kind=focus.failure_kind if focus is not None else None,
+                        notes=notes,
+                    )
+                    if notes is not None:
+                        opened_id = opening.failure_id if opening is not None else None
+                        log_failure_index(stream, name, report, opened_id, k == 0, shown)
+                        log_lost_tracks(stream, name, ghosts[name], notes, scene, clock, shown)
+                        log_failure_timeline(stream, name, report, scene, clock, shown, opened_id if k == 0 else None)
+            if notes is not None:
+                notes.send(stream, clock, scene)
+            if focus is not None:
+                evidence = all_evidence(inputs, runs, reports)
+                finding = explain_focus(inputs, focus, evidence, first_frame=shown.start)
+                log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding)
+                legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
+                stream.send_blueprint(
+                    default_blueprint(inputs.trackers, inputs.classes, focus, legends, caps),
+                    make_active=True,
+                    make_default=True,
+                )
+            digests = run_digests(runs)
+            log_provenance(stream, provenance_of(inputs, digests))
+    ms = {run.name: 1000.0 * float(np.mean([f.step_time_s for f in run.tracking.frames])) for run in runs}
+    return ViewResult(ms, digests, comparison, (*inputs.notices, *notices), focus, reports)

@@ -1,6 +1,6 @@
-"""Tracking a split, in this process or as Ray tasks: the one entry point of ``gnnpmb track`` (``track_to_file``)
-and of the per-scene step of ``gnnpmb failures`` (``scene_failures``); ``sweep`` and ``tune`` track through the
-same ``gnnpmb.study.data`` steps.
+"""Tracking a split, in this process or as Ray tasks: the one entry point of ``gnnpmb track`` (``track_to_file``);
+``sweep`` and ``tune`` track through the same ``gnnpmb.study.data`` steps. (One scene's failures go through the
+stages of ``gnnpmb.stages``.)
 
 In this process each scene is read from the indexes and tracked in turn. On Ray this process reads each scene's
 inputs (the scene and its detections, from the indexes) and sends them with the task, a few consecutive scenes
@@ -17,14 +17,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.study.data import SceneInputs, SceneRun, StudyData, load_inputs, run_inputs, track_inputs
+from gnnpmb.study.data import SceneInputs, SceneRun, StudyData, load_inputs, track_inputs
 from gnnpmb.study.runner import Execution, run_tasks, session
 
 if TYPE_CHECKING:
-    from gnnpmb.data.nuscenes import DatasetLocation
-    from gnnpmb.eval.failures import FailureReport
-    from gnnpmb.events import EventSink
-    from gnnpmb.pipeline import TrackingRun
+    pass
 
 IN_PROCESS = Execution(workers=1)
 TASKS_PER_WORKER = 4
@@ -108,37 +105,3 @@ def track_to_file(
     boxes = sum(len(b) for r in runs for b in r.results.values())
     step_s = sum(r.step_time_s for r in runs)
     return TrackSummary(len(runs), frames, boxes, 1e3 * step_s / max(frames, 1))
-
-
-@dataclass(frozen=True, slots=True)
-class SceneFailures:
-    """One scene tracked (the run, with its scene) and its failure report."""
-
-    run: TrackingRun
-    report: FailureReport
-
-
-def scene_failures(
-    location: DatasetLocation,
-    scene_name: str,
-    tracker: str,
-    config: TrackerConfig,
-    detections: Path | None,
-    detector: str,
-    seed: int,
-    sink: EventSink | None = None,
-    bounds: tuple[int | None, int | None] = (None, None),
-) -> SceneFailures:
-    """Track one scene (its events to ``sink``; ``bounds``: only those keyframes, as ``--frames`` gives them) and
-    find its failures (``gnnpmb failures``) in the keyframes tracked, the report stored for the next time."""
-    from gnnpmb.eval.failure_cache import scene_report
-    from gnnpmb.eval.submission import run_results
-    from gnnpmb.session import evaluated_keyframes, frame_range_of
-    from gnnpmb.study.data import scene_study
-
-    data = scene_study(location, scene_name, detections, detector, seed)
-    inputs = load_inputs(data, scene_name)
-    frames = frame_range_of(bounds, inputs.scene)
-    run = run_inputs(inputs, tracker, config, detector, seed, sink=sink, frame_range=frames)
-    keyframes = evaluated_keyframes(frames, inputs.scene)
-    return SceneFailures(run, scene_report(location, scene_name, tracker, run_results(run), keyframes))

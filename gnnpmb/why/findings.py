@@ -49,6 +49,8 @@ NEAR_M = 2.0
 (``tracking_nips_2019`` dist_th_tp), which ``reason`` reads from the devkit config and checks against this."""
 EVALUATED_OFFSET_M = 0.5
 """An interpolated box this far or farther from the annotation makes a failure the evaluation's doing."""
+FRAMES_BEFORE = 8
+"""A finding looks back this many keyframes before its failure (and a focus recording starts there)."""
 
 
 class Party(enum.Enum):

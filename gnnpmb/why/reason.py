@@ -18,13 +18,13 @@ from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.evaluated import GtStatus
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport
 from gnnpmb.events import AxisKind
-from gnnpmb.focus import FRAMES_BEFORE
 from gnnpmb.foreign import BoxOn
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.facts import TrackerFacts, UseMode
 from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
+    FRAMES_BEFORE,
     NEAR_M,
     Blame,
     Deciding,

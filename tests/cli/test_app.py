@@ -18,8 +18,11 @@ from gnnpmb.errors import DataError, GnnpmbError, UnknownNameError
 from gnnpmb.pipeline import run_tracker
 from gnnpmb.provenance import PACKAGES
 from gnnpmb.registry import TRACKER_NAMES
-from gnnpmb.session import find_reports, parse_classes, parse_frames, prepare, rerun_runs
+from gnnpmb.stages.evaluation import find_reports
+from gnnpmb.stages.request import parse_classes, parse_frames
+from gnnpmb.stages.runs import Run
 from tests.inprocess import run_main
+from tests.pipeline import prepare, reports_of
 from tests.viz.rrd import at_frame, read_rows
 from viz import paths
 from viz.provenance import PROPERTY_ENTITY, read_provenance
@@ -57,7 +60,7 @@ def test_summary_line_and_where_to_look_next(full_run: tuple[Path, str], demo_da
     assert sorted(p.name for p in out.parent.iterdir()) == ["x.rrd"]
     # The failures found, and the id of the one to open first with --focus (the same ids `gnnpmb failures` prints).
     request = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot)
-    report = find_reports(request, rerun_runs(request))[0]["gnnpmb"]
+    report = reports_of(request)[0]["gnnpmb"]
     first = report.first_worth_opening()
     assert first is not None and report.by_id(first) is not None
     (hint,) = hints
@@ -298,7 +301,7 @@ def test_failures_are_skipped_with_a_notice_without_ground_truth(
         raise DataError(f"scene {SCENE} is in no nuScenes split, so the devkit cannot evaluate it")
 
     monkeypatch.setattr(failures, "find_failures", not_in_a_split)
-    runs = [run_tracker(request.scene, request.detections, "gnn", request.config, frame_range=request.frame_range)]
+    runs = [Run(run_tracker(request.scene, request.detections, "gnn", request.config, frame_range=request.frame_range))]
     reports, notices = find_reports(request, runs, lambda: calls.append(None))
     assert reports == {}
     assert notices == [

@@ -19,9 +19,11 @@ from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import Keyframe, Pose, SceneData
 from gnnpmb.pipeline import run_tracker
 from gnnpmb.provenance import Provenance, TrackDigest
-from gnnpmb.session import compare_runs, prepare
+from gnnpmb.stages.findings import compare_runs
+from gnnpmb.stages.runs import Run
 from tests.gnnpmb.test_compare import A_FRAMES, B_FRAMES, GT
 from tests.inprocess import run_main
+from tests.pipeline import prepare
 from tests.viz.rrd import at_frame, read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
@@ -59,12 +61,14 @@ def expected(demo_dataroot: Path) -> Comparison:
     """The comparison computed apart from the recording (same inputs, trackers without a sink)."""
     request = prepare(SCENE, TRACKERS, dataroot=demo_dataroot)
     runs = [
-        run_tracker(
-            request.scene,
-            request.frame_detections,
-            t,
-            request.config,
-            classes=request.classes,
+        Run(
+            run_tracker(
+                request.scene,
+                request.frame_detections,
+                t,
+                request.config,
+                classes=request.classes,
+            )
         )
         for t in TRACKERS
     ]

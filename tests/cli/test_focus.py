@@ -15,10 +15,13 @@ from rerun.chunk import RrdReader
 
 from cli.app import main
 from gnnpmb.eval.failures import FailureKind, short_id
-from gnnpmb.session import explain_all, find_reports, gather_evidence, prepare, rerun_runs
+from gnnpmb.stages.evaluation import find_reports
+from gnnpmb.stages.findings import explain_all
+from gnnpmb.stages.runs import run_all
 from gnnpmb.why.facts import Ending
 from gnnpmb.why.findings import Party, Rule
 from gnnpmb.why.words import column_name, whose_text, why_lines
+from tests.pipeline import evidence_of_all, prepare
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
@@ -36,9 +39,9 @@ ARGS = ["--detector", "pointpillars"]
 def failures_and_runs(demo_dataroot: Path):
     """The first tracker's failures on the scene (the ids ``gnnpmb failures`` prints) and the runs."""
     request = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars")
-    runs = rerun_runs(request)
+    runs = run_all(request, record=False)
     reports, _ = find_reports(request, runs)
-    return reports["gnnpmb"], runs
+    return reports["gnnpmb"], [run.tracking for run in runs]
 
 
 def blueprint_rows(path: Path) -> list[tuple[str, dict]]:
@@ -220,7 +223,7 @@ def test_the_summary_opens_with_the_decisions_that_made_the_switch(
 def findings_of(demo_dataroot: Path, trackers: tuple[str, ...], detector: str = "pointpillars") -> dict:
     """Per tracker, failure id -> its ``Finding`` (the data every sentence of the focus document is made from)."""
     request = prepare(SCENE, list(trackers), dataroot=demo_dataroot, detector=detector)
-    evidence, _ = gather_evidence(request)
+    evidence, _, _ = evidence_of_all(request)
     found = explain_all(request, evidence)
     return {t: dict(zip(evidence[t].report.ids(), fs, strict=True)) for t, fs in found.items()}
 

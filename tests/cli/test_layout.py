@@ -21,7 +21,10 @@ def test_track_and_failures_use_the_gnnpmb_entry_point() -> None:
     import inspect
 
     import cli.batch
+    import cli.failures
 
     source = inspect.getsource(cli.batch)
-    assert "track_to_file(" in source and "scene_failures(" in source
+    assert "track_to_file(" in source and "failure_reports(" in source
     assert "run_tracker(" not in source and "load_scene(" not in source
+    stages = inspect.getsource(cli.failures)
+    assert "load_inputs(" in stages and "run_all(" in stages and "find_reports(" in stages

@@ -11,9 +11,10 @@ import pytest
 
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.foreign import NEAREST_M, OnHow, box_on
-from gnnpmb.session import prepare, track_run
+from gnnpmb.stages.runs import track_run
 from gnnpmb.types import Boxes
 from gnnpmb.why.facts import FactSink, UseMode, Went
+from tests.pipeline import prepare
 
 SCENE = "scene-0103"
 

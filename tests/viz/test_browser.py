@@ -147,11 +147,11 @@ def test_focus_recordings_load_and_render_in_headless_chromium(
     One recording, with two trackers: its layout holds every view a one-tracker focus recording has (the browser
     load is 60-100 s on this 2-core machine); ``tests/cli/test_focus.py`` checks focus recordings of other
     failure kinds and of one tracker without a browser."""
-    from gnnpmb.session import find_reports, prepare, rerun_runs
+    from tests.pipeline import prepare, reports_of
 
     _require_chromium()
     request = prepare("scene-0103", ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars")
-    reports, _ = find_reports(request, rerun_runs(request))
+    reports, _ = reports_of(request)
     ids = [i for i in reports["gnnpmb"].ids() if not i.startswith("miss:")]
     pick = next((i for i in ids if i.startswith(kind + ":")), ids[0])
     rrd = tmp_path / "focus.rrd"
@@ -199,7 +199,7 @@ def test_the_full_demo_recording_loads_and_renders_in_headless_chromium(
 ) -> None:
     """The demo as the README makes it (one tracker, the whole scene, no --focus): ready by the viewer's own
     state with its sparse bird's-eye view, opened at the first failure worth a look."""
-    from gnnpmb.session import find_reports, prepare, rerun_runs
+    from tests.pipeline import prepare, reports_of
 
     _require_chromium()
     rrd = tmp_path / "demo.rrd"
@@ -213,7 +213,7 @@ def test_the_full_demo_recording_loads_and_renders_in_headless_chromium(
     assert result.rendered, f"the views did not render; look at {shot} and the logs in {tmp_path / 'web'}"
     assert {"gnnpmb bird's-eye", "gnnpmb failures", "gnnpmb failures over time"} <= result.state.views
     request = prepare("scene-0103", ["gnnpmb"], dataroot=demo_dataroot)
-    report = find_reports(request, rerun_runs(request))[0]["gnnpmb"]
+    report = reports_of(request)[0]["gnnpmb"]
     assert result.state.timeline_max["focus"] == report.by_id(report.first_worth_opening()).frame_index
     for pgid in result.process_groups:
         assert group_members(pgid) == [], f"process group {pgid} still has processes"

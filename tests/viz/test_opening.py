@@ -12,12 +12,12 @@ import pytest
 from rerun.chunk import RrdReader
 
 from cli.app import main
-from gnnpmb.session import find_reports, prepare, rerun_runs
+from tests.pipeline import prepare, reports_of
 from tests.viz.rrd import at_frame, read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
-from viz.blueprint import failure_index_doc
 from viz.opening import TIMELINE_KINDS, failure_timeline, lost_tracks, timeline_rows
+from viz.paths import failure_index_doc
 
 SCENE = "scene-0103"
 
@@ -30,7 +30,7 @@ def recorded(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> t
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         main([*argv, "--save", str(out), "--no-progress"])
     request = prepare(SCENE, ["gnnpmb", "jpda"], dataroot=demo_dataroot, detector="pointpillars")
-    reports, _ = find_reports(request, rerun_runs(request))
+    reports, _ = reports_of(request)
     return out, read_rows(out), reports
 
 

@@ -14,7 +14,7 @@ from gnnpmb.eval.failures import _split_with_scene, find_failures
 from gnnpmb.eval.nuscenes_eval import quiet_devkit, scene_sample_tokens, tracking_config
 from gnnpmb.eval.submission import run_results
 from gnnpmb.pipeline import run_tracker
-from gnnpmb.session import prepare
+from tests.pipeline import prepare
 
 SCENE = "scene-0103"
 

@@ -13,8 +13,9 @@ from gnnpmb.data.demo import DEMO_SCENES
 from gnnpmb.data.demo_staged import STAGED_SCENES
 from gnnpmb.data.simdet_presets import PRESETS
 from gnnpmb.registry import TRACKER_NAMES
-from gnnpmb.session import explain_all, gather_evidence, prepare
+from gnnpmb.stages.findings import explain_all
 from gnnpmb.why.findings import Blame, Rule
+from tests.pipeline import evidence_of_all, prepare
 from tools import oracle
 
 SCENES = DEMO_SCENES + STAGED_SCENES
@@ -53,7 +54,7 @@ def test_the_oracle_catches_a_false_claim(demo_dataroot: Path) -> None:
     """A finding made to say something untrue (a detector gap where the object had a detection, a track output
     where it was not) is caught."""
     request = prepare("scene-0103", ["jpda"], dataroot=demo_dataroot, detector="megvii")
-    evidence, _ = gather_evidence(request)
+    evidence, _, _ = evidence_of_all(request)
     (fid, finding) = next(
         (i, f)
         for i, f in zip(evidence["jpda"].report.ids(), explain_all(request, evidence)["jpda"], strict=True)
@@ -87,7 +88,7 @@ def test_the_oracle_catches_a_false_claim_about_a_results_file(demo_dataroot: Pa
     from gnnpmb.why.claims import claims
 
     request = prepare("scene-0103", [], results=[f"cv={cv_results}"], dataroot=demo_dataroot)
-    evidence, _ = gather_evidence(request)
+    evidence, _, _ = evidence_of_all(request)
     findings = explain_all(request, evidence)["cv"]
     src = oracle.sources(request, "cv", evidence)
     finding = next(f for f in findings if f.boxes_on)

@@ -1,0 +1,61 @@
+"""``gnnpmb diff A B``: two runs through the same stages, scene by scene (inputs → runs → evaluation), their
+failures matched (``gnnpmb.diff.scene_diff``) and their metrics scored together by the devkit."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from gnnpmb.diff import DiffEntry, DiffResult, metric_deltas, scene_diff
+from gnnpmb.errors import GnnpmbError
+from gnnpmb.stages.evaluation import find_reports
+from gnnpmb.stages.inputs import Inputs
+from gnnpmb.stages.runs import run_all
+
+
+def diff_runs(
+    a: str,
+    b: str,
+    scenes: Sequence[str],
+    where: str,
+    *,
+    scene_inputs: Callable[[str, list[str]], Inputs],
+    split_tokens: Sequence[str],
+    dataset_tokens: set[str],
+) -> DiffResult:
+    """Diff run spellings ``a`` and ``b`` (``runs.parse_run``) over ``scenes`` (``gnnpmb.diff``).
+    scene_inputs(scene, runs) -> the loaded inputs of both runs on that scene (the caller's data options);
+    split_tokens: every sample of ``scenes`` (a results file must cover them); dataset_tokens: every sample of the
+    dataset."""
+    from gnnpmb.data.nuscenes import open_nuscenes
+    from gnnpmb.eval.scene_scores import scene_scores
+    from gnnpmb.eval.submission import run_results
+    from gnnpmb.eval.subset import eval_location
+    from gnnpmb.foreign import check_coverage, read_results
+    from gnnpmb.runs import check_runs, parse_run
+
+    specs = check_runs([parse_run(a, "A"), parse_run(b, "B")])
+    if len(specs) < 2:
+        raise GnnpmbError(f"A and B are the same run ({specs[0].text()}); compare two different runs")
+    notices = []
+    for spec in specs:
+        if spec.results is not None:
+            notice = check_coverage(read_results(spec.results), spec.results.name, where, split_tokens, dataset_tokens)
+            notices += [notice] if notice else []
+    entries: list[DiffEntry] = []
+    results: dict[str, dict] = {s.name: {} for s in specs}
+    location = None
+    for scene in scenes:
+        inputs = scene_inputs(scene, [s.text() for s in specs])
+        location = inputs.location
+        runs = run_all(inputs, record=False)
+        reports, problems = find_reports(inputs, runs)
+        if len(reports) < 2:
+            raise GnnpmbError(f"{scene} cannot be evaluated: {'; '.join(problems)}")
+        entries += scene_diff(scene, reports[specs[0].name], reports[specs[1].name])
+        for run in runs:
+            results[run.name].update(run_results(run.tracking))
+    nusc = open_nuscenes(eval_location(location, list(scenes)))  # a version folder of these scenes only
+    scores = [scene_scores(nusc, scenes, results[s.name]) for s in specs]
+    return DiffResult(
+        specs[0], specs[1], where, tuple(scenes), tuple(entries), tuple(metric_deltas(*scores)), tuple(notices)
+    )

@@ -1,0 +1,37 @@
+"""Stage 4, the evaluation: each run's failures found with the devkit's own matching in the tracked keyframes
+(``eval.failures``), or read back from an earlier run of the same tracks (``eval.failure_cache``)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
+
+from gnnpmb.errors import DataError
+from gnnpmb.stages.inputs import Inputs
+from gnnpmb.stages.runs import Run
+
+if TYPE_CHECKING:
+    from gnnpmb.eval.failures import FailureReport
+
+
+def find_reports(
+    inputs: Inputs, runs: Sequence[Run], on_done: Callable[[], None] = lambda: None
+) -> tuple[dict[str, FailureReport], list[str]]:
+    """Each run's failure report, by name, and notices: a scene without ground truth, or one the devkit cannot
+    evaluate, gives no reports."""
+    from gnnpmb.eval.failure_cache import scene_report
+    from gnnpmb.eval.submission import run_results
+
+    scene = inputs.scene
+    if not any(len(k.gt) for k in scene.keyframes):
+        return {}, [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
+    reports = {}
+    for run in runs:
+        try:
+            reports[run.name] = scene_report(
+                inputs.location, scene.name, run.name, run_results(run.tracking), inputs.evaluated_keyframes
+            )
+        except DataError as exc:
+            return {}, [f"failure markers skipped: {exc}"]
+        on_done()
+    return reports, []
