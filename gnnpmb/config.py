@@ -555,23 +555,9 @@ def paper_config() -> TrackerConfig:
 
 
 _SECTIONS: dict[str, type] = {
-    kind.SECTION: kind
-    for kind in (
-        PreprocessParams,
-        ModelParams,
-        PmbParams,
-        PmbmParams,
-        LbpParams,
-        PhdParams,
-        VectorParams,
-        GreedyParams,
-        Ab3dmotParams,
-        Prob3dmotParams,
-        SimpleTrackParams,
-        ImmortalParams,
-        CbmotParams,
-    )
+    f.name: type(f.default) for f in dataclasses.fields(TrackerConfig) if isinstance(f.default, Section)
 }
+"""The shared sections, in file order: name -> its dataclass (whose ``SECTION`` is that name)."""
 
 MOVED_KEYS: dict[tuple[str, str], str] = {("pmb", f.name): "models" for f in dataclasses.fields(ModelParams)}
 """(old section, key) -> the section the key lives in now; parameter files and dotted names may still use the old

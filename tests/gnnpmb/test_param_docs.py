@@ -23,6 +23,7 @@ def test_the_rendered_parameter_files_load_to_the_defaults_and_the_paper():
 
 
 def test_every_declared_default_and_paper_value_is_inside_its_declared_range():
+    assert all(name == kind.SECTION for name, kind in _SECTIONS.items())  # the name errors give it
     for kind in (*_SECTIONS.values(), ClassParams, BoxNoise):
         for d in declared(kind):
             assert d.spec.doc and d.type in (int, float), (kind.SECTION, d.name)
