@@ -141,10 +141,6 @@ def declared(kind: type) -> Iterator[Declared]:
         yield Declared(f.name, kind_of, f.default, f.metadata["param"])
 
 
-def spec_of(kind: type, key: str) -> Param:
-    return next(d.spec for d in declared(kind) if d.name == key)
-
-
 class Section:
     """Base of a parameter section: every field is checked against its declaration on construction."""
 
