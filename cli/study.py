@@ -114,7 +114,10 @@ def register(app: typer.Typer) -> None:
             list[str] | None,
             typer.Option(
                 metavar="KEY=V1,V2",
-                help="A swept key and its values (repeatable): pmb.gate_chi2=20,40, car.q_x=0.1,0.2, *.r_x=0.05,0.1.",
+                help=(
+                    "A swept key and its values (repeatable): pmb.gate_chi2=20,40, car.q_x=0.1,0.2, *.r_x=0.05,0.1 "
+                    "(keys, units, ranges: docs/parameters.md)."
+                ),
             ),
         ] = None,
         tracker: TrackerOption = DEFAULT_TRACKER,

@@ -4,11 +4,14 @@ Defaults follow Liu et al., "GNN-PMB", IEEE T-IV 2023, sec. V-B and Table II, an
 authors' public code (see ``gnnpmb/default_params.toml``, which is the editable copy of these values), except
 three values chosen on the demo mini_train split (``ModelParams``, ``PmbParams``); ``gnnpmb/params/paper.toml``
 restores the paper's.
+Each parameter is declared once, as a field of its section's dataclass with ``gnnpmb.param.param``: default,
+meaning, unit, allowed range (with the model's overflow limit), the paper's value. The reader, the checks, the
+sweeps' ``--param``, ``paper_config`` and the generated files (``gnnpmb.param_docs``) read those declarations.
 The models every tracker shares (survival, gate, clutter, birth) are the ``[models]`` section (``ModelParams``,
 used through ``gnnpmb.models``); the keys they had in ``[pmb]`` before (``[pmb] p_survive`` ...) still work and
 mean the same (``MOVED_KEYS``).
 A parameter file may set any subset; unknown keys are an error so typos do not go unnoticed, and every value is
-checked against its allowed range (``RULES``; the error names the key, the value and the range).
+checked against its declared range (the error names the key, the value and the range).
 
 Per-class parameters: ``[classes.<class>]`` holds the class's own models (``ClassParams``: Q, R, the greedy
 matching distance) and may override any key of the shared sections for that class only, e.g.
@@ -22,162 +25,62 @@ parameter is its dotted path: ``pmb.gate_chi2``, ``classes.car.birth_weight``, `
 from __future__ import annotations
 
 import dataclasses
-import math
 import re
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import MISSING, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from gnnpmb.errors import GnnpmbError
+from gnnpmb.param import (
+    FACTOR_LIMIT,
+    GIOU,
+    NON_NEGATIVE,
+    POSITIVE,
+    PROB,
+    SQUARED_LIMIT,
+    STD_LIMIT,
+    SWITCH,
+    VARIANCE_LIMIT,
+    ConfigError,
+    Range,
+    Section,
+    at_least,
+    check_section,
+    declared,
+    paper_values,
+    param,
+    unit_interval,
+)
 from gnnpmb.types import TRACKING_CLASSES
 
-
-class ConfigError(GnnpmbError):
-    """A parameter file that cannot be used; the message says what to fix."""
+_Q = "process noise of x (y) position and velocity per keyframe, Q = diag(q_x, q_y, q_x, q_y)"
 
 
 @dataclass(frozen=True, slots=True)
-class Range:
-    """Allowed values of one parameter: lo < v (or <= if ``lo_closed``) and v < hi (or <= if ``hi_closed``)."""
+class ClassParams(Section):
+    """Per-class models ``[classes.<class>]`` (defaults per class: ``PAPER_CLASS_PARAMS``)."""
 
-    lo: float
-    hi: float
-    lo_closed: bool
-    hi_closed: bool
+    SECTION = "classes"
 
-    def contains(self, value: float) -> bool:
-        if not math.isfinite(value):
-            return False
-        above = value >= self.lo if self.lo_closed else value > self.lo
-        below = value <= self.hi if self.hi_closed else value < self.hi
-        return above and below
-
-    def __str__(self) -> str:
-        if self.hi == math.inf:
-            return f">= {self.lo:g}" if self.lo_closed else f"> {self.lo:g}"
-        return f"in {'[' if self.lo_closed else '('}{self.lo:g}, {self.hi:g}{']' if self.hi_closed else ')'}"
-
-
-_INF = math.inf
-_PROB = Range(0.0, 1.0, True, True)
-_POSITIVE = Range(0.0, _INF, False, False)
-_NON_NEGATIVE = Range(0.0, _INF, True, False)
-
-
-def _at_least(n: int) -> Range:
-    return Range(float(n), _INF, True, False)
-
-
-RULES: dict[str, Range] = {
-    "preprocess.score_threshold": _PROB,
-    "preprocess.nms_iou_3d": _PROB,
-    "models.p_survive": Range(0.0, 1.0, False, True),
-    "models.clutter_intensity": _POSITIVE,
-    "models.gate_chi2": _POSITIVE,
-    "models.birth_weight": _POSITIVE,
-    "models.birth_pos_std_m": _POSITIVE,
-    "models.birth_vel_std_mps": _POSITIVE,
-    "pmb.prune_existence": Range(0.0, 1.0, True, False),
-    "pmb.extraction_threshold": _PROB,
-    "pmb.miss_p_detect_max": Range(0.0, 1.0, False, True),
-    "pmb.miss_score_decay": Range(0.0, 1.0, False, True),
-    "pmb.heading_std_rad": Range(0.0, 1.5, True, True),
-    "pmb.size_log_std": Range(0.0, 2.0, True, True),
-    "pmb.size_log_spread": _POSITIVE,
-    "pmb.box_outlier_prob": Range(0.0, 1.0, False, False),
-    "pmb.gate_giou_min": Range(-1.0, 1.0, True, True),
-    "models.motion_model": Range(0.0, 1.0, True, True),
-    "models.turn_rate_std_rps": _NON_NEGATIVE,
-    "models.birth_turn_rate_std_rps": _POSITIVE,
-    "pmbm.n_hypotheses": _at_least(1),
-    "pmbm.hypothesis_prune": Range(0.0, 1.0, True, False),
-    "lbp.max_iterations": _at_least(1),
-    "lbp.tolerance": _POSITIVE,
-    "phd.p_detect": Range(0.0, 1.0, False, True),
-    "phd.prune_weight": _NON_NEGATIVE,
-    "phd.merge_threshold": _NON_NEGATIVE,
-    "phd.max_components": _at_least(1),
-    "phd.extraction_weight": _POSITIVE,
-    "phd.max_cardinality": _at_least(1),
-    "vector.p_detect": Range(0.0, 1.0, False, False),
-    "vector.confirm_m": Range(1.0, 62.0, True, True),
-    "vector.confirm_n": Range(1.0, 62.0, True, True),
-    "vector.delete_misses": _at_least(1),
-    "vector.exact_cluster_max": _at_least(1),
-    "greedy.max_age": _at_least(1),
-    "ab3dmot.iou_threshold": Range(0.0, 1.0, True, False),
-    "ab3dmot.min_hits": _at_least(0),
-    "ab3dmot.max_misses": _at_least(1),
-    "prob3dmot.distance_threshold": _POSITIVE,
-    "prob3dmot.min_hits": _at_least(0),
-    "prob3dmot.max_misses": _at_least(1),
-    "simpletrack.giou_threshold": Range(-1.0, 1.0, True, True),
-    "simpletrack.first_stage_score": _PROB,
-    "simpletrack.min_hits": _at_least(0),
-    "simpletrack.max_misses": _at_least(1),
-    "simpletrack.miss_score_factor": _PROB,
-    "simpletrack.two_stage": Range(0.0, 1.0, True, True),
-    "simpletrack.detector_velocity": Range(0.0, 1.0, True, True),
-    "simpletrack.second_stage_score": _PROB,
-    "simpletrack.second_stage_giou": Range(-1.0, 1.0, True, True),
-    "immortal.min_hits": _at_least(0),
-    "immortal.output_max_misses": _at_least(0),
-    "cbmot.score_decay": _PROB,
-    "cbmot.max_misses": _at_least(1),
-    "cbmot.delete_score": Range(0.0, 1.0, True, False),
-    "classes.q_x": _NON_NEGATIVE,
-    "classes.q_y": _NON_NEGATIVE,
-    "classes.r_x": _POSITIVE,
-    "classes.r_y": _POSITIVE,
-    "classes.match_distance_m": _POSITIVE,
-    "classes.cbmot_distance_m": _POSITIVE,
-    "classes.r_vx": _POSITIVE,
-    "classes.r_vy": _POSITIVE,
-    "pmb.measure_velocity": Range(0.0, 1.0, True, True),
-    "pmb.clutter_velocity_density": _POSITIVE,
-    **{f"box_noise.{k}": _POSITIVE for k in ("r_x", "r_y", "r_z", "r_yaw", "r_l", "r_w", "r_h")},
-    **{f"box_noise.{k}": _NON_NEGATIVE for k in ("q_x", "q_y", "q_z", "q_yaw", "q_size", "q_vx", "q_vy", "q_vz")},
-    **{f"box_noise.{k}": _POSITIVE for k in ("p_vx", "p_vy", "p_vz", "p_scale")},
-}
-"""Allowed range of every parameter, by ``section.key`` (``classes.key`` for the per-class models). Covariance
-entries: Q may be 0 (no process noise), R must be > 0 (a zero R makes a perfect sensor and a singular S)."""
-
-
-def check_value(section: str, key: str, value: float, where: str) -> None:
-    """Raise a ``ConfigError`` naming ``where`` (e.g. ``[pmb]`` or ``[classes.car]``), the key, the value and
-    the allowed range if ``value`` is outside ``RULES[section.key]``."""
-    rule = RULES[f"{section}.{key}"]
-    if not rule.contains(float(value)):
-        raise ConfigError(f"{where} {key} must be {rule}, got {value!r}")
-
-
-def validate_section(params: Any, section: str) -> None:
-    """Check every field of a section dataclass against ``RULES`` (called by its ``__post_init__``)."""
-    where = f"[{section}]"
-    for f in dataclasses.fields(params):
-        check_value(section, f.name, getattr(params, f.name), where)
-
-
-@dataclass(frozen=True, slots=True)
-class ClassParams:
-    """Per-class models: process noise Q = diag(q_x, q_y, q_x, q_y), measurement noise R = diag(r_x, r_y), and
-    the greedy tracker's matching distance (``gnnpmb.greedy``; CenterPoint's per-class values), the velocity
-    measurement noise r_vx, r_vy ((m/s)^2) used only by the opt-in ``[pmb] measure_velocity = 1`` variant, and
-    CBMOT's matching distance (``gnnpmb.cbmot``: the earlier CenterPoint values its code ships)."""
-
-    q_x: float
-    q_y: float
-    r_x: float
-    r_y: float
-    match_distance_m: float = 4.0
-    r_vx: float = 0.5
-    r_vy: float = 0.5
-    cbmot_distance_m: float = 3.0
-
-    def __post_init__(self) -> None:
-        validate_section(self, "classes")
+    q_x: float = param(MISSING, _Q, NON_NEGATIVE, "m^2", limit=VARIANCE_LIMIT)
+    q_y: float = param(MISSING, _Q.replace("x (y)", "y (x)"), NON_NEGATIVE, "m^2", limit=VARIANCE_LIMIT)
+    r_x: float = param(
+        MISSING, "measurement noise of the centre's x, R = diag(r_x, r_y)", POSITIVE, "m^2", limit=VARIANCE_LIMIT
+    )
+    r_y: float = param(MISSING, "measurement noise of the centre's y", POSITIVE, "m^2", limit=VARIANCE_LIMIT)
+    match_distance_m: float = param(
+        4.0, "greedy tracker's matching distance (CenterPoint's per class)", POSITIVE, "m", limit=SQUARED_LIMIT
+    )
+    r_vx: float = param(
+        0.5,
+        "velocity measurement noise (only with [pmb] measure_velocity = 1)",
+        POSITIVE,
+        "(m/s)^2",
+        limit=VARIANCE_LIMIT,
+    )
+    r_vy: float = param(0.5, "as r_vx, of vy", POSITIVE, "(m/s)^2", limit=VARIANCE_LIMIT)
+    cbmot_distance_m: float = param(3.0, "CBMOT's matching distance", POSITIVE, "m", limit=SQUARED_LIMIT)
 
 
 PAPER_CLASS_PARAMS: dict[str, ClassParams] = {
@@ -194,42 +97,56 @@ PAPER_CLASS_PARAMS: dict[str, ClassParams] = {
 et al. 2021; an earlier CenterPoint version: car 3, trailer 2, motorcycle 4, bicycle 2.5 m)."""
 
 
-@dataclass(frozen=True, slots=True)
-class BoxNoise:
-    """Diagonal noise of one class's 10-D box Kalman filter (``gnnpmb.box.kalman``), state [x, y, z, yaw, l, w,
-    h, vx, vy, vz], measurement the first 7, in SI units per keyframe step.
+_BOX_R = "measurement noise R of the box's {}"
+_BOX_Q = "process noise of the box's {} per keyframe"
+_BOX_P = "initial variance of the box's {}"
 
-    r_*: measurement noise R (m^2; r_yaw rad^2); q_x, q_y, q_z, q_yaw: process noise of the position and heading
-    per step; q_size: of l, w, h; q_vx, q_vy, q_vz: of the velocity ((m/s)^2 per step); p_vx, p_vy, p_vz: the
-    initial velocity variance ((m/s)^2); p_scale: the initial variance of the 7 measured components is p_scale R.
+
+def _box(template: str, what: str, unit: str, range_: Any = POSITIVE) -> Any:
+    return param(MISSING, template.format(what), range_, unit, limit=VARIANCE_LIMIT)
+
+
+@dataclass(frozen=True, slots=True)
+class BoxNoise(Section):
+    """Diagonal noise of one class's 10-D box Kalman filter (``gnnpmb.box.kalman``), state [x, y, z, yaw, l, w,
+    h, vx, vy, vz], measurement the first 7, in SI units per keyframe step; the initial variance of the 7
+    measured components is p_scale R.
 
     The defaults (``NUSCENES_BOX_NOISE``) are Probabilistic 3D MOT's statistics of nuScenes train (Chiu et al.
     2020, sec. IV-C, its ``covariance.py`` ``NuScenesCovariance``); its velocities are per 0.5 s keyframe, so its
     velocity entries are divided by 0.5^2 here. ``benchmarks/learn_box_noise.py`` learns them from a split.
     """
 
-    r_x: float
-    r_y: float
-    r_z: float
-    r_yaw: float
-    r_l: float
-    r_w: float
-    r_h: float
-    q_x: float
-    q_y: float
-    q_z: float
-    q_yaw: float
-    q_size: float
-    q_vx: float
-    q_vy: float
-    q_vz: float
-    p_vx: float
-    p_vy: float
-    p_vz: float
-    p_scale: float = 1.0
+    SECTION = "box_noise"
+
+    r_x: float = _box(_BOX_R, "x", "m^2")
+    r_y: float = _box(_BOX_R, "y", "m^2")
+    r_z: float = _box(_BOX_R, "z", "m^2")
+    r_yaw: float = _box(_BOX_R, "heading", "rad^2")
+    r_l: float = _box(_BOX_R, "length", "m^2")
+    r_w: float = _box(_BOX_R, "width", "m^2")
+    r_h: float = _box(_BOX_R, "height", "m^2")
+    q_x: float = _box(_BOX_Q, "x", "m^2", NON_NEGATIVE)
+    q_y: float = _box(_BOX_Q, "y", "m^2", NON_NEGATIVE)
+    q_z: float = _box(_BOX_Q, "z", "m^2", NON_NEGATIVE)
+    q_yaw: float = _box(_BOX_Q, "heading", "rad^2", NON_NEGATIVE)
+    q_size: float = _box(_BOX_Q, "l, w and h", "m^2", NON_NEGATIVE)
+    q_vx: float = _box(_BOX_Q, "vx", "(m/s)^2", NON_NEGATIVE)
+    q_vy: float = _box(_BOX_Q, "vy", "(m/s)^2", NON_NEGATIVE)
+    q_vz: float = _box(_BOX_Q, "vz", "(m/s)^2", NON_NEGATIVE)
+    p_vx: float = _box(_BOX_P, "vx", "(m/s)^2")
+    p_vy: float = _box(_BOX_P, "vy", "(m/s)^2")
+    p_vz: float = _box(_BOX_P, "vz", "(m/s)^2")
+    p_scale: float = param(1.0, "initial variance of the measured components as a multiple of R", POSITIVE)
 
     def __post_init__(self) -> None:
-        validate_section(self, "box_noise")
+        check_section(self)
+        largest = max(self.r_x, self.r_y, self.r_z, self.r_yaw, self.r_l, self.r_w, self.r_h)
+        if self.p_scale * largest > VARIANCE_LIMIT.hi:
+            raise ConfigError(
+                f"[box_noise] p_scale R must stay <= {VARIANCE_LIMIT.hi:g} ({VARIANCE_LIMIT.why}), got p_scale = "
+                f"{self.p_scale!r} with largest R entry {largest!r}"
+            )
 
     @staticmethod
     def uniform(r: float, q: float, q_size: float, q_velocity: float, p_velocity: float, p_scale: float) -> BoxNoise:
@@ -286,330 +203,287 @@ NUSCENES_BOX_NOISE: dict[str, BoxNoise] = {
 
 
 @dataclass(frozen=True, slots=True)
-class PreprocessParams:
+class PreprocessParams(Section):
     """Detection preprocessing (paper sec. V-B, Table II)."""
 
-    score_threshold: float = 0.1
-    nms_iou_3d: float = 0.1
+    SECTION = "preprocess"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "preprocess")
+    score_threshold: float = param(0.1, "detections scoring below it are dropped", PROB)
+    nms_iou_3d: float = param(0.1, "non-maximum suppression's 3D IoU threshold", PROB)
 
 
 @dataclass(frozen=True, slots=True)
-class ModelParams:
+class ModelParams(Section):
     """The models every tracker shares (``gnnpmb.models``): survival P_S, the gate, the clutter intensity and the
-    measurement-driven birth (paper sec. V-B). The detection probability is the detection's score for the PMB
-    family and ``p_detect`` of ``[phd]`` / ``[vector]`` for the others.
-
-    p_survive: P_S per keyframe; clutter_intensity: kappa per m^2; gate_chi2: the squared Mahalanobis gate G;
-    birth_weight: w_b per detection; birth_pos_std_m, birth_vel_std_mps: the birth covariance
-    diag(s_p^2, s_p^2, s_v^2, s_v^2). Two defaults differ from the paper's (``gnnpmb/params/paper.toml``), chosen on
-    the demo ``mini_train`` split only (``benchmarks/tune_mini_train.py``):
+    measurement-driven birth, birth covariance diag(s_p^2, s_p^2, s_v^2, s_v^2) (paper sec. V-B). The detection
+    probability is the detection's score for the PMB family and ``p_detect`` of ``[phd]`` / ``[vector]`` for the
+    others. Two defaults differ from the paper's (``gnnpmb/params/paper.toml``), chosen on the demo
+    ``mini_train`` split only (``benchmarks/tune_mini_train.py``):
 
     - p_survive 0.95 (paper 0.7 per 0.5 s keyframe, a mean lifetime of 1.7 s): with 0.7 a track occluded for a
       few frames decays so far that its object comes back under a new id.
     - birth_weight 0.3 (paper 0.1): the prior rate of new objects per detection; a larger one makes a detection's
       first Bernoulli more likely (r_new = w s N / (c + w s N)), so a new object's first box is scored higher.
 
-    motion_model: 0 = constant velocity (the paper's), 1 = coordinated turn (constant turn rate and velocity,
-    state [x, y, vx, vy, omega], extended Kalman predict; ``gnnpmb.models.ct_model``), read by the PMB family;
-    turn_rate_std_rps: the turn rate's process noise per keyframe (rad/s); birth_turn_rate_std_rps: a new track's
-    turn-rate standard deviation (its turn rate starts at 0).
+    The coordinated-turn model (``motion_model = 1``) has state [x, y, vx, vy, omega] and the extended Kalman
+    predict (``gnnpmb.models.ct_model``); a new track's turn rate starts at 0.
     """
 
-    p_survive: float = 0.95
-    clutter_intensity: float = 1e-3
-    gate_chi2: float = 40.0
-    birth_weight: float = 0.3
-    birth_pos_std_m: float = 15.0
-    birth_vel_std_mps: float = 1.0
-    motion_model: int = 0
-    turn_rate_std_rps: float = 0.2
-    birth_turn_rate_std_rps: float = 0.5
+    SECTION = "models"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "models")
+    p_survive: float = param(
+        0.95, "P_S, the probability an object survives one keyframe", unit_interval(False, True), paper=0.7
+    )
+    clutter_intensity: float = param(1e-3, "kappa, the clutter intensity", POSITIVE, "1/m^2", limit=FACTOR_LIMIT)
+    gate_chi2: float = param(40.0, "G, the squared Mahalanobis gate", POSITIVE)
+    birth_weight: float = param(0.3, "w_b, the birth weight per detection", POSITIVE, paper=0.1)
+    birth_pos_std_m: float = param(15.0, "s_p, a new track's position std", POSITIVE, "m", limit=STD_LIMIT)
+    birth_vel_std_mps: float = param(1.0, "s_v, a new track's velocity std", POSITIVE, "m/s", limit=STD_LIMIT)
+    motion_model: int = param(
+        0, "0 = constant velocity (the paper's), 1 = coordinated turn (PMB family)", SWITCH, paper=0
+    )
+    turn_rate_std_rps: float = param(
+        0.2, "the turn rate's process noise per keyframe", NON_NEGATIVE, "rad/s", limit=STD_LIMIT
+    )
+    birth_turn_rate_std_rps: float = param(0.5, "a new track's turn-rate std", POSITIVE, "rad/s", limit=STD_LIMIT)
 
 
 @dataclass(frozen=True, slots=True)
-class PmbParams:
+class PmbParams(Section):
     """The Poisson multi-Bernoulli family (GNN-PMB, PMBM, TO-PMB), beyond the shared ``[models]``.
 
-    prune_existence: Bernoullis with r below it are dropped. extraction_threshold 0.01 (paper 0.9, chosen on the
-    demo ``mini_train`` split like ``ModelParams``): every Bernoulli with r >= 0.01 is output with tracking
-    score = its detection score x r. With 0.9 a new object is reported only from its second detection (a new
-    Bernoulli starts at r ~ 0.065 s with the paper's birth model) and a missed track not at all. AMOTA sweeps the
-    score threshold, so low-r boxes scored s r rank below every confident track and only add recall.
-    miss_p_detect_max: the P_D of a track's misdetection hypothesis is its last detection score capped at this
-    (paper: no cap, 1.0). With the paper's rule (r' = r (1 - P_D) / (1 - r P_D) after P_S = 0.95) a track last
-    detected at 0.9 falls 0.95 -> 0.48 -> 0.08 -> 0.01 in three missed frames; with the cap 0.3, 0.95 -> 0.87 ->
-    0.76 -> 0.65. A returning object's detection then updates its track instead of starting a new one (seen with
-    ``--focus identity_theft:1`` on scene-0103 pointpillars: "m2 -> new track 315 over track 61, margin 0.31").
-    0.3 was chosen on the demo
-    ``mini_train`` split among 1.0 / 0.7 / 0.5 / 0.3 (gnnpmb AMOTA centerpoint 0.878 / 0.912 / 0.926 / 0.925,
-    pointpillars 0.799 / 0.803 / 0.802 / 0.828; IDS 27 -> 4 and 18 -> 4).
-    measure_velocity: 1 = measure [x, y, vx, vy] (``kalman``; R adds r_vx = r_vy = 0.5 (m/s)^2), 0 = the paper's
-    [x, y]. 1 was chosen on the demo ``mini_train`` split over the three presets and detector seeds 0, 1, 2
-    (gnnpmb mean AMOTA 0.8695 -> 0.8883, better on every preset, IDS 4.2 -> 2.7, AMOTP 0.428 -> 0.378 m;
-    ``benchmarks/tune_models.py``) and is ``params/velocity.toml``; it is not the default yet because it about
-    doubles the low-score boxes output and so the entities of a recording (``docs/results.md``).
-    clutter_velocity_density: with measure_velocity = 1 the clutter intensity is per m^2 per (m/s)^2, so it is
-    clutter_intensity x this density of a clutter detection's velocity (default: uniform over a 20 x 20 m/s
-    square, 1/400); unused otherwise.
-    miss_score_decay: a Bernoulli missed for n frames in a row is output with tracking score s r d^n (d = this;
-    1: no decay, the paper's s r). Its predicted box stays in the output while r >= the extraction threshold,
-    ranked below the boxes of detected tracks (Poly-MOT's score decay of unmatched tracks, Li et al. 2023).
-    heading_std_rad, size_log_std, size_log_spread, box_outlier_prob: the heading and size measurement model
-    (``gnnpmb.box_likelihood``): sigma_psi of a detection's heading, sigma_s of its log width and length, sigma_c
-    the spread of the class's log sizes, eps the outlier share; a sigma of 0 leaves that part out (the paper).
-    gate_giou_min: a pair inside the Mahalanobis gate is also required to have a bird's-eye GIoU of at least this
-    between the detection and the track's predicted box (its filtered centre, its last detection's size and
-    heading); -1 (GIoU > -1 always): no overlap gate, the paper's. Poly-MOT and SimpleTrack gate on GIoU alone.
+    extraction_threshold 0.01 (paper 0.9, chosen on the demo ``mini_train`` split like ``ModelParams``): every
+    Bernoulli with r >= 0.01 is output with tracking score = its detection score x r. With 0.9 a new object is
+    reported only from its second detection (a new Bernoulli starts at r ~ 0.065 s with the paper's birth model)
+    and a missed track not at all. AMOTA sweeps the score threshold, so low-r boxes scored s r rank below every
+    confident track and only add recall.
+    miss_p_detect_max 0.3 (paper: no cap, 1.0): with the paper's rule (r' = r (1 - P_D) / (1 - r P_D) after
+    P_S = 0.95) a track last detected at 0.9 falls 0.95 -> 0.48 -> 0.08 -> 0.01 in three missed frames; with the
+    cap 0.3, 0.95 -> 0.87 -> 0.76 -> 0.65. A returning object's detection then updates its track instead of
+    starting a new one (seen with ``--focus identity_theft:1`` on scene-0103 pointpillars: "m2 -> new track 315
+    over track 61, margin 0.31"). 0.3 was chosen on the demo ``mini_train`` split among 1.0 / 0.7 / 0.5 / 0.3
+    (gnnpmb AMOTA centerpoint 0.878 / 0.912 / 0.926 / 0.925, pointpillars 0.799 / 0.803 / 0.802 / 0.828; IDS
+    27 -> 4 and 18 -> 4).
+    measure_velocity 1 (R adds r_vx = r_vy = 0.5 (m/s)^2) was chosen on the demo ``mini_train`` split over the
+    three presets and detector seeds 0, 1, 2 (gnnpmb mean AMOTA 0.8695 -> 0.8883, better on every preset, IDS
+    4.2 -> 2.7, AMOTP 0.428 -> 0.378 m; ``benchmarks/tune_models.py``) and is ``params/velocity.toml``; it is not
+    the default yet because it about doubles the low-score boxes output and so the entities of a recording
+    (``docs/results.md``). With it the clutter intensity is per m^2 per (m/s)^2: clutter_intensity x
+    clutter_velocity_density (default: uniform over a 20 x 20 m/s square, 1/400).
+    miss_score_decay d: a Bernoulli missed for n frames in a row is output with tracking score s r d^n; its
+    predicted box stays in the output while r >= the extraction threshold, ranked below the boxes of detected
+    tracks (Poly-MOT's score decay of unmatched tracks, Li et al. 2023).
+    Heading and size model (``gnnpmb.box_likelihood``): a sigma of 0 leaves that part out (the paper).
+    gate_giou_min: the predicted box is the track's filtered centre with its last detection's size and heading;
+    Poly-MOT and SimpleTrack gate on GIoU alone.
     """
 
-    prune_existence: float = 1e-6
-    extraction_threshold: float = 0.01
-    miss_p_detect_max: float = 0.3
-    measure_velocity: int = 0
-    clutter_velocity_density: float = 1.0 / 400.0
-    miss_score_decay: float = 1.0
-    heading_std_rad: float = 0.0
-    size_log_std: float = 0.0
-    size_log_spread: float = 0.2
-    box_outlier_prob: float = 0.1
-    gate_giou_min: float = -1.0
+    SECTION = "pmb"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "pmb")
+    prune_existence: float = param(1e-6, "Bernoullis with existence r below it are dropped", unit_interval(True, False))
+    extraction_threshold: float = param(0.01, "Bernoullis with r at least this are output", PROB, paper=0.9)
+    miss_p_detect_max: float = param(
+        0.3, "cap of a missed track's P_D (its last detection score)", unit_interval(False, True), paper=1.0
+    )
+    measure_velocity: int = param(0, "1 = measure [x, y, vx, vy], 0 = the paper's [x, y]", SWITCH, paper=0)
+    clutter_velocity_density: float = param(
+        1.0 / 400.0,
+        "density of a clutter detection's velocity (measure_velocity = 1)",
+        POSITIVE,
+        "1/(m/s)^2",
+        limit=FACTOR_LIMIT,
+    )
+    miss_score_decay: float = param(
+        1.0, "d: a track missed n frames is scored s r d^n (1: the paper's s r)", unit_interval(False, True), paper=1.0
+    )
+    heading_std_rad: float = param(
+        0.0, "sigma_psi of a detection's heading (0: heading not used)", Range(0.0, 1.5, True, True), "rad", paper=0.0
+    )
+    size_log_std: float = param(
+        0.0, "sigma_s of a detection's log width and length (0: size not used)", Range(0.0, 2.0, True, True), paper=0.0
+    )
+    size_log_spread: float = param(0.2, "sigma_c, the spread of the class's log sizes", POSITIVE, limit=STD_LIMIT)
+    box_outlier_prob: float = param(0.1, "eps, the share of outlier headings and sizes", unit_interval(False, False))
+    gate_giou_min: float = param(
+        -1.0, "least bird's-eye GIoU of a gated pair (-1: no overlap gate, the paper's)", GIOU, paper=-1.0
+    )
 
 
 @dataclass(frozen=True, slots=True)
-class PmbmParams:
+class PmbmParams(Section):
     """PMBM hypothesis management (``gnnpmb.pmb.pmbm``; García-Fernández et al. 2018, sec. V).
 
-    n_hypotheses: N_h, the most global hypotheses kept; prior hypothesis h of weight w_h gets its
-    ceil(N_h w_h) best assignments (Murty). Default N_h = 20, the per-frame hypothesis budget: on the demo
-    mini_train scenes it gave the AMOTA of the paper's N_h = 100 (``params/paper.toml``) to 4 decimals at less
-    than half the time per frame; with the velocity measured (``params/velocity.toml``) N_h = 10 gave that of
-    N_h = 20 (mean over 3 presets x 3 seeds 0.8881 vs 0.8878) in 16 % less time. N_h = 1 is exactly GNN-PMB.
-    hypothesis_prune: global hypotheses whose normalised weight falls below it are dropped (the most likely one
-    always stays).
+    Prior hypothesis h of weight w_h gets its ceil(N_h w_h) best assignments (Murty). Default N_h = 20, the
+    per-frame hypothesis budget: on the demo mini_train scenes it gave the AMOTA of the paper's N_h = 100
+    (``params/paper.toml``) to 4 decimals at less than half the time per frame; with the velocity measured
+    (``params/velocity.toml``) N_h = 10 gave that of N_h = 20 (mean over 3 presets x 3 seeds 0.8881 vs 0.8878) in
+    16 % less time. N_h = 1 is exactly GNN-PMB.
     """
 
-    n_hypotheses: int = 20
-    hypothesis_prune: float = 1e-4
+    SECTION = "pmbm"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "pmbm")
+    n_hypotheses: int = param(20, "N_h, the most global hypotheses kept", at_least(1), paper=100)
+    hypothesis_prune: float = param(
+        1e-4, "global hypotheses lighter than this are dropped (the best always stays)", unit_interval(True, False)
+    )
 
 
 @dataclass(frozen=True, slots=True)
-class LbpParams:
+class LbpParams(Section):
     """Loopy belief propagation for marginal association probabilities (TO-PMB, JPDA; ``gnnpmb.assign.lbp``,
-    Williams & Lau 2014).
-
-    max_iterations: at most this many message-passing rounds (>= 1); tolerance: stop once no marginal
-    probability changes by more than this between two rounds (> 0). On the demo scenes TO-PMB's LBP stops after
-    2 rounds (median; 8 at most), so the cap is a safeguard rather than a speed setting.
+    Williams & Lau 2014). On the demo scenes TO-PMB's LBP stops after 2 rounds (median; 8 at most), so the cap is
+    a safeguard rather than a speed setting.
     """
 
-    max_iterations: int = 100
-    tolerance: float = 1e-7
+    SECTION = "lbp"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "lbp")
+    max_iterations: int = param(100, "at most this many message-passing rounds", at_least(1))
+    tolerance: float = param(1e-7, "stop once no marginal changes by more than this in a round", POSITIVE)
 
 
 @dataclass(frozen=True, slots=True)
-class PhdParams:
+class PhdParams(Section):
     """GM-PHD / GM-CPHD filters (``gnnpmb.phd``; Vo & Ma 2006; Vo, Vo & Cantoni 2007).
 
-    p_detect: detection probability P_D in (0, 1] of a persistent component (a measurement-driven birth component
-    is detected by construction). prune_weight: components lighter than this are dropped (Vo & Ma Table II, T).
-    merge_threshold: components within this squared Mahalanobis distance (4-D state) of a heavier one are merged
-    into it (U). max_components: at most this many components are kept per class (J_max). extraction_weight: the
-    PHD filter reports every component at least this heavy, round(w) times (Table III). max_cardinality: hard
-    upper bound of the CPHD cardinality support per class; below it the support follows the previous posterior
-    plus the birth count, so most frames use far fewer terms (median 7, at most 21 on the demo scenes); the CPHD
-    reports at most this many tracks per class. Survival, gate, clutter intensity and birth come from ``[models]``
+    A measurement-driven birth component is detected by construction. Below max_cardinality the CPHD's
+    cardinality support follows the previous posterior plus the birth count, so most frames use far fewer terms
+    (median 7, at most 21 on the demo scenes). Survival, gate, clutter intensity and birth come from ``[models]``
     so every tracker of the study sees the same models. T, U, J_max and the 0.5 extraction weight are Vo & Ma's.
     """
 
-    p_detect: float = 0.9
-    prune_weight: float = 1e-5
-    merge_threshold: float = 4.0
-    max_components: int = 100
-    extraction_weight: float = 0.5
-    max_cardinality: int = 100
+    SECTION = "phd"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "phd")
+    p_detect: float = param(0.9, "P_D of a persistent component", unit_interval(False, True))
+    prune_weight: float = param(1e-5, "T: components lighter than this are dropped", NON_NEGATIVE)
+    merge_threshold: float = param(4.0, "U: squared Mahalanobis distance within which components merge", NON_NEGATIVE)
+    max_components: int = param(100, "J_max: the most components kept per class", at_least(1))
+    extraction_weight: float = param(0.5, "components at least this heavy are reported, round(w) times", POSITIVE)
+    max_cardinality: int = param(100, "the CPHD's largest cardinality (most tracks per class)", at_least(1))
 
 
 @dataclass(frozen=True, slots=True)
-class VectorParams:
-    """Vector-type trackers (GNN, JPDA; ``gnnpmb.vector``).
-
-    p_detect: constant detection probability P_D in (0, 1) of the association likelihoods (Blackman & Popoli
-    1999, ch. 6; Bar-Shalom, Daum & Huang 2009). confirm_m / confirm_n: a tentative track is confirmed once it
-    has confirm_m hits within its first confirm_n frames (the birth frame counts as a hit) and deleted as soon
-    as it can no longer get there. delete_misses: a confirmed track is deleted after this many consecutive
-    misses. exact_cluster_max: JPDA enumerates a gated cluster exactly when it has at most this many tracks
-    (and at most ``vector.jpda.EXACT_ASSOCIATION_BUDGET`` joint events), otherwise it uses loopy belief
-    propagation (``[lbp]``). The gate, clutter intensity kappa and
-    the initial covariance of a new track come from ``[models]`` (gate_chi2, clutter_intensity, birth_pos_std_m,
-    birth_vel_std_mps), so every tracker of the study sees the same gate and clutter model.
+class VectorParams(Section):
+    """Vector-type trackers (GNN, JPDA; ``gnnpmb.vector``; Blackman & Popoli 1999, ch. 6; Bar-Shalom, Daum &
+    Huang 2009). A tentative track is confirmed once it has confirm_m hits within its first confirm_n frames (the
+    birth frame counts as a hit) and deleted as soon as it can no longer get there. JPDA enumerates a gated
+    cluster exactly when it has at most exact_cluster_max tracks (and at most
+    ``vector.jpda.EXACT_ASSOCIATION_BUDGET`` joint events), otherwise it uses loopy belief propagation
+    (``[lbp]``). The gate, clutter intensity and the initial covariance of a new track come from ``[models]``.
     """
 
-    p_detect: float = 0.9
-    confirm_m: int = 2
-    confirm_n: int = 3
-    delete_misses: int = 3
-    exact_cluster_max: int = 8
+    SECTION = "vector"
+
+    p_detect: float = param(0.9, "constant P_D of the association likelihoods", unit_interval(False, False))
+    confirm_m: int = param(2, "M of M-of-N confirmation", Range(1.0, 62.0, True, True))
+    confirm_n: int = param(3, "N of M-of-N confirmation", Range(1.0, 62.0, True, True))
+    delete_misses: int = param(3, "a confirmed track missed this many frames in a row is deleted", at_least(1))
+    exact_cluster_max: int = param(8, "JPDA enumerates clusters of at most this many tracks", at_least(1))
 
     def __post_init__(self) -> None:
-        validate_section(self, "vector")
+        check_section(self)
         if self.confirm_m > self.confirm_n:
             raise ConfigError(
                 f"[vector] need confirm_m <= confirm_n, got confirm_m = {self.confirm_m}, confirm_n = {self.confirm_n}"
             )
 
 
-@dataclass(frozen=True, slots=True)
-class GreedyParams:
-    """The greedy closest-pair baseline (``gnnpmb.greedy``; CenterPoint, Yin et al. 2021).
-
-    max_age: a track missed this many frames in a row is deleted (CenterPoint's nuScenes setting: 3).
-    """
-
-    max_age: int = 3
-
-    def __post_init__(self) -> None:
-        validate_section(self, "greedy")
+_MIN_HITS = "a track is output from its min_hits-th hit on"
+_MAX_MISSES = "a track missed this many frames in a row is deleted"
 
 
 @dataclass(frozen=True, slots=True)
-class Ab3dmotParams:
+class GreedyParams(Section):
+    """The greedy closest-pair baseline (``gnnpmb.greedy``; CenterPoint, Yin et al. 2021)."""
+
+    SECTION = "greedy"
+
+    max_age: int = param(3, _MAX_MISSES + " (CenterPoint's nuScenes 3)", at_least(1))
+
+
+@dataclass(frozen=True, slots=True)
+class Ab3dmotParams(Section):
     """AB3DMOT (Weng, Wang, Held & Kitani, IROS 2020) as it runs on nuScenes (the configuration Probabilistic 3D
-    MOT published for it, ``config/AB3DMOT.yaml``; ``gnnpmb.box.ab3dmot``).
-
-    iou_threshold: a detection and a predicted box are matched only if their 3D IoU exceeds this (after the
-    Hungarian solve over all pairs). min_hits: a track is output from its min_hits-th hit on (and every track
-    in the first min_hits frames). max_misses: a track missed this many frames in a row is deleted; a track
-    missed fewer is output at its prediction (AB3DMOT's max_age).
+    MOT published for it, ``config/AB3DMOT.yaml``; ``gnnpmb.box.ab3dmot``). Every track is output in the first
+    min_hits frames; a track missed fewer than max_misses frames is output at its prediction (AB3DMOT's max_age).
     """
 
-    iou_threshold: float = 0.1
-    min_hits: int = 3
-    max_misses: int = 2
+    SECTION = "ab3dmot"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "ab3dmot")
+    iou_threshold: float = param(0.1, "a matched pair's 3D IoU must exceed this", unit_interval(True, False))
+    min_hits: int = param(3, _MIN_HITS, at_least(0))
+    max_misses: int = param(2, _MAX_MISSES, at_least(1))
 
 
 @dataclass(frozen=True, slots=True)
-class Prob3dmotParams:
+class Prob3dmotParams(Section):
     """Probabilistic 3D MOT (Chiu, Prioletti, Li & Bohg, 2020; ``gnnpmb.box.prob3dmot``); its per-class noise is
-    ``[box_noise.<class>]``.
+    ``[box_noise.<class>]``; min_hits and max_misses as ``[ab3dmot]`` (AB3DMOT's 3 and 2)."""
 
-    distance_threshold: a pair is matched only if the Mahalanobis distance sqrt(nu^T S^-1 nu) of the 7-D box
-    residual is below this (11). min_hits, max_misses: as ``[ab3dmot]`` (AB3DMOT's 3 and 2).
-    """
+    SECTION = "prob3dmot"
 
-    distance_threshold: float = 11.0
-    min_hits: int = 3
-    max_misses: int = 2
-
-    def __post_init__(self) -> None:
-        validate_section(self, "prob3dmot")
+    distance_threshold: float = param(
+        11.0, "a matched pair's box Mahalanobis distance sqrt(nu' S^-1 nu) is below this", POSITIVE, limit=SQUARED_LIMIT
+    )
+    min_hits: int = param(3, _MIN_HITS, at_least(0))
+    max_misses: int = param(2, _MAX_MISSES, at_least(1))
 
 
 @dataclass(frozen=True, slots=True)
-class SimpleTrackParams:
+class SimpleTrackParams(Section):
     """SimpleTrack (Pang, Li & Wang, 2021; ``gnnpmb.box.simpletrack``), its nuScenes 2 Hz configurations
     (``configs/nu_configs/giou.yaml`` and ``velo_giou.yaml``); ImmortalTracker reads them too.
 
-    giou_threshold: a pair is matched only if the 3D GIoU of the detection and the track's box is at least this
-    (its 1 - GIoU <= 1.5). first_stage_score: detections scoring below it take no part in the first stage and
-    start no track (its score_threshold 0.01, below the preprocessing threshold, so by default every kept
-    detection does). min_hits: a track is output from its min_hits-th hit on (0: at once). max_misses: a track
-    missed this many frames in a row is deleted (its max_age_since_update). miss_score_factor: a missed track's
-    score is multiplied by this each missed frame (0.01). two_stage: 1 = the second association stage (its "mm"
-    redundancy mode; off in both nuScenes 2 Hz configurations): a track the first stage left unmatched stays
-    alive, not updated by the detection, when a detection scoring above second_stage_score has GIoU >=
-    second_stage_giou with it. detector_velocity: the motion model, 1 = its "velo" model (``velo_giou.yaml``: a
-    track is its last detection moved by that detection's velocity, and detections are stepped back by their own
-    velocity to meet the tracks; the SimpleTrack paper finds this the more robust model at low frame rates), 0 =
-    its Kalman filter (``giou.yaml``). 1 was chosen on the demo mini_train split (centerpoint / pointpillars
-    presets, seed 0: simpletrack AMOTA 0.753 / 0.602 against 0.697 / 0.522 with the Kalman filter; immortal 0.822
-    / 0.682 against 0.771 / 0.659): at 2 Hz a new Kalman track has no velocity, so a fast, small object (a
-    motorcycle moving 5 m per keyframe) misses its second detection's GIoU gate.
+    giou_threshold -0.5 is its 1 - GIoU <= 1.5; first_stage_score 0.01 is its score_threshold, below the
+    preprocessing threshold, so by default every kept detection takes part. two_stage = 1 is its "mm" redundancy
+    mode (off in both nuScenes 2 Hz configurations): a track the first stage left unmatched stays alive, not
+    updated by the detection, when a detection scoring above second_stage_score has GIoU >= second_stage_giou
+    with it. detector_velocity = 1 is its "velo" model (``velo_giou.yaml``: a track is its last detection moved by
+    that detection's velocity, and detections are stepped back by their own velocity to meet the tracks; the
+    SimpleTrack paper finds this the more robust model at low frame rates), 0 its Kalman filter (``giou.yaml``).
+    1 was chosen on the demo mini_train split (centerpoint / pointpillars presets, seed 0: simpletrack AMOTA 0.753
+    / 0.602 against 0.697 / 0.522 with the Kalman filter; immortal 0.822 / 0.682 against 0.771 / 0.659): at 2 Hz
+    a new Kalman track has no velocity, so a fast, small object (a motorcycle moving 5 m per keyframe) misses its
+    second detection's GIoU gate.
     """
 
-    giou_threshold: float = -0.5
-    first_stage_score: float = 0.01
-    min_hits: int = 0
-    max_misses: int = 2
-    miss_score_factor: float = 0.01
-    two_stage: int = 0
-    second_stage_score: float = 0.1
-    second_stage_giou: float = -0.5
-    detector_velocity: int = 1
+    SECTION = "simpletrack"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "simpletrack")
+    giou_threshold: float = param(-0.5, "a matched pair's 3D GIoU is at least this", GIOU)
+    first_stage_score: float = param(0.01, "detections below it skip the first stage and start no track", PROB)
+    min_hits: int = param(0, _MIN_HITS + " (0: at once)", at_least(0))
+    max_misses: int = param(2, _MAX_MISSES + " (its max_age_since_update)", at_least(1))
+    miss_score_factor: float = param(0.01, "a missed track's score is multiplied by this each frame", PROB)
+    two_stage: int = param(0, "1 = the second association stage", SWITCH)
+    second_stage_score: float = param(0.1, "least score of a second-stage detection", PROB)
+    second_stage_giou: float = param(-0.5, "least GIoU of a second-stage pair", GIOU)
+    detector_velocity: int = param(1, "motion model: 1 = the detector's velocity, 0 = the Kalman filter", SWITCH)
 
 
 @dataclass(frozen=True, slots=True)
-class ImmortalParams:
+class ImmortalParams(Section):
     """ImmortalTracker (Wang, Chen, Pang, Wang & Zhang, 2021; ``gnnpmb.box.simpletrack``): SimpleTrack
     (``[simpletrack]``, its motion model included: ImmortalTracker's own code has only the Kalman filter,
     ``[simpletrack] detector_velocity = 0``) whose tracks are never deleted (its ``configs/nu_configs/
-    immortal.yaml``).
-
-    min_hits: as SimpleTrack's (1). output_max_misses: a track is output while it has been missed at most this
-    many frames in a row (1: its nuScenes result creation keeps tracks updated at most one frame ago).
+    immortal.yaml``; its nuScenes result creation keeps tracks updated at most one frame ago).
     """
 
-    min_hits: int = 1
-    output_max_misses: int = 1
+    SECTION = "immortal"
 
-    def __post_init__(self) -> None:
-        validate_section(self, "immortal")
+    min_hits: int = param(1, _MIN_HITS, at_least(0))
+    output_max_misses: int = param(1, "a track is output while missed at most this many frames in a row", at_least(0))
 
 
 @dataclass(frozen=True, slots=True)
-class CbmotParams:
+class CbmotParams(Section):
     """CBMOT (Benbarka, Schröder & Zell, "Score refinement for confidence-based 3D multi-object tracking", IROS
-    2021; ``gnnpmb.cbmot``), its LiDAR-only configuration (multiplication score update, score decay 0.2).
+    2021; ``gnnpmb.cbmot``), its LiDAR-only configuration (multiplication score update, score decay 0.2)."""
 
-    score_decay: subtracted from a track's score every frame before the update. max_misses: a track missed this
-    many frames in a row is deleted (its max_age, 40). delete_score: a missed track whose score falls to or below
-    this is deleted (0).
-    """
+    SECTION = "cbmot"
 
-    score_decay: float = 0.2
-    max_misses: int = 40
-    delete_score: float = 0.0
+    score_decay: float = param(0.2, "subtracted from a track's score every frame before the update", PROB)
+    max_misses: int = param(40, _MAX_MISSES + " (its max_age)", at_least(1))
+    delete_score: float = param(0.0, "a missed track scoring at or below this is deleted", unit_interval(True, False))
 
-    def __post_init__(self) -> None:
-        validate_section(self, "cbmot")
-
-
-PAPER_MODELS = ModelParams(p_survive=0.7, birth_weight=0.1, motion_model=0)
-PAPER_PMB = PmbParams(
-    extraction_threshold=0.9,
-    miss_p_detect_max=1.0,
-    measure_velocity=0,
-    miss_score_decay=1.0,
-    heading_std_rad=0.0,
-    size_log_std=0.0,
-    gate_giou_min=-1.0,
-)
-PAPER_PMBM = PmbmParams(n_hypotheses=100)
-"""The paper's ``[models]``, ``[pmb]`` and ``[pmbm]`` values (sec. V-B, Table II), where the defaults differ
-(``gnnpmb/params/paper.toml``)."""
 
 Overrides = dict[str, dict[str, dict[str, float]]]
 """Per-class overrides of shared-section keys: class name -> section -> key -> value."""
@@ -676,24 +550,14 @@ class TrackerConfig:
 def paper_config() -> TrackerConfig:
     """The defaults with the paper's own ``[models]``, ``[pmb]`` and ``[pmbm]`` values: the trackers exactly as
     published."""
-    return TrackerConfig(models=PAPER_MODELS, pmb=PAPER_PMB, pmbm=PAPER_PMBM)
+    changes = {name: kind(**paper_values(kind)) for name, kind in _SECTIONS.items() if paper_values(kind)}
+    return TrackerConfig(**changes)
 
 
 _SECTIONS: dict[str, type] = {
-    "preprocess": PreprocessParams,
-    "models": ModelParams,
-    "pmb": PmbParams,
-    "pmbm": PmbmParams,
-    "lbp": LbpParams,
-    "phd": PhdParams,
-    "vector": VectorParams,
-    "greedy": GreedyParams,
-    "ab3dmot": Ab3dmotParams,
-    "prob3dmot": Prob3dmotParams,
-    "simpletrack": SimpleTrackParams,
-    "immortal": ImmortalParams,
-    "cbmot": CbmotParams,
+    f.name: type(f.default) for f in dataclasses.fields(TrackerConfig) if isinstance(f.default, Section)
 }
+"""The shared sections, in file order: name -> its dataclass (whose ``SECTION`` is that name)."""
 
 MOVED_KEYS: dict[tuple[str, str], str] = {("pmb", f.name): "models" for f in dataclasses.fields(ModelParams)}
 """(old section, key) -> the section the key lives in now; parameter files and dotted names may still use the old
@@ -712,25 +576,26 @@ for _section, _kind in _SECTIONS.items():
 
 
 def _typed_value(kind: type, key: str, value: Any, where: str) -> float | int:
-    """``value`` as the type of field ``key`` of ``kind`` (int or float), or a ``ConfigError``."""
-    known = {f.name: f for f in dataclasses.fields(kind)}
+    """``value`` as the declared type of parameter ``key`` of section ``kind``, checked against its declared
+    range, or a ``ConfigError``."""
+    known = {d.name: d for d in declared(kind)}
     if key not in known:
         raise ConfigError(f"{where}: unknown parameter '{key}' (known: {', '.join(sorted(known))})")
-    want = int if known[key].type in ("int", int) else float
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ConfigError(f"{where} {key}: expected a number, got {value!r}")
-    if want is int and not float(value).is_integer():
+    if known[key].type is int and not float(value).is_integer():
         raise ConfigError(f"{where} {key}: expected an integer, got {value!r}")
-    return want(value)
+    typed = known[key].type(value)
+    known[key].spec.check(key, typed, where)
+    return typed
 
 
-def _typed_section(kind: type, section: str, values: Any, where: str, base: Any) -> Any:
+def _typed_section(kind: type, values: Any, where: str, base: Any) -> Any:
     if not isinstance(values, dict):
         raise ConfigError(f"{where} must be a table of parameters, got {values!r}")
     changes = {}
     for key, value in values.items():
         changes[key] = _typed_value(kind, key, value, where)
-        check_value(section, key, changes[key], where)
     return dataclasses.replace(base, **changes)
 
 
@@ -748,7 +613,6 @@ def _class_table(name: str, values: Any, params: ClassParams, overrides: dict[st
             for sub_key, sub_value in value.items():
                 section = current_section(key, sub_key)
                 typed = _typed_value(_SECTIONS[section], sub_key, sub_value, f"[classes.{name}.{key}]")
-                check_value(section, sub_key, typed, f"[classes.{name}.{key}]")
                 overrides.setdefault(section, {})[sub_key] = typed
             continue
         sections = _SECTIONS_OF_KEY.get(key, ())
@@ -761,9 +625,8 @@ def _class_table(name: str, values: Any, params: ClassParams, overrides: dict[st
                 f"sub-table such as [classes.{name}.{sections[0]}]"
             )
         typed = _typed_value(_SECTIONS[sections[0]], key, value, where)
-        check_value(sections[0], key, typed, where)
         overrides.setdefault(sections[0], {})[key] = typed
-    return _typed_section(ClassParams, "classes", model, where, params)
+    return _typed_section(ClassParams, model, where, params)
 
 
 def _box_noise_tables(values: Any, base: dict[str, BoxNoise]) -> dict[str, BoxNoise]:
@@ -774,7 +637,7 @@ def _box_noise_tables(values: Any, base: dict[str, BoxNoise]) -> dict[str, BoxNo
     for name, table in values.items():
         if name not in TRACKING_CLASSES:
             raise ConfigError(f"[box_noise.{name}]: unknown class (known: {', '.join(TRACKING_CLASSES)})")
-        out[name] = _typed_section(BoxNoise, "box_noise", table, f"[box_noise.{name}]", out[name])
+        out[name] = _typed_section(BoxNoise, table, f"[box_noise.{name}]", out[name])
     return out
 
 
@@ -813,7 +676,7 @@ def config_from_dict(data: Mapping[str, Any], base: TrackerConfig | None = None)
                 by_section.setdefault(section, {})[sub_key] = value
             for section, section_values in by_section.items():
                 base_section = changes.get(section, getattr(cfg, section))
-                changes[section] = _typed_section(_SECTIONS[section], section, section_values, f"[{key}]", base_section)
+                changes[section] = _typed_section(_SECTIONS[section], section_values, f"[{key}]", base_section)
         else:
             raise ConfigError(f"unknown section [{key}] (known: classes, box_noise, {', '.join(_SECTIONS)})")
     out = cfg.replace(**changes)

@@ -2,14 +2,14 @@
 
 Every tracker is a ``skeleton.ClassFilter``, whose ``step(measurements, dt_s, sink) -> list[TrackEstimate]`` is
 the one frame loop; a family writes its hooks. The PMB family shares ``pmb.core.PmbCore`` and differs only in
-the hypothesis strategy (paper sec. III-IV). Adding a tracker: its ``ClassFilter`` subclass (or strategy), one
-factory here, one line in ``TRACKER_DESCRIPTIONS``.
+the hypothesis strategy (paper sec. III-IV). Adding a tracker: its ``ClassFilter`` subclass (or strategy) and
+one entry in ``_TRACKERS``.
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
+import importlib
 from typing import TYPE_CHECKING
 
 from gnnpmb.classes import TRACKING_CLASSES
@@ -22,124 +22,67 @@ if TYPE_CHECKING:  # numpy-heavy; the CLI imports this module for its help text
     from gnnpmb.types import IdAllocator
 
 
-def _gnnpmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.pmb.core import PmbCore
-    from gnnpmb.pmb.gnnpmb import BestAssignment
-
-    return PmbCore(class_name, config, BestAssignment(), ids)
-
-
-def _pmbm(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.pmb.core import PmbCore
-    from gnnpmb.pmb.pmbm import KBest
-
-    return PmbCore(class_name, config, KBest(config.pmbm), ids)
-
-
-def _topmb(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.pmb.core import PmbCore
-    from gnnpmb.pmb.topmb import MarginalMerge
-
-    return PmbCore(class_name, config, MarginalMerge(config.lbp), ids)
-
-
-def _phd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.phd.gmphd import GmPhdTracker
-
-    return GmPhdTracker(class_name, config, ids)
-
-
-def _cphd(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.phd.cphd import CphdTracker
-
-    return CphdTracker(class_name, config, ids)
-
-
-def _jpda(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.vector.jpda import JpdaTracker
-
-    return JpdaTracker(class_name, config, ids)
-
-
-def _gnn(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.vector.gnn import GnnTracker
-
-    return GnnTracker(class_name, config, ids)
-
-
-def _greedy(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.greedy import GreedyTracker
-
-    return GreedyTracker(class_name, config, ids)
-
-
-def _ab3dmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.box.ab3dmot import make
-
-    return make(class_name, config, ids)
-
-
-def _prob3dmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.box.prob3dmot import make
-
-    return make(class_name, config, ids)
-
-
-def _simpletrack(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.box.simpletrack import make_simpletrack
-
-    return make_simpletrack(class_name, config, ids)
-
-
-def _immortal(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.box.simpletrack import make_immortal
-
-    return make_immortal(class_name, config, ids)
-
-
-def _cbmot(class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
-    from gnnpmb.cbmot import CbmotTracker
-
-    return CbmotTracker(class_name, config, ids)
-
-
-_FACTORIES: dict[str, Callable[[str, TrackerConfig, IdAllocator], ClassFilter]] = {
-    "gnnpmb": _gnnpmb,
-    "pmbm": _pmbm,
-    "topmb": _topmb,
-    "phd": _phd,
-    "cphd": _cphd,
-    "jpda": _jpda,
-    "gnn": _gnn,
-    "greedy": _greedy,
-    "ab3dmot": _ab3dmot,
-    "prob3dmot": _prob3dmot,
-    "simpletrack": _simpletrack,
-    "immortal": _immortal,
-    "cbmot": _cbmot,
+_TRACKERS: dict[str, tuple[str, str]] = {
+    "gnnpmb": (
+        "gnnpmb.pmb.gnnpmb:BestAssignment",
+        "GNN-PMB: PMB keeping the single best global hypothesis (Hungarian)",
+    ),
+    "pmbm": ("gnnpmb.pmb.pmbm:KBest", "PMBM: up to N_h global hypotheses from Murty's k-best assignments"),
+    "topmb": ("gnnpmb.pmb.topmb:MarginalMerge", "TO-PMB: track-oriented PMB, marginals by loopy belief propagation"),
+    "phd": ("gnnpmb.phd.gmphd:GmPhdTracker", "GM-PHD: Gaussian-mixture probability hypothesis density filter"),
+    "cphd": ("gnnpmb.phd.cphd:CphdTracker", "GM-CPHD: cardinalised PHD filter"),
+    "jpda": ("gnnpmb.vector.jpda:JpdaTracker", "JPDA: joint probabilistic data association with M/N track logic"),
+    "gnn": ("gnnpmb.vector.gnn:GnnTracker", "GNN: global nearest neighbour Kalman trackers with M/N track logic"),
+    "greedy": (
+        "gnnpmb.greedy:GreedyTracker",
+        "greedy: CenterPoint's closest-pair matching of velocity-projected detection centres",
+    ),
+    "ab3dmot": (
+        "gnnpmb.box.ab3dmot:make",
+        "AB3DMOT: 3D IoU, Hungarian, 10-D box Kalman filter, birth and death by hits and misses",
+    ),
+    "prob3dmot": (
+        "gnnpmb.box.prob3dmot:make",
+        "Probabilistic 3D MOT: Mahalanobis distance, greedy matching, noise learned per class",
+    ),
+    "simpletrack": (
+        "gnnpmb.box.simpletrack:make_simpletrack",
+        "SimpleTrack: 3D GIoU, Hungarian, NMS, detector-velocity motion model, score decay",
+    ),
+    "immortal": (
+        "gnnpmb.box.simpletrack:make_immortal",
+        "ImmortalTracker: SimpleTrack whose tracks are never deleted, predicted while unseen",
+    ),
+    "cbmot": (
+        "gnnpmb.cbmot:CbmotTracker",
+        "CBMOT: CenterPoint's greedy tracker with confidence-based score refinement",
+    ),
 }
+"""Tracker name -> (``module:callable`` building its ``ClassFilter`` from (class name, config, ids), or for the
+PMB family its hypothesis strategy, ``_PMB_STRATEGY_SECTION``; one-line description). Modules are imported on
+first use: the CLI imports this module for its help text."""
 
-TRACKER_NAMES: tuple[str, ...] = tuple(_FACTORIES)
+_PMB_STRATEGY_SECTION: dict[str, str | None] = {"gnnpmb": None, "pmbm": "pmbm", "topmb": "lbp"}
+"""The PMB family (``pmb.core.PmbCore`` with a strategy): the config section its strategy is built from."""
 
-TRACKER_DESCRIPTIONS: dict[str, str] = {
-    "gnnpmb": "GNN-PMB: PMB keeping the single best global hypothesis (Hungarian)",
-    "pmbm": "PMBM: up to N_h global hypotheses from Murty's k-best assignments",
-    "topmb": "TO-PMB: track-oriented PMB, marginals by loopy belief propagation",
-    "phd": "GM-PHD: Gaussian-mixture probability hypothesis density filter",
-    "cphd": "GM-CPHD: cardinalised PHD filter",
-    "jpda": "JPDA: joint probabilistic data association with M/N track logic",
-    "gnn": "GNN: global nearest neighbour Kalman trackers with M/N track logic",
-    "greedy": "greedy: CenterPoint's closest-pair matching of velocity-projected detection centres",
-    "ab3dmot": "AB3DMOT: 3D IoU, Hungarian, 10-D box Kalman filter, birth and death by hits and misses",
-    "prob3dmot": "Probabilistic 3D MOT: Mahalanobis distance, greedy matching, noise learned per class",
-    "simpletrack": "SimpleTrack: 3D GIoU, Hungarian, NMS, detector-velocity motion model, score decay",
-    "immortal": "ImmortalTracker: SimpleTrack whose tracks are never deleted, predicted while unseen",
-    "cbmot": "CBMOT: CenterPoint's greedy tracker with confidence-based score refinement",
-}
+TRACKER_NAMES: tuple[str, ...] = tuple(_TRACKERS)
+
+TRACKER_DESCRIPTIONS: dict[str, str] = {name: description for name, (_, description) in _TRACKERS.items()}
+
+
+def _build(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
+    module, _, attribute = _TRACKERS[name][0].partition(":")
+    make = getattr(importlib.import_module(module), attribute)
+    if name not in _PMB_STRATEGY_SECTION:
+        return make(class_name, config, ids)
+    from gnnpmb.pmb.core import PmbCore
+
+    section = _PMB_STRATEGY_SECTION[name]
+    return PmbCore(class_name, config, make() if section is None else make(getattr(config, section)), ids)
 
 
 def check_tracker(name: str) -> str:
-    if name not in _FACTORIES:
+    if name not in _TRACKERS:
         raise UnknownNameError(f"unknown tracker '{name}'; choose one of: {', '.join(TRACKER_NAMES)}")
     return name
 
@@ -193,4 +136,4 @@ def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool, bool]:
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     """Tracker ``name`` for class ``class_name``; it sees ``config`` with that class's overrides applied."""
-    return _FACTORIES[check_tracker(name)](class_name, config.resolved(class_name), ids)
+    return _build(check_tracker(name), class_name, config.resolved(class_name), ids)

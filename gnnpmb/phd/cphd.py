@@ -186,9 +186,28 @@ def poisson_pmf(mean: float, tail: float = CARDINALITY_TAIL) -> np.ndarray:
     return trim_pmf(np.exp(-mean + n * math.log(mean) - gammaln(n + 1)), tail)
 
 
+_LOG_SMALLEST = math.log(np.finfo(float).tiny)
+"""Below this log-probability a pmf entry underflows float64."""
+
+
+def check_birth_fits(birth_mean: float, max_cardinality: int) -> None:
+    """Refuse a Poisson birth count whose pmf on 0..max_cardinality underflows to zero (its largest entry there,
+    at n = max_cardinality once the mean is beyond it, is below float64's smallest number): the predicted
+    cardinality would be 0 / 0."""
+    if birth_mean <= max_cardinality:
+        return
+    n = max_cardinality
+    if -birth_mean + n * math.log(birth_mean) - float(gammaln(n + 1)) < _LOG_SMALLEST:
+        raise ConfigError(
+            f"the CPHD's birth count (mean {birth_mean:.4g}: [models] birth_weight x the frame's detections) "
+            f"lies beyond [phd] max_cardinality = {max_cardinality}; lower birth_weight or raise max_cardinality"
+        )
+
+
 def predict_cardinality(pmf: np.ndarray, p_survive: float, birth_mean: float, max_cardinality: int) -> np.ndarray:
     """Vo, Vo & Cantoni 2007, eq. 13: binomial survival thinning of ``pmf`` (N + 1,) convolved with a Poisson birth
     count of mean ``birth_mean``, cut at ``max_cardinality`` and renormalised."""
+    check_birth_fits(birth_mean, max_cardinality)
     n_max = len(pmf) - 1
     lag, valid = _lags(n_max)
     ell = np.arange(n_max + 1)
