@@ -17,8 +17,6 @@ from cli.diff import register as register_diff
 from cli.errors import entry_point
 from cli.failures import register as register_failures
 from cli.options import (
-    DEFAULT_DETECTOR,
-    DEFAULT_TRACKER,
     AddressOption,
     DatarootOption,
     DetectionsOption,
@@ -35,6 +33,7 @@ from cli.study import VerboseOption, register
 from cli.tune import register as register_tune
 from gnnpmb.eval.nuscenes_eval import default_split
 from gnnpmb.outputs import check_output_dir, check_output_file
+from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER
 
 if TYPE_CHECKING:  # rich, numpy and the devkit load only on the paths that use them (fast --help)
     pass

@@ -16,8 +16,6 @@ from rich.table import Table
 
 from cli.errors import announce_stop
 from cli.options import (
-    DEFAULT_DETECTOR,
-    DEFAULT_TRACKER,
     AddressOption,
     DatarootOption,
     DetectionsOption,
@@ -30,6 +28,7 @@ from cli.options import (
     stdout_console,
 )
 from cli.progress import progress_bar
+from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER
 
 if TYPE_CHECKING:
     pass

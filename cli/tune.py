@@ -13,8 +13,6 @@ from rich.table import Table
 
 from cli.errors import announce_stop
 from cli.options import (
-    DEFAULT_DETECTOR,
-    DEFAULT_TRACKER,
     AddressOption,
     DatarootOption,
     DetectionsOption,
@@ -35,6 +33,7 @@ from cli.study import (
     train_split,
 )
 from gnnpmb.errors import GnnpmbError
+from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER
 
 if TYPE_CHECKING:
     from gnnpmb.study.data import StudyData
