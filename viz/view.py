@@ -33,6 +33,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
     import numpy as np
 
     from gnnpmb.data.nuscenes import load_lidar_points
+    from gnnpmb.data.sensor_files import lidar_presence
     from gnnpmb.events import TeeSink
     from gnnpmb.pipeline import TrackingRun
     from gnnpmb.why.reason import explain_failure
@@ -51,7 +52,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
     )
     from viz.provenance import log_provenance
     from viz.recording import recording
-    from viz.scene import log_scene
+    from viz.scene import lidar_notice, log_scene
     from viz.timeline import PLAIN_CLOCK, Clock
 
     scene, frame_range = request.scene, request.frame_range
@@ -62,6 +63,16 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
     elif failures:  # a full recording opens at its first failure worth a look (viz.opening)
         opening, reports, notices = resolve_opening(request)
     shown = focus.window(frame_range) if focus is not None else frame_range
+    # Missing LiDAR files are drawn around, said once (gnnpmb.data.sensor_files); damaged ones stay an error.
+    lidar = lidar_presence(scene, shown)
+    sensor_note = lidar_notice(lidar)
+    if sensor_note is not None:
+        notices = [*notices, sensor_note]
+    points_loader = None
+    if not lidar.absent:
+        points_loader = (
+            load_lidar_points if lidar.complete else lambda k: load_lidar_points(k) if lidar.has(k.index) else None
+        )
     start = focus or opening
     clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
     n = len(shown)
@@ -96,9 +107,10 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
             scene,
             [request.frame_detections[i] for i in shown],
             shown,
-            points_loader=load_lidar_points,
+            points_loader=points_loader,
             on_frame=lambda: bar.advance(sensors),
             clock=clock,
+            sensor_note=sensor_note,
         )
         for tracker in request.trackers:
             task = bar.add_task(f"{scene.name} {tracker}", total=len(frame_range))
