@@ -127,6 +127,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                 has_existence=caps[tracker].has_existence,
                 focus_class=focus.class_name if focus is not None else None,
                 facts=sink.facts,
+                label_tracks=focus is not None,  # a full recording labels only what its failures note
             )
             runs.append(track_run(request, tracker, TeeSink(sink, logger), lambda task=task: bar.advance(task)))
             logger.finish()
@@ -141,9 +142,8 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                 comparison.within(shown),
                 scene,
                 clock,
-                show_labels=focus is None,
+                show_labels=False,  # "only in one run" is the marker's colour; its words are a click away
                 focus_class=focus.class_name if focus is not None else None,
-                notes=notes,
             )
         if failures or focus is not None:
             for k, (name, report) in enumerate(reports.items()):
@@ -163,7 +163,9 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                     opened = opening.failure_id if opening is not None else None
                     log_failure_index(stream, name, report, opened, k == 0, shown)
                     log_lost_tracks(stream, name, ghosts[name], notes, scene, clock, shown)
-                    log_failure_timeline(stream, name, report, scene, clock, shown, opened if k == 0 else None)
+                    log_failure_timeline(
+                        stream, name, report, scene, clock, shown, opened if k == 0 else None, len(request.trackers)
+                    )
         if notes is not None:
             notes.send(stream, clock, scene)
         if focus is not None:
