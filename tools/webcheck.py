@@ -339,21 +339,35 @@ def _wait_for_http(url: str, timeout_s: float, proc: subprocess.Popen[bytes], wh
         time.sleep(0.25)
 
 
+class DevToolsBusy(WebCheckError):
+    """The page did not answer a DevTools command in time (its thread busy rendering); ask again later."""
+
+
 class DevTools:
     """A minimal Chrome DevTools protocol client over one page's websocket: ``call`` sends a command and waits
-    for its reply (events in between are ignored)."""
+    for its reply (events in between are ignored). A reply can take minutes: software WebGL on a busy 2-core
+    machine holds the page's thread that long while the recording streams in, so a poll without a reply in
+    ``timeout_s`` is skipped (``DevToolsBusy``) rather than fatal."""
 
-    def __init__(self, ws_url: str, timeout_s: float = 60.0) -> None:
+    def __init__(self, ws_url: str, timeout_s: float = 90.0) -> None:
         import websocket
 
         self._ws = websocket.create_connection(ws_url, timeout=timeout_s, suppress_origin=True)
         self._ids = itertools.count(1)
 
     def call(self, method: str, **params: Any) -> dict[str, Any]:
+        """The reply to ``method``; DevToolsBusy when none came within the timeout (a later reply to it is
+        skipped by the next call, which waits for its own id)."""
+        import websocket
+
         msg_id = next(self._ids)
         self._ws.send(json.dumps({"id": msg_id, "method": method, "params": params}))
         while True:
-            reply = json.loads(self._ws.recv())
+            try:
+                raw = self._ws.recv()
+            except websocket.WebSocketTimeoutException:
+                raise DevToolsBusy(f"DevTools {method}: no reply yet") from None
+            reply = json.loads(raw)
             if reply.get("id") != msg_id:
                 continue
             if "error" in reply:
@@ -512,13 +526,18 @@ def check_recording(
         while True:
             time.sleep(poll_s)
             elapsed = time.monotonic() - navigated
-            raw = devtools.call("Runtime.evaluate", expression=VIEWER_STATE_JS, returnByValue=True)
-            value = raw.get("result", {}).get("value")
-            if value:
-                state = read_viewer_state(base64.b64decode(value))
-                if loaded is None and expected.met_by(state):
-                    loaded = elapsed
-            png = base64.b64decode(devtools.call("Page.captureScreenshot", format="png")["data"])
+            try:
+                raw = devtools.call("Runtime.evaluate", expression=VIEWER_STATE_JS, returnByValue=True)
+                value = raw.get("result", {}).get("value")
+                if value:
+                    state = read_viewer_state(base64.b64decode(value))
+                    if loaded is None and expected.met_by(state):
+                        loaded = elapsed
+                png = base64.b64decode(devtools.call("Page.captureScreenshot", format="png")["data"])
+            except DevToolsBusy:
+                if elapsed > timeout_s:
+                    break
+                continue
             shots += 1
             _write_atomic(out, png)
             image = decode_png(png)

@@ -343,7 +343,9 @@ def comparison_panel(
     return rrb.Horizontal(counts, log, column_shares=[2, 3], name="comparison")
 
 
-def _tracker_views(tracker: str, focus: FocusTarget | None, strip: range | None = None, rows: int = 1) -> rrb.Container:
+def _tracker_views(
+    tracker: str, focus: FocusTarget | None, strip: range | None = None, rows: int = 1, runs: int = 1
+) -> rrb.Container:
     """The bird's-eye view above the perspective view; with a focus the bird's-eye view, where the failure is
     read, takes more of the height; with ``strip`` (a full recording whose failures were found: its frames) the
     failures over those frames below them, in ``rows`` rows (``viz.opening.log_failure_timeline``)."""
@@ -352,7 +354,7 @@ def _tracker_views(tracker: str, focus: FocusTarget | None, strip: range | None 
     if strip is not None:
         from viz.opening import failure_timeline, timeline_bounds
 
-        x_range, y_range = timeline_bounds(strip, rows)
+        x_range, y_range = timeline_bounds(strip, rows, runs)
         strip_view = rrb.Spatial2DView(
             origin=failure_timeline(tracker),
             name=f"{tracker} failures over time",
@@ -385,7 +387,7 @@ def default_blueprint(
     strips = frames if focus is None and failure_index and frames is not None else None
     panels = [tracker_panel(t, classes, focus, legends, _caps(t, caps), opening, failure_index) for t in trackers]
     rows = timeline_rows or {}
-    scene = rrb.Horizontal(*[_tracker_views(t, focus, strips, rows.get(t, 1)) for t in trackers])
+    scene = rrb.Horizontal(*[_tracker_views(t, focus, strips, rows.get(t, 1), len(trackers)) for t in trackers])
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:

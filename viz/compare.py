@@ -2,16 +2,15 @@
 
 Per kind: the involved boxes (the GT object, or the track only one tracker reports) drawn a little larger than
 the objects in the kind's colour at their frame, under ``world/trackers/<viewer>/comparison/<kind>`` for each
-tracker's views (each labels them in its own terms: a full recording merges what concerns the viewer's own track
-into its label); a per-frame count series
-(``comparison/counts/<kind>``); and one TextLog line per disagreement (``comparison/log``). Everything is sent
-column-wise: a few calls however many disagreements there are.
+tracker's views (the colour says which kind; the words, e.g. "only pmbm: track 92", are the boxes' labels, shown
+on hover, not printed over the view); a per-frame count series (``comparison/counts/<kind>``); and one TextLog
+line per disagreement (``comparison/log``). Everything is sent column-wise: a few calls however many
+disagreements there are.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 import rerun as rr
@@ -21,9 +20,6 @@ from gnnpmb.data.scene import SceneData
 from viz import paths
 from viz.markers import send_counts, send_marker_boxes, send_text_lines
 from viz.timeline import PLAIN_CLOCK, Clock
-
-if TYPE_CHECKING:
-    from viz.opening import LabelNotes
 
 COMPARISON = "comparison"
 KIND_COLORS: dict[DisagreementKind, tuple[int, int, int]] = {
@@ -86,41 +82,18 @@ def marker_label(d: Disagreement) -> str:
     raise AssertionError(d.kind)
 
 
-def track_note(d: Disagreement, viewer: str) -> tuple[int, str] | None:
-    """What disagreement ``d`` says about a track of ``viewer`` drawn on its box, for that track's label (a full
-    recording's ``viz.opening.LabelNotes``): (track id, words), None when it names none of viewer's tracks."""
-    match d.kind:
-        case DisagreementKind.MISSED_BY_ONE if viewer == d.tracker:
-            return d.track_ids[0], f"{d.other} misses it"
-        case DisagreementKind.ONLY_IN_ONE if viewer == d.tracker:
-            return d.track_ids[0], f"{d.other} shows no track here"
-        case DisagreementKind.ID_CHANGE if viewer == d.tracker:
-            old, new, kept = d.track_ids
-            return new, f"was {old}; {d.other} kept {kept}"
-        case DisagreementKind.ID_CHANGE if viewer == d.other:
-            old, new, kept = d.track_ids
-            return kept, f"{d.tracker} switched {old}->{new}"
-    return None
-
-
 def _markers(
-    disagreements: list[Disagreement],
-    frame_indices: tuple[int, ...],
-    viewer: str,
-    notes: LabelNotes | None = None,
+    disagreements: list[Disagreement], frame_indices: tuple[int, ...]
 ) -> tuple[list[Disagreement], list[str], np.ndarray]:
-    """One box per object and frame (labels of several disagreements about it joined; what a note on one of
-    ``viewer``'s drawn tracks carries is left out), and (F,) boxes per frame."""
+    """One box per object and frame (labels of several disagreements about it joined), and (F,) boxes per
+    frame."""
     position = {f: i for i, f in enumerate(frame_indices)}
     boxes: dict[tuple[int, str], Disagreement] = {}
     labels: dict[tuple[int, str], list[str]] = {}
     for d in disagreements:
         key = (d.frame_index, d.gt_id or f"{d.tracker}/{d.track_ids[0]}")
         boxes.setdefault(key, d)
-        said = labels.setdefault(key, [])
-        note = track_note(d, viewer) if notes is not None else None
-        if note is None or not notes.note(viewer, d.frame_index, note[0], note[1]):
-            said.append(marker_label(d))
+        labels.setdefault(key, []).append(marker_label(d))
     keys = sorted(boxes, key=lambda k: (position[k[0]], k[1]))
     lengths = np.zeros(len(frame_indices), dtype=np.int64)
     for frame, _ in keys:
@@ -136,14 +109,12 @@ def log_comparison(
     *,
     show_labels: bool = True,
     focus_class: str | None = None,
-    notes: LabelNotes | None = None,
 ) -> None:
     """Log ``comparison`` (over keyframes of ``scene``) on the recording's timelines (``clock``): per kind a
     count at every compared frame and, for each tracker's views, marker boxes (an empty batch at frames without
-    any), plus the text log. show_labels: show the marker labels (a focus recording labels the involved objects
-    itself); focus_class: also log the disagreements about this class on their own (``focus_log_path``); notes: a
-    full recording's ``viz.opening.LabelNotes``: in a tracker's views, what a disagreement says about its drawn
-    track goes into that track's label (``track_note``), not the marker's."""
+    any), plus the text log. show_labels: show the marker labels (recordings of ``gnnpmb-viz`` do not: which run
+    did what is the marker's colour, its words a click away and in the log); focus_class: also log the
+    disagreements about this class on their own (``focus_log_path``)."""
     frames = np.asarray(comparison.frame_indices, dtype=np.int64)
     stamps = np.array([scene.keyframes[i].timestamp_us for i in frames.tolist()], dtype=np.int64)
     for kind in DisagreementKind:
@@ -152,8 +123,8 @@ def log_comparison(
         found = comparison.of_kind(kind)
         if not found:
             continue
+        boxes, labels, lengths = _markers(found, comparison.frame_indices)
         for viewer in comparison.trackers:
-            boxes, labels, lengths = _markers(found, comparison.frame_indices, viewer, notes)
             send_marker_boxes(
                 stream,
                 clock,

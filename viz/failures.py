@@ -16,7 +16,7 @@ import numpy as np
 import rerun as rr
 
 from gnnpmb.data.scene import SceneData
-from gnnpmb.eval.failures import Failure, FailureBox, FailureKind, FailureReport, short_id
+from gnnpmb.eval.failures import OPEN_FIRST, Failure, FailureBox, FailureKind, FailureReport, short_id
 from viz import paths
 from viz.failure_style import KIND_COLORS, KIND_LABELS, KIND_LEVELS
 from viz.markers import send_counts, send_marker_boxes, send_text_lines
@@ -74,6 +74,32 @@ def _frame_boxes(
     return boxes, labels, lengths
 
 
+def _keep_apart(
+    tracker: str,
+    drawn: dict[FailureKind, tuple[list[FailureBox], list[str], np.ndarray]],
+    notes: LabelNotes,
+    scene: SceneData,
+) -> None:
+    """Blank the marker labels (and drop the track notes, ``LabelNotes.keep_apart``) that would cover a more
+    important label of the same frame in the bird's-eye view (``viz.label_room``); markers that miss never show
+    theirs."""
+    from viz.label_room import Candidate
+
+    markers = []
+    for kind, (boxes, labels, lengths) in drawn.items():
+        if kind is FailureKind.MISS:
+            continue
+        frame_of = np.repeat(np.arange(lengths.size), lengths)
+        rank = OPEN_FIRST.index(kind)
+        for k, (box, text) in enumerate(zip(boxes, labels, strict=True)):
+            if text:
+                xy = (float(box.translation_m[0]), float(box.translation_m[1]))
+                markers.append((int(frame_of[k]), Candidate(rank, ("marker", kind, k), text, xy)))
+    dropped = notes.keep_apart(tracker, scene, markers)
+    for _, kind, k in dropped:
+        drawn[kind][1][k] = ""
+
+
 def log_failures(
     stream: rr.RecordingStream,
     tracker: str,
@@ -114,6 +140,13 @@ def log_failures(
             if f.frame_index in in_range:
                 quiet = f.kind is FailureKind.ID_SWITCH and (f.frame_index, f.gt_ids) in thefts
                 merged[id(f)] = failure_notes(tracker, f, notes, quiet=quiet)
+    drawn: dict[FailureKind, tuple[list[FailureBox], list[str], np.ndarray]] = {}
+    for kind in FailureKind:
+        failures = [f for f in report.of_kind(kind) if f.frame_index in in_range]
+        if failures:
+            drawn[kind] = _frame_boxes(failures, n, merged)
+    if notes is not None:  # the words left on markers and tracks, clear of each other in the bird's-eye view
+        _keep_apart(tracker, drawn, notes, scene)
     for kind in FailureKind:
         color = KIND_COLORS[kind]
         send_counts(
@@ -126,10 +159,9 @@ def log_failures(
             stamps[every_frame],
             report.counts(kind)[every_frame],
         )
-        failures = [f for f in report.of_kind(kind) if f.frame_index in in_range]
-        if not failures:
+        if kind not in drawn:
             continue
-        boxes, labels, lengths = _frame_boxes(failures, n, merged)
+        boxes, labels, lengths = drawn[kind]
         send_marker_boxes(
             stream,
             clock,

@@ -149,7 +149,15 @@ def log_focus(
             facts = views[tracker].facts
             steps = {t: facts.steps(t, focus.class_name).get(i) for t in sorted(ids)}
             ghosts = _log_ghosts(
-                stream, tracker, frames[tracker], i, steps, {e.track_id for e in chosen}, palette, facts.output_only
+                stream,
+                tracker,
+                frames[tracker],
+                i,
+                steps,
+                {e.track_id for e in chosen},
+                palette,
+                facts.output_only,
+                failure_frame=i == focus.frame_index,
             )
             given = {e.meas_index for e in chosen if e.meas_index >= 0}
             given |= {m for s in steps.values() if s is not None for m in s.used}
@@ -296,21 +304,27 @@ def _log_ghosts(
     output: set[int],
     palette: Mapping[int, tuple[int, int, int]],
     output_only: bool = False,
+    failure_frame: bool = False,
 ) -> list[Callout]:
     """A pale box at the predicted position of each involved track the tracker kept but did not output at frame
     ``i``, with the size and heading of its last output box (within ``GHOST_LOOKBACK`` frames): where the
     tracker expected the object, so a label "61 predicted …, missed" points at a track's shape, not at bare
     ground. A run known by its output only (``output_only``) predicts nothing we know of: its involved tracks not
     output are drawn pale at their last output box instead, with a callout ("5 last output at frame 8", returned
-    for the callout column). An empty batch when there is none."""
+    for the callout column). At the failure frame (``failure_frame``) every involved track that was ever output is
+    drawn, its last output box however old: one the tracker no longer predicts (deleted, or it lost the object
+    before) pale there, with the same callout, so the lost track is always on screen. An empty batch when there is
+    none."""
     ghosts, labels, callouts = [], [], []
     for t, step in steps.items():
-        if t in output or (not output_only and (step is None or step.predicted_xy_m is None)):
+        predicted = step is not None and step.predicted_xy_m is not None
+        if t in output or (not output_only and not predicted and not failure_frame):
             continue
+        back = i if failure_frame else GHOST_LOOKBACK
         found = next(
             (
                 (j, e)
-                for j in range(i - 1, max(-1, i - 1 - GHOST_LOOKBACK), -1)
+                for j in range(i - 1, max(-1, i - 1 - back), -1)
                 for e in (frames[j].estimates if j in frames else ())
                 if e.track_id == t
             ),
@@ -319,7 +333,7 @@ def _log_ghosts(
         if found is None:
             continue
         at, last = found
-        if output_only:
+        if output_only or not predicted:
             ghosts.append((t, (float(last.translation_m[0]), float(last.translation_m[1])), last))
             labels.append(f"{t} (last output at frame {at})")
             callouts.append(Callout(tuple(last.translation_m), f"{t} last output at frame {at}", palette[t]))

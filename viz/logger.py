@@ -142,6 +142,7 @@ class TrackerLogger:
         has_existence: bool = True,
         focus_class: str | None = None,
         facts: TrackerFacts | None = None,
+        label_tracks: bool = True,
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
         self.stream = stream
@@ -154,6 +155,9 @@ class TrackerLogger:
         self.clock = clock
         self.log_frames = log_frames
         self.focus_tracks = focus_tracks
+        self.label_tracks = label_tracks
+        """Show every track's id label; False: ids stay data a click away and only the labels a full recording
+        notes (``viz.opening.LabelNotes``: its failures at that frame) are shown."""
         self.flush_frames = flush_frames
         self.has_existence = has_existence
         self.facts = facts if facts is not None else TrackerFacts(tracker_name, has_existence=has_existence)
@@ -698,7 +702,7 @@ class TrackerLogger:
             "class_ids": np.array([CLASS_IDS.get(e.class_name, 0) for e in estimates], dtype=np.uint16),
             "labels": [str(e.track_id) for e in estimates],
             "radii": np.full(n, TRACK_LINE_RADIUS_M, dtype=np.float32),
-        }
+        } | ({} if self.label_tracks else {"show_labels": np.zeros(n, dtype=bool)})
 
     # The decision view.
     def _draw_decisions(

@@ -18,7 +18,7 @@ box.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import rerun as rr
@@ -33,6 +33,7 @@ from viz import paths
 from viz.colors import faded, packed_track_colors
 from viz.failure_style import KIND_COLORS, KIND_LABELS
 from viz.geometry import estimate_boxes
+from viz.label_room import Candidate
 from viz.timeline import FOCUS, FRAME, Clock
 
 LOST_LOOKBACK = 20
@@ -63,19 +64,21 @@ class LabelNotes:
     """Notes to add to the labels of drawn tracks (and of lost tracks drawn pale, ``lost_ghosts``), per run, frame
     and track (module docstring); ``note`` says whether a note could be placed (the track is drawn there), so the
     caller leaves its own label empty. drawn: per run, ``drawn_tracks``; ghosts: per run, the (frame, track id) of
-    its lost tracks drawn pale."""
+    its lost tracks drawn pale (``lost_ghosts``)."""
 
     def __init__(
         self,
         drawn: Mapping[str, Mapping[tuple[int, int], TrackEstimate]],
-        ghosts: Mapping[str, Collection[tuple[int, int]]] | None = None,
+        ghosts: Mapping[str, Mapping[tuple[int, int], tuple[TrackEstimate, tuple[float, float]]]] | None = None,
     ) -> None:
         self.drawn = drawn
         self.ghosts = ghosts or {}
         self.notes: dict[str, dict[tuple[int, int], list[str]]] = defaultdict(dict)
         self.ghost_notes: dict[str, dict[tuple[int, int], list[str]]] = defaultdict(dict)
+        self.ranks: dict[str, dict[tuple[int, int], int]] = defaultdict(dict)
+        """Per run, (frame, track id) -> the rank of its most important note (lower first, ``keep_apart``)."""
 
-    def note(self, tracker: str, frame: int, track_id: int, text: str) -> bool:
+    def note(self, tracker: str, frame: int, track_id: int, text: str, rank: int = 0) -> bool:
         key = (frame, track_id)
         if key in self.drawn.get(tracker, {}):
             into = self.notes[tracker]
@@ -86,7 +89,42 @@ class LabelNotes:
         texts = into.setdefault(key, [])
         if text not in texts:
             texts.append(text)
+        self.ranks[tracker][key] = min(rank, self.ranks[tracker].get(key, rank))
         return True
+
+    def keep_apart(self, tracker: str, scene: SceneData, others: Sequence[tuple[int, Candidate]] = ()) -> set[object]:
+        """Drop the notes of ``tracker`` whose labels would cover a more important one in the bird's-eye view
+        (``viz.label_room.keep_apart``), among them and the (frame, label) ``others`` (e.g. failure markers'); their
+        tracks keep their boxes, and the words their hover text. Returns the keys of the ``others`` left out."""
+        from viz.label_room import keep_apart
+
+        by_frame: dict[int, list[Candidate]] = defaultdict(list)
+        for frame, c in others:
+            by_frame[frame].append(c)
+        left_out: set[object] = set()
+        for key, texts in self.notes[tracker].items():
+            e = self.drawn[tracker][key]
+            text = f"{key[1]} · {'; '.join(texts)}"
+            xy = (float(e.translation_m[0]), float(e.translation_m[1]))
+            by_frame[key[0]].append(Candidate(self.ranks[tracker][key], ("drawn", key), text, xy))
+        ghosts = self.ghosts.get(tracker, {})
+        for key, texts in self.ghost_notes[tracker].items():
+            at = ghosts[key][1]
+            text = f"{key[1]} (lost) · {'; '.join(texts)}"
+            by_frame[key[0]].append(Candidate(self.ranks[tracker][key], ("ghost", key), text, at))
+        for frame, candidates in sorted(by_frame.items()):
+            kept = keep_apart(sorted(candidates, key=lambda c: str(c.key)), scene.keyframes[frame].ego_pose)
+            for c in candidates:
+                if c.key in kept:
+                    continue
+                kind, *key = c.key
+                if kind == "drawn":
+                    self.notes[tracker].pop(key[0])
+                elif kind == "ghost":
+                    self.ghost_notes[tracker].pop(key[0])
+                else:
+                    left_out.add(c.key)
+        return left_out
 
     def has(self, tracker: str, frame: int, track_id: int) -> bool:
         """Whether track ``track_id`` of ``tracker`` is drawn (or drawn pale as lost) at ``frame``."""
@@ -109,7 +147,9 @@ class LabelNotes:
                     paths.track(tracker, class_name, t),
                     frames,
                     stamps,
-                    lambda sel, labels=labels: rr.Boxes3D.columns(labels=[labels[i] for i in sel]),
+                    lambda sel, labels=labels: rr.Boxes3D.columns(
+                        labels=[labels[i] for i in sel], show_labels=np.ones(len(sel), dtype=bool)
+                    ),
                 )
 
 
@@ -121,8 +161,10 @@ def failure_notes(tracker: str, failure: Failure, notes: LabelNotes, *, quiet: b
     gt = short_id(failure.gt_ids[0]) if failure.gt_ids else ""
     merged: set[tuple[str, str]] = set()
 
+    rank = OPEN_FIRST.index(failure.kind)
+
     def put(role: str, track: str, text: str) -> bool:
-        if notes.has(tracker, f, int(track)) if quiet else notes.note(tracker, f, int(track), text):
+        if notes.has(tracker, f, int(track)) if quiet else notes.note(tracker, f, int(track), text, rank):
             merged.add((role, track))
             return True
         return False
@@ -130,22 +172,26 @@ def failure_notes(tracker: str, failure: Failure, notes: LabelNotes, *, quiet: b
     match failure.kind:
         case FailureKind.FALSE_TRACK:
             put("false track", ids[0], "false track")
-        case FailureKind.ID_SWITCH:
-            if put("new track", ids[1], f"ID switch: took GT {gt} from {ids[0]}"):
-                merged.add(("gt", failure.gt_ids[0]))
-            put("old track", ids[0], f"ID switch: lost GT {gt}")
+        case FailureKind.ID_SWITCH:  # one label says both ids: the new track's, else the old one's
+            if put("new track", ids[1], f"ID switch, was {ids[0]}"):
+                merged.update({("gt", failure.gt_ids[0]), ("old track", ids[0])})
+            elif put("old track", ids[0], f"ID switch: GT {gt} went to {ids[1]}"):
+                merged.update({("gt", failure.gt_ids[0]), ("new track", ids[1])})
         case FailureKind.IDENTITY_THEFT:
-            if put("thief track", ids[0], f"identity theft: took GT {gt} from {ids[1]}"):
-                merged.add(("gt", failure.gt_ids[0]))
-            put("victim track", ids[1], f"identity theft: lost GT {gt}")
+            if put("thief track", ids[0], f"identity theft from {ids[1]}"):
+                merged.update({("gt", failure.gt_ids[0]), ("victim track", ids[1])})
+            elif put("victim track", ids[1], f"identity theft: GT {gt} went to {ids[0]}"):
+                merged.update({("gt", failure.gt_ids[0]), ("thief track", ids[0])})
         case FailureKind.COALESCENCE:
-            covers = " and ".join(f"GT {short_id(g)}" for g in failure.gt_ids)
-            if put("track", ids[0], f"coalescence: covers {covers}"):
+            if put("track", ids[0], f"coalescence: {len(failure.gt_ids)} objects"):
                 merged |= {("matched gt", failure.gt_ids[0])} | {("missed gt", g) for g in failure.gt_ids[1:]}
         case FailureKind.FRAGMENTATION:
-            put("track", ids[0], f"fragmentation: lost GT {gt}")
+            if put("track", ids[0], f"fragmentation (GT {gt})"):
+                merged.add(("missed gt", failure.gt_ids[0]))
         case FailureKind.MISS:
             pass
+    if failure.kind in (FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT) and not merged:
+        merged = {(b.role, b.object_id) for b in failure.boxes if b.role != "gt"}  # one label: the object's marker
     return merged
 
 
@@ -274,7 +320,9 @@ def log_lost_tracks(
     frames: Sequence[int],
 ) -> None:
     """The lost tracks (``lost_ghosts``) pale at their failure frames, labelled ``26 (lost) · <notes>``; an empty
-    batch at the other keyframes of ``frames`` (nothing when there is none at all)."""
+    batch at the other keyframes of ``frames`` (nothing when there is none at all). The labels show at a frame only
+    when a failure noted one of them there (a lost track another label names, as an ID switch's new track does,
+    is a pale box whose words are a click away)."""
     if not ghosts:
         return
     every = np.array(list(frames), dtype=np.int64)
@@ -285,10 +333,13 @@ def log_lost_tracks(
     centers = boxes.centers_m.copy()
     centers[:, :2] = np.array([xy for _, (*_, xy) in flat], dtype=np.float64)
     colors = faded(packed_track_colors(np.array([t for _, (t, *_) in flat], dtype=np.int64)), LOST_KEEP)
-    labels = []
+    labels, noted = [], set()
     for i, (t, *_) in flat:
         said = notes.ghost_notes.get(tracker, {}).get((i, t), [])
         labels.append(f"{t} (lost)" + (f" · {'; '.join(said)}" if said else ""))
+        if said:
+            noted.add(i)
+    shown = np.isin(every, list(noted))
     lengths = np.array([len(r) for r in rows], dtype=np.int64)
     starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
 
@@ -304,6 +355,7 @@ def log_lost_tracks(
         ).partition(lengths[sel])
 
     clock.send(stream, lost_tracks(tracker), every, stamps, columns)
+    clock.send(stream, lost_tracks(tracker), every, stamps, lambda sel: rr.Boxes3D.columns(show_labels=shown[sel]))
 
 
 TIMELINE_KINDS: tuple[FailureKind, ...] = OPEN_FIRST
@@ -312,7 +364,12 @@ gets no row)."""
 TICK_EVERY = 5
 """Frame numbers are written under the failure timeline every this many keyframes."""
 LABEL_SPAN = 7.0
-"""Keyframes' worth of room on the left of the failure timeline for the row names."""
+"""Least keyframes' worth of room on the left of the failure timeline for the row names (``label_span``)."""
+SCENE_COLUMN_PX = 0.9 * 1920 * 3 / 5
+"""Width the runs' views share at 1920 px (the scene column, ``viz.blueprint`` 3:2, less a tenth for borders)."""
+NAME_CHAR_PX = 7.0
+"""Width of one character of a row name (egui's default font)."""
+LONGEST_NAME = max(len(f"{name} (999)") for name in KIND_LABELS.values())
 
 
 def failure_timeline(tracker: str) -> str:
@@ -326,10 +383,19 @@ def timeline_rows(report: FailureReport, frames: range) -> list[FailureKind]:
     return rows or [TIMELINE_KINDS[0]]
 
 
-def timeline_bounds(frames: range, rows: int) -> tuple[tuple[float, float], tuple[float, float]]:
-    """(x range, y range) the failure timeline's view shows: every frame and row, the row names on the left and
-    the frame numbers below."""
-    return (frames.start - LABEL_SPAN, frames.stop + 0.5), (-1.0, rows + 0.4)
+def label_span(frames: range, runs: int = 1) -> float:
+    """Keyframes' worth of room on the left of the failure timeline for the longest row name ("identity theft
+    (999)"), centred there: the view is as wide as the scene column shared by ``runs`` runs and shows the frames
+    plus this room, so the room is the name's width over the width left for the frames."""
+    text_px = NAME_CHAR_PX * (LONGEST_NAME + 2)
+    width_px = SCENE_COLUMN_PX / max(runs, 1)
+    return max(LABEL_SPAN, text_px * (len(frames) + 0.5) / max(width_px - text_px, text_px))
+
+
+def timeline_bounds(frames: range, rows: int, runs: int = 1) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(x range, y range) the failure timeline's view shows: every frame and row, the row names on the left
+    (``label_span``, for ``runs`` runs side by side) and the frame numbers below."""
+    return (frames.start - label_span(frames, runs), frames.stop + 0.5), (-1.0, rows + 0.4)
 
 
 def log_failure_timeline(
@@ -340,12 +406,14 @@ def log_failure_timeline(
     clock: Clock,
     frames: range,
     opening: str | None = None,
+    runs: int = 1,
 ) -> None:
     """Where a run's failures are over the whole scene, whatever timeline the viewer is on: one row per kind that
     occurred (``timeline_rows``), a dot in the kind's colour at each frame with failures of that kind (larger for
     more), the frame numbers below, the failure the recording opens at boxed, and a cursor at the current frame
     (the only part that moves with time). A time series would show only the frames of the timeline it is on, and
-    the one a full recording opens on ends at its opening failure."""
+    the one a full recording opens on ends at its opening failure. runs: how many runs' views share the width
+    (``label_span``)."""
     root = failure_timeline(tracker)
     kinds = timeline_rows(report, frames)
     xs, ys, colors, radii = [], [], [], []
@@ -368,7 +436,7 @@ def log_failure_timeline(
     stream.log(
         f"{root}/kinds",
         rr.Points2D(
-            np.column_stack([np.full(len(kinds), frames.start - LABEL_SPAN / 2), np.arange(len(kinds))]),
+            np.column_stack([np.full(len(kinds), frames.start - label_span(frames, runs) / 2), np.arange(len(kinds))]),
             colors=[KIND_COLORS[k] for k in kinds],
             radii=0.01,
             labels=[f"{KIND_LABELS[k]} ({n_of[k]})" for k in kinds],

@@ -14,15 +14,18 @@ import numpy as np
 import rerun as rr
 
 from gnnpmb.data.scene import Keyframe, SceneData
+from gnnpmb.data.sensor_files import LidarPresence
 from gnnpmb.types import Boxes, FrameDetections
+from gnnpmb.why.words import frames_text
 from viz import paths
 from viz.colors import annotation_context, class_colors, class_ids
 from viz.geometry import quat_wxyz_to_xyzw, rerun_boxes
 from viz.pointcloud import DEFAULT_MAX_POINTS, DEFAULT_VOXEL_M, intensity_colors, prepare_sweep
 from viz.timeline import PLAIN_CLOCK, Clock
 
-PointsLoader = Callable[[Keyframe], np.ndarray]
-"""Returns a keyframe's LiDAR sweep as (N, >=4) [x, y, z, intensity, ...] in the sensor frame."""
+PointsLoader = Callable[[Keyframe], np.ndarray | None]
+"""Returns a keyframe's LiDAR sweep as (N, >=4) [x, y, z, intensity, ...] in the sensor frame, or None when its
+file is not on disk (``gnnpmb.data.sensor_files``): that keyframe then shows no points, not the last sweep."""
 
 GT_LINE_RADIUS_M = 0.05
 DETECTION_LINE_RADIUS_M = 0.03
@@ -49,21 +52,31 @@ def log_scene(
     voxel_m: float = DEFAULT_VOXEL_M,
     on_frame: Callable[[], None] | None = None,
     clock: Clock = PLAIN_CLOCK,
+    sensor_note: str | None = None,
 ) -> None:
     """Log the keyframes ``frame_range`` (default: all) of ``scene`` on the timelines of ``clock``.
 
     frame_detections: one entry per logged keyframe, in order (``[f.detections for f in run.frames]``).
     points_loader: reads a keyframe's sweep; without one no LiDAR is logged. Sweeps above max_points are
-    voxel-downsampled (edge voxel_m). on_frame is called after each keyframe (progress bars).
+    voxel-downsampled (edge voxel_m). on_frame is called after each keyframe (progress bars). sensor_note: a line
+    for the scene's document about sensor files that are not on disk (``lidar_notice``).
     """
     indices = frame_range if frame_range is not None else range(len(scene.keyframes))
     if len(frame_detections) != len(indices):
         raise ValueError(f"got {len(frame_detections)} frames of detections for {len(indices)} keyframes")
     log_static_context(stream)
-    stream.log(paths.SCENE_INFO, rr.TextDocument(_scene_markdown(scene), media_type="text/markdown"), static=True)
+    stream.log(
+        paths.SCENE_INFO, rr.TextDocument(_scene_markdown(scene, sensor_note), media_type="text/markdown"), static=True
+    )
     stream.log(
         paths.EGO_BODY,
-        rr.Boxes3D(centers=[EGO_BODY_CENTER_M], sizes=[EGO_BODY_SIZE_XYZ_M], labels=["ego"], colors=[(200, 200, 200)]),
+        rr.Boxes3D(
+            centers=[EGO_BODY_CENTER_M],
+            sizes=[EGO_BODY_SIZE_XYZ_M],
+            labels=["ego"],
+            colors=[(200, 200, 200)],
+            show_labels=False,  # the grey box the views follow; its name is a click away
+        ),
         static=True,
     )
     if len(indices):
@@ -102,9 +115,12 @@ def log_keyframe(
     clock.set(stream, keyframe.index, keyframe.timestamp_us)
     pose = keyframe.ego_pose
     stream.log(paths.EGO, rr.Transform3D(translation=pose.translation_m, quaternion=quat_wxyz_to_xyzw(pose.quat_wxyz)))
-    if points_loader is not None:
-        sweep = prepare_sweep(points_loader(keyframe), max_points=max_points, voxel_m=voxel_m)
+    points = points_loader(keyframe) if points_loader is not None else None
+    if points is not None:
+        sweep = prepare_sweep(points, max_points=max_points, voxel_m=voxel_m)
         stream.log(paths.LIDAR, rr.Points3D(sweep[:, :3], colors=intensity_colors(sweep[:, 3])))
+    elif points_loader is not None:  # this keyframe's file is missing: no points, rather than the last sweep
+        stream.log(paths.LIDAR, rr.Points3D(np.empty((0, 3), dtype=np.float32)))
     stream.log(paths.GT, _gt_boxes(keyframe.gt))
     kept = np.flatnonzero(np.asarray(detections.kept, dtype=bool))
     stream.log(paths.DETECTIONS_KEPT, _detection_boxes(detections.boxes.subset(kept), kept))
@@ -166,9 +182,27 @@ def _detection_boxes(boxes: Boxes, source_index: np.ndarray, reasons: np.ndarray
     )
 
 
-def _scene_markdown(scene: SceneData) -> str:
+def lidar_notice(presence: LidarPresence) -> str | None:
+    """The one line that says which LiDAR files the recording is drawn without (None when none is missing)."""
+    if presence.complete:
+        return None
+    if presence.absent:
+        return (
+            f"{presence.scene_name}: no LiDAR files in this dataroot (looked for {presence.example}; a metadata-only "
+            "download?): boxes, tracks, failures and explanations are drawn without the point cloud"
+        )
+    return (
+        f"{presence.scene_name}: the LiDAR files of {len(presence.missing)} of {len(presence.checked)} keyframes are "
+        f"missing ({frames_text(presence.missing)}; e.g. {presence.example}): those keyframes are drawn without "
+        "points, the others with their sweep"
+    )
+
+
+def _scene_markdown(scene: SceneData, sensor_note: str | None = None) -> str:
     kind = "synthetic demo data" if scene.synthetic else "nuScenes"
+    note = f"- sensor files: {sensor_note.split(': ', 1)[-1]}\n" if sensor_note else ""
     return (
         f"# {scene.name}\n\n{scene.description}\n\n"
         f"- dataset: {kind}, version `{scene.version}`\n- keyframes: {len(scene.keyframes)}\n- token: `{scene.token}`\n"
+        + note
     )

@@ -96,6 +96,7 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
     import numpy as np
 
     from gnnpmb.data.nuscenes import load_lidar_points
+    from gnnpmb.data.sensor_files import lidar_presence
     from viz.blueprint import default_blueprint
     from viz.compare import log_comparison
     from viz.failures import log_failures
@@ -111,7 +112,7 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
     )
     from viz.provenance import log_provenance
     from viz.recording import recording
-    from viz.scene import log_scene
+    from viz.scene import lidar_notice, log_scene
     from viz.timeline import PLAIN_CLOCK, Clock
 
     scene, frame_range = inputs.scene, inputs.frame_range
@@ -127,6 +128,16 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
             reports, notices = find_reports(inputs, runs)
             opening = opening_focus(inputs, runs, reports)
         shown = focus.window(frame_range) if focus is not None else frame_range
+        # Missing LiDAR files are drawn around, said once (gnnpmb.data.sensor_files); damaged ones stay an error.
+        lidar = lidar_presence(scene, shown)
+        sensor_note = lidar_notice(lidar)
+        if sensor_note is not None:
+            notices = [*notices, sensor_note]
+        points_loader = None
+        if not lidar.absent:
+            points_loader = (
+                load_lidar_points if lidar.complete else lambda k: load_lidar_points(k) if lidar.has(k.index) else None
+            )
         start = focus or opening
         clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
         # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
@@ -157,9 +168,10 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
                 scene,
                 [inputs.frame_detections[i] for i in shown],
                 shown,
-                points_loader=load_lidar_points,
+                points_loader=points_loader,
                 on_frame=lambda: bar.advance(sensors),
                 clock=clock,
+                sensor_note=sensor_note,
             )
             for run in runs:
                 logger = loggers[run.name] = TrackerLogger(
@@ -173,6 +185,7 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
                     has_existence=caps[run.name].has_existence,
                     focus_class=focus.class_name if focus is not None else None,
                     facts=run.facts,
+                    label_tracks=focus is not None,  # a full recording labels only what its failures note
                 )
                 run.replay(logger)
                 logger.finish()
@@ -187,9 +200,8 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
                     comparison.within(shown),
                     scene,
                     clock,
-                    show_labels=focus is None,
+                    show_labels=False,  # "only in one run" is the marker's colour; its words are a click away
                     focus_class=focus.class_name if focus is not None else None,
-                    notes=notes,
                 )
             if failures or focus is not None:
                 for k, (name, report) in enumerate(reports.items()):
@@ -209,7 +221,9 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
                         opened_id = opening.failure_id if opening is not None else None
                         log_failure_index(stream, name, report, opened_id, k == 0, shown)
                         log_lost_tracks(stream, name, ghosts[name], notes, scene, clock, shown)
-                        log_failure_timeline(stream, name, report, scene, clock, shown, opened_id if k == 0 else None)
+                        log_failure_timeline(
+                            stream, name, report, scene, clock, shown, opened_id if k == 0 else None, len(runs)
+                        )
             if notes is not None:
                 notes.send(stream, clock, scene)
             if focus is not None:

@@ -15,8 +15,9 @@ from cli.app import main
 from tests.pipeline import prepare, reports_of
 from tests.viz.rrd import at_frame, read_rows
 from tests.viz.test_blueprint import stored_views
+from tools.labels import Recording, overlaps, screen_boxes, view_size_px
 from viz import compare, paths
-from viz.opening import TIMELINE_KINDS, failure_timeline, lost_tracks, timeline_rows
+from viz.opening import TIMELINE_KINDS, failure_timeline, lost_tracks, timeline_bounds, timeline_rows
 from viz.paths import failure_index_doc
 
 SCENE = "scene-0103"
@@ -103,3 +104,45 @@ def test_failures_over_the_whole_scene_whatever_the_timeline(recorded) -> None:
     opened = report.by_id(report.first_worth_opening())
     assert rows[f"{root}/opened"][0]["Boxes2D:centers"] == [[opened.frame_index, kinds.index(opened.kind)]]
     assert sorted({r["frame"] for r in rows[f"{root}/now"] if not r["static"]}) == list(range(40))
+
+
+MOST_LABELS = 15
+"""Issue 31: at most this many labels per view per frame in a full recording."""
+
+
+def test_labels_only_where_they_carry_the_story(recorded) -> None:
+    """Counted as the viewer draws them (``tools.labels``): at most ``MOST_LABELS`` per 3D view and frame, none
+    overlapping in the bird's-eye views' default camera at 1920 x 1080, no comparison sentences, and a labelled
+    track only where a failure of its run names it at that frame."""
+    path, _, reports = recorded
+    rec = Recording(path)
+    views = [v for v in rec.views if v.name.startswith(("gnnpmb ", "jpda "))]
+    assert len(views) == 4
+    failing = {
+        run: {(f.frame_index, t) for f in report.failures for t in f.track_ids} for run, report in reports.items()
+    }
+    size = view_size_px(2)
+    for view in views:
+        run = view.name.split(" ")[0]
+        for frame in sorted(rec.frames):
+            labels = rec.labels(view, frame)
+            assert len(labels) <= MOST_LABELS, (view.name, frame, [label.text for label in labels])
+            for label in labels:
+                assert not label.text.startswith("only ") and "shows no track" not in label.text
+                if "/tracks/" in label.entity:
+                    assert (frame, label.entity.rsplit("/", 1)[1]) in failing[run], (view.name, frame, label.text)
+            if view.birds_eye:
+                assert not overlaps(screen_boxes(rec, view, frame, size)), (view.name, frame)
+
+
+@pytest.mark.parametrize("runs", [1, 2, 3])
+def test_the_failure_timeline_leaves_room_for_its_longest_row_name(runs: int) -> None:
+    """The row names are centred in the room left of frame 0; the view spans that room and the frames over its
+    width (the scene column shared by ``runs``), so the longest name fits: "oalescence (8)" was clipped."""
+    from viz.opening import LONGEST_NAME, NAME_CHAR_PX, SCENE_COLUMN_PX, label_span
+
+    frames = range(40)
+    (x0, x1), _ = timeline_bounds(frames, 4, runs)
+    px_per_frame = SCENE_COLUMN_PX / runs / (x1 - x0)
+    assert label_span(frames, runs) * px_per_frame >= NAME_CHAR_PX * LONGEST_NAME
+    assert x0 == frames.start - label_span(frames, runs) and x1 == frames.stop + 0.5
