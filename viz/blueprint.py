@@ -26,6 +26,7 @@ from gnnpmb.events import Panel
 from gnnpmb.runs import Capabilities, tracker_capabilities
 from viz import compare, paths
 from viz.failures import failure_log
+from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M
 from viz.legend import LegendPlacement
 
 if TYPE_CHECKING:
@@ -35,9 +36,6 @@ EYE_POSITION_M = (-18.0, -14.0, 22.0)
 EYE_TARGET_M = (10.0, 0.0, 0.0)
 """Default camera of the perspective views in the ego frame (x forward, z up): behind, left of and above the car,
 looking at a point 10 m ahead. The views' origin is the ego vehicle, so the camera follows the car."""
-BEV_EYE_POSITION_M = (12.0, 0.0, 80.0)
-BEV_TARGET_M = (12.0, 0.0, 0.0)
-"""Bird's-eye camera in the ego frame: straight down on a point 12 m ahead, forward pointing up the screen."""
 FOCUS_HEIGHT_M: dict[str, float] = {"pedestrian": 16.0, "bicycle": 18.0, "motorcycle": 18.0, "car": 28.0}
 """Height of the bird's-eye camera above a focused place by class (small objects closer)."""
 DEFAULT_FOCUS_HEIGHT_M = 40.0

@@ -1,7 +1,7 @@
 """Room for labels in the bird's-eye view: which of a frame's labels fit side by side without covering each other.
 
 Rerun draws a 3D label centred under its anchor in screen space, at a fixed font size, so in the full recording's
-bird's-eye camera (``viz.blueprint.BEV_EYE_POSITION_M``: 80 m above a point ahead of the ego car, Rerun's default
+bird's-eye camera (``BEV_EYE_POSITION_M``: 80 m above a point ahead of the ego car, Rerun's default
 ``FOV_Y_DEG``, forward up the screen) a label of 15 characters spans about 25 m of ground: two failures a few
 metres apart would print one label over the other. ``keep_apart`` goes through a frame's labels by rank (the
 failure kinds' order, ``gnnpmb.eval.failures.OPEN_FIRST``) and keeps one only if its text box, projected to the
@@ -21,8 +21,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.data.scene import Pose
-from viz.blueprint import BEV_EYE_POSITION_M
 
+BEV_EYE_POSITION_M = (12.0, 0.0, 80.0)
+BEV_TARGET_M = (12.0, 0.0, 0.0)
+"""Bird's-eye camera in the ego frame: straight down on a point 12 m ahead, forward pointing up the screen."""
 FOV_Y_DEG = 55.0
 """Vertical field of view of Rerun's default 3D eye."""
 VIEW_HEIGHT_PX = 380.0
