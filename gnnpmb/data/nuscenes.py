@@ -277,7 +277,7 @@ def load_scene(location: DatasetLocation, scene_name: str) -> SceneData:
 def _scene_data(location: DatasetLocation, part: SceneSlice) -> SceneData:
     samples, anns = part.samples, part.annotations
     name, tokens = part.scene.name, samples.column("token").to_pylist()
-    has_lidar = samples.column("has_lidar").to_numpy(zero_copy_only=False)
+    has_lidar = np.array(samples.column("has_lidar").to_pylist(), dtype=bool)  # to_numpy would import pandas
     if not has_lidar.all():
         missing = tokens[int(np.flatnonzero(~has_lidar)[0])]
         raise DataError(f"sample {missing} of {name} has no {LIDAR_CHANNEL} data; the dataset is incomplete")
@@ -332,9 +332,11 @@ def _demo_hotspots(scene_name: str) -> tuple[ClutterHotspot, ...]:
 
 
 def load_lidar_points(keyframe: Keyframe) -> np.ndarray:
-    """(N, 4) float32 x, y, z, intensity of the keyframe's LIDAR_TOP sweep, in the sensor frame."""
-    from nuscenes.utils.data_classes import LidarPointCloud
+    """(N, 4) float32 x, y, z, intensity of the keyframe's LIDAR_TOP sweep, in the sensor frame.
 
+    Read as the devkit's ``LidarPointCloud.from_file`` reads it (float32 x 5 per point, the ring index dropped),
+    without importing the devkit: ``nuscenes.utils`` pulls in scikit-learn and matplotlib, over a second of a warm
+    ``gnnpmb-viz`` start for a two-line read (``tests/gnnpmb/data/test_nuscenes_loader.py`` holds the two equal)."""
     path = keyframe.lidar_path
     try:
         size = path.stat().st_size
@@ -348,7 +350,7 @@ def load_lidar_points(keyframe: Keyframe) -> np.ndarray:
         )
     if size == 0:
         raise DataError(f"LiDAR file {path} of sample {keyframe.sample_token} is empty (0 points); download it again")
-    points = np.ascontiguousarray(LidarPointCloud.from_file(str(path)).points.T, dtype=np.float32)
+    points = np.ascontiguousarray(np.fromfile(path, dtype=np.float32).reshape(-1, 5)[:, :4])
     bad = int(np.count_nonzero(~np.isfinite(points).all(axis=1)))
     if bad:
         raise DataError(

@@ -176,6 +176,9 @@ def test_load_lidar_points(location: DatasetLocation, tmp_path: Path) -> None:
     raw = np.fromfile(keyframe.lidar_path, dtype=np.float32).reshape(-1, 5)
     assert points.dtype == np.float32 and points.shape == (raw.shape[0], 4)
     assert np.array_equal(points, raw[:, :4])
+    from nuscenes.utils.data_classes import LidarPointCloud
+
+    assert np.array_equal(points, LidarPointCloud.from_file(str(keyframe.lidar_path)).points.T)  # as the devkit reads
 
     truncated = tmp_path / "cut.pcd.bin"
     truncated.write_bytes(keyframe.lidar_path.read_bytes()[:-3])
