@@ -277,7 +277,7 @@ def load_scene(location: DatasetLocation, scene_name: str) -> SceneData:
 def _scene_data(location: DatasetLocation, part: SceneSlice) -> SceneData:
     samples, anns = part.samples, part.annotations
     name, tokens = part.scene.name, samples.column("token").to_pylist()
-    has_lidar = np.array(samples.column("has_lidar").to_pylist(), dtype=bool)  # to_numpy would import pandas
+    has_lidar = samples.column("has_lidar").to_numpy(zero_copy_only=False)
     if not has_lidar.all():
         missing = tokens[int(np.flatnonzero(~has_lidar)[0])]
         raise DataError(f"sample {missing} of {name} has no {LIDAR_CHANNEL} data; the dataset is incomplete")
