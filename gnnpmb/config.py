@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from gnnpmb.errors import GnnpmbError
+from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES
 
 
@@ -869,6 +870,7 @@ def load_config(path: Path | None) -> TrackerConfig:
     if path is None:
         return TrackerConfig()
     path = Path(path)
+    refuse_symlink_loop(path, "parameter file")
     if path.is_dir():
         raise ConfigError(f"parameter file {path} is a folder; pass a .toml file")
     try:

@@ -335,6 +335,7 @@ def prepare_reproduction(
     from gnnpmb.config import config_from_dict
     from gnnpmb.data.nuscenes import check_dataroot, load_scene
     from gnnpmb.pipeline import get_detections, preprocess_frames
+    from gnnpmb.provenance import DetectionsSource, file_sha256
 
     p = provenance
     target = check_output_file(save, "--save", ".rrd") if save is not None else None
@@ -357,8 +358,8 @@ def prepare_reproduction(
         path = Path(detections_file) if detections_file is not None else Path(str(recorded.path))
         if not path.is_file():
             raise DataError(f"the recorded detections file {path} is missing; pass --detections FILE.json")
-        source = detections_source(scene, {}, path, DEFAULT_DETECTOR, p.seed)
-        if source.sha256 != recorded.sha256:
+        source = DetectionsSource("file", file_sha256(path), path=str(Path(path).expanduser().absolute()))
+        if source.sha256 != recorded.sha256:  # the file's bytes hashed now, never a digest kept by a cache
             raise DataError(
                 f"detections file {path} has changed since the recording (sha256 {source.sha256[:12]}, "
                 f"recorded {recorded.sha256[:12]})"
@@ -406,11 +407,11 @@ def recording_name(request: ViewRequest, focus: FocusTarget | None = None) -> st
 
 def provenance_of(request: ViewRequest, digests: dict[str, TrackDigest]) -> Provenance:
     """The provenance of a run of ``request`` whose tracks have ``digests``."""
-    from gnnpmb.provenance import Provenance, package_versions
+    from gnnpmb.provenance import Provenance, recorded_versions
 
     return Provenance(
         argv=request.argv,
-        versions=package_versions(),
+        versions=recorded_versions(),
         config=request.config.as_dict(),
         dataroot=str(request.location.dataroot),
         version=request.location.version,
@@ -469,8 +470,9 @@ def find_reports(
     from gnnpmb.eval.submission import run_results
 
     scene = request.scene
-    if not any(len(k.gt) for k in scene.keyframes):
-        return {}, [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
+    missing = scene.no_ground_truth()
+    if missing is not None:
+        return {}, [missing]
     reports = {}
     keyframes = evaluated_keyframes(request.frame_range, scene)
     for run in runs:
@@ -626,8 +628,16 @@ def digest_report(recorded: dict[str, TrackDigest], now: dict[str, TrackDigest])
 
 
 def version_notes(recorded: dict[str, str]) -> list[str]:
-    """A note for each package whose version differs from the recorded one."""
-    from gnnpmb.provenance import package_versions
+    """A note for each package whose version differs from the recorded one, and one when the ``gnnpmb`` source
+    files differ (``provenance.SOURCE_KEY``), whatever the version says."""
+    from gnnpmb.provenance import SOURCE_KEY, code_differs, package_versions, source_digest
 
-    now = package_versions(tuple(recorded))
-    return [f"note: recorded with {k} {v}, now {now[k]}" for k, v in recorded.items() if now.get(k) != v]
+    packages = {k: v for k, v in recorded.items() if k != SOURCE_KEY}
+    now = package_versions(tuple(packages))
+    notes = [f"note: recorded with {k} {v}, now {now[k]}" for k, v in packages.items() if now.get(k) != v]
+    if code_differs(recorded):
+        notes.append(
+            f"note: recorded with other gnnpmb code (source digest {recorded[SOURCE_KEY]}, now {source_digest()}): "
+            "tracks may differ because the code differs"
+        )
+    return notes

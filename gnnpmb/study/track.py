@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gnnpmb.config import TrackerConfig
+from gnnpmb.errors import DataError
 from gnnpmb.study.data import SceneInputs, SceneRun, StudyData, load_inputs, run_inputs, track_inputs
 from gnnpmb.study.runner import Execution, run_tasks, session
 
@@ -138,6 +139,9 @@ def scene_failures(
 
     data = scene_study(location, scene_name, detections, detector, seed)
     inputs = load_inputs(data, scene_name)
+    missing = inputs.scene.no_ground_truth()
+    if missing is not None:
+        raise DataError(missing)
     frames = frame_range_of(bounds, inputs.scene)
     run = run_inputs(inputs, tracker, config, detector, seed, sink=sink, frame_range=frames)
     keyframes = evaluated_keyframes(frames, inputs.scene)
