@@ -41,7 +41,7 @@ from cli.progress import progress_bar
 from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.runs import parse_runs
-from gnnpmb.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, ServeTarget, check_display
+from gnnpmb.serve import DEFAULT_BIND, DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, ServeTarget, check_bind, check_display
 from gnnpmb.session import (
     DEFAULT_DETECTOR,
     DEFAULT_TRACKER,
@@ -137,8 +137,8 @@ def view(
         bool,
         typer.Option(
             "--serve",
-            help="Serve the web viewer on localhost and print its URL (for a remote machine or no display); "
-            "Ctrl-C stops it.",
+            help="Serve the web viewer on 127.0.0.1 (see --bind) and print its URL (for a remote machine or no "
+            "display); Ctrl-C stops it.",
         ),
     ] = False,
     web_port: Annotated[
@@ -147,6 +147,14 @@ def view(
     grpc_port: Annotated[
         int, typer.Option(metavar="PORT", help="gRPC port the web viewer reads the data from (with --serve).")
     ] = DEFAULT_GRPC_PORT,
+    bind: Annotated[
+        str | None,
+        typer.Option(
+            metavar="ADDRESS",
+            help="With --serve: listen on this IP address (e.g. 0.0.0.0 for every interface, which exposes the "
+            "recording to the network) instead of 127.0.0.1 (this machine only).",
+        ),
+    ] = None,
     failures: Annotated[
         bool,
         typer.Option(help="Find and mark each tracker's failures with the devkit's matching (needs GT)."),
@@ -178,12 +186,14 @@ def view(
         classes=classes,
         frames=frames,
         save=save,
-        serve=ServeTarget(web_port, grpc_port) if serve else None,
+        serve=serve_target(serve, web_port, grpc_port, bind),
         argv=command_line(),
         focus=focus,
     )
     from viz.view import run_view
 
+    if request.serve is not None and request.serve.exposure_warning() is not None:  # after every check passed
+        typer.echo(request.serve.exposure_warning(), err=True)
     result = run_view(request, progress=progress_bar(progress), failures=failures)
     if result.focus is not None:
         typer.echo(f"focus: {result.focus.title}")
@@ -221,6 +231,17 @@ def view(
         wait_for_ctrl_c(request.serve)
 
 
+def serve_target(serve: bool, web_port: int, grpc_port: int, bind: str | None) -> ServeTarget | None:
+    """The ``--serve`` target (None without it); ``--bind`` without ``--serve`` is an error."""
+    from gnnpmb.errors import GnnpmbError
+
+    if not serve:
+        if bind is not None:
+            raise GnnpmbError("--bind only applies with --serve; add --serve or drop --bind")
+        return None
+    return ServeTarget(web_port, grpc_port, check_bind(bind) if bind is not None else DEFAULT_BIND)
+
+
 @reproduce_app.command(help=REPRODUCE_HELP)
 def reproduce(
     recording_file: Annotated[
@@ -242,6 +263,7 @@ def reproduce(
 ) -> None:
     """Re-run a recording's trackers and compare their track digests (``REPRODUCE_HELP``)."""
     from gnnpmb.outputs import check_output_file
+    from gnnpmb.provenance import SOURCE_KEY, code_differs, source_digest
     from viz.provenance import read_provenance
     from viz.view import run_view
 
@@ -262,6 +284,11 @@ def reproduce(
     lines, same = digest_report(provenance.track_digests, digests)
     for line in lines:
         typer.echo(line)
+    if not same and code_differs(provenance.versions):
+        typer.echo(
+            f"the gnnpmb code differs from the recording's (source digest {provenance.versions[SOURCE_KEY]}, now "
+            f"{source_digest()}): run the recorded code to tell a change of code from one of data"
+        )
     if save is not None:
         typer.echo(f"saved {request.save}")
     if not same:
