@@ -42,7 +42,7 @@ from cli.reproduce import COMMAND_LINE, PROG, command_line, reproduce_app
 from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.runs import parse_runs
-from gnnpmb.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, ServeTarget, check_display
+from gnnpmb.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, check_display, serve_target
 from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER, check_request
 
 tidy_help()
@@ -107,8 +107,8 @@ def view(
         bool,
         typer.Option(
             "--serve",
-            help="Serve the web viewer on localhost and print its URL (for a remote machine or no display); "
-            "Ctrl-C stops it.",
+            help="Serve the web viewer on 127.0.0.1 (see --bind) and print its URL (for a remote machine or no "
+            "display); Ctrl-C stops it.",
         ),
     ] = False,
     web_port: Annotated[
@@ -117,6 +117,14 @@ def view(
     grpc_port: Annotated[
         int, typer.Option(metavar="PORT", help="gRPC port the web viewer reads the data from (with --serve).")
     ] = DEFAULT_GRPC_PORT,
+    bind: Annotated[
+        str | None,
+        typer.Option(
+            metavar="ADDRESS",
+            help="With --serve: listen on this IP address (e.g. 0.0.0.0 for every interface, which exposes the "
+            "recording to the network) instead of 127.0.0.1 (this machine only).",
+        ),
+    ] = None,
     failures: Annotated[
         bool,
         typer.Option(help="Find and mark each tracker's failures with the devkit's matching (needs GT)."),
@@ -148,7 +156,7 @@ def view(
         classes=classes,
         frames=frames,
         save=save,
-        serve=ServeTarget(web_port, grpc_port) if serve else None,
+        serve=serve_target(serve, web_port, grpc_port, bind),
         argv=command_line(),
         focus=focus,
     )
@@ -156,6 +164,8 @@ def view(
     from viz.view import run_view
 
     inputs = load_inputs(request)
+    if request.serve is not None and request.serve.exposure_warning() is not None:  # after every check passed
+        typer.echo(request.serve.exposure_warning(), err=True)
     result = run_view(inputs, progress=progress_bar(progress), failures=failures)
     if result.focus is not None:
         typer.echo(f"focus: {result.focus.title}")

@@ -12,6 +12,7 @@ import contextlib
 import os
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import typer
 
@@ -88,11 +89,24 @@ def usage_line(exc: Exception) -> str:
 
 
 def os_error_line(exc: OSError) -> str:
-    """An OSError while reading or writing a user's path as one line (e.g. disk full, permission denied)."""
-    reason = exc.strerror or str(exc)
-    if exc.filename is not None:
-        return f"cannot write or read {os.fsdecode(exc.filename)}: {reason}"
-    return reason
+    """An OSError while reading or writing a user's path as one line (``gnnpmb.os_errors``)."""
+    from gnnpmb.os_errors import os_error_line as line
+
+    return line(exc)
+
+
+def symlink_loop_line(exc: RuntimeError) -> str | None:
+    """pathlib's ``RuntimeError("Symlink loop from '<path>'")`` (Python 3.11's ``Path.resolve``) as one line, or
+    None for any other RuntimeError."""
+    text = str(exc)
+    if not text.startswith(_PATHLIB_LOOP):
+        return None
+    from gnnpmb.symlinks import loop_line
+
+    return loop_line(Path(text[len(_PATHLIB_LOOP) :].strip("'\"")), "path")
+
+
+_PATHLIB_LOOP = "Symlink loop from "
 
 
 _ANNOUNCED: list[str] = []
@@ -128,6 +142,11 @@ def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
         _quiet_broken_pipe()
     except OSError as exc:
         _fail(os_error_line(exc))
+    except RuntimeError as exc:
+        line = symlink_loop_line(exc)
+        if line is None:
+            raise
+        _fail(line)
     except Exception as exc:
         if not isinstance(exc, _click_exception_types()):
             raise

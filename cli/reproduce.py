@@ -58,7 +58,7 @@ def reproduce(
 ) -> None:
     """Re-run a recording's trackers and compare their track digests (``REPRODUCE_HELP``)."""
     from gnnpmb.outputs import check_output_file
-    from gnnpmb.provenance import digest_report, version_notes
+    from gnnpmb.provenance import SOURCE_KEY, code_differs, digest_report, source_digest, version_notes
     from gnnpmb.stages.inputs import reproduction_inputs
     from gnnpmb.stages.runs import run_all, run_digests
     from viz.provenance import read_provenance
@@ -81,6 +81,11 @@ def reproduce(
     lines, same = digest_report(provenance.track_digests, digests)
     for line in lines:
         typer.echo(line)
+    if not same and code_differs(provenance.versions):
+        typer.echo(
+            f"the gnnpmb code differs from the recording's (source digest {provenance.versions[SOURCE_KEY]}, now "
+            f"{source_digest()}): run the recorded code to tell a change of code from one of data"
+        )
     if save is not None:
         typer.echo(f"saved {inputs.save}")
     if not same:

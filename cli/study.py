@@ -146,6 +146,7 @@ def register(app: typer.Typer) -> None:
         from gnnpmb.study.data import resolve_study_data
         from gnnpmb.study.folder import check_study_dir, drop_stale_plots, identity, merge_study, read_study
         from gnnpmb.study.grid import parse_param
+        from gnnpmb.study.lock import hold_study_folder
         from gnnpmb.study.plots import plot_sweep
         from gnnpmb.study.results import best_amota, best_rows, write_results
         from gnnpmb.study.runner import execution, session
@@ -159,6 +160,7 @@ def register(app: typer.Typer) -> None:
         run = execution(workers, address, verbose)
         location = resolve_dataroot(dataroot, version, (split,) if split else ())
         data = resolve_study_data(location, split or default_split(location.version), detections, preset, seed)
+        hold_study_folder(folder, lambda line: typer.echo(line, err=True))  # one sweep at a time per folder
         plan, note = merge_study(plan_sweep(tracker, data, base, swept, one_at_a_time), read_study(folder), out, params)
         if note is not None:
             typer.echo(note, err=True)

@@ -27,14 +27,34 @@ _SWEPT: set[Path] = set()
 """Folders already swept by this process."""
 
 
+NAME_MAX_BYTES = 255
+"""The longest file name (in bytes) of the usual Linux and macOS file systems."""
+TEMP_TAIL_MAX_BYTES = 20
+"""The longest random part and suffix a writer appends to ``temp_prefix`` (``viz.recording``: 12 hex digits and
+``.partial``; ``atomic_path``: 8 characters and ``.tmp``)."""
+
+
+def temp_name_bytes(target: Path) -> int:
+    """The length in bytes of the longest temporary name written beside ``target`` (a file's or a folder's)."""
+    return len(os.fsencode(temp_prefix(target, "build"))) + TEMP_TAIL_MAX_BYTES
+
+
 def owner_tag() -> str:
     """``<host>-<pid>``: this host (a short hash of its name) and process, as temporary names carry them."""
     return f"{_HOST}-{os.getpid()}"
 
 
 def temp_prefix(target: Path, kind: str = "") -> str:
-    """The ``tempfile`` prefix of a temporary file (or, with ``kind`` e.g. ``build``, folder) for ``target``."""
-    return f".{Path(target).name}.{kind + '-' if kind else ''}{owner_tag()}-"
+    """The ``tempfile`` prefix of a temporary file (or, with ``kind`` e.g. ``build``, folder) for ``target``.
+
+    A long name is cut (at ``NAME_MAX_BYTES`` minus the rest of the temporary name) so that every name the file
+    system allows can be written: the temporary name is never longer than ``NAME_MAX_BYTES``."""
+    tail = f".{kind + '-' if kind else ''}{owner_tag()}-"
+    room = NAME_MAX_BYTES - 1 - len(tail.encode()) - TEMP_TAIL_MAX_BYTES
+    name = os.fsencode(Path(target).name)
+    if len(name) > room:
+        name = name[:room]
+    return f".{os.fsdecode(name)}{tail}"
 
 
 def umask() -> int:

@@ -52,6 +52,7 @@ from gnnpmb.param import (
     param,
     unit_interval,
 )
+from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES
 
 _Q = "process noise of x (y) position and velocity per keyframe, Q = diag(q_x, q_y, q_x, q_y)"
@@ -732,6 +733,7 @@ def load_config(path: Path | None) -> TrackerConfig:
     if path is None:
         return TrackerConfig()
     path = Path(path)
+    refuse_symlink_loop(path, "parameter file")
     if path.is_dir():
         raise ConfigError(f"parameter file {path} is a folder; pass a .toml file")
     try:

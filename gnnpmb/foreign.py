@@ -102,13 +102,14 @@ def read_results(path: Path) -> dict[str, Any]:
     """The parsed results file (``eval.submission.read_submission``: one line for a missing, truncated or non-JSON
     file) with a ``results`` object keyed by sample token; a file read is kept while it is unchanged (a split is
     read once for all its scenes). Treat it as read-only."""
+    from gnnpmb.data.file_identity import file_identity
+
     path = Path(path).absolute()
-    stat = path.stat()
-    return _read(path, stat.st_mtime_ns, stat.st_size)
+    return _read(path, tuple(file_identity(path)[1:]))
 
 
 @functools.lru_cache(maxsize=2)
-def _read(path: Path, mtime_ns: int, size: int) -> dict[str, Any]:
+def _read(path: Path, identity: tuple[Any, ...]) -> dict[str, Any]:
     from gnnpmb.eval.submission import read_submission
 
     data = read_submission(path)
@@ -166,6 +167,7 @@ def scene_results(
     source = Path(path).name
     tokens = [k.sample_token for k in scene.keyframes]
     notice = check_coverage(data, source, scene.name, tokens, dataset_tokens)
+    _check_whole_file(data, source)
     if not any(data["results"][t] for t in tokens if isinstance(data["results"][t], list)):
         raise DataError(f"{source} has no boxes in the {len(tokens)} samples of {scene.name}: nothing to show")
     part = {"meta": data.get("meta", SUBMISSION_META), "results": {t: data["results"][t] for t in tokens}}
@@ -205,6 +207,21 @@ def scene_results(
             "order of appearance",
         )
     return ForeignResults(name, Path(path), tuple(estimates), boxes_on, original, notices)
+
+
+_CHECKED_FILES: list[Mapping[str, Any]] = []
+"""The last parsed results files whose whole-file checks passed (as many as ``read_results`` keeps)."""
+
+
+def _check_whole_file(data: Mapping[str, Any], source: str) -> None:
+    """The checks that need every sample of the file (``check_id_types``), once per parsed file (a split's scenes
+    share one)."""
+    from gnnpmb.eval.submission import check_id_types
+
+    if any(seen is data for seen in _CHECKED_FILES):
+        return
+    check_id_types(data["results"], source)
+    _CHECKED_FILES[:] = [*_CHECKED_FILES[-1:], data]
 
 
 def _numbering(boxes: Sequence[Sequence[Mapping[str, Any]]]) -> tuple[dict[tuple[str, str], int], bool]:

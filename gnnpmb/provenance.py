@@ -56,6 +56,35 @@ def package_versions(packages: Sequence[str] = PACKAGES) -> dict[str, str]:
     return out
 
 
+SOURCE_KEY = "gnnpmb source"
+"""The ``versions`` entry of a recording that holds ``source_digest``: two trees of one package version can hold
+different code (a checkout, an edit), which a version number does not show."""
+
+
+def source_digest() -> str:
+    """SHA-256 (hex, first 16 digits) of the ``gnnpmb`` package's source files (``.py`` and ``.toml``, by relative
+    path), the code that computes the tracks."""
+    import gnnpmb
+
+    root = Path(gnnpmb.__file__).parent
+    digest = hashlib.sha256()
+    for path in sorted(root.rglob("*")):
+        if path.suffix in (".py", ".toml") and path.is_file():
+            digest.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()[:16]
+
+
+def recorded_versions() -> dict[str, str]:
+    """What a recording keeps of the code: the package versions and the ``SOURCE_KEY`` digest."""
+    return package_versions() | {SOURCE_KEY: source_digest()}
+
+
+def code_differs(recorded: Mapping[str, str]) -> bool:
+    """Whether a recording's ``versions`` name other ``gnnpmb`` code than this (its source digest differs; a
+    recording without one says nothing)."""
+    return SOURCE_KEY in recorded and recorded[SOURCE_KEY] != source_digest()
+
+
 def file_sha256(path: Path) -> str:
     """SHA-256 (hex) of a file's bytes, read in 1 MiB blocks."""
     digest = hashlib.sha256()
@@ -300,10 +329,12 @@ class Provenance:
 
 
 def tables_fingerprint(location: DatasetLocation) -> list[list[Any]]:
-    """Name, size and modification time of every table file: cheap even for trainval, and changes whenever a
-    table is rewritten."""
+    """The identity of every table file (``gnnpmb.data.file_identity``: size, times, inode, a digest of its first
+    and last blocks): cheap even for trainval, and changes whenever a table is written, even in place."""
+    from gnnpmb.data.file_identity import file_identity
+
     folder = location.dataroot / location.version
-    return [[p.name, p.stat().st_size, p.stat().st_mtime_ns] for p in sorted(folder.glob("*.json"))]
+    return [[p.name, *file_identity(p)[1:]] for p in sorted(folder.glob("*.json"))]
 
 
 _SCORING_STUDY_FILES = frozenset({"study/data.py", "study/evaluate.py"})
@@ -349,6 +380,14 @@ def digest_report(recorded: dict[str, TrackDigest], now: dict[str, TrackDigest])
 
 
 def version_notes(recorded: dict[str, str]) -> list[str]:
-    """A note for each package whose version differs from the recorded one."""
-    now = package_versions(tuple(recorded))
-    return [f"note: recorded with {k} {v}, now {now[k]}" for k, v in recorded.items() if now.get(k) != v]
+    """A note for each package whose version differs from the recorded one, and one when the ``gnnpmb`` source
+    files differ (``SOURCE_KEY``), whatever the version says."""
+    packages = {k: v for k, v in recorded.items() if k != SOURCE_KEY}
+    now = package_versions(tuple(packages))
+    notes = [f"note: recorded with {k} {v}, now {now[k]}" for k, v in packages.items() if now.get(k) != v]
+    if code_differs(recorded):
+        notes.append(
+            f"note: recorded with other gnnpmb code (source digest {recorded[SOURCE_KEY]}, now {source_digest()}): "
+            "tracks may differ because the code differs"
+        )
+    return notes

@@ -30,6 +30,7 @@ from gnnpmb.registry import (
     tracker_has_gates,
     tracker_panels,
 )
+from gnnpmb.symlinks import refuse_symlink_loop
 
 if TYPE_CHECKING:
     from gnnpmb.events import Panel
@@ -126,6 +127,7 @@ def _results(name: str, file: str, text: str) -> RunSpec:
         raise GnnpmbError(f"results file {file} must be a .json tracking submission (in '{text}')")
     if path.is_dir():
         raise GnnpmbError(f"results path {file} is a folder; pass the tracking results .json (in '{text}')")
+    refuse_symlink_loop(path, "results file")
     if not path.is_file():
         raise GnnpmbError(f"results file not found: {file} (in '{text}')")
     return RunSpec(name, results=path)
@@ -155,6 +157,7 @@ def parse_run(text: str, option: str = "--tracker") -> RunSpec:
         params_path = Path(params).expanduser()
         if params_path.suffix.lower() != PARAMS_SUFFIX:
             raise GnnpmbError(f"bad {option} '{text}': the parameters after ':' must be a .toml file")
+        refuse_symlink_loop(params_path, "parameter file")
         if not params_path.is_file():
             raise GnnpmbError(f"parameter file not found: {params} (in {option} '{text}')")
     own = default_name(tracker, params_path)

@@ -16,6 +16,7 @@ import rerun as rr
 
 from gnnpmb.errors import DataError
 from gnnpmb.provenance import Provenance
+from gnnpmb.symlinks import refuse_symlink_loop
 
 PROPERTY = "provenance"
 PROPERTY_ENTITY = f"/__properties/{PROPERTY}"
@@ -52,6 +53,7 @@ def read_provenance(path: Path) -> Provenance:
     from rerun.error_utils import RerunWarning
 
     path = Path(path)
+    refuse_symlink_loop(path, "recording")
     if not path.is_file():
         raise DataError(f"recording {path} does not exist")
     try:

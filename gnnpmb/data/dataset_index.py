@@ -131,6 +131,11 @@ class DatasetIndex:
             self.store.batch("instances.arrow", record.batch),
         )
 
+    def tracked_annotations(self, name: str) -> int:
+        """How many annotations of scene ``name`` are of a tracking class (what the evaluation scores against)."""
+        batch = self.store.batch("annotations.arrow", self._by_name[name].batch)
+        return batch.num_rows - batch.column("tracking_name").null_count
+
     def sample_tokens(self, name: str) -> list[str]:
         """The sample tokens of scene ``name`` in time order."""
         return self.store.batch("samples.arrow", self._by_name[name].batch).column("token").to_pylist()
@@ -215,7 +220,7 @@ def _build(tmp: Path, dataroot: Path, version: str, sources: list[list[Any]], pr
     poses = _poses(tables, {sd["ego_pose_token"] for _, sd in lidar.values()})
     instances = [r for r in tables.rows("instance")]
     try:
-        chains = [_chain(scene, samples) for scene in scenes]
+        chains = [_chain(scene, samples, tables) for scene in scenes]
     except KeyError as exc:
         raise tables.field_error("sample", exc) from None
     sample_rows = _sample_batches(chains, samples, lidar, poses, calibrated, tables)
@@ -262,16 +267,29 @@ def _poses(tables: _Tables, wanted: set[str]) -> dict[str, tuple[int, dict]]:
     return {r["token"]: (pos, r) for pos, r in enumerate(tables.rows("ego_pose")) if r["token"] in wanted}
 
 
-def _chain(scene: dict[str, Any], samples: dict[str, tuple[int, dict]]) -> list[str]:
-    """The scene's sample tokens in time order (following ``next`` from ``first_sample_token``)."""
+def _chain(scene: dict[str, Any], samples: dict[str, tuple[int, dict]], tables: _Tables) -> list[str]:
+    """The scene's sample tokens in time order (following ``next`` from ``first_sample_token``); a token that
+    points at no sample, or a chain that loops, is a DataError naming the table, row and field that hold it."""
     chain: list[str] = []
-    token = scene["first_sample_token"]
+    name = scene.get("name")
+    token, table, field = scene["first_sample_token"], "scene", f"scene {name!r} has first_sample_token"
     while token:
+        if token not in samples:
+            raise _broken_link(tables, table, f"{field} {token!r}, the token of no row of sample.json")
         chain.append(token)
+        table, field = "sample", f"sample {token} of scene {name!r} has next"
         token = samples[token][1]["next"]
         if len(chain) > len(samples):
-            raise KeyError("next (a cycle)")
+            raise _broken_link(tables, "sample", f"the next chain of scene {name!r} loops")
     return chain
+
+
+def _broken_link(tables: _Tables, table: str, what: str) -> DataError:
+    """A table whose rows parse but point at a row that does not exist."""
+    return DataError(
+        f"{tables.dataroot / tables.version / table}.json: {what}; repair the table or use an unedited copy of the "
+        "dataset"
+    )
 
 
 _Rows = dict[str, tuple[int, dict[str, Any]]]

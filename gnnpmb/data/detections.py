@@ -26,6 +26,7 @@ import numpy as np
 
 from gnnpmb.data.json_stream import JsonStreamError, NotUtf8Error
 from gnnpmb.errors import DataError
+from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES, Boxes
 
 if TYPE_CHECKING:
@@ -61,7 +62,7 @@ MIN_QUAT_NORM = 1e-6
 """A rotation quaternion shorter than this has no direction (e.g. all zeros)."""
 
 
-_opened: dict[tuple[str, int, int, int], DetectionIndex] = {}
+_opened: dict[tuple[str, int, int, int, int], DetectionIndex] = {}
 """The index of the detection file last used in this process, keyed by the file's identity."""
 
 
@@ -92,7 +93,7 @@ def _box_problem(entry: Any) -> str | None:
             return f"field '{name}' must hold numbers, not text or null: {_short(entry[name])}"
         if name != "velocity" and not np.isfinite(value).all():
             return f"field '{name}' has a NaN or infinite value: {_short(entry[name])}"
-        physical = _physical_problem(name, value[None, :])
+        physical = physical_problem(name, value[None, :])
         if physical is not None:
             return f"field '{name}' {physical}: {_short(entry[name])}"
     if "detection_name" not in entry:
@@ -117,7 +118,7 @@ def _all_numbers(value: Any) -> bool:
     return isinstance(value, list) and all(type(v) in (int, float) for v in value)
 
 
-def _physical_problem(name: str, values: np.ndarray) -> str | None:
+def physical_problem(name: str, values: np.ndarray) -> str | None:
     """Why (n, k) values of field ``name`` cannot be a real box, or None: centres beyond ``MAX_ABS_COORD_M``,
     sizes not in (0, ``MAX_SIZE_M``], speeds beyond ``MAX_SPEED_MPS`` (NaN, unknown, passes), quaternions of
     (almost) zero length."""
@@ -170,7 +171,7 @@ def convert_sample(token: str, entries: Any) -> Boxes | str:
         and np.isfinite(score).all()
         and ((score >= 0.0) & (score <= 1.0)).all()
         and np.isin(names.astype(str), DETECTION_CLASSES).all()
-        and all(_physical_problem(name, arrays[name]) is None for name, _ in _VECTOR_FIELDS)
+        and all(physical_problem(name, arrays[name]) is None for name, _ in _VECTOR_FIELDS)
     )
     if not fine:
         return _diagnose(token, entries)
@@ -213,6 +214,7 @@ def _index(path: Path) -> DetectionIndex:
     from gnnpmb.data.demo import cache_root
     from gnnpmb.data.detection_index import open_detection_index
 
+    refuse_symlink_loop(path, "detections file")
     try:
         st = path.stat()
     except FileNotFoundError:
@@ -224,7 +226,7 @@ def _index(path: Path) -> DetectionIndex:
     if not path.is_file():
         raise DataError(f"detections path {path} is not a file; pass a nuScenes detection results .json file")
     resolved = path.resolve()
-    key = (str(resolved), st.st_ino, st.st_mtime_ns, st.st_size)
+    key = (str(resolved), st.st_ino, st.st_mtime_ns, st.st_ctime_ns, st.st_size)
     if key not in _opened:
         _opened.clear()
         _opened[key] = open_detection_index(cache_root(), resolved, convert_sample, lambda exc: _read_error(path, exc))

@@ -2,10 +2,12 @@
 temporary folder and renamed into place, with a manifest that says what it was built from.
 
 Integrity: the manifest (``manifest.json``) is written last; it holds the format version, the source files'
-identity (path, size, modification time) and, per Arrow file, its size and the CRC-32 of every record batch.
-``open_store`` trusts a folder only when the manifest parses, matches the sources and every file has its recorded
-size; each batch read is checked against its CRC (``Store.batch``), so damage found later raises
-``IndexDamaged`` and the caller rebuilds. Files are memory-mapped: a command reads only the batches it needs.
+identity (``gnnpmb.data.file_identity``: path, size, modification and change times, inode, a digest of the first
+and last blocks) and, per Arrow file, its size and the CRC-32 of every record batch.
+``open_store`` trusts a folder only when the manifest parses, matches the sources, every file has its recorded
+size and every small JSON side file its CRC (a damaged one makes the index be built again); each batch read is
+checked against its CRC (``Store.batch``), so damage found later raises ``IndexDamaged`` and the caller rebuilds.
+Files are memory-mapped: a command reads only the batches it needs.
 A lock file serialises builds of the same index between processes.
 """
 
@@ -15,6 +17,7 @@ import contextlib
 import fcntl
 import json
 import os
+import re
 import shutil
 import tempfile
 import zlib
@@ -26,10 +29,27 @@ from typing import Any
 import pyarrow as pa
 
 from gnnpmb.atomic import sweep_leftovers, temp_prefix
+from gnnpmb.data.file_identity import file_identity
+from gnnpmb.errors import GnnpmbError
+from gnnpmb.os_errors import os_error_line
 
 MANIFEST = "manifest.json"
 NOTE_MIN_BYTES = 50_000_000
 """Sources from this size on take seconds to index: say so even when stderr is not a terminal."""
+
+
+class CacheWriteError(GnnpmbError):
+    """An index could not be written into the cache (a full disk, a read-only cache folder)."""
+
+
+def _with_errno(exc: OSError) -> OSError:
+    """``exc`` with its errno and the system's text for it; pyarrow puts the errno only in a long text ("Error
+    writing bytes to file. Detail: [errno 28] No space left on device")."""
+    number = exc.errno
+    if number is None:
+        match = re.search(r"\[errno (\d+)\]", str(exc))
+        number = int(match[1]) if match else None
+    return exc if number is None else OSError(number, os.strerror(number))
 
 
 class IndexDamaged(Exception):
@@ -37,17 +57,9 @@ class IndexDamaged(Exception):
 
 
 def source_identity(paths: Sequence[Path]) -> list[list[Any]]:
-    """(absolute path, size in bytes, modification time in ns, inode) of each source file (a file rewritten
-    atomically gets a new inode); a missing one is (path, -1, -1, -1)."""
-    out: list[list[Any]] = []
-    for path in paths:
-        try:
-            st = path.stat()
-        except OSError:
-            out.append([str(path), -1, -1, -1])
-            continue
-        out.append([str(path), st.st_size, st.st_mtime_ns, st.st_ino])
-    return out
+    """The identity of each source file (``file_identity.file_identity``: path, size, modification and change
+    times, inode and a digest of its first and last blocks), checked at every open."""
+    return [file_identity(path) for path in paths]
 
 
 def batch_crc(batch: pa.RecordBatch) -> int:
@@ -113,6 +125,8 @@ def open_store(folder: Path, fmt: int, sources: list[list[Any]]) -> Store | None
         for name, entry in files.items():
             if (folder / name).stat().st_size != entry["size"]:
                 return None
+            if not name.endswith(".arrow") and zlib.crc32((folder / name).read_bytes()) != entry["crc"][0]:
+                return None  # a small JSON side file (scenes.json, samples.json, ...) is checked whole at open
         readers = {
             name: pa.ipc.open_file(pa.memory_map(str(folder / name))) for name in files if name.endswith(".arrow")
         }
@@ -143,7 +157,10 @@ def open_or_build(folder: Path, fmt: int, sources: list[list[Any]], build: Calla
         sweep_leftovers(folder.parent)  # builds of killed runs (gnnpmb.atomic)
         tmp = Path(tempfile.mkdtemp(prefix=temp_prefix(folder, "build"), dir=folder.parent))
         try:
-            build(tmp)
+            try:
+                build(tmp)
+            except OSError as exc:  # pyarrow's write errors are OSErrors without a file name
+                raise CacheWriteError(os_error_line(_with_errno(exc), folder)) from None
             if folder.exists():
                 old = Path(tempfile.mkdtemp(prefix=temp_prefix(folder, "old"), dir=folder.parent))
                 os.replace(folder, old / "index")

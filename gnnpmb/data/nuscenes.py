@@ -29,6 +29,8 @@ from gnnpmb.data.demo import (
 )
 from gnnpmb.data.scene import Keyframe, Pose, SceneData
 from gnnpmb.errors import DataError, UnknownNameError
+from gnnpmb.outputs import check_dataset_inputs
+from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import Boxes
 
 if TYPE_CHECKING:
@@ -79,9 +81,11 @@ def is_synthetic_description(description: str) -> bool:
 def check_dataroot(dataroot: Path, version: str | None, source: str = "--dataroot") -> DatasetLocation:
     """Check that ``dataroot`` holds the tables of ``version`` (or of its only ``v1.0-*`` folder if None).
 
-    ``source`` names where the path came from, for the error message.
+    ``source`` names where the path came from, for the error message. The dataset's files become inputs: an
+    output of this process that is one of them (a hard link included) is refused (``outputs.check_dataset_inputs``).
     """
     dataroot = Path(dataroot).expanduser()
+    refuse_symlink_loop(dataroot, f"dataroot (from {source})")
     if not dataroot.exists():
         raise DataError(f"dataroot {dataroot} (from {source}) does not exist; {_FIX_HINT}")
     if not dataroot.is_dir():
@@ -106,6 +110,7 @@ def check_dataroot(dataroot: Path, version: str | None, source: str = "--dataroo
     missing = [t for t in TABLE_NAMES if not (dataroot / version / f"{t}.json").is_file()]
     if missing:
         raise _not_a_dataroot(dataroot, f"{version}/ lacks the table(s) {', '.join(f'{t}.json' for t in missing)}")
+    check_dataset_inputs(dataroot, version)
     scenes = _read_scene_table(dataroot, version)
     synthetic = bool(scenes) and all(is_synthetic_description(str(r.get("description", ""))) for r in scenes)
     return DatasetLocation(dataroot=dataroot, version=version, synthetic=synthetic)

@@ -68,3 +68,13 @@ class SceneData:
     @property
     def sample_tokens(self) -> tuple[str, ...]:
         return tuple(k.sample_token for k in self.keyframes)
+
+    def no_ground_truth(self) -> str | None:
+        """Why no failure can be found in this scene (it has no annotation of a tracked class, e.g. a dataset whose
+        ``sample_annotation`` table is empty, as v1.0-test's), or None when it has ground truth."""
+        if any(len(k.gt) for k in self.keyframes):
+            return None
+        return (
+            f"{self.name} has no ground-truth boxes (no annotation of a tracked class in "
+            f"{self.version}/sample_annotation.json, as in a test split): no failure can be found or scored"
+        )

@@ -4,8 +4,9 @@
 an engineer often runs the same command again, e.g. with ``--focus`` on a failure the first run listed. A
 report is a pure function of the scene's ground truth, the tracker's submission boxes and the code, so it is
 stored under ``<cache root>/failures/<key>.json`` where key = SHA-256 of (scene, tracker, the submission boxes,
-the dataset's table files (name, size, mtime), the code version: ``gnnpmb`` sources and devkit, motmetrics and
-numpy versions). Any change of tracks, parameters, data or code gives another key. A damaged file counts as
+the dataset's table files (``provenance.tables_fingerprint``: size, times, a digest of their edges), the code
+version: ``gnnpmb`` sources and devkit, motmetrics and numpy versions). Any change of tracks, parameters, data
+or code gives another key. A damaged file counts as
 absent and one that cannot be written is skipped; files are written atomically, and only the newest
 ``MAX_REPORTS`` are kept.
 """

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from gnnpmb.atomic import finish
+from gnnpmb.atomic import finish, temp_prefix
 from gnnpmb.errors import DataError
 from gnnpmb.eval.submission import check_submission, read_submission
 
@@ -184,7 +184,7 @@ def run_tracking_eval(results_path: Path, dataroot: Path, version: str, split: s
 
     out_dir = Path(out_dir)
     out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", dir=out_dir.parent))
+    tmp = Path(tempfile.mkdtemp(prefix=temp_prefix(out_dir, "build"), dir=out_dir.parent))
     try:
         with quiet_devkit():
             cfg = tracking_config()
@@ -215,7 +215,7 @@ def evaluate_submission(
     """Check ``results_path`` against ``split`` of the dataset at ``location``, then score it with the
     official evaluation, on a version folder holding only the split's evaluation tables
     (``gnnpmb.eval.subset``); the devkit's files go to ``out_dir`` (default ``default_eval_dir(results_path)``)."""
-    from gnnpmb.data.nuscenes import all_sample_tokens, sample_tokens, split_scenes
+    from gnnpmb.data.nuscenes import all_sample_tokens, dataset_index, sample_tokens, split_scenes
     from gnnpmb.eval.subset import eval_location
 
     results_path = Path(results_path)
@@ -224,6 +224,13 @@ def evaluate_submission(
     scene_names = split_scenes(split, location)
     if not scene_names:
         raise DataError(f"split {split} has no scenes in {location.dataroot / location.version}; pick another split")
+    index = dataset_index(location)
+    if not any(index.tracked_annotations(name) for name in scene_names):
+        raise DataError(
+            f"split {split} of {location.dataroot} has no ground truth: {location.version}/sample_annotation.json "
+            f"holds no annotation of a tracked class in its {len(scene_names)} scenes (as in a test split); the "
+            "official evaluation needs ground truth to score against"
+        )
     check_submission(
         data,
         results_path.name,

@@ -20,9 +20,11 @@ from typing import Any
 
 import numpy as np
 
+from gnnpmb.data.detections import physical_problem
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError
 from gnnpmb.pipeline import TrackingRun
+from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES
 
 SUBMISSION_META: dict[str, bool] = {
@@ -44,6 +46,8 @@ _VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
     ("velocity", 2),
 )
 _REQUIRED_FIELDS = ("sample_token", "tracking_id", "tracking_name", "tracking_score")
+QUAT_NORM_TOLERANCE = 1e-3
+"""How far from 1 a results box's rotation quaternion may be (files written with 6 decimals are within 1e-5)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -148,12 +152,13 @@ def write_json(path: Path, data: Any) -> None:
     ``path`` is kept and its target written.
     """
     from gnnpmb.atomic import write_text
+    from gnnpmb.os_errors import os_error_line
 
     text = json.dumps(data, allow_nan=False, separators=(",", ":"))  # the C encoder; json.dump is pure Python
     try:
         write_text(Path(path), text)
     except OSError as exc:
-        raise DataError(f"cannot write {path}: {exc.strerror or exc}; free space or write elsewhere") from None
+        raise DataError(os_error_line(exc, path)) from None
 
 
 def write_submission(path: Path, submission: Mapping[str, Any]) -> None:
@@ -164,6 +169,7 @@ def write_submission(path: Path, submission: Mapping[str, Any]) -> None:
 def check_results_file(path: Path) -> None:
     """A one-line ``DataError`` unless ``path`` is an existing file (checked before any slow work)."""
     path = Path(path)
+    refuse_symlink_loop(path, "results file")
     if path.is_dir():
         raise DataError(f"results path {path} is a folder; pass the .json written by 'gnnpmb track'")
     if not path.is_file():
@@ -208,6 +214,25 @@ def _vector_problem(name: str, value: Any, length: int) -> str | None:
     return None
 
 
+def _value_problem(name: str, value: Any) -> str | None:
+    """Why a well-formed field ``name`` cannot be a real box (the detection file's limits, ``physical_problem``,
+    and a rotation that is not a unit quaternion), or None."""
+    values = np.asarray(value, dtype=float)[None, :]
+    problem = physical_problem(name, values)
+    if problem is None and name == "rotation":
+        norm = float(np.linalg.norm(values))
+        if abs(norm - 1.0) > QUAT_NORM_TOLERANCE:
+            problem = f"is not a unit quaternion (length {norm:.6g}); normalise it"
+    return None if problem is None else f"field '{name}' {problem}: {_short(value)}"
+
+
+def _values_fine(name: str, array: np.ndarray) -> bool:
+    """Whether (n, k) values of field ``name`` all pass ``_value_problem`` (vectorised)."""
+    if physical_problem(name, array) is not None:
+        return False
+    return name != "rotation" or bool((np.abs(np.linalg.norm(array, axis=1) - 1.0) <= QUAT_NORM_TOLERANCE).all())
+
+
 def _box_problem(token: str, box: Any) -> str | None:
     """What is wrong with one submission box, or None (the devkit's TrackingBox checks, and finiteness)."""
     if not isinstance(box, dict):
@@ -218,7 +243,7 @@ def _box_problem(token: str, box: Any) -> str | None:
     if box["sample_token"] != token:
         return f"has sample_token {_short(box['sample_token'])}; it must equal its results key"
     for name, length in _VECTOR_FIELDS:
-        problem = _vector_problem(name, box[name], length)
+        problem = _vector_problem(name, box[name], length) or _value_problem(name, box[name])
         if problem is not None:
             return problem
     track_id = box["tracking_id"]
@@ -247,6 +272,8 @@ def _sample_fine(token: str, boxes: list) -> bool:
                 return False
             array = np.array([b[name] for b in boxes], dtype=float)
             if array.shape != (len(boxes), length) or not np.isfinite(array).all():
+                return False
+            if not _values_fine(name, array):
                 return False
         scores = [b["tracking_score"] for b in boxes]
         names = [b["tracking_name"] for b in boxes]
@@ -301,6 +328,7 @@ def check_submission(
             f"{source} has {len(extra)} samples of other splits than {split} (e.g. {extra[0]}); "
             "evaluate it on the split it was made for"
         )
+    check_id_types(results, source)
     n_boxes = 0
     for token in split_tokens:
         boxes = results[token]
@@ -329,6 +357,27 @@ def check_submission(
             "score (did the tracker keep no tracks? check score_threshold and the detections)"
         )
     return SubmissionStats(samples=len(split_tokens), boxes=n_boxes)
+
+
+def check_id_types(results: Mapping[str, Any], source: str) -> None:
+    """A one-line DataError when the file's ``tracking_id`` values are integers in some boxes and strings in others:
+    the devkit keeps each id as read, so 5 and "5" are two tracks to it, while a reader that turns ids into text
+    would join them. One type per file keeps every reader of the file in agreement."""
+    first: dict[type, str] = {}
+    for token, boxes in results.items():
+        if not isinstance(boxes, list):
+            continue
+        for box in boxes:
+            track_id = box.get("tracking_id") if isinstance(box, dict) else None
+            kind = type(track_id)
+            if kind in (int, str) and kind not in first:
+                first[kind] = token
+                if len(first) == 2:
+                    raise DataError(
+                        f"{source}: tracking_id is an integer in some boxes (e.g. sample {first[int]}) and a string "
+                        f'in others (e.g. sample {first[str]}); the official evaluation counts 5 and "5" as two '
+                        "tracks: write every id as a string"
+                    )
 
 
 def _duplicate_id(boxes: list[dict[str, Any]]) -> tuple[str, str] | None:

@@ -9,8 +9,8 @@ with the original values (floats written with ``repr`` read back bit for bit), i
 ``<cache root>/evalroot/<key>/<version>/`` beside the version's ``splits.json``; the metrics are those of a full
 load (``tests/gnnpmb/eval/test_subset.py``). Map masks are empty placeholder files: the devkit checks that they
 exist and the evaluation never opens them. The folder is built in a temporary folder and renamed into place,
-with ``sizes.json`` written last; one whose files do not have their recorded sizes is built again. The newest
-``KEEP_FOLDERS`` are kept.
+with ``sizes.json`` written last; one whose files do not have their recorded sizes and CRCs is built again. The
+newest ``KEEP_FOLDERS`` are kept.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import json
 import os
 import shutil
 import tempfile
+import zlib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -54,12 +55,18 @@ def eval_location(location: DatasetLocation, scene_names: Sequence[str]) -> Data
 
 
 def _complete(folder: Path) -> bool:
-    """Whether every file listed in the folder's ``sizes.json`` (written last) has its recorded size."""
+    """Whether every file listed in the folder's ``sizes.json`` (written last) has its recorded size and CRC-32
+    (a table damaged in place at the same size is written again, not scored)."""
     try:
         sizes = json.loads((folder / SIZES).read_text(encoding="utf-8"))
-        return all((folder / name).stat().st_size == size for name, size in sizes.items())
-    except (OSError, ValueError, AttributeError):
+        return all(_size_crc(folder / name) == list(entry) for name, entry in sizes.items())
+    except (OSError, ValueError, AttributeError, TypeError):
         return False
+
+
+def _size_crc(path: Path) -> list[int]:
+    data = path.read_bytes()
+    return [len(data), zlib.crc32(data)]
 
 
 def _write(folder: Path, version: str, tables: dict[str, list[dict[str, Any]]], custom: bytes) -> None:
@@ -76,7 +83,7 @@ def _write(folder: Path, version: str, tables: dict[str, list[dict[str, Any]]], 
             path = tmp / row["filename"]
             path.parent.mkdir(parents=True, exist_ok=True)
             path.touch()
-        sizes = {p.relative_to(tmp).as_posix(): p.stat().st_size for p in tmp.rglob("*") if p.is_file()}
+        sizes = {p.relative_to(tmp).as_posix(): _size_crc(p) for p in tmp.rglob("*") if p.is_file()}
         (tmp / SIZES).write_text(json.dumps(sizes), encoding="utf-8")
         try:
             os.replace(tmp, folder)

@@ -23,8 +23,9 @@ def find_reports(
     from gnnpmb.eval.submission import run_results
 
     scene = inputs.scene
-    if not any(len(k.gt) for k in scene.keyframes):
-        return {}, [f"{scene.name} has no ground-truth boxes (no annotations): failure markers skipped"]
+    missing = scene.no_ground_truth()
+    if missing is not None:
+        return {}, [missing]
     reports = {}
     for run in runs:
         try:

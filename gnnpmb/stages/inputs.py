@@ -193,6 +193,7 @@ def reproduction_inputs(
     from gnnpmb.config import config_from_dict
     from gnnpmb.data.nuscenes import check_dataroot, load_scene
     from gnnpmb.pipeline import get_detections, preprocess_frames
+    from gnnpmb.provenance import DetectionsSource, file_sha256
 
     p = provenance
     target = check_output_file(save, "--save", ".rrd") if save is not None else None
@@ -215,8 +216,8 @@ def reproduction_inputs(
         path = Path(detections_file) if detections_file is not None else Path(str(recorded.path))
         if not path.is_file():
             raise DataError(f"the recorded detections file {path} is missing; pass --detections FILE.json")
-        source = detections_source(scene, {}, path, DEFAULT_DETECTOR, p.seed)
-        if source.sha256 != recorded.sha256:
+        source = DetectionsSource("file", file_sha256(path), path=str(Path(path).expanduser().absolute()))
+        if source.sha256 != recorded.sha256:  # the file's bytes hashed now, never a digest kept by a cache
             raise DataError(
                 f"detections file {path} has changed since the recording (sha256 {source.sha256[:12]}, "
                 f"recorded {recorded.sha256[:12]})"

@@ -102,11 +102,11 @@ def run_digests(runs: Sequence[Run]) -> dict[str, TrackDigest]:
 
 def provenance_of(inputs: Inputs, digests: dict[str, TrackDigest]) -> Provenance:
     """The provenance of the runs of ``inputs`` whose tracks have ``digests``."""
-    from gnnpmb.provenance import Provenance, package_versions
+    from gnnpmb.provenance import Provenance, recorded_versions
 
     return Provenance(
         argv=inputs.argv,
-        versions=package_versions(),
+        versions=recorded_versions(),
         config=inputs.config.as_dict(),
         dataroot=str(inputs.location.dataroot),
         version=inputs.location.version,

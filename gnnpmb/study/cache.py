@@ -1,7 +1,9 @@
 """The resumable cache of a study: one JSON file per finished configuration under ``DIR/cache/``.
 
 The file name is the SHA-256 of (tracker, the configuration's full parameter TOML, the inputs fingerprint, the
-code version), so a configuration is rerun only if one of them changed. Files are written atomically.
+code version), so a configuration is rerun only if one of them changed. Files are written atomically, each with
+the SHA-256 of its row: a file damaged in place (a flipped digit still parses) counts as not cached, like a
+truncated one.
 """
 
 from __future__ import annotations
@@ -33,12 +35,20 @@ class ResultCache:
         return self.folder / f"{key}.json"
 
     def get(self, key: str) -> dict[str, Any] | None:
-        """The stored row, or None if absent or unreadable (a damaged file counts as not cached)."""
+        """The stored row, or None if absent, unreadable or not matching its digest (a damaged file counts as not
+        cached)."""
         try:
             data = json.loads(self._path(key).read_text(encoding="utf-8"))
         except (OSError, ValueError):
             return None
-        return data if isinstance(data, dict) else None
+        if not isinstance(data, dict) or not isinstance(data.get("row"), dict):
+            return None
+        return data["row"] if data.get("sha256") == _row_digest(data["row"]) else None
 
     def put(self, key: str, row: Mapping[str, Any]) -> None:
-        write_json(self._path(key), dict(row))
+        write_json(self._path(key), {"sha256": _row_digest(row), "row": dict(row)})
+
+
+def _row_digest(row: Mapping[str, Any]) -> str:
+    """SHA-256 of a row's canonical JSON (sorted keys): the same for the row written and the row read back."""
+    return hashlib.sha256(json.dumps(row, sort_keys=True, allow_nan=False).encode()).hexdigest()

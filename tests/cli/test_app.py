@@ -295,7 +295,8 @@ def test_failures_are_skipped_with_a_notice_without_ground_truth(
     calls: list[None] = []
     reports, notices = find_reports(dataclasses.replace(request, scene=unannotated), [], lambda: calls.append(None))
     assert reports == {}
-    assert notices == [f"{SCENE} has no ground-truth boxes (no annotations): failure markers skipped"]
+    assert notices == [unannotated.no_ground_truth()]
+    assert notices[0].startswith(f"{SCENE} has no ground-truth boxes (no annotation of a tracked class")
 
     def not_in_a_split(*_args, **_kwargs):
         raise DataError(f"scene {SCENE} is in no nuScenes split, so the devkit cannot evaluate it")

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from gnnpmb.errors import GnnpmbError
-from gnnpmb.serve import ServeTarget, check_display
+from gnnpmb.serve import ServeTarget, check_bind, check_display
 
 BIN = Path(sys.executable).parent
 
@@ -63,7 +63,24 @@ def test_serve_prints_the_url_serves_the_viewer_and_stops_on_ctrl_c(demo_dataroo
 
 
 def test_url_points_the_viewer_at_the_grpc_server() -> None:
-    assert ServeTarget(9090, 9876).url == "http://localhost:9090/?url=rerun%2Bhttp%3A%2F%2Flocalhost%3A9876%2Fproxy"
+    assert ServeTarget(9090, 9876).url == "http://127.0.0.1:9090/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A9876%2Fproxy"
+    assert ServeTarget(9090, 9876, "::1").url.startswith("http://[::1]:9090/?url=rerun%2Bhttp%3A%2F%2F%5B%3A%3A1%5D")
+
+
+@pytest.mark.parametrize(
+    ("bind", "warned"), [("127.0.0.1", False), ("::1", False), ("0.0.0.0", True), ("::", True), ("10.1.2.3", True)]
+)
+def test_only_a_bind_address_beyond_this_machine_is_warned_about(bind: str, warned: bool) -> None:
+    warning = ServeTarget(9090, 9876, check_bind(bind)).exposure_warning()
+    assert (warning is not None) == warned
+    if warned:
+        assert warning.startswith(f"warning: --bind {bind} serves the viewer and the recording's data")
+
+
+def test_a_bind_address_is_an_ip_address() -> None:
+    assert check_bind("[::1]") == "::1"
+    with pytest.raises(GnnpmbError, match="--bind localhost: not an IP address"):
+        check_bind("localhost")
 
 
 def test_no_display_is_refused_on_linux(monkeypatch: pytest.MonkeyPatch) -> None:

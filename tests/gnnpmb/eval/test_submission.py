@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -187,7 +188,29 @@ def test_too_many_boxes_and_bad_layout() -> None:
 
 
 def test_integer_tracking_ids_are_accepted() -> None:
-    check(submission(s1=[box("s1", track_id=3)]))
+    check(submission(**{t: [box(t, track_id=3)] for t in SPLIT}))
+
+
+def test_integer_and_string_ids_in_one_file_are_refused() -> None:
+    """The devkit keeps ids as read (3 and "3" are two tracks to it): one type per file (issue 33 case 3)."""
+    with pytest.raises(DataError, match=r"tracking_id is an integer in some boxes \(e.g. sample s1\) and a string"):
+        check(submission(s1=[box("s1", track_id=3)]))
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"rotation": [0.0, 0.0, 0.0, 0.0]}, "field 'rotation' is not a rotation"),
+        ({"rotation": [2.0, 0.0, 0.0, 0.0]}, "field 'rotation' is not a unit quaternion (length 2)"),
+        ({"size": [0.0, 4.5, 1.6]}, "field 'size' must be positive"),
+        ({"size": [-1.0, 4.5, 1.6]}, "field 'size' must be positive"),
+        ({"translation": [1e6 + 600.0, 1600.0, 1.0]}, "field 'translation' is beyond 1e+05 m"),
+        ({"velocity": [900.0, 0.0]}, "field 'velocity' is faster than 200 m/s"),
+    ],
+)
+def test_impossible_boxes_are_refused_like_in_detection_files(changes: dict, message: str) -> None:
+    with pytest.raises(DataError, match=re.escape(f"box 0 of sample s1 {message}")):
+        check(submission(s1=[box("s1", **changes)]))
 
 
 def test_write_is_atomic_and_refuses_nan(tmp_path: Path) -> None:

@@ -45,12 +45,12 @@ def test_a_second_grid_joins_the_table_and_another_study_is_refused(tiny_dataroo
     _one_line(other.stderr, f"error: --out {out} holds a study of another kind (tracker gnnpmb;")
     assert "give a new --out folder" in other.stderr and _snapshot(out) == before
 
-    entry = next(p for p in (out / "cache").glob("*.json") if json.loads(p.read_text())["amota"] is not None)
+    entry = next(p for p in (out / "cache").glob("*.json") if json.loads(p.read_text())["row"]["amota"] is not None)
     entry.write_text("{}")  # valid JSON, no metrics: must be scored again, not read as empty cells
     again = _run(f"{sweep} --param car.q_x=0.2", env, tmp_path)
     assert again.returncode == 0, again.stderr
     assert "3 of 3 configurations (2 from cache, 1 run)" in again.stdout
-    assert all(r["amota"] != "" for r in _rows(out)) and "amota" in json.loads(entry.read_text())
+    assert all(r["amota"] != "" for r in _rows(out)) and "amota" in json.loads(entry.read_text())["row"]
 
 
 def test_sigterm_during_a_ray_sweep_keeps_what_finished(tiny_dataroot: Path, tmp_path: Path) -> None:
