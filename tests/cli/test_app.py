@@ -16,7 +16,7 @@ from cli.app import main
 from gnnpmb.config import TrackerConfig
 from gnnpmb.errors import DataError, GnnpmbError, UnknownNameError
 from gnnpmb.pipeline import run_tracker
-from gnnpmb.provenance import PACKAGES
+from gnnpmb.provenance import PACKAGES, SOURCE_KEY
 from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.stages.evaluation import find_reports
 from gnnpmb.stages.request import parse_classes, parse_frames
@@ -128,7 +128,7 @@ def test_recording_name_and_provenance(full_run: tuple[Path, str], demo_dataroot
         str(out),
         "--no-progress",
     )
-    assert set(p.versions) == set(PACKAGES) and p.versions["rerun-sdk"].startswith("0.41")
+    assert set(p.versions) == {*PACKAGES, SOURCE_KEY} and p.versions["rerun-sdk"].startswith("0.41")
     assert p.config == TrackerConfig().as_dict()
     assert p.dataroot == str(demo_dataroot.resolve()) and p.version == "v1.0-mini" and p.synthetic
     assert p.scene_name == SCENE and len(p.scene_token) == 32
