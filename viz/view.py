@@ -116,6 +116,7 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
     from viz.timeline import PLAIN_CLOCK, Clock
 
     scene, frame_range = inputs.scene, inputs.frame_range
+    caps = {t: inputs.capabilities(t) for t in inputs.trackers}
     bar = progress if progress is not None else SilentProgress()
     with bar:
         tasks = {t: bar.add_task(f"{scene.name} {t}", total=len(frame_range)) for t in inputs.trackers}
@@ -141,7 +142,6 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
         start = focus or opening
         clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
         # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
-        caps = {t: inputs.capabilities(t) for t in inputs.trackers}
         blueprint = None
         if focus is None:
             blueprint = default_blueprint(

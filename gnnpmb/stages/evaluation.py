@@ -28,10 +28,9 @@ def find_reports(
         return {}, [missing]
     reports = {}
     for run in runs:
+        results = run_results(run.tracking)
         try:
-            reports[run.name] = scene_report(
-                inputs.location, scene.name, run.name, run_results(run.tracking), inputs.evaluated_keyframes
-            )
+            reports[run.name] = scene_report(inputs.location, scene.name, run.name, results, inputs.evaluated_keyframes)
         except DataError as exc:
             return {}, [f"failure markers skipped: {exc}"]
         on_done()

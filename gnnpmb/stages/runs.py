@@ -48,12 +48,11 @@ def track_run(
     from gnnpmb.foreign import replay
     from gnnpmb.pipeline import run_tracker
 
-    foreign = inputs.foreign.get(name)
+    spec, foreign = inputs.spec(name), inputs.foreign.get(name)
     if foreign is not None:
         return replay(
             foreign, inputs.scene, inputs.frame_detections, inputs.classes, inputs.frame_range, sink, on_frame
         )
-    spec = inputs.spec(name)
     run = run_tracker(
         inputs.scene,
         inputs.own_frames.get(name, inputs.frame_detections),
@@ -69,12 +68,12 @@ def track_run(
 
 def run_one(inputs: Inputs, name: str, *, record: bool, on_frame: Callable[[], None] | None = None) -> Run:
     """Run ``name`` once; with ``record`` its events and facts are kept (module docstring)."""
-    if not record:
-        return Run(track_run(inputs, name, on_frame=on_frame))
     from gnnpmb.events import ListSink, TeeSink
     from gnnpmb.why.facts import FactSink
 
     caps = inputs.capabilities(name)
+    if not record:
+        return Run(track_run(inputs, name, on_frame=on_frame))
     facts = FactSink(name, has_existence=caps.has_existence, output_only=caps.output_only)
     events = ListSink()
     tracking = track_run(inputs, name, TeeSink(facts, events), on_frame)
