@@ -22,6 +22,7 @@ from gnnpmb.events import (
     axis_labels,
 )
 from gnnpmb.explain import explain
+from gnnpmb.why.counterfactual import would_take
 from gnnpmb.why.words import choice_text, choice_why
 from tools.truth import replay
 from tools.truth.devkit import EvalFacts
@@ -95,7 +96,8 @@ def _because(existence: np.ndarray | None, d2: np.ndarray = TAKEN) -> str:
     _, m, a = _world(existence, d2)
     d = explain(m, a)
     choice = next(ch for c in d.conflicts for ch in c.choices if ch.meas.ref == 0)
-    why = choice_why(choice)
+    would = would_take(m, a, 0, int(choice.alternative.ref))
+    why = choice_why(choice, would=would)
     return f"Because (frame 3): {why}." if why else ""
 
 
@@ -189,3 +191,12 @@ def test_a_capped_or_wrong_margin_is_caught_and_the_solvers_margin_passes() -> N
     assert (found == []) == (real <= 5.0), (true, real)
     planted = true.rsplit("margin ", 1)[0] + f"margin {real + 1.0:.2f}"
     assert [c.kind for c in _found(planted).found] == ["misleading"]
+
+
+@pytest.mark.parametrize("existence", [None, np.array([0.1, 0.5, 0.9])], ids=["gnn", "pmb"])
+@pytest.mark.parametrize("d2", [TAKEN, FREE], ids=["rival taken", "rival free"])
+def test_the_explainers_own_because_holds_when_replayed(d2: np.ndarray, existence: np.ndarray | None) -> None:
+    text = _because(existence, d2)
+    t = _found(text, existence=existence, d2=d2)
+    assert t.found == [], (text, t.found)
+    assert t.replays == 1, text  # the explainer said what the solver would do, and the replay agreed

@@ -15,7 +15,7 @@ from collections import defaultdict
 from collections.abc import Sequence
 from pathlib import Path
 
-from tools.truth.sentences import CLASSES, Context, Tally, check_text
+from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
 
 DEVSET = Path("/work/shared/devset")
 MINI_VAL = ("scene-0103", "scene-0916")
@@ -27,9 +27,16 @@ def split_of_scene(scene: str) -> str:
 
 
 def run_cell(
-    tracker: str, scene: str, preset: str, dataroot: Path = DEVSET, version: str = "v1.0-mini"
+    tracker: str,
+    scene: str,
+    preset: str,
+    dataroot: Path = DEVSET,
+    version: str = "v1.0-mini",
+    where: list[tuple[str, Contradiction]] | None = None,
 ) -> tuple[Tally, int]:
-    """Check every finding of ``tracker`` on ``scene`` with ``preset``'s detection file; (tally, findings)."""
+    """Check every finding of ``tracker`` on ``scene`` with ``preset``'s detection file; (tally, findings).
+    where: gets ("tracker scene preset failure-id", contradiction) for each contradiction."""
+    where = [] if where is None else where
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.submission import run_results
     from gnnpmb.events import ListSink, TeeSink
@@ -65,8 +72,7 @@ def run_cell(
         )
         one = check_text(text, ctx, raw, ev, tracker)
         tally.add(one)
-        for c in one.found:
-            print(f"  {tracker} {scene} {preset} {fid}: [{c.kind}] {c.sentence!r} -- {c.truth}", file=sys.stderr)
+        where.extend((f"{tracker} {scene} {preset} {fid}", c) for c in one.found)
     return tally, len(report.failures)
 
 
@@ -81,12 +87,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     per: dict[str, Tally] = defaultdict(Tally)
     findings: dict[str, int] = defaultdict(int)
+    where: list[tuple[str, Contradiction]] = []
     for scene in args.scene or MINI_VAL:
         for preset in args.detector or PRESETS:
             for tracker in args.tracker or TRACKER_NAMES:
-                tally, n = run_cell(tracker, scene, preset, args.dataroot)
+                tally, n = run_cell(tracker, scene, preset, args.dataroot, where=where)
                 per[tracker].add(tally)
                 findings[tracker] += n
+                print(f"checked {tracker} {scene} {preset}: {n} findings", file=sys.stderr, flush=True)
     head = " ".join(f"{k:>14}" for k in CLASSES)
     print(f"{'tracker':12} {'findings':>8} {head} {'replays':>8} {'refuted':>8}")
     total = Tally()
@@ -98,6 +106,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         cells = " ".join(f"{counts[k]:>6}/{t.checked[k]:<7}" for k in CLASSES)
         print(f"{tracker:12} {findings[tracker]:>8} {cells} {t.replays:>8} {t.refuted:>8}")
     print(f"contradictions: {len(total.found)} (false/checked per class above)")
+    for place, c in where:
+        print(f"  {place}: [{c.kind}] {c.sentence!r} -- {c.truth}")
     return 1 if total.found else 0
 
 

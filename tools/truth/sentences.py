@@ -75,11 +75,21 @@ ABOVE = re.compile(
     rf"With a predicted existence above ({_NUM}) \(instead of ({_NUM})\), track (\d+) would have taken m(\d+)"
 )
 NO_EXISTENCE = re.compile(r"No predicted existence would have given m(\d+) to track (\d+)")
-EVEN_AT_ZERO = re.compile(r"Even with m(\d+) right on its prediction \(d² 0\), track (\d+) would have cost more")
-RIVAL = re.compile(r"m(\d+) went to (.+?) \(cost [-\d.]+\) rather than track (\d+) \(cost")
+EVEN_AT_ZERO = re.compile(
+    r"Even with m(\d+) right on its prediction \(d² 0\), track (\d+) would (?:have cost more|not have taken it)"
+)
+RIVAL = re.compile(
+    r"m(\d+) went to (.+?) \(cost [-\d.]+\) rather than track (\d+) \(cost [-\d.]+\): the lower cost wins"
+)
+RIVAL_TAKEN = re.compile(r"m(\d+) went to (.+?) \(cost [-\d.]+\); track (\d+) \(cost [-\d.]+\) went to m(\d+)")
+COULD_NOT = re.compile(
+    r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it; track (\d+) could not take it: its column's cost for "
+    r"it was infinite"
+)
 CHOICE = re.compile(
     r"frame (\d+): m(\d+)(?: \(score [\d.]+\))? → ([^(]+?) \([^()]*\) "
     r"(?:over (track \d+|new|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)|\(no other\)), margin (inf|\d+\.\d+)"
+    r"((?: [a-zA-Z]+)? or more)?"
 )
 THEFT = re.compile(
     r"track (\d+) had been a false track at [^(]+\(matched to no object: the evaluation still gave GT (\w+) to "
@@ -113,6 +123,11 @@ def check_text(text: str, ctx: Context, raw: RawEvents | None, ev: EvalFacts, tr
         if not raw.gone(x, c, t):
             cost = raw.entry(x, c, meas, t)
             bad("gone", m[0], f"track {t} had a column at frame {x} (cost for m{meas}: {cost})")
+    for m in COULD_NOT.finditer(text):
+        x, meas, t = int(m[1]), int(m[2]), int(m[3])
+        out.checked["gone"] += 1
+        if not raw.could_not_take(x, c, meas, t):
+            bad("gone", m[0], f"(m{meas}, track {t}) at frame {x}: cost {raw.entry(x, c, meas, t)}")
     for b in BECAUSE.finditer(text):
         x, para = int(b[1]), b[2]
         for m in OUTSIDE.finditer(para):
@@ -221,6 +236,14 @@ def _check_counterfactuals(x: int, para: str, c: str, raw: RawEvents, out: Tally
             continue
         mat, _, row, col = s
         verdict(m[0], replay.replay_d2(mat, row, col, 0.0) is False, f"at d² 0, m{meas} goes to track {t}")
+    for m in RIVAL_TAKEN.finditer(para):
+        meas, t, k = int(m[1]), int(m[3]), int(m[4])
+        if found is None:
+            continue
+        out.checked["counterfactual"] += 1
+        other = [int(r.ref) for r, col in found[1].pairs if col.kind is AxisKind.TRACK and int(col.ref) == t]
+        if other != [k]:
+            bad("counterfactual", m[0], f"the assignment of frame {x} gave track {t} to {other}")
     for m in RIVAL.finditer(para):
         meas, t = int(m[1]), int(m[3])
         if found is None:
@@ -233,7 +256,7 @@ def _check_counterfactuals(x: int, para: str, c: str, raw: RawEvents, out: Tally
 
 
 def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
-    x, meas, alt, printed = int(m[1]), int(m[2]), m[4], m[5]
+    x, meas, alt, printed, at_least = int(m[1]), int(m[2]), m[4], m[5], m[6] is not None
     found = raw.deciding(x, c)
     if found is None:
         return
@@ -253,5 +276,9 @@ def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
     if math.isnan(true):
         return
     shown = math.inf if printed == "inf" else float(printed)
+    if at_least:  # "margin 5.00 or more"
+        if true < shown - 0.006:
+            bad("misleading", m[0], f"re-solved without the pair, the total rises by {true:.3f}")
+        return
     if (math.isinf(true) and not math.isinf(shown)) or (math.isfinite(true) and abs(shown - true) > 0.006):
         bad("misleading", m[0], f"re-solved without the pair, the total rises by {true:.3f}")
