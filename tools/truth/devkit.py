@@ -5,7 +5,8 @@ ground truth, add ego distances, ``filter_eval_boxes`` (class range, zero points
 (which interpolates gaps inside a track); then per class ``TrackingEvaluation.accumulate`` (all recall thresholds,
 as ``compute_metrics`` scores them), the best-MOTA threshold, and ``accumulate_threshold`` at it, whose
 ``acc.events`` (MATCH / SWITCH / MISS / FP per devkit frame id, OId, HId) are read back onto keyframe indices by
-replaying the accumulator's frame numbering (a frame with neither ground truth nor a kept track has no id).
+replaying the accumulator's frame numbering (a frame with neither ground truth nor a kept track has no id), and
+onto the scene's object and track ids through the devkit's own merge mappings (the merge renumbers them).
 """
 
 from __future__ import annotations
@@ -109,8 +110,7 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         best = int(np.nanargmax(md.mota))
         threshold = None if np.isnan(md.confidence[best]) else float(md.confidence[best])
         out.thresholds[class_name] = threshold
-        with contextlib.redirect_stderr(io.StringIO()):
-            events, _ = ev.accumulate_threshold(threshold)  # the merged acc.events of the scene
+        events, oid_of, hid_of = _accumulate_threshold(ev, threshold)
         frame_of_id = []  # devkit frame id -> keyframe index, numbered as accumulate_threshold numbers them
         counted: set[str] = set()
         for stamp in scene_gt:
@@ -130,6 +130,38 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         ):
             if str(kind) in MATCHED:
                 frame = frame_of_id[int(frame_id)]
-                out.gt_to_track[(class_name, frame)][str(oid)] = str(hid)
-                out.track_to_gt[(class_name, frame)][str(hid)] = str(oid)
+                gt_id, track_id = str(oid_of[oid]), str(hid_of[hid])
+                out.gt_to_track[(class_name, frame)][gt_id] = track_id
+                out.track_to_gt[(class_name, frame)][track_id] = gt_id
     return out
+
+
+def _accumulate_threshold(ev, threshold: float | None):
+    """``ev.accumulate_threshold(threshold)``'s events with the ids the scene gave them: the devkit merges the
+    per-scene accumulators with ``MOTAccumulatorCustom.merge_event_dataframes``, which renumbers object and
+    hypothesis ids; its own mappings (``return_mappings``) are read back here. Returns (events, new OId ->
+    object id, new HId -> track id)."""
+    import contextlib
+    import io
+
+    from nuscenes.eval.tracking.mot import MOTAccumulatorCustom
+
+    original = MOTAccumulatorCustom.merge_event_dataframes
+    mappings: list[dict] = []
+
+    def merge(dfs, *args, **kwargs):
+        merged, infos = original(dfs, *args, return_mappings=True, **kwargs)
+        mappings.extend(infos)
+        return merged
+
+    MOTAccumulatorCustom.merge_event_dataframes = staticmethod(merge)
+    try:
+        with contextlib.redirect_stderr(io.StringIO()):
+            events, _ = ev.accumulate_threshold(threshold)
+    finally:
+        MOTAccumulatorCustom.merge_event_dataframes = staticmethod(original)
+    (info,) = mappings  # one scene
+    assert info.get("frame_offset", 0) == 0
+    oid_of = {new: old for old, new in info.get("oid_map", {}).items()}
+    hid_of = {new: old for old, new in info.get("hid_map", {}).items()}
+    return events, oid_of, hid_of
