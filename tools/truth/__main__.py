@@ -94,7 +94,13 @@ def main(argv: Sequence[str] | None = None) -> int:
                 tally, n = run_cell(tracker, scene, preset, args.dataroot, where=where)
                 per[tracker].add(tally)
                 findings[tracker] += n
-                print(f"checked {tracker} {scene} {preset}: {n} findings", file=sys.stderr, flush=True)
+                line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)
+                print(
+                    f"checked {tracker} {scene} {preset}: {n} findings; false/checked {line}; replays "
+                    f"{tally.replays} refuted {tally.refuted}",
+                    file=sys.stderr,
+                    flush=True,
+                )
     head = " ".join(f"{k:>14}" for k in CLASSES)
     print(f"{'tracker':12} {'findings':>8} {head} {'replays':>8} {'refuted':>8}")
     total = Tally()
