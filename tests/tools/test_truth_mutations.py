@@ -200,3 +200,24 @@ def test_the_explainers_own_because_holds_when_replayed(d2: np.ndarray, existenc
     t = _found(text, existence=existence, d2=d2)
     assert t.found == [], (text, t.found)
     assert t.replays == 1, text  # the explainer said what the solver would do, and the replay agreed
+
+
+def test_a_track_said_to_be_matched_instead_to_a_missed_object_is_caught() -> None:
+    sentence = "car GT bbbbbb lies 0.4 m away and the evaluation matched it to another track (track 7): two tracks"
+    assert [c.kind for c in _found(sentence).found] == ["matched"]  # GT B was missed at frame 3
+    assert _found(sentence, Context(C, 3, GT_A)).found == []  # GT A was matched to track 7
+
+
+def test_a_greedy_choice_over_a_column_another_detection_took_is_caught() -> None:
+    from gnnpmb.events import CostScale
+
+    rows = axis_labels(AxisKind.MEASUREMENT, [0, 1])
+    cols = axis_labels(AxisKind.TRACK, [5, 7]) + axis_labels(AxisKind.NEW_TRACK, [0, 1])
+    cost = np.array([[1.0, 4.0, 9.0, np.inf], [2.0, 3.0, np.inf, 9.0]])
+    m = CostMatrix(C, cost, rows, cols, scale=CostScale("distance", "m", 0.3, optimal=False))
+    a = Assignment(C, ((rows[0], cols[0]), (rows[1], cols[1])), 4.0, ())
+    raw = RawEvents.of([FrameStarted("t", 3, "token", 0, 0.5), m, a])
+    planted = "then, frame 3: m1 → track 7 (cost 3.00 m) over track 5 (2.00 m), margin 0.00 m"
+    assert [c.kind for c in check_text(planted, CTX, raw, _eval()).found] == ["misleading"]
+    fair = "then, frame 3: m1 → track 7 (cost 3.00 m) over new (9.00 m), margin 5.00 m or more"
+    assert check_text(fair, CTX, raw, _eval()).found == []
