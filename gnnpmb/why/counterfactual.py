@@ -8,8 +8,9 @@ the solver, so it is only said when re-solving the matrix with that change gives
 * existence: every entry of column k moves by the change of log(1 - r P_D) - log r from r_k to X.
 
 The break-even is found by bisection with the optimal solver (``assign.hungarian``: the PMB family's and GNN's);
-the value stated is rounded to the safe side (d² down to 0.1, existence up to 0.01, as ``words`` prints them) and
-checked once more. The rival's other detection (the one the assignment gave it, if any) is part of the re-solve.
+the value stated is rounded to the safe side (d² down to 0.1, existence up to 0.01, as ``words`` prints them;
+more decimals where the current value would print the same) and checked once more. The rival's other detection
+(the one the assignment gave it, if any) is part of the re-solve.
 """
 
 from __future__ import annotations
@@ -30,7 +31,8 @@ class WouldTake:
     """Track ``track`` and detection ``meas`` at one frame: kind "d2" or "existence"; now: its current value;
     needed: the value from which the re-solved assignment gives it the detection, rounded to the safe side (None:
     no value does; a break-even two decimals cannot state safely gives no ``WouldTake`` at all); taken_by: the
-    detection the assignment gave the track instead (None: none)."""
+    detection the assignment gave the track instead (None: none); digits: the decimals that tell needed from now
+    apart (a near tie needs more than the usual one for d², two for an existence)."""
 
     track: int
     meas: int
@@ -38,6 +40,7 @@ class WouldTake:
     now: float
     needed: float | None
     taken_by: int | None
+    digits: int = 1
 
 
 def _takes(cost: np.ndarray, row: int, col: int) -> bool:
@@ -88,8 +91,12 @@ def _by_d2(
     for _ in range(BISECTIONS):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if at(mid) else (lo, mid)
-    stated = math.floor(lo * 10.0) / 10.0
-    return WouldTake(track, meas, "d2", d2, stated, taken_by) if at(stated) else None
+    for digits in (1, 2, 3, 4):
+        scale = 10.0**digits
+        stated = math.floor(lo * scale) / scale
+        if f"{stated:.{digits}f}" != f"{d2:.{digits}f}":
+            break
+    return WouldTake(track, meas, "d2", d2, stated, taken_by, digits) if at(stated) else None
 
 
 def _by_existence(
@@ -113,7 +120,11 @@ def _by_existence(
     for _ in range(BISECTIONS):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if at(mid) else (mid, hi)
-    stated = math.ceil(hi * 100.0) / 100.0
+    for digits in (2, 3, 4):
+        scale = 10.0**digits
+        stated = math.ceil(hi * scale) / scale
+        if f"{stated:.{digits}f}" != f"{r:.{digits}f}":
+            break
     if stated <= r or stated >= 1.0 or not at(stated * (1.0 + 1e-6)):
-        return None  # no value with two decimals states it: say nothing
-    return WouldTake(track, meas, "existence", r, stated, taken_by)
+        return None  # no value with that many decimals states it: say nothing
+    return WouldTake(track, meas, "existence", r, stated, taken_by, digits)

@@ -217,13 +217,15 @@ def _would_have(w: WouldTake, name: str, meas: str) -> str:
     if w.kind == "existence":
         if w.needed is None:
             return f"No predicted existence would have given {meas} to {name}"
-        return (
-            f"With a predicted existence above {existence_text(w.needed)} (instead of {existence_text(w.now)}), "
-            f"{name} would have taken {meas}"
+        needed, now = (
+            (existence_text(w.needed), existence_text(w.now))
+            if w.digits == 2
+            else (f"{w.needed:.{w.digits}f}", f"{w.now:.{w.digits}f}")
         )
+        return f"With a predicted existence above {needed} (instead of {now}), {name} would have taken {meas}"
     if w.needed is None:
         return f"Even with {meas} right on its prediction (d² 0), {name} would not have taken it"
-    return f"Within d² {w.needed:.1f} (instead of {w.now:.1f}), {name} would have taken {meas}"
+    return f"Within d² {w.needed:.{w.digits}f} (instead of {w.now:.{w.digits}f}), {name} would have taken {meas}"
 
 
 def choice_text(frame: int, c: PairChoice, went: int, born: bool) -> str:

@@ -221,3 +221,17 @@ def test_a_greedy_choice_over_a_column_another_detection_took_is_caught() -> Non
     assert [c.kind for c in check_text(planted, CTX, raw, _eval()).found] == ["misleading"]
     fair = "then, frame 3: m1 → track 7 (cost 3.00 m) over new (9.00 m), margin 5.00 m or more"
     assert check_text(fair, CTX, raw, _eval()).found == []
+
+
+def test_a_near_tie_is_stated_with_the_decimals_that_tell_the_two_values_apart() -> None:
+    """m0 goes to track 7 at d² 2.52; track 5 (a spread 0.05 nats wider) breaks even at d² 2.42 and sits at 2.44:
+    with one decimal both would print as 2.4."""
+    d2 = FREE.copy()
+    d2[1, 0], d2[0, 0] = 2.52, 2.44
+    even = 2.42
+    _, m, a = _world(None, d2)
+    w = would_take(m, a, 0, 5)
+    assert w is not None and w.digits >= 2 and w.needed < even
+    text = _because(None, d2)
+    assert f"Within d² {w.needed:.{w.digits}f} (instead of {d2[0, 0]:.{w.digits}f})" in text, text
+    assert _found(text, d2=d2).found == []
