@@ -13,7 +13,8 @@ closer than the slack, and stay small even when wide gates of low-existence cand
 For every chosen pair the *margin* is how much the best assignment of the conflict gets worse when that pair is
 forbidden (re-solved with the Hungarian algorithm), capped at ``LINK_SLACK``: a margin near 0 is a close call,
 the usual cause of an ID switch. A greedy matcher's choices are not a best total (``CostScale.optimal`` False):
-its margin is the detection's next cheapest column minus its chosen one. What counts as close is the matrix's own
+its margin is the detection's next cheapest column that no other detection took minus its chosen one (a cheaper
+column another detection took was not there to take). What counts as close is the matrix's own
 ``CostScale.close_call`` (nats, metres, ...).
 """
 
@@ -245,12 +246,14 @@ def _conflict(
         masked = sub.copy()
         kept = chosen_sub >= 0
         masked[at[kept], chosen_sub[kept]] = np.inf
+        if not matrix.scale.optimal:  # a greedy matcher's alternatives: only the columns no other detection took
+            masked[:, chosen_sub[kept]] = np.inf
         best = np.argmin(masked, axis=1)
         cols_list, chosen_list, best_list = cols.tolist(), chosen_sub.tolist(), best.tolist()
         chosen_costs, best_costs = chosen_cost.tolist(), masked[at, best].tolist()
         if matrix.scale.optimal:
             margins = [_margin(sub, i, j, total) for i, j in enumerate(chosen_list)]
-        else:  # a greedy matcher: the row's next cheapest entry against its chosen one
+        else:  # a greedy matcher: the row's next cheapest free entry against its chosen one
             margins = [_capped(b, c) for b, c in zip(masked[at, best].tolist(), chosen_cost.tolist(), strict=True)]
     mrows, mcols = matrix.rows, matrix.cols
     choices = []

@@ -31,6 +31,7 @@ from gnnpmb.events import (
     BudgetReached,
     Cardinality,
     CostMatrix,
+    CostScale,
     Event,
     Extracted,
     FrameStarted,
@@ -155,7 +156,8 @@ class TrackStep:
     (detection, d2) inside its gate, nearest first; use: how its update used the detections (None: no update
     reported for it); born_from: the detection that started it this frame; posterior_existence: after the update
     (None if it ended); output: its box in the tracker's output (None: not output); ended: how it ended (None: it
-    lives on).
+    lives on); column: (detection, cost) of its column in the cost matrix the frame was decided over (+inf: it
+    could not take that detection; None: it had no column), on that matrix's ``column_scale``.
     """
 
     frame: int
@@ -169,10 +171,17 @@ class TrackStep:
     ended: TrackEnd | None = None
     decided_existence: float | None = None
     marginal_existence: float | None = None
+    column: tuple[tuple[int, float], ...] | None = None
+    column_scale: CostScale | None = None
 
     @property
     def used(self) -> tuple[int, ...]:
         return self.use.used if self.use is not None else ()
+
+    def column_cost(self, meas: int) -> float | None:
+        """Its column's cost for detection ``meas`` in the matrix the frame was decided over (+inf: it could not
+        take it); None when it had no column or the matrix no row for the detection."""
+        return next((c for m, c in self.column or () if m == meas), None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -433,6 +442,14 @@ class TrackerFacts:
             marginal = _marginal(hyp, t)
             if hyp.best_parent != 0:
                 decided = _decided_existence(cf, t)
+        column = scale = None
+        matrix = cf.cost
+        if matrix is not None:
+            cols = [k for k, c in enumerate(matrix.cols) if c.kind is AxisKind.TRACK and c.ref == t]
+            if cols:
+                refs = [int(r.ref) for r in matrix.rows]
+                column = tuple(zip(refs, np.asarray(matrix.cost)[:, cols[0]].tolist(), strict=True))
+                scale = matrix.scale
         return TrackStep(
             frame=f,
             prior_existence=prior_r,
@@ -445,6 +462,8 @@ class TrackerFacts:
             ended=ended,
             decided_existence=decided,
             marginal_existence=marginal,
+            column=column,
+            column_scale=scale,
         )
 
     def track_ids(self, class_name: str, frames: Iterable[int] | None = None) -> set[int]:

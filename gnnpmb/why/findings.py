@@ -42,6 +42,7 @@ from gnnpmb.eval.evaluated import GtFrame, TrackEval
 from gnnpmb.eval.failures import FailureKind
 from gnnpmb.explain import PairChoice
 from gnnpmb.foreign import BoxOn
+from gnnpmb.why.counterfactual import WouldTake
 from gnnpmb.why.facts import Destination, TrackStep
 
 NEAR_M = 2.0
@@ -132,7 +133,8 @@ class Near:
 class OnObject:
     """A track output within ``NEAR_M`` of an object: its id, distance, output score, the detection its box sits
     on (-1: none this frame) and how the evaluation took it (``TrackEval``; None: not evaluated) against the
-    class's threshold (None: every box counts)."""
+    class's threshold (None: every box counts); false_here: the evaluation matched it to no object at this frame
+    (a false track there)."""
 
     track_id: int
     distance_m: float
@@ -140,6 +142,7 @@ class OnObject:
     meas: int
     evaluated: TrackEval | None
     threshold: float | None
+    false_here: bool = False
 
     @property
     def counted(self) -> bool:
@@ -200,12 +203,15 @@ class LostTrack:
 @dataclass(frozen=True, slots=True)
 class Origin:
     """Where the track that took the object came from: born at ``frame`` from detection ``meas`` (frame -1: before
-    the window), and the frames it was a false track before the failure (identity theft)."""
+    the window), and the frames it was a false track before the failure (identity theft); victim_held: at each of those
+    frames the evaluation matched the object (no miss of it) and the victim was no false track, so the victim held
+    it."""
 
     track_id: int
     frame: int
     meas: int
     false_frames: tuple[int, ...] = ()
+    victim_held: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -213,8 +219,10 @@ class Deciding:
     """A solver's choice that decided where the object's detection went: at ``frame``, ``choice`` (the chosen
     column, its cost, the next best, the margin, and the cost terms when the tracker gives them); went: the id of
     the track the detection went to (-1: none), or that it started (``born``); lost: the track that had the object
-    when it is neither of the compared columns, with its own cost for the detection (None: outside its gate or not
-    in the matrix) and whether the detection was in its gate."""
+    when it is neither of the compared columns and had a column in the frame's matrix (None otherwise: a track
+    without a column is not said to be outside a gate), and whether its column could take the detection (a finite
+    cost); would / lost_would: what change of the next best's / the lost track's cost would have given it the
+    detection, re-solved (``counterfactual.WouldTake``; None: nothing is said)."""
 
     frame: int
     choice: PairChoice
@@ -222,6 +230,8 @@ class Deciding:
     born: bool
     lost: int | None = None
     lost_in_gate: bool = False
+    would: WouldTake | None = None
+    lost_would: WouldTake | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -269,7 +279,8 @@ class FalseOutput:
     """A false track's box at the failure frame: the detection it was output on (None: none, it was predicted, or
     not output at all), where the box lies, the frames of the track's own boxes the evaluation interpolated this
     one between (None: the tracker output it), the nearest object of its class (gt id, distance, how the evaluation
-    saw it), the nearest of any class, and the track the evaluation matched to that object instead (None: none)."""
+    saw it), the nearest of any class, and the track the evaluation matched to that object instead (None: none);
+    object_missed: the evaluation matched that object to no track at this frame."""
 
     track_id: int
     on: Near | None
@@ -280,6 +291,7 @@ class FalseOutput:
     matched_instead: int | None
     evaluated: TrackEval | None
     threshold: float | None
+    object_missed: bool = False
 
 
 @dataclass(frozen=True, slots=True)

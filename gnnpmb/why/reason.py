@@ -9,6 +9,7 @@ checks (``claims``) read the same data.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -17,10 +18,11 @@ import numpy as np
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.evaluated import GtStatus
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport
-from gnnpmb.events import AxisKind
+from gnnpmb.events import AxisKind, CostMatrix
 from gnnpmb.foreign import BoxOn
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import TrackEstimate
+from gnnpmb.why.counterfactual import would_take
 from gnnpmb.why.facts import TrackerFacts, UseMode
 from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
@@ -154,9 +156,9 @@ class _Context:
                 continue
             d = float(np.hypot(e.translation_m[0] - xy[0], e.translation_m[1] - xy[1]))
             if d < NEAR_M:
-                out.append(
-                    OnObject(e.track_id, d, e.score, e.meas_index, report.track_evals.get(str(e.track_id)), threshold)
-                )
+                evaluated = report.track_evals.get(str(e.track_id))
+                false_here = self.false_at(report, fr.keyframe.index, e.track_id)
+                out.append(OnObject(e.track_id, d, e.score, e.meas_index, evaluated, threshold, false_here))
         return tuple(sorted(out, key=lambda o: o.distance_m))
 
     def sightings(self, gt_id: str) -> tuple[Sighting, ...]:
@@ -338,7 +340,18 @@ class _Context:
                 }
             )
         )
-        return Origin(track_id, born[0], born[1], false if self.failure.kind is FailureKind.IDENTITY_THEFT else ())
+        if self.failure.kind is not FailureKind.IDENTITY_THEFT:
+            false = ()
+        gt_id = self.failure.gt_ids[0] if self.failure.gt_ids else None
+        victim = self.failure.track_ids[1] if len(self.failure.track_ids) > 1 else None
+        held = bool(false) and all(
+            gt_id is not None
+            and victim is not None
+            and not self.missed_at(gt_id, x)
+            and not self.false_at(self.report, x, int(victim))
+            for x in false
+        )
+        return Origin(track_id, born[0], born[1], false, held)
 
     def blame_lost(self, sightings: tuple[Sighting, ...], deciding: tuple[int, ...], lost: LostTrack) -> tuple:
         seen = {s.frame: s for s in sightings}
@@ -410,10 +423,20 @@ class _Context:
             return None
         f, c, went, is_born = best
         compared = {label.ref for label in (c.chosen, c.alternative) if label is not None}
+        frame = self.facts.frame(f, self.class_name)
+        matrix, assignment = frame.cost, frame.assignment
         lost = None if lost_id in compared else lost_id
-        step = self.facts.steps(lost_id, self.class_name).get(f)
-        in_gate = step is not None and any(m == c.meas.ref for m, _ in step.gated)
-        return Deciding(f, c, went, is_born, lost, in_gate)
+        in_gate, lost_would = False, None
+        if lost is not None:  # said only of a track with a column in the matrix: its cost for the detection
+            entry = _entry(matrix, int(c.meas.ref), lost)
+            lost = None if entry is None else lost
+            in_gate = entry is not None and math.isfinite(entry)
+            if in_gate and assignment is not None:
+                lost_would = would_take(matrix, assignment, int(c.meas.ref), lost_id)
+        would = None
+        if matrix is not None and assignment is not None and c.alternative is not None:
+            would = would_take(matrix, assignment, int(c.meas.ref), int(c.alternative.ref))
+        return Deciding(f, c, went, is_born, lost, in_gate, would, lost_would)
 
     def switch(self, tracks: set[int], deciding: tuple[int, ...]) -> HypothesisSwitch | None:
         """A PMBM hypothesis switch in the deciding frames: the best hypothesis descends from another prior
@@ -511,19 +534,31 @@ class _Context:
             matched,
             self.report.track_evals.get(str(t)),
             self.threshold,
+            nearest_own is not None and self.missed_at(nearest_own[0], self.f),
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
+
+    @staticmethod
+    def false_at(report: FailureReport, frame: int, track_id: int) -> bool:
+        """Whether the evaluation matched track ``track_id`` to no object at ``frame`` (a false track there)."""
+        return any(
+            f.frame_index == frame and str(track_id) in f.track_ids for f in report.of_kind(FailureKind.FALSE_TRACK)
+        )
+
+    def missed_at(self, gt_id: str, frame: int) -> bool:
+        """Whether the evaluation matched object ``gt_id`` to no track at ``frame`` (a miss there)."""
+        return any(f.frame_index == frame and gt_id in f.gt_ids for f in self.report.of_kind(FailureKind.MISS))
 
     def matched_to(self, gt_id: str) -> int | None:
         """The track the evaluation matched object ``gt_id`` to at the failure frame: a counted track of the class
         output within ``NEAR_M`` of its evaluated box, nearest first (None: none)."""
         g = self.report.gt_frame(gt_id, self.f)
-        if g is None or g.evaluated_xy_m is None:
+        if g is None or g.evaluated_xy_m is None or self.missed_at(gt_id, self.f):
             return None
         others = [
             o
             for o in self.on_object(self.report, self.frames.get(self.f), np.asarray(g.evaluated_xy_m))
-            if o.counted and o.track_id != int(self.failure.track_ids[0])
+            if o.counted and not o.false_here and o.track_id != int(self.failure.track_ids[0])
         ]
         return others[0].track_id if others else None
 
@@ -548,7 +583,7 @@ class _Context:
             out.append(Blame(Rule.TRACK_DROPPED, f))
         if any(not o.counted for o in s.on_it if o not in dropped):
             out.append(Blame(Rule.NOT_COUNTED, f))
-        if any(o.counted for o in s.on_it if o not in dropped):  # counted, yet matched to another object
+        if any(o.counted and not o.false_here for o in s.on_it if o not in dropped):  # matched to another object
             out.append(Blame(Rule.COVERED_TWO, f))
         own = s.nearest_own
         if own is None and s.nearest_any is not None and s.nearest_any.class_name == self.class_name:
@@ -570,7 +605,7 @@ class _Context:
             blame += uncovered
             if s.went is not None and s.went.track_id == int(self.failure.track_ids[0]):
                 blame.append(Blame(Rule.COVERED_TWO, (self.f,)))
-        covered = tuple(g for g in self.failure.gt_ids if g != self.failure.gt_ids[1])
+        covered = self.failure.gt_ids[:1]  # the object the evaluation matched the track to (failures docstring)
         return {"deciding": (self.f,), "blame": tuple(dict.fromkeys(blame)), "covered": covered}
 
     def key_decisions(self, involved: set[int]) -> tuple[KeyDecision, ...]:
@@ -636,6 +671,16 @@ def _same_place(f: Failure, gt_id: str | None, xy: np.ndarray | None) -> bool:
     if xy is None:
         return False
     return any(np.hypot(*(np.asarray(b.translation_m[:2]) - xy)) < NEAR_M for b in f.boxes)
+
+
+def _entry(matrix: CostMatrix | None, meas: int, track: int) -> float | None:
+    """Track ``track``'s cost for detection ``meas`` in ``matrix`` (+inf: it could not take it); None when the
+    matrix has no column for the track (or no row for the detection)."""
+    if matrix is None:
+        return None
+    rows = [i for i, r in enumerate(matrix.rows) if r.kind is AxisKind.MEASUREMENT and int(r.ref) == meas]
+    cols = [k for k, col in enumerate(matrix.cols) if col.kind is AxisKind.TRACK and int(col.ref) == track]
+    return float(np.asarray(matrix.cost)[rows[0], cols[0]]) if rows and cols else None
 
 
 def _went(chosen, born_id: int | None) -> tuple[int, bool]:

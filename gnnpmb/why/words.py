@@ -12,9 +12,10 @@ from collections.abc import Iterable, Sequence
 
 from gnnpmb.eval.evaluated import Dropped, GtFrame, GtStatus, TrackEval
 from gnnpmb.eval.failures import FailureKind, short_id
-from gnnpmb.events import AxisKind, AxisLabel, PairTerms
-from gnnpmb.explain import PairChoice
+from gnnpmb.events import AxisKind, AxisLabel, CostScale, PairTerms
+from gnnpmb.explain import LINK_SLACK, PairChoice
 from gnnpmb.foreign import NEAREST_M, BoxOn, OnHow
+from gnnpmb.why.counterfactual import WouldTake
 from gnnpmb.why.facts import Destination, Ending, TrackStep, UseMode, Went
 from gnnpmb.why.findings import (
     NEAR_M,
@@ -145,9 +146,10 @@ def margin_value(value: float, choice: PairChoice) -> str:
     """A margin (a difference of costs) in the tracker's own terms: ``0.31`` (nats), ``0.20 m``, ``0.29 of
     GIoU``."""
     scale = choice.scale
+    more = " or more" if math.isfinite(value) and value >= LINK_SLACK else ""  # ``explain`` caps margins there
     if scale.similarity is not None:
-        return f"{value:.2f} of {scale.similarity}"
-    return f"{value:.2f}" if scale.unit == "nats" else f"{value:.2f} {scale.unit}"
+        return f"{value:.2f}{more} of {scale.similarity}"
+    return f"{value:.2f}{more}" if scale.unit == "nats" else f"{value:.2f} {scale.unit}{more}"
 
 
 def destination_text(went: int, born: bool, chosen: AxisLabel | None = None) -> str:
@@ -157,11 +159,13 @@ def destination_text(went: int, born: bool, chosen: AxisLabel | None = None) -> 
     return f"new track {went}" if born else f"track {went}"
 
 
-def choice_why(c: PairChoice, went: str | None = None) -> str | None:
+def choice_why(c: PairChoice, went: str | None = None, would: WouldTake | None = None) -> str | None:
     """Why a detection went to its chosen column rather than the track that was its next best: both costs, each
-    track's taken apart (when the tracker's matrix says what they are made of), and the predicted existence at
-    which that track would have been the cheaper of the two. went: how to name the chosen column ("new track
-    212"; default ``column_name``). None when the next best is not a track or its terms are unknown."""
+    track's taken apart (when the tracker's matrix says what they are made of), and, with ``would`` (the matrix
+    re-solved, ``counterfactual``), what would have given that track the detection. went: how to name the chosen
+    column ("new track 212"; default ``column_name``). None when the next best is not a track or its terms are
+    unknown. When the assignment gave the next best another detection, the lower cost did not decide alone: the
+    sentence says whose it was and that the lower total wins."""
     alt = c.alternative_terms
     if alt is None or c.alternative is None:
         return None
@@ -171,23 +175,31 @@ def choice_why(c: PairChoice, went: str | None = None) -> str | None:
         chosen = went if went and went.startswith("new track ") else "a new track"
     else:
         chosen = went or column_name(c.chosen)
-    lines = [
-        f"{meas} went to {chosen} (cost {c.chosen_cost:.2f}) rather than {other} (cost {c.alternative_cost:.2f}): "
-        "the lower cost wins"
-    ]
+    taken_by = would.taken_by if would is not None else None
+    if taken_by is not None:
+        head = (
+            f"{meas} went to {chosen} (cost {c.chosen_cost:.2f}); {other} (cost {c.alternative_cost:.2f}) went to "
+            f"{meas_name(taken_by)}: the lower total of the assignment wins"
+        )
+    else:
+        head = f"{meas} went to {chosen} (cost {c.chosen_cost:.2f}) rather than {other} (cost {c.alternative_cost:.2f})"
+        if would is not None:  # re-solved: the next best was free, so the lower cost decided
+            head += ": the lower cost wins"
+    lines = [head]
     if c.chosen_terms is not None:
         lines.append(
             f"{column_name(c.chosen).capitalize()}'s {c.chosen_cost:.2f} = {cost_breakdown(c.chosen_terms, meas)}"
         )
     lines.append(f"{other.capitalize()}'s {c.alternative_cost:.2f} = {cost_breakdown(alt, meas)}")
-    lines.append(_would_have(alt, other, c.alternative_cost - c.chosen_cost, meas))
+    if would is not None:
+        lines.append(_would_have(would, other, meas))
     return ". ".join(lines)
 
 
-def track_why(c: PairChoice, track_id: int, role: str = "") -> str | None:
+def track_why(c: PairChoice, track_id: int, role: str = "", would: WouldTake | None = None) -> str | None:
     """What track ``track_id`` (neither the chosen nor the next best column of ``c``; ``role``: words after its
-    name, e.g. ", which had the object,") would have cost for c's detection, taken apart, and what would have made
-    it cheaper than the chosen column; None when the matrix does not say or has no such track."""
+    name, e.g. ", which had the object,") would have cost for c's detection, taken apart, and (with ``would``)
+    what would have given it the detection; None when the matrix does not say or has no such track."""
     if c.terms is None or c.row < 0:
         return None
     col = c.terms.column_of(track_id)
@@ -196,22 +208,24 @@ def track_why(c: PairChoice, track_id: int, role: str = "") -> str | None:
     t = c.terms.pair(c.row, col)
     meas, name = meas_name(c.meas.ref), f"track {track_id}"
     cost = f"Track {track_id}{role} would have cost {t.total_nats:.2f} = {cost_breakdown(t, meas)}"
-    return f"{cost}. {_would_have(t, name, t.total_nats - c.chosen_cost, meas)}"
+    return cost if would is None else f"{cost}. {_would_have(would, name, meas)}"
 
 
-def _would_have(t: PairTerms, name: str, gap: float, meas: str) -> str:
-    """What would have made track ``name`` (terms ``t``) ``gap`` nats cheaper: its predicted existence (PMB
-    family) or its distance (GNN)."""
-    if t.existence is not None:
-        needed = t.existence_for(gap)
-        if needed is None:
+def _would_have(w: WouldTake, name: str, meas: str) -> str:
+    """What re-solving the matrix says would have given ``meas`` to track ``name``: a predicted existence (PMB
+    family) or a distance (GNN), on the safe side of the break-even (``counterfactual``)."""
+    if w.kind == "existence":
+        if w.needed is None:
             return f"No predicted existence would have given {meas} to {name}"
-        now, above = existence_text(t.existence), existence_text(needed)
-        return f"With a predicted existence above {above} (instead of {now}), {name} would have taken {meas}"
-    closer = t.d2_for(gap)
-    if closer is None:
-        return f"Even with {meas} right on its prediction (d² 0), {name} would have cost more"
-    return f"Within d² {closer:.1f} (instead of {t.d2:.1f}), {name} would have taken {meas}"
+        needed, now = (
+            (existence_text(w.needed), existence_text(w.now))
+            if w.digits == 2
+            else (f"{w.needed:.{w.digits}f}", f"{w.now:.{w.digits}f}")
+        )
+        return f"With a predicted existence above {needed} (instead of {now}), {name} would have taken {meas}"
+    if w.needed is None:
+        return f"Even with {meas} right on its prediction (d² 0), {name} would not have taken it"
+    return f"Within d² {w.needed:.{w.digits}f} (instead of {w.now:.{w.digits}f}), {name} would have taken {meas}"
 
 
 def choice_text(frame: int, c: PairChoice, went: int, born: bool) -> str:
@@ -403,17 +417,36 @@ def because_text(f: Finding) -> str | None:
     d = f.decision
     if d is None:
         return None
-    why = choice_why(d.choice, destination_text(d.went, d.born, d.choice.chosen))
+    why = choice_why(d.choice, destination_text(d.went, d.born, d.choice.chosen), d.would)
     if why is None:
         return None
-    if d.lost is not None:
+    if d.lost is not None:  # the lost track had a column in the matrix (``Deciding``)
         if not d.lost_in_gate:
-            why += f". {meas_name(d.choice.meas.ref)} was outside the gate of track {d.lost}, which had the object"
-        elif (lost_why := track_why(d.choice, d.lost, ", which had the object,")) is not None:
+            why += (
+                f". Track {d.lost}, which had the object, could not take {meas_name(d.choice.meas.ref)}: its "
+                f"column's cost for it was infinite ({_failed_test(d.choice)})"
+            )
+        elif (lost_why := track_why(d.choice, d.lost, ", which had the object,", d.lost_would)) is not None:
             why += f". {lost_why}"
     back = f.frame - d.frame
     where = f"; the views open at frame {f.frame}: step back {plural(back, 'frame')} to see it" if back > 0 else ""
     return f"**Because** (frame {d.frame}{where}): {why}."
+
+
+def _failed_test(c: PairChoice) -> str:
+    """The test an infinite cost stands for on the matrix's scale: a gate, or the tracker's cost threshold."""
+    return scale_test(c.scale)
+
+
+def scale_test(scale: CostScale | None) -> str:
+    """``outside its gate``, or ``beyond its distance threshold`` for a matrix with a cost threshold."""
+    if scale is not None and scale.threshold is not None:
+        return f"beyond its {scale.name} threshold"
+    return "outside its gate"
+
+
+def step_test(step: TrackStep) -> str:
+    return scale_test(step.column_scale)
 
 
 def _presence(f: Finding) -> str:
@@ -527,12 +560,18 @@ def _unused(f: Finding) -> list[tuple[tuple[int, int], str]]:
             if f.lost is not None:
                 step = f.lost.step(x)
                 nis = next((d2 for m, d2 in (step.gated if step is not None else ()) if m == n.meas), None)
+                t = f.lost.track_id
+                cost = step.column_cost(n.meas) if step is not None else None
                 if nis is not None:
-                    gate = f", in track {f.lost.track_id}'s gate at NIS {nis:.1f}"
+                    gate = f", in track {t}'s gate at NIS {nis:.1f}"
                 elif f.output_only and step is None:
-                    gate = f"; track {f.lost.track_id} was not output"
-                elif step is None or step.ended is not None:
-                    gate = f"; track {f.lost.track_id} was gone"
+                    gate = f"; track {t} was not output"
+                elif step is None:  # no event of the frame names the track
+                    gate = f"; track {t} was gone"
+                elif cost is not None and not math.isfinite(cost):  # what stopped it, then its deletion
+                    gate = f"; track {t} could not take it: its column's cost for it was infinite ({step_test(step)})"
+                    if step.ended is not None:
+                        gate += f", and it ended at frame {x}"
             went = went_phrase(s.went, mode) if mode is UseMode.OUTPUT else went_text(s.went, mode)
             text = f"at frame {x} {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m from it{gate}) {went}"
             out.append(((x, n.meas), text))
@@ -575,7 +614,7 @@ def _lost_object(f: Finding) -> list[str]:
         s = f.sighting(f.frame)
         for b in f.blame:
             if b.rule is Rule.COVERED_TWO and s is not None:
-                ids = ", ".join(str(o.track_id) for o in s.on_it if o.counted)
+                ids = ", ".join(str(o.track_id) for o in s.on_it if o.counted and not o.false_here)
                 parts.append(
                     f"at frame {f.frame} track {ids} lay within {NEAR_M:.0f} m of it and was counted, but the "
                     "evaluation matched it to another object: one track for two objects"
@@ -594,10 +633,10 @@ def _lost_object(f: Finding) -> list[str]:
                 )
     if f.taker is not None and f.taker.false_frames:
         victim = f"track {lost.track_id}" if lost is not None else "another track"
+        held = f": the evaluation still gave GT {short_id(f.gt_id or '')} to {victim}" if f.taker.victim_held else ""
         parts.append(
             f"track {f.taker.track_id} had been a false track at {frames_text(f.taker.false_frames)} (matched to no "
-            f"object: the evaluation still gave GT {short_id(f.gt_id or '')} to {victim}), so its taking the object "
-            "is an identity theft"
+            f"object{held}), so its taking the object is an identity theft"
         )
     return parts
 
@@ -730,6 +769,8 @@ def _false_track(f: Finding) -> list[str]:
                 f"{on}, but the evaluation has it interpolated {g.offset_m:.1f} m from the annotation, out of the "
                 "track's reach (see nuscenes-devkit issue #1141)"
             )
+        elif o.object_missed:  # the evaluation matched the object to no track: nothing was matched instead
+            parts.append(f"{on}, but the evaluation matched neither to the other (it counted the object missed)")
         else:
             other = f" (track {o.matched_instead})" if o.matched_instead is not None else ""
             parts.append(f"{on} and the evaluation matched it to another track{other}: two tracks on one object")
@@ -842,7 +883,7 @@ def _miss(f: Finding) -> list[str]:
     if s.nearest_own is not None and not s.on_it:
         parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
     if any(b.rule is Rule.COVERED_TWO for b in f.blame):
-        covering = ", ".join(str(o.track_id) for o in s.on_it if o.counted)
+        covering = ", ".join(str(o.track_id) for o in s.on_it if o.counted and not o.false_here)
         parts.append(
             f"track {covering} lay within {NEAR_M:.0f} m of it and was counted, but the evaluation matched it to "
             "another object: one track for two objects"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms, axis_labels
 from gnnpmb.explain import LINK_SLACK, _margin, explain
 
 INF = math.inf
@@ -192,3 +192,18 @@ def test_choices_read_the_terms_of_their_track_columns() -> None:
     births = CostMatrix("car", np.array([[-1.0, 0.5]]), (meas(0),), (track(1), new(0)), terms=terms)
     (only,) = explain(births, Assignment("car", ((meas(0), track(1)),), -1.0, ())).conflicts[0].choices
     assert only.chosen_terms == terms.pair(0, 0) and only.alternative == new(0) and only.alternative_terms is None
+
+
+def test_a_greedy_choice_is_not_said_to_pass_over_a_column_another_detection_took() -> None:
+    """Greedy: m0 takes track 5 (1.0), then m1 takes track 7 (3.0) though track 5 cost it 2.0: track 5 was gone
+    when m1's turn came, so m1's next best is its new-track column (9.0), margin 6.0 (capped at LINK_SLACK)."""
+    from gnnpmb.events import CostScale
+
+    rows = axis_labels(AxisKind.MEASUREMENT, [0, 1])
+    cols = axis_labels(AxisKind.TRACK, [5, 7]) + axis_labels(AxisKind.NEW_TRACK, [0, 1])
+    cost = np.array([[1.0, 4.0, 9.0, np.inf], [2.0, 3.0, np.inf, 9.0]])
+    matrix = CostMatrix("car", cost, rows, cols, scale=CostScale("distance", "m", 0.3, optimal=False))
+    pairs = ((rows[0], cols[0]), (rows[1], cols[1]))
+    (conflict,) = explain(matrix, Assignment("car", pairs, 4.0, ())).conflicts
+    m1 = next(c for c in conflict.choices if c.meas.ref == 1)
+    assert m1.alternative == cols[3] and m1.alternative_cost == 9.0 and m1.margin == LINK_SLACK

@@ -68,10 +68,16 @@ def test_the_averaged_score_names_the_frames_the_evaluation_kept_when_not_all() 
 
 def test_an_identity_theft_names_the_frames_its_thief_was_a_false_track() -> None:
     lost = LostTrack(61, 13, (), None, None, None)
-    f = finding(FailureKind.IDENTITY_THEFT, lost, taker=Origin(315, 12, 2, (12, 13)), frame=14)
+    f = finding(FailureKind.IDENTITY_THEFT, lost, taker=Origin(315, 12, 2, (12, 13), victim_held=True), frame=14)
     assert (
         "track 315 had been a false track at frames 12, 13 (matched to no object: the evaluation still gave GT bf3d85 "
         "to track 61), so its taking the object is an identity theft" in why_lines(f)[0]
+    )
+    # Where the evaluation missed the object (or the victim was false) at those frames, the aside is not said.
+    f = finding(FailureKind.IDENTITY_THEFT, lost, taker=Origin(315, 12, 2, (12, 13)), frame=14)
+    assert (
+        "track 315 had been a false track at frames 12, 13 (matched to no object), so its taking the object is an "
+        "identity theft" in why_lines(f)[0]
     )
 
 

@@ -1,0 +1,237 @@
+"""The independent checker (``tools.truth``) catches each class of false statement planted into a finding's text,
+and passes the true sentence it replaces: one frame of hand-made raw events (a GNN-like and a PMB-like cost
+matrix with their terms, the assignment, the predicted tracks) and hand-made devkit matches. The true
+counterfactual and margin sentences are rendered by the explainer's own words (``gnnpmb.why.words``) from its own
+decisions (``gnnpmb.explain``), so what is planted is exactly what the renderer would print if its rule were wrong.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gnnpmb.events import (
+    Assignment,
+    AxisKind,
+    CostMatrix,
+    CostTerms,
+    FrameStarted,
+    Predicted,
+    axis_labels,
+)
+from gnnpmb.explain import explain
+from gnnpmb.why.counterfactual import would_take
+from gnnpmb.why.words import choice_text, choice_why
+from tools.truth import replay
+from tools.truth.devkit import EvalFacts
+from tools.truth.rawevents import RawEvents
+from tools.truth.sentences import Context, check_text
+
+C = "car"
+GT_A, GT_B = "a" * 32, "b" * 32
+
+
+TAKEN = np.array([[6.0, 30.0], [2.0, 1.0], [50.0, 50.0]])
+"""d2 (K, M): m0 is nearer track 7 than track 5, but track 7 is m1's (the rival the assignment gave away)."""
+FREE = np.array([[6.0, 30.0], [2.5, 40.0], [50.0, 50.0]])
+"""d2: m0 goes to track 7, track 5 is its free next best, m1 starts a track."""
+
+
+def _matrix(existence: np.ndarray | None, d2: np.ndarray) -> CostMatrix:
+    """Two detections (m0, m1), three tracks (5, 7, 9: 9 cannot take either, +inf), one new-track column each."""
+    log_det = np.array([0.2, 0.1, 0.3])
+    miss = None if existence is None else np.log1p(-existence * 0.9)
+    terms = CostTerms(
+        existence=existence,
+        miss_log_lik=miss,
+        score=None if existence is None else np.array([0.9, 0.8]),
+        d2=d2,
+        log_det_S=log_det,
+        dim=2,
+        offset_nats=-9.0 if existence is None else 0.0,
+        track_ids=np.array([5, 7, 9]),
+    )
+    cost = np.full((2, 5), np.inf)
+    for j in range(2):
+        for k in range(2):
+            cost[j, k] = terms.pair(j, k).total_nats
+        cost[j, 3 + j] = 0.0 if existence is None else 10.0
+    rows = axis_labels(AxisKind.MEASUREMENT, [0, 1])
+    cols = axis_labels(AxisKind.TRACK, [5, 7, 9]) + axis_labels(AxisKind.NEW_TRACK, [0, 1])
+    return CostMatrix(C, cost, rows, cols, terms=terms)
+
+
+def _world(existence: np.ndarray | None, d2: np.ndarray = TAKEN):
+    from gnnpmb.assign.hungarian import solve
+
+    m = _matrix(existence, d2)
+    cols, total = solve(np.asarray(m.cost))
+    pairs = tuple((m.rows[j], m.cols[int(k)]) for j, k in enumerate(cols))
+    a = Assignment(C, pairs, total, ())
+    predicted = Predicted(C, np.array([5, 7, 9]), np.zeros((3, 4)), np.tile(np.eye(4), (3, 1, 1)), np.ones(3))
+    raw = RawEvents.of([FrameStarted("t", 3, "token", 0, 0.5), predicted, m, a])
+    return raw, m, a
+
+
+def _eval() -> EvalFacts:
+    ev = EvalFacts(thresholds={C: 0.5})
+    ev.gt_to_track[(C, 3)] = {GT_A: "7", GT_B: None}  # GT B missed: matched to nothing
+    ev.track_to_gt[(C, 3)] = {"7": GT_A, "5": None, "11": None}
+    ev.counted[C] = {"7", "11"}
+    return ev
+
+
+CTX = Context(C, 3, GT_B, covered=(GT_A,), false_frames=(3,), taker=11)
+
+
+def _found(text: str, ctx: Context = CTX, existence: np.ndarray | None = None, d2: np.ndarray = TAKEN):
+    raw, _, _ = _world(existence, d2)
+    return check_text(text, ctx, raw, _eval())
+
+
+def _because(existence: np.ndarray | None, d2: np.ndarray = TAKEN) -> str:
+    """The explainer's own Because sentence for m0's choice (frame 3); empty when it has none."""
+    _, m, a = _world(existence, d2)
+    d = explain(m, a)
+    choice = next(ch for c in d.conflicts for ch in c.choices if ch.meas.ref == 0)
+    would = would_take(m, a, 0, int(choice.alternative.ref))
+    why = choice_why(choice, would=would)
+    return f"Because (frame 3): {why}." if why else ""
+
+
+PLANTED = {
+    # class: (true sentence, planted false sentence)
+    "matched: covered two": (
+        "track 7 lay within 2 m of it and was counted, but the evaluation matched it to another object",
+        "track 11 lay within 2 m of it and was counted, but the evaluation matched it to another object",
+    ),
+    "matched: identity theft": (
+        None,
+        "track 11 had been a false track at frame 3 (matched to no object: the evaluation still gave GT bbbbbb to "
+        "track 7), so its taking the object is an identity theft",
+    ),
+    "matched: coalescence": (
+        "at frame 3 track 7 was matched to GT aaaaaa and also lay within 2 m of GT bbbbbb",
+        "at frame 3 track 5 was matched to GT aaaaaa and also lay within 2 m of GT bbbbbb",
+    ),
+    "matched: not counted": (
+        "track 5 was output on it, but its score averaged over its 3 frames, 0.40, is below the car threshold "
+        "0.500: the evaluation did not count it",
+        "track 7 was output on it, but its score averaged over its 3 frames, 0.40, is below the car threshold "
+        "0.500: the evaluation did not count it",
+    ),
+    "gone: column of infinite cost": (
+        None,
+        "at frame 3 m1 (score 0.80, 0.3 m from it; track 9 was gone) → track 7",
+    ),
+    "gone: outside the gate of a deleted track": (
+        "Because (frame 3): m1 was outside the gate of track 9, which had the object.",
+        "Because (frame 3): m1 was outside the gate of track 12, which had the object.",
+    ),
+    "misleading: viewer note in the terminal": (None, "its existence was too low to be shown here"),
+}
+
+
+@pytest.mark.parametrize("name", list(PLANTED))
+def test_each_planted_statement_is_caught_and_its_true_form_passes(name: str) -> None:
+    true, false = PLANTED[name]
+    kind = name.split(":")[0]
+    if true is not None:
+        assert _found(true).found == [], true
+    caught = _found(false).found
+    assert [c.kind for c in caught][:1] == [kind], (false, caught)
+
+
+def _break_even_d2() -> float:
+    """The d2 of (m0, track 5) at which track 5 costs what track 7 does for m0 (FREE world), by hand."""
+    m = _matrix(None, FREE)
+    c5, c7 = m.cost[0, 0], m.cost[0, 1]
+    return FREE[0, 0] - 2.0 * (c5 - c7)
+
+
+def test_a_counterfactual_past_the_break_even_or_the_current_value_is_refuted() -> None:
+    even = _break_even_d2()
+    sentence = "Because (frame 3): Within d² {:.2f} (instead of 6.0), track 5 would have taken m0."
+    holds = _found(sentence.format(even - 0.05), d2=FREE)
+    assert holds.found == [] and holds.replays == 1
+    for wrong in (even + 0.05, 6.5):  # just past the break-even (the issue's 14.3 for 14.25); above the current d2
+        caught = _found(sentence.format(wrong), d2=FREE)
+        assert [c.kind for c in caught.found] == ["counterfactual"] and caught.refuted == 1, wrong
+
+
+def test_a_planted_existence_threshold_below_the_current_one_is_caught() -> None:
+    existence = np.array([0.1, 0.5, 0.9])  # m0 goes to track 7; track 5 would take it above existence ~0.92
+    sentence = "Because (frame 3): With a predicted existence above {} (instead of 0.10), track 5 would have taken m0."
+    assert _found(sentence.format("0.95"), existence=existence, d2=FREE).found == []
+    for wrong in ("0.90", "0.05"):  # short of the break-even; below the current existence
+        found = _found(sentence.format(wrong), existence=existence, d2=FREE).found
+        assert [c.kind for c in found] == ["counterfactual"], wrong
+
+
+def test_a_rival_the_assignment_gave_to_another_detection_is_caught() -> None:
+    fair = "Because (frame 3): m0 went to track 7 (cost -8.0) rather than track 5 (cost -5.0): the lower cost wins."
+    assert _found(fair, d2=FREE).found == []  # track 5 is free: naming it is fair
+    planted = "Because (frame 3): m0 went to track 5 (cost -5.0) rather than track 7 (cost -8.0): the lower cost wins."
+    assert [c.kind for c in _found(planted).found] == ["counterfactual"]
+
+
+def test_a_capped_or_wrong_margin_is_caught_and_the_solvers_margin_passes() -> None:
+    _, m, a = _world(None)
+    d = explain(m, a)
+    choice = next(ch for c in d.conflicts for ch in c.choices if ch.meas.ref == 0)
+    went = int(choice.chosen.ref)
+    true = "then, " + choice_text(3, choice, went, False).replace("**", "")
+    row, col = replay.row_of(m, 0), replay.chosen_col(m, a, 0)
+    real = replay.margin(m, row, col)
+    shown = float(true.rsplit("margin ", 1)[1])
+    assert math.isclose(shown, min(real, 5.0), abs_tol=0.006)
+    found = _found(true).found
+    assert (found == []) == (real <= 5.0), (true, real)
+    planted = true.rsplit("margin ", 1)[0] + f"margin {real + 1.0:.2f}"
+    assert [c.kind for c in _found(planted).found] == ["misleading"]
+
+
+@pytest.mark.parametrize("existence", [None, np.array([0.1, 0.5, 0.9])], ids=["gnn", "pmb"])
+@pytest.mark.parametrize("d2", [TAKEN, FREE], ids=["rival taken", "rival free"])
+def test_the_explainers_own_because_holds_when_replayed(d2: np.ndarray, existence: np.ndarray | None) -> None:
+    text = _because(existence, d2)
+    t = _found(text, existence=existence, d2=d2)
+    assert t.found == [], (text, t.found)
+    assert t.replays == 1, text  # the explainer said what the solver would do, and the replay agreed
+
+
+def test_a_track_said_to_be_matched_instead_to_a_missed_object_is_caught() -> None:
+    sentence = "car GT bbbbbb lies 0.4 m away and the evaluation matched it to another track (track 7): two tracks"
+    assert [c.kind for c in _found(sentence).found] == ["matched"]  # GT B was missed at frame 3
+    assert _found(sentence, Context(C, 3, GT_A)).found == []  # GT A was matched to track 7
+
+
+def test_a_greedy_choice_over_a_column_another_detection_took_is_caught() -> None:
+    from gnnpmb.events import CostScale
+
+    rows = axis_labels(AxisKind.MEASUREMENT, [0, 1])
+    cols = axis_labels(AxisKind.TRACK, [5, 7]) + axis_labels(AxisKind.NEW_TRACK, [0, 1])
+    cost = np.array([[1.0, 4.0, 9.0, np.inf], [2.0, 3.0, np.inf, 9.0]])
+    m = CostMatrix(C, cost, rows, cols, scale=CostScale("distance", "m", 0.3, optimal=False))
+    a = Assignment(C, ((rows[0], cols[0]), (rows[1], cols[1])), 4.0, ())
+    raw = RawEvents.of([FrameStarted("t", 3, "token", 0, 0.5), m, a])
+    planted = "then, frame 3: m1 → track 7 (cost 3.00 m) over track 5 (2.00 m), margin 0.00 m"
+    assert [c.kind for c in check_text(planted, CTX, raw, _eval()).found] == ["misleading"]
+    fair = "then, frame 3: m1 → track 7 (cost 3.00 m) over new (9.00 m), margin 5.00 m or more"
+    assert check_text(fair, CTX, raw, _eval()).found == []
+
+
+def test_a_near_tie_is_stated_with_the_decimals_that_tell_the_two_values_apart() -> None:
+    """m0 goes to track 7 at d² 2.52; track 5 (a spread 0.05 nats wider) breaks even at d² 2.42 and sits at 2.44:
+    with one decimal both would print as 2.4."""
+    d2 = FREE.copy()
+    d2[1, 0], d2[0, 0] = 2.52, 2.44
+    even = 2.42
+    _, m, a = _world(None, d2)
+    w = would_take(m, a, 0, 5)
+    assert w is not None and w.digits >= 2 and w.needed < even
+    text = _because(None, d2)
+    assert f"Within d² {w.needed:.{w.digits}f} (instead of {d2[0, 0]:.{w.digits}f})" in text, text
+    assert _found(text, d2=d2).found == []

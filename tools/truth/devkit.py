@@ -1,0 +1,167 @@
+"""The evaluation's facts from the devkit's own per-frame bookkeeping, with no code of ``gnnpmb.eval``.
+
+Steps, as ``nuscenes.eval.tracking.evaluate.TrackingEval.__init__`` takes them for the scene's samples: load the
+ground truth, add ego distances, ``filter_eval_boxes`` (class range, zero points, bike racks), ``create_tracks``
+(which interpolates gaps inside a track); then per class ``TrackingEvaluation.accumulate`` (all recall thresholds,
+as ``compute_metrics`` scores them), the best-MOTA threshold, and ``accumulate_threshold`` at it, whose
+``acc.events`` (MATCH / SWITCH / MISS / FP per devkit frame id, OId, HId) are read back onto keyframe indices by
+replaying the accumulator's frame numbering (a frame with neither ground truth nor a kept track has no id), and
+onto the scene's object and track ids through the devkit's own merge mappings (the merge renumbers them).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+MATCHED = ("MATCH", "SWITCH")
+
+
+@dataclass
+class EvalFacts:
+    """Per class: threshold (None: every box counts), and at each keyframe index who the accumulator matched.
+
+    gt_to_track[(class, frame)][gt id] = track id (str) or None (a MISS); track_to_gt likewise (None: an FP);
+    counted[(class)] = track ids whose averaged score passes the threshold; evaluated_gt[(frame, gt id)] = the
+    BEV centre of the box the devkit scored (an annotation or an interpolation)."""
+
+    thresholds: dict[str, float | None] = field(default_factory=dict)
+    gt_to_track: dict[tuple[str, int], dict[str, str | None]] = field(default_factory=dict)
+    track_to_gt: dict[tuple[str, int], dict[str, str | None]] = field(default_factory=dict)
+    counted: dict[str, set[str]] = field(default_factory=dict)
+    evaluated_gt: dict[tuple[int, str], tuple[float, float]] = field(default_factory=dict)
+
+    def matched_track(self, class_name: str, frame: int, gt_id: str) -> str | None:
+        return self.gt_to_track.get((class_name, frame), {}).get(gt_id)
+
+    def matched_gt(self, class_name: str, frame: int, track_id: str) -> str | None:
+        return self.track_to_gt.get((class_name, frame), {}).get(track_id)
+
+
+def _split_of(nusc, scene_name: str) -> str:
+    """The smallest devkit split (or custom split of the dataroot) that holds the scene."""
+    import json
+    from pathlib import Path
+
+    from nuscenes.utils.splits import create_splits_scenes
+
+    splits = create_splits_scenes()
+    custom = Path(nusc.dataroot) / nusc.version / "splits.json"
+    if custom.is_file():
+        splits.update(json.loads(custom.read_text(encoding="utf-8")))
+    return min((n for n, s in splits.items() if scene_name in s), key=lambda n: len(splits[n]))
+
+
+def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str, Any]]]) -> EvalFacts:
+    """The devkit's matching of ``results`` (sample token -> submission boxes) on one scene (module docstring)."""
+    import contextlib
+    import io
+
+    from nuscenes.eval.common.config import config_factory
+    from nuscenes.eval.common.data_classes import EvalBoxes
+    from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes, load_gt_of_sample_tokens
+    from nuscenes.eval.tracking.algo import TrackingEvaluation
+    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetricData
+    from nuscenes.eval.tracking.loaders import create_tracks
+
+    cfg = config_factory("tracking_nips_2019")
+    scene = next(s for s in nusc.scene if s["name"] == scene_name)
+    tokens, token = [], scene["first_sample_token"]
+    while token:
+        tokens.append(token)
+        token = nusc.get("sample", token)["next"]
+    frame_of_stamp = {nusc.get("sample", t)["timestamp"]: i for i, t in enumerate(tokens)}
+    split = _split_of(nusc, scene_name)
+    with contextlib.redirect_stdout(io.StringIO()):
+        gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
+        pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in tokens}, TrackingBox)
+        gt = filter_eval_boxes(nusc, add_center_dist(nusc, gt), cfg.class_range, verbose=False)
+        pred = filter_eval_boxes(nusc, add_center_dist(nusc, pred), cfg.class_range, verbose=False)
+        tracks_gt = create_tracks(gt, nusc, split, gt=True)
+        tracks_pred = create_tracks(pred, nusc, split, gt=False)
+    out = EvalFacts()
+    scene_gt = tracks_gt[scene["token"]]
+    scene_pred = tracks_pred[scene["token"]]
+    for stamp, boxes in scene_gt.items():
+        for b in boxes:
+            out.evaluated_gt[(frame_of_stamp[stamp], str(b.tracking_id))] = (
+                float(b.translation[0]),
+                float(b.translation[1]),
+            )
+    for class_name in cfg.class_names:
+        ev = TrackingEvaluation(
+            tracks_gt,
+            tracks_pred,
+            class_name,
+            cfg.dist_fcn_callable,
+            cfg.dist_th_tp,
+            cfg.min_recall,
+            num_thresholds=TrackingMetricData.nelem,
+            metric_worst=cfg.metric_worst,
+            verbose=False,
+        )
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            md = ev.accumulate()
+        if np.all(np.isnan(md.mota)):
+            continue
+        best = int(np.nanargmax(md.mota))
+        threshold = None if np.isnan(md.confidence[best]) else float(md.confidence[best])
+        out.thresholds[class_name] = threshold
+        events, oid_of, hid_of = _accumulate_threshold(ev, threshold)
+        frame_of_id = []  # devkit frame id -> keyframe index, numbered as accumulate_threshold numbers them
+        counted: set[str] = set()
+        for stamp in scene_gt:
+            g = [b for b in scene_gt[stamp] if b.tracking_name == class_name]
+            p = [b for b in scene_pred[stamp] if b.tracking_name == class_name]
+            if threshold is not None:
+                p = [b for b in p if b.tracking_score >= threshold]
+            counted.update(str(b.tracking_id) for b in p)
+            if g or p:
+                frame_of_id.append(frame_of_stamp[stamp])
+                out.gt_to_track[(class_name, frame_of_stamp[stamp])] = {str(b.tracking_id): None for b in g}
+                out.track_to_gt[(class_name, frame_of_stamp[stamp])] = {str(b.tracking_id): None for b in p}
+        out.counted[class_name] = counted
+        events = events.reset_index()
+        for frame_id, kind, oid, hid in zip(
+            events["FrameId"], events["Type"], events["OId"], events["HId"], strict=True
+        ):
+            if str(kind) in MATCHED:
+                frame = frame_of_id[int(frame_id)]
+                gt_id, track_id = str(oid_of[oid]), str(hid_of[hid])
+                out.gt_to_track[(class_name, frame)][gt_id] = track_id
+                out.track_to_gt[(class_name, frame)][track_id] = gt_id
+    return out
+
+
+def _accumulate_threshold(ev, threshold: float | None):
+    """``ev.accumulate_threshold(threshold)``'s events with the ids the scene gave them: the devkit merges the
+    per-scene accumulators with ``MOTAccumulatorCustom.merge_event_dataframes``, which renumbers object and
+    hypothesis ids; its own mappings (``return_mappings``) are read back here. Returns (events, new OId ->
+    object id, new HId -> track id)."""
+    import contextlib
+    import io
+
+    from nuscenes.eval.tracking.mot import MOTAccumulatorCustom
+
+    original = MOTAccumulatorCustom.merge_event_dataframes
+    mappings: list[dict] = []
+
+    def merge(dfs, *args, **kwargs):
+        merged, infos = original(dfs, *args, return_mappings=True, **kwargs)
+        mappings.extend(infos)
+        return merged
+
+    MOTAccumulatorCustom.merge_event_dataframes = staticmethod(merge)
+    try:
+        with contextlib.redirect_stderr(io.StringIO()):
+            events, _ = ev.accumulate_threshold(threshold)
+    finally:
+        MOTAccumulatorCustom.merge_event_dataframes = staticmethod(original)
+    (info,) = mappings  # one scene
+    assert info.get("frame_offset", 0) == 0
+    oid_of = {new: old for old, new in info.get("oid_map", {}).items()}
+    hid_of = {new: old for old, new in info.get("hid_map", {}).items()}
+    return events, oid_of, hid_of

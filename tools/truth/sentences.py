@@ -1,0 +1,284 @@
+"""Each sentence of a rendered finding that states a checkable fact, checked against the independent sources:
+the devkit's matching (``devkit.EvalFacts``), the raw events (``rawevents.RawEvents``) and replays
+(``replay``). The sentence is read from the text a user sees (``gnnpmb failures --why``); the finding is read only
+for what the text abbreviates (full object ids, the frames a range stands for).
+
+Classes of false statement (the issue's numbering):
+
+* ``matched``: who the evaluation matched (or counted);
+* ``gone``: a track said to be gone, or a detection outside a track's gate, against that frame's columns;
+* ``counterfactual``: a "would have taken" / "would have cost more" replayed, a rival already taken, a stated
+  threshold on the wrong side of the current value;
+* ``misleading``: a margin other than the solver's (a capped one included), a greedy alternative already taken,
+  a note meant for the viewer printed in the terminal.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+
+from gnnpmb.events import AxisKind
+from tools.truth import replay
+from tools.truth.devkit import EvalFacts
+from tools.truth.rawevents import RawEvents
+
+CLASSES = ("matched", "gone", "counterfactual", "misleading")
+
+
+@dataclass(frozen=True)
+class Contradiction:
+    """A sentence found false: its class (``CLASSES``), the sentence, and what the sources say."""
+
+    kind: str
+    sentence: str
+    truth: str
+
+
+@dataclass(frozen=True)
+class Context:
+    """What the text abbreviates: the finding's class, frame, full object id, covered objects' ids, the taking
+    track's false frames."""
+
+    class_name: str
+    frame: int
+    gt_id: str | None
+    covered: tuple[str, ...] = ()
+    false_frames: tuple[int, ...] = ()
+    taker: int | None = None
+
+
+@dataclass
+class Tally:
+    """Sentences checked and contradictions per class; counterfactual replays checked and refuted."""
+
+    checked: dict[str, int] = field(default_factory=lambda: dict.fromkeys(CLASSES, 0))
+    found: list[Contradiction] = field(default_factory=list)
+    replays: int = 0
+    refuted: int = 0
+
+    def add(self, other: Tally) -> None:
+        for k, v in other.checked.items():
+            self.checked[k] += v
+        self.found += other.found
+        self.replays += other.replays
+        self.refuted += other.refuted
+
+
+_NUM = r"[-\d.e+]+"
+GONE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it; track (\d+) was gone\)")
+BECAUSE = re.compile(r"Because \(frame (\d+)[^)]*\): (.*)")
+OUTSIDE = re.compile(r"m(\d+) was outside the gate of track (\d+), which had the object")
+WITHIN = re.compile(rf"Within d² ({_NUM}) \(instead of ({_NUM})\), track (\d+) would have taken m(\d+)")
+ABOVE = re.compile(
+    rf"With a predicted existence above ({_NUM}) \(instead of ({_NUM})\), track (\d+) would have taken m(\d+)"
+)
+NO_EXISTENCE = re.compile(r"No predicted existence would have given m(\d+) to track (\d+)")
+EVEN_AT_ZERO = re.compile(
+    r"Even with m(\d+) right on its prediction \(d² 0\), track (\d+) would (?:have cost more|not have taken it)"
+)
+RIVAL = re.compile(
+    r"m(\d+) went to (.+?) \(cost [-\d.]+\) rather than track (\d+) \(cost [-\d.]+\): the lower cost wins"
+)
+RIVAL_TAKEN = re.compile(r"m(\d+) went to (.+?) \(cost [-\d.]+\); track (\d+) \(cost [-\d.]+\) went to m(\d+)")
+COULD_NOT = re.compile(
+    r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it; track (\d+) could not take it: its column's cost for "
+    r"it was infinite"
+)
+CHOICE = re.compile(
+    r"frame (\d+): m(\d+)(?: \(score [\d.]+\))? → ([^(]+?) \([^()]*\) "
+    r"(?:over (track \d+|new|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)|\(no other\)), margin (inf|\d+\.\d+)"
+    r"((?: [a-zA-Z]+)? or more)?"
+)
+THEFT = re.compile(
+    r"track (\d+) had been a false track at [^(]+\(matched to no object: the evaluation still gave GT (\w+) to "
+    r"track (\d+)\)"
+)
+COVERED = re.compile(r"track ([\d, ]+) lay within \d m of it and was counted, but the evaluation matched it to another")
+COALESCED = re.compile(r"at frame (\d+) track (\d+) was matched to (GT \w+(?:, GT \w+)*) and also lay within")
+MATCHED_INSTEAD = re.compile(r"the evaluation matched it to another track \(track (\d+)\)")
+NOT_COUNTED = re.compile(r"track (\d+) was output on it, but [^:]*?: the evaluation did not count it")
+VIEWER_ONLY = ("too low to be shown here",)
+
+
+def check_text(text: str, ctx: Context, raw: RawEvents | None, ev: EvalFacts, tracker: str = "") -> Tally:
+    """Every checkable sentence of ``text`` (one finding's rendered lines); raw None for a results file."""
+    out = Tally()
+
+    def bad(kind: str, sentence: str, truth: str) -> None:
+        out.found.append(Contradiction(kind, sentence, truth))
+
+    c = ctx.class_name
+    _check_eval(text, ctx, ev, out, bad)
+    for phrase in VIEWER_ONLY:
+        if phrase in text:
+            out.checked["misleading"] += 1
+            bad("misleading", phrase, "a note about the viewer printed where nothing is shown")
+    if raw is None:
+        return out
+    for m in GONE.finditer(text):
+        x, meas, t = int(m[1]), int(m[2]), int(m[3])
+        out.checked["gone"] += 1
+        if not raw.gone(x, c, t):
+            cost = raw.entry(x, c, meas, t)
+            bad("gone", m[0], f"track {t} had a column at frame {x} (cost for m{meas}: {cost})")
+    for m in COULD_NOT.finditer(text):
+        x, meas, t = int(m[1]), int(m[2]), int(m[3])
+        out.checked["gone"] += 1
+        if not raw.could_not_take(x, c, meas, t):
+            bad("gone", m[0], f"(m{meas}, track {t}) at frame {x}: cost {raw.entry(x, c, meas, t)}")
+    for b in BECAUSE.finditer(text):
+        x, para = int(b[1]), b[2]
+        for m in OUTSIDE.finditer(para):
+            meas, t = int(m[1]), int(m[2])
+            out.checked["gone"] += 1
+            if t not in raw.columns(x, c):
+                bad("gone", m[0], f"track {t} had no column at frame {x} (gone or deleted)")
+            elif not raw.could_not_take(x, c, meas, t):
+                bad("gone", m[0], f"(m{meas}, track {t}) cost {raw.entry(x, c, meas, t)}: inside")
+        _check_counterfactuals(x, para, c, raw, out, bad)
+    for m in CHOICE.finditer(text):
+        _check_choice(m, c, raw, out, bad)
+    return out
+
+
+def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None:
+    c = ctx.class_name
+    for m in THEFT.finditer(text):
+        taker, victim = m[1], m[3]
+        out.checked["matched"] += 1
+        wrong = [x for x in ctx.false_frames if ev.matched_track(c, x, ctx.gt_id or "") != victim]
+        if wrong:
+            got = {x: ev.matched_track(c, x, ctx.gt_id or "") for x in wrong}
+            bad("matched", m[0], f"the devkit matched the object at those frames to {got}")
+        stolen = [x for x in ctx.false_frames if ev.matched_gt(c, x, taker) is not None]
+        if stolen:
+            bad("matched", m[0], f"track {taker} was matched at frames {stolen}")
+    for m in COVERED.finditer(text):
+        for t in (s.strip() for s in m[1].split(",")):
+            out.checked["matched"] += 1
+            got = ev.matched_gt(c, ctx.frame, t)
+            if got is None or got == ctx.gt_id:
+                bad("matched", m[0], f"the devkit matched track {t} at frame {ctx.frame} to {got}")
+    for m in COALESCED.finditer(text):
+        x, t = int(m[1]), m[2]
+        for g in ctx.covered:
+            out.checked["matched"] += 1
+            got = ev.matched_track(c, x, g)
+            if got != t:
+                bad("matched", m[0], f"the devkit matched GT {g[:6]} at frame {x} to {got}")
+    for m in MATCHED_INSTEAD.finditer(text):
+        out.checked["matched"] += 1
+        got = ev.matched_track(c, ctx.frame, ctx.gt_id or "")
+        if got != m[1]:
+            bad("matched", m[0], f"the devkit matched the object at frame {ctx.frame} to {got}")
+    for m in NOT_COUNTED.finditer(text):
+        out.checked["matched"] += 1
+        if m[1] in ev.counted.get(c, set()):
+            bad("matched", m[0], f"track {m[1]} passes the {c} threshold {ev.thresholds.get(c)}")
+
+
+def _check_counterfactuals(x: int, para: str, c: str, raw: RawEvents, out: Tally, bad) -> None:
+    found = raw.deciding(x, c)
+
+    def setup(meas: int, t: int):
+        if found is None:
+            return None
+        mat, a = found
+        row, col = replay.row_of(mat, meas), replay.track_col(mat, t)
+        return None if row is None or col is None else (mat, a, row, col)
+
+    def verdict(sentence: str, holds: bool | None, truth: str) -> None:
+        out.checked["counterfactual"] += 1
+        out.replays += 1
+        if not holds:
+            out.refuted += 1
+            bad("counterfactual", sentence, truth)
+
+    for m in WITHIN.finditer(para):
+        stated, now, t, meas = float(m[1]), float(m[2]), int(m[3]), int(m[4])
+        s = setup(meas, t)
+        if s is None:
+            verdict(m[0], False, f"no matrix of frame {x} has m{meas} and track {t}")
+            continue
+        mat, _, row, col = s
+        if stated >= now:
+            verdict(m[0], False, f"the stated d² {stated} is not below the current {now}")
+            continue
+        verdict(
+            m[0], replay.replay_d2(mat, row, col, stated), f"re-solved at d² {stated}, m{meas} does not go to track {t}"
+        )
+    for m in ABOVE.finditer(para):
+        stated, now, t, meas = float(m[1]), float(m[2]), int(m[3]), int(m[4])
+        s = setup(meas, t)
+        if s is None:
+            verdict(m[0], False, f"no matrix of frame {x} has m{meas} and track {t}")
+            continue
+        mat, _, row, col = s
+        if stated <= now:
+            verdict(m[0], False, f"the stated existence {stated} is not above the current {now}")
+            continue
+        holds = replay.replay_existence(mat, row, col, min(stated * (1 + replay.ABOVE), 1.0))
+        verdict(m[0], holds, f"re-solved with existence just above {stated}, m{meas} does not go to track {t}")
+    for m in NO_EXISTENCE.finditer(para):
+        meas, t = int(m[1]), int(m[2])
+        s = setup(meas, t)
+        if s is None:
+            continue
+        mat, _, row, col = s
+        holds = replay.replay_existence(mat, row, col, 1.0 - 1e-9)
+        verdict(m[0], holds is False, f"with existence 1, m{meas} goes to track {t}")
+    for m in EVEN_AT_ZERO.finditer(para):
+        meas, t = int(m[1]), int(m[2])
+        s = setup(meas, t)
+        if s is None:
+            continue
+        mat, _, row, col = s
+        verdict(m[0], replay.replay_d2(mat, row, col, 0.0) is False, f"at d² 0, m{meas} goes to track {t}")
+    for m in RIVAL_TAKEN.finditer(para):
+        meas, t, k = int(m[1]), int(m[3]), int(m[4])
+        if found is None:
+            continue
+        out.checked["counterfactual"] += 1
+        other = [int(r.ref) for r, col in found[1].pairs if col.kind is AxisKind.TRACK and int(col.ref) == t]
+        if other != [k]:
+            bad("counterfactual", m[0], f"the assignment of frame {x} gave track {t} to {other}")
+    for m in RIVAL.finditer(para):
+        meas, t = int(m[1]), int(m[3])
+        if found is None:
+            continue
+        mat, a = found
+        out.checked["counterfactual"] += 1
+        other = [int(r.ref) for r, col in a.pairs if col.kind is AxisKind.TRACK and int(col.ref) == t]
+        if other and other[0] != meas:
+            bad("counterfactual", m[0], f"the assignment of frame {x} gave track {t} to m{other[0]}")
+
+
+def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
+    x, meas, alt, printed, at_least = int(m[1]), int(m[2]), m[4], m[5], m[6] is not None
+    found = raw.deciding(x, c)
+    if found is None:
+        return
+    mat, a = found
+    row, col = replay.row_of(mat, meas), replay.chosen_col(mat, a, meas)
+    if row is None or col is None:
+        return
+    out.checked["misleading"] += 1
+    if not mat.scale.optimal:
+        if alt and alt.startswith("track "):
+            t = int(alt.split()[1])
+            other = [int(r.ref) for r, k in a.pairs if k.kind is AxisKind.TRACK and int(k.ref) == t]
+            if other and other[0] != meas:
+                bad("misleading", m[0], f"greedy: track {t} had been given m{other[0]}")
+        return
+    true = replay.margin(mat, row, col)
+    if math.isnan(true):
+        return
+    shown = math.inf if printed == "inf" else float(printed)
+    if at_least:  # "margin 5.00 or more"
+        if true < shown - 0.006:
+            bad("misleading", m[0], f"re-solved without the pair, the total rises by {true:.3f}")
+        return
+    if (math.isinf(true) and not math.isinf(shown)) or (math.isfinite(true) and abs(shown - true) > 0.006):
+        bad("misleading", m[0], f"re-solved without the pair, the total rises by {true:.3f}")
