@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from cli.calibrate import register as register_calibrate
 from cli.diff import register as register_diff
 from cli.errors import entry_point
 from cli.options import (
@@ -385,4 +386,5 @@ def demo_data(
 
 register(app)
 register_diff(app)
+register_calibrate(app)
 main = entry_point(app, "gnnpmb")
