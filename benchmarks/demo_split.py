@@ -28,15 +28,17 @@ class DemoSplit:
     tokens: tuple[str, ...]
 
     @staticmethod
-    def load(split: str) -> DemoSplit:
-        location = resolve_dataroot(None, None, (split,))
+    def load(split: str, dataroot: Path | None = None, version: str | None = None) -> DemoSplit:
+        """The demo's ``split``, or the split of the dataset at ``dataroot`` (e.g. the dev set)."""
+        location = resolve_dataroot(dataroot, version, (split,))
         nusc = open_nuscenes(location)
         names = split_scenes(split, location)
         scenes = tuple(load_scene(location, n) for n in names)
         return DemoSplit(split, location, scenes, tuple(split_sample_tokens(nusc, names)))
 
-    def detections(self, preset: str, seed: int) -> list[dict[str, Boxes]]:
-        return [get_detections(s, None, preset, seed) for s in self.scenes]
+    def detections(self, preset: str, seed: int, detections_file: Path | None = None) -> list[dict[str, Boxes]]:
+        """Per scene: the detections of ``detections_file``, else the simulated detector ``preset``."""
+        return [get_detections(s, detections_file, preset, seed) for s in self.scenes]
 
 
 @dataclass(frozen=True, slots=True)

@@ -16,9 +16,14 @@ submissions, one file per preset and seed (``{split}``, ``{preset}`` and ``{seed
 e.g. Poly-MOT run outside this project on the same simulated detections; its per-frame time is read from
 ``<file>_time.json`` (``track_cpu_ms``) when there is one.
 
+``--devset DIR`` puts a second world beside the demo: a nuScenes-format dataset nobody here made (e.g.
+``../shared/devset``) with its own detection files ``DIR/detections/{preset}_{split}.json``, one run per preset,
+printed after the demo's figures on the same row (``| dev`` and its AMOTA, IDS, FP, FN; per class too), so no
+lead is read off the demo alone. ``--external`` patterns may use ``{world}`` (demo or dev) for the dev set's files.
+
 Usage: uv run python benchmarks/table1.py [--tracker NAME ...] [--preset NAME ...] [--seeds 0,1,2]
        [--params FILE|default ...] [--split mini_val] [--no-per-class] [--no-paper] [--external NAME=PATTERN ...]
-       [--out DIR]
+       [--devset DIR] [--out DIR]
 """
 
 from __future__ import annotations
@@ -78,14 +83,27 @@ def external_runs(split: DemoSplit, pattern: str, preset: str, seeds: list[int],
     return runs
 
 
-def print_row(preset: str, label: str, runs: list[RunScores], widths: dict[str, int], per_class: bool) -> None:
+def print_row(
+    preset: str,
+    label: str,
+    runs: list[RunScores],
+    widths: dict[str, int],
+    per_class: bool,
+    dev: RunScores | None = None,
+) -> None:
     cells = [f"{cell(c, [r.scores.overall[c] for r in runs]):>{widths[c]}s}" for c in COLUMNS]
     ms = float(np.median(np.concatenate([r.step_ms for r in runs])))
-    print(f"{preset:13s} {label:16s} " + " ".join(cells) + f" {ms:7.2f}", flush=True)
+    tail = ""
+    if dev is not None:
+        o = dev.scores.overall
+        tail = f" | dev {o['amota']:.3f} IDS {o['ids']:3.0f} FP {o['fp']:4.0f} FN {o['fn']:4.0f}"
+    print(f"{preset:13s} {label:16s} " + " ".join(cells) + f" {ms:7.2f}" + tail, flush=True)
     if per_class:
         classes = sorted(runs[0].scores.per_class)
         values = [[r.scores.per_class[c]["amota"] for r in runs] for c in classes]
         print(f"{'':13s} {'':16s} " + " ".join(f"{c} {cell('amota', v)}" for c, v in zip(classes, values, strict=True)))
+        if dev is not None:
+            print(f"{'':13s} {'(dev)':16s} " + " ".join(f"{c} {dev.scores.per_class[c]['amota']:.3f}" for c in classes))
 
 
 def main() -> None:
@@ -98,6 +116,7 @@ def main() -> None:
     parser.add_argument("--no-per-class", dest="per_class", action="store_false", help="overall rows only")
     parser.add_argument("--no-paper", dest="paper", action="store_false", help="no paper-configuration rows")
     parser.add_argument("--external", action="append", default=[], help="NAME=PATTERN of submission files")
+    parser.add_argument("--devset", type=Path, help="a second nuScenes-format world, scored beside the demo")
     parser.add_argument("--out", type=Path, help="keep submissions and metric files here")
     args = parser.parse_args()
     out = args.out or Path(tempfile.mkdtemp(prefix="gnnpmb-table1-"))
@@ -106,12 +125,15 @@ def main() -> None:
     paper = layered_config([*params, str(PAPER)])
     seeds = [int(s) for s in args.seeds.split(",")]
     split = DemoSplit.load(args.split)
+    dev = DemoSplit.load(args.split, args.devset, "v1.0-mini") if args.devset else None
     print(f"split {args.split}, params {' + '.join(params)}, detector seeds {seeds}")
     widths = {c: 12 if c in ("amota", "amotp") else 10 if c in WITH_STD else 6 for c in COLUMNS}
     header = f"{'preset':13s} {'tracker':16s} " + " ".join(f"{c.upper():>{widths[c]}s}" for c in COLUMNS)
-    print(header + f" {'med ms':>7s}", flush=True)
+    print(header + f" {'med ms':>7s}" + (f" | dev ({args.devset}, one run per preset)" if dev else ""), flush=True)
     for preset in args.preset or ("centerpoint", "megvii", "pointpillars"):
         detections = {seed: split.detections(preset, seed) for seed in seeds}
+        dev_file = args.devset / "detections" / f"{preset}_{args.split}.json" if dev is not None else None
+        dev_detections = dev.detections(preset, 0, dev_file) if dev is not None else None
         for tracker in args.tracker or TRACKER_NAMES:
             configs = [(tracker, config)]
             if args.paper and tracker in PMB_TRACKERS:
@@ -121,10 +143,17 @@ def main() -> None:
                 runs = [
                     score(split, detections[seed], tracker, cfg, out / f"{preset}_{name}_s{seed}") for seed in seeds
                 ]
-                print_row(preset, label, runs, widths, args.per_class)
+                dev_run = None
+                if dev is not None and dev_detections is not None:
+                    dev_run = score(dev, dev_detections, tracker, cfg, out / f"dev_{preset}_{name}")
+                print_row(preset, label, runs, widths, args.per_class, dev_run)
         for item in args.external:
             label, _, pattern = item.partition("=")
-            print_row(preset, label, external_runs(split, pattern, preset, seeds, out), widths, args.per_class)
+            runs = external_runs(split, pattern.replace("{world}", "demo"), preset, seeds, out)
+            dev_run = None
+            if dev is not None and "{world}" in pattern:
+                dev_run = external_runs(dev, pattern.replace("{world}", "dev"), preset, [0], out / "dev")[0]
+            print_row(preset, label, runs, widths, args.per_class, dev_run)
     print(f"submissions and metric files: {out}")
 
 

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from cli.calibrate import register as register_calibrate
 from cli.diff import register as register_diff
 from cli.errors import entry_point
 from cli.failures import register as register_failures
@@ -209,4 +210,5 @@ def demo_data(
 register(app)
 register_tune(app)
 register_diff(app)
+register_calibrate(app)
 main = entry_point(app, "gnnpmb")

@@ -11,7 +11,15 @@ from collections.abc import Callable
 from pathlib import Path
 
 from gnnpmb.atomic import write_text
-from gnnpmb.config import _SECTIONS, PAPER_CLASS_PARAMS, BoxNoise, ClassParams, TrackerConfig, dump_config
+from gnnpmb.config import (
+    _SECTIONS,
+    DEFAULT_CLASS_PARAMS,
+    PAPER_CLASS_PARAMS,
+    BoxNoise,
+    ClassParams,
+    TrackerConfig,
+    dump_config,
+)
 from gnnpmb.param import Declared, declared
 
 _PACKAGE = Path(__file__).resolve().parent
@@ -19,9 +27,10 @@ _PACKAGE = Path(__file__).resolve().parent
 _DEFAULTS_HEADER = """\
 # gnnpmb-viz tracker parameters: the GNN-PMB paper defaults (Liu et al., IEEE T-IV 2023, sec. V-B, Table II)
 # and the per-class noise of the authors' code, except [models] p_survive, birth_weight and [pmb]
-# extraction_threshold, miss_p_detect_max, chosen on the demo mini_train split (see gnnpmb/config.py
-# ModelParams, PmbParams; gnnpmb/params/paper.toml has the paper's). [models] holds what every tracker
-# shares; these keys are also accepted under [pmb], where they were before.
+# extraction_threshold, miss_p_detect_max, chosen on the demo mini_train split, and [pmb] measure_velocity,
+# clutter_velocity_density, [pmbm] n_hypotheses and the two-wheelers' q_x, q_y, chosen on the mini_train splits
+# of the demo and the dev set (see gnnpmb/config.py; gnnpmb/params/paper.toml has the paper's). [models] holds
+# what every tracker shares; these keys are also accepted under [pmb], where they were before.
 # Copy this file, edit it and pass it with --params FILE. Any subset of keys may be given; unknown keys are an
 # error. [classes.<class>] may also override any key of the shared sections for that class, e.g.
 # [classes.pedestrian] birth_weight = 0.1 (p_detect, in two sections, goes in [classes.<class>.phd] or .vector).
@@ -41,7 +50,7 @@ _BOX_NOISE_NOTE = """\
 _PAPER_HEADER = """\
 # The GNN-PMB paper's own values (Liu et al., IEEE T-IV 2023, sec. V-B, Table II) where the defaults differ:
 # pass with --params to run the tracker exactly as published (constant velocity, the centre alone measured,
-# no overlap gate, a missed track's score not decayed).
+# no overlap gate, a missed track's score not decayed, the authors' process noise of two-wheelers).
 """
 
 _DOCS_HEADER = """\
@@ -95,6 +104,16 @@ def paper_toml() -> str:
         if values:
             lines.append(f"[{section}]")
             lines.extend(f"{d.name} = {d.type(d.spec.paper)!r}" for d in values)
+            lines.append("")
+    for name, paper in PAPER_CLASS_PARAMS.items():
+        differ = [
+            d.name
+            for d in declared(ClassParams)
+            if getattr(paper, d.name) != getattr(DEFAULT_CLASS_PARAMS[name], d.name)
+        ]
+        if differ:
+            lines.append(f"[classes.{name}]")
+            lines.extend(f"{key} = {getattr(paper, key)!r}" for key in differ)
             lines.append("")
     return "\n".join(lines)
 

@@ -73,11 +73,12 @@ def test_birth_then_update_with_velocity_measurement_match_hand_computation():
     np.testing.assert_allclose(gated.innovation_cov[0], S[:2, :2], rtol=1e-9)
 
 
-def test_the_chosen_model_set_measures_velocity_and_the_defaults_and_paper_do_not():
-    """Chosen on mini_train, ``params/velocity.toml`` (not the default yet, ``config.PmbParams``); the defaults and
-    ``params/paper.toml`` keep the paper's position-only model."""
+def test_the_defaults_measure_velocity_and_the_paper_does_not():
+    """Chosen on the mini_train splits of both worlds (issue 32, ``config.PmbParams``), the defaults are
+    ``params/velocity.toml``'s model set; ``params/paper.toml`` keeps the paper's position-only model."""
     chosen = load_config(Path(__file__).resolve().parents[3] / "gnnpmb" / "params" / "velocity.toml")
-    assert chosen.pmb.measure_velocity == 1 and chosen.pmbm.n_hypotheses == 10
-    assert TrackerConfig().pmb.measure_velocity == 0 and paper_config().pmb.measure_velocity == 0
+    assert chosen == TrackerConfig()
+    assert TrackerConfig().pmb.measure_velocity == 1 and TrackerConfig().pmbm.n_hypotheses == 10
+    assert paper_config().pmb.measure_velocity == 0
     assert cv_model(0.5, TrackerConfig().for_class("car")).R.shape == (2, 2)
     assert cv_model(0.5, TrackerConfig().for_class("car"), measure_velocity=True).R.shape == (4, 4)

@@ -1,0 +1,61 @@
+"""``gnnpmb calibrate`` as a user runs it: a real process on the demo's two annotated scenes writes one parameter
+file that every tracker reads, with a comment on every learnt value; bad input is one ``error:`` line."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from gnnpmb.config import load_config
+from gnnpmb.types import TRACKING_CLASSES
+
+SCRIPT = Path(sys.executable).parent / "gnnpmb"
+
+
+@pytest.fixture(scope="module")
+def calibrated(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    out = tmp_path_factory.mktemp("calibrate") / "params.toml"
+    argv = [str(SCRIPT), "calibrate", "--dataroot", str(demo_dataroot), "--split", "mini_val", "--out", str(out)]
+    done = subprocess.run(argv, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return out, done.stdout
+
+
+def test_the_file_is_read_by_the_parameter_reader_and_changes_each_class(calibrated: tuple[Path, str]) -> None:
+    path, stdout = calibrated
+    assert re.fullmatch(r"calibrate: \d+ per-class values from 2 scenes of mini_val -> .*params\.toml\n", stdout)
+    config = load_config(path)
+    for cls in TRACKING_CLASSES:
+        own = config.for_class(cls)
+        view = config.resolved(cls)
+        assert 0.0 < own.r_x < 1.0 and 0.0 < own.r_vx < 5.0
+        assert 0.0 < view.phd.p_detect < 1.0 and view.phd.p_detect == view.vector.p_detect
+        assert view.pmb.heading_std_rad > 0.0 and view.models.clutter_intensity > 0.0
+    assert config.box_noise["car"].r_x != load_config(None).box_noise["car"].r_x
+
+
+def test_every_learnt_value_says_what_it_was_learnt_from(calibrated: tuple[Path, str]) -> None:
+    text = calibrated[0].read_text()
+    data = tomllib.loads(text)
+    assert set(data["classes"]) == set(TRACKING_CLASSES)
+    values = [line for line in text.split("[box_noise.")[0].splitlines() if "=" in line and line[0] not in "#["]
+    assert len(values) > 7 * 5
+    for line in values:
+        key, _, rest = line.partition("=")
+        assert "  # " in rest, f"{key.strip()} has no comment"
+    # the evaluation's matching distance is named where the values come from
+    assert "2 m centre distance" in text
+
+
+def test_a_wrong_output_suffix_is_one_error_line(demo_dataroot: Path, tmp_path: Path) -> None:
+    out = tmp_path / "params.json"
+    argv = [str(SCRIPT), "calibrate", "--dataroot", str(demo_dataroot), "--split", "mini_val", "--out", str(out)]
+    done = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert done.stderr.startswith("error: --out") and done.stderr.count("\n") == 1
+    assert not out.exists()
