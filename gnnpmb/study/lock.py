@@ -10,7 +10,6 @@ folder.
 from __future__ import annotations
 
 import fcntl
-import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import IO
@@ -30,16 +29,10 @@ def hold_study_folder(folder: Path, say: Callable[[str], None]) -> None:
         return
     cache = folder / CACHE_FOLDER
     cache.mkdir(parents=True, exist_ok=True)
-    lock = open(cache / LOCK_NAME, "a+")  # noqa: SIM115 - kept open (and locked) until the process ends
+    lock = open(cache / LOCK_NAME, "a")  # noqa: SIM115 - kept open (and locked) until the process ends; stays empty
     try:
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
-        lock.seek(0)
-        holder = lock.read().strip() or "another process"
-        say(f"note: another sweep ({holder}) is writing {folder}; waiting for it to end, then adding to its table")
+        say(f"note: another sweep is writing {folder}; waiting for it to end, then adding to its table")
         fcntl.flock(lock, fcntl.LOCK_EX)
-    lock.seek(0)
-    lock.truncate()
-    lock.write(f"pid {os.getpid()}")
-    lock.flush()
     _HELD[folder] = lock

@@ -1,0 +1,461 @@
+"""Issue 33 ("nothing silently wrong, part 3") in real processes: the dataset's files are inputs, caches key on
+content, results files are checked like detection files, one sweep per study folder, full disks, long names and
+symlink loops said in one line before the work, ``--serve`` on localhost, ``reproduce`` naming a change of code.
+
+Each case runs the installed scripts and checks the exit code, the one ``error:`` line (or the right answer where
+the input was legal) and the files left. The full disk is a real 2 MB tmpfs when running as root (skipped
+elsewhere; ``tests/gnnpmb/test_outputs.py`` checks the same lines in-process with the free space patched).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import time
+from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from tests.cli.test_user_errors import BIN, VIZ, _check, _env, _snapshot, _work_folder
+
+DATASET_INPUT = "the dataset's files are inputs"
+LOOP = "is a symlink loop"
+
+
+def _cache_env(demo: Path, cache: Path, **extra: str) -> dict[str, str]:
+    return _env(demo) | {"GNNPMB_CACHE_DIR": str(cache)} | extra
+
+
+def _run(command: list[str], env: dict[str, str], cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
+    exe = str(BIN / command[0])
+    return subprocess.run([exe, *command[1:]], capture_output=True, text=True, env=env, cwd=cwd, timeout=timeout)
+
+
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def _copy_tables(demo: Path, to: Path) -> Path:
+    """A dataroot at ``to`` with its own copy of the demo's tables; sensor files and maps linked to the demo's."""
+    to.mkdir(parents=True)
+    shutil.copytree(demo / "v1.0-mini", to / "v1.0-mini")
+    for name in ("samples", "maps"):
+        (to / name).symlink_to(demo / name)
+    return to
+
+
+def _scene_tokens(dataroot: Path, scene_name: str) -> list[str]:
+    tables = dataroot / "v1.0-mini"
+    scene = next(s for s in json.loads((tables / "scene.json").read_text()) if s["name"] == scene_name)
+    samples = {s["token"]: s for s in json.loads((tables / "sample.json").read_text())}
+    tokens, token = [], scene["first_sample_token"]
+    while token:
+        tokens.append(token)
+        token = samples[token]["next"]
+    return tokens
+
+
+def _detections(path: Path, demo: Path, x_m: float = 600.0) -> None:
+    """A detection file with one car per sample of both demo scenes, at x = ``x_m`` + the keyframe index."""
+    results = {}
+    for scene in ("scene-0103", "scene-0916"):
+        for k, token in enumerate(_scene_tokens(demo, scene)):
+            results[token] = [
+                {
+                    "sample_token": token,
+                    "translation": [x_m + k, 1600.0, 1.0],
+                    "size": [2.0, 4.5, 1.6],
+                    "rotation": [1.0, 0.0, 0.0, 0.0],
+                    "velocity": [2.0, 0.0],
+                    "detection_name": "car",
+                    "detection_score": 0.9,
+                    "attribute_name": "",
+                }
+            ]
+    path.write_text(json.dumps({"meta": {"use_lidar": True}, "results": results}))
+
+
+def _edit_in_place(path: Path, old: bytes, new: bytes) -> None:
+    """Overwrite ``old`` with ``new`` (same length) in the file itself (same inode), then give it back its
+    modification time: path, size, mtime and inode all stay as they were."""
+    assert len(old) == len(new)
+    st = path.stat()
+    data = path.read_bytes()
+    with open(path, "r+b") as f:
+        f.seek(data.index(old))
+        f.write(new)
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
+    after = path.stat()
+    assert (after.st_size, after.st_mtime_ns, after.st_ino) == (st.st_size, st.st_mtime_ns, st.st_ino)
+
+
+def _submission(path: Path, demo: Path, box_of: callable) -> None:
+    """A tracking submission for mini_val with ``box_of(token, k)`` as the one box of the k-th sample."""
+    tokens = _scene_tokens(demo, "scene-0103") + _scene_tokens(demo, "scene-0916")
+    results = {t: [box_of(t, k)] for k, t in enumerate(tokens)}
+    path.write_text(json.dumps({"meta": {"use_lidar": True}, "results": results}))
+
+
+def _box(token: str, k: int, **changes: object) -> dict:
+    box = {
+        "sample_token": token,
+        "translation": [600.0 + k, 1600.0, 1.0],
+        "size": [2.0, 4.5, 1.6],
+        "rotation": [1.0, 0.0, 0.0, 0.0],
+        "velocity": [0.0, 0.0],
+        "tracking_id": str(k),
+        "tracking_name": "car",
+        "tracking_score": 0.9,
+    }
+    return box | changes
+
+
+# --- case 1, 8, 11, 14: refused at start-up, before the dataset is read --------------------------------------------
+
+
+def _early_cases(demo: Path) -> list[tuple[str, str, str]]:
+    table = demo / "v1.0-mini" / "sample_annotation.json"
+    return [
+        ("1 out is a table", f"gnnpmb track --out {table}", DATASET_INPUT),
+        ("1 out is the splits file", f"gnnpmb track --out {demo}/v1.0-mini/splits.json", DATASET_INPUT),
+        ("1 out is a table, relative", "gnnpmb track --out demo/v1.0-mini/scene.json", DATASET_INPUT),
+        ("1 out is a table, symlink", "gnnpmb track --out table.json", DATASET_INPUT),
+        ("1 out is a table, hard link", "gnnpmb track --out hard-table.json", "a hard link of the nuScenes file"),
+        ("1 json is a table", f"gnnpmb failures scene-0103 --json {demo}/v1.0-mini/scene.json", DATASET_INPUT),
+        ("1 save in the sensor folder", f"{VIZ} scene-0103 --save {demo}/samples/x.rrd", DATASET_INPUT),
+        ("1 eval out is the table folder", f"gnnpmb eval good.json --out {demo}/v1.0-mini", DATASET_INPUT),
+        ("8 loop out", "gnnpmb track --out loop.json", LOOP),
+        ("8 loop detections", "gnnpmb track --out new.json --detections loop.json", LOOP),
+        ("8 loop params", "gnnpmb track --out new.json --params loop.json", LOOP),
+        ("8 loop save", f"{VIZ} scene-0103 --save loop.rrd", LOOP),
+        ("8 loop results", "gnnpmb failures scene-0103 --results mine=loop.json", LOOP),
+        ("8 loop eval", "gnnpmb eval loop.json", LOOP),
+        ("8 loop recording", f"{VIZ} reproduce loop.rrd", LOOP),
+        ("8 loop dataroot", "gnnpmb track --out new.json --dataroot loop.json", LOOP),
+        ("11 name too long", f"gnnpmb track --out {'n' * 252}.json", "the name is 257 bytes long"),
+        ("14 bind not an address", f"{VIZ} scene-0103 --serve --bind nowhere", "--bind nowhere: not an IP address"),
+        ("14 bind without serve", f"{VIZ} scene-0103 --save x.rrd --bind 0.0.0.0", "--bind only applies with --serve"),
+    ]
+
+
+def test_outputs_onto_the_dataset_loops_and_long_names_are_one_line_before_any_work(
+    demo_dataroot: Path, tmp_path: Path
+) -> None:
+    dataset_before = _tree(demo_dataroot / "v1.0-mini")
+    env = _env(demo_dataroot)
+
+    def one(case: tuple[str, str, str]) -> list[str]:
+        name, command, expected = case
+        work = _work_folder(tmp_path / name.replace(" ", "_").replace(",", ""))
+        (work / "demo").symlink_to(demo_dataroot)
+        (work / "table.json").symlink_to(demo_dataroot / "v1.0-mini" / "sample_annotation.json")
+        os.link(demo_dataroot / "v1.0-mini" / "sample_annotation.json", work / "hard-table.json")
+        for suffix in (".json", ".rrd"):
+            (work / f"loop{suffix}").symlink_to(f"loop2{suffix}")
+            (work / f"loop2{suffix}").symlink_to(f"loop{suffix}")
+        before = _snapshot(work)
+        proc = _run(command.split(), env, work)
+        problems = _check(name, proc, expected)
+        if _snapshot(work) != before:
+            problems.append(f"{name}: files changed")
+        return problems
+
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        problems = [p for found in pool.map(one, _early_cases(demo_dataroot)) for p in found]
+    assert problems == []
+    assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
+
+
+def test_a_255_byte_output_name_is_written(demo_dataroot: Path, tmp_path: Path) -> None:
+    """The longest legal name works: the temporary file beside it is named within the limit too."""
+    name = "r" * 250 + ".json"
+    proc = _run(["gnnpmb", "track", "--out", name, "--no-progress"], _env(demo_dataroot), tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert [p.name for p in tmp_path.iterdir()] == [name]
+    assert json.loads((tmp_path / name).read_text())["results"]
+
+
+def test_a_port_taken_on_ipv6_loopback_counts_as_in_use(demo_dataroot: Path, tmp_path: Path) -> None:
+    if not socket.has_ipv6:
+        pytest.skip("no IPv6 here")
+    with socket.socket(socket.AF_INET6) as taken:
+        taken.setsockopt(socket.IPPROTO_IPV6, socket.IPV6_V6ONLY, 1)
+        try:
+            taken.bind(("::1", 0))
+        except OSError:
+            pytest.skip("no ::1 here")
+        taken.listen()
+        port = taken.getsockname()[1]
+        proc = _run([VIZ, "scene-0103", "--serve", "--web-port", str(port)], _env(demo_dataroot), tmp_path)
+    assert _check("port on ::1", proc, f"--web-port {port}: the port is in use on ::1") == []
+
+
+# --- case 14: what --serve listens on --------------------------------------------------------------------------------
+
+
+def _listening(port: int) -> list[str]:
+    """The local addresses (hex, as /proc/net/tcp* shows them) listening on TCP ``port``."""
+    out = []
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        with open(table) as f:
+            for line in f.readlines()[1:]:
+                fields = line.split()
+                address, port_hex = fields[1].split(":")
+                if int(port_hex, 16) == port and fields[3] == "0A":
+                    out.append(address)
+    return out
+
+
+@pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
+def test_serve_listens_on_loopback_only(demo_dataroot: Path, tmp_path: Path) -> None:
+    from tests.gnnpmb.test_serve import _free_ports
+
+    web, grpc = _free_ports(2)
+    argv = [str(BIN / VIZ), "scene-0103", "--tracker", "gnn", "--frames", "0:2", "--no-failures", "--no-progress"]
+    argv += ["--serve", "--web-port", str(web), "--grpc-port", str(grpc)]
+    proc = subprocess.Popen(
+        argv,
+        env=_env(demo_dataroot),
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    try:
+        lines: list[str] = []
+        while not (lines and lines[-1].startswith("serving")):
+            line = proc.stderr.readline()
+            assert line, f"ended early: {lines}"
+            lines.append(line)
+        assert lines[0].startswith(f"web viewer: http://127.0.0.1:{web}/"), lines
+        for port in (web, grpc):
+            assert _listening(port) == ["0100007F"], (port, _listening(port))  # 127.0.0.1, nothing else
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=60)
+    assert proc.returncode == 0
+    assert _listening(web) == [] and _listening(grpc) == []  # the web viewer's process ended with the run
+
+
+# --- case 2: caches key on content ------------------------------------------------------------------------------------
+
+
+def test_a_detection_file_edited_in_place_with_its_old_mtime_is_read_again(demo_dataroot: Path, tmp_path: Path) -> None:
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    _detections(tmp_path / "det.json", demo_dataroot)
+    track = ["gnnpmb", "track", "--detections", "det.json", "--tracker", "gnn", "--no-progress", "--out"]
+    first = _run([*track, "a.json"], env, tmp_path)
+    assert first.returncode == 0, first.stderr
+    _edit_in_place(tmp_path / "det.json", b"[601.0, 1600.0", b"[951.0, 1600.0")
+    second = _run([*track, "b.json"], env, tmp_path)
+    assert second.returncode == 0, second.stderr
+    assert (tmp_path / "a.json").read_bytes() != (tmp_path / "b.json").read_bytes()  # the old code: identical
+
+
+def test_reproduce_hashes_the_detection_file_itself(demo_dataroot: Path, tmp_path: Path) -> None:
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    _detections(tmp_path / "det.json", demo_dataroot)
+    record = [VIZ, "scene-0103", "--detections", "det.json", "--tracker", "gnn", "--frames", "0:3"]
+    proc = _run([*record, "--no-failures", "--no-progress", "--save", "run.rrd"], env, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    _edit_in_place(tmp_path / "det.json", b"[601.0, 1600.0", b"[951.0, 1600.0")
+    proc = _run([VIZ, "reproduce", "run.rrd"], env, tmp_path)
+    assert _check("reproduce after an edit", proc, "det.json has changed since the recording") == []
+
+
+# --- case 7: a damaged index side file is rebuilt ---------------------------------------------------------------------
+
+
+def _flip_a_byte(path: Path) -> None:
+    data = bytearray(path.read_bytes())
+    position = data.index(b'"', len(data) // 2) + 1  # inside a string: still JSON, another value
+    data[position] ^= 0x01
+    path.write_bytes(bytes(data))
+
+
+@pytest.mark.parametrize("side_file", ["scenes.json", "small.json"])
+def test_a_damaged_dataset_index_side_file_is_rebuilt(side_file: str, demo_dataroot: Path, tmp_path: Path) -> None:
+    """A flipped byte in a side file of the dataset's index: the next run rebuilds the index and says the same."""
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    command = ["gnnpmb", "failures", "scene-0103", "--tracker", "gnn", "--frames", "0:2"]
+    first = _run(command, env, tmp_path)
+    assert first.returncode == 0, first.stderr
+    (index,) = (tmp_path / "cache" / "index").glob("dataset-*")
+    _flip_a_byte(index / side_file)
+    second = _run(command, env, tmp_path)
+    assert second.returncode == 0, second.stderr
+    assert second.stdout == first.stdout
+
+
+def test_a_damaged_detection_index_side_file_is_rebuilt(demo_dataroot: Path, tmp_path: Path) -> None:
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    _detections(tmp_path / "det.json", demo_dataroot)
+    track = ["gnnpmb", "track", "--detections", "det.json", "--tracker", "gnn", "--no-progress", "--out"]
+    assert _run([*track, "a.json"], env, tmp_path).returncode == 0
+    (index,) = (tmp_path / "cache" / "index").glob("detections-*")
+    _flip_a_byte(index / "samples.json")
+    second = _run([*track, "b.json"], env, tmp_path)
+    assert second.returncode == 0, second.stderr
+    assert (tmp_path / "a.json").read_bytes() == (tmp_path / "b.json").read_bytes()
+
+
+# --- case 3, 5, 6, 12: results files and tables checked like detection files ------------------------------------------
+
+
+def test_results_files_the_devkit_would_read_otherwise_are_one_line(demo_dataroot: Path, tmp_path: Path) -> None:
+    cases = {
+        "mixed ids": (lambda t, k: _box(t, k, tracking_id=k if k % 2 else str(k)), "tracking_id is an integer"),
+        "zero quaternion": (lambda t, k: _box(t, k, rotation=[0.0, 0.0, 0.0, 0.0]), "is not a rotation"),
+        "non-unit quaternion": (lambda t, k: _box(t, k, rotation=[0.5, 0.0, 0.0, 0.0]), "not a unit quaternion"),
+        "zero size": (lambda t, k: _box(t, k, size=[0.0, 4.5, 1.6]), "field 'size' must be positive"),
+        "far away": (lambda t, k: _box(t, k, translation=[1e6 + 600.0, 1600.0, 1.0]), "beyond 1e+05 m"),
+    }
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+
+    def one(item: tuple[str, tuple]) -> list[str]:
+        name, (box_of, expected) = item
+        work = tmp_path / name.replace(" ", "_")
+        work.mkdir()
+        _submission(work / "r.json", demo_dataroot, box_of)
+        before = _snapshot(work)
+        problems = []
+        for command in (
+            ["gnnpmb", "eval", "r.json", "--out", "ev"],
+            ["gnnpmb", "failures", "scene-0103", "--results", "mine=r.json"],
+        ):
+            problems += _check(f"{name}: {command[1]}", _run(command, env, work), expected)
+        if _snapshot(work) != before:
+            problems.append(f"{name}: files changed")
+        return problems
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        problems = [p for found in pool.map(one, cases.items()) for p in found]
+    assert problems == []
+
+
+def test_a_dataset_without_annotations_is_said_once(demo_dataroot: Path, tmp_path: Path) -> None:
+    root = _copy_tables(demo_dataroot, tmp_path / "test-like")
+    (root / "v1.0-mini" / "sample_annotation.json").write_text("[]")
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    _submission(tmp_path / "r.json", demo_dataroot, lambda t, k: _box(t, k))
+    proc = _run(["gnnpmb", "eval", "r.json", "--dataroot", str(root), "--out", "ev"], env, tmp_path)
+    assert _check("eval", proc, "split mini_val of") == []
+    assert "has no ground truth" in proc.stderr
+    proc = _run(["gnnpmb", "failures", "scene-0103", "--dataroot", str(root), "-t", "gnn"], env, tmp_path)
+    assert _check("failures", proc, "scene-0103 has no ground-truth boxes") == []
+    assert not (tmp_path / "ev").exists()
+
+
+def test_a_first_sample_token_that_names_no_sample_is_one_line(demo_dataroot: Path, tmp_path: Path) -> None:
+    root = _copy_tables(demo_dataroot, tmp_path / "edited")
+    scenes = json.loads((root / "v1.0-mini" / "scene.json").read_text())
+    scenes[0]["first_sample_token"] = "f" * 32
+    (root / "v1.0-mini" / "scene.json").write_text(json.dumps(scenes))
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    proc = _run(["gnnpmb", "failures", scenes[0]["name"], "--dataroot", str(root)], env, tmp_path)
+    expected = f"v1.0-mini/scene.json: scene '{scenes[0]['name']}' has first_sample_token '{'f' * 32}', the token of no"
+    assert _check("bad first sample", proc, expected) == []
+
+
+# --- case 4: one sweep at a time per study folder ------------------------------------------------------------------
+
+
+def test_a_second_sweep_into_a_folder_waits_for_the_first(demo_dataroot: Path, tmp_path: Path) -> None:
+    """Another process holds the study folder (as a running sweep does): the sweep says so and waits; it runs once
+    the folder is let go."""
+    import sys
+
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    study = tmp_path / "study"
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from gnnpmb.study.lock import hold_study_folder; "
+            f"hold_study_folder({str(study)!r}, print); print('held', flush=True); sys.stdin.readline()",
+        ],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    assert holder.stdout.readline().strip() == "held"
+    sweep = ["gnnpmb", "sweep", "--out", "study", "--tracker", "gnn", "--param", "models.gate_chi2=20", "--no-progress"]
+    proc = subprocess.Popen(
+        [str(BIN / sweep[0]), *sweep[1:]],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    first = proc.stderr.readline()
+    assert first.startswith(f"note: another sweep is writing {study}; waiting"), first
+    time.sleep(1.0)
+    assert proc.poll() is None and not (study / "results.json").exists()  # still waiting
+    holder.communicate("go\n", timeout=60)
+    out, err = proc.communicate(timeout=600)
+    assert proc.returncode == 0, err
+    assert len(json.loads((study / "results.json").read_text())["rows"]) == 1
+
+
+# --- case 10: full disk ---------------------------------------------------------------------------------------------
+
+
+@pytest.fixture
+def full_disk(tmp_path: Path) -> Iterator[Path]:
+    """A 2 MB tmpfs filled to 1.8 MB (root only)."""
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        pytest.skip("mounting a tmpfs needs root")
+    mount = tmp_path / "small"
+    mount.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2m", "tmpfs", str(mount)], capture_output=True)
+    if done.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {done.stderr!r}")
+    try:
+        (mount / "fill").write_bytes(b"\0" * 1_800_000)
+        yield mount
+    finally:
+        subprocess.run(["umount", str(mount)], check=False)
+
+
+def test_a_full_disk_is_one_line_naming_the_place(demo_dataroot: Path, tmp_path: Path, full_disk: Path) -> None:
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    proc = _run(["gnnpmb", "track", "--out", str(full_disk / "r.json")], env, tmp_path)
+    assert (
+        _check("out on a full disk", proc, f"--out {full_disk / 'r.json'}: the disk of folder {full_disk} is full")
+        == []
+    )
+    cache = full_disk / "cache"
+    proc = _run(["gnnpmb", "track", "--out", "r.json", "--no-progress"], _cache_env(demo_dataroot, cache), tmp_path)
+    assert _check("cache on a full disk", proc, f"cannot write {cache}/index/dataset-") == []
+    assert f"free space in {cache} or point GNNPMB_CACHE_DIR at a folder with room" in proc.stderr
+    assert sorted(p.name for p in full_disk.iterdir()) == ["cache", "fill"]
+    assert not (tmp_path / "r.json").exists()
+
+
+# --- case 13: reproduce says when the code differs --------------------------------------------------------------------
+
+
+def test_reproduce_names_a_change_of_code(demo_dataroot: Path, tmp_path: Path) -> None:
+    """The recording is made by a copy of the package that differs by one comment (same version number)."""
+    import gnnpmb
+
+    copy = tmp_path / "code"
+    shutil.copytree(Path(gnnpmb.__file__).parent, copy / "gnnpmb")
+    with open(copy / "gnnpmb" / "kalman.py", "a") as f:
+        f.write("# an edit\n")
+    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    record = [VIZ, "scene-0103", "--tracker", "gnn", "--frames", "0:3", "--no-failures", "--no-progress"]
+    proc = _run([*record, "--save", "run.rrd"], env | {"PYTHONPATH": str(copy)}, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    proc = _run([VIZ, "reproduce", "run.rrd"], env, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "note: recorded with other gnnpmb code (source digest" in proc.stderr
+    assert "gnn: identical" in proc.stdout
