@@ -348,6 +348,7 @@ class _Context:
             gt_id is not None
             and victim is not None
             and not self.missed_at(gt_id, x)
+            and self.evaluated_at(gt_id, x)
             and not self.false_at(self.report, x, int(victim))
             for x in false
         )
@@ -545,22 +546,28 @@ class _Context:
             f.frame_index == frame and str(track_id) in f.track_ids for f in report.of_kind(FailureKind.FALSE_TRACK)
         )
 
+    def evaluated_at(self, gt_id: str, frame: int) -> bool:
+        """Whether the evaluation had a box of object ``gt_id`` at ``frame`` (annotated or interpolated)."""
+        g = self.report.gt_frame(gt_id, frame)
+        return g is not None and g.evaluated_xy_m is not None
+
     def missed_at(self, gt_id: str, frame: int) -> bool:
         """Whether the evaluation matched object ``gt_id`` to no track at ``frame`` (a miss there)."""
         return any(f.frame_index == frame and gt_id in f.gt_ids for f in self.report.of_kind(FailureKind.MISS))
 
     def matched_to(self, gt_id: str) -> int | None:
-        """The track the evaluation matched object ``gt_id`` to at the failure frame: a counted track of the class
-        output within ``NEAR_M`` of its evaluated box, nearest first (None: none)."""
+        """The track the evaluation matched object ``gt_id`` to at the failure frame: the one counted track of the
+        class output within ``NEAR_M`` of its evaluated box that was no false track there, the object not missed
+        (None: none, or more than one could have been)."""
         g = self.report.gt_frame(gt_id, self.f)
-        if g is None or g.evaluated_xy_m is None or self.missed_at(gt_id, self.f):
+        if not self.evaluated_at(gt_id, self.f) or self.missed_at(gt_id, self.f):
             return None
         others = [
             o
             for o in self.on_object(self.report, self.frames.get(self.f), np.asarray(g.evaluated_xy_m))
             if o.counted and not o.false_here and o.track_id != int(self.failure.track_ids[0])
         ]
-        return others[0].track_id if others else None
+        return others[0].track_id if len(others) == 1 else None  # of two or more, which one is not known here
 
     def miss(self, sightings: tuple[Sighting, ...]) -> dict:
         s = next((s for s in sightings if s.frame == self.f), None)
