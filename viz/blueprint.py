@@ -361,10 +361,7 @@ def _tracker_views(
             name=f"{tracker} failures over time",
             visual_bounds=rrb.VisualBounds2D(x_range=x_range, y_range=y_range),
         )
-        strip_share = 2 if rows <= 2 else 3  # each row name needs ~20 px: 3+ rows take height from the 3D view
-        return rrb.Vertical(
-            bev_view(tracker), spatial_view(tracker), strip_view, row_shares=[6, 6 - strip_share, strip_share]
-        )
+        return rrb.Vertical(bev_view(tracker), spatial_view(tracker), strip_view, row_shares=[6, 4, 2])
     return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[3, 2])
 
 
