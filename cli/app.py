@@ -160,6 +160,13 @@ def view(
         ),
     ] = None,
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
+    cameras: Annotated[
+        bool, typer.Option(help="Show the camera images with the boxes projected into them (where the data has them).")
+    ] = True,
+    sweeps: Annotated[
+        bool,
+        typer.Option(help="Also log the LiDAR sweeps between keyframes, each at its own time (timestamp timeline)."),
+    ] = False,
 ) -> None:
     """Track SCENE into one recording and show or save it (``VIEW_HELP``)."""
     if save is None and not serve:
@@ -184,7 +191,7 @@ def view(
     )
     from viz.view import run_view
 
-    result = run_view(request, progress=progress_bar(progress), failures=failures)
+    result = run_view(request, progress=progress_bar(progress), failures=failures, cameras=cameras, sweeps=sweeps)
     if result.focus is not None:
         typer.echo(f"focus: {result.focus.title}")
     for notice in result.notices:

@@ -25,11 +25,20 @@ from gnnpmb.session import (
 from viz.opening import timeline_rows
 
 
-def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failures: bool = True) -> ViewResult:
+def run_view(
+    request: ViewRequest,
+    *,
+    progress: ProgressBar | None = None,
+    failures: bool = True,
+    cameras: bool = True,
+    sweeps: bool = False,
+) -> ViewResult:
     """Log the scene, run every tracker into one recording (sharing the preprocessed detections), compare them
     and log failures and provenance. With ``request.focus`` the trackers first run without logging to find the
     focus (``resolve_request_focus``); the recording then holds the keyframes around it, opens on it and explains
-    it (``focus/summary``). ``progress``: a progress display (e.g. a rich ``Progress``; none by default)."""
+    it (``focus/summary``). ``progress``: a progress display (e.g. a rich ``Progress``; none by default).
+    ``cameras``: the camera images with the boxes projected into them (``viz.cameras``; where the dataset has them,
+    else a notice); ``sweeps``: also the LiDAR sweeps between keyframes (a notice when there are none)."""
     import numpy as np
 
     from gnnpmb.data.nuscenes import load_lidar_points
@@ -62,6 +71,23 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
     elif failures:  # a full recording opens at its first failure worth a look (viz.opening)
         opening, reports, notices = resolve_opening(request)
     shown = focus.window(frame_range) if focus is not None else frame_range
+    sensors, channels, sight = None, (), None
+    if cameras or sweeps:
+        from gnnpmb.data.sensors import load_scene_sensors
+        from viz.cameras import absent_reason
+
+        sensors = load_scene_sensors(scene, shown)
+        absent = absent_reason(sensors, shown) if cameras else None
+        if absent is not None:
+            notices.append(absent)
+        elif cameras:
+            channels = sensors.channels
+        if sweeps and not sensors.sweeps:
+            notices.append("sweeps absent: the dataset has no LiDAR sweeps between this scene's keyframes")
+    if focus is not None and channels:
+        from gnnpmb.focus_cameras import focus_sight
+
+        sight = focus_sight(focus, scene, sensors)
     start = focus or opening
     clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
     n = len(shown)
@@ -77,6 +103,7 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
             failure_index=bool(reports),
             frames=shown,
             timeline_rows={t: len(timeline_rows(r, shown)) for t, r in reports.items()},
+            cameras=channels,
         )
     bar = progress if progress is not None else SilentProgress()
     runs: list[TrackingRun] = []
@@ -90,16 +117,24 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
     else:
         opened = recording(recording_name(request, focus), request.save, blueprint)
     with opened as stream, bar:
-        sensors = bar.add_task(f"{scene.name} sensors", total=n)
+        sensors_task = bar.add_task(f"{scene.name} sensors", total=n)
         log_scene(
             stream,
             scene,
             [request.frame_detections[i] for i in shown],
             shown,
             points_loader=load_lidar_points,
-            on_frame=lambda: bar.advance(sensors),
+            on_frame=lambda: bar.advance(sensors_task),
             clock=clock,
         )
+        if channels:
+            from viz.cameras import log_cameras
+
+            log_cameras(stream, scene, sensors, shown, clock)
+        if sweeps and sensors is not None and sensors.sweeps:
+            from viz.cameras import log_sweeps
+
+            log_sweeps(stream, scene, sensors, shown)
         for tracker in request.trackers:
             task = bar.add_task(f"{scene.name} {tracker}", total=len(frame_range))
             sink = fact_sink(request, tracker)
@@ -163,10 +198,18 @@ def run_view(request: ViewRequest, *, progress: ProgressBar | None = None, failu
                 owner = evidence[focus.failure_tracker]
                 others = [ev for t, ev in evidence.items() if t != focus.failure_tracker]
                 finding = explain_failure(focus.failure_id, owner, scene, others, first_frame=shown.start)
-            log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding)
+            log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding, sight)
             legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
             stream.send_blueprint(
-                default_blueprint(request.trackers, request.classes, focus, legends, caps),
+                default_blueprint(
+                    request.trackers,
+                    request.classes,
+                    focus,
+                    legends,
+                    caps,
+                    cameras=channels,
+                    focus_camera=sight.best_channel if sight is not None else None,
+                ),
                 make_active=True,
                 make_default=True,
             )
