@@ -23,11 +23,13 @@ OBJECT_HEIGHT_M = 0.8
 @dataclass(frozen=True, slots=True)
 class FocusSight:
     """frame_index: the focus frame; gt_id: the instance token looked for (None: the focus place, e.g. a false
-    track's); seen: the cameras whose view held it, most central first (empty: none did)."""
+    track's, whose id is track_id when the failure names one); seen: the cameras whose view held it, most central
+    first (empty: none did)."""
 
     frame_index: int
     gt_id: str | None
     seen: tuple[CameraSighting, ...]
+    track_id: int | None = None
 
     @property
     def best_channel(self) -> str | None:
@@ -45,4 +47,5 @@ def focus_sight(focus: FocusTarget, scene: SceneData, sensors: SceneSensors) -> 
             return FocusSight(k, gt_id, sightings(sensors.cameras[k], gt.translation_m[rows[0]]))
     x, y = focus.center_xy_m
     point = np.array([x, y, scene.keyframes[k].ego_pose.translation_m[2] + OBJECT_HEIGHT_M])
-    return FocusSight(k, None, sightings(sensors.cameras[k], point))
+    track = focus.failure_tracks[0] if focus.failure_tracks else None
+    return FocusSight(k, None, sightings(sensors.cameras[k], point), track)

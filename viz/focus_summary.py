@@ -137,7 +137,9 @@ def camera_lines(sight: FocusSight | None) -> list[str]:
     """Whether the focus object was inside a camera's view at the focus frame, and which (none: no cameras)."""
     if sight is None:
         return []
-    what = f"GT {short_id(sight.gt_id)}" if sight.gt_id is not None else "The focus place"
+    what = "The focus place" if sight.track_id is None else f"Track {sight.track_id}"
+    if sight.gt_id is not None:
+        what = f"GT {short_id(sight.gt_id)}"
     if not sight.seen:
         return [f"**Cameras**: {what} was outside every camera's view at frame {sight.frame_index}.", ""]
     seen = ", ".join(f"{s.channel} ({s.distance_m:.0f} m away)" for s in sight.seen)

@@ -76,6 +76,8 @@ def test_the_focus_document_names_the_camera_or_says_none_saw_it() -> None:
     assert "GT bf3d85 was inside the view of CAM_FRONT_LEFT (18 m away) at frame 7" in line
     (line, _) = camera_lines(FocusSight(7, None, ()))
     assert line == "**Cameras**: The focus place was outside every camera's view at frame 7."
+    (line, _) = camera_lines(FocusSight(7, None, seen.seen, track_id=212))
+    assert line.startswith("**Cameras**: Track 212 was inside the view of CAM_FRONT_LEFT (18 m away) at frame 7")
     assert camera_lines(None) == []
 
 
