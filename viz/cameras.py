@@ -6,8 +6,9 @@ y down, z forward) and its JPEG as an ``EncodedImage`` (the file's bytes, never 
 a camera entity projects the 3D boxes under ``world`` (ground truth, detections, each tracker's tracks and the focus
 highlights) into the image through that transform tree, so the boxes are drawn where the camera saw them.
 
-Images and transforms go in with ``send_columns``, one chunk per camera (two in a focus recording), so six cameras
-add a few dozen chunks whatever the number of keyframes.
+Images and transforms go in together with ``send_columns``: per camera one static chunk (the pinhole) and one
+temporal chunk (two where the recording opens at a failure, ``viz.timeline.Clock``), whatever the number of
+keyframes.
 
 Sweeps (``--sweeps``): the LIDAR_TOP sweeps between keyframes on the ``timestamp`` timeline only (their own time),
 under ``world/sweeps/ego_vehicle/LIDAR_TOP`` with each sweep's own ego pose; tracks stay at the keyframes.
@@ -75,17 +76,21 @@ def log_cameras(
         translation = np.array([t for _, t in poses])
         blobs = [image.path.read_bytes() for _, image in rows]
         logged += sum(len(b) for b in blobs)
-        clock.send(stream, path, index, stamps, _transform_columns(rotation, translation))
-        clock.send(stream, path, index, stamps, _image_columns(blobs))
+        clock.send(stream, path, index, stamps, _camera_columns(rotation, translation, blobs))
     return logged
 
 
-def _transform_columns(rotation: np.ndarray, translation: np.ndarray) -> Callable[[np.ndarray], rr.ComponentColumnList]:
-    return lambda rows: rr.Transform3D.columns(translation=translation[rows], mat3x3=rotation[rows])
+def _camera_columns(
+    rotation: np.ndarray, translation: np.ndarray, blobs: list[bytes]
+) -> Callable[[np.ndarray], rr.ComponentColumnList]:
+    """The pose and JPEG columns of the selected rows, sent together: one chunk per camera (and timeline group)."""
 
+    def columns(rows: np.ndarray) -> rr.ComponentColumnList:
+        pose = rr.Transform3D.columns(translation=translation[rows], mat3x3=rotation[rows])
+        image = rr.EncodedImage.columns(blob=[blobs[j] for j in rows], media_type=["image/jpeg"] * len(rows))
+        return rr.ComponentColumnList([*pose, *image])
 
-def _image_columns(blobs: list[bytes]) -> Callable[[np.ndarray], rr.ComponentColumnList]:
-    return lambda rows: rr.EncodedImage.columns(blob=[blobs[j] for j in rows], media_type=["image/jpeg"] * len(rows))
+    return columns
 
 
 def log_sweeps(

@@ -93,7 +93,7 @@ def test_cameras_log_in_a_few_chunks(demo_dataroot: Path, tmp_path: Path, monkey
     log_cameras(stream, scene, sensors, FRAMES, PLAIN_CLOCK)
     stream.disconnect()
     chunks = [c for c in RrdReader(path).store().stream() if "CAM_" in c.entity_path]
-    assert len(chunks) <= 3 * len(CAMERA_ORDER)  # pinhole, transforms, images
+    assert len(chunks) == 2 * len(CAMERA_ORDER)  # the static pinhole; the poses and images together
 
 
 def test_sweeps_are_on_their_own_time_only_and_hand_over_with_the_keyframe_cloud(
