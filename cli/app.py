@@ -138,6 +138,13 @@ def view(
         ),
     ] = None,
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
+    cameras: Annotated[
+        bool, typer.Option(help="Show the camera images with the boxes projected into them (where the data has them).")
+    ] = True,
+    sweeps: Annotated[
+        bool,
+        typer.Option(help="Also log the LiDAR sweeps between keyframes, each at its own time (timestamp timeline)."),
+    ] = False,
 ) -> None:
     """Track SCENE into one recording and show or save it (``VIEW_HELP``)."""
     if save is None and not serve:
@@ -166,7 +173,7 @@ def view(
     inputs = load_inputs(request)
     if request.serve is not None and request.serve.exposure_warning() is not None:  # after every check passed
         typer.echo(request.serve.exposure_warning(), err=True)
-    result = run_view(inputs, progress=progress_bar(progress), failures=failures)
+    result = run_view(inputs, progress=progress_bar(progress), failures=failures, cameras=cameras, sweeps=sweeps)
     if result.focus is not None:
         typer.echo(f"focus: {result.focus.title}")
     for notice in result.notices:

@@ -189,6 +189,16 @@ def demo_data(
             help="Comma-separated scene names, or mini_val, staged, mini_train or all (default mini_val,staged).",
         ),
     ] = "mini_val,staged",
+    sweeps: Annotated[
+        bool, typer.Option(help="Also write the 9 LiDAR sweeps between keyframes (sweeps/LIDAR_TOP; ~10x slower).")
+    ] = False,
+    images: Annotated[
+        bool,
+        typer.Option(
+            help="Render every camera image now (samples/CAM_*, ~5 s per scene), for tools other than gnnpmb-viz; "
+            "without it each scene's images are rendered when first shown."
+        ),
+    ] = False,
 ) -> None:
     """Write the synthetic nuScenes-format demo dataset (v1.0-mini; the mini_val scenes scene-0103 and
     scene-0916 and the staged scene-9001 by default, the eight generated mini_train scenes on request)."""
@@ -203,8 +213,14 @@ def demo_data(
         "all": DEMO_SCENES + STAGED_SCENES + TRAIN_SCENES,
     }
     names = tuple(n for part in scenes.split(",") if part.strip() for n in groups.get(part.strip(), (part.strip(),)))
-    path = generate_demo_dataset(check_output_dir(out, "--out"), seed=seed, scenes=names)
-    typer.echo(f"demo dataset (v1.0-mini, seed {seed}, {len(set(names))} scenes) -> {path}")
+    path = generate_demo_dataset(check_output_dir(out, "--out"), seed=seed, scenes=names, sweeps=sweeps)
+    if images:
+        from gnnpmb.data.demo import ensure_scene_images
+
+        for name in dict.fromkeys(names):
+            ensure_scene_images(path, name)
+    with_sweeps = ", with sweeps" if sweeps else ""
+    typer.echo(f"demo dataset (v1.0-mini, seed {seed}, {len(set(names))} scenes{with_sweeps}) -> {path}")
 
 
 register(app)

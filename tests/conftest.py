@@ -30,3 +30,19 @@ def cv_results(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) ->
     results = track_scenes(list(DEMO_SCENES), demo_dataroot, None, "centerpoint")
     write_json(path, {"meta": dict(SUBMISSION_META), "results": results})
     return path
+
+
+@pytest.fixture(scope="session")
+def swept_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The demo's scene-0103 built with one LiDAR sweep between keyframes (nuScenes has nine; one keeps the
+    tests quick)."""
+    from gnnpmb.data import demo
+
+    patch = pytest.MonkeyPatch()
+    patch.setattr(demo, "SWEEPS_PER_INTERVAL", 1)
+    try:
+        return demo.generate_demo_dataset(
+            tmp_path_factory.mktemp("swept") / "data", scenes=("scene-0103",), sweeps=True
+        )
+    finally:
+        patch.undo()

@@ -22,9 +22,11 @@ from typing import TYPE_CHECKING
 
 import rerun.blueprint as rrb
 
+from gnnpmb.data.sensors import CAMERA_ORDER
 from gnnpmb.events import Panel
 from gnnpmb.runs import Capabilities, tracker_capabilities
 from viz import compare, paths
+from viz.cameras import with_cameras
 from viz.failures import failure_log
 from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M
 from viz.legend import LegendPlacement
@@ -75,7 +77,8 @@ def focus_world() -> str:
 
 
 def _contents(tracker: str) -> list[str]:
-    return ["+ world/**", "- world/trackers/**", f"+ {paths.tracker_world(tracker)}/**"]
+    cameras = [f"- {paths.camera(c)}/**" for c in CAMERA_ORDER]  # the camera views show them
+    return ["+ world/**", "- world/trackers/**", f"+ {paths.tracker_world(tracker)}/**", *cameras]
 
 
 def _hidden(tracker: str, *, lidar: bool, callouts: bool = False) -> dict[str, rrb.EntityBehavior]:
@@ -83,7 +86,7 @@ def _hidden(tracker: str, *, lidar: bool, callouts: bool = False) -> dict[str, r
     the focus callouts (``callouts``; their column is laid out for the bird's-eye camera)."""
     hidden = [paths.tracker_world(tracker) + "/candidates", paths.DETECTIONS_SUPPRESSED]
     if lidar:
-        hidden.append(paths.LIDAR)
+        hidden += [paths.LIDAR, paths.SWEEP_LIDAR]
     if callouts:
         hidden += [paths.focus_callouts(tracker), paths.focus_callouts(tracker) + "/leaders"]
     return {p: rrb.EntityBehavior(visible=False) for p in hidden}
@@ -372,6 +375,8 @@ def default_blueprint(
     failure_index: bool = False,
     frames: range | None = None,
     timeline_rows: Mapping[str, int] | None = None,
+    cameras: Sequence[str] = (),
+    focus_camera: str | None = None,
 ) -> rrb.Blueprint:
     """The layout for a recording of ``trackers`` (one or more runs, side by side) over ``classes``; with ``focus``
     the layout opens at and looks at the failure. ``legends``: where the legends of series views go, keyed by
@@ -379,13 +384,16 @@ def default_blueprint(
     (``gnnpmb.runs.Capabilities``; default: the registry's tracker of that name). A full recording whose failures
     were found (``failure_index``) shows each run's failure index and its failures over ``frames`` (in
     ``timeline_rows`` rows per run), and opens at the failure ``opening`` (``viz.opening``): its ``focus`` timeline
-    ends there."""
+    ends there. ``cameras``: the channels to show below the scene views (``viz.cameras.with_cameras``; in a focus
+    recording only ``focus_camera``, the one that sees the focus object, when one does)."""
     if not trackers:
         raise ValueError("default_blueprint needs at least one tracker")
     strips = frames if focus is None and failure_index and frames is not None else None
     panels = [tracker_panel(t, classes, focus, legends, _caps(t, caps), opening, failure_index) for t in trackers]
     rows = timeline_rows or {}
     scene = rrb.Horizontal(*[_tracker_views(t, focus, strips, rows.get(t, 1), len(trackers)) for t in trackers])
+    if cameras:
+        scene = with_cameras(scene, cameras, trackers, focus is not None, focus_camera)
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:

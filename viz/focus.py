@@ -26,6 +26,7 @@ from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.failures import short_id
 from gnnpmb.focus import FocusTarget
+from gnnpmb.focus_cameras import FocusSight
 from gnnpmb.pipeline import FrameResult
 from gnnpmb.types import Boxes
 from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode
@@ -75,13 +76,14 @@ def log_focus(
     clock: Clock,
     shown: range,
     finding: Finding | None = None,
+    sight: FocusSight | None = None,
 ) -> None:
     """The summary document and, at every keyframe of ``shown``, the highlighted objects. views: per tracker its
     evidence (report, facts, run) as the document shows it; finding: the failure's (None: the focus is no
-    failure)."""
+    failure); sight: the cameras that held the focus object in view (None: no cameras)."""
     stream.log(
         focus_doc(),
-        rr.TextDocument(focus_markdown(focus, finding, views, shown, scene), media_type="text/markdown"),
+        rr.TextDocument(focus_markdown(focus, finding, views, shown, scene, sight), media_type="text/markdown"),
         static=True,
     )
     stream.log(reading_guide_doc(), rr.TextDocument(READING_GUIDE, media_type="text/markdown"), static=True)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from gnnpmb.eval.failures import short_id
 from gnnpmb.events import AxisKind
 from gnnpmb.focus import FocusTarget
+from gnnpmb.focus_cameras import FocusSight
 from gnnpmb.why.facts import Ending, TrackerFacts, TrackStep, UseMode, Went
 from gnnpmb.why.findings import NEAR_M, Finding, Sighting
 from gnnpmb.why.reason import Evidence, key_decisions, object_frames
@@ -64,11 +65,16 @@ class TrackerView:
 
 
 def focus_markdown(
-    focus: FocusTarget, finding: Finding | None, views: Mapping[str, TrackerView], shown: range, scene
+    focus: FocusTarget,
+    finding: Finding | None,
+    views: Mapping[str, TrackerView],
+    shown: range,
+    scene,
+    sight: FocusSight | None = None,
 ) -> str:
-    """The summary document: the failure and its finding, the key decisions, where the trackers part, the ids;
-    per tracker a line per involved track, frame tables of the involved object and tracks, the update at the focus
-    frame and the story."""
+    """The summary document: the failure and its finding, the key decisions, where the trackers part, the ids
+    (and which camera held the object in view, ``sight``; None: no cameras); per tracker a line per involved
+    track, frame tables of the involved object and tracks, the update at the focus frame and the story."""
     lines = [f"# {focus.title}", ""]
     if finding is not None:
         lines += evaluation_lines(finding)
@@ -93,6 +99,7 @@ def focus_markdown(
     lines += [
         f"**Involved** ({focus.class_name}): " + (" · ".join(involved) or "nothing else"),
         "",
+        *camera_lines(sight),
         f"Opened at frame **{focus.frame_index}** on the `{FOCUS_TIMELINE}` timeline, which ends there; choose the "
         f"`frame` timeline in the time panel to step past it. Recorded frames: {shown.start}–{shown.stop - 1}. "
         "The tab *how to read the views* explains the boxes, lines and colours.",
@@ -124,6 +131,23 @@ def focus_markdown(
             lines += [f"- frame {line.frame}: {line.text}" for line in story[-MAX_STORY_LINES:]]
             lines.append("")
     return "\n".join(lines) + "\n"
+
+
+def camera_lines(sight: FocusSight | None) -> list[str]:
+    """Whether the focus object was inside a camera's view at the focus frame, and which (none: no cameras)."""
+    if sight is None:
+        return []
+    what = "The focus place" if sight.track_id is None else f"Track {sight.track_id}"
+    if sight.gt_id is not None:
+        what = f"GT {short_id(sight.gt_id)}"
+    if not sight.seen:
+        return [f"**Cameras**: {what} was outside every camera's view at frame {sight.frame_index}.", ""]
+    seen = ", ".join(f"{s.channel} ({s.distance_m:.0f} m away)" for s in sight.seen)
+    return [
+        f"**Cameras**: {what} was inside the view of {seen} at frame {sight.frame_index} (field of view only: "
+        f"something may hide it); the camera view shows {sight.seen[0].channel}.",
+        "",
+    ]
 
 
 def _parting(focus: FocusTarget, views: Mapping[str, TrackerView]) -> list[str]:

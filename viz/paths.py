@@ -21,6 +21,10 @@ DETECTIONS_SUPPRESSED = f"{DETECTIONS}/suppressed"
 WORLD_TRACKERS = f"{WORLD}/trackers"
 TRACKERS = "trackers"
 SCENE_INFO = "scene/info"
+SWEEPS = f"{WORLD}/sweeps"
+SWEEP_EGO = f"{SWEEPS}/ego_vehicle"
+"""The ego pose at each LiDAR sweep between keyframes (on the timestamp timeline only)."""
+SWEEP_LIDAR = f"{SWEEP_EGO}/LIDAR_TOP"
 
 
 def _name(part: str) -> str:
@@ -28,6 +32,11 @@ def _name(part: str) -> str:
     if not part or "/" in part or part.strip() != part:
         raise ValueError(f"invalid entity path segment {part!r}")
     return part
+
+
+def camera(channel: str) -> str:
+    """One camera (``CAM_FRONT`` ...): its pose in the keyframe's ego frame, static pinhole and JPEG images."""
+    return f"{EGO}/{_name(channel)}"
 
 
 # Spatial, per tracker (global frame).

@@ -87,12 +87,21 @@ def recording_name(inputs: Inputs, focus: FocusTarget | None = None) -> str:
     return name
 
 
-def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: bool = True) -> ViewResult:
+def run_view(
+    inputs: Inputs,
+    *,
+    progress: ProgressBar | None = None,
+    failures: bool = True,
+    cameras: bool = True,
+    sweeps: bool = False,
+) -> ViewResult:
     """Run every tracker once with its events recorded, find the failures (with ``failures``, or for a focus), the
     focus or the opening failure and the comparison, then log the scene, replay each run's events into its logger
     and log failures and provenance. With ``inputs.focus`` the recording holds the keyframes around the focus,
     opens on it and explains it (``focus/summary``). ``progress``: a progress display (e.g. a rich ``Progress``;
-    none by default)."""
+    none by default). ``cameras``: the camera images with the boxes projected into them (``viz.cameras``; where the
+    dataset has them, else a notice); ``sweeps``: also the LiDAR sweeps between keyframes (a notice when there are
+    none)."""
     import numpy as np
 
     from gnnpmb.data.nuscenes import load_lidar_points
@@ -139,6 +148,23 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
             points_loader = (
                 load_lidar_points if lidar.complete else lambda k: load_lidar_points(k) if lidar.has(k.index) else None
             )
+        sensors, channels, sight = None, (), None
+        if cameras or sweeps:
+            from gnnpmb.data.sensors import load_scene_sensors
+            from viz.cameras import absent_reason
+
+            sensors = load_scene_sensors(scene, shown)
+            absent = absent_reason(sensors, shown) if cameras else None
+            if absent is not None:
+                notices = [*notices, absent]
+            elif cameras:
+                channels = sensors.channels
+            if sweeps and not sensors.sweeps:
+                notices = [*notices, "sweeps absent: the dataset has no LiDAR sweeps between this scene's keyframes"]
+        if focus is not None and channels:
+            from gnnpmb.focus_cameras import focus_sight
+
+            sight = focus_sight(focus, scene, sensors)
         start = focus or opening
         clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
         # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
@@ -152,6 +178,7 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
                 failure_index=bool(reports),
                 frames=shown,
                 timeline_rows={t: len(timeline_rows(r, shown)) for t, r in reports.items()},
+                cameras=channels,
             )
         loggers: dict[str, TrackerLogger] = {}
         comparison = None
@@ -162,17 +189,25 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
         else:
             opened = recording(recording_name(inputs, focus), inputs.save, blueprint)
         with opened as stream:
-            sensors = bar.add_task(f"{scene.name} sensors", total=len(shown))
+            sensors_task = bar.add_task(f"{scene.name} sensors", total=len(shown))
             log_scene(
                 stream,
                 scene,
                 [inputs.frame_detections[i] for i in shown],
                 shown,
                 points_loader=points_loader,
-                on_frame=lambda: bar.advance(sensors),
+                on_frame=lambda: bar.advance(sensors_task),
                 clock=clock,
                 sensor_note=sensor_note,
             )
+            if channels:
+                from viz.cameras import log_cameras
+
+                log_cameras(stream, scene, sensors, shown, clock)
+            if sweeps and sensors is not None and sensors.sweeps:
+                from viz.cameras import log_sweeps
+
+                log_sweeps(stream, scene, sensors, shown)
             for run in runs:
                 logger = loggers[run.name] = TrackerLogger(
                     stream,
@@ -229,10 +264,18 @@ def run_view(inputs: Inputs, *, progress: ProgressBar | None = None, failures: b
             if focus is not None:
                 evidence = all_evidence(inputs, runs, reports)
                 finding = explain_focus(inputs, focus, evidence, first_frame=shown.start)
-                log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding)
+                log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding, sight)
                 legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
                 stream.send_blueprint(
-                    default_blueprint(inputs.trackers, inputs.classes, focus, legends, caps),
+                    default_blueprint(
+                        inputs.trackers,
+                        inputs.classes,
+                        focus,
+                        legends,
+                        caps,
+                        cameras=channels,
+                        focus_camera=sight.best_channel if sight is not None else None,
+                    ),
                     make_active=True,
                     make_default=True,
                 )

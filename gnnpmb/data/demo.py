@@ -35,8 +35,12 @@ scene-0916, a two-lane road (ego at d = -1.75, 5 m/s):
       a cyclist the ego overtakes, an oncoming motorcycle and truck.
 
 Files: ``<dataroot>/v1.0-mini/*.json``, ``samples/LIDAR_TOP/*.pcd.bin`` (float32 x 5: x, y, z, intensity, ring in
-the LIDAR_TOP frame), ``maps/*.png`` (an empty semantic-prior mask: the demo has no map) and ``gnnpmb-demo.json``
-(generator version and seed, the mark of a demo dataroot that may be regenerated in place).
+the LIDAR_TOP frame), ``samples/CAM_*/*.jpg`` (nuScenes' six cameras, ``demo_cameras``: their rows are written with
+the tables, the images rendered on first use by ``ensure_scene_images``), ``maps/*.png`` (an empty semantic-prior
+mask: the demo has no map) and ``gnnpmb-demo.json`` (generator version and seed, the mark of a demo dataroot that
+may be regenerated in place). Built with ``sweeps`` (``gnnpmb demo-data --sweeps``, or ``GNNPMB_DEMO_SWEEPS=1`` for
+the cached demo) it also holds nine LiDAR sweeps between keyframes in ``sweeps/LIDAR_TOP``, as nuScenes' 20 Hz
+LiDAR does; the keyframes, annotations and detections stay the same.
 """
 
 from __future__ import annotations
@@ -54,6 +58,7 @@ from pathlib import Path
 import numpy as np
 
 from gnnpmb.atomic import sweep_leftovers, temp_prefix
+from gnnpmb.data import demo_cameras
 from gnnpmb.data.demo_spec import SYNTHETIC_MARKER, Motion, ObjectSpec, SceneSpec, Segment
 from gnnpmb.data.demo_staged import (
     HOTSPOT_FRAMES,
@@ -71,7 +76,7 @@ from gnnpmb.errors import DataError
 DEMO_VERSION = "v1.0-mini"
 DEMO_SCENES: tuple[str, ...] = ("scene-0103", "scene-0916")
 DEMO_SEED = 0
-GENERATOR_VERSION = 3
+GENERATOR_VERSION = 4
 """Bump when the generated data changes, so cached copies (``demo-v<N>``) are regenerated."""
 """Every demo scene description starts with this."""
 MARKER_FILE = "gnnpmb-demo.json"
@@ -380,9 +385,10 @@ class Trajectories:
     ego_yaw: np.ndarray
 
 
-def scene_trajectories(spec: SceneSpec) -> Trajectories:
-    """Integrate every object's and the ego's motion at the keyframe times and place them in the global frame."""
-    times = keyframe_times_s()
+def scene_trajectories(spec: SceneSpec, times_s: np.ndarray | None = None) -> Trajectories:
+    """Integrate every object's and the ego's motion at the keyframe times (or at ``times_s`` since the scene
+    start, multiples of 10 ms) and place them in the global frame."""
+    times = keyframe_times_s() if times_s is None else times_s
     xy, yaw, speed = [], [], []
     for obj in spec.objects:
         pos, heading, v = integrate_motion(obj.motion, times)
@@ -522,8 +528,16 @@ def _link(rows: list[dict]) -> None:
         row["next"] = rows[i + 1]["token"] if i + 1 < len(rows) else ""
 
 
-def _write_scene(spec: SceneSpec, tables: dict[str, list[dict]], dataroot: Path, rng: np.random.Generator) -> None:
-    """Simulate one scene: its log, samples, LiDAR sweeps and annotations."""
+def _write_scene(
+    spec: SceneSpec,
+    tables: dict[str, list[dict]],
+    dataroot: Path,
+    rng: np.random.Generator,
+    sweep_rng: np.random.Generator | None = None,
+) -> None:
+    """Simulate one scene: its log, samples, LiDAR keyframe sweeps and annotations; with ``sweep_rng`` also the
+    LiDAR sweeps between keyframes (``_intermediate_sweeps``, their noise from that generator, so the keyframes
+    stay the same)."""
     traj = scene_trajectories(spec)
     times_us = spec.start_us + np.arange(KEYFRAMES_PER_SCENE) * KEYFRAME_INTERVAL_US
     log_name = f"gnnpmb-demo-{spec.name}"
@@ -600,11 +614,17 @@ def _write_scene(spec: SceneSpec, tables: dict[str, list[dict]], dataroot: Path,
             }
         )
     _link(samples)
+    if sweep_rng is not None:
+        sweeps = sorted(
+            sweeps + _intermediate_sweeps(spec, tables, dataroot, sweep_rng, samples, calib_token),
+            key=lambda r: r["timestamp"],
+        )
     _link(sweeps)
     for row in samples:
         tables["sample"].append(row)
     for row in sweeps:
         tables["sample_data"].append(row)
+    _camera_rows(spec, tables, samples)
     tables["scene"].append(
         {
             "token": token("scene", spec.name),
@@ -655,6 +675,150 @@ def _write_scene(spec: SceneSpec, tables: dict[str, list[dict]], dataroot: Path,
         )
 
 
+SWEEPS_PER_INTERVAL = 9
+"""LiDAR sweeps between two keyframes when the demo is built with sweeps (nuScenes: a 20 Hz LiDAR, 2 Hz
+keyframes)."""
+SWEEPS_ENV = "GNNPMB_DEMO_SWEEPS"
+"""Set to 1 to give the cached demo the sweeps between keyframes (a separate cache folder)."""
+
+
+def _intermediate_sweeps(
+    spec: SceneSpec,
+    tables: dict[str, list[dict]],
+    dataroot: Path,
+    rng: np.random.Generator,
+    samples: list[dict],
+    calib_token: str,
+) -> list[dict]:
+    """The non-keyframe LIDAR_TOP sweeps between consecutive keyframes (``SWEEPS_PER_INTERVAL`` each, evenly
+    spaced), each with its ego pose; a sweep belongs to the next keyframe's sample, as in nuScenes."""
+    step_s = KEYFRAME_INTERVAL_US * 1e-6 / (SWEEPS_PER_INTERVAL + 1)
+    offsets = np.arange(1, SWEEPS_PER_INTERVAL + 1) * step_s
+    times_s = (keyframe_times_s()[:-1, None] + offsets[None]).reshape(-1)
+    traj = scene_trajectories(spec, times_s)
+    sizes = np.array([o.size_wlh_m for o in spec.objects], dtype=float)
+    intensity = np.array([o.intensity for o in spec.objects])
+    centres = np.concatenate([traj.xy, np.broadcast_to(0.5 * sizes[:, None, 2:], traj.xy.shape[:2] + (1,))], axis=2)
+    calib_t, calib_r = np.array(LIDAR_TRANSLATION_M), _yaw_matrix(LIDAR_YAW_RAD)
+    reach = LIDAR.max_range_m + 0.5 * np.linalg.norm(sizes, axis=1) + np.linalg.norm(calib_t[:2])
+    log_name = f"gnnpmb-demo-{spec.name}"
+    rows = []
+    for j, t_s in enumerate(times_s):
+        ego_t = np.array([traj.ego_xy[j, 0], traj.ego_xy[j, 1], 0.0])
+        ego_r = _yaw_matrix(float(traj.ego_yaw[j]))
+        cast = np.flatnonzero(np.linalg.norm(traj.xy[:, j] - traj.ego_xy[j], axis=1) <= reach)
+        boxes = SceneBoxes(
+            centre_m=centres[cast, j], size_wlh_m=sizes[cast], yaw_rad=traj.yaw[cast, j], intensity=intensity[cast]
+        )
+        scan = cast_scan(LIDAR, ego_t + ego_r @ calib_t, ego_r @ calib_r, boxes, rng)
+        timestamp = spec.start_us + int(round(t_s * 1e6))
+        filename = f"sweeps/LIDAR_TOP/{log_name}__LIDAR_TOP__{timestamp}.pcd.bin"
+        (dataroot / filename).write_bytes(scan.points.astype("<f4").tobytes())
+        pose_token = token("ego_pose", spec.name, "LIDAR_TOP", "sweep", j)
+        tables["ego_pose"].append(
+            {
+                "token": pose_token,
+                "timestamp": timestamp,
+                "rotation": _yaw_quat_wxyz(float(traj.ego_yaw[j])),
+                "translation": [float(ego_t[0]), float(ego_t[1]), 0.0],
+            },
+        )
+        rows.append(
+            {
+                "token": token("sample_data", spec.name, "LIDAR_TOP", "sweep", j),
+                "sample_token": samples[j // SWEEPS_PER_INTERVAL + 1]["token"],
+                "ego_pose_token": pose_token,
+                "calibrated_sensor_token": calib_token,
+                "timestamp": timestamp,
+                "fileformat": "pcd",
+                "is_key_frame": False,
+                "height": 0,
+                "width": 0,
+                "filename": filename,
+            }
+        )
+    return rows
+
+
+def _camera_rows(spec: SceneSpec, tables: dict[str, list[dict]], samples: list[dict]) -> None:
+    """Each camera's calibration and, per keyframe, its keyframe ``sample_data`` row taken at the LiDAR time with
+    its own ``ego_pose`` row (the keyframe's pose); the images themselves are rendered on first use
+    (``ensure_scene_images``)."""
+    log_name = f"gnnpmb-demo-{spec.name}"
+    keyframe_poses = {token("ego_pose", spec.name, k) for k in range(len(samples))}
+    lidar_poses = {row["timestamp"]: row for row in tables["ego_pose"] if row["token"] in keyframe_poses}
+    for cam in demo_cameras.CAMERAS:
+        calib_token = token("calibrated_sensor", spec.name, cam.channel)
+        tables["calibrated_sensor"].append(
+            {
+                "token": calib_token,
+                "sensor_token": token("sensor", cam.channel),
+                "translation": list(cam.translation_m),
+                "rotation": list(cam.quat_wxyz),
+                "camera_intrinsic": [list(r) for r in cam.intrinsic],
+            },
+        )
+        rows = []
+        for k, sample in enumerate(samples):
+            timestamp = sample["timestamp"]
+            pose_token = token("ego_pose", spec.name, cam.channel, k)
+            tables["ego_pose"].append({**lidar_poses[timestamp], "token": pose_token})
+            rows.append(
+                {
+                    "token": token("sample_data", spec.name, cam.channel, k),
+                    "sample_token": sample["token"],
+                    "ego_pose_token": pose_token,
+                    "calibrated_sensor_token": calib_token,
+                    "timestamp": timestamp,
+                    "fileformat": "jpg",
+                    "is_key_frame": True,
+                    "height": demo_cameras.IMAGE_HEIGHT_PX,
+                    "width": demo_cameras.IMAGE_WIDTH_PX,
+                    "filename": demo_cameras.image_filename(log_name, cam.channel, timestamp),
+                }
+            )
+        _link(rows)
+        tables["sample_data"].extend(rows)
+
+
+def _road_left_m(spec: SceneSpec) -> float:
+    """The road's left edge (road d, metres): wider when vehicles drive in a second oncoming lane."""
+    wide = any(
+        o.category.startswith("vehicle.") and o.motion.speed_mps > 0 and o.motion.d_m >= 5.0 for o in spec.objects
+    )
+    return demo_cameras.WIDE_ROAD_LEFT_M if wide else demo_cameras.ROAD_HALF_WIDTH_M
+
+
+def ensure_scene_images(dataroot: Path, scene_name: str, frames: range | None = None) -> int:
+    """Render the missing camera images of demo scene ``scene_name`` at the keyframes ``frames`` (default: all)
+    into ``dataroot`` (a demo dataroot of the current generator version); the number written. Each keyframe shows
+    every object of the scene (annotated or not) at its keyframe pose."""
+    spec = scene_spec(scene_name)
+    traj = scene_trajectories(spec)
+    times_us = spec.start_us + np.arange(KEYFRAMES_PER_SCENE) * KEYFRAME_INTERVAL_US
+    ego_s = integrate_motion(spec.ego, keyframe_times_s())[0][:, 0]
+    sizes = np.array([o.size_wlh_m for o in spec.objects], dtype=float).reshape(-1, 3)
+    rgb = demo_cameras.category_rgb([o.category for o in spec.objects])
+    log_name = f"gnnpmb-demo-{spec.name}"
+    jobs = []
+    for k in frames if frames is not None else range(KEYFRAMES_PER_SCENE):
+        centres = np.column_stack([traj.xy[:, k], 0.5 * sizes[:, 2]]) if len(sizes) else np.zeros((0, 3))
+        view = demo_cameras.WorldView(
+            road_origin_m=spec.road_origin_m,
+            road_heading_rad=spec.road_heading_rad,
+            road_left_m=_road_left_m(spec),
+            ego_s_m=float(ego_s[k]),
+            centre_m=centres,
+            size_wlh_m=sizes,
+            yaw_rad=traj.yaw[:, k] if len(sizes) else np.zeros(0),
+            rgb=rgb,
+        )
+        for cam in demo_cameras.CAMERAS:
+            pose = demo_cameras.CameraPose.of(cam, traj.ego_xy[k], float(traj.ego_yaw[k]))
+            jobs.append((demo_cameras.image_filename(log_name, cam.channel, int(times_us[k])), view, pose))
+    return demo_cameras.render_views(dataroot, jobs)
+
+
 def _empty_mask_png() -> bytes:
     """A small all-background semantic-prior mask (8-bit grey PNG), so the devkit's map table resolves."""
     from PIL import Image
@@ -671,11 +835,14 @@ def _scene_seeds(seed: int, names: tuple[str, ...]) -> list[np.random.SeedSequen
     return [val[n] if n in val else np.random.SeedSequence([seed, layout[n]]) for n in names]
 
 
-def _write_dataset(dataroot: Path, seed: int, names: tuple[str, ...]) -> None:
-    """Write the demo scenes ``names`` into the (empty) folder ``dataroot``."""
+def _write_dataset(dataroot: Path, seed: int, names: tuple[str, ...], sweeps: bool = False) -> None:
+    """Write the demo scenes ``names`` into the (empty) folder ``dataroot`` (with the LiDAR sweeps between
+    keyframes when ``sweeps``)."""
     specs = [scene_spec(n) for n in names]
     (dataroot / DEMO_VERSION).mkdir(parents=True)
     (dataroot / "samples" / "LIDAR_TOP").mkdir(parents=True)
+    if sweeps:
+        (dataroot / "sweeps" / "LIDAR_TOP").mkdir(parents=True)
     (dataroot / "maps").mkdir()
     tables: dict[str, list[dict]] = {name: [] for name in TABLE_NAMES}
     for name, description in CATEGORIES:
@@ -692,8 +859,11 @@ def _write_dataset(dataroot: Path, seed: int, names: tuple[str, ...]) -> None:
             },
         )
     tables["sensor"].append({"token": token("sensor", "LIDAR_TOP"), "channel": "LIDAR_TOP", "modality": "lidar"})
+    for cam in demo_cameras.CAMERAS:
+        tables["sensor"].append({"token": token("sensor", cam.channel), "channel": cam.channel, "modality": "camera"})
     for spec, scene_seed in zip(specs, _scene_seeds(seed, names), strict=True):
-        _write_scene(spec, tables, dataroot, np.random.default_rng(scene_seed))
+        sweep_rng = np.random.default_rng(scene_seed.spawn(1)[0]) if sweeps else None
+        _write_scene(spec, tables, dataroot, np.random.default_rng(scene_seed), sweep_rng)
 
     mask = _empty_mask_png()
     for location in sorted({s.location for s in specs}):
@@ -715,13 +885,16 @@ def _write_dataset(dataroot: Path, seed: int, names: tuple[str, ...]) -> None:
         "generator_version": GENERATOR_VERSION,
         "seed": seed,
         "scenes": list(names),
+        **({"sweeps": SWEEPS_PER_INTERVAL} if sweeps else {}),
     }
     (dataroot / MARKER_FILE).write_text(json.dumps(marker, indent=1) + "\n", encoding="utf-8")
 
 
-def is_demo_dataroot(path: Path, seed: int | None = None, scenes: tuple[str, ...] = ()) -> bool:
+def is_demo_dataroot(
+    path: Path, seed: int | None = None, scenes: tuple[str, ...] = (), sweeps: bool | None = None
+) -> bool:
     """Whether ``path`` holds a complete demo of the current generator version (and of ``seed`` if given, with at
-    least the scenes ``scenes``)."""
+    least the scenes ``scenes``, with or without the sweeps between keyframes as ``sweeps`` says if given)."""
     try:
         marker = json.loads((path / MARKER_FILE).read_text(encoding="utf-8"))
     except (OSError, ValueError):
@@ -729,6 +902,8 @@ def is_demo_dataroot(path: Path, seed: int | None = None, scenes: tuple[str, ...
     if not isinstance(marker, dict) or marker.get("generator_version") != GENERATOR_VERSION:
         return False
     if not set(scenes) <= set(marker.get("scenes", ())):
+        return False
+    if sweeps is not None and bool(marker.get("sweeps")) != sweeps:
         return False
     return seed is None or marker.get("seed") == seed
 
@@ -746,10 +921,15 @@ def check_demo_scenes(names: tuple[str, ...]) -> tuple[str, ...]:
 
 
 def generate_demo_dataset(
-    out_dir: Path, seed: int = DEMO_SEED, scenes: tuple[str, ...] = DEMO_SCENES + STAGED_SCENES
+    out_dir: Path,
+    seed: int = DEMO_SEED,
+    scenes: tuple[str, ...] = DEMO_SCENES + STAGED_SCENES,
+    *,
+    sweeps: bool = False,
 ) -> Path:
     """Write the demo scenes ``scenes`` (default: the two mini_val ones and the staged one) into ``out_dir`` (the
-    dataroot) and return it.
+    dataroot) and return it; ``sweeps``: also the LiDAR sweeps between keyframes (``SWEEPS_PER_INTERVAL`` per
+    interval, ``sweeps/LIDAR_TOP``; the build then takes about ten times as long).
 
     The data is built in a sibling temp folder and renamed into place, so a reader never sees half a dataset.
     ``out_dir`` may be missing, empty or an earlier demo; anything else is refused with a ``DataError``.
@@ -767,7 +947,7 @@ def generate_demo_dataset(
     sweep_leftovers(out_dir.parent)  # builds of killed runs
     build = Path(tempfile.mkdtemp(prefix=temp_prefix(out_dir, "build"), dir=out_dir.parent))
     try:
-        _write_dataset(build / "data", seed, check_demo_scenes(tuple(scenes)))
+        _write_dataset(build / "data", seed, check_demo_scenes(tuple(scenes)), sweeps)
         if out_dir.exists():
             old = Path(tempfile.mkdtemp(prefix=temp_prefix(out_dir, "old"), dir=out_dir.parent))
             os.replace(out_dir, old / "data")
@@ -793,8 +973,16 @@ def cache_root() -> Path:
 def demo_cache_dir(full: bool = False) -> Path:
     """Where ``ensure_demo_dataset`` keeps the demo: a ``demo-v<GENERATOR_VERSION>`` subfolder of ``cache_root``
     (the two mini_val scenes and the staged one) or ``demo-v<GENERATOR_VERSION>-all`` (with the eight mini_train
-    scenes, when ``full``)."""
-    return cache_root() / f"demo-v{GENERATOR_VERSION}{'-all' if full else ''}"
+    scenes, when ``full``); ``-sweeps`` is appended when ``$GNNPMB_DEMO_SWEEPS`` is 1 (``demo_sweeps``)."""
+    return cache_root() / f"demo-v{GENERATOR_VERSION}{'-all' if full else ''}{'-sweeps' if demo_sweeps() else ''}"
+
+
+def demo_sweeps() -> bool:
+    """Whether the cached demo has the LiDAR sweeps between keyframes: ``$GNNPMB_DEMO_SWEEPS`` set to 1."""
+    value = os.environ.get(SWEEPS_ENV, "").strip()
+    if value not in ("", "0", "1"):
+        raise DataError(f"{SWEEPS_ENV}={value!r} is not valid; set it to 1 (demo with LiDAR sweeps) or 0")
+    return value == "1"
 
 
 TRAIN_NEEDS = ("mini_train", "train")
@@ -812,15 +1000,17 @@ def demo_layout(needs: tuple[str, ...] = ()) -> tuple[Path, tuple[str, ...]]:
 
 def ensure_demo_dataset(needs: tuple[str, ...] = (), *, rebuild: bool = False) -> Path:
     """The dataroot of the cached demo (seed ``DEMO_SEED``) for ``needs`` (``demo_layout``), generated on first
-    use, so the default val demo stays quick to build; ``rebuild`` generates it again (a damaged cache)."""
+    use, so the default val demo stays quick to build; ``rebuild`` generates it again (a damaged cache). With
+    ``$GNNPMB_DEMO_SWEEPS=1`` the demo (in its own folder) also holds the LiDAR sweeps between keyframes."""
     dataroot, scenes = demo_layout(needs)
+    sweeps = demo_sweeps()
     sweep_leftovers(dataroot.parent)  # builds of killed runs
-    if not rebuild and is_demo_dataroot(dataroot, DEMO_SEED, scenes):
+    if not rebuild and is_demo_dataroot(dataroot, DEMO_SEED, scenes, sweeps):
         return dataroot
     try:
-        return generate_demo_dataset(dataroot, DEMO_SEED, scenes)
+        return generate_demo_dataset(dataroot, DEMO_SEED, scenes, sweeps=sweeps)
     except OSError as exc:
-        if is_demo_dataroot(dataroot, DEMO_SEED, scenes):
+        if is_demo_dataroot(dataroot, DEMO_SEED, scenes, sweeps):
             return dataroot
         raise DataError(
             f"cannot create the demo dataset in {dataroot}: {exc.strerror or exc}; set {CACHE_ENV} to a writable folder"

@@ -38,6 +38,7 @@ if TYPE_CHECKING:
     from nuscenes.nuscenes import NuScenes
 
     from gnnpmb.data.dataset_index import DatasetIndex, SceneSlice
+    from gnnpmb.data.sensors import LidarSweep
 
 DATAROOT_ENV = "NUSCENES_DATAROOT"
 LIDAR_CHANNEL = "LIDAR_TOP"
@@ -336,8 +337,9 @@ def _demo_hotspots(scene_name: str) -> tuple[ClutterHotspot, ...]:
     return tuple(h for h in CLUTTER_HOTSPOTS if h.scene_name == scene_name)
 
 
-def load_lidar_points(keyframe: Keyframe) -> np.ndarray:
-    """(N, 4) float32 x, y, z, intensity of the keyframe's LIDAR_TOP sweep, in the sensor frame.
+def load_lidar_points(keyframe: Keyframe | LidarSweep) -> np.ndarray:
+    """(N, 4) float32 x, y, z, intensity of the keyframe's LIDAR_TOP sweep (or of a sweep between keyframes), in
+    the sensor frame.
 
     Read as the devkit's ``LidarPointCloud.from_file`` reads it (float32 x 5 per point, the ring index dropped),
     without importing the devkit: ``nuscenes.utils`` pulls in scikit-learn and matplotlib, over a second of a warm

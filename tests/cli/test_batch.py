@@ -145,8 +145,8 @@ def _numbered(kinds: list[str]) -> list[tuple[str, int]]:
 def test_demo_data_calls_the_generator(monkeypatch, tmp_path: Path, capsys) -> None:
     calls = []
 
-    def fake(out: Path, seed: int, scenes: tuple[str, ...]) -> Path:
-        calls.append((out, seed, scenes))
+    def fake(out: Path, seed: int, scenes: tuple[str, ...], sweeps: bool = False) -> Path:
+        calls.append((out, seed, scenes) + (("sweeps",) if sweeps else ()))
         return out
 
     monkeypatch.setattr("gnnpmb.data.demo.generate_demo_dataset", fake)
@@ -155,6 +155,9 @@ def test_demo_data_calls_the_generator(monkeypatch, tmp_path: Path, capsys) -> N
     assert out == f"demo dataset (v1.0-mini, seed 7, 3 scenes) -> {tmp_path / 'demo'}\n"
     code, out, _ = run(["demo-data", "--out", str(tmp_path / "d2"), "--scenes", "mini_train,scene-0103"], capsys)
     assert code == 0 and len(calls[-1][2]) == 9 and calls[-1][2][-1] == "scene-0103"
+    code, out, _ = run(["demo-data", "--out", str(tmp_path / "d3"), "--scenes", "scene-0103", "--sweeps"], capsys)
+    assert code == 0 and calls[-1] == (tmp_path / "d3", 0, ("scene-0103",), "sweeps")
+    assert out == f"demo dataset (v1.0-mini, seed 0, 1 scenes, with sweeps) -> {tmp_path / 'd3'}\n"
 
 
 def test_demo_data_refuses_an_unknown_scene(tmp_path: Path, capsys) -> None:

@@ -6,6 +6,7 @@ import pytest
 import rerun.blueprint as rrb
 from rerun.chunk import RrdReader
 
+from gnnpmb.data.sensors import CAMERA_ORDER
 from viz import compare, paths
 from viz.blueprint import EYE_POSITION_M, EYE_TARGET_M, default_blueprint, failures_root
 from viz.failures import failure_log
@@ -42,7 +43,8 @@ def test_a_birds_eye_and_a_perspective_view_per_tracker_showing_only_its_own_tra
     assert [v.name for v in spatial] == ["gnnpmb bird's-eye", "gnnpmb 3D", "pmbm bird's-eye", "pmbm 3D"]
     for v, name in zip(spatial, ["gnnpmb", "gnnpmb", "pmbm", "pmbm"], strict=True):
         assert v.origin == paths.EGO  # the camera follows the ego vehicle
-        assert v.contents == ["+ world/**", "- world/trackers/**", f"+ world/trackers/{name}/**"]
+        assert v.contents[:3] == ["+ world/**", "- world/trackers/**", f"+ world/trackers/{name}/**"]
+        assert v.contents[3:] == [f"- world/ego_vehicle/{c}/**" for c in CAMERA_ORDER]  # the camera views show them
 
 
 def hidden(view: rrb.Spatial3DView) -> set[str]:
@@ -52,7 +54,12 @@ def hidden(view: rrb.Spatial3DView) -> set[str]:
 
 def test_birds_eye_hides_lidar_candidates_and_suppressed_detections_by_default() -> None:
     bev, persp = [v for v in views(default_blueprint(["gnnpmb"], ["car"])) if isinstance(v, rrb.Spatial3DView)]
-    assert hidden(bev) == {paths.LIDAR, "world/trackers/gnnpmb/candidates", paths.DETECTIONS_SUPPRESSED}
+    assert hidden(bev) == {
+        paths.LIDAR,
+        paths.SWEEP_LIDAR,
+        "world/trackers/gnnpmb/candidates",
+        paths.DETECTIONS_SUPPRESSED,
+    }
     assert hidden(persp) == {"world/trackers/gnnpmb/candidates", paths.DETECTIONS_SUPPRESSED}
 
 

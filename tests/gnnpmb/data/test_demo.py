@@ -312,7 +312,7 @@ def test_ensure_demo_dataset_generates_once_into_the_cache(
 
     (expected / demo.MARKER_FILE).unlink()  # an incomplete or foreign-looking cache is rebuilt
     calls: list[Path] = []
-    monkeypatch.setattr(demo, "generate_demo_dataset", lambda out, seed, scenes: calls.append(out) or out)
+    monkeypatch.setattr(demo, "generate_demo_dataset", lambda out, seed, scenes, sweeps=False: calls.append(out) or out)
     ensure_demo_dataset()
     assert calls == [expected]
     ensure_demo_dataset(("mini_val", "scene-0103"))  # val needs alone never build the train scenes
