@@ -464,7 +464,11 @@ def _check(c: Claim, f: Finding, src: Sources) -> str:  # noqa: C901 (one branch
                 return "cost differs"
             if v[5] is not None:
                 k = next(k for k, col in enumerate(m.cols) if col.kind.value == v[5] and col.ref == v[6])
-                others = np.delete(np.asarray(m.cost[i], dtype=float), j)
+                row = np.asarray(m.cost[i], dtype=float).copy()
+                if not m.scale.optimal:  # a greedy matcher's alternative is a column no other detection took
+                    taken = {(col.kind, col.ref) for r, col in a.pairs if r.ref != v[1]}
+                    row[[n for n, col in enumerate(m.cols) if (col.kind, col.ref) in taken]] = np.inf
+                others = np.delete(row, j)
                 if abs(float(m.cost[i, k]) - v[7]) > ATOL or float(m.cost[i, k]) > others.min() + ATOL:
                     return "the alternative is not the row's next cheapest"
             return ""

@@ -164,8 +164,10 @@ def test_greedy_close_calls_are_in_metres_on_its_own_scale() -> None:
     teller.frame_lines(0)
     calls = [line for line in teller.frame_lines(1) if line.kind is StoryKind.CLOSE_CALL]
     assert calls == []  # m0: 0.5 m against 1.1 m; m1: 0.4 m against 2.0 m (new)
-    near = np.array([[0.5, 0.7, 2.0, np.inf], [3.0, 0.4, np.inf, 2.0]])
+    # m0's runner-up is a free track 0.2 m farther (m1 started a new track); a taken column is no alternative
+    near = np.array([[0.5, 0.7, 2.0, np.inf], [3.0, 3.0, np.inf, 2.0]])
     events[7] = CostMatrix("car", near, rows, cols, scale=metres)
+    events[8] = Assignment("car", ((rows[0], cols[0]), (rows[1], cols[3])), 0.9, ())
     teller = Storyteller(facts_of(events))
     teller.frame_lines(0)
     (call,) = [line for line in teller.frame_lines(1) if line.kind is StoryKind.CLOSE_CALL]
