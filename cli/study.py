@@ -160,20 +160,22 @@ def register(app: typer.Typer) -> None:
         run = execution(workers, address, verbose)
         location = resolve_dataroot(dataroot, version, (split,) if split else ())
         data = resolve_study_data(location, split or default_split(location.version), detections, preset, seed)
-        hold_study_folder(folder, lambda line: typer.echo(line, err=True))  # one sweep at a time per folder
-        plan, note = merge_study(plan_sweep(tracker, data, base, swept, one_at_a_time), read_study(folder), out, params)
-        if note is not None:
-            typer.echo(note, err=True)
-        n = len(plan.assignments)
+        plan = plan_sweep(tracker, data, base, swept, one_at_a_time)
         rows_seen: list[dict[str, Any]] = []
-        with session(run), study_progress(progress, n, "configurations") as bar:  # the bar once Ray is up
+        with session(run):  # Ray is up (or one error line) before the folder is touched
+            hold_study_folder(folder, lambda line: typer.echo(line, err=True))  # one sweep at a time per folder
+            plan, note = merge_study(plan, read_study(folder), out, params)
+            if note is not None:
+                typer.echo(note, err=True)
+            n = len(plan.assignments)
+            with study_progress(progress, n, "configurations") as bar:  # the bar once Ray is up
 
-            def on_row(row: dict[str, Any], from_cache: bool) -> None:
-                rows_seen.append(row)
-                task = bar.task_ids[0]
-                bar.update(task, advance=1, description=best_label("configurations", best_amota(rows_seen)))
+                def on_row(row: dict[str, Any], from_cache: bool) -> None:
+                    rows_seen.append(row)
+                    task = bar.task_ids[0]
+                    bar.update(task, advance=1, description=best_label("configurations", best_amota(rows_seen)))
 
-            outcome = run_sweep(plan, ResultCache(folder / CACHE_FOLDER), run, on_row)
+                outcome = run_sweep(plan, ResultCache(folder / CACHE_FOLDER), run, on_row)
         meta = {
             **identity(plan, params),
             "keys": list(plan.keys),

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from gnnpmb.stages.evaluation import find_reports
@@ -26,3 +27,8 @@ def evidence_of_all(inputs: Inputs) -> tuple[dict, list[str], list[Run]]:
     runs = run_all(inputs, record=True)
     reports, notices = find_reports(inputs, runs)
     return all_evidence(inputs, runs, reports), notices, runs
+
+
+POSITION_ONLY = Path(__file__).resolve().parents[1] / "gnnpmb" / "params" / "position_only.toml"
+"""The PMB family's model set before issue 32: the tests that open a GNN-PMB ID switch on the demo pin it (the
+defaults make none on scene-0103)."""

@@ -21,7 +21,7 @@ from gnnpmb.stages.runs import run_all
 from gnnpmb.why.facts import Ending
 from gnnpmb.why.findings import Party, Rule
 from gnnpmb.why.words import column_name, whose_text, why_lines
-from tests.pipeline import evidence_of_all, prepare
+from tests.pipeline import POSITION_ONLY, evidence_of_all, prepare
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
@@ -32,13 +32,13 @@ from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_
 
 SCENE = "scene-0103"
 SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
-ARGS = ["--detector", "pointpillars"]
+ARGS = ["--detector", "pointpillars", "--params", str(POSITION_ONLY)]
 
 
 @pytest.fixture(scope="module")
 def failures_and_runs(demo_dataroot: Path):
     """The first tracker's failures on the scene (the ids ``gnnpmb failures`` prints) and the runs."""
-    request = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars")
+    request = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars", params=POSITION_ONLY)
     runs = run_all(request, record=False)
     reports, _ = find_reports(request, runs)
     return reports["gnnpmb"], [run.tracking for run in runs]
@@ -222,7 +222,7 @@ def test_the_summary_opens_with_the_decisions_that_made_the_switch(
 
 def findings_of(demo_dataroot: Path, trackers: tuple[str, ...], detector: str = "pointpillars") -> dict:
     """Per tracker, failure id -> its ``Finding`` (the data every sentence of the focus document is made from)."""
-    request = prepare(SCENE, list(trackers), dataroot=demo_dataroot, detector=detector)
+    request = prepare(SCENE, list(trackers), dataroot=demo_dataroot, detector=detector, params=POSITION_ONLY)
     evidence, _, _ = evidence_of_all(request)
     found = explain_all(request, evidence)
     return {t: dict(zip(evidence[t].report.ids(), fs, strict=True)) for t, fs in found.items()}
@@ -232,7 +232,7 @@ def test_a_failure_at_an_interpolated_gt_box_is_explained(
     demo_dataroot: Path, tmp_path: Path, failures_and_runs
 ) -> None:
     report, _ = failures_and_runs
-    scene = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars").scene
+    scene = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars", params=POSITION_ONLY).scene
     # The devkit's boxes are flagged interpolated exactly where the annotated object has no points.
     for f in report.failures:
         for b in (b for b in f.boxes if b.is_gt):

@@ -84,7 +84,11 @@ CASES_BEFORE_DATA: tuple[Case, ...] = (
     _case("viz save folder", f"{VIZ} scene-0103 --save {{w}}/dir.rrd", "is a folder"),
     _case("viz save missing folder", f"{VIZ} scene-0103 --save {{w}}/no/x.rrd", "does not exist"),
     # gnnpmb
-    _case("batch no command", "gnnpmb", "missing a command (track, eval, failures, demo-data, sweep, tune, diff)"),
+    _case(
+        "batch no command",
+        "gnnpmb",
+        "missing a command (track, eval, failures, demo-data, sweep, tune, diff, calibrate)",
+    ),
     _case("batch unknown command", "gnnpmb trak", "no such command 'trak'"),
     _case("batch old --version V", "gnnpmb track --version v1.0-mini", "--nuscenes-version"),
     _case("track no out", "gnnpmb track", "missing option '--out'"),

@@ -12,7 +12,7 @@ import pytest
 from rerun.chunk import RrdReader
 
 from cli.app import main
-from tests.pipeline import prepare, reports_of
+from tests.pipeline import POSITION_ONLY, prepare, reports_of
 from tests.viz.rrd import at_frame, read_rows
 from tests.viz.test_blueprint import stored_views
 from tools.labels import Recording, overlaps, screen_boxes, view_size_px
@@ -28,9 +28,10 @@ def recorded(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> t
     """GNN-PMB beside JPDA on the pointpillars preset (ID switches and an identity theft), its rows and reports."""
     out = tmp_path_factory.mktemp("full") / "full.rrd"
     argv = [SCENE, "-t", "gnnpmb", "-t", "jpda", "--detector", "pointpillars", "--dataroot", str(demo_dataroot)]
+    argv += ["--params", str(POSITION_ONLY)]  # the model set whose GNN-PMB switches IDs on this scene
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         main([*argv, "--save", str(out), "--no-progress"])
-    request = prepare(SCENE, ["gnnpmb", "jpda"], dataroot=demo_dataroot, detector="pointpillars")
+    request = prepare(SCENE, ["gnnpmb", "jpda"], dataroot=demo_dataroot, detector="pointpillars", params=POSITION_ONLY)
     reports, _ = reports_of(request)
     return out, read_rows(out), reports
 

@@ -275,7 +275,10 @@ def _hashes(root: Path) -> dict[str, str]:
 
 def test_same_seed_gives_byte_identical_files(demo_dataroot: Path, tmp_path: Path) -> None:
     again = generate_demo_dataset(tmp_path / "again", seed=DEMO_SEED)
-    assert _hashes(again) == _hashes(demo_dataroot)
+    ours, shared = _hashes(again), _hashes(demo_dataroot)
+    # camera images are rendered when a scene is first shown: the shared dataset may hold some the new one lacks
+    rendered = {k for k in shared.keys() - ours.keys() if k.startswith("samples/CAM_")}
+    assert {k: v for k, v in shared.items() if k not in rendered} == ours
     json.loads((again / demo.MARKER_FILE).read_text())
 
 

@@ -3,6 +3,8 @@ camera's view holds a point."""
 
 from __future__ import annotations
 
+import os
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -18,8 +20,11 @@ SCENE = "scene-0103"
 
 @pytest.fixture
 def scene(demo_dataroot: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> SceneData:
+    """The demo scene in a copy of the dataset (files linked) without the camera images other tests rendered."""
     monkeypatch.setenv("GNNPMB_CACHE_DIR", str(tmp_path / "cache"))
-    return load_scene(resolve_dataroot(demo_dataroot, None), SCENE)
+    copy = tmp_path / "demo"
+    shutil.copytree(demo_dataroot, copy, ignore=shutil.ignore_patterns("CAM_*"), copy_function=os.symlink)
+    return load_scene(resolve_dataroot(copy, None), SCENE)
 
 
 def test_each_keyframe_has_six_calibrated_images_and_only_asked_ones_are_rendered(scene: SceneData) -> None:
