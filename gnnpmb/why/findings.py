@@ -183,7 +183,11 @@ class LostTrack:
     """The track that had the object: ``held_until`` the last frame it was output within ``NEAR_M`` of it (None:
     never in the window); steps: its ``TrackStep`` per frame of the window; off: output away from the object at the
     failure's frame; evaluated: how the evaluation took it; shown_min: the existence from which the viewer shows a
-    track (for a track never shown that the evaluation still counted)."""
+    track (for a track never shown that the evaluation still counted); elsewhere: the frames of the window at which
+    it has no step of its own but a cost matrix of a hypothesis other than the chosen one had its column (PMBM: it
+    was held only by hypotheses the tracker did not choose, so it was not gone); finite_elsewhere: (frame,
+    detection) pairs its column could not take in the chosen hypothesis's matrix but another hypothesis's matrix
+    gave a finite cost (PMBM)."""
 
     track_id: int
     held_until: int | None
@@ -191,6 +195,8 @@ class LostTrack:
     off: OffObject | None
     evaluated: TrackEval | None
     threshold: float | None
+    elsewhere: tuple[int, ...] = ()
+    finite_elsewhere: tuple[tuple[int, int], ...] = ()
 
     def step(self, frame: int) -> TrackStep | None:
         return next((s for s in self.steps if s.frame == frame), None)

@@ -23,7 +23,7 @@ from gnnpmb.foreign import BoxOn
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.counterfactual import would_take
-from gnnpmb.why.facts import TrackerFacts, UseMode
+from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode
 from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
     FRAMES_BEFORE,
@@ -320,7 +320,32 @@ class _Context:
                     boxes = fr.detections.boxes
                     earlier += [(s.frame, m) for m in s.used if np.hypot(*(boxes.translation_m[m, :2] - at)) >= NEAR_M]
                 off = OffObject(gap, e.meas_index, tuple(earlier))
-        return LostTrack(track_id, held, in_window, off, self.report.track_evals.get(str(track_id)), self.threshold)
+        elsewhere = tuple(f for f in self.window if f not in steps and self.has_column(f, track_id))
+        evaluated = self.report.track_evals.get(str(track_id))
+        finite = self.finite_elsewhere(track_id, steps)
+        return LostTrack(track_id, held, in_window, off, evaluated, self.threshold, elsewhere, finite)
+
+    def finite_elsewhere(self, track_id: int, steps: Mapping[int, TrackStep]) -> tuple[tuple[int, int], ...]:
+        """(frame, detection) pairs of the window that track ``track_id`` could not take in its step's matrix (an
+        infinite cost) but another hypothesis's matrix gave a finite cost."""
+        out = []
+        for f in self.window:
+            cf, step = self.facts.frames.get(f, {}).get(self.class_name), steps.get(f)
+            if cf is None or step is None:
+                continue
+            for m in cf.costs.values():
+                cols = [k for k, c in enumerate(m.cols) if c.kind is AxisKind.TRACK and int(c.ref) == track_id]
+                for i, r in enumerate(m.rows) if cols else ():
+                    own = step.column_cost(int(r.ref))
+                    if own is not None and not math.isfinite(own) and math.isfinite(float(m.cost[i, cols[0]])):
+                        out.append((f, int(r.ref)))
+        return tuple(sorted(set(out)))
+
+    def has_column(self, frame: int, track_id: int) -> bool:
+        """Whether any cost matrix of ``frame`` (any hypothesis) has a column of track ``track_id``."""
+        cf = self.facts.frames.get(frame, {}).get(self.class_name)
+        matrices = cf.costs.values() if cf is not None else ()
+        return any(c.kind is AxisKind.TRACK and int(c.ref) == track_id for m in matrices for c in m.cols)
 
     def origin(self, track_id: int) -> Origin:
         """Where ``track_id`` came from: the detection that started it and when; its false frames before the

@@ -566,8 +566,15 @@ def _unused(f: Finding) -> list[tuple[tuple[int, int], str]]:
                     gate = f", in track {t}'s gate at NIS {nis:.1f}"
                 elif f.output_only and step is None:
                     gate = f"; track {t} was not output"
+                elif step is None and x in f.lost.elsewhere:  # held only by hypotheses not chosen
+                    gate = f"; track {t} was only in hypotheses the tracker did not choose"
                 elif step is None:  # no event of the frame names the track
                     gate = f"; track {t} was gone"
+                elif cost is not None and not math.isfinite(cost) and (x, n.meas) in f.lost.finite_elsewhere:
+                    gate = (
+                        f"; track {t} could not take it in the hypothesis the tracker chose (its column's cost there "
+                        f"was infinite, {step_test(step)}; another hypothesis gave it a finite cost)"
+                    )
                 elif cost is not None and not math.isfinite(cost):  # what stopped it, then its deletion
                     gate = f"; track {t} could not take it: its column's cost for it was infinite ({step_test(step)})"
                     if step.ended is not None:

@@ -17,7 +17,8 @@ from pathlib import Path
 
 from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
 
-DEVSET = Path("/work/shared/devset")
+DEVSET = Path(__file__).resolve().parents[3] / "shared" / "devset"
+"""The dev set beside the checkout (``../shared/devset``), as this project's machines and CI lay it out."""
 MINI_VAL = ("scene-0103", "scene-0916")
 PRESETS = ("centerpoint", "megvii", "pointpillars")
 
