@@ -12,9 +12,10 @@ from pathlib import Path
 
 import pytest
 
+from tools.truth import __main__ as truth_main
 from tools.truth.__main__ import run_cell
 
-DEVSET = Path(os.environ.get("GNNPMB_DEVSET", Path(__file__).resolve().parents[3] / "shared" / "devset"))
+DEVSET = Path(os.environ.get("GNNPMB_DEVSET", str(truth_main.DEVSET)))
 SQUARE = [  # (scene, preset, tracker): each tracker once per scene and per preset
     ("scene-0103", "centerpoint", "gnn"),
     ("scene-0103", "megvii", "ab3dmot"),
