@@ -63,9 +63,10 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
     from nuscenes.eval.common.config import config_factory
     from nuscenes.eval.common.data_classes import EvalBoxes
     from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes, load_gt_of_sample_tokens
-    from nuscenes.eval.tracking.algo import TrackingEvaluation
-    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetricData
+    from nuscenes.eval.tracking.data_classes import TrackingBox
     from nuscenes.eval.tracking.loaders import create_tracks
+
+    from gnnpmb.eval.nuscenes_eval import class_evaluation
 
     cfg = config_factory("tracking_nips_2019")
     scene = next(s for s in nusc.scene if s["name"] == scene_name)
@@ -92,17 +93,9 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
                 float(b.translation[1]),
             )
     for class_name in cfg.class_names:
-        ev = TrackingEvaluation(
-            tracks_gt,
-            tracks_pred,
-            class_name,
-            cfg.dist_fcn_callable,
-            cfg.dist_th_tp,
-            cfg.min_recall,
-            num_thresholds=TrackingMetricData.nelem,
-            metric_worst=cfg.metric_worst,
-            verbose=False,
-        )
+        ev = class_evaluation(
+            tracks_gt, tracks_pred, class_name, cfg
+        )  # the devkit's own object, as TrackingEval builds it
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             md = ev.accumulate()
         if np.all(np.isnan(md.mota)):
