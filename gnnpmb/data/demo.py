@@ -794,14 +794,24 @@ def ensure_scene_images(dataroot: Path, scene_name: str, frames: range | None = 
     into ``dataroot`` (a demo dataroot of the current generator version); the number written. Each keyframe shows
     every object of the scene (annotated or not) at its keyframe pose."""
     spec = scene_spec(scene_name)
-    traj = scene_trajectories(spec)
     times_us = spec.start_us + np.arange(KEYFRAMES_PER_SCENE) * KEYFRAME_INTERVAL_US
+    log_name = f"gnnpmb-demo-{spec.name}"
+    missing = [
+        k
+        for k in (frames if frames is not None else range(KEYFRAMES_PER_SCENE))
+        if not all(
+            (dataroot / demo_cameras.image_filename(log_name, cam.channel, int(times_us[k]))).is_file()
+            for cam in demo_cameras.CAMERAS
+        )
+    ]
+    if not missing:
+        return 0
+    traj = scene_trajectories(spec)
     ego_s = integrate_motion(spec.ego, keyframe_times_s())[0][:, 0]
     sizes = np.array([o.size_wlh_m for o in spec.objects], dtype=float).reshape(-1, 3)
     rgb = demo_cameras.category_rgb([o.category for o in spec.objects])
-    log_name = f"gnnpmb-demo-{spec.name}"
     jobs = []
-    for k in frames if frames is not None else range(KEYFRAMES_PER_SCENE):
+    for k in missing:
         centres = np.column_stack([traj.xy[:, k], 0.5 * sizes[:, 2]]) if len(sizes) else np.zeros((0, 3))
         view = demo_cameras.WorldView(
             road_origin_m=spec.road_origin_m,
