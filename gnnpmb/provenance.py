@@ -114,25 +114,35 @@ def boxes_sha256(detections: Mapping[str, Boxes], sample_tokens: Sequence[str]) 
     return digest.hexdigest()
 
 
-def _fixed(values: np.ndarray, decimals: int) -> list[str]:
-    rounded = np.round(np.asarray(values, dtype=np.float64), decimals) + 0.0  # -0.0 + 0.0 == +0.0
-    return [f"{v:.{decimals}f}" for v in rounded.tolist()]
+_DECIMALS = np.array([4] * 6 + [6] * 4 + [4] * 2 + [6] * 2)
+"""Decimals of the numbers of a line: x y z w l h, the quaternion, vx vy, score and existence."""
+
+
+def _lines(estimates: Sequence[TrackEstimate]) -> list[str]:
+    """The canonical text line of each estimate (see the module docstring), rounded in one pass per frame."""
+    values = np.array(
+        [[*e.translation_m, *e.size_wlh_m, *e.quat_wxyz, *e.velocity_mps, e.score, e.existence] for e in estimates],
+        dtype=np.float64,
+    ).reshape(-1, len(_DECIMALS))
+    rounded = np.where(_DECIMALS == 4, np.round(values, 4), np.round(values, 6)) + 0.0  # -0.0 + 0.0 == +0.0
+    return [
+        " ".join(
+            [str(e.track_id), e.class_name]
+            + [f"{v:.{d}f}" for v, d in zip(row, _DECIMALS.tolist(), strict=True)]
+            + [str(e.meas_index)]
+        )
+        for e, row in zip(estimates, rounded.tolist(), strict=True)
+    ]
 
 
 def estimate_line(e: TrackEstimate) -> str:
     """The canonical text line of one estimate (see the module docstring)."""
-    parts = [str(e.track_id), e.class_name]
-    parts += _fixed(np.array([*e.translation_m, *e.size_wlh_m]), 4)
-    parts += _fixed(np.array(e.quat_wxyz), 6)
-    parts += _fixed(np.array(e.velocity_mps), 4)
-    parts += _fixed(np.array([e.score, e.existence]), 6)
-    parts.append(str(e.meas_index))
-    return " ".join(parts)
+    return _lines([e])[0]
 
 
 def frame_digest(estimates: Sequence[TrackEstimate]) -> str:
     """SHA-256 (hex) of one frame's estimates: their lines sorted by track id, joined by newlines."""
-    lines = [estimate_line(e) for e in sorted(estimates, key=lambda e: (e.track_id, e.class_name))]
+    lines = _lines(sorted(estimates, key=lambda e: (e.track_id, e.class_name)))
     return hashlib.sha256("\n".join(lines).encode()).hexdigest()
 
 
