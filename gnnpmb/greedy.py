@@ -39,6 +39,7 @@ from gnnpmb.events import (
     EventSink,
     Pruned,
     PruneReason,
+    ScoreRule,
     axis_labels,
 )
 from gnnpmb.skeleton import ClassFilter, TrackView
@@ -54,11 +55,13 @@ column minus its chosen one, and a close call one under 0.3 m, about the detecto
 
 @dataclass(frozen=True, slots=True)
 class GreedyTracks(StructOfArrays):
-    """K live tracks: track_id (K,), center_xy (K, 2) m, velocity_mps (K, 2), misses (K,) consecutive misses."""
+    """K live tracks: track_id (K,), center_xy (K, 2) m, velocity_mps (K, 2), score (K,) the track's score (its
+    last detection's; CBMOT's refined score), misses (K,) consecutive misses."""
 
     track_id: np.ndarray
     center_xy: np.ndarray
     velocity_mps: np.ndarray
+    score: np.ndarray
     misses: np.ndarray
 
     @staticmethod
@@ -67,6 +70,7 @@ class GreedyTracks(StructOfArrays):
             track_id=np.zeros(0, dtype=np.int64),
             center_xy=np.zeros((0, 2)),
             velocity_mps=np.zeros((0, 2)),
+            score=np.zeros(0),
             misses=np.zeros(0, dtype=np.int64),
         )
 
@@ -125,16 +129,42 @@ class GreedyPrior:
 
 
 class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]]):
-    """One class's greedy closest-pair tracker (module docstring); the frame loop is ``skeleton.ClassFilter.step``."""
+    """One class's greedy closest-pair tracker (module docstring); the frame loop is ``skeleton.ClassFilter.step``.
+    CBMOT (``gnnpmb.cbmot``) is this tracker with another pairing order and refined scores: the hooks
+    ``pairs``, ``hit_scores``, ``missed_scores`` and ``deletions``."""
 
     has_existence = False  # a track lives until max_age misses
     has_gates = False  # a matching distance, no Gaussian gate
+    score_rule: ScoreRule | None = None
+    """How the track scores move, for a tracker whose output score is its tracks' (None: the detections')."""
 
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         super().__init__(class_name, config, ids)
-        self.max_distance_m = self.class_params.match_distance_m
+        self.max_distance_m = self.distance_threshold_m()
         self.max_age = config.greedy.max_age
+        self.description = COST_DESCRIPTION
+        self.scale = COST_SCALE
         self.tracks = GreedyTracks.empty()
+
+    def distance_threshold_m(self) -> float:
+        """d_class: the largest distance a pair may have."""
+        return self.class_params.match_distance_m
+
+    def pairs(self, dist: np.ndarray) -> np.ndarray:
+        """(P, 2) the matched (detection, track) index pairs of the (M, K) distances: closest pairs first."""
+        return greedy_pairs(dist)
+
+    def hit_scores(self, tracks: GreedyTracks, pairs: np.ndarray, det_score: np.ndarray) -> np.ndarray:
+        """(M,) the scores of the tracks the M detections continue or start: each detection's own."""
+        return det_score
+
+    def missed_scores(self, tracks: GreedyTracks) -> np.ndarray:
+        """(K,) the scores of the K tracks after a missed frame: kept."""
+        return tracks.score
+
+    def deletions(self, missed: GreedyTracks) -> list[PruneReason | None]:
+        """Why each missed track is deleted, or None where it lives on: ``max_age`` misses."""
+        return [PruneReason.TRACK_LOGIC if n >= self.max_age else None for n in missed.misses.tolist()]
 
     def predict(self, meas: Measurements, dt_s: float) -> GreedyPrior:
         """The distances D[j, k] = || (p_j - v_j dt) - t_k || (+inf above the threshold) and the coasted
@@ -148,12 +178,13 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
         return self._view(prior.tracks), None
 
     def update(self, prior: GreedyPrior, meas: Measurements, sink: EventSink) -> tuple[GreedyTracks, Measurements]:
-        """Closest pairs first (``greedy_pairs``): a matched track takes its detection's centre and velocity, an
-        unmatched detection starts a track, an unmatched track coasts and is deleted after ``max_age`` misses.
-        Returns the new tracks, whose first M are this frame's M detections in order, and those detections.
+        """The pairs (``pairs``): a matched track takes its detection's centre and velocity, an unmatched
+        detection starts a track, an unmatched track coasts and is deleted as ``deletions`` says. Returns the new
+        tracks, whose first M are this frame's M detections in order, and those detections.
         Events: ``CostMatrix``, ``Assignment``, ``Born``, ``Pruned``."""
         m, k = prior.dist.shape
-        pairs = greedy_pairs(prior.dist)
+        t = prior.tracks
+        pairs = self.pairs(prior.dist)
         track_of_meas = np.full(m, -1, dtype=np.int64)
         track_of_meas[pairs[:, 0]] = pairs[:, 1]
         matched = np.zeros(k, dtype=bool)
@@ -161,27 +192,31 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
         new_j = np.flatnonzero(track_of_meas < 0)
         new_ids = np.array([self.ids.allocate() for _ in new_j], dtype=np.int64)
         ids_of_meas = np.empty(m, dtype=np.int64)
-        ids_of_meas[pairs[:, 0]] = prior.tracks.track_id[pairs[:, 1]]
+        ids_of_meas[pairs[:, 0]] = t.track_id[pairs[:, 1]]
         ids_of_meas[new_j] = new_ids
-        t = prior.tracks
-        coasting = GreedyTracks(t.track_id, prior.coasted_xy, t.velocity_mps, t.misses + 1).subset(~matched)
-        deleted = coasting.misses >= self.max_age
+        score = self.hit_scores(t, pairs, np.asarray(meas.boxes.score, dtype=float))
         velocity = meas.boxes.velocity_mps
-        detected = GreedyTracks(ids_of_meas, meas.z.copy(), velocity.copy(), np.zeros(m, dtype=np.int64))
-        self.tracks = GreedyTracks.concatenate([detected, coasting.subset(~deleted)])
+        detected = GreedyTracks(ids_of_meas, meas.z.copy(), velocity.copy(), score, np.zeros(m, dtype=np.int64))
+        coasted = GreedyTracks(t.track_id, prior.coasted_xy, t.velocity_mps, self.missed_scores(t), t.misses + 1)
+        missed = coasted.subset(~matched)
+        reasons = self.deletions(missed)
+        self.tracks = GreedyTracks.concatenate(
+            [detected, missed.subset(np.array([r is None for r in reasons], dtype=bool))]
+        )
         if sink.enabled:
-            self._emit(prior, meas, track_of_meas, new_j, new_ids, coasting.track_id[deleted], sink)
+            self._emit(prior, meas, track_of_meas, (new_j, new_ids), missed, reasons, sink)
         return self.tracks, meas
 
     def extract(
         self, posterior: tuple[GreedyTracks, Measurements], sink: EventSink
     ) -> tuple[list[TrackEstimate], float]:
-        """Every detection with its own box and score, under its track's id (threshold 1: none is withheld)."""
+        """Every detection with its own box, under its track's id and with its track's score (threshold 1: none
+        is withheld)."""
         tracks, meas = posterior
         m = len(meas)
         det = DetectionFields.from_measurements(meas, np.arange(m))
         state = np.concatenate([tracks.center_xy[:m], tracks.velocity_mps[:m]], axis=1)
-        return det.to_estimates(self.class_name, tracks.track_id[:m], state, det.score, np.ones(m)), 1.0
+        return det.to_estimates(self.class_name, tracks.track_id[:m], state, tracks.score[:m], np.ones(m)), 1.0
 
     def posterior_view(self, posterior: tuple[GreedyTracks, Measurements]) -> TrackView:
         return self._view(posterior[0])
@@ -189,24 +224,28 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
     def _view(self, t: GreedyTracks) -> TrackView:
         """K tracks as events show them: state [x, y, vx, vy] (K, 4), existence 1, and covariance (K, 4, 4)
         diag(d^2, d^2, 1, 1): the greedy tracker has no covariance, so events carry the matching disc of radius
-        d = the class threshold (one standard deviation drawn = the disc) and unit velocity."""
+        d = the class threshold (one standard deviation drawn = the disc) and unit velocity; with a
+        ``score_rule``, the track scores."""
         d2 = self.max_distance_m**2
         cov = np.broadcast_to(np.diag([d2, d2, 1.0, 1.0]), (len(t), 4, 4)).copy()
-        return TrackView(t.track_id, np.concatenate([t.center_xy, t.velocity_mps], axis=1), cov, np.ones(len(t)))
+        mean = np.concatenate([t.center_xy, t.velocity_mps], axis=1)
+        if self.score_rule is None:
+            return TrackView(t.track_id, mean, cov, np.ones(len(t)))
+        return TrackView(t.track_id, mean, cov, np.ones(len(t)), t.score.copy(), self.score_rule)
 
     def _emit(
         self,
         prior: GreedyPrior,
         meas: Measurements,
         track_of_meas: np.ndarray,
-        new_j: np.ndarray,
-        new_ids: np.ndarray,
-        deleted_ids: np.ndarray,
+        born: tuple[np.ndarray, np.ndarray],
+        missed: GreedyTracks,
+        reasons: list[PruneReason | None],
         sink: EventSink,
     ) -> None:
-        """``CostMatrix`` (distances, new-track column = the threshold), ``Assignment``, ``Born``, ``Pruned``."""
-        detected = set(track_of_meas[track_of_meas >= 0].tolist())
-        missed = tuple(int(t) for i, t in enumerate(prior.tracks.track_id.tolist()) if i not in detected)
+        """``CostMatrix`` (distances, new-track column = the threshold), ``Assignment``, ``Born``, ``Pruned`` (the
+        value: the track's score with a ``score_rule``, else 1)."""
+        missed_ids = missed.track_id.tolist()
         emit_distance_choices(
             self.class_name,
             prior.dist,
@@ -214,11 +253,13 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
             meas,
             prior.tracks.track_id,
             track_of_meas,
-            (new_j, new_ids),
-            missed,
-            COST_DESCRIPTION,
-            COST_SCALE,
+            born,
+            tuple(missed_ids),
+            self.description,
+            self.scale,
             sink,
         )
-        for t in deleted_ids.tolist():
-            sink.emit(Pruned(self.class_name, int(t), PruneReason.TRACK_LOGIC, 1.0))
+        values = missed.score.tolist() if self.score_rule is not None else [1.0] * len(missed_ids)
+        for track_id, reason, value in zip(missed_ids, reasons, values, strict=True):
+            if reason is not None:
+                sink.emit(Pruned(self.class_name, int(track_id), reason, float(value)))
