@@ -227,12 +227,6 @@ class PairTerms:
             return None
         return 1.0 / (math.exp(target) + self.p_detect)
 
-    def d2_for(self, cheaper_by_nats: float) -> float | None:
-        """The squared distance at which this cost would be ``cheaper_by_nats`` lower, all else equal (d2 - 2
-        cheaper_by_nats); None when even d2 = 0 is not enough."""
-        target = self.d2 - 2.0 * cheaper_by_nats
-        return target if target >= 0.0 else None
-
 
 @dataclass(frozen=True, slots=True)
 class CostTerms:

@@ -50,10 +50,6 @@ class RunSpec:
     params: Path | None = None
     results: Path | None = None
 
-    @property
-    def is_results(self) -> bool:
-        return self.results is not None
-
     def text(self) -> str:
         """The spelling that gives this run back (``parse_run``), ``NAME=`` only where the name is not implied."""
         if self.results is not None:

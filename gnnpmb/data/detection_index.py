@@ -12,7 +12,7 @@ time) or the index is damaged (``gnnpmb.data.index_store``).
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -146,8 +146,3 @@ def _build(
     }
     manifest = {"format": FORMAT, "sources": sources, "sha256": digest.hexdigest(), "files": files}
     write_manifest(tmp, manifest)
-
-
-def read_boxes(index: DetectionIndex, tokens: Sequence[str]) -> dict[str, Boxes]:
-    """The boxes of ``tokens`` (each present and without problem), in that order."""
-    return {token: index.boxes(token) for token in tokens}

@@ -90,17 +90,6 @@ def resolve_study_data(
     )
 
 
-def scene_study(
-    location: DatasetLocation, scene_name: str, detections: Path | None, detector: str, seed: int
-) -> StudyData:
-    """One scene as a study of its own (``gnnpmb failures``), split None."""
-    from gnnpmb.data.nuscenes import sample_tokens
-
-    path = None if detections is None else detections.resolve()
-    tokens = tuple(sample_tokens(location, [scene_name]))
-    return StudyData(location, "", (scene_name,), tokens, path, detector, seed)
-
-
 def load_inputs(data: StudyData, scene_name: str) -> SceneInputs:
     """The scene from the dataset index and its detections from the detection file's index (only its samples)."""
     from gnnpmb.data.detections import load_detection_file

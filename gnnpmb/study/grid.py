@@ -183,8 +183,3 @@ def base_value(config: TrackerConfig, key: str) -> Scalar | None:
             node = node[part]
         values.append(node)
     return values[0] if values and all(v == values[0] for v in values) else None
-
-
-def format_assignment(assignment: Assignment) -> str:
-    """``pmb.gate_chi2=20, car.q_x=0.1`` (``base`` for the empty assignment)."""
-    return ", ".join(f"{k}={v}" for k, v in assignment) or "base"
