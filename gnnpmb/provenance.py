@@ -116,6 +116,7 @@ def boxes_sha256(detections: Mapping[str, Boxes], sample_tokens: Sequence[str]) 
 
 _DECIMALS = np.array([4] * 6 + [6] * 4 + [4] * 2 + [6] * 2)
 """Decimals of the numbers of a line: x y z w l h, the quaternion, vx vy, score and existence."""
+_LINE_NUMBERS = " ".join(f"%.{d}f" for d in _DECIMALS.tolist())
 
 
 def _lines(estimates: Sequence[TrackEstimate]) -> list[str]:
@@ -126,11 +127,7 @@ def _lines(estimates: Sequence[TrackEstimate]) -> list[str]:
     ).reshape(-1, len(_DECIMALS))
     rounded = np.where(_DECIMALS == 4, np.round(values, 4), np.round(values, 6)) + 0.0  # -0.0 + 0.0 == +0.0
     return [
-        " ".join(
-            [str(e.track_id), e.class_name]
-            + [f"{v:.{d}f}" for v, d in zip(row, _DECIMALS.tolist(), strict=True)]
-            + [str(e.meas_index)]
-        )
+        f"{e.track_id} {e.class_name} {_LINE_NUMBERS % tuple(row)} {e.meas_index}"
         for e, row in zip(estimates, rounded.tolist(), strict=True)
     ]
 
