@@ -31,6 +31,7 @@ from cli.errors import check_version_flag, exit_now_on_failure, run_app
 from cli.options import (
     DatarootOption,
     DetectionsOption,
+    DetectorOption,
     ParamsOption,
     ResultsOption,
     SeedOption,
@@ -43,7 +44,7 @@ from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.runs import parse_runs
 from gnnpmb.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, check_display, serve_target
-from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER, check_request
+from gnnpmb.stages.request import DEFAULT_TRACKER, check_request
 
 tidy_help()
 app = typer.Typer(
@@ -80,13 +81,7 @@ def view(
     dataroot: DatarootOption = None,
     version: VersionOption = None,
     detections: DetectionsOption = None,
-    detector: Annotated[
-        str | None,
-        typer.Option(
-            metavar="PRESET",
-            help=f"Simulated detector preset: centerpoint, megvii or pointpillars (default {DEFAULT_DETECTOR}).",
-        ),
-    ] = None,
+    detector: DetectorOption = None,
     seed: SeedOption = 0,
     params: ParamsOption = None,
     classes: Annotated[
