@@ -390,6 +390,34 @@ def _prepared(nusc: NuScenes, boxes: EvalBoxes, cfg: TrackingConfig) -> tuple[Ev
     return raw, boxes, _copy(boxes)
 
 
+def devkit_tracks(
+    nusc: NuScenes,
+    tokens: Sequence[str],
+    results: Mapping[str, Sequence[Mapping[str, Any]]],
+    split: str,
+    cfg: TrackingConfig,
+    whose: str = "",
+) -> tuple[EvalBoxes, EvalBoxes, EvalBoxes, dict, dict]:
+    """The devkit's loading of ground truth and of ``results`` (submission boxes by sample token) on the samples
+    ``tokens``, as ``TrackingEval`` does (call it inside ``quiet_devkit``): the ground truth before and after its
+    filter (``_prepared``), the kept predictions, then both as tracks by scene (``create_tracks``). Results that
+    are not submission boxes raise ``DataError`` (``whose``: which results, e.g. " of scene-0103")."""
+    from nuscenes.eval.common.data_classes import EvalBoxes
+    from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
+    from nuscenes.eval.tracking.data_classes import TrackingBox
+    from nuscenes.eval.tracking.loaders import create_tracks
+
+    try:
+        pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in tokens}, TrackingBox)
+    except (AssertionError, KeyError, TypeError, ValueError) as exc:
+        raise DataError(f"the tracking results{whose} are not valid submission boxes: {exc}") from None
+    gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
+    raw_gt, prepared_gt, kept_gt = _prepared(nusc, gt, cfg)
+    _, prepared_pred, kept_pred = _prepared(nusc, pred, cfg)
+    tracks_gt = create_tracks(prepared_gt, nusc, split, gt=True)
+    return raw_gt, kept_gt, kept_pred, tracks_gt, create_tracks(prepared_pred, nusc, split, gt=False)
+
+
 def _copy(boxes: EvalBoxes) -> EvalBoxes:
     """Another ``EvalBoxes`` with the same boxes in new lists."""
     from nuscenes.eval.common.data_classes import EvalBoxes
@@ -596,11 +624,6 @@ def find_failures(
     an entry count as empty. keyframes: evaluate only these (those a ``--frames`` run tracked), as if the
     scene held no others; None or the whole scene: all. Failures are sorted by frame, then kind, class and ids.
     """
-    from nuscenes.eval.common.data_classes import EvalBoxes
-    from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
-    from nuscenes.eval.tracking.data_classes import TrackingBox
-    from nuscenes.eval.tracking.loaders import create_tracks
-
     tokens = scene_sample_tokens(nusc, scene_name)
     window = range(len(tokens))
     if keyframes is not None:
@@ -610,15 +633,9 @@ def find_failures(
     split = _split_with_scene(nusc, scene_name)
     cfg = tracking_config()
     with quiet_devkit():
-        try:
-            pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in evaluated}, TrackingBox)
-        except (AssertionError, KeyError, TypeError, ValueError) as exc:
-            raise DataError(f"the tracking results of {scene_name} are not valid submission boxes: {exc}") from None
-        gt = load_gt_of_sample_tokens(nusc, evaluated, TrackingBox, verbose=False)
-        raw_gt, prepared_gt, kept_gt = _prepared(nusc, gt, cfg)
-        _, prepared_pred, kept_pred = _prepared(nusc, pred, cfg)
-        tracks_gt = create_tracks(prepared_gt, nusc, split, gt=True)
-        tracks_pred = create_tracks(prepared_pred, nusc, split, gt=False)
+        raw_gt, kept_gt, kept_pred, tracks_gt, tracks_pred = devkit_tracks(
+            nusc, evaluated, results, split, cfg, f" of {scene_name}"
+        )
         scene_token = nusc.get("sample", evaluated[0])["scene_token"]
         classes: list[ClassEvaluation] = []
         failures: list[Failure] = []

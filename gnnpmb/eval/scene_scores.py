@@ -30,13 +30,10 @@ def scene_scores(
     """(per class {metric: value}, overall {metric: value}) of ``results`` (submission boxes by sample token; a
     sample without an entry counts as empty) on ``scene_names`` (all in one devkit or custom split), as named in
     the devkit's ``metrics_summary.json``; NaN where a class has no ground truth."""
-    from nuscenes.eval.common.data_classes import EvalBoxes
-    from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
     from nuscenes.eval.tracking.constants import AVG_METRIC_MAP, MOT_METRIC_MAP
-    from nuscenes.eval.tracking.data_classes import TrackingBox, TrackingMetrics
-    from nuscenes.eval.tracking.loaders import create_tracks
+    from nuscenes.eval.tracking.data_classes import TrackingMetrics
 
-    from gnnpmb.eval.failures import _prepared, _split_with_scene
+    from gnnpmb.eval.failures import _split_with_scene, devkit_tracks
 
     if not scene_names:
         raise DataError("no scenes to score")
@@ -45,14 +42,7 @@ def scene_scores(
     split = max(splits, key=lambda s: sum(_split_with_scene(nusc, n) == s for n in scene_names))
     cfg = tracking_config()
     with quiet_devkit():
-        try:
-            pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in tokens}, TrackingBox)
-        except (AssertionError, KeyError, TypeError, ValueError) as exc:
-            raise DataError(f"the tracking results are not valid submission boxes: {exc}") from None
-        gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
-        prepared = [_prepared(nusc, boxes, cfg)[1] for boxes in (gt, pred)]  # the devkit's filters
-        tracks_gt = create_tracks(prepared[0], nusc, split, gt=True)
-        tracks_pred = create_tracks(prepared[1], nusc, split, gt=False)
+        *_, tracks_gt, tracks_pred = devkit_tracks(nusc, tokens, results, split, cfg)
         metrics = TrackingMetrics(cfg)
         for class_name in cfg.class_names:
             md = class_evaluation(tracks_gt, tracks_pred, class_name, cfg).accumulate()
