@@ -19,6 +19,7 @@ a display for the spawned viewer; without one it stops at once with a hint inste
 from __future__ import annotations
 
 import functools
+import gc
 import os
 import sys
 from collections.abc import Sequence
@@ -210,6 +211,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     the viewer command (typer cannot have a positional SCENE beside a subcommand). As the script (``argv``
     None) a failed run exits at once (``cli.errors.exit_now_on_failure``)."""
     if argv is None:
+        gc.disable()  # no collection until the inputs are loaded (stages.inputs.freeze_loaded): all made stays alive
         exit_now_on_failure(lambda: _main(sys.argv[1:]))
     else:
         _main(list(argv))

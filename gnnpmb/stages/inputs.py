@@ -174,9 +174,11 @@ def freeze_loaded() -> None:
     """Collect garbage, then move every object alive (the devkit's tables, the scene, the frames) out of the
     garbage collector's reach (``gc.freeze``): they live as long as the process, and a full collection walking
     them cost ~130 ms in the middle of tracking. Objects frozen are still freed by reference counting; only
-    reference cycles among them would outlive their use."""
+    reference cycles among them would outlive their use. The collector is on afterwards (the ``gnnpmb-viz``
+    script keeps it off while it imports and loads, ``cli.app.main``: what it makes then stays alive)."""
     gc.collect()
     gc.freeze()
+    gc.enable()
 
 
 def reproduction_inputs(
