@@ -41,6 +41,7 @@ from viz.blueprint import (
     reading_guide_doc,
 )
 from viz.callouts import Callout, log_callouts
+from viz.cameras import SCENE_HEIGHT_WITH_CAMERAS
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
 from viz.focus_summary import TrackerView, focus_markdown
@@ -95,6 +96,8 @@ def log_focus(
     evaluated = evaluated_offsets(focus, reports.get(focus.failure_tracker or ""))
     reach_m = range_near_focus(focus, scene)
     height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
+    if sight is not None:  # a camera view below: the bird's-eye view is shorter, a pixel more metres
+        height_m /= SCENE_HEIGHT_WITH_CAMERAS
     for i in shown:
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
