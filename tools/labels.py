@@ -478,6 +478,8 @@ class LabelSummary:
 
     most: dict[str, tuple[int, int]]
     overlapping: dict[str, dict[int, list[tuple[str, str]]]]
+    clipped: dict[str, dict[int, list[str]]] = field(default_factory=dict)
+    """Per view, frame -> the labels whose text box runs past the view's edge (cut off)."""
 
 
 def summarize(rrd: Path, frames: Iterable[int] | None = None) -> LabelSummary:
@@ -485,20 +487,38 @@ def summarize(rrd: Path, frames: Iterable[int] | None = None) -> LabelSummary:
     frames = sorted(rec.frames) if frames is None else list(frames)
     most: dict[str, tuple[int, int]] = {}
     overlapping: dict[str, dict[int, list[tuple[str, str]]]] = defaultdict(dict)
+    clipped: dict[str, dict[int, list[str]]] = defaultdict(dict)
     for view in rec.views:
         for f in frames:
             n = len(rec.labels(view, f))
             if n > most.get(view.name, (-1, -1))[0]:
                 most[view.name] = (n, f)
             if view.camera:
-                pairs = overlaps(camera_boxes(rec, view, f))
-                if pairs:
-                    overlapping[view.name][f] = [(a.text, b.text) for a, b in pairs]
-            if view.eye is not None:
-                pairs = overlaps(screen_boxes(rec, view, f, view.size_px))
-                if pairs:
-                    overlapping[view.name][f] = [(a.text, b.text) for a, b in pairs]
-    return LabelSummary(most, dict(overlapping))
+                boxes, rect = camera_boxes(rec, view, f), camera_rect(rec, view)
+            elif view.eye is not None:
+                boxes, rect = screen_boxes(rec, view, f, view.size_px), (0.0, 0.0, *view.size_px)
+            else:
+                continue
+            pairs = overlaps(boxes)
+            if pairs:
+                overlapping[view.name][f] = [(a.text, b.text) for a, b in pairs]
+            cut = [label.text for label, box in boxes if not inside(box, rect)]
+            if cut:
+                clipped[view.name][f] = cut
+    return LabelSummary(most, dict(overlapping), dict(clipped))
+
+
+def camera_rect(rec: Recording, view: View3D) -> tuple[float, float, float, float]:
+    """The camera view's rectangle in the screen pixels of ``camera_boxes`` (the image fitted and centred)."""
+    _, (width, height) = rec.pinholes[view.origin]
+    scale = camera_scale(rec, view)
+    dx, dy = 0.5 * (view.size_px[0] - width * scale), 0.5 * (view.size_px[1] - height * scale)
+    return -dx, -dy, width * scale + dx, height * scale + dy
+
+
+def inside(box: tuple[float, float, float, float], rect: tuple[float, float, float, float]) -> bool:
+    """Whether a text box lies wholly inside a view's rectangle (else the view's edge cuts it off)."""
+    return box[0] >= rect[0] and box[1] >= rect[1] and box[2] <= rect[2] and box[3] <= rect[3]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -508,9 +528,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     summary = summarize(args.rrd)
     for name, (n, f) in summary.most.items():
         over = summary.overlapping.get(name, {})
-        print(f"{name}: at most {n} labels (frame {f}); overlapping pairs at {len(over)} frames")
+        cut = summary.clipped.get(name, {})
+        print(
+            f"{name}: at most {n} labels (frame {f}); overlapping pairs at {len(over)} frames; "
+            f"labels cut by the view's edge at {len(cut)} frames"
+        )
         for f, pairs in sorted(over.items())[:5]:
             print(f"  frame {f}: {pairs[:4]}")
+        for f, texts in sorted(cut.items())[:3]:
+            print(f"  frame {f}, cut: {texts[:4]}")
     return 0
 
 

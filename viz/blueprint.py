@@ -28,7 +28,7 @@ from gnnpmb.runs import Capabilities, tracker_capabilities
 from viz import compare, paths
 from viz.cameras import with_cameras
 from viz.failures import failure_log
-from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M, EYE_POSITION_M, EYE_TARGET_M
+from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M, BEV_UP, EYE_POSITION_M, EYE_TARGET_M
 from viz.legend import LegendPlacement
 
 if TYPE_CHECKING:
@@ -109,7 +109,7 @@ def bev_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3DVie
     """Top-down view without LiDAR: tracks, trails, association lines, gates, detections, ground truth."""
     if focus is None:
         origin = paths.EGO
-        eye = rrb.EyeControls3D(position=BEV_EYE_POSITION_M, look_target=BEV_TARGET_M, eye_up=(1, 0, 0))
+        eye = rrb.EyeControls3D(position=BEV_EYE_POSITION_M, look_target=BEV_TARGET_M, eye_up=BEV_UP)
     else:
         x, y = focus.center_xy_m
         origin = paths.WORLD

@@ -247,7 +247,14 @@ def draw_layer(boxes: Sequence[Box], cams: Mapping[int, CameraFrame], frames: Se
         drawn.colors[k].extend([box.rgb] * len(parts))
         if box.label:
             points = np.concatenate(parts)
-            anchor = (float(0.5 * (points[:, 0].min() + points[:, 0].max())), float(points[:, 1].min()))
+            cam = cams[box.frame]
+            anchor = _inside_image(
+                box.label,
+                float(0.5 * (points[:, 0].min() + points[:, 0].max())),
+                float(points[:, 1].min()),
+                cam.width_px,
+                cam.height_px,
+            )
             screen = text_box(box.label, anchor[0] * CAMERA_VIEW_SCALE, anchor[1] * CAMERA_VIEW_SCALE)
             wanted[k].append((box.rank, len(wanted[k]), screen, box.label, anchor, box.rgb))
     for k, candidates in enumerate(wanted):
@@ -258,6 +265,15 @@ def draw_layer(boxes: Sequence[Box], cams: Mapping[int, CameraFrame], frames: Se
             drawn.anchors[k].append(anchor)
             drawn.label_rgb[k].append(rgb)
     return drawn
+
+
+def _inside_image(text: str, u: float, v: float, width_px: int, height_px: int) -> tuple[float, float]:
+    """A label's anchor (pixels) moved so that its text, centred under it at ``CAMERA_VIEW_SCALE``, stays inside
+    the image: a label cut by the view's edge reads as something else."""
+    x0, y0, x1, y1 = (c / CAMERA_VIEW_SCALE for c in text_box(text, 0.0, 0.0))
+    u = min(max(u, -x0), max(width_px - x1, -x0))
+    v = min(max(v, 0.0), height_px - y1)
+    return u, v
 
 
 def log_camera_boxes(

@@ -25,9 +25,11 @@ import numpy as np
 
 from gnnpmb.data.scene import Pose
 
-BEV_EYE_POSITION_M = (12.0, 0.0, 80.0)
-BEV_TARGET_M = (12.0, 0.0, 0.0)
-"""Bird's-eye camera in the ego frame: straight down on a point 12 m ahead, forward pointing up the screen."""
+BEV_EYE_POSITION_M = (6.0, 0.0, 80.0)
+BEV_TARGET_M = (6.0, 0.0, 0.0)
+BEV_UP = (1.0, 0.0, 0.0)
+"""Bird's-eye camera in the ego frame: straight down on a point 6 m ahead, forward pointing up the screen (the
+labels, centred under their boxes, then run across the road, where the wide view has room for them)."""
 EYE_POSITION_M = (-18.0, -14.0, 22.0)
 EYE_TARGET_M = (10.0, 0.0, 0.0)
 """Default camera of the perspective views in the ego frame (x forward, z up): behind, left of and above the car,
@@ -39,6 +41,8 @@ VIEW_HEIGHT_PX = 380.0
 screenshots); with the camera grid below it is smaller (``viz.opening.view_heights_px``)."""
 PERSPECTIVE_HEIGHT_PX = 255.0
 """The same for the perspective view (its share 4 against the bird's-eye view's 6)."""
+VIEW_WIDTH_PX = 576.0
+"""Width of each run's 3D views in a two-run recording at 1920 x 1080 (3/5 of the width, halved)."""
 CHAR_PX = 7.0
 HEIGHT_PX = 18.0
 PAD_PX = 4.0
@@ -61,12 +65,21 @@ class Candidate:
 
 @dataclass(frozen=True, slots=True)
 class Eye:
-    """A 3D view's default camera in the ego frame (position, look target, up) and its height in pixels."""
+    """A 3D view's default camera in the ego frame (position, look target, up) and its size in pixels."""
 
     position_m: tuple[float, float, float]
     target_m: tuple[float, float, float]
     up: tuple[float, float, float]
     height_px: float
+    width_px: float = VIEW_WIDTH_PX
+
+    def cuts(self, box: tuple[float, float, float, float], anchor: tuple[float, float]) -> bool:
+        """Whether the view's edge cuts off a text box (screen pixels from the view's centre) whose anchor is
+        inside the view."""
+        w, h = 0.5 * self.width_px, 0.5 * self.height_px
+        if not (-w <= anchor[0] <= w and -h <= anchor[1] <= h):
+            return False
+        return box[0] < -w or box[2] > w or box[1] < -h or box[3] > h
 
     def screen_px(self, point_ego_m: np.ndarray) -> tuple[float, float] | None:
         """A point in the ego frame -> screen pixels relative to the view's centre (x right, y down); None
@@ -85,12 +98,14 @@ class Eye:
 
 
 def eyes(
-    bev_height_px: float = VIEW_HEIGHT_PX, perspective_height_px: float = PERSPECTIVE_HEIGHT_PX
+    bev_height_px: float = VIEW_HEIGHT_PX,
+    perspective_height_px: float = PERSPECTIVE_HEIGHT_PX,
+    width_px: float = VIEW_WIDTH_PX,
 ) -> tuple[Eye, ...]:
-    """The full recording's bird's-eye and perspective cameras at these view heights."""
+    """The full recording's bird's-eye and perspective cameras at these view sizes."""
     return (
-        Eye(BEV_EYE_POSITION_M, BEV_TARGET_M, (1.0, 0.0, 0.0), bev_height_px),
-        Eye(EYE_POSITION_M, EYE_TARGET_M, (0.0, 0.0, 1.0), perspective_height_px),
+        Eye(BEV_EYE_POSITION_M, BEV_TARGET_M, BEV_UP, bev_height_px, width_px),
+        Eye(EYE_POSITION_M, EYE_TARGET_M, (0.0, 0.0, 1.0), perspective_height_px, width_px),
     )
 
 
@@ -114,14 +129,20 @@ def to_ego(xy_global_m: tuple[float, float], ego: Pose, z_m: float = LABEL_Z_M) 
 def keep_apart(candidates: Sequence[Candidate], ego: Pose, views: Sequence[Eye] | None = None) -> set[object]:
     """The keys of the labels to show at one frame (module docstring): by rank, then in the given order, each
     kept when its text box is at least ``CLEARANCE_PX`` from every one kept before in each of ``views`` (default:
-    ``eyes()``); a label behind a view's camera does not count there."""
+    ``eyes()``) and not cut off by a view's edge (half a label reads as something else); a label behind a view's
+    camera does not count there."""
     kept: set[object] = set(c.key for c in candidates)
     for eye in views if views is not None else eyes():
         boxes = []
         for c in candidates:
             at = eye.screen_px(to_ego(c.xy_global_m, ego))
-            if at is not None:
-                boxes.append((c.rank, c.key, text_box(c.text, *at)))
+            if at is None:
+                continue
+            box = text_box(c.text, *at)
+            if eye.cuts(box, at):
+                kept.discard(c.key)
+            else:
+                boxes.append((c.rank, c.key, box))
         shown = keep_clear([b for b in sorted(boxes, key=lambda b: b[0]) if b[1] in kept])
         kept = {c.key for c in candidates if c.key in shown or c.key not in {b[1] for b in boxes}} & kept
     return kept

@@ -418,13 +418,13 @@ def strip_share(rows: int, cameras: bool = False) -> float:
     return max(2.0, sum(SCENE_SHARES) * need_px / max(column_px - need_px, 1.0))
 
 
-def view_eyes(rows: int, cameras: bool = False) -> tuple[Eye, ...]:
-    """The default cameras of a full recording's bird's-eye and perspective views with their heights (content,
-    under the title) at 1920 x 1080 above a failure timeline of ``rows`` rows (``strip_share``), for the labels'
-    room (``viz.label_room``)."""
+def view_eyes(rows: int, cameras: bool = False, runs: int = 2) -> tuple[Eye, ...]:
+    """The default cameras of a full recording's bird's-eye and perspective views with their sizes (content,
+    under the title) at 1920 x 1080 above a failure timeline of ``rows`` rows (``strip_share``), ``runs`` side by
+    side (3/5 of the width), for the labels' room (``viz.label_room``)."""
     shares = sum(SCENE_SHARES) + strip_share(rows, cameras)
     bev, perspective = (RUN_COLUMN_PX[cameras] * share / shares - VIEW_TITLE_PX for share in SCENE_SHARES)
-    return eyes(bev, perspective)
+    return eyes(bev, perspective, 1920 * 3 / 5 / max(runs, 1))
 
 
 def row_step(frames: range, runs: int = 1) -> float:

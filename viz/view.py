@@ -237,7 +237,7 @@ def run_view(
             if focus is None and reports:  # a full recording: one label per box, the lost tracks drawn (viz.opening)
                 ghosts = {run.name: lost_ghosts(reports[run.name], run.tracking, run.facts, shown) for run in runs}
                 strip_rows = max(len(timeline_rows(r, shown)) for r in reports.values())
-                eyes = view_eyes(strip_rows, bool(channels))
+                eyes = view_eyes(strip_rows, bool(channels), len(runs))
                 notes = LabelNotes({run.name: drawn_tracks(run.tracking) for run in runs}, ghosts, eyes)
             if len(runs) > 1:
                 comparison = compare_runs(runs)

@@ -82,5 +82,5 @@ def test_keep_apart_keeps_the_more_important_of_two_close_labels() -> None:
     metres = 150.0 / px_per_m()  # sideways by more than the two half-widths (56 + 74 px) and the clearance
     far = [near[0], Candidate(0, "switch", "9 · ID switch, was 4", (12.0, 1.0 + metres))]
     assert keep_apart(far, IDENTITY, bev) == {"false", "switch"}
-    ahead = [near[0], Candidate(0, "switch", "9 · ID switch, was 4", (22.0, 1.0))]  # 10 m ahead: rows apart
+    ahead = [near[0], Candidate(0, "switch", "9 · ID switch, was 4", (34.0, 1.0))]  # 22 m ahead, forward is right
     assert keep_apart(ahead, IDENTITY, bev) == {"false", "switch"}

@@ -16,7 +16,7 @@ from cli.app import main
 from tests.pipeline import POSITION_ONLY, prepare, reports_of
 from tests.viz.rrd import at_frame, read_rows
 from tests.viz.test_blueprint import stored_views
-from tools.labels import Recording, camera_boxes, overlaps, screen_boxes
+from tools.labels import Recording, camera_boxes, camera_rect, inside, overlaps, screen_boxes
 from viz import compare, paths
 from viz.opening import TIMELINE_KINDS, failure_timeline, lost_tracks, row_step, timeline_bounds, timeline_rows
 from viz.paths import failure_index_doc
@@ -137,6 +137,8 @@ def test_labels_only_where_they_carry_the_story(recorded) -> None:
                     assert (frame, label.entity.rsplit("/", 1)[1]) in failing[run], (view.name, frame, label.text)
             boxes = camera_boxes(rec, view, frame) if view.camera else screen_boxes(rec, view, frame, view.size_px)
             assert not overlaps(boxes), (view.name, frame)
+            rect = camera_rect(rec, view) if view.camera else (0.0, 0.0, *view.size_px)
+            assert all(inside(box, rect) for _, box in boxes), (view.name, frame)  # none cut by the view's edge
 
 
 @pytest.mark.parametrize("runs", [1, 2, 3])
