@@ -178,23 +178,25 @@ def scene_boxes(
 def failure_boxes(
     reports: Mapping[str, FailureReport], frames: set[int], involved: Mapping[str, set[str]] | None = None
 ) -> list[Box]:
-    """Each run's failure boxes at ``frames`` in the kind's colour with ``viz.failures`` words; a box several runs
-    share (same frame, kind, role and object) is drawn once, its label prefixed by the run's name when only some
-    runs have it. With ``involved`` only the focus's objects get words."""
-    runs: dict[tuple[int, FailureKind, str, str], list[str]] = {}
-    first: dict[tuple[int, FailureKind, str, str], object] = {}
+    """Each run's failure boxes at ``frames`` in the kind's colour with ``viz.failures`` words; a ground-truth box
+    several runs share (same frame, kind, role and instance) is drawn once, its label prefixed by the runs' names
+    when only some runs have it; a track's box is its run's own (track ids are per run), prefixed with the run's
+    name when there are several runs. With ``involved`` only the focus's objects get words."""
+    runs: dict[tuple[int, FailureKind, str, str, str], list[str]] = {}
+    first: dict[tuple[int, FailureKind, str, str, str], object] = {}
     for name, report in reports.items():
         for failure in report.failures:
             if failure.frame_index not in frames:
                 continue
             for box in failure.boxes:
-                key = (failure.frame_index, failure.kind, box.role, box.object_id)
+                owner = "" if box.is_gt else name
+                key = (failure.frame_index, failure.kind, box.role, box.object_id, owner)
                 if name not in runs.setdefault(key, []):
                     runs[key].append(name)
                 first.setdefault(key, box)
     out = []
     for key, names in runs.items():
-        frame, kind, _, object_id = key
+        frame, kind, _, object_id, _ = key
         box = first[key]
         text = failure_label(kind, box)
         if len(names) < len(reports):

@@ -252,8 +252,8 @@ def index_markdown(
         "|---|---|---|---|---|---|",
     ]
     for group in _groups(kept):
-        first, last = group[0], group[-1]
-        span = ids[id(first)] if len(group) == 1 else f"{ids[id(first)]} … {ids[id(last)]}"
+        first = group[0]
+        span = id_span([ids[id(f)] for f in group])
         if ids[id(first)] == opening and first_run:
             span = f"**{span}** (opened)"
         frames = frames_text(f.frame_index for f in group).split(" ", 1)[1]
@@ -263,6 +263,25 @@ def index_markdown(
             objects += " (interpolated)"
         lines.append(f"| {span} | {frames} | {KIND_LABELS[first.kind]} | {first.class_name} | {tracks} | {objects} |")
     return "\n".join(lines) + "\n"
+
+
+def id_span(failure_ids: Sequence[str]) -> str:
+    """A row's failure ids (``kind:N``, in order) as the index shows them: one id, ``kind:3 … kind:7`` for
+    consecutive numbers, else every number (``false_track:3–7, 9, 12``): a row of one track's false boxes can skip
+    numbers another track's failures took, and ``3 … 14`` would read as if those were in the row too."""
+    if len(failure_ids) == 1:
+        return failure_ids[0]
+    kind = failure_ids[0].rsplit(":", 1)[0]
+    numbers = [int(i.rsplit(":", 1)[1]) for i in failure_ids]
+    if numbers == list(range(numbers[0], numbers[-1] + 1)):
+        return f"{failure_ids[0]} … {failure_ids[-1]}"
+    runs: list[list[int]] = []
+    for n in numbers:
+        if runs and n == runs[-1][-1] + 1:
+            runs[-1].append(n)
+        else:
+            runs.append([n])
+    return f"{kind}:" + ", ".join(f"{r[0]}–{r[-1]}" if len(r) > 1 else str(r[0]) for r in runs)
 
 
 def _groups(failures: Sequence[Failure]) -> list[list[Failure]]:

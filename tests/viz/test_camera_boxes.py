@@ -56,15 +56,23 @@ def _failure(kind: FailureKind, frame: int, role: str, object_id: str, x: float,
     return Failure(kind, frame, f"sample{frame}", "car", (), (object_id,), (box,))
 
 
-def test_only_the_frames_failures_are_labelled_the_run_named_when_only_one_has_it() -> None:
+def test_only_the_frames_failures_are_labelled_with_the_run_a_track_belongs_to() -> None:
     a = SimpleNamespace(failures=(_failure(FailureKind.FALSE_TRACK, 0, "false track", "7", 20.0, 0.0),))
     b = SimpleNamespace(failures=(*a.failures, _failure(FailureKind.ID_SWITCH, 1, "new track", "9", 15.0, 2.0)))
-    boxes = failure_boxes({"a": a, "b": b}, {0, 1})
-    assert [(x.frame, x.label) for x in boxes] == [(0, "false track 7"), (1, "b: ID switch: new track 9")]
+    boxes = failure_boxes({"a": a, "b": b}, {0, 1})  # track 7 of a and track 7 of b are two tracks
+    assert [(x.frame, x.label) for x in boxes] == [
+        (0, "a: false track 7"),
+        (0, "b: false track 7"),
+        (1, "b: ID switch: new track 9"),
+    ]
     assert [x.label for x in failure_boxes({"a": a, "b": b}, {0, 1}, involved={"b": {"9"}})] == [
+        "",
         "",
         "b: ID switch: new track 9",
     ]
+    missed = _failure(FailureKind.MISS, 2, "missed gt", "4ab7b6aaaa", 20.0, 0.0)
+    both = {"a": SimpleNamespace(failures=(missed,)), "b": SimpleNamespace(failures=(missed,))}
+    assert [x.label for x in failure_boxes(both, {2})] == ["missed gt 4ab7b6"]  # one object, both runs missed it
 
 
 @pytest.fixture

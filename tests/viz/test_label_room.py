@@ -40,3 +40,12 @@ def test_the_callout_column_goes_left_when_only_there_it_stays_in_view() -> None
     half_label_m = 0.5 * CHAR_PX * 30 * M_PER_PX_PER_HEIGHT * height_m
     tight = column_positions(anchors, chars, height_m, (-5.0, free[0, 0] + half_label_m - 1.0))  # right cut
     assert np.all(tight[:, 0] < anchors[:, 0].min())
+
+
+def test_the_failure_index_lists_a_rows_ids_when_other_rows_took_numbers_between() -> None:
+    from viz.opening import id_span
+
+    assert id_span(["miss:4"]) == "miss:4"
+    assert id_span(["miss:4", "miss:5", "miss:6"]) == "miss:4 … miss:6"
+    ids = ["false_track:3", "false_track:4", "false_track:5", "false_track:9", "false_track:12", "false_track:13"]
+    assert id_span(ids) == "false_track:3–5, 9, 12–13"  # not "false_track:3 … false_track:13"
