@@ -41,8 +41,8 @@ def column_positions(
     anchors_xy_m: np.ndarray, chars: np.ndarray, height_m: float, view_x_m: tuple[float, float] | None = None
 ) -> np.ndarray:
     """(N, 2) label centres for N callouts at (N, 2) anchors with (N,) text lengths: one column right of the
-    rightmost anchor (left of the leftmost one when only there it stays inside ``view_x_m``, the x range the
-    view shows), rows top-down in the order of the anchors' y (highest first, so leaders rarely cross),
+    rightmost anchor (left of the leftmost one when the view's edge, ``view_x_m``: the x range the view shows,
+    would cut less of it there), rows top-down in the order of the anchors' y (highest first, so leaders rarely cross),
     ``LINE_PX`` apart and centred on the anchors' mean y."""
     n = len(anchors_xy_m)
     if n == 0:
@@ -51,8 +51,9 @@ def column_positions(
     half_width_m = 0.5 * CHAR_PX * float(np.max(chars)) * m_per_px
     x = float(np.max(anchors_xy_m[:, 0])) + GAP_PX * m_per_px + half_width_m
     left = float(np.min(anchors_xy_m[:, 0])) - GAP_PX * m_per_px - half_width_m
-    if view_x_m is not None and x + half_width_m > view_x_m[1] and left - half_width_m >= view_x_m[0]:
-        x = left
+    if view_x_m is not None and x + half_width_m > view_x_m[1]:
+        over_right, over_left = x + half_width_m - view_x_m[1], view_x_m[0] - (left - half_width_m)
+        x = left if over_left < over_right else x
     order = np.argsort(-anchors_xy_m[:, 1], kind="stable")
     line_m = LINE_PX * m_per_px
     rows_y = float(np.mean(anchors_xy_m[:, 1])) + line_m * (0.5 * (n - 1) - np.arange(n))

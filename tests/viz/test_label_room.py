@@ -49,3 +49,10 @@ def test_the_failure_index_lists_a_rows_ids_when_other_rows_took_numbers_between
     assert id_span(["miss:4", "miss:5", "miss:6"]) == "miss:4 … miss:6"
     ids = ["false_track:3", "false_track:4", "false_track:5", "false_track:9", "false_track:12", "false_track:13"]
     assert id_span(ids) == "false_track:3–5, 9, 12–13"  # not "false_track:3 … false_track:13"
+
+
+def test_when_neither_side_has_room_the_column_goes_where_less_is_cut() -> None:
+    anchors = np.array([[0.0, 0.0]])
+    chars = np.array([40])  # a column about 12 m wide at 18 m: wider than either side of a 5 m view
+    assert column_positions(anchors, chars, 18.0, (-2.0, 3.0))[0, 0] > 0.0  # more room on the right
+    assert column_positions(anchors, chars, 18.0, (-3.0, 2.0))[0, 0] < 0.0  # more room on the left
