@@ -8,11 +8,16 @@ it). A label is drawn, as Rerun 0.41 draws it (``re_view_spatial``'s ``show_labe
 instances; its text is the instance's label, else its class's name from the annotation context; one label on a
 batch of many instances is drawn once. Empty texts are not counted.
 
-Overlap is decided in the default camera of the bird's-eye views: the label's anchor (box centre, point, strip
-midpoint) projected with the view's eye (Rerun's default vertical field of view, ``FOV_Y_DEG``) into the view's
-rectangle, the text box as Rerun places it (centred under the anchor), ``CHAR_PX`` per character. The view's
-size in pixels comes from the layout at 1920 x 1080 (``view_size_px``); it is an estimate of egui's text metrics,
-so the check keeps ``MARGIN_PX`` of air.
+Overlap is decided in the default camera of the bird's-eye and perspective views: the label's anchor (box centre,
+point, strip midpoint) projected with the view's eye (Rerun's default vertical field of view, ``FOV_Y_DEG``) into
+the view's rectangle, the text box as Rerun places it (centred under the anchor), ``CHAR_PX`` per character. The view's
+size in pixels is laid out from the blueprint's containers at 1920 x 1080 (``layout_px``); the text size is an
+estimate of egui's text metrics, so the check keeps ``MARGIN_PX`` of air.
+
+Camera views (2D views on a ``Pinhole`` camera entity) count the labels of 2D entities under the camera whose
+anchor lies in the image, and of 3D entities their contents include projected through the keyframe's ego pose, the
+camera's ``Transform3D`` and its pinhole (in front of the camera and inside the image); their overlaps are decided
+at the size the full recording's camera grid shows an image at 1920 x 1080 (``CAMERA_SCALE``).
 
 By hand: ``uv run python -m tools.labels FILE.rrd`` prints the most labels per view and the overlaps.
 """
@@ -22,6 +27,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import uuid
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -47,8 +53,17 @@ ANCHORS = {
     "LineStrips3D": ("strips", "strips"),
     "Ellipsoids3D": ("centers", "half_sizes"),
     "Arrows3D": ("origins", "vectors"),
+    "Points2D": ("positions", "positions"),
+    "LineStrips2D": ("strips", "strips"),
+    "Boxes2D": ("centers", "half_sizes"),
 }
 """Archetype -> (component that places the label, component whose length is the number of instances)."""
+TOP_BAR_PX = 36.0
+TIME_PANEL_PX = 25.0
+"""The web viewer's top bar and collapsed time panel at 1920 x 1080; the rest holds the blueprint's root container."""
+TITLE_PX = 24.0
+"""A view's title bar (or its tab bar), above its content."""
+CONTAINER_KINDS = {1: "tabs", 2: "horizontal", 3: "vertical", 4: "grid"}
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,10 +76,17 @@ class View3D:
     rules: tuple[str, ...]
     hidden: tuple[str, ...]
     eye: tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]] | None
+    size_px: tuple[float, float] = (0.0, 0.0)
+    """Width and height of the view's content at 1920 x 1080, laid out from the blueprint (``layout_px``)."""
 
     @property
     def birds_eye(self) -> bool:
         return self.name.endswith("bird's-eye")
+
+    @property
+    def camera(self) -> bool:
+        """A 2D view on a camera (its origin a pinhole entity, ``world/ego_vehicle/CAM_*``)."""
+        return self.eye is None and "/CAM_" in self.origin
 
     def shows(self, entity: str) -> bool:
         """Whether the view's contents include ``entity`` and it is not hidden (most specific rule wins)."""
@@ -115,17 +137,62 @@ def _strip_id(path: str) -> str:
     return path.lstrip("/")
 
 
-def read_views(rrd: Path) -> list[View3D]:
-    """The 3D views of the recording's default blueprint."""
+def layout_px(
+    containers: dict[str, dict[str, Any]], root: str, viewport: tuple[int, int] = (1920, 1080)
+) -> dict[str, tuple[float, float]]:
+    """View id -> (width, height) of its content: the root container fills the viewport less ``TOP_BAR_PX`` and
+    ``TIME_PANEL_PX``; a horizontal (vertical) container splits its width (height) by its shares (equal without),
+    a grid into ``grid_columns`` columns and as many equal rows as needed, tabs give each child the whole rect; a
+    view loses ``TITLE_PX`` to its title. Borders (a few pixels) are left out."""
+    sizes: dict[str, tuple[float, float]] = {}
+
+    def place(node: str, w: float, h: float) -> None:
+        kind, _, node_id = node.partition("/")
+        if kind == "view":
+            sizes[node_id] = (w, max(h - TITLE_PX, 0.0))
+            return
+        c = containers.get(node_id, {})
+        children = list(c.get("ContainerBlueprint:contents") or [])
+        if not children:
+            return
+        layout = CONTAINER_KINDS.get((c.get("ContainerBlueprint:container_kind") or [1])[0], "tabs")
+        if layout == "tabs":
+            for child in children:
+                place(child, w, h)
+        elif layout == "grid":
+            cols = (c.get("ContainerBlueprint:grid_columns") or [math.ceil(math.sqrt(len(children)))])[0]
+            rows = math.ceil(len(children) / cols)
+            for child in children:
+                place(child, w / cols, h / rows)
+        else:
+            key = "ContainerBlueprint:col_shares" if layout == "horizontal" else "ContainerBlueprint:row_shares"
+            shares = list(c.get(key) or [1.0] * len(children))
+            for child, share in zip(children, shares, strict=False):
+                part = share / sum(shares)
+                place(child, w * part, h) if layout == "horizontal" else place(child, w, h * part)
+
+    place(f"container/{root}", float(viewport[0]), viewport[1] - TOP_BAR_PX - TIME_PANEL_PX)
+    return sizes
+
+
+def read_views(rrd: Path, kinds: tuple[str, ...] = ("3D", "camera")) -> list[View3D]:
+    """The views of the recording's default blueprint of ``kinds``: "3D", "camera" (a 2D view on a camera
+    entity), "2D" (any other 2D view)."""
     reader = RrdReader(rrd)
     blueprints = reader.blueprints()
     if not blueprints:
         return []
     props: dict[str, dict[str, Any]] = defaultdict(dict)
     hidden: dict[str, list[str]] = defaultdict(list)
+    containers: dict[str, dict[str, Any]] = defaultdict(dict)
+    root = ""
     for chunk in reader.stream(store=blueprints[0]):
         path = chunk.entity_path
         for row in chunk.to_record_batch().to_pylist():
+            if path == "/viewport" and row.get("ViewportBlueprint:root_container"):
+                root = str(uuid.UUID(bytes=bytes(row["ViewportBlueprint:root_container"][0])))
+            if path.startswith("/container/"):
+                containers[path.split("/")[2]].update({k: v for k, v in row.items() if v is not None})
             if not path.startswith("/view/"):
                 continue
             view_id = path.split("/")[2]
@@ -137,9 +204,13 @@ def read_views(rrd: Path) -> list[View3D]:
             for key, value in row.items():
                 if value is not None and not key.startswith(("rerun.", "log_time", "blueprint")):
                     props[view_id][key] = value
+    sizes = layout_px(containers, root)
     views = []
     for view_id, p in props.items():
-        if p.get("ViewBlueprint:class_identifier") != ["3D"]:
+        kind = p.get("ViewBlueprint:class_identifier")
+        origin = _strip_id(p["ViewBlueprint:space_origin"][0])
+        camera = kind == ["2D"] and "/CAM_" in origin
+        if ("camera" if camera else (kind or ["?"])[0]) not in kinds:
             continue
         eye = None
         if p.get("EyeControls3D:position"):
@@ -151,10 +222,11 @@ def read_views(rrd: Path) -> list[View3D]:
         views.append(
             View3D(
                 name=p["ViewBlueprint:display_name"][0],
-                origin=_strip_id(p["ViewBlueprint:space_origin"][0]),
-                rules=tuple(p.get("ViewContents:query", ["+ $origin/**"])),
+                origin=origin,
+                rules=tuple(r.replace("$origin", origin) for r in p.get("ViewContents:query", ["+ $origin/**"])),
                 hidden=tuple(hidden[view_id]),
                 eye=eye,
+                size_px=sizes.get(view_id, (0.0, 0.0)),
             )
         )
     return sorted(views, key=lambda v: v.name)
@@ -171,6 +243,10 @@ class Recording:
         self.frames: set[int] = set()
         self.ego: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self.class_names: dict[int, str] = {}
+        self.pinholes: dict[str, tuple[np.ndarray, tuple[float, float]]] = {}
+        """Camera entity -> (K (3, 3), (width, height) in pixels)."""
+        self.cameras: dict[str, dict[int, tuple[np.ndarray, np.ndarray]]] = defaultdict(dict)
+        """Camera entity -> frame -> (rotation (3, 3), translation (3,)): the camera in the ego frame."""
         clears: dict[str, list[int]] = defaultdict(list)
         labelled = {
             (_strip_id(chunk.entity_path), a)
@@ -199,6 +275,18 @@ class Recording:
                         self.ego[row["frame"]] = (
                             np.asarray(row["Transform3D:translation"][0], dtype=np.float64),
                             np.asarray((row.get("Transform3D:quaternion") or [[0, 0, 0, 1]])[0], dtype=np.float64),
+                        )
+            if "Pinhole:image_from_camera" in names:
+                for row in batch.select(["Pinhole:image_from_camera", "Pinhole:resolution"]).to_pylist():
+                    if row["Pinhole:image_from_camera"]:
+                        k = np.reshape(row["Pinhole:image_from_camera"][0], (3, 3)).T
+                        self.pinholes[path] = (k, tuple(row["Pinhole:resolution"][0]))
+            if "/CAM_" in path and "Transform3D:mat3x3" in names and "frame" in names:
+                for row in batch.select(["frame", "Transform3D:mat3x3", "Transform3D:translation"]).to_pylist():
+                    if row["Transform3D:mat3x3"] and row["frame"] is not None:
+                        self.cameras[path][row["frame"]] = (
+                            np.reshape(row["Transform3D:mat3x3"][0], (3, 3)).T,
+                            np.asarray(row["Transform3D:translation"][0], dtype=np.float64),
                         )
             if "Clear:is_recursive" in names:
                 for row in batch.select([n for n in ("frame", "Clear:is_recursive") if n in names]).to_pylist():
@@ -270,7 +358,28 @@ class Recording:
                     text = self.class_names.get(int(class_ids[min(i, len(class_ids) - 1)]))
                 if text:
                     out.append(Label(path, text, _anchor(a)))
+        if view.camera:
+            return [label for label in out if self.pixel(view, frame, label) is not None]
         return out
+
+    def pixel(self, view: View3D, frame: int, label: Label) -> tuple[float, float] | None:
+        """Where a camera view draws ``label`` in its image (pixels), None when it is behind the camera or
+        outside the image. 2D entities under the camera are in pixels already; 3D ones are projected."""
+        k, (width, height) = self.pinholes[view.origin]
+        if label.entity.startswith(view.origin + "/"):
+            u, v = label.anchor_m[:2]
+        else:
+            frames = self.cameras[view.origin]
+            at = frames.get(frame) or frames[max((f for f in frames if f <= frame), default=min(frames))]
+            ego_point = np.asarray(label.anchor_m, dtype=np.float64)
+            if not label.entity.startswith("world/ego_vehicle"):
+                pose = self.ego.get(frame) or self.ego[max(f for f in self.ego if f <= frame)]
+                ego_point = _rotation_xyzw(pose[1]).T @ (ego_point - pose[0])
+            p = at[0].T @ (ego_point - at[1])
+            if p[2] <= 0:
+                return None
+            u, v = (k @ p)[:2] / p[2]
+        return (float(u), float(v)) if 0 <= u <= width and 0 <= v <= height else None
 
     def to_origin(self, view: View3D, frame: int, label: Label) -> np.ndarray:
         """A label's anchor in the view's origin frame (the ego frame for views on ``world/ego_vehicle``)."""
@@ -298,14 +407,6 @@ def _rotation_xyzw(q: np.ndarray) -> np.ndarray:
             [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
         ]
     )
-
-
-def view_size_px(n_trackers: int, viewport: tuple[int, int] = (1920, 1080)) -> tuple[float, float]:
-    """Width and height in pixels of one bird's-eye view in the default full-recording layout: the trackers'
-    views side by side in the left 3/5 of the window (blueprint ``column_shares`` 3:2); 380 px tall at 1080 px
-    (measured on the web viewer's screenshots of two-tracker recordings: 574 x 380 px), scaled with the height."""
-    width, height = viewport
-    return width * 3 / 5 / max(n_trackers, 1) - 2, 380.0 * height / 1080
 
 
 def screen_boxes(
@@ -337,6 +438,24 @@ def screen_boxes(
     return out
 
 
+def camera_scale(rec: Recording, view: View3D) -> float:
+    """Screen pixels per image pixel of camera view ``view``: its image fitted into the view's content."""
+    _, (width, height) = rec.pinholes[view.origin]
+    return min(view.size_px[0] / width, view.size_px[1] / height)
+
+
+def camera_boxes(rec: Recording, view: View3D, frame: int) -> list[tuple[Label, tuple[float, float, float, float]]]:
+    """The labels of camera view ``view`` at ``frame``, each with its text box in screen pixels (``camera_scale``)."""
+    out = []
+    scale = camera_scale(rec, view)
+    for label in rec.labels(view, frame):
+        u, v = rec.pixel(view, frame, label)
+        x, y = u * scale, v * scale
+        half = 0.5 * (CHAR_PX * len(label.text) + 2 * LABEL_PAD_PX)
+        out.append((label, (x - half, y + 3.0, x + half, y + 3.0 + LABEL_HEIGHT_PX)))
+    return out
+
+
 def overlaps(boxes: Sequence[tuple[Label, tuple[float, float, float, float]]]) -> list[tuple[Label, Label]]:
     """Pairs of labels whose text boxes overlap (or come closer than ``MARGIN_PX``)."""
     pairs = []
@@ -354,28 +473,52 @@ def overlaps(boxes: Sequence[tuple[Label, tuple[float, float, float, float]]]) -
 
 @dataclass(frozen=True, slots=True)
 class LabelSummary:
-    """Per 3D view: the most labels at one frame (and that frame), and the bird's-eye overlaps per frame."""
+    """Per 3D and camera view: the most labels at one frame (and that frame), and the overlaps per frame (in
+    the views' default cameras)."""
 
     most: dict[str, tuple[int, int]]
     overlapping: dict[str, dict[int, list[tuple[str, str]]]]
+    clipped: dict[str, dict[int, list[str]]] = field(default_factory=dict)
+    """Per view, frame -> the labels whose text box runs past the view's edge (cut off)."""
 
 
 def summarize(rrd: Path, frames: Iterable[int] | None = None) -> LabelSummary:
     rec = Recording(rrd)
     frames = sorted(rec.frames) if frames is None else list(frames)
-    n_bev = sum(v.birds_eye for v in rec.views)
     most: dict[str, tuple[int, int]] = {}
     overlapping: dict[str, dict[int, list[tuple[str, str]]]] = defaultdict(dict)
+    clipped: dict[str, dict[int, list[str]]] = defaultdict(dict)
     for view in rec.views:
         for f in frames:
             n = len(rec.labels(view, f))
             if n > most.get(view.name, (-1, -1))[0]:
                 most[view.name] = (n, f)
-            if view.birds_eye and view.eye is not None:
-                pairs = overlaps(screen_boxes(rec, view, f, view_size_px(n_bev)))
-                if pairs:
-                    overlapping[view.name][f] = [(a.text, b.text) for a, b in pairs]
-    return LabelSummary(most, dict(overlapping))
+            if view.camera:
+                boxes, rect = camera_boxes(rec, view, f), camera_rect(rec, view)
+            elif view.eye is not None:
+                boxes, rect = screen_boxes(rec, view, f, view.size_px), (0.0, 0.0, *view.size_px)
+            else:
+                continue
+            pairs = overlaps(boxes)
+            if pairs:
+                overlapping[view.name][f] = [(a.text, b.text) for a, b in pairs]
+            cut = [label.text for label, box in boxes if not inside(box, rect)]
+            if cut:
+                clipped[view.name][f] = cut
+    return LabelSummary(most, dict(overlapping), dict(clipped))
+
+
+def camera_rect(rec: Recording, view: View3D) -> tuple[float, float, float, float]:
+    """The camera view's rectangle in the screen pixels of ``camera_boxes`` (the image fitted and centred)."""
+    _, (width, height) = rec.pinholes[view.origin]
+    scale = camera_scale(rec, view)
+    dx, dy = 0.5 * (view.size_px[0] - width * scale), 0.5 * (view.size_px[1] - height * scale)
+    return -dx, -dy, width * scale + dx, height * scale + dy
+
+
+def inside(box: tuple[float, float, float, float], rect: tuple[float, float, float, float]) -> bool:
+    """Whether a text box lies wholly inside a view's rectangle (else the view's edge cuts it off)."""
+    return box[0] >= rect[0] and box[1] >= rect[1] and box[2] <= rect[2] and box[3] <= rect[3]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -385,9 +528,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     summary = summarize(args.rrd)
     for name, (n, f) in summary.most.items():
         over = summary.overlapping.get(name, {})
-        print(f"{name}: at most {n} labels (frame {f}); overlapping pairs at {len(over)} frames")
+        cut = summary.clipped.get(name, {})
+        print(
+            f"{name}: at most {n} labels (frame {f}); overlapping pairs at {len(over)} frames; "
+            f"labels cut by the view's edge at {len(cut)} frames"
+        )
         for f, pairs in sorted(over.items())[:5]:
             print(f"  frame {f}: {pairs[:4]}")
+        for f, texts in sorted(cut.items())[:3]:
+            print(f"  frame {f}, cut: {texts[:4]}")
     return 0
 
 

@@ -28,16 +28,12 @@ from gnnpmb.runs import Capabilities, tracker_capabilities
 from viz import compare, paths
 from viz.cameras import with_cameras
 from viz.failures import failure_log
-from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M
+from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M, BEV_UP, EYE_POSITION_M, EYE_TARGET_M
 from viz.legend import LegendPlacement
 
 if TYPE_CHECKING:
     from gnnpmb.focus import FocusTarget
 
-EYE_POSITION_M = (-18.0, -14.0, 22.0)
-EYE_TARGET_M = (10.0, 0.0, 0.0)
-"""Default camera of the perspective views in the ego frame (x forward, z up): behind, left of and above the car,
-looking at a point 10 m ahead. The views' origin is the ego vehicle, so the camera follows the car."""
 FOCUS_HEIGHT_M: dict[str, float] = {"pedestrian": 16.0, "bicycle": 18.0, "motorcycle": 18.0, "car": 28.0}
 """Height of the bird's-eye camera above a focused place by class (small objects closer)."""
 DEFAULT_FOCUS_HEIGHT_M = 40.0
@@ -113,7 +109,7 @@ def bev_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3DVie
     """Top-down view without LiDAR: tracks, trails, association lines, gates, detections, ground truth."""
     if focus is None:
         origin = paths.EGO
-        eye = rrb.EyeControls3D(position=BEV_EYE_POSITION_M, look_target=BEV_TARGET_M, eye_up=(1, 0, 0))
+        eye = rrb.EyeControls3D(position=BEV_EYE_POSITION_M, look_target=BEV_TARGET_M, eye_up=BEV_UP)
     else:
         x, y = focus.center_xy_m
         origin = paths.WORLD
@@ -345,15 +341,22 @@ def comparison_panel(
 
 
 def _tracker_views(
-    tracker: str, focus: FocusTarget | None, strip: range | None = None, rows: int = 1, runs: int = 1
+    tracker: str,
+    focus: FocusTarget | None,
+    strip: range | None = None,
+    rows: int = 1,
+    runs: int = 1,
+    strip_rows: int = 1,
+    cameras: bool = False,
 ) -> rrb.Container:
     """The bird's-eye view above the perspective view; with a focus the bird's-eye view, where the failure is
     read, takes more of the height; with ``strip`` (a full recording whose failures were found: its frames) the
-    failures over those frames below them, in ``rows`` rows (``viz.opening.log_failure_timeline``)."""
+    failures over those frames below them, in ``rows`` rows (``viz.opening.log_failure_timeline``), the view as
+    tall as ``strip_rows`` rows need (the most any run has; with ``cameras`` below, ``viz.opening.strip_share``)."""
     if focus is not None:
         return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[7, 3])
     if strip is not None:
-        from viz.opening import failure_timeline, timeline_bounds
+        from viz.opening import SCENE_SHARES, failure_timeline, strip_share, timeline_bounds
 
         x_range, y_range = timeline_bounds(strip, rows, runs)
         strip_view = rrb.Spatial2DView(
@@ -361,7 +364,8 @@ def _tracker_views(
             name=f"{tracker} failures over time",
             visual_bounds=rrb.VisualBounds2D(x_range=x_range, y_range=y_range),
         )
-        return rrb.Vertical(bev_view(tracker), spatial_view(tracker), strip_view, row_shares=[6, 4, 2])
+        shares = [*SCENE_SHARES, strip_share(strip_rows, cameras)]
+        return rrb.Vertical(bev_view(tracker), spatial_view(tracker), strip_view, row_shares=shares)
     return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[3, 2])
 
 
@@ -391,9 +395,12 @@ def default_blueprint(
     strips = frames if focus is None and failure_index and frames is not None else None
     panels = [tracker_panel(t, classes, focus, legends, _caps(t, caps), opening, failure_index) for t in trackers]
     rows = timeline_rows or {}
-    scene = rrb.Horizontal(*[_tracker_views(t, focus, strips, rows.get(t, 1), len(trackers)) for t in trackers])
+    most = max(rows.values(), default=1)
+    scene = rrb.Horizontal(
+        *[_tracker_views(t, focus, strips, rows.get(t, 1), len(trackers), most, bool(cameras)) for t in trackers]
+    )
     if cameras:
-        scene = with_cameras(scene, cameras, trackers, focus is not None, focus_camera)
+        scene = with_cameras(scene, cameras, focus is not None, focus_camera)
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:

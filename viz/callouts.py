@@ -37,9 +37,12 @@ class Callout:
     color: tuple[int, int, int]
 
 
-def column_positions(anchors_xy_m: np.ndarray, chars: np.ndarray, height_m: float) -> np.ndarray:
+def column_positions(
+    anchors_xy_m: np.ndarray, chars: np.ndarray, height_m: float, view_x_m: tuple[float, float] | None = None
+) -> np.ndarray:
     """(N, 2) label centres for N callouts at (N, 2) anchors with (N,) text lengths: one column right of the
-    rightmost anchor, rows top-down in the order of the anchors' y (highest first, so leaders rarely cross),
+    rightmost anchor (left of the leftmost one when the view's edge, ``view_x_m``: the x range the view shows,
+    would cut less of it there), rows top-down in the order of the anchors' y (highest first, so leaders rarely cross),
     ``LINE_PX`` apart and centred on the anchors' mean y."""
     n = len(anchors_xy_m)
     if n == 0:
@@ -47,6 +50,10 @@ def column_positions(anchors_xy_m: np.ndarray, chars: np.ndarray, height_m: floa
     m_per_px = M_PER_PX_PER_HEIGHT * height_m
     half_width_m = 0.5 * CHAR_PX * float(np.max(chars)) * m_per_px
     x = float(np.max(anchors_xy_m[:, 0])) + GAP_PX * m_per_px + half_width_m
+    left = float(np.min(anchors_xy_m[:, 0])) - GAP_PX * m_per_px - half_width_m
+    if view_x_m is not None and x + half_width_m > view_x_m[1]:
+        over_right, over_left = x + half_width_m - view_x_m[1], view_x_m[0] - (left - half_width_m)
+        x = left if over_left < over_right else x
     order = np.argsort(-anchors_xy_m[:, 1], kind="stable")
     line_m = LINE_PX * m_per_px
     rows_y = float(np.mean(anchors_xy_m[:, 1])) + line_m * (0.5 * (n - 1) - np.arange(n))
@@ -56,12 +63,18 @@ def column_positions(anchors_xy_m: np.ndarray, chars: np.ndarray, height_m: floa
     return out
 
 
-def log_callouts(stream: rr.RecordingStream, path: str, callouts: Sequence[Callout], height_m: float) -> None:
+def log_callouts(
+    stream: rr.RecordingStream,
+    path: str,
+    callouts: Sequence[Callout],
+    height_m: float,
+    view_x_m: tuple[float, float] | None = None,
+) -> None:
     """The callouts as labelled points (``path``) and leader lines (``path/leaders``) at the current time; an
-    empty list clears both."""
+    empty list clears both. ``view_x_m``: the x range the bird's-eye view shows (``column_positions``)."""
     anchors = np.array([c.anchor_m for c in callouts], dtype=np.float64).reshape(-1, 3)
     chars = np.array([len(c.text) for c in callouts], dtype=np.int64)
-    xy = column_positions(anchors[:, :2], chars, height_m)
+    xy = column_positions(anchors[:, :2], chars, height_m, view_x_m)
     labels_at = np.concatenate([xy, anchors[:, 2:]], axis=1)
     colors = np.array([c.color for c in callouts], dtype=np.uint8).reshape(-1, 3)
     stream.log(

@@ -29,6 +29,11 @@ from viz.geometry import quat_wxyz_to_xyzw
 from viz.pointcloud import DEFAULT_MAX_POINTS, DEFAULT_VOXEL_M, intensity_colors, prepare_sweep
 from viz.timeline import TIMESTAMP, Clock
 
+SCENE_ROW_SHARES = (3.0, 2.0)
+"""Row shares of the scene views and the camera views below them."""
+SCENE_HEIGHT_WITH_CAMERAS = 0.55
+"""A scene view's height with the camera views below it over its height without: 3/5 of the rows, less the
+title bars (0.57 for the focus bird's-eye view laid out at 1920 x 1080, ``tools.labels.layout_px``)."""
 IMAGE_PLANE_DISTANCE_M = 1.5
 """How far in front of a camera its image is drawn in a 3D view (Rerun's frustum)."""
 
@@ -143,25 +148,19 @@ def log_sweeps(
     return len(inside)
 
 
-def camera_view(channel: str, trackers: Sequence[str], focus_tracks: bool = False) -> rrb.Spatial2DView:
-    """One camera's image with the 3D boxes projected into it: ground truth, kept detections, each tracker's
-    tracks (and, in a focus recording, the highlighted objects)."""
-    contents = ["+ $origin/**", f"+ {paths.GT}/**", f"+ {paths.DETECTIONS_KEPT}/**"]
-    for tracker in trackers:
-        contents.append(f"+ {paths.tracker_world(tracker)}/tracks/**")
-        if focus_tracks:
-            contents.append(f"+ {paths.tracker_world(tracker)}/focus/**")
-    if focus_tracks:
-        contents.append(f"+ {paths.WORLD}/focus/**")
-    return rrb.Spatial2DView(origin=paths.camera(channel), contents=contents, name=channel)
+def camera_view(channel: str) -> rrb.Spatial2DView:
+    """One camera's image with the boxes drawn into it (``viz.camera_boxes``: ground truth, kept detections, each
+    tracker's tracks and the frame's failures, clipped to the image), nothing from the 3D scene: Rerun would
+    draw 3D boxes past the image's edge and every 3D label with them."""
+    return rrb.Spatial2DView(origin=paths.camera(channel), contents=["+ $origin/**"], name=channel)
 
 
 def with_cameras(
-    scene: rrb.Container, channels: Sequence[str], trackers: Sequence[str], focus: bool, focus_channel: str | None
+    scene: rrb.Container, channels: Sequence[str], focus: bool, focus_channel: str | None
 ) -> rrb.Container:
     """The scene views above the cameras: in a focus recording the camera that sees the focus object (all six when
     none does), else the six in nuScenes' layout."""
     if focus and focus_channel is not None:
-        return rrb.Vertical(scene, camera_view(focus_channel, trackers, focus_tracks=True), row_shares=[3, 2])
-    views = [camera_view(c, trackers, focus_tracks=focus) for c in channels]
-    return rrb.Vertical(scene, rrb.Grid(*views, grid_columns=3, name="cameras"), row_shares=[3, 2])
+        return rrb.Vertical(scene, camera_view(focus_channel), row_shares=list(SCENE_ROW_SHARES))
+    views = [camera_view(c) for c in channels]
+    return rrb.Vertical(scene, rrb.Grid(*views, grid_columns=3, name="cameras"), row_shares=list(SCENE_ROW_SHARES))

@@ -43,7 +43,7 @@ def failure_log(tracker: str) -> str:
     return f"{paths.tracker_root(tracker)}/failure_log"
 
 
-def _label(kind: FailureKind, box: FailureBox) -> str:
+def failure_label(kind: FailureKind, box: FailureBox) -> str:
     """``ID switch: old track 26``; a role that already names the kind is not repeated (``false track 20``)."""
     name = short_id(box.object_id) if box.is_gt else box.object_id
     if box.role.startswith(KIND_LABELS[kind]):
@@ -69,7 +69,7 @@ def _frame_boxes(
                 continue
             seen.add(key)
             boxes.append(box)
-            labels.append("" if (box.role, box.object_id) in carried else _label(failure.kind, box))
+            labels.append("" if (box.role, box.object_id) in carried else failure_label(failure.kind, box))
             lengths[failure.frame_index] += 1
     return boxes, labels, lengths
 

@@ -40,7 +40,8 @@ from viz.blueprint import (
     focus_world,
     reading_guide_doc,
 )
-from viz.callouts import Callout, log_callouts
+from viz.callouts import M_PER_PX_PER_HEIGHT, Callout, log_callouts
+from viz.cameras import SCENE_HEIGHT_WITH_CAMERAS
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
 from viz.focus_summary import TrackerView, focus_markdown
@@ -65,6 +66,10 @@ GHOST_LINE_RADIUS_M = 0.05
 def tracker_focus(tracker: str) -> str:
     """Boxes3D of one tracker's involved tracks (only in that tracker's views)."""
     return f"{paths.tracker_world(tracker)}/focus"
+
+
+FOCUS_VIEW_WIDTH_PX = 1920 * 3 / 5
+"""Width the runs' bird's-eye views share in a focus recording at 1920 x 1080 (the scene column, ``viz.blueprint``)."""
 
 
 def log_focus(
@@ -95,6 +100,10 @@ def log_focus(
     evaluated = evaluated_offsets(focus, reports.get(focus.failure_tracker or ""))
     reach_m = range_near_focus(focus, scene)
     height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
+    if sight is not None:  # a camera view below: the bird's-eye view is shorter, a pixel more metres
+        height_m /= SCENE_HEIGHT_WITH_CAMERAS
+    half_view_m = 0.5 * FOCUS_VIEW_WIDTH_PX / max(len(loggers), 1) * M_PER_PX_PER_HEIGHT * height_m
+    view_x_m = (focus.center_xy_m[0] - half_view_m, focus.center_xy_m[0] + half_view_m)
     for i in shown:
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
@@ -177,6 +186,7 @@ def log_focus(
                 + _prediction_callouts(steps, z_m, palette, facts.has_existence)
                 + ghosts,
                 height_m,
+                view_x_m,
             )
         if meas and detections is not None:
             given = sorted(meas)

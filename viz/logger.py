@@ -702,7 +702,14 @@ class TrackerLogger:
             "class_ids": np.array([CLASS_IDS.get(e.class_name, 0) for e in estimates], dtype=np.uint16),
             "labels": [str(e.track_id) for e in estimates],
             "radii": np.full(n, TRACK_LINE_RADIUS_M, dtype=np.float32),
-        } | ({} if self.label_tracks else {"show_labels": np.zeros(n, dtype=bool)})
+        } | ({} if self._labelled(estimates) else {"show_labels": np.zeros(n, dtype=bool)})
+
+    def _labelled(self, estimates: list[TrackEstimate]) -> bool:
+        """Whether a track's box shows its id: with ``label_tracks``, and in a focus recording only the focus's
+        tracks (the others are dimmed boxes whose id is a click away)."""
+        if not self.label_tracks:
+            return False
+        return not self.focus_tracks or all(e.track_id in self.focus_tracks for e in estimates)
 
     # The decision view.
     def _draw_decisions(

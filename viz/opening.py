@@ -33,7 +33,7 @@ from viz import paths
 from viz.colors import faded, packed_track_colors
 from viz.failure_style import KIND_COLORS, KIND_LABELS
 from viz.geometry import estimate_boxes
-from viz.label_room import Candidate
+from viz.label_room import Candidate, Eye, eyes
 from viz.timeline import FOCUS, FRAME, Clock
 
 LOST_LOOKBACK = 20
@@ -64,15 +64,18 @@ class LabelNotes:
     """Notes to add to the labels of drawn tracks (and of lost tracks drawn pale, ``lost_ghosts``), per run, frame
     and track (module docstring); ``note`` says whether a note could be placed (the track is drawn there), so the
     caller leaves its own label empty. drawn: per run, ``drawn_tracks``; ghosts: per run, the (frame, track id) of
-    its lost tracks drawn pale (``lost_ghosts``)."""
+    its lost tracks drawn pale (``lost_ghosts``); views: the 3D views' cameras the labels are kept apart in
+    (``view_eyes``; default ``viz.label_room.eyes()``)."""
 
     def __init__(
         self,
         drawn: Mapping[str, Mapping[tuple[int, int], TrackEstimate]],
         ghosts: Mapping[str, Mapping[tuple[int, int], tuple[TrackEstimate, tuple[float, float]]]] | None = None,
+        views: Sequence[Eye] | None = None,
     ) -> None:
         self.drawn = drawn
         self.ghosts = ghosts or {}
+        self.views = views
         self.notes: dict[str, dict[tuple[int, int], list[str]]] = defaultdict(dict)
         self.ghost_notes: dict[str, dict[tuple[int, int], list[str]]] = defaultdict(dict)
         self.ranks: dict[str, dict[tuple[int, int], int]] = defaultdict(dict)
@@ -113,7 +116,8 @@ class LabelNotes:
             text = f"{key[1]} (lost) · {'; '.join(texts)}"
             by_frame[key[0]].append(Candidate(self.ranks[tracker][key], ("ghost", key), text, at))
         for frame, candidates in sorted(by_frame.items()):
-            kept = keep_apart(sorted(candidates, key=lambda c: str(c.key)), scene.keyframes[frame].ego_pose)
+            ordered = sorted(candidates, key=lambda c: str(c.key))
+            kept = keep_apart(ordered, scene.keyframes[frame].ego_pose, self.views)
             for c in candidates:
                 if c.key in kept:
                     continue
@@ -248,8 +252,8 @@ def index_markdown(
         "|---|---|---|---|---|---|",
     ]
     for group in _groups(kept):
-        first, last = group[0], group[-1]
-        span = ids[id(first)] if len(group) == 1 else f"{ids[id(first)]} … {ids[id(last)]}"
+        first = group[0]
+        span = id_span([ids[id(f)] for f in group])
         if ids[id(first)] == opening and first_run:
             span = f"**{span}** (opened)"
         frames = frames_text(f.frame_index for f in group).split(" ", 1)[1]
@@ -259,6 +263,25 @@ def index_markdown(
             objects += " (interpolated)"
         lines.append(f"| {span} | {frames} | {KIND_LABELS[first.kind]} | {first.class_name} | {tracks} | {objects} |")
     return "\n".join(lines) + "\n"
+
+
+def id_span(failure_ids: Sequence[str]) -> str:
+    """A row's failure ids (``kind:N``, in order) as the index shows them: one id, ``kind:3 … kind:7`` for
+    consecutive numbers, else every number (``false_track:3–7, 9, 12``): a row of one track's false boxes can skip
+    numbers another track's failures took, and ``3 … 14`` would read as if those were in the row too."""
+    if len(failure_ids) == 1:
+        return failure_ids[0]
+    kind = failure_ids[0].rsplit(":", 1)[0]
+    numbers = [int(i.rsplit(":", 1)[1]) for i in failure_ids]
+    if numbers == list(range(numbers[0], numbers[-1] + 1)):
+        return f"{failure_ids[0]} … {failure_ids[-1]}"
+    runs: list[list[int]] = []
+    for n in numbers:
+        if runs and n == runs[-1][-1] + 1:
+            runs[-1].append(n)
+        else:
+            runs.append([n])
+    return f"{kind}:" + ", ".join(f"{r[0]}–{r[-1]}" if len(r) > 1 else str(r[0]) for r in runs)
 
 
 def _groups(failures: Sequence[Failure]) -> list[list[Failure]]:
@@ -321,8 +344,8 @@ def log_lost_tracks(
 ) -> None:
     """The lost tracks (``lost_ghosts``) pale at their failure frames, labelled ``26 (lost) · <notes>``; an empty
     batch at the other keyframes of ``frames`` (nothing when there is none at all). The labels show at a frame only
-    when a failure noted one of them there (a lost track another label names, as an ID switch's new track does,
-    is a pale box whose words are a click away)."""
+    when a failure noted one of them there, and only on those (``LabelNotes.keep_apart`` placed them; a lost track
+    another label names, as an ID switch's new track does, is a pale box without words)."""
     if not ghosts:
         return
     every = np.array(list(frames), dtype=np.int64)
@@ -336,7 +359,7 @@ def log_lost_tracks(
     labels, noted = [], set()
     for i, (t, *_) in flat:
         said = notes.ghost_notes.get(tracker, {}).get((i, t), [])
-        labels.append(f"{t} (lost)" + (f" · {'; '.join(said)}" if said else ""))
+        labels.append(f"{t} (lost) · {'; '.join(said)}" if said else "")  # no note: no words beside the others
         if said:
             noted.add(i)
     shown = np.isin(every, list(noted))
@@ -369,6 +392,19 @@ SCENE_COLUMN_PX = 0.9 * 1920 * 3 / 5
 """Width the runs' views share at 1920 px (the scene column, ``viz.blueprint`` 3:2, less a tenth for borders)."""
 NAME_CHAR_PX = 7.0
 """Width of one character of a row name (egui's default font)."""
+ROW_PX = 24.0
+"""Height one row of the failure timeline needs: a row name (18 px) and air, so names of adjacent rows never touch."""
+VIEW_TITLE_PX = 24.0
+"""Height of a view's title bar."""
+RUN_COLUMN_PX = {False: 815.0, True: 489.0}
+"""Height of one run's views (bird's-eye, perspective and failure timeline) at 1920 x 1080 in a recording of two
+runs or more, without and with the camera grid below them: 1019 px under the web viewer's bars, 4/5 of it above
+the comparison panel, 3/5 of that above the cameras (``viz.blueprint``; 481 px measured on a screenshot)."""
+BELOW_ROWS = 0.9
+"""Steps below the last row's centre the failure timeline shows: the frame numbers written 0.8 steps below it,
+under their anchor (a name's height)."""
+SCENE_SHARES = (6.0, 4.0)
+"""Row shares of the bird's-eye and the perspective view above the failure timeline."""
 LONGEST_NAME = max(len(f"{name} (999)") for name in KIND_LABELS.values())
 
 
@@ -392,10 +428,37 @@ def label_span(frames: range, runs: int = 1) -> float:
     return max(LABEL_SPAN, text_px * (len(frames) + 0.5) / max(width_px - text_px, text_px))
 
 
+def strip_share(rows: int, cameras: bool = False) -> float:
+    """Row share of the failure timeline beside ``SCENE_SHARES`` that holds its ``rows`` rows ``ROW_PX`` apart (and
+    the frame numbers under them, ``timeline_bounds``: rows + 1 + ``BELOW_ROWS`` steps) in the run column's height
+    (``RUN_COLUMN_PX``, with or without the camera grid); at least 2."""
+    need_px = ROW_PX * (rows + 1 + BELOW_ROWS) + VIEW_TITLE_PX
+    column_px = RUN_COLUMN_PX[cameras]
+    return max(2.0, sum(SCENE_SHARES) * need_px / max(column_px - need_px, 1.0))
+
+
+def view_eyes(rows: int, cameras: bool = False, runs: int = 2) -> tuple[Eye, ...]:
+    """The default cameras of a full recording's bird's-eye and perspective views with their sizes (content,
+    under the title) at 1920 x 1080 above a failure timeline of ``rows`` rows (``strip_share``), ``runs`` side by
+    side (3/5 of the width), for the labels' room (``viz.label_room``)."""
+    shares = sum(SCENE_SHARES) + strip_share(rows, cameras)
+    bev, perspective = (RUN_COLUMN_PX[cameras] * share / shares - VIEW_TITLE_PX for share in SCENE_SHARES)
+    return eyes(bev, perspective, 1920 * 3 / 5 / max(runs, 1))
+
+
+def row_step(frames: range, runs: int = 1) -> float:
+    """Units between two rows of the failure timeline. A 2D view shows x and y at one scale, set by its width (the
+    frames and ``label_span`` over the run's share of ``SCENE_COLUMN_PX``), so rows one unit apart would be a few
+    pixels apart and their names would overlap: rows are ``ROW_PX`` apart at that scale."""
+    span = frames.stop + 0.5 - (frames.start - label_span(frames, runs))
+    return ROW_PX * span / (SCENE_COLUMN_PX / max(runs, 1))
+
+
 def timeline_bounds(frames: range, rows: int, runs: int = 1) -> tuple[tuple[float, float], tuple[float, float]]:
-    """(x range, y range) the failure timeline's view shows: every frame and row, the row names on the left
-    (``label_span``, for ``runs`` runs side by side) and the frame numbers below."""
-    return (frames.start - label_span(frames, runs), frames.stop + 0.5), (-1.0, rows + 0.4)
+    """(x range, y range) the failure timeline's view shows: every frame and row (``row_step`` apart), the row
+    names on the left (``label_span``, for ``runs`` runs side by side) and the frame numbers below."""
+    step = row_step(frames, runs)
+    return (frames.start - label_span(frames, runs), frames.stop + 0.5), (-step, (rows + BELOW_ROWS) * step)
 
 
 def log_failure_timeline(
@@ -416,13 +479,14 @@ def log_failure_timeline(
     (``label_span``)."""
     root = failure_timeline(tracker)
     kinds = timeline_rows(report, frames)
+    step = row_step(frames, runs)
     xs, ys, colors, radii = [], [], [], []
     for row, kind in enumerate(kinds):
         counts = report.counts(kind)
         for f in frames:
             if counts[f]:
                 xs.append(f)
-                ys.append(row)
+                ys.append(row * step)
                 colors.append(KIND_COLORS[kind])
                 radii.append(0.2 + 0.05 * min(int(counts[f]), 4))
     stream.log(
@@ -436,7 +500,9 @@ def log_failure_timeline(
     stream.log(
         f"{root}/kinds",
         rr.Points2D(
-            np.column_stack([np.full(len(kinds), frames.start - label_span(frames, runs) / 2), np.arange(len(kinds))]),
+            np.column_stack(
+                [np.full(len(kinds), frames.start - label_span(frames, runs) / 2), step * np.arange(len(kinds))]
+            ),
             colors=[KIND_COLORS[k] for k in kinds],
             radii=0.01,
             labels=[f"{KIND_LABELS[k]} ({n_of[k]})" for k in kinds],
@@ -448,7 +514,7 @@ def log_failure_timeline(
     stream.log(
         f"{root}/frames",
         rr.Points2D(
-            np.column_stack([ticks, np.full(len(ticks), len(kinds) - 0.2)]),
+            np.column_stack([ticks, np.full(len(ticks), (len(kinds) - 0.2) * step)]),
             colors=[(120, 120, 120)],
             radii=0.01,
             labels=[str(f) for f in ticks],
@@ -460,12 +526,14 @@ def log_failure_timeline(
         f = report.by_id(opening)
         stream.log(
             f"{root}/opened",
-            rr.Boxes2D(centers=[(f.frame_index, kinds.index(f.kind))], half_sizes=[(0.5, 0.45)], colors=[(40, 40, 40)]),
+            rr.Boxes2D(
+                centers=[(f.frame_index, kinds.index(f.kind) * step)], half_sizes=[(0.5, 0.45)], colors=[(40, 40, 40)]
+            ),
             static=True,
         )
     every = np.array(list(frames), dtype=np.int64)
     stamps = np.array([scene.keyframes[i].timestamp_us for i in every.tolist()], dtype=np.int64)
-    top, bottom = -0.6, len(kinds) - 0.5
+    top, bottom = -0.6 * step, (len(kinds) - 0.5) * step
     strips = np.stack(
         [np.column_stack([every, np.full(every.size, top)]), np.column_stack([every, np.full(every.size, bottom)])],
         axis=1,

@@ -39,6 +39,17 @@ def camera(channel: str) -> str:
     return f"{EGO}/{_name(channel)}"
 
 
+def camera_boxes(channel: str, layer: str) -> str:
+    """LineStrips2D in one camera's image: the boxes of ``layer`` (``gt``, ``detections``, a tracker's name,
+    ``failures``) projected and clipped to the image (``viz.camera_boxes``)."""
+    return f"{camera(channel)}/boxes/{_name(layer)}"
+
+
+def camera_labels(channel: str) -> str:
+    """Points2D in one camera's image carrying the labels of the frame's failures (``viz.camera_boxes``)."""
+    return f"{camera(channel)}/labels"
+
+
 # Spatial, per tracker (global frame).
 def tracker_world(tracker: str) -> str:
     return f"{WORLD_TRACKERS}/{_name(tracker)}"

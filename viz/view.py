@@ -118,6 +118,7 @@ def run_view(
         log_failure_timeline,
         log_lost_tracks,
         lost_ghosts,
+        view_eyes,
     )
     from viz.provenance import log_provenance
     from viz.recording import recording
@@ -201,9 +202,17 @@ def run_view(
                 sensor_note=sensor_note,
             )
             if channels:
+                from viz.camera_boxes import log_camera_boxes, scene_boxes
                 from viz.cameras import log_cameras
+                from viz.opening import drawn_tracks
 
                 log_cameras(stream, scene, sensors, shown, clock)
+                involved = {r.name: focus.object_ids(r.name) for r in runs} if focus is not None else None
+                tracks = {run.name: drawn_tracks(run.tracking) for run in runs}
+                boxes = scene_boxes(
+                    scene, shown, [inputs.frame_detections[i] for i in shown], tracks, reports, involved
+                )
+                log_camera_boxes(stream, scene, sensors, shown, clock, boxes)
             if sweeps and sensors is not None and sensors.sweeps:
                 from viz.cameras import log_sweeps
 
@@ -227,7 +236,9 @@ def run_view(
             notes = None
             if focus is None and reports:  # a full recording: one label per box, the lost tracks drawn (viz.opening)
                 ghosts = {run.name: lost_ghosts(reports[run.name], run.tracking, run.facts, shown) for run in runs}
-                notes = LabelNotes({run.name: drawn_tracks(run.tracking) for run in runs}, ghosts)
+                strip_rows = max(len(timeline_rows(r, shown)) for r in reports.values())
+                eyes = view_eyes(strip_rows, bool(channels), len(runs))
+                notes = LabelNotes({run.name: drawn_tracks(run.tracking) for run in runs}, ghosts, eyes)
             if len(runs) > 1:
                 comparison = compare_runs(runs)
                 log_comparison(

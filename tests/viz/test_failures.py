@@ -14,7 +14,15 @@ from gnnpmb.eval.failures import ClassEvaluation, Failure, FailureBox, FailureKi
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
 from viz.colors import faded, pack_rgba
-from viz.failures import FOCUS_MARGIN_M, KIND_COLORS, MARKER_MARGIN_M, MARKER_SCALE, _label, failure_log, log_failures
+from viz.failures import (
+    FOCUS_MARGIN_M,
+    KIND_COLORS,
+    MARKER_MARGIN_M,
+    MARKER_SCALE,
+    failure_label,
+    failure_log,
+    log_failures,
+)
 
 T = "gnnpmb"
 GT_ID = "a1b2c3d4e5f6"
@@ -168,9 +176,9 @@ def test_a_failure_at_an_interpolated_gt_box_is_named_and_suggested_last(tiny_sc
 
 
 def test_a_marker_label_does_not_repeat_the_kind() -> None:
-    assert _label(FailureKind.FALSE_TRACK, fbox("false track", "20", 0.0)) == "false track 20"
-    assert _label(FailureKind.FRAGMENTATION, fbox("missed gt", GT_ID, 0.0)) == "fragmentation: missed gt a1b2c3"
-    assert _label(FailureKind.IDENTITY_THEFT, fbox("thief track", "9", 0.0)) == "identity theft: thief track 9"
+    assert failure_label(FailureKind.FALSE_TRACK, fbox("false track", "20", 0.0)) == "false track 20"
+    assert failure_label(FailureKind.FRAGMENTATION, fbox("missed gt", GT_ID, 0.0)) == "fragmentation: missed gt a1b2c3"
+    assert failure_label(FailureKind.IDENTITY_THEFT, fbox("thief track", "9", 0.0)) == "identity theft: thief track 9"
 
 
 def test_a_focus_pales_the_markers_of_other_objects_and_draws_its_kind_around_the_others(

@@ -13,7 +13,7 @@ from gnnpmb.data.scene import Pose
 from tools.labels import Recording, overlaps, screen_boxes
 from viz.blueprint import bev_view
 from viz.colors import annotation_context
-from viz.label_room import Candidate, keep_apart, px_per_m
+from viz.label_room import Candidate, eyes, keep_apart, px_per_m
 
 IDENTITY = Pose(np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
 
@@ -77,9 +77,10 @@ def test_keep_apart_keeps_the_more_important_of_two_close_labels() -> None:
         Candidate(4, "false", "7 · false track", (12.0, 1.0)),
         Candidate(0, "switch", "9 · ID switch, was 4", (12.5, 0.0)),
     ]
-    assert keep_apart(near, IDENTITY) == {"switch"}
+    bev = eyes()[:1]
+    assert keep_apart(near, IDENTITY, bev) == {"switch"}
     metres = 150.0 / px_per_m()  # sideways by more than the two half-widths (56 + 74 px) and the clearance
     far = [near[0], Candidate(0, "switch", "9 · ID switch, was 4", (12.0, 1.0 + metres))]
-    assert keep_apart(far, IDENTITY) == {"false", "switch"}
-    ahead = [near[0], Candidate(0, "switch", "9 · ID switch, was 4", (22.0, 1.0))]  # 10 m ahead: rows apart
-    assert keep_apart(ahead, IDENTITY) == {"false", "switch"}
+    assert keep_apart(far, IDENTITY, bev) == {"false", "switch"}
+    ahead = [near[0], Candidate(0, "switch", "9 · ID switch, was 4", (34.0, 1.0))]  # 22 m ahead, forward is right
+    assert keep_apart(ahead, IDENTITY, bev) == {"false", "switch"}

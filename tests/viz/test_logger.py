@@ -290,6 +290,7 @@ def test_focus_logs_only_its_frames_but_keeps_the_history(saved_stream: tuple[rr
     assert not at_frame(rows[paths.track(T, "car", 1)], 0)  # frame 0 is outside the recorded window
     (box,) = [r for r in at_frame(rows[paths.track(T, "car", 1)], 1) if "Boxes3D:labels" in r]  # beside the trail row
     assert box["Boxes3D:labels"] == ["1"]
+    assert box["Boxes3D:show_labels"] == [False]  # not involved: its id a click away, not on screen
     # Track 1 is not involved: drawn pale so that the focused track 2 stands out.
     pale = faded(pack_rgba(track_colors(np.array([1]))), DIMMED_KEEP)
     assert box["Boxes3D:colors"] == [int(pale[0])]

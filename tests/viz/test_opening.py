@@ -8,6 +8,7 @@ import contextlib
 import io
 from pathlib import Path
 
+import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
@@ -15,9 +16,9 @@ from cli.app import main
 from tests.pipeline import POSITION_ONLY, prepare, reports_of
 from tests.viz.rrd import at_frame, read_rows
 from tests.viz.test_blueprint import stored_views
-from tools.labels import Recording, overlaps, screen_boxes, view_size_px
+from tools.labels import Recording, camera_boxes, camera_rect, inside, overlaps, screen_boxes
 from viz import compare, paths
-from viz.opening import TIMELINE_KINDS, failure_timeline, lost_tracks, timeline_bounds, timeline_rows
+from viz.opening import TIMELINE_KINDS, failure_timeline, lost_tracks, row_step, timeline_bounds, timeline_rows
 from viz.paths import failure_index_doc
 
 SCENE = "scene-0103"
@@ -97,13 +98,16 @@ def test_failures_over_the_whole_scene_whatever_the_timeline(recorded) -> None:
     root = failure_timeline("gnnpmb")
     dots = rows[f"{root}/failures"][0]  # static: seen on the focus timeline too, which ends at the opening
     kinds = timeline_rows(report, range(40))
+    step = row_step(range(40), 2)  # rows a name's height apart (two runs side by side)
     expected = {(f.frame_index, kinds.index(f.kind)) for f in report.failures}
-    assert {tuple(map(int, p)) for p in dots["Points2D:positions"]} == expected
+    assert {(int(x), round(y / step)) for x, y in dots["Points2D:positions"]} == expected
     names = rows[f"{root}/kinds"][0]["Points2D:labels"]
     assert names[0].startswith("ID switch (") and names[-1].startswith("miss (")  # the kinds that occurred
     assert [k for k in TIMELINE_KINDS if k in kinds] == kinds and len(names) == len(kinds)
     opened = report.by_id(report.first_worth_opening())
-    assert rows[f"{root}/opened"][0]["Boxes2D:centers"] == [[opened.frame_index, kinds.index(opened.kind)]]
+    assert np.allclose(
+        rows[f"{root}/opened"][0]["Boxes2D:centers"], [[opened.frame_index, kinds.index(opened.kind) * step]]
+    )
     assert sorted({r["frame"] for r in rows[f"{root}/now"] if not r["static"]}) == list(range(40))
 
 
@@ -113,18 +117,17 @@ MOST_LABELS = 15
 
 def test_labels_only_where_they_carry_the_story(recorded) -> None:
     """Counted as the viewer draws them (``tools.labels``): at most ``MOST_LABELS`` per 3D view and frame, none
-    overlapping in the bird's-eye views' default camera at 1920 x 1080, no comparison sentences, and a labelled
+    overlapping in the 3D and camera views' default cameras at 1920 x 1080, no comparison sentences, and a labelled
     track only where a failure of its run names it at that frame."""
     path, _, reports = recorded
     rec = Recording(path)
-    views = [v for v in rec.views if v.name.startswith(("gnnpmb ", "jpda "))]
-    assert len(views) == 4
+    views = [v for v in rec.views if v.name.startswith(("gnnpmb ", "jpda ")) or v.camera]
+    assert sum(not v.camera for v in views) == 4 and sum(v.camera for v in views) == 6
     failing = {
         run: {(f.frame_index, t) for f in report.failures for t in f.track_ids} for run, report in reports.items()
     }
-    size = view_size_px(2)
     for view in views:
-        run = view.name.split(" ")[0]
+        run = view.name.split(" ")[0]  # a camera view's tracks are drawn under the camera, not under /tracks/
         for frame in sorted(rec.frames):
             labels = rec.labels(view, frame)
             assert len(labels) <= MOST_LABELS, (view.name, frame, [label.text for label in labels])
@@ -132,8 +135,10 @@ def test_labels_only_where_they_carry_the_story(recorded) -> None:
                 assert not label.text.startswith("only ") and "shows no track" not in label.text
                 if "/tracks/" in label.entity:
                     assert (frame, label.entity.rsplit("/", 1)[1]) in failing[run], (view.name, frame, label.text)
-            if view.birds_eye:
-                assert not overlaps(screen_boxes(rec, view, frame, size)), (view.name, frame)
+            boxes = camera_boxes(rec, view, frame) if view.camera else screen_boxes(rec, view, frame, view.size_px)
+            assert not overlaps(boxes), (view.name, frame)
+            rect = camera_rect(rec, view) if view.camera else (0.0, 0.0, *view.size_px)
+            assert all(inside(box, rect) for _, box in boxes), (view.name, frame)  # none cut by the view's edge
 
 
 @pytest.mark.parametrize("runs", [1, 2, 3])

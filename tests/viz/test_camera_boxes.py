@@ -1,0 +1,115 @@
+"""Boxes drawn into the camera images (``viz.camera_boxes``): clipped to the image or left out when mostly outside
+it, and words only on the frame's failures, kept apart; read back from a saved recording as the viewer draws
+them (``tools.labels``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import rerun as rr
+import rerun.blueprint as rrb
+from PIL import Image
+from pyquaternion import Quaternion
+
+from gnnpmb.data.scene import Pose
+from gnnpmb.data.sensors import CameraImage, SceneSensors
+from gnnpmb.eval.failures import Failure, FailureBox, FailureKind
+from tests.viz.rrd import read_rows
+from tools.labels import Recording, camera_boxes, overlaps
+from viz import paths
+from viz.camera_boxes import MAX_CAMERA_LABELS, Box, CameraFrame, failure_boxes, log_camera_boxes, project_box
+from viz.cameras import camera_view, log_cameras
+from viz.timeline import PLAIN_CLOCK
+
+WIDTH, HEIGHT = 1600, 900
+K = np.array([[1266.0, 0.0, 800.0], [0.0, 1266.0, 450.0], [0.0, 0.0, 1.0]])
+CAMERA_IN_EGO = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+"""A front camera at the ego origin: its x (right) is the ego's -y, y (down) -z, z (forward) x."""
+FRONT = CameraFrame(CAMERA_IN_EGO.T, np.zeros(3), K, WIDTH, HEIGHT)
+
+
+def _box(x: float, y: float, length: float = 4.5, frame: int = 0, label: str = "") -> Box:
+    return Box(frame, (x, y, 0.0), (2.0, length, 1.6), (1.0, 0.0, 0.0, 0.0), (255, 0, 0), label)
+
+
+def _inside(strips: list[np.ndarray]) -> bool:
+    pts = np.concatenate(strips)
+    return bool(np.all((pts >= -1e-3) & (pts <= np.array([WIDTH, HEIGHT]) + 1e-3)))
+
+
+def test_a_box_in_view_is_drawn_whole_one_at_the_edge_clipped_one_mostly_outside_left_out() -> None:
+    ahead = project_box(_box(20.0, 0.0), FRONT)
+    assert ahead and _inside(ahead) and sum(len(s) - 1 for s in ahead) == 12  # the twelve edges
+    edge = project_box(_box(10.0, 6.0), FRONT)  # centre at u = 40 px, the near corners past the left edge
+    assert edge and _inside(edge) and np.isclose(np.concatenate(edge)[:, 0].min(), 0.0)
+    assert project_box(_box(10.0, 9.0), FRONT) == []  # centre left of the image: mostly outside
+    assert project_box(_box(-10.0, 0.0), FRONT) == []  # behind the camera
+    near = project_box(_box(1.0, 0.0, length=8.0), FRONT)  # reaches behind the camera: cut at the near plane
+    assert near and _inside(near)
+
+
+def _failure(kind: FailureKind, frame: int, role: str, object_id: str, x: float, y: float) -> Failure:
+    box = FailureBox(role, object_id, (x, y, 0.0), (2.0, 4.5, 1.6), (1.0, 0.0, 0.0, 0.0))
+    return Failure(kind, frame, f"sample{frame}", "car", (), (object_id,), (box,))
+
+
+def test_only_the_frames_failures_are_labelled_with_the_run_a_track_belongs_to() -> None:
+    a = SimpleNamespace(failures=(_failure(FailureKind.FALSE_TRACK, 0, "false track", "7", 20.0, 0.0),))
+    b = SimpleNamespace(failures=(*a.failures, _failure(FailureKind.ID_SWITCH, 1, "new track", "9", 15.0, 2.0)))
+    boxes = failure_boxes({"a": a, "b": b}, {0, 1})  # track 7 of a and track 7 of b are two tracks
+    assert [(x.frame, x.label) for x in boxes] == [
+        (0, "a: false track 7"),
+        (0, "b: false track 7"),
+        (1, "b: ID switch: new track 9"),
+    ]
+    assert [x.label for x in failure_boxes({"a": a, "b": b}, {0, 1}, involved={"b": {"9"}})] == [
+        "",
+        "",
+        "b: ID switch: new track 9",
+    ]
+    missed = _failure(FailureKind.MISS, 2, "missed gt", "4ab7b6aaaa", 20.0, 0.0)
+    both = {"a": SimpleNamespace(failures=(missed,)), "b": SimpleNamespace(failures=(missed,))}
+    assert [x.label for x in failure_boxes(both, {2})] == ["missed gt 4ab7b6"]  # one object, both runs missed it
+
+
+@pytest.fixture
+def camera_recording(tmp_path: Path, tiny_scene, strict: None) -> Path:
+    """The tiny scene's three keyframes seen by one front camera, with a crowd of failures ahead at frame 0 and
+    a plain ground-truth box: saved with the camera's view as the blueprint."""
+    scene, _ = tiny_scene
+    jpeg = tmp_path / "front.jpg"
+    Image.new("RGB", (WIDTH, HEIGHT), (90, 120, 90)).save(jpeg)
+    calib = Pose(np.zeros(3), Quaternion(matrix=CAMERA_IN_EGO).elements)
+    images = tuple(
+        (CameraImage("CAM_FRONT", jpeg, k.timestamp_us, WIDTH, HEIGHT, K, k.ego_pose, calib),) for k in scene.keyframes
+    )
+    sensors = SceneSensors(cameras=images, sweeps=())
+    crowd = tuple(_failure(FailureKind.FALSE_TRACK, 0, "false track", str(i), 20.0, 0.3 * i) for i in range(8))
+    report = SimpleNamespace(failures=crowd)
+    layers = {"gt": [_box(12.0, -1.0, frame=f) for f in range(3)], "failures": failure_boxes({"a": report}, {0})}
+    path = tmp_path / "cam.rrd"
+    stream = rr.RecordingStream("camera-boxes-test")
+    stream.set_log_time_enabled(False)
+    stream.save(path, default_blueprint=rrb.Blueprint(rrb.Grid(*[camera_view("CAM_FRONT")] * 6, grid_columns=3)))
+    frames = range(3)
+    log_cameras(stream, scene, sensors, frames, PLAIN_CLOCK)
+    log_camera_boxes(stream, scene, sensors, frames, PLAIN_CLOCK, layers)
+    stream.disconnect()
+    return path
+
+
+def test_camera_labels_are_the_failures_kept_apart_and_every_line_inside_the_image(camera_recording: Path) -> None:
+    rec = Recording(camera_recording)
+    view = rec.views[0]
+    assert view.camera
+    at0 = rec.labels(view, 0)
+    assert 1 <= len(at0) <= MAX_CAMERA_LABELS and all(label.text.startswith("false track ") for label in at0)
+    assert not overlaps(camera_boxes(rec, view, 0))  # eight failures side by side: the ones that fit
+    assert rec.labels(view, 1) == [] and rec.labels(view, 2) == []  # no failure there: no words
+    rows = read_rows(camera_recording)
+    for layer in ("gt", "failures"):
+        strips = [s for r in rows[paths.camera_boxes("CAM_FRONT", layer)] for s in r.get("LineStrips2D:strips") or []]
+        assert strips and _inside([np.asarray(s) for s in strips])

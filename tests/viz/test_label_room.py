@@ -1,0 +1,58 @@
+"""Room for labels in the full recording's 3D views (``viz.label_room``): kept apart in the perspective view as in
+the bird's-eye view, and never cut off by a view's edge; the focus callouts' column on the side that has room."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gnnpmb.data.scene import Pose
+from viz.callouts import CHAR_PX, M_PER_PX_PER_HEIGHT, column_positions
+from viz.label_room import Candidate, eyes, keep_apart, px_per_m
+
+IDENTITY = Pose(np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
+
+
+def test_a_label_the_views_edge_would_cut_is_left_out() -> None:
+    bev = eyes()[:1]
+    half_height_m = 0.5 * bev[0].height_px / px_per_m()
+    near_edge = Candidate(0, "edge", "9 · ID switch, was 4", (bev[0].target_m[0] - half_height_m + 1.0, 0.0))
+    inside = Candidate(0, "inside", "9 · ID switch, was 4", (bev[0].target_m[0], 0.0))
+    assert keep_apart([near_edge, inside], IDENTITY, bev) == {"inside"}  # its text would run below the view
+
+
+def test_labels_apart_from_above_but_on_one_line_of_sight_in_the_perspective_view_keep_one() -> None:
+    bev, perspective = eyes()
+    # 10 m apart on a line of sight of the perspective camera: apart from above, one over the other from behind
+    eye = np.array(perspective.position_m[:2])
+    ahead = (np.array(perspective.target_m[:2]) - eye) / np.linalg.norm(np.array(perspective.target_m[:2]) - eye)
+    a, b = eye + 50.0 * ahead, eye + 60.0 * ahead
+    pair = [Candidate(0, "first", "7 · false track", tuple(a)), Candidate(1, "second", "8 · false track", tuple(b))]
+    assert keep_apart(pair, IDENTITY, (bev,)) == {"first", "second"}
+    assert keep_apart(pair, IDENTITY) == {"first"}
+
+
+def test_the_callout_column_goes_left_when_only_there_it_stays_in_view() -> None:
+    anchors = np.array([[10.0, 0.0], [10.2, 0.5]])
+    chars = np.array([30, 12])
+    height_m = 18.0
+    free = column_positions(anchors, chars, height_m)
+    assert np.all(free[:, 0] > anchors[:, 0].max())
+    half_label_m = 0.5 * CHAR_PX * 30 * M_PER_PX_PER_HEIGHT * height_m
+    tight = column_positions(anchors, chars, height_m, (-5.0, free[0, 0] + half_label_m - 1.0))  # right cut
+    assert np.all(tight[:, 0] < anchors[:, 0].min())
+
+
+def test_the_failure_index_lists_a_rows_ids_when_other_rows_took_numbers_between() -> None:
+    from viz.opening import id_span
+
+    assert id_span(["miss:4"]) == "miss:4"
+    assert id_span(["miss:4", "miss:5", "miss:6"]) == "miss:4 … miss:6"
+    ids = ["false_track:3", "false_track:4", "false_track:5", "false_track:9", "false_track:12", "false_track:13"]
+    assert id_span(ids) == "false_track:3–5, 9, 12–13"  # not "false_track:3 … false_track:13"
+
+
+def test_when_neither_side_has_room_the_column_goes_where_less_is_cut() -> None:
+    anchors = np.array([[0.0, 0.0]])
+    chars = np.array([40])  # a column about 12 m wide at 18 m: wider than either side of a 5 m view
+    assert column_positions(anchors, chars, 18.0, (-2.0, 3.0))[0, 0] > 0.0  # more room on the right
+    assert column_positions(anchors, chars, 18.0, (-3.0, 2.0))[0, 0] < 0.0  # more room on the left

@@ -1,0 +1,332 @@
+"""Boxes drawn into the camera images: each keyframe's ground truth, kept detections and every tracker's tracks,
+projected through the camera's calibration and clipped to the image; words only on the boxes of that frame's
+failures.
+
+Rerun projects 3D boxes into a 2D view itself, but draws a box partly outside the image beyond the image's edge and
+every 3D label with it. Here each box's eight corners go global -> ego (the keyframe's pose) -> camera
+(``gnnpmb.data.sensors.camera_in_ego``) -> pixels (the intrinsic ``K``: ``u = K p / p_z``); an edge is cut where it
+crosses ``NEAR_M`` in front of the camera, then the box's edges are clipped to the image rectangle (shapely). A box
+whose centre is behind the camera or outside the image (mostly outside it) is not drawn.
+
+Labels: one per failure box of the frame (``viz.failures`` words, the run's name in front when only one of several
+runs has it), at the top of the box's drawn part, kept apart at the size the camera grid shows an image
+(``CAMERA_VIEW_SCALE``, ``viz.label_room.keep_clear``) by the failure kinds' order; ``MAX_CAMERA_LABELS`` at most
+per image. In a focus recording only the focus's objects are labelled.
+
+Each layer of each camera is one ``send_columns`` call (one chunk per camera and layer, two where the recording
+opens at a failure), a keyframe's strips one row.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import rerun as rr
+import shapely
+
+from gnnpmb.data.scene import Pose, SceneData
+from gnnpmb.data.sensors import CameraImage, SceneSensors, camera_in_ego
+from gnnpmb.eval.failures import OPEN_FIRST, FailureKind, FailureReport
+from gnnpmb.types import FrameDetections, TrackEstimate
+from viz import paths
+from viz.colors import class_colors, track_color
+from viz.failure_style import KIND_COLORS
+from viz.failures import failure_label
+from viz.label_room import keep_clear, text_box
+from viz.timeline import Clock
+
+NEAR_M = 0.1
+"""Edges are cut this far in front of the camera (metres)."""
+CAMERA_VIEW_SCALE = 0.15
+"""Screen pixels per image pixel of one camera in a two-run recording's 3 x 2 camera grid at 1920 x 1080 (a
+1600 x 900 image in a 384 x 139 px view: 0.154; 0.148 measured on a web viewer's screenshot); larger elsewhere."""
+MAX_CAMERA_LABELS = 4
+"""Labels per camera image and frame, at most."""
+DETECTION_RGB = (170, 170, 170)
+EDGES = ((0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7))
+"""The twelve edges of a box between its corners (``box_corners`` order: bottom face, then top face)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Box:
+    """One box to draw in the cameras at one keyframe: centre, size (w, l, h) and rotation (w, x, y, z) in the
+    global frame, its colour, and its label ("" for none; a failure box's words) with the label's rank."""
+
+    frame: int
+    center_m: tuple[float, float, float]
+    size_wlh_m: tuple[float, float, float]
+    quat_wxyz: tuple[float, float, float, float]
+    rgb: tuple[int, int, int]
+    label: str = ""
+    rank: int = 0
+
+
+def _rotation(quat_wxyz: Sequence[float]) -> np.ndarray:
+    w, x, y, z = (float(v) for v in quat_wxyz)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def box_corners(box: Box) -> np.ndarray:
+    """(8, 3) corners in the global frame: bottom face then top face, counter-clockwise from front-left (the
+    length along the box's x axis, as the devkit's ``Box``)."""
+    w, length, h = box.size_wlh_m
+    x = np.array([1, -1, -1, 1, 1, -1, -1, 1]) * length / 2
+    y = np.array([1, 1, -1, -1, 1, 1, -1, -1]) * w / 2
+    z = np.array([-1, -1, -1, -1, 1, 1, 1, 1]) * h / 2
+    return np.column_stack([x, y, z]) @ _rotation(box.quat_wxyz).T + np.asarray(box.center_m, dtype=np.float64)
+
+
+@dataclass(frozen=True, slots=True)
+class CameraFrame:
+    """Global -> camera for one image at one keyframe: ``to_camera(p)`` maps (N, 3) global points to (N, 3)
+    camera points (x right, y down, z forward); ``K`` (3, 3); the image's width and height in pixels."""
+
+    rotation: np.ndarray
+    translation_m: np.ndarray
+    intrinsic: np.ndarray
+    width_px: int
+    height_px: int
+
+    @staticmethod
+    def of(image: CameraImage, ego: Pose) -> CameraFrame:
+        cam_r, cam_t = camera_in_ego(image, ego)
+        ego_r = _rotation(ego.quat_wxyz)
+        # global -> ego: ego_r.T (p - ego_t); ego -> camera: cam_r.T (q - cam_t)
+        rotation = cam_r.T @ ego_r.T
+        translation = -cam_r.T @ (ego_r.T @ np.asarray(ego.translation_m, dtype=np.float64) + cam_t)
+        return CameraFrame(rotation, translation, np.asarray(image.intrinsic), image.width_px, image.height_px)
+
+    def to_camera(self, points_m: np.ndarray) -> np.ndarray:
+        return np.asarray(points_m, dtype=np.float64) @ self.rotation.T + self.translation_m
+
+    def pixels(self, camera_points_m: np.ndarray) -> np.ndarray:
+        """(N, 3) camera points with z > 0 -> (N, 2) pixels (u right, v down)."""
+        uvw = camera_points_m @ self.intrinsic.T
+        return uvw[:, :2] / uvw[:, 2:3]
+
+
+def project_box(box: Box, cam: CameraFrame) -> list[np.ndarray]:
+    """The drawn part of ``box`` in ``cam``'s image: a list of (K, 2) pixel polylines clipped to the image, empty
+    when the box's centre is behind the camera or outside the image (module docstring)."""
+    centre = cam.to_camera(np.asarray(box.center_m, dtype=np.float64)[None])[0]
+    if centre[2] <= NEAR_M:
+        return []
+    u, v = cam.pixels(centre[None])[0]
+    if not (0 <= u <= cam.width_px and 0 <= v <= cam.height_px):
+        return []
+    corners = cam.to_camera(box_corners(box))
+    segments = []
+    for i, j in EDGES:
+        a, b = corners[i], corners[j]
+        if a[2] < NEAR_M and b[2] < NEAR_M:
+            continue
+        if a[2] < NEAR_M or b[2] < NEAR_M:  # cut the edge at the near plane
+            t = (NEAR_M - a[2]) / (b[2] - a[2])
+            cut = a + t * (b - a)
+            a, b = (cut, b) if a[2] < NEAR_M else (a, cut)
+        segments.append(cam.pixels(np.stack([a, b])))
+    clipped = shapely.clip_by_rect(shapely.MultiLineString(segments), 0.0, 0.0, cam.width_px, cam.height_px)
+    merged = shapely.line_merge(clipped) if not clipped.is_empty else clipped
+    parts = getattr(merged, "geoms", [merged])
+    return [np.asarray(g.coords, dtype=np.float32) for g in parts if not g.is_empty and len(g.coords) >= 2]
+
+
+def scene_boxes(
+    scene: SceneData,
+    frames: range,
+    detections: Sequence[FrameDetections],
+    tracks: Mapping[str, Mapping[tuple[int, int], TrackEstimate]],
+    reports: Mapping[str, FailureReport],
+    involved: Mapping[str, set[str]] | None = None,
+) -> dict[str, list[Box]]:
+    """The boxes of each layer at the keyframes ``frames``: ``gt`` (class colours), ``detections`` (the kept ones;
+    ``detections[k]`` is frame ``frames[k]``), each run's drawn tracks (``tracks``: per run, (frame, track id) ->
+    estimate; the track's colour) and ``failures`` (each run's failure boxes in the kind's colour, labelled; with
+    ``involved``, per run the ids a focus is about, only those labelled)."""
+    layers: dict[str, list[Box]] = {"gt": [], "detections": []}
+    for k, i in enumerate(frames):
+        gt = scene.keyframes[i].gt
+        for j, rgb in enumerate(class_colors(gt.class_name)[:, :3].tolist() if len(gt.class_name) else []):
+            layers["gt"].append(
+                Box(i, tuple(gt.translation_m[j]), tuple(gt.size_wlh_m[j]), tuple(gt.quat_wxyz[j]), tuple(rgb))
+            )
+        det = detections[k]
+        for j in np.flatnonzero(det.kept):
+            b = det.boxes
+            layers["detections"].append(
+                Box(i, tuple(b.translation_m[j]), tuple(b.size_wlh_m[j]), tuple(b.quat_wxyz[j]), DETECTION_RGB)
+            )
+    shown = set(frames)
+    for name, drawn in tracks.items():
+        layers[name] = [
+            Box(f, e.translation_m, e.size_wlh_m, e.quat_wxyz, track_color(track_id))
+            for (f, track_id), e in sorted(drawn.items())
+            if f in shown
+        ]
+    layers["failures"] = failure_boxes(reports, shown, involved)
+    return layers
+
+
+def failure_boxes(
+    reports: Mapping[str, FailureReport], frames: set[int], involved: Mapping[str, set[str]] | None = None
+) -> list[Box]:
+    """Each run's failure boxes at ``frames`` in the kind's colour with ``viz.failures`` words; a ground-truth box
+    several runs share (same frame, kind, role and instance) is drawn once, its label prefixed by the runs' names
+    when only some runs have it; a track's box is its run's own (track ids are per run), prefixed with the run's
+    name when there are several runs. With ``involved`` only the focus's objects get words."""
+    runs: dict[tuple[int, FailureKind, str, str, str], list[str]] = {}
+    first: dict[tuple[int, FailureKind, str, str, str], object] = {}
+    for name, report in reports.items():
+        for failure in report.failures:
+            if failure.frame_index not in frames:
+                continue
+            for box in failure.boxes:
+                owner = "" if box.is_gt else name
+                key = (failure.frame_index, failure.kind, box.role, box.object_id, owner)
+                if name not in runs.setdefault(key, []):
+                    runs[key].append(name)
+                first.setdefault(key, box)
+    out = []
+    for key, names in runs.items():
+        frame, kind, _, object_id, _ = key
+        box = first[key]
+        text = failure_label(kind, box)
+        if len(names) < len(reports):
+            text = f"{', '.join(names)}: {text}"
+        if involved is not None and not any(object_id in involved.get(n, set()) for n in names):
+            text = ""
+        out.append(
+            Box(
+                frame, box.translation_m, box.size_wlh_m, box.quat_wxyz, KIND_COLORS[kind], text, OPEN_FIRST.index(kind)
+            )
+        )
+    return sorted(out, key=lambda b: (b.frame, b.rank, b.label))
+
+
+@dataclass(frozen=True, slots=True)
+class _Drawn:
+    """One layer of one camera, keyframe by keyframe: the strips and their colours, and the labels (anchor
+    pixel, text, colour)."""
+
+    strips: list[list[np.ndarray]]
+    colors: list[list[tuple[int, int, int]]]
+    anchors: list[list[tuple[float, float]]]
+    texts: list[list[str]]
+    label_rgb: list[list[tuple[int, int, int]]]
+
+
+def draw_layer(boxes: Sequence[Box], cams: Mapping[int, CameraFrame], frames: Sequence[int]) -> _Drawn:
+    """``boxes`` projected into one camera at each of ``frames`` (``cams``: that camera at each keyframe); the
+    labelled ones kept apart at ``CAMERA_VIEW_SCALE`` (at most ``MAX_CAMERA_LABELS``)."""
+    at = {f: k for k, f in enumerate(frames)}
+    n = len(frames)
+    drawn = _Drawn(
+        [[] for _ in range(n)],
+        [[] for _ in range(n)],
+        [[] for _ in range(n)],
+        [[] for _ in range(n)],
+        [[] for _ in range(n)],
+    )
+    wanted: list[list[tuple[int, object, tuple[float, float, float, float], str, tuple[float, float], tuple]]] = [
+        [] for _ in range(n)
+    ]
+    for box in boxes:
+        k = at.get(box.frame)
+        if k is None or box.frame not in cams:
+            continue
+        parts = project_box(box, cams[box.frame])
+        if not parts:
+            continue
+        drawn.strips[k].extend(parts)
+        drawn.colors[k].extend([box.rgb] * len(parts))
+        if box.label:
+            points = np.concatenate(parts)
+            cam = cams[box.frame]
+            anchor = _inside_image(
+                box.label,
+                float(0.5 * (points[:, 0].min() + points[:, 0].max())),
+                float(points[:, 1].min()),
+                cam.width_px,
+                cam.height_px,
+            )
+            screen = text_box(box.label, anchor[0] * CAMERA_VIEW_SCALE, anchor[1] * CAMERA_VIEW_SCALE)
+            wanted[k].append((box.rank, len(wanted[k]), screen, box.label, anchor, box.rgb))
+    for k, candidates in enumerate(wanted):
+        keep = keep_clear([(rank, key, screen) for rank, key, screen, *_ in candidates])
+        chosen = [c for c in sorted(candidates, key=lambda c: (c[0], c[1])) if c[1] in keep][:MAX_CAMERA_LABELS]
+        for _, _, _, text, anchor, rgb in chosen:
+            drawn.texts[k].append(text)
+            drawn.anchors[k].append(anchor)
+            drawn.label_rgb[k].append(rgb)
+    return drawn
+
+
+def _inside_image(text: str, u: float, v: float, width_px: int, height_px: int) -> tuple[float, float]:
+    """A label's anchor (pixels) moved so that its text, centred under it at ``CAMERA_VIEW_SCALE``, stays inside
+    the image: a label cut by the view's edge reads as something else."""
+    x0, y0, x1, y1 = (c / CAMERA_VIEW_SCALE for c in text_box(text, 0.0, 0.0))
+    u = min(max(u, -x0), max(width_px - x1, -x0))
+    v = min(max(v, 0.0), height_px - y1)
+    return u, v
+
+
+def log_camera_boxes(
+    stream: rr.RecordingStream,
+    scene: SceneData,
+    sensors: SceneSensors,
+    frames: range,
+    clock: Clock,
+    layers: Mapping[str, Sequence[Box]],
+) -> None:
+    """Each layer of ``layers`` (``scene_boxes``) drawn into every camera at the keyframes ``frames``: one
+    LineStrips2D per camera and layer (``paths.camera_boxes``), failures thicker, and the failures' labels as
+    Points2D (``paths.camera_labels``)."""
+    index = np.array(list(frames), dtype=np.int64)
+    stamps = np.array([scene.keyframes[i].timestamp_us for i in index], dtype=np.int64)
+    for channel in sensors.channels:
+        cams = {
+            i: CameraFrame.of(image, scene.keyframes[i].ego_pose)
+            for i in frames
+            for image in sensors.cameras[i]
+            if image.channel == channel
+        }
+        for layer, boxes in layers.items():
+            drawn = draw_layer(boxes, cams, list(frames))
+            radius = rr.components.Radius.ui_points(2.5 if layer == "failures" else 1.0)
+            clock.send(stream, paths.camera_boxes(channel, layer), index, stamps, _strip_columns(drawn, radius))
+            if layer == "failures":
+                clock.send(stream, paths.camera_labels(channel), index, stamps, _label_columns(drawn))
+
+
+def _strip_columns(drawn: _Drawn, radius: rr.components.Radius) -> Callable[[np.ndarray], rr.ComponentColumnList]:
+    def columns(rows: np.ndarray) -> rr.ComponentColumnList:
+        strips = [s for r in rows for s in drawn.strips[r]]
+        colors = [c for r in rows for c in drawn.colors[r]]
+        lengths = [len(drawn.strips[r]) for r in rows]
+        cols = rr.LineStrips2D.columns(strips=strips, colors=colors, radii=[radius] * len(strips))
+        return cols.partition(lengths)
+
+    return columns
+
+
+def _label_columns(drawn: _Drawn) -> Callable[[np.ndarray], rr.ComponentColumnList]:
+    def columns(rows: np.ndarray) -> rr.ComponentColumnList:
+        anchors = [a for r in rows for a in drawn.anchors[r]]
+        lengths = [len(drawn.anchors[r]) for r in rows]
+        cols = rr.Points2D.columns(
+            positions=np.asarray(anchors, dtype=np.float32).reshape(-1, 2),
+            labels=[t for r in rows for t in drawn.texts[r]],
+            colors=[c for r in rows for c in drawn.label_rgb[r]],
+            radii=[rr.components.Radius.ui_points(3.0)] * len(anchors),
+        )
+        return rr.ComponentColumnList([*cols.partition(lengths), *rr.Points2D.columns(show_labels=[True] * len(rows))])
+
+    return columns
