@@ -69,9 +69,7 @@ class Disagreement:
         gt = f"{self.class_name} GT {short_gt_id(self.gt_id)}"
         match self.kind:
             case DisagreementKind.MISSED_BY_ONE:
-                return (
-                    f"{gt}: tracked by {self.tracker} (track {self.track_ids[0]}), no shown track of {self.other} on it"
-                )
+                return f"{gt}: {self.tracker} shows track {self.track_ids[0]} on it, {self.other} shows no track on it"
             case DisagreementKind.ID_CHANGE:
                 old, new, kept = self.track_ids
                 return f"{gt}: {self.tracker} switched track {old} -> {new}, {self.other} kept track {kept}"

@@ -29,7 +29,7 @@ KIND_COLORS: dict[DisagreementKind, tuple[int, int, int]] = {
 }
 """Colours apart from the class colours and from the failure markers' (``viz.failure_style.KIND_COLORS``)."""
 KIND_LABELS: dict[DisagreementKind, str] = {
-    DisagreementKind.MISSED_BY_ONE: "tracked by one only",
+    DisagreementKind.MISSED_BY_ONE: "shown by one only",
     DisagreementKind.ID_CHANGE: "id changed in one only",
     DisagreementKind.ONLY_IN_ONE: "track in one only",
 }

@@ -92,7 +92,7 @@ def test_disagreement_boxes_and_descriptions() -> None:
     assert lone.translation_m == (20.0, 5.0, 1.0)
     assert lone.describe() == "car track 8 of A matches no GT; B shows no car track there"
     missed = comparison.of_kind(MISSED)[0]
-    assert missed.describe() == "car GT g2: tracked by A (track 2), no shown track of B on it"
+    assert missed.describe() == "car GT g2: A shows track 2 on it, B shows no track on it"
 
 
 def test_identical_trackers_agree_and_three_trackers_compare_pairwise() -> None:
