@@ -1,12 +1,12 @@
-"""Runs Poly-MOT's own, unmodified tracker (Li et al. 2023, github lixiaoyu2000/Poly-MOT) frame by frame and
-prints its CPU time per frame as JSON; started by ``polymot_speed.py`` with Poly-MOT's own Python environment
-(numba, lap, ...), never imported by this project.
+"""Runs Poly-MOT's own, unmodified tracker (Li et al. 2023, its authors' public repository
+lixiaoyu2000/Poly-MOT) frame by frame and prints its CPU time per frame as JSON; started by ``polymot_speed.py``
+with Poly-MOT's own Python environment (numba, lap, ...), never imported by this project.
 
 Usage: PYTHON polymot_driver.py POLYMOT_DIR DETECTIONS.json FIRST_TOKENS.json OUT.json
 
 Times ``Tracker.tracking(frame)`` only: its loader's score filter and NMS (preprocessing, which this project's
-tracker times leave out as well) run outside the timed part. The first frame of the run includes numba's
-compilation; the caller reports medians and the mean without it.
+tracker times leave out as well) run outside the timed part. numba compiles on first use, inside one frame's
+time; the caller compares medians.
 """
 
 import contextlib
