@@ -483,8 +483,9 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         return best
 
     def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
-        """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r, times
-        d^n for a Bernoulli missed n frames in a row (``[pmb] miss_score_decay`` d)."""
+        """Step 6: Bernoullis with r >= the extraction threshold, missed at most ``[pmb] output_max_misses`` frames
+        in a row; tracking score = detection score x r, times d^n for a Bernoulli missed n frames in a row
+        (``[pmb] miss_score_decay`` d)."""
         threshold = self.params.extraction_threshold
         b = posterior
         keep = (b.existence >= threshold) & (b.misses <= self.params.output_max_misses)
