@@ -22,11 +22,19 @@ Kirubarajan 2001, sec. 5.2 for the Gaussian noise; Mahler 2007, ch. 9 for P_D, c
 - birth: new objects per keyframe (annotations whose instance was not counted at an earlier keyframe of the scene,
   after its first keyframe) divided by the detections per keyframe, the weight w_b of each detection's birth
   component (``models.measurement_birth``), with where births happen (median range) as a comment;
+- process noise q_x, q_y of the constant-velocity model: the variance of the annotations' velocity change per
+  keyframe (``process_noise``);
 - score threshold: the lowest score from which every 0.05-wide score window holding ``MIN_SAMPLES`` detections is
   true with probability at least ``MIN_PRECISION``;
 - the box Kalman noise of ``prob3dmot`` (``gnnpmb.box.noise``).
 
-A statistic with fewer than ``MIN_SAMPLES`` samples keeps the value of the base configuration.
+A statistic with fewer than ``MIN_SAMPLES`` samples keeps the value of the base configuration. Process noise,
+clutter intensity (and its velocity density) and the birth weight are never written below the base
+configuration's (the comment then gives the learnt value): the trackers' models are cruder than the data (a
+Gaussian for heavy-tailed manoeuvres; a birth component at every detection), and on the dev set's ``mini_train``
+the learnt values below the defaults lost AMOTA in-sample (issue 32 in ``docs/results.md``: Q of 1e-4 from the
+mostly parked objects, 0.92 -> 0.77; the learnt clutter, ~40 times below the default, made clutter detections
+tracks at once).
 """
 
 from __future__ import annotations
@@ -293,35 +301,38 @@ def learn_class(cls: str, s: ClassSamples, base: TrackerConfig) -> list[Learnt]:
     clutter = s.clutter_score[s.clutter_score >= t]
     area_m2 = math.pi * s.range_m**2
     if len(s.detection_score) >= MIN_SAMPLES:
-        kappa = max(len(clutter) / frames / area_m2, 1e-7)
+        kappa, floor = len(clutter) / frames / area_m2, base.resolved(cls).models.clutter_intensity
         out.append(
             Learnt(
                 own,
                 "clutter_intensity",
-                kappa,
+                max(kappa, floor),
                 f"{len(clutter)} unmatched detections with score >= {t:g} over {s.frames} keyframes and "
-                f"pi {s.range_m:g}^2 m^2 (1/m^2)",
+                f"pi {s.range_m:g}^2 m^2 (1/m^2){_raised(kappa, floor)}",
             )
         )
     if len(clutter) >= MIN_SAMPLES:
         v = s.clutter_velocity_mps[s.clutter_score >= t]
         sx, sy = np.maximum(np.std(v, axis=0), 0.1).tolist()
-        density = 1.0 / (4.0 * math.pi * sx * sy)
+        density, floor = 1.0 / (4.0 * math.pi * sx * sy), base.resolved(cls).pmb.clutter_velocity_density
         out.append(
             Learnt(
                 pmb,
                 "clutter_velocity_density",
-                density,
+                max(density, floor),
                 f"mean density 1/(4 pi sx sy) of a Gaussian fitted to {len(v)} clutter velocities, sx {sx:.2f}, "
-                f"sy {sy:.2f} m/s (1/(m/s)^2)",
+                f"sy {sy:.2f} m/s (1/(m/s)^2){_raised(density, floor)}",
             )
         )
     kept = np.sum(s.detection_score >= t)
     if s.later_keyframes and kept >= MIN_SAMPLES:
         births = len(s.birth_range_m)
         per_frame = births / s.later_keyframes
-        w_b = float(np.clip(per_frame / (kept / frames), 1e-4, 1.0))
+        rate = per_frame / (kept / frames)
+        floor = base.resolved(cls).models.birth_weight
+        w_b = float(np.clip(max(rate, floor), 1e-4, 1.0))
         where = f", median range {np.median(s.birth_range_m):.0f} m" if births else ""
+        where += _raised(rate, floor)
         out.append(
             Learnt(
                 own,
@@ -331,6 +342,32 @@ def learn_class(cls: str, s: ClassSamples, base: TrackerConfig) -> list[Learnt]:
                 f"{where}) / {kept / frames:.2f} detections with score >= {t:g} per keyframe",
             )
         )
+    return out
+
+
+def _raised(learnt: float, floor: float) -> str:
+    """The comment saying a learnt value below the base configuration's was raised to it (module docstring)."""
+    return f"; {learnt:.3g} raised to the base's {floor:g}" if learnt < floor else ""
+
+
+def process_noise(cls: str, velocity_change_mps: np.ndarray, base: TrackerConfig) -> list[Learnt]:
+    """q_x, q_y of the constant-velocity model (``ClassParams``; Q = diag(q_x, q_y, q_x, q_y) per keyframe): the
+    variance of the annotations' velocity change from one keyframe to the next (``box.noise``: dv (N, 3), x y z),
+    the white-acceleration model's velocity noise per step (Bar-Shalom, Li & Kirubarajan 2001, sec. 6.2), never
+    below the base configuration's: parked and cruising objects make most changes ~0, while the changes that
+    matter, a cyclist braking or turning while missed, are the tails a Gaussian fitted to all of them
+    under-states (a smaller Q loses such an object's track: ``config.TWO_WHEELER_Q``). Nothing below
+    ``MIN_SAMPLES`` changes."""
+    dv = velocity_change_mps[:, :2]
+    dv = dv[np.isfinite(dv).all(axis=1)]
+    if len(dv) < MIN_SAMPLES:
+        return []
+    own = base.classes[cls]
+    out = []
+    for axis, v, floor in zip("xy", np.var(dv, axis=0).tolist(), (own.q_x, own.q_y), strict=True):
+        source = f"variance of the annotated velocity change per keyframe ((m/s)^2), {len(dv)} changes"
+        source += _raised(v, floor)
+        out.append(Learnt(f"classes.{cls}", f"q_{axis}", max(v, floor), source))
     return out
 
 
@@ -364,12 +401,12 @@ def calibrate(
 ) -> tuple[dict[str, list[Learnt]], dict[str, list[str]], TrackerConfig]:
     """Per class, the learnt values and comment lines; and ``base`` with ``prob3dmot``'s box noise learnt."""
     samples = collect(scenes, detections, class_range_m, match_distance_m)
-    learnt = {c: learn_class(c, samples[c], base) for c in TRACKING_CLASSES}
+    box = collect_samples(scenes, detections, TRACKING_CLASSES)
+    learnt = {c: process_noise(c, box[c].dv, base) + learn_class(c, samples[c], base) for c in TRACKING_CLASSES}
     notes = {}
     for c in TRACKING_CLASSES:
         t = next((v.value for v in learnt[c] if v.key == "score_threshold"), None)
         notes[c] = curves(samples[c], base.resolved(c).preprocess.score_threshold if t is None else t)
-    box = collect_samples(scenes, detections, TRACKING_CLASSES)
     noise = {c: noise_from_samples(box[c], base.box_noise[c]) for c in TRACKING_CLASSES}
     return learnt, notes, dataclasses.replace(base, box_noise=noise)
 

@@ -27,7 +27,8 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
     existence: (K,) r in [0, 1]; mean: (K, n) ([x, y, vx, vy], or with the turn rate omega); cov: (K, n, n);
     det: the last associated detection's fields (``score``, ``z_m``, ... read through as the Bernoullis' own);
     misses: (K,) int64, frames since the last detection (0 for a Bernoulli detected this frame; the prediction
-    adds 1), which sets the decayed output score of a missed track (``PmbParams.miss_score_decay``).
+    adds 1), which sets the decayed output score of a missed track (``PmbParams.miss_score_decay``) and whether it
+    is output at all (``PmbParams.output_max_misses``).
     """
 
     track_id: np.ndarray

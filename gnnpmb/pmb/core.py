@@ -483,10 +483,12 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         return best
 
     def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
-        """Step 6: Bernoullis with r >= the extraction threshold; tracking score = detection score x r, times
-        d^n for a Bernoulli missed n frames in a row (``[pmb] miss_score_decay`` d)."""
+        """Step 6: Bernoullis with r >= the extraction threshold, missed at most ``[pmb] output_max_misses`` frames
+        in a row; tracking score = detection score x r, times d^n for a Bernoulli missed n frames in a row
+        (``[pmb] miss_score_decay`` d)."""
         threshold = self.params.extraction_threshold
-        b, keep = posterior, posterior.existence >= threshold
+        b = posterior
+        keep = (b.existence >= threshold) & (b.misses <= self.params.output_max_misses)
         det, track_id, mean, existence, misses = b.det, b.track_id, b.mean, b.existence, b.misses
         if not keep.all():
             sel = keep.nonzero()[0]

@@ -1,5 +1,6 @@
-"""Missed Bernoullis are output at their prediction with a decayed score (``[pmb] miss_score_decay``), and the
-coordinated-turn state runs through the PMB trackers with events showing [x, y, vx, vy]."""
+"""Missed Bernoullis are output at their prediction with a decayed score (``[pmb] miss_score_decay``) for at most
+``[pmb] output_max_misses`` frames in a row, and the coordinated-turn state runs through the PMB trackers with
+events showing [x, y, vx, vy]."""
 
 from __future__ import annotations
 
@@ -28,6 +29,20 @@ def test_missed_track_score_decays_by_the_factor_per_missed_frame():
         assert est.score == pytest.approx(0.8 * est.existence * 0.5**n, rel=1e-12)
     (est,) = core.step(make_measurements([(5.0, 0.0)], 0.7, velocity=[(2.0, 0.0)]), 0.5, NullSink())
     assert core.hypotheses[0].bernoullis.misses.tolist() == [0] and est.score == pytest.approx(0.7 * est.existence)
+
+
+def test_a_track_missed_beyond_output_max_misses_stays_in_the_filter_but_is_not_output():
+    cfg = with_params(TrackerConfig(), {"pmb.output_max_misses": 1})
+    core = PmbCore("car", cfg, BestAssignment(), IdAllocator())
+    for t in range(3):
+        (born,) = core.step(
+            make_measurements([(1.0 * t, 0.0)], 0.8, velocity=[(2.0, 0.0)]), 0.5 if t else 0.0, NullSink()
+        )
+    assert len(core.step(make_measurements([], 0.8), 0.5, NullSink())) == 1
+    assert core.step(make_measurements([], 0.8), 0.5, NullSink()) == []
+    assert core.hypotheses[0].bernoullis.misses.tolist() == [2]
+    (back,) = core.step(make_measurements([(6.0, 0.0)], 0.8, velocity=[(2.0, 0.0)]), 0.5, NullSink())
+    assert back.track_id == born.track_id
 
 
 @pytest.mark.parametrize(
