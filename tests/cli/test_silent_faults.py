@@ -23,6 +23,7 @@ from pathlib import Path
 import pytest
 
 from tests.cli.test_user_errors import BIN, VIZ, _check, _env, _snapshot, _work_folder
+from tests.inprocess import run_script_with
 
 DATASET_INPUT = "the dataset's files are inputs"
 LOOP = "is a symlink loop"
@@ -119,55 +120,82 @@ def _box(token: str, k: int, **changes: object) -> dict:
 # --- case 1, 8, 11, 14: refused at start-up, before the dataset is read --------------------------------------------
 
 
-def _early_cases(demo: Path) -> list[tuple[str, str, str]]:
-    table = demo / "v1.0-mini" / "sample_annotation.json"
-    return [
-        ("1 out is a table", f"gnnpmb track --out {table}", DATASET_INPUT),
-        ("1 out is the splits file", f"gnnpmb track --out {demo}/v1.0-mini/splits.json", DATASET_INPUT),
-        ("1 out is a table, relative", "gnnpmb track --out demo/v1.0-mini/scene.json", DATASET_INPUT),
-        ("1 out is a table, symlink", "gnnpmb track --out table.json", DATASET_INPUT),
-        ("1 out is a table, hard link", "gnnpmb track --out hard-table.json", "a hard link of the nuScenes file"),
-        ("1 json is a table", f"gnnpmb failures scene-0103 --json {demo}/v1.0-mini/scene.json", DATASET_INPUT),
-        ("1 save in the sensor folder", f"{VIZ} scene-0103 --save {demo}/samples/x.rrd", DATASET_INPUT),
-        ("1 eval out is the table folder", f"gnnpmb eval good.json --out {demo}/v1.0-mini", DATASET_INPUT),
-        ("8 loop out", "gnnpmb track --out loop.json", LOOP),
-        ("8 loop detections", "gnnpmb track --out new.json --detections loop.json", LOOP),
-        ("8 loop params", "gnnpmb track --out new.json --params loop.json", LOOP),
-        ("8 loop save", f"{VIZ} scene-0103 --save loop.rrd", LOOP),
-        ("8 loop results", "gnnpmb failures scene-0103 --results mine=loop.json", LOOP),
-        ("8 loop eval", "gnnpmb eval loop.json", LOOP),
-        ("8 loop recording", f"{VIZ} reproduce loop.rrd", LOOP),
-        ("8 loop dataroot", "gnnpmb track --out new.json --dataroot loop.json", LOOP),
-        ("11 name too long", f"gnnpmb track --out {'n' * 252}.json", "the name is 257 bytes long"),
-        ("14 bind not an address", f"{VIZ} scene-0103 --serve --bind nowhere", "--bind nowhere: not an IP address"),
-        ("14 bind without serve", f"{VIZ} scene-0103 --save x.rrd --bind 0.0.0.0", "--bind only applies with --serve"),
-    ]
+EARLY_CASES: tuple[tuple[str, str, str], ...] = (
+    # (name, command with {demo} for the dataroot, text of the error line)
+    ("1 out is a table", "gnnpmb track --out {demo}/v1.0-mini/sample_annotation.json", DATASET_INPUT),
+    ("1 out is the splits file", "gnnpmb track --out {demo}/v1.0-mini/splits.json", DATASET_INPUT),
+    ("1 out is a table, relative", "gnnpmb track --out demo/v1.0-mini/scene.json", DATASET_INPUT),
+    ("1 out is a table, symlink", "gnnpmb track --out table.json", DATASET_INPUT),
+    ("1 out is a table, hard link", "gnnpmb track --out hard-table.json", "a hard link of the nuScenes file"),
+    ("1 json is a table", "gnnpmb failures scene-0103 --json {demo}/v1.0-mini/scene.json", DATASET_INPUT),
+    ("1 save in the sensor folder", f"{VIZ} scene-0103 --save {{demo}}/samples/x.rrd", DATASET_INPUT),
+    ("1 eval out is the table folder", "gnnpmb eval good.json --out {demo}/v1.0-mini", DATASET_INPUT),
+    ("8 loop out", "gnnpmb track --out loop.json", LOOP),
+    ("8 loop detections", "gnnpmb track --out new.json --detections loop.json", LOOP),
+    ("8 loop params", "gnnpmb track --out new.json --params loop.json", LOOP),
+    ("8 loop save", f"{VIZ} scene-0103 --save loop.rrd", LOOP),
+    ("8 loop results", "gnnpmb failures scene-0103 --results mine=loop.json", LOOP),
+    ("8 loop eval", "gnnpmb eval loop.json", LOOP),
+    ("8 loop recording", f"{VIZ} reproduce loop.rrd", LOOP),
+    ("8 loop dataroot", "gnnpmb track --out new.json --dataroot loop.json", LOOP),
+    ("11 name too long", f"gnnpmb track --out {'n' * 252}.json", "the name is 257 bytes long"),
+    ("14 bind not an address", f"{VIZ} scene-0103 --serve --bind nowhere", "--bind nowhere: not an IP address"),
+    ("14 bind without serve", f"{VIZ} scene-0103 --save x.rrd --bind 0.0.0.0", "--bind only applies with --serve"),
+)
 
 
+def _early_work(case: tuple[str, str, str], root: Path, demo: Path) -> Path:
+    """The case's work folder: good outputs, the dataset linked in (``demo``, ``table.json``, a hard link of a
+    table) and symlink loops."""
+    work = _work_folder(root / case[0].replace(" ", "_").replace(",", ""))
+    (work / "demo").symlink_to(demo)
+    (work / "table.json").symlink_to(demo / "v1.0-mini" / "sample_annotation.json")
+    os.link(demo / "v1.0-mini" / "sample_annotation.json", work / "hard-table.json")
+    for suffix in (".json", ".rrd"):
+        (work / f"loop{suffix}").symlink_to(f"loop2{suffix}")
+        (work / f"loop2{suffix}").symlink_to(f"loop{suffix}")
+    return work
+
+
+EARLY_REAL_PROCESS = ("1 out is a table, hard link", "8 loop save")
+"""Early cases run again through the installed scripts (one per entry point)."""
+
+
+@pytest.mark.parametrize("case", EARLY_CASES, ids=lambda c: c[0])
 def test_outputs_onto_the_dataset_loops_and_long_names_are_one_line_before_any_work(
-    demo_dataroot: Path, tmp_path: Path
+    case: tuple[str, str, str],
+    demo_dataroot: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
+    """In-process (``tests.inprocess.run_script``); the dataset's tables are unchanged after each."""
+    name, command, expected = case
+    dataset_before = _tree(demo_dataroot / "v1.0-mini")
+    work = _early_work(case, tmp_path, demo_dataroot)
+    before = _snapshot(work)
+    proc = run_script_with(command.format(demo=demo_dataroot).split(), _env(demo_dataroot), work, monkeypatch, capsys)
+    assert _check(name, proc, expected) == []
+    assert _snapshot(work) == before
+    assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
+
+
+def test_early_refusals_in_real_processes(demo_dataroot: Path, tmp_path: Path) -> None:
     dataset_before = _tree(demo_dataroot / "v1.0-mini")
     env = _env(demo_dataroot)
+    cases = [c for c in EARLY_CASES if c[0] in EARLY_REAL_PROCESS]
+    assert len(cases) == len(EARLY_REAL_PROCESS)
 
     def one(case: tuple[str, str, str]) -> list[str]:
-        name, command, expected = case
-        work = _work_folder(tmp_path / name.replace(" ", "_").replace(",", ""))
-        (work / "demo").symlink_to(demo_dataroot)
-        (work / "table.json").symlink_to(demo_dataroot / "v1.0-mini" / "sample_annotation.json")
-        os.link(demo_dataroot / "v1.0-mini" / "sample_annotation.json", work / "hard-table.json")
-        for suffix in (".json", ".rrd"):
-            (work / f"loop{suffix}").symlink_to(f"loop2{suffix}")
-            (work / f"loop2{suffix}").symlink_to(f"loop{suffix}")
+        work = _early_work(case, tmp_path, demo_dataroot)
         before = _snapshot(work)
-        proc = _run(command.split(), env, work)
-        problems = _check(name, proc, expected)
+        problems = _check(case[0], _run(case[1].format(demo=demo_dataroot).split(), env, work), case[2])
         if _snapshot(work) != before:
-            problems.append(f"{name}: files changed")
+            problems.append(f"{case[0]}: files changed")
         return problems
 
-    with ThreadPoolExecutor(max_workers=4) as pool:
-        problems = [p for found in pool.map(one, _early_cases(demo_dataroot)) for p in found]
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        problems = [p for found in pool.map(one, cases) for p in found]
     assert problems == []
     assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
 
