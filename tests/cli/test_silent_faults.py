@@ -203,7 +203,7 @@ def test_early_refusals_in_real_processes(demo_dataroot: Path, tmp_path: Path) -
 def test_a_255_byte_output_name_is_written(demo_dataroot: Path, tmp_path: Path) -> None:
     """The longest legal name works: the temporary file beside it is named within the limit too."""
     name = "r" * 250 + ".json"
-    proc = _run(["gnnpmb", "track", "--out", name, "--no-progress"], _env(demo_dataroot), tmp_path)
+    proc = _run(["gnnpmb", "track", "--out", name, "--tracker", "gnn", "--no-progress"], _env(demo_dataroot), tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert [p.name for p in tmp_path.iterdir()] == [name]
     assert json.loads((tmp_path / name).read_text())["results"]
@@ -337,35 +337,38 @@ def test_a_damaged_detection_index_side_file_is_rebuilt(demo_dataroot: Path, tmp
 # --- case 3, 5, 6, 12: results files and tables checked like detection files ------------------------------------------
 
 
-def test_results_files_the_devkit_would_read_otherwise_are_one_line(demo_dataroot: Path, tmp_path: Path) -> None:
-    cases = {
-        "mixed ids": (lambda t, k: _box(t, k, tracking_id=k if k % 2 else str(k)), "tracking_id is an integer"),
-        "zero quaternion": (lambda t, k: _box(t, k, rotation=[0.0, 0.0, 0.0, 0.0]), "is not a rotation"),
-        "non-unit quaternion": (lambda t, k: _box(t, k, rotation=[0.5, 0.0, 0.0, 0.0]), "not a unit quaternion"),
-        "zero size": (lambda t, k: _box(t, k, size=[0.0, 4.5, 1.6]), "field 'size' must be positive"),
-        "far away": (lambda t, k: _box(t, k, translation=[1e6 + 600.0, 1600.0, 1.0]), "beyond 1e+05 m"),
-    }
+RESULTS_CASES = {
+    "mixed ids": (lambda t, k: _box(t, k, tracking_id=k if k % 2 else str(k)), "tracking_id is an integer"),
+    "zero quaternion": (lambda t, k: _box(t, k, rotation=[0.0, 0.0, 0.0, 0.0]), "is not a rotation"),
+    "non-unit quaternion": (lambda t, k: _box(t, k, rotation=[0.5, 0.0, 0.0, 0.0]), "not a unit quaternion"),
+    "zero size": (lambda t, k: _box(t, k, size=[0.0, 4.5, 1.6]), "field 'size' must be positive"),
+    "far away": (lambda t, k: _box(t, k, translation=[1e6 + 600.0, 1600.0, 1.0]), "beyond 1e+05 m"),
+}
+
+
+@pytest.mark.parametrize("name", RESULTS_CASES)
+def test_results_files_the_devkit_would_read_otherwise_are_one_line(
+    name: str,
+    demo_dataroot: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """In-process (``tests.inprocess.run_script_with``): the checks of the file are under test; a results file's
+    one line in a real process is ``test_user_errors``' 'eval truncated'."""
+    box_of, expected = RESULTS_CASES[name]
     env = _cache_env(demo_dataroot, tmp_path / "cache")
-
-    def one(item: tuple[str, tuple]) -> list[str]:
-        name, (box_of, expected) = item
-        work = tmp_path / name.replace(" ", "_")
-        work.mkdir()
-        _submission(work / "r.json", demo_dataroot, box_of)
-        before = _snapshot(work)
-        problems = []
-        for command in (
-            ["gnnpmb", "eval", "r.json", "--out", "ev"],
-            ["gnnpmb", "failures", "scene-0103", "--results", "mine=r.json"],
-        ):
-            problems += _check(f"{name}: {command[1]}", _run(command, env, work), expected)
-        if _snapshot(work) != before:
-            problems.append(f"{name}: files changed")
-        return problems
-
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        problems = [p for found in pool.map(one, cases.items()) for p in found]
-    assert problems == []
+    work = tmp_path / "work"
+    work.mkdir()
+    _submission(work / "r.json", demo_dataroot, box_of)
+    before = _snapshot(work)
+    for command in (
+        ["gnnpmb", "eval", "r.json", "--out", "ev"],
+        ["gnnpmb", "failures", "scene-0103", "--results", "mine=r.json"],
+    ):
+        proc = run_script_with(command, env, work, monkeypatch, capsys)
+        assert _check(f"{name}: {command[1]}", proc, expected) == []
+    assert _snapshot(work) == before
 
 
 def test_a_dataset_without_annotations_is_said_once(demo_dataroot: Path, tmp_path: Path) -> None:
