@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.cli.test_user_errors import BIN, VIZ, _check, _env, _snapshot, _work_folder
+from tests.cli.test_user_errors import BIN, VIZ, _check, _env, _scene_tokens, _snapshot, _work_folder
 from tests.inprocess import run_script_with
 
 DATASET_INPUT = "the dataset's files are inputs"
@@ -49,17 +49,6 @@ def _copy_tables(demo: Path, to: Path) -> Path:
     for name in ("samples", "maps"):
         (to / name).symlink_to(demo / name)
     return to
-
-
-def _scene_tokens(dataroot: Path, scene_name: str) -> list[str]:
-    tables = dataroot / "v1.0-mini"
-    scene = next(s for s in json.loads((tables / "scene.json").read_text()) if s["name"] == scene_name)
-    samples = {s["token"]: s for s in json.loads((tables / "sample.json").read_text())}
-    tokens, token = [], scene["first_sample_token"]
-    while token:
-        tokens.append(token)
-        token = samples[token]["next"]
-    return tokens
 
 
 def _detections(path: Path, demo: Path, x_m: float = 600.0) -> None:
