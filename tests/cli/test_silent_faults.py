@@ -12,7 +12,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 import socket
 import subprocess
 import time
@@ -214,51 +213,6 @@ def test_a_port_taken_on_ipv6_loopback_counts_as_in_use(demo_dataroot: Path, tmp
 
 
 # --- case 14: what --serve listens on --------------------------------------------------------------------------------
-
-
-def _listening(port: int) -> list[str]:
-    """The local addresses (hex, as /proc/net/tcp* shows them) listening on TCP ``port``."""
-    out = []
-    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
-        with open(table) as f:
-            for line in f.readlines()[1:]:
-                fields = line.split()
-                address, port_hex = fields[1].split(":")
-                if int(port_hex, 16) == port and fields[3] == "0A":
-                    out.append(address)
-    return out
-
-
-@pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
-def test_serve_listens_on_loopback_only(demo_dataroot: Path, tmp_path: Path) -> None:
-    from tests.gnnpmb.test_serve import _free_ports
-
-    web, grpc = _free_ports(2)
-    argv = [str(BIN / VIZ), "scene-0103", "--tracker", "gnn", "--frames", "0:2", "--no-failures", "--no-progress"]
-    argv += ["--serve", "--web-port", str(web), "--grpc-port", str(grpc)]
-    proc = subprocess.Popen(
-        argv,
-        env=_env(demo_dataroot),
-        cwd=tmp_path,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
-    try:
-        lines: list[str] = []
-        while not (lines and lines[-1].startswith("serving")):
-            line = proc.stderr.readline()
-            assert line, f"ended early: {lines}"
-            lines.append(line)
-        assert lines[0].startswith(f"web viewer: http://127.0.0.1:{web}/"), lines
-        for port in (web, grpc):
-            assert _listening(port) == ["0100007F"], (port, _listening(port))  # 127.0.0.1, nothing else
-    finally:
-        proc.send_signal(signal.SIGINT)
-        proc.communicate(timeout=60)
-    assert proc.returncode == 0
-    assert _listening(web) == [] and _listening(grpc) == []  # the web viewer's process ended with the run
 
 
 # --- case 2: caches key on content ------------------------------------------------------------------------------------
