@@ -23,11 +23,17 @@ def run_main(main: Callable[[list[str]], object], argv: list[str], capsys: pytes
     return code, out, err
 
 
+FRESH_PROCESS_STATE = ("_DATASETS", "_CHECKED")
+"""``gnnpmb.outputs``' lists of the datasets opened and the outputs checked by this process: empty at the start of
+each in-process command, as in a new process."""
+
+
 def run_script(argv: Sequence[str], capsys: pytest.CaptureFixture[str]) -> subprocess.CompletedProcess[str]:
     """A console script's command line (``gnnpmb-viz ...`` or ``gnnpmb ...``) in-process, as the script runs it
     up to the point where a real process would exit: exit code, stdout and stderr as ``subprocess.run`` gives
     them. An exception escaping the command is printed as the interpreter would (a traceback, exit 1)."""
     from cli.errors import check_version_flag, run_app
+    from gnnpmb import outputs
 
     program, args = argv[0], list(argv[1:])
     if program == "gnnpmb-viz":
@@ -41,11 +47,14 @@ def run_script(argv: Sequence[str], capsys: pytest.CaptureFixture[str]) -> subpr
     else:
         raise ValueError(f"not a console script of this project: {program}")
     capsys.readouterr()
-    try:
-        code, out, err = run_main(main, args, capsys)
-    except Exception:
-        out, err = capsys.readouterr()
-        code, err = 1, err + traceback.format_exc()
+    with pytest.MonkeyPatch.context() as patch:
+        for name in FRESH_PROCESS_STATE:  # what an earlier command in this process would have left
+            patch.setattr(outputs, name, [])
+        try:
+            code, out, err = run_main(main, args, capsys)
+        except Exception:
+            out, err = capsys.readouterr()
+            code, err = 1, err + traceback.format_exc()
     return subprocess.CompletedProcess(list(argv), code, out, err)
 
 
