@@ -1,10 +1,43 @@
-"""Shared fixtures: the synthetic demo dataset, generated once per test session."""
+"""Shared fixtures: the synthetic demo dataset and its recording, made once per test session (shared by the xdist
+workers), and runs of other trackers on it."""
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
+import io
+import os
+import shutil
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
+
+
+@contextlib.contextmanager
+def _locked(path: Path) -> Iterator[None]:
+    with open(path, "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+
+
+def made_once(tmp_path_factory: pytest.TempPathFactory, name: str, make: Callable[[Path], None]) -> Path:
+    """The folder ``name`` filled by ``make(folder)`` once per test session: under pytest-xdist the workers share
+    it (made by the first that needs it while the others wait on a file lock, as xdist's documentation shows);
+    treat it as read-only."""
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base  # the session's folder of all workers
+    folder, done = root / f"shared-{name}", root / f"shared-{name}.done"
+    with _locked(root / f"shared-{name}.lock"):
+        if not done.exists():
+            shutil.rmtree(folder, ignore_errors=True)  # what a failed attempt left
+            folder.mkdir()
+            make(folder)
+            done.touch()
+    return folder
 
 
 @pytest.fixture(scope="session")
@@ -15,7 +48,36 @@ def demo_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """
     from gnnpmb.data.demo import DEMO_SEED, generate_demo_dataset
 
-    return generate_demo_dataset(tmp_path_factory.mktemp("demo") / "nuscenes", seed=DEMO_SEED)
+    def make(folder: Path) -> None:
+        generate_demo_dataset(folder / "nuscenes", seed=DEMO_SEED)
+
+    return made_once(tmp_path_factory, "demo", make) / "nuscenes"
+
+
+@pytest.fixture(scope="session")
+def demo_recording(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """The README's demo command, ``gnnpmb-viz scene-0103 --save x.rrd`` (all defaults), run in-process on the
+    demo: the recording (alone in its folder) and what the command printed on stdout, stripped."""
+    from cli.app import main
+
+    def make(folder: Path) -> None:
+        (folder / "rrd").mkdir()
+        stdout = io.StringIO()
+        with contextlib.redirect_stdout(stdout):
+            main(
+                [
+                    "scene-0103",
+                    "--dataroot",
+                    str(demo_dataroot),
+                    "--save",
+                    str(folder / "rrd" / "x.rrd"),
+                    "--no-progress",
+                ]
+            )
+        (folder / "stdout.txt").write_text(stdout.getvalue().strip())
+
+    folder = made_once(tmp_path_factory, "demo-recording", make)
+    return folder / "rrd" / "x.rrd", (folder / "stdout.txt").read_text()
 
 
 @pytest.fixture(scope="session")

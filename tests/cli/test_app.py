@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import os
 import subprocess
@@ -38,13 +36,9 @@ def run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, 
 
 
 @pytest.fixture(scope="module")
-def full_run(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    """scene-0103 with gnnpmb (all defaults) saved to an .rrd; returns the file and stdout."""
-    out = tmp_path_factory.mktemp("e2e") / "x.rrd"
-    stdout = io.StringIO()
-    with contextlib.redirect_stdout(stdout):
-        main([SCENE, "--dataroot", str(demo_dataroot), "--save", str(out), "--no-progress"])
-    return out, stdout.getvalue().strip()
+def full_run(demo_recording: tuple[Path, str]) -> tuple[Path, str]:
+    """scene-0103 with gnnpmb (all defaults) saved to an .rrd (``tests/conftest.py``); the file and stdout."""
+    return demo_recording
 
 
 @pytest.fixture(scope="module")

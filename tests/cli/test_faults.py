@@ -24,6 +24,7 @@ from gnnpmb import atomic
 from gnnpmb.data.demo import GENERATOR_VERSION
 from tests.cli.test_user_errors import BIN, VIZ, _env, _snapshot, _work_folder
 from tests.gnnpmb.study.test_runner import FakeHead
+from tests.inprocess import run_script_with
 
 QUICK_VIZ = f"{VIZ} scene-0103 --tracker gnn --frames 0:3 --no-failures --no-progress"
 
@@ -217,8 +218,15 @@ def test_an_address_that_is_no_ray_head_is_one_line_in_bounded_time(
     assert not (tmp_path / "s").exists()
 
 
-def test_frames_evaluates_and_numbers_failures_within_the_window(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_frames_evaluates_and_numbers_failures_within_the_window(
+    demo_dataroot: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """In-process (``tests.inprocess.run_script_with``): the numbering, not the process, is under test."""
     env = _fault_env(demo_dataroot, tmp_path / "cache")
+
+    def _run(command: str, env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess[str]:
+        return run_script_with(command.split(), env, cwd, monkeypatch, capsys)
+
     listed = _run("gnnpmb failures scene-0103 --frames 10:30 --json f.json", env, tmp_path)
     assert listed.returncode == 0, listed.stderr
     totals = next(line for line in listed.stdout.splitlines() if line.startswith("scene-0103, gnnpmb"))

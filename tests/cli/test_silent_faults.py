@@ -12,7 +12,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 import socket
 import subprocess
 import time
@@ -22,7 +21,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.cli.test_user_errors import BIN, VIZ, _check, _env, _snapshot, _work_folder
+from tests.cli.test_user_errors import BIN, VIZ, _check, _env, _scene_tokens, _snapshot, _work_folder
+from tests.inprocess import run_script_with
 
 DATASET_INPUT = "the dataset's files are inputs"
 LOOP = "is a symlink loop"
@@ -48,17 +48,6 @@ def _copy_tables(demo: Path, to: Path) -> Path:
     for name in ("samples", "maps"):
         (to / name).symlink_to(demo / name)
     return to
-
-
-def _scene_tokens(dataroot: Path, scene_name: str) -> list[str]:
-    tables = dataroot / "v1.0-mini"
-    scene = next(s for s in json.loads((tables / "scene.json").read_text()) if s["name"] == scene_name)
-    samples = {s["token"]: s for s in json.loads((tables / "sample.json").read_text())}
-    tokens, token = [], scene["first_sample_token"]
-    while token:
-        tokens.append(token)
-        token = samples[token]["next"]
-    return tokens
 
 
 def _detections(path: Path, demo: Path, x_m: float = 600.0) -> None:
@@ -119,55 +108,82 @@ def _box(token: str, k: int, **changes: object) -> dict:
 # --- case 1, 8, 11, 14: refused at start-up, before the dataset is read --------------------------------------------
 
 
-def _early_cases(demo: Path) -> list[tuple[str, str, str]]:
-    table = demo / "v1.0-mini" / "sample_annotation.json"
-    return [
-        ("1 out is a table", f"gnnpmb track --out {table}", DATASET_INPUT),
-        ("1 out is the splits file", f"gnnpmb track --out {demo}/v1.0-mini/splits.json", DATASET_INPUT),
-        ("1 out is a table, relative", "gnnpmb track --out demo/v1.0-mini/scene.json", DATASET_INPUT),
-        ("1 out is a table, symlink", "gnnpmb track --out table.json", DATASET_INPUT),
-        ("1 out is a table, hard link", "gnnpmb track --out hard-table.json", "a hard link of the nuScenes file"),
-        ("1 json is a table", f"gnnpmb failures scene-0103 --json {demo}/v1.0-mini/scene.json", DATASET_INPUT),
-        ("1 save in the sensor folder", f"{VIZ} scene-0103 --save {demo}/samples/x.rrd", DATASET_INPUT),
-        ("1 eval out is the table folder", f"gnnpmb eval good.json --out {demo}/v1.0-mini", DATASET_INPUT),
-        ("8 loop out", "gnnpmb track --out loop.json", LOOP),
-        ("8 loop detections", "gnnpmb track --out new.json --detections loop.json", LOOP),
-        ("8 loop params", "gnnpmb track --out new.json --params loop.json", LOOP),
-        ("8 loop save", f"{VIZ} scene-0103 --save loop.rrd", LOOP),
-        ("8 loop results", "gnnpmb failures scene-0103 --results mine=loop.json", LOOP),
-        ("8 loop eval", "gnnpmb eval loop.json", LOOP),
-        ("8 loop recording", f"{VIZ} reproduce loop.rrd", LOOP),
-        ("8 loop dataroot", "gnnpmb track --out new.json --dataroot loop.json", LOOP),
-        ("11 name too long", f"gnnpmb track --out {'n' * 252}.json", "the name is 257 bytes long"),
-        ("14 bind not an address", f"{VIZ} scene-0103 --serve --bind nowhere", "--bind nowhere: not an IP address"),
-        ("14 bind without serve", f"{VIZ} scene-0103 --save x.rrd --bind 0.0.0.0", "--bind only applies with --serve"),
-    ]
+EARLY_CASES: tuple[tuple[str, str, str], ...] = (
+    # (name, command with {demo} for the dataroot, text of the error line)
+    ("1 out is a table", "gnnpmb track --out {demo}/v1.0-mini/sample_annotation.json", DATASET_INPUT),
+    ("1 out is the splits file", "gnnpmb track --out {demo}/v1.0-mini/splits.json", DATASET_INPUT),
+    ("1 out is a table, relative", "gnnpmb track --out demo/v1.0-mini/scene.json", DATASET_INPUT),
+    ("1 out is a table, symlink", "gnnpmb track --out table.json", DATASET_INPUT),
+    ("1 out is a table, hard link", "gnnpmb track --out hard-table.json", "a hard link of the nuScenes file"),
+    ("1 json is a table", "gnnpmb failures scene-0103 --json {demo}/v1.0-mini/scene.json", DATASET_INPUT),
+    ("1 save in the sensor folder", f"{VIZ} scene-0103 --save {{demo}}/samples/x.rrd", DATASET_INPUT),
+    ("1 eval out is the table folder", "gnnpmb eval good.json --out {demo}/v1.0-mini", DATASET_INPUT),
+    ("8 loop out", "gnnpmb track --out loop.json", LOOP),
+    ("8 loop detections", "gnnpmb track --out new.json --detections loop.json", LOOP),
+    ("8 loop params", "gnnpmb track --out new.json --params loop.json", LOOP),
+    ("8 loop save", f"{VIZ} scene-0103 --save loop.rrd", LOOP),
+    ("8 loop results", "gnnpmb failures scene-0103 --results mine=loop.json", LOOP),
+    ("8 loop eval", "gnnpmb eval loop.json", LOOP),
+    ("8 loop recording", f"{VIZ} reproduce loop.rrd", LOOP),
+    ("8 loop dataroot", "gnnpmb track --out new.json --dataroot loop.json", LOOP),
+    ("11 name too long", f"gnnpmb track --out {'n' * 252}.json", "the name is 257 bytes long"),
+    ("14 bind not an address", f"{VIZ} scene-0103 --serve --bind nowhere", "--bind nowhere: not an IP address"),
+    ("14 bind without serve", f"{VIZ} scene-0103 --save x.rrd --bind 0.0.0.0", "--bind only applies with --serve"),
+)
 
 
+def _early_work(case: tuple[str, str, str], root: Path, demo: Path) -> Path:
+    """The case's work folder: good outputs, the dataset linked in (``demo``, ``table.json``, a hard link of a
+    table) and symlink loops."""
+    work = _work_folder(root / case[0].replace(" ", "_").replace(",", ""))
+    (work / "demo").symlink_to(demo)
+    (work / "table.json").symlink_to(demo / "v1.0-mini" / "sample_annotation.json")
+    os.link(demo / "v1.0-mini" / "sample_annotation.json", work / "hard-table.json")
+    for suffix in (".json", ".rrd"):
+        (work / f"loop{suffix}").symlink_to(f"loop2{suffix}")
+        (work / f"loop2{suffix}").symlink_to(f"loop{suffix}")
+    return work
+
+
+EARLY_REAL_PROCESS = ("1 out is a table, hard link", "8 loop save")
+"""Early cases run again through the installed scripts (one per entry point)."""
+
+
+@pytest.mark.parametrize("case", EARLY_CASES, ids=lambda c: c[0])
 def test_outputs_onto_the_dataset_loops_and_long_names_are_one_line_before_any_work(
-    demo_dataroot: Path, tmp_path: Path
+    case: tuple[str, str, str],
+    demo_dataroot: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
+    """In-process (``tests.inprocess.run_script``); the dataset's tables are unchanged after each."""
+    name, command, expected = case
+    dataset_before = _tree(demo_dataroot / "v1.0-mini")
+    work = _early_work(case, tmp_path, demo_dataroot)
+    before = _snapshot(work)
+    proc = run_script_with(command.format(demo=demo_dataroot).split(), _env(demo_dataroot), work, monkeypatch, capsys)
+    assert _check(name, proc, expected) == []
+    assert _snapshot(work) == before
+    assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
+
+
+def test_early_refusals_in_real_processes(demo_dataroot: Path, tmp_path: Path) -> None:
     dataset_before = _tree(demo_dataroot / "v1.0-mini")
     env = _env(demo_dataroot)
+    cases = [c for c in EARLY_CASES if c[0] in EARLY_REAL_PROCESS]
+    assert len(cases) == len(EARLY_REAL_PROCESS)
 
     def one(case: tuple[str, str, str]) -> list[str]:
-        name, command, expected = case
-        work = _work_folder(tmp_path / name.replace(" ", "_").replace(",", ""))
-        (work / "demo").symlink_to(demo_dataroot)
-        (work / "table.json").symlink_to(demo_dataroot / "v1.0-mini" / "sample_annotation.json")
-        os.link(demo_dataroot / "v1.0-mini" / "sample_annotation.json", work / "hard-table.json")
-        for suffix in (".json", ".rrd"):
-            (work / f"loop{suffix}").symlink_to(f"loop2{suffix}")
-            (work / f"loop2{suffix}").symlink_to(f"loop{suffix}")
+        work = _early_work(case, tmp_path, demo_dataroot)
         before = _snapshot(work)
-        proc = _run(command.split(), env, work)
-        problems = _check(name, proc, expected)
+        problems = _check(case[0], _run(case[1].format(demo=demo_dataroot).split(), env, work), case[2])
         if _snapshot(work) != before:
-            problems.append(f"{name}: files changed")
+            problems.append(f"{case[0]}: files changed")
         return problems
 
-    with ThreadPoolExecutor(max_workers=4) as pool:
-        problems = [p for found in pool.map(one, _early_cases(demo_dataroot)) for p in found]
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        problems = [p for found in pool.map(one, cases) for p in found]
     assert problems == []
     assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
 
@@ -175,7 +191,7 @@ def test_outputs_onto_the_dataset_loops_and_long_names_are_one_line_before_any_w
 def test_a_255_byte_output_name_is_written(demo_dataroot: Path, tmp_path: Path) -> None:
     """The longest legal name works: the temporary file beside it is named within the limit too."""
     name = "r" * 250 + ".json"
-    proc = _run(["gnnpmb", "track", "--out", name, "--no-progress"], _env(demo_dataroot), tmp_path)
+    proc = _run(["gnnpmb", "track", "--out", name, "--tracker", "gnn", "--no-progress"], _env(demo_dataroot), tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert [p.name for p in tmp_path.iterdir()] == [name]
     assert json.loads((tmp_path / name).read_text())["results"]
@@ -197,51 +213,6 @@ def test_a_port_taken_on_ipv6_loopback_counts_as_in_use(demo_dataroot: Path, tmp
 
 
 # --- case 14: what --serve listens on --------------------------------------------------------------------------------
-
-
-def _listening(port: int) -> list[str]:
-    """The local addresses (hex, as /proc/net/tcp* shows them) listening on TCP ``port``."""
-    out = []
-    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
-        with open(table) as f:
-            for line in f.readlines()[1:]:
-                fields = line.split()
-                address, port_hex = fields[1].split(":")
-                if int(port_hex, 16) == port and fields[3] == "0A":
-                    out.append(address)
-    return out
-
-
-@pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
-def test_serve_listens_on_loopback_only(demo_dataroot: Path, tmp_path: Path) -> None:
-    from tests.gnnpmb.test_serve import _free_ports
-
-    web, grpc = _free_ports(2)
-    argv = [str(BIN / VIZ), "scene-0103", "--tracker", "gnn", "--frames", "0:2", "--no-failures", "--no-progress"]
-    argv += ["--serve", "--web-port", str(web), "--grpc-port", str(grpc)]
-    proc = subprocess.Popen(
-        argv,
-        env=_env(demo_dataroot),
-        cwd=tmp_path,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
-    try:
-        lines: list[str] = []
-        while not (lines and lines[-1].startswith("serving")):
-            line = proc.stderr.readline()
-            assert line, f"ended early: {lines}"
-            lines.append(line)
-        assert lines[0].startswith(f"web viewer: http://127.0.0.1:{web}/"), lines
-        for port in (web, grpc):
-            assert _listening(port) == ["0100007F"], (port, _listening(port))  # 127.0.0.1, nothing else
-    finally:
-        proc.send_signal(signal.SIGINT)
-        proc.communicate(timeout=60)
-    assert proc.returncode == 0
-    assert _listening(web) == [] and _listening(grpc) == []  # the web viewer's process ended with the run
 
 
 # --- case 2: caches key on content ------------------------------------------------------------------------------------
@@ -309,35 +280,38 @@ def test_a_damaged_detection_index_side_file_is_rebuilt(demo_dataroot: Path, tmp
 # --- case 3, 5, 6, 12: results files and tables checked like detection files ------------------------------------------
 
 
-def test_results_files_the_devkit_would_read_otherwise_are_one_line(demo_dataroot: Path, tmp_path: Path) -> None:
-    cases = {
-        "mixed ids": (lambda t, k: _box(t, k, tracking_id=k if k % 2 else str(k)), "tracking_id is an integer"),
-        "zero quaternion": (lambda t, k: _box(t, k, rotation=[0.0, 0.0, 0.0, 0.0]), "is not a rotation"),
-        "non-unit quaternion": (lambda t, k: _box(t, k, rotation=[0.5, 0.0, 0.0, 0.0]), "not a unit quaternion"),
-        "zero size": (lambda t, k: _box(t, k, size=[0.0, 4.5, 1.6]), "field 'size' must be positive"),
-        "far away": (lambda t, k: _box(t, k, translation=[1e6 + 600.0, 1600.0, 1.0]), "beyond 1e+05 m"),
-    }
+RESULTS_CASES = {
+    "mixed ids": (lambda t, k: _box(t, k, tracking_id=k if k % 2 else str(k)), "tracking_id is an integer"),
+    "zero quaternion": (lambda t, k: _box(t, k, rotation=[0.0, 0.0, 0.0, 0.0]), "is not a rotation"),
+    "non-unit quaternion": (lambda t, k: _box(t, k, rotation=[0.5, 0.0, 0.0, 0.0]), "not a unit quaternion"),
+    "zero size": (lambda t, k: _box(t, k, size=[0.0, 4.5, 1.6]), "field 'size' must be positive"),
+    "far away": (lambda t, k: _box(t, k, translation=[1e6 + 600.0, 1600.0, 1.0]), "beyond 1e+05 m"),
+}
+
+
+@pytest.mark.parametrize("name", RESULTS_CASES)
+def test_results_files_the_devkit_would_read_otherwise_are_one_line(
+    name: str,
+    demo_dataroot: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """In-process (``tests.inprocess.run_script_with``): the checks of the file are under test; a results file's
+    one line in a real process is ``test_user_errors``' 'eval truncated'."""
+    box_of, expected = RESULTS_CASES[name]
     env = _cache_env(demo_dataroot, tmp_path / "cache")
-
-    def one(item: tuple[str, tuple]) -> list[str]:
-        name, (box_of, expected) = item
-        work = tmp_path / name.replace(" ", "_")
-        work.mkdir()
-        _submission(work / "r.json", demo_dataroot, box_of)
-        before = _snapshot(work)
-        problems = []
-        for command in (
-            ["gnnpmb", "eval", "r.json", "--out", "ev"],
-            ["gnnpmb", "failures", "scene-0103", "--results", "mine=r.json"],
-        ):
-            problems += _check(f"{name}: {command[1]}", _run(command, env, work), expected)
-        if _snapshot(work) != before:
-            problems.append(f"{name}: files changed")
-        return problems
-
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        problems = [p for found in pool.map(one, cases.items()) for p in found]
-    assert problems == []
+    work = tmp_path / "work"
+    work.mkdir()
+    _submission(work / "r.json", demo_dataroot, box_of)
+    before = _snapshot(work)
+    for command in (
+        ["gnnpmb", "eval", "r.json", "--out", "ev"],
+        ["gnnpmb", "failures", "scene-0103", "--results", "mine=r.json"],
+    ):
+        proc = run_script_with(command, env, work, monkeypatch, capsys)
+        assert _check(f"{name}: {command[1]}", proc, expected) == []
+    assert _snapshot(work) == before
 
 
 def test_a_dataset_without_annotations_is_said_once(demo_dataroot: Path, tmp_path: Path) -> None:

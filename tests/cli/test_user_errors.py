@@ -1,9 +1,10 @@
-"""Every user mistake of issue 10, through the installed scripts in a real process: exit code 2, one ``error:``
-line on stderr, no traceback, no new or changed file (a good output already sits at the output paths).
+"""Every user mistake of issue 10: exit code 2, one ``error:`` line on stderr, no traceback, no new or changed file
+(a good output already sits at the output paths).
 
-Cases that fail before the dataset is read run in parallel (a process start each, ~0.5 s); the few that need the
-dataset (a bad box in one sample, an empty submission) load the demo once each; the variants of those are unit
-tests of the checks.
+Cases that fail before the dataset is read run in-process (``tests.inprocess.run_script``: the console script's
+code up to its exit, without a process start each); a few of them, one per entry point and kind of mistake, run
+again through the installed scripts in real processes. The few that need the dataset (a bad box in one sample, an
+empty submission) load the demo once each; the variants of those are unit tests of the checks.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+
+from tests.inprocess import run_script_with
 
 BIN = Path(sys.executable).parent
 GOOD = b"a good output from an earlier run\n"
@@ -283,21 +286,55 @@ def busy_port() -> int:
     sock.close()
 
 
-def test_mistakes_found_before_the_data_are_one_line(demo_dataroot: Path, tmp_path: Path, busy_port: int) -> None:
+REAL_PROCESS = (
+    "viz typo option",
+    "reproduce not a recording",
+    "viz port in use",
+    "batch unknown command",
+    "track out hard link",
+    "eval truncated",
+)
+"""Cases run again through the installed scripts: each entry point (``gnnpmb-viz``, its ``reproduce``,
+``gnnpmb``) with a parser's usage error and with one of our own checks."""
+
+
+def _case_work(root: Path, case: Case, busy_port: int) -> tuple[Path, list[str]]:
+    """The case's work folder (good outputs in place) and its command line."""
+    work = _work_folder(root / case.name.replace(" ", "_").replace(",", ""))
+    return work, [a.format(w=work, busy_port=busy_port) for a in case.argv]
+
+
+@pytest.mark.parametrize("case", CASES_BEFORE_DATA, ids=lambda c: c.name)
+def test_mistakes_found_before_the_data_are_one_line(
+    case: Case,
+    demo_dataroot: Path,
+    tmp_path: Path,
+    busy_port: int,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    work, argv = _case_work(tmp_path, case, busy_port)
+    before = _snapshot(work)
+    proc = run_script_with(argv, _env(demo_dataroot), work, monkeypatch, capsys)
+    assert _check(case.name, proc, case.expected) == []
+    assert _snapshot(work) == before
+
+
+def test_mistakes_in_real_processes_are_one_line(demo_dataroot: Path, tmp_path: Path, busy_port: int) -> None:
     env = _env(demo_dataroot)
+    cases = [c for c in CASES_BEFORE_DATA if c.name in REAL_PROCESS]
+    assert len(cases) == len(REAL_PROCESS)
 
     def one(case: Case) -> list[str]:
-        work = _work_folder(tmp_path / case.name.replace(" ", "_"))
+        work, argv = _case_work(tmp_path, case, busy_port)
         before = _snapshot(work)
-        argv = [a.format(w=work, busy_port=busy_port) for a in case.argv]
-        proc = _run(argv, env, cwd=work)
-        problems = _check(case.name, proc, case.expected)
+        problems = _check(case.name, _run(argv, env, cwd=work), case.expected)
         if _snapshot(work) != before:
             problems.append(f"{case.name}: files changed")
         return problems
 
-    with ThreadPoolExecutor(max_workers=4) as pool:
-        problems = [p for found in pool.map(one, CASES_BEFORE_DATA) for p in found]
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        problems = [p for found in pool.map(one, cases) for p in found]
     assert problems == []
 
 

@@ -36,22 +36,15 @@ def test_partial_override(tmp_path):
     assert cfg.pmbm.n_hypotheses == 10 and isinstance(cfg.pmbm.n_hypotheses, int)
 
 
-@pytest.mark.parametrize(
-    ("text", "message"),
-    [
-        ("[pmb]\np_surive = 0.9\n", "unknown parameter 'p_surive'"),
-        ("[classes.boat]\nq_x = 1\n", "unknown class"),
-        ("[pmb]\np_survive = 'high'\n", "expected a number"),
-        ("[pmbm]\nn_hypotheses = 2.5\n", "expected an integer"),
-        ("[nonsense]\n", "unknown section"),
-        ("[pmb\n", "not valid TOML"),
-    ],
-)
-def test_bad_parameter_files_name_the_problem(tmp_path, text, message):
-    path = tmp_path / "p.toml"
-    path.write_text(text)
-    with pytest.raises(ConfigError, match=message):
-        load_config(path)
+BAD_FILES = [
+    ("[pmb]\np_surive = 0.9\n", "unknown parameter 'p_surive'"),
+    ("[classes.boat]\nq_x = 1\n", "unknown class"),
+    ("[pmb]\np_survive = 'high'\n", "expected a number"),
+    ("[pmbm]\nn_hypotheses = 2.5\n", "expected an integer"),
+    ("[nonsense]\n", "unknown section"),
+    ("[pmb\n", "not valid TOML"),
+]
+"""Parameter files and the error each gives."""
 
 
 def test_missing_parameter_file(tmp_path):
@@ -59,31 +52,24 @@ def test_missing_parameter_file(tmp_path):
         load_config(tmp_path / "nope.toml")
 
 
-@pytest.mark.parametrize(
-    ("text", "message"),
-    [
-        ("[classes]\ncar = 5\n", r"\[classes.car\] must be a table"),
-        ("[classes.car]\nq_x = -0.1\n", r"\[classes.car\] q_x must be >= 0, got -0.1"),
-        ("[classes.car]\nr_y = 0\n", r"\[classes.car\] r_y must be > 0, got 0.0"),
-        ("[pmb]\np_survive = 1.5\n", r"\[pmb\] p_survive must be in \(0, 1\], got 1.5"),
-        ("[pmb]\ngate_chi2 = nan\n", r"\[pmb\] gate_chi2 must be > 0, got nan"),
-        ("[pmb]\ngate_chi2 = -4\n", r"\[pmb\] gate_chi2 must be > 0, got -4.0"),
-        ("[pmb]\nextraction_threshold = 1.2\n", r"extraction_threshold must be in \[0, 1\], got 1.2"),
-        ("[pmb]\nbirth_weight = 0\n", r"birth_weight must be > 0, got 0.0"),
-        ("[preprocess]\nscore_threshold = -0.1\n", r"\[preprocess\] score_threshold must be in \[0, 1\]"),
-        ("[classes.pedestrian]\nbirth_weight = -1\n", r"\[classes.pedestrian\] birth_weight must be > 0, got -1"),
-        ("[classes.car]\np_detect = 0.8\n", r"several sections \(phd, vector\); set it in a sub-table"),
-        ("[classes.car.vector]\np_detect = 1.0\n", r"\[classes.car.vector\] p_detect must be in \(0, 1\)"),
-        ("[classes.car]\nbirth_wieght = 1\n", "unknown parameter 'birth_wieght'"),
-        ("[classes.car.vector]\nconfirm_m = 5\n", "confirm_m <= confirm_n"),
-        ("[greedy]\nmax_age = 0\n", r"\[greedy\] max_age must be >= 1, got 0"),
-    ],
-)
-def test_every_value_is_range_checked_and_the_error_names_key_value_and_range(tmp_path, text, message):
-    path = tmp_path / "p.toml"
-    path.write_text(text)
-    with pytest.raises(ConfigError, match=message):
-        load_config(path)
+OUT_OF_RANGE = [
+    ("[classes]\ncar = 5\n", r"\[classes.car\] must be a table"),
+    ("[classes.car]\nq_x = -0.1\n", r"\[classes.car\] q_x must be >= 0, got -0.1"),
+    ("[classes.car]\nr_y = 0\n", r"\[classes.car\] r_y must be > 0, got 0.0"),
+    ("[pmb]\np_survive = 1.5\n", r"\[pmb\] p_survive must be in \(0, 1\], got 1.5"),
+    ("[pmb]\ngate_chi2 = nan\n", r"\[pmb\] gate_chi2 must be > 0, got nan"),
+    ("[pmb]\ngate_chi2 = -4\n", r"\[pmb\] gate_chi2 must be > 0, got -4.0"),
+    ("[pmb]\nextraction_threshold = 1.2\n", r"extraction_threshold must be in \[0, 1\], got 1.2"),
+    ("[pmb]\nbirth_weight = 0\n", r"birth_weight must be > 0, got 0.0"),
+    ("[preprocess]\nscore_threshold = -0.1\n", r"\[preprocess\] score_threshold must be in \[0, 1\]"),
+    ("[classes.pedestrian]\nbirth_weight = -1\n", r"\[classes.pedestrian\] birth_weight must be > 0, got -1"),
+    ("[classes.car]\np_detect = 0.8\n", r"several sections \(phd, vector\); set it in a sub-table"),
+    ("[classes.car.vector]\np_detect = 1.0\n", r"\[classes.car.vector\] p_detect must be in \(0, 1\)"),
+    ("[classes.car]\nbirth_wieght = 1\n", "unknown parameter 'birth_wieght'"),
+    ("[classes.car.vector]\nconfirm_m = 5\n", "confirm_m <= confirm_n"),
+    ("[greedy]\nmax_age = 0\n", r"\[greedy\] max_age must be >= 1, got 0"),
+]
+"""Every value is range-checked: the error names the key, the value and the range."""
 
 
 def test_a_folder_as_parameter_file_is_a_config_error(tmp_path):
@@ -169,18 +155,19 @@ def test_box_noise_tables_read_check_and_round_trip(tmp_path):
     assert load_config(again) == cfg
 
 
-@pytest.mark.parametrize(
-    ("text", "message"),
-    [
-        ("[box_noise.boat]\nr_x = 1\n", r"\[box_noise.boat\]: unknown class"),
-        ("[box_noise.car]\nr_x = 0\n", r"\[box_noise.car\] r_x must be > 0, got 0"),
-        ("[box_noise.car]\nr_xx = 1\n", "unknown parameter 'r_xx'"),
-        ("[ab3dmot]\niou_threshold = 1.0\n", r"\[ab3dmot\] iou_threshold must be in \[0, 1\), got 1.0"),
-        ("[simpletrack]\ndetector_velocity = 2\n", r"\[simpletrack\] detector_velocity must be in \[0, 1\], got 2"),
-        ("[classes.car]\nmin_hits = 2\n", r"'min_hits' is a parameter of several sections"),
-    ],
-)
-def test_bad_baseline_parameters_give_one_clear_error(tmp_path, text, message):
+BAD_BASELINE_PARAMETERS = [
+    ("[box_noise.boat]\nr_x = 1\n", r"\[box_noise.boat\]: unknown class"),
+    ("[box_noise.car]\nr_x = 0\n", r"\[box_noise.car\] r_x must be > 0, got 0"),
+    ("[box_noise.car]\nr_xx = 1\n", "unknown parameter 'r_xx'"),
+    ("[ab3dmot]\niou_threshold = 1.0\n", r"\[ab3dmot\] iou_threshold must be in \[0, 1\), got 1.0"),
+    ("[simpletrack]\ndetector_velocity = 2\n", r"\[simpletrack\] detector_velocity must be in \[0, 1\], got 2"),
+    ("[classes.car]\nmin_hits = 2\n", r"'min_hits' is a parameter of several sections"),
+]
+"""The baseline trackers' sections and the box-noise tables: one clear error each."""
+
+
+@pytest.mark.parametrize(("text", "message"), [*BAD_FILES, *OUT_OF_RANGE, *BAD_BASELINE_PARAMETERS])
+def test_bad_parameter_files_name_the_problem(tmp_path, text, message):
     path = tmp_path / "p.toml"
     path.write_text(text)
     with pytest.raises(ConfigError, match=message):

@@ -1,5 +1,6 @@
 """``gnnpmb-viz --serve`` in a real process without a display: the web viewer answers on its port, the gRPC port
-is open, the URL is printed, and Ctrl-C ends the run with exit code 0."""
+is open, both listen on localhost only (issue 33, case 14), the URL is printed, and Ctrl-C ends the run with exit
+code 0 and both ports closed."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from gnnpmb.errors import GnnpmbError
 from gnnpmb.serve import ServeTarget, check_bind, check_display
 
 BIN = Path(sys.executable).parent
+LINUX_TCP_TABLES = Path("/proc/net/tcp").exists()
 
 
 def _free_ports(n: int) -> list[int]:
@@ -29,6 +31,19 @@ def _free_ports(n: int) -> list[int]:
     finally:
         for sock in sockets:
             sock.close()
+
+
+def _listening(port: int) -> list[str]:
+    """The local addresses (hex, as /proc/net/tcp* shows them) listening on TCP ``port``."""
+    out = []
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        with open(table) as f:
+            for line in f.readlines()[1:]:
+                fields = line.split()
+                address, port_hex = fields[1].split(":")
+                if int(port_hex, 16) == port and fields[3] == "0A":
+                    out.append(address)
+    return out
 
 
 def test_serve_prints_the_url_serves_the_viewer_and_stops_on_ctrl_c(demo_dataroot: Path) -> None:
@@ -55,11 +70,16 @@ def test_serve_prints_the_url_serves_the_viewer_and_stops_on_ctrl_c(demo_dataroo
         page = urllib.request.urlopen(f"http://localhost:{target.web_port}/", timeout=30).read()
         assert b"<html" in page.lower()
         socket.create_connection(("localhost", target.grpc_port), timeout=10).close()
+        if LINUX_TCP_TABLES:
+            for port in (target.web_port, target.grpc_port):
+                assert _listening(port) == ["0100007F"], (port, _listening(port))  # 127.0.0.1, nothing else
     finally:
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=60)
     assert proc.returncode == 0, err
     assert out.strip().endswith(f"served at {target.url}")
+    if LINUX_TCP_TABLES:  # the web viewer's process ended with the run
+        assert _listening(target.web_port) == [] and _listening(target.grpc_port) == []
 
 
 def test_url_points_the_viewer_at_the_grpc_server() -> None:

@@ -198,16 +198,14 @@ def test_a_sparse_birds_eye_view_counts_as_rendered() -> None:
 
 @pytest.mark.slow
 def test_the_full_demo_recording_loads_and_renders_in_headless_chromium(
-    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    demo_dataroot: Path, demo_recording: tuple[Path, str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """The demo as the README makes it (one tracker, the whole scene, no --focus): ready by the viewer's own
-    state with its sparse bird's-eye view, opened at the first failure worth a look."""
+    """The demo as the README makes it (one tracker, the whole scene, no --focus; ``tests/conftest.py``): ready by
+    the viewer's own state with its sparse bird's-eye view, opened at the first failure worth a look."""
     from tests.pipeline import prepare, reports_of
 
     _require_chromium()
-    rrd = tmp_path / "demo.rrd"
-    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-        main(["scene-0103", "--dataroot", str(demo_dataroot), "--save", str(rrd), "--no-progress"])
+    rrd = demo_recording[0]
     shot = tmp_path / "demo.png"
     result = check_recording(rrd, shot, n_views=1, timeout_s=420.0, work_dir=tmp_path / "web")
     with capsys.disabled():

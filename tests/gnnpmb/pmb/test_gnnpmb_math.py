@@ -5,22 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gnnpmb.config import TrackerConfig, paper_config
+from gnnpmb.config import TrackerConfig
 from gnnpmb.events import Assignment, AxisKind, Born, CostMatrix, Gated, ListSink, NullSink, Pruned
 from gnnpmb.pmb.core import PmbCore
 from gnnpmb.pmb.gnnpmb import BestAssignment
 from gnnpmb.types import IdAllocator
-from tests.gnnpmb.pmb.helpers import make_measurements
-
-CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-P = CFG.models
-CAR = CFG.for_class("car")
-R = np.diag([CAR.r_x, CAR.r_y])
-Q = np.diag([CAR.q_x, CAR.q_y, CAR.q_x, CAR.q_y])
-
-
-def gauss2(nu: np.ndarray, S: np.ndarray) -> float:
-    return float(np.exp(-0.5 * nu @ np.linalg.solve(S, nu)) / (2 * np.pi * np.sqrt(np.linalg.det(S))))
+from tests.gnnpmb.pmb.helpers import CFG, P, Q, R, gauss2, make_measurements
 
 
 def birth_state(z, v, score):

@@ -15,7 +15,7 @@ from scipy.special import logsumexp
 from gnnpmb.assign import murty
 from gnnpmb.assign.clusters import Cluster
 from gnnpmb.assign.murty import k_best
-from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig, paper_config
+from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig
 from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses, ListSink, NullSink, Pruned, PruneReason
 from gnnpmb.pmb.bernoulli import Bernoullis
@@ -23,17 +23,7 @@ from gnnpmb.pmb.core import GlobalHypothesis, PmbCore, UpdateContext, posterior_
 from gnnpmb.pmb.gnnpmb import BestAssignment
 from gnnpmb.pmb.pmbm import KBest, SharedRanking, _presence_patterns, _row_keys, hypothesis_budget
 from gnnpmb.types import IdAllocator, Measurements
-from tests.gnnpmb.pmb.helpers import make_measurements
-
-CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
-P = CFG.models
-CAR = CFG.for_class("car")
-R = np.diag([CAR.r_x, CAR.r_y])
-Q = np.diag([CAR.q_x, CAR.q_y, CAR.q_x, CAR.q_y])
-
-
-def gauss2(nu: np.ndarray, S: np.ndarray) -> float:
-    return float(np.exp(-0.5 * nu @ np.linalg.solve(S, nu)) / (2 * np.pi * np.sqrt(np.linalg.det(S))))
+from tests.gnnpmb.pmb.helpers import CFG, P, Q, R, gauss2, make_measurements
 
 
 def one_track(score: float = 0.9, pos_var: float = 0.1, vel_var: float = 0.5) -> Bernoullis:

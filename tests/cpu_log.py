@@ -1,0 +1,65 @@
+"""CPU seconds per test, for finding what makes the suite slow on a shared machine (wall times there mostly
+measure the neighbours).
+
+Load it as a plugin with a folder to write to, then sum::
+
+    CPULOG_DIR=/tmp/cpu bash scripts/test.sh -p tests.cpu_log
+    uv run python -m tests.cpu_log /tmp/cpu
+
+Each test's line is the CPU time of its worker process and of the child processes it waited for (the console
+scripts run in real processes; not Chromium's renderer and GPU processes, which Chromium does not reap before it
+is killed), from the start of its setup to the end of its teardown: a module fixture counts in its first test.
+"""
+
+from __future__ import annotations
+
+import collections
+import os
+import resource
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+
+def _cpu_s() -> float:
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
+    folder = os.environ.get("CPULOG_DIR")
+    cpu_s, wall_s = _cpu_s(), time.monotonic()
+    yield
+    if folder:
+        with open(Path(folder) / f"{os.getpid()}.tsv", "a") as f:
+            f.write(f"{item.nodeid}\t{_cpu_s() - cpu_s:.3f}\t{time.monotonic() - wall_s:.3f}\n")
+
+
+def summary(folder: Path, most: int = 30) -> str:
+    """The number of tests, their CPU and wall seconds summed, and the ``most`` costliest modules and tests."""
+    rows = []
+    for path in sorted(folder.glob("*.tsv")):
+        for line in path.read_text().splitlines():
+            nodeid, cpu_s, wall_s = line.split("\t")
+            rows.append((nodeid, float(cpu_s), float(wall_s)))
+    modules: dict[str, list[float]] = collections.defaultdict(lambda: [0.0, 0.0, 0])
+    for nodeid, cpu_s, wall_s in rows:
+        module = modules[nodeid.split("::")[0]]
+        module[0] += cpu_s
+        module[1] += wall_s
+        module[2] += 1
+    lines = [f"{len(rows)} tests: {sum(r[1] for r in rows):.1f} s CPU, {sum(r[2] for r in rows):.1f} s wall summed"]
+    lines.append("modules by CPU (s CPU, s wall, tests):")
+    for name, (cpu_s, wall_s, n) in sorted(modules.items(), key=lambda kv: -kv[1][0])[:most]:
+        lines.append(f"{cpu_s:8.1f} {wall_s:8.1f} {int(n):5d}  {name}")
+    lines.append("tests by CPU (s CPU, s wall):")
+    for nodeid, cpu_s, wall_s in sorted(rows, key=lambda r: -r[1])[:most]:
+        lines.append(f"{cpu_s:8.1f} {wall_s:8.1f}  {nodeid}")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(summary(Path(sys.argv[1]), int(sys.argv[2]) if len(sys.argv) > 2 else 30))
