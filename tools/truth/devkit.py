@@ -11,6 +11,7 @@ onto the scene's object and track ids through the devkit's own merge mappings (t
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -96,12 +97,10 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         ev = class_evaluation(
             tracks_gt, tracks_pred, class_name, cfg
         )  # the devkit's own object, as TrackingEval builds it
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            md = ev.accumulate()
-        if np.all(np.isnan(md.mota)):
+        best = _best_mota_threshold(ev)
+        if best is None:
             continue
-        best = int(np.nanargmax(md.mota))
-        threshold = None if np.isnan(md.confidence[best]) else float(md.confidence[best])
+        threshold = best[0]
         out.thresholds[class_name] = threshold
         events, oid_of, hid_of = _accumulate_threshold(ev, threshold)
         frame_of_id = []  # devkit frame id -> keyframe index, numbered as accumulate_threshold numbers them
@@ -127,6 +126,40 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
                 out.gt_to_track[(class_name, frame)][gt_id] = track_id
                 out.track_to_gt[(class_name, frame)][track_id] = gt_id
     return out
+
+
+def _best_mota_threshold(ev) -> tuple[float | None] | None:
+    """(threshold,) at which ``ev.accumulate()`` would have its best MOTA, as ``TrackingEval`` picks it
+    (``np.nanargmax(md.mota)``, None: the confidence there is NaN); None when the class has no ground truth.
+    The same devkit steps as ``accumulate`` (``compute_thresholds``, ``accumulate_threshold`` per distinct
+    threshold, the devkit's ``mota_custom``, NaN for unachieved recalls, duplicates repeated), computing MOTA only:
+    the other metrics ``accumulate`` computes take most of its time and do not choose the threshold."""
+    import contextlib
+    import io
+
+    from nuscenes.eval.tracking.utils import create_motmetrics
+
+    count = sum(
+        b.tracking_name == ev.class_name for scene in ev.tracks_gt.values() for frame in scene.values() for b in frame
+    )
+    if count == 0:
+        return None
+    mh = create_motmetrics()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        thresholds, _ = ev.compute_thresholds(count)
+        mota: list[float] = []
+        for t, threshold in enumerate(thresholds):
+            if np.isnan(threshold):
+                mota.append(math.nan)
+            elif threshold in thresholds[:t]:
+                mota.append(mota[list(thresholds).index(threshold)])
+            else:
+                acc, _ = ev.accumulate_threshold(threshold)
+                mota.append(float(mh.compute(acc, metrics=["mota_custom"], name="t")["mota_custom"].iloc[0]))
+    if all(math.isnan(v) for v in mota):
+        return (None,)  # no recall reached: the devkit fills the worst MOTA and its confidence is NaN
+    best = int(np.nanargmax(mota))
+    return (None if np.isnan(thresholds[best]) else float(thresholds[best]),)
 
 
 def _accumulate_threshold(ev, threshold: float | None):
