@@ -127,9 +127,9 @@ class _Context:
         hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
         return int(self.scene.keyframes[frame].gt_num_pts[hit[0]]) if hit.size else 0
 
-    def near(self, frame: int, xy: np.ndarray, *, own: bool) -> Near | None:
-        """The nearest detection within ``NEAR_M`` of ``xy`` at ``frame``: any class and score (own False), or a
-        kept one of the failure's class (own True)."""
+    def near(self, frame: int, xy: np.ndarray, *, own: bool, kept_only: bool = True) -> Near | None:
+        """The nearest detection within ``NEAR_M`` of ``xy`` at ``frame``: any class and score (own False), or one of
+        the failure's class (own True) that preprocessing kept (kept_only) or removed (not kept_only)."""
         fr = self.frames.get(frame)
         if fr is None:
             return None
@@ -139,7 +139,7 @@ class _Context:
         d = np.hypot(*(boxes.translation_m[:, :2] - xy).T)
         ok = d < NEAR_M
         if own:
-            ok &= kept & (boxes.class_name == self.class_name)
+            ok &= (kept if kept_only else ~kept) & (boxes.class_name == self.class_name)
         if not ok.any():
             return None
         m = int(np.flatnonzero(ok)[np.argmin(d[ok])])
@@ -178,6 +178,7 @@ class _Context:
                     own,
                     went,
                     self.on_object(self.report, self.frames[f], xy),
+                    self.near(f, xy, own=True, kept_only=False),
                 )
             )
         return tuple(out)

@@ -34,6 +34,12 @@ class EvalFacts:
     track_to_gt: dict[tuple[str, int], dict[str, str | None]] = field(default_factory=dict)
     counted: dict[str, set[str]] = field(default_factory=dict)
     evaluated_gt: dict[tuple[int, str], tuple[float, float]] = field(default_factory=dict)
+    switches: dict[tuple[str, int], set[str]] = field(default_factory=dict)
+    submitted: dict[int, set[str]] = field(default_factory=dict)
+    """frame -> the track ids the submission has a box of there (before any filter)."""
+    boxes: dict[int, list[tuple[str, str, tuple[float, float]]]] = field(default_factory=dict)
+    """frame -> the submission's boxes there: (track id, class, ground-plane centre)."""
+    """(class, frame) -> the object ids of the frame's SWITCH events."""
 
     def matched_track(self, class_name: str, frame: int, gt_id: str) -> str | None:
         return self.gt_to_track.get((class_name, frame), {}).get(gt_id)
@@ -85,6 +91,13 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         tracks_gt = create_tracks(gt, nusc, split, gt=True)
         tracks_pred = create_tracks(pred, nusc, split, gt=False)
     out = EvalFacts()
+    for token in tokens:
+        frame = frame_of_stamp[nusc.get("sample", token)["timestamp"]]
+        out.boxes[frame] = [
+            (str(b["tracking_id"]), b["tracking_name"], (float(b["translation"][0]), float(b["translation"][1])))
+            for b in results.get(token, [])
+        ]
+        out.submitted[frame] = {b[0] for b in out.boxes[frame]}
     scene_gt = tracks_gt[scene["token"]]
     scene_pred = tracks_pred[scene["token"]]
     for stamp, boxes in scene_gt.items():
@@ -125,6 +138,8 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
                 gt_id, track_id = str(oid_of[oid]), str(hid_of[hid])
                 out.gt_to_track[(class_name, frame)][gt_id] = track_id
                 out.track_to_gt[(class_name, frame)][track_id] = gt_id
+                if str(kind) == "SWITCH":
+                    out.switches.setdefault((class_name, frame), set()).add(gt_id)
     return out
 
 
