@@ -262,8 +262,8 @@ PRESENCE_KEPT = "in the 2 recorded frames up to 3 (2–3), GT aaaaaa had a car d
 PLANTED_FACTS = {
     # class: (true sentence, planted false sentence, raw events at frame 3); frame 2 has no event: m0 removed there
     "detector: score": (
-        "at frame 3 detection m0 (score 0.90) lay 0.3 m from car GT aaaaaa and started new track 7",
-        "at frame 3 detection m0 (score 0.80) lay 0.3 m from car GT aaaaaa and started new track 7",
+        "at frame 3 detection m0 (score 0.90) lay 0.3 m from car GT aaaaaa and started no track",
+        "at frame 3 detection m0 (score 0.80) lay 0.3 m from car GT aaaaaa and started no track",
         (),
     ),
     "detector: distance": (

@@ -24,6 +24,7 @@ DEVSET = next(
 """The dev set beside the checkout (``../shared/devset``, as CI lays it out), else where the developers' machines
 keep it."""
 MINI_VAL = ("scene-0103", "scene-0916")
+MINI_TRAIN = tuple(f"scene-{n}" for n in ("0061", "0553", "0655", "0757", "0796", "1077", "1094", "1100"))
 PRESETS = ("centerpoint", "megvii", "pointpillars")
 
 
@@ -112,6 +113,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", action="append", help="dev-set scenes (default: the two mini_val scenes)")
+    parser.add_argument("--all-scenes", action="store_true", help="all ten: mini_val and mini_train")
     parser.add_argument("--detector", action="append", help="presets (default: all three)")
     parser.add_argument("--tracker", action="append", help="trackers (default: all)")
     parser.add_argument("--dataroot", type=Path, default=DEVSET)
@@ -121,7 +123,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     per: dict[str, Tally] = defaultdict(Tally)
     findings: dict[str, int] = defaultdict(int)
     where: list[tuple[str, Contradiction]] = []
-    todo = cells(args.scene or MINI_VAL, args.detector or PRESETS, args.tracker or TRACKER_NAMES, args.square)
+    scenes = MINI_VAL + MINI_TRAIN if args.all_scenes else (args.scene or MINI_VAL)
+    todo = cells(scenes, args.detector or PRESETS, args.tracker or TRACKER_NAMES, args.square)
     for scene, preset, tracker in todo:
         other = None if args.other == "none" else other_of(tracker, args.other)
         tally, n = run_cell(tracker, scene, preset, args.dataroot, where=where, other=other)

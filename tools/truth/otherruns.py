@@ -3,17 +3,20 @@ bookkeeping of that other run (``devkit.EvalFacts`` of its results, built the sa
 
 By failure kind, at the failure's frame x, for the object: a miss is the devkit's MISS of it (no match at x); an
 ID switch or identity theft is a SWITCH event of it at x; a fragmentation is a match at x after none at x - 1 and
-one before that. "Did not fail here: its track T was output on the object and counted" holds when the devkit matched
-the object to one of the named tracks at x. "Did not have this failure" said of a run that had no track matched to
+one before, and one again after. "Did not fail here: its track T was output on the object and counted" holds when
+the other run's submission has T's box within 2 m of the object's annotation at x and T passes the class threshold
+(and no such failure). "Did not have this failure" said of a run that had no track matched to
 the object at x is the issue's class 4: that run lost the object too.
 """
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping
 
 from tools.truth.devkit import EvalFacts
+from tools.truth.scene import NEAR_M
 
 OTHER = re.compile(
     r"(\w+) on the same detections (failed here too|did not have this failure|had no counted track on the object "
@@ -31,13 +34,22 @@ def _failed(ev: EvalFacts, kind: str, c: str, x: int, gt: str) -> bool | None:
         return here[gt] is None
     if kind in ("id_switch", "identity_theft"):
         return gt in ev.switches.get((c, x), set())
-    if kind == "fragmentation":
-        before = [ev.matched_track(c, y, gt) for y in range(x)]
-        return here[gt] is not None and bool(before) and before[-1] is None and any(before)
+    if kind == "fragmentation":  # the devkit's FRAG: tracked, then missed here, tracked again later
+        present = sorted(y for (k, y), objs in ev.gt_to_track.items() if k == c and gt in objs)
+        before = [y for y in present if y < x]
+        after = [y for y in present if y > x]
+        return (
+            here[gt] is None
+            and bool(before)
+            and ev.matched_track(c, before[-1], gt) is not None
+            and any(ev.matched_track(c, y, gt) is not None for y in after)
+        )
     return None
 
 
-def check_others(text: str, kind: str, c: str, x: int, gt: str | None, others: Mapping[str, EvalFacts], out, bad):
+def check_others(
+    text: str, kind: str, c: str, x: int, gt: str | None, others: Mapping[str, EvalFacts], scene, out, bad
+) -> None:
     """Each other-run sentence of ``text`` about object ``gt`` (``out``: the ``Tally``; ``bad``)."""
     if gt is None:
         return
@@ -55,10 +67,16 @@ def check_others(text: str, kind: str, c: str, x: int, gt: str | None, others: M
         elif said.startswith("had no counted track"):
             if matched is not None:
                 bad("other run", m[0], f"the devkit matched the object at frame {x} to {m[1]}'s track {matched}")
-        elif said.startswith("did not fail here"):
+        elif said.startswith("did not fail here"):  # its named tracks lay within reach of the object, counted
             named = {t.strip() for t in m[3].split(",")}
-            if matched not in named or failed:
-                bad("other run", m[0], f"the devkit matched the object at frame {x} to {m[1]}'s track {matched}")
+            a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
+            near = {
+                t
+                for t, cls, xy in ev.boxes.get(x, [])
+                if a is not None and cls == c and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < NEAR_M
+            }
+            if failed or not named <= near & ev.counted.get(c, set()):
+                bad("other run", m[0], f"{m[1]}'s counted tracks within {NEAR_M} m at frame {x}: {sorted(near)}")
         else:  # did not have this failure
             if failed:
                 bad("other run", m[0], f"the devkit's events of {m[1]} have a {kind} of the object at frame {x}")

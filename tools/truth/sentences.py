@@ -119,7 +119,12 @@ NO_TRACK_NEAR = re.compile(r"no (\w+) track was output within 2 m of it")
 COUNTED_AT = re.compile(
     r"the evaluation counted the track: its score averaged [^:]*?, is at least the (\w+) threshold ([\d.]+)"
 )
-OUTPUT_AT = re.compile(r"at frame (\d+) track (\d+) \(\w+\) was output on")
+OUTPUT_AT = re.compile(r"at frame (\d+) track (\d+) (?:\(\w+\) )?was (?:still )?output (?:on|[\d.]+ m from)")
+LAST_OUTPUT = re.compile(r"track (\d+) was last output on it at frame (\d+)")
+STARTED_NEW = re.compile(
+    r"at frame (\d+) (?:detection )?m(\d+) \([^()]*(?:\([^()]*\)[^()]*)*\)(?: lay [\d.]+ m from \w+ GT \w+ and started|"
+    r" →) new track (\d+)"
+)
 STARTED = re.compile(r"track (\d+) had been started at frame (\d+) by m(\d+)")
 
 
@@ -145,7 +150,7 @@ def check_text(
     _check_eval(text, ctx, ev, out, bad)
     if scene is not None:
         detector.check_detector(text, ctx.gt_id, ctx.frame, c, scene, raw, out, bad)
-    otherruns.check_others(text, ctx.kind, c, ctx.frame, ctx.gt_id, others or {}, out, bad)
+    otherruns.check_others(text, ctx.kind, c, ctx.frame, ctx.gt_id, others or {}, scene, out, bad)
     for phrase in VIEWER_ONLY:
         if phrase in text:
             out.checked["misleading"] += 1
@@ -167,20 +172,27 @@ def check_text(
             ]
             if near:
                 bad("detector", m[0], f"the submission has {m[1]} tracks {near} within 2 m at frame {ctx.frame}")
-    for m in OUTPUT_AT.finditer(text):
+    said_output = [(int(m[1]), m[2], m[0]) for m in OUTPUT_AT.finditer(text)]
+    said_output += [(int(m[2]), m[1], m[0]) for m in LAST_OUTPUT.finditer(text)]
+    for x, t, sentence in said_output:
         out.checked["misleading"] += 1
-        if m[2] not in ev.submitted.get(int(m[1]), set()):
-            bad("misleading", m[0], f"the submission has no box of track {m[2]} at frame {m[1]} (an interpolation)")
+        if t not in ev.submitted.get(x, set()):
+            bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
     if raw is None:
         return out
-    for m in STARTED.finditer(text):
-        x, t, meas = int(m[2]), int(m[1]), int(m[3])
+    started = [(int(m[2]), int(m[1]), int(m[3]), m[0]) for m in STARTED.finditer(text)]
+    started += [(int(m[1]), int(m[3]), int(m[2]), m[0]) for m in STARTED_NEW.finditer(text)]
+    for x, t, meas, sentence in started:
         out.checked["misleading"] += 1
         born = {
             (int(a), int(b)) for e in raw.of_kind(x, c, Born) for a, b in zip(e.track_ids, e.meas_indices, strict=True)
         }
         if (t, meas) not in born:
-            bad("misleading", m[0], f"no Born event of frame {x} starts track {t} from m{meas} (born: {sorted(born)})")
+            bad(
+                "misleading",
+                sentence,
+                f"no Born event of frame {x} starts track {t} from m{meas} (born: {sorted(born)})",
+            )
     for m in GONE.finditer(text):
         x, meas, t = int(m[1]), int(m[2]), int(m[3])
         out.checked["gone"] += 1
