@@ -245,7 +245,7 @@ def _scene():
     objects = [{GT_A: Annotation(C, (0.0, 0.0), 12), GT_B: Annotation(C, (30.0, 0.0), 0)} for _ in range(4)]
     detections = [[Detection(C, 0.9, (0.3, 0.0))] for _ in range(3)]
     detections.append([Detection(C, 0.9, (0.3, 0.0)), Detection("truck", 0.4, (31.0, 0.0))])
-    return SceneTruth(detections, objects)
+    return SceneTruth(detections, objects, [(-45.0, 0.0)] * 4)  # GT A 45 m from the ego pose
 
 
 def _raw_with(*events):
@@ -275,6 +275,11 @@ PLANTED_FACTS = {
         "at frame 3 the detector gave no car detection within 2 m of car GT bbbbbb (0 LiDAR and radar points in its "
         "box), but a truck detection, m1 (score 0.40), 1.0 m away",
         "at frame 3 the detector gave no detection within 2 m of car GT aaaaaa (12 LiDAR and radar points in its box)",
+        (),
+    ),
+    "detector: range side": (
+        "it lies 45.0 m from the ego vehicle, inside the evaluation's 50 m range",
+        "it lies 45.0 m from the ego vehicle, beyond the evaluation's 50 m range",
         (),
     ),
     "misleading: removed detections left out of 'had a detection within 2 m'": (

@@ -36,11 +36,23 @@ OUTPUT_ON = re.compile(rf"at frame (\d+) track \d+ \((\w+)\) was output on detec
 ITS_DETECTION = re.compile(rf"its detection m(\d+) \(score ({_F}), ({_F}) m away\)")
 OTHER_CLASS = re.compile(rf"at ({_FRAMES}) the detector saw it only as another class \(([^)]*)\)")
 OTHER_ITEM = re.compile(rf"(\w+) m(\d+) ({_F}) m away")
+EGO = re.compile(rf"it lies ({_F}) m from the ego vehicle, (inside|beyond) the evaluation's ({_F}) m range")
+INTERPOLATED_AT = re.compile(rf"the evaluation scored it at a box it interpolated, ({_F}) m from the annotation")
 PRESENCE = re.compile(
     rf"in the (\d+) recorded frames up to (\d+) \((\d+)–(\d+)\), GT (\w+) had an? (\w+) detection "
     rf"(?:the tracker kept )?within 2 m at ({_FRAMES}|no frame)(?: only)?"
     rf"(?:,? and at ({_FRAMES}) only one? (?:that )?(?:its )?preprocessing removed)?"
 )
+
+
+def _class_range() -> dict[str, float]:
+    from nuscenes.eval.common.config import config_factory
+
+    return dict(config_factory("tracking_nips_2019").class_range)
+
+
+RANGE_M = _class_range()
+"""The devkit's evaluation range per class (``tracking_nips_2019``), metres from the ego pose."""
 
 
 def frames_of(text: str) -> list[int]:
@@ -62,8 +74,11 @@ def _close(printed: str, value: float) -> bool:
     return abs(float(printed) - value) <= 0.5 * 10.0**-decimals + 1e-9
 
 
-def check_detector(text: str, gt_id: str | None, frame: int, class_name: str, scene: SceneTruth, raw, out, bad):
-    """Every detector sentence of ``text`` (``out``: the ``Tally``; ``bad(kind, sentence, truth)``)."""
+def check_detector(
+    text: str, gt_id: str | None, frame: int, class_name: str, scene: SceneTruth, raw, out, bad, evaluated=None
+) -> None:
+    """Every detector sentence of ``text`` (``out``: the ``Tally``; ``bad(kind, sentence, truth)``); evaluated: the
+    devkit's scored object boxes, (frame, object id) -> (x, y) (``devkit.EvalFacts.evaluated_gt``)."""
 
     def gt_xy(x: int, short: str | None = None):
         if x >= len(scene.objects):
@@ -146,6 +161,24 @@ def check_detector(text: str, gt_id: str | None, frame: int, class_name: str, sc
                 bad("detector", item[0], f"no frame of {frames} has it so with no {class_name} detection in reach")
     for m in PRESENCE.finditer(text):
         _check_presence(m, gt_id, class_name, scene, raw, out, bad)
+    a = gt_xy(frame)
+    for m in EGO.finditer(text):
+        out.checked["detector"] += 1
+        if a is None or scene.ego_xy_m is None:
+            bad("detector", m[0], f"no annotation of the object at frame {frame}")
+            continue
+        ex, ey = scene.ego_xy_m[frame]
+        d = ((a.xy_m[0] - ex) ** 2 + (a.xy_m[1] - ey) ** 2) ** 0.5
+        r = RANGE_M[class_name]
+        if not _close(m[1], d) or float(m[3]) != r or (m[2] == "inside") != (d < r):
+            bad("detector", m[0], f"{d:.2f} m from the ego pose; the devkit's {class_name} range is {r:g} m")
+    for m in INTERPOLATED_AT.finditer(text):
+        out.checked["matched"] += 1
+        box = evaluated.get((frame, gt_id or "")) if evaluated is not None else None
+        if a is None or box is None:
+            bad("matched", m[0], f"the devkit scored no box of the object at frame {frame}")
+        elif not _close(m[1], ((box[0] - a.xy_m[0]) ** 2 + (box[1] - a.xy_m[1]) ** 2) ** 0.5):
+            bad("matched", m[0], f"the devkit's box lies {box} against the annotation {a.xy_m}")
 
 
 def _check_presence(m: re.Match, gt_id, class_name: str, scene: SceneTruth, raw: RawEvents | None, out, bad) -> None:

@@ -40,6 +40,8 @@ class SceneTruth:
 
     detections: list[list[Detection]]
     objects: list[dict[str, Annotation]]
+    ego_xy_m: list[tuple[float, float]] | None = None
+    """Per keyframe, the ego pose of its LIDAR_TOP sample data (as the devkit's ``add_center_dist`` takes it)."""
 
     @classmethod
     def read(cls, nusc, scene_name: str, detection_file: Path) -> SceneTruth:
@@ -47,9 +49,11 @@ class SceneTruth:
 
         results = json.loads(Path(detection_file).read_text(encoding="utf-8"))["results"]
         scene = next(s for s in nusc.scene if s["name"] == scene_name)
-        detections, objects, token = [], [], scene["first_sample_token"]
+        detections, objects, ego, token = [], [], [], scene["first_sample_token"]
         while token:
             sample = nusc.get("sample", token)
+            pose = nusc.get("ego_pose", nusc.get("sample_data", sample["data"]["LIDAR_TOP"])["ego_pose_token"])
+            ego.append((float(pose["translation"][0]), float(pose["translation"][1])))
             detections.append(
                 [
                     Detection(b["detection_name"], float(b["detection_score"]), tuple(map(float, b["translation"][:2])))
@@ -65,7 +69,7 @@ class SceneTruth:
                     here[a["instance_token"]] = Annotation(name, tuple(map(float, a["translation"][:2])), points)
             objects.append(here)
             token = sample["next"]
-        return cls(detections, objects)
+        return cls(detections, objects, ego)
 
     def object_of(self, frame: int, short_id: str) -> tuple[str, Annotation] | None:
         """The annotation at ``frame`` whose instance token starts with ``short_id`` (as the text prints it)."""

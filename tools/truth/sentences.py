@@ -149,7 +149,7 @@ def check_text(
     out.clauses, out.unchecked = coverage(text)
     _check_eval(text, ctx, ev, out, bad)
     if scene is not None:
-        detector.check_detector(text, ctx.gt_id, ctx.frame, c, scene, raw, out, bad)
+        detector.check_detector(text, ctx.gt_id, ctx.frame, c, scene, raw, out, bad, ev.evaluated_gt)
     otherruns.check_others(text, ctx.kind, c, ctx.frame, ctx.gt_id, others or {}, scene, out, bad)
     for phrase in VIEWER_ONLY:
         if phrase in text:
