@@ -39,6 +39,8 @@ class EvalFacts:
     """frame -> the track ids the submission has a box of there (before any filter)."""
     boxes: dict[int, list[tuple[str, str, tuple[float, float]]]] = field(default_factory=dict)
     """frame -> the submission's boxes there: (track id, class, ground-plane centre)."""
+    scores: dict[tuple[int, str], float] = field(default_factory=dict)
+    """(frame, track id) -> the submission box's tracking score."""
     """(class, frame) -> the object ids of the frame's SWITCH events."""
 
     def matched_track(self, class_name: str, frame: int, gt_id: str) -> str | None:
@@ -98,6 +100,7 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
             for b in results.get(token, [])
         ]
         out.submitted[frame] = {b[0] for b in out.boxes[frame]}
+        out.scores.update({(frame, str(b["tracking_id"])): float(b["tracking_score"]) for b in results.get(token, [])})
     scene_gt = tracks_gt[scene["token"]]
     scene_pred = tracks_pred[scene["token"]]
     for stamp, boxes in scene_gt.items():

@@ -14,7 +14,8 @@ Classes of false statement (the issue's numbering):
   detection within 2 m" unsaid, "did not have this failure" of a run that lost the object too, a bare percentage;
 
 and beyond the issue's four: ``detector`` (scores, distances, points, detections in reach: ``detector``), ``other
-run`` (``otherruns``), ``share`` (PHD percentages: ``shares``). ``coverage`` says which clauses of a text any
+run`` (``otherruns``), ``share`` (PHD percentages: ``shares``), ``output`` (a track's box on the object, its score,
+against the submission). ``coverage`` says which clauses of a text any
 pattern reads.
 """
 
@@ -32,7 +33,7 @@ from tools.truth.devkit import EvalFacts
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import SceneTruth
 
-CLASSES = ("matched", "gone", "counterfactual", "misleading", "detector", "other run", "share")
+CLASSES = ("matched", "gone", "counterfactual", "misleading", "detector", "other run", "share", "output")
 
 
 @dataclass(frozen=True)
@@ -113,7 +114,10 @@ THEFT = re.compile(
 COVERED = re.compile(r"track ([\d, ]+) lay within \d m of it and was counted, but the evaluation matched it to another")
 COALESCED = re.compile(r"at frame (\d+) track (\d+) was matched to (GT \w+(?:, GT \w+)*) and also lay within")
 MATCHED_INSTEAD = re.compile(r"the evaluation matched it to another track \(track (\d+)\)")
-NOT_COUNTED = re.compile(r"track (\d+) was output on it, but [^:]*?: the evaluation did not count it")
+NOT_COUNTED = re.compile(
+    r"track (\d+) was output on it(?: \(score [\d.]+\))?, but [^:]*?: the evaluation did not count it"
+)
+ON_IT = re.compile(r"track (\d+) was (not )?output on it(?: \(score ([\d.]+)\))?")
 VIEWER_ONLY = ("too low to be shown here",)
 NO_TRACK_NEAR = re.compile(r"no (\w+) track was output within 2 m of it")
 COUNTED_AT = re.compile(
@@ -172,6 +176,8 @@ def check_text(
             ]
             if near:
                 bad("detector", m[0], f"the submission has {m[1]} tracks {near} within 2 m at frame {ctx.frame}")
+    if scene is not None and ctx.gt_id is not None:
+        _check_on_it(text, ctx, scene, ev, out, bad)
     said_output = [(int(m[1]), m[2], m[0]) for m in OUTPUT_AT.finditer(text)]
     said_output += [(int(m[2]), m[1], m[0]) for m in LAST_OUTPUT.finditer(text)]
     for x, t, sentence in said_output:
@@ -284,6 +290,25 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None
         out.checked["matched"] += 1
         if m[1] in ev.counted.get(c, set()):
             bad("matched", m[0], f"track {m[1]} passes the {c} threshold {ev.thresholds.get(c)}")
+
+
+def _check_on_it(text: str, ctx: Context, scene: SceneTruth, ev: EvalFacts, out: Tally, bad) -> None:
+    """ "track T was (not) output on it (score S)" at the finding's frame: T's box in the submission within 2 m of
+    the object's annotation, with that score."""
+    a = scene.objects[ctx.frame].get(ctx.gt_id or "") if ctx.frame < len(scene.objects) else None
+    if a is None:
+        return
+    near = {
+        t
+        for t, cls, xy in ev.boxes.get(ctx.frame, [])
+        if cls == ctx.class_name and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < 2.0
+    }
+    for m in ON_IT.finditer(text):
+        out.checked["output"] += 1
+        if (m[1] in near) == bool(m[2]):
+            bad("output", m[0], f"the submission's {ctx.class_name} boxes within 2 m at frame {ctx.frame}: {near}")
+        elif m[3] is not None and abs(ev.scores.get((ctx.frame, m[1]), math.nan) - float(m[3])) > 0.005 + 1e-9:
+            bad("output", m[0], f"its box's score is {ev.scores.get((ctx.frame, m[1]))}")
 
 
 def _check_counterfactuals(x: int, para: str, c: str, raw: RawEvents, out: Tally, bad) -> None:
