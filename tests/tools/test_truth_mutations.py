@@ -122,6 +122,12 @@ PLANTED = {
         "track 7 was output on it, but its score averaged over its 3 frames, 0.40, is below the car threshold "
         "0.500: the evaluation did not count it",
     ),
+    "matched: the class threshold, at a sentence's end": (
+        "the evaluation counted the track: its score averaged over its 3 frames, 0.700, is at least the car threshold "
+        "0.500.",
+        "the evaluation counted the track: its score averaged over its 3 frames, 0.700, is at least the car threshold "
+        "0.400.",
+    ),
     "gone: column of infinite cost": (
         None,
         "at frame 3 m1 (score 0.80, 0.3 m from it; track 9 was gone) → track 7",

@@ -121,7 +121,7 @@ ON_IT = re.compile(r"track (\d+) was (not )?output on it(?: \(score ([\d.]+)\))?
 VIEWER_ONLY = ("too low to be shown here",)
 NO_TRACK_NEAR = re.compile(r"no (\w+) track was output within 2 m of it")
 COUNTED_AT = re.compile(
-    r"the evaluation counted the track: its score averaged [^:]*?, is at least the (\w+) threshold ([\d.]+)"
+    r"the evaluation counted the track: its score averaged [^:]*?, is at least the (\w+) threshold (\d+\.\d+)"
 )
 OUTPUT_AT = re.compile(r"at frame (\d+) track (\d+) (?:\(\w+\) )?was (?:still )?output (?:on|[\d.]+ m from)")
 LAST_OUTPUT = re.compile(r"track (\d+) was last output on it at frame (\d+)")
