@@ -345,3 +345,18 @@ def test_an_interpolated_box_said_output_and_a_start_without_a_birth_are_caught(
     assert check_text(started, CTX, _raw_with(born), _eval()).found == []
     handed = check_text(started, CTX, _raw_with(), _eval()).found  # a label handed over, no birth
     assert [c.kind for c in handed] == ["misleading"]
+
+
+def test_another_runs_false_track_and_an_empty_place_are_checked_where_the_false_box_lies() -> None:
+    ev, other = _eval(), _eval()
+    ev.boxes[3] = [("11", C, (0.0, 0.0)), ("12", C, (10.0, 0.0))]
+    other.pred_xy[(C, 3)] = {"5": (0.5, 0.0), "7": (0.0, 0.0)}  # its track 5 is a false positive beside the box
+    at = Context(C, 3, None, kind="false_track", track=11)
+    fair = "pmbm on the same detections had a false track here too"
+    assert check_text(fair, at, None, ev, others={"pmbm": other}).found == []
+    planted = "pmbm on the same detections had no false track here"
+    assert [c.kind for c in check_text(planted, at, None, ev, others={"pmbm": other}).found] == ["other run"]
+    empty = "no object of any class lies within 2 m of it"
+    assert [c.kind for c in check_text(empty, at, None, ev, scene=_scene()).found] == ["detector"]  # GT A is there
+    away = Context(C, 3, None, kind="false_track", track=12)
+    assert check_text(empty, away, None, ev, scene=_scene()).found == []

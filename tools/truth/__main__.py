@@ -86,6 +86,7 @@ def run_cell(
             f.taker.track_id if f.taker is not None else None,
             f.kind.value,
             f.lost.track_id if f.lost is not None else None,
+            f.false_output.track_id if f.false_output is not None else None,
         )
         one = check_text(text, ctx, raw, ev, tracker, truth, others)
         tally.add(one)

@@ -39,6 +39,8 @@ class EvalFacts:
     """frame -> the track ids the submission has a box of there (before any filter)."""
     boxes: dict[int, list[tuple[str, str, tuple[float, float]]]] = field(default_factory=dict)
     """frame -> the submission's boxes there: (track id, class, ground-plane centre)."""
+    pred_xy: dict[tuple[str, int], dict[str, tuple[float, float]]] = field(default_factory=dict)
+    """(class, frame) -> the centre of each track box the accumulator scored there (interpolations included)."""
     scores: dict[tuple[int, str], float] = field(default_factory=dict)
     """(frame, track id) -> the submission box's tracking score."""
     """(class, frame) -> the object ids of the frame's SWITCH events."""
@@ -131,6 +133,9 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
                 frame_of_id.append(frame_of_stamp[stamp])
                 out.gt_to_track[(class_name, frame_of_stamp[stamp])] = {str(b.tracking_id): None for b in g}
                 out.track_to_gt[(class_name, frame_of_stamp[stamp])] = {str(b.tracking_id): None for b in p}
+                out.pred_xy[(class_name, frame_of_stamp[stamp])] = {
+                    str(b.tracking_id): (float(b.translation[0]), float(b.translation[1])) for b in p
+                }
         out.counted[class_name] = counted
         events = events.reset_index()
         for frame_id, kind, oid, hid in zip(

@@ -83,3 +83,26 @@ def check_others(
             elif matched is None and kind in LOST_KINDS:
                 out.checked["misleading"] += 1
                 bad("misleading", m[0], f"{m[1]} had no track matched to the object at frame {x}: it lost it too")
+
+
+FALSE_HERE = re.compile(r"(\w+) on the same detections (had a false track here too|had no false track here)")
+
+
+def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapping[str, EvalFacts], out, bad) -> None:
+    """ "Had a false track here too / had no false track here": whether the other run's accumulator counted a track
+    box within ``NEAR_M`` of the place (the object, or the false box) as a false positive at frame x."""
+    if place_xy_m is None:
+        return
+    for m in FALSE_HERE.finditer(text):
+        ev = others.get(m[1])
+        if ev is None:
+            continue
+        out.checked["other run"] += 1
+        xy = ev.pred_xy.get((c, x), {})
+        false = sorted(
+            t
+            for t, g in ev.track_to_gt.get((c, x), {}).items()
+            if g is None and t in xy and math.hypot(xy[t][0] - place_xy_m[0], xy[t][1] - place_xy_m[1]) < NEAR_M
+        )
+        if bool(false) != m[2].startswith("had a false"):
+            bad("other run", m[0], f"{m[1]}'s false positives within {NEAR_M} m at frame {x}: {false}")

@@ -58,6 +58,8 @@ class Context:
     taker: int | None = None
     kind: str = ""
     lost: int | None = None
+    track: int | None = None
+    """A false track's id (its box is the place the finding is about)."""
 
 
 @dataclass
@@ -119,6 +121,7 @@ NOT_COUNTED = re.compile(
 )
 ON_IT = re.compile(r"track (\d+) was (not )?output on it(?: \(score ([\d.]+)\))?")
 VIEWER_ONLY = ("too low to be shown here",)
+NOTHING_NEAR = re.compile(r"no object of any class lies within 2 m")
 NO_TRACK_NEAR = re.compile(r"no (\w+) track was output within 2 m of it")
 COUNTED_AT = re.compile(
     r"the evaluation counted the track: its score averaged [^:]*?, is at least the (\w+) threshold (\d+\.\d+)"
@@ -155,6 +158,15 @@ def check_text(
     if scene is not None:
         detector.check_detector(text, ctx.gt_id, ctx.frame, c, scene, raw, out, bad, ev.evaluated_gt)
     otherruns.check_others(text, ctx.kind, c, ctx.frame, ctx.gt_id, others or {}, scene, out, bad)
+    place = _place(ctx, ev, scene)
+    otherruns.check_other_false_tracks(text, c, ctx.frame, place, others or {}, out, bad)
+    if scene is not None and ctx.gt_id is None and place is not None:
+        for m in NOTHING_NEAR.finditer(text):
+            out.checked["detector"] += 1
+            here = scene.objects[ctx.frame] if ctx.frame < len(scene.objects) else {}
+            near = [k[:6] for k, a in here.items() if math.hypot(a.xy_m[0] - place[0], a.xy_m[1] - place[1]) < 2.0]
+            if near:
+                bad("detector", m[0], f"annotated objects within 2 m of track {ctx.track}'s box: {near}")
     for phrase in VIEWER_ONLY:
         if phrase in text:
             out.checked["misleading"] += 1
@@ -290,6 +302,16 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None
         out.checked["matched"] += 1
         if m[1] in ev.counted.get(c, set()):
             bad("matched", m[0], f"track {m[1]} passes the {c} threshold {ev.thresholds.get(c)}")
+
+
+def _place(ctx: Context, ev: EvalFacts, scene: SceneTruth | None) -> tuple[float, float] | None:
+    """Where a finding is: its object's annotation, else its false track's box as the submission has it."""
+    if ctx.gt_id is not None:
+        a = scene.objects[ctx.frame].get(ctx.gt_id) if scene is not None and ctx.frame < len(scene.objects) else None
+        return a.xy_m if a is not None else None
+    if ctx.track is None:
+        return None
+    return next((xy for t, _, xy in ev.boxes.get(ctx.frame, []) if t == str(ctx.track)), None)
 
 
 def _check_on_it(text: str, ctx: Context, scene: SceneTruth, ev: EvalFacts, out: Tally, bad) -> None:
