@@ -98,11 +98,14 @@ def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapp
         if ev is None:
             continue
         out.checked["other run"] += 1
-        xy = ev.pred_xy.get((c, x), {})
         false = sorted(
             t
-            for t, g in ev.track_to_gt.get((c, x), {}).items()
-            if g is None and t in xy and math.hypot(xy[t][0] - place_xy_m[0], xy[t][1] - place_xy_m[1]) < NEAR_M
+            for (k, y), tracks in ev.track_to_gt.items()
+            if y == x
+            for t, g in tracks.items()
+            if g is None
+            and (xy := ev.pred_xy.get((k, y), {}).get(t)) is not None
+            and math.hypot(xy[0] - place_xy_m[0], xy[1] - place_xy_m[1]) < NEAR_M
         )
         if bool(false) != m[2].startswith("had a false"):
             bad("other run", m[0], f"{m[1]}'s false positives within {NEAR_M} m at frame {x}: {false}")

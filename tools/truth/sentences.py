@@ -305,12 +305,16 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None
 
 
 def _place(ctx: Context, ev: EvalFacts, scene: SceneTruth | None) -> tuple[float, float] | None:
-    """Where a finding is: its object's annotation, else its false track's box as the submission has it."""
+    """Where a finding is: its object's annotation, else its false track's box as the accumulator scored it (an
+    interpolation where the devkit made one), else as the submission has it."""
     if ctx.gt_id is not None:
         a = scene.objects[ctx.frame].get(ctx.gt_id) if scene is not None and ctx.frame < len(scene.objects) else None
         return a.xy_m if a is not None else None
     if ctx.track is None:
         return None
+    scored = ev.pred_xy.get((ctx.class_name, ctx.frame), {}).get(str(ctx.track))
+    if scored is not None:
+        return scored
     return next((xy for t, _, xy in ev.boxes.get(ctx.frame, []) if t == str(ctx.track)), None)
 
 
