@@ -155,8 +155,9 @@ class OnObject:
 @dataclass(frozen=True, slots=True)
 class Sighting:
     """The object at one frame: its LiDAR + radar points, how the evaluation saw it, the nearest detection of any
-    class (within ``NEAR_M``, kept or not), the nearest kept detection of its class and where that went, and the
-    tracks of its class output on it."""
+    class (within ``NEAR_M``, kept or not), the nearest kept detection of its class and where that went, the
+    tracks of its class output on it, and the nearest detection of its class within ``NEAR_M`` that preprocessing
+    removed (score threshold or NMS)."""
 
     frame: int
     points: int
@@ -165,6 +166,7 @@ class Sighting:
     nearest_own: Near | None
     went: Destination | None
     on_it: tuple[OnObject, ...]
+    removed_own: Near | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -127,9 +127,9 @@ class _Context:
         hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
         return int(self.scene.keyframes[frame].gt_num_pts[hit[0]]) if hit.size else 0
 
-    def near(self, frame: int, xy: np.ndarray, *, own: bool) -> Near | None:
-        """The nearest detection within ``NEAR_M`` of ``xy`` at ``frame``: any class and score (own False), or a
-        kept one of the failure's class (own True)."""
+    def near(self, frame: int, xy: np.ndarray, *, own: bool, kept_only: bool = True) -> Near | None:
+        """The nearest detection within ``NEAR_M`` of ``xy`` at ``frame``: any class and score (own False), or one of
+        the failure's class (own True) that preprocessing kept (kept_only) or removed (not kept_only)."""
         fr = self.frames.get(frame)
         if fr is None:
             return None
@@ -139,7 +139,7 @@ class _Context:
         d = np.hypot(*(boxes.translation_m[:, :2] - xy).T)
         ok = d < NEAR_M
         if own:
-            ok &= kept & (boxes.class_name == self.class_name)
+            ok &= (kept if kept_only else ~kept) & (boxes.class_name == self.class_name)
         if not ok.any():
             return None
         m = int(np.flatnonzero(ok)[np.argmin(d[ok])])
@@ -178,6 +178,7 @@ class _Context:
                     own,
                     went,
                     self.on_object(self.report, self.frames[f], xy),
+                    self.near(f, xy, own=True, kept_only=False),
                 )
             )
         return tuple(out)
@@ -670,9 +671,9 @@ class _Context:
             xy = self.gt_xy(gt_id, self.f) if gt_id is not None else None
             if xy is None and self.failure.boxes:
                 xy = np.asarray(self.failure.boxes[0].translation_m[:2])
+            kinds = SAME_FAILURE.get(self.failure.kind, {self.failure.kind})
             failed = any(
-                f.kind is self.failure.kind and f.frame_index == self.f and _same_place(f, gt_id, xy)
-                for f in ev.report.failures
+                f.kind in kinds and f.frame_index == self.f and _same_place(f, gt_id, xy) for f in ev.report.failures
             )
             on_it = self.on_object(ev.report, fr, xy) if xy is not None else ()
             place = (float(xy[0]), float(xy[1])) if xy is not None else None
@@ -694,6 +695,14 @@ def key_decisions(
     """Choices in ``frames`` that sent a detection away from one of ``involved`` while it was the next best, or
     gave one to an involved track by a close call (``_Context.key_decisions``)."""
     return _Context(evidence, scene, frames.stop - 1, class_name, frames.start).key_decisions(involved)
+
+
+SAME_FAILURE = {
+    FailureKind.ID_SWITCH: {FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT},
+    FailureKind.IDENTITY_THEFT: {FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT},
+}
+"""Kinds that are one failure for another run: both are the devkit's SWITCH of the object (a theft is a switch whose
+new track had been false), so a run with either did not 'not fail here'."""
 
 
 def _same_place(f: Failure, gt_id: str | None, xy: np.ndarray | None) -> bool:

@@ -295,7 +295,9 @@ def destination_name(d: Destination | None, mode: UseMode) -> str:
         return "not received (dropped by preprocessing)"
     if d.went is Went.TRACK:
         extra = share_text(d.share, mode)
-        return f"track {d.track_id}" + (f" ({extra.replace(' of its weight', '')})" if extra else "")
+        if mode is UseMode.WEIGHTS:  # the detection's weight, not the track's: say whose
+            return f"track {d.track_id} ({100 * d.share:.0f} % of {meas_name(d.meas)})"
+        return f"track {d.track_id}" + (f" ({extra})" if extra else "")
     if d.went is Went.NEW_TRACK:
         return f"new track {d.track_id}"
     return "new (started no track: a candidate or clutter)"
@@ -455,11 +457,18 @@ def _presence(f: Finding) -> str:
     if not seen or f.gt_id is None:
         return ""
     detected = [s.frame for s in seen if s.nearest_own is not None]
+    removed = [s.frame for s in seen if s.nearest_own is None and s.removed_own is not None]
     at = frames_text(detected) if detected else "no frame"
     only = " only" if 0 < len(detected) < len(seen) else ""
+    kept = "the tracker kept " if removed else ""
+    also = (
+        f", and at {frames_text(removed)} only one its preprocessing removed (score threshold or NMS)"
+        if removed
+        else ""
+    )
     return (
         f"in the {len(seen)} recorded frames up to {f.frame} ({seen[0].frame}–{seen[-1].frame}), GT "
-        f"{short_id(f.gt_id)} had a {f.class_name} detection within {NEAR_M:.0f} m at {at}{only}"
+        f"{short_id(f.gt_id)} had a {f.class_name} detection {kept}within {NEAR_M:.0f} m at {at}{only}{also}"
     )
 
 
@@ -734,8 +743,8 @@ def _counted_unshown(f: Finding, lost: LostTrack) -> list[str]:
     else:
         versus = f"is above the {f.class_name} threshold {threshold:.3f}"
     return [
-        f"too low for track {lost.track_id} to be shown here (existence below {SHOW_MIN_EXISTENCE:g}), yet the "
-        f"evaluation counted it: {averaged_text(ev)}, {versus}"
+        f"track {lost.track_id}'s existence stayed below {SHOW_MIN_EXISTENCE:g} (the views draw tracks from "
+        f"{SHOW_MIN_EXISTENCE:g} up), yet the evaluation counted it: {averaged_text(ev)}, {versus}"
     ]
 
 
@@ -965,6 +974,8 @@ def _others(f: Finding) -> list[str]:
                 f"{who} did not fail here: its track{'s' if len(counted) > 1 else ''} "
                 f"{ids} {'were' if len(counted) > 1 else 'was'} output on the object and counted"
             )
+        elif f.kind in (FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT, FailureKind.FRAGMENTATION):
+            out.append(f"{who} had no counted track on the object here either")  # it lost the object too
         else:
             out.append(f"{who} did not have this failure")
     return out

@@ -122,6 +122,12 @@ PLANTED = {
         "track 7 was output on it, but its score averaged over its 3 frames, 0.40, is below the car threshold "
         "0.500: the evaluation did not count it",
     ),
+    "matched: the class threshold, at a sentence's end": (
+        "the evaluation counted the track: its score averaged over its 3 frames, 0.700, is at least the car threshold "
+        "0.500.",
+        "the evaluation counted the track: its score averaged over its 3 frames, 0.700, is at least the car threshold "
+        "0.400.",
+    ),
     "gone: column of infinite cost": (
         None,
         "at frame 3 m1 (score 0.80, 0.3 m from it; track 9 was gone) → track 7",
@@ -235,3 +241,122 @@ def test_a_near_tie_is_stated_with_the_decimals_that_tell_the_two_values_apart()
     text = _because(None, d2)
     assert f"Within d² {w.needed:.{w.digits}f} (instead of {d2[0, 0]:.{w.digits}f})" in text, text
     assert _found(text, d2=d2).found == []
+
+
+def _scene():
+    """Frames 0-3: GT A (car, 12 points) at the origin, GT B (car, 0 points) 30 m away; m0 (car, 0.90) 0.3 m from A
+    at every frame, m1 (truck, 0.40) 1.0 m from B at frame 3."""
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    objects = [{GT_A: Annotation(C, (0.0, 0.0), 12), GT_B: Annotation(C, (30.0, 0.0), 0)} for _ in range(4)]
+    detections = [[Detection(C, 0.9, (0.3, 0.0))] for _ in range(3)]
+    detections.append([Detection(C, 0.9, (0.3, 0.0)), Detection("truck", 0.4, (31.0, 0.0))])
+    return SceneTruth(detections, objects, [(-45.0, 0.0)] * 4)  # GT A 45 m from the ego pose
+
+
+def _raw_with(*events):
+    return RawEvents.of([FrameStarted("t", 3, "token", 0, 0.5), *events])
+
+
+def _received(*meas: int):
+    from gnnpmb.events import MeasurementsReceived
+
+    return MeasurementsReceived(C, np.array(meas), np.zeros((len(meas), 3)), np.full(len(meas), 0.9))
+
+
+PRESENCE_KEPT = "in the 2 recorded frames up to 3 (2–3), GT aaaaaa had a car detection the tracker kept within 2 m at "
+PLANTED_FACTS = {
+    # class: (true sentence, planted false sentence, raw events at frame 3); frame 2 has no event: m0 removed there
+    "detector: score": (
+        "at frame 3 detection m0 (score 0.90) lay 0.3 m from car GT aaaaaa and started no track",
+        "at frame 3 detection m0 (score 0.80) lay 0.3 m from car GT aaaaaa and started no track",
+        (),
+    ),
+    "detector: distance": (
+        "at frame 3 m0 (score 0.90, 0.3 m from it) → track 7",
+        "at frame 3 m0 (score 0.90, 1.3 m from it) → track 7",
+        (),
+    ),
+    "detector: no detection though one was in reach": (
+        "at frame 3 the detector gave no car detection within 2 m of car GT bbbbbb (0 LiDAR and radar points in its "
+        "box), but a truck detection, m1 (score 0.40), 1.0 m away",
+        "at frame 3 the detector gave no detection within 2 m of car GT aaaaaa (12 LiDAR and radar points in its box)",
+        (),
+    ),
+    "detector: range side": (
+        "it lies 45.0 m from the ego vehicle, inside the evaluation's 50 m range",
+        "it lies 45.0 m from the ego vehicle, beyond the evaluation's 50 m range",
+        (),
+    ),
+    "misleading: removed detections left out of 'had a detection within 2 m'": (
+        PRESENCE_KEPT + "frame 3 only, and at frame 2 only one its preprocessing removed (score threshold or NMS)",
+        "in the 2 recorded frames up to 3 (2–3), GT aaaaaa had a car detection within 2 m at frame 3 only",
+        (_received(0),),
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(PLANTED_FACTS))
+def test_each_planted_detector_statement_is_caught_against_the_files(name: str) -> None:
+    true, false, events = PLANTED_FACTS[name]
+    ctx = Context(C, 3, GT_A)
+    raw = _raw_with(*events)
+    assert check_text(true, ctx, raw, _eval(), scene=_scene()).found == [], true
+    caught = check_text(false, ctx, raw, _eval(), scene=_scene()).found
+    assert [c.kind for c in caught][:1] == [name.split(":")[0]], (false, caught)
+
+
+def test_another_run_said_not_to_have_a_switch_it_had_no_track_for_is_caught() -> None:
+    other = _eval()  # GT B unmatched at frame 3 in the other run too; GT A matched to its track 7
+    ctx = Context(C, 3, GT_B, kind="id_switch")
+    planted = "pmbm on the same detections did not have this failure"
+    assert [c.kind for c in check_text(planted, ctx, None, _eval(), others={"pmbm": other}).found] == ["misleading"]
+    fair = "pmbm on the same detections had no counted track on the object here either"
+    assert check_text(fair, ctx, None, _eval(), others={"pmbm": other}).found == []
+    wrong = "pmbm on the same detections did not fail here: its track 7 was output on the object and counted"
+    assert [c.kind for c in check_text(wrong, ctx, None, _eval(), others={"pmbm": other}).found] == ["other run"]
+
+
+def test_a_bare_percentage_and_a_wrong_one_are_caught() -> None:
+    from gnnpmb.events import UpdateWeights
+
+    w = UpdateWeights(C, np.array([7]), np.array([1]), np.ones(1), np.array([0.03]), np.array([[0.99]]), np.zeros(1))
+    raw = _raw_with(w)
+    ctx = Context(C, 3, GT_A, lost=7)
+    assert check_text("at frame 3 m1 (score 0.80, 0.3 m from it) → track 7 (99 % of m1)", ctx, raw, _eval()).found == []
+    bare = check_text("at frame 3 m1 (score 0.80, 0.3 m from it) → track 7 (99 %)", ctx, raw, _eval()).found
+    assert [c.kind for c in bare] == ["misleading"]
+    assert check_text("at frame 3 it took 97 % of its weight from m1", ctx, raw, _eval()).found == []
+    wrong = check_text("at frame 3 it took 99 % of its weight from m1", ctx, raw, _eval()).found
+    assert [c.kind for c in wrong] == ["share"]  # 0.99 / (0.03 + 0.99) is 97 %
+
+
+def test_an_interpolated_box_said_output_and_a_start_without_a_birth_are_caught() -> None:
+    from gnnpmb.events import Born
+
+    ev = _eval()
+    ev.submitted[3] = {"5"}  # track 7's box at frame 3 is the evaluation's interpolation
+    said = "at frame 3 track 7 (car) was output on detection m0 (car, score 0.90)"
+    assert [c.kind for c in check_text(said, CTX, None, ev).found] == ["misleading"]
+    ev.submitted[3] = {"5", "7"}
+    assert check_text(said, CTX, None, ev).found == []
+    born = Born(C, np.array([7]), np.array([1]), np.zeros((1, 4)), np.ones(1))
+    started = "track 7 had been started at frame 3 by m1"
+    assert check_text(started, CTX, _raw_with(born), _eval()).found == []
+    handed = check_text(started, CTX, _raw_with(), _eval()).found  # a label handed over, no birth
+    assert [c.kind for c in handed] == ["misleading"]
+
+
+def test_another_runs_false_track_and_an_empty_place_are_checked_where_the_false_box_lies() -> None:
+    ev, other = _eval(), _eval()
+    ev.boxes[3] = [("11", C, (0.0, 0.0)), ("12", C, (10.0, 0.0))]
+    other.pred_xy[(C, 3)] = {"5": (0.5, 0.0), "7": (0.0, 0.0)}  # its track 5 is a false positive beside the box
+    at = Context(C, 3, None, kind="false_track", track=11)
+    fair = "pmbm on the same detections had a false track here too"
+    assert check_text(fair, at, None, ev, others={"pmbm": other}).found == []
+    planted = "pmbm on the same detections had no false track here"
+    assert [c.kind for c in check_text(planted, at, None, ev, others={"pmbm": other}).found] == ["other run"]
+    empty = "no object of any class lies within 2 m of it"
+    assert [c.kind for c in check_text(empty, at, None, ev, scene=_scene()).found] == ["detector"]  # GT A is there
+    away = Context(C, 3, None, kind="false_track", track=12)
+    assert check_text(empty, away, None, ev, scene=_scene()).found == []

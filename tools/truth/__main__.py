@@ -24,6 +24,7 @@ DEVSET = next(
 """The dev set beside the checkout (``../shared/devset``, as CI lays it out), else where the developers' machines
 keep it."""
 MINI_VAL = ("scene-0103", "scene-0916")
+MINI_TRAIN = tuple(f"scene-{n}" for n in ("0061", "0553", "0655", "0757", "0796", "1077", "1094", "1100"))
 PRESETS = ("centerpoint", "megvii", "pointpillars")
 
 
@@ -38,9 +39,12 @@ def run_cell(
     dataroot: Path = DEVSET,
     version: str = "v1.0-mini",
     where: list[tuple[str, Contradiction]] | None = None,
+    other: str | None = None,
 ) -> tuple[Tally, int]:
     """Check every finding of ``tracker`` on ``scene`` with ``preset``'s detection file; (tally, findings).
-    where: gets ("tracker scene preset failure-id", contradiction) for each contradiction."""
+    where: gets ("tracker scene preset failure-id", contradiction) for each contradiction; other: a second tracker
+    run on the same detections, whose outcome the findings state ("pmbm on the same detections ...") and which is
+    checked against its own devkit bookkeeping."""
     where = [] if where is None else where
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.submission import run_results
@@ -54,22 +58,24 @@ def run_cell(
     from gnnpmb.why.words import plain, why_lines
     from tools.truth.devkit import eval_facts
     from tools.truth.rawevents import RawEvents
+    from tools.truth.scene import SceneTruth
 
     detections = dataroot / "detections" / f"{preset}_{split_of_scene(scene)}.json"
-    request = load_inputs(
-        check_request(scene, [tracker], dataroot=dataroot, version=version, detections_file=detections)
-    )
-    name = request.trackers[0]
-    (run,) = run_all(request, record=True)
-    reports, _ = find_reports(request, [run])
-    evidence = evidence_of(request, reports[name], run)
-    raw = RawEvents.of(list(run.events))
-    ev = eval_facts(open_nuscenes(request.location), scene, run_results(run.tracking))
+    names = [tracker] + ([other] if other is not None and other != tracker else [])
+    request = load_inputs(check_request(scene, names, dataroot=dataroot, version=version, detections_file=detections))
+    runs = run_all(request, record=True)
+    reports, _ = find_reports(request, runs)
+    evidence = [evidence_of(request, reports[n], r) for n, r in zip(request.trackers, runs, strict=True)]
+    raw = RawEvents.of(list(runs[0].events))
+    nusc = open_nuscenes(request.location)
+    ev = eval_facts(nusc, scene, run_results(runs[0].tracking))
+    others = {n: eval_facts(nusc, scene, run_results(r.tracking)) for n, r in zip(names[1:], runs[1:], strict=True)}
+    truth = SceneTruth.read(nusc, scene, detections)
     tally = Tally()
-    report = reports[name]
+    report = reports[request.trackers[0]]
     for fid, failure in zip(report.ids(), report.failures, strict=True):
         start = max(request.frame_range.start, failure.frame_index - FRAMES_BEFORE)
-        f = explain_failure(fid, evidence, request.scene, [], first_frame=start)
+        f = explain_failure(fid, evidence[0], request.scene, evidence[1:], first_frame=start)
         text = "\n".join(plain(line) for line in why_lines(f))
         ctx = Context(
             f.class_name,
@@ -78,11 +84,29 @@ def run_cell(
             tuple(f.covered),
             f.taker.false_frames if f.taker is not None else (),
             f.taker.track_id if f.taker is not None else None,
+            f.kind.value,
+            f.lost.track_id if f.lost is not None else None,
+            f.false_output.track_id if f.false_output is not None else None,
         )
-        one = check_text(text, ctx, raw, ev, tracker)
+        one = check_text(text, ctx, raw, ev, tracker, truth, others)
         tally.add(one)
         where.extend((f"{tracker} {scene} {preset} {fid}", c) for c in one.found)
     return tally, len(report.failures)
+
+
+def other_of(tracker: str, other: str) -> str:
+    """The run a tracker's findings are compared with: ``other``, or gnnpmb for ``other`` itself."""
+    return "gnnpmb" if tracker == other else other
+
+
+def cells(scenes: Sequence[str], presets: Sequence[str], trackers: Sequence[str], square: bool):
+    """(scene, preset, tracker) in order; square: each tracker once, walking scenes and presets in turn (a Latin
+    square over the first ``len(trackers)`` cells of scenes × presets)."""
+    if not square:
+        return [(s, p, t) for s in scenes for p in presets for t in trackers]
+    return [
+        (scenes[i % len(scenes)], presets[(i // len(scenes) + i) % len(presets)], t) for i, t in enumerate(trackers)
+    ]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -90,26 +114,31 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", action="append", help="dev-set scenes (default: the two mini_val scenes)")
+    parser.add_argument("--all-scenes", action="store_true", help="all ten: mini_val and mini_train")
     parser.add_argument("--detector", action="append", help="presets (default: all three)")
     parser.add_argument("--tracker", action="append", help="trackers (default: all)")
     parser.add_argument("--dataroot", type=Path, default=DEVSET)
+    parser.add_argument("--other", default="pmbm", help="the run findings compare with ('none': no other run)")
+    parser.add_argument("--square", action="store_true", help="each tracker once over the scenes and presets")
     args = parser.parse_args(argv)
     per: dict[str, Tally] = defaultdict(Tally)
     findings: dict[str, int] = defaultdict(int)
     where: list[tuple[str, Contradiction]] = []
-    for scene in args.scene or MINI_VAL:
-        for preset in args.detector or PRESETS:
-            for tracker in args.tracker or TRACKER_NAMES:
-                tally, n = run_cell(tracker, scene, preset, args.dataroot, where=where)
-                per[tracker].add(tally)
-                findings[tracker] += n
-                line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)
-                print(
-                    f"checked {tracker} {scene} {preset}: {n} findings; false/checked {line}; replays "
-                    f"{tally.replays} refuted {tally.refuted}",
-                    file=sys.stderr,
-                    flush=True,
-                )
+    scenes = MINI_VAL + MINI_TRAIN if args.all_scenes else (args.scene or MINI_VAL)
+    todo = cells(scenes, args.detector or PRESETS, args.tracker or TRACKER_NAMES, args.square)
+    for scene, preset, tracker in todo:
+        other = None if args.other == "none" else other_of(tracker, args.other)
+        tally, n = run_cell(tracker, scene, preset, args.dataroot, where=where, other=other)
+        per[tracker].add(tally)
+        findings[tracker] += n
+        line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)
+        print(
+            f"checked {tracker} {scene} {preset}: {n} findings; false/checked {line}; replays "
+            f"{tally.replays} refuted {tally.refuted}; clauses {tally.clauses - sum(tally.unchecked.values())}/"
+            f"{tally.clauses} read",
+            file=sys.stderr,
+            flush=True,
+        )
     head = " ".join(f"{k:>14}" for k in CLASSES)
     print(f"{'tracker':12} {'findings':>8} {head} {'replays':>8} {'refuted':>8}")
     total = Tally()
@@ -118,9 +147,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         counts = defaultdict(int)
         for c in t.found:
             counts[c.kind] += 1
-        cells = " ".join(f"{counts[k]:>6}/{t.checked[k]:<7}" for k in CLASSES)
-        print(f"{tracker:12} {findings[tracker]:>8} {cells} {t.replays:>8} {t.refuted:>8}")
+        cells_text = " ".join(f"{counts[k]:>6}/{t.checked[k]:<7}" for k in CLASSES)
+        print(f"{tracker:12} {findings[tracker]:>8} {cells_text} {t.replays:>8} {t.refuted:>8}")
     print(f"contradictions: {len(total.found)} (false/checked per class above)")
+    read = total.clauses - sum(total.unchecked.values())
+    share = 100.0 * read / total.clauses if total.clauses else 0.0
+    print(f"coverage: {read} of {total.clauses} printed clauses read by a checker pattern ({share:.1f} %)")
+    print("clause kinds not checked (count):")
+    for kind, n in total.unchecked.most_common():
+        print(f"  {n:6} {kind}")
     for place, c in where:
         print(f"  {place}: [{c.kind}] {c.sentence!r} -- {c.truth}")
     return 1 if total.found else 0

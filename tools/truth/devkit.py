@@ -11,6 +11,7 @@ onto the scene's object and track ids through the devkit's own merge mappings (t
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -33,6 +34,16 @@ class EvalFacts:
     track_to_gt: dict[tuple[str, int], dict[str, str | None]] = field(default_factory=dict)
     counted: dict[str, set[str]] = field(default_factory=dict)
     evaluated_gt: dict[tuple[int, str], tuple[float, float]] = field(default_factory=dict)
+    switches: dict[tuple[str, int], set[str]] = field(default_factory=dict)
+    submitted: dict[int, set[str]] = field(default_factory=dict)
+    """frame -> the track ids the submission has a box of there (before any filter)."""
+    boxes: dict[int, list[tuple[str, str, tuple[float, float]]]] = field(default_factory=dict)
+    """frame -> the submission's boxes there: (track id, class, ground-plane centre)."""
+    pred_xy: dict[tuple[str, int], dict[str, tuple[float, float]]] = field(default_factory=dict)
+    """(class, frame) -> the centre of each track box the accumulator scored there (interpolations included)."""
+    scores: dict[tuple[int, str], float] = field(default_factory=dict)
+    """(frame, track id) -> the submission box's tracking score."""
+    """(class, frame) -> the object ids of the frame's SWITCH events."""
 
     def matched_track(self, class_name: str, frame: int, gt_id: str) -> str | None:
         return self.gt_to_track.get((class_name, frame), {}).get(gt_id)
@@ -84,6 +95,14 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         tracks_gt = create_tracks(gt, nusc, split, gt=True)
         tracks_pred = create_tracks(pred, nusc, split, gt=False)
     out = EvalFacts()
+    for token in tokens:
+        frame = frame_of_stamp[nusc.get("sample", token)["timestamp"]]
+        out.boxes[frame] = [
+            (str(b["tracking_id"]), b["tracking_name"], (float(b["translation"][0]), float(b["translation"][1])))
+            for b in results.get(token, [])
+        ]
+        out.submitted[frame] = {b[0] for b in out.boxes[frame]}
+        out.scores.update({(frame, str(b["tracking_id"])): float(b["tracking_score"]) for b in results.get(token, [])})
     scene_gt = tracks_gt[scene["token"]]
     scene_pred = tracks_pred[scene["token"]]
     for stamp, boxes in scene_gt.items():
@@ -96,12 +115,10 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         ev = class_evaluation(
             tracks_gt, tracks_pred, class_name, cfg
         )  # the devkit's own object, as TrackingEval builds it
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            md = ev.accumulate()
-        if np.all(np.isnan(md.mota)):
+        best = _best_mota_threshold(ev)
+        if best is None:
             continue
-        best = int(np.nanargmax(md.mota))
-        threshold = None if np.isnan(md.confidence[best]) else float(md.confidence[best])
+        threshold = best[0]
         out.thresholds[class_name] = threshold
         events, oid_of, hid_of = _accumulate_threshold(ev, threshold)
         frame_of_id = []  # devkit frame id -> keyframe index, numbered as accumulate_threshold numbers them
@@ -116,6 +133,9 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
                 frame_of_id.append(frame_of_stamp[stamp])
                 out.gt_to_track[(class_name, frame_of_stamp[stamp])] = {str(b.tracking_id): None for b in g}
                 out.track_to_gt[(class_name, frame_of_stamp[stamp])] = {str(b.tracking_id): None for b in p}
+                out.pred_xy[(class_name, frame_of_stamp[stamp])] = {
+                    str(b.tracking_id): (float(b.translation[0]), float(b.translation[1])) for b in p
+                }
         out.counted[class_name] = counted
         events = events.reset_index()
         for frame_id, kind, oid, hid in zip(
@@ -126,7 +146,43 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
                 gt_id, track_id = str(oid_of[oid]), str(hid_of[hid])
                 out.gt_to_track[(class_name, frame)][gt_id] = track_id
                 out.track_to_gt[(class_name, frame)][track_id] = gt_id
+                if str(kind) == "SWITCH":
+                    out.switches.setdefault((class_name, frame), set()).add(gt_id)
     return out
+
+
+def _best_mota_threshold(ev) -> tuple[float | None] | None:
+    """(threshold,) at which ``ev.accumulate()`` would have its best MOTA, as ``TrackingEval`` picks it
+    (``np.nanargmax(md.mota)``, None: the confidence there is NaN); None when the class has no ground truth.
+    The same devkit steps as ``accumulate`` (``compute_thresholds``, ``accumulate_threshold`` per distinct
+    threshold, the devkit's ``mota_custom``, NaN for unachieved recalls, duplicates repeated), computing MOTA only:
+    the other metrics ``accumulate`` computes take most of its time and do not choose the threshold."""
+    import contextlib
+    import io
+
+    from nuscenes.eval.tracking.utils import create_motmetrics
+
+    count = sum(
+        b.tracking_name == ev.class_name for scene in ev.tracks_gt.values() for frame in scene.values() for b in frame
+    )
+    if count == 0:
+        return None
+    mh = create_motmetrics()
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        thresholds, _ = ev.compute_thresholds(count)
+        mota: list[float] = []
+        for t, threshold in enumerate(thresholds):
+            if np.isnan(threshold):
+                mota.append(math.nan)
+            elif threshold in thresholds[:t]:
+                mota.append(mota[list(thresholds).index(threshold)])
+            else:
+                acc, _ = ev.accumulate_threshold(threshold)
+                mota.append(float(mh.compute(acc, metrics=["mota_custom"], name="t")["mota_custom"].iloc[0]))
+    if all(math.isnan(v) for v in mota):
+        return (None,)  # no recall reached: the devkit fills the worst MOTA and its confidence is NaN
+    best = int(np.nanargmax(mota))
+    return (None if np.isnan(thresholds[best]) else float(thresholds[best]),)
 
 
 def _accumulate_threshold(ev, threshold: float | None):

@@ -24,6 +24,7 @@ from gnnpmb.events import (
     AxisKind,
     CostMatrix,
     FrameStarted,
+    MeasurementsReceived,
     Predicted,
     Pruned,
     TrackLogic,
@@ -59,6 +60,12 @@ class RawEvents:
 
     def predicted(self, frame: int, class_name: str) -> set[int]:
         return {int(t) for p in self.of_kind(frame, class_name, Predicted) for t in np.asarray(p.track_ids)}
+
+    def received(self, frame: int, class_name: str) -> set[int]:
+        """The detections the tracker received at ``frame`` for ``class_name`` (after its preprocessing)."""
+        return {
+            int(m) for e in self.of_kind(frame, class_name, MeasurementsReceived) for m in np.asarray(e.meas_indices)
+        }
 
     def gone(self, frame: int, class_name: str, track: int) -> bool:
         return track not in self.columns(frame, class_name) and track not in self.predicted(frame, class_name)

@@ -10,21 +10,30 @@ Classes of false statement (the issue's numbering):
 * ``counterfactual``: a "would have taken" / "would have cost more" replayed, a rival already taken, a stated
   threshold on the wrong side of the current value;
 * ``misleading``: a margin other than the solver's (a capped one included), a greedy alternative already taken,
-  a note meant for the viewer printed in the terminal.
+  a note meant for the viewer printed in the terminal, detections preprocessing removed left out of "had a
+  detection within 2 m" unsaid, "did not have this failure" of a run that lost the object too, a bare percentage;
+
+and beyond the issue's four: ``detector`` (scores, distances, points, detections in reach: ``detector``), ``other
+run`` (``otherruns``), ``share`` (PHD percentages: ``shares``), ``output`` (a track's box on the object, its score,
+against the submission). ``coverage`` says which clauses of a text any
+pattern reads.
 """
 
 from __future__ import annotations
 
 import math
 import re
+from collections import Counter
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from gnnpmb.events import AxisKind
-from tools.truth import replay
+from gnnpmb.events import AxisKind, Born
+from tools.truth import detector, otherruns, replay, shares
 from tools.truth.devkit import EvalFacts
 from tools.truth.rawevents import RawEvents
+from tools.truth.scene import SceneTruth
 
-CLASSES = ("matched", "gone", "counterfactual", "misleading")
+CLASSES = ("matched", "gone", "counterfactual", "misleading", "detector", "other run", "share", "output")
 
 
 @dataclass(frozen=True)
@@ -47,6 +56,10 @@ class Context:
     covered: tuple[str, ...] = ()
     false_frames: tuple[int, ...] = ()
     taker: int | None = None
+    kind: str = ""
+    lost: int | None = None
+    track: int | None = None
+    """A false track's id (its box is the place the finding is about)."""
 
 
 @dataclass
@@ -57,6 +70,9 @@ class Tally:
     found: list[Contradiction] = field(default_factory=list)
     replays: int = 0
     refuted: int = 0
+    clauses: int = 0
+    unchecked: Counter = field(default_factory=Counter)
+    """Clauses of the texts, and the kinds (``clause_kind``) of those no pattern reads."""
 
     def add(self, other: Tally) -> None:
         for k, v in other.checked.items():
@@ -64,6 +80,8 @@ class Tally:
         self.found += other.found
         self.replays += other.replays
         self.refuted += other.refuted
+        self.clauses += other.clauses
+        self.unchecked += other.unchecked
 
 
 _NUM = r"[-\d.e+]+"
@@ -98,25 +116,101 @@ THEFT = re.compile(
 COVERED = re.compile(r"track ([\d, ]+) lay within \d m of it and was counted, but the evaluation matched it to another")
 COALESCED = re.compile(r"at frame (\d+) track (\d+) was matched to (GT \w+(?:, GT \w+)*) and also lay within")
 MATCHED_INSTEAD = re.compile(r"the evaluation matched it to another track \(track (\d+)\)")
-NOT_COUNTED = re.compile(r"track (\d+) was output on it, but [^:]*?: the evaluation did not count it")
+NOT_COUNTED = re.compile(
+    r"track (\d+) was output on it(?: \(score [\d.]+\))?, but [^:]*?: the evaluation did not count it"
+)
+ON_IT = re.compile(r"track (\d+) was (not )?output on it(?: \(score ([\d.]+)\))?")
 VIEWER_ONLY = ("too low to be shown here",)
+NOTHING_NEAR = re.compile(r"no object of any class lies within 2 m")
+NO_TRACK_NEAR = re.compile(r"no (\w+) track was output within 2 m of it")
+COUNTED_AT = re.compile(
+    r"the evaluation counted the track: its score averaged [^:]*?, is at least the (\w+) threshold (\d+\.\d+)"
+)
+OUTPUT_AT = re.compile(r"at frame (\d+) track (\d+) (?:\(\w+\) )?was (?:still )?output (?:on|[\d.]+ m from)")
+LAST_OUTPUT = re.compile(r"track (\d+) was last output on it at frame (\d+)")
+STARTED_NEW = re.compile(
+    r"at frame (\d+) (?:detection )?m(\d+) \([^()]*(?:\([^()]*\)[^()]*)*\)(?: lay [\d.]+ m from \w+ GT \w+ and started|"
+    r" →) new track (\d+)"
+)
+STARTED = re.compile(r"track (\d+) had been started at frame (\d+) by m(\d+)")
 
 
-def check_text(text: str, ctx: Context, raw: RawEvents | None, ev: EvalFacts, tracker: str = "") -> Tally:
-    """Every checkable sentence of ``text`` (one finding's rendered lines); raw None for a results file."""
+def check_text(
+    text: str,
+    ctx: Context,
+    raw: RawEvents | None,
+    ev: EvalFacts,
+    tracker: str = "",
+    scene: SceneTruth | None = None,
+    others: Mapping[str, EvalFacts] | None = None,
+) -> Tally:
+    """Every checkable sentence of ``text`` (one finding's rendered lines); raw None for a results file; scene: the
+    files' own detections and annotations (None: detector sentences unchecked); others: other runs' devkit facts
+    by tracker name."""
     out = Tally()
 
     def bad(kind: str, sentence: str, truth: str) -> None:
         out.found.append(Contradiction(kind, sentence, truth))
 
     c = ctx.class_name
+    out.clauses, out.unchecked = coverage(text)
     _check_eval(text, ctx, ev, out, bad)
+    if scene is not None:
+        detector.check_detector(text, ctx.gt_id, ctx.frame, c, scene, raw, out, bad, ev.evaluated_gt)
+    otherruns.check_others(text, ctx.kind, c, ctx.frame, ctx.gt_id, others or {}, scene, out, bad)
+    place = _place(ctx, ev, scene)
+    otherruns.check_other_false_tracks(text, c, ctx.frame, place, others or {}, out, bad)
+    if scene is not None and ctx.gt_id is None and place is not None:
+        for m in NOTHING_NEAR.finditer(text):
+            out.checked["detector"] += 1
+            here = scene.objects[ctx.frame] if ctx.frame < len(scene.objects) else {}
+            near = [k[:6] for k, a in here.items() if math.hypot(a.xy_m[0] - place[0], a.xy_m[1] - place[1]) < 2.0]
+            if near:
+                bad("detector", m[0], f"annotated objects within 2 m of track {ctx.track}'s box: {near}")
     for phrase in VIEWER_ONLY:
         if phrase in text:
             out.checked["misleading"] += 1
             bad("misleading", phrase, "a note about the viewer printed where nothing is shown")
+    for m in COUNTED_AT.finditer(text):
+        out.checked["matched"] += 1
+        if ev.thresholds.get(m[1]) is None or abs(ev.thresholds[m[1]] - float(m[2])) > 0.0005 + 1e-9:
+            bad("matched", m[0], f"the devkit's best-MOTA threshold for {m[1]} is {ev.thresholds.get(m[1])}")
+    if scene is not None and ctx.gt_id is not None:
+        for m in NO_TRACK_NEAR.finditer(text):
+            a = scene.objects[ctx.frame].get(ctx.gt_id) if ctx.frame < len(scene.objects) else None
+            if a is None:
+                continue
+            out.checked["detector"] += 1
+            near = [
+                t
+                for t, cls, xy in ev.boxes.get(ctx.frame, [])
+                if cls == m[1] and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < 2.0
+            ]
+            if near:
+                bad("detector", m[0], f"the submission has {m[1]} tracks {near} within 2 m at frame {ctx.frame}")
+    if scene is not None and ctx.gt_id is not None:
+        _check_on_it(text, ctx, scene, ev, out, bad)
+    said_output = [(int(m[1]), m[2], m[0]) for m in OUTPUT_AT.finditer(text)]
+    said_output += [(int(m[2]), m[1], m[0]) for m in LAST_OUTPUT.finditer(text)]
+    for x, t, sentence in said_output:
+        out.checked["misleading"] += 1
+        if t not in ev.submitted.get(x, set()):
+            bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
     if raw is None:
         return out
+    started = [(int(m[2]), int(m[1]), int(m[3]), m[0]) for m in STARTED.finditer(text)]
+    started += [(int(m[1]), int(m[3]), int(m[2]), m[0]) for m in STARTED_NEW.finditer(text)]
+    for x, t, meas, sentence in started:
+        out.checked["misleading"] += 1
+        born = {
+            (int(a), int(b)) for e in raw.of_kind(x, c, Born) for a, b in zip(e.track_ids, e.meas_indices, strict=True)
+        }
+        if (t, meas) not in born:
+            bad(
+                "misleading",
+                sentence,
+                f"no Born event of frame {x} starts track {t} from m{meas} (born: {sorted(born)})",
+            )
     for m in GONE.finditer(text):
         x, meas, t = int(m[1]), int(m[2]), int(m[3])
         out.checked["gone"] += 1
@@ -140,7 +234,38 @@ def check_text(text: str, ctx: Context, raw: RawEvents | None, ev: EvalFacts, tr
         _check_counterfactuals(x, para, c, raw, out, bad)
     for m in CHOICE.finditer(text):
         _check_choice(m, c, raw, out, bad)
+    shares.check_shares(text, c, ctx.lost, raw, out, bad)
     return out
+
+
+def _patterns() -> list[re.Pattern]:
+    mods = (detector, otherruns, shares)
+    here = [v for v in globals().values() if isinstance(v, re.Pattern) and v is not BECAUSE]
+    return here + [v for mod in mods for v in vars(mod).values() if isinstance(v, re.Pattern)]
+
+
+def clause_kind(clause: str) -> str:
+    """A clause with its numbers, ids and class names blanked, cut to its first words: what kind of sentence."""
+    text = re.sub(r"\b[0-9a-f]{6}\b", "H", clause)
+    text = re.sub(r"\d+(\.\d+)?", "N", text)
+    text = re.sub(r"\b(car|truck|bus|trailer|bicycle|motorcycle|pedestrian)\b", "C", text)
+    return " ".join(text.split()[:7])
+
+
+def coverage(text: str) -> tuple[int, Counter]:
+    """(clauses, Counter of unchecked clause kinds): a Why paragraph's clauses are its "; " parts, a Because
+    paragraph's its sentences; a clause is checked when a checker pattern's match overlaps it."""
+    spans = [m.span() for p in _patterns() for m in p.finditer(text)]
+    clauses: list[tuple[int, int]] = []
+    for line in re.finditer(r"[^\n]+", text):
+        head = line[0].find("): ")
+        start = line.start() + (head + 3 if head >= 0 else 0)
+        sep = r"; " if line[0].startswith("Why") else r"\. (?=[A-Z])"
+        for part in re.finditer(rf"(?:(?!{sep}).)+", text[start : line.end()]):
+            if part[0].strip(" ."):
+                clauses.append((start + part.start(), start + part.end()))
+    unchecked = Counter(clause_kind(text[a:b]) for a, b in clauses if not any(s < b and e > a for s, e in spans))
+    return len(clauses), unchecked
 
 
 def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None:
@@ -177,6 +302,39 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None
         out.checked["matched"] += 1
         if m[1] in ev.counted.get(c, set()):
             bad("matched", m[0], f"track {m[1]} passes the {c} threshold {ev.thresholds.get(c)}")
+
+
+def _place(ctx: Context, ev: EvalFacts, scene: SceneTruth | None) -> tuple[float, float] | None:
+    """Where a finding is: its object's annotation, else its false track's box as the accumulator scored it (an
+    interpolation where the devkit made one), else as the submission has it."""
+    if ctx.gt_id is not None:
+        a = scene.objects[ctx.frame].get(ctx.gt_id) if scene is not None and ctx.frame < len(scene.objects) else None
+        return a.xy_m if a is not None else None
+    if ctx.track is None:
+        return None
+    scored = ev.pred_xy.get((ctx.class_name, ctx.frame), {}).get(str(ctx.track))
+    if scored is not None:
+        return scored
+    return next((xy for t, _, xy in ev.boxes.get(ctx.frame, []) if t == str(ctx.track)), None)
+
+
+def _check_on_it(text: str, ctx: Context, scene: SceneTruth, ev: EvalFacts, out: Tally, bad) -> None:
+    """ "track T was (not) output on it (score S)" at the finding's frame: T's box in the submission within 2 m of
+    the object's annotation, with that score."""
+    a = scene.objects[ctx.frame].get(ctx.gt_id or "") if ctx.frame < len(scene.objects) else None
+    if a is None:
+        return
+    near = {
+        t
+        for t, cls, xy in ev.boxes.get(ctx.frame, [])
+        if cls == ctx.class_name and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < 2.0
+    }
+    for m in ON_IT.finditer(text):
+        out.checked["output"] += 1
+        if (m[1] in near) == bool(m[2]):
+            bad("output", m[0], f"the submission's {ctx.class_name} boxes within 2 m at frame {ctx.frame}: {near}")
+        elif m[3] is not None and abs(ev.scores.get((ctx.frame, m[1]), math.nan) - float(m[3])) > 0.005 + 1e-9:
+            bad("output", m[0], f"its box's score is {ev.scores.get((ctx.frame, m[1]))}")
 
 
 def _check_counterfactuals(x: int, para: str, c: str, raw: RawEvents, out: Tally, bad) -> None:

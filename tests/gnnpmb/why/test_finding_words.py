@@ -52,11 +52,12 @@ def test_a_track_never_shown_is_said_to_count_when_its_average_reaches_the_thres
     lost = LostTrack(26, 7, (step(7, output=estimate(26, 0.01)),), None, evaluated, 0.037)
     (line, _) = why_lines(finding(FailureKind.ID_SWITCH, lost))
     assert (
-        "too low for track 26 to be shown here (existence below 0.5), yet the evaluation counted it: its score "
-        "averaged over its 3 frames, 0.037, is exactly the bicycle threshold (the lowest score counted)" in line
+        "track 26's existence stayed below 0.5 (the views draw tracks from 0.5 up), yet the evaluation counted it: "
+        "its score averaged over its 3 frames, 0.037, is exactly the bicycle threshold (the lowest score counted)"
+        in line
     )
     shown = LostTrack(26, 7, (step(7, output=estimate(26, 0.9)),), None, evaluated, 0.037)
-    assert "too low" not in why_lines(finding(FailureKind.ID_SWITCH, shown))[0]  # it was shown: nothing to explain
+    assert "stayed below" not in why_lines(finding(FailureKind.ID_SWITCH, shown))[0]  # it was shown: nothing to explain
 
 
 def test_the_averaged_score_names_the_frames_the_evaluation_kept_when_not_all() -> None:
@@ -139,3 +140,28 @@ def test_a_deleted_track_and_a_detection_that_started_another_are_both_said() ->
     assert "its track logic deleted it at frame 14 (no hit in its last 3 frames)" in line
     assert "at frame 15 m0 (score 0.89, 0.1 m from it; track 62 was gone) → new track 348" in line
     assert "given no detection" not in line and "?" not in line
+
+
+def test_frames_with_only_a_removed_detection_are_said_apart_and_a_run_that_lost_the_object_too_is_named_so() -> None:
+    from gnnpmb.why.findings import OtherRun
+
+    kept, removed = Near(0, "bicycle", 0.89, 0.1, True), Near(1, "bicycle", 0.05, 0.3, False)
+    seen = (
+        Sighting(11, 80, None, kept, kept, None, ()),
+        Sighting(12, 80, None, removed, None, None, (), removed),
+    )
+    lost = LostTrack(62, 11, (), None, None, None)
+    f = finding(FailureKind.ID_SWITCH, lost, frame=12, sightings=seen, others=(OtherRun("pmbm", False, ()),))
+    line = why_lines(f)[0]
+    assert (
+        "GT bf3d85 had a bicycle detection the tracker kept within 2 m at frame 11 only, and at frame 12 only one its "
+        "preprocessing removed (score threshold or NMS)" in line
+    )
+    assert "pmbm on the same detections had no counted track on the object here either" in line
+    assert "did not have this failure" not in line
+
+
+def test_a_detections_share_of_a_phd_update_names_whose_weight_it_is() -> None:
+    from gnnpmb.why.words import destination_name
+
+    assert destination_name(Destination(2, Went.TRACK, 26, 0.99), UseMode.WEIGHTS) == "track 26 (99 % of m2)"

@@ -1,0 +1,211 @@
+"""Sentences about what the detector gave, checked against the detection file and the annotations themselves
+(``scene.SceneTruth``), and, for what the tracker kept, the tracker's own ``MeasurementsReceived`` events.
+
+Each pattern names a detection ``mN`` with its score and distance from the object, says the detector gave no
+detection near an object (and how many points the object had), or lists the frames at which the object had a
+detection of its class within reach. The last must count every detection the file has there: a detection the
+tracker's preprocessing removed (score threshold or NMS) is either in the stated frames or stated apart; leaving it
+out without saying so is the issue's class 4 ("misleading").
+"""
+
+from __future__ import annotations
+
+import re
+
+from tools.truth.rawevents import RawEvents
+from tools.truth.scene import NEAR_M, SceneTruth
+
+_F = r"[\d.]+"
+_FRAMES = r"frames? [\d–, ]*\d"
+SCORE_AT = re.compile(rf"at frame (\d+) detection m(\d+) \(score ({_F})\) lay ({_F}) m from (\w+) GT (\w+)")
+NO_DETECTION = re.compile(
+    r"at frame (\d+) the detector gave no detection within 2 m of (\w+) GT (\w+) \((\d+) LiDAR and radar points in "
+    r"its box\)"
+)
+WRONG_CLASS = re.compile(
+    rf"at frame (\d+) the detector gave no (\w+) detection within 2 m of \w+ GT (\w+) \((\d+) LiDAR and radar points "
+    rf"in its box\), but a (\w+) detection, m(\d+) \(score ({_F})\), ({_F}) m away"
+)
+NONE_ANY = re.compile(rf"at ({_FRAMES}) the detector gave no detection of any class within 2 m, though it had")
+HIDDEN = re.compile(
+    rf"at ({_FRAMES}) (?:\w+ GT (\w+)|it) had no LiDAR or radar points \(no detector could see it\) and no detection "
+    r"within 2 m"
+)
+UNUSED = re.compile(rf"at frame (\d+) m(\d+) \((?:(\w+), )?score ({_F}), ({_F}) m from it")
+OUTPUT_ON = re.compile(rf"at frame (\d+) track \d+ \((\w+)\) was output on detection m(\d+) \((\w+), score ({_F})\)")
+ITS_DETECTION = re.compile(rf"its detection m(\d+) \(score ({_F}), ({_F}) m away\)")
+OTHER_CLASS = re.compile(rf"at ({_FRAMES}) the detector saw it only as another class \(([^)]*)\)")
+OTHER_ITEM = re.compile(rf"(\w+) m(\d+) ({_F}) m away")
+EGO = re.compile(rf"it lies ({_F}) m from the ego vehicle, (inside|beyond) the evaluation's ({_F}) m range")
+INTERPOLATED_AT = re.compile(rf"the evaluation scored it at a box it interpolated, ({_F}) m from the annotation")
+PRESENCE = re.compile(
+    rf"in the (\d+) recorded frames up to (\d+) \((\d+)–(\d+)\), GT (\w+) had an? (\w+) detection "
+    rf"(?:the tracker kept )?within 2 m at ({_FRAMES}|no frame)(?: only)?"
+    rf"(?:,? and at ({_FRAMES}) only one? (?:that )?(?:its )?preprocessing removed)?"
+)
+
+
+def _class_range() -> dict[str, float]:
+    from nuscenes.eval.common.config import config_factory
+
+    return dict(config_factory("tracking_nips_2019").class_range)
+
+
+RANGE_M = _class_range()
+"""The devkit's evaluation range per class (``tracking_nips_2019``), metres from the ego pose."""
+
+
+def frames_of(text: str) -> list[int]:
+    """``frame 3`` / ``frames 1–4, 7, 9`` -> [1, 2, 3, 4, 7, 9]."""
+    out: list[int] = []
+    for part in text.split(" ", 1)[1].split(","):
+        part = part.strip()
+        if "–" in part:
+            lo, hi = part.split("–")
+            out += range(int(lo), int(hi) + 1)
+        elif part:
+            out.append(int(part))
+    return out
+
+
+def _close(printed: str, value: float) -> bool:
+    """Whether ``value`` prints as ``printed`` (its decimals), a rounding ulp allowed."""
+    decimals = len(printed.split(".")[1]) if "." in printed else 0
+    return abs(float(printed) - value) <= 0.5 * 10.0**-decimals + 1e-9
+
+
+def check_detector(
+    text: str, gt_id: str | None, frame: int, class_name: str, scene: SceneTruth, raw, out, bad, evaluated=None
+) -> None:
+    """Every detector sentence of ``text`` (``out``: the ``Tally``; ``bad(kind, sentence, truth)``); evaluated: the
+    devkit's scored object boxes, (frame, object id) -> (x, y) (``devkit.EvalFacts.evaluated_gt``)."""
+
+    def gt_xy(x: int, short: str | None = None):
+        if x >= len(scene.objects):
+            return None
+        key = gt_id if short is None or (gt_id or "").startswith(short) else None
+        if key is not None and key in scene.objects[x]:
+            return scene.objects[x][key]
+        hit = scene.object_of(x, short) if short else None
+        return hit[1] if hit else None
+
+    def det(x: int, m: int):
+        dets = scene.detections[x] if x < len(scene.detections) else []
+        return dets[m] if m < len(dets) else None
+
+    def score_distance(sentence: str, x: int, m: int, score: str, dist: str | None, ann, cls: str | None = None):
+        out.checked["detector"] += 1
+        d = det(x, m)
+        if d is None or ann is None:
+            bad("detector", sentence, f"the file has no detection m{m} at frame {x} (or no such object)")
+            return
+        true_d = float(((d.xy_m[0] - ann.xy_m[0]) ** 2 + (d.xy_m[1] - ann.xy_m[1]) ** 2) ** 0.5)
+        if not _close(score, d.score) or (dist is not None and not _close(dist, true_d)):
+            bad("detector", sentence, f"the file's m{m}: score {d.score:.4f}, {true_d:.3f} m from the object")
+        elif cls is not None and d.class_name != cls:
+            bad("detector", sentence, f"the file's m{m} is a {d.class_name}")
+
+    for m in SCORE_AT.finditer(text):
+        x = int(m[1])
+        score_distance(m[0], x, int(m[2]), m[3], m[4], gt_xy(x, m[6]))
+    for m in UNUSED.finditer(text):
+        x = int(m[1])
+        score_distance(m[0], x, int(m[2]), m[4], m[5], gt_xy(x), m[3])
+    for m in ITS_DETECTION.finditer(text):
+        score_distance(m[0], frame, int(m[1]), m[2], m[3], gt_xy(frame))
+    for m in OUTPUT_ON.finditer(text):
+        x = int(m[1])
+        out.checked["detector"] += 1
+        d = det(x, int(m[3]))
+        if d is None or d.class_name != m[4] or not _close(m[5], d.score):
+            bad("detector", m[0], f"the file's m{m[3]} at frame {x}: {d}")
+    for m in NO_DETECTION.finditer(text):
+        x, ann = int(m[1]), gt_xy(int(m[1]), m[3])
+        out.checked["detector"] += 1
+        if ann is None:
+            bad("detector", m[0], f"no annotation of GT {m[3]} at frame {x}")
+        elif scene.near(x, ann.xy_m) or ann.points != int(m[4]):
+            bad("detector", m[0], f"detections within {NEAR_M} m: {scene.near(x, ann.xy_m)}; points {ann.points}")
+    for m in WRONG_CLASS.finditer(text):
+        x, ann = int(m[1]), gt_xy(int(m[1]), m[3])
+        out.checked["detector"] += 1
+        if ann is None or scene.near(x, ann.xy_m, m[2]) or ann.points != int(m[4]):
+            own = scene.near(x, ann.xy_m, m[2]) if ann else None
+            bad("detector", m[0], f"{m[2]} detections within reach: {own}; points {ann.points if ann else None}")
+        score_distance(m[0], x, int(m[6]), m[7], m[8], ann, m[5])
+    for m in NONE_ANY.finditer(text):
+        out.checked["detector"] += 1
+        seen = {x: scene.near(x, a.xy_m) for x in frames_of(m[1]) if (a := gt_xy(x)) is not None}
+        if any(seen.values()):
+            bad("detector", m[0], f"detections within {NEAR_M} m by frame: {seen}")
+    for m in HIDDEN.finditer(text):
+        out.checked["detector"] += 1
+        wrong = {}
+        for x in frames_of(m[1]):
+            a = gt_xy(x, m[2])
+            if a is None or a.points != 0 or scene.near(x, a.xy_m):
+                wrong[x] = None if a is None else (a.points, scene.near(x, a.xy_m))
+        if wrong:
+            bad("detector", m[0], f"(points, detections within reach) by frame: {wrong}")
+    for m in OTHER_CLASS.finditer(text):
+        frames = frames_of(m[1])
+        for item in OTHER_ITEM.finditer(m[2]):
+            out.checked["detector"] += 1
+            ok = False
+            for x in frames:
+                d, a = det(x, int(item[2])), gt_xy(x)
+                if d is not None and a is not None and d.class_name == item[1] and d.class_name != class_name:
+                    dist = ((d.xy_m[0] - a.xy_m[0]) ** 2 + (d.xy_m[1] - a.xy_m[1]) ** 2) ** 0.5
+                    ok = ok or (_close(item[3], dist) and not scene.near(x, a.xy_m, class_name))
+            if not ok:
+                bad("detector", item[0], f"no frame of {frames} has it so with no {class_name} detection in reach")
+    for m in PRESENCE.finditer(text):
+        _check_presence(m, gt_id, class_name, scene, raw, out, bad)
+    a = gt_xy(frame)
+    for m in EGO.finditer(text):
+        out.checked["detector"] += 1
+        if a is None or scene.ego_xy_m is None:
+            bad("detector", m[0], f"no annotation of the object at frame {frame}")
+            continue
+        ex, ey = scene.ego_xy_m[frame]
+        d = ((a.xy_m[0] - ex) ** 2 + (a.xy_m[1] - ey) ** 2) ** 0.5
+        r = RANGE_M[class_name]
+        if not _close(m[1], d) or float(m[3]) != r or (m[2] == "inside") != (d < r):
+            bad("detector", m[0], f"{d:.2f} m from the ego pose; the devkit's {class_name} range is {r:g} m")
+    for m in INTERPOLATED_AT.finditer(text):
+        out.checked["matched"] += 1
+        box = evaluated.get((frame, gt_id or "")) if evaluated is not None else None
+        if a is None or box is None:
+            bad("matched", m[0], f"the devkit scored no box of the object at frame {frame}")
+        elif not _close(m[1], ((box[0] - a.xy_m[0]) ** 2 + (box[1] - a.xy_m[1]) ** 2) ** 0.5):
+            bad("matched", m[0], f"the devkit's box lies {box} against the annotation {a.xy_m}")
+
+
+def _check_presence(m: re.Match, gt_id, class_name: str, scene: SceneTruth, raw: RawEvents | None, out, bad) -> None:
+    first, last, cls = int(m[3]), int(m[4]), m[6]
+    stated = set(frames_of(m[7])) if m[7] != "no frame" else set()
+    stated_removed = set(frames_of(m[8])) if m[8] else set()
+    any_near, kept_near = set(), set()
+    for x in range(first, last + 1):
+        a = scene.objects[x].get(gt_id or "") if x < len(scene.objects) else None
+        if a is None:
+            continue
+        near = scene.near(x, a.xy_m, cls)
+        if near:
+            any_near.add(x)
+        if raw is not None and set(near) & raw.received(x, cls):
+            kept_near.add(x)
+    out.checked["detector"] += 1
+    if raw is None:
+        if stated | stated_removed != any_near:
+            bad("detector", m[0], f"the file has a {cls} detection within {NEAR_M} m at frames {sorted(any_near)}")
+        return
+    if stated != kept_near:
+        bad("detector", m[0], f"the tracker received a {cls} detection within reach at frames {sorted(kept_near)}")
+    elif stated_removed != any_near - kept_near:
+        bad(
+            "misleading",
+            m[0],
+            f"at frames {sorted(any_near - kept_near)} the file has a {cls} detection within {NEAR_M} m that "
+            "preprocessing removed, not said",
+        )

@@ -1,0 +1,111 @@
+"""Sentences about how another tracker on the same detections fared at the failure, checked against the devkit
+bookkeeping of that other run (``devkit.EvalFacts`` of its results, built the same way as the first run's).
+
+By failure kind, at the failure's frame x, for the object: a miss is the devkit's MISS of it (no match at x); an
+ID switch or identity theft is a SWITCH event of it at x; a fragmentation is a match at x after none at x - 1 and
+one before, and one again after. "Did not fail here: its track T was output on the object and counted" holds when
+the other run's submission has T's box within 2 m of the object's annotation at x and T passes the class threshold
+(and no such failure). "Did not have this failure" said of a run that had no track matched to
+the object at x is the issue's class 4: that run lost the object too.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+
+from tools.truth.devkit import EvalFacts
+from tools.truth.scene import NEAR_M
+
+OTHER = re.compile(
+    r"(\w+) on the same detections (failed here too|did not have this failure|had no counted track on the object "
+    r"here either|did not fail here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted)"
+)
+LOST_KINDS = ("id_switch", "identity_theft", "fragmentation")
+
+
+def _failed(ev: EvalFacts, kind: str, c: str, x: int, gt: str) -> bool | None:
+    """Whether the other run had a failure of ``kind`` on ``gt`` at ``x`` by the devkit's events (None: unknown)."""
+    here = ev.gt_to_track.get((c, x), {})
+    if gt not in here:
+        return None
+    if kind == "miss":
+        return here[gt] is None
+    if kind in ("id_switch", "identity_theft"):
+        return gt in ev.switches.get((c, x), set())
+    if kind == "fragmentation":  # the devkit's FRAG: tracked, then missed here, tracked again later
+        present = sorted(y for (k, y), objs in ev.gt_to_track.items() if k == c and gt in objs)
+        before = [y for y in present if y < x]
+        after = [y for y in present if y > x]
+        return (
+            here[gt] is None
+            and bool(before)
+            and ev.matched_track(c, before[-1], gt) is not None
+            and any(ev.matched_track(c, y, gt) is not None for y in after)
+        )
+    return None
+
+
+def check_others(
+    text: str, kind: str, c: str, x: int, gt: str | None, others: Mapping[str, EvalFacts], scene, out, bad
+) -> None:
+    """Each other-run sentence of ``text`` about object ``gt`` (``out``: the ``Tally``; ``bad``)."""
+    if gt is None:
+        return
+    for m in OTHER.finditer(text):
+        ev = others.get(m[1])
+        if ev is None:
+            continue
+        matched = ev.matched_track(c, x, gt)
+        failed = _failed(ev, kind, c, x, gt)
+        out.checked["other run"] += 1
+        said = m[2]
+        if said == "failed here too":
+            if failed is False:
+                bad("other run", m[0], f"the devkit's events of {m[1]} have no {kind} of the object at frame {x}")
+        elif said.startswith("had no counted track"):
+            if matched is not None:
+                bad("other run", m[0], f"the devkit matched the object at frame {x} to {m[1]}'s track {matched}")
+        elif said.startswith("did not fail here"):  # its named tracks lay within reach of the object, counted
+            named = {t.strip() for t in m[3].split(",")}
+            a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
+            near = {
+                t
+                for t, cls, xy in ev.boxes.get(x, [])
+                if a is not None and cls == c and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < NEAR_M
+            }
+            if failed or not named <= near & ev.counted.get(c, set()):
+                bad("other run", m[0], f"{m[1]}'s counted tracks within {NEAR_M} m at frame {x}: {sorted(near)}")
+        else:  # did not have this failure
+            if failed:
+                bad("other run", m[0], f"the devkit's events of {m[1]} have a {kind} of the object at frame {x}")
+            elif matched is None and kind in LOST_KINDS:
+                out.checked["misleading"] += 1
+                bad("misleading", m[0], f"{m[1]} had no track matched to the object at frame {x}: it lost it too")
+
+
+FALSE_HERE = re.compile(r"(\w+) on the same detections (had a false track here too|had no false track here)")
+
+
+def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapping[str, EvalFacts], out, bad) -> None:
+    """ "Had a false track here too / had no false track here": whether the other run's accumulator counted a track
+    box within ``NEAR_M`` of the place (the object, or the false box) as a false positive at frame x."""
+    if place_xy_m is None:
+        return
+    for m in FALSE_HERE.finditer(text):
+        ev = others.get(m[1])
+        if ev is None:
+            continue
+        out.checked["other run"] += 1
+        false = sorted(
+            t
+            for (k, y), tracks in ev.track_to_gt.items()
+            if y == x
+            for t, g in tracks.items()
+            if g is None
+            and (xy := ev.pred_xy.get((k, y), {}).get(t)) is not None
+            and math.hypot(xy[0] - place_xy_m[0], xy[1] - place_xy_m[1]) < NEAR_M
+        )
+        if bool(false) != m[2].startswith("had a false"):
+            bad("other run", m[0], f"{m[1]}'s false positives within {NEAR_M} m at frame {x}: {false}")

@@ -1,0 +1,101 @@
+"""The scene as the files give it, read with code of its own: the detection file's boxes per keyframe and the
+annotations (nothing of ``gnnpmb.data`` or ``gnnpmb.why``).
+
+Detection ``mN`` is the N-th box of the keyframe's sample in the file, counting only the seven tracking classes (the
+order the file lists them in); an annotation's object id is its instance token, its class the devkit's
+``category_to_tracking_name``, its points ``num_lidar_pts + num_radar_pts``. Distances are between box centres in
+the ground plane (x, y), in metres.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+NEAR_M = 2.0
+"""The reach the sentences name ("within 2 m"): the checker's own copy of it."""
+
+
+@dataclass(frozen=True)
+class Detection:
+    class_name: str
+    score: float
+    xy_m: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Annotation:
+    class_name: str
+    xy_m: tuple[float, float]
+    points: int
+
+
+@dataclass
+class SceneTruth:
+    """detections[frame] = the keyframe's boxes in file order (tracking classes only); objects[frame][instance] =
+    its annotation (tracking classes only)."""
+
+    detections: list[list[Detection]]
+    objects: list[dict[str, Annotation]]
+    ego_xy_m: list[tuple[float, float]] | None = None
+    """Per keyframe, the ego pose of its LIDAR_TOP sample data (as the devkit's ``add_center_dist`` takes it)."""
+
+    @classmethod
+    def read(cls, nusc, scene_name: str, detection_file: Path) -> SceneTruth:
+        from nuscenes.eval.tracking.utils import category_to_tracking_name
+
+        results = json.loads(Path(detection_file).read_text(encoding="utf-8"))["results"]
+        scene = next(s for s in nusc.scene if s["name"] == scene_name)
+        detections, objects, ego, token = [], [], [], scene["first_sample_token"]
+        while token:
+            sample = nusc.get("sample", token)
+            pose = nusc.get("ego_pose", nusc.get("sample_data", sample["data"]["LIDAR_TOP"])["ego_pose_token"])
+            ego.append((float(pose["translation"][0]), float(pose["translation"][1])))
+            detections.append(
+                [
+                    Detection(b["detection_name"], float(b["detection_score"]), tuple(map(float, b["translation"][:2])))
+                    for b in results.get(token, [])
+                    if b["detection_name"] in TRACKING
+                ]
+            )
+            here: dict[str, Annotation] = {}
+            for a in (nusc.get("sample_annotation", t) for t in sample["anns"]):
+                name = category_to_tracking_name(a["category_name"])
+                if name is not None:
+                    points = int(a["num_lidar_pts"]) + int(a["num_radar_pts"])
+                    here[a["instance_token"]] = Annotation(name, tuple(map(float, a["translation"][:2])), points)
+            objects.append(here)
+            token = sample["next"]
+        return cls(detections, objects, ego)
+
+    def object_of(self, frame: int, short_id: str) -> tuple[str, Annotation] | None:
+        """The annotation at ``frame`` whose instance token starts with ``short_id`` (as the text prints it)."""
+        hit = (
+            [(k, a) for k, a in self.objects[frame].items() if k.startswith(short_id)]
+            if frame < len(self.objects)
+            else []
+        )
+        return hit[0] if len(hit) == 1 else None
+
+    def distances(self, frame: int, xy_m: tuple[float, float]) -> np.ndarray:
+        """(M,) ground-plane distance of each detection of ``frame`` from ``xy_m``."""
+        dets = self.detections[frame]
+        if not dets:
+            return np.zeros(0)
+        return np.hypot(*(np.array([d.xy_m for d in dets]) - np.asarray(xy_m)).T)
+
+    def near(self, frame: int, xy_m: tuple[float, float], class_name: str | None = None) -> list[int]:
+        """Detections of ``frame`` within ``NEAR_M`` of ``xy_m`` (of ``class_name`` only, if given)."""
+        d = self.distances(frame, xy_m)
+        return [
+            m
+            for m in np.flatnonzero(d < NEAR_M).tolist()
+            if class_name is None or self.detections[frame][m].class_name == class_name
+        ]
+
+
+TRACKING = ("bicycle", "bus", "car", "motorcycle", "pedestrian", "trailer", "truck")
+"""The nuScenes tracking classes (the devkit's ``TRACKING_NAMES``), whose boxes the detection ids count."""
