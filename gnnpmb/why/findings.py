@@ -317,13 +317,15 @@ class OtherRun:
     """Another tracker on the same detections at the failure: whether it has a failure of the same kind on the
     same object (without an object: within ``NEAR_M`` of ``place_xy_m``) at the same frame, and the tracks it
     output on the object there (counted or not); output_only: it is a results file (what detections it was given is
-    not known)."""
+    not known); missed: its evaluation counted the object missed at that frame (the devkit's MISS, whatever lay
+    near the annotated box: the evaluation may have scored an interpolated box elsewhere)."""
 
     tracker: str
     failed_same: bool
     on_it: tuple[OnObject, ...]
     place_xy_m: tuple[float, float] | None = None
     output_only: bool = False
+    missed: bool = False
 
 
 @dataclass(frozen=True, slots=True)

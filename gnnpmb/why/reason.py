@@ -677,7 +677,10 @@ class _Context:
             )
             on_it = self.on_object(ev.report, fr, xy) if xy is not None else ()
             place = (float(xy[0]), float(xy[1])) if xy is not None else None
-            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only))
+            missed = gt_id is not None and any(
+                f.kind is FailureKind.MISS and f.frame_index == self.f and gt_id in f.gt_ids for f in ev.report.failures
+            )
+            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed))
         return tuple(out)
 
 

@@ -974,8 +974,8 @@ def _others(f: Finding) -> list[str]:
                 f"{who} did not fail here: its track{'s' if len(counted) > 1 else ''} "
                 f"{ids} {'were' if len(counted) > 1 else 'was'} output on the object and counted"
             )
-        elif f.kind in (FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT, FailureKind.FRAGMENTATION):
-            out.append(f"{who} had no counted track on the object here either")  # it lost the object too
+        elif o.missed:  # its evaluation counted a miss there: it lost the object too
+            out.append(f"{who} had no counted track on the object here either")
         else:
             out.append(f"{who} did not have this failure")
     return out
