@@ -377,8 +377,10 @@ def evaluation_lines(f: Finding) -> list[str]:
             return f"{f.tracker} track{'s' if len(ids) > 1 else ''} {', '.join(map(str, ids))}" if ids else "no track"
 
         if r.near_annotated and not r.near_evaluated:
+            # the verdict names the evaluation alone only when the Why blames it alone (its header names the rest)
+            lead = "**Verdict: the evaluation's doing.**" if len(f.parties) == 1 else "**The evaluation's part:**"
             out += [
-                f"**Verdict: the evaluation's doing.** {tracks(r.near_annotated)} followed the annotated object, but "
+                f"{lead} {tracks(r.near_annotated)} followed the annotated object, but "
                 f"the evaluation scored it against a box {r.offset_m:.1f} m away.",
                 "",
             ]
