@@ -510,7 +510,10 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     steps = lost.steps
     parts = []
     if lost.held_until is not None:
-        parts.append(f"track {t} was last output on it at frame {lost.held_until}")
+        # "last on it" is not "last output": say where it was output after, away from the object
+        away = [s.frame for s in steps if lost.held_until < s.frame < f.frame and s.output is not None]
+        elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
+        parts.append(f"track {t} was last output on it at frame {lost.held_until}{elsewhere}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]

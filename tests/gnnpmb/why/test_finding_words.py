@@ -168,3 +168,15 @@ def test_a_detections_share_of_a_phd_update_names_whose_weight_it_is() -> None:
     from gnnpmb.why.words import destination_name
 
     assert destination_name(Destination(2, Went.TRACK, 26, 0.99), UseMode.WEIGHTS) == "track 26 (99 % of m2)"
+
+
+def test_a_track_output_away_from_the_object_after_it_was_last_on_it_is_said_so() -> None:
+    # demo fragmentation:1 said "track 21 was last output on it at frame 14" of a track output at frame 15, as a
+    # false track beside the object: "last on it" must not read as "last output"
+    steps = (step(10, output=estimate(21, 0.9)), step(11, output=estimate(21, 0.9)), step(12), step(13))
+    lost = LostTrack(21, 10, steps, None, None, None)
+    line = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=13, has_existence=False))[0]
+    assert "track 21 was last output on it at frame 10 (output farther than 2 m from it at frame 11)" in line
+    alone = LostTrack(21, 11, steps, None, None, None)
+    line = why_lines(finding(FailureKind.FRAGMENTATION, alone, frame=13, has_existence=False))[0]
+    assert "track 21 was last output on it at frame 11," in line
