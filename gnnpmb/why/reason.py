@@ -593,7 +593,22 @@ class _Context:
             for o in self.on_object(self.report, self.frames.get(self.f), np.asarray(g.evaluated_xy_m))
             if o.counted and not o.false_here and o.track_id != int(self.failure.track_ids[0])
         ]
+        if self.interpolated_track_here():
+            return None  # the evaluation filled in a box of a track of the class here: it may have matched that one
         return others[0].track_id if len(others) == 1 else None  # of two or more, which one is not known here
+
+    def interpolated_track_here(self) -> bool:
+        """Whether the evaluation interpolated a box at the failure frame for a track of the class other than the
+        failure's (the devkit fills a track's gaps between its kept boxes; that box is in no output here)."""
+        own = self.failure.track_ids[0]
+        filled = {t for t, ev in self.report.track_evals.items() if self.f in ev.interpolated and t != own}
+        if not filled:
+            return False
+        return any(
+            str(e.track_id) in filled and e.class_name == self.class_name
+            for fr in self.frames.values()
+            for e in fr.estimates
+        )
 
     def miss(self, sightings: tuple[Sighting, ...]) -> dict:
         s = next((s for s in sightings if s.frame == self.f), None)
