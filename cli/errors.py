@@ -136,7 +136,9 @@ def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
         _stopped()
     except typer.Exit as exc:
         sys.exit(exc.exit_code)
-    except typer.Abort:
+    except typer.Abort as exc:
+        if isinstance(exc.__cause__, KeyboardInterrupt):  # click turns a Ctrl-C (or SIGTERM) it meets into Abort
+            _stopped()
         sys.exit(1)
     except BrokenPipeError:
         _quiet_broken_pipe()

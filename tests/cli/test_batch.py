@@ -249,3 +249,20 @@ def test_default_split() -> None:
     assert default_split("v1.0-mini") == "mini_val"
     assert default_split("v1.0-trainval") == "val"
     assert default_split("v1.0-test") == "test"
+
+
+def test_a_stop_that_click_turned_into_abort_still_exits_130_with_its_line(capsys: pytest.CaptureFixture[str]) -> None:
+    # click raises Abort from a KeyboardInterrupt (Ctrl-C, or SIGTERM via gnnpmb.signals) that reaches it outside
+    # the command's own handling, e.g. during a Ray sweep's shutdown: that was exit 1 with nothing said
+    import typer
+
+    def app(args: list[str], standalone_mode: bool) -> None:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as e:
+            raise typer.Abort() from e
+
+    with pytest.raises(SystemExit) as stop:
+        run_app(app, [])
+    assert stop.value.code == 130
+    assert capsys.readouterr().err.strip() == "interrupted by Ctrl-C: unfinished outputs were not written"
