@@ -5,21 +5,12 @@ The box's length runs along its heading (the local x axis), its width along the 
 devkit's ``Box.corners``. Detectors and annotations rotate boxes about the vertical axis only, so the geometry
 here uses the yaw angle and ignores pitch and roll.
 
-3D IoU (as in the paper's NMS, sec. V-B): the intersection of the two rotated rectangles in the ground plane
-times the overlap of their vertical extents, divided by the union volume ``V_a + V_b - V_intersection``.
-The rectangle intersection is computed for many pairs at once by convex-polygon clipping in numpy: the
-intersection polygon's vertices are the corners of each rectangle inside the other plus the crossings of their
-edges; sorted by angle around their mean they give the area by the shoelace formula.
+How much two boxes overlap (IoU, GIoU, the NMS's 3D IoU) is ``gnnpmb.box.overlap``.
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-_INSIDE_TOL = 1e-9
-"""Slack of the point-in-polygon test (a cross product, m^2), so that shared corners count as inside."""
-_PARALLEL_TOL = 1e-12
-"""Edges whose direction cross product is below this are treated as parallel (no crossing point)."""
 
 
 def yaw_from_quat_wxyz(quat_wxyz: np.ndarray) -> np.ndarray:
@@ -64,124 +55,3 @@ def box_corners_3d(translation_m: np.ndarray, size_wlh_m: np.ndarray, quat_wxyz:
     z_bottom = np.repeat((t[:, 2] - 0.5 * size[:, 2])[:, None, None], 4, axis=1)
     z_top = z_bottom + size[:, 2][:, None, None]
     return np.concatenate([np.concatenate([bev, z_bottom], -1), np.concatenate([bev, z_top], -1)], axis=1)
-
-
-def _inside_convex(
-    px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray, ex: np.ndarray, ey: np.ndarray
-) -> np.ndarray:
-    """(P, K) bool: whether points (px, py), (P, K) each, lie in (or on) convex CCW polygons with vertices
-    (vx, vy) and edge vectors (ex, ey), (P, V) each: edge x (point - vertex) >= 0 for every edge."""
-    cross = ex[:, None, :] * (py[:, :, None] - vy[:, None, :]) - ey[:, None, :] * (px[:, :, None] - vx[:, None, :])
-    return np.all(cross >= -_INSIDE_TOL, axis=2)
-
-
-def convex_intersection_area(poly_a: np.ndarray, poly_b: np.ndarray) -> np.ndarray:
-    """(P,) intersection areas of P pairs of counter-clockwise convex polygons, (P, Va, 2) and (P, Vb, 2)."""
-    poly_a = np.asarray(poly_a, dtype=float)
-    poly_b = np.asarray(poly_b, dtype=float)
-    n_pairs = poly_a.shape[0]
-    if n_pairs == 0:
-        return np.zeros(0)
-    # Work relative to the first vertex of A (precision far from the origin) and with x, y as separate arrays.
-    origin = poly_a[:, :1, :]
-    ax, ay = np.moveaxis(poly_a - origin, -1, 0)  # (P, Va) each
-    bx, by = np.moveaxis(poly_b - origin, -1, 0)  # (P, Vb) each
-    rx, ry = np.roll(ax, -1, axis=1) - ax, np.roll(ay, -1, axis=1) - ay
-    sx, sy = np.roll(bx, -1, axis=1) - bx, np.roll(by, -1, axis=1) - by
-    a_in_b = _inside_convex(ax, ay, bx, by, sx, sy)
-    b_in_a = _inside_convex(bx, by, ax, ay, rx, ry)
-
-    # Edge i of A (p + t r) meets edge j of B (q + u s) at t = (q-p) x s / (r x s), u = (q-p) x r / (r x s).
-    rx3, ry3, sx3, sy3 = rx[:, :, None], ry[:, :, None], sx[:, None, :], sy[:, None, :]
-    qpx = bx[:, None, :] - ax[:, :, None]  # (P, Va, Vb)
-    qpy = by[:, None, :] - ay[:, :, None]
-    denom = rx3 * sy3 - ry3 * sx3
-    ok = np.abs(denom) > _PARALLEL_TOL
-    inv = np.divide(1.0, denom, out=np.zeros_like(denom), where=ok)
-    t = (qpx * sy3 - qpy * sx3) * inv
-    u = (qpx * ry3 - qpy * rx3) * inv
-    crossing_ok = ok & (t >= 0.0) & (t <= 1.0) & (u >= 0.0) & (u <= 1.0)
-    cx = ax[:, :, None] + t * rx3
-    cy = ay[:, :, None] + t * ry3
-
-    x = np.concatenate([ax, bx, cx.reshape(n_pairs, -1)], axis=1)  # (P, K) candidate vertices
-    y = np.concatenate([ay, by, cy.reshape(n_pairs, -1)], axis=1)
-    valid = np.concatenate([a_in_b, b_in_a, crossing_ok.reshape(n_pairs, -1)], axis=1)
-    count = valid.sum(axis=1)
-    n_valid = np.maximum(count, 1)
-    x = x - np.where(valid, x, 0.0).sum(axis=1, keepdims=True) / n_valid[:, None]
-    y = y - np.where(valid, y, 0.0).sum(axis=1, keepdims=True) / n_valid[:, None]
-    # Pseudo-angle in [0, 4), monotone in the true angle around the centre; unused candidates sort last.
-    norm1 = np.abs(x) + np.abs(y)
-    ratio = np.divide(x, norm1, out=np.zeros_like(x), where=norm1 > 0.0)
-    angle = np.where(valid, np.where(y >= 0.0, 1.0 - ratio, 3.0 + ratio), np.inf)
-    order = np.argsort(angle, axis=1)
-    x = np.take_along_axis(x, order, axis=1)
-    y = np.take_along_axis(y, order, axis=1)
-    valid = np.take_along_axis(valid, order, axis=1)
-    # Unused slots repeat the first vertex: repeated points add nothing to the shoelace sum.
-    x = np.where(valid, x, x[:, :1])
-    y = np.where(valid, y, y[:, :1])
-    twice_area = np.sum(x[:, :-1] * y[:, 1:] - x[:, 1:] * y[:, :-1], axis=1) + (x[:, -1] * y[:, 0] - x[:, 0] * y[:, -1])
-    return np.where(count >= 3, np.maximum(0.5 * twice_area, 0.0), 0.0)
-
-
-def iou_3d(
-    translation_a: np.ndarray,
-    size_wlh_a: np.ndarray,
-    yaw_a: np.ndarray,
-    translation_b: np.ndarray,
-    size_wlh_b: np.ndarray,
-    yaw_b: np.ndarray,
-) -> np.ndarray:
-    """(P,) 3D IoU of P box pairs (row i of the a arrays with row i of the b arrays); 0 for zero-volume pairs.
-
-    IoU = A_bev(a ∩ b) · h(a ∩ b) / (V_a + V_b - A_bev(a ∩ b) · h(a ∩ b)), with h the vertical overlap.
-    """
-    ta, tb = np.asarray(translation_a, dtype=float), np.asarray(translation_b, dtype=float)
-    sa, sb = np.asarray(size_wlh_a, dtype=float), np.asarray(size_wlh_b, dtype=float)
-    top = np.minimum(ta[:, 2] + 0.5 * sa[:, 2], tb[:, 2] + 0.5 * sb[:, 2])
-    bottom = np.maximum(ta[:, 2] - 0.5 * sa[:, 2], tb[:, 2] - 0.5 * sb[:, 2])
-    overlap_h = np.maximum(top - bottom, 0.0)
-    area = convex_intersection_area(bev_corners(ta[:, :2], sa[:, :2], yaw_a), bev_corners(tb[:, :2], sb[:, :2], yaw_b))
-    inter = area * overlap_h
-    union = np.prod(sa, axis=1) + np.prod(sb, axis=1) - inter
-    return np.where(union > 0.0, inter / np.where(union > 0.0, union, 1.0), 0.0)
-
-
-def overlap_candidates(
-    translation_m: np.ndarray, size_wlh_m: np.ndarray, group: np.ndarray | None = None
-) -> tuple[np.ndarray, np.ndarray]:
-    """Index pairs (i, j), i < j, of boxes that may overlap: bounding circles and vertical extents intersect.
-
-    A cheap filter before ``iou_3d``: every pair with a positive 3D IoU is returned (and usually few others).
-    group: optional (N,) labels; only boxes with equal labels are paired (e.g. the class, for per-class NMS).
-    Returns two (P,) integer arrays.
-    """
-    t = np.asarray(translation_m, dtype=float)
-    size = np.asarray(size_wlh_m, dtype=float)
-    radius = 0.5 * np.hypot(size[:, 0], size[:, 1])
-    d2 = (t[:, None, 0] - t[None, :, 0]) ** 2 + (t[:, None, 1] - t[None, :, 1]) ** 2  # (N, N)
-    near = d2 <= (radius[:, None] + radius[None, :]) ** 2
-    near &= np.abs(t[:, None, 2] - t[None, :, 2]) <= 0.5 * (size[:, None, 2] + size[None, :, 2])
-    if group is not None:
-        codes = np.unique(np.asarray(group), return_inverse=True)[1].reshape(-1)
-        near &= codes[:, None] == codes[None, :]
-    i, j = np.nonzero(near)
-    upper = i < j
-    return i[upper], j[upper]
-
-
-def pairwise_iou_3d(translation_m: np.ndarray, size_wlh_m: np.ndarray, quat_wxyz: np.ndarray) -> np.ndarray:
-    """(N, N) symmetric 3D IoU matrix of N boxes (diagonal 1 for boxes with a volume)."""
-    t = np.asarray(translation_m, dtype=float)
-    size = np.asarray(size_wlh_m, dtype=float)
-    yaw = yaw_from_quat_wxyz(quat_wxyz)
-    n = t.shape[0]
-    out = np.zeros((n, n))
-    i, j = overlap_candidates(t, size)
-    iou = iou_3d(t[i], size[i], yaw[i], t[j], size[j], yaw[j])
-    out[i, j] = iou
-    out[j, i] = iou
-    out[np.arange(n), np.arange(n)] = (np.prod(size, axis=1) > 0).astype(float)
-    return out

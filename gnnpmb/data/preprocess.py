@@ -22,8 +22,9 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from gnnpmb.box.overlap import UprightBoxes, iou_3d_pairs, overlap_candidates
 from gnnpmb.config import PreprocessParams
-from gnnpmb.data.boxes3d import iou_3d, overlap_candidates, yaw_from_quat_wxyz
+from gnnpmb.data.boxes3d import yaw_from_quat_wxyz
 from gnnpmb.data.detections import MAX_ABS_COORD_M, MAX_SIZE_M, MAX_SPEED_MPS, MIN_QUAT_NORM
 from gnnpmb.types import Boxes, FrameDetections
 
@@ -39,8 +40,8 @@ def nms_3d(boxes: Boxes, iou_threshold: float | np.ndarray) -> np.ndarray:
     i, j = overlap_candidates(t, size, group=boxes.class_name)
     if i.size == 0:
         return keep
-    yaw = yaw_from_quat_wxyz(boxes.quat_wxyz)
-    iou = iou_3d(t[i], size[i], yaw[i], t[j], size[j], yaw[j])
+    upright = UprightBoxes.of(t, size, yaw_from_quat_wxyz(boxes.quat_wxyz))
+    iou = iou_3d_pairs(upright, upright, i, j)
     over = iou > np.broadcast_to(np.asarray(iou_threshold, dtype=float), (n,))[i]
     i, j = i[over], j[over]
     if i.size == 0:

@@ -16,10 +16,11 @@ from gnnpmb.box.overlap import (
     giou_3d_bound_pairs,
     giou_3d_pairs,
     giou_bev,
+    iou_3d,
     iou_3d_pairs,
     iou_bev,
 )
-from gnnpmb.data.boxes3d import bev_corners, iou_3d
+from gnnpmb.data.boxes3d import bev_corners
 
 UNIT = np.array([[1.0, 1.0]])
 
