@@ -29,16 +29,7 @@ from typing import Annotated
 import typer
 
 from cli.errors import check_version_flag, exit_now_on_failure, run_app
-from cli.options import (
-    DatarootOption,
-    DetectionsOption,
-    DetectorOption,
-    ParamsOption,
-    ResultsOption,
-    SeedOption,
-    VersionOption,
-    tidy_help,
-)
+from cli.options import DEFAULT_SOURCE, ResultsOption, Source, source_options, tidy_help
 from cli.progress import progress_bar
 from cli.reproduce import COMMAND_LINE, PROG, command_line, reproduce_app
 from gnnpmb.classes import TRACKING_CLASSES
@@ -66,6 +57,7 @@ VIEW_HELP = (
 
 
 @app.command(help=VIEW_HELP)
+@source_options
 def view(
     scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
     tracker: Annotated[
@@ -79,12 +71,7 @@ def view(
         ),
     ] = None,
     results: ResultsOption = None,
-    dataroot: DatarootOption = None,
-    version: VersionOption = None,
-    detections: DetectionsOption = None,
-    detector: DetectorOption = None,
-    seed: SeedOption = 0,
-    params: ParamsOption = None,
+    source: Source = DEFAULT_SOURCE,
     classes: Annotated[
         str | None,
         typer.Option(
@@ -150,12 +137,7 @@ def view(
         scene,
         tracker or [],
         results=results or [],
-        dataroot=dataroot,
-        version=version,
-        detections_file=detections,
-        detector=detector,
-        seed=seed,
-        params=params,
+        **source.request_args(),
         classes=classes,
         frames=frames,
         save=save,

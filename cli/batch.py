@@ -18,15 +18,14 @@ from cli.diff import register as register_diff
 from cli.errors import entry_point
 from cli.failures import register as register_failures
 from cli.options import (
+    DEFAULT_SOURCE,
     AddressOption,
     DatarootOption,
-    DetectionsOption,
-    DetectorOption,
-    ParamsOption,
-    SeedOption,
+    Source,
     SplitOption,
     TrackerOption,
     VersionOption,
+    source_options,
     stdout_console,
     tidy_help,
 )
@@ -52,16 +51,12 @@ tidy_help()
 
 
 @app.command(short_help="Track a split into a nuScenes tracking submission.")
+@source_options
 def track(
     out: Annotated[Path, typer.Option(metavar="FILE.json", help="Where to write the tracking submission (.json).")],
-    dataroot: DatarootOption = None,
-    version: VersionOption = None,
+    source: Source = DEFAULT_SOURCE,
     split: SplitOption = None,
-    detections: DetectionsOption = None,
-    detector: DetectorOption = None,
     tracker: TrackerOption = DEFAULT_TRACKER,
-    seed: SeedOption = 0,
-    params: ParamsOption = None,
     progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
     workers: Annotated[
         int, typer.Option(metavar="N", help="Scenes tracked in parallel on Ray; 1 (default) runs in this process.")
@@ -73,24 +68,21 @@ def track(
     from gnnpmb.data.simdet_presets import detector_choice
     from gnnpmb.registry import check_tracker
 
-    target = check_output_file(out, "--out", inputs=(("--detections", detections), ("--params", params)))
+    target = check_output_file(out, "--out", inputs=source.input_files)
     check_tracker(tracker)
-    preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
+    preset = detector_choice(source.detections, source.detector, DEFAULT_DETECTOR)
 
     from cli.progress import progress_bar
     from gnnpmb.config import load_config
     from gnnpmb.data.detections import check_detection_file
-    from gnnpmb.data.nuscenes import resolve_dataroot
-    from gnnpmb.study.data import resolve_study_data
     from gnnpmb.study.runner import execution
     from gnnpmb.study.track import track_to_file
 
-    config = load_config(params)
+    config = load_config(source.params)
     run = execution(workers, address, verbose)
-    if detections is not None:  # a bad file fails before a dataset is looked for
-        check_detection_file(detections)
-    location = resolve_dataroot(dataroot, version, (split,) if split else ())
-    data = resolve_study_data(location, split or default_split(location.version), detections, preset, seed)
+    if source.detections is not None:  # a bad file fails before a dataset is looked for
+        check_detection_file(source.detections)
+    data = source.split_data(split, preset, default_split)
     with progress_bar(progress, transient=True) as bar:
         scenes_task = bar.add_task("scenes", total=len(data.scene_names))
         frames_task = bar.add_task("frames", total=None, visible=not run.uses_ray)

@@ -8,13 +8,12 @@ all for scripts.
 
 from __future__ import annotations
 
-import shlex
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from cli.options import DatarootOption, DetectionsOption, ParamsOption, SeedOption, VersionOption
+from cli.options import DEFAULT_SOURCE, Source, source_options
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.outputs import check_output_file
 
@@ -37,7 +36,9 @@ RunArgument = Annotated[
 
 def register(app: typer.Typer) -> None:
     """Add ``diff`` to the ``gnnpmb`` app."""
-    app.command("diff", help=DIFF_HELP, short_help="What changed between two runs: failures and metrics.")(diff)
+    app.command("diff", help=DIFF_HELP, short_help="What changed between two runs: failures and metrics.")(
+        source_options(diff)
+    )
 
 
 def diff(
@@ -48,14 +49,7 @@ def diff(
         str | None,
         typer.Option(metavar="NAME", help="Split (default: mini_val, val or test by --nuscenes-version)."),
     ] = None,
-    dataroot: DatarootOption = None,
-    version: VersionOption = None,
-    detections: DetectionsOption = None,
-    detector: Annotated[
-        str | None, typer.Option(metavar="PRESET", help="Simulated detector preset (default centerpoint).")
-    ] = None,
-    seed: SeedOption = 0,
-    params: ParamsOption = None,
+    source: Source = DEFAULT_SOURCE,
     json_out: Annotated[
         Path | None, typer.Option("--json", metavar="FILE.json", help="Also write the diff as JSON here.")
     ] = None,
@@ -69,13 +63,13 @@ def diff(
     from gnnpmb.stages.inputs import load_inputs
     from gnnpmb.stages.request import check_request
 
-    inputs = (("--detections", detections), ("--params", params), *run_inputs([parse_run(a), parse_run(b)]))
+    inputs = (*source.input_files, *run_inputs([parse_run(a), parse_run(b)]))
     target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
     if scene is not None and split is not None:
         raise GnnpmbError("pass either --scene SCENE or --split NAME, not both")
-    if detections is not None and detector is not None:
+    if source.detections is not None and source.detector is not None:
         raise GnnpmbError("pass either --detections FILE.json or --detector PRESET, not both")
-    location = resolve_dataroot(dataroot, version, tuple(x for x in (scene, split) if x))
+    location = resolve_dataroot(source.dataroot, source.version, tuple(x for x in (scene, split) if x))
     if scene is not None:
         scenes, where = [scene], scene
     else:
@@ -83,24 +77,16 @@ def diff(
         scenes, where = split_scenes(split, location), f"split {split}"
         if not scenes:
             raise GnnpmbError(f"split {split} has no scenes in {location.dataroot / location.version}")
-    data_options = {
-        "dataroot": dataroot,
-        "version": version,
-        "detections_file": detections,
-        "detector": detector,
-        "seed": seed,
-        "params": params,
-    }
     result = diff_runs(
         a,
         b,
         scenes,
         where,
-        scene_inputs=lambda name, runs: load_inputs(check_request(name, runs, **data_options)),
+        scene_inputs=lambda name, runs: load_inputs(check_request(name, runs, **source.request_args())),
         split_tokens=sample_tokens(location, scenes),  # an unknown scene is one line here
         dataset_tokens=all_sample_tokens(location),
     )
-    options = _options(dataroot, version, detections, detector, seed, params)
+    options = source.shell_words()
     for notice in result.notices:
         typer.echo(f"note: {notice}", err=True)
     if target is not None:
@@ -110,23 +96,6 @@ def diff(
     print_diff(result, options, stdout_console())
     if json_out is not None:
         typer.echo(f"diff -> {json_out}")
-
-
-def _options(dataroot, version, detections, detector, seed, params) -> str:
-    """The data options a ``gnnpmb-viz`` command needs to see what the diff saw."""
-    parts = []
-    for flag, value in (
-        ("--dataroot", dataroot),
-        ("--nuscenes-version", version),
-        ("--detections", detections),
-        ("--detector", detector),
-        ("--params", params),
-    ):
-        if value is not None:
-            parts += [flag, str(value)]
-    if seed:
-        parts += ["--seed", str(seed)]
-    return shlex.join(parts)
 
 
 def focus_command(result: DiffResult, entry: DiffEntry, options: str) -> str:

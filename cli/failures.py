@@ -10,17 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from cli.options import (
-    DatarootOption,
-    DetectionsOption,
-    DetectorOption,
-    ParamsOption,
-    ResultsOption,
-    RunsOption,
-    SeedOption,
-    VersionOption,
-    stdout_console,
-)
+from cli.options import DEFAULT_SOURCE, ResultsOption, RunsOption, Source, source_options, stdout_console
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.outputs import check_output_file
 from gnnpmb.stages.request import DEFAULT_TRACKER
@@ -37,16 +27,12 @@ def register(app: typer.Typer) -> None:
     """Add the ``failures`` command to ``app``."""
 
     @app.command(short_help="List one scene's tracking failures per frame.")
+    @source_options
     def failures(
         scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
         tracker: RunsOption = None,
         results: ResultsOption = None,
-        dataroot: DatarootOption = None,
-        version: VersionOption = None,
-        detections: DetectionsOption = None,
-        detector: DetectorOption = None,
-        seed: SeedOption = 0,
-        params: ParamsOption = None,
+        source: Source = DEFAULT_SOURCE,
         json_out: Annotated[
             Path | None, typer.Option("--json", metavar="FILE.json", help="Also write the report as JSON here.")
         ] = None,
@@ -71,18 +57,13 @@ def register(app: typer.Typer) -> None:
         from gnnpmb.runs import parse_runs, run_inputs
 
         runs = parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)
-        inputs = (("--detections", detections), ("--params", params), *run_inputs(runs))
+        inputs = (*source.input_files, *run_inputs(runs))
         json_target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
         reports, findings, loaded = failure_reports(
             scene,
             tracker or [],
             results or [],
-            dataroot=dataroot,
-            version=version,
-            detections=detections,
-            detector=detector,
-            seed=seed,
-            params=params,
+            source,
             why=why,
             frames=frames,
         )
@@ -104,13 +85,8 @@ def failure_reports(
     scene: str,
     trackers: Sequence[str],
     results: Sequence[str],
+    source: Source,
     *,
-    dataroot: Path | None,
-    version: str | None,
-    detections: Path | None,
-    detector: str | None,
-    seed: int,
-    params: Path | None,
     why: bool,
     frames: str | None = None,
 ) -> "tuple[dict[str, FailureReport], dict[str, list[Finding]], Inputs]":
@@ -130,12 +106,7 @@ def failure_reports(
         scene,
         trackers,
         results=results,
-        dataroot=dataroot,
-        version=version,
-        detections_file=detections,
-        detector=detector,
-        seed=seed,
-        params=params,
+        **source.request_args(),
         frames=frames,
     )
     inputs = load_inputs(request)

@@ -3,8 +3,12 @@ and help text each, and the console tables are printed on."""
 
 from __future__ import annotations
 
+import functools
+import inspect
+from collections.abc import Callable
+from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -13,6 +17,8 @@ from gnnpmb.stages.request import DEFAULT_DETECTOR
 
 if TYPE_CHECKING:
     from rich.console import Console
+
+    from gnnpmb.study.data import StudyData
 
 _TABLE_WIDTH = 160
 """Console width when stdout is not a terminal (pipes, tests), so tables are not squeezed to 80 columns."""
@@ -83,6 +89,99 @@ AddressOption = Annotated[
         help="Join the Ray cluster at HOST:PORT (default: $RAY_ADDRESS, else a local Ray instance).",
     ),
 ]
+
+
+@dataclass(frozen=True, slots=True)
+class Source:
+    """Where a command's tracking input comes from: the options --dataroot, --nuscenes-version, --detections,
+    --detector, --seed and --params, as typed (checked by the stages that read them)."""
+
+    dataroot: Path | None = None
+    version: str | None = None
+    detections: Path | None = None
+    detector: str | None = None
+    seed: int = 0
+    params: Path | None = None
+
+    @property
+    def input_files(self) -> tuple[tuple[str, Path | None], ...]:
+        """(option, file) of the files read, which an output file must not overwrite."""
+        return (("--detections", self.detections), ("--params", self.params))
+
+    def request_args(self) -> dict[str, Any]:
+        """The keyword arguments of ``gnnpmb.stages.request.check_request`` these options give."""
+        return {
+            "dataroot": self.dataroot,
+            "version": self.version,
+            "detections_file": self.detections,
+            "detector": self.detector,
+            "seed": self.seed,
+            "params": self.params,
+        }
+
+    def shell_words(self) -> str:
+        """The options, as a shell would take them, that give this source again (the defaults left out)."""
+        import shlex
+
+        parts = []
+        for flag, value in (
+            ("--dataroot", self.dataroot),
+            ("--nuscenes-version", self.version),
+            ("--detections", self.detections),
+            ("--detector", self.detector),
+            ("--params", self.params),
+        ):
+            if value is not None:
+                parts += [flag, str(value)]
+        if self.seed:
+            parts += ["--seed", str(self.seed)]
+        return shlex.join(parts)
+
+    def split_data(self, split: str | None, preset: str | None, default_split: Callable[[str], str]) -> StudyData:
+        """The scenes of ``split`` (None: ``default_split`` of the dataset's version) and their detections: the
+        file, else the simulated detector ``preset`` (``gnnpmb.study.data.resolve_study_data``)."""
+        from gnnpmb.data.nuscenes import resolve_dataroot
+        from gnnpmb.study.data import resolve_study_data
+
+        location = resolve_dataroot(self.dataroot, self.version, (split,) if split else ())
+        split = split or default_split(location.version)
+        return resolve_study_data(location, split, self.detections, preset, self.seed)
+
+
+DEFAULT_SOURCE = Source()
+"""The default of a command's ``source`` parameter (``source_options`` replaces it by the options)."""
+
+_SOURCE_OPTIONS = {
+    "dataroot": DatarootOption,
+    "version": VersionOption,
+    "detections": DetectionsOption,
+    "detector": DetectorOption,
+    "seed": SeedOption,
+    "params": ParamsOption,
+}
+
+
+def source_options(command: Callable[..., None]) -> Callable[..., None]:
+    """``command`` with the ``Source`` options in place of its parameter ``source: Source`` (typer reads the
+    signature), which it is given as one ``Source``."""
+    signature = inspect.signature(command, eval_str=True)
+    parameters: list[inspect.Parameter] = []
+    for parameter in signature.parameters.values():
+        if parameter.name != "source":
+            parameters.append(parameter)
+            continue
+        for field in fields(Source):
+            option = _SOURCE_OPTIONS[field.name]
+            parameters.append(inspect.Parameter(field.name, parameter.kind, default=field.default, annotation=option))
+
+    @functools.wraps(command)
+    def with_source(**kwargs: Any) -> None:
+        source = Source(**{name: kwargs.pop(name) for name in _SOURCE_OPTIONS})
+        return command(source=source, **kwargs)
+
+    with_source.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
+    with_source.__annotations__ = {p.name: p.annotation for p in parameters} | {"return": None}
+    return with_source
 
 
 def stdout_console() -> Console:

@@ -16,15 +16,12 @@ from rich.table import Table
 
 from cli.errors import announce_stop
 from cli.options import (
+    DEFAULT_SOURCE,
     AddressOption,
-    DatarootOption,
-    DetectionsOption,
-    DetectorOption,
-    ParamsOption,
-    SeedOption,
+    Source,
     SplitOption,
     TrackerOption,
-    VersionOption,
+    source_options,
     stdout_console,
 )
 from cli.progress import progress_bar
@@ -107,6 +104,7 @@ def register(app: typer.Typer) -> None:
     """Add ``sweep`` to the ``gnnpmb`` app."""
 
     @app.command()
+    @source_options
     def sweep(
         out: Annotated[Path, typer.Option(metavar="DIR", help="Folder for results.csv/.json, plots and the cache.")],
         param: Annotated[
@@ -120,13 +118,8 @@ def register(app: typer.Typer) -> None:
             ),
         ] = None,
         tracker: TrackerOption = DEFAULT_TRACKER,
-        dataroot: DatarootOption = None,
-        version: VersionOption = None,
+        source: Source = DEFAULT_SOURCE,
         split: SplitOption = None,
-        detections: DetectionsOption = None,
-        detector: DetectorOption = None,
-        seed: SeedOption = 0,
-        params: ParamsOption = None,
         one_at_a_time: Annotated[
             bool,
             typer.Option(help="Vary one key at a time around the base parameters (Table II style), not the grid."),
@@ -138,12 +131,10 @@ def register(app: typer.Typer) -> None:
         verbose: VerboseOption = False,
     ) -> None:
         """Score every configuration of a parameter grid with the official evaluation (cached, resumable)."""
-        from gnnpmb.data.nuscenes import resolve_dataroot
         from gnnpmb.data.simdet_presets import detector_choice
         from gnnpmb.eval.nuscenes_eval import default_split
         from gnnpmb.registry import check_tracker
         from gnnpmb.study.cache import CACHE_FOLDER, ResultCache
-        from gnnpmb.study.data import resolve_study_data
         from gnnpmb.study.folder import check_study_dir, drop_stale_plots, identity, merge_study, read_study
         from gnnpmb.study.grid import parse_param
         from gnnpmb.study.lock import hold_study_folder
@@ -153,18 +144,17 @@ def register(app: typer.Typer) -> None:
         from gnnpmb.study.sweep import plan_sweep, run_sweep
 
         check_tracker(tracker)
-        preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
+        preset = detector_choice(source.detections, source.detector, DEFAULT_DETECTOR)
         swept = [parse_param(p) for p in param or []]
-        base = base_params(params)
-        folder = check_study_dir(out, [p.key for p in swept], (("--detections", detections), ("--params", params)))
+        base = base_params(source.params)
+        folder = check_study_dir(out, [p.key for p in swept], source.input_files)
         run = execution(workers, address, verbose)
-        location = resolve_dataroot(dataroot, version, (split,) if split else ())
-        data = resolve_study_data(location, split or default_split(location.version), detections, preset, seed)
+        data = source.split_data(split, preset, default_split)
         plan = plan_sweep(tracker, data, base, swept, one_at_a_time)
         rows_seen: list[dict[str, Any]] = []
         with session(run):  # Ray is up (or one error line) before the folder is touched
             hold_study_folder(folder, lambda line: typer.echo(line, err=True))  # one sweep at a time per folder
-            plan, note = merge_study(plan, read_study(folder), out, params)
+            plan, note = merge_study(plan, read_study(folder), out, source.params)
             if note is not None:
                 typer.echo(note, err=True)
             n = len(plan.assignments)
@@ -177,7 +167,7 @@ def register(app: typer.Typer) -> None:
 
                 outcome = run_sweep(plan, ResultCache(folder / CACHE_FOLDER), run, on_row)
         meta = {
-            **identity(plan, params),
+            **identity(plan, source.params),
             "keys": list(plan.keys),
             "one_at_a_time": plan.one_at_a_time,
             "base_values": plan.base_values,
