@@ -20,14 +20,8 @@ import numpy as np
 
 from gnnpmb.assign.matching import BoundedCosts
 from gnnpmb.box import kalman
-from gnnpmb.box.overlap import (
-    UprightBoxes,
-    all_pairs,
-    giou_3d_bound_matrix,
-    giou_3d_bound_pairs,
-    giou_3d_pairs,
-    iou_3d_pairs,
-)
+from gnnpmb.box.overlap import giou_3d_bound_matrix, giou_3d_bound_pairs, giou_3d_pairs
+from gnnpmb.data.boxes3d import UprightBoxes, all_pairs, iou_3d_pairs
 from gnnpmb.events import CostScale
 from gnnpmb.kalman import Innovation
 

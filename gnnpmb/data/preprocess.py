@@ -22,9 +22,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from gnnpmb.box.overlap import UprightBoxes, iou_3d_pairs, overlap_candidates
 from gnnpmb.config import PreprocessParams
-from gnnpmb.data.boxes3d import yaw_from_quat_wxyz
+from gnnpmb.data.boxes3d import UprightBoxes, iou_3d_pairs, overlap_candidates, yaw_from_quat_wxyz
 from gnnpmb.data.detections import MAX_ABS_COORD_M, MAX_SIZE_M, MAX_SPEED_MPS, MIN_QUAT_NORM
 from gnnpmb.types import Boxes, FrameDetections
 

@@ -8,19 +8,14 @@ from scipy.spatial import ConvexHull
 from shapely.geometry import Polygon
 
 from gnnpmb.box.overlap import (
-    UprightBoxes,
-    all_pairs,
     convex_hull_area,
     giou_3d,
     giou_3d_bound_matrix,
     giou_3d_bound_pairs,
     giou_3d_pairs,
     giou_bev,
-    iou_3d,
-    iou_3d_pairs,
-    iou_bev,
 )
-from gnnpmb.data.boxes3d import bev_corners
+from gnnpmb.data.boxes3d import UprightBoxes, all_pairs, bev_corners, iou_3d, iou_3d_pairs, iou_bev
 
 UNIT = np.array([[1.0, 1.0]])
 

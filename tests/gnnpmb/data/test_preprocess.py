@@ -2,9 +2,17 @@ import numpy as np
 import pytest
 import shapely
 
-from gnnpmb.box.overlap import convex_intersection_area, iou_3d, overlap_candidates, pairwise_iou_3d
 from gnnpmb.config import PreprocessParams
-from gnnpmb.data.boxes3d import bev_corners, box_corners_3d, quat_wxyz_from_yaw, yaw_from_quat_wxyz
+from gnnpmb.data.boxes3d import (
+    bev_corners,
+    box_corners_3d,
+    convex_intersection_area,
+    iou_3d,
+    overlap_candidates,
+    pairwise_iou_3d,
+    quat_wxyz_from_yaw,
+    yaw_from_quat_wxyz,
+)
 from gnnpmb.data.preprocess import nms_3d, preprocess
 from gnnpmb.types import Boxes
 
