@@ -67,8 +67,6 @@ _PMB_STRATEGY_SECTION: dict[str, str | None] = {"gnnpmb": None, "pmbm": "pmbm", 
 
 TRACKER_NAMES: tuple[str, ...] = tuple(_TRACKERS)
 
-TRACKER_DESCRIPTIONS: dict[str, str] = {name: description for name, (_, description) in _TRACKERS.items()}
-
 
 def _build(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     module, _, attribute = _TRACKERS[name][0].partition(":")
@@ -98,32 +96,27 @@ def check_classes(names: list[str]) -> list[str]:
 
 def tracker_panels(name: str) -> tuple[Panel, ...]:
     """The tracker-specific viewer panels tracker ``name`` declares (the same for every class)."""
-    return _declared(name)[0]
+    return declared(name)[0]
 
 
 def tracker_has_existence(name: str) -> bool:
     """Whether tracker ``name``'s tracks have an existence probability (``skeleton.ClassFilter.has_existence``)."""
-    return _declared(name)[1]
+    return declared(name)[1]
 
 
 def tracker_has_gates(name: str) -> bool:
     """Whether tracker ``name`` gates with the innovation covariance (``skeleton.ClassFilter.has_gates``)."""
-    return _declared(name)[2]
-
-
-def tracker_has_costs(name: str) -> bool:
-    """Whether tracker ``name``'s update follows a chosen assignment (``skeleton.ClassFilter.has_costs``)."""
-    return _declared(name)[3]
+    return declared(name)[2]
 
 
 def tracker_keeps_detection_box(name: str) -> bool:
     """Whether tracker ``name``'s output boxes carry their detections' size and heading
     (``skeleton.ClassFilter.keeps_detection_box``)."""
-    return _declared(name)[4]
+    return declared(name)[4]
 
 
 @functools.cache
-def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool, bool]:
+def declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool, bool]:
     """What tracker ``name`` declares (panels, has_existence, has_gates, has_costs, keeps_detection_box), read
     once from an instance for the first class with the default configuration (building one costs a couple of
     milliseconds, and the blueprint asks several times per tracker)."""
@@ -136,4 +129,5 @@ def _declared(name: str) -> tuple[tuple[Panel, ...], bool, bool, bool, bool]:
 
 def make_class_tracker(name: str, class_name: str, config: TrackerConfig, ids: IdAllocator) -> ClassFilter:
     """Tracker ``name`` for class ``class_name``; it sees ``config`` with that class's overrides applied."""
-    return _build(check_tracker(name), class_name, config.resolved(class_name), ids)
+    check_tracker(name)
+    return _build(name, class_name, config.resolved(class_name), ids)

@@ -22,14 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gnnpmb.errors import GnnpmbError, UnknownNameError
-from gnnpmb.registry import (
-    TRACKER_NAMES,
-    check_tracker,
-    tracker_has_costs,
-    tracker_has_existence,
-    tracker_has_gates,
-    tracker_panels,
-)
+from gnnpmb.registry import TRACKER_NAMES, check_tracker, declared
 from gnnpmb.symlinks import refuse_symlink_loop
 
 if TYPE_CHECKING:
@@ -88,7 +81,8 @@ def capabilities(spec: RunSpec) -> Capabilities:
     if spec.tracker is None:
         return OUTPUT_ONLY
     t = spec.tracker
-    return Capabilities(tracker_panels(t), tracker_has_existence(t), tracker_has_gates(t), tracker_has_costs(t))
+    panels, has_existence, has_gates, has_costs, _ = declared(t)
+    return Capabilities(panels, has_existence, has_gates, has_costs)
 
 
 def tracker_capabilities(name: str) -> Capabilities:

@@ -206,7 +206,7 @@ def track_series_views(
 ) -> list[rrb.TimeSeriesView]:
     """Existence (for a tracker that has it, ``registry.tracker_has_existence``), normalised innovation (for a
     tracker that gates, ``registry.tracker_has_gates``) and chosen cost (for a tracker that chooses an assignment,
-    ``registry.tracker_has_costs``) per track; only the involved tracks when focused, or in a full recording the
+    ``registry.declared``) per track; only the involved tracks when focused, or in a full recording the
     tracks at the failure it opens at (``opening``), with a legend naming them (placed by ``legends``, keyed by
     the view's origin). caps: what the run can show (default: the registry's)."""
     caps = caps or tracker_capabilities(tracker)

@@ -38,21 +38,6 @@ IMAGE_PLANE_DISTANCE_M = 1.5
 """How far in front of a camera its image is drawn in a 3D view (Rerun's frustum)."""
 
 
-def absent_reason(sensors: SceneSensors, frames: range) -> str | None:
-    """Why the scene's cameras cannot be shown at the keyframes ``frames`` (None: they can): no camera rows, or
-    image files missing."""
-    count = sum(len(sensors.cameras[i]) for i in frames)
-    if count == 0:
-        return "cameras absent: the dataset has no camera images for this scene"
-    missing = sensors.missing_images(frames)
-    if missing:
-        return (
-            f"cameras absent: {len(missing)} of {count} camera images of this scene are missing (first: "
-            f"{missing[0]}); download the nuScenes samples/CAM_* folders into the dataroot"
-        )
-    return None
-
-
 def log_cameras(
     stream: rr.RecordingStream, scene: SceneData, sensors: SceneSensors, frames: range, clock: Clock
 ) -> int:

@@ -151,8 +151,7 @@ def run_view(
             )
         sensors, channels, sight = None, (), None
         if cameras or sweeps:
-            from gnnpmb.data.sensors import load_scene_sensors
-            from viz.cameras import absent_reason
+            from gnnpmb.data.sensors import absent_reason, load_scene_sensors
 
             sensors = load_scene_sensors(scene, shown)
             absent = absent_reason(sensors, shown) if cameras else None

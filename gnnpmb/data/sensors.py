@@ -84,6 +84,21 @@ class SceneSensors:
         return [c.path for i in frames for c in self.cameras[i] if not c.path.is_file()]
 
 
+def absent_reason(sensors: SceneSensors, frames: range) -> str | None:
+    """Why the scene's cameras cannot be shown at the keyframes ``frames`` (None: they can): no camera rows, or
+    image files missing."""
+    count = sum(len(sensors.cameras[i]) for i in frames)
+    if count == 0:
+        return "cameras absent: the dataset has no camera images for this scene"
+    missing = sensors.missing_images(frames)
+    if missing:
+        return (
+            f"cameras absent: {len(missing)} of {count} camera images of this scene are missing (first: "
+            f"{missing[0]}); download the nuScenes samples/CAM_* folders into the dataroot"
+        )
+    return None
+
+
 _POSE = ["ego_t_0", "ego_t_1", "ego_t_2", "ego_q_0", "ego_q_1", "ego_q_2", "ego_q_3"]
 _CALIB = ["calib_t_0", "calib_t_1", "calib_t_2", "calib_q_0", "calib_q_1", "calib_q_2", "calib_q_3"]
 _CAMERA_SCHEMA = pa.schema(

@@ -11,14 +11,14 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
-from gnnpmb.data.sensors import CAMERA_ORDER, CameraSighting, SceneSensors, load_scene_sensors
+from gnnpmb.data.sensors import CAMERA_ORDER, CameraSighting, SceneSensors, absent_reason, load_scene_sensors
 from gnnpmb.focus_cameras import FocusSight
 from gnnpmb.types import Boxes, FrameDetections
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import views
 from viz import paths
 from viz.blueprint import default_blueprint
-from viz.cameras import absent_reason, log_cameras
+from viz.cameras import log_cameras
 from viz.focus_summary import camera_lines
 from viz.timeline import PLAIN_CLOCK
 
