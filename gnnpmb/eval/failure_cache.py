@@ -91,11 +91,11 @@ def scene_report(
     keyframes: range | None = None,
 ) -> FailureReport:
     """The failure report of one scene's tracking results (on ``keyframes`` only, None: all): stored, else found by
-    the devkit's evaluation on a version folder holding only that scene (``gnnpmb.eval.subset``)."""
+    the devkit's evaluation on a version folder holding only that scene (``gnnpmb.data.eval_subset``)."""
     from gnnpmb.data.demo import cache_root
+    from gnnpmb.data.eval_subset import eval_location
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.failures import find_failures
-    from gnnpmb.eval.subset import eval_location
 
     def find() -> FailureReport:
         nusc = open_nuscenes(eval_location(location, [scene_name]))

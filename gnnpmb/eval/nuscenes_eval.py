@@ -214,9 +214,9 @@ def evaluate_submission(
 ) -> TrackingScores:
     """Check ``results_path`` against ``split`` of the dataset at ``location``, then score it with the
     official evaluation, on a version folder holding only the split's evaluation tables
-    (``gnnpmb.eval.subset``); the devkit's files go to ``out_dir`` (default ``default_eval_dir(results_path)``)."""
+    (``gnnpmb.data.eval_subset``); the devkit's files go to ``out_dir`` (default ``default_eval_dir(results_path)``)."""
+    from gnnpmb.data.eval_subset import eval_location
     from gnnpmb.data.nuscenes import all_sample_tokens, dataset_index, sample_tokens, split_scenes
-    from gnnpmb.eval.subset import eval_location
 
     results_path = Path(results_path)
     check_split_version(split, location.version)

@@ -26,10 +26,10 @@ def diff_runs(
     scene_inputs(scene, runs) -> the loaded inputs of both runs on that scene (the caller's data options);
     split_tokens: every sample of ``scenes`` (a results file must cover them); dataset_tokens: every sample of the
     dataset."""
+    from gnnpmb.data.eval_subset import eval_location
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.scene_scores import scene_scores
     from gnnpmb.eval.submission import run_results
-    from gnnpmb.eval.subset import eval_location
     from gnnpmb.foreign import check_coverage, read_results
     from gnnpmb.runs import check_runs, parse_run
 

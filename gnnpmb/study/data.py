@@ -43,7 +43,7 @@ class StudyData:
     """The split's ``SceneInputs`` by scene name, or a Ray ``ObjectRef`` to them (``for_scoring``); None: read
     each scene from the indexes when needed."""
     evaluation: DatasetLocation | None = None
-    """The version folder holding only the split's evaluation tables (``gnnpmb.eval.subset``; ``for_scoring``)."""
+    """The version folder holding only the split's evaluation tables (``gnnpmb.data.eval_subset``; ``for_scoring``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -104,7 +104,7 @@ def load_inputs(data: StudyData, scene_name: str) -> SceneInputs:
 def for_scoring(data: StudyData, on_ray: bool) -> StudyData:
     """``data`` with the split's evaluation folder built, and ``on_ray`` every scene's inputs in Ray's object
     store (one copy, shared by the workers of a node): the configurations scored in workers load nothing."""
-    from gnnpmb.eval.subset import eval_location
+    from gnnpmb.data.eval_subset import eval_location
 
     data = replace(data, evaluation=eval_location(data.location, data.scene_names))
     if not on_ray:

@@ -9,11 +9,11 @@ from pathlib import Path
 
 import pytest
 
+from gnnpmb.data.eval_subset import eval_location
 from gnnpmb.data.nuscenes import check_dataroot, load_scene, open_nuscenes, sample_tokens
 from gnnpmb.eval.failures import find_failures
 from gnnpmb.eval.nuscenes_eval import run_tracking_eval
 from gnnpmb.eval.submission import build_submission, run_results, write_submission
-from gnnpmb.eval.subset import eval_location
 from gnnpmb.pipeline import get_detections, run_tracker
 
 SCENES = ("scene-0103", "scene-0916")
