@@ -141,30 +141,29 @@ def run_view(
         shown = focus.window(frame_range) if focus is not None else frame_range
         # Missing LiDAR files are drawn around, said once (gnnpmb.data.sensor_files); damaged ones stay an error.
         lidar = lidar_presence(scene, shown)
-        sensor_note = lidar_notice(lidar)
-        if sensor_note is not None:
-            notices = [*notices, sensor_note]
         points_loader = None
         if not lidar.absent:
             points_loader = (
                 load_lidar_points if lidar.complete else lambda k: load_lidar_points(k) if lidar.has(k.index) else None
             )
-        sensors, channels, sight = None, (), None
+        sensors, channels, sight, camera_notices = None, (), None, []
         if cameras or sweeps:
             from gnnpmb.data.sensors import absent_reason, load_scene_sensors
 
             sensors = load_scene_sensors(scene, shown)
             absent = absent_reason(sensors, shown) if cameras else None
             if absent is not None:
-                notices = [*notices, absent]
+                camera_notices.append(absent)
             elif cameras:
                 channels = sensors.channels
             if sweeps and not sensors.sweeps:
-                notices = [*notices, "sweeps absent: the dataset has no LiDAR sweeps between this scene's keyframes"]
+                camera_notices.append("sweeps absent: the dataset has no LiDAR sweeps between this scene's keyframes")
         if focus is not None and channels:
             from gnnpmb.focus_cameras import focus_sight
 
             sight = focus_sight(focus, scene, sensors)
+        sensor_note = lidar_notice(lidar)  # the sensor data first, then what is said of it
+        notices = [*notices, *([sensor_note] if sensor_note is not None else []), *camera_notices]
         start = focus or opening
         clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
         # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
