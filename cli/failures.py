@@ -166,6 +166,15 @@ def print_report(report: "FailureReport", console: "Console") -> None:
         counts = (format_metric(m, getattr(c, m)) for m in ("tp", "fp", "fn", "ids", "frag"))
         classes.add_row(c.class_name, threshold, format_metric("mota", c.mota), *counts)
     console.print(classes)
+    for c in report.classes:
+        if c.threshold is None and any(f.class_name == c.class_name for f in report.failures):
+            console.print(
+                f"{c.class_name}: no score threshold reached the evaluation's lowest recall, so it counts every "
+                f"{c.class_name} box missed and no false track, ID switch or fragmentation ('-'); the "
+                f"{c.class_name} failures below are what matching every box finds, outside those counts",
+                highlight=False,
+                soft_wrap=True,
+            )
 
     grouped: dict[tuple[int, FailureKind], list[tuple[str, str]]] = defaultdict(list)
     for failure_id, f in zip(report.ids(), report.failures, strict=True):

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from gnnpmb.eval.evaluated import GtStatus
+from gnnpmb.eval.failures import FailureKind
 from gnnpmb.events import (
     Assignment,
     AxisKind,
@@ -42,6 +43,7 @@ from gnnpmb.events import (
     FrameStarted,
     Gated,
     GlobalHypotheses,
+    IntensityWeights,
     ListSink,
     Marginals,
     Posterior,
@@ -409,6 +411,11 @@ def _check(c: Claim, f: Finding, src: Sources) -> str:  # noqa: C901 (one branch
             )
             return "" if same and abs(missed - v[3]) < ATOL else f"events say {shares}, missed {missed}"
         case "existence":
+            intensity = src.one(x, v[0], IntensityWeights)  # GM-PHD / CPHD: the label's heaviest weight
+            if intensity is not None:
+                mine = np.asarray(intensity.weights)[np.asarray(intensity.labels) == v[1]]
+                if mine.size:
+                    return "" if abs(float(mine.max()) - v[2]) < ATOL else "weight differs"
             post = src.one(x, v[0], Posterior)
             rows = np.flatnonzero(np.asarray(post.track_ids) == v[1]) if post is not None else []
             if len(rows) == 0:
@@ -568,12 +575,14 @@ def _check_blame(rule: Rule, frames: tuple[int, ...], f: Finding, src: Sources) 
                     nearest = min(own, key=lambda j: d[j])
                     if used is not None and nearest in [m for m, _ in used[0]]:
                         return f"track {f.lost.track_id} used m{nearest} at frame {x}"
-            case Rule.TRACK_DROPPED if f.false_output is not None:
-                kept, _ = src.devkit.tracks.get(str(f.false_output.track_id), ((), None))
-                if src.box(x, f.false_output.track_id) is None or x in kept:
+            case Rule.TRACK_DROPPED if f.false_output is not None or f.kind is FailureKind.COALESCENCE:
+                t = f.false_output.track_id if f.false_output is not None else f.track_ids[0]
+                kept, _ = src.devkit.tracks.get(str(t), ((), None))
+                if src.box(x, t) is None or x in kept:
                     return "the track's box was not dropped there"
             case Rule.TRACK_INTERPOLATED:
-                kept, _ = src.devkit.tracks.get(str(f.false_output.track_id), ((), None))
+                t = f.false_output.track_id if f.false_output is not None else f.track_ids[0]
+                kept, _ = src.devkit.tracks.get(str(t), ((), None))
                 if x in kept:
                     return "the evaluation kept the track's own box there"
             case Rule.TRACK_DROPPED:

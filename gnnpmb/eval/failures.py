@@ -118,8 +118,13 @@ class Failure:
 
     def describe(self) -> str:
         """One readable line naming the ids (and saying when a ground-truth box was interpolated)."""
-        interpolated = " (GT box interpolated by the evaluation: no points)" if self.gt_interpolated else ""
-        return self._what() + interpolated
+        made_up = list(dict.fromkeys(b.object_id for b in self.boxes if b.is_gt and b.interpolated))
+        if not made_up:
+            return self._what()
+        if len(self.gt_ids) == 1:
+            return self._what() + " (GT box interpolated by the evaluation: no points)"
+        named = ", ".join(f"GT {short_id(g)}" for g in made_up)  # of several objects, the one(s) it concerns
+        return self._what() + f" ({named}: box interpolated by the evaluation, no points)"
 
     @property
     def gt_interpolated(self) -> bool:

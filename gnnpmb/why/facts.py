@@ -155,9 +155,10 @@ class TrackStep:
     hypotheses after the update (None for other trackers); predicted_xy_m: its predicted BEV position; gated:
     (detection, d2) inside its gate, nearest first; use: how its update used the detections (None: no update
     reported for it); born_from: the detection that started it this frame; posterior_existence: after the update
-    (None if it ended); output: its box in the tracker's output (None: not output); ended: how it ended (None: it
-    lives on); column: (detection, cost) of its column in the cost matrix the frame was decided over (+inf: it
-    could not take that detection; None: it had no column), on that matrix's ``column_scale``.
+    (GM-PHD / CPHD: its label's heaviest weight, an expected number that may exceed 1; None if it ended); output:
+    its box in the tracker's output (None: not output); ended: how it ended (None: it lives on); column:
+    (detection, cost) of its column in the cost matrix the frame was decided over (+inf: it could not take that
+    detection; None: it had no column), on that matrix's ``column_scale``.
     """
 
     frame: int
@@ -432,6 +433,10 @@ class TrackerFacts:
             row = _row_of(cf.posterior.track_ids, t)
             if row is not None:
                 posterior_r = float(cf.posterior.existence[row])
+        if cf.intensity is not None:  # GM-PHD / CPHD: the label's heaviest weight, not the Posterior's min(w, 1)
+            mine = np.asarray(cf.intensity.weights)[np.asarray(cf.intensity.labels) == t]
+            if mine.size:
+                posterior_r = float(mine.max())
         output = next((e for e in self.output(f, class_name) if e.track_id == t), None)
         ended = _ending(cf, t)
         if prior_r is None and posterior_r is None and output is None and ended is None and t not in born:

@@ -653,6 +653,12 @@ class _Context:
             blame += uncovered
             if s.went is not None and s.went.track_id == int(self.failure.track_ids[0]):
                 blame.append(Blame(Rule.COVERED_TWO, (self.f,)))
+        t = int(self.failure.track_ids[0])
+        ev = self.report.track_evals.get(str(t))
+        if ev is not None and self.f in ev.interpolated:  # the box matched is the evaluation's, not the tracker's
+            blame.insert(0, Blame(Rule.TRACK_INTERPOLATED, (self.f,)))
+            if self.estimate(t, self.f) is not None:
+                blame.insert(1, Blame(Rule.TRACK_DROPPED, (self.f,)))  # output, but beyond the range: dropped
         covered = self.failure.gt_ids[:1]  # the object the evaluation matched the track to (failures docstring)
         return {"deciding": (self.f,), "blame": tuple(dict.fromkeys(blame)), "covered": covered}
 

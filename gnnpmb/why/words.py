@@ -18,6 +18,7 @@ from gnnpmb.foreign import NEAREST_M, BoxOn, OnHow
 from gnnpmb.why.counterfactual import WouldTake
 from gnnpmb.why.facts import Destination, Ending, TrackStep, UseMode, Went
 from gnnpmb.why.findings import (
+    EVALUATED_OFFSET_M,
     NEAR_M,
     FalseOutput,
     Finding,
@@ -503,6 +504,28 @@ def _hidden(f: Finding) -> list[str]:
     ]
 
 
+def _scored_away(f: Finding, t: int) -> str:
+    """`` (at frame 16, though, the evaluation scored the object at a box it interpolated 10.9 m from the
+    annotation)``: the frames before the failure's at which track ``t`` was output on the annotated object while
+    the evaluation scored the object elsewhere, so "on it" there was no match ("" if none)."""
+    away = [
+        s
+        for s in f.sightings
+        if s.frame < f.frame
+        and s.evaluated is not None
+        and s.evaluated.status is GtStatus.INTERPOLATED
+        and s.evaluated.offset_m >= EVALUATED_OFFSET_M
+        and any(o.track_id == t for o in s.on_it)
+    ]
+    if not away:
+        return ""
+    offsets = ", ".join(f"{s.evaluated.offset_m:.1f}" for s in away)
+    return (
+        f" (at {frames_text(s.frame for s in away)}, though, the evaluation scored the object at a box it "
+        f"interpolated {offsets} m from the annotation)"
+    )
+
+
 def _lost_story(f: Finding, lost: LostTrack) -> str:
     """What the lost track did over the window, in the tracker's terms."""
     mode = UseMode(f.mode)
@@ -513,7 +536,7 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         # "last on it" is not "last output": say where it was output after, away from the object
         away = [s.frame for s in steps if lost.held_until < s.frame < f.frame and s.output is not None]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
-        parts.append(f"track {t} was last output on it at frame {lost.held_until}{elsewhere}")
+        parts.append(f"track {t} was last output on it at frame {lost.held_until}{elsewhere}{_scored_away(f, t)}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]
@@ -599,6 +622,23 @@ def _unused(f: Finding) -> list[tuple[tuple[int, int], str]]:
     return out
 
 
+def _still_on_annotated(f: Finding, lost: LostTrack) -> list[str]:
+    """The lost track still output on the annotated object at the failure's frame while the evaluation scored the
+    object at an interpolated box out of its reach (the blame ``INTERPOLATED`` and ``f.reach``): "last output on
+    it" alone would read as if the track had left it."""
+    r, s = f.reach, f.sighting(f.frame)
+    if r is None or s is None or lost.track_id not in r.near_annotated or lost.track_id in r.near_evaluated:
+        return []
+    on = next((o for o in s.on_it if o.track_id == lost.track_id), None)
+    if on is None:
+        return []
+    return [
+        f"at frame {f.frame} track {lost.track_id} was still output {on.distance_m:.1f} m from the annotated object, "
+        f"but the evaluation scored the object at a box it interpolated {r.offset_m:.1f} m from the annotation, "
+        "out of the track's reach"
+    ]
+
+
 def _lost_object(f: Finding) -> list[str]:
     parts = [_presence(f)]
     parts += _detector_gaps(f)
@@ -624,6 +664,8 @@ def _lost_object(f: Finding) -> list[str]:
             parts.append(f"track {o.track_id} had existed since frame {o.frame} in a hypothesis other than the best")
     if lost is not None and lost.off is not None:
         parts.append(_off_text(f, lost))
+    if lost is not None:
+        parts += _still_on_annotated(f, lost)
     if lost is not None and any(b.rule is Rule.TWO_TRACKS for b in f.blame):
         s = f.sighting(f.frame)
         others = [o.track_id for o in (s.on_it if s else ()) if o.track_id != lost.track_id]
@@ -931,8 +973,18 @@ def _coalescence(f: Finding) -> list[str]:
     s = f.sighting(f.frame)
     t = f.track_ids[0]
     covered = ", ".join(f"GT {short_id(g)}" for g in f.covered)
+    tests = {b.rule for b in f.blame}
+    if Rule.TRACK_INTERPOLATED in tests:
+        why = (
+            "was output beyond the evaluation's range for the class, so its box was dropped"
+            if Rule.TRACK_DROPPED in tests
+            else "was not output"
+        )
+        whose = f"track {t} {why}; the box the evaluation interpolated for it in its place"
+    else:
+        whose = f"track {t}"
     parts = [
-        f"at frame {f.frame} track {t} was matched to {covered} and also lay within {NEAR_M:.0f} m of "
+        f"at frame {f.frame} {whose} was matched to {covered} and also lay within {NEAR_M:.0f} m of "
         f"GT {short_id(f.gt_id or '')}, which no counted track covered"
     ]
     if s is None:
