@@ -345,6 +345,9 @@ class PmbmParams(Section):
     (``params/paper.toml``) on the demo mini_train scenes to 4 decimals at less than half the time per frame; with
     the velocity measured (the default) N_h = 10 gave that of N_h = 20 (mean over 3 presets x 3 seeds 0.8881 vs
     0.8878) in 16 % less time. N_h = 1 is exactly GNN-PMB.
+    n_scan N > 0: after each update only the hypotheses descending from the best one's ancestor N frames back
+    are kept (N-scan pruning), so an alternative (e.g. "track missed, its detection starts a duplicate
+    Bernoulli") must become the best within N frames or is dropped.
     """
 
     SECTION = "pmbm"
@@ -352,6 +355,9 @@ class PmbmParams(Section):
     n_hypotheses: int = param(10, "N_h, the most global hypotheses kept", at_least(1), paper=100)
     hypothesis_prune: float = param(
         1e-4, "global hypotheses lighter than this are dropped (the best always stays)", unit_interval(True, False)
+    )
+    n_scan: int = param(
+        0, "N-scan pruning: only hypotheses sharing the best one's ancestor N frames back stay (0: off)", at_least(0)
     )
 
 
