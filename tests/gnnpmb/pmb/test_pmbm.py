@@ -204,7 +204,7 @@ class PlainKBest:
 
 @pytest.mark.parametrize("prune_existence", [1e-6, 1e-3])
 def test_equals_the_plain_per_hypothesis_reference(prune_existence):
-    config = CFG.replace(pmb=PmbParams(prune_existence=prune_existence), pmbm=PmbmParams(n_hypotheses=30))
+    config = CFG.replace(pmb=PmbParams(prune_existence=prune_existence), pmbm=PmbmParams(n_hypotheses=30, n_scan=0))
     a = PmbCore("car", config, KBest(config.pmbm), IdAllocator())
     b = PmbCore("car", config, PlainKBest(config.pmbm), IdAllocator())
     most = 0
@@ -221,7 +221,7 @@ def test_equals_the_plain_per_hypothesis_reference(prune_existence):
 
 
 def test_weights_normalised_sorted_and_at_most_n_h():
-    config = CFG.replace(pmbm=PmbmParams(n_hypotheses=20))
+    config = CFG.replace(pmbm=PmbmParams(n_hypotheses=20, n_scan=0))
     core = PmbCore("car", config, KBest(config.pmbm), IdAllocator())
     sink = ListSink()
     parents = []
