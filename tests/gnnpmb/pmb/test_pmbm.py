@@ -416,3 +416,16 @@ def test_n_scan_longer_than_the_sequence_changes_nothing():
     for meas in cluttered_sequence(seed=4):
         assert off.step(meas, 0.5, NullSink()) == long.step(meas, 0.5, NullSink())
     assert [h.log_weight for h in off.hypotheses] == [h.log_weight for h in long.hypotheses]
+
+
+def test_the_overlap_gate_holds_with_several_hypotheses():
+    """``[pmb] gate_giou_min`` gates every hypothesis, not only a lone one: a detection 3 m beside a 2 m wide
+    track (inside its Mahalanobis gate, no overlap) updates it in no hypothesis when a GIoU >= 0.5 is required."""
+    config = CFG.replace(pmb=dataclasses.replace(CFG.pmb, gate_giou_min=0.5))
+    beside = make_measurements([(0.0, 3.0)], 0.9)
+    for gated, expect_update in ((config, False), (CFG, True)):
+        core = core_with_track(KBest(gated.pmbm), gated)
+        core.hypotheses = [GlobalHypothesis(math.log(0.6), one_track()), GlobalHypothesis(math.log(0.4), one_track())]
+        core.step(beside, 0.5, NullSink())
+        updated = [bool((h.bernoullis.track_id == 1)[h.bernoullis.det.meas_index == 0].any()) for h in core.hypotheses]
+        assert any(updated) == expect_update
