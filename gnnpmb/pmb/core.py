@@ -532,7 +532,14 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         union, members = hypothesis_union(self.hypotheses)
         union_prior = predict_bernoullis(union, model, p.p_survive)
         union_local = local_hypotheses(
-            union_prior, meas, new, model.R, p.gate_chi2, self.params.miss_p_detect_max, self.box
+            union_prior,
+            meas,
+            new,
+            model.R,
+            p.gate_chi2,
+            self.params.miss_p_detect_max,
+            self.box,
+            self.params.gate_giou_min,
         )
         priors = [GlobalHypothesis(h.log_weight, union_prior, i) for h, i in zip(self.hypotheses, members, strict=True)]
         return PmbPrior(priors, HypothesisLocals(union_local, members))

@@ -10,7 +10,8 @@ has children a = the H_h = ceil(N_h w_h) best assignments of C_h (``assign.murty
 since an assignment's likelihood is the product of its local hypothesis likelihoods. Children that will hold
 the same Bernoullis (same multiset of local keys after the core's existence pruning) are merged by adding
 weights; then the weights are normalised, sorted (ties keep parent, then rank order), children below
-``hypothesis_prune`` dropped, at most N_h kept and renormalised. With N_h = 1 this is exactly GNN-PMB
+``hypothesis_prune`` dropped, with ``[pmbm] n_scan`` N > 0 those not descending from the best child's ancestor N
+frames back dropped (N-scan pruning), at most N_h kept and renormalised. With N_h = 1 this is exactly GNN-PMB
 (``gnnpmb.BestAssignment``).
 
 Of a parent's H_h best assignments only those costing at most -log(hypothesis_prune) more than its best are
@@ -38,6 +39,7 @@ the same assignments, costs and Bernoullis, bit for bit, as the plain computatio
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -140,6 +142,10 @@ class KBest:
         self.crowd_hypotheses = crowd_hypotheses
         self._log_prune = math.log(params.hypothesis_prune) if params.hypothesis_prune > 0 else -math.inf
         self._max_increase = -self._log_prune
+        self._lineage: list[tuple[int, ...]] = []
+        """Per current hypothesis (``n_scan`` > 0): its own serial, then its ancestors' newest first, at most
+        ``n_scan`` of them."""
+        self._serial = itertools.count()
 
     def update(
         self, priors: list[GlobalHypothesis], locals_: Sequence[LocalHypotheses], ctx: UpdateContext
@@ -167,7 +173,8 @@ class KBest:
         bases = (prior_log_w + _sums_of_rows(union.miss_log_lik, members)).tolist()  # + sum_k log l_k0
         for h, assignments in enumerate(ranked):
             children.extend(_Child(bases[h] - total, h, col_of_row, total) for col_of_row, total in assignments)
-        kept, log_w = self._select(_merge_identical(children, union, members, ctx))
+        merged = _merge_identical(children, union, members, ctx)
+        kept, log_w = self._select(merged, self._child_lineages(merged, len(priors)))
         store, rows = posteriors_from_assignments(
             union, [members[c.parent] for c in kept], [c.col_of_row for c in kept], ctx
         )
@@ -181,15 +188,38 @@ class KBest:
             _emit(best.total_cost, own, local, best.parent, posteriors, tuple(c.parent for c in kept), ctx)
         return posteriors
 
-    def _select(self, children: list[_Child]) -> tuple[list[_Child], np.ndarray]:
-        """Normalise, sort descending (stable), drop below ``hypothesis_prune`` (the best always stays), cap
-        to N_h, renormalise. Returns the kept children and their normalised log weights."""
+    def _child_lineages(self, children: list[_Child], n_priors: int) -> list[tuple[int, ...]] | None:
+        """Each child's lineage (``n_scan`` > 0, else None): a new serial, then its parent's lineage cut to
+        ``n_scan`` entries. Prior hypotheses this strategy did not make (the first frame, a state set from
+        outside) start lineages of their own."""
+        n = self.params.n_scan
+        if n == 0:
+            return None
+        if len(self._lineage) != n_priors:
+            self._lineage = [(next(self._serial),) for _ in range(n_priors)]
+        return [(next(self._serial), *self._lineage[c.parent][:n]) for c in children]
+
+    def _select(
+        self, children: list[_Child], lineages: list[tuple[int, ...]] | None = None
+    ) -> tuple[list[_Child], np.ndarray]:
+        """Normalise, sort descending (stable), drop below ``hypothesis_prune`` (the best always stays), with
+        ``lineages`` drop those whose ancestor ``n_scan`` frames back is not the best one's (N-scan pruning,
+        Blackman 2004, "Multiple hypothesis tracking for multiple target tracking", IEEE AES Magazine 19(1),
+        sec. IV: the association decision N frames back becomes final), cap to N_h, renormalise. Returns the
+        kept children and their normalised log weights."""
         log_w = np.array([c.log_weight for c in children])
         log_w = log_w - log_sum_exp(log_w)
         order = np.argsort(-log_w, kind="stable")
         keep = order[log_w[order] >= self._log_prune]
-        keep = (keep if len(keep) else order[:1])[: self.params.n_hypotheses]
+        keep = keep if len(keep) else order[:1]
+        if lineages is not None:
+            n = self.params.n_scan
+            root = lineages[keep[0]][n : n + 1]
+            keep = keep[np.array([lineages[i][n : n + 1] == root for i in keep.tolist()])]
+        keep = keep[: self.params.n_hypotheses]
         kept_log_w = log_w[keep] - log_sum_exp(log_w[keep])
+        if lineages is not None:
+            self._lineage = [lineages[i] for i in keep.tolist()]
         return [children[i] for i in keep], kept_log_w
 
 

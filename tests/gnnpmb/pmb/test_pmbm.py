@@ -204,7 +204,7 @@ class PlainKBest:
 
 @pytest.mark.parametrize("prune_existence", [1e-6, 1e-3])
 def test_equals_the_plain_per_hypothesis_reference(prune_existence):
-    config = CFG.replace(pmb=PmbParams(prune_existence=prune_existence), pmbm=PmbmParams(n_hypotheses=30))
+    config = CFG.replace(pmb=PmbParams(prune_existence=prune_existence), pmbm=PmbmParams(n_hypotheses=30, n_scan=0))
     a = PmbCore("car", config, KBest(config.pmbm), IdAllocator())
     b = PmbCore("car", config, PlainKBest(config.pmbm), IdAllocator())
     most = 0
@@ -221,7 +221,7 @@ def test_equals_the_plain_per_hypothesis_reference(prune_existence):
 
 
 def test_weights_normalised_sorted_and_at_most_n_h():
-    config = CFG.replace(pmbm=PmbmParams(n_hypotheses=20))
+    config = CFG.replace(pmbm=PmbmParams(n_hypotheses=20, n_scan=0))
     core = PmbCore("car", config, KBest(config.pmbm), IdAllocator())
     sink = ListSink()
     parents = []
@@ -372,3 +372,60 @@ def test_presence_patterns_of_many_blocks_equal_each_blocks_unique():
     for b, (first, pattern) in got.items():
         _, want_first, want_pattern = np.unique(_row_keys(has_column[:, found[b].meas]), True, True)
         assert first.tolist() == want_first.tolist() and pattern.tolist() == want_pattern.ravel().tolist()
+
+
+def _ancestors_of_kept(n_scan: int, seed: int = 2) -> tuple[list[list[int]], list[int]]:
+    """Per frame of ``cluttered_sequence(seed)``: each kept hypothesis' ancestor ``n_scan`` frames back (as an
+    index among that frame's hypotheses, from the ``GlobalHypotheses`` events' parents), and the number of
+    hypotheses kept, with N-scan pruning at ``n_scan``."""
+    config = CFG.replace(pmbm=dataclasses.replace(CFG.pmbm, n_hypotheses=20, n_scan=n_scan))
+    core = PmbCore("car", config, KBest(config.pmbm), IdAllocator())
+    sink = ListSink()
+    for meas in cluttered_sequence(seed=seed):
+        core.step(meas, 0.5, sink)
+    parents = [e.parents for e in sink.of_type(GlobalHypotheses)]
+    ancestors = []
+    for k in range(n_scan - 1, len(parents)):
+        up = list(range(len(parents[k])))
+        for back in range(n_scan):
+            up = [parents[k - back][i] for i in up]
+        ancestors.append(up)
+    return ancestors, [len(p) for p in parents]
+
+
+@pytest.mark.parametrize("n_scan", [1, 2])
+def test_n_scan_keeps_only_the_best_hypothesis_descendants_of_n_frames_back(n_scan):
+    """N-scan pruning: after every update, every kept hypothesis descends from the same hypothesis N frames
+    back as the best one (García-Fernández et al.'s PMBM keeps any; N-scan makes the decision N frames back
+    final). Without it, the same sequence keeps hypotheses of different ancestors."""
+    ancestors, sizes = _ancestors_of_kept(n_scan)
+    assert all(len(set(a)) == 1 for a in ancestors)
+    assert max(sizes) > 1  # alternatives within the last N frames are still kept
+    config = CFG.replace(pmbm=dataclasses.replace(CFG.pmbm, n_hypotheses=20))
+    core = PmbCore("car", config, KBest(config.pmbm), IdAllocator())
+    sink = ListSink()
+    for meas in cluttered_sequence(seed=2):
+        core.step(meas, 0.5, sink)
+    assert any(len(set(e.parents)) > 1 for e in sink.of_type(GlobalHypotheses))
+
+
+def test_n_scan_longer_than_the_sequence_changes_nothing():
+    off = PmbCore("car", CFG, KBest(CFG.pmbm), IdAllocator())
+    config = CFG.replace(pmbm=dataclasses.replace(CFG.pmbm, n_scan=50))
+    long = PmbCore("car", config, KBest(config.pmbm), IdAllocator())
+    for meas in cluttered_sequence(seed=4):
+        assert off.step(meas, 0.5, NullSink()) == long.step(meas, 0.5, NullSink())
+    assert [h.log_weight for h in off.hypotheses] == [h.log_weight for h in long.hypotheses]
+
+
+def test_the_overlap_gate_holds_with_several_hypotheses():
+    """``[pmb] gate_giou_min`` gates every hypothesis, not only a lone one: a detection 3 m beside a 2 m wide
+    track (inside its Mahalanobis gate, no overlap) updates it in no hypothesis when a GIoU >= 0.5 is required."""
+    config = CFG.replace(pmb=dataclasses.replace(CFG.pmb, gate_giou_min=0.5))
+    beside = make_measurements([(0.0, 3.0)], 0.9)
+    for gated, expect_update in ((config, False), (CFG, True)):
+        core = core_with_track(KBest(gated.pmbm), gated)
+        core.hypotheses = [GlobalHypothesis(math.log(0.6), one_track()), GlobalHypothesis(math.log(0.4), one_track())]
+        core.step(beside, 0.5, NullSink())
+        updated = [bool((h.bernoullis.track_id == 1)[h.bernoullis.det.meas_index == 0].any()) for h in core.hypotheses]
+        assert any(updated) == expect_update
