@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import re
 from pathlib import Path
@@ -227,8 +228,10 @@ def test_the_summary_opens_with_the_decisions_that_made_the_switch(
     assert line.startswith(f"- frame {switch.frame_index}: m") and "over track " in line and "margin " in line
 
 
+@functools.cache
 def findings_of(demo_dataroot: Path, trackers: tuple[str, ...], detector: str = "pointpillars") -> dict:
-    """Per tracker, failure id -> its ``Finding`` (the data every sentence of the focus document is made from)."""
+    """Per tracker, failure id -> its ``Finding`` (the data every sentence of the focus document is made from);
+    made once per worker for each set of arguments (read-only: findings are frozen)."""
     request = prepare(SCENE, list(trackers), dataroot=demo_dataroot, detector=detector, params=POSITION_ONLY)
     evidence, _, _ = evidence_of_all(request)
     found = explain_all(request, evidence)
