@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's test command: installs what the suite needs (uv; Chromium for the browser check when running as
 # root with apt-get), checks lint and formatting (ruff), then runs pytest on every core (pytest-xdist; a module's
-# tests stay on one worker so its shared runs are made once). Extra arguments go to pytest.
+# tests stay on one worker so its shared runs are made once; modules go out in the order tests/conftest.py sets:
+# the browser checks first). Extra arguments go to pytest.
 # Python's bytecode is cached under .pytest_cache/bytecode even when PYTHONDONTWRITEBYTECODE is set: the suite
 # starts hundreds of Python processes (xdist workers, the console scripts in real processes), and without a cache
 # each one compiles every module it imports (numpy, scipy, rerun, the devkit...) from source again, 1.5 s of CPU
@@ -27,4 +28,4 @@ unset PYTHONDONTWRITEBYTECODE
 export PYTHONPYCACHEPREFIX="${PYTHONPYCACHEPREFIX:-$PWD/.pytest_cache/bytecode}"
 "${UV[@]}" run ruff check .
 "${UV[@]}" run ruff format --check .
-exec "${UV[@]}" run pytest -n auto --dist loadscope "$@"
+exec "${UV[@]}" run pytest -n auto --dist loadscope --no-loadscope-reorder "$@"

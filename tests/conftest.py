@@ -108,3 +108,20 @@ def swept_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
         )
     finally:
         patch.undo()
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Modules in the order the workers should take them (``scripts/test.sh`` runs ``--dist loadscope
+    --no-loadscope-reorder``): first those opening the web viewer in Chromium (``browser``: a minute or more each
+    of software WebGL, so they start at once, one per worker, rather than last on one worker while the other
+    idles), then the other ``slow`` ones, then the rest by number of tests, most first (xdist's own reordering);
+    a module's tests keep their order."""
+    modules: dict[str, list[pytest.Item]] = {}
+    for item in items:
+        modules.setdefault(item.nodeid.split("::")[0], []).append(item)
+
+    def rank(tests: list[pytest.Item]) -> tuple[int, int]:
+        marks = {mark.name for test in tests for mark in test.iter_markers()}
+        return (0 if "browser" in marks else 1 if "slow" in marks else 2, -len(tests))
+
+    items[:] = [item for tests in sorted(modules.values(), key=rank) for item in tests]

@@ -1,15 +1,17 @@
 """A real-browser check of a saved recording: serve it with Rerun's web viewer, open it in headless Chromium
 and screenshot it once the viewer has taken in the whole recording and the 3D views show the scene.
 
-``rerun FILE.rrd --serve-web`` hosts the web viewer over HTTP and the recording over gRPC (both bound to
-127.0.0.1, on free ports). Chromium runs headless with WebGL2 on SwiftShader (no GPU) and a fresh profile; it
-is driven over the DevTools protocol (``websocket-client``): set the viewport, navigate, then poll every few
-seconds. Ready means, in this order: the viewer's own state (``WebHandle.viewer_state()``, read with
+The recording is served over HTTP from a thread of this process and ``rerun URL --serve-web`` hosts the web viewer
+that opens it (both bound to 127.0.0.1, on free ports). Not ``rerun FILE.rrd --serve-web``: its gRPC proxy spins on
+one core while idle (Rerun 0.41, rerun-io/rerun#10944; 65 s of CPU in one check here), which a 2-core machine
+rendering WebGL in software cannot spare. Chromium runs headless with WebGL2 on SwiftShader (no GPU) and a fresh
+profile; it is driven over the DevTools protocol (``websocket-client``): set the viewport, navigate, then poll
+every few seconds. Ready means, in this order: the viewer's own state (``WebHandle.viewer_state()``, read with
 ``read_viewer_state``) shows the recording open with every view of its blueprint and every timeline of the file
-loaded to its last time; the viewer's ingestion-backlog readout is gone; and the 3D-view regions hold many
-varied, non-background pixels (LiDAR points, coloured boxes) in two shots in a row. Pixels alone are not
-enough: panels can still be empty while the 3D views look finished. Both servers run in their own process
-groups and are killed (group-wide) on every exit path.
+loaded to its last time; the viewer's ingestion-backlog readout is gone; and the 3D-view regions hold many varied,
+non-background pixels (LiDAR points, coloured boxes) in two shots in a row. Pixels alone are not enough: panels can
+still be empty while the 3D views look finished. Both servers run in their own process groups and are killed
+(group-wide) on every exit path; the file server stops with the check.
 
 By hand: ``uv run python -m tools.webcheck FILE.rrd --out shot.png [--views 2]``.
 """
@@ -19,6 +21,8 @@ from __future__ import annotations
 import argparse
 import base64
 import contextlib
+import functools
+import http.server
 import io
 import itertools
 import json
@@ -28,6 +32,7 @@ import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import urllib.error
 import urllib.parse
@@ -279,6 +284,33 @@ def rerun_executable() -> Path:
     return exe
 
 
+class _QuietCorsHandler(http.server.SimpleHTTPRequestHandler):
+    """Files of one folder, readable from the web viewer's page on another port (CORS), without a log line per
+    request."""
+
+    def end_headers(self) -> None:
+        self.send_header("Access-Control-Allow-Origin", "*")
+        super().end_headers()
+
+    def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 (the base class's name)
+        pass
+
+
+@contextlib.contextmanager
+def served_file(path: Path) -> Iterator[str]:
+    """The URL of ``path`` served over HTTP on 127.0.0.1 (a free port) by a thread of this process, for as long
+    as the context lasts."""
+    handler = functools.partial(_QuietCorsHandler, directory=str(path.parent))
+    with http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler) as httpd:
+        thread = threading.Thread(target=httpd.serve_forever, name="webcheck-file", daemon=True)
+        thread.start()
+        try:
+            yield f"http://127.0.0.1:{httpd.server_address[1]}/{urllib.parse.quote(path.name)}"
+        finally:
+            httpd.shutdown()
+            thread.join()
+
+
 @contextlib.contextmanager
 def process_group(argv: Sequence[str], log_path: Path) -> Iterator[subprocess.Popen[bytes]]:
     """Run ``argv`` in a new session (its own process group), output to ``log_path``; on exit SIGTERM the
@@ -471,21 +503,13 @@ def check_recording(
     with contextlib.ExitStack() as stack:
         work = Path(work_dir) if work_dir is not None else Path(stack.enter_context(tempfile.TemporaryDirectory()))
         work.mkdir(parents=True, exist_ok=True)
-        web_port, grpc_port, debug_port = free_port(), free_port(), free_port()
+        web_port, debug_port = free_port(), free_port()
         serve_log, browser_log = work / "rerun-serve.log", work / "chromium.log"
+        rrd_url = stack.enter_context(served_file(rrd))
         server = stack.enter_context(
             process_group(
-                [
-                    str(rerun_executable()),
-                    str(rrd),
-                    "--serve-web",
-                    "--web-viewer-port",
-                    str(web_port),
-                    "--port",
-                    str(grpc_port),
-                    "--bind",
-                    "127.0.0.1",
-                ],
+                [str(rerun_executable()), rrd_url, "--serve-web", "--web-viewer-port", str(web_port)]
+                + ["--bind", "127.0.0.1"],
                 serve_log,
             )
         )
@@ -513,8 +537,7 @@ def check_recording(
             deviceScaleFactor=1,
             mobile=False,
         )
-        grpc_url = f"rerun+http://127.0.0.1:{grpc_port}/proxy"
-        url = f"http://127.0.0.1:{web_port}/?url={urllib.parse.quote(grpc_url, safe='')}"
+        url = f"http://127.0.0.1:{web_port}/?url={urllib.parse.quote(rrd_url, safe='')}"
         devtools.call("Page.navigate", url=url)
         navigated = time.monotonic()
         boxes = view_regions(width, height, n_views)

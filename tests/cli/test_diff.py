@@ -6,8 +6,6 @@ from __future__ import annotations
 import contextlib
 import io
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -15,11 +13,11 @@ import pytest
 from cli.app import main as viz_main
 from gnnpmb.diff import Change, match_failures, scene_diff
 from gnnpmb.eval.failures import Failure, FailureBox, FailureKind, FailureReport
+from tests.inprocess import run_script
 from tests.viz.rrd import read_rows
 from viz.blueprint import focus_doc
 
 SCENE = "scene-0103"
-BIN = Path(sys.executable).parent
 PAPER = "gnnpmb/params/paper.toml"
 
 
@@ -60,11 +58,15 @@ def test_failures_are_matched_by_what_they_are_about_not_by_track_ids() -> None:
     assert [e.change for e in entries] == [Change.KEPT, Change.KEPT, Change.INTRODUCED, Change.FIXED]
 
 
-def test_diff_of_the_papers_parameters_and_the_defaults_in_a_real_process(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_diff_of_the_papers_parameters_and_the_defaults(
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``gnnpmb diff`` as the console script runs it, in-process (``tests.inprocess``; the script's start in a
+    real process is checked in ``tests/cli/test_user_errors.py``)."""
     out = tmp_path / "diff.json"
-    proc = subprocess.run(
+    proc = run_script(
         [
-            str(BIN / "gnnpmb"),
+            "gnnpmb",
             "diff",
             f"gnnpmb:{PAPER}",
             "gnnpmb",
@@ -75,9 +77,7 @@ def test_diff_of_the_papers_parameters_and_the_defaults_in_a_real_process(demo_d
             "--json",
             str(out),
         ],
-        capture_output=True,
-        text=True,
-        timeout=180,
+        capsys,
     )
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +20,7 @@ from gnnpmb.stages.runs import run_all
 from gnnpmb.why.facts import Ending
 from gnnpmb.why.findings import Party, Rule
 from gnnpmb.why.words import column_name, whose_text, why_lines
+from tests.inprocess import run_script_with
 from tests.pipeline import POSITION_ONLY, evidence_of_all, prepare
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
@@ -31,7 +31,6 @@ from viz.focus import predicted_ghosts
 from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_legend
 
 SCENE = "scene-0103"
-SCRIPT = Path(sys.executable).parent / "gnnpmb-viz"
 ARGS = ["--detector", "pointpillars", "--params", str(POSITION_ONLY)]
 
 
@@ -189,14 +188,23 @@ def test_focus_in_a_comparison_highlights_each_trackers_tracks(
         ("gt:zzzz", "--focus gt:zzzz: no ground-truth object of scene-0103 has an id starting so"),
     ],
 )
-def test_bad_focus_is_one_line_and_exit_2(demo_dataroot: Path, tmp_path: Path, focus: str, message: str) -> None:
+def test_bad_focus_is_one_line_and_exit_2(
+    demo_dataroot: Path,
+    tmp_path: Path,
+    focus: str,
+    message: str,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """In-process (``tests.inprocess``): the installed script's own error path runs in real processes in
+    ``tests/cli/test_user_errors.py``; what is checked here is the focus's message."""
     out = tmp_path / "x.rrd"
-    proc = subprocess.run(
-        [str(SCRIPT), SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={"PATH": "/usr/bin:/bin", "NO_COLOR": "1", "HOME": str(tmp_path)},
+    proc = run_script_with(
+        ["gnnpmb-viz", SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out)],
+        {"PATH": "/usr/bin:/bin", "NO_COLOR": "1", "HOME": str(tmp_path)},
+        tmp_path,
+        monkeypatch,
+        capsys,
     )
     assert proc.returncode == 2, proc.stderr
     errors = [line for line in proc.stderr.splitlines() if line.startswith("error:")]
@@ -220,8 +228,10 @@ def test_the_summary_opens_with_the_decisions_that_made_the_switch(
     assert line.startswith(f"- frame {switch.frame_index}: m") and "over track " in line and "margin " in line
 
 
+@functools.cache
 def findings_of(demo_dataroot: Path, trackers: tuple[str, ...], detector: str = "pointpillars") -> dict:
-    """Per tracker, failure id -> its ``Finding`` (the data every sentence of the focus document is made from)."""
+    """Per tracker, failure id -> its ``Finding`` (the data every sentence of the focus document is made from);
+    made once per worker for each set of arguments (read-only: findings are frozen)."""
     request = prepare(SCENE, list(trackers), dataroot=demo_dataroot, detector=detector, params=POSITION_ONLY)
     evidence, _, _ = evidence_of_all(request)
     found = explain_all(request, evidence)

@@ -343,10 +343,14 @@ def test_a_first_sample_token_that_names_no_sample_is_one_line(demo_dataroot: Pa
 
 def test_a_second_sweep_into_a_folder_waits_for_the_first(demo_dataroot: Path, tmp_path: Path) -> None:
     """Another process holds the study folder (as a running sweep does): the sweep says so and waits; it runs once
-    the folder is let go."""
+    the folder is let go. On the study tests' tiny data (one scene cut to a few keyframes) and one worker (no
+    Ray instance for one configuration): the wait is the point, not the sweep's work."""
     import sys
 
-    env = _cache_env(demo_dataroot, tmp_path / "cache")
+    from tests.gnnpmb.study.conftest import TINY_FRAMES, TINY_SCENE, cut_dataset
+
+    tiny = cut_dataset(demo_dataroot, tmp_path / "tiny", TINY_SCENE, TINY_FRAMES)
+    env = _cache_env(tiny, tmp_path / "cache")
     study = tmp_path / "study"
     holder = subprocess.Popen(
         [
@@ -360,7 +364,8 @@ def test_a_second_sweep_into_a_folder_waits_for_the_first(demo_dataroot: Path, t
         text=True,
     )
     assert holder.stdout.readline().strip() == "held"
-    sweep = ["gnnpmb", "sweep", "--out", "study", "--tracker", "gnn", "--param", "models.gate_chi2=20", "--no-progress"]
+    sweep = ["gnnpmb", "sweep", "--out", "study", "--tracker", "gnn", "--param", "models.gate_chi2=20"]
+    sweep += ["--workers", "1", "--no-progress"]
     proc = subprocess.Popen(
         [str(BIN / sweep[0]), *sweep[1:]],
         env=env,

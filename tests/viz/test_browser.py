@@ -1,5 +1,7 @@
-"""The comparison recording in a real browser (Rerun's web viewer in headless Chromium), and the pieces of
-``tools.webcheck`` that decide whether a screenshot shows the rendered scene."""
+"""A focus recording of two trackers in a real browser (Rerun's web viewer in headless Chromium), and the pieces
+of ``tools.webcheck`` that decide whether a screenshot shows the rendered scene. The README's demo recording has
+its browser check in ``test_browser_demo.py``: a module of its own, so the two checks run on two workers at
+once (``tests/conftest.py`` hands them out first)."""
 
 from __future__ import annotations
 
@@ -129,7 +131,8 @@ def test_viewer_state_is_decoded_from_its_protobuf_bytes() -> None:
         protobuf_fields(b"\x0a\x05ab")  # a 5-byte field with 2 bytes left
 
 
-def _require_chromium() -> None:
+def require_chromium() -> None:
+    """Skip without Chromium, or fail when the suite said it must run (GNNPMB_REQUIRE_BROWSER=1)."""
     if not CHROMIUM.is_file():
         if REQUIRE_BROWSER:
             pytest.fail(f"GNNPMB_REQUIRE_BROWSER=1 but there is no Chromium at {CHROMIUM}")
@@ -137,6 +140,7 @@ def _require_chromium() -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.browser
 @pytest.mark.parametrize(("kind", "trackers"), [("id_switch", ("gnnpmb", "pmbm"))])
 def test_focus_recordings_load_and_render_in_headless_chromium(
     demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str, trackers: tuple[str, ...]
@@ -149,7 +153,7 @@ def test_focus_recordings_load_and_render_in_headless_chromium(
     failure kinds and of one tracker without a browser."""
     from tests.pipeline import POSITION_ONLY, prepare, reports_of
 
-    _require_chromium()
+    require_chromium()
     request = prepare("scene-0103", ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars", params=POSITION_ONLY)
     reports, _ = reports_of(request)
     ids = [i for i in reports["gnnpmb"].ids() if not i.startswith("miss:")]
@@ -194,27 +198,3 @@ def test_a_sparse_birds_eye_view_counts_as_rendered() -> None:
         img[y + 30, x : x + 42] = rng.integers(0, 256, (42, 3))
     stats = region_stats(img, (0, 0, 800, 400))
     assert 0.005 < stats.foreground_fraction < 0.02 and stats.rendered
-
-
-@pytest.mark.slow
-def test_the_full_demo_recording_loads_and_renders_in_headless_chromium(
-    demo_dataroot: Path, demo_recording: tuple[Path, str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    """The demo as the README makes it (one tracker, the whole scene, no --focus; ``tests/conftest.py``): ready by
-    the viewer's own state with its sparse bird's-eye view, opened at the first failure worth a look."""
-    from tests.pipeline import prepare, reports_of
-
-    _require_chromium()
-    rrd = demo_recording[0]
-    shot = tmp_path / "demo.png"
-    result = check_recording(rrd, shot, n_views=1, timeout_s=420.0, work_dir=tmp_path / "web")
-    with capsys.disabled():
-        print(f"\nbrowser check (full demo recording): {result.describe()}", file=sys.stderr)
-    assert result.seconds_to_load is not None, f"the viewer never showed everything loaded; see {shot}"
-    assert result.rendered, f"the views did not render; look at {shot} and the logs in {tmp_path / 'web'}"
-    assert {"gnnpmb bird's-eye", "gnnpmb failures", "gnnpmb failures over time"} <= result.state.views
-    request = prepare("scene-0103", ["gnnpmb"], dataroot=demo_dataroot)
-    report = reports_of(request)[0]["gnnpmb"]
-    assert result.state.timeline_max["focus"] == report.by_id(report.first_worth_opening()).frame_index
-    for pgid in result.process_groups:
-        assert group_members(pgid) == [], f"process group {pgid} still has processes"
