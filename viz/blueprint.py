@@ -38,6 +38,9 @@ FOCUS_HEIGHT_M: dict[str, float] = {"pedestrian": 16.0, "bicycle": 18.0, "motorc
 """Height of the bird's-eye camera above a focused place by class (small objects closer)."""
 DEFAULT_FOCUS_HEIGHT_M = 40.0
 """The same for the other classes."""
+COMPARED_ROW_SHARES = (4, 1)
+"""With two runs or more, the left column's rows: the scene views, the comparison panel below them."""
+COMPARED_SCENE_SHARE = COMPARED_ROW_SHARES[0] / sum(COMPARED_ROW_SHARES)
 STORY_COLUMNS = rrb.TextLogColumns(
     text_log_columns=[
         rrb.components.TextLogColumn(kind="LogLevel", visible=True),
@@ -404,7 +407,7 @@ def default_blueprint(
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:
-        left = rrb.Vertical(scene, comparison_panel(trackers, legends, focus), row_shares=[4, 1])
+        left = rrb.Vertical(scene, comparison_panel(trackers, legends, focus), row_shares=list(COMPARED_ROW_SHARES))
         layout = rrb.Horizontal(left, rrb.Tabs(*panels), column_shares=[3, 2])
     if focus is None and opening is None:
         time_panel = rrb.TimePanel(state="collapsed", timeline="frame", play_state="paused")

@@ -10,14 +10,22 @@ overlap. The focus bird's-eye camera looks straight down from ``height_m`` with 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import rerun as rr
 
-M_PER_PX_PER_HEIGHT = 0.0022
-"""Metres per screen pixel per metre of camera height in the focus bird's-eye view (measured: 18 m -> 0.04 m)."""
+FOV_Y_DEG = 55.0
+"""Vertical field of view of the bird's-eye view's eye (Rerun's default)."""
+FOCUS_BEV_HEIGHT_PX = 683.0
+"""Height of a focus recording's bird's-eye view of one run without a camera view, at 1920 x 1080 (measured in the
+web viewer: dev set scene-0103 simpletrack fragmentation:9; two runs and a camera view below shorten it,
+``viz.focus``)."""
+M_PER_PX_PER_HEIGHT = 2.0 * math.tan(math.radians(FOV_Y_DEG / 2.0)) / FOCUS_BEV_HEIGHT_PX
+"""Metres per screen pixel per metre of camera height in that view (a pinhole looking straight down: 18 m ->
+0.027 m; it was a measured 0.0022, true of a shorter view, so a column could sit past a taller view's edge)."""
 LINE_PX = 22.0
 """Rows of the column are this many pixels apart (a label is about 16 px tall)."""
 CHAR_PX = 7.5

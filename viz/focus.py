@@ -34,6 +34,7 @@ from gnnpmb.why.findings import Finding
 from gnnpmb.why.words import existence_text, share_text, went_text
 from viz import compare, paths
 from viz.blueprint import (
+    COMPARED_SCENE_SHARE,
     DEFAULT_FOCUS_HEIGHT_M,
     FOCUS_HEIGHT_M,
     focus_doc,
@@ -102,6 +103,8 @@ def log_focus(
     height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
     if sight is not None:  # a camera view below: the bird's-eye view is shorter, a pixel more metres
         height_m /= SCENE_HEIGHT_WITH_CAMERAS
+    if len(loggers) > 1:  # runs compared: the comparison panel takes a share of the scene's height
+        height_m /= COMPARED_SCENE_SHARE
     half_view_m = 0.5 * FOCUS_VIEW_WIDTH_PX / max(len(loggers), 1) * M_PER_PX_PER_HEIGHT * height_m
     view_x_m = (focus.center_xy_m[0] - half_view_m, focus.center_xy_m[0] + half_view_m)
     for i in shown:
