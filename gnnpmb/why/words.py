@@ -102,8 +102,8 @@ def cost_breakdown(terms: PairTerms, meas: str) -> str:
     predicted position, the distance and the detection's score add, and the constant the tracker adds to every
     pair (``events.PairTerms``; the parts a tracker's cost does not have are left out)."""
     parts: list[tuple[float, str]] = []
-    if terms.offset_text:
-        parts.append((terms.offset_nats, f"for {terms.offset_text}"))
+    if terms.offset_text or terms.offset_nats:  # an unnamed constant is still a part: the parts add up to the cost
+        parts.append((terms.offset_nats, f"for {terms.offset_text or 'a constant every pair of the matrix shares'}"))
     if terms.existence is not None:
         parts.append((terms.existence_nats, f"for its predicted existence {existence_text(terms.existence)}"))
     parts.append((terms.spread_nats, f"for the uncertainty of its predicted position (±{terms.spread_m:.1f} m)"))

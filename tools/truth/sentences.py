@@ -28,12 +28,25 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from gnnpmb.events import AxisKind, Born
-from tools.truth import detector, otherruns, replay, shares
+from tools.truth import costs, detector, hypotheses, lost, otherruns, place, replay, shares
 from tools.truth.devkit import EvalFacts
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import SceneTruth
 
-CLASSES = ("matched", "gone", "counterfactual", "misleading", "detector", "other run", "share", "output")
+CLASSES = (
+    "matched",
+    "gone",
+    "counterfactual",
+    "misleading",
+    "detector",
+    "other run",
+    "share",
+    "output",
+    "tracker",
+    "cost",
+    "hypothesis",
+    "evaluation",
+)
 
 
 @dataclass(frozen=True)
@@ -158,13 +171,21 @@ def check_text(
     if scene is not None:
         detector.check_detector(text, ctx.gt_id, ctx.frame, c, scene, raw, out, bad, ev.evaluated_gt)
     otherruns.check_others(text, ctx.kind, c, ctx.frame, ctx.gt_id, others or {}, scene, out, bad)
-    place = _place(ctx, ev, scene)
-    otherruns.check_other_false_tracks(text, c, ctx.frame, place, others or {}, out, bad)
-    if scene is not None and ctx.gt_id is None and place is not None:
+    where = _place(ctx, ev, scene)
+    otherruns.check_other_false_tracks(text, c, ctx.frame, where, others or {}, out, bad)
+    if ctx.gt_id is None:
+        place.check_place(text, c, ctx.frame, where, scene, out, bad)
+    place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)
+    out.checked["misleading"] += 2
+    if "?" in text:
+        bad("misleading", text[max(0, text.index("?") - 60) : text.index("?") + 1], "a placeholder in the text")
+    if "cause unknown" in text:
+        bad("misleading", "cause unknown", "no stated test held")
+    if scene is not None and ctx.gt_id is None and where is not None:
         for m in NOTHING_NEAR.finditer(text):
             out.checked["detector"] += 1
             here = scene.objects[ctx.frame] if ctx.frame < len(scene.objects) else {}
-            near = [k[:6] for k, a in here.items() if math.hypot(a.xy_m[0] - place[0], a.xy_m[1] - place[1]) < 2.0]
+            near = [k[:6] for k, a in here.items() if math.hypot(a.xy_m[0] - where[0], a.xy_m[1] - where[1]) < 2.0]
             if near:
                 bad("detector", m[0], f"annotated objects within 2 m of track {ctx.track}'s box: {near}")
     for phrase in VIEWER_ONLY:
@@ -235,11 +256,14 @@ def check_text(
     for m in CHOICE.finditer(text):
         _check_choice(m, c, raw, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
+    lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
+    costs.check_costs(text, c, raw, scene, out, bad)
+    hypotheses.check_hypotheses(text, c, raw, out, bad)
     return out
 
 
 def _patterns() -> list[re.Pattern]:
-    mods = (detector, otherruns, shares)
+    mods = (detector, otherruns, shares, lost, place, costs, hypotheses)
     here = [v for v in globals().values() if isinstance(v, re.Pattern) and v is not BECAUSE]
     return here + [v for mod in mods for v in vars(mod).values() if isinstance(v, re.Pattern)]
 

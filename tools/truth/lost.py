@@ -1,0 +1,155 @@
+"""What the Why says the lost track did, checked against its raw events and the submission.
+
+* "its existence went from A (frame x) to B (frame y)" / "its existence was A (frame x)" (a PHD's "weight"): the
+  track's existence in the ``Posterior`` event of each named frame (rounded as printed), and no ``Posterior`` of
+  the frames between above A (A is the highest);
+* "it was not output at frames …": the submission has no box of the track at any of them;
+* "its track logic deleted it at frame x (h of w hits)": a delete ``TrackLogic`` event of x names it, with those
+  hits; "it was pruned at frame x (reason)": a ``Pruned`` event of x with that reason; "it was merged into another
+  component at frame x": a ``Merged`` event of x names it among the absorbed; "and it ended at frame x": one of
+  the three;
+* "at frame x it used mN (p P), mK (p Q) +n more": the track's row of the frame's ``Marginals`` (association
+  probabilities): the detections with a share of at least 1 %, most likely first, with those probabilities;
+  "was given mN": the frame's ``Assignment`` pairs mN with the track.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from gnnpmb.events import Assignment, AxisKind, Marginals, Merged, Posterior, Pruned, TrackLogic, TrackLogicAction
+
+_V = r"\d+(?:\.\d+)?(?:e-?\d+)?"
+WENT_FROM = re.compile(rf"its (existence|weight) went from ({_V}) \(frame (\d+)\) to ({_V}) \(frame (\d+)\)")
+WAS = re.compile(rf"its (existence|weight) was ({_V}) \(frames? (\d+)(?:–(\d+))?\)")
+NOT_OUTPUT = re.compile(r"it was not output at (frames? [\d–, ]*\d)")
+DELETED = re.compile(
+    r"its track logic deleted it at frame (\d+)(?: \((?:(\d+) of (\d+) hits|no hit in its last (\d+) frames)\))?"
+)
+PRUNED = re.compile(r"it was pruned at frame (\d+) \(([^)]+)\)")
+MERGED = re.compile(r"it was merged into another component at frame (\d+)")
+ENDED = re.compile(
+    r"track (\d+) could not take it: its column's cost for it was infinite \([^)]*\), and it ended at frame (\d+)"
+)
+USED = re.compile(
+    rf"at frame (\d+) it (used|was given) (m\d+(?: \(p {_V}\))?(?:, m\d+(?: \(p {_V}\))?)?)(?: \+(\d+) more)?"
+)
+USED_SHARE = 0.01
+"""The checker's own copy of the share from which an update is said to have used a detection."""
+
+
+def frames_of(text: str) -> list[int]:
+    """``frame 7``, ``frames 7, 13``, ``frames 12–14, 20`` -> the frames."""
+    out: list[int] = []
+    for part in text.split(" ", 1)[1].split(", "):
+        lo, _, hi = part.partition("–")
+        out += list(range(int(lo), int(hi or lo) + 1))
+    return out
+
+
+def printed(r: float) -> str:
+    """An existence as the text prints one: two decimals, one significant digit below 0.01."""
+    return f"{r:.2f}" if r >= 0.01 or r == 0 else f"{r:.1g}"
+
+
+def _existence(raw, x: int, c: str, track: int) -> float | None:
+    found = raw.of_kind(x, c, Posterior)
+    if not found:
+        return None
+    ids = np.asarray(found[-1].track_ids).tolist()
+    return float(np.asarray(found[-1].existence)[ids.index(track)]) if track in ids else None
+
+
+def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
+    """The lost track's story (module docstring); ``lost``: the track the Why follows (None: nothing checked)."""
+    if lost is None:
+        return
+    for m in WENT_FROM.finditer(text):
+        out.checked["tracker"] += 1
+        (hi, x), (lo, y) = (m[2], int(m[3])), (m[4], int(m[5]))
+        got = {f: _existence(raw, f, c, lost) for f in (x, y)}
+        if any(v is None for v in got.values()) or printed(got[x]) != hi or printed(got[y]) != lo:
+            bad("tracker", m[0], f"the Posterior events give track {lost} {got}")
+            continue
+        between = [(f, v) for f in range(min(x, y), max(x, y) + 1) if (v := _existence(raw, f, c, lost)) is not None]
+        above = [(f, round(v, 4)) for f, v in between if printed(v) != hi and v > float(hi)]
+        if above:
+            bad("tracker", m[0], f"its {m[1]} was higher between: {above}")
+    for m in WAS.finditer(text):
+        out.checked["tracker"] += 1
+        frames = range(int(m[3]), int(m[4] or m[3]) + 1)
+        got = {f: _existence(raw, f, c, lost) for f in frames}
+        if any(v is None or printed(v) != m[2] for v in got.values()):
+            bad("tracker", m[0], f"the Posterior events give track {lost} {got}")
+    for m in NOT_OUTPUT.finditer(text):
+        out.checked["tracker"] += 1
+        output = [x for x in frames_of(m[1]) if str(lost) in ev.submitted.get(x, set())]
+        if output:
+            bad("tracker", m[0], f"the submission has track {lost}'s box at frames {output}")
+    for m in DELETED.finditer(text):
+        out.checked["tracker"] += 1
+        x = int(m[1])
+        logic = [
+            e for e in raw.of_kind(x, c, TrackLogic) if e.track_id == lost and e.action is TrackLogicAction.DELETED
+        ]
+        hits = (int(m[2]), int(m[3])) if m[2] else (0, int(m[4])) if m[4] else None
+        if not logic:
+            bad("tracker", m[0], f"no delete TrackLogic event of frame {x} names track {lost}")
+        elif hits is not None and hits not in {(e.hits, e.window) for e in logic}:
+            bad("tracker", m[0], f"the track logic counted {[(e.hits, e.window) for e in logic]}")
+    for m in PRUNED.finditer(text):
+        out.checked["tracker"] += 1
+        reasons = [p.reason.value for p in raw.of_kind(int(m[1]), c, Pruned) if p.track_id == lost]
+        if m[2] not in reasons:
+            bad("tracker", m[0], f"the Pruned events of frame {m[1]} give track {lost} {reasons}")
+    for m in MERGED.finditer(text):
+        out.checked["tracker"] += 1
+        if not _merged(raw, int(m[1]), c, lost):
+            bad("tracker", m[0], f"no Merged event of frame {m[1]} absorbed track {lost}")
+    for m in ENDED.finditer(text):
+        out.checked["tracker"] += 1
+        t, x = int(m[1]), int(m[2])
+        if not (raw.deleted(x, c, t) or _merged(raw, x, c, t)):
+            bad("tracker", m[0], f"no event of frame {x} ends track {t}")
+    for m in USED.finditer(text):
+        _check_used(m, c, lost, raw, out, bad)
+
+
+def _merged(raw, x: int, c: str, track: int) -> bool:
+    return any(track in e.from_ids and e.into_id != track for e in raw.of_kind(x, c, Merged))
+
+
+def _check_used(m: re.Match, c: str, lost: int, raw, out, bad) -> None:
+    x = int(m[1])
+    said = [(int(a), b or None) for a, b in re.findall(rf"m(\d+)(?: \(p ({_V})\))?", m[3])]
+    more = int(m[4] or 0)
+    if m[2] == "was given":
+        found = raw.of_kind(x, c, Assignment)
+        if not found:
+            return
+        out.checked["tracker"] += 1
+        given = [int(r.ref) for r, k in found[-1].pairs if k.kind is AxisKind.TRACK and int(k.ref) == lost]
+        if [s for s, _ in said] != given or more:
+            bad("tracker", m[0], f"the assignment of frame {x} gave track {lost} {given}")
+        return
+    found = raw.of_kind(x, c, Marginals)
+    if not found:
+        return
+    out.checked["tracker"] += 1
+    marg = found[-1]
+    rows = [i for i, r in enumerate(marg.rows) if int(r.ref) == lost]
+    if not rows:
+        bad("tracker", m[0], f"the Marginals of frame {x} have no row of track {lost}")
+        return
+    p = np.asarray(marg.probs)[rows[0]]
+    shares = sorted(
+        ((int(k.ref), float(p[j])) for j, k in enumerate(marg.cols) if k.kind is AxisKind.MEASUREMENT),
+        key=lambda s: (-s[1], s[0]),
+    )
+    used = [(d, v) for d, v in shares if v >= USED_SHARE]
+    ok = [d for d, _ in used[:2]] == [d for d, _ in said] and max(0, len(used) - 2) == more
+    ok = ok and all(v is None or f"{q:.2f}" == v for (_, q), (_, v) in zip(used, said, strict=False))
+    if not ok:
+        bad("tracker", m[0], f"the Marginals of frame {x} give track {lost} {[(d, round(v, 3)) for d, v in used]}")
