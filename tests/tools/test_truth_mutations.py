@@ -508,3 +508,32 @@ def test_a_planted_issue_1141_note_is_caught() -> None:
 def test_a_placeholder_or_an_unknown_cause_is_caught() -> None:
     assert [c.kind for c in _found("at frame 3 m? → track 7").found] == ["misleading"]
     assert [c.kind for c in _found("Why (gnn, cause unknown): track 7 was not output").found] == ["misleading"]
+
+
+def test_a_planted_placement_of_a_results_files_box_is_caught() -> None:
+    """A results file (no events): track 11's box repeats m0's size, rotation and height at frame 3; track 12's
+    lies 0.2 m from m0 with another size."""
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    box = (1.8, 4.5, 1.6, 1.0, 0.0, 0.0, 0.0, 0.9)
+    scene = SceneTruth([[Detection(C, 0.9, (0.3, 0.0), box)]] * 4, [{GT_A: Annotation(C, (0.0, 0.0), 9)}] * 4)
+    ev = _eval()
+    ev.boxes[3] = [("11", C, (0.3, 0.0)), ("12", C, (0.5, 0.0))]
+    ev.geometry = {(3, "11"): box, (3, "12"): (2.0, 4.5, 1.6, 1.0, 0.0, 0.0, 0.0, 0.9)}
+    ev.submitted = {2: {"12"}, 3: {"11", "12"}}
+    ctx = Context(C, 3, GT_A)
+    on = "at frame 3 track 11 (car) was output on detection m0 (car, score 0.90; its box carries m0's size, heading "
+    on += "and height)"
+    near = "at frame 3 track 12 (car) was output on detection m0 (car, score 0.90; m0 is the nearest car detection, "
+    near += "0.20 m from its box (none carries its size, heading and height))"
+    for true, false in (
+        (on, on.replace("track 11", "track 12")),
+        (near, near.replace("0.20 m", "0.30 m")),
+        (
+            "at frame 3 m0 (score 0.90, 0.3 m from it) lay under track 11's box",
+            "at frame 3 m0 (score 0.90, 0.3 m from it) lay under no output box",
+        ),
+        ("track 11 was first output at frame 3", "track 12 was first output at frame 3"),
+    ):
+        assert check_text(true, ctx, None, ev, scene=scene).found == [], true
+        assert [c.kind for c in check_text(false, ctx, None, ev, scene=scene).found] == ["output"], false

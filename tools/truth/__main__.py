@@ -55,9 +55,12 @@ def run_scene(
     dataroot: Path = DEVSET,
     version: str = "v1.0-mini",
     where: list[tuple[str, Contradiction]] | None = None,
+    results: Mapping[str, Path] | None = None,
 ) -> dict[str, tuple[Tally, int]]:
     """``run_cell`` for several trackers on one scene and preset (tracker -> the run its findings compare with, or
-    None), each tracker run and evaluated once: the cells of a row of the matrix share their other run."""
+    None), each tracker run and evaluated once: the cells of a row of the matrix share their other run. results:
+    name -> a results file of a tracker outside the project, made on the same detections (its findings checked
+    against the file: it has no events); a name of ``trackers`` may be one of them."""
     where = [] if where is None else where
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.submission import run_results
@@ -74,8 +77,19 @@ def run_scene(
     from tools.truth.scene import SceneTruth
 
     detections = dataroot / "detections" / f"{preset}_{split_of_scene(scene)}.json"
+    results = dict(results or {})
     names = list(dict.fromkeys([*trackers, *(o for o in trackers.values() if o is not None)]))
-    request = load_inputs(check_request(scene, names, dataroot=dataroot, version=version, detections_file=detections))
+    files = [f"{n}={p}" for n, p in results.items() if n in names]
+    request = load_inputs(
+        check_request(
+            scene,
+            [n for n in names if n not in results],
+            results=files,
+            dataroot=dataroot,
+            version=version,
+            detections_file=detections,
+        )
+    )
     runs = dict(zip(request.trackers, run_all(request, record=True), strict=True))
     reports, _ = find_reports(request, list(runs.values()))
     evidence = {n: evidence_of(request, reports[n], r) for n, r in runs.items()}
@@ -91,7 +105,7 @@ def run_scene(
     out = {}
     for tracker, other in trackers.items():
         rest = [other] if other is not None and other != tracker else []
-        raw = RawEvents.of(list(runs[tracker].events))
+        raw = None if tracker in results else RawEvents.of(list(runs[tracker].events))
         ev = ev_of(tracker)
         others = {n: ev_of(n) for n in rest}
         tally = Tally()
@@ -144,18 +158,27 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--dataroot", type=Path, default=DEVSET)
     parser.add_argument("--other", default="pmbm", help="the run findings compare with ('none': no other run)")
     parser.add_argument("--square", action="store_true", help="each tracker once over the scenes and presets")
+    parser.add_argument(
+        "--results",
+        action="append",
+        default=[],
+        metavar="NAME=FILE.json",
+        help="check a results file's findings (made on the preset's detections) instead of the trackers'",
+    )
     args = parser.parse_args(argv)
     per: dict[str, Tally] = defaultdict(Tally)
     findings: dict[str, int] = defaultdict(int)
     where: list[tuple[str, Contradiction]] = []
     scenes = MINI_VAL + MINI_TRAIN if args.all_scenes else (args.scene or MINI_VAL)
-    todo = cells(scenes, args.detector or PRESETS, args.tracker or TRACKER_NAMES, args.square)
+    files = {spec.split("=", 1)[0]: Path(spec.split("=", 1)[1]) for spec in args.results}
+    todo = cells(scenes, args.detector or PRESETS, args.tracker or ([] if files else TRACKER_NAMES), args.square)
+    todo += [(s, p, name) for s in scenes for p in args.detector or PRESETS for name in files]
     rows: dict[tuple[str, str], dict[str, str | None]] = defaultdict(dict)
     for scene, preset, tracker in todo:
         rows[(scene, preset)][tracker] = None if args.other == "none" else other_of(tracker, args.other)
     for (scene, preset), row in rows.items():
         here: list[tuple[str, Contradiction]] = []
-        for tracker, (tally, n) in run_scene(scene, preset, row, args.dataroot, where=here).items():
+        for tracker, (tally, n) in run_scene(scene, preset, row, args.dataroot, where=here, results=files).items():
             per[tracker].add(tally)
             findings[tracker] += n
             line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)

@@ -42,6 +42,8 @@ class EvalFacts:
     pred_xy: dict[tuple[str, int], dict[str, tuple[float, float]]] = field(default_factory=dict)
     """(class, frame) -> the centre of each track box the accumulator scored there (interpolations included)."""
     scores: dict[tuple[int, str], float] = field(default_factory=dict)
+    geometry: dict[tuple[int, str], tuple[float, ...]] = field(default_factory=dict)
+    """(frame, track id) -> the submission box's size, rotation and centre height (``scene.Detection.box``)."""
     kept_gt: set[tuple[int, str]] = field(default_factory=set)
     """(frame, object id) of each annotated box the devkit's filters kept (the ends its interpolation joins)."""
     stamps: dict[int, int] = field(default_factory=dict)
@@ -109,7 +111,9 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         ]
         out.submitted[frame] = {b[0] for b in out.boxes[frame]}
         out.stamps[frame] = int(nusc.get("sample", token)["timestamp"])
-        out.scores.update({(frame, str(b["tracking_id"])): float(b["tracking_score"]) for b in results.get(token, [])})
+        for b in results.get(token, []):
+            out.scores[(frame, str(b["tracking_id"]))] = float(b["tracking_score"])
+            out.geometry[(frame, str(b["tracking_id"]))] = (*b["size"], *b["rotation"], b["translation"][2])
     scene_gt = tracks_gt[scene["token"]]
     scene_pred = tracks_pred[scene["token"]]
     for stamp, boxes in scene_gt.items():

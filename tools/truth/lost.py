@@ -83,11 +83,6 @@ def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
         got = {f: _existence(raw, f, c, lost) for f in frames}
         if any(v is None or printed(v) != m[2] for v in got.values()):
             bad("tracker", m[0], f"the Posterior events give track {lost} {got}")
-    for m in NOT_OUTPUT.finditer(text):
-        out.checked["tracker"] += 1
-        output = [x for x in frames_of(m[1]) if str(lost) in ev.submitted.get(x, set())]
-        if output:
-            bad("tracker", m[0], f"the submission has track {lost}'s box at frames {output}")
     for m in DELETED.finditer(text):
         out.checked["tracker"] += 1
         x = int(m[1])
@@ -115,6 +110,15 @@ def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
             bad("tracker", m[0], f"no event of frame {x} ends track {t}")
     for m in USED.finditer(text):
         _check_used(m, c, lost, raw, out, bad)
+
+
+def check_not_output(text: str, lost: int | None, ev, out, bad) -> None:
+    """ "it was not output at frames …" of the lost track, against the submission (a results file's too)."""
+    for m in NOT_OUTPUT.finditer(text) if lost is not None else ():
+        out.checked["tracker"] += 1
+        output = [x for x in frames_of(m[1]) if str(lost) in ev.submitted.get(x, set())]
+        if output:
+            bad("tracker", m[0], f"the submission has track {lost}'s box at frames {output}")
 
 
 def _merged(raw, x: int, c: str, track: int) -> bool:

@@ -28,7 +28,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from gnnpmb.events import AxisKind, Born
-from tools.truth import costs, detector, hypotheses, lost, otherruns, place, replay, shares
+from tools.truth import costs, detector, hypotheses, lost, otherruns, output, place, replay, shares
 from tools.truth.devkit import EvalFacts
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import SceneTruth
@@ -217,7 +217,9 @@ def check_text(
         out.checked["misleading"] += 1
         if t not in ev.submitted.get(x, set()):
             bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
-    if raw is None:
+    lost.check_not_output(text, ctx.lost, ev, out, bad)
+    if raw is None:  # a results file: where its boxes sit
+        output.check_output(text, c, ctx.lost, scene, ev, out, bad)
         return out
     started = [(int(m[2]), int(m[1]), int(m[3]), m[0]) for m in STARTED.finditer(text)]
     started += [(int(m[1]), int(m[3]), int(m[2]), m[0]) for m in STARTED_NEW.finditer(text)]
@@ -263,7 +265,7 @@ def check_text(
 
 
 def _patterns() -> list[re.Pattern]:
-    mods = (detector, otherruns, shares, lost, place, costs, hypotheses)
+    mods = (detector, otherruns, shares, lost, place, costs, hypotheses, output)
     here = [v for v in globals().values() if isinstance(v, re.Pattern) and v is not BECAUSE]
     return here + [v for mod in mods for v in vars(mod).values() if isinstance(v, re.Pattern)]
 
