@@ -520,9 +520,12 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         if alive:
             peak = max(alive, key=lambda s: s.posterior_existence)
             last = alive[-1]
-            if existence_text(peak.posterior_existence) == existence_text(last.posterior_existence):
-                span = f"frame {last.frame}" if peak.frame == last.frame else f"frames {alive[0].frame}–{last.frame}"
+            if len({existence_text(s.posterior_existence) for s in alive}) == 1:  # the same over the window
+                span = f"frame {last.frame}" if len(alive) == 1 else f"frames {alive[0].frame}–{last.frame}"
                 parts.append(f"its {word} was {existence_text(last.posterior_existence)} ({span})")
+            elif existence_text(peak.posterior_existence) == existence_text(last.posterior_existence):
+                # back up at its highest after a dip: the last frame only, not a span it did not hold over
+                parts.append(f"its {word} was {existence_text(last.posterior_existence)} (frame {last.frame})")
             else:
                 parts.append(
                     f"its {word} went from {existence_text(peak.posterior_existence)} (frame {peak.frame}) to "

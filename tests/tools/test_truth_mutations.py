@@ -537,3 +537,39 @@ def test_a_planted_placement_of_a_results_files_box_is_caught() -> None:
     ):
         assert check_text(true, ctx, None, ev, scene=scene).found == [], true
         assert [c.kind for c in check_text(false, ctx, None, ev, scene=scene).found] == ["output"], false
+
+
+def test_a_planted_gate_distance_or_averaged_score_is_caught() -> None:
+    from gnnpmb.events import Gated
+
+    d2 = np.array([[3.14, 50.0]])
+    gated = Gated(C, np.array([7]), np.array([0, 1]), d2 < 16.0, np.zeros((1, 2)), np.eye(2)[None], 16.0, d2)
+    raw = _raw_with(gated)
+    ctx = Context(C, 3, GT_A, lost=7)
+    gate = "at frame 3 m{} (score 0.90, 0.3 m from it, in track 7's gate at NIS {}) → track 5"
+    assert check_text(gate.format(0, "3.1"), ctx, raw, _eval()).found == []
+    for meas, nis in ((0, "4.1"), (1, "50.0")):  # another d²; a detection outside the gate
+        assert [c.kind for c in check_text(gate.format(meas, nis), ctx, raw, _eval()).found] == ["tracker"]
+    ev = _eval()
+    ev.averaged, ev.submitted = {"5": (2, 0.4)}, {1: {"5"}, 2: {"5"}, 3: {"5"}}
+    said = "track 5 was output on it, but its score averaged over {}, {}, is below the car threshold 0.500"
+    kept = "the 2 of its 3 frames the evaluation kept (within the class range)"
+    assert check_text(said.format(kept, "0.400"), CTX, None, ev).found == []
+    for over, score in ((kept, "0.410"), ("its 3 frames", "0.400")):
+        assert [c.kind for c in check_text(said.format(over, score), CTX, None, ev).found] == ["matched"]
+
+
+def test_an_existence_said_held_over_frames_it_dipped_in_is_caught() -> None:
+    """pmbm on dev-set scene-0916 megvii said 'its existence was 1.00 (frames 10–18)' of a track at 0.15 at frame 15;
+    a deletion by maximum age and a merge recorded as ``Pruned`` events hold."""
+    from gnnpmb.events import Pruned, PruneReason
+
+    raw = _frames({1: [_posterior(7, 1.0)], 2: [_posterior(7, 0.15)], 3: [_posterior(7, 1.0)]})
+    ctx = Context(C, 3, GT_A, lost=7)
+    assert check_text("its existence was 1.00 (frame 3)", ctx, raw, _eval()).found == []
+    assert [c.kind for c in check_text("its existence was 1.00 (frames 1–3)", ctx, raw, _eval()).found] == ["tracker"]
+    ended = _raw_with(Pruned(C, 7, PruneReason.TRACK_LOGIC, 1.0), Pruned(C, 8, PruneReason.MERGED, 0.2))
+    assert check_text("its track logic deleted it at frame 3", ctx, ended, _eval()).found == []
+    merged = Context(C, 3, GT_A, lost=8)
+    assert check_text("it was merged into another component at frame 3", merged, ended, _eval()).found == []
+    assert check_text("it was merged into another component at frame 3", ctx, ended, _eval()).found != []

@@ -44,6 +44,8 @@ class EvalFacts:
     scores: dict[tuple[int, str], float] = field(default_factory=dict)
     geometry: dict[tuple[int, str], tuple[float, ...]] = field(default_factory=dict)
     """(frame, track id) -> the submission box's size, rotation and centre height (``scene.Detection.box``)."""
+    averaged: dict[str, tuple[int, float]] = field(default_factory=dict)
+    """track id -> (frames the devkit's filters kept its box, the score ``create_tracks`` averaged over them)."""
     kept_gt: set[tuple[int, str]] = field(default_factory=set)
     """(frame, object id) of each annotated box the devkit's filters kept (the ends its interpolation joins)."""
     stamps: dict[int, int] = field(default_factory=dict)
@@ -99,6 +101,7 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         gt = filter_eval_boxes(nusc, add_center_dist(nusc, gt), cfg.class_range, verbose=False)
         kept_gt = [(t, str(b.tracking_id)) for t in tokens for b in gt[t]]  # create_tracks adds its interpolations
         pred = filter_eval_boxes(nusc, add_center_dist(nusc, pred), cfg.class_range, verbose=False)
+        kept_pred = [str(b.tracking_id) for t in tokens for b in pred[t]]
         tracks_gt = create_tracks(gt, nusc, split, gt=True)
         tracks_pred = create_tracks(pred, nusc, split, gt=False)
     out = EvalFacts()
@@ -116,6 +119,8 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
             out.geometry[(frame, str(b["tracking_id"]))] = (*b["size"], *b["rotation"], b["translation"][2])
     scene_gt = tracks_gt[scene["token"]]
     scene_pred = tracks_pred[scene["token"]]
+    average = {str(b.tracking_id): float(b.tracking_score) for boxes in scene_pred.values() for b in boxes}
+    out.averaged = {t: (kept_pred.count(t), average[t]) for t in set(kept_pred) if t in average}
     for stamp, boxes in scene_gt.items():
         for b in boxes:
             out.evaluated_gt[(frame_of_stamp[stamp], str(b.tracking_id))] = (

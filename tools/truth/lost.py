@@ -5,9 +5,10 @@
   the frames between above A (A is the highest);
 * "it was not output at frames …": the submission has no box of the track at any of them;
 * "its track logic deleted it at frame x (h of w hits)": a delete ``TrackLogic`` event of x names it, with those
-  hits; "it was pruned at frame x (reason)": a ``Pruned`` event of x with that reason; "it was merged into another
-  component at frame x": a ``Merged`` event of x names it among the absorbed; "and it ended at frame x": one of
-  the three;
+  hits (without hits: a track-logic ``Pruned`` event, greedy's maximum age, also does); "it was pruned at frame x
+  (reason)": a ``Pruned`` event of x with that reason; "it was merged into another component at frame x": a
+  ``Merged`` event of x names it among the absorbed, or a ``Pruned`` one removes it as merged; "and it ended at
+  frame x": one of the three;
 * "at frame x it used mN (p P), mK (p Q) +n more": the track's row of the frame's ``Marginals`` (association
   probabilities): the detections with a share of at least 1 %, most likely first, with those probabilities;
   "was given mN": the frame's ``Assignment`` pairs mN with the track.
@@ -19,7 +20,18 @@ import re
 
 import numpy as np
 
-from gnnpmb.events import Assignment, AxisKind, Marginals, Merged, Posterior, Pruned, TrackLogic, TrackLogicAction
+from gnnpmb.events import (
+    Assignment,
+    AxisKind,
+    Gated,
+    Marginals,
+    Merged,
+    Posterior,
+    Pruned,
+    PruneReason,
+    TrackLogic,
+    TrackLogicAction,
+)
 
 _V = r"\d+(?:\.\d+)?(?:e-?\d+)?"
 WENT_FROM = re.compile(rf"its (existence|weight) went from ({_V}) \(frame (\d+)\) to ({_V}) \(frame (\d+)\)")
@@ -35,6 +47,11 @@ ENDED = re.compile(
 )
 USED = re.compile(
     rf"at frame (\d+) it (used|was given) (m\d+(?: \(p {_V}\))?(?:, m\d+(?: \(p {_V}\))?)?)(?: \+(\d+) more)?"
+)
+GATE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it, in track (\d+)'s gate at NIS (\d+\.\d)\)")
+AVERAGED = re.compile(
+    r"(?:track (\d+)[^;:]*?|the evaluation counted the track: )its score averaged over (?:its (\d+) frames?|the (\d+) "
+    r"of its (\d+) frames the evaluation kept \(within the class range\)), (\d+\.\d{3})"
 )
 USED_SHARE = 0.01
 """The checker's own copy of the share from which an update is said to have used a detection."""
@@ -90,8 +107,9 @@ def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
             e for e in raw.of_kind(x, c, TrackLogic) if e.track_id == lost and e.action is TrackLogicAction.DELETED
         ]
         hits = (int(m[2]), int(m[3])) if m[2] else (0, int(m[4])) if m[4] else None
-        if not logic:
-            bad("tracker", m[0], f"no delete TrackLogic event of frame {x} names track {lost}")
+        aged = [p for p in raw.of_kind(x, c, Pruned) if p.track_id == lost and p.reason is PruneReason.TRACK_LOGIC]
+        if not logic and (hits is not None or not aged):
+            bad("tracker", m[0], f"no delete TrackLogic event (nor, without hits, a track-logic Pruned) of frame {x}")
         elif hits is not None and hits not in {(e.hits, e.window) for e in logic}:
             bad("tracker", m[0], f"the track logic counted {[(e.hits, e.window) for e in logic]}")
     for m in PRUNED.finditer(text):
@@ -112,6 +130,36 @@ def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
         _check_used(m, c, lost, raw, out, bad)
 
 
+def check_gates(text: str, c: str, raw, out, bad) -> None:
+    """ "mN (…, in track T's gate at NIS V)": the frame's ``Gated`` event has mN inside T's gate at that d²."""
+    for m in GATE.finditer(text):
+        x, meas, t = int(m[1]), int(m[2]), int(m[3])
+        found = raw.of_kind(x, c, Gated)
+        out.checked["tracker"] += 1
+        g = found[-1] if found else None
+        rows = np.flatnonzero(np.asarray(g.track_ids) == t) if g is not None else []
+        cols = np.flatnonzero(np.asarray(g.meas_indices) == meas) if g is not None else []
+        if len(rows) == 0 or len(cols) == 0 or not bool(np.asarray(g.inside)[rows[0], cols[0]]):
+            bad("tracker", m[0], f"the Gated event of frame {x} does not have m{meas} inside track {t}'s gate")
+        elif f"{float(np.asarray(g.d2)[rows[0], cols[0]]):.1f}" != m[4]:
+            bad("tracker", m[0], f"its d² is {float(np.asarray(g.d2)[rows[0], cols[0]]):.3f}")
+
+
+def check_averaged(text: str, track: int | None, ev, out, bad) -> None:
+    """ "its score averaged over its N frames, S" / "over the K of its N frames the evaluation kept …": the devkit
+    kept the track's box at K (N) frames and averaged S over them; N the file's boxes of the track."""
+    for m in AVERAGED.finditer(text):
+        t = m[1] or (str(track) if track is not None else None)
+        if t is None:
+            continue
+        out.checked["matched"] += 1
+        kept, score = ev.averaged.get(t, (0, float("nan")))
+        submitted = sum(t in ids for ids in ev.submitted.values())
+        said_kept, said_all = (int(m[2]), int(m[2])) if m[2] else (int(m[3]), int(m[4]))
+        if (kept, submitted) != (said_kept, said_all) or f"{score:.3f}" != m[5]:
+            bad("matched", m[0], f"the devkit kept {kept} of its {submitted} boxes and averaged {score:.4f}")
+
+
 def check_not_output(text: str, lost: int | None, ev, out, bad) -> None:
     """ "it was not output at frames …" of the lost track, against the submission (a results file's too)."""
     for m in NOT_OUTPUT.finditer(text) if lost is not None else ():
@@ -122,6 +170,9 @@ def check_not_output(text: str, lost: int | None, ev, out, bad) -> None:
 
 
 def _merged(raw, x: int, c: str, track: int) -> bool:
+    """A ``Merged`` event of x absorbed the track, or a ``Pruned`` one removed it as merged."""
+    if any(p.track_id == track and p.reason is PruneReason.MERGED for p in raw.of_kind(x, c, Pruned)):
+        return True
     return any(track in e.from_ids and e.into_id != track for e in raw.of_kind(x, c, Merged))
 
 

@@ -218,6 +218,7 @@ def check_text(
         if t not in ev.submitted.get(x, set()):
             bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
     lost.check_not_output(text, ctx.lost, ev, out, bad)
+    lost.check_averaged(text, ctx.track, ev, out, bad)
     if raw is None:  # a results file: where its boxes sit
         output.check_output(text, c, ctx.lost, scene, ev, out, bad)
         return out
@@ -259,6 +260,7 @@ def check_text(
         _check_choice(m, c, raw, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
     lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
+    lost.check_gates(text, c, raw, out, bad)
     costs.check_costs(text, c, raw, scene, out, bad)
     hypotheses.check_hypotheses(text, c, raw, out, bad)
     return out
