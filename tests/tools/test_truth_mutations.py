@@ -573,3 +573,22 @@ def test_an_existence_said_held_over_frames_it_dipped_in_is_caught() -> None:
     merged = Context(C, 3, GT_A, lost=8)
     assert check_text("it was merged into another component at frame 3", merged, ended, _eval()).found == []
     assert check_text("it was merged into another component at frame 3", ctx, ended, _eval()).found != []
+
+
+def test_a_planted_interpolation_or_unshown_existence_is_caught() -> None:
+    ev = _eval()
+    ev.kept_gt = {(1, GT_A), (4, GT_A)}
+    ev.submitted = {1: {"11"}, 2: set(), 3: {"11"}}
+    ev.pred_xy[(C, 2)] = {"11": (0.0, 0.0)}
+    ev.track_to_gt[(C, 2)] = {"11": None}
+    at2 = Context(C, 2, GT_A)
+    assert check_text("the evaluation scored it at a box; from frames 1 and 4.", at2, None, ev).found == []
+    assert [c.kind for c in check_text("a box; from frames 0 and 4.", at2, None, ev).found] == ["evaluation"]
+    said = "at frame 2 track 11 (car) was not output: the evaluation interpolated it between its boxes at frames {} "
+    said += "and 3, and that box matched no object"
+    assert check_text(said.format(1), at2, None, ev).found == []
+    assert [c.kind for c in check_text(said.format(0), at2, None, ev).found] == ["evaluation"]
+    raw = _frames({1: [_posterior(11, 0.3)], 3: [_posterior(11, 0.6)]})
+    stayed = "track 11's existence stayed below 0.5 (the views draw tracks from 0.5 up), yet the evaluation counted it"
+    found = check_text(stayed, Context(C, 3, GT_A, lost=11), raw, ev).found
+    assert [c.kind for c in found] == ["tracker"]  # 0.6 at frame 3, where it was output

@@ -49,8 +49,10 @@ USED = re.compile(
     rf"at frame (\d+) it (used|was given) (m\d+(?: \(p {_V}\))?(?:, m\d+(?: \(p {_V}\))?)?)(?: \+(\d+) more)?"
 )
 GATE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it, in track (\d+)'s gate at NIS (\d+\.\d)\)")
+STAYED = re.compile(r"track (\d+)'s existence stayed below (\d+(?:\.\d+)?) \(the views draw tracks from")
 AVERAGED = re.compile(
-    r"(?:track (\d+)[^;:]*?|the evaluation counted the track: )its score averaged over (?:its (\d+) frames?|the (\d+) "
+    r"(?:track (\d+)[^;:]*?|the evaluation counted the track: |track (\d+)'s existence stayed below [^;]*?counted it: )"
+    r"its score averaged over (?:its (\d+) frames?|the (\d+) "
     r"of its (\d+) frames the evaluation kept \(within the class range\)), (\d+\.\d{3})"
 )
 USED_SHARE = 0.01
@@ -149,15 +151,31 @@ def check_averaged(text: str, track: int | None, ev, out, bad) -> None:
     """ "its score averaged over its N frames, S" / "over the K of its N frames the evaluation kept …": the devkit
     kept the track's box at K (N) frames and averaged S over them; N the file's boxes of the track."""
     for m in AVERAGED.finditer(text):
-        t = m[1] or (str(track) if track is not None else None)
+        t = m[1] or m[2] or (str(track) if track is not None else None)
         if t is None:
             continue
         out.checked["matched"] += 1
         kept, score = ev.averaged.get(t, (0, float("nan")))
         submitted = sum(t in ids for ids in ev.submitted.values())
-        said_kept, said_all = (int(m[2]), int(m[2])) if m[2] else (int(m[3]), int(m[4]))
-        if (kept, submitted) != (said_kept, said_all) or f"{score:.3f}" != m[5]:
+        said_kept, said_all = (int(m[3]), int(m[3])) if m[3] else (int(m[4]), int(m[5]))
+        if (kept, submitted) != (said_kept, said_all) or f"{score:.3f}" != m[6]:
             bad("matched", m[0], f"the devkit kept {kept} of its {submitted} boxes and averaged {score:.4f}")
+
+
+def check_stayed_below(text: str, c: str, raw, ev, out, bad) -> None:
+    """ "track T's existence stayed below E (…)": its ``Posterior`` existence at every frame the submission has its
+    box is below E."""
+    for m in STAYED.finditer(text):
+        out.checked["tracker"] += 1
+        t, below = int(m[1]), float(m[2])
+        above = {
+            x: v
+            for x in sorted(ev.submitted)
+            if str(t) in ev.submitted[x] and (v := _existence(raw, x, c, t)) is not None
+        }
+        above = {x: round(v, 3) for x, v in above.items() if v >= below}
+        if above:
+            bad("tracker", m[0], f"its existence at frames it was output: {above}")
 
 
 def check_not_output(text: str, lost: int | None, ev, out, bad) -> None:

@@ -26,6 +26,16 @@ SWAPPED = re.compile(
 )
 
 
+BETWEEN = re.compile(r"(?:^|; )from frames (\d+) and (\d+)(?=[;.]|$)", re.M)
+TRACK_BETWEEN = re.compile(
+    r"at frame (\d+) track (\d+) \((\w+)\) was not output: the evaluation interpolated it between its boxes at "
+    r"frames (\d+) and (\d+), and that box matched no object"
+)
+PREDICTED = re.compile(
+    r"at frame (\d+) track (\d+) \((\w+)\) was output on no detection this frame \(a predicted box\)"
+)
+
+
 def _d(a: tuple[float, float], b: tuple[float, float]) -> float:
     return math.hypot(a[0] - b[0], a[1] - b[1])
 
@@ -51,6 +61,35 @@ def check_place(text: str, c: str, x: int, place, scene, out, bad) -> None:
             bad("detector", m[0], f"{m[1]} annotations within 2 m: {own}")
         elif hit is None or hit[1].class_name != m[2] or f"{_d(hit[1].xy_m, place):.1f}" != m[4]:
             bad("detector", m[0], f"GT {m[3]} is {hit[1] if hit else 'not annotated here'}")
+
+
+def _ends(ev, gt_id: str, x: int) -> tuple[int, int] | None:
+    """The frames before and after x nearest it at which the devkit kept the object's box (its interpolation's
+    ends)."""
+    kept = sorted(f for f, g in ev.kept_gt if g == gt_id)
+    before, after = [f for f in kept if f < x], [f for f in kept if f > x]
+    return (before[-1], after[0]) if before and after else None
+
+
+def check_interpolated(text: str, x: int, gt_id: str | None, ev, out, bad) -> None:
+    """ "from frames L and R" (the object's interpolation) and a false track's interpolated box: "at frame x track
+    T (C) was not output: the evaluation interpolated it between its boxes at frames L and R, and that box matched
+    no object" (no box of T at x, boxes at L and R, the accumulator scored one at x, matched to nothing)."""
+    for m in BETWEEN.finditer(text) if gt_id is not None else ():
+        out.checked["evaluation"] += 1
+        if _ends(ev, gt_id, x) != (int(m[1]), int(m[2])):
+            bad("evaluation", m[0], f"the devkit's kept neighbours of frame {x}: {_ends(ev, gt_id, x)}")
+    for m in TRACK_BETWEEN.finditer(text):
+        out.checked["evaluation"] += 1
+        y, t, c, left, right = int(m[1]), m[2], m[3], int(m[4]), int(m[5])
+        has = [f for f in (y, left, right) if t in ev.submitted.get(f, set())]
+        scored = t in ev.pred_xy.get((c, y), {})
+        if has != [left, right] or not scored or ev.matched_gt(c, y, t) is not None:
+            bad("evaluation", m[0], f"boxes at {has}, scored at {y}: {scored}, matched {ev.matched_gt(c, y, t)}")
+    for m in PREDICTED.finditer(text):
+        out.checked["output"] += 1
+        if m[2] not in ev.submitted.get(int(m[1]), set()):
+            bad("output", m[0], f"the submission has no box of track {m[2]} at frame {m[1]}")
 
 
 def check_swapped(text: str, x: int, gt_id: str | None, scene, ev, out, bad) -> None:

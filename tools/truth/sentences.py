@@ -176,6 +176,7 @@ def check_text(
     if ctx.gt_id is None:
         place.check_place(text, c, ctx.frame, where, scene, out, bad)
     place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)
+    place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
     out.checked["misleading"] += 2
     if "?" in text:
         bad("misleading", text[max(0, text.index("?") - 60) : text.index("?") + 1], "a placeholder in the text")
@@ -261,6 +262,7 @@ def check_text(
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
     lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
     lost.check_gates(text, c, raw, out, bad)
+    lost.check_stayed_below(text, c, raw, ev, out, bad)
     costs.check_costs(text, c, raw, scene, out, bad)
     hypotheses.check_hypotheses(text, c, raw, out, bad)
     return out
