@@ -742,9 +742,10 @@ def _counted_unshown(f: Finding, lost: LostTrack) -> list[str]:
     ev, threshold = lost.evaluated, lost.threshold
     if not f.has_existence or ev is None or ev.averaged_score is None or threshold is None:
         return []
-    if ev.averaged_score < threshold or any(
-        s.output is not None and s.output.existence >= SHOW_MIN_EXISTENCE for s in lost.steps
-    ):
+    output = {s.frame: s.output for s in lost.steps if s.output is not None}
+    if not set(ev.submitted) <= set(output):  # output outside the window too: whether it was ever shown is not known
+        return []
+    if ev.averaged_score < threshold or any(o.existence >= SHOW_MIN_EXISTENCE for o in output.values()):
         return []
     if math.isclose(ev.averaged_score, threshold, rel_tol=1e-9):
         versus = f"is exactly the {f.class_name} threshold (the lowest score counted)"

@@ -592,3 +592,13 @@ def test_a_planted_interpolation_or_unshown_existence_is_caught() -> None:
     stayed = "track 11's existence stayed below 0.5 (the views draw tracks from 0.5 up), yet the evaluation counted it"
     found = check_text(stayed, Context(C, 3, GT_A, lost=11), raw, ev).found
     assert [c.kind for c in found] == ["tracker"]  # 0.6 at frame 3, where it was output
+
+
+def test_a_coalesced_object_said_to_have_no_detection_of_its_own_is_checked() -> None:
+    said = "the detector gave GT {} no detection of its own within 2 m ({} LiDAR and radar points)"
+    at2 = Context(C, 2, GT_A)
+    assert check_text(said.format("bbbbbb", 0), at2, None, _eval(), scene=_scene()).found == []
+    for gt, points in (("aaaaaa", 12), ("bbbbbb", 5)):  # m0 lies 0.3 m from GT A; GT B has no points
+        assert [c.kind for c in check_text(said.format(gt, points), at2, None, _eval(), scene=_scene()).found] == [
+            "detector"
+        ]

@@ -36,6 +36,11 @@ PREDICTED = re.compile(
 )
 
 
+NONE_OF_ITS_OWN = re.compile(
+    r"the detector gave GT (\w{6}) no detection of its own within 2 m \((\d+) LiDAR and radar points\)"
+)
+
+
 def _d(a: tuple[float, float], b: tuple[float, float]) -> float:
     return math.hypot(a[0] - b[0], a[1] - b[1])
 
@@ -90,6 +95,17 @@ def check_interpolated(text: str, x: int, gt_id: str | None, ev, out, bad) -> No
         out.checked["output"] += 1
         if m[2] not in ev.submitted.get(int(m[1]), set()):
             bad("output", m[0], f"the submission has no box of track {m[2]} at frame {m[1]}")
+
+
+def check_none_of_its_own(text: str, x: int, scene, out, bad) -> None:
+    """A coalescence's "the detector gave GT H no detection of its own within 2 m (N LiDAR and radar points)": no
+    detection of any class within 2 m of H's annotation at x, and H has N points."""
+    for m in NONE_OF_ITS_OWN.finditer(text) if scene is not None else ():
+        out.checked["detector"] += 1
+        hit = scene.object_of(x, m[1])
+        near = scene.near(x, hit[1].xy_m) if hit is not None else None
+        if hit is None or near or hit[1].points != int(m[2]):
+            bad("detector", m[0], f"detections within 2 m: {near}; points {hit[1].points if hit else None}")
 
 
 def check_swapped(text: str, x: int, gt_id: str | None, scene, ev, out, bad) -> None:

@@ -177,6 +177,7 @@ def check_text(
         place.check_place(text, c, ctx.frame, where, scene, out, bad)
     place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
+    place.check_none_of_its_own(text, ctx.frame, scene, out, bad)
     out.checked["misleading"] += 2
     if "?" in text:
         bad("misleading", text[max(0, text.index("?") - 60) : text.index("?") + 1], "a placeholder in the text")
