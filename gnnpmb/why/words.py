@@ -103,8 +103,8 @@ def cost_breakdown(terms: PairTerms, meas: str) -> str:
     predicted position, the distance and the detection's score add, and the constant the tracker adds to every
     pair (``events.PairTerms``; the parts a tracker's cost does not have are left out)."""
     parts: list[tuple[float, str]] = []
-    if terms.offset_text:
-        parts.append((terms.offset_nats, f"for {terms.offset_text}"))
+    if terms.offset_text or terms.offset_nats:  # an unnamed constant is still a part: the parts add up to the cost
+        parts.append((terms.offset_nats, f"for {terms.offset_text or 'a constant every pair of the matrix shares'}"))
     if terms.existence is not None:
         parts.append((terms.existence_nats, f"for its predicted existence {existence_text(terms.existence)}"))
     parts.append((terms.spread_nats, f"for the uncertainty of its predicted position (±{terms.spread_m:.1f} m)"))
@@ -543,9 +543,12 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         if alive:
             peak = max(alive, key=lambda s: s.posterior_existence)
             last = alive[-1]
-            if existence_text(peak.posterior_existence) == existence_text(last.posterior_existence):
-                span = f"frame {last.frame}" if peak.frame == last.frame else f"frames {alive[0].frame}–{last.frame}"
+            if len({existence_text(s.posterior_existence) for s in alive}) == 1:  # the same over the window
+                span = f"frame {last.frame}" if len(alive) == 1 else f"frames {alive[0].frame}–{last.frame}"
                 parts.append(f"its {word} was {existence_text(last.posterior_existence)} ({span})")
+            elif existence_text(peak.posterior_existence) == existence_text(last.posterior_existence):
+                # back up at its highest after a dip: the last frame only, not a span it did not hold over
+                parts.append(f"its {word} was {existence_text(last.posterior_existence)} (frame {last.frame})")
             else:
                 parts.append(
                     f"its {word} went from {existence_text(peak.posterior_existence)} (frame {peak.frame}) to "
@@ -781,9 +784,10 @@ def _counted_unshown(f: Finding, lost: LostTrack) -> list[str]:
     ev, threshold = lost.evaluated, lost.threshold
     if not f.has_existence or ev is None or ev.averaged_score is None or threshold is None:
         return []
-    if ev.averaged_score < threshold or any(
-        s.output is not None and s.output.existence >= SHOW_MIN_EXISTENCE for s in lost.steps
-    ):
+    output = {s.frame: s.output for s in lost.steps if s.output is not None}
+    if not set(ev.submitted) <= set(output):  # output outside the window too: whether it was ever shown is not known
+        return []
+    if ev.averaged_score < threshold or any(o.existence >= SHOW_MIN_EXISTENCE for o in output.values()):
         return []
     if math.isclose(ev.averaged_score, threshold, rel_tol=1e-9):
         versus = f"is exactly the {f.class_name} threshold (the lowest score counted)"

@@ -2,7 +2,9 @@
 of mini_val, each with a tracker whose findings exercise the rules that broke there (GNN's counterfactuals and
 margins, AB3DMOT's lost tracks with a column of infinite cost, CPHD's percentages and label starts beside PMBM's
 outcome on the same detections), and one of mini_train (PHD's false track beside an object the devkit matched to
-a track's interpolated box). Every checkable sentence holds. The whole matrix (13 trackers × 10 scenes × 3
+a track's interpolated box); and a results file of a tracker outside the project (``examples/cv_tracker.py``'s
+constant-velocity tracker on the same detections), whose boxes the findings place on detections. Every checkable
+sentence holds. The whole matrix (13 trackers × 10 scenes × 3
 presets, mini_train detections for the 8 mini_train scenes) is ``-m exhaustive`` or
 ``uv run python -m tools.truth --all-scenes`` (docs/debugging.md)."""
 
@@ -15,7 +17,7 @@ import pytest
 
 from gnnpmb.registry import TRACKER_NAMES
 from tools.truth import __main__ as truth_main
-from tools.truth.__main__ import PRESETS, other_of, run_cell
+from tools.truth.__main__ import PRESETS, other_of, run_cell, run_scene
 
 DEVSET = Path(os.environ.get("GNNPMB_DEVSET", str(truth_main.DEVSET)))
 HAS_DEVSET = pytest.mark.skipif(not (DEVSET / "v1.0-mini").is_dir(), reason=f"no dev set at {DEVSET} (GNNPMB_DEVSET)")
@@ -50,3 +52,33 @@ def test_no_checkable_sentence_on_the_dev_set_is_false(scene: str, preset: str, 
 @pytest.mark.parametrize("scene", SCENES)
 def test_the_whole_dev_set_matrix_holds(scene: str, preset: str, tracker: str) -> None:
     _holds(scene, preset, tracker, other_of(tracker, "pmbm"))
+
+
+def _cv_results(scene_name: str, detections: Path, out: Path) -> Path:
+    """``examples/cv_tracker.py``'s tracker run on a dev-set scene's detection file, written as a submission."""
+    from examples.cv_tracker import ConstantVelocityTracker
+    from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
+    from gnnpmb.eval.submission import SUBMISSION_META, write_json
+    from gnnpmb.pipeline import get_detections
+
+    scene = load_scene(resolve_dataroot(DEVSET, "v1.0-mini", (scene_name,)), scene_name)
+    boxes = get_detections(scene, detections, "centerpoint", 0)
+    tracker, previous, results = ConstantVelocityTracker(), None, {}
+    for k in scene.keyframes:
+        dt_s = 0.0 if previous is None else (k.timestamp_us - previous) * 1e-6
+        previous = k.timestamp_us
+        results[k.sample_token] = tracker.step(k.sample_token, boxes[k.sample_token], dt_s)
+    write_json(out, {"meta": dict(SUBMISSION_META), "results": results})
+    return out
+
+
+@HAS_DEVSET
+def test_no_checkable_sentence_about_a_results_file_is_false(tmp_path: Path) -> None:
+    detections = DEVSET / "detections" / "pointpillars_mini_val.json"
+    cv = _cv_results("scene-0916", detections, tmp_path / "cv.json")
+    where: list = []
+    (tally, findings) = run_scene("scene-0916", "pointpillars", {"cv": None}, DEVSET, where=where, results={"cv": cv})[
+        "cv"
+    ]
+    assert findings > 0 and tally.checked["output"] > 0, "no placement was checked"
+    assert where == [], [f"{p}: [{c.kind}] {c.sentence} -- {c.truth}" for p, c in where[:5]]

@@ -360,3 +360,245 @@ def test_another_runs_false_track_and_an_empty_place_are_checked_where_the_false
     assert [c.kind for c in check_text(empty, at, None, ev, scene=_scene()).found] == ["detector"]  # GT A is there
     away = Context(C, 3, None, kind="false_track", track=12)
     assert check_text(empty, away, None, ev, scene=_scene()).found == []
+
+
+# The kinds the retired tools/oracle.py checked: the lost track's story, places, costs, hypotheses, #1141.
+def _frames(by_frame: dict[int, list]) -> RawEvents:
+    events: list = []
+    for x in sorted(by_frame):
+        events += [FrameStarted("t", x, f"token{x}", x * 500_000, 0.5), *by_frame[x]]
+    return RawEvents.of(events)
+
+
+def _posterior(track: int, existence: float):
+    from gnnpmb.events import Posterior
+
+    return Posterior(C, np.array([track]), np.zeros((1, 4)), np.eye(4)[None], np.array([existence]))
+
+
+def test_each_planted_statement_about_the_lost_track_is_caught() -> None:
+    from gnnpmb.events import Marginals, Pruned, PruneReason, TrackLogic, TrackLogicAction
+
+    marg = Marginals(
+        C,
+        np.array([[0.7, 0.2, 0.1]]),
+        axis_labels(AxisKind.TRACK, [7]),
+        axis_labels(AxisKind.MEASUREMENT, [0, 1]) + axis_labels(AxisKind.MISSED, [7]),
+        "exact",
+    )
+    raw = _frames(
+        {
+            1: [_posterior(7, 0.9)],
+            2: [_posterior(7, 0.95)],
+            3: [
+                _posterior(7, 0.4),
+                marg,
+                TrackLogic(C, 7, TrackLogicAction.DELETED, 1, 3),
+                Pruned(C, 7, PruneReason.LOW_EXISTENCE, 0.4),
+            ],
+        }
+    )
+    ev = _eval()
+    ev.submitted = {2: {"7"}, 3: {"5"}}
+    ctx = Context(C, 3, GT_A, lost=7)
+    pairs = [
+        (
+            "its existence went from 0.95 (frame 2) to 0.40 (frame 3)",
+            "its existence went from 0.90 (frame 1) to 0.40 (frame 3)",
+        ),  # frame 2 was higher: not the peak
+        ("its existence was 0.40 (frame 3)", "its existence was 0.90 (frame 3)"),
+        ("it was not output at frame 3", "it was not output at frames 2, 3"),
+        ("its track logic deleted it at frame 3 (1 of 3 hits)", "its track logic deleted it at frame 3 (2 of 3 hits)"),
+        (
+            "it was pruned at frame 3 (existence below pruning threshold)",
+            "it was pruned at frame 3 (over the component cap)",
+        ),
+        ("at frame 3 it used m0 (p 0.70), m1 (p 0.20)", "at frame 3 it used m1 (p 0.70), m0 (p 0.20)"),
+    ]
+    for true, false in pairs:
+        assert check_text(true, ctx, raw, ev).found == [], true
+        assert [c.kind for c in check_text(false, ctx, raw, ev).found] == ["tracker"], false
+
+
+def test_a_planted_cost_in_a_breakdown_or_a_choice_is_caught() -> None:
+    existence = np.array([0.1, 0.5, 0.9])
+    text = _because(existence, FREE)
+    assert "Track 5's " in text and _found(text, existence=existence, d2=FREE).found == [], text
+    total = text.split("Track 5's ", 1)[1].split(" ", 1)[0]
+    planted = text.replace(f"Track 5's {total}", f"Track 5's {float(total) + 1:.2f}")
+    assert "cost" in [c.kind for c in _found(planted, existence=existence, d2=FREE).found], planted
+    d2 = text.split("(d² ", 1)[1].split(")", 1)[0]
+    planted = text.replace(f"(d² {d2})", f"(d² {float(d2) + 1:.1f})", 1)
+    assert "cost" in [c.kind for c in _found(planted, existence=existence, d2=FREE).found], planted
+    _, m, a = _world(None, FREE)
+    choice = next(ch for c in explain(m, a).conflicts for ch in c.choices if ch.meas.ref == 0)
+    true = "then, " + choice_text(3, choice, int(choice.chosen.ref), False).replace("**", "")
+    assert not [c for c in _found(true, d2=FREE).found if c.kind == "cost"], true
+    cost = true.split("(cost ", 1)[1].split(")", 1)[0]
+    planted = true.replace(f"(cost {cost})", f"(cost {float(cost) - 1:.2f})")
+    assert "cost" in [c.kind for c in _found(planted, d2=FREE).found], planted
+
+
+def test_a_planted_hypothesis_switch_or_holding_frame_is_caught() -> None:
+    from gnnpmb.events import GlobalHypotheses
+
+    def hyp(weights: list[float], members):
+        return GlobalHypotheses(
+            C,
+            np.log(weights),
+            members,
+            tuple((0,) * len(m) for m in members),
+            tuple((0.9,) * len(m) for m in members),
+            (0,) * len(weights),
+        )
+
+    raw = _frames(
+        {
+            1: [hyp([1.0], ((5,),))],
+            2: [hyp([0.6, 0.4], ((5,), (5, 7)))],
+            3: [Assignment(C, (), 0.0, (), hypothesis=1), hyp([1.0], ((5, 7),))],
+        }
+    )
+    ctx = Context(C, 3, GT_A, lost=5)
+    head = "at frame 3 the best hypothesis switched: it descends from prior hypothesis 1 (probability {} after frame "
+    head += "2, against 0.60 for the best), not from a cost choice within the best (track 7: held by a kept "
+    head += "hypothesis since frame {})"
+    assert check_text(head.format("0.40", 2), ctx, raw, _eval()).found == []
+    for p, since in (("0.30", 2), ("0.40", 3)):
+        found = check_text(head.format(p, since), ctx, raw, _eval()).found
+        assert [c.kind for c in found] == ["hypothesis"], (p, since)
+
+
+def test_a_planted_place_of_a_false_box_is_caught() -> None:
+    ev = _eval()
+    ev.boxes[3] = [("11", C, (0.5, 0.0)), ("12", "truck", (0.5, 0.0))]
+    car, truck = (
+        Context(C, 3, None, kind="false_track", track=11),
+        Context("truck", 3, None, kind="false_track", track=12),
+    )
+    assert check_text("car GT aaaaaa lies 0.5 m away", car, None, ev, scene=_scene()).found == []
+    for false in ("car GT aaaaaa lies 1.5 m away", "car GT bbbbbb lies 29.5 m away"):  # the nearest is GT A
+        assert [c.kind for c in check_text(false, car, None, ev, scene=_scene()).found] == ["detector"], false
+    fair = "no truck GT lies within 2 m, but GT car aaaaaa does (0.5 m): the detector gave it the wrong class"
+    assert check_text(fair, truck, None, ev, scene=_scene()).found == []
+    planted = "no car GT lies within 2 m, but GT car aaaaaa does (0.5 m): the detector gave it the wrong class"
+    assert [c.kind for c in check_text(planted, car, None, ev, scene=_scene()).found] == ["detector"]
+
+
+def test_a_planted_issue_1141_note_is_caught() -> None:
+    """GT A annotated at x = 0, 4, 10 m at frames 1-3 (0.5, 1.0, 1.6 s); the devkit kept frames 1 and 3 and
+    interpolated frame 2 with the ends swapped (x 5.45): weighted the right way, x 4.55, 0.5 m from the
+    annotation."""
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (x, 0.0), 9)} for x in (0.0, 0.0, 4.0, 10.0)])
+    ev = _eval()
+    ev.kept_gt = {(0, GT_A), (1, GT_A), (3, GT_A)}
+    ev.stamps = {0: 0, 1: 500_000, 2: 1_000_000, 3: 1_600_000}
+    ev.evaluated_gt[(2, GT_A)] = (10.0 * 6 / 11, 0.0)
+    ctx = Context(C, 2, GT_A)
+    note = "from frames {} and 3, weighting the two ends the wrong way round (nuscenes-devkit issue #1141): weighted "
+    note += "the right way the box would lie {} m from the annotation"
+    assert check_text(note.format(1, "0.5"), ctx, None, ev, scene=scene).found == []
+    for left, d in ((0, "0.5"), (1, "1.5")):
+        found = check_text(note.format(left, d), ctx, None, ev, scene=scene).found
+        assert [c.kind for c in found] == ["evaluation"], (left, d)
+
+
+def test_a_placeholder_or_an_unknown_cause_is_caught() -> None:
+    assert [c.kind for c in _found("at frame 3 m? → track 7").found] == ["misleading"]
+    assert [c.kind for c in _found("Why (gnn, cause unknown): track 7 was not output").found] == ["misleading"]
+
+
+def test_a_planted_placement_of_a_results_files_box_is_caught() -> None:
+    """A results file (no events): track 11's box repeats m0's size, rotation and height at frame 3; track 12's
+    lies 0.2 m from m0 with another size."""
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    box = (1.8, 4.5, 1.6, 1.0, 0.0, 0.0, 0.0, 0.9)
+    scene = SceneTruth([[Detection(C, 0.9, (0.3, 0.0), box)]] * 4, [{GT_A: Annotation(C, (0.0, 0.0), 9)}] * 4)
+    ev = _eval()
+    ev.boxes[3] = [("11", C, (0.3, 0.0)), ("12", C, (0.5, 0.0))]
+    ev.geometry = {(3, "11"): box, (3, "12"): (2.0, 4.5, 1.6, 1.0, 0.0, 0.0, 0.0, 0.9)}
+    ev.submitted = {2: {"12"}, 3: {"11", "12"}}
+    ctx = Context(C, 3, GT_A)
+    on = "at frame 3 track 11 (car) was output on detection m0 (car, score 0.90; its box carries m0's size, heading "
+    on += "and height)"
+    near = "at frame 3 track 12 (car) was output on detection m0 (car, score 0.90; m0 is the nearest car detection, "
+    near += "0.20 m from its box (none carries its size, heading and height))"
+    for true, false in (
+        (on, on.replace("track 11", "track 12")),
+        (near, near.replace("0.20 m", "0.30 m")),
+        (
+            "at frame 3 m0 (score 0.90, 0.3 m from it) lay under track 11's box",
+            "at frame 3 m0 (score 0.90, 0.3 m from it) lay under no output box",
+        ),
+        ("track 11 was first output at frame 3", "track 12 was first output at frame 3"),
+    ):
+        assert check_text(true, ctx, None, ev, scene=scene).found == [], true
+        assert [c.kind for c in check_text(false, ctx, None, ev, scene=scene).found] == ["output"], false
+
+
+def test_a_planted_gate_distance_or_averaged_score_is_caught() -> None:
+    from gnnpmb.events import Gated
+
+    d2 = np.array([[3.14, 50.0]])
+    gated = Gated(C, np.array([7]), np.array([0, 1]), d2 < 16.0, np.zeros((1, 2)), np.eye(2)[None], 16.0, d2)
+    raw = _raw_with(gated)
+    ctx = Context(C, 3, GT_A, lost=7)
+    gate = "at frame 3 m{} (score 0.90, 0.3 m from it, in track 7's gate at NIS {}) → track 5"
+    assert check_text(gate.format(0, "3.1"), ctx, raw, _eval()).found == []
+    for meas, nis in ((0, "4.1"), (1, "50.0")):  # another d²; a detection outside the gate
+        assert [c.kind for c in check_text(gate.format(meas, nis), ctx, raw, _eval()).found] == ["tracker"]
+    ev = _eval()
+    ev.averaged, ev.submitted = {"5": (2, 0.4)}, {1: {"5"}, 2: {"5"}, 3: {"5"}}
+    said = "track 5 was output on it, but its score averaged over {}, {}, is below the car threshold 0.500"
+    kept = "the 2 of its 3 frames the evaluation kept (within the class range)"
+    assert check_text(said.format(kept, "0.400"), CTX, None, ev).found == []
+    for over, score in ((kept, "0.410"), ("its 3 frames", "0.400")):
+        assert [c.kind for c in check_text(said.format(over, score), CTX, None, ev).found] == ["matched"]
+
+
+def test_an_existence_said_held_over_frames_it_dipped_in_is_caught() -> None:
+    """pmbm on dev-set scene-0916 megvii said 'its existence was 1.00 (frames 10–18)' of a track at 0.15 at frame 15;
+    a deletion by maximum age and a merge recorded as ``Pruned`` events hold."""
+    from gnnpmb.events import Pruned, PruneReason
+
+    raw = _frames({1: [_posterior(7, 1.0)], 2: [_posterior(7, 0.15)], 3: [_posterior(7, 1.0)]})
+    ctx = Context(C, 3, GT_A, lost=7)
+    assert check_text("its existence was 1.00 (frame 3)", ctx, raw, _eval()).found == []
+    assert [c.kind for c in check_text("its existence was 1.00 (frames 1–3)", ctx, raw, _eval()).found] == ["tracker"]
+    ended = _raw_with(Pruned(C, 7, PruneReason.TRACK_LOGIC, 1.0), Pruned(C, 8, PruneReason.MERGED, 0.2))
+    assert check_text("its track logic deleted it at frame 3", ctx, ended, _eval()).found == []
+    merged = Context(C, 3, GT_A, lost=8)
+    assert check_text("it was merged into another component at frame 3", merged, ended, _eval()).found == []
+    assert check_text("it was merged into another component at frame 3", ctx, ended, _eval()).found != []
+
+
+def test_a_planted_interpolation_or_unshown_existence_is_caught() -> None:
+    ev = _eval()
+    ev.kept_gt = {(1, GT_A), (4, GT_A)}
+    ev.submitted = {1: {"11"}, 2: set(), 3: {"11"}}
+    ev.pred_xy[(C, 2)] = {"11": (0.0, 0.0)}
+    ev.track_to_gt[(C, 2)] = {"11": None}
+    at2 = Context(C, 2, GT_A)
+    assert check_text("the evaluation scored it at a box; from frames 1 and 4.", at2, None, ev).found == []
+    assert [c.kind for c in check_text("a box; from frames 0 and 4.", at2, None, ev).found] == ["evaluation"]
+    said = "at frame 2 track 11 (car) was not output: the evaluation interpolated it between its boxes at frames {} "
+    said += "and 3, and that box matched no object"
+    assert check_text(said.format(1), at2, None, ev).found == []
+    assert [c.kind for c in check_text(said.format(0), at2, None, ev).found] == ["evaluation"]
+    raw = _frames({1: [_posterior(11, 0.3)], 3: [_posterior(11, 0.6)]})
+    stayed = "track 11's existence stayed below 0.5 (the views draw tracks from 0.5 up), yet the evaluation counted it"
+    found = check_text(stayed, Context(C, 3, GT_A, lost=11), raw, ev).found
+    assert [c.kind for c in found] == ["tracker"]  # 0.6 at frame 3, where it was output
+
+
+def test_a_coalesced_object_said_to_have_no_detection_of_its_own_is_checked() -> None:
+    said = "the detector gave GT {} no detection of its own within 2 m ({} LiDAR and radar points)"
+    at2 = Context(C, 2, GT_A)
+    assert check_text(said.format("bbbbbb", 0), at2, None, _eval(), scene=_scene()).found == []
+    for gt, points in (("aaaaaa", 12), ("bbbbbb", 5)):  # m0 lies 0.3 m from GT A; GT B has no points
+        assert [c.kind for c in check_text(said.format(gt, points), at2, None, _eval(), scene=_scene()).found] == [
+            "detector"
+        ]

@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import sys
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
@@ -45,6 +45,22 @@ def run_cell(
     where: gets ("tracker scene preset failure-id", contradiction) for each contradiction; other: a second tracker
     run on the same detections, whose outcome the findings state ("pmbm on the same detections ...") and which is
     checked against its own devkit bookkeeping."""
+    return run_scene(scene, preset, {tracker: other}, dataroot, version, where)[tracker]
+
+
+def run_scene(
+    scene: str,
+    preset: str,
+    trackers: Mapping[str, str | None],
+    dataroot: Path = DEVSET,
+    version: str = "v1.0-mini",
+    where: list[tuple[str, Contradiction]] | None = None,
+    results: Mapping[str, Path] | None = None,
+) -> dict[str, tuple[Tally, int]]:
+    """``run_cell`` for several trackers on one scene and preset (tracker -> the run its findings compare with, or
+    None), each tracker run and evaluated once: the cells of a row of the matrix share their other run. results:
+    name -> a results file of a tracker outside the project, made on the same detections (its findings checked
+    against the file: it has no events); a name of ``trackers`` may be one of them."""
     where = [] if where is None else where
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.submission import run_results
@@ -61,37 +77,59 @@ def run_cell(
     from tools.truth.scene import SceneTruth
 
     detections = dataroot / "detections" / f"{preset}_{split_of_scene(scene)}.json"
-    names = [tracker] + ([other] if other is not None and other != tracker else [])
-    request = load_inputs(check_request(scene, names, dataroot=dataroot, version=version, detections_file=detections))
-    runs = run_all(request, record=True)
-    reports, _ = find_reports(request, runs)
-    evidence = [evidence_of(request, reports[n], r) for n, r in zip(request.trackers, runs, strict=True)]
-    raw = RawEvents.of(list(runs[0].events))
-    nusc = open_nuscenes(request.location)
-    ev = eval_facts(nusc, scene, run_results(runs[0].tracking))
-    others = {n: eval_facts(nusc, scene, run_results(r.tracking)) for n, r in zip(names[1:], runs[1:], strict=True)}
-    truth = SceneTruth.read(nusc, scene, detections)
-    tally = Tally()
-    report = reports[request.trackers[0]]
-    for fid, failure in zip(report.ids(), report.failures, strict=True):
-        start = max(request.frame_range.start, failure.frame_index - FRAMES_BEFORE)
-        f = explain_failure(fid, evidence[0], request.scene, evidence[1:], first_frame=start)
-        text = "\n".join(plain(line) for line in why_lines(f))
-        ctx = Context(
-            f.class_name,
-            f.frame,
-            f.gt_id,
-            tuple(f.covered),
-            f.taker.false_frames if f.taker is not None else (),
-            f.taker.track_id if f.taker is not None else None,
-            f.kind.value,
-            f.lost.track_id if f.lost is not None else None,
-            f.false_output.track_id if f.false_output is not None else None,
+    results = dict(results or {})
+    names = list(dict.fromkeys([*trackers, *(o for o in trackers.values() if o is not None)]))
+    files = [f"{n}={p}" for n, p in results.items() if n in names]
+    request = load_inputs(
+        check_request(
+            scene,
+            [n for n in names if n not in results],
+            results=files,
+            dataroot=dataroot,
+            version=version,
+            detections_file=detections,
         )
-        one = check_text(text, ctx, raw, ev, tracker, truth, others)
-        tally.add(one)
-        where.extend((f"{tracker} {scene} {preset} {fid}", c) for c in one.found)
-    return tally, len(report.failures)
+    )
+    runs = dict(zip(request.trackers, run_all(request, record=True), strict=True))
+    reports, _ = find_reports(request, list(runs.values()))
+    evidence = {n: evidence_of(request, reports[n], r) for n, r in runs.items()}
+    nusc = open_nuscenes(request.location)
+    facts: dict[str, object] = {}
+
+    def ev_of(name: str):
+        if name not in facts:
+            facts[name] = eval_facts(nusc, scene, run_results(runs[name].tracking))
+        return facts[name]
+
+    truth = SceneTruth.read(nusc, scene, detections)
+    out = {}
+    for tracker, other in trackers.items():
+        rest = [other] if other is not None and other != tracker else []
+        raw = None if tracker in results else RawEvents.of(list(runs[tracker].events))
+        ev = ev_of(tracker)
+        others = {n: ev_of(n) for n in rest}
+        tally = Tally()
+        report = reports[tracker]
+        for fid, failure in zip(report.ids(), report.failures, strict=True):
+            start = max(request.frame_range.start, failure.frame_index - FRAMES_BEFORE)
+            f = explain_failure(fid, evidence[tracker], request.scene, [evidence[n] for n in rest], first_frame=start)
+            text = "\n".join(plain(line) for line in why_lines(f))
+            ctx = Context(
+                f.class_name,
+                f.frame,
+                f.gt_id,
+                tuple(f.covered),
+                f.taker.false_frames if f.taker is not None else (),
+                f.taker.track_id if f.taker is not None else None,
+                f.kind.value,
+                f.lost.track_id if f.lost is not None else None,
+                f.false_output.track_id if f.false_output is not None else None,
+            )
+            one = check_text(text, ctx, raw, ev, tracker, truth, others)
+            tally.add(one)
+            where.extend((f"{tracker} {scene} {preset} {fid}", c) for c in one.found)
+        out[tracker] = (tally, len(report.failures))
+    return out
 
 
 def other_of(tracker: str, other: str) -> str:
@@ -120,25 +158,40 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--dataroot", type=Path, default=DEVSET)
     parser.add_argument("--other", default="pmbm", help="the run findings compare with ('none': no other run)")
     parser.add_argument("--square", action="store_true", help="each tracker once over the scenes and presets")
+    parser.add_argument(
+        "--results",
+        action="append",
+        default=[],
+        metavar="NAME=FILE.json",
+        help="check a results file's findings (made on the preset's detections) instead of the trackers'",
+    )
     args = parser.parse_args(argv)
     per: dict[str, Tally] = defaultdict(Tally)
     findings: dict[str, int] = defaultdict(int)
     where: list[tuple[str, Contradiction]] = []
     scenes = MINI_VAL + MINI_TRAIN if args.all_scenes else (args.scene or MINI_VAL)
-    todo = cells(scenes, args.detector or PRESETS, args.tracker or TRACKER_NAMES, args.square)
+    files = {spec.split("=", 1)[0]: Path(spec.split("=", 1)[1]) for spec in args.results}
+    todo = cells(scenes, args.detector or PRESETS, args.tracker or ([] if files else TRACKER_NAMES), args.square)
+    todo += [(s, p, name) for s in scenes for p in args.detector or PRESETS for name in files]
+    rows: dict[tuple[str, str], dict[str, str | None]] = defaultdict(dict)
     for scene, preset, tracker in todo:
-        other = None if args.other == "none" else other_of(tracker, args.other)
-        tally, n = run_cell(tracker, scene, preset, args.dataroot, where=where, other=other)
-        per[tracker].add(tally)
-        findings[tracker] += n
-        line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)
-        print(
-            f"checked {tracker} {scene} {preset}: {n} findings; false/checked {line}; replays "
-            f"{tally.replays} refuted {tally.refuted}; clauses {tally.clauses - sum(tally.unchecked.values())}/"
-            f"{tally.clauses} read",
-            file=sys.stderr,
-            flush=True,
-        )
+        rows[(scene, preset)][tracker] = None if args.other == "none" else other_of(tracker, args.other)
+    for (scene, preset), row in rows.items():
+        here: list[tuple[str, Contradiction]] = []
+        for tracker, (tally, n) in run_scene(scene, preset, row, args.dataroot, where=here, results=files).items():
+            per[tracker].add(tally)
+            findings[tracker] += n
+            line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)
+            print(
+                f"checked {tracker} {scene} {preset}: {n} findings; false/checked {line}; replays "
+                f"{tally.replays} refuted {tally.refuted}; clauses {tally.clauses - sum(tally.unchecked.values())}/"
+                f"{tally.clauses} read",
+                file=sys.stderr,
+                flush=True,
+            )
+        for place, c in here:
+            print(f"  {place}: [{c.kind}] {c.sentence!r} -- {c.truth}", file=sys.stderr, flush=True)
+        where += here
     head = " ".join(f"{k:>14}" for k in CLASSES)
     print(f"{'tracker':12} {'findings':>8} {head} {'replays':>8} {'refuted':>8}")
     total = Tally()

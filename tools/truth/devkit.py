@@ -42,6 +42,14 @@ class EvalFacts:
     pred_xy: dict[tuple[str, int], dict[str, tuple[float, float]]] = field(default_factory=dict)
     """(class, frame) -> the centre of each track box the accumulator scored there (interpolations included)."""
     scores: dict[tuple[int, str], float] = field(default_factory=dict)
+    geometry: dict[tuple[int, str], tuple[float, ...]] = field(default_factory=dict)
+    """(frame, track id) -> the submission box's size, rotation and centre height (``scene.Detection.box``)."""
+    averaged: dict[str, tuple[int, float]] = field(default_factory=dict)
+    """track id -> (frames the devkit's filters kept its box, the score ``create_tracks`` averaged over them)."""
+    kept_gt: set[tuple[int, str]] = field(default_factory=set)
+    """(frame, object id) of each annotated box the devkit's filters kept (the ends its interpolation joins)."""
+    stamps: dict[int, int] = field(default_factory=dict)
+    """frame -> its sample's timestamp (µs), the time the devkit interpolates over."""
     """(frame, track id) -> the submission box's tracking score."""
     """(class, frame) -> the object ids of the frame's SWITCH events."""
 
@@ -91,10 +99,13 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
         pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in tokens}, TrackingBox)
         gt = filter_eval_boxes(nusc, add_center_dist(nusc, gt), cfg.class_range, verbose=False)
+        kept_gt = [(t, str(b.tracking_id)) for t in tokens for b in gt[t]]  # create_tracks adds its interpolations
         pred = filter_eval_boxes(nusc, add_center_dist(nusc, pred), cfg.class_range, verbose=False)
+        kept_pred = [str(b.tracking_id) for t in tokens for b in pred[t]]
         tracks_gt = create_tracks(gt, nusc, split, gt=True)
         tracks_pred = create_tracks(pred, nusc, split, gt=False)
     out = EvalFacts()
+    out.kept_gt = {(frame_of_stamp[nusc.get("sample", t)["timestamp"]], g) for t, g in kept_gt}
     for token in tokens:
         frame = frame_of_stamp[nusc.get("sample", token)["timestamp"]]
         out.boxes[frame] = [
@@ -102,9 +113,14 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
             for b in results.get(token, [])
         ]
         out.submitted[frame] = {b[0] for b in out.boxes[frame]}
-        out.scores.update({(frame, str(b["tracking_id"])): float(b["tracking_score"]) for b in results.get(token, [])})
+        out.stamps[frame] = int(nusc.get("sample", token)["timestamp"])
+        for b in results.get(token, []):
+            out.scores[(frame, str(b["tracking_id"]))] = float(b["tracking_score"])
+            out.geometry[(frame, str(b["tracking_id"]))] = (*b["size"], *b["rotation"], b["translation"][2])
     scene_gt = tracks_gt[scene["token"]]
     scene_pred = tracks_pred[scene["token"]]
+    average = {str(b.tracking_id): float(b.tracking_score) for boxes in scene_pred.values() for b in boxes}
+    out.averaged = {t: (kept_pred.count(t), average[t]) for t in set(kept_pred) if t in average}
     for stamp, boxes in scene_gt.items():
         for b in boxes:
             out.evaluated_gt[(frame_of_stamp[stamp], str(b.tracking_id))] = (

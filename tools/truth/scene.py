@@ -24,6 +24,8 @@ class Detection:
     class_name: str
     score: float
     xy_m: tuple[float, float]
+    box: tuple[float, ...] = ()
+    """Size (w, l, h, m), rotation (w, x, y, z) and centre height (m): what a box that carries it repeats."""
 
 
 @dataclass(frozen=True)
@@ -56,7 +58,12 @@ class SceneTruth:
             ego.append((float(pose["translation"][0]), float(pose["translation"][1])))
             detections.append(
                 [
-                    Detection(b["detection_name"], float(b["detection_score"]), tuple(map(float, b["translation"][:2])))
+                    Detection(
+                        b["detection_name"],
+                        float(b["detection_score"]),
+                        tuple(map(float, b["translation"][:2])),
+                        tuple(map(float, [*b["size"], *b["rotation"], b["translation"][2]])),
+                    )
                     for b in results.get(token, [])
                     if b["detection_name"] in TRACKING
                 ]

@@ -28,12 +28,25 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from gnnpmb.events import AxisKind, Born
-from tools.truth import detector, otherruns, replay, shares
+from tools.truth import costs, detector, hypotheses, lost, otherruns, output, place, replay, shares
 from tools.truth.devkit import EvalFacts
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import SceneTruth
 
-CLASSES = ("matched", "gone", "counterfactual", "misleading", "detector", "other run", "share", "output")
+CLASSES = (
+    "matched",
+    "gone",
+    "counterfactual",
+    "misleading",
+    "detector",
+    "other run",
+    "share",
+    "output",
+    "tracker",
+    "cost",
+    "hypothesis",
+    "evaluation",
+)
 
 
 @dataclass(frozen=True)
@@ -158,13 +171,23 @@ def check_text(
     if scene is not None:
         detector.check_detector(text, ctx.gt_id, ctx.frame, c, scene, raw, out, bad, ev.evaluated_gt)
     otherruns.check_others(text, ctx.kind, c, ctx.frame, ctx.gt_id, others or {}, scene, out, bad)
-    place = _place(ctx, ev, scene)
-    otherruns.check_other_false_tracks(text, c, ctx.frame, place, others or {}, out, bad)
-    if scene is not None and ctx.gt_id is None and place is not None:
+    where = _place(ctx, ev, scene)
+    otherruns.check_other_false_tracks(text, c, ctx.frame, where, others or {}, out, bad)
+    if ctx.gt_id is None:
+        place.check_place(text, c, ctx.frame, where, scene, out, bad)
+    place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)
+    place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
+    place.check_none_of_its_own(text, ctx.frame, scene, out, bad)
+    out.checked["misleading"] += 2
+    if "?" in text:
+        bad("misleading", text[max(0, text.index("?") - 60) : text.index("?") + 1], "a placeholder in the text")
+    if "cause unknown" in text:
+        bad("misleading", "cause unknown", "no stated test held")
+    if scene is not None and ctx.gt_id is None and where is not None:
         for m in NOTHING_NEAR.finditer(text):
             out.checked["detector"] += 1
             here = scene.objects[ctx.frame] if ctx.frame < len(scene.objects) else {}
-            near = [k[:6] for k, a in here.items() if math.hypot(a.xy_m[0] - place[0], a.xy_m[1] - place[1]) < 2.0]
+            near = [k[:6] for k, a in here.items() if math.hypot(a.xy_m[0] - where[0], a.xy_m[1] - where[1]) < 2.0]
             if near:
                 bad("detector", m[0], f"annotated objects within 2 m of track {ctx.track}'s box: {near}")
     for phrase in VIEWER_ONLY:
@@ -196,7 +219,10 @@ def check_text(
         out.checked["misleading"] += 1
         if t not in ev.submitted.get(x, set()):
             bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
-    if raw is None:
+    lost.check_not_output(text, ctx.lost, ev, out, bad)
+    lost.check_averaged(text, ctx.track, ev, out, bad)
+    if raw is None:  # a results file: where its boxes sit
+        output.check_output(text, c, ctx.lost, scene, ev, out, bad)
         return out
     started = [(int(m[2]), int(m[1]), int(m[3]), m[0]) for m in STARTED.finditer(text)]
     started += [(int(m[1]), int(m[3]), int(m[2]), m[0]) for m in STARTED_NEW.finditer(text)]
@@ -235,11 +261,16 @@ def check_text(
     for m in CHOICE.finditer(text):
         _check_choice(m, c, raw, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
+    lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
+    lost.check_gates(text, c, raw, out, bad)
+    lost.check_stayed_below(text, c, raw, ev, out, bad)
+    costs.check_costs(text, c, raw, scene, out, bad)
+    hypotheses.check_hypotheses(text, c, raw, out, bad)
     return out
 
 
 def _patterns() -> list[re.Pattern]:
-    mods = (detector, otherruns, shares)
+    mods = (detector, otherruns, shares, lost, place, costs, hypotheses, output)
     here = [v for v in globals().values() if isinstance(v, re.Pattern) and v is not BECAUSE]
     return here + [v for mod in mods for v in vars(mod).values() if isinstance(v, re.Pattern)]
 

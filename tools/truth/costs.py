@@ -1,0 +1,118 @@
+"""Costs as printed, checked against the deciding cost matrix of the frame (the one its assignment indexes) and
+the detection file.
+
+* a breakdown, "Track T's C = a for … + b for its predicted existence E + c for … (±S m) + d for the distance to
+  mN (d² D) + e for mN's score S'" (also "Track T, which had the object, would have cost C = …"): C is the
+  matrix's entry (mN, track T); the parts add up to C (as printed); E is the matrix's predicted existence of T
+  (its ``CostTerms``), D its d²[T, mN], S' the detection file's score of mN;
+* a choice, "frame x: mN (score S) → track T (cost C) over track U (C' at existence E, ±S m, d² D)": C is the
+  entry of the column the assignment gave mN, C' the entry (mN, U), E and D U's terms, S the file's score.
+
+Printed values are compared as printed: two decimals for costs, existences and scores, one for d².
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from tools.truth import replay
+
+_N = r"-?\d+\.\d+"
+_E = r"\d+(?:\.\d+)?(?:e-?\d+)?"
+BECAUSE = re.compile(r"Because \(frame (\d+)[^)]*\): ([^\n]*)")
+BREAKDOWN = re.compile(
+    rf"Track (\d+)(?:'s|, which had the object, would have cost) ({_N}) = ({_N} for .+?)(?=\. [A-Z]|\.$|$)"
+)
+PART = re.compile(rf"({_N}) for ")
+EXISTENCE = re.compile(rf"for its predicted existence ({_E})")
+DISTANCE = re.compile(rf"for the distance to m(\d+) \(d² ({_N})\)")
+SCORE = re.compile(rf"for m(\d+)'s score ({_N})")
+CHOICE = re.compile(
+    rf"frame (\d+): m(\d+)(?: \(score ({_N})\))? → (?:new track \d+|track \d+|new|missed \d+) \(cost ({_N})\) "
+    rf"over track (\d+) \(({_N})(?: at (?:existence ({_E}), )?±[\d.]+ m, d² ({_N}))?\)"
+)
+
+
+def _printed(v: float) -> str:
+    return f"{v:.2f}" if v >= 0.01 or v == 0 else f"{v:.1g}"
+
+
+def check_costs(text: str, c: str, raw, scene, out, bad) -> None:
+    for b in BECAUSE.finditer(text):
+        x = int(b[1])
+        for m in BREAKDOWN.finditer(b[2]):
+            _check_breakdown(m, x, c, raw, scene, out, bad)
+    for m in CHOICE.finditer(text):
+        _check_choice_costs(m, c, raw, scene, out, bad)
+
+
+def _terms_of(mat, row: int, t: int) -> tuple[float | None, float | None]:
+    """(predicted existence, d²) of track ``t`` for the matrix's ``row`` (None: its terms do not say)."""
+    terms = mat.terms
+    k = terms.column_of(t) if terms is not None else None
+    if k is None:
+        return None, None
+    existence = None if terms.existence is None else float(terms.existence[k])
+    return existence, float(terms.d2[k, row])
+
+
+def _check_breakdown(m: re.Match, x: int, c: str, raw, scene, out, bad) -> None:
+    t, total, parts = int(m[1]), m[2], m[3]
+    dist = DISTANCE.search(parts)
+    found = raw.deciding(x, c)
+    if dist is None or found is None:
+        return
+    meas = int(dist[1])
+    mat, _ = found
+    row, col = replay.row_of(mat, meas), replay.track_col(mat, t)
+    out.checked["cost"] += 1
+    if row is None or col is None:
+        bad("cost", m[0], f"the deciding matrix of frame {x} has no entry (m{meas}, track {t})")
+        return
+    entry = float(mat.cost[row, col])
+    summed = sum(float(v) for v in PART.findall(parts))
+    existence, d2 = _terms_of(mat, row, t)
+    wrong = []
+    if not math.isfinite(entry) or f"{entry:.2f}" != total:
+        wrong.append(f"the matrix's entry is {entry:.4f}")
+    if abs(summed - float(total)) > 0.005 + 1e-9:
+        wrong.append(f"the parts add up to {summed:.2f}")
+    e = EXISTENCE.search(parts)
+    if e is not None and (existence is None or _printed(existence) != e[1]):
+        wrong.append(f"its predicted existence is {existence}")
+    if d2 is not None and f"{d2:.1f}" != dist[2]:
+        wrong.append(f"its d² is {d2:.3f}")
+    s = SCORE.search(parts)
+    if s is not None and scene is not None and f"{scene.detections[x][int(s[1])].score:.2f}" != s[2]:
+        wrong.append(f"m{s[1]}'s score is {scene.detections[x][int(s[1])].score}")
+    if wrong:
+        bad("cost", m[0][:160], "; ".join(wrong))
+
+
+def _check_choice_costs(m: re.Match, c: str, raw, scene, out, bad) -> None:
+    x, meas, alt = int(m[1]), int(m[2]), int(m[5])
+    found = raw.deciding(x, c)
+    if found is None:
+        return
+    mat, a = found
+    row, chosen, other = replay.row_of(mat, meas), replay.chosen_col(mat, a, meas), replay.track_col(mat, alt)
+    if row is None or chosen is None:
+        return
+    out.checked["cost"] += 1
+    wrong = []
+    if f"{float(mat.cost[row, chosen]):.2f}" != m[4]:
+        wrong.append(f"the chosen entry is {float(mat.cost[row, chosen]):.4f}")
+    if other is None or f"{float(mat.cost[row, other]):.2f}" != m[6]:
+        wrong.append(f"track {alt}'s entry is {None if other is None else float(mat.cost[row, other])}")
+    elif m[8] is not None:
+        existence, d2 = _terms_of(mat, row, alt)
+        if m[7] is not None and (existence is None or _printed(existence) != m[7]):
+            wrong.append(f"track {alt}'s predicted existence is {existence}")
+        if d2 is None or f"{d2:.1f}" != m[8]:
+            wrong.append(f"track {alt}'s d² is {d2}")
+    dets = scene.detections[x] if scene is not None and x < len(scene.detections) else []
+    if m[3] is not None and meas < len(dets) and f"{dets[meas].score:.2f}" != m[3]:
+        wrong.append(f"m{meas}'s score is {dets[meas].score}")
+    if wrong:
+        bad("cost", m[0], "; ".join(wrong))

@@ -1,0 +1,228 @@
+"""What the Why says the lost track did, checked against its raw events and the submission.
+
+* "its existence went from A (frame x) to B (frame y)" / "its existence was A (frame x)" (a PHD's "weight"): the
+  track's existence in the ``Posterior`` event of each named frame (rounded as printed), and no ``Posterior`` of
+  the frames between above A (A is the highest);
+* "it was not output at frames …": the submission has no box of the track at any of them;
+* "its track logic deleted it at frame x (h of w hits)": a delete ``TrackLogic`` event of x names it, with those
+  hits (without hits: a track-logic ``Pruned`` event, greedy's maximum age, also does); "it was pruned at frame x
+  (reason)": a ``Pruned`` event of x with that reason; "it was merged into another component at frame x": a
+  ``Merged`` event of x names it among the absorbed, or a ``Pruned`` one removes it as merged; "and it ended at
+  frame x": one of the three;
+* "at frame x it used mN (p P), mK (p Q) +n more": the track's row of the frame's ``Marginals`` (association
+  probabilities): the detections with a share of at least 1 %, most likely first, with those probabilities;
+  "was given mN": the frame's ``Assignment`` pairs mN with the track.
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from gnnpmb.events import (
+    Assignment,
+    AxisKind,
+    Gated,
+    Marginals,
+    Merged,
+    Posterior,
+    Pruned,
+    PruneReason,
+    TrackLogic,
+    TrackLogicAction,
+)
+
+_V = r"\d+(?:\.\d+)?(?:e-?\d+)?"
+WENT_FROM = re.compile(rf"its (existence|weight) went from ({_V}) \(frame (\d+)\) to ({_V}) \(frame (\d+)\)")
+WAS = re.compile(rf"its (existence|weight) was ({_V}) \(frames? (\d+)(?:–(\d+))?\)")
+NOT_OUTPUT = re.compile(r"it was not output at (frames? [\d–, ]*\d)")
+DELETED = re.compile(
+    r"its track logic deleted it at frame (\d+)(?: \((?:(\d+) of (\d+) hits|no hit in its last (\d+) frames)\))?"
+)
+PRUNED = re.compile(r"it was pruned at frame (\d+) \(([^)]+)\)")
+MERGED = re.compile(r"it was merged into another component at frame (\d+)")
+ENDED = re.compile(
+    r"track (\d+) could not take it: its column's cost for it was infinite \([^)]*\), and it ended at frame (\d+)"
+)
+USED = re.compile(
+    rf"at frame (\d+) it (used|was given) (m\d+(?: \(p {_V}\))?(?:, m\d+(?: \(p {_V}\))?)?)(?: \+(\d+) more)?"
+)
+GATE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it, in track (\d+)'s gate at NIS (\d+\.\d)\)")
+STAYED = re.compile(r"track (\d+)'s existence stayed below (\d+(?:\.\d+)?) \(the views draw tracks from")
+AVERAGED = re.compile(
+    r"(?:track (\d+)[^;:]*?|the evaluation counted the track: |track (\d+)'s existence stayed below [^;]*?counted it: )"
+    r"its score averaged over (?:its (\d+) frames?|the (\d+) "
+    r"of its (\d+) frames the evaluation kept \(within the class range\)), (\d+\.\d{3})"
+)
+USED_SHARE = 0.01
+"""The checker's own copy of the share from which an update is said to have used a detection."""
+
+
+def frames_of(text: str) -> list[int]:
+    """``frame 7``, ``frames 7, 13``, ``frames 12–14, 20`` -> the frames."""
+    out: list[int] = []
+    for part in text.split(" ", 1)[1].split(", "):
+        lo, _, hi = part.partition("–")
+        out += list(range(int(lo), int(hi or lo) + 1))
+    return out
+
+
+def printed(r: float) -> str:
+    """An existence as the text prints one: two decimals, one significant digit below 0.01."""
+    return f"{r:.2f}" if r >= 0.01 or r == 0 else f"{r:.1g}"
+
+
+def _existence(raw, x: int, c: str, track: int) -> float | None:
+    found = raw.of_kind(x, c, Posterior)
+    if not found:
+        return None
+    ids = np.asarray(found[-1].track_ids).tolist()
+    return float(np.asarray(found[-1].existence)[ids.index(track)]) if track in ids else None
+
+
+def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
+    """The lost track's story (module docstring); ``lost``: the track the Why follows (None: nothing checked)."""
+    if lost is None:
+        return
+    for m in WENT_FROM.finditer(text):
+        out.checked["tracker"] += 1
+        (hi, x), (lo, y) = (m[2], int(m[3])), (m[4], int(m[5]))
+        got = {f: _existence(raw, f, c, lost) for f in (x, y)}
+        if any(v is None for v in got.values()) or printed(got[x]) != hi or printed(got[y]) != lo:
+            bad("tracker", m[0], f"the Posterior events give track {lost} {got}")
+            continue
+        between = [(f, v) for f in range(min(x, y), max(x, y) + 1) if (v := _existence(raw, f, c, lost)) is not None]
+        above = [(f, round(v, 4)) for f, v in between if printed(v) != hi and v > float(hi)]
+        if above:
+            bad("tracker", m[0], f"its {m[1]} was higher between: {above}")
+    for m in WAS.finditer(text):
+        out.checked["tracker"] += 1
+        frames = range(int(m[3]), int(m[4] or m[3]) + 1)
+        got = {f: _existence(raw, f, c, lost) for f in frames}
+        if any(v is None or printed(v) != m[2] for v in got.values()):
+            bad("tracker", m[0], f"the Posterior events give track {lost} {got}")
+    for m in DELETED.finditer(text):
+        out.checked["tracker"] += 1
+        x = int(m[1])
+        logic = [
+            e for e in raw.of_kind(x, c, TrackLogic) if e.track_id == lost and e.action is TrackLogicAction.DELETED
+        ]
+        hits = (int(m[2]), int(m[3])) if m[2] else (0, int(m[4])) if m[4] else None
+        aged = [p for p in raw.of_kind(x, c, Pruned) if p.track_id == lost and p.reason is PruneReason.TRACK_LOGIC]
+        if not logic and (hits is not None or not aged):
+            bad("tracker", m[0], f"no delete TrackLogic event (nor, without hits, a track-logic Pruned) of frame {x}")
+        elif hits is not None and hits not in {(e.hits, e.window) for e in logic}:
+            bad("tracker", m[0], f"the track logic counted {[(e.hits, e.window) for e in logic]}")
+    for m in PRUNED.finditer(text):
+        out.checked["tracker"] += 1
+        reasons = [p.reason.value for p in raw.of_kind(int(m[1]), c, Pruned) if p.track_id == lost]
+        if m[2] not in reasons:
+            bad("tracker", m[0], f"the Pruned events of frame {m[1]} give track {lost} {reasons}")
+    for m in MERGED.finditer(text):
+        out.checked["tracker"] += 1
+        if not _merged(raw, int(m[1]), c, lost):
+            bad("tracker", m[0], f"no Merged event of frame {m[1]} absorbed track {lost}")
+    for m in ENDED.finditer(text):
+        out.checked["tracker"] += 1
+        t, x = int(m[1]), int(m[2])
+        if not (raw.deleted(x, c, t) or _merged(raw, x, c, t)):
+            bad("tracker", m[0], f"no event of frame {x} ends track {t}")
+    for m in USED.finditer(text):
+        _check_used(m, c, lost, raw, out, bad)
+
+
+def check_gates(text: str, c: str, raw, out, bad) -> None:
+    """ "mN (…, in track T's gate at NIS V)": the frame's ``Gated`` event has mN inside T's gate at that d²."""
+    for m in GATE.finditer(text):
+        x, meas, t = int(m[1]), int(m[2]), int(m[3])
+        found = raw.of_kind(x, c, Gated)
+        out.checked["tracker"] += 1
+        g = found[-1] if found else None
+        rows = np.flatnonzero(np.asarray(g.track_ids) == t) if g is not None else []
+        cols = np.flatnonzero(np.asarray(g.meas_indices) == meas) if g is not None else []
+        if len(rows) == 0 or len(cols) == 0 or not bool(np.asarray(g.inside)[rows[0], cols[0]]):
+            bad("tracker", m[0], f"the Gated event of frame {x} does not have m{meas} inside track {t}'s gate")
+        elif f"{float(np.asarray(g.d2)[rows[0], cols[0]]):.1f}" != m[4]:
+            bad("tracker", m[0], f"its d² is {float(np.asarray(g.d2)[rows[0], cols[0]]):.3f}")
+
+
+def check_averaged(text: str, track: int | None, ev, out, bad) -> None:
+    """ "its score averaged over its N frames, S" / "over the K of its N frames the evaluation kept …": the devkit
+    kept the track's box at K (N) frames and averaged S over them; N the file's boxes of the track."""
+    for m in AVERAGED.finditer(text):
+        t = m[1] or m[2] or (str(track) if track is not None else None)
+        if t is None:
+            continue
+        out.checked["matched"] += 1
+        kept, score = ev.averaged.get(t, (0, float("nan")))
+        submitted = sum(t in ids for ids in ev.submitted.values())
+        said_kept, said_all = (int(m[3]), int(m[3])) if m[3] else (int(m[4]), int(m[5]))
+        if (kept, submitted) != (said_kept, said_all) or f"{score:.3f}" != m[6]:
+            bad("matched", m[0], f"the devkit kept {kept} of its {submitted} boxes and averaged {score:.4f}")
+
+
+def check_stayed_below(text: str, c: str, raw, ev, out, bad) -> None:
+    """ "track T's existence stayed below E (…)": its ``Posterior`` existence at every frame the submission has its
+    box is below E."""
+    for m in STAYED.finditer(text):
+        out.checked["tracker"] += 1
+        t, below = int(m[1]), float(m[2])
+        above = {
+            x: v
+            for x in sorted(ev.submitted)
+            if str(t) in ev.submitted[x] and (v := _existence(raw, x, c, t)) is not None
+        }
+        above = {x: round(v, 3) for x, v in above.items() if v >= below}
+        if above:
+            bad("tracker", m[0], f"its existence at frames it was output: {above}")
+
+
+def check_not_output(text: str, lost: int | None, ev, out, bad) -> None:
+    """ "it was not output at frames …" of the lost track, against the submission (a results file's too)."""
+    for m in NOT_OUTPUT.finditer(text) if lost is not None else ():
+        out.checked["tracker"] += 1
+        output = [x for x in frames_of(m[1]) if str(lost) in ev.submitted.get(x, set())]
+        if output:
+            bad("tracker", m[0], f"the submission has track {lost}'s box at frames {output}")
+
+
+def _merged(raw, x: int, c: str, track: int) -> bool:
+    """A ``Merged`` event of x absorbed the track, or a ``Pruned`` one removed it as merged."""
+    if any(p.track_id == track and p.reason is PruneReason.MERGED for p in raw.of_kind(x, c, Pruned)):
+        return True
+    return any(track in e.from_ids and e.into_id != track for e in raw.of_kind(x, c, Merged))
+
+
+def _check_used(m: re.Match, c: str, lost: int, raw, out, bad) -> None:
+    x = int(m[1])
+    said = [(int(a), b or None) for a, b in re.findall(rf"m(\d+)(?: \(p ({_V})\))?", m[3])]
+    more = int(m[4] or 0)
+    if m[2] == "was given":
+        found = raw.of_kind(x, c, Assignment)
+        if not found:
+            return
+        out.checked["tracker"] += 1
+        given = [int(r.ref) for r, k in found[-1].pairs if k.kind is AxisKind.TRACK and int(k.ref) == lost]
+        if [s for s, _ in said] != given or more:
+            bad("tracker", m[0], f"the assignment of frame {x} gave track {lost} {given}")
+        return
+    found = raw.of_kind(x, c, Marginals)
+    if not found:
+        return
+    out.checked["tracker"] += 1
+    marg = found[-1]
+    rows = [i for i, r in enumerate(marg.rows) if int(r.ref) == lost]
+    if not rows:
+        bad("tracker", m[0], f"the Marginals of frame {x} have no row of track {lost}")
+        return
+    p = np.asarray(marg.probs)[rows[0]]
+    shares = sorted(
+        ((int(k.ref), float(p[j])) for j, k in enumerate(marg.cols) if k.kind is AxisKind.MEASUREMENT),
+        key=lambda s: (-s[1], s[0]),
+    )
+    used = [(d, v) for d, v in shares if v >= USED_SHARE]
+    ok = [d for d, _ in used[:2]] == [d for d, _ in said] and max(0, len(used) - 2) == more
+    ok = ok and all(v is None or f"{q:.2f}" == v for (_, q), (_, v) in zip(used, said, strict=False))
+    if not ok:
+        bad("tracker", m[0], f"the Marginals of frame {x} give track {lost} {[(d, round(v, 3)) for d, v in used]}")

@@ -1,0 +1,134 @@
+"""Where a false track's box lay among the annotations, and the devkit's interpolation of an object, checked
+against the annotation files and the devkit's own boxes.
+
+* "C GT H lies D m away": H is annotated at the finding's frame with class C, D m (as printed, one decimal) from
+  the false box (as the accumulator scored it, else as submitted), and no other annotation of class C is nearer;
+* "no C GT lies within 2 m, but GT K H does (D m)": no annotation of class C within 2 m of the box, and H is
+  annotated there with class K, D m away;
+* "… from frames L and R, weighting the two ends the wrong way round (nuscenes-devkit issue #1141): weighted the
+  right way the box would lie D m from the annotation": L and R are the nearest frames before and after the
+  finding's frame at which the devkit kept the object's box; the box interpolated linearly in time between those
+  two annotations lies D m from the annotation, and the devkit's own box lies at least 0.05 m from it.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+from tools.truth.scene import NEAR_M
+
+AWAY = re.compile(r"(\w+) GT (\w{6}) lies (\d+\.\d) m away")
+OTHER_CLASS = re.compile(r"no (\w+) GT lies within 2 m, but GT (\w+) (\w{6}) does \((\d+\.\d) m\)")
+SWAPPED = re.compile(
+    r"from frames (\d+) and (\d+), weighting the two ends the wrong way round \(nuscenes-devkit issue #1141\): "
+    r"weighted the right way the box would lie (\d+\.\d) m from the annotation"
+)
+
+
+BETWEEN = re.compile(r"(?:^|; )from frames (\d+) and (\d+)(?=[;.]|$)", re.M)
+TRACK_BETWEEN = re.compile(
+    r"at frame (\d+) track (\d+) \((\w+)\) was not output: the evaluation interpolated it between its boxes at "
+    r"frames (\d+) and (\d+), and that box matched no object"
+)
+PREDICTED = re.compile(
+    r"at frame (\d+) track (\d+) \((\w+)\) was output on no detection this frame \(a predicted box\)"
+)
+
+
+NONE_OF_ITS_OWN = re.compile(
+    r"the detector gave GT (\w{6}) no detection of its own within 2 m \((\d+) LiDAR and radar points\)"
+)
+
+
+def _d(a: tuple[float, float], b: tuple[float, float]) -> float:
+    return math.hypot(a[0] - b[0], a[1] - b[1])
+
+
+def check_place(text: str, c: str, x: int, place, scene, out, bad) -> None:
+    """The annotations around a false box at ``place`` (None: nothing checked) at frame ``x``."""
+    if place is None or scene is None or x >= len(scene.objects):
+        return
+    here = scene.objects[x]
+    for m in AWAY.finditer(text):
+        out.checked["detector"] += 1
+        hit = scene.object_of(x, m[2])
+        own = sorted((_d(a.xy_m, place), k[:6]) for k, a in here.items() if a.class_name == c)
+        if hit is None or hit[1].class_name != m[1] or f"{_d(hit[1].xy_m, place):.1f}" != m[3]:
+            bad("detector", m[0], f"the {c} annotations' distances from the box: {own[:3]}")
+        elif own and own[0][1] != m[2] and own[0][0] < _d(hit[1].xy_m, place) - 1e-9:
+            bad("detector", m[0], f"GT {own[0][1]} lies nearer ({own[0][0]:.2f} m)")
+    for m in OTHER_CLASS.finditer(text):
+        out.checked["detector"] += 1
+        own = [k[:6] for k, a in here.items() if a.class_name == m[1] and _d(a.xy_m, place) < NEAR_M]
+        hit = scene.object_of(x, m[3])
+        if own:
+            bad("detector", m[0], f"{m[1]} annotations within 2 m: {own}")
+        elif hit is None or hit[1].class_name != m[2] or f"{_d(hit[1].xy_m, place):.1f}" != m[4]:
+            bad("detector", m[0], f"GT {m[3]} is {hit[1] if hit else 'not annotated here'}")
+
+
+def _ends(ev, gt_id: str, x: int) -> tuple[int, int] | None:
+    """The frames before and after x nearest it at which the devkit kept the object's box (its interpolation's
+    ends)."""
+    kept = sorted(f for f, g in ev.kept_gt if g == gt_id)
+    before, after = [f for f in kept if f < x], [f for f in kept if f > x]
+    return (before[-1], after[0]) if before and after else None
+
+
+def check_interpolated(text: str, x: int, gt_id: str | None, ev, out, bad) -> None:
+    """ "from frames L and R" (the object's interpolation) and a false track's interpolated box: "at frame x track
+    T (C) was not output: the evaluation interpolated it between its boxes at frames L and R, and that box matched
+    no object" (no box of T at x, boxes at L and R, the accumulator scored one at x, matched to nothing)."""
+    for m in BETWEEN.finditer(text) if gt_id is not None else ():
+        out.checked["evaluation"] += 1
+        if _ends(ev, gt_id, x) != (int(m[1]), int(m[2])):
+            bad("evaluation", m[0], f"the devkit's kept neighbours of frame {x}: {_ends(ev, gt_id, x)}")
+    for m in TRACK_BETWEEN.finditer(text):
+        out.checked["evaluation"] += 1
+        y, t, c, left, right = int(m[1]), m[2], m[3], int(m[4]), int(m[5])
+        has = [f for f in (y, left, right) if t in ev.submitted.get(f, set())]
+        scored = t in ev.pred_xy.get((c, y), {})
+        if has != [left, right] or not scored or ev.matched_gt(c, y, t) is not None:
+            bad("evaluation", m[0], f"boxes at {has}, scored at {y}: {scored}, matched {ev.matched_gt(c, y, t)}")
+    for m in PREDICTED.finditer(text):
+        out.checked["output"] += 1
+        if m[2] not in ev.submitted.get(int(m[1]), set()):
+            bad("output", m[0], f"the submission has no box of track {m[2]} at frame {m[1]}")
+
+
+def check_none_of_its_own(text: str, x: int, scene, out, bad) -> None:
+    """A coalescence's "the detector gave GT H no detection of its own within 2 m (N LiDAR and radar points)": no
+    detection of any class within 2 m of H's annotation at x, and H has N points."""
+    for m in NONE_OF_ITS_OWN.finditer(text) if scene is not None else ():
+        out.checked["detector"] += 1
+        hit = scene.object_of(x, m[1])
+        near = scene.near(x, hit[1].xy_m) if hit is not None else None
+        if hit is None or near or hit[1].points != int(m[2]):
+            bad("detector", m[0], f"detections within 2 m: {near}; points {hit[1].points if hit else None}")
+
+
+def check_swapped(text: str, x: int, gt_id: str | None, scene, ev, out, bad) -> None:
+    """The #1141 note about object ``gt_id`` at frame ``x``."""
+    if gt_id is None or scene is None:
+        return
+    for m in SWAPPED.finditer(text):
+        out.checked["evaluation"] += 1
+        left, right = int(m[1]), int(m[2])
+        kept = sorted(f for f, g in ev.kept_gt if g == gt_id)
+        before = [f for f in kept if f < x]
+        after = [f for f in kept if f > x]
+        if not before or not after or (before[-1], after[0]) != (left, right):
+            bad("evaluation", m[0], f"the devkit kept the object's box at frames {kept}")
+            continue
+        a, b, here = (scene.objects[f].get(gt_id) for f in (left, right, x))
+        scored = ev.evaluated_gt.get((x, gt_id))
+        if a is None or b is None or here is None or scored is None:
+            bad("evaluation", m[0], "the object is not annotated at both ends and here, or not scored")
+            continue
+        w = (ev.stamps[x] - ev.stamps[left]) / (ev.stamps[right] - ev.stamps[left])
+        right_way = (a.xy_m[0] + w * (b.xy_m[0] - a.xy_m[0]), a.xy_m[1] + w * (b.xy_m[1] - a.xy_m[1]))
+        if f"{_d(right_way, here.xy_m):.1f}" != m[3]:
+            bad("evaluation", m[0], f"interpolated in time the box lies {_d(right_way, here.xy_m):.2f} m away")
+        elif _d(right_way, scored) < 0.05:
+            bad("evaluation", m[0], "the devkit's box is the one interpolated the right way")
