@@ -504,25 +504,35 @@ def _hidden(f: Finding) -> list[str]:
     ]
 
 
-def _scored_away(f: Finding, t: int) -> str:
+def _out_of_reach(lost: LostTrack, s: Sighting) -> bool:
+    """Whether the lost track was output on the annotated object at ``s.frame`` while the evaluation scored the
+    object at a box it interpolated ``EVALUATED_OFFSET_M`` or more away and ``NEAR_M`` or more from the track's
+    box (the devkit's matching distance): there "on it" was no match."""
+    g, step = s.evaluated, lost.step(s.frame)
+    if (
+        g is None
+        or g.status is not GtStatus.INTERPOLATED
+        or g.offset_m < EVALUATED_OFFSET_M
+        or g.evaluated_xy_m is None
+    ):
+        return False
+    if step is None or step.output is None or not any(o.track_id == lost.track_id for o in s.on_it):
+        return False
+    x, y = step.output.translation_m[:2]
+    return math.hypot(x - g.evaluated_xy_m[0], y - g.evaluated_xy_m[1]) >= NEAR_M
+
+
+def _scored_away(f: Finding, lost: LostTrack) -> str:
     """`` (at frame 16, though, the evaluation scored the object at a box it interpolated 10.9 m from the
-    annotation)``: the frames before the failure's at which track ``t`` was output on the annotated object while
-    the evaluation scored the object elsewhere, so "on it" there was no match ("" if none)."""
-    away = [
-        s
-        for s in f.sightings
-        if s.frame < f.frame
-        and s.evaluated is not None
-        and s.evaluated.status is GtStatus.INTERPOLATED
-        and s.evaluated.offset_m >= EVALUATED_OFFSET_M
-        and any(o.track_id == t for o in s.on_it)
-    ]
+    annotation)``: the frames before the failure's at which the lost track was output on the annotated object
+    and out of reach of the box the evaluation scored the object at (``_out_of_reach``; "" if none)."""
+    away = [s for s in f.sightings if s.frame < f.frame and _out_of_reach(lost, s)]
     if not away:
         return ""
     offsets = ", ".join(f"{s.evaluated.offset_m:.1f}" for s in away)
     return (
         f" (at {frames_text(s.frame for s in away)}, though, the evaluation scored the object at a box it "
-        f"interpolated {offsets} m from the annotation)"
+        f"interpolated {offsets} m from the annotation, out of the track's reach)"
     )
 
 
@@ -536,7 +546,7 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         # "last on it" is not "last output": say where it was output after, away from the object
         away = [s.frame for s in steps if lost.held_until < s.frame < f.frame and s.output is not None]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
-        parts.append(f"track {t} was last output on it at frame {lost.held_until}{elsewhere}{_scored_away(f, t)}")
+        parts.append(f"track {t} was last output on it at frame {lost.held_until}{elsewhere}{_scored_away(f, lost)}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]
@@ -850,11 +860,13 @@ def _false_track(f: Finding) -> list[str]:
             f"no {f.class_name} GT lies within {NEAR_M:.0f} m, but GT {cls} {short_id(gt_id)} does ({d:.1f} m): {what}"
         )
     elif o.on is not None:
-        parts.append(f"no object of any class lies within {NEAR_M:.0f} m: a detection of nothing")
+        parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of nothing")
     elif Rule.TRACK_INTERPOLATED in tests:
-        parts.append(f"no object of any class lies within {NEAR_M:.0f} m of it")
+        parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m of it")
     else:
-        parts.append(f"no object of any class lies within {NEAR_M:.0f} m: the tracker output a box where nothing was")
+        parts.append(
+            f"no object of a tracked class lies within {NEAR_M:.0f} m: the tracker output a box where nothing was"
+        )
     ev = o.evaluated
     if ev is not None and ev.averaged_score is not None and o.threshold is not None:
         parts.append(

@@ -356,7 +356,7 @@ def test_another_runs_false_track_and_an_empty_place_are_checked_where_the_false
     assert check_text(fair, at, None, ev, others={"pmbm": other}).found == []
     planted = "pmbm on the same detections had no false track here"
     assert [c.kind for c in check_text(planted, at, None, ev, others={"pmbm": other}).found] == ["other run"]
-    empty = "no object of any class lies within 2 m of it"
+    empty = "no object of a tracked class lies within 2 m of it"
     assert [c.kind for c in check_text(empty, at, None, ev, scene=_scene()).found] == ["detector"]  # GT A is there
     away = Context(C, 3, None, kind="false_track", track=12)
     assert check_text(empty, away, None, ev, scene=_scene()).found == []

@@ -1,8 +1,8 @@
 """What the Why says the lost track did, checked against its raw events and the submission.
 
 * "its existence went from A (frame x) to B (frame y)" / "its existence was A (frame x)" (a PHD's "weight"): the
-  track's existence in the ``Posterior`` event of each named frame (rounded as printed), and no ``Posterior`` of
-  the frames between above A (A is the highest);
+  track's existence in the ``Posterior`` event of each named frame (a PHD label's heaviest ``IntensityWeights``
+  component; rounded as printed), and none of the frames between above A (A is the highest);
 * "it was not output at frames …": the submission has no box of the track at any of them;
 * "its track logic deleted it at frame x (h of w hits)": a delete ``TrackLogic`` event of x names it, with those
   hits (without hits: a track-logic ``Pruned`` event, greedy's maximum age, also does); "it was pruned at frame x
@@ -24,6 +24,7 @@ from gnnpmb.events import (
     Assignment,
     AxisKind,
     Gated,
+    IntensityWeights,
     Marginals,
     Merged,
     Posterior,
@@ -74,6 +75,13 @@ def printed(r: float) -> str:
 
 
 def _existence(raw, x: int, c: str, track: int) -> float | None:
+    """The track's existence after the update of frame ``x``; a GM-PHD / CPHD label's weight is its heaviest
+    ``IntensityWeights`` component (a PHD weight is an expected number and may exceed 1; the ``Posterior`` event
+    holds min(w, 1))."""
+    intensity = raw.of_kind(x, c, IntensityWeights)
+    if intensity:
+        mine = np.asarray(intensity[-1].weights)[np.asarray(intensity[-1].labels) == track]
+        return float(mine.max()) if mine.size else None
     found = raw.of_kind(x, c, Posterior)
     if not found:
         return None
@@ -90,7 +98,7 @@ def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
         (hi, x), (lo, y) = (m[2], int(m[3])), (m[4], int(m[5]))
         got = {f: _existence(raw, f, c, lost) for f in (x, y)}
         if any(v is None for v in got.values()) or printed(got[x]) != hi or printed(got[y]) != lo:
-            bad("tracker", m[0], f"the Posterior events give track {lost} {got}")
+            bad("tracker", m[0], f"the update events give track {lost} {got}")
             continue
         between = [(f, v) for f in range(min(x, y), max(x, y) + 1) if (v := _existence(raw, f, c, lost)) is not None]
         above = [(f, round(v, 4)) for f, v in between if printed(v) != hi and v > float(hi)]
@@ -101,7 +109,7 @@ def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
         frames = range(int(m[3]), int(m[4] or m[3]) + 1)
         got = {f: _existence(raw, f, c, lost) for f in frames}
         if any(v is None or printed(v) != m[2] for v in got.values()):
-            bad("tracker", m[0], f"the Posterior events give track {lost} {got}")
+            bad("tracker", m[0], f"the update events give track {lost} {got}")
     for m in DELETED.finditer(text):
         out.checked["tracker"] += 1
         x = int(m[1])

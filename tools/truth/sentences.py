@@ -134,7 +134,7 @@ NOT_COUNTED = re.compile(
 )
 ON_IT = re.compile(r"track (\d+) was (not )?output on it(?: \(score ([\d.]+)\))?")
 VIEWER_ONLY = ("too low to be shown here",)
-NOTHING_NEAR = re.compile(r"no object of any class lies within 2 m")
+NOTHING_NEAR = re.compile(r"no object of a tracked class lies within 2 m")
 NO_TRACK_NEAR = re.compile(r"no (\w+) track was output within 2 m of it")
 COUNTED_AT = re.compile(
     r"the evaluation counted the track: its score averaged [^:]*?, is at least the (\w+) threshold (\d+\.\d+)"
