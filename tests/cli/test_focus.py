@@ -285,22 +285,28 @@ def test_a_failure_at_an_interpolated_gt_box_is_explained(
     assert all(not r["Boxes3D:centers"] for f, r in drawn.items() if f != failure.frame_index)
 
 
+PMBM_ALL = "pmbm-all"
+"""A PMBM run without N-scan pruning (``gnnpmb/params/pmbm_no_nscan.toml``, the README's example): it parts
+from GNN-PMB at the failure below; the default PMBM (N-scan 1) loses the bicycle too."""
+
+
 def test_why_and_where_two_trackers_part_on_the_failure_frame(
     demo_dataroot: Path, tmp_path: Path, failures_and_runs
 ) -> None:
+    pmbm = f"{PMBM_ALL}=pmbm:{POSITION_ONLY.with_name('pmbm_no_nscan.toml')}"
     report, _ = failures_and_runs
     pick = next(i for i in report.ids() if i.startswith("id_switch:"))
     failure = report.by_id(pick)
     old, new = (int(t) for t in failure.track_ids)
-    finding = findings_of(demo_dataroot, ("gnnpmb", "pmbm"))["gnnpmb"][pick]
+    finding = findings_of(demo_dataroot, ("gnnpmb", pmbm))["gnnpmb"][pick]
     # The data: the lost and the new track, the choice that started the new one, the other tracker as evidence.
     assert finding.lost.track_id == old and finding.taker.track_id == new
     d = finding.decision
     assert d is not None and d.went == new and d.born and d.frame <= failure.frame_index
     assert d.choice.alternative is not None and d.choice.alternative_terms is not None
     (other,) = finding.others
-    assert other.tracker == "pmbm"
-    out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", "pmbm"))
+    assert other.tracker == PMBM_ALL
+    out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", pmbm))
     summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
     why, because = summary.split("\n\n")[1:3]
     assert why.startswith(f"**Why** (gnnpmb, {whose_text(finding)}): ")
@@ -327,7 +333,7 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     assert about and all(f": {failure.class_name} " in line for line in about)
     assert about == [line for line in everything if f": {failure.class_name} " in line] and len(everything) > len(about)
     # The picture says it too: the detection's label names where it went, in each tracker's view.
-    for tracker in ("gnnpmb", "pmbm"):
+    for tracker in ("gnnpmb", PMBM_ALL):
         callouts = [r for r in rows[paths.focus_callouts(tracker)] if r.get("frame") == failure.frame_index]
         went = [label.split(" → ")[1] for label in callouts[0]["Points3D:labels"] if re.match(r"m\d+ ", label)]
         assert went and all(re.fullmatch(r"(?:new )?track \d+", w) for w in went)
@@ -340,7 +346,7 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     assert rest, "the two trackers sent a detection on the object to different places; the summary says where"
     assert "## gnnpmb" not in head  # it comes before the per-tracker sections
     lines = [line for line in rest.split("\n\n")[1].splitlines() if line.startswith("- ")]
-    assert any("gnnpmb: m" in line and f"new track {new}" in line and " · pmbm: m" in line for line in lines)
+    assert any("gnnpmb: m" in line and f"new track {new}" in line and f" · {PMBM_ALL}: m" in line for line in lines)
     for line in lines:
         gnnpmb, pmbm = line[2:].split(" · ")
         assert gnnpmb.split("→")[1].split("(")[0] != pmbm.split("→")[1].split("(")[0]  # different destinations
