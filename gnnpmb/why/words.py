@@ -860,12 +860,13 @@ def _false_track(f: Finding) -> list[str]:
             f"no {f.class_name} GT lies within {NEAR_M:.0f} m, but GT {cls} {short_id(gt_id)} does ({d:.1f} m): {what}"
         )
     elif o.on is not None:
-        parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of nothing")
+        parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of no tracked object")
     elif Rule.TRACK_INTERPOLATED in tests:
         parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m of it")
     else:
         parts.append(
-            f"no object of a tracked class lies within {NEAR_M:.0f} m: the tracker output a box where nothing was"
+            f"no object of a tracked class lies within {NEAR_M:.0f} m: the tracker output a box where no tracked "
+            "object was"
         )
     ev = o.evaluated
     if ev is not None and ev.averaged_score is not None and o.threshold is not None:
