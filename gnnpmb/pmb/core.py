@@ -515,10 +515,9 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         predicted and gated once and each hypothesis takes its rows when asked (``HypothesisLocals``; PMBM,
         García-Fernández et al. 2018, sec. V)."""
         p = self.models
-        if len(self.hypotheses) == 1:
-            h = self.hypotheses[0]
-            prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
-            local = local_hypotheses(
+
+        def localise(prior: Bernoullis) -> LocalHypotheses:  # one call for both paths: they once gated differently
+            return local_hypotheses(
                 prior,
                 meas,
                 new,
@@ -528,19 +527,14 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
                 self.box,
                 self.params.gate_giou_min,
             )
-            return PmbPrior([GlobalHypothesis(h.log_weight, prior)], [local])
+
+        if len(self.hypotheses) == 1:
+            h = self.hypotheses[0]
+            prior = predict_bernoullis(h.bernoullis, model, p.p_survive)
+            return PmbPrior([GlobalHypothesis(h.log_weight, prior)], [localise(prior)])
         union, members = hypothesis_union(self.hypotheses)
         union_prior = predict_bernoullis(union, model, p.p_survive)
-        union_local = local_hypotheses(
-            union_prior,
-            meas,
-            new,
-            model.R,
-            p.gate_chi2,
-            self.params.miss_p_detect_max,
-            self.box,
-            self.params.gate_giou_min,
-        )
+        union_local = localise(union_prior)
         priors = [GlobalHypothesis(h.log_weight, union_prior, i) for h, i in zip(self.hypotheses, members, strict=True)]
         return PmbPrior(priors, HypothesisLocals(union_local, members))
 
