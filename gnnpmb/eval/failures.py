@@ -40,6 +40,7 @@ import numpy as np
 from gnnpmb.errors import DataError
 from gnnpmb.eval.evaluated import GtFrame, TrackEval, gt_frames, track_evals
 from gnnpmb.eval.nuscenes_eval import class_evaluation, quiet_devkit, scene_sample_tokens, tracking_config
+from gnnpmb.eval.official_scores import OfficialScores, official_scores
 
 if TYPE_CHECKING:
     from nuscenes import NuScenes
@@ -224,7 +225,8 @@ class FailureReport:
     evaluation saw the object there, track_evals: tracking id -> how it saw the track (``eval.evaluated``);
     frames: the keyframes (start, end exclusive) evaluated when only those were tracked (``--frames``), None for
     the whole scene; failure frame indices are always the scene's keyframe indices, and ids number the failures
-    of the evaluated keyframes."""
+    of the evaluated keyframes; scores: the official metrics of the evaluated keyframes, read from the same
+    accumulation as the failures (None: not kept)."""
 
     scene_name: str
     tracker: str
@@ -236,6 +238,7 @@ class FailureReport:
     gt_frames: Mapping[str, Mapping[int, GtFrame]] = field(default_factory=dict)
     track_evals: Mapping[str, TrackEval] = field(default_factory=dict)
     frames: tuple[int, int] | None = None
+    scores: OfficialScores | None = None
 
     def gt_frame(self, gt_id: str, frame: int) -> GtFrame | None:
         """How the evaluation saw object ``gt_id`` at ``frame`` (None: not annotated there)."""
@@ -314,6 +317,7 @@ class FailureReport:
             "gt_frames": {g: [v.to_json() for v in frames.values()] for g, frames in self.gt_frames.items()},
             "track_evals": {t: v.to_json() for t, v in self.track_evals.items()},
             "frames": None if self.frames is None else list(self.frames),
+            "scores": None if self.scores is None else self.scores.to_json(),
             "failures": [f.to_json() for f in self.failures],
         }
 
@@ -342,6 +346,7 @@ class FailureReport:
             },
             track_evals={str(t): TrackEval.from_json(v) for t, v in data.get("track_evals", {}).items()},
             frames=None if data.get("frames") is None else (int(data["frames"][0]), int(data["frames"][1])),
+            scores=None if data.get("scores") is None else OfficialScores.from_json(data["scores"]),
         )
 
 
@@ -627,7 +632,8 @@ def find_failures(
 
     results: submission boxes keyed by sample token (``submission.run_results``); samples of the scene without
     an entry count as empty. keyframes: evaluate only these (those a ``--frames`` run tracked), as if the
-    scene held no others; None or the whole scene: all. Failures are sorted by frame, then kind, class and ids.
+    scene held no others; None or the whole scene: all. Failures are sorted by frame, then kind, class and ids;
+    the report keeps the official metrics of the same accumulation (``FailureReport.scores``).
     """
     tokens = scene_sample_tokens(nusc, scene_name)
     window = range(len(tokens))
@@ -644,9 +650,10 @@ def find_failures(
         scene_token = nusc.get("sample", evaluated[0])["scene_token"]
         classes: list[ClassEvaluation] = []
         failures: list[Failure] = []
+        class_data = []
         for class_name in cfg.class_names:
-            evaluation = class_evaluation(tracks_gt, tracks_pred, class_name, cfg)
-            md = evaluation.accumulate()
+            md = class_evaluation(tracks_gt, tracks_pred, class_name, cfg).accumulate()
+            class_data.append((class_name, md))
             if np.all(np.isnan(md.mota)):
                 continue  # no ground truth of this class: the devkit does not score it
             best = int(np.nanargmax(md.mota))
@@ -667,6 +674,7 @@ def find_failures(
                 frame_of_timestamp,
             )
             failures += _class_failures(frames, class_name, tokens, cfg.dist_th_tp, coalescence_radius_m)
+        scores = official_scores(class_data, cfg)
     kind_order = {kind: i for i, kind in enumerate(FailureKind)}
     failures.sort(key=lambda f: (f.frame_index, kind_order[f.kind], f.class_name, f.gt_ids, f.track_ids))
     track_scores = {
@@ -684,4 +692,5 @@ def find_failures(
         gt_frames(raw_gt, kept_gt, tracks_gt[scene_token], frame_of_timestamp, tokens, cfg.class_range),
         track_evals(results, kept_pred, tracks_pred[scene_token], track_scores, frame_of_timestamp, tokens),
         None if whole else (window.start, window.stop),
+        scores,
     )

@@ -1,15 +1,22 @@
 """``gnnpmb diff A B``: two runs through the same stages, scene by scene (inputs → runs → evaluation), their
-failures matched (``gnnpmb.diff.scene_diff``) and their metrics scored together by the devkit."""
+failures matched (``gnnpmb.diff.scene_diff``) and their metrics scored by the devkit: on one scene, the figures
+of the accumulation that found each run's failures (``FailureReport.scores``, each run evaluated once); on
+several, each run's scenes scored together (the official metrics of a split pick each class's threshold over
+all its scenes, the failure reports per scene)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 from gnnpmb.diff import DiffEntry, DiffResult, metric_deltas, scene_diff
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.stages.evaluation import find_reports
 from gnnpmb.stages.inputs import Inputs
 from gnnpmb.stages.runs import run_all
+
+if TYPE_CHECKING:
+    from gnnpmb.eval.failures import FailureReport
 
 
 def diff_runs(
@@ -44,6 +51,7 @@ def diff_runs(
     entries: list[DiffEntry] = []
     results: dict[str, dict] = {s.name: {} for s in specs}
     location = None
+    scene_reports: list[dict[str, FailureReport]] = []
     for scene in scenes:
         inputs = scene_inputs(scene, [s.text() for s in specs])
         location = inputs.location
@@ -52,10 +60,16 @@ def diff_runs(
         if len(reports) < 2:
             raise GnnpmbError(f"{scene} cannot be evaluated: {'; '.join(problems)}")
         entries += scene_diff(scene, reports[specs[0].name], reports[specs[1].name])
+        scene_reports.append(reports)
         for run in runs:
             results[run.name].update(run_results(run.tracking))
-    nusc = open_nuscenes(eval_location(location, list(scenes)))  # a version folder of these scenes only
-    scores = [scene_scores(nusc, scenes, results[s.name]) for s in specs]
+    one_scene = [scene_reports[0][s.name] for s in specs] if len(scenes) == 1 else []
+    shared = [r.scores for r in one_scene if r.scores is not None and r.frames is None]
+    if len(shared) == len(specs):
+        scores = [s.as_floats() for s in shared]
+    else:
+        nusc = open_nuscenes(eval_location(location, list(scenes)))  # a version folder of these scenes only
+        scores = [scene_scores(nusc, scenes, results[s.name]) for s in specs]
     return DiffResult(
         specs[0], specs[1], where, tuple(scenes), tuple(entries), tuple(metric_deltas(*scores)), tuple(notices)
     )

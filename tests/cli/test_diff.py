@@ -59,10 +59,21 @@ def test_failures_are_matched_by_what_they_are_about_not_by_track_ids() -> None:
 
 
 def test_diff_of_the_papers_parameters_and_the_defaults(
-    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """``gnnpmb diff`` as the console script runs it, in-process (``tests.inprocess``; the script's start in a
-    real process is checked in ``tests/cli/test_user_errors.py``)."""
+    real process is checked in ``tests/cli/test_user_errors.py``). With no failure report stored, the devkit
+    accumulates each class of each run once: the metrics come from the accumulation that found the failures."""
+    from nuscenes.eval.tracking.algo import TrackingEvaluation
+
+    from gnnpmb.eval.nuscenes_eval import tracking_config
+
+    monkeypatch.setenv("GNNPMB_CACHE_DIR", str(tmp_path / "cache"))
+    accumulated: list[str] = []
+    accumulate = TrackingEvaluation.accumulate
+    monkeypatch.setattr(
+        TrackingEvaluation, "accumulate", lambda self: accumulated.append(self.class_name) or accumulate(self)
+    )
     out = tmp_path / "diff.json"
     proc = run_script(
         [
@@ -80,6 +91,7 @@ def test_diff_of_the_papers_parameters_and_the_defaults(
         capsys,
     )
     assert proc.returncode == 0, proc.stderr
+    assert sorted(accumulated) == sorted(tracking_config().class_names * 2)
     data = json.loads(out.read_text())
     assert (data["a"], data["b"], data["where"]) == (f"gnnpmb:{PAPER}", "gnnpmb", SCENE)
     totals = data["totals"]
