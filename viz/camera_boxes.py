@@ -274,9 +274,10 @@ def draw_layer(boxes: Sequence[Box], cams: Mapping[int, CameraFrame], frames: Se
 
 def _inside_image(text: str, u: float, v: float, width_px: int, height_px: int) -> tuple[float, float]:
     """A label's anchor (pixels) moved so that its text, centred under it at ``CAMERA_VIEW_SCALE``, stays inside
-    the image: a label cut by the view's edge reads as something else."""
+    the image: a label cut by the view's edge reads as something else. A text wider than the image is centred on
+    it, so that it runs into the view's margins beside a letterboxed image evenly rather than off one side."""
     x0, y0, x1, y1 = (c / CAMERA_VIEW_SCALE for c in text_box(text, 0.0, 0.0))
-    u = min(max(u, -x0), max(width_px - x1, -x0))
+    u = 0.5 * width_px if x1 - x0 > width_px else min(max(u, -x0), width_px - x1)
     v = min(max(v, 0.0), height_px - y1)
     return u, v
 
