@@ -189,7 +189,9 @@ class LostTrack:
     it has no step of its own but a cost matrix of a hypothesis other than the chosen one had its column (PMBM: it
     was held only by hypotheses the tracker did not choose, so it was not gone); finite_elsewhere: (frame,
     detection) pairs its column could not take in the chosen hypothesis's matrix but another hypothesis's matrix
-    gave a finite cost (PMBM)."""
+    gave a finite cost (PMBM); matched_until: the last frame before the failure at which the evaluation matched
+    the object to a track (the devkit's memory of its last match, which for a lost object is this track: None if
+    none)."""
 
     track_id: int
     held_until: int | None
@@ -199,6 +201,7 @@ class LostTrack:
     threshold: float | None
     elsewhere: tuple[int, ...] = ()
     finite_elsewhere: tuple[tuple[int, int], ...] = ()
+    matched_until: int | None = None
 
     def step(self, frame: int) -> TrackStep | None:
         return next((s for s in self.steps if s.frame == frame), None)

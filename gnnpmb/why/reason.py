@@ -324,7 +324,23 @@ class _Context:
         elsewhere = tuple(f for f in self.window if f not in steps and self.has_column(f, track_id))
         evaluated = self.report.track_evals.get(str(track_id))
         finite = self.finite_elsewhere(track_id, steps)
-        return LostTrack(track_id, held, in_window, off, evaluated, self.threshold, elsewhere, finite)
+        matched = self.matched_until(gt_id)
+        return LostTrack(track_id, held, in_window, off, evaluated, self.threshold, elsewhere, finite, matched)
+
+    def matched_until(self, gt_id: str) -> int | None:
+        """The last frame before the failure at which the evaluation matched object ``gt_id`` to a track: it scored
+        a box of the object there (annotated or interpolated) and had no MISS of it. The devkit matches every
+        scored object it does not miss (CLEAR-MOT), and an ID switch, identity theft or fragmentation is about the
+        track of that last match (its accumulator's memory), so for a lost object this is the lost track's last
+        match on it (None: the evaluation matched it at no earlier frame, or evaluated no earlier frame)."""
+        missed = {f.frame_index for f in self.report.of_kind(FailureKind.MISS) if gt_id in f.gt_ids}
+        first = self.report.frames[0] if self.report.frames is not None else 0
+        scored = [
+            x
+            for x, g in self.report.gt_frames.get(gt_id, {}).items()
+            if first <= x < self.f and g.evaluated_xy_m is not None and x not in missed
+        ]
+        return max(scored, default=None)
 
     def finite_elsewhere(self, track_id: int, steps: Mapping[int, TrackStep]) -> tuple[tuple[int, int], ...]:
         """(frame, detection) pairs of the window that track ``track_id`` could not take in its step's matrix (an

@@ -542,11 +542,19 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     t = lost.track_id
     steps = lost.steps
     parts = []
-    if lost.held_until is not None:
+    held, matched = lost.held_until, lost.matched_until
+    if matched is not None:
         # "last on it" is not "last output": say where it was output after, away from the object
-        away = [s.frame for s in steps if lost.held_until < s.frame < f.frame and s.output is not None]
+        after = held if held is not None else -1
+        away = [s.frame for s in steps if after < s.frame < f.frame and s.output is not None]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
-        parts.append(f"track {t} was last output on it at frame {lost.held_until}{elsewhere}{_scored_away(f, lost)}")
+        # "on it" reads as the evaluation's match: said only where the devkit's last match was that output
+        last = (
+            f"track {t} was last output on it at frame {held}"
+            if held == matched
+            else f"the evaluation last matched track {t} to it at frame {matched}"
+        )
+        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]

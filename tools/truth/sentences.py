@@ -220,6 +220,7 @@ def check_text(
         if t not in ev.submitted.get(x, set()):
             bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
     lost.check_not_output(text, ctx.lost, ev, out, bad)
+    lost.check_last_match(text, c, ctx.frame, ctx.gt_id, ev, out, bad)
     lost.check_averaged(text, ctx.track, ev, out, bad)
     if raw is None:  # a results file: where its boxes sit
         output.check_output(text, c, ctx.lost, scene, ev, out, bad)

@@ -178,12 +178,31 @@ def test_a_track_output_away_from_the_object_after_it_was_last_on_it_is_said_so(
     # demo fragmentation:1 said "track 21 was last output on it at frame 14" of a track output at frame 15, as a
     # false track beside the object: "last on it" must not read as "last output"
     steps = (step(10, output=estimate(21, 0.9)), step(11, output=estimate(21, 0.9)), step(12), step(13))
-    lost = LostTrack(21, 10, steps, None, None, None)
+    lost = LostTrack(21, 10, steps, None, None, None, matched_until=10)
     line = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=13, has_existence=False))[0]
     assert "track 21 was last output on it at frame 10 (output farther than 2 m from it at frame 11)" in line
-    alone = LostTrack(21, 11, steps, None, None, None)
+    alone = LostTrack(21, 11, steps, None, None, None, matched_until=11)
     line = why_lines(finding(FailureKind.FRAGMENTATION, alone, frame=13, has_existence=False))[0]
     assert "track 21 was last output on it at frame 11," in line
+
+
+def test_last_on_it_is_said_only_of_the_evaluations_last_match_else_that_match_is_named() -> None:
+    # independent audit, dev set: ab3dmot scene-0655 centerpoint id_switch:13 said "track 111 was last output on it
+    # at frame 20" where the devkit last matched the object (to track 111) at frame 19 (no box of it at 20);
+    # prob3dmot scene-0553 megvii id_switch:9 and identity_theft:1 "track 99 ... at frame 23", matched to another
+    # object there, last matched to this one at 22
+    steps = (step(19, output=estimate(111, 0.9)), step(20, output=estimate(111, 0.9)), step(21), step(22))
+    kind = FailureKind.ID_SWITCH
+    before = LostTrack(111, 20, steps, None, None, None, matched_until=19)
+    line = why_lines(finding(kind, before, frame=22, window=(19, 22), has_existence=False))[0]
+    assert "was last output on it" not in line
+    assert "the evaluation last matched track 111 to it at frame 19," in line
+    same = LostTrack(111, 20, steps, None, None, None, matched_until=20)
+    line = why_lines(finding(kind, same, frame=22, window=(19, 22), has_existence=False))[0]
+    assert "track 111 was last output on it at frame 20," in line
+    never = LostTrack(111, 20, steps, None, None, None)  # no earlier match known: nothing said of one
+    line = why_lines(finding(kind, never, frame=22, window=(19, 22), has_existence=False))[0]
+    assert "last output on it" not in line and "last matched" not in line
 
 
 def test_last_on_it_says_where_the_evaluation_scored_the_object_out_of_the_tracks_reach_and_only_there() -> None:
@@ -198,7 +217,7 @@ def test_last_on_it_says_where_the_evaluation_scored_the_object_out_of_the_track
         return Sighting(frame, 0, g, None, None, None, (OnObject(47, 0.1, 0.5, -1, None, None),))
 
     steps = tuple(step(x, output=estimate(47, 0.9)) for x in (8, 9, 11)) + (step(12),)
-    lost = LostTrack(47, 11, steps, None, None, None)
+    lost = LostTrack(47, 11, steps, None, None, None, matched_until=11)
     sightings = (seen(8, 2.6), seen(9, 1.3), seen(11, 1.3))
     line = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=12, sightings=sightings, has_existence=False))[0]
     assert (
