@@ -923,6 +923,21 @@ def _no_box_reason(g: GtFrame | None) -> str:
     return f"{why}, so its box was dropped, and no box could be interpolated"
 
 
+def _out_of_reach_on_it(f: Finding, s: Sighting) -> list[str]:
+    """The counted tracks output on the object that the evaluation's interpolated box put out of the devkit's reach
+    (``f.reach``, with the blame ``INTERPOLATED``): a miss beside a track that was on the annotation."""
+    r = f.reach
+    if r is None:
+        return []
+    away = [o for o in s.on_it if o.counted and o.track_id in r.near_annotated and o.track_id not in r.near_evaluated]
+    return [
+        f"at frame {f.frame} track {o.track_id} was output {o.distance_m:.1f} m from the annotated object, but the "
+        f"evaluation scored the object at a box it interpolated {r.offset_m:.1f} m from the annotation, out of the "
+        "track's reach"
+        for o in away
+    ]
+
+
 def _miss(f: Finding) -> list[str]:
     s = f.sighting(f.frame)
     if s is None or f.gt_id is None:
@@ -932,9 +947,10 @@ def _miss(f: Finding) -> list[str]:
     inside = f"{s.points} LiDAR and radar points in its box"
     parts = []
     if s.nearest_any is None and s.points == 0:
+        carried = "" if s.on_it else ", and no track carried it through"  # said only of an object no track was on
         parts.append(
             f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and no detection "
-            f"within {NEAR_M:.0f} m, and no track carried it through"
+            f"within {NEAR_M:.0f} m{carried}"
         )
     elif s.nearest_any is None:
         parts.append(
@@ -980,6 +996,7 @@ def _miss(f: Finding) -> list[str]:
     if g is not None and g.status is GtStatus.INTERPOLATED and g.offset_m >= 0.05:
         parts.append(f"the evaluation scored it at a box it interpolated, {g.offset_m:.1f} m from the annotation")
         parts.append(_between(g).removeprefix(" "))
+    parts += _out_of_reach_on_it(f, s)
     for o in s.on_it:
         if o.evaluated is not None and f.frame not in o.evaluated.kept and f.frame in o.evaluated.submitted:
             parts.append(

@@ -621,3 +621,24 @@ def test_a_last_output_on_the_object_the_devkit_did_not_match_there_is_caught() 
         "the evaluation last matched track 5 to it at frame 1",
     ):
         assert [c.kind for c in check_text(said, ctx, None, ev).found] == ["matched"], said
+
+
+def test_no_track_carrying_an_object_a_track_was_on_and_a_reach_the_devkit_did_not_take_are_caught() -> None:
+    # dev set scene-0757 megvii prob3dmot miss:133 (track 200 1.8 m from the annotation, 2.1 m from the devkit's box)
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 0)}])
+    ev = _eval()
+    ev.boxes[3] = [("200", C, (0.0, -1.8))]
+    ev.submitted[3] = {"200"}
+    ev.evaluated_gt[(3, GT_A)] = (0.0, 0.3)  # interpolated (not kept): 2.1 m from track 200's box
+    ctx = Context(C, 3, GT_A, kind="miss")
+    said = "no detection within 2 m, and no track carried it through"
+    assert [c.kind for c in check_text(said, ctx, None, ev, scene=scene).found] == ["output"]
+    reach = (
+        "at frame 3 track 200 was output 1.8 m from the annotated object, but the evaluation scored the object at a "
+        "box it interpolated 0.3 m from the annotation, out of the track's reach"
+    )
+    assert check_text(reach, ctx, None, ev, scene=scene).found == []
+    ev.evaluated_gt[(3, GT_A)] = (0.0, -0.3)  # 1.5 m from the track's box: within the devkit's reach
+    assert [c.kind for c in check_text(reach, ctx, None, ev, scene=scene).found] == ["evaluation"]

@@ -224,3 +224,26 @@ def test_last_on_it_says_where_the_evaluation_scored_the_object_out_of_the_track
         "track 47 was last output on it at frame 11 (at frame 8, though, the evaluation scored the object at a box it "
         "interpolated 2.6 m from the annotation, out of the track's reach)" in line
     )
+
+
+def test_an_unseen_object_a_track_was_on_is_not_said_to_be_carried_by_no_track() -> None:
+    # dev set scene-0757 megvii prob3dmot miss:133: "no track carried it through" of a truck track 200 was output
+    # 1.8 m from (coasting); the devkit's box, interpolated 0.3 m off the annotation, lay 2.1 m from the track
+    from gnnpmb.eval.evaluated import GtFrame, GtStatus
+    from gnnpmb.why.findings import EvaluatedReach, OnObject
+
+    evaluated = TrackEval((13,), (13,), (), 0.7, 0.7)
+    g = GtFrame(13, GtStatus.INTERPOLATED, (0.0, 0.0), (0.3, 0.0), None, 0, 20.0, 50.0)
+    on = OnObject(200, 1.8, 0.66, -1, evaluated, 0.59, false_here=True)
+    seen = Sighting(13, 0, g, None, None, None, (on,))
+    blame = (Blame(Rule.INTERPOLATED, (13,)),)
+    reach = EvaluatedReach(0.3, (), (200,))
+    (line, _) = why_lines(finding(FailureKind.MISS, sightings=(seen,), blame=blame, reach=reach))
+    assert "carried it through" not in line
+    assert (
+        "at frame 13 track 200 was output 1.8 m from the annotated object, but the evaluation scored the object at a "
+        "box it interpolated 0.3 m from the annotation, out of the track's reach" in line
+    )
+    alone = Sighting(13, 0, g, None, None, None, ())
+    (line, _) = why_lines(finding(FailureKind.MISS, sightings=(alone,), blame=(Blame(Rule.UNSEEN, (13,)),)))
+    assert "no detection within 2 m, and no track carried it through" in line
