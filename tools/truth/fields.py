@@ -216,20 +216,21 @@ def _update_of(src: Sources, x: int, c: str, track: int) -> int | None:
 
 def failed_here(ev: EvalFacts, kind: str, c: str, x: int, gt_id: str | None, place) -> bool | None:
     """Whether a run (its devkit bookkeeping ``ev``) had a failure of ``kind`` at frame ``x`` on object ``gt_id``
-    (or, without one, a false track within ``NEAR_M`` of ``place``); None: not decidable from the bookkeeping (an
-    identity theft that is no first-generation one)."""
+    of class ``c`` (or, without one, a false track of any class within ``NEAR_M`` of ``place``); None: a kind the
+    bookkeeping does not decide here."""
     pairs = ev.gt_to_track.get((c, x), {})
     if kind in ("id_switch", "identity_theft"):
         return gt_id is not None and gt_id in ev.switches.get((c, x), set())
     if kind == "miss":
         return gt_id is not None and gt_id in pairs and pairs[gt_id] is None
-    if kind == "false_track":
+    if kind == "false_track":  # a false track of any class within reach of the place
         if gt_id is not None or place is None:
             return False  # a false track is about a place: no failure of it names an object
-        at = ev.pred_xy.get((c, x), {})
         return any(
-            g is None and t in at and math.hypot(at[t][0] - place[0], at[t][1] - place[1]) < NEAR_M
-            for t, g in ev.track_to_gt.get((c, x), {}).items()
+            g is None and (p := ev.pred_xy.get((k, y), {}).get(t)) is not None and math.dist(p, place) < NEAR_M
+            for (k, y), tracks in ev.track_to_gt.items()
+            if y == x
+            for t, g in tracks.items()
         )
     if gt_id is None:
         return False
@@ -506,18 +507,8 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             far = at is not None and math.dist(at, f.false_output.output_xy_m) >= NEAR_M
             if status != "interpolated" or not far:
                 return "the evaluation's box of the object is within the track's reach"
-        elif name == "INTERPOLATED":  # far from the annotation, or out of reach of a counted track on it
-            status, at = src.status(x, f.gt_id)
-            if status != "interpolated" or xy is None:
-                return "the evaluation scored no interpolated box"
-            threshold = src.ev.thresholds.get(c) or 0.0
-            counted = [
-                t
-                for t in _boxes_on(src, x, c, xy)
-                if x in src.kept_frames(int(t)) and src.ev.averaged.get(t, (0, -math.inf))[1] >= threshold
-            ]
-            reach = [t for t in counted if math.dist(next(p for tt, _, p in src.ev.boxes[x] if tt == t), at) < NEAR_M]
-            if math.dist(at, xy) < EVALUATED_OFFSET_M and set(counted) <= set(reach):
+        elif name == "INTERPOLATED":  # of one of the failure's objects (a coalescence's covered one too)
+            if not any(_interpolated_decided(src, x, c, g) for g in (f.gt_id, *f.covered) if g is not None):
                 return "the evaluation scored no far interpolated box, nor one out of a counted track's reach"
         elif name == "DETECTION_UNUSED":
             if xy is None:
@@ -569,6 +560,24 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
         if tuple(gaps) != tuple(frames):
             return f"frames without a detection: {gaps}"
     return ""
+
+
+def _interpolated_decided(src: Sources, x: int, c: str, gt_id: str) -> bool:
+    """Whether the devkit scored object ``gt_id`` at ``x`` at an interpolated box ``EVALUATED_OFFSET_M`` or more
+    from its annotation, or 2 m or more from a counted track's box within 2 m of the annotation."""
+    status, at = src.status(x, gt_id)
+    xy = src.gt_xy(x, gt_id)
+    if status != "interpolated" or xy is None:
+        return False
+    if math.dist(at, xy) >= EVALUATED_OFFSET_M:
+        return True
+    threshold = src.ev.thresholds.get(c) or 0.0
+    counted = [
+        t
+        for t in _boxes_on(src, x, c, xy)
+        if x in src.kept_frames(int(t)) and src.ev.averaged.get(t, (0, -math.inf))[1] >= threshold
+    ]
+    return any(math.dist(next(p for tt, _, p in src.ev.boxes[x] if tt == t), at) >= NEAR_M for t in counted)
 
 
 def _boxes_on(src: Sources, x: int, c: str, xy: np.ndarray | None) -> list[str]:
