@@ -435,9 +435,10 @@ class _Context:
         )
 
     def evaluation_blame(self) -> tuple[Blame, ...]:
-        """The evaluation's tests at the failure frame for the failure's objects."""
+        """The evaluation's tests at the failure frame for the finding's object (a coalescence's is its first
+        missed one: its other objects are not what the finding is about)."""
         out = []
-        for gt_id in self.failure.gt_ids:
+        for gt_id in self.failure.gt_ids[1:2] if self.failure.kind is FailureKind.COALESCENCE else self.failure.gt_ids:
             g = self.report.gt_frame(gt_id, self.f)
             if g is None:
                 continue

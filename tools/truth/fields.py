@@ -507,8 +507,8 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             far = at is not None and math.dist(at, f.false_output.output_xy_m) >= NEAR_M
             if status != "interpolated" or not far:
                 return "the evaluation's box of the object is within the track's reach"
-        elif name == "INTERPOLATED":  # of one of the failure's objects (a coalescence's covered one too)
-            if not any(_interpolated_decided(src, x, c, g) for g in (f.gt_id, *f.covered) if g is not None):
+        elif name == "INTERPOLATED":
+            if f.gt_id is None or not _interpolated_decided(src, x, c, f.gt_id):
                 return "the evaluation scored no far interpolated box, nor one out of a counted track's reach"
         elif name == "DETECTION_UNUSED":
             if xy is None:
@@ -524,7 +524,8 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
                     return f"track {f.lost.track_id} used m{nearest} at frame {x}"
         elif name == "TRACK_DROPPED" and (false_track is not None or f.kind.value == "coalescence"):
             t = false_track if false_track is not None else f.track_ids[0]
-            if src.box(x, t) is None or x in src.kept_frames(t):
+            on = _boxes_on(src, x, c, xy) if false_track is None else []  # a coalescence: or a track on its object
+            if (src.box(x, t) is None or x in src.kept_frames(t)) and all(x in src.kept_frames(int(u)) for u in on):
                 return "the track's box was not dropped there"
         elif name == "TRACK_INTERPOLATED":
             t = false_track if false_track is not None else f.track_ids[0]

@@ -247,3 +247,16 @@ def test_an_unseen_object_a_track_was_on_is_not_said_to_be_carried_by_no_track()
     alone = Sighting(13, 0, g, None, None, None, ())
     (line, _) = why_lines(finding(FailureKind.MISS, sightings=(alone,), blame=(Blame(Rule.UNSEEN, (13,)),)))
     assert "no detection within 2 m, and no track carried it through" in line
+
+
+def test_a_coalesced_objects_interpolated_box_is_said_where_it_makes_the_finding_the_evaluations() -> None:
+    # dev set scene-1077 megvii phd coalescence:25: "the evaluation's doing" said of a coalescence whose text named
+    # no interpolation (the blame came from another object of the failure); now only the finding's object counts,
+    # and its interpolated box is named
+    from gnnpmb.eval.evaluated import GtFrame, GtStatus
+
+    g = GtFrame(13, GtStatus.INTERPOLATED, (0.0, 0.0), (0.6, 0.0), None, 0, 20.0, 40.0)
+    seen = Sighting(13, 0, g, None, None, None, ())
+    f = finding(FailureKind.COALESCENCE, sightings=(seen,), blame=(Blame(Rule.INTERPOLATED, (13,)),), covered=(GT,))
+    (line, _) = why_lines(f)
+    assert "the evaluation scored GT bf3d85 at a box it interpolated, 0.6 m from the annotation" in line
