@@ -1,5 +1,5 @@
 """What a finding asserts, as atomic typed claims, so each can be checked against facts gathered apart from the
-explanation code (the tracker's submission, its raw events, the devkit's evaluation): ``tools.oracle`` does.
+explanation code (the tracker's submission, its raw events, the devkit's evaluation): ``tools.truth.fields`` does.
 
 Every sentence of ``words`` is rendered from the fields these claims are drawn from; a claim that fails is a
 sentence a user would catch being wrong.

@@ -23,7 +23,8 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   (``COVERED_TWO``), or the object had no LiDAR or radar points, so no detector could see it, and no track carried
   it (``UNSEEN``);
 * **the evaluation's**: the box the object was scored against is an interpolation ``EVALUATED_OFFSET_M`` or more
-  from the annotation (``INTERPOLATED``), or the evaluation has no box of the object there, beyond its range or
+  from the annotation, or one that put a counted track output within ``NEAR_M`` of the annotation out of the
+  devkit's ``NEAR_M`` (``INTERPOLATED``), or the evaluation has no box of the object there, beyond its range or
   for want of points (``NO_EVAL_BOX``), or the false track's box is one the evaluation interpolated between two of
   the track's boxes, at a frame the tracker did not output it (``TRACK_INTERPOLATED``), or a track output on the
   object was dropped there by the evaluation's range or bike-rack filter (``TRACK_DROPPED``).
@@ -189,7 +190,9 @@ class LostTrack:
     it has no step of its own but a cost matrix of a hypothesis other than the chosen one had its column (PMBM: it
     was held only by hypotheses the tracker did not choose, so it was not gone); finite_elsewhere: (frame,
     detection) pairs its column could not take in the chosen hypothesis's matrix but another hypothesis's matrix
-    gave a finite cost (PMBM)."""
+    gave a finite cost (PMBM); matched_until: the last frame before the failure at which the evaluation matched
+    the object to a track (the devkit's memory of its last match, which for a lost object is this track: None if
+    none)."""
 
     track_id: int
     held_until: int | None
@@ -199,6 +202,7 @@ class LostTrack:
     threshold: float | None
     elsewhere: tuple[int, ...] = ()
     finite_elsewhere: tuple[tuple[int, int], ...] = ()
+    matched_until: int | None = None
 
     def step(self, frame: int) -> TrackStep | None:
         return next((s for s in self.steps if s.frame == frame), None)

@@ -542,11 +542,19 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     t = lost.track_id
     steps = lost.steps
     parts = []
-    if lost.held_until is not None:
+    held, matched = lost.held_until, lost.matched_until
+    if matched is not None:
         # "last on it" is not "last output": say where it was output after, away from the object
-        away = [s.frame for s in steps if lost.held_until < s.frame < f.frame and s.output is not None]
+        after = held if held is not None else -1
+        away = [s.frame for s in steps if after < s.frame < f.frame and s.output is not None]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
-        parts.append(f"track {t} was last output on it at frame {lost.held_until}{elsewhere}{_scored_away(f, lost)}")
+        # "on it" reads as the evaluation's match: said only where the devkit's last match was that output
+        last = (
+            f"track {t} was last output on it at frame {held}"
+            if held == matched
+            else f"the evaluation last matched track {t} to it at frame {matched}"
+        )
+        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]
@@ -690,7 +698,7 @@ def _lost_object(f: Finding) -> list[str]:
         s = f.sighting(f.frame)
         for b in f.blame:
             if b.rule is Rule.COVERED_TWO and s is not None:
-                ids = ", ".join(str(o.track_id) for o in s.on_it if o.counted and not o.false_here)
+                ids = _covering(s)
                 parts.append(
                     f"at frame {f.frame} track {ids} lay within {NEAR_M:.0f} m of it and was counted, but the "
                     "evaluation matched it to another object: one track for two objects"
@@ -915,6 +923,51 @@ def _no_box_reason(g: GtFrame | None) -> str:
     return f"{why}, so its box was dropped, and no box could be interpolated"
 
 
+def _covering(s: Sighting) -> str:
+    """The counted tracks on the object that the evaluation matched to another object: no false track there, and
+    their box kept by the evaluation (one it dropped was matched to nothing)."""
+    return ", ".join(
+        str(o.track_id)
+        for o in s.on_it
+        if o.counted and not o.false_here and o.evaluated is not None and s.frame in o.evaluated.kept
+    )
+
+
+def _not_counted_on_it(f: Finding, s: Sighting) -> list[str]:
+    """The tracks output on the object whose averaged score the class threshold did not reach."""
+    return [
+        f"track {o.track_id} was output on it (score {o.score:.2f}), but {averaged_text(o.evaluated)}, is below the "
+        f"{f.class_name} threshold {o.threshold:.3f}: the evaluation did not count it"
+        for o in s.on_it
+        if not o.counted and o.evaluated is not None and o.evaluated.averaged_score is not None
+    ]
+
+
+def _dropped_on_it(f: Finding, s: Sighting) -> list[str]:
+    """The tracks output on the object whose box there the evaluation's range or bike-rack filter dropped."""
+    return [
+        f"track {o.track_id} was output on it, but its box lies beyond the evaluation's range for the class (or in a "
+        "bike rack): the evaluation dropped that box"
+        for o in s.on_it
+        if o.evaluated is not None and f.frame not in o.evaluated.kept and f.frame in o.evaluated.submitted
+    ]
+
+
+def _out_of_reach_on_it(f: Finding, s: Sighting) -> list[str]:
+    """The counted tracks output on the object that the evaluation's interpolated box put out of the devkit's reach
+    (``f.reach``, with the blame ``INTERPOLATED``): a miss beside a track that was on the annotation."""
+    r = f.reach
+    if r is None:
+        return []
+    away = [o for o in s.on_it if o.counted and o.track_id in r.near_annotated and o.track_id not in r.near_evaluated]
+    return [
+        f"at frame {f.frame} track {o.track_id} was output {o.distance_m:.1f} m from the annotated object, but the "
+        f"evaluation scored the object at a box it interpolated {r.offset_m:.1f} m from the annotation, out of the "
+        "track's reach"
+        for o in away
+    ]
+
+
 def _miss(f: Finding) -> list[str]:
     s = f.sighting(f.frame)
     if s is None or f.gt_id is None:
@@ -924,9 +977,10 @@ def _miss(f: Finding) -> list[str]:
     inside = f"{s.points} LiDAR and radar points in its box"
     parts = []
     if s.nearest_any is None and s.points == 0:
+        carried = "" if s.on_it else ", and no track carried it through"  # said only of an object no track was on
         parts.append(
             f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and no detection "
-            f"within {NEAR_M:.0f} m, and no track carried it through"
+            f"within {NEAR_M:.0f} m{carried}"
         )
     elif s.nearest_any is None:
         parts.append(
@@ -954,16 +1008,11 @@ def _miss(f: Finding) -> list[str]:
         )
         if s.went is not None and s.went.track_id >= 0 and s.went.track_id not in {o.track_id for o in s.on_it}:
             parts.append(f"track {s.went.track_id} was not output on it")
-    for o in s.on_it:
-        if not o.counted and o.evaluated is not None and o.evaluated.averaged_score is not None:
-            parts.append(
-                f"track {o.track_id} was output on it (score {o.score:.2f}), but {averaged_text(o.evaluated)}, is "
-                f"below the {f.class_name} threshold {o.threshold:.3f}: the evaluation did not count it"
-            )
+    parts += _not_counted_on_it(f, s)
     if s.nearest_own is not None and not s.on_it:
         parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
     if any(b.rule is Rule.COVERED_TWO for b in f.blame):
-        covering = ", ".join(str(o.track_id) for o in s.on_it if o.counted and not o.false_here)
+        covering = _covering(s)
         parts.append(
             f"track {covering} lay within {NEAR_M:.0f} m of it and was counted, but the evaluation matched it to "
             "another object: one track for two objects"
@@ -972,12 +1021,8 @@ def _miss(f: Finding) -> list[str]:
     if g is not None and g.status is GtStatus.INTERPOLATED and g.offset_m >= 0.05:
         parts.append(f"the evaluation scored it at a box it interpolated, {g.offset_m:.1f} m from the annotation")
         parts.append(_between(g).removeprefix(" "))
-    for o in s.on_it:
-        if o.evaluated is not None and f.frame not in o.evaluated.kept and f.frame in o.evaluated.submitted:
-            parts.append(
-                f"track {o.track_id} was output on it, but its box lies beyond the evaluation's range for the class "
-                "(or in a bike rack): the evaluation dropped that box"
-            )
+    parts += _out_of_reach_on_it(f, s)
+    parts += _dropped_on_it(f, s)
     if g is not None and abs(g.ego_distance_m - g.range_m) <= 5.0:
         side = "inside" if g.ego_distance_m < g.range_m else "beyond"
         parts.append(
@@ -1006,6 +1051,13 @@ def _coalescence(f: Finding) -> list[str]:
     ]
     if s is None:
         return parts
+    g = s.evaluated
+    if any(b.rule is Rule.INTERPOLATED for b in f.blame) and g is not None and g.status is GtStatus.INTERPOLATED:
+        parts.append(
+            f"the evaluation scored GT {short_id(f.gt_id or '')} at a box it interpolated, {g.offset_m:.1f} m from "
+            f"the annotation;{_between(g)}".removesuffix(";")
+        )
+        parts += _out_of_reach_on_it(f, s)
     mode = UseMode(f.mode)
     if s.nearest_any is None:
         parts.append(
@@ -1029,7 +1081,7 @@ def _coalescence(f: Finding) -> list[str]:
             f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) was dropped by "
             "preprocessing (score threshold or NMS)"
         )
-    return parts
+    return parts + _not_counted_on_it(f, s) + _dropped_on_it(f, s)  # the evaluation's tests on its own tracks
 
 
 def _others(f: Finding) -> list[str]:

@@ -10,11 +10,13 @@ presets, mini_train detections for the 8 mini_train scenes) is ``-m exhaustive``
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
 
 import pytest
 
+from gnnpmb.foreign import OnHow
 from gnnpmb.registry import TRACKER_NAMES
 from tools.truth import __main__ as truth_main
 from tools.truth.__main__ import PRESETS, other_of, run_cell, run_scene
@@ -77,8 +79,32 @@ def test_no_checkable_sentence_about_a_results_file_is_false(tmp_path: Path) -> 
     detections = DEVSET / "detections" / "pointpillars_mini_val.json"
     cv = _cv_results("scene-0916", detections, tmp_path / "cv.json")
     where: list = []
-    (tally, findings) = run_scene("scene-0916", "pointpillars", {"cv": None}, DEVSET, where=where, results={"cv": cv})[
-        "cv"
-    ]
-    assert findings > 0 and tally.checked["output"] > 0, "no placement was checked"
+    seen: list = []
+    (tally, findings) = run_scene(
+        "scene-0916",
+        "pointpillars",
+        {"cv": None},
+        DEVSET,
+        where=where,
+        results={"cv": cv},
+        seen=lambda f, src: seen.append((f, src)),
+    )["cv"]
+    assert findings > 0 and tally.checked["output"] > 0 and tally.checked["fields"] > 10 * findings
     assert where == [], [f"{p}: [{c.kind}] {c.sentence} -- {c.truth}" for p, c in where[:5]]
+    # a field made false (the box's placement on a detection) is caught
+    f, src = next((f, s) for f, s in seen if f.boxes_on)
+    frame, track, on = f.boxes_on[0]
+    how = OnHow.NEAREST if on.how is OnHow.SAME_BOX else OnHow.SAME_BOX
+    lie = dataclasses.replace(f, boxes_on=((frame, track, dataclasses.replace(on, how=how)),))
+    assert any("output on" in p for p in _field_problems(lie, src))
+    moved = dataclasses.replace(f, boxes_on=((frame, track, dataclasses.replace(on, meas=on.meas + 1)),))
+    assert _field_problems(moved, src)
+
+
+def _field_problems(f, src) -> list[str]:
+    from tools.truth.fields import check_fields
+    from tools.truth.sentences import Tally
+
+    out = Tally()
+    check_fields(f, src, out, lambda kind, sentence, why: out.found.append(f"{sentence}: {why}"))
+    return out.found

@@ -602,3 +602,43 @@ def test_a_coalesced_object_said_to_have_no_detection_of_its_own_is_checked() ->
         assert [c.kind for c in check_text(said.format(gt, points), at2, None, _eval(), scene=_scene()).found] == [
             "detector"
         ]
+
+
+def test_a_last_output_on_the_object_the_devkit_did_not_match_there_is_caught() -> None:
+    # independent audit, dev set (ab3dmot scene-0655 centerpoint id_switch:13; prob3dmot scene-0553 megvii
+    # id_switch:9, identity_theft:1): "last output on it at frame F" where the devkit's last match was at F-1
+    # (no box of the object at F, or track 7 matched to another object there)
+    ev = _eval()
+    ev.gt_to_track[(C, 1)] = {GT_A: "7"}
+    ev.gt_to_track[(C, 2)] = {GT_B: "7"}  # track 7 output by GT A at frame 2, but matched to GT B there
+    ev.submitted.update({1: {"7"}, 2: {"7"}})
+    ctx = Context(C, 3, GT_A, kind="id_switch", lost=7)
+    for said in ("track 7 was last output on it at frame 1", "the evaluation last matched track 7 to it at frame 1"):
+        assert check_text(said, ctx, None, ev).found == [], said
+    for said in (
+        "track 7 was last output on it at frame 2",
+        "the evaluation last matched track 7 to it at frame 2",
+        "the evaluation last matched track 5 to it at frame 1",
+    ):
+        assert [c.kind for c in check_text(said, ctx, None, ev).found] == ["matched"], said
+
+
+def test_no_track_carrying_an_object_a_track_was_on_and_a_reach_the_devkit_did_not_take_are_caught() -> None:
+    # dev set scene-0757 megvii prob3dmot miss:133 (track 200 1.8 m from the annotation, 2.1 m from the devkit's box)
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 0)}])
+    ev = _eval()
+    ev.boxes[3] = [("200", C, (0.0, -1.8))]
+    ev.submitted[3] = {"200"}
+    ev.evaluated_gt[(3, GT_A)] = (0.0, 0.3)  # interpolated (not kept): 2.1 m from track 200's box
+    ctx = Context(C, 3, GT_A, kind="miss")
+    said = "no detection within 2 m, and no track carried it through"
+    assert [c.kind for c in check_text(said, ctx, None, ev, scene=scene).found] == ["output"]
+    reach = (
+        "at frame 3 track 200 was output 1.8 m from the annotated object, but the evaluation scored the object at a "
+        "box it interpolated 0.3 m from the annotation, out of the track's reach"
+    )
+    assert check_text(reach, ctx, None, ev, scene=scene).found == []
+    ev.evaluated_gt[(3, GT_A)] = (0.0, -0.3)  # 1.5 m from the track's box: within the devkit's reach
+    assert [c.kind for c in check_text(reach, ctx, None, ev, scene=scene).found] == ["evaluation"]

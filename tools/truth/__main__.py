@@ -2,9 +2,10 @@
 
 Per cell it runs the tracker once (a ``ListSink`` beside the fact sink), finds and explains its failures
 (``gnnpmb.why``), renders each finding as ``gnnpmb failures --why`` prints it, and checks every checkable sentence
-(``tools.truth.sentences``) against the devkit's own matching (``tools.truth.devkit``), the raw events
-(``tools.truth.rawevents``) and replays (``tools.truth.replay``). Prints contradictions per tracker and per class
-and the counterfactual replays checked / refuted; exit 1 when any contradiction is found.
+(``tools.truth.sentences``) and every typed field of the finding (``tools.truth.fields``) against the devkit's own
+matching (``tools.truth.devkit``), the raw events (``tools.truth.rawevents``), the files and replays
+(``tools.truth.replay``). ``--demo``: the demo world instead of the dev set. Prints contradictions per tracker and
+per class and the counterfactual replays checked / refuted; exit 1 when any contradiction is found.
 """
 
 from __future__ import annotations
@@ -12,9 +13,10 @@ from __future__ import annotations
 import argparse
 import sys
 from collections import defaultdict
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
+from tools.truth import fields
 from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
 
 DEVSET = next(
@@ -56,14 +58,21 @@ def run_scene(
     version: str = "v1.0-mini",
     where: list[tuple[str, Contradiction]] | None = None,
     results: Mapping[str, Path] | None = None,
+    detections: Path | None = None,
+    focus: bool = False,
+    seen: Callable[[object, fields.Sources], None] | None = None,
 ) -> dict[str, tuple[Tally, int]]:
     """``run_cell`` for several trackers on one scene and preset (tracker -> the run its findings compare with, or
     None), each tracker run and evaluated once: the cells of a row of the matrix share their other run. results:
     name -> a results file of a tracker outside the project, made on the same detections (its findings checked
-    against the file: it has no events); a name of ``trackers`` may be one of them."""
+    against the file: it has no events); a name of ``trackers`` may be one of them. detections: the detection file
+    (default: the dev set's of ``preset`` and the scene's split). focus: also render each finding's focus document
+    (``gnnpmb-viz --focus``'s summary, the run beside it included) and check it for a ``?`` placeholder. seen: called
+    with each finding and the sources its fields were checked against."""
     where = [] if where is None else where
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.submission import run_results
+    from gnnpmb.registry import tracker_keeps_detection_box
     from gnnpmb.stages.evaluation import find_reports
     from gnnpmb.stages.findings import evidence_of
     from gnnpmb.stages.inputs import load_inputs
@@ -76,7 +85,7 @@ def run_scene(
     from tools.truth.rawevents import RawEvents
     from tools.truth.scene import SceneTruth
 
-    detections = dataroot / "detections" / f"{preset}_{split_of_scene(scene)}.json"
+    detections = detections or dataroot / "detections" / f"{preset}_{split_of_scene(scene)}.json"
     results = dict(results or {})
     names = list(dict.fromkeys([*trackers, *(o for o in trackers.values() if o is not None)]))
     files = [f"{n}={p}" for n, p in results.items() if n in names]
@@ -102,6 +111,11 @@ def run_scene(
         return facts[name]
 
     truth = SceneTruth.read(nusc, scene, detections)
+    keeps = {n: n in results or tracker_keeps_detection_box(str(request.spec(n).tracker)) for n in trackers}
+
+    def found(tally: Tally):
+        return lambda kind, sentence, why: tally.found.append(Contradiction(kind, sentence, why))
+
     out = {}
     for tracker, other in trackers.items():
         rest = [other] if other is not None and other != tracker else []
@@ -126,10 +140,53 @@ def run_scene(
                 f.false_output.track_id if f.false_output is not None else None,
             )
             one = check_text(text, ctx, raw, ev, tracker, truth, others)
+            sources = fields.Sources(truth, raw, ev, others, keeps[tracker])
+            fields.check_fields(f, sources, one, found(one))
+            if focus:
+                _check_focus(fid, f, request, {n: reports[n] for n in [tracker, *rest]}, evidence, one)
+            if seen is not None:
+                seen(f, sources)
             tally.add(one)
             where.extend((f"{tracker} {scene} {preset} {fid}", c) for c in one.found)
         out[tracker] = (tally, len(report.failures))
     return out
+
+
+def _check_focus(fid: str, finding, request, reports: Mapping, evidence: Mapping, out: Tally) -> None:
+    """The focus document of failure ``fid`` (its summary, as ``gnnpmb-viz --focus`` shows it with the runs of
+    ``reports``) holds no ``?`` placeholder."""
+    from gnnpmb.focus import resolve_focus
+    from gnnpmb.why.story import Storyteller
+    from viz.focus_summary import TrackerView, focus_markdown
+
+    views = {}
+    for name in reports:
+        ev = evidence[name]
+        teller = Storyteller(ev.facts)
+        story = tuple(line for x in ev.facts.frame_indices for line in teller.frame_lines(x))
+        views[name] = TrackerView(ev, request.capabilities(name).has_gates, story, frozenset(teller.shown_ever))
+    estimates = {n: [fr.estimates for fr in evidence[n].run.frames] for n in reports}
+    target = resolve_focus(fid, request.scene, reports, estimates, request.frame_range)
+    doc = focus_markdown(target, finding, views, target.window(request.frame_range), request.scene)
+    out.checked["misleading"] += 1
+    doc = doc.replace("?url=", "")
+    if "?" in doc:
+        at = doc.index("?")
+        out.found.append(Contradiction("misleading", doc[max(0, at - 60) : at + 1], "a placeholder in the focus doc"))
+
+
+def demo_detections(dataroot: Path, scene: str, preset: str, folder: Path) -> Path:
+    """The demo world's simulated detector (``preset``, seed 0) on ``scene`` written as a detection file in
+    ``folder``: the boxes the tracker gets with ``--detector preset``, and the file the checker reads them from."""
+    from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
+    from gnnpmb.data.simdet import to_submission
+    from gnnpmb.eval.submission import write_json
+    from gnnpmb.pipeline import get_detections
+
+    data = load_scene(resolve_dataroot(dataroot, None, (scene,)), scene)
+    path = folder / f"{preset}_{scene}.json"
+    write_json(path, to_submission(get_detections(data, None, preset, 0)))
+    return path
 
 
 def other_of(tracker: str, other: str) -> str:
@@ -155,9 +212,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--all-scenes", action="store_true", help="all ten: mini_val and mini_train")
     parser.add_argument("--detector", action="append", help="presets (default: all three)")
     parser.add_argument("--tracker", action="append", help="trackers (default: all)")
-    parser.add_argument("--dataroot", type=Path, default=DEVSET)
+    parser.add_argument("--dataroot", type=Path, default=None, help="default: the dev set (the demo with --demo)")
+    parser.add_argument(
+        "--demo", action="store_true", help="the demo world (its val and staged scenes, simulated detector presets)"
+    )
     parser.add_argument("--other", default="pmbm", help="the run findings compare with ('none': no other run)")
     parser.add_argument("--square", action="store_true", help="each tracker once over the scenes and presets")
+    parser.add_argument(
+        "--focus", action="store_true", help="also check each finding's focus document (on by default with --demo)"
+    )
     parser.add_argument(
         "--results",
         action="append",
@@ -170,6 +233,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     findings: dict[str, int] = defaultdict(int)
     where: list[tuple[str, Contradiction]] = []
     scenes = MINI_VAL + MINI_TRAIN if args.all_scenes else (args.scene or MINI_VAL)
+    dataroot, folder = args.dataroot or DEVSET, None
+    if args.demo:
+        import tempfile
+
+        from gnnpmb.data.demo import DEMO_SCENES, ensure_demo_dataset
+        from gnnpmb.data.demo_staged import STAGED_SCENES
+
+        scenes = tuple(args.scene or DEMO_SCENES + STAGED_SCENES)
+        dataroot = args.dataroot or ensure_demo_dataset(DEMO_SCENES + STAGED_SCENES)
+        folder = Path(tempfile.mkdtemp(prefix="truth-demo-"))
     files = {spec.split("=", 1)[0]: Path(spec.split("=", 1)[1]) for spec in args.results}
     todo = cells(scenes, args.detector or PRESETS, args.tracker or ([] if files else TRACKER_NAMES), args.square)
     todo += [(s, p, name) for s in scenes for p in args.detector or PRESETS for name in files]
@@ -178,7 +251,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         rows[(scene, preset)][tracker] = None if args.other == "none" else other_of(tracker, args.other)
     for (scene, preset), row in rows.items():
         here: list[tuple[str, Contradiction]] = []
-        for tracker, (tally, n) in run_scene(scene, preset, row, args.dataroot, where=here, results=files).items():
+        detections = demo_detections(dataroot, scene, preset, folder) if folder is not None else None
+        focus = args.focus or args.demo
+        done = run_scene(scene, preset, row, dataroot, where=here, results=files, detections=detections, focus=focus)
+        for tracker, (tally, n) in done.items():
             per[tracker].add(tally)
             findings[tracker] += n
             line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)

@@ -37,7 +37,9 @@ ITS_DETECTION = re.compile(rf"its detection m(\d+) \(score ({_F}), ({_F}) m away
 OTHER_CLASS = re.compile(rf"at ({_FRAMES}) the detector saw it only as another class \(([^)]*)\)")
 OTHER_ITEM = re.compile(rf"(\w+) m(\d+) ({_F}) m away")
 EGO = re.compile(rf"it lies ({_F}) m from the ego vehicle, (inside|beyond) the evaluation's ({_F}) m range")
-INTERPOLATED_AT = re.compile(rf"the evaluation scored it at a box it interpolated, ({_F}) m from the annotation")
+INTERPOLATED_AT = re.compile(
+    rf"the evaluation scored (?:it|GT \w{{6}}) at a box it interpolated, ({_F}) m from the annotation"
+)
 PRESENCE = re.compile(
     rf"in the (\d+) recorded frames up to (\d+) \((\d+)–(\d+)\), GT (\w+) had an? (\w+) detection "
     rf"(?:the tracker kept )?within 2 m at ({_FRAMES}|no frame)(?: only)?"

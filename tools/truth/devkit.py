@@ -46,6 +46,8 @@ class EvalFacts:
     """(frame, track id) -> the submission box's size, rotation and centre height (``scene.Detection.box``)."""
     averaged: dict[str, tuple[int, float]] = field(default_factory=dict)
     """track id -> (frames the devkit's filters kept its box, the score ``create_tracks`` averaged over them)."""
+    kept_frames: dict[str, tuple[int, ...]] = field(default_factory=dict)
+    """track id -> the frames at which the devkit's filters kept its box (those ``averaged`` is over)."""
     kept_gt: set[tuple[int, str]] = field(default_factory=set)
     """(frame, object id) of each annotated box the devkit's filters kept (the ends its interpolation joins)."""
     stamps: dict[int, int] = field(default_factory=dict)
@@ -102,9 +104,13 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         kept_gt = [(t, str(b.tracking_id)) for t in tokens for b in gt[t]]  # create_tracks adds its interpolations
         pred = filter_eval_boxes(nusc, add_center_dist(nusc, pred), cfg.class_range, verbose=False)
         kept_pred = [str(b.tracking_id) for t in tokens for b in pred[t]]
+        kept_at = [(t, str(b.tracking_id)) for t in tokens for b in pred[t]]
         tracks_gt = create_tracks(gt, nusc, split, gt=True)
         tracks_pred = create_tracks(pred, nusc, split, gt=False)
     out = EvalFacts()
+    for t, track in kept_at:
+        out.kept_frames.setdefault(track, ())
+        out.kept_frames[track] += (frame_of_stamp[nusc.get("sample", t)["timestamp"]],)
     out.kept_gt = {(frame_of_stamp[nusc.get("sample", t)["timestamp"]], g) for t, g in kept_gt}
     for token in tokens:
         frame = frame_of_stamp[nusc.get("sample", token)["timestamp"]]

@@ -11,7 +11,10 @@
   frame x": one of the three;
 * "at frame x it used mN (p P), mK (p Q) +n more": the track's row of the frame's ``Marginals`` (association
   probabilities): the detections with a share of at least 1 %, most likely first, with those probabilities;
-  "was given mN": the frame's ``Assignment`` pairs mN with the track.
+  "was given mN": the frame's ``Assignment`` pairs mN with the track;
+* "track T was last output on it at frame F" / "the evaluation last matched track T to it at frame F": the last
+  frame before the failure's at which the devkit's accumulator matched the object (MATCH or SWITCH) is F, and to
+  track T ("on it" reads as the evaluation's match; where the track was last within 2 m is the tracker's business).
 """
 
 from __future__ import annotations
@@ -55,6 +58,9 @@ AVERAGED = re.compile(
     r"(?:track (\d+)[^;:]*?|the evaluation counted the track: |track (\d+)'s existence stayed below [^;]*?counted it: )"
     r"its score averaged over (?:its (\d+) frames?|the (\d+) "
     r"of its (\d+) frames the evaluation kept \(within the class range\)), (\d+\.\d{3})"
+)
+LAST_ON_IT = re.compile(
+    r"(?:track (\d+) was last output on it|the evaluation last matched track (\d+) to it) at frame (\d+)"
 )
 USED_SHARE = 0.01
 """The checker's own copy of the share from which an update is said to have used a detection."""
@@ -234,3 +240,22 @@ def _check_used(m: re.Match, c: str, lost: int, raw, out, bad) -> None:
     ok = ok and all(v is None or f"{q:.2f}" == v for (_, q), (_, v) in zip(used, said, strict=False))
     if not ok:
         bad("tracker", m[0], f"the Marginals of frame {x} give track {lost} {[(d, round(v, 3)) for d, v in used]}")
+
+
+def check_last_match(text: str, class_name: str, frame: int, gt_id: str | None, ev, out, bad) -> None:
+    """The sentences "track T was last output on it at frame F" and "the evaluation last matched track T to it at
+    frame F" against the devkit's last MATCH or SWITCH of object ``gt_id`` before ``frame`` (module docstring)."""
+    for m in LAST_ON_IT.finditer(text):
+        t, said = m[1] or m[2], int(m[3])
+        out.checked["matched"] += 1
+        last = max(
+            (x for (c, x), pairs in ev.gt_to_track.items() if c == class_name and x < frame and pairs.get(gt_id)),
+            default=None,
+        )
+        track = ev.matched_track(class_name, last, gt_id) if last is not None else None
+        if (last, track) != (said, t):
+            bad(
+                "matched",
+                m[0],
+                f"the devkit last matched the object before frame {frame} at frame {last} (to track {track})",
+            )

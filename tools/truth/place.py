@@ -8,7 +8,12 @@ against the annotation files and the devkit's own boxes.
 * "… from frames L and R, weighting the two ends the wrong way round (nuscenes-devkit issue #1141): weighted the
   right way the box would lie D m from the annotation": L and R are the nearest frames before and after the
   finding's frame at which the devkit kept the object's box; the box interpolated linearly in time between those
-  two annotations lies D m from the annotation, and the devkit's own box lies at least 0.05 m from it.
+  two annotations lies D m from the annotation, and the devkit's own box lies at least 0.05 m from it;
+* "at frame x track T was (still) output D m from the annotated object, but the evaluation scored the object at a
+  box it interpolated O m from the annotation, out of the track's reach": T's submitted box lies D m from the
+  annotation (under 2 m), the devkit did not keep the annotation there and scored a box O m from it, 2 m or more
+  from T's box;
+* "…, and no track carried it through": no submitted box of the object's class lies within 2 m of its annotation.
 """
 
 from __future__ import annotations
@@ -34,6 +39,39 @@ TRACK_BETWEEN = re.compile(
 PREDICTED = re.compile(
     r"at frame (\d+) track (\d+) \((\w+)\) was output on no detection this frame \(a predicted box\)"
 )
+
+
+OUT_OF_REACH = re.compile(
+    r"at frame (\d+) track (\d+) was (?:still )?output (\d+\.\d) m from the annotated object, but the evaluation "
+    r"scored the object at a box it interpolated (\d+\.\d) m from the annotation, out of the track's reach"
+)
+NOT_CARRIED = "and no track carried it through"
+
+
+def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, out, bad) -> None:
+    """A track on the annotated object out of the reach of the devkit's interpolated box, and "no track carried it
+    through" (module docstring), at the finding's frame ``x``."""
+    a = scene.objects[x].get(gt_id) if scene is not None and gt_id is not None and x < len(scene.objects) else None
+    if a is None:
+        return
+    for m in OUT_OF_REACH.finditer(text):
+        out.checked["evaluation"] += 1
+        y, t = int(m[1]), m[2]
+        at = scene.objects[y].get(gt_id) if y < len(scene.objects) else None
+        box = next((xy for tt, _, xy in ev.boxes.get(y, []) if tt == t), None)
+        scored = ev.evaluated_gt.get((y, gt_id))
+        if at is None or box is None or scored is None or (y, gt_id) in ev.kept_gt:
+            bad("evaluation", m[0], f"no box of track {t}, or the devkit scored the annotation itself at {y}")
+            continue
+        on, off, away = math.dist(box, at.xy_m), math.dist(scored, at.xy_m), math.dist(box, scored)
+        if not (on < NEAR_M and f"{on:.1f}" == m[3] and f"{off:.1f}" == m[4] and away >= NEAR_M):
+            said = f"box {on:.2f} m from the annotation, {away:.2f} m from the devkit's ({off:.2f} off)"
+            bad("evaluation", m[0], said)
+    if NOT_CARRIED in text:
+        out.checked["output"] += 1
+        near = [t for t, cls, xy in ev.boxes.get(x, []) if cls == c and math.dist(xy, a.xy_m) < NEAR_M]
+        if near:
+            bad("output", NOT_CARRIED, f"tracks {near} were output within 2 m of it at frame {x}")
 
 
 NONE_OF_ITS_OWN = re.compile(

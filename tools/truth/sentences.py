@@ -15,8 +15,8 @@ Classes of false statement (the issue's numbering):
 
 and beyond the issue's four: ``detector`` (scores, distances, points, detections in reach: ``detector``), ``other
 run`` (``otherruns``), ``share`` (PHD percentages: ``shares``), ``output`` (a track's box on the object, its score,
-against the submission). ``coverage`` says which clauses of a text any
-pattern reads.
+against the submission), ``fields`` (a finding's typed fields: ``fields``). ``coverage`` says which clauses of a
+text any pattern reads.
 """
 
 from __future__ import annotations
@@ -46,6 +46,7 @@ CLASSES = (
     "cost",
     "hypothesis",
     "evaluation",
+    "fields",
 )
 
 
@@ -177,6 +178,7 @@ def check_text(
         place.check_place(text, c, ctx.frame, where, scene, out, bad)
     place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
+    place.check_out_of_reach(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     place.check_none_of_its_own(text, ctx.frame, scene, out, bad)
     out.checked["misleading"] += 2
     if "?" in text:
@@ -220,6 +222,7 @@ def check_text(
         if t not in ev.submitted.get(x, set()):
             bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
     lost.check_not_output(text, ctx.lost, ev, out, bad)
+    lost.check_last_match(text, c, ctx.frame, ctx.gt_id, ev, out, bad)
     lost.check_averaged(text, ctx.track, ev, out, bad)
     if raw is None:  # a results file: where its boxes sit
         output.check_output(text, c, ctx.lost, scene, ev, out, bad)
