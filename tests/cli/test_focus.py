@@ -216,10 +216,12 @@ def test_bad_focus_is_one_line_and_exit_2(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     """In-process (``tests.inprocess``): the installed script's own error path runs in real processes in
-    ``tests/cli/test_user_errors.py``; what is checked here is the focus's message."""
+    ``tests/cli/test_user_errors.py``; what is checked here is the focus's message. A failure id or an object is
+    looked up in the tracked frames: three of them (``--frames 0:3``) are enough to find that there is none."""
     out = tmp_path / "x.rrd"
+    argv = ["gnnpmb-viz", SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--frames", "0:3", "--focus", focus]
     proc = run_script_with(
-        ["gnnpmb-viz", SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out)],
+        [*argv, "--save", str(out)],
         {"PATH": "/usr/bin:/bin", "NO_COLOR": "1", "HOME": str(tmp_path)},
         tmp_path,
         monkeypatch,
