@@ -83,31 +83,31 @@ def demo_recording(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory
 @pytest.fixture(scope="session")
 def cv_results(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Another tracker's results on the demo's ``mini_val`` scenes (a tracking submission written by
-    ``examples/cv_tracker.py``, a constant-velocity tracker outside the registry, on the centerpoint preset)."""
+    ``examples/cv_tracker.py``, a constant-velocity tracker outside the registry, on the centerpoint preset), made
+    once per session (shared by the xdist workers); read-only."""
     from examples.cv_tracker import track_scenes
     from gnnpmb.data.demo import DEMO_SCENES
     from gnnpmb.eval.submission import SUBMISSION_META, write_json
 
-    path = tmp_path_factory.mktemp("cv") / "cv.json"
-    results = track_scenes(list(DEMO_SCENES), demo_dataroot, None, "centerpoint")
-    write_json(path, {"meta": dict(SUBMISSION_META), "results": results})
-    return path
+    def make(folder: Path) -> None:
+        results = track_scenes(list(DEMO_SCENES), demo_dataroot, None, "centerpoint")
+        write_json(folder / "cv.json", {"meta": dict(SUBMISSION_META), "results": results})
+
+    return made_once(tmp_path_factory, "cv", make) / "cv.json"
 
 
 @pytest.fixture(scope="session")
 def swept_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The demo's scene-0103 built with one LiDAR sweep between keyframes (nuScenes has nine; one keeps the
-    tests quick)."""
+    tests quick), made once per session (shared by the xdist workers); read-only."""
     from gnnpmb.data import demo
 
-    patch = pytest.MonkeyPatch()
-    patch.setattr(demo, "SWEEPS_PER_INTERVAL", 1)
-    try:
-        return demo.generate_demo_dataset(
-            tmp_path_factory.mktemp("swept") / "data", scenes=("scene-0103",), sweeps=True
-        )
-    finally:
-        patch.undo()
+    def make(folder: Path) -> None:
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(demo, "SWEEPS_PER_INTERVAL", 1)
+            demo.generate_demo_dataset(folder / "data", scenes=("scene-0103",), sweeps=True)
+
+    return made_once(tmp_path_factory, "swept", make) / "data"
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:

@@ -14,9 +14,7 @@ from rerun.chunk import RrdReader
 
 from cli.app import main
 from gnnpmb.eval.failures import FailureKind, short_id
-from gnnpmb.stages.evaluation import find_reports
 from gnnpmb.stages.findings import explain_all
-from gnnpmb.stages.runs import run_all
 from gnnpmb.why.facts import Ending
 from gnnpmb.why.findings import Party, Rule
 from gnnpmb.why.words import column_name, whose_text, why_lines
@@ -32,15 +30,50 @@ from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_
 
 SCENE = "scene-0103"
 ARGS = ["--detector", "pointpillars", "--params", str(POSITION_ONLY)]
+PMBM_ALL = "pmbm-all"
+PMBM = f"{PMBM_ALL}=pmbm:{POSITION_ONLY.with_name('pmbm_no_nscan.toml')}"
+"""A PMBM run without N-scan pruning (``gnnpmb/params/pmbm_no_nscan.toml``, the README's example): it parts
+from GNN-PMB at the first ID switch; the default PMBM (N-scan 1) loses the bicycle too."""
+
+
+@functools.cache
+def evidence_of(demo_dataroot: Path, trackers: tuple[str, ...], detector: str = "pointpillars") -> tuple:
+    """The inputs of ``trackers`` on the scene and, per tracker, the evidence of its run (its failure report, its
+    events): each set of arguments run once per worker (a module's tests share a worker), read-only."""
+    request = prepare(SCENE, list(trackers), dataroot=demo_dataroot, detector=detector, params=POSITION_ONLY)
+    evidence, _, _ = evidence_of_all(request)
+    return request, evidence
 
 
 @pytest.fixture(scope="module")
-def failures_and_runs(demo_dataroot: Path):
-    """The first tracker's failures on the scene (the ids ``gnnpmb failures`` prints) and the runs."""
-    request = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars", params=POSITION_ONLY)
-    runs = run_all(request, record=False)
-    reports, _ = find_reports(request, runs)
-    return reports["gnnpmb"], [run.tracking for run in runs]
+def gnnpmb_report(demo_dataroot: Path):
+    """GNN-PMB's failures on the scene (the ids ``gnnpmb failures`` prints), from the run the findings below are
+    made from."""
+    _, evidence = evidence_of(demo_dataroot, ("gnnpmb",))
+    return evidence["gnnpmb"].report
+
+
+@pytest.fixture(scope="module")
+def record(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory):
+    """``record(focus, trackers)``: ``gnnpmb-viz SCENE --focus FOCUS --save focus.rrd`` in-process, each command
+    line run once in the module (tests that look at the same recording share it; read-only): the recording and
+    what the command printed."""
+    made: dict[tuple[str, tuple[str, ...]], tuple[Path, str]] = {}
+
+    def run(focus: str, trackers: tuple[str, ...] = ("gnnpmb",)) -> tuple[Path, str]:
+        if (focus, trackers) not in made:
+            out = tmp_path_factory.mktemp("focus") / "focus.rrd"
+            stdout = io.StringIO()
+            argv = [SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out)]
+            argv.append("--no-progress")
+            for t in trackers:
+                argv += ["--tracker", t]
+            with contextlib.redirect_stdout(stdout):
+                main(argv)
+            made[focus, trackers] = (out, stdout.getvalue())
+        return made[focus, trackers]
+
+    return run
 
 
 def blueprint_rows(path: Path) -> list[tuple[str, dict]]:
@@ -57,24 +90,11 @@ def stored_legends(bp: list[tuple[str, dict]]) -> dict[str, tuple[int | None, li
     return {names[v]: (corner, ranges.get(v)) for v, corner in corners.items()}
 
 
-def record(demo_dataroot: Path, tmp_path: Path, focus: str, trackers: tuple[str, ...] = ("gnnpmb",)) -> tuple:
-    out = tmp_path / "focus.rrd"
-    stdout = io.StringIO()
-    argv = [SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out), "--no-progress"]
-    for t in trackers:
-        argv += ["--tracker", t]
-    with contextlib.redirect_stdout(stdout):
-        main(argv)
-    return out, stdout.getvalue()
-
-
-def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
-    demo_dataroot: Path, tmp_path: Path, failures_and_runs
-) -> None:
-    report, _ = failures_and_runs
+def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(demo_dataroot: Path, record, gnnpmb_report) -> None:
+    report = gnnpmb_report
     pick = next(i for i, f in zip(report.ids(), report.failures, strict=True) if f.gt_ids and f.track_ids)
     failure = report.by_id(pick)
-    out, stdout = record(demo_dataroot, tmp_path, pick)
+    out, stdout = record(pick)
     assert f"focus: {pick} at frame {failure.frame_index} (gnnpmb): {failure.describe()}" in stdout
     rows = read_rows(out)
     # Only the frames around the failure are recorded; the focus timeline ends at the failure frame.
@@ -156,27 +176,26 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(
     assert len(set(np.round(label_at[:, 1], 6).tolist())) == len(labels)
 
 
-def test_focus_on_a_track_and_on_a_ground_truth_prefix(demo_dataroot: Path, tmp_path: Path, failures_and_runs) -> None:
-    report, _ = failures_and_runs
+def test_focus_on_a_track_and_on_a_ground_truth_prefix(record, gnnpmb_report) -> None:
+    report = gnnpmb_report
     failure = next(f for f in report.failures if f.track_ids and f.gt_ids)
-    out, stdout = record(demo_dataroot, tmp_path, f"track:{failure.track_ids[0]}")
+    out, stdout = record(f"track:{failure.track_ids[0]}")
     assert "focus: " in stdout and f"track {failure.track_ids[0]}" in stdout
-    out2, stdout2 = record(demo_dataroot, tmp_path, f"gt:{failure.gt_ids[0][:8]}")
+    out2, stdout2 = record(f"gt:{failure.gt_ids[0][:8]}")
     assert "focus: " in stdout2
     summary = read_rows(out2)[focus_doc()][0]["TextDocument:text"][0]
     assert f"GT {failure.gt_ids[0][:6]}" in summary
 
 
-def test_focus_in_a_comparison_highlights_each_trackers_tracks(
-    demo_dataroot: Path, tmp_path: Path, failures_and_runs
-) -> None:
-    report, _ = failures_and_runs
-    pick = next(i for i, f in zip(report.ids(), report.failures, strict=True) if f.gt_ids and f.track_ids)
-    out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", "gnn"))
+def test_focus_in_a_comparison_highlights_each_trackers_tracks(record, gnnpmb_report) -> None:
+    """On the comparison ``test_why_and_where_two_trackers_part_on_the_failure_frame`` records (one run shared)."""
+    pick = next(i for i in gnnpmb_report.ids() if i.startswith("id_switch:"))
+    out, _ = record(pick, ("gnnpmb", PMBM))
     rows = read_rows(out)
     summary = rows[focus_doc()][0]["TextDocument:text"][0]
-    assert "## gnnpmb" in summary and "## gnn" in summary
-    assert paths.tracker_world("gnnpmb") + "/focus" in rows
+    assert "\n## gnnpmb" in summary and f"\n## {PMBM_ALL}" in summary
+    for tracker in ("gnnpmb", PMBM_ALL):
+        assert paths.tracker_world(tracker) + "/focus" in rows
 
 
 @pytest.mark.parametrize(
@@ -197,10 +216,12 @@ def test_bad_focus_is_one_line_and_exit_2(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     """In-process (``tests.inprocess``): the installed script's own error path runs in real processes in
-    ``tests/cli/test_user_errors.py``; what is checked here is the focus's message."""
+    ``tests/cli/test_user_errors.py``; what is checked here is the focus's message. A failure id or an object is
+    looked up in the tracked frames: three of them (``--frames 0:3``) are enough to find that there is none."""
     out = tmp_path / "x.rrd"
+    argv = ["gnnpmb-viz", SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--frames", "0:3", "--focus", focus]
     proc = run_script_with(
-        ["gnnpmb-viz", SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out)],
+        [*argv, "--save", str(out)],
         {"PATH": "/usr/bin:/bin", "NO_COLOR": "1", "HOME": str(tmp_path)},
         tmp_path,
         monkeypatch,
@@ -213,13 +234,11 @@ def test_bad_focus_is_one_line_and_exit_2(
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir() if p.suffix == ".rrd") == []
 
 
-def test_the_summary_opens_with_the_decisions_that_made_the_switch(
-    demo_dataroot: Path, tmp_path: Path, failures_and_runs
-) -> None:
-    report, _ = failures_and_runs
+def test_the_summary_opens_with_the_decisions_that_made_the_switch(demo_dataroot: Path, record, gnnpmb_report) -> None:
+    report = gnnpmb_report
     switch = report.by_id("id_switch:1")
     old, new = switch.track_ids
-    out, _ = record(demo_dataroot, tmp_path, "id_switch:1")
+    out, _ = record("id_switch:1")
     summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
     head = summary.split("Opened at frame")[0]
     assert "**Key decisions of gnnpmb**" in head
@@ -232,17 +251,14 @@ def test_the_summary_opens_with_the_decisions_that_made_the_switch(
 def findings_of(demo_dataroot: Path, trackers: tuple[str, ...], detector: str = "pointpillars") -> dict:
     """Per tracker, failure id -> its ``Finding`` (the data every sentence of the focus document is made from);
     made once per worker for each set of arguments (read-only: findings are frozen)."""
-    request = prepare(SCENE, list(trackers), dataroot=demo_dataroot, detector=detector, params=POSITION_ONLY)
-    evidence, _, _ = evidence_of_all(request)
+    request, evidence = evidence_of(demo_dataroot, trackers, detector)
     found = explain_all(request, evidence)
     return {t: dict(zip(evidence[t].report.ids(), fs, strict=True)) for t, fs in found.items()}
 
 
-def test_a_failure_at_an_interpolated_gt_box_is_explained(
-    demo_dataroot: Path, tmp_path: Path, failures_and_runs
-) -> None:
-    report, _ = failures_and_runs
-    scene = prepare(SCENE, ["gnnpmb"], dataroot=demo_dataroot, detector="pointpillars", params=POSITION_ONLY).scene
+def test_a_failure_at_an_interpolated_gt_box_is_explained(demo_dataroot: Path, record, gnnpmb_report) -> None:
+    report = gnnpmb_report
+    scene = evidence_of(demo_dataroot, ("gnnpmb",))[0].scene
     # The devkit's boxes are flagged interpolated exactly where the annotated object has no points.
     for f in report.failures:
         for b in (b for b in f.boxes if b.is_gt):
@@ -258,7 +274,7 @@ def test_a_failure_at_an_interpolated_gt_box_is_explained(
     assert finding.parties[0] is Party.EVALUATION and finding.reach is not None
     g = report.gt_frame(failure.gt_ids[0], failure.frame_index)
     assert finding.reach.offset_m == pytest.approx(g.offset_m) and g.offset_m >= 0.5
-    out, _ = record(demo_dataroot, tmp_path, pick)
+    out, _ = record(pick)
     rows = read_rows(out)
     summary = rows[focus_doc()][0]["TextDocument:text"][0]
     gt = short_id(failure.gt_ids[0])
@@ -285,16 +301,9 @@ def test_a_failure_at_an_interpolated_gt_box_is_explained(
     assert all(not r["Boxes3D:centers"] for f, r in drawn.items() if f != failure.frame_index)
 
 
-PMBM_ALL = "pmbm-all"
-"""A PMBM run without N-scan pruning (``gnnpmb/params/pmbm_no_nscan.toml``, the README's example): it parts
-from GNN-PMB at the failure below; the default PMBM (N-scan 1) loses the bicycle too."""
-
-
-def test_why_and_where_two_trackers_part_on_the_failure_frame(
-    demo_dataroot: Path, tmp_path: Path, failures_and_runs
-) -> None:
-    pmbm = f"{PMBM_ALL}=pmbm:{POSITION_ONLY.with_name('pmbm_no_nscan.toml')}"
-    report, _ = failures_and_runs
+def test_why_and_where_two_trackers_part_on_the_failure_frame(demo_dataroot: Path, record, gnnpmb_report) -> None:
+    pmbm = PMBM
+    report = gnnpmb_report
     pick = next(i for i in report.ids() if i.startswith("id_switch:"))
     failure = report.by_id(pick)
     old, new = (int(t) for t in failure.track_ids)
@@ -306,7 +315,7 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
     assert d.choice.alternative is not None and d.choice.alternative_terms is not None
     (other,) = finding.others
     assert other.tracker == PMBM_ALL
-    out, _ = record(demo_dataroot, tmp_path, pick, ("gnnpmb", pmbm))
+    out, _ = record(pick, ("gnnpmb", pmbm))
     summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
     why, because = summary.split("\n\n")[1:3]
     assert why.startswith(f"**Why** (gnnpmb, {whose_text(finding)}): ")
@@ -353,9 +362,9 @@ def test_why_and_where_two_trackers_part_on_the_failure_frame(
 
 
 def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
-    demo_dataroot: Path, tmp_path: Path, failures_and_runs
+    demo_dataroot: Path, record, gnnpmb_report
 ) -> None:
-    report, _ = failures_and_runs
+    report = gnnpmb_report
     findings = findings_of(demo_dataroot, ("gnnpmb",))["gnnpmb"]
     checked = 0
     for pick, failure in zip(report.ids(), report.failures, strict=True):
@@ -378,15 +387,13 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
         checked += 1
     assert checked
     pick = next(i for i, f in zip(report.ids(), report.failures, strict=True) if f.kind is FailureKind.FALSE_TRACK)
-    rec, _ = record(demo_dataroot, tmp_path, pick)
+    rec, _ = record(pick)
     why = read_rows(rec)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
     assert why == why_lines(findings[pick])[0]  # the document says what the finding holds
 
 
-def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(
-    demo_dataroot: Path, tmp_path: Path, failures_and_runs
-) -> None:
-    report, _ = failures_and_runs
+def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(demo_dataroot: Path, record, gnnpmb_report) -> None:
+    report = gnnpmb_report
     pick, failure = next(
         (i, f)
         for i, f in zip(report.ids(), report.failures, strict=True)
@@ -400,14 +407,12 @@ def test_a_miss_says_whether_the_detector_or_the_tracker_missed_it(
     for o in s.on_it:  # tracks on it were not counted: their averaged score is below the class threshold
         assert not o.counted and o.evaluated.averaged_score < report.threshold_of(failure.class_name)
     assert (Rule.NOT_COUNTED in rules) == any(not o.counted for o in s.on_it)
-    out, _ = record(demo_dataroot, tmp_path, pick)
+    out, _ = record(pick)
     why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
     assert why == why_lines(finding)[0] and why.startswith(f"**Why** (gnnpmb, {whose_text(finding)}): ")
 
 
-def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(
-    demo_dataroot: Path, tmp_path: Path
-) -> None:
+def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(demo_dataroot: Path, record) -> None:
     """GNN on pointpillars: the old track ended while the object had no points; the new one was started later."""
     findings = findings_of(demo_dataroot, ("gnn",))["gnn"]
     pick = next(i for i in findings if i.startswith("id_switch:"))
@@ -415,7 +420,7 @@ def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(
     ended = [s for s in finding.lost.steps if s.ended is not None]
     assert ended and ended[0].ended.ending is Ending.DELETED and ended[0].ended.hits >= 0
     assert finding.decision is None and finding.taker.meas >= 0  # no close call: where the new track came from
-    out, _ = record(demo_dataroot, tmp_path, pick, ("gnn",))
+    out, _ = record(pick, ("gnn",))
     why = read_rows(out)[focus_doc()][0]["TextDocument:text"][0].split("\n\n")[1]
     assert why.startswith("**Why** (gnn, ") and "existence" not in why  # GNN's tracks have none
     e = ended[0]

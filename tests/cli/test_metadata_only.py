@@ -1,5 +1,6 @@
-"""A dataroot with the nuScenes tables and none (or some) of the LiDAR files, through ``gnnpmb-viz`` in a real
-process: the recording holds boxes, tracks and failures, the terminal says once which LiDAR files are missing
+"""A dataroot with the nuScenes tables and none (or some) of the LiDAR files, through ``gnnpmb-viz`` (in a real
+process when no file is there; the others in-process, ``tests.inprocess.run_script``, a process start less each):
+the recording holds boxes, tracks and failures, the terminal says once which LiDAR files are missing
 (``gnnpmb.data.sensor_files``), and the keyframes without a file show no points rather than the last sweep."""
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.inprocess import run_script
 from tests.viz.rrd import read_rows
 from viz import paths
 
@@ -36,11 +38,14 @@ def _lidar_files(demo: Path, frames: range) -> list[Path]:
     return [scene.keyframes[i].lidar_path for i in frames]
 
 
+def _argv(dataroot: Path, out: Path) -> list[str]:
+    frames = f"{FRAMES.start}:{FRAMES.stop}"
+    return ["gnnpmb-viz", SCENE, "--dataroot", str(dataroot), "--frames", frames, "--save", str(out), "--no-progress"]
+
+
 def _view(dataroot: Path, out: Path) -> subprocess.CompletedProcess[str]:
-    argv = [str(BIN / "gnnpmb-viz"), SCENE, "--dataroot", str(dataroot), "--frames", f"{FRAMES.start}:{FRAMES.stop}"]
-    return subprocess.run(
-        [*argv, "--save", str(out), "--no-progress"], capture_output=True, text=True, timeout=600, check=False
-    )
+    argv = _argv(dataroot, out)
+    return subprocess.run([str(BIN / argv[0]), *argv[1:]], capture_output=True, text=True, timeout=600, check=False)
 
 
 def _points_per_frame(rows: dict) -> dict[int, int]:
@@ -64,7 +69,9 @@ def test_tables_without_lidar_files_still_draw_tracks_and_failures(demo_dataroot
     assert "sensor files: no LiDAR files in this dataroot" in doc
 
 
-def test_some_lidar_files_missing_are_named_and_shown_empty(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_some_lidar_files_missing_are_named_and_shown_empty(
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     root = _copy_tables(demo_dataroot, tmp_path / "partial")
     files = _lidar_files(demo_dataroot, FRAMES)
     present = [0, 1, 4, 5]
@@ -73,7 +80,7 @@ def test_some_lidar_files_missing_are_named_and_shown_empty(demo_dataroot: Path,
         (root / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(files[i], root / rel)
     out = tmp_path / "partial.rrd"
-    done = _view(root, out)
+    done = run_script(_argv(root, out), capsys)
     assert done.returncode == 0, done.stderr
     notes = [line for line in done.stderr.splitlines() if "LiDAR" in line]
     assert len(notes) == 1, done.stderr
@@ -85,7 +92,9 @@ def test_some_lidar_files_missing_are_named_and_shown_empty(demo_dataroot: Path,
 
 
 @pytest.mark.parametrize("damage", ["truncated"])
-def test_a_damaged_lidar_file_is_still_an_error(demo_dataroot: Path, tmp_path: Path, damage: str) -> None:
+def test_a_damaged_lidar_file_is_still_an_error(
+    demo_dataroot: Path, tmp_path: Path, damage: str, capsys: pytest.CaptureFixture[str]
+) -> None:
     root = _copy_tables(demo_dataroot, tmp_path / "damaged")
     files = _lidar_files(demo_dataroot, FRAMES)
     for i, f in enumerate(files):
@@ -94,7 +103,7 @@ def test_a_damaged_lidar_file_is_still_an_error(demo_dataroot: Path, tmp_path: P
         data = f.read_bytes()
         (root / rel).write_bytes(data[:-3] if i == 2 else data)
     out = tmp_path / "damaged.rrd"
-    done = _view(root, out)
+    done = run_script(_argv(root, out), capsys)
     assert done.returncode == 2
     assert done.stderr.strip().splitlines()[-1].startswith("error: LiDAR file ") and "truncated" in done.stderr
     assert not out.exists()

@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from cli.app import main as viz_main
+from tests.inprocess import run_script
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import paths
@@ -20,10 +21,14 @@ from viz.blueprint import focus_doc
 
 SCENE = "scene-0103"
 BIN = Path(sys.executable).parent
+CvFailures = tuple[subprocess.CompletedProcess[str], dict]
 
 
-def test_failures_of_a_results_file_in_a_real_process(demo_dataroot: Path, cv_results: Path, tmp_path: Path) -> None:
-    report = tmp_path / "cv_failures.json"
+@pytest.fixture(scope="module")
+def cv_failures(demo_dataroot: Path, cv_results: Path, tmp_path_factory: pytest.TempPathFactory) -> CvFailures:
+    """``gnnpmb failures SCENE --results cv=FILE --tracker gnnpmb --why --json F`` in a real process, run once for
+    the module: the finished process and the JSON it wrote (read-only)."""
+    report = tmp_path_factory.mktemp("cv_failures") / "cv_failures.json"
     argv = [str(BIN / "gnnpmb"), "failures", SCENE, "--results", f"cv={cv_results}", "--tracker", "gnnpmb"]
     proc = subprocess.run(
         [*argv, "--dataroot", str(demo_dataroot), "--why", "--json", str(report)],
@@ -32,11 +37,15 @@ def test_failures_of_a_results_file_in_a_real_process(demo_dataroot: Path, cv_re
         timeout=120,
     )
     assert proc.returncode == 0, proc.stderr
+    return proc, json.loads(report.read_text())
+
+
+def test_failures_of_a_results_file_in_a_real_process(cv_failures: CvFailures) -> None:
+    proc, data = cv_failures
     assert "note: cv.json: " in proc.stderr and "samples outside scene-0103 left out" in proc.stderr
     out = proc.stdout
     assert f"{SCENE}, cv: " in out and f"{SCENE}, gnnpmb: " in out  # both runs, the results first
     assert out.index(f"{SCENE}, cv: ") < out.index(f"{SCENE}, gnnpmb: ")
-    data = json.loads(report.read_text())
     assert data["tracker"] == "cv" and [r["tracker"] for r in data["other_runs"]] == ["gnnpmb"]
     findings = data["findings"]
     assert findings and all(f["mode"] == "output only" for f in findings)
@@ -49,27 +58,10 @@ def test_failures_of_a_results_file_in_a_real_process(demo_dataroot: Path, cv_re
     assert "its box carries m" in text and "gnnpmb on the given detections" in text
 
 
-def test_a_focus_recording_of_a_results_run(demo_dataroot: Path, cv_results: Path, tmp_path: Path) -> None:
-    report = json.loads(
-        subprocess.run(
-            [
-                str(BIN / "gnnpmb"),
-                "failures",
-                SCENE,
-                "--results",
-                f"cv={cv_results}",
-                "--dataroot",
-                str(demo_dataroot),
-                "--json",
-                str(tmp_path / "r.json"),
-            ],
-            capture_output=True,
-            text=True,
-            timeout=120,
-        ).returncode
-        == 0
-        and (tmp_path / "r.json").read_text()
-    )
+def test_a_focus_recording_of_a_results_run(
+    demo_dataroot: Path, cv_results: Path, tmp_path: Path, cv_failures: CvFailures
+) -> None:
+    _, report = cv_failures  # the results file's failures as ``gnnpmb failures`` lists them
     pick = next(f"id_switch:{n}" for n, _ in enumerate([f for f in report["failures"] if f["kind"] == "id_switch"], 1))
     out = tmp_path / "cv.rrd"
     argv = [SCENE, "--results", f"cv={cv_results}", "-t", "gnnpmb", "--dataroot", str(demo_dataroot)]
@@ -100,11 +92,18 @@ def test_a_focus_recording_of_a_results_run(demo_dataroot: Path, cv_results: Pat
     ],
 )
 def test_results_errors_are_one_line(
-    demo_dataroot: Path, cv_results: Path, tmp_path: Path, args: list[str], message: str
+    demo_dataroot: Path,
+    cv_results: Path,
+    tmp_path: Path,
+    args: list[str],
+    message: str,
+    capsys: pytest.CaptureFixture[str],
 ) -> None:
+    """In-process (``tests.inprocess.run_script``); ``gnnpmb failures --results`` in a real process is the test
+    above."""
     args = [a.format(f=cv_results, missing=tmp_path / "missing.json") for a in args]
-    argv = [str(BIN / "gnnpmb"), "failures", SCENE, *args, "--dataroot", str(demo_dataroot)]
-    proc = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    proc = run_script(["gnnpmb", "failures", SCENE, *args, "--dataroot", str(demo_dataroot)], capsys)
+    assert "Traceback" not in proc.stderr
     if not message:
         assert proc.returncode == 0, proc.stderr
         return

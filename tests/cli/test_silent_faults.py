@@ -2,13 +2,18 @@
 content, results files are checked like detection files, one sweep per study folder, full disks, long names and
 symlink loops said in one line before the work, ``--serve`` on localhost, ``reproduce`` naming a change of code.
 
-Each case runs the installed scripts and checks the exit code, the one ``error:`` line (or the right answer where
-the input was legal) and the files left. The full disk is a real 2 MB tmpfs when running as root (skipped
-elsewhere; ``tests/gnnpmb/test_outputs.py`` checks the same lines in-process with the free space patched).
+Each case runs a console script's command line and checks the exit code, the one ``error:`` line (or the right
+answer where the input was legal) and the files left. Where the files are what is under test (caches, names,
+results files) the command runs in-process (``tests.inprocess.run_script_with``: a new process's state, the
+installed script's own code path), a process start less each (~2 s of CPU); each entry point is also run in
+real processes here (the early refusals, the code change of ``reproduce``, a second sweep, a port taken) for the
+real exit code and no traceback. The full disk is a real 2 MB tmpfs when running as root (skipped elsewhere;
+``tests/gnnpmb/test_outputs.py`` checks the same lines in-process with the free space patched).
 """
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import shutil
@@ -35,6 +40,30 @@ def _cache_env(demo: Path, cache: Path, **extra: str) -> dict[str, str]:
 def _run(command: list[str], env: dict[str, str], cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
     exe = str(BIN / command[0])
     return subprocess.run([exe, *command[1:]], capture_output=True, text=True, env=env, cwd=cwd, timeout=timeout)
+
+
+INDEXES_OPENED = (("gnnpmb.data.nuscenes", "_INDEXES"), ("gnnpmb.data.detections", "_opened"))
+"""The dataset's and the detection file's indexes a process keeps open once read: emptied before each command
+run in-process, so that each reads its index from the cache folder (``GNNPMB_CACHE_DIR``) as a new process would;
+the caches on disk are what these tests are about."""
+
+
+class _InProcess:
+    """``_run``'s signature for the commands of one test run in-process (``run_script_with``), each starting with
+    no index open (``INDEXES_OPENED``)."""
+
+    def __init__(self, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+        self.monkeypatch, self.capsys = monkeypatch, capsys
+
+    def __call__(self, command: list[str], env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess:
+        for module, name in INDEXES_OPENED:
+            self.monkeypatch.setattr(importlib.import_module(module), name, {})
+        return run_script_with(command, env, cwd, self.monkeypatch, self.capsys)
+
+
+@pytest.fixture
+def run_in(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> _InProcess:
+    return _InProcess(monkeypatch, capsys)
 
 
 def _tree(folder: Path) -> dict[str, bytes]:
@@ -188,10 +217,11 @@ def test_early_refusals_in_real_processes(demo_dataroot: Path, tmp_path: Path) -
     assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
 
 
-def test_a_255_byte_output_name_is_written(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_a_255_byte_output_name_is_written(demo_dataroot: Path, tmp_path: Path, run_in: _InProcess) -> None:
     """The longest legal name works: the temporary file beside it is named within the limit too."""
     name = "r" * 250 + ".json"
-    proc = _run(["gnnpmb", "track", "--out", name, "--tracker", "gnn", "--no-progress"], _env(demo_dataroot), tmp_path)
+    track = ["gnnpmb", "track", "--out", name, "--tracker", "gnn", "--no-progress"]
+    proc = run_in(track, _env(demo_dataroot), tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert [p.name for p in tmp_path.iterdir()] == [name]
     assert json.loads((tmp_path / name).read_text())["results"]
@@ -218,26 +248,28 @@ def test_a_port_taken_on_ipv6_loopback_counts_as_in_use(demo_dataroot: Path, tmp
 # --- case 2: caches key on content ------------------------------------------------------------------------------------
 
 
-def test_a_detection_file_edited_in_place_with_its_old_mtime_is_read_again(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_a_detection_file_edited_in_place_with_its_old_mtime_is_read_again(
+    demo_dataroot: Path, tmp_path: Path, run_in: _InProcess
+) -> None:
     env = _cache_env(demo_dataroot, tmp_path / "cache")
     _detections(tmp_path / "det.json", demo_dataroot)
     track = ["gnnpmb", "track", "--detections", "det.json", "--tracker", "gnn", "--no-progress", "--out"]
-    first = _run([*track, "a.json"], env, tmp_path)
+    first = run_in([*track, "a.json"], env, tmp_path)
     assert first.returncode == 0, first.stderr
     _edit_in_place(tmp_path / "det.json", b"[601.0, 1600.0", b"[951.0, 1600.0")
-    second = _run([*track, "b.json"], env, tmp_path)
+    second = run_in([*track, "b.json"], env, tmp_path)
     assert second.returncode == 0, second.stderr
     assert (tmp_path / "a.json").read_bytes() != (tmp_path / "b.json").read_bytes()  # the old code: identical
 
 
-def test_reproduce_hashes_the_detection_file_itself(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_reproduce_hashes_the_detection_file_itself(demo_dataroot: Path, tmp_path: Path, run_in: _InProcess) -> None:
     env = _cache_env(demo_dataroot, tmp_path / "cache")
     _detections(tmp_path / "det.json", demo_dataroot)
     record = [VIZ, "scene-0103", "--detections", "det.json", "--tracker", "gnn", "--frames", "0:3"]
-    proc = _run([*record, "--no-failures", "--no-progress", "--save", "run.rrd"], env, tmp_path)
+    proc = run_in([*record, "--no-failures", "--no-progress", "--save", "run.rrd"], env, tmp_path)
     assert proc.returncode == 0, proc.stderr
     _edit_in_place(tmp_path / "det.json", b"[601.0, 1600.0", b"[951.0, 1600.0")
-    proc = _run([VIZ, "reproduce", "run.rrd"], env, tmp_path)
+    proc = run_in([VIZ, "reproduce", "run.rrd"], env, tmp_path)
     assert _check("reproduce after an edit", proc, "det.json has changed since the recording") == []
 
 
@@ -252,27 +284,31 @@ def _flip_a_byte(path: Path) -> None:
 
 
 @pytest.mark.parametrize("side_file", ["scenes.json", "small.json"])
-def test_a_damaged_dataset_index_side_file_is_rebuilt(side_file: str, demo_dataroot: Path, tmp_path: Path) -> None:
+def test_a_damaged_dataset_index_side_file_is_rebuilt(
+    side_file: str, demo_dataroot: Path, tmp_path: Path, run_in: _InProcess
+) -> None:
     """A flipped byte in a side file of the dataset's index: the next run rebuilds the index and says the same."""
     env = _cache_env(demo_dataroot, tmp_path / "cache")
     command = ["gnnpmb", "failures", "scene-0103", "--tracker", "gnn", "--frames", "0:2"]
-    first = _run(command, env, tmp_path)
+    first = run_in(command, env, tmp_path)
     assert first.returncode == 0, first.stderr
     (index,) = (tmp_path / "cache" / "index").glob("dataset-*")
     _flip_a_byte(index / side_file)
-    second = _run(command, env, tmp_path)
+    second = run_in(command, env, tmp_path)
     assert second.returncode == 0, second.stderr
     assert second.stdout == first.stdout
 
 
-def test_a_damaged_detection_index_side_file_is_rebuilt(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_a_damaged_detection_index_side_file_is_rebuilt(
+    demo_dataroot: Path, tmp_path: Path, run_in: _InProcess
+) -> None:
     env = _cache_env(demo_dataroot, tmp_path / "cache")
     _detections(tmp_path / "det.json", demo_dataroot)
     track = ["gnnpmb", "track", "--detections", "det.json", "--tracker", "gnn", "--no-progress", "--out"]
-    assert _run([*track, "a.json"], env, tmp_path).returncode == 0
+    assert run_in([*track, "a.json"], env, tmp_path).returncode == 0
     (index,) = (tmp_path / "cache" / "index").glob("detections-*")
     _flip_a_byte(index / "samples.json")
-    second = _run([*track, "b.json"], env, tmp_path)
+    second = run_in([*track, "b.json"], env, tmp_path)
     assert second.returncode == 0, second.stderr
     assert (tmp_path / "a.json").read_bytes() == (tmp_path / "b.json").read_bytes()
 
@@ -314,26 +350,28 @@ def test_results_files_the_devkit_would_read_otherwise_are_one_line(
     assert _snapshot(work) == before
 
 
-def test_a_dataset_without_annotations_is_said_once(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_a_dataset_without_annotations_is_said_once(demo_dataroot: Path, tmp_path: Path, run_in: _InProcess) -> None:
     root = _copy_tables(demo_dataroot, tmp_path / "test-like")
     (root / "v1.0-mini" / "sample_annotation.json").write_text("[]")
     env = _cache_env(demo_dataroot, tmp_path / "cache")
     _submission(tmp_path / "r.json", demo_dataroot, lambda t, k: _box(t, k))
-    proc = _run(["gnnpmb", "eval", "r.json", "--dataroot", str(root), "--out", "ev"], env, tmp_path)
+    proc = run_in(["gnnpmb", "eval", "r.json", "--dataroot", str(root), "--out", "ev"], env, tmp_path)
     assert _check("eval", proc, "split mini_val of") == []
     assert "has no ground truth" in proc.stderr
-    proc = _run(["gnnpmb", "failures", "scene-0103", "--dataroot", str(root), "-t", "gnn"], env, tmp_path)
+    proc = run_in(["gnnpmb", "failures", "scene-0103", "--dataroot", str(root), "-t", "gnn"], env, tmp_path)
     assert _check("failures", proc, "scene-0103 has no ground-truth boxes") == []
     assert not (tmp_path / "ev").exists()
 
 
-def test_a_first_sample_token_that_names_no_sample_is_one_line(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_a_first_sample_token_that_names_no_sample_is_one_line(
+    demo_dataroot: Path, tmp_path: Path, run_in: _InProcess
+) -> None:
     root = _copy_tables(demo_dataroot, tmp_path / "edited")
     scenes = json.loads((root / "v1.0-mini" / "scene.json").read_text())
     scenes[0]["first_sample_token"] = "f" * 32
     (root / "v1.0-mini" / "scene.json").write_text(json.dumps(scenes))
     env = _cache_env(demo_dataroot, tmp_path / "cache")
-    proc = _run(["gnnpmb", "failures", scenes[0]["name"], "--dataroot", str(root)], env, tmp_path)
+    proc = run_in(["gnnpmb", "failures", scenes[0]["name"], "--dataroot", str(root)], env, tmp_path)
     expected = f"v1.0-mini/scene.json: scene '{scenes[0]['name']}' has first_sample_token '{'f' * 32}', the token of no"
     assert _check("bad first sample", proc, expected) == []
 
@@ -404,15 +442,17 @@ def full_disk(tmp_path: Path) -> Iterator[Path]:
         subprocess.run(["umount", str(mount)], check=False)
 
 
-def test_a_full_disk_is_one_line_naming_the_place(demo_dataroot: Path, tmp_path: Path, full_disk: Path) -> None:
+def test_a_full_disk_is_one_line_naming_the_place(
+    demo_dataroot: Path, tmp_path: Path, full_disk: Path, run_in: _InProcess
+) -> None:
     env = _cache_env(demo_dataroot, tmp_path / "cache")
-    proc = _run(["gnnpmb", "track", "--out", str(full_disk / "r.json")], env, tmp_path)
+    proc = run_in(["gnnpmb", "track", "--out", str(full_disk / "r.json")], env, tmp_path)
     assert (
         _check("out on a full disk", proc, f"--out {full_disk / 'r.json'}: the disk of folder {full_disk} is full")
         == []
     )
     cache = full_disk / "cache"
-    proc = _run(["gnnpmb", "track", "--out", "r.json", "--no-progress"], _cache_env(demo_dataroot, cache), tmp_path)
+    proc = run_in(["gnnpmb", "track", "--out", "r.json", "--no-progress"], _cache_env(demo_dataroot, cache), tmp_path)
     assert _check("cache on a full disk", proc, f"cannot write {cache}/index/dataset-") == []
     assert f"free space in {cache} or point GNNPMB_CACHE_DIR at a folder with room" in proc.stderr
     assert sorted(p.name for p in full_disk.iterdir()) == ["cache", "fill"]

@@ -4,7 +4,7 @@
 Cases that fail before the dataset is read run in-process (``tests.inprocess.run_script``: the console script's
 code up to its exit, without a process start each); a few of them, one per entry point and kind of mistake, run
 again through the installed scripts in real processes. The few that need the dataset (a bad box in one sample, an
-empty submission) load the demo once each; the variants of those are unit tests of the checks.
+empty submission) load the demo once each, in-process too; the variants of those are unit tests of the checks.
 """
 
 from __future__ import annotations
@@ -339,11 +339,17 @@ def test_mistakes_in_real_processes_are_one_line(demo_dataroot: Path, tmp_path: 
 
 
 @pytest.mark.parametrize("case", CASES_WITH_DATA, ids=lambda c: c.name)
-def test_mistakes_found_in_the_data_are_one_line(case: DataCase, demo_dataroot: Path, tmp_path: Path) -> None:
+def test_mistakes_found_in_the_data_are_one_line(
+    case: DataCase,
+    demo_dataroot: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     work = _work_folder(tmp_path / "w")
     case.setup(work / "input.json", demo_dataroot)
     before = _snapshot(work)
-    proc = _run(case.command.format(w=work).split(), _env(demo_dataroot), cwd=work)
+    proc = run_script_with(case.command.format(w=work).split(), _env(demo_dataroot), work, monkeypatch, capsys)
     assert _check(case.name, proc, case.expected) == []
     assert _snapshot(work) == before
 
