@@ -293,10 +293,12 @@ def test_a_damaged_dataset_index_side_file_is_rebuilt(
     first = run_in(command, env, tmp_path)
     assert first.returncode == 0, first.stderr
     (index,) = (tmp_path / "cache" / "index").glob("dataset-*")
+    intact = (index / side_file).read_bytes()
     _flip_a_byte(index / side_file)
     second = run_in(command, env, tmp_path)
     assert second.returncode == 0, second.stderr
     assert second.stdout == first.stdout
+    assert (index / side_file).read_bytes() == intact  # rebuilt, not read as it was (nor left damaged)
 
 
 def test_a_damaged_detection_index_side_file_is_rebuilt(
@@ -307,10 +309,12 @@ def test_a_damaged_detection_index_side_file_is_rebuilt(
     track = ["gnnpmb", "track", "--detections", "det.json", "--tracker", "gnn", "--no-progress", "--out"]
     assert run_in([*track, "a.json"], env, tmp_path).returncode == 0
     (index,) = (tmp_path / "cache" / "index").glob("detections-*")
+    intact = (index / "samples.json").read_bytes()
     _flip_a_byte(index / "samples.json")
     second = run_in([*track, "b.json"], env, tmp_path)
     assert second.returncode == 0, second.stderr
     assert (tmp_path / "a.json").read_bytes() == (tmp_path / "b.json").read_bytes()
+    assert (index / "samples.json").read_bytes() == intact  # rebuilt, not read as it was (nor left damaged)
 
 
 # --- case 3, 5, 6, 12: results files and tables checked like detection files ------------------------------------------
