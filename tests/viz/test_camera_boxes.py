@@ -20,7 +20,16 @@ from gnnpmb.eval.failures import Failure, FailureBox, FailureKind
 from tests.viz.rrd import read_rows
 from tools.labels import Recording, camera_boxes, overlaps
 from viz import paths
-from viz.camera_boxes import MAX_CAMERA_LABELS, Box, CameraFrame, failure_boxes, log_camera_boxes, project_box
+from viz.camera_boxes import (
+    CAMERA_VIEW_SCALE,
+    MAX_CAMERA_LABELS,
+    Box,
+    CameraFrame,
+    _inside_image,
+    failure_boxes,
+    log_camera_boxes,
+    project_box,
+)
 from viz.cameras import camera_view, log_cameras
 from viz.timeline import PLAIN_CLOCK
 
@@ -113,3 +122,17 @@ def test_camera_labels_are_the_failures_kept_apart_and_every_line_inside_the_ima
     for layer in ("gt", "failures"):
         strips = [s for r in rows[paths.camera_boxes("CAM_FRONT", layer)] for s in r.get("LineStrips2D:strips") or []]
         assert strips and _inside([np.asarray(s) for s in strips])
+
+
+def test_a_label_wider_than_the_image_is_centred_on_it_and_a_narrow_one_kept_inside() -> None:
+    """A text wider than the image runs into the margins of a letterboxed view evenly, not off its right edge."""
+    from viz.label_room import text_box
+
+    wide = "simpletrack: fragmentation: missed gt bf3d85"
+    x0, _, x1, _ = (c / CAMERA_VIEW_SCALE for c in text_box(wide, 0.0, 0.0))
+    assert x1 - x0 > 1600.0
+    assert _inside_image(wide, 10.0, 300.0, 1600, 900)[0] == 800.0
+    narrow = "miss"
+    x0, _, x1, _ = (c / CAMERA_VIEW_SCALE for c in text_box(narrow, 0.0, 0.0))
+    u, _ = _inside_image(narrow, 1599.0, 300.0, 1600, 900)
+    assert u + x1 <= 1600.0 and u + x0 >= 0.0
