@@ -30,7 +30,7 @@ import numpy as np
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError
 from gnnpmb.events import EventSink, Extracted, FrameStarted, MeasurementsReceived, NullSink
-from gnnpmb.pipeline import FrameResult, TrackingRun
+from gnnpmb.pipeline import FrameResult, TrackingRun, keyframe_steps
 from gnnpmb.types import Boxes, FrameDetections, TrackEstimate
 
 SAME_BOX_TOL = 1e-4
@@ -253,13 +253,8 @@ def replay(
     """The results as a ``TrackingRun`` named ``results.name`` over ``frame_range`` (default all keyframes), its
     output-only events sent to ``sink`` (module docstring)."""
     sink = sink or NullSink()
-    indices = frame_range if frame_range is not None else range(len(scene.keyframes))
     out: list[FrameResult] = []
-    previous_us: int | None = None
-    for i in indices:
-        keyframe = scene.keyframes[i]
-        dt_s = 0.0 if previous_us is None else (keyframe.timestamp_us - previous_us) * 1e-6
-        previous_us = keyframe.timestamp_us
+    for i, keyframe, dt_s in keyframe_steps(scene, frame_range):
         given = given_detections(frames[i])
         estimates = results.estimates[i]
         if sink.enabled:

@@ -349,6 +349,17 @@ class TrackerFacts:
             known[class_name] = None if cf is None else read(cf)
         return known[class_name]
 
+    def mode(self, class_name: str, frames: range) -> UseMode:
+        """How the tracker's update used detections in ``frames`` (assignment without any update event; output only
+        for a run known by its output)."""
+        if self.output_only:
+            return UseMode.OUTPUT
+        for f in frames:
+            use = self.use(f, class_name)
+            if use is not None and use.tracks:
+                return use.mode
+        return UseMode.ASSIGNED
+
     def destination(self, frame: int, class_name: str, meas: int) -> Destination | None:
         """Where detection ``meas`` went at ``frame`` (None: the tracker of the class did not receive it)."""
         use = self.use(frame, class_name)
