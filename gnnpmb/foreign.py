@@ -136,14 +136,11 @@ def check_coverage(
         )
     if missing:
         raise DataError(f"{source} lacks {len(missing)} of the {len(tokens)} samples of {what} (e.g. {missing[0]})")
+    from gnnpmb.eval.submission import check_in_dataset
+
     wanted = set(tokens)
     extra = [t for t in results if t not in wanted]
-    unknown = [t for t in extra if t not in dataset_tokens]
-    if unknown:
-        raise DataError(
-            f"{source} has {len(unknown)} samples that are not in the dataset (e.g. {unknown[0]}); was it made for "
-            "another dataset version?"
-        )
+    check_in_dataset(source, extra, dataset_tokens)
     if not extra:
         return None
     boxes = sum(len(results[t]) if isinstance(results[t], list) else 0 for t in extra)

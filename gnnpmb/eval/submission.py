@@ -287,6 +287,17 @@ def _sample_fine(token: str, boxes: list) -> bool:
     )
 
 
+def check_in_dataset(source: str, tokens: Sequence[str], dataset_tokens: Collection[str]) -> None:
+    """Raise a one-line ``DataError`` naming the first of ``tokens`` (a results file's sample tokens) that is not
+    one of ``dataset_tokens`` (the dataset version's)."""
+    unknown = [t for t in tokens if t not in dataset_tokens]
+    if unknown:
+        raise DataError(
+            f"{source} has {len(unknown)} samples that are not in the dataset (e.g. {unknown[0]}); was it made for "
+            "another dataset version?"
+        )
+
+
 def check_submission(
     data: Any,
     source: str,
@@ -318,12 +329,7 @@ def check_submission(
             "was it made for another split?"
         )
     if extra:
-        unknown = [t for t in extra if t not in dataset_tokens]
-        if unknown:
-            raise DataError(
-                f"{source} has {len(unknown)} samples that are not in the dataset (e.g. {unknown[0]}); "
-                "was it made for another dataset version?"
-            )
+        check_in_dataset(source, extra, dataset_tokens)
         raise DataError(
             f"{source} has {len(extra)} samples of other splits than {split} (e.g. {extra[0]}); "
             "evaluate it on the split it was made for"
