@@ -74,7 +74,8 @@ def _as_floats(value: Any) -> np.ndarray | None:
         return None
 
 
-def _short(value: Any) -> str:
+def short_repr(value: Any) -> str:
+    """``repr(value)`` cut to 60 characters, for an error line quoting a bad value."""
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
@@ -88,14 +89,14 @@ def _box_problem(entry: Any) -> str | None:
             return f"has no '{name}' field"
         value = _as_floats(entry[name])
         if value is None or value.shape != (length,):
-            return f"field '{name}' must be a list of {length} numbers, got {_short(entry[name])}"
+            return f"field '{name}' must be a list of {length} numbers, got {short_repr(entry[name])}"
         if name != "velocity" and not _all_numbers(entry[name]):
-            return f"field '{name}' must hold numbers, not text or null: {_short(entry[name])}"
+            return f"field '{name}' must hold numbers, not text or null: {short_repr(entry[name])}"
         if name != "velocity" and not np.isfinite(value).all():
-            return f"field '{name}' has a NaN or infinite value: {_short(entry[name])}"
+            return f"field '{name}' has a NaN or infinite value: {short_repr(entry[name])}"
         physical = physical_problem(name, value[None, :])
         if physical is not None:
-            return f"field '{name}' {physical}: {_short(entry[name])}"
+            return f"field '{name}' {physical}: {short_repr(entry[name])}"
     if "detection_name" not in entry:
         return "has no 'detection_name' field"
     if entry["detection_name"] not in DETECTION_CLASSES:
@@ -104,10 +105,10 @@ def _box_problem(entry: Any) -> str | None:
         return "has no 'detection_score' field"
     raw_score = entry["detection_score"]
     if isinstance(raw_score, bool) or not isinstance(raw_score, int | float):
-        return f"field 'detection_score' must be a number, got {_short(raw_score)}"
+        return f"field 'detection_score' must be a number, got {short_repr(raw_score)}"
     score = _as_floats(raw_score)
     if score is None or score.shape != () or not np.isfinite(score):
-        return f"field 'detection_score' must be a finite number, got {_short(entry['detection_score'])}"
+        return f"field 'detection_score' must be a finite number, got {short_repr(entry['detection_score'])}"
     if not 0.0 <= float(score) <= 1.0:
         return f"field 'detection_score' must lie in [0, 1], got {float(score)}"
     return None

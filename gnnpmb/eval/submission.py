@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from gnnpmb.data.detections import physical_problem
+from gnnpmb.data.detections import physical_problem, short_repr
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError
 from gnnpmb.pipeline import TrackingRun
@@ -197,20 +197,15 @@ def read_submission(path: Path) -> dict[str, Any]:
     return data
 
 
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _vector_problem(name: str, value: Any, length: int) -> str | None:
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         array = None
     if array is None or array.shape != (length,) or isinstance(value, str):
-        return f"field '{name}' must be a list of {length} numbers, got {_short(value)}"
+        return f"field '{name}' must be a list of {length} numbers, got {short_repr(value)}"
     if not np.isfinite(array).all():
-        return f"field '{name}' has a NaN or infinite value: {_short(value)}"
+        return f"field '{name}' has a NaN or infinite value: {short_repr(value)}"
     return None
 
 
@@ -223,7 +218,7 @@ def _value_problem(name: str, value: Any) -> str | None:
         norm = float(np.linalg.norm(values))
         if abs(norm - 1.0) > QUAT_NORM_TOLERANCE:
             problem = f"is not a unit quaternion (length {norm:.6g}); normalise it"
-    return None if problem is None else f"field '{name}' {problem}: {_short(value)}"
+    return None if problem is None else f"field '{name}' {problem}: {short_repr(value)}"
 
 
 def _values_fine(name: str, array: np.ndarray) -> bool:
@@ -241,22 +236,22 @@ def _box_problem(token: str, box: Any) -> str | None:
         if name not in box:
             return f"has no '{name}' field"
     if box["sample_token"] != token:
-        return f"has sample_token {_short(box['sample_token'])}; it must equal its results key"
+        return f"has sample_token {short_repr(box['sample_token'])}; it must equal its results key"
     for name, length in _VECTOR_FIELDS:
         problem = _vector_problem(name, box[name], length) or _value_problem(name, box[name])
         if problem is not None:
             return problem
     track_id = box["tracking_id"]
     if isinstance(track_id, bool) or not isinstance(track_id, str | int) or track_id == "":
-        return f"field 'tracking_id' must be a non-empty string, got {_short(track_id)}"
+        return f"field 'tracking_id' must be a non-empty string, got {short_repr(track_id)}"
     if box["tracking_name"] not in TRACKING_CLASSES:
         return (
-            f"has tracking_name {_short(box['tracking_name'])}, not one of the tracking classes "
+            f"has tracking_name {short_repr(box['tracking_name'])}, not one of the tracking classes "
             f"({', '.join(TRACKING_CLASSES)})"
         )
     score = box["tracking_score"]
     if isinstance(score, bool) or not isinstance(score, int | float):
-        return f"field 'tracking_score' must be a number, got {_short(score)}"
+        return f"field 'tracking_score' must be a number, got {short_repr(score)}"
     if not math.isfinite(score):
         return f"field 'tracking_score' must be finite, got {score}"
     return None
