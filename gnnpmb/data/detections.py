@@ -46,12 +46,21 @@ DETECTION_CLASSES: tuple[str, ...] = (
 )
 """The ten nuScenes detection classes; all but barrier, traffic_cone and construction_vehicle are tracked."""
 
-_VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
+VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
     ("translation", 3),
     ("size", 3),
     ("rotation", 4),
     ("velocity", 2),
 )
+"""The list fields of a detection or tracking box and their lengths."""
+LIDAR_ONLY_META: dict[str, bool] = {
+    "use_camera": False,
+    "use_lidar": True,
+    "use_radar": False,
+    "use_map": False,
+    "use_external": False,
+}
+"""The ``meta`` of a submission made from LiDAR only: our tracking submissions and simulated detection files."""
 MAX_ABS_COORD_M = 1e5
 """Largest accepted |x|, |y|, |z| of a box centre in the global frame (nuScenes maps span a few km)."""
 MAX_SIZE_M = 100.0
@@ -84,7 +93,7 @@ def _box_problem(entry: Any) -> str | None:
     """What is wrong with one box entry, or None."""
     if not isinstance(entry, dict):
         return f"is a {type(entry).__name__}, not an object"
-    for name, length in _VECTOR_FIELDS:
+    for name, length in VECTOR_FIELDS:
         if name not in entry:
             return f"has no '{name}' field"
         value = _as_floats(entry[name])
@@ -157,7 +166,7 @@ def convert_sample(token: str, entries: Any) -> Boxes | str:
         names = np.array([e["detection_name"] for e in entries], dtype=object)
         scores = [e["detection_score"] for e in entries]
         raw_score = np.array(scores)
-        raw = {name: np.array([e[name] for e in entries]) for name, _ in _VECTOR_FIELDS if name != "velocity"}
+        raw = {name: np.array([e[name] for e in entries]) for name, _ in VECTOR_FIELDS if name != "velocity"}
         velocity = np.array([e["velocity"] for e in entries], dtype=float)
     except (KeyError, TypeError, ValueError):
         return _diagnose(token, entries)
@@ -166,13 +175,13 @@ def convert_sample(token: str, entries: Any) -> Boxes | str:
     score = raw_score.astype(float)
     arrays = {name: a.astype(float) for name, a in raw.items()} | {"velocity": velocity}
     fine = (
-        all(arrays[name].shape == (n, length) for name, length in _VECTOR_FIELDS)
+        all(arrays[name].shape == (n, length) for name, length in VECTOR_FIELDS)
         and score.shape == (n,)
         and all(np.isfinite(a).all() for name, a in arrays.items() if name != "velocity")
         and np.isfinite(score).all()
         and ((score >= 0.0) & (score <= 1.0)).all()
         and np.isin(names.astype(str), DETECTION_CLASSES).all()
-        and all(physical_problem(name, arrays[name]) is None for name, _ in _VECTOR_FIELDS)
+        and all(physical_problem(name, arrays[name]) is None for name, _ in VECTOR_FIELDS)
     )
     if not fine:
         return _diagnose(token, entries)

@@ -20,31 +20,19 @@ from typing import Any
 
 import numpy as np
 
-from gnnpmb.data.detections import physical_problem, short_repr
+from gnnpmb.data.detections import LIDAR_ONLY_META, VECTOR_FIELDS, physical_problem, short_repr
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError
 from gnnpmb.pipeline import TrackingRun
 from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES
 
-SUBMISSION_META: dict[str, bool] = {
-    "use_camera": False,
-    "use_lidar": True,
-    "use_radar": False,
-    "use_map": False,
-    "use_external": False,
-}
+SUBMISSION_META: dict[str, bool] = LIDAR_ONLY_META
 """What our submissions declare: LiDAR detections only."""
 
 MAX_BOXES_PER_SAMPLE = 500
 """The devkit's ``max_boxes_per_sample`` of the ``tracking_nips_2019`` config."""
 
-_VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
-    ("translation", 3),
-    ("size", 3),
-    ("rotation", 4),
-    ("velocity", 2),
-)
 _REQUIRED_FIELDS = ("sample_token", "tracking_id", "tracking_name", "tracking_score")
 QUAT_NORM_TOLERANCE = 1e-3
 """How far from 1 a results box's rotation quaternion may be (files written with 6 decimals are within 1e-5)."""
@@ -232,12 +220,12 @@ def _box_problem(token: str, box: Any) -> str | None:
     """What is wrong with one submission box, or None (the devkit's TrackingBox checks, and finiteness)."""
     if not isinstance(box, dict):
         return f"is a {type(box).__name__}, not an object"
-    for name in _REQUIRED_FIELDS + tuple(n for n, _ in _VECTOR_FIELDS):
+    for name in _REQUIRED_FIELDS + tuple(n for n, _ in VECTOR_FIELDS):
         if name not in box:
             return f"has no '{name}' field"
     if box["sample_token"] != token:
         return f"has sample_token {short_repr(box['sample_token'])}; it must equal its results key"
-    for name, length in _VECTOR_FIELDS:
+    for name, length in VECTOR_FIELDS:
         problem = _vector_problem(name, box[name], length) or _value_problem(name, box[name])
         if problem is not None:
             return problem
@@ -262,7 +250,7 @@ def _sample_fine(token: str, boxes: list) -> bool:
     try:
         if any(b["sample_token"] != token for b in boxes):
             return False
-        for name, length in _VECTOR_FIELDS:
+        for name, length in VECTOR_FIELDS:
             if any(isinstance(b[name], str) for b in boxes):
                 return False
             array = np.array([b[name] for b in boxes], dtype=float)

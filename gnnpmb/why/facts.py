@@ -91,9 +91,6 @@ class Use:
         """The detections the update used (share >= ``USED_SHARE``)."""
         return tuple(m for m, _ in self.shares)
 
-    def share_of(self, meas: int) -> float:
-        return next((s for m, s in self.shares if m == meas), 0.0)
-
 
 class Went(enum.Enum):
     """Where a detection went."""
