@@ -32,17 +32,15 @@ MAX_REPORTS = 500
 """The cache keeps the most recently written reports up to this many (each is tens of kB)."""
 
 
-def cached_report(
-    root: Path,
+def report_key(
     location: DatasetLocation,
     scene_name: str,
     tracker: str,
     results: Mapping[str, Sequence[Mapping[str, Any]]],
-    find: Callable[[], FailureReport],
     keyframes: range | None = None,
-) -> FailureReport:
-    """The stored report for these inputs (``results``: submission boxes by sample token, evaluated on
-    ``keyframes``, None: all), else ``find()``'s, stored under ``root/failures`` by the SHA-256 of the inputs."""
+) -> str:
+    """Cache key (hex SHA-256) of the failure report of ``results`` (submission boxes by sample token), evaluated
+    on ``keyframes`` only (None: the whole scene)."""
     from gnnpmb.provenance import code_version, tables_fingerprint
 
     blob = {
@@ -56,8 +54,22 @@ def cached_report(
     }
     if keyframes is not None:
         blob["keyframes"] = [keyframes.start, keyframes.stop]
-    key = hashlib.sha256(json.dumps(blob, sort_keys=True, allow_nan=True).encode()).hexdigest()
+    return hashlib.sha256(json.dumps(blob, sort_keys=True, allow_nan=True).encode()).hexdigest()
+
+
+def cached_report(
+    root: Path,
+    location: DatasetLocation,
+    scene_name: str,
+    tracker: str,
+    results: Mapping[str, Sequence[Mapping[str, Any]]],
+    find: Callable[[], FailureReport],
+    keyframes: range | None = None,
+) -> FailureReport:
+    """The stored report for these inputs (evaluated on ``keyframes``, None: all), else ``find()``'s, stored under
+    ``root/failures``."""
     cache = ResultCache(root / FAILURES_FOLDER)
+    key = report_key(location, scene_name, tracker, results, keyframes)
     stored = cache.get(key)
     if stored is not None:
         try:
