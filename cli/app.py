@@ -29,7 +29,15 @@ from typing import Annotated
 import typer
 
 from cli.errors import check_version_flag, exit_now_on_failure, run_app
-from cli.options import DEFAULT_SOURCE, ResultsOption, Source, source_options, tidy_help
+from cli.options import (
+    DEFAULT_SOURCE,
+    ProgressOption,
+    ResultsOption,
+    SceneArgument,
+    Source,
+    source_options,
+    tidy_help,
+)
 from cli.progress import progress_bar
 from cli.reproduce import COMMAND_LINE, PROG, command_line, reproduce_app
 from gnnpmb.classes import TRACKING_CLASSES
@@ -59,7 +67,7 @@ VIEW_HELP = (
 @app.command(help=VIEW_HELP)
 @source_options
 def view(
-    scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
+    scene: SceneArgument,
     tracker: Annotated[
         list[str] | None,
         typer.Option(
@@ -120,7 +128,7 @@ def view(
             "The recording holds the frames around it and opens at it, looking at the place.",
         ),
     ] = None,
-    progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
+    progress: ProgressOption = True,
     cameras: Annotated[
         bool, typer.Option(help="Show the camera images with the boxes projected into them (where the data has them).")
     ] = True,

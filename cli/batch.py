@@ -21,15 +21,17 @@ from cli.options import (
     DEFAULT_SOURCE,
     AddressOption,
     DatarootOption,
+    ProgressOption,
     Source,
     SplitOption,
     TrackerOption,
+    VerboseOption,
     VersionOption,
     source_options,
     stdout_console,
     tidy_help,
 )
-from cli.study import VerboseOption, register
+from cli.study import register
 from cli.tune import register as register_tune
 from gnnpmb.eval.nuscenes_eval import default_split
 from gnnpmb.outputs import check_output_dir, check_output_file
@@ -57,7 +59,7 @@ def track(
     source: Source = DEFAULT_SOURCE,
     split: SplitOption = None,
     tracker: TrackerOption = DEFAULT_TRACKER,
-    progress: Annotated[bool, typer.Option(help="Show a progress bar on stderr.")] = True,
+    progress: ProgressOption = True,
     workers: Annotated[
         int, typer.Option(metavar="N", help="Scenes tracked in parallel on Ray; 1 (default) runs in this process.")
     ] = 1,

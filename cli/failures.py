@@ -10,7 +10,15 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from cli.options import DEFAULT_SOURCE, ResultsOption, RunsOption, Source, source_options, stdout_console
+from cli.options import (
+    DEFAULT_SOURCE,
+    ResultsOption,
+    RunsOption,
+    SceneArgument,
+    Source,
+    source_options,
+    stdout_console,
+)
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.outputs import check_output_file
 from gnnpmb.stages.request import DEFAULT_TRACKER
@@ -29,7 +37,7 @@ def register(app: typer.Typer) -> None:
     @app.command(short_help="List one scene's tracking failures per frame.")
     @source_options
     def failures(
-        scene: Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")],
+        scene: SceneArgument,
         tracker: RunsOption = None,
         results: ResultsOption = None,
         source: Source = DEFAULT_SOURCE,

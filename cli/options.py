@@ -82,6 +82,9 @@ DetectorOption = Annotated[
 TrackerOption = Annotated[
     str, typer.Option("--tracker", "-t", metavar="NAME", help=f"Tracker: {', '.join(TRACKER_NAMES)}.")
 ]
+SceneArgument = Annotated[str, typer.Argument(metavar="SCENE", help="Scene name, e.g. scene-0103.")]
+ProgressOption = Annotated[bool, typer.Option(help="Show a progress bar on stderr.")]
+VerboseOption = Annotated[bool, typer.Option("--verbose", help="Show Ray's own log lines (hidden by default).")]
 AddressOption = Annotated[
     str | None,
     typer.Option(

@@ -8,7 +8,7 @@ the work is in ``gnnpmb.study``. No
 
 import tomllib
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import Annotated, Any
 
 import typer
 from rich.progress import Progress
@@ -18,17 +18,16 @@ from cli.errors import announce_stop
 from cli.options import (
     DEFAULT_SOURCE,
     AddressOption,
+    ProgressOption,
     Source,
     SplitOption,
     TrackerOption,
+    VerboseOption,
     source_options,
     stdout_console,
 )
 from cli.progress import progress_bar
 from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER
-
-if TYPE_CHECKING:
-    pass
 
 WorkersOption = Annotated[
     int | None,
@@ -37,8 +36,6 @@ WorkersOption = Annotated[
         help="Parallel tasks (default: the CPU count; on a cluster, all its CPUs); 1 runs in this process without Ray.",
     ),
 ]
-ProgressOption = Annotated[bool, typer.Option(help="Show a progress bar on stderr.")]
-VerboseOption = Annotated[bool, typer.Option("--verbose", help="Show Ray's own log lines (hidden by default).")]
 
 
 def base_params(params: Path | None) -> dict[str, Any]:

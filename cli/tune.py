@@ -18,13 +18,13 @@ from cli.options import (
     DetectionsOption,
     DetectorOption,
     ParamsOption,
+    ProgressOption,
     TrackerOption,
+    VerboseOption,
     VersionOption,
     stdout_console,
 )
 from cli.study import (
-    ProgressOption,
-    VerboseOption,
     WorkersOption,
     base_params,
     best_label,

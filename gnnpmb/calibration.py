@@ -234,28 +234,29 @@ def score_threshold(s: ClassSamples) -> float | None:
     return float(round(edges[last_low + 1], 2)) if last_low >= 0 else 0.0
 
 
+def _variances(path: str, key: str, residual: np.ndarray, what: str, outliers: str) -> list[Learnt]:
+    """The variances of the x and y columns of ``residual`` (N, 2) without its outliers (``inliers``), at least
+    ``VARIANCE_FLOOR``, as parameters ``key`` (a template of the axis) of ``path``; none below ``MIN_SAMPLES``."""
+    n = len(residual)
+    if n < MIN_SAMPLES:
+        return []
+    keep = inliers(residual)
+    var = np.maximum(np.var(residual[keep], axis=0), VARIANCE_FLOOR)
+    share = f"{100 * (1 - keep.mean()):.1f} % {outliers} left out"
+    return [
+        Learnt(path, key.format(axis), v, f"variance of {what.format(axis)}, {n} pairs, {share}")
+        for axis, v in zip("xy", var.tolist(), strict=True)
+    ]
+
+
 def learn_class(cls: str, s: ClassSamples, base: TrackerConfig) -> list[Learnt]:
     """The learnt values of one class (module docstring), each with its source."""
     out: list[Learnt] = []
     own, pmb = f"classes.{cls}", f"classes.{cls}.pmb"
     n = len(s.position_residual_m)
-    if n >= MIN_SAMPLES:
-        keep = inliers(s.position_residual_m)
-        var = np.maximum(np.var(s.position_residual_m[keep], axis=0), VARIANCE_FLOOR)
-        share = f"{100 * (1 - keep.mean()):.1f} % outliers beyond {OUTLIER_SIGMAS:g} robust sigma left out"
-        for axis, v in zip("xy", var.tolist(), strict=True):
-            out.append(
-                Learnt(own, f"r_{axis}", v, f"variance of detection - annotation {axis} (m^2), {n} pairs, {share}")
-            )
-    nv = len(s.velocity_residual_mps)
-    if nv >= MIN_SAMPLES:
-        keep = inliers(s.velocity_residual_mps)
-        var = np.maximum(np.var(s.velocity_residual_mps[keep], axis=0), VARIANCE_FLOOR)
-        share = f"{100 * (1 - keep.mean()):.1f} % outliers left out"
-        for axis, v in zip("xy", var.tolist(), strict=True):
-            out.append(
-                Learnt(own, f"r_v{axis}", v, f"variance of detected - annotated v{axis} ((m/s)^2), {nv} pairs, {share}")
-            )
+    beyond = f"outliers beyond {OUTLIER_SIGMAS:g} robust sigma"
+    out += _variances(own, "r_{}", s.position_residual_m, "detection - annotation {} (m^2)", beyond)
+    out += _variances(own, "r_v{}", s.velocity_residual_mps, "detected - annotated v{} ((m/s)^2)", "outliers")
     if n >= MIN_SAMPLES:
         heading = s.heading_residual_rad[:, None]
         sigma_psi = max(float(robust_std(heading)[0]), 1e-3)

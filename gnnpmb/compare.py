@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from gnnpmb.eval.failures import short_id
 from gnnpmb.types import Boxes, TrackEstimate
 
 MATCH_DISTANCE_M = 2.0
@@ -66,7 +67,7 @@ class Disagreement:
 
     def describe(self) -> str:
         """One readable line naming trackers and ids."""
-        gt = f"{self.class_name} GT {short_gt_id(self.gt_id)}"
+        gt = f"{self.class_name} GT {short_id(self.gt_id)}"
         match self.kind:
             case DisagreementKind.MISSED_BY_ONE:
                 return f"{gt}: {self.tracker} shows track {self.track_ids[0]} on it, {self.other} shows no track on it"
@@ -111,11 +112,6 @@ class Comparison:
             tuple(f for f in self.frame_indices if f in frames),
             tuple(d for d in self.disagreements if d.frame_index in frames),
         )
-
-
-def short_gt_id(gt_id: str) -> str:
-    """First 6 characters of a long instance token (as the viewer labels GT boxes)."""
-    return gt_id if len(gt_id) <= 8 else gt_id[:6]
 
 
 def match_to_gt(

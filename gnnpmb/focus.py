@@ -16,8 +16,8 @@ focus frame, so a comparison recording highlights what each tracker did at the s
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -50,10 +50,8 @@ class FocusTarget:
 
     title: the failure in words; frame_index: the keyframe shown on opening; center_xy_m: global BEV centre of
     the place; class_name; track_ids: involved track ids per tracker; gt_ids: involved instance tokens;
-    failure_id: the id ``gnnpmb failures`` prints (None when the focus is not a failure); evaluated_gt_xy_m:
-    instance token -> global BEV centre of its box as the evaluation saw it at ``frame_index`` (the devkit
-    interpolates a box between annotated frames where it had no LiDAR points, so this can lie metres from the
-    annotation; empty when the focus is not a failure); failure_kind, failure_tracker and failure_tracks: the
+    failure_id: the id ``gnnpmb failures`` prints (None when the focus is not a failure); failure_kind,
+    failure_tracker and failure_tracks: the
     failure's kind, the tracker it is of and its own track ids in their order (e.g. old, new for an ID switch;
     thief, victim for an identity theft).
     """
@@ -65,7 +63,6 @@ class FocusTarget:
     track_ids: dict[str, tuple[int, ...]]
     gt_ids: tuple[str, ...]
     failure_id: str | None = None
-    evaluated_gt_xy_m: dict[str, tuple[float, float]] = field(default_factory=dict)
     failure_kind: FailureKind | None = None
     failure_tracker: str | None = None
     failure_tracks: tuple[int, ...] = ()
@@ -95,17 +92,18 @@ def resolve_focus(
     """
     kind, ref = parse_focus(spec)
     trackers = list(reports)
+    tracked = _Tracked(scene, reports, estimates, frames)
     if kind == "track":
-        return _track_focus(int(ref), scene, reports, estimates, frames)
+        return tracked.track_focus(int(ref))
     if kind == "gt":
-        return _gt_focus(ref, scene, reports, estimates, frames)
+        return tracked.gt_focus(ref)
     if kind == "diff":
         from gnnpmb.diff import diff_failure
 
         failure, run, fid, entry = diff_failure(ref, reports)
         if failure.frame_index not in frames:
             raise GnnpmbError(f"--focus {spec}: {entry.diff_id} is at frame {failure.frame_index}, outside --frames")
-        target = _from_failure(failure, run, fid, scene, estimates, frames)
+        target = tracked.from_failure(failure, run, fid)
         a, b = list(reports)[:2]
         title = f"{entry.diff_id} ({entry.change.value} from {a} to {b}): {target.title}"
         return replace(target, title=title)
@@ -120,43 +118,114 @@ def resolve_focus(
             f"--focus {spec}: no such failure of {first} on {scene.name} in the tracked frames ({known}); "
             f"gnnpmb failures {scene.name} --tracker {first}{same} lists them"
         )
-    return _from_failure(failure, first, spec.strip(), scene, estimates, frames)
+    return tracked.from_failure(failure, first, spec.strip())
 
 
-def _from_failure(
-    failure: Failure,
-    tracker: str,
-    failure_id: str | None,
-    scene: SceneData,
-    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
-    frames: range,
-) -> FocusTarget:
-    centers = np.array([b.translation_m[:2] for b in failure.boxes], dtype=np.float64).reshape(-1, 2)
-    gt_centers = np.array([b.translation_m[:2] for b in failure.boxes if b.is_gt], dtype=np.float64).reshape(-1, 2)
-    # The ground truth is where the failure happens; a lost track's last box can be frames old and metres away.
-    place = gt_centers if len(gt_centers) else centers
-    center = place.mean(axis=0) if len(place) else _ego_xy(scene, failure.frame_index)
-    ids: dict[str, tuple[int, ...]] = {}
-    for name, per_frame in estimates.items():
-        own = {int(t) for t in failure.track_ids} if name == tracker else set()
-        near: set[int] = set()
-        for i in range(max(frames.start, failure.frame_index - NEAR_FRAMES), failure.frame_index + 1):
-            near |= _tracks_near(per_frame[i - frames.start], failure.class_name, gt_xy(scene, i, failure.gt_ids))
-        ids[name] = tuple(sorted(own | near))
-    label = failure_id or failure.kind.value
-    return FocusTarget(
-        title=f"{label} at frame {failure.frame_index} ({tracker}): {failure.describe()}",
-        frame_index=failure.frame_index,
-        center_xy_m=(float(center[0]), float(center[1])),
-        class_name=failure.class_name,
-        track_ids=ids,
-        gt_ids=failure.gt_ids or _gt_under_false_track(failure, scene),
-        failure_id=failure_id,
-        evaluated_gt_xy_m={b.object_id: (b.translation_m[0], b.translation_m[1]) for b in failure.boxes if b.is_gt},
-        failure_kind=failure.kind,
-        failure_tracker=tracker,
-        failure_tracks=tuple(int(t) for t in failure.track_ids),
-    )
+@dataclass(frozen=True, slots=True)
+class _Tracked:
+    """What a focus is found in (``resolve_focus``'s arguments)."""
+
+    scene: SceneData
+    reports: Mapping[str, FailureReport]
+    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]]
+    frames: range
+
+    def from_failure(self, failure: Failure, tracker: str, failure_id: str | None) -> FocusTarget:
+        """The focus on ``failure`` of ``tracker`` (printed as ``failure_id``; None: not named by a failure id)."""
+        centers = np.array([b.translation_m[:2] for b in failure.boxes], dtype=np.float64).reshape(-1, 2)
+        gt_centers = np.array([b.translation_m[:2] for b in failure.boxes if b.is_gt], dtype=np.float64).reshape(-1, 2)
+        # The ground truth is where the failure happens; a lost track's last box can be frames old and metres away.
+        place = gt_centers if len(gt_centers) else centers
+        center = place.mean(axis=0) if len(place) else _ego_xy(self.scene, failure.frame_index)
+        ids: dict[str, tuple[int, ...]] = {}
+        for name, per_frame in self.estimates.items():
+            own = {int(t) for t in failure.track_ids} if name == tracker else set()
+            near: set[int] = set()
+            start = self.frames.start
+            for i in range(max(start, failure.frame_index - NEAR_FRAMES), failure.frame_index + 1):
+                near |= _tracks_near(per_frame[i - start], failure.class_name, gt_xy(self.scene, i, failure.gt_ids))
+            ids[name] = tuple(sorted(own | near))
+        label = failure_id or failure.kind.value
+        return FocusTarget(
+            title=f"{label} at frame {failure.frame_index} ({tracker}): {failure.describe()}",
+            frame_index=failure.frame_index,
+            center_xy_m=(float(center[0]), float(center[1])),
+            class_name=failure.class_name,
+            track_ids=ids,
+            gt_ids=failure.gt_ids or _gt_under_false_track(failure, self.scene),
+            failure_id=failure_id,
+            failure_kind=failure.kind,
+            failure_tracker=tracker,
+            failure_tracks=tuple(int(t) for t in failure.track_ids),
+        )
+
+    def first_failure(self, involved: Callable[[Failure], bool]) -> FocusTarget | None:
+        """The focus on the first failure satisfying ``involved``, by kind priority then frame (None: no such)."""
+        found = [
+            (_KIND_ORDER.index(f.kind), f.frame_index, name, fid, f)
+            for name, report in self.reports.items()
+            for fid, f in zip(report.ids(), report.failures, strict=True)
+            if f.frame_index in self.frames and involved(f)
+        ]
+        if not found:
+            return None
+        _, _, name, fid, failure = min(found, key=lambda x: x[:2])
+        return self.from_failure(failure, name, fid)
+
+    def track_focus(self, track_id: int) -> FocusTarget:
+        hit = self.first_failure(lambda f: str(track_id) in f.track_ids)
+        if hit is not None:
+            return hit
+        for name, per_frame in self.estimates.items():
+            seen = [(k, e) for k, est in enumerate(per_frame) for e in est if e.track_id == track_id]
+            if seen:
+                k, e = seen[-1]
+                return FocusTarget(
+                    title=f"track {track_id} ({name}, {e.class_name}), last reported at frame {self.frames[k]}",
+                    frame_index=self.frames[k],
+                    center_xy_m=(float(e.translation_m[0]), float(e.translation_m[1])),
+                    class_name=e.class_name,
+                    track_ids={n: (track_id,) if n == name else () for n in self.estimates},
+                    gt_ids=(),
+                )
+        raise GnnpmbError(
+            f"--focus track:{track_id}: no tracker reported a track {track_id} on {self.scene.name} in the tracked "
+            "frames"
+        )
+
+    def gt_focus(self, prefix: str) -> FocusTarget:
+        scene, frames = self.scene, self.frames
+        tokens = sorted(
+            {str(t) for i in frames for t in scene.keyframes[i].gt.instance_id if str(t).startswith(prefix)}
+        )
+        if not tokens:
+            raise GnnpmbError(f"--focus gt:{prefix}: no ground-truth object of {scene.name} has an id starting so")
+        if len(tokens) > 1:
+            shown = ", ".join(short_id(t) for t in tokens[:5])
+            raise GnnpmbError(f"--focus gt:{prefix} is ambiguous ({shown}...); give more characters of the id")
+        token = tokens[0]
+        hit = self.first_failure(lambda f: token in f.gt_ids)
+        if hit is not None:
+            return hit
+        for i in frames:
+            gt = scene.keyframes[i].gt
+            rows = np.flatnonzero(gt.instance_id == token)
+            if rows.size:
+                xy = gt.translation_m[rows[0], :2]
+                class_name = str(gt.class_name[rows[0]])
+                near = {
+                    name: tuple(sorted(_tracks_near(per_frame[i - frames.start], class_name, xy[None, :])))
+                    for name, per_frame in self.estimates.items()
+                }
+                return FocusTarget(
+                    title=f"GT {short_id(token)} ({class_name}) first visible at frame {i}, no failure",
+                    frame_index=i,
+                    center_xy_m=(float(xy[0]), float(xy[1])),
+                    class_name=class_name,
+                    track_ids=near,
+                    gt_ids=(token,),
+                )
+        raise AssertionError("token found above")
 
 
 def _gt_under_false_track(failure: Failure, scene: SceneData) -> tuple[str, ...]:
@@ -171,87 +240,6 @@ def _gt_under_false_track(failure: Failure, scene: SceneData) -> tuple[str, ...]
     d = np.hypot(*(gt.translation_m[:, :2] - np.asarray(failure.boxes[0].translation_m[:2])).T)
     k = int(np.argmin(d))
     return (str(gt.instance_id[k]),) if d[k] <= NEAR_M else ()
-
-
-def _first_failure(reports: Mapping[str, FailureReport], involved, frames: range) -> tuple[Failure, str, str] | None:
-    """The first failure satisfying ``involved``, by kind priority then frame: (failure, tracker, id)."""
-    found = [
-        (_KIND_ORDER.index(f.kind), f.frame_index, name, fid, f)
-        for name, report in reports.items()
-        for fid, f in zip(report.ids(), report.failures, strict=True)
-        if f.frame_index in frames and involved(f)
-    ]
-    if not found:
-        return None
-    _, _, name, fid, failure = min(found, key=lambda x: x[:2])
-    return failure, name, fid
-
-
-def _track_focus(
-    track_id: int,
-    scene: SceneData,
-    reports: Mapping[str, FailureReport],
-    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
-    frames: range,
-) -> FocusTarget:
-    hit = _first_failure(reports, lambda f: str(track_id) in f.track_ids, frames)
-    if hit is not None:
-        failure, tracker, fid = hit
-        return _from_failure(failure, tracker, fid, scene, estimates, frames)
-    for name, per_frame in estimates.items():
-        seen = [(k, e) for k, est in enumerate(per_frame) for e in est if e.track_id == track_id]
-        if seen:
-            k, e = seen[-1]
-            return FocusTarget(
-                title=f"track {track_id} ({name}, {e.class_name}), last reported at frame {frames[k]}",
-                frame_index=frames[k],
-                center_xy_m=(float(e.translation_m[0]), float(e.translation_m[1])),
-                class_name=e.class_name,
-                track_ids={n: (track_id,) if n == name else () for n in estimates},
-                gt_ids=(),
-            )
-    raise GnnpmbError(
-        f"--focus track:{track_id}: no tracker reported a track {track_id} on {scene.name} in the tracked frames"
-    )
-
-
-def _gt_focus(
-    prefix: str,
-    scene: SceneData,
-    reports: Mapping[str, FailureReport],
-    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
-    frames: range,
-) -> FocusTarget:
-    tokens = sorted({str(t) for i in frames for t in scene.keyframes[i].gt.instance_id if str(t).startswith(prefix)})
-    if not tokens:
-        raise GnnpmbError(f"--focus gt:{prefix}: no ground-truth object of {scene.name} has an id starting so")
-    if len(tokens) > 1:
-        shown = ", ".join(short_id(t) for t in tokens[:5])
-        raise GnnpmbError(f"--focus gt:{prefix} is ambiguous ({shown}...); give more characters of the id")
-    token = tokens[0]
-    hit = _first_failure(reports, lambda f: token in f.gt_ids, frames)
-    if hit is not None:
-        failure, tracker, fid = hit
-        return _from_failure(failure, tracker, fid, scene, estimates, frames)
-    for i in frames:
-        gt = scene.keyframes[i].gt
-        rows = np.flatnonzero(gt.instance_id == token)
-        if rows.size:
-            xy = gt.translation_m[rows[0], :2]
-            class_name = str(gt.class_name[rows[0]])
-            near = {
-                name: tuple(sorted(_tracks_near(per_frame[i - frames.start], class_name, xy[None, :])))
-                for name, per_frame in estimates.items()
-            }
-            return FocusTarget(
-                title=f"GT {short_id(token)} ({class_name}) first visible at frame {i}, no failure",
-                frame_index=i,
-                center_xy_m=(float(xy[0]), float(xy[1])),
-                class_name=class_name,
-                track_ids=near,
-                gt_ids=(token,),
-            )
-    raise AssertionError("token found above")
 
 
 def _tracks_near(estimates: Sequence[TrackEstimate], class_name: str, centers_xy: np.ndarray) -> set[int]:

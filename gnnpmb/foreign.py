@@ -30,7 +30,7 @@ import numpy as np
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError
 from gnnpmb.events import EventSink, Extracted, FrameStarted, MeasurementsReceived, NullSink
-from gnnpmb.pipeline import FrameResult, TrackingRun
+from gnnpmb.pipeline import FrameResult, TrackingRun, keyframe_steps
 from gnnpmb.types import Boxes, FrameDetections, TrackEstimate
 
 SAME_BOX_TOL = 1e-4
@@ -136,14 +136,11 @@ def check_coverage(
         )
     if missing:
         raise DataError(f"{source} lacks {len(missing)} of the {len(tokens)} samples of {what} (e.g. {missing[0]})")
+    from gnnpmb.eval.submission import check_in_dataset
+
     wanted = set(tokens)
     extra = [t for t in results if t not in wanted]
-    unknown = [t for t in extra if t not in dataset_tokens]
-    if unknown:
-        raise DataError(
-            f"{source} has {len(unknown)} samples that are not in the dataset (e.g. {unknown[0]}); was it made for "
-            "another dataset version?"
-        )
+    check_in_dataset(source, extra, dataset_tokens)
     if not extra:
         return None
     boxes = sum(len(results[t]) if isinstance(results[t], list) else 0 for t in extra)
@@ -253,13 +250,8 @@ def replay(
     """The results as a ``TrackingRun`` named ``results.name`` over ``frame_range`` (default all keyframes), its
     output-only events sent to ``sink`` (module docstring)."""
     sink = sink or NullSink()
-    indices = frame_range if frame_range is not None else range(len(scene.keyframes))
     out: list[FrameResult] = []
-    previous_us: int | None = None
-    for i in indices:
-        keyframe = scene.keyframes[i]
-        dt_s = 0.0 if previous_us is None else (keyframe.timestamp_us - previous_us) * 1e-6
-        previous_us = keyframe.timestamp_us
+    for i, keyframe, dt_s in keyframe_steps(scene, frame_range):
         given = given_detections(frames[i])
         estimates = results.estimates[i]
         if sink.enabled:

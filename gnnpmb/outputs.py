@@ -127,16 +127,22 @@ def check_not_input(target: Path, option: str, given: Path, inputs: Inputs) -> N
             )
 
 
+def _given_and_target(path: Path, option: str) -> tuple[Path, Path]:
+    """``option``'s value as given (``~`` expanded) and the absolute path it writes (a symlink resolved), or an
+    OutputPathError for a name too long or a symlink loop."""
+    given = Path(path).expanduser()
+    _check_name_length(given.absolute(), option, given)
+    _check_no_loop(given, option)
+    return given, given.resolve() if given.is_symlink() else given.absolute()
+
+
 def check_output_file(path: Path, option: str, suffix: str | None = None, *, inputs: Inputs = ()) -> Path:
     """The absolute regular-file path to write for ``option`` (e.g. ``--out``), or an OutputPathError.
 
     suffix: the required extension (e.g. ``.json``), or None for any. A symlink resolves to its target.
     inputs: the command's input files, which the output must not be.
     """
-    given = Path(path).expanduser()
-    _check_name_length(given.absolute(), option, given)
-    _check_no_loop(given, option)
-    target = given.resolve() if given.is_symlink() else given.absolute()
+    given, target = _given_and_target(path, option)
     if suffix is not None and target.suffix.lower() != suffix:
         raise OutputPathError(f"{option} {given}: the file name must end in {suffix}")
     _check_name_length(target, option, given)
@@ -164,10 +170,7 @@ def check_output_dir(
     files, folders: the names the command writes in it; each must be a file (or a folder) there, writable,
     and none of ``inputs``.
     """
-    given = Path(path).expanduser()
-    _check_name_length(given.absolute(), option, given)
-    _check_no_loop(given, option)
-    target = given.resolve() if given.is_symlink() else given.absolute()
+    given, target = _given_and_target(path, option)
     _check_name_length(target, option, given)
     _check_not_dataset(target, option, given)
     if not target.exists():

@@ -7,7 +7,7 @@ Per keyframe: the detections are score-thresholded and NMS-filtered per class (p
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -67,6 +67,16 @@ def preprocess_frames(
     return [preprocess(detections[k.sample_token], params, classes) for k in scene.keyframes]
 
 
+def keyframe_steps(scene: SceneData, frame_range: range | None) -> Iterator[tuple[int, Keyframe, float]]:
+    """(index, keyframe, dt_s) over ``frame_range`` (default all keyframes of ``scene``); dt_s is the real time
+    since the range's previous keyframe (0 at its first)."""
+    previous_us: int | None = None
+    for i in frame_range if frame_range is not None else range(len(scene.keyframes)):
+        keyframe = scene.keyframes[i]
+        yield i, keyframe, 0.0 if previous_us is None else (keyframe.timestamp_us - previous_us) * 1e-6
+        previous_us = keyframe.timestamp_us
+
+
 def run_tracker(
     scene: SceneData,
     detections: Mapping[str, Boxes] | Sequence[FrameDetections],
@@ -92,13 +102,8 @@ def run_tracker(
     else:
         frames_in = detections
     mot = MultiClassTracker(tracker, config, classes)
-    indices = frame_range if frame_range is not None else range(len(scene.keyframes))
     results: list[FrameResult] = []
-    previous_us: int | None = None
-    for i in indices:
-        keyframe = scene.keyframes[i]
-        dt_s = 0.0 if previous_us is None else (keyframe.timestamp_us - previous_us) * 1e-6
-        previous_us = keyframe.timestamp_us
+    for i, keyframe, dt_s in keyframe_steps(scene, frame_range):
         if sink.enabled:
             sink.emit(FrameStarted(tracker, i, keyframe.sample_token, keyframe.timestamp_us, dt_s))
         start = time.perf_counter()

@@ -15,8 +15,9 @@ from collections.abc import Sequence
 import numpy as np
 import rerun as rr
 
-from gnnpmb.compare import Comparison, Disagreement, DisagreementKind, short_gt_id
+from gnnpmb.compare import Comparison, Disagreement, DisagreementKind
 from gnnpmb.data.scene import SceneData
+from gnnpmb.eval.failures import short_id
 from viz import paths
 from viz.markers import send_counts, send_marker_boxes, send_text_lines
 from viz.timeline import PLAIN_CLOCK, Clock
@@ -73,10 +74,10 @@ def marker_label(d: Disagreement) -> str:
     """Short box label naming the trackers and ids."""
     match d.kind:
         case DisagreementKind.MISSED_BY_ONE:
-            return f"only {d.tracker} tracks GT {short_gt_id(d.gt_id)} (track {d.track_ids[0]})"
+            return f"only {d.tracker} tracks GT {short_id(d.gt_id)} (track {d.track_ids[0]})"
         case DisagreementKind.ID_CHANGE:
             old, new, kept = d.track_ids
-            return f"{d.tracker} {old}->{new}, {d.other} kept {kept}: GT {short_gt_id(d.gt_id)}"
+            return f"{d.tracker} {old}->{new}, {d.other} kept {kept}: GT {short_id(d.gt_id)}"
         case DisagreementKind.ONLY_IN_ONE:
             return f"only {d.tracker}: track {d.track_ids[0]}"
     raise AssertionError(d.kind)

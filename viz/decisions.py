@@ -19,7 +19,7 @@ import numpy as np
 
 from gnnpmb.events import AxisKind, CostMatrix, GlobalHypotheses, label_positions
 from gnnpmb.explain import LINK_SLACK, Conflict, Decisions
-from gnnpmb.why.words import choice_why, column_name, meas_name
+from gnnpmb.why.words import choice_why, column_name, meas_name, plural
 
 _TRACK = AxisKind.TRACK.value
 _NEW = AxisKind.NEW_TRACK.value
@@ -47,10 +47,6 @@ def _ids(track_ids: tuple[int, ...], reported: set[int] | None) -> str:
     return ", ".join(shown) + (f" (+{counted})" if hidden else "")
 
 
-def _plural(n: int, word: str) -> str:
-    return f"{n} {word}{'s' if n != 1 else ''}"
-
-
 def _tracks_phrase(track_ids: tuple[int, ...], reported: set[int] | None) -> str:
     """``track 26``, ``tracks 26, 123 and 1 candidate``, ``2 candidate tracks`` (candidates: never reported)."""
     shown = [str(t) for t in track_ids if reported is None or t in reported]
@@ -58,7 +54,7 @@ def _tracks_phrase(track_ids: tuple[int, ...], reported: set[int] | None) -> str
     if not shown:
         return f"{hidden} candidate track{'s' if hidden != 1 else ''}" if hidden else "no track"
     named = f"track{'s' if len(shown) > 1 else ''} {', '.join(shown)}"
-    return named + (f" and {_plural(hidden, 'candidate')}" if hidden else "")
+    return named + (f" and {plural(hidden, 'candidate')}" if hidden else "")
 
 
 def conflict_markdown(conflict: Conflict, reported: set[int] | None = None) -> str:
@@ -122,7 +118,7 @@ def decisions_markdown(
         body.append(f"### {d.class_name}")
         if d.births_only:
             body.append(
-                f"{_plural(len(d.births_only), 'detection')} no track competed for (outside every gate, or dearer "
+                f"{plural(len(d.births_only), 'detection')} no track competed for (outside every gate, or dearer "
                 f"than a new track by over {LINK_SLACK:g}), so each is a new track or clutter: "
                 + ", ".join(meas_name(m) for m in d.births_only)
             )

@@ -222,7 +222,7 @@ def _diagnosis(view: TrackerView, class_name: str, track_ids: list[int], frames:
             parts.append(f"nothing in its gate at {frames_text(empty)}")
         passed = [s for s in since if s.gated and not s.used]
         if passed:
-            mode = _mode(facts, class_name, frames)
+            mode = facts.mode(class_name, frames)
             went = []
             for s in passed:
                 nearest = s.gated[:2]
@@ -245,7 +245,7 @@ def _diagnosis(view: TrackerView, class_name: str, track_ids: list[int], frames:
                 parts.append(f"{e.ending.value} at frame {ended.frame} ({e.reason.value})")
         alive = [s for s in steps if s.posterior_existence is not None]
         if facts.has_existence and alive:
-            word = "weight" if _mode(facts, class_name, frames) is UseMode.WEIGHTS else "existence"
+            word = "weight" if facts.mode(class_name, frames) is UseMode.WEIGHTS else "existence"
             peak = max(alive, key=lambda s: s.posterior_existence)
             last = alive[-1]
             if existence_text(peak.posterior_existence) == existence_text(last.posterior_existence):
@@ -261,23 +261,13 @@ def _diagnosis(view: TrackerView, class_name: str, track_ids: list[int], frames:
     return out
 
 
-def _mode(facts: TrackerFacts, class_name: str, frames: range) -> UseMode:
-    if facts.output_only:
-        return UseMode.OUTPUT
-    for f in frames:
-        use = facts.use(f, class_name)
-        if use is not None and use.tracks:
-            return use.mode
-    return UseMode.ASSIGNED
-
-
 def _gt_markdown(focus: FocusTarget, view: TrackerView, gt_id: str, seen: tuple[Sighting, ...]) -> list[str]:
     """The involved object frame by frame: points in its box and how the evaluation scored it, the nearest
     detection of its class (or of another class), where the tracker sent it, and the tracks output on it with
     their scores and whether the evaluation counted them."""
     if not seen:
         return []
-    mode = _mode(view.facts, focus.class_name, range(seen[0].frame, seen[-1].frame + 1))
+    mode = view.facts.mode(focus.class_name, range(seen[0].frame, seen[-1].frame + 1))
     rows = []
     for s in seen:
         if s.nearest_own is not None:

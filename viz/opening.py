@@ -28,7 +28,7 @@ from gnnpmb.eval.failures import OPEN_FIRST, Failure, FailureKind, FailureReport
 from gnnpmb.pipeline import TrackingRun
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.facts import TrackerFacts
-from gnnpmb.why.words import SHOW_MIN_EXISTENCE, frames_text
+from gnnpmb.why.words import SHOW_MIN_EXISTENCE, consecutive_runs, frames_text
 from viz import paths
 from viz.colors import faded, packed_track_colors
 from viz.failure_style import KIND_COLORS, KIND_LABELS
@@ -275,12 +275,7 @@ def id_span(failure_ids: Sequence[str]) -> str:
     numbers = [int(i.rsplit(":", 1)[1]) for i in failure_ids]
     if numbers == list(range(numbers[0], numbers[-1] + 1)):
         return f"{failure_ids[0]} … {failure_ids[-1]}"
-    runs: list[list[int]] = []
-    for n in numbers:
-        if runs and n == runs[-1][-1] + 1:
-            runs[-1].append(n)
-        else:
-            runs.append([n])
+    runs = consecutive_runs(numbers)
     return f"{kind}:" + ", ".join(f"{r[0]}–{r[-1]}" if len(r) > 1 else str(r[0]) for r in runs)
 
 

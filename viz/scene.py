@@ -15,6 +15,7 @@ import rerun as rr
 
 from gnnpmb.data.scene import Keyframe, SceneData
 from gnnpmb.data.sensor_files import LidarPresence
+from gnnpmb.eval.failures import short_id
 from gnnpmb.types import Boxes, FrameDetections
 from gnnpmb.why.words import frames_text
 from viz import paths
@@ -135,11 +136,6 @@ def log_keyframe(
     )
 
 
-def short_instance_id(token: str) -> str:
-    """A short, still distinctive label for a ground-truth instance token (first 6 characters of long ids)."""
-    return token if len(token) <= 8 else token[:6]
-
-
 def _gt_boxes(gt: Boxes) -> rr.Boxes3D:
     b = rerun_boxes(gt)
     return rr.Boxes3D(
@@ -147,7 +143,7 @@ def _gt_boxes(gt: Boxes) -> rr.Boxes3D:
         sizes=b.sizes_xyz_m,
         quaternions=b.quat_xyzw,
         class_ids=class_ids(gt.class_name),
-        labels=[short_instance_id(str(t)) for t in gt.instance_id],
+        labels=[short_id(str(t)) for t in gt.instance_id],
         radii=GT_LINE_RADIUS_M,
         fill_mode=rr.components.FillMode.TransparentFillMajorWireframe,
         show_labels=False,

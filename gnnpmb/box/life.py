@@ -21,6 +21,7 @@ import numpy as np
 
 from gnnpmb.events import EventSink, Pruned, PruneReason, TrackLogic, TrackLogicAction
 from gnnpmb.soa import StructOfArrays
+from gnnpmb.vector.track_logic import LogicUpdate
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,22 +51,13 @@ class LifeState(StructOfArrays):
         return LifeState(np.ones(n, dtype=np.int64), np.zeros(n, dtype=np.int64), np.full(n, rule.min_hits <= 1))
 
 
-@dataclass(frozen=True, slots=True)
-class LifeUpdate:
-    """The state after a frame and what changed: confirmed_now, deleted (K,) bool over the K tracks."""
-
-    state: LifeState
-    confirmed_now: np.ndarray
-    deleted: np.ndarray
-
-
-def advance(state: LifeState, hit: np.ndarray, rule: LifeRule) -> LifeUpdate:
+def advance(state: LifeState, hit: np.ndarray, rule: LifeRule) -> LogicUpdate[LifeState]:
     """The K tracks' life after a frame in which tracks ``hit`` (K,) bool were updated (or kept alive)."""
     hits = state.hits + hit
     misses = np.where(hit, 0, state.misses + 1)
     confirmed_now = ~state.confirmed & (hits >= rule.min_hits)
     deleted = np.zeros(len(hit), dtype=bool) if rule.max_misses is None else misses >= rule.max_misses
-    return LifeUpdate(LifeState(hits, misses, state.confirmed | confirmed_now), confirmed_now, deleted)
+    return LogicUpdate(LifeState(hits, misses, state.confirmed | confirmed_now), confirmed_now, deleted)
 
 
 def output_mask(state: LifeState, rule: LifeRule, frame: int) -> np.ndarray:
@@ -76,7 +68,7 @@ def output_mask(state: LifeState, rule: LifeRule, frame: int) -> np.ndarray:
 def emit_transitions(
     class_name: str,
     track_ids: np.ndarray,
-    update: LifeUpdate,
+    update: LogicUpdate[LifeState],
     born_ids: np.ndarray,
     rule: LifeRule,
     sink: EventSink,

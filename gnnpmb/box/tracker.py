@@ -32,7 +32,7 @@ import numpy as np
 from gnnpmb.assign.matching import BoundedCosts, SecondStage, Solver, StageMatches, two_stage_match
 from gnnpmb.box import kalman
 from gnnpmb.box.cost import BoxCost
-from gnnpmb.box.life import LifeRule, LifeState, LifeUpdate, advance, emit_transitions, output_mask
+from gnnpmb.box.life import LifeRule, LifeState, advance, emit_transitions, output_mask
 from gnnpmb.config import BoxNoise, TrackerConfig
 from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import (
@@ -50,6 +50,7 @@ from gnnpmb.skeleton import ClassFilter, Gating, TrackView
 from gnnpmb.soa import StructOfArrays
 from gnnpmb.track_scores import decay_on_miss
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
+from gnnpmb.vector.track_logic import LogicUpdate
 
 
 class Prediction(enum.Enum):
@@ -287,7 +288,7 @@ class BoxTracker(ClassFilter[BoxPrior, BoxTracks]):
         prior: BoxPrior,
         meas: Measurements,
         matches: StageMatches,
-        life: LifeUpdate,
+        life: LogicUpdate[LifeState],
         born: BoxTracks,
         sink: EventSink,
     ) -> None:

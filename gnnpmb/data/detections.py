@@ -46,12 +46,21 @@ DETECTION_CLASSES: tuple[str, ...] = (
 )
 """The ten nuScenes detection classes; all but barrier, traffic_cone and construction_vehicle are tracked."""
 
-_VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
+VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
     ("translation", 3),
     ("size", 3),
     ("rotation", 4),
     ("velocity", 2),
 )
+"""The list fields of a detection or tracking box and their lengths."""
+LIDAR_ONLY_META: dict[str, bool] = {
+    "use_camera": False,
+    "use_lidar": True,
+    "use_radar": False,
+    "use_map": False,
+    "use_external": False,
+}
+"""The ``meta`` of a submission made from LiDAR only: our tracking submissions and simulated detection files."""
 MAX_ABS_COORD_M = 1e5
 """Largest accepted |x|, |y|, |z| of a box centre in the global frame (nuScenes maps span a few km)."""
 MAX_SIZE_M = 100.0
@@ -74,7 +83,8 @@ def _as_floats(value: Any) -> np.ndarray | None:
         return None
 
 
-def _short(value: Any) -> str:
+def short_repr(value: Any) -> str:
+    """``repr(value)`` cut to 60 characters, for an error line quoting a bad value."""
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
@@ -83,19 +93,19 @@ def _box_problem(entry: Any) -> str | None:
     """What is wrong with one box entry, or None."""
     if not isinstance(entry, dict):
         return f"is a {type(entry).__name__}, not an object"
-    for name, length in _VECTOR_FIELDS:
+    for name, length in VECTOR_FIELDS:
         if name not in entry:
             return f"has no '{name}' field"
         value = _as_floats(entry[name])
         if value is None or value.shape != (length,):
-            return f"field '{name}' must be a list of {length} numbers, got {_short(entry[name])}"
+            return f"field '{name}' must be a list of {length} numbers, got {short_repr(entry[name])}"
         if name != "velocity" and not _all_numbers(entry[name]):
-            return f"field '{name}' must hold numbers, not text or null: {_short(entry[name])}"
+            return f"field '{name}' must hold numbers, not text or null: {short_repr(entry[name])}"
         if name != "velocity" and not np.isfinite(value).all():
-            return f"field '{name}' has a NaN or infinite value: {_short(entry[name])}"
+            return f"field '{name}' has a NaN or infinite value: {short_repr(entry[name])}"
         physical = physical_problem(name, value[None, :])
         if physical is not None:
-            return f"field '{name}' {physical}: {_short(entry[name])}"
+            return f"field '{name}' {physical}: {short_repr(entry[name])}"
     if "detection_name" not in entry:
         return "has no 'detection_name' field"
     if entry["detection_name"] not in DETECTION_CLASSES:
@@ -104,10 +114,10 @@ def _box_problem(entry: Any) -> str | None:
         return "has no 'detection_score' field"
     raw_score = entry["detection_score"]
     if isinstance(raw_score, bool) or not isinstance(raw_score, int | float):
-        return f"field 'detection_score' must be a number, got {_short(raw_score)}"
+        return f"field 'detection_score' must be a number, got {short_repr(raw_score)}"
     score = _as_floats(raw_score)
     if score is None or score.shape != () or not np.isfinite(score):
-        return f"field 'detection_score' must be a finite number, got {_short(entry['detection_score'])}"
+        return f"field 'detection_score' must be a finite number, got {short_repr(entry['detection_score'])}"
     if not 0.0 <= float(score) <= 1.0:
         return f"field 'detection_score' must lie in [0, 1], got {float(score)}"
     return None
@@ -156,7 +166,7 @@ def convert_sample(token: str, entries: Any) -> Boxes | str:
         names = np.array([e["detection_name"] for e in entries], dtype=object)
         scores = [e["detection_score"] for e in entries]
         raw_score = np.array(scores)
-        raw = {name: np.array([e[name] for e in entries]) for name, _ in _VECTOR_FIELDS if name != "velocity"}
+        raw = {name: np.array([e[name] for e in entries]) for name, _ in VECTOR_FIELDS if name != "velocity"}
         velocity = np.array([e["velocity"] for e in entries], dtype=float)
     except (KeyError, TypeError, ValueError):
         return _diagnose(token, entries)
@@ -165,13 +175,13 @@ def convert_sample(token: str, entries: Any) -> Boxes | str:
     score = raw_score.astype(float)
     arrays = {name: a.astype(float) for name, a in raw.items()} | {"velocity": velocity}
     fine = (
-        all(arrays[name].shape == (n, length) for name, length in _VECTOR_FIELDS)
+        all(arrays[name].shape == (n, length) for name, length in VECTOR_FIELDS)
         and score.shape == (n,)
         and all(np.isfinite(a).all() for name, a in arrays.items() if name != "velocity")
         and np.isfinite(score).all()
         and ((score >= 0.0) & (score <= 1.0)).all()
         and np.isin(names.astype(str), DETECTION_CLASSES).all()
-        and all(physical_problem(name, arrays[name]) is None for name, _ in _VECTOR_FIELDS)
+        and all(physical_problem(name, arrays[name]) is None for name, _ in VECTOR_FIELDS)
     )
     if not fine:
         return _diagnose(token, entries)

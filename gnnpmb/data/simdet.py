@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 
 from gnnpmb.data.boxes3d import quat_wxyz_from_yaw, yaw_from_quat_wxyz
+from gnnpmb.data.detections import LIDAR_ONLY_META
 from gnnpmb.data.scene import Keyframe, SceneData
 from gnnpmb.data.simdet_presets import (
     CLASS_MODELS,
@@ -511,11 +512,4 @@ def to_submission(detections: Mapping[str, Boxes]) -> dict[str, Any]:
             }
             for translation, size, rotation, velocity, name, score, v in columns
         ]
-    meta = {
-        "use_camera": False,
-        "use_lidar": True,
-        "use_radar": False,
-        "use_map": False,
-        "use_external": False,
-    }
-    return {"meta": meta, "results": results}
+    return {"meta": dict(LIDAR_ONLY_META), "results": results}

@@ -40,7 +40,7 @@ import numpy as np
 from gnnpmb.errors import DataError
 from gnnpmb.eval.evaluated import GtFrame, TrackEval, gt_frames, track_evals
 from gnnpmb.eval.nuscenes_eval import class_evaluation, quiet_devkit, scene_sample_tokens, tracking_config
-from gnnpmb.eval.official_scores import OfficialScores, official_scores
+from gnnpmb.eval.official_scores import OfficialScores, json_number, official_scores
 
 if TYPE_CHECKING:
     from nuscenes import NuScenes
@@ -308,7 +308,7 @@ class FailureReport:
                 {
                     "class_name": c.class_name,
                     "threshold": c.threshold,
-                    **{k: _json_number(getattr(c, k)) for k in ("mota", "tp", "fp", "fn", "ids", "frag")},
+                    **{k: json_number(getattr(c, k)) for k in ("mota", "tp", "fp", "fn", "ids", "frag")},
                 }
                 for c in self.classes
             ],
@@ -348,10 +348,6 @@ class FailureReport:
             frames=None if data.get("frames") is None else (int(data["frames"][0]), int(data["frames"][1])),
             scores=None if data.get("scores") is None else OfficialScores.from_json(data["scores"]),
         )
-
-
-def _json_number(value: float) -> float | None:
-    return None if np.isnan(value) else float(value)
 
 
 def _box(role: str, box: TrackingBox) -> FailureBox:

@@ -76,9 +76,12 @@ def official_scores(class_data: Sequence[tuple[str, TrackingMetricData]], cfg: T
     metrics.add_runtime(0.0)
     summary = metrics.serialize()
     label_metrics: dict[str, dict[str, float]] = summary["label_metrics"]
+    per_class = tuple(
+        (c, {m: json_number(label_metrics[m].get(c, np.nan)) for m in label_metrics}) for c in cfg.class_names
+    )
+    return OfficialScores(per_class, {m: json_number(summary[m]) for m in label_metrics})
 
-    def number(value: Any) -> float | None:
-        return None if np.isnan(value) else float(value)
 
-    per_class = tuple((c, {m: number(label_metrics[m].get(c, np.nan)) for m in label_metrics}) for c in cfg.class_names)
-    return OfficialScores(per_class, {m: number(summary[m]) for m in label_metrics})
+def json_number(value: Any) -> float | None:
+    """``value`` as a float, None for NaN (what JSON and the tables show as undefined)."""
+    return None if np.isnan(value) else float(value)

@@ -20,31 +20,19 @@ from typing import Any
 
 import numpy as np
 
-from gnnpmb.data.detections import physical_problem
+from gnnpmb.data.detections import LIDAR_ONLY_META, VECTOR_FIELDS, physical_problem, short_repr
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import DataError
 from gnnpmb.pipeline import TrackingRun
 from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES
 
-SUBMISSION_META: dict[str, bool] = {
-    "use_camera": False,
-    "use_lidar": True,
-    "use_radar": False,
-    "use_map": False,
-    "use_external": False,
-}
+SUBMISSION_META: dict[str, bool] = LIDAR_ONLY_META
 """What our submissions declare: LiDAR detections only."""
 
 MAX_BOXES_PER_SAMPLE = 500
 """The devkit's ``max_boxes_per_sample`` of the ``tracking_nips_2019`` config."""
 
-_VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
-    ("translation", 3),
-    ("size", 3),
-    ("rotation", 4),
-    ("velocity", 2),
-)
 _REQUIRED_FIELDS = ("sample_token", "tracking_id", "tracking_name", "tracking_score")
 QUAT_NORM_TOLERANCE = 1e-3
 """How far from 1 a results box's rotation quaternion may be (files written with 6 decimals are within 1e-5)."""
@@ -197,20 +185,15 @@ def read_submission(path: Path) -> dict[str, Any]:
     return data
 
 
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _vector_problem(name: str, value: Any, length: int) -> str | None:
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
         array = None
     if array is None or array.shape != (length,) or isinstance(value, str):
-        return f"field '{name}' must be a list of {length} numbers, got {_short(value)}"
+        return f"field '{name}' must be a list of {length} numbers, got {short_repr(value)}"
     if not np.isfinite(array).all():
-        return f"field '{name}' has a NaN or infinite value: {_short(value)}"
+        return f"field '{name}' has a NaN or infinite value: {short_repr(value)}"
     return None
 
 
@@ -223,7 +206,7 @@ def _value_problem(name: str, value: Any) -> str | None:
         norm = float(np.linalg.norm(values))
         if abs(norm - 1.0) > QUAT_NORM_TOLERANCE:
             problem = f"is not a unit quaternion (length {norm:.6g}); normalise it"
-    return None if problem is None else f"field '{name}' {problem}: {_short(value)}"
+    return None if problem is None else f"field '{name}' {problem}: {short_repr(value)}"
 
 
 def _values_fine(name: str, array: np.ndarray) -> bool:
@@ -237,26 +220,26 @@ def _box_problem(token: str, box: Any) -> str | None:
     """What is wrong with one submission box, or None (the devkit's TrackingBox checks, and finiteness)."""
     if not isinstance(box, dict):
         return f"is a {type(box).__name__}, not an object"
-    for name in _REQUIRED_FIELDS + tuple(n for n, _ in _VECTOR_FIELDS):
+    for name in _REQUIRED_FIELDS + tuple(n for n, _ in VECTOR_FIELDS):
         if name not in box:
             return f"has no '{name}' field"
     if box["sample_token"] != token:
-        return f"has sample_token {_short(box['sample_token'])}; it must equal its results key"
-    for name, length in _VECTOR_FIELDS:
+        return f"has sample_token {short_repr(box['sample_token'])}; it must equal its results key"
+    for name, length in VECTOR_FIELDS:
         problem = _vector_problem(name, box[name], length) or _value_problem(name, box[name])
         if problem is not None:
             return problem
     track_id = box["tracking_id"]
     if isinstance(track_id, bool) or not isinstance(track_id, str | int) or track_id == "":
-        return f"field 'tracking_id' must be a non-empty string, got {_short(track_id)}"
+        return f"field 'tracking_id' must be a non-empty string, got {short_repr(track_id)}"
     if box["tracking_name"] not in TRACKING_CLASSES:
         return (
-            f"has tracking_name {_short(box['tracking_name'])}, not one of the tracking classes "
+            f"has tracking_name {short_repr(box['tracking_name'])}, not one of the tracking classes "
             f"({', '.join(TRACKING_CLASSES)})"
         )
     score = box["tracking_score"]
     if isinstance(score, bool) or not isinstance(score, int | float):
-        return f"field 'tracking_score' must be a number, got {_short(score)}"
+        return f"field 'tracking_score' must be a number, got {short_repr(score)}"
     if not math.isfinite(score):
         return f"field 'tracking_score' must be finite, got {score}"
     return None
@@ -267,7 +250,7 @@ def _sample_fine(token: str, boxes: list) -> bool:
     try:
         if any(b["sample_token"] != token for b in boxes):
             return False
-        for name, length in _VECTOR_FIELDS:
+        for name, length in VECTOR_FIELDS:
             if any(isinstance(b[name], str) for b in boxes):
                 return False
             array = np.array([b[name] for b in boxes], dtype=float)
@@ -285,6 +268,17 @@ def _sample_fine(token: str, boxes: list) -> bool:
         and all(n in TRACKING_CLASSES for n in names)
         and all(type(i) in (str, int) and i != "" for i in ids)
     )
+
+
+def check_in_dataset(source: str, tokens: Sequence[str], dataset_tokens: Collection[str]) -> None:
+    """Raise a one-line ``DataError`` naming the first of ``tokens`` (a results file's sample tokens) that is not
+    one of ``dataset_tokens`` (the dataset version's)."""
+    unknown = [t for t in tokens if t not in dataset_tokens]
+    if unknown:
+        raise DataError(
+            f"{source} has {len(unknown)} samples that are not in the dataset (e.g. {unknown[0]}); was it made for "
+            "another dataset version?"
+        )
 
 
 def check_submission(
@@ -318,12 +312,7 @@ def check_submission(
             "was it made for another split?"
         )
     if extra:
-        unknown = [t for t in extra if t not in dataset_tokens]
-        if unknown:
-            raise DataError(
-                f"{source} has {len(unknown)} samples that are not in the dataset (e.g. {unknown[0]}); "
-                "was it made for another dataset version?"
-            )
+        check_in_dataset(source, extra, dataset_tokens)
         raise DataError(
             f"{source} has {len(extra)} samples of other splits than {split} (e.g. {extra[0]}); "
             "evaluate it on the split it was made for"

@@ -16,6 +16,7 @@ The last 62 frames of hits are kept as bits of an int64 (bit 0 = latest frame) a
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -66,16 +67,20 @@ class LogicState(StructOfArrays):
         return np.bitwise_count(self.history & np.int64((1 << window) - 1)).astype(np.int64)
 
 
-@dataclass(frozen=True, slots=True)
-class LogicUpdate:
-    """The state after one frame and what changed: confirmed_now, deleted: (K,) bool over the K tracks."""
+StateT = TypeVar("StateT")
 
-    state: LogicState
+
+@dataclass(frozen=True, slots=True)
+class LogicUpdate(Generic[StateT]):
+    """The state after one frame and what changed: confirmed_now, deleted: (K,) bool over the K tracks (the box
+    trackers' ``box.life`` keeps its own state in it too)."""
+
+    state: StateT
     confirmed_now: np.ndarray
     deleted: np.ndarray
 
 
-def advance(state: LogicState, hit: np.ndarray, params: VectorParams) -> LogicUpdate:
+def advance(state: LogicState, hit: np.ndarray, params: VectorParams) -> LogicUpdate[LogicState]:
     """Record this frame's hit (K,) bool for tracks that existed before the frame and apply the M/N rules."""
     m, n = params.confirm_m, params.confirm_n
     history = ((state.history << 1) & _HISTORY_MASK) | hit.astype(np.int64)
@@ -98,7 +103,7 @@ def advance(state: LogicState, hit: np.ndarray, params: VectorParams) -> LogicUp
 def emit_transitions(
     class_name: str,
     track_ids: np.ndarray,
-    update: LogicUpdate,
+    update: LogicUpdate[LogicState],
     born_ids: np.ndarray,
     params: VectorParams,
     sink: EventSink,

@@ -125,12 +125,17 @@ class MofNDeleter:
     def __init__(self, params: VectorParams):
         self.params = params
 
-    def update(self, logic: LogicState, hit: np.ndarray) -> LogicUpdate:
+    def update(self, logic: LogicState, hit: np.ndarray) -> LogicUpdate[LogicState]:
         """The track logic after a frame in which tracks ``hit`` (K,) bool were associated with a detection."""
         return advance(logic, hit, self.params)
 
     def emit(
-        self, class_name: str, track_ids: np.ndarray, update: LogicUpdate, born_ids: np.ndarray, sink: EventSink
+        self,
+        class_name: str,
+        track_ids: np.ndarray,
+        update: LogicUpdate[LogicState],
+        born_ids: np.ndarray,
+        sink: EventSink,
     ) -> None:
         """``TrackLogic`` events of the frame and ``Pruned`` for every track the logic deleted."""
         emit_transitions(class_name, track_ids, update, born_ids, self.params, sink)

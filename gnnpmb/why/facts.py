@@ -91,9 +91,6 @@ class Use:
         """The detections the update used (share >= ``USED_SHARE``)."""
         return tuple(m for m, _ in self.shares)
 
-    def share_of(self, meas: int) -> float:
-        return next((s for m, s in self.shares if m == meas), 0.0)
-
 
 class Went(enum.Enum):
     """Where a detection went."""
@@ -348,6 +345,17 @@ class TrackerFacts:
             read = output_use if self.output_only else frame_use
             known[class_name] = None if cf is None else read(cf)
         return known[class_name]
+
+    def mode(self, class_name: str, frames: range) -> UseMode:
+        """How the tracker's update used detections in ``frames`` (assignment without any update event; output only
+        for a run known by its output)."""
+        if self.output_only:
+            return UseMode.OUTPUT
+        for f in frames:
+            use = self.use(f, class_name)
+            if use is not None and use.tracks:
+                return use.mode
+        return UseMode.ASSIGNED
 
     def destination(self, frame: int, class_name: str, meas: int) -> Destination | None:
         """Where detection ``meas`` went at ``frame`` (None: the tracker of the class did not receive it)."""

@@ -10,7 +10,7 @@ checks (``claims``) read the same data.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,11 +19,12 @@ from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.evaluated import GtFrame, GtStatus
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport
 from gnnpmb.events import AxisKind, CostMatrix
+from gnnpmb.explain import PairChoice
 from gnnpmb.foreign import BoxOn
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.counterfactual import would_take
-from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode
+from gnnpmb.why.facts import TrackerFacts, TrackStep
 from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
     FRAMES_BEFORE,
@@ -215,7 +216,7 @@ class _Context:
             track_ids=tuple(int(t) for t in failure.track_ids),
             window=(self.window.start, self.window.stop - 1),
             sightings=sightings,
-            mode=_mode(self.facts, self.class_name, self.window).value,
+            mode=self.facts.mode(self.class_name, self.window).value,
             has_existence=self.facts.has_existence,
             key_decisions=self.key_decisions(involved),
             others=self.others(others, gt_id),
@@ -462,19 +463,12 @@ class _Context:
         """The solver's last choice up to the failure that sent a detection to the taker (or started it) while an
         involved track (the lost one, or one in between) was the next best, or by a close call."""
         best = None
-        for f in self.window:
-            d = self.facts.decisions(f, self.class_name)
-            if d is None:
+        for f, c, born in self.choices():
+            went, is_born = _went(c.chosen, born.get(int(c.meas.ref)))
+            if went != taker_id or c.alternative is None or c.alternative.kind is not AxisKind.TRACK:
                 continue
-            born = self.facts.frame(f, self.class_name).born_of()
-            for conflict in d.conflicts:
-                for c in conflict.choices:
-                    went, is_born = _went(c.chosen, born.get(int(c.meas.ref)))
-                    if went != taker_id or c.alternative is None or c.alternative.kind is not AxisKind.TRACK:
-                        continue
-                    if not (c.alternative.ref in involved or c.close_call):
-                        continue
-                    best = (f, c, went, is_born)
+            if c.alternative.ref in involved or c.close_call:
+                best = (f, c, went, is_born)
         if best is None:
             return None
         f, c, went, is_born = best
@@ -695,20 +689,24 @@ class _Context:
         """Choices up to the failure that sent a detection elsewhere while an involved track was its next best,
         or gave one to an involved track by a close call (on the tracker's own cost scale)."""
         out = []
+        for f, c, born in self.choices():
+            alt = c.alternative
+            alt_involved = alt is not None and alt.kind is AxisKind.TRACK and alt.ref in involved
+            chosen_involved = c.chosen.kind is AxisKind.TRACK and c.chosen.ref in involved
+            if (alt_involved and not chosen_involved) or (chosen_involved and c.close_call):
+                went, is_born = _went(c.chosen, born.get(int(c.meas.ref)))
+                out.append(KeyDecision(f, c, went, is_born))
+        return tuple(out)
+
+    def choices(self) -> Iterator[tuple[int, PairChoice, dict[int, int]]]:
+        """(frame, choice, the frame's detection -> track born of it) of every conflict's choice in the window."""
         for f in self.window:
             d = self.facts.decisions(f, self.class_name)
             if d is None:
                 continue
             born = self.facts.frame(f, self.class_name).born_of()
             for conflict in d.conflicts:
-                for c in conflict.choices:
-                    alt = c.alternative
-                    alt_involved = alt is not None and alt.kind is AxisKind.TRACK and alt.ref in involved
-                    chosen_involved = c.chosen.kind is AxisKind.TRACK and c.chosen.ref in involved
-                    if (alt_involved and not chosen_involved) or (chosen_involved and c.close_call):
-                        went, is_born = _went(c.chosen, born.get(int(c.meas.ref)))
-                        out.append(KeyDecision(f, c, went, is_born))
-        return tuple(out)
+                yield from ((f, c, born) for c in conflict.choices)
 
     def others(self, others: Sequence[Evidence], gt_id: str | None) -> tuple[OtherRun, ...]:
         """How other trackers fared at the same place: a failure of the same kind on the same object (or, for a
@@ -788,15 +786,3 @@ def _blames(*tests: tuple[Rule, list[int]]) -> tuple[Blame, ...]:
     """The held tests (those with frames), detector's before tracker's."""
     held = [Blame(t, tuple(frames)) for t, frames in tests if frames]
     return tuple(sorted(held, key=lambda b: list(type(b.party)).index(b.party)))
-
-
-def _mode(facts: TrackerFacts, class_name: str, frames: range) -> UseMode:
-    """How the tracker's update used detections in ``frames`` (assignment without any update event; output only
-    for a run known by its output)."""
-    if facts.output_only:
-        return UseMode.OUTPUT
-    for f in frames:
-        use = facts.use(f, class_name)
-        if use is not None and use.tracks:
-            return use.mode
-    return UseMode.ASSIGNED

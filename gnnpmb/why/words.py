@@ -62,16 +62,21 @@ def existence_text(r: float) -> str:
     return f"{r:.2f}" if r >= 0.01 or r == 0 else f"{r:.1g}"
 
 
+def consecutive_runs(numbers: Iterable[int]) -> list[list[int]]:
+    """``numbers`` in their order, cut where one is not the one before plus 1: [3, 4, 5, 9] -> [[3, 4, 5], [9]]."""
+    runs: list[list[int]] = []
+    for n in numbers:
+        if runs and n == runs[-1][-1] + 1:
+            runs[-1].append(n)
+        else:
+            runs.append([n])
+    return runs
+
+
 def frames_text(frames: Iterable[int]) -> str:
     """``frame 7``, ``frames 7, 13``, ``frames 12–14`` (consecutive runs joined)."""
     fs = sorted(set(frames))
-    runs: list[list[int]] = []
-    for f in fs:
-        if runs and f == runs[-1][-1] + 1:
-            runs[-1].append(f)
-        else:
-            runs.append([f])
-    parts = [f"{r[0]}–{r[-1]}" if len(r) > 2 else ", ".join(map(str, r)) for r in runs]
+    parts = [f"{r[0]}–{r[-1]}" if len(r) > 2 else ", ".join(map(str, r)) for r in consecutive_runs(fs)]
     return f"frame{'s' if len(fs) > 1 else ''} {', '.join(parts)}"
 
 

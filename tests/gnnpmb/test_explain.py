@@ -8,22 +8,11 @@ import numpy as np
 import pytest
 
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms, axis_labels
+from gnnpmb.events import Assignment, AxisKind, CostMatrix, CostTerms, axis_labels
 from gnnpmb.explain import LINK_SLACK, _margin, explain
+from tests.labels import meas, new, track
 
 INF = math.inf
-
-
-def meas(i: int) -> AxisLabel:
-    return AxisLabel(AxisKind.MEASUREMENT, i)
-
-
-def track(t: int) -> AxisLabel:
-    return AxisLabel(AxisKind.TRACK, t)
-
-
-def new(i: int) -> AxisLabel:
-    return AxisLabel(AxisKind.NEW_TRACK, i)
 
 
 def staged() -> tuple[CostMatrix, Assignment]:

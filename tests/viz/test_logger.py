@@ -11,8 +11,6 @@ from rerun.chunk import RrdReader
 
 from gnnpmb.events import (
     Assignment,
-    AxisKind,
-    AxisLabel,
     Born,
     Cardinality,
     CostMatrix,
@@ -33,6 +31,7 @@ from gnnpmb.events import (
     TrackLogicAction,
 )
 from gnnpmb.types import TrackEstimate
+from tests.labels import meas, missed, new, track
 from tests.viz.rrd import at_frame, latest_at, read_rows
 from viz import paths
 from viz.colors import INVOLVED_PALETTE, faded, pack_rgba, track_colors
@@ -48,22 +47,6 @@ def est(track_id: int, x: float, r: float, meas_index: int = -1, class_name: str
     return TrackEstimate(
         track_id, class_name, (x, 2.0, 0.9), (2.0, 4.5, 1.6), (1.0, 0.0, 0.0, 0.0), (1.0, 0.0), 0.9, r, meas_index
     )
-
-
-def meas(j: int) -> AxisLabel:
-    return AxisLabel(AxisKind.MEASUREMENT, j)
-
-
-def track(t: int) -> AxisLabel:
-    return AxisLabel(AxisKind.TRACK, t)
-
-
-def new(j: int) -> AxisLabel:
-    return AxisLabel(AxisKind.NEW_TRACK, j)
-
-
-def missed() -> AxisLabel:
-    return AxisLabel(AxisKind.MISSED, -1)
 
 
 def frame(i: int, tracker: str = T) -> FrameStarted:

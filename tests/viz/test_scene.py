@@ -4,10 +4,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from gnnpmb.eval.failures import short_id
 from tests.viz.conftest import N_FRAMES, POINTS_PER_SWEEP, read_sweep
 from tests.viz.rrd import at_frame, read_rows
 from viz import paths
-from viz.scene import log_scene, short_instance_id
+from viz.scene import log_scene
 
 
 @pytest.fixture
@@ -80,6 +81,6 @@ def test_no_points_loader_means_no_lidar_and_mismatched_frames_are_rejected(save
     assert all(r["static"] for r in read_rows(path)[paths.LIDAR])
 
 
-def test_short_instance_id() -> None:
-    assert short_instance_id("6dd2cbf4c24b4caeb625035869bca7b5") == "6dd2cb"
-    assert short_instance_id("ped-7") == "ped-7"
+def test_short_id() -> None:
+    assert short_id("6dd2cbf4c24b4caeb625035869bca7b5") == "6dd2cb"
+    assert short_id("ped-7") == "ped-7"

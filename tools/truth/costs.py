@@ -17,6 +17,7 @@ import math
 import re
 
 from tools.truth import replay
+from tools.truth.lost import printed
 
 _N = r"-?\d+\.\d+"
 _E = r"\d+(?:\.\d+)?(?:e-?\d+)?"
@@ -32,10 +33,6 @@ CHOICE = re.compile(
     rf"frame (\d+): m(\d+)(?: \(score ({_N})\))? → (?:new track \d+|track \d+|new|missed \d+) \(cost ({_N})\) "
     rf"over track (\d+) \(({_N})(?: at (?:existence ({_E}), )?±[\d.]+ m, d² ({_N}))?\)"
 )
-
-
-def _printed(v: float) -> str:
-    return f"{v:.2f}" if v >= 0.01 or v == 0 else f"{v:.1g}"
 
 
 def check_costs(text: str, c: str, raw, scene, out, bad) -> None:
@@ -79,7 +76,7 @@ def _check_breakdown(m: re.Match, x: int, c: str, raw, scene, out, bad) -> None:
     if abs(summed - float(total)) > 0.005 + 1e-9:
         wrong.append(f"the parts add up to {summed:.2f}")
     e = EXISTENCE.search(parts)
-    if e is not None and (existence is None or _printed(existence) != e[1]):
+    if e is not None and (existence is None or printed(existence) != e[1]):
         wrong.append(f"its predicted existence is {existence}")
     if d2 is not None and f"{d2:.1f}" != dist[2]:
         wrong.append(f"its d² is {d2:.3f}")
@@ -107,7 +104,7 @@ def _check_choice_costs(m: re.Match, c: str, raw, scene, out, bad) -> None:
         wrong.append(f"track {alt}'s entry is {None if other is None else float(mat.cost[row, other])}")
     elif m[8] is not None:
         existence, d2 = _terms_of(mat, row, alt)
-        if m[7] is not None and (existence is None or _printed(existence) != m[7]):
+        if m[7] is not None and (existence is None or printed(existence) != m[7]):
             wrong.append(f"track {alt}'s predicted existence is {existence}")
         if d2 is None or f"{d2:.1f}" != m[8]:
             wrong.append(f"track {alt}'s d² is {d2}")

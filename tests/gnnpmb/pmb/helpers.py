@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from gnnpmb.config import paper_config
-from gnnpmb.types import Boxes, Measurements
+from gnnpmb.types import Measurements
+from tests.gnnpmb.box.helpers import boxes
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
 P = CFG.models
@@ -25,20 +26,5 @@ def make_measurements(
     cls: str = "car",
     velocity: list[tuple[float, float]] | None = None,
 ) -> Measurements:
-    """M car boxes at the given BEV positions (z = 1 m, 2 x 4.5 x 1.6 m, identity rotation)."""
-    m = len(xy)
-    scores = np.full(m, score, dtype=float) if np.isscalar(score) else np.asarray(score, dtype=float)
-    trans = np.zeros((m, 3))
-    if m:
-        trans[:, :2] = np.asarray(xy, dtype=float)
-    trans[:, 2] = 1.0
-    boxes = Boxes(
-        translation_m=trans,
-        size_wlh_m=np.tile([2.0, 4.5, 1.6], (m, 1)),
-        quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (m, 1)),
-        velocity_mps=np.asarray(velocity, dtype=float).reshape(m, 2) if velocity else np.zeros((m, 2)),
-        score=scores,
-        class_name=np.array([cls] * m, dtype=object),
-        instance_id=np.array([""] * m, dtype=object),
-    )
-    return Measurements(boxes=boxes, source_index=np.arange(m))
+    """M car boxes at the given BEV positions (z = 1 m, 2 x 4.5 x 1.6 m, identity rotation; ``boxes``)."""
+    return boxes(xy, score, velocity, cls=cls)
