@@ -115,18 +115,43 @@ class _Cameras:
         return uvw[..., :2] / uvw[..., 2:3]
 
 
+@dataclass(frozen=True, slots=True)
+class Polylines:
+    """The drawn parts of N boxes, flat: (P, 2) float32 pixels of all polylines, (S + 1,) offsets of the S
+    polylines into them and (S,) the box each belongs to (box by box, each box's in clipping's order)."""
+
+    points_px: np.ndarray
+    offsets: np.ndarray
+    box: np.ndarray
+
+    def of_box(self, n: int) -> list[np.ndarray]:
+        """Box ``n``'s polylines, (K, 2) each (none: not drawn)."""
+        lo, hi = np.searchsorted(self.box, [n, n + 1])
+        return [self.points_px[self.offsets[s] : self.offsets[s + 1]] for s in range(lo, hi)]
+
+
+def take_lines(points: np.ndarray, offsets: np.ndarray, lines: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Polylines ``lines`` ((L,) indices, in that order) of the flat polylines (``points``, ``offsets``, as in
+    ``Polylines``): their points and their (L + 1,) offsets into them."""
+    starts = offsets[:-1][lines]
+    lengths = offsets[1:][lines] - starts
+    taken = np.zeros(len(lines) + 1, dtype=np.int64)
+    np.cumsum(lengths, out=taken[1:])
+    return points[np.repeat(starts - taken[:-1], lengths) + np.arange(taken[-1])], taken
+
+
 def project_boxes(
     center_m: np.ndarray, size_wlh_m: np.ndarray, quat_wxyz: np.ndarray, cams: list[CameraFrame]
-) -> list[list[np.ndarray]]:
+) -> Polylines:
     """The drawn part of each of N boxes ((N, 3) centres, (N, 3) sizes w, l, h, (N, 4) rotations) in its camera
-    (``cams[n]``): a list of (K, 2) float32 pixel polylines clipped to the image, empty when the box's centre is
-    behind the camera or outside the image (module docstring)."""
+    (``cams[n]``): pixel polylines clipped to the image, none for a box whose centre is behind the camera or
+    outside the image (module docstring)."""
     import shapely
 
     n = len(cams)
-    out: list[list[np.ndarray]] = [[] for _ in range(n)]
+    none = Polylines(np.zeros((0, 2), dtype=np.float32), np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64))
     if n == 0:
-        return out
+        return none
     stacked = _Cameras.of(cams)
     centre_m = np.asarray(center_m, dtype=np.float64).reshape(n, 1, 3)
     centre = stacked.to_camera(centre_m)[:, 0]
@@ -136,7 +161,7 @@ def project_boxes(
     inside &= uv[:, 1] <= stacked.height_px[ahead]
     drawn = ahead[inside]
     if drawn.size == 0:
-        return out
+        return none
     cams_drawn = stacked.take(drawn)
     size = np.asarray(size_wlh_m, dtype=np.float64).reshape(n, 3)[drawn]
     quat = np.asarray(quat_wxyz, dtype=np.float64).reshape(n, 4)[drawn]
@@ -167,11 +192,8 @@ def project_boxes(
     merged[full] = shapely.line_merge(clipped[full])
     parts, owner = shapely.get_parts(merged, return_index=True)
     coords, part = shapely.get_coordinates(parts, return_index=True)
-    if part.size == 0:
-        return out
-    starts = np.flatnonzero(np.diff(part)) + 1
-    pieces = np.split(coords.astype(np.float32), starts)
-    for p, piece in zip(part[np.concatenate([[0], starts])], pieces, strict=True):
-        if len(piece) >= 2:
-            out[drawn[owner[p]]].append(piece)
-    return out
+    lengths = np.bincount(part, minlength=len(parts))
+    offsets = np.zeros(len(parts) + 1, dtype=np.int64)
+    np.cumsum(lengths, out=offsets[1:])
+    points, offsets = take_lines(coords.astype(np.float32), offsets, np.flatnonzero(lengths >= 2))
+    return Polylines(points, offsets, drawn[owner[lengths >= 2]])

@@ -29,12 +29,12 @@ from gnnpmb.data.sensors import SceneSensors
 from gnnpmb.eval.failures import OPEN_FIRST, FailureKind, FailureReport
 from gnnpmb.types import FrameDetections, TrackEstimate
 from viz import paths
-from viz.box_projection import CameraFrame, project_boxes
+from viz.box_projection import CameraFrame, project_boxes, take_lines
 from viz.colors import class_colors, track_color
 from viz.failure_style import KIND_COLORS
 from viz.failures import failure_label
 from viz.label_room import keep_clear, text_box
-from viz.rows import strips_array
+from viz.rows import flat_strips_array
 from viz.timeline import Clock
 
 CAMERA_VIEW_SCALE = 0.15
@@ -133,64 +133,72 @@ def failure_boxes(
 
 @dataclass(frozen=True, slots=True)
 class _Drawn:
-    """One layer of one camera, keyframe by keyframe: the strips and their colours, and the labels (anchor
-    pixel, text, colour)."""
+    """One layer of one camera: its S polylines keyframe by keyframe ((P, 2) pixels, the (S + 1,) offsets of the
+    polylines into them, the (n + 1,) offsets of each of the n keyframes' polylines, (S, 3) uint8 colours) and
+    per keyframe the labels (anchor pixel, text, colour)."""
 
-    strips: list[list[np.ndarray]]
-    colors: list[list[tuple[int, int, int]]]
+    points_px: np.ndarray
+    line_offsets: np.ndarray
+    frame_offsets: np.ndarray
+    rgb: np.ndarray
     anchors: list[list[tuple[float, float]]]
     texts: list[list[str]]
     label_rgb: list[list[tuple[int, int, int]]]
 
+    def lines_of(self, rows: np.ndarray) -> np.ndarray:
+        """The polylines of keyframes ``rows`` (indices into the n keyframes), in order."""
+        return np.concatenate(
+            [np.arange(self.frame_offsets[r], self.frame_offsets[r + 1]) for r in rows] or [np.zeros(0, np.int64)]
+        )
+
 
 def draw_layer(boxes: Sequence[Box], cams: Mapping[int, CameraFrame], frames: Sequence[int]) -> _Drawn:
-    """``boxes`` projected into one camera at each of ``frames`` (``cams``: that camera at each keyframe); the
-    labelled ones kept apart at ``CAMERA_VIEW_SCALE`` (at most ``MAX_CAMERA_LABELS``)."""
+    """``boxes`` projected into one camera at each of ``frames`` (``cams``: that camera at each keyframe), a
+    keyframe's polylines in the order of its boxes; the labelled ones kept apart at ``CAMERA_VIEW_SCALE`` (at
+    most ``MAX_CAMERA_LABELS``)."""
     at = {f: k for k, f in enumerate(frames)}
     n = len(frames)
-    drawn = _Drawn(
-        [[] for _ in range(n)],
-        [[] for _ in range(n)],
-        [[] for _ in range(n)],
-        [[] for _ in range(n)],
-        [[] for _ in range(n)],
-    )
-    wanted: list[list[tuple[int, object, tuple[float, float, float, float], str, tuple[float, float], tuple]]] = [
-        [] for _ in range(n)
-    ]
     shown = [box for box in boxes if box.frame in at and box.frame in cams]
-    projected = project_boxes(
+    lines = project_boxes(
         np.array([box.center_m for box in shown], dtype=np.float64).reshape(-1, 3),
         np.array([box.size_wlh_m for box in shown], dtype=np.float64).reshape(-1, 3),
         np.array([box.quat_wxyz for box in shown], dtype=np.float64).reshape(-1, 4),
         [cams[box.frame] for box in shown],
     )
-    for box, parts in zip(shown, projected, strict=True):
+    frame_of_box = np.array([at[box.frame] for box in shown], dtype=np.int64)
+    frame_of_line = frame_of_box[lines.box]
+    order = np.argsort(frame_of_line, kind="stable")
+    points, line_offsets = take_lines(lines.points_px, lines.offsets, order)
+    frame_offsets = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(frame_of_line, minlength=n), out=frame_offsets[1:])
+    rgb = np.array([box.rgb for box in shown], dtype=np.uint8).reshape(-1, 3)[lines.box[order]]
+    wanted: list[list[tuple[int, object, tuple[float, float, float, float], str, tuple[float, float], tuple]]] = [
+        [] for _ in range(n)
+    ]
+    for b, box in enumerate(shown):
+        parts = lines.of_box(b) if box.label else []
         if not parts:
             continue
         k = at[box.frame]
-        drawn.strips[k].extend(parts)
-        drawn.colors[k].extend([box.rgb] * len(parts))
-        if box.label:
-            points = np.concatenate(parts)
-            cam = cams[box.frame]
-            anchor = _inside_image(
-                box.label,
-                float(0.5 * (points[:, 0].min() + points[:, 0].max())),
-                float(points[:, 1].min()),
-                cam.width_px,
-                cam.height_px,
-            )
-            screen = text_box(box.label, anchor[0] * CAMERA_VIEW_SCALE, anchor[1] * CAMERA_VIEW_SCALE)
-            wanted[k].append((box.rank, len(wanted[k]), screen, box.label, anchor, box.rgb))
-    for k, candidates in enumerate(wanted):
+        points_b = np.concatenate(parts)
+        cam = cams[box.frame]
+        anchor = _inside_image(
+            box.label,
+            float(0.5 * (points_b[:, 0].min() + points_b[:, 0].max())),
+            float(points_b[:, 1].min()),
+            cam.width_px,
+            cam.height_px,
+        )
+        screen = text_box(box.label, anchor[0] * CAMERA_VIEW_SCALE, anchor[1] * CAMERA_VIEW_SCALE)
+        wanted[k].append((box.rank, len(wanted[k]), screen, box.label, anchor, box.rgb))
+    anchors, texts, label_rgb = [], [], []
+    for candidates in wanted:
         keep = keep_clear([(rank, key, screen) for rank, key, screen, *_ in candidates])
         chosen = [c for c in sorted(candidates, key=lambda c: (c[0], c[1])) if c[1] in keep][:MAX_CAMERA_LABELS]
-        for _, _, _, text, anchor, rgb in chosen:
-            drawn.texts[k].append(text)
-            drawn.anchors[k].append(anchor)
-            drawn.label_rgb[k].append(rgb)
-    return drawn
+        texts.append([c[3] for c in chosen])
+        anchors.append([c[4] for c in chosen])
+        label_rgb.append([c[5] for c in chosen])
+    return _Drawn(points, line_offsets, frame_offsets, rgb, anchors, texts, label_rgb)
 
 
 def _inside_image(text: str, u: float, v: float, width_px: int, height_px: int) -> tuple[float, float]:
@@ -233,10 +241,10 @@ def log_camera_boxes(
 
 def _strip_columns(drawn: _Drawn, radius: rr.components.Radius) -> Callable[[np.ndarray], rr.ComponentColumnList]:
     def columns(rows: np.ndarray) -> rr.ComponentColumnList:
-        strips = strips_array([s for r in rows for s in drawn.strips[r]], dims=2)
-        colors = [c for r in rows for c in drawn.colors[r]]
-        lengths = [len(drawn.strips[r]) for r in rows]
-        cols = rr.LineStrips2D.columns(strips=strips, colors=colors, radii=[radius] * len(strips))
+        lines = drawn.lines_of(rows)
+        strips = flat_strips_array(*take_lines(drawn.points_px, drawn.line_offsets, lines), dims=2)
+        lengths = drawn.frame_offsets[rows + 1] - drawn.frame_offsets[rows]
+        cols = rr.LineStrips2D.columns(strips=strips, colors=drawn.rgb[lines], radii=[radius] * len(lines))
         return cols.partition(lengths)
 
     return columns

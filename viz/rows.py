@@ -224,16 +224,19 @@ def strips_array(strips: list[Any] | np.ndarray, dims: int = 3) -> pa.Array:
     """The Arrow ``LineStrip3D`` (``dims`` 3) or ``LineStrip2D`` (``dims`` 2) array of ``strips`` (each a
     (k_i, dims) array or list of points; an (n, k, dims) array counts as n strips), built from one concatenated
     point array: Rerun's own conversion handles strips one at a time."""
-    strip_batch, point_batch = _STRIP_BATCHES[dims]
     if isinstance(strips, np.ndarray) and strips.ndim == 3:  # N strips of k points each
         n, k = strips.shape[:2]
-        offsets = np.arange(0, (n + 1) * k, k, dtype=np.int32)
-        points = _float32(strips).reshape(-1, dims)
-    else:
-        strips = [np.asarray(strip).reshape(-1, dims) for strip in strips]
-        lengths = np.fromiter((s.shape[0] for s in strips), dtype=np.int32, count=len(strips))
-        offsets = np.zeros(len(strips) + 1, dtype=np.int32)
-        np.cumsum(lengths, out=offsets[1:])
-        points = _float32(np.concatenate(strips)) if strips else np.zeros((0, dims), dtype=np.float32)
-    inner = point_batch(points).as_arrow_array()
-    return pa.ListArray.from_arrays(pa.array(offsets), inner, type=strip_batch._ARROW_DATATYPE)
+        return flat_strips_array(strips.reshape(-1, dims), np.arange(0, (n + 1) * k, k), dims)
+    strips = [np.asarray(strip).reshape(-1, dims) for strip in strips]
+    offsets = np.zeros(len(strips) + 1, dtype=np.int64)
+    np.cumsum(np.fromiter((s.shape[0] for s in strips), dtype=np.int64, count=len(strips)), out=offsets[1:])
+    return flat_strips_array(np.concatenate(strips) if strips else np.zeros((0, dims)), offsets, dims)
+
+
+def flat_strips_array(points: np.ndarray, offsets: np.ndarray, dims: int = 3) -> pa.Array:
+    """The Arrow ``LineStrip3D`` (``dims`` 3) or ``LineStrip2D`` (``dims`` 2) array of S strips given flat: their
+    (P, dims) points and the (S + 1,) offsets of each strip's first point into them."""
+    strip_batch, point_batch = _STRIP_BATCHES[dims]
+    inner = point_batch(_float32(points).reshape(-1, dims)).as_arrow_array()
+    offsets = pa.array(np.asarray(offsets, dtype=np.int32))
+    return pa.ListArray.from_arrays(offsets, inner, type=strip_batch._ARROW_DATATYPE)

@@ -44,8 +44,8 @@ def _box(x: float, y: float, length: float = 4.5, frame: int = 0, label: str = "
 
 
 def project_box(box: Box, cam: CameraFrame) -> list[np.ndarray]:
-    (parts,) = project_boxes(np.array([box.center_m]), np.array([box.size_wlh_m]), np.array([box.quat_wxyz]), [cam])
-    return parts
+    lines = project_boxes(np.array([box.center_m]), np.array([box.size_wlh_m]), np.array([box.quat_wxyz]), [cam])
+    return lines.of_box(0)
 
 
 def _inside(strips: list[np.ndarray]) -> bool:
@@ -79,8 +79,9 @@ def test_boxes_projected_together_are_drawn_as_each_alone_in_its_own_camera() ->
     )
     alone = [project_box(b, c) for b, c in zip(boxes, cams, strict=True)]
     assert sum(bool(parts) for parts in alone) >= 6
-    for a, t in zip(alone, together, strict=True):
-        assert len(a) == len(t) and all(np.array_equal(x, y) for x, y in zip(a, t, strict=True))
+    for n, parts in enumerate(alone):
+        drawn = together.of_box(n)
+        assert len(parts) == len(drawn) and all(np.array_equal(x, y) for x, y in zip(parts, drawn, strict=True))
 
 
 def _failure(kind: FailureKind, frame: int, role: str, object_id: str, x: float, y: float) -> Failure:
