@@ -25,8 +25,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
+from gnnpmb.assign.lsap import linear_sum_assignment
 from gnnpmb.eval.failures import short_id
 from gnnpmb.types import Boxes, TrackEstimate
 

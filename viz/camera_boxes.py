@@ -3,10 +3,9 @@ projected through the camera's calibration and clipped to the image; words only 
 failures.
 
 Rerun projects 3D boxes into a 2D view itself, but draws a box partly outside the image beyond the image's edge and
-every 3D label with it. Here each box's eight corners go global -> ego (the keyframe's pose) -> camera
-(``gnnpmb.data.sensors.camera_in_ego``) -> pixels (the intrinsic ``K``: ``u = K p / p_z``); an edge is cut where it
-crosses ``NEAR_M`` in front of the camera, then the box's edges are clipped to the image rectangle (shapely). A box
-whose centre is behind the camera or outside the image (mostly outside it) is not drawn.
+every 3D label with it. Here the boxes are projected through the camera's calibration and clipped to the image
+(``viz.box_projection``: all of a layer's boxes in one camera at once); a box whose centre is behind the camera or
+outside the image (mostly outside it) is not drawn.
 
 Labels: one per failure box of the frame (``viz.failures`` words, the run's name in front when only one of several
 runs has it), at the top of the box's drawn part, kept apart at the size the camera grid shows an image
@@ -24,29 +23,26 @@ from dataclasses import dataclass
 
 import numpy as np
 import rerun as rr
-import shapely
 
-from gnnpmb.data.scene import Pose, SceneData
-from gnnpmb.data.sensors import CameraImage, SceneSensors, camera_in_ego
+from gnnpmb.data.scene import SceneData
+from gnnpmb.data.sensors import SceneSensors
 from gnnpmb.eval.failures import OPEN_FIRST, FailureKind, FailureReport
 from gnnpmb.types import FrameDetections, TrackEstimate
 from viz import paths
+from viz.box_projection import CameraFrame, project_boxes, take_lines
 from viz.colors import class_colors, track_color
 from viz.failure_style import KIND_COLORS
 from viz.failures import failure_label
 from viz.label_room import keep_clear, text_box
+from viz.rows import flat_strips_array
 from viz.timeline import Clock
 
-NEAR_M = 0.1
-"""Edges are cut this far in front of the camera (metres)."""
 CAMERA_VIEW_SCALE = 0.15
 """Screen pixels per image pixel of one camera in a two-run recording's 3 x 2 camera grid at 1920 x 1080 (a
 1600 x 900 image in a 384 x 139 px view: 0.154; 0.148 measured on a web viewer's screenshot); larger elsewhere."""
 MAX_CAMERA_LABELS = 4
 """Labels per camera image and frame, at most."""
 DETECTION_RGB = (170, 170, 170)
-EDGES = ((0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7))
-"""The twelve edges of a box between its corners (``box_corners`` order: bottom face, then top face)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,85 +57,6 @@ class Box:
     rgb: tuple[int, int, int]
     label: str = ""
     rank: int = 0
-
-
-def _rotation(quat_wxyz: Sequence[float]) -> np.ndarray:
-    w, x, y, z = (float(v) for v in quat_wxyz)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def box_corners(box: Box) -> np.ndarray:
-    """(8, 3) corners in the global frame: bottom face then top face, counter-clockwise from front-left (the
-    length along the box's x axis, as the devkit's ``Box``)."""
-    w, length, h = box.size_wlh_m
-    x = np.array([1, -1, -1, 1, 1, -1, -1, 1]) * length / 2
-    y = np.array([1, 1, -1, -1, 1, 1, -1, -1]) * w / 2
-    z = np.array([-1, -1, -1, -1, 1, 1, 1, 1]) * h / 2
-    return np.column_stack([x, y, z]) @ _rotation(box.quat_wxyz).T + np.asarray(box.center_m, dtype=np.float64)
-
-
-@dataclass(frozen=True, slots=True)
-class CameraFrame:
-    """Global -> camera for one image at one keyframe: ``to_camera(p)`` maps (N, 3) global points to (N, 3)
-    camera points (x right, y down, z forward); ``K`` (3, 3); the image's width and height in pixels."""
-
-    rotation: np.ndarray
-    translation_m: np.ndarray
-    intrinsic: np.ndarray
-    width_px: int
-    height_px: int
-
-    @staticmethod
-    def of(image: CameraImage, ego: Pose) -> CameraFrame:
-        cam_r, cam_t = camera_in_ego(image, ego)
-        ego_r = _rotation(ego.quat_wxyz)
-        # global -> ego: ego_r.T (p - ego_t); ego -> camera: cam_r.T (q - cam_t)
-        rotation = cam_r.T @ ego_r.T
-        translation = -cam_r.T @ (ego_r.T @ np.asarray(ego.translation_m, dtype=np.float64) + cam_t)
-        return CameraFrame(rotation, translation, np.asarray(image.intrinsic), image.width_px, image.height_px)
-
-    def to_camera(self, points_m: np.ndarray) -> np.ndarray:
-        return np.asarray(points_m, dtype=np.float64) @ self.rotation.T + self.translation_m
-
-    def pixels(self, camera_points_m: np.ndarray) -> np.ndarray:
-        """(N, 3) camera points with z > 0 -> (N, 2) pixels (u right, v down)."""
-        uvw = camera_points_m @ self.intrinsic.T
-        return uvw[:, :2] / uvw[:, 2:3]
-
-
-def project_box(box: Box, cam: CameraFrame) -> list[np.ndarray]:
-    """The drawn part of ``box`` in ``cam``'s image: a list of (K, 2) pixel polylines clipped to the image, empty
-    when the box's centre is behind the camera or outside the image (module docstring)."""
-    centre = cam.to_camera(np.asarray(box.center_m, dtype=np.float64)[None])[0]
-    if centre[2] <= NEAR_M:
-        return []
-    u, v = cam.pixels(centre[None])[0]
-    if not (0 <= u <= cam.width_px and 0 <= v <= cam.height_px):
-        return []
-    corners = cam.to_camera(box_corners(box))
-    segments = []
-    for i, j in EDGES:
-        a, b = corners[i], corners[j]
-        if a[2] < NEAR_M and b[2] < NEAR_M:
-            continue
-        if a[2] < NEAR_M or b[2] < NEAR_M:  # cut the edge at the near plane
-            t = (NEAR_M - a[2]) / (b[2] - a[2])
-            cut = a + t * (b - a)
-            a, b = (cut, b) if a[2] < NEAR_M else (a, cut)
-        segments.append(cam.pixels(np.stack([a, b])))
-    lines = shapely.linestrings(np.concatenate(segments), indices=np.repeat(np.arange(len(segments)), 2))
-    clipped = shapely.clip_by_rect(shapely.multilinestrings(lines), 0.0, 0.0, cam.width_px, cam.height_px)
-    merged = shapely.line_merge(clipped) if not clipped.is_empty else clipped
-    # shapely's array functions, not each part's .coords: the same coordinates, a fifth of a warm demo run less
-    coords, part = shapely.get_coordinates(shapely.get_parts(merged), return_index=True)
-    pieces = np.split(coords.astype(np.float32), np.flatnonzero(np.diff(part)) + 1)
-    return [p for p in pieces if len(p) >= 2]
 
 
 def scene_boxes(
@@ -216,60 +133,72 @@ def failure_boxes(
 
 @dataclass(frozen=True, slots=True)
 class _Drawn:
-    """One layer of one camera, keyframe by keyframe: the strips and their colours, and the labels (anchor
-    pixel, text, colour)."""
+    """One layer of one camera: its S polylines keyframe by keyframe ((P, 2) pixels, the (S + 1,) offsets of the
+    polylines into them, the (n + 1,) offsets of each of the n keyframes' polylines, (S, 3) uint8 colours) and
+    per keyframe the labels (anchor pixel, text, colour)."""
 
-    strips: list[list[np.ndarray]]
-    colors: list[list[tuple[int, int, int]]]
+    points_px: np.ndarray
+    line_offsets: np.ndarray
+    frame_offsets: np.ndarray
+    rgb: np.ndarray
     anchors: list[list[tuple[float, float]]]
     texts: list[list[str]]
     label_rgb: list[list[tuple[int, int, int]]]
 
+    def lines_of(self, rows: np.ndarray) -> np.ndarray:
+        """The polylines of keyframes ``rows`` (indices into the n keyframes), in order."""
+        return np.concatenate(
+            [np.arange(self.frame_offsets[r], self.frame_offsets[r + 1]) for r in rows] or [np.zeros(0, np.int64)]
+        )
+
 
 def draw_layer(boxes: Sequence[Box], cams: Mapping[int, CameraFrame], frames: Sequence[int]) -> _Drawn:
-    """``boxes`` projected into one camera at each of ``frames`` (``cams``: that camera at each keyframe); the
-    labelled ones kept apart at ``CAMERA_VIEW_SCALE`` (at most ``MAX_CAMERA_LABELS``)."""
+    """``boxes`` projected into one camera at each of ``frames`` (``cams``: that camera at each keyframe), a
+    keyframe's polylines in the order of its boxes; the labelled ones kept apart at ``CAMERA_VIEW_SCALE`` (at
+    most ``MAX_CAMERA_LABELS``)."""
     at = {f: k for k, f in enumerate(frames)}
     n = len(frames)
-    drawn = _Drawn(
-        [[] for _ in range(n)],
-        [[] for _ in range(n)],
-        [[] for _ in range(n)],
-        [[] for _ in range(n)],
-        [[] for _ in range(n)],
+    shown = [box for box in boxes if box.frame in at and box.frame in cams]
+    lines = project_boxes(
+        np.array([box.center_m for box in shown], dtype=np.float64).reshape(-1, 3),
+        np.array([box.size_wlh_m for box in shown], dtype=np.float64).reshape(-1, 3),
+        np.array([box.quat_wxyz for box in shown], dtype=np.float64).reshape(-1, 4),
+        [cams[box.frame] for box in shown],
     )
+    frame_of_box = np.array([at[box.frame] for box in shown], dtype=np.int64)
+    frame_of_line = frame_of_box[lines.box]
+    order = np.argsort(frame_of_line, kind="stable")
+    points, line_offsets = take_lines(lines.points_px, lines.offsets, order)
+    frame_offsets = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(frame_of_line, minlength=n), out=frame_offsets[1:])
+    rgb = np.array([box.rgb for box in shown], dtype=np.uint8).reshape(-1, 3)[lines.box[order]]
     wanted: list[list[tuple[int, object, tuple[float, float, float, float], str, tuple[float, float], tuple]]] = [
         [] for _ in range(n)
     ]
-    for box in boxes:
-        k = at.get(box.frame)
-        if k is None or box.frame not in cams:
-            continue
-        parts = project_box(box, cams[box.frame])
+    for b, box in enumerate(shown):
+        parts = lines.of_box(b) if box.label else []
         if not parts:
             continue
-        drawn.strips[k].extend(parts)
-        drawn.colors[k].extend([box.rgb] * len(parts))
-        if box.label:
-            points = np.concatenate(parts)
-            cam = cams[box.frame]
-            anchor = _inside_image(
-                box.label,
-                float(0.5 * (points[:, 0].min() + points[:, 0].max())),
-                float(points[:, 1].min()),
-                cam.width_px,
-                cam.height_px,
-            )
-            screen = text_box(box.label, anchor[0] * CAMERA_VIEW_SCALE, anchor[1] * CAMERA_VIEW_SCALE)
-            wanted[k].append((box.rank, len(wanted[k]), screen, box.label, anchor, box.rgb))
-    for k, candidates in enumerate(wanted):
+        k = at[box.frame]
+        points_b = np.concatenate(parts)
+        cam = cams[box.frame]
+        anchor = _inside_image(
+            box.label,
+            float(0.5 * (points_b[:, 0].min() + points_b[:, 0].max())),
+            float(points_b[:, 1].min()),
+            cam.width_px,
+            cam.height_px,
+        )
+        screen = text_box(box.label, anchor[0] * CAMERA_VIEW_SCALE, anchor[1] * CAMERA_VIEW_SCALE)
+        wanted[k].append((box.rank, len(wanted[k]), screen, box.label, anchor, box.rgb))
+    anchors, texts, label_rgb = [], [], []
+    for candidates in wanted:
         keep = keep_clear([(rank, key, screen) for rank, key, screen, *_ in candidates])
         chosen = [c for c in sorted(candidates, key=lambda c: (c[0], c[1])) if c[1] in keep][:MAX_CAMERA_LABELS]
-        for _, _, _, text, anchor, rgb in chosen:
-            drawn.texts[k].append(text)
-            drawn.anchors[k].append(anchor)
-            drawn.label_rgb[k].append(rgb)
-    return drawn
+        texts.append([c[3] for c in chosen])
+        anchors.append([c[4] for c in chosen])
+        label_rgb.append([c[5] for c in chosen])
+    return _Drawn(points, line_offsets, frame_offsets, rgb, anchors, texts, label_rgb)
 
 
 def _inside_image(text: str, u: float, v: float, width_px: int, height_px: int) -> tuple[float, float]:
@@ -312,10 +241,10 @@ def log_camera_boxes(
 
 def _strip_columns(drawn: _Drawn, radius: rr.components.Radius) -> Callable[[np.ndarray], rr.ComponentColumnList]:
     def columns(rows: np.ndarray) -> rr.ComponentColumnList:
-        strips = [s for r in rows for s in drawn.strips[r]]
-        colors = [c for r in rows for c in drawn.colors[r]]
-        lengths = [len(drawn.strips[r]) for r in rows]
-        cols = rr.LineStrips2D.columns(strips=strips, colors=colors, radii=[radius] * len(strips))
+        lines = drawn.lines_of(rows)
+        strips = flat_strips_array(*take_lines(drawn.points_px, drawn.line_offsets, lines), dims=2)
+        lengths = drawn.frame_offsets[rows + 1] - drawn.frame_offsets[rows]
+        cols = rr.LineStrips2D.columns(strips=strips, colors=drawn.rgb[lines], radii=[radius] * len(lines))
         return cols.partition(lengths)
 
     return columns

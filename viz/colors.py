@@ -111,9 +111,9 @@ def pack_rgba(colors: np.ndarray, alpha: int = 255) -> np.ndarray:
 
 @functools.lru_cache(maxsize=4096)
 def track_color(track_id: int) -> tuple[int, int, int]:
-    """RGB colour of one track id (see ``track_colors``)."""
-    r, g, b = track_colors(np.array([track_id]))[0]
-    return int(r), int(g), int(b)
+    """RGB colour of one track id (see ``track_colors``; looked up in ``packed_track_colors``'s table)."""
+    packed = int(packed_track_colors(np.array([track_id]))[0])
+    return (packed >> 24) & 0xFF, (packed >> 16) & 0xFF, (packed >> 8) & 0xFF
 
 
 INVOLVED_PALETTE: tuple[tuple[int, int, int], ...] = (

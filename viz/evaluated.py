@@ -91,9 +91,9 @@ RANGE_CIRCLE_POINTS = 721
 @cache
 def _class_ranges() -> dict[str, float]:
     """The evaluation's range per class (m from the ego vehicle; the devkit's ``tracking_nips_2019``)."""
-    from gnnpmb.eval.nuscenes_eval import tracking_config
+    from gnnpmb.eval.nuscenes_eval import tracking_config_file
 
-    return {k: float(v) for k, v in tracking_config().class_range.items()}
+    return {k: float(v) for k, v in tracking_config_file()["class_range"].items()}
 
 
 def evaluation_range_world() -> str:

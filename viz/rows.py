@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 import rerun as rr
-from rerun.components import LineStrip3DBatch
-from rerun.encodings import Vec3DBatch
+from rerun.components import LineStrip2DBatch, LineStrip3DBatch
+from rerun.encodings import Vec2DBatch, Vec3DBatch
 
 from viz.timeline import Clock, ListColumn
 
@@ -91,7 +91,7 @@ def _flat_column(archetype: type, name: str, flats: list[Any]) -> tuple[rr.Compo
     if name == STRIPS:
         arrays = all(isinstance(f, np.ndarray) and f.ndim == 3 for f in flats)
         same = arrays and len({f.shape[1] for f in flats}) == 1
-        value: Any = _strips_array(np.concatenate(flats) if same else [strip for flat in flats for strip in flat])
+        value: Any = strips_array(np.concatenate(flats) if same else [strip for flat in flats for strip in flat])
     elif isinstance(flats[0], list):
         value = pa.array([item for flat in flats for item in flat], type=pa.utf8())
     else:
@@ -216,19 +216,27 @@ def _float32(values: Any) -> np.ndarray:
     return np.clip(np.asarray(values, dtype=np.float64), -_FLOAT32_MAX, _FLOAT32_MAX).astype(np.float32)
 
 
-def _strips_array(strips: list[Any] | np.ndarray) -> pa.Array:
-    """The Arrow ``LineStrip3D`` array of ``strips`` (each a (k_i, 3) array or list of points; an (n, k, 3) array
-    counts as n strips), built from one concatenated point array: Rerun's own conversion handles strips one at a
-    time."""
+_STRIP_BATCHES = {2: (LineStrip2DBatch, Vec2DBatch), 3: (LineStrip3DBatch, Vec3DBatch)}
+"""Per point dimension: the Arrow batch of line strips and of their points."""
+
+
+def strips_array(strips: list[Any] | np.ndarray, dims: int = 3) -> pa.Array:
+    """The Arrow ``LineStrip3D`` (``dims`` 3) or ``LineStrip2D`` (``dims`` 2) array of ``strips`` (each a
+    (k_i, dims) array or list of points; an (n, k, dims) array counts as n strips), built from one concatenated
+    point array: Rerun's own conversion handles strips one at a time."""
     if isinstance(strips, np.ndarray) and strips.ndim == 3:  # N strips of k points each
         n, k = strips.shape[:2]
-        offsets = np.arange(0, (n + 1) * k, k, dtype=np.int32)
-        points = _float32(strips).reshape(-1, 3)
-    else:
-        strips = [_float32(strip).reshape(-1, 3) for strip in strips]
-        lengths = np.fromiter((s.shape[0] for s in strips), dtype=np.int32, count=len(strips))
-        offsets = np.zeros(len(strips) + 1, dtype=np.int32)
-        np.cumsum(lengths, out=offsets[1:])
-        points = np.concatenate(strips) if strips else np.zeros((0, 3), dtype=np.float32)
-    inner = Vec3DBatch(points).as_arrow_array()
-    return pa.ListArray.from_arrays(pa.array(offsets), inner, type=LineStrip3DBatch._ARROW_DATATYPE)
+        return flat_strips_array(strips.reshape(-1, dims), np.arange(0, (n + 1) * k, k), dims)
+    strips = [np.asarray(strip).reshape(-1, dims) for strip in strips]
+    offsets = np.zeros(len(strips) + 1, dtype=np.int64)
+    np.cumsum(np.fromiter((s.shape[0] for s in strips), dtype=np.int64, count=len(strips)), out=offsets[1:])
+    return flat_strips_array(np.concatenate(strips) if strips else np.zeros((0, dims)), offsets, dims)
+
+
+def flat_strips_array(points: np.ndarray, offsets: np.ndarray, dims: int = 3) -> pa.Array:
+    """The Arrow ``LineStrip3D`` (``dims`` 3) or ``LineStrip2D`` (``dims`` 2) array of S strips given flat: their
+    (P, dims) points and the (S + 1,) offsets of each strip's first point into them."""
+    strip_batch, point_batch = _STRIP_BATCHES[dims]
+    inner = point_batch(_float32(points).reshape(-1, dims)).as_arrow_array()
+    offsets = pa.array(np.asarray(offsets, dtype=np.int32))
+    return pa.ListArray.from_arrays(offsets, inner, type=strip_batch._ARROW_DATATYPE)

@@ -109,7 +109,6 @@ def run_view(
     from viz.blueprint import default_blueprint
     from viz.compare import log_comparison
     from viz.failures import log_failures
-    from viz.focus import focus_legends, log_focus, tracker_views
     from viz.logger import FLUSH_FRAMES, TrackerLogger
     from viz.opening import (
         LabelNotes,
@@ -271,6 +270,8 @@ def run_view(
             if notes is not None:
                 notes.send(stream, clock, scene)
             if focus is not None:
+                from viz.focus import focus_legends, log_focus, tracker_views
+
                 evidence = all_evidence(inputs, runs, reports)
                 finding = explain_focus(inputs, focus, evidence, first_frame=shown.start)
                 log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding, sight)

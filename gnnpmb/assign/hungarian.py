@@ -9,7 +9,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
+
+from gnnpmb.assign.lsap import linear_sum_assignment
 
 
 class InfeasibleAssignment(ValueError):

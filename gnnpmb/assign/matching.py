@@ -29,9 +29,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from gnnpmb.assign.greedy import greedy_pairs
+from gnnpmb.assign.lsap import linear_sum_assignment
 
 
 class Solver(enum.Enum):

@@ -34,10 +34,10 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from gnnpmb.assign.clusters import Cluster, gate_clusters
 from gnnpmb.assign.hungarian import InfeasibleAssignment, solve
+from gnnpmb.assign.lsap import linear_sum_assignment
 
 ENUMERATION_LIMIT = 1024
 """A block whose rows' allowed-column counts multiply to at most this is ranked by listing its candidate

@@ -26,8 +26,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
+from gnnpmb.assign.lsap import linear_sum_assignment
 from gnnpmb.box.kalman import half_turn_residual, measurements, wrap_angle
 from gnnpmb.config import BoxNoise
 from gnnpmb.data.scene import SceneData

@@ -12,7 +12,9 @@ silences the devkit's printing, and writes its output files (``metrics_summary.j
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import io
+import json
 import math
 import shutil
 import tempfile
@@ -85,6 +87,17 @@ def tracking_config() -> TrackingConfig:
     from nuscenes.eval.common.config import config_factory
 
     return config_factory(EVAL_CONFIG)
+
+
+def tracking_config_file() -> dict[str, Any]:
+    """The official ``tracking_nips_2019`` config as the devkit ships it (its JSON file), read without importing
+    the devkit, whose package loads scikit-learn, matplotlib and OpenCV (1.4 s): for settings that need no
+    evaluation, e.g. the class ranges (``tracking_config`` for the evaluation itself)."""
+    spec = importlib.util.find_spec("nuscenes")
+    if spec is None or not spec.submodule_search_locations:
+        raise DataError("the nuScenes devkit is not installed (pip install nuscenes-devkit)")
+    folder = Path(next(iter(spec.submodule_search_locations)))
+    return json.loads((folder / "eval" / "tracking" / "configs" / f"{EVAL_CONFIG}.json").read_text(encoding="utf-8"))
 
 
 def class_evaluation(tracks_gt: Any, tracks_pred: Any, class_name: str, cfg: TrackingConfig) -> Any:

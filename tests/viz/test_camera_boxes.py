@@ -20,15 +20,14 @@ from gnnpmb.eval.failures import Failure, FailureBox, FailureKind
 from tests.viz.rrd import read_rows
 from tools.labels import Recording, camera_boxes, overlaps
 from viz import paths
+from viz.box_projection import CameraFrame, project_boxes
 from viz.camera_boxes import (
     CAMERA_VIEW_SCALE,
     MAX_CAMERA_LABELS,
     Box,
-    CameraFrame,
     _inside_image,
     failure_boxes,
     log_camera_boxes,
-    project_box,
 )
 from viz.cameras import camera_view, log_cameras
 from viz.timeline import PLAIN_CLOCK
@@ -42,6 +41,11 @@ FRONT = CameraFrame(CAMERA_IN_EGO.T, np.zeros(3), K, WIDTH, HEIGHT)
 
 def _box(x: float, y: float, length: float = 4.5, frame: int = 0, label: str = "") -> Box:
     return Box(frame, (x, y, 0.0), (2.0, length, 1.6), (1.0, 0.0, 0.0, 0.0), (255, 0, 0), label)
+
+
+def project_box(box: Box, cam: CameraFrame) -> list[np.ndarray]:
+    lines = project_boxes(np.array([box.center_m]), np.array([box.size_wlh_m]), np.array([box.quat_wxyz]), [cam])
+    return lines.of_box(0)
 
 
 def _inside(strips: list[np.ndarray]) -> bool:
@@ -58,6 +62,26 @@ def test_a_box_in_view_is_drawn_whole_one_at_the_edge_clipped_one_mostly_outside
     assert project_box(_box(-10.0, 0.0), FRONT) == []  # behind the camera
     near = project_box(_box(1.0, 0.0, length=8.0), FRONT)  # reaches behind the camera: cut at the near plane
     assert near and _inside(near)
+
+
+def test_boxes_projected_together_are_drawn_as_each_alone_in_its_own_camera() -> None:
+    turned = Quaternion(axis=(0.0, 0.0, 1.0), angle=0.4)
+    side = CameraFrame(turned.rotation_matrix.T @ CAMERA_IN_EGO.T, np.array([3.0, -1.0, 0.5]), K, 1280, 720)
+    boxes = [_box(20.0, 0.0), _box(10.0, 6.0), _box(10.0, 9.0), _box(-10.0, 0.0), _box(1.0, 0.0, length=8.0)]
+    boxes += [Box(0, (15.0, -2.0, 1.0), (1.0, 3.0, 2.0), tuple(turned.elements), (0, 0, 255))]
+    cams = [FRONT, side] * len(boxes)
+    boxes = [b for b in boxes for _ in range(2)]
+    together = project_boxes(
+        np.array([b.center_m for b in boxes]),
+        np.array([b.size_wlh_m for b in boxes]),
+        np.array([b.quat_wxyz for b in boxes]),
+        cams,
+    )
+    alone = [project_box(b, c) for b, c in zip(boxes, cams, strict=True)]
+    assert sum(bool(parts) for parts in alone) >= 6
+    for n, parts in enumerate(alone):
+        drawn = together.of_box(n)
+        assert len(parts) == len(drawn) and all(np.array_equal(x, y) for x, y in zip(parts, drawn, strict=True))
 
 
 def _failure(kind: FailureKind, frame: int, role: str, object_id: str, x: float, y: float) -> Failure:

@@ -40,6 +40,8 @@ def test_track_colours_are_a_pure_function_of_the_id() -> None:
     np.testing.assert_array_equal(a, track_colors(ids))
     np.testing.assert_array_equal(track_colors(ids[::-1]), a[::-1])
     assert track_color(42) == tuple(int(v) for v in a[41])
+    some = (-7, 0, 42, 5000)  # one id's colour (the packed table's) is the id's own, negative ids too
+    assert [track_color(i) for i in some] == [tuple(int(v) for v in track_colors(np.array([i]))[0]) for i in some]
     assert a.dtype == np.uint8 and a.shape == (199, 3)
 
 

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import rerun as rr
-from rerun.components import LineStrip3DBatch
+from rerun.components import LineStrip2DBatch, LineStrip3DBatch
 
 from tests.viz.rrd import read_rows
-from viz.rows import EntityRows, RowBuffer, _strips_array, send_entities
+from viz.rows import EntityRows, RowBuffer, send_entities, strips_array
 from viz.timeline import Clock
 
 T0_US = 1_533_151_603_547_590
@@ -23,8 +23,11 @@ def test_strips_built_at_once_equal_rerun_s_own_conversion() -> None:
     same_length = rng.normal(size=(3, 33, 3))
     rows = [ragged, same_length, [], [[(0.0, 1.0, 2.0), (3.0, 4.0, 5.0)]]]
     flat = [*ragged, *same_length, np.array([[0.0, 1.0, 2.0], [3.0, 4.0, 5.0]])]
-    assert _strips_array([strip for row in rows for strip in row]).equals(LineStrip3DBatch(flat).as_arrow_array())
-    assert _strips_array([]).equals(LineStrip3DBatch([]).as_arrow_array())
+    assert strips_array([strip for row in rows for strip in row]).equals(LineStrip3DBatch(flat).as_arrow_array())
+    assert strips_array([]).equals(LineStrip3DBatch([]).as_arrow_array())
+    pixels = [rng.normal(size=(k, 2)).astype(np.float32) for k in (2, 7, 3)]
+    assert strips_array(pixels, dims=2).equals(LineStrip2DBatch(pixels).as_arrow_array())
+    assert strips_array([], dims=2).equals(LineStrip2DBatch([]).as_arrow_array())
 
 
 def _stamps(frames: list[int]) -> np.ndarray:

@@ -13,7 +13,7 @@ import pytest
 from gnnpmb.data.demo_cameras import CAMERAS, quat_matrix
 from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
 from gnnpmb.data.scene import SceneData
-from gnnpmb.data.sensors import CAMERA_ORDER, camera_in_ego, load_scene_sensors, sightings
+from gnnpmb.data.sensors import CAMERA_ORDER, _pixel, camera_in_ego, load_scene_sensors, sightings
 
 SCENE = "scene-0103"
 
@@ -66,6 +66,16 @@ def test_a_point_is_seen_by_the_camera_it_lies_in_front_of(
     assert seen[0].distance_m == pytest.approx(np.linalg.norm(np.array(ego_xyz) - [1.5, 0, 1.5]), abs=1.5)
     above = quat_matrix(pose.quat_wxyz) @ np.array([0.0, 0.0, 30.0]) + pose.translation_m
     assert sightings(sensors.cameras[0], above) == ()
+
+
+def test_a_camera_point_s_pixel_is_the_devkit_s_to_the_bit() -> None:
+    from nuscenes.utils.geometry_utils import view_points
+
+    rng = np.random.default_rng(3)
+    intrinsic = np.array([[1266.4, 0.0, 816.3], [0.0, 1266.4, 491.5], [0.0, 0.0, 1.0]])
+    for point in rng.normal(size=(200, 3)) * [20.0, 5.0, 20.0] + [0.0, 0.0, 21.0]:
+        expected = view_points(point.reshape(3, 1), intrinsic, normalize=True)[:2, 0]
+        assert np.array_equal(_pixel(point, intrinsic), expected)
 
 
 def test_sweeps_leave_the_keyframes_and_annotations_as_they_were(swept_dataroot: Path, demo_dataroot: Path) -> None:

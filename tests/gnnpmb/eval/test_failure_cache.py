@@ -6,6 +6,7 @@ import copy
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from gnnpmb.data.nuscenes import DatasetLocation, check_dataroot, load_scene, open_nuscenes
@@ -113,3 +114,23 @@ def test_only_the_newest_reports_are_kept(
     newest = Finder(report)
     cached_report(tmp_path, location, SCENE, "c", switched, newest)
     assert newest.calls == 0
+
+
+def test_the_key_counts_the_boxes_numbers_not_their_objects_order_of_tokens_or_spelling(
+    location: DatasetLocation, switched: dict
+) -> None:
+    def key(results: dict) -> str:
+        return failure_cache.report_key(location, SCENE, "staged", results)
+
+    first = key(switched)
+    assert key(dict(reversed(list(json.loads(json.dumps(switched)).items())))) == first
+    spelled = copy.deepcopy(switched)
+    box = next(boxes for boxes in spelled.values() if boxes)[0]
+    assert box["tracking_score"] == 1.0
+    box["tracking_score"] = 1  # the same number to the evaluation
+    assert key(spelled) == first
+    box["rotation"][1] = float(np.nextafter(box["rotation"][1], 1.0))  # one float64 step
+    assert key(spelled) != first
+    extra = copy.deepcopy(switched)
+    next(boxes for boxes in extra.values() if boxes)[0]["attribute_name"] = ""  # another layout: JSON
+    assert key(extra) not in (first, key(spelled)) and key(copy.deepcopy(extra)) == key(extra)

@@ -24,6 +24,7 @@ from gnnpmb.eval.nuscenes_eval import (
     quiet_devkit,
     split_sample_tokens,
     tracking_config,
+    tracking_config_file,
 )
 from gnnpmb.eval.submission import (
     build_submission,
@@ -58,6 +59,11 @@ def gt_scores(tmp_path_factory: pytest.TempPathFactory, location: DatasetLocatio
     path = tmp_path_factory.mktemp("gt") / "gt.json"
     write_submission(path, gt_submission)
     return evaluate_submission(path, location, SPLIT)
+
+
+def test_the_config_file_read_without_the_devkit_holds_the_devkit_s_settings() -> None:
+    read = tracking_config_file()
+    assert read["class_range"] == tracking_config().class_range and read["dist_th_tp"] == tracking_config().dist_th_tp
 
 
 def test_ground_truth_submission_is_perfect(gt_scores) -> None:
