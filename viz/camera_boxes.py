@@ -30,7 +30,7 @@ from gnnpmb.eval.failures import OPEN_FIRST, FailureKind, FailureReport
 from gnnpmb.types import FrameDetections, TrackEstimate
 from viz import paths
 from viz.box_projection import CameraFrame, project_boxes, take_lines
-from viz.colors import class_colors, track_color
+from viz.colors import class_colors, readable_text, track_color
 from viz.failure_style import KIND_COLORS
 from viz.failures import failure_label
 from viz.label_room import keep_clear, text_box
@@ -197,7 +197,7 @@ def draw_layer(boxes: Sequence[Box], cams: Mapping[int, CameraFrame], frames: Se
         chosen = [c for c in sorted(candidates, key=lambda c: (c[0], c[1])) if c[1] in keep][:MAX_CAMERA_LABELS]
         texts.append([c[3] for c in chosen])
         anchors.append([c[4] for c in chosen])
-        label_rgb.append([c[5] for c in chosen])
+        label_rgb.append([readable_text(c[5]) for c in chosen])
     return _Drawn(points, line_offsets, frame_offsets, rgb, anchors, texts, label_rgb)
 
 
@@ -221,7 +221,7 @@ def log_camera_boxes(
 ) -> None:
     """Each layer of ``layers`` (``scene_boxes``) drawn into every camera at the keyframes ``frames``: one
     LineStrips2D per camera and layer (``paths.camera_boxes``), failures thicker, and the failures' labels as
-    Points2D (``paths.camera_labels``)."""
+    Points2D (``paths.camera_labels``) in their kind's colour darkened to be read (``colors.readable_text``)."""
     index = np.array(list(frames), dtype=np.int64)
     stamps = np.array([scene.keyframes[i].timestamp_us for i in index], dtype=np.int64)
     for channel in sensors.channels:

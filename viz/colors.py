@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 import rerun as rr
@@ -170,6 +170,26 @@ def _hsv_to_rgb(h: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(N, 3) RGB in [0, 1] from (N,) hue, saturation, value in [0, 1] (standard hexcone model)."""
     k = np.mod(np.array([5.0, 3.0, 1.0])[None, :] + h[:, None] * 6.0, 6.0)
     return v[:, None] - v[:, None] * s[:, None] * np.clip(np.minimum(k, 4.0 - k), 0.0, 1.0)
+
+
+TEXT_LUMINANCE_MAX = 0.35
+"""Largest luminance of a label's text: the viewer draws labels on a pale pill, on which a light colour (the
+orange of a fragmentation) cannot be read (seen on the demo's camera views)."""
+
+
+def luminance(rgb: Sequence[int]) -> float:
+    """0.2126 R + 0.7152 G + 0.0722 B of 0..255 channels, in 0..1 (ITU-R BT.709 weights)."""
+    return (0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]) / 255.0
+
+
+def readable_text(rgb: tuple[int, int, int]) -> tuple[int, int, int]:
+    """``rgb`` darkened (same hue, scaled) until its ``luminance`` is at most ``TEXT_LUMINANCE_MAX``; a dark
+    enough colour unchanged."""
+    if luminance(rgb) <= TEXT_LUMINANCE_MAX:
+        return rgb
+    scale = TEXT_LUMINANCE_MAX / luminance(rgb)
+    r, g, b = (int(c * scale) for c in rgb)
+    return r, g, b
 
 
 FADE_TO = np.array([236, 236, 236], dtype=np.float64)

@@ -30,6 +30,8 @@ from viz.camera_boxes import (
     log_camera_boxes,
 )
 from viz.cameras import camera_view, log_cameras
+from viz.colors import TEXT_LUMINANCE_MAX, luminance, readable_text
+from viz.failure_style import KIND_COLORS
 from viz.timeline import PLAIN_CLOCK
 
 WIDTH, HEIGHT = 1600, 900
@@ -112,6 +114,10 @@ def test_only_the_frames_failures_are_labelled_with_the_run_a_track_belongs_to()
 def camera_recording(tmp_path: Path, tiny_scene, strict: None) -> Path:
     """The tiny scene's three keyframes seen by one front camera, with a crowd of failures ahead at frame 0 and
     a plain ground-truth box: saved with the camera's view as the blueprint."""
+    return _camera_recording(tmp_path, tiny_scene, FailureKind.FALSE_TRACK, "false track")
+
+
+def _camera_recording(tmp_path: Path, tiny_scene, kind: FailureKind, role: str) -> Path:
     scene, _ = tiny_scene
     jpeg = tmp_path / "front.jpg"
     Image.new("RGB", (WIDTH, HEIGHT), (90, 120, 90)).save(jpeg)
@@ -120,7 +126,7 @@ def camera_recording(tmp_path: Path, tiny_scene, strict: None) -> Path:
         (CameraImage("CAM_FRONT", jpeg, k.timestamp_us, WIDTH, HEIGHT, K, k.ego_pose, calib),) for k in scene.keyframes
     )
     sensors = SceneSensors(cameras=images, sweeps=())
-    crowd = tuple(_failure(FailureKind.FALSE_TRACK, 0, "false track", str(i), 20.0, 0.3 * i) for i in range(8))
+    crowd = tuple(_failure(kind, 0, role, str(i), 20.0, 0.3 * i) for i in range(8))
     report = SimpleNamespace(failures=crowd)
     layers = {"gt": [_box(12.0, -1.0, frame=f) for f in range(3)], "failures": failure_boxes({"a": report}, {0})}
     path = tmp_path / "cam.rrd"
@@ -146,6 +152,24 @@ def test_camera_labels_are_the_failures_kept_apart_and_every_line_inside_the_ima
     for layer in ("gt", "failures"):
         strips = [s for r in rows[paths.camera_boxes("CAM_FRONT", layer)] for s in r.get("LineStrips2D:strips") or []]
         assert strips and _inside([np.asarray(s) for s in strips])
+
+
+def test_a_light_failure_colour_is_darkened_for_its_camera_label_the_box_keeps_it(
+    tmp_path: Path, tiny_scene, strict: None
+) -> None:
+    """Fragmentation orange on the viewer's pale label pill cannot be read (seen on the demo's camera views)."""
+    rows = read_rows(_camera_recording(tmp_path, tiny_scene, FailureKind.FRAGMENTATION, "missed gt"))
+
+    def rgb(packed: list[int]) -> set[tuple[int, int, int]]:
+        return {((c >> 24) & 0xFF, (c >> 16) & 0xFF, (c >> 8) & 0xFF) for c in packed}
+
+    text = rgb([c for r in rows[paths.camera_labels("CAM_FRONT")] for c in r.get("Points2D:colors") or []])
+    boxes = rgb(
+        [c for r in rows[paths.camera_boxes("CAM_FRONT", "failures")] for c in r.get("LineStrips2D:colors") or []]
+    )
+    assert boxes == {KIND_COLORS[FailureKind.FRAGMENTATION]}
+    assert text == {readable_text(KIND_COLORS[FailureKind.FRAGMENTATION])}
+    assert all(luminance(c) <= TEXT_LUMINANCE_MAX for c in text)
 
 
 def test_a_label_wider_than_the_image_is_centred_on_it_and_a_narrow_one_kept_inside() -> None:

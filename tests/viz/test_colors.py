@@ -12,6 +12,7 @@ from viz.colors import (
     class_ids,
     pack_rgba,
     packed_track_colors,
+    readable_text,
     track_color,
     track_colors,
 )
@@ -91,3 +92,11 @@ def test_involved_tracks_get_distinct_palette_colours_no_marker_uses() -> None:
     assert car == {26: INVOLVED_PALETTE[1], 123: INVOLVED_PALETTE[2]}
     beyond = involved_track_colors(range(1, len(INVOLVED_PALETTE) + 2))
     assert beyond[len(INVOLVED_PALETTE) + 1] == track_color(len(INVOLVED_PALETTE) + 1)
+
+
+def test_label_text_is_darkened_to_be_read_on_a_pale_pill_keeping_its_hue() -> None:
+    orange = (255, 140, 0)
+    dark = readable_text(orange)
+    assert colors.luminance(dark) <= colors.TEXT_LUMINANCE_MAX < colors.luminance(orange)
+    assert dark[0] > dark[1] > dark[2] == 0 and abs(dark[1] / dark[0] - 140 / 255) < 0.01  # still orange
+    assert readable_text((0, 0, 200)) == (0, 0, 200)  # dark blue already reads
