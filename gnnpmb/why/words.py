@@ -541,6 +541,40 @@ def _scored_away(f: Finding, lost: LostTrack) -> str:
     )
 
 
+def _matched_away(f: Finding, lost: LostTrack, name_evaluation: bool) -> str:
+    """``, then matched track 160 to pedestrian GT 2e96cc at frames 22–34``: the other objects the evaluation
+    matched the lost track to after its last match on this one (``LostTrack.matched_away``; "" if none), so "last
+    matched to it" does not read as if the track had followed the object unmatched since; name_evaluation: the
+    clause before spoke of the tracker's output (``the evaluation matched ...``)."""
+    if not lost.matched_away:
+        return ""
+    objects = " and ".join(
+        f"to {f.class_name} GT {short_id(a.gt_id)} at {frames_text(a.frames)}" for a in lost.matched_away
+    )
+    who = "the evaluation " if name_evaluation else ""
+    return f", then {who}matched track {lost.track_id} {objects}"
+
+
+def _two_tracks(f: Finding, lost: LostTrack) -> str:
+    """The lost track still output within ``NEAR_M`` of the object at the failure's frame beside the track the
+    evaluation matched to the object there (the blame ``TWO_TRACKS``). Where the evaluation matched the lost track
+    to another object at that frame, it was no spare second track on this one: that is said instead."""
+    s = f.sighting(f.frame)
+    on = {o.track_id: o for o in (s.on_it if s else ())}
+    away = next((a for a in lost.matched_away if f.frame in a.frames), None)
+    if away is not None and lost.track_id in on and f.taker is not None:
+        return (
+            f"at frame {f.frame} track {lost.track_id} was still output {on[lost.track_id].distance_m:.1f} m from "
+            f"it, but the evaluation matched track {lost.track_id} to {f.class_name} GT {short_id(away.gt_id)} and "
+            f"track {f.taker.track_id} to GT {short_id(f.gt_id or '')}"
+        )
+    others = [t for t in on if t != lost.track_id]
+    return (
+        f"at frame {f.frame} track {lost.track_id} was still output on the object, but so was track "
+        f"{', '.join(map(str, others))}: two tracks on one object, and the evaluation matched the other"
+    )
+
+
 def _lost_story(f: Finding, lost: LostTrack) -> str:
     """What the lost track did over the window, in the tracker's terms."""
     mode = UseMode(f.mode)
@@ -559,7 +593,7 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
             if held == matched
             else f"the evaluation last matched track {t} to it at frame {matched}"
         )
-        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}")
+        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}{_matched_away(f, lost, held == matched)}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]
@@ -693,12 +727,7 @@ def _lost_object(f: Finding) -> list[str]:
     if lost is not None:
         parts += _still_on_annotated(f, lost)
     if lost is not None and any(b.rule is Rule.TWO_TRACKS for b in f.blame):
-        s = f.sighting(f.frame)
-        others = [o.track_id for o in (s.on_it if s else ()) if o.track_id != lost.track_id]
-        parts.append(
-            f"at frame {f.frame} track {lost.track_id} was still output on the object, but so was track "
-            f"{', '.join(map(str, others))}: two tracks on one object, and the evaluation matched the other"
-        )
+        parts.append(_two_tracks(f, lost))
     if lost is not None and f.kind is FailureKind.FRAGMENTATION:
         s = f.sighting(f.frame)
         for b in f.blame:
