@@ -334,7 +334,10 @@ class OtherRun:
     same object (without an object: within ``NEAR_M`` of ``place_xy_m``) at the same frame, and the tracks it
     output on the object there (counted or not); output_only: it is a results file (what detections it was given is
     not known); missed: its evaluation counted the object missed at that frame (the devkit's MISS, whatever lay
-    near the annotated box: the evaluation may have scored an interpolated box elsewhere)."""
+    near the annotated box: the evaluation may have scored an interpolated box elsewhere); matched: the track its
+    evaluation matched the object to there (None: none), and each of ``on_it`` carries its own matches
+    (``OnObject.evaluated``), so a track on the object that the evaluation matched elsewhere is not said to have
+    kept it."""
 
     tracker: str
     failed_same: bool
@@ -342,6 +345,7 @@ class OtherRun:
     place_xy_m: tuple[float, float] | None = None
     output_only: bool = False
     missed: bool = False
+    matched: int | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -730,7 +730,15 @@ class _Context:
             missed = gt_id is not None and any(
                 f.kind is FailureKind.MISS and f.frame_index == self.f and gt_id in f.gt_ids for f in ev.report.failures
             )
-            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed))
+            matched = next(
+                (
+                    int(t)
+                    for t, e in ev.report.track_evals.items()
+                    if gt_id is not None and e.matched_at(self.f) == gt_id
+                ),
+                None,
+            )
+            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed, matched))
         return tuple(out)
 
 

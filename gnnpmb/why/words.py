@@ -1128,17 +1128,36 @@ def _others(f: Finding) -> list[str]:
             out.append(f"{who} {same}")
         elif o.failed_same:
             out.append(f"{who} failed here too")
-        elif counted:
-            ids = ", ".join(str(x.track_id) for x in counted)
-            out.append(
-                f"{who} did not fail here: its track{'s' if len(counted) > 1 else ''} "
-                f"{ids} {'were' if len(counted) > 1 else 'was'} output on the object and counted"
+        elif counted and o.matched in {x.track_id for x in counted}:
+            out.append(f"{who} did not fail here: {_its_tracks(counted)} output on the object and counted")
+        elif counted and o.missed:  # on the annotation, but the evaluation matched them elsewhere or to nothing
+            elsewhere = " and ".join(
+                f"track {x.track_id} to "
+                + (f"{f.class_name} GT {short_id(g)}" if (g := _matched_at(x, f.frame)) is not None else "no object")
+                for x in counted
             )
+            out.append(
+                f"{who} did not match the object here: {_its_tracks(counted)} output on the object and counted, "
+                f"but the evaluation matched {elsewhere}"
+            )
+        elif counted and o.matched is not None:  # matched to a track of its off the annotation (an interpolation)
+            out.append(f"{who} did not fail here: the evaluation matched the object to its track {o.matched}")
         elif o.missed:  # its evaluation counted a miss there: it lost the object too
             out.append(f"{who} had no counted track on the object here either")
         else:
             out.append(f"{who} did not have this failure")
     return out
+
+
+def _its_tracks(on: Sequence[OnObject]) -> str:
+    """``its track 12 was`` / ``its tracks 12, 14 were``."""
+    ids = ", ".join(str(x.track_id) for x in on)
+    return f"its track {ids} was" if len(on) == 1 else f"its tracks {ids} were"
+
+
+def _matched_at(o: OnObject, frame: int) -> str | None:
+    """The object the evaluation matched the track ``o`` to at ``frame`` (None: none, or not evaluated)."""
+    return o.evaluated.matched_at(frame) if o.evaluated is not None else None
 
 
 def _other_name(f: Finding, o: OtherRun) -> str:

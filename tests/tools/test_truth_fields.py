@@ -91,3 +91,13 @@ def test_a_false_match_of_the_lost_track_to_another_object_is_caught(staged: lis
     assert any("matched away" in p for p in _problems(lie, src))
     earlier = dataclasses.replace(f, lost=dataclasses.replace(f.lost, matched_until=f.lost.matched_until - 1))
     assert any("matched away" in p for p in _problems(earlier, src))
+
+
+def test_the_track_another_runs_evaluation_matched_the_object_to_is_read_from_its_devkit_bookkeeping(
+    staged: list,
+) -> None:
+    f, src = next((f, s) for f, s in staged if f.others and f.gt_id is not None)
+    other = f.others[0]
+    assert not any("other matched" in p for p in _problems(f, src))
+    wrong = dataclasses.replace(other, matched=-5 if other.matched is not None else 10_000)
+    assert any("other matched" in p for p in _problems(dataclasses.replace(f, others=(wrong,)), src))

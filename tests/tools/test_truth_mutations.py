@@ -710,3 +710,31 @@ def test_two_tracks_on_one_object_said_of_a_track_matched_to_another_object_is_c
     assert [c.kind for c in check_text(both.format("0.5", "bbbbbb", 11), ctx, None, ev, scene=scene).found] == [
         "matched"
     ]
+
+
+def test_another_runs_track_on_the_object_said_to_keep_it_where_its_evaluation_matched_it_elsewhere_is_caught() -> None:
+    ev, scene, _ = _matched_away_world()  # the other run: GT A missed at frame 2, track 7 (on it) matched to GT B
+    ev.boxes[2] = [("7", C, (0.0, 0.5))]
+    ev.counted[C] = {"7", "11"}
+    scene.objects[2][GT_A] = scene.objects[3][GT_A]
+    ctx = Context(C, 2, GT_A, kind="id_switch")
+    kept = "pmbm on the same detections did not fail here: its track 7 was output on the object and counted"
+    assert [c.kind for c in check_text(kept, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found] == [
+        "misleading"
+    ]
+    told = (
+        "pmbm on the same detections did not match the object here: its track 7 was output on the object and "
+        "counted, but the evaluation matched track 7 to car GT {}"
+    )
+    assert check_text(told.format("bbbbbb"), ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found == []
+    planted = told.format("cccccc")
+    assert [c.kind for c in check_text(planted, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found] == [
+        "other run"
+    ]
+    to_it = "pmbm on the same detections did not fail here: the evaluation matched the object to its track 7"
+    assert [c.kind for c in check_text(to_it, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found] == [
+        "other run"
+    ]
+    ctx3 = Context(C, 3, GT_A, kind="id_switch")
+    to_11 = to_it.replace("track 7", "track 11")
+    assert check_text(to_11, ctx3, None, _eval(), scene=scene, others={"pmbm": ev}).found == []

@@ -401,6 +401,12 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
                 return ""
             failed = failed_here(other, v[1], c, x, v[2], v[3])
             return "" if failed is None or failed == v[4] else f"it {'did' if failed else 'did not'} fail"
+        case "other matched":
+            other = src.others.get(v[0])
+            if other is None:
+                return ""
+            got = other.matched_track(c, x, v[1])
+            return "" if got == (None if v[2] is None else str(v[2])) else f"its evaluation matched it to {got}"
         case "blame":
             return check_blame(v[0], v[1], f, src)
         case "deciding":

@@ -327,3 +327,36 @@ def test_two_tracks_on_one_object_is_said_only_where_the_evaluation_matched_the_
             "at frame 34 track 160 was still output on the object, but so was track 718: two tracks on one object, "
             "and the evaluation matched the other" in line
         )
+
+
+def test_another_runs_track_on_the_object_is_not_said_to_have_kept_it_where_its_evaluation_matched_it_elsewhere() -> (
+    None
+):
+    # dev set scene-0655 pointpillars (truth checker, r38 follow-up): "pmbm on the same detections did not fail here:
+    # its track 160 was output on the object and counted" where pmbm's evaluation missed the object and matched
+    # track 160 to pedestrian GT 2e96cc
+    from gnnpmb.why.findings import OnObject, OtherRun
+
+    other = "2e96cc" + "1" * 26
+    matched_there = TrackEval((34,), (34,), (), 0.9, 0.9, ((34, other),))
+    false_there = TrackEval((34,), (34,), (), 0.9, 0.9, ())
+    on = (OnObject(160, 0.5, 0.9, -1, matched_there, 0.3), OnObject(170, 0.9, 0.9, -1, false_there, 0.3))
+    lost = LostTrack(62, 30, (), None, None, None)
+
+    def said(run: OtherRun) -> str:
+        return why_lines(finding(FailureKind.ID_SWITCH, lost, frame=34, others=(run,)))[0]
+
+    assert (
+        "pmbm on the same detections did not match the object here: its tracks 160, 170 were output on the object "
+        "and counted, but the evaluation matched track 160 to bicycle GT 2e96cc and track 170 to no object"
+        in said(OtherRun("pmbm", False, on, missed=True))
+    )
+    kept = TrackEval((34,), (34,), (), 0.9, 0.9, ((34, GT),))
+    held = (OnObject(160, 0.5, 0.9, -1, kept, 0.3),)
+    assert "pmbm on the same detections did not fail here: its track 160 was output on the object and counted" in said(
+        OtherRun("pmbm", False, held, matched=160)
+    )
+    assert (  # matched to a track of its off the annotation (the evaluation's interpolated box)
+        "pmbm on the same detections did not fail here: the evaluation matched the object to its track 171"
+        in said(OtherRun("pmbm", False, on, matched=171))
+    )
