@@ -562,7 +562,9 @@ def _two_tracks(f: Finding, lost: LostTrack) -> str:
     s = f.sighting(f.frame)
     on = {o.track_id: o for o in (s.on_it if s else ())}
     away = next((a for a in lost.matched_away if f.frame in a.frames), None)
-    if away is not None and lost.track_id in on and f.taker is not None:
+    if away is not None:  # without the lost track's box or the taker, less is said, never the spare-track form
+        if lost.track_id not in on or f.taker is None:
+            return ""
         return (
             f"at frame {f.frame} track {lost.track_id} was still output {on[lost.track_id].distance_m:.1f} m from "
             f"it, but the evaluation matched track {lost.track_id} to {f.class_name} GT {short_id(away.gt_id)} and "

@@ -319,6 +319,9 @@ def test_two_tracks_on_one_object_is_said_only_where_the_evaluation_matched_the_
         "at frame 34 track 160 was still output 0.5 m from it, but the evaluation matched track 160 to bicycle GT "
         "2e96cc and track 718 to GT bf3d85" in line
     )
+    untold = dict(kw, taker=None)  # the track that took the object unknown: less is said, not the spare-track form
+    line = why_lines(finding(kind, elsewhere, **untold))[0]
+    assert "two tracks on one object" not in line and "still output" not in line
     before = LostTrack(160, 34, steps, None, None, None, matched_until=20, matched_away=(MatchedAway(other, (22,)),))
     spare = LostTrack(160, 34, steps, None, None, None, matched_until=20)
     for lost in (before, spare):  # matched to no other object at frame 34: a spare second track there
