@@ -82,12 +82,7 @@ def check_others(
             _check_matched_elsewhere(m, c, x, gt, ev, scene, out, bad)
         elif said.startswith("did not fail here"):  # its named tracks lay within reach of the object, counted
             named = {t.strip() for t in m[3].split(",")}
-            a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
-            near = {
-                t
-                for t, cls, xy in ev.boxes.get(x, [])
-                if a is not None and cls == c and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < NEAR_M
-            }
+            near = _near(ev, c, x, gt, scene)
             if failed or not named <= near & ev.counted.get(c, set()):
                 bad("other run", m[0], f"{m[1]}'s counted tracks within {NEAR_M} m at frame {x}: {sorted(near)}")
             elif matched not in named and gt in ev.gt_to_track.get((c, x), {}):
