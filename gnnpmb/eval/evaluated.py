@@ -108,32 +108,48 @@ class TrackEval:
     """One submitted track, as evaluated: submitted (frames it has a box in the submission), kept (those the
     class-range and bike-rack filters kept), interpolated (frames the evaluation filled in between its kept
     boxes); submitted_mean: its score averaged over every submitted box; averaged_score: over the kept ones, the
-    score the devkit compares with the class's threshold (None: no box kept, the track is not evaluated)."""
+    score the devkit compares with the class's threshold (None: no box kept, the track is not evaluated); matches:
+    (frame, object) for each frame at which the devkit's accumulator matched the track to an object (a MATCH or
+    SWITCH event at the class's best-MOTA threshold), in frame order."""
 
     submitted: tuple[int, ...]
     kept: tuple[int, ...]
     interpolated: tuple[int, ...]
     submitted_mean: float
     averaged_score: float | None
+    matches: tuple[tuple[int, str], ...] = ()
+
+    def matched_at(self, frame: int) -> str | None:
+        """The object the evaluation matched the track to at ``frame`` (None: none, e.g. a false track there)."""
+        return next((g for x, g in self.matches if x == frame), None)
 
     def to_json(self) -> dict[str, Any]:
+        """The fields; ``matches`` as object -> its frames (each object's id written once)."""
+        frames: dict[str, list[int]] = {}
+        for x, g in self.matches:
+            frames.setdefault(g, []).append(x)
         return {
             "submitted": list(self.submitted),
             "kept": list(self.kept),
             "interpolated": list(self.interpolated),
             "submitted_mean": self.submitted_mean,
             "averaged_score": self.averaged_score,
+            "matches": frames,
         }
 
     @staticmethod
     def from_json(data: Mapping[str, Any]) -> TrackEval:
+        """The track ``to_json`` wrote; one written before ``matches`` existed raises KeyError (a cached report of
+        an older version is evaluated again, not read as if the evaluation had matched the track nowhere)."""
         averaged = data["averaged_score"]
+        matches = sorted((int(x), str(g)) for g, frames in data["matches"].items() for x in frames)
         return TrackEval(
             tuple(int(f) for f in data["submitted"]),
             tuple(int(f) for f in data["kept"]),
             tuple(int(f) for f in data["interpolated"]),
             float(data["submitted_mean"]),
             None if averaged is None else float(averaged),
+            tuple(matches),
         )
 
 
@@ -228,10 +244,12 @@ def track_evals(
     averaged: Mapping[str, float],
     frame_of_timestamp: Mapping[int, int],
     token_of_frame: Sequence[str],
+    matches: Mapping[str, Sequence[tuple[int, str]]],
 ) -> dict[str, TrackEval]:
     """Tracking id -> ``TrackEval`` for every track of the scene's submission ``results`` (boxes by sample token),
     from the boxes the devkit kept, the tracks it built (a frame where it has a box of the track that is not one
-    it kept is one it interpolated) and the scores it averaged (``averaged``: id -> the score its tracks carry)."""
+    it kept is one it interpolated), the scores it averaged (``averaged``: id -> the score its tracks carry) and
+    its accumulator's matches (``matches``: id -> (frame, object) pairs)."""
     submitted: dict[str, list[tuple[int, float]]] = {}
     for f, token in enumerate(token_of_frame):
         for box in results.get(token, ()):
@@ -257,5 +275,6 @@ def track_evals(
             interpolated=tuple(sorted(in_tracks.get(t, set()) - set(kept_t))),
             submitted_mean=float(np.mean([s for _, s in frames])),
             averaged_score=averaged.get(t),
+            matches=tuple(sorted(matches.get(t, ()))),
         )
     return out

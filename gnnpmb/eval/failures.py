@@ -646,6 +646,7 @@ def find_failures(
         scene_token = nusc.get("sample", evaluated[0])["scene_token"]
         classes: list[ClassEvaluation] = []
         failures: list[Failure] = []
+        matches: dict[str, list[tuple[int, str]]] = defaultdict(list)  # track -> (frame, object) it was matched to
         class_data = []
         for class_name in cfg.class_names:
             md = class_evaluation(tracks_gt, tracks_pred, class_name, cfg).accumulate()
@@ -670,6 +671,10 @@ def find_failures(
                 frame_of_timestamp,
             )
             failures += _class_failures(frames, class_name, tokens, cfg.dist_th_tp, coalescence_radius_m)
+            for fr in frames:
+                for kind, o, h in fr.events:
+                    if kind in ("MATCH", "SWITCH"):
+                        matches[h].append((fr.frame_index, o))
         scores = official_scores(class_data, cfg)
     kind_order = {kind: i for i, kind in enumerate(FailureKind)}
     failures.sort(key=lambda f: (f.frame_index, kind_order[f.kind], f.class_name, f.gt_ids, f.track_ids))
@@ -686,7 +691,7 @@ def find_failures(
         coalescence_radius_m,
         track_scores,
         gt_frames(raw_gt, kept_gt, tracks_gt[scene_token], frame_of_timestamp, tokens, cfg.class_range),
-        track_evals(results, kept_pred, tracks_pred[scene_token], track_scores, frame_of_timestamp, tokens),
+        track_evals(results, kept_pred, tracks_pred[scene_token], track_scores, frame_of_timestamp, tokens, matches),
         None if whole else (window.start, window.stop),
         scores,
     )

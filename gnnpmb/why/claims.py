@@ -44,8 +44,12 @@ CLAIM_KINDS = (
     "evaluated",  # (gt, status, evaluated xy or None)
     "false at",  # (track, frames): the evaluation counted it a false track at these frames
     "other failed",  # (tracker, kind, gt, place xy, failed): at the object (or, without one, the place)
+    "other matched",  # (tracker, gt, track): that run's evaluation matched the object to this track (None: none)
     "blame",  # (rule, frames): the stated test held at each frame
     "deciding",  # (track, gt, frames): the frames after the track was last output on the object, up to the failure
+    "matched away",  # (track, gt, since, ((other gt, frames), ...)): the evaluation last matched the object before
+    # this frame at frame since, to the track, and after it up to this frame matched the track to exactly these
+    # other objects at these frames
     "output on",  # (track, meas, how, distance_m): a results file's box sits on that detection by ``foreign.box_on``
     "first output",  # (track,): a results file's track has its first box at this frame
 )
@@ -97,6 +101,9 @@ def claims(f: Finding) -> list[Claim]:
         if lost.held_until is not None:
             add("output near", lost.held_until, t, f.gt_id, None)
         add("deciding", f.frame, t, f.gt_id, f.deciding)
+        if lost.matched_until is not None:
+            away = tuple((a.gt_id, a.frames) for a in lost.matched_away)
+            add("matched away", f.frame, t, f.gt_id, lost.matched_until, away)
         for x in f.deciding:
             step = lost.step(x)
             if step is None or step.output is None:
@@ -158,6 +165,8 @@ def claims(f: Finding) -> list[Claim]:
                 add("evaluated", f.frame, gt_id, g.status, g.evaluated_xy_m)
     for other in f.others:
         add("other failed", f.frame, other.tracker, f.kind.value, f.gt_id, other.place_xy_m, other.failed_same)
+        if f.gt_id is not None:
+            add("other matched", f.frame, other.tracker, f.gt_id, other.matched)
     for frame, track, on in f.boxes_on:
         add("output on", frame, track, on.meas, on.how.value, on.distance_m)
     for b in f.blame:

@@ -182,6 +182,16 @@ class OffObject:
 
 
 @dataclass(frozen=True, slots=True)
+class MatchedAway:
+    """An object other than the finding's to which the evaluation matched the lost track after its last match on
+    the finding's object, up to the failure's frame (the devkit's MATCH or SWITCH events, ``TrackEval.matches``):
+    its id and the frames of those matches."""
+
+    gt_id: str
+    frames: tuple[int, ...]
+
+
+@dataclass(frozen=True, slots=True)
 class LostTrack:
     """The track that had the object: ``held_until`` the last frame it was output within ``NEAR_M`` of it (None:
     never in the window); steps: its ``TrackStep`` per frame of the window; off: output away from the object at the
@@ -192,7 +202,8 @@ class LostTrack:
     detection) pairs its column could not take in the chosen hypothesis's matrix but another hypothesis's matrix
     gave a finite cost (PMBM); matched_until: the last frame before the failure at which the evaluation matched
     the object to a track (the devkit's memory of its last match, which for a lost object is this track: None if
-    none)."""
+    none); matched_away: the other objects the evaluation matched this track to after that frame, up to the
+    failure's (``MatchedAway``, by first frame)."""
 
     track_id: int
     held_until: int | None
@@ -203,6 +214,7 @@ class LostTrack:
     elsewhere: tuple[int, ...] = ()
     finite_elsewhere: tuple[tuple[int, int], ...] = ()
     matched_until: int | None = None
+    matched_away: tuple[MatchedAway, ...] = ()
 
     def step(self, frame: int) -> TrackStep | None:
         return next((s for s in self.steps if s.frame == frame), None)
@@ -322,7 +334,10 @@ class OtherRun:
     same object (without an object: within ``NEAR_M`` of ``place_xy_m``) at the same frame, and the tracks it
     output on the object there (counted or not); output_only: it is a results file (what detections it was given is
     not known); missed: its evaluation counted the object missed at that frame (the devkit's MISS, whatever lay
-    near the annotated box: the evaluation may have scored an interpolated box elsewhere)."""
+    near the annotated box: the evaluation may have scored an interpolated box elsewhere); matched: the track its
+    evaluation matched the object to there (None: none), and each of ``on_it`` carries its own matches
+    (``OnObject.evaluated``), so a track on the object that the evaluation matched elsewhere is not said to have
+    kept it."""
 
     tracker: str
     failed_same: bool
@@ -330,6 +345,7 @@ class OtherRun:
     place_xy_m: tuple[float, float] | None = None
     output_only: bool = False
     missed: bool = False
+    matched: int | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gnnpmb.data.scene import SceneData
-from gnnpmb.eval.evaluated import GtFrame, GtStatus
+from gnnpmb.eval.evaluated import GtFrame, GtStatus, TrackEval
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport
 from gnnpmb.events import AxisKind, CostMatrix
 from gnnpmb.explain import PairChoice
@@ -38,6 +38,7 @@ from gnnpmb.why.findings import (
     HypothesisTrack,
     KeyDecision,
     LostTrack,
+    MatchedAway,
     Near,
     OffObject,
     OnObject,
@@ -326,7 +327,8 @@ class _Context:
         evaluated = self.report.track_evals.get(str(track_id))
         finite = self.finite_elsewhere(track_id, steps)
         matched = self.matched_until(gt_id)
-        return LostTrack(track_id, held, in_window, off, evaluated, self.threshold, elsewhere, finite, matched)
+        away = matched_away(evaluated, gt_id, matched, self.f)
+        return LostTrack(track_id, held, in_window, off, evaluated, self.threshold, elsewhere, finite, matched, away)
 
     def matched_until(self, gt_id: str) -> int | None:
         """The last frame before the failure at which the evaluation matched object ``gt_id`` to a track: it scored
@@ -728,8 +730,29 @@ class _Context:
             missed = gt_id is not None and any(
                 f.kind is FailureKind.MISS and f.frame_index == self.f and gt_id in f.gt_ids for f in ev.report.failures
             )
-            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed))
+            matched = next(
+                (
+                    int(t)
+                    for t, e in ev.report.track_evals.items()
+                    if gt_id is not None and e.matched_at(self.f) == gt_id
+                ),
+                None,
+            )
+            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed, matched))
         return tuple(out)
+
+
+def matched_away(evaluated: TrackEval | None, gt_id: str, since: int | None, frame: int) -> tuple[MatchedAway, ...]:
+    """The objects other than ``gt_id`` the evaluation matched a track to after frame ``since`` (the track's last
+    match on ``gt_id``; None: none known, nothing said) up to ``frame``, each with its frames, by first frame, from
+    the devkit's own matches (``evaluated``: the track as evaluated; None: not evaluated)."""
+    if evaluated is None or since is None:
+        return ()
+    frames: dict[str, list[int]] = {}
+    for x, g in evaluated.matches:
+        if since < x <= frame and g != gt_id:
+            frames.setdefault(g, []).append(x)
+    return tuple(MatchedAway(g, tuple(xs)) for g, xs in frames.items())
 
 
 def object_frames(

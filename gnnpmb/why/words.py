@@ -541,6 +541,42 @@ def _scored_away(f: Finding, lost: LostTrack) -> str:
     )
 
 
+def _matched_away(f: Finding, lost: LostTrack, name_evaluation: bool) -> str:
+    """``, then matched track 160 to pedestrian GT 2e96cc at frames 22–34``: the other objects the evaluation
+    matched the lost track to after its last match on this one (``LostTrack.matched_away``; "" if none), so "last
+    matched to it" does not read as if the track had followed the object unmatched since; name_evaluation: the
+    clause before spoke of the tracker's output (``the evaluation matched ...``)."""
+    if not lost.matched_away:
+        return ""
+    objects = " and ".join(
+        f"to {f.class_name} GT {short_id(a.gt_id)} at {frames_text(a.frames)}" for a in lost.matched_away
+    )
+    who = "the evaluation " if name_evaluation else ""
+    return f", then {who}matched track {lost.track_id} {objects}"
+
+
+def _two_tracks(f: Finding, lost: LostTrack) -> str:
+    """The lost track still output within ``NEAR_M`` of the object at the failure's frame beside the track the
+    evaluation matched to the object there (the blame ``TWO_TRACKS``). Where the evaluation matched the lost track
+    to another object at that frame, it was no spare second track on this one: that is said instead."""
+    s = f.sighting(f.frame)
+    on = {o.track_id: o for o in (s.on_it if s else ())}
+    away = next((a for a in lost.matched_away if f.frame in a.frames), None)
+    if away is not None:  # without the lost track's box or the taker, less is said, never the spare-track form
+        if lost.track_id not in on or f.taker is None:
+            return ""
+        return (
+            f"at frame {f.frame} track {lost.track_id} was still output {on[lost.track_id].distance_m:.1f} m from "
+            f"it, but the evaluation matched track {lost.track_id} to {f.class_name} GT {short_id(away.gt_id)} and "
+            f"track {f.taker.track_id} to GT {short_id(f.gt_id or '')}"
+        )
+    others = [t for t in on if t != lost.track_id]
+    return (
+        f"at frame {f.frame} track {lost.track_id} was still output on the object, but so was track "
+        f"{', '.join(map(str, others))}: two tracks on one object, and the evaluation matched the other"
+    )
+
+
 def _lost_story(f: Finding, lost: LostTrack) -> str:
     """What the lost track did over the window, in the tracker's terms."""
     mode = UseMode(f.mode)
@@ -559,7 +595,7 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
             if held == matched
             else f"the evaluation last matched track {t} to it at frame {matched}"
         )
-        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}")
+        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}{_matched_away(f, lost, held == matched)}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]
@@ -693,12 +729,7 @@ def _lost_object(f: Finding) -> list[str]:
     if lost is not None:
         parts += _still_on_annotated(f, lost)
     if lost is not None and any(b.rule is Rule.TWO_TRACKS for b in f.blame):
-        s = f.sighting(f.frame)
-        others = [o.track_id for o in (s.on_it if s else ()) if o.track_id != lost.track_id]
-        parts.append(
-            f"at frame {f.frame} track {lost.track_id} was still output on the object, but so was track "
-            f"{', '.join(map(str, others))}: two tracks on one object, and the evaluation matched the other"
-        )
+        parts.append(_two_tracks(f, lost))
     if lost is not None and f.kind is FailureKind.FRAGMENTATION:
         s = f.sighting(f.frame)
         for b in f.blame:
@@ -1099,17 +1130,36 @@ def _others(f: Finding) -> list[str]:
             out.append(f"{who} {same}")
         elif o.failed_same:
             out.append(f"{who} failed here too")
-        elif counted:
-            ids = ", ".join(str(x.track_id) for x in counted)
-            out.append(
-                f"{who} did not fail here: its track{'s' if len(counted) > 1 else ''} "
-                f"{ids} {'were' if len(counted) > 1 else 'was'} output on the object and counted"
+        elif counted and o.matched in {x.track_id for x in counted}:
+            out.append(f"{who} did not fail here: {_its_tracks(counted)} output on the object and counted")
+        elif counted and o.missed:  # on the annotation, but the evaluation matched them elsewhere or to nothing
+            elsewhere = " and ".join(
+                f"track {x.track_id} to "
+                + (f"{f.class_name} GT {short_id(g)}" if (g := _matched_at(x, f.frame)) is not None else "no object")
+                for x in counted
             )
+            out.append(
+                f"{who} did not match the object here: {_its_tracks(counted)} output on the object and counted, "
+                f"but the evaluation matched {elsewhere}"
+            )
+        elif counted and o.matched is not None:  # matched to a track of its off the annotation (an interpolation)
+            out.append(f"{who} did not fail here: the evaluation matched the object to its track {o.matched}")
         elif o.missed:  # its evaluation counted a miss there: it lost the object too
             out.append(f"{who} had no counted track on the object here either")
         else:
             out.append(f"{who} did not have this failure")
     return out
+
+
+def _its_tracks(on: Sequence[OnObject]) -> str:
+    """``its track 12 was`` / ``its tracks 12, 14 were``."""
+    ids = ", ".join(str(x.track_id) for x in on)
+    return f"its track {ids} was" if len(on) == 1 else f"its tracks {ids} were"
+
+
+def _matched_at(o: OnObject, frame: int) -> str | None:
+    """The object the evaluation matched the track ``o`` to at ``frame`` (None: none, or not evaluated)."""
+    return o.evaluated.matched_at(frame) if o.evaluated is not None else None
 
 
 def _other_name(f: Finding, o: OtherRun) -> str:

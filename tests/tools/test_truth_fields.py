@@ -79,3 +79,25 @@ def test_another_runs_outcome_is_read_from_its_devkit_bookkeeping(staged: list) 
     other = f.others[0]
     flipped = dataclasses.replace(other, failed_same=not other.failed_same)
     assert any("other failed" in p for p in _problems(dataclasses.replace(f, others=(flipped,)), src))
+
+
+def test_a_false_match_of_the_lost_track_to_another_object_is_caught(staged: list) -> None:
+    from gnnpmb.why.findings import MatchedAway
+
+    f, src = next((f, s) for f, s in staged if f.lost is not None and f.lost.matched_until is not None)
+    assert _problems(f, src) == []
+    planted = MatchedAway("c" * 32, (f.frame,))  # an object the devkit never matched the track to
+    lie = dataclasses.replace(f, lost=dataclasses.replace(f.lost, matched_away=(*f.lost.matched_away, planted)))
+    assert any("matched away" in p for p in _problems(lie, src))
+    earlier = dataclasses.replace(f, lost=dataclasses.replace(f.lost, matched_until=f.lost.matched_until - 1))
+    assert any("matched away" in p for p in _problems(earlier, src))
+
+
+def test_the_track_another_runs_evaluation_matched_the_object_to_is_read_from_its_devkit_bookkeeping(
+    staged: list,
+) -> None:
+    f, src = next((f, s) for f, s in staged if f.others and f.gt_id is not None)
+    other = f.others[0]
+    assert not any("other matched" in p for p in _problems(f, src))
+    wrong = dataclasses.replace(other, matched=-5 if other.matched is not None else 10_000)
+    assert any("other matched" in p for p in _problems(dataclasses.replace(f, others=(wrong,)), src))

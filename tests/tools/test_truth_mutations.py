@@ -642,3 +642,99 @@ def test_no_track_carrying_an_object_a_track_was_on_and_a_reach_the_devkit_did_n
     assert check_text(reach, ctx, None, ev, scene=scene).found == []
     ev.evaluated_gt[(3, GT_A)] = (0.0, -0.3)  # 1.5 m from the track's box: within the devkit's reach
     assert [c.kind for c in check_text(reach, ctx, None, ev, scene=scene).found] == ["evaluation"]
+
+
+def _matched_away_world():
+    """Track 7 matched to GT A at frame 1, to GT B at frames 2 and 3 (GT A missed at 2), track 11 to GT A at 3; the
+    files: GT A at the origin at frame 3, track 7's box 0.5 m from it, track 11's 0.7 m."""
+    from tools.truth.scene import Annotation, SceneTruth
+
+    ev = EvalFacts(thresholds={C: 0.5})
+    ev.gt_to_track.update({(C, 1): {GT_A: "7"}, (C, 2): {GT_A: None, GT_B: "7"}, (C, 3): {GT_A: "11", GT_B: "7"}})
+    ev.track_to_gt.update({(C, 1): {"7": GT_A}, (C, 2): {"7": GT_B}, (C, 3): {"7": GT_B, "11": GT_A}})
+    ev.submitted.update({1: {"7"}, 2: {"7"}, 3: {"7", "11"}})
+    ev.boxes[3] = [("7", C, (0.5, 0.0)), ("11", C, (0.0, 0.7))]
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 0)}])
+    return ev, scene, Context(C, 3, GT_A, kind="id_switch", lost=7, taker=11)
+
+
+def test_the_lost_tracks_matches_to_another_object_left_out_or_misstated_are_caught() -> None:
+    # independent audit r38, dev set scene-0655 pointpillars pmbm id_switch:3: "the evaluation last matched track
+    # 160 to it at frame 20" where the devkit matched track 160 to another pedestrian from frame 22 to the failure
+    ev, scene, ctx = _matched_away_world()
+    true = "the evaluation last matched track 7 to it at frame 1, then matched track 7 to car GT bbbbbb at frames 2, 3"
+    assert check_text(true, ctx, None, ev, scene=scene).found == []
+    planted = {
+        "the evaluation last matched track 7 to it at frame 1, its existence was 1.00": "misleading",  # left out
+        "the evaluation last matched track 7 to it at frame 1, then matched track 7 to car GT bbbbbb at frame 2": (
+            "matched"
+        ),
+        "the evaluation last matched track 7 to it at frame 1, then matched track 7 to car GT cccccc at frames 2, 3": (
+            "matched"
+        ),
+        "track 7 was last output on it at frame 1, then the evaluation matched track 7 to car GT bbbbbb at frames 2, 3 "
+        "and to car GT cccccc at frame 3": "matched",
+    }
+    for said, kind in planted.items():
+        assert [c.kind for c in check_text(said, ctx, None, ev, scene=scene).found] == [kind], said
+    ev.track_to_gt[(C, 2)] = {"7": None}  # matched to nothing at 2: no other object to name there
+    ev.track_to_gt[(C, 3)] = {"7": None, "11": GT_A}
+    assert [c.kind for c in check_text(true, ctx, None, ev, scene=scene).found] == ["matched"]
+    assert check_text("the evaluation last matched track 7 to it at frame 1,", ctx, None, ev, scene=scene).found == []
+
+
+def test_two_tracks_on_one_object_said_of_a_track_matched_to_another_object_is_caught() -> None:
+    # the same audit finding: "track 160 was still output on the object, but so was track 718: two tracks on one
+    # object, and the evaluation matched the other" where the devkit matched track 160 to GT 2e96cc at that frame
+    ev, scene, ctx = _matched_away_world()
+    two = (
+        "at frame 3 track 7 was still output on the object, but so was track {}: two tracks on one object, and the "
+        "evaluation matched the other"
+    )
+    assert [c.kind for c in check_text(two.format(11), ctx, None, ev, scene=scene).found] == ["misleading"]
+    both = (
+        "at frame 3 track 7 was still output {} m from it, but the evaluation matched track 7 to car GT {} and track "
+        "{} to GT aaaaaa"
+    )
+    assert check_text(both.format("0.5", "bbbbbb", 11), ctx, None, ev, scene=scene).found == []
+    for said, kind in (
+        (both.format("0.5", "cccccc", 11), "matched"),
+        (both.format("0.5", "bbbbbb", 12), "matched"),
+        (both.format("1.5", "bbbbbb", 11), "output"),
+    ):
+        assert [c.kind for c in check_text(said, ctx, None, ev, scene=scene).found] == [kind], said
+    ev.track_to_gt[(C, 3)] = {"7": None, "11": GT_A}  # track 7 matched to nothing at 3: a spare second track
+    ev.gt_to_track[(C, 3)] = {GT_A: "11", GT_B: None}
+    assert check_text(two.format(11), ctx, None, ev, scene=scene).found == []
+    assert [c.kind for c in check_text(two.format(12), ctx, None, ev, scene=scene).found] == ["matched"]
+    assert [c.kind for c in check_text(both.format("0.5", "bbbbbb", 11), ctx, None, ev, scene=scene).found] == [
+        "matched"
+    ]
+
+
+def test_another_runs_track_on_the_object_said_to_keep_it_where_its_evaluation_matched_it_elsewhere_is_caught() -> None:
+    ev, scene, _ = _matched_away_world()  # the other run: GT A missed at frame 2, track 7 (on it) matched to GT B
+    ev.boxes[2] = [("7", C, (0.0, 0.5))]
+    ev.counted[C] = {"7", "11"}
+    scene.objects[2][GT_A] = scene.objects[3][GT_A]
+    ctx = Context(C, 2, GT_A, kind="id_switch")
+    kept = "pmbm on the same detections did not fail here: its track 7 was output on the object and counted"
+    assert [c.kind for c in check_text(kept, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found] == [
+        "misleading"
+    ]
+    told = (
+        "pmbm on the same detections did not match the object here: its track 7 was output on the object and "
+        "counted, but the evaluation matched track 7 to car GT {}"
+    )
+    assert check_text(told.format("bbbbbb"), ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found == []
+    planted = told.format("cccccc")
+    assert [c.kind for c in check_text(planted, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found] == [
+        "other run"
+    ]
+    to_it = "pmbm on the same detections did not fail here: the evaluation matched the object to its track 7"
+    assert [c.kind for c in check_text(to_it, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found] == [
+        "other run"
+    ]
+    ctx3 = Context(C, 3, GT_A, kind="id_switch")
+    to_11 = to_it.replace("track 7", "track 11")
+    assert check_text(to_11, ctx3, None, _eval(), scene=scene, others={"pmbm": ev}).found == []

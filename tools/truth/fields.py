@@ -401,6 +401,12 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
                 return ""
             failed = failed_here(other, v[1], c, x, v[2], v[3])
             return "" if failed is None or failed == v[4] else f"it {'did' if failed else 'did not'} fail"
+        case "other matched":
+            other = src.others.get(v[0])
+            if other is None:
+                return ""
+            got = other.matched_track(c, x, v[1])
+            return "" if got == (None if v[2] is None else str(v[2])) else f"its evaluation matched it to {got}"
         case "blame":
             return check_blame(v[0], v[1], f, src)
         case "deciding":
@@ -412,6 +418,8 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
                     break
             expected = tuple(range((held + 1) if held is not None else x, x + 1))
             return "" if expected == tuple(v[2]) else f"the submission gives {expected}"
+        case "matched away":
+            return _check_matched_away(x, c, v, src.ev)
         case "output on":
             p = placed(x, str(v[0]), src.scene, src.ev)
             if p is None:
@@ -422,6 +430,24 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
             earlier = [y for y in range(x) if src.box(y, v[0]) is not None]
             return "" if src.box(x, v[0]) is not None and not earlier else f"output at frames {earlier} before"
     return f"unknown claim {what}"
+
+
+def _check_matched_away(x: int, c: str, v: tuple, ev: EvalFacts) -> str:
+    """'matched away' (track, gt, since, ((other gt, frames), ...)): the accumulator's last match of the object
+    before ``x`` is at since, to the track, and its matches of the track after since up to ``x`` to other objects
+    are exactly those."""
+    track, gt, since, away = str(v[0]), v[1], v[2], v[3]
+    last = max((y for (k, y), objs in ev.gt_to_track.items() if k == c and y < x and objs.get(gt)), default=None)
+    if last != since or ev.matched_track(c, last, gt) != track:
+        got = None if last is None else ev.matched_track(c, last, gt)
+        return f"the devkit last matched the object before frame {x} at frame {last} (to track {got})"
+    devkit: dict[str, list[int]] = {}
+    for y in range(since + 1, x + 1):
+        g = ev.matched_gt(c, y, track)
+        if g is not None and g != gt:
+            devkit.setdefault(g, []).append(y)
+    said = {g: list(frames) for g, frames in away}
+    return "" if said == devkit else f"the devkit matched track {track} to {devkit} after frame {since}"
 
 
 def _check_output(x: int, v: tuple, src: Sources) -> str:

@@ -14,11 +14,21 @@
   "was given mN": the frame's ``Assignment`` pairs mN with the track;
 * "track T was last output on it at frame F" / "the evaluation last matched track T to it at frame F": the last
   frame before the failure's at which the devkit's accumulator matched the object (MATCH or SWITCH) is F, and to
-  track T ("on it" reads as the evaluation's match; where the track was last within 2 m is the tracker's business).
+  track T ("on it" reads as the evaluation's match; where the track was last within 2 m is the tracker's business);
+  ", then (the evaluation) matched track T to C GT X at frames …( and to C GT Y at frames …)": after that frame,
+  up to the failure's, the accumulator matched T to exactly those other objects at exactly those frames; and where
+  it matched T to another object there and the text leaves that out, the last-match sentence is misleading (it
+  reads as if T had followed the object, unmatched, since);
+* "at frame F track T was still output on the object, but so was track U: two tracks on one object, and the
+  evaluation matched the other": at F the accumulator matched the object to U, and T to no other object (else T
+  was no spare second track, but another object's match: misleading); "at frame F track T was still output D m
+  from it, but the evaluation matched track T to C GT X and track U to GT Y": at F it matched T to X and U to the
+  object Y, and the submission's box of T lies D m from the object's annotation.
 """
 
 from __future__ import annotations
 
+import math
 import re
 
 import numpy as np
@@ -61,6 +71,19 @@ AVERAGED = re.compile(
 )
 LAST_ON_IT = re.compile(
     r"(?:track (\d+) was last output on it|the evaluation last matched track (\d+) to it) at frame (\d+)"
+)
+AWAY = re.compile(
+    r"then (?:the evaluation )?matched track (\d+) (to \w+ GT \w+ at frames? [\d–, ]*\d"
+    r"(?: and to \w+ GT \w+ at frames? [\d–, ]*\d)*)"
+)
+AWAY_OBJECT = re.compile(r"to (\w+) GT (\w+) at (frames? [\d–, ]*\d)")
+TWO_ON_ONE = re.compile(
+    r"at frame (\d+) track (\d+) was still output on the object, but so was track ([\d, ]+): two tracks on one "
+    r"object, and the evaluation matched the other"
+)
+MATCHED_BOTH = re.compile(
+    r"at frame (\d+) track (\d+) was still output (\d+\.\d) m from it, but the evaluation matched track (\d+) to "
+    r"(\w+) GT (\w+) and track (\d+) to GT (\w+)"
 )
 USED_SHARE = 0.01
 """The checker's own copy of the share from which an update is said to have used a detection."""
@@ -242,16 +265,38 @@ def _check_used(m: re.Match, c: str, lost: int, raw, out, bad) -> None:
         bad("tracker", m[0], f"the Marginals of frame {x} give track {lost} {[(d, round(v, 3)) for d, v in used]}")
 
 
+def _short(object_id: str) -> str:
+    """The checker's own copy of how the text shortens an object id (first 6 characters of a long token)."""
+    return object_id if len(object_id) <= 8 else object_id[:6]
+
+
+def _last_match(ev, class_name: str, frame: int, gt_id: str | None) -> int | None:
+    """The last frame before ``frame`` at which the accumulator matched object ``gt_id`` (MATCH or SWITCH)."""
+    return max(
+        (x for (c, x), pairs in ev.gt_to_track.items() if c == class_name and x < frame and pairs.get(gt_id)),
+        default=None,
+    )
+
+
+def _matched_away(ev, class_name: str, track: str, gt_id: str | None, since: int, frame: int) -> dict[str, list[int]]:
+    """Short object id -> the frames after ``since`` up to ``frame`` at which the accumulator matched ``track`` to
+    that object, other than ``gt_id``."""
+    away: dict[str, list[int]] = {}
+    for x in range(since + 1, frame + 1):
+        g = ev.matched_gt(class_name, x, track)
+        if g is not None and g != gt_id:
+            away.setdefault(_short(g), []).append(x)
+    return away
+
+
 def check_last_match(text: str, class_name: str, frame: int, gt_id: str | None, ev, out, bad) -> None:
     """The sentences "track T was last output on it at frame F" and "the evaluation last matched track T to it at
-    frame F" against the devkit's last MATCH or SWITCH of object ``gt_id`` before ``frame`` (module docstring)."""
+    frame F" against the devkit's last MATCH or SWITCH of object ``gt_id`` before ``frame``, and the clause ", then
+    matched track T to …" (or its absence) against the devkit's matches of T after it (module docstring)."""
     for m in LAST_ON_IT.finditer(text):
         t, said = m[1] or m[2], int(m[3])
         out.checked["matched"] += 1
-        last = max(
-            (x for (c, x), pairs in ev.gt_to_track.items() if c == class_name and x < frame and pairs.get(gt_id)),
-            default=None,
-        )
+        last = _last_match(ev, class_name, frame, gt_id)
         track = ev.matched_track(class_name, last, gt_id) if last is not None else None
         if (last, track) != (said, t):
             bad(
@@ -259,3 +304,55 @@ def check_last_match(text: str, class_name: str, frame: int, gt_id: str | None, 
                 m[0],
                 f"the devkit last matched the object before frame {frame} at frame {last} (to track {track})",
             )
+            continue
+        away = _matched_away(ev, class_name, t, gt_id, last, frame)
+        told = [a for a in AWAY.finditer(text) if a[1] == t]
+        out.checked["misleading"] += 1
+        if away and not told:
+            bad(
+                "misleading",
+                m[0],
+                f"left unsaid: after frame {last} the devkit matched track {t} to other objects {away}",
+            )
+        for a in told:
+            out.checked["matched"] += 1
+            said_away = {g: frames_of(frames) for cls, g, frames in AWAY_OBJECT.findall(a[2]) if cls == class_name}
+            if said_away != away or len(AWAY_OBJECT.findall(a[2])) != len(said_away):
+                bad("matched", a[0], f"after frame {last} the devkit matched track {t} to {away}")
+
+
+def check_two_tracks(text: str, class_name: str, frame: int, gt_id: str | None, scene, ev, out, bad) -> None:
+    """ "… two tracks on one object, and the evaluation matched the other" and "… but the evaluation matched track T
+    to C GT X and track U to GT Y" against the accumulator's matches at that frame (module docstring)."""
+    for m in TWO_ON_ONE.finditer(text):
+        x, t = int(m[1]), m[2]
+        named = {u.strip() for u in m[3].split(",")}
+        out.checked["matched"] += 1
+        matched = ev.matched_track(class_name, x, gt_id or "")
+        if matched not in named:
+            bad("matched", m[0], f"the devkit matched the object at frame {x} to track {matched}")
+        other = ev.matched_gt(class_name, x, t)
+        out.checked["misleading"] += 1
+        if other is not None and other != gt_id:
+            bad("misleading", m[0], f"at frame {x} the devkit matched track {t} to another object, GT {_short(other)}")
+    for m in MATCHED_BOTH.finditer(text):
+        x, t, distance, t2, cls, g, u, g2 = int(m[1]), m[2], float(m[3]), m[4], m[5], m[6], m[7], m[8]
+        out.checked["matched"] += 1
+        got_t, got_u = ev.matched_gt(class_name, x, t2), ev.matched_track(class_name, x, gt_id or "")
+        if (
+            t2 != t
+            or cls != class_name
+            or got_t is None
+            or _short(got_t) != g
+            or got_u != u
+            or _short(gt_id or "") != g2
+        ):
+            bad("matched", m[0], f"at frame {x} the devkit matched track {t2} to {got_t} and the object to {got_u}")
+        a = scene.objects[x].get(gt_id or "") if scene is not None and x < len(scene.objects) else None
+        box = next((xy for tt, _, xy in ev.boxes.get(x, []) if tt == t), None)
+        if a is None or box is None:
+            continue
+        out.checked["output"] += 1
+        d = math.hypot(box[0] - a.xy_m[0], box[1] - a.xy_m[1])
+        if abs(d - distance) > 0.05 + 1e-9 or d >= 2.0:
+            bad("output", m[0], f"the submission's box of track {t} lies {d:.2f} m from the annotation")

@@ -5,8 +5,12 @@ By failure kind, at the failure's frame x, for the object: a miss is the devkit'
 ID switch or identity theft is a SWITCH event of it at x; a fragmentation is a match at x after none at x - 1 and
 one before, and one again after. "Did not fail here: its track T was output on the object and counted" holds when
 the other run's submission has T's box within 2 m of the object's annotation at x and T passes the class threshold
-(and no such failure). "Did not have this failure" said of a run that had no track matched to
-the object at x is the issue's class 4: that run lost the object too.
+(and no such failure); it misleads where that run's evaluation matched the object at x to none of the named tracks
+(they were matched elsewhere, or to nothing, and the object to another track or missed). "Did not match the
+object here: its track T was output on the object and counted, but the evaluation matched track T to C GT X (to
+no object)" and "did not fail here: the evaluation matched the object to its track M" are checked against that
+run's matches. "Did not have this failure" said of a run that had no track matched to the object at x is the
+issue's class 4: that run lost the object too.
 """
 
 from __future__ import annotations
@@ -20,8 +24,12 @@ from tools.truth.scene import NEAR_M
 
 OTHER = re.compile(
     r"(\w+) on the same detections (failed here too|did not have this failure|had no counted track on the object "
-    r"here either|did not fail here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted)"
+    r"here either|did not fail here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted"
+    r"|did not fail here: the evaluation matched the object to its track (\d+)"
+    r"|did not match the object here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted, but the "
+    r"evaluation matched (track \d+ to (?:\w+ GT \w+|no object)(?: and track \d+ to (?:\w+ GT \w+|no object))*))"
 )
+MATCHED_TO = re.compile(r"track (\d+) to (?:(\w+) GT (\w+)|no object)")
 LOST_KINDS = ("id_switch", "identity_theft", "fragmentation")
 
 
@@ -67,22 +75,57 @@ def check_others(
         elif said.startswith("had no counted track"):
             if matched is not None:
                 bad("other run", m[0], f"the devkit matched the object at frame {x} to {m[1]}'s track {matched}")
+        elif said.startswith("did not fail here: the evaluation"):
+            if failed or matched != m[4]:
+                bad("other run", m[0], f"{m[1]}'s evaluation matched the object at frame {x} to track {matched}")
+        elif said.startswith("did not match the object"):  # on it and counted, but matched elsewhere or to nothing
+            _check_matched_elsewhere(m, c, x, gt, ev, scene, out, bad)
         elif said.startswith("did not fail here"):  # its named tracks lay within reach of the object, counted
             named = {t.strip() for t in m[3].split(",")}
-            a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
-            near = {
-                t
-                for t, cls, xy in ev.boxes.get(x, [])
-                if a is not None and cls == c and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < NEAR_M
-            }
+            near = _near(ev, c, x, gt, scene)
             if failed or not named <= near & ev.counted.get(c, set()):
                 bad("other run", m[0], f"{m[1]}'s counted tracks within {NEAR_M} m at frame {x}: {sorted(near)}")
+            elif matched not in named and gt in ev.gt_to_track.get((c, x), {}):
+                out.checked["misleading"] += 1
+                elsewhere = {t: ev.matched_gt(c, x, t) for t in sorted(named)}
+                bad(
+                    "misleading",
+                    m[0],
+                    f"{m[1]}'s evaluation matched the object at frame {x} to track {matched}, and {elsewhere}",
+                )
         else:  # did not have this failure
             if failed:
                 bad("other run", m[0], f"the devkit's events of {m[1]} have a {kind} of the object at frame {x}")
             elif matched is None and kind in LOST_KINDS:
                 out.checked["misleading"] += 1
                 bad("misleading", m[0], f"{m[1]} had no track matched to the object at frame {x}: it lost it too")
+
+
+def _near(ev: EvalFacts, c: str, x: int, gt: str, scene) -> set[str]:
+    """The other run's track ids of class ``c`` with a box within ``NEAR_M`` of the object's annotation at ``x``."""
+    a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
+    return {
+        t
+        for t, cls, xy in ev.boxes.get(x, [])
+        if a is not None and cls == c and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < NEAR_M
+    }
+
+
+def _check_matched_elsewhere(m: re.Match, c: str, x: int, gt: str, ev: EvalFacts, scene, out, bad) -> None:
+    """ "Did not match the object here: its track T was output on the object and counted, but the evaluation matched
+    track T to C GT X (or to no object)": the devkit scored the object at x and matched it to no track (a MISS), T's box
+    lies within 2 m of its annotation and T passes the threshold, and the devkit matched T at x as said."""
+    named = {t.strip() for t in m[5].split(",")}
+    said = {t: (g if cls == c else "?") if g else None for t, cls, g in MATCHED_TO.findall(m[6])}
+    if gt not in ev.gt_to_track.get((c, x), {}) or ev.matched_track(c, x, gt) is not None:
+        bad("other run", m[0], f"{m[1]}'s evaluation matched the object at frame {x} to {ev.matched_track(c, x, gt)}")
+    near = _near(ev, c, x, gt, scene)
+    if not named <= near & ev.counted.get(c, set()):
+        bad("other run", m[0], f"{m[1]}'s counted tracks within {NEAR_M} m at frame {x}: {sorted(near)}")
+    got = {t: (g if len(g) <= 8 else g[:6]) if (g := ev.matched_gt(c, x, t)) else None for t in named}
+    out.checked["other run"] += 1
+    if said != got:
+        bad("other run", m[0], f"{m[1]}'s evaluation matched them at frame {x} to {got}")
 
 
 FALSE_HERE = re.compile(r"(\w+) on the same detections (had a false track here too|had no false track here)")

@@ -223,6 +223,7 @@ def check_text(
             bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
     lost.check_not_output(text, ctx.lost, ev, out, bad)
     lost.check_last_match(text, c, ctx.frame, ctx.gt_id, ev, out, bad)
+    lost.check_two_tracks(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     lost.check_averaged(text, ctx.track, ev, out, bad)
     if raw is None:  # a results file: where its boxes sit
         output.check_output(text, c, ctx.lost, scene, ev, out, bad)

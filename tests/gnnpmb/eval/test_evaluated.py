@@ -127,3 +127,38 @@ def test_a_tracks_score_is_averaged_over_the_frames_the_range_filter_kept(evalua
             assert ev.averaged_score is None
         differing += len(kept) != len(scores)
     assert differing > 0  # some tracks leave the range: the two averages differ there
+
+
+def test_a_tracks_matches_are_the_devkits_match_and_switch_events_at_the_best_mota_threshold(evaluated) -> None:
+    _scene, report, *_ = evaluated
+    from gnnpmb.eval.failures import FailureKind
+
+    by_frame: dict[tuple[int, str], list[str]] = {}
+    for t, ev in report.track_evals.items():
+        assert list(ev.matches) == sorted(ev.matches) and len({x for x, _ in ev.matches}) == len(ev.matches)
+        for x, g in ev.matches:
+            assert x in ev.submitted or x in ev.interpolated  # the evaluation scored a box of the track there
+            assert ev.matched_at(x) == g
+            by_frame.setdefault((x, g), []).append(t)
+    assert by_frame and all(len(ts) == 1 for ts in by_frame.values())  # one track per object and frame
+    for f in report.failures:
+        x = f.frame_index
+        if f.kind is FailureKind.ID_SWITCH:  # the new track took the object
+            assert report.track_evals[f.track_ids[1]].matched_at(x) == f.gt_ids[0]
+        elif f.kind is FailureKind.FALSE_TRACK:  # matched to nothing
+            assert report.track_evals[f.track_ids[0]].matched_at(x) is None
+        elif f.kind in (FailureKind.MISS, FailureKind.FRAGMENTATION):  # nothing matched to it
+            assert (x, f.gt_ids[0]) not in by_frame
+    assert {FailureKind.FALSE_TRACK, FailureKind.MISS} <= {f.kind for f in report.failures}  # both cases seen
+
+
+def test_a_track_read_back_keeps_its_matches_and_one_written_without_them_is_not_read() -> None:
+    from gnnpmb.eval.evaluated import TrackEval
+
+    ev = TrackEval((1, 2, 3), (1, 2, 3), (), 0.5, 0.5, ((1, "a" * 32), (2, "b" * 32), (3, "a" * 32)))
+    data = ev.to_json()
+    assert data["matches"] == {"a" * 32: [1, 3], "b" * 32: [2]}  # each object's id once
+    assert TrackEval.from_json(data) == ev
+    del data["matches"]  # a cached report of the version before: evaluated again, not read as matched nowhere
+    with pytest.raises(KeyError):
+        TrackEval.from_json(data)

@@ -260,3 +260,106 @@ def test_a_coalesced_objects_interpolated_box_is_said_where_it_makes_the_finding
     f = finding(FailureKind.COALESCENCE, sightings=(seen,), blame=(Blame(Rule.INTERPOLATED, (13,)),), covered=(GT,))
     (line, _) = why_lines(f)
     assert "the evaluation scored GT bf3d85 at a box it interpolated, 0.6 m from the annotation" in line
+
+
+def test_the_objects_the_evaluation_matched_the_lost_track_to_after_its_last_match_here_are_named() -> None:
+    # independent audit r38, dev set scene-0655 pointpillars pmbm id_switch:3: "the evaluation last matched track
+    # 160 to it at frame 20" left out that the devkit matched track 160 to pedestrian GT 2e96cc from frame 22 to 34
+    from gnnpmb.why.reason import matched_away
+
+    other, third = "2e96cc" + "1" * 26, "77aa00" + "2" * 26
+    matches = ((18, GT), (20, GT), (22, other), (23, other), (24, other), (26, third), (35, other))
+    evaluated = TrackEval((18, 20, 22), (18, 20, 22), (), 0.6, 0.6, matches)
+    away = matched_away(evaluated, GT, 20, 34)
+    assert [(a.gt_id, a.frames) for a in away] == [(other, (22, 23, 24)), (third, (26,))]  # not 35: after the failure
+    assert matched_away(evaluated, GT, None, 34) == ()  # no last match known: nothing said
+    assert matched_away(None, GT, 20, 34) == ()
+    steps = (step(20, output=estimate(160, 0.9)), step(34, output=estimate(160, 0.9)))
+    kind = FailureKind.ID_SWITCH
+    lost = LostTrack(160, 30, steps, None, evaluated, None, matched_until=20, matched_away=away)
+    line = why_lines(finding(kind, lost, frame=34, window=(26, 34), has_existence=False))[0]
+    assert (
+        "the evaluation last matched track 160 to it at frame 20, then matched track 160 to bicycle GT 2e96cc at "
+        "frames 22–24 and to bicycle GT 77aa00 at frame 26" in line
+    )
+    held = LostTrack(160, 20, steps, None, evaluated, None, matched_until=20, matched_away=away[:1])
+    line = why_lines(finding(kind, held, frame=34, window=(26, 34), has_existence=False))[0]
+    assert (
+        "track 160 was last output on it at frame 20, then the evaluation matched track 160 to bicycle GT 2e96cc at "
+        "frames 22–24" in line
+    )
+    alone = LostTrack(160, 20, steps, None, evaluated, None, matched_until=20)
+    line = why_lines(finding(kind, alone, frame=34, window=(26, 34), has_existence=False))[0]
+    assert "then" not in line.split("last output on it at frame 20")[1].split(";")[0]
+
+
+def test_two_tracks_on_one_object_is_said_only_where_the_evaluation_matched_the_lost_one_to_no_other() -> None:
+    # independent audit r38 (as above): at frame 34 track 160 was the devkit's match of GT 2e96cc, not a spare
+    # second track on GT 6b4853
+    from gnnpmb.why.findings import MatchedAway, OnObject
+
+    other = "2e96cc" + "1" * 26
+    on = (OnObject(160, 0.5, 0.9, -1, None, None), OnObject(718, 0.7, 0.4, 3, None, None))
+    sightings = (Sighting(34, 5, None, None, None, None, on),)
+    steps = (step(34, output=estimate(160, 0.9)),)
+    kind = FailureKind.ID_SWITCH
+    kw = dict(
+        frame=34,
+        window=(26, 34),
+        has_existence=False,
+        sightings=sightings,
+        blame=(Blame(Rule.TWO_TRACKS, (34,)),),
+        taker=Origin(718, 33, -1),
+        track_ids=(160, 718),
+    )
+    elsewhere = LostTrack(160, 34, steps, None, None, None, matched_until=20, matched_away=(MatchedAway(other, (34,)),))
+    line = why_lines(finding(kind, elsewhere, **kw))[0]
+    assert "two tracks on one object" not in line
+    assert (
+        "at frame 34 track 160 was still output 0.5 m from it, but the evaluation matched track 160 to bicycle GT "
+        "2e96cc and track 718 to GT bf3d85" in line
+    )
+    untold = dict(kw, taker=None)  # the track that took the object unknown: less is said, not the spare-track form
+    line = why_lines(finding(kind, elsewhere, **untold))[0]
+    assert "two tracks on one object" not in line and "still output" not in line
+    before = LostTrack(160, 34, steps, None, None, None, matched_until=20, matched_away=(MatchedAway(other, (22,)),))
+    spare = LostTrack(160, 34, steps, None, None, None, matched_until=20)
+    for lost in (before, spare):  # matched to no other object at frame 34: a spare second track there
+        line = why_lines(finding(kind, lost, **kw))[0]
+        assert (
+            "at frame 34 track 160 was still output on the object, but so was track 718: two tracks on one object, "
+            "and the evaluation matched the other" in line
+        )
+
+
+def test_another_runs_track_on_the_object_is_not_said_to_have_kept_it_where_its_evaluation_matched_it_elsewhere() -> (
+    None
+):
+    # dev set scene-0655 pointpillars (truth checker, r38 follow-up): "pmbm on the same detections did not fail here:
+    # its track 160 was output on the object and counted" where pmbm's evaluation missed the object and matched
+    # track 160 to pedestrian GT 2e96cc
+    from gnnpmb.why.findings import OnObject, OtherRun
+
+    other = "2e96cc" + "1" * 26
+    matched_there = TrackEval((34,), (34,), (), 0.9, 0.9, ((34, other),))
+    false_there = TrackEval((34,), (34,), (), 0.9, 0.9, ())
+    on = (OnObject(160, 0.5, 0.9, -1, matched_there, 0.3), OnObject(170, 0.9, 0.9, -1, false_there, 0.3))
+    lost = LostTrack(62, 30, (), None, None, None)
+
+    def said(run: OtherRun) -> str:
+        return why_lines(finding(FailureKind.ID_SWITCH, lost, frame=34, others=(run,)))[0]
+
+    assert (
+        "pmbm on the same detections did not match the object here: its tracks 160, 170 were output on the object "
+        "and counted, but the evaluation matched track 160 to bicycle GT 2e96cc and track 170 to no object"
+        in said(OtherRun("pmbm", False, on, missed=True))
+    )
+    kept = TrackEval((34,), (34,), (), 0.9, 0.9, ((34, GT),))
+    held = (OnObject(160, 0.5, 0.9, -1, kept, 0.3),)
+    assert "pmbm on the same detections did not fail here: its track 160 was output on the object and counted" in said(
+        OtherRun("pmbm", False, held, matched=160)
+    )
+    assert (  # matched to a track of its off the annotation (the evaluation's interpolated box)
+        "pmbm on the same detections did not fail here: the evaluation matched the object to its track 171"
+        in said(OtherRun("pmbm", False, on, matched=171))
+    )
