@@ -110,18 +110,29 @@ def swept_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return made_once(tmp_path_factory, "swept", make) / "data"
 
 
+MODULE_CPU_S = Path(__file__).with_name("module_cpu_s.json")
+"""CPU seconds of each test module in a suite run (``python -m tests.cpu_log DIR --write``): what the workers'
+order is planned by on a fresh clone, where pytest has no durations of its own yet."""
+UNMEASURED_TEST_CPU_S = 0.3
+"""A module not in ``MODULE_CPU_S`` (new) counts this many CPU seconds per test."""
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Modules in the order the workers should take them (``scripts/test.sh`` runs ``--dist loadscope
-    --no-loadscope-reorder``): first those opening the web viewer in Chromium (``browser``: a minute or more each
-    of software WebGL, so they start at once, one per worker, rather than last on one worker while the other
-    idles), then the other ``slow`` ones, then the rest by number of tests, most first (xdist's own reordering);
+    --no-loadscope-reorder``: a worker that runs out of work takes the next module): first those opening the web
+    viewer in Chromium (``browser``: a minute of software WebGL each, so they start at once, one per worker), then
+    the rest costliest first by ``MODULE_CPU_S`` (longest processing time first: the modules left at the end are
+    the cheap ones, so the workers finish together rather than one running a 40 s module while the other idles);
     a module's tests keep their order."""
+    import json
+
+    costs = json.loads(MODULE_CPU_S.read_text()) if MODULE_CPU_S.is_file() else {}
     modules: dict[str, list[pytest.Item]] = {}
     for item in items:
         modules.setdefault(item.nodeid.split("::")[0], []).append(item)
 
-    def rank(tests: list[pytest.Item]) -> tuple[int, int]:
-        marks = {mark.name for test in tests for mark in test.iter_markers()}
-        return (0 if "browser" in marks else 1 if "slow" in marks else 2, -len(tests))
+    def rank(name: str) -> tuple[int, float]:
+        browser = any(mark.name == "browser" for test in modules[name] for mark in test.iter_markers())
+        return (0 if browser else 1, -costs.get(name, UNMEASURED_TEST_CPU_S * len(modules[name])))
 
-    items[:] = [item for tests in sorted(modules.values(), key=rank) for item in tests]
+    items[:] = [item for name in sorted(modules, key=rank) for item in modules[name]]

@@ -1,10 +1,11 @@
 """CPU seconds per test, for finding what makes the suite slow on a shared machine (wall times there mostly
 measure the neighbours).
 
-Load it as a plugin with a folder to write to, then sum::
+Load it as a plugin with a folder to write to, then sum, and (``--write``) refresh the modules' costs that
+``tests/conftest.py`` orders the modules by::
 
     CPULOG_DIR=/tmp/cpu bash scripts/test.sh -p tests.cpu_log
-    uv run python -m tests.cpu_log /tmp/cpu
+    uv run python -m tests.cpu_log /tmp/cpu [--write tests/module_cpu_s.json]
 
 Each test's line is the CPU time of its worker process and of the child processes it waited for (the console
 scripts run in real processes; not Chromium's renderer and GPU processes, which Chromium does not reap before it
@@ -13,7 +14,9 @@ is killed), from the start of its setup to the end of its teardown: a module fix
 
 from __future__ import annotations
 
+import argparse
 import collections
+import json
 import os
 import resource
 import sys
@@ -38,13 +41,26 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
             f.write(f"{item.nodeid}\t{_cpu_s() - cpu_s:.3f}\t{time.monotonic() - wall_s:.3f}\n")
 
 
-def summary(folder: Path, most: int = 30) -> str:
-    """The number of tests, their CPU and wall seconds summed, and the ``most`` costliest modules and tests."""
+def _rows(folder: Path) -> list[tuple[str, float, float]]:
     rows = []
     for path in sorted(folder.glob("*.tsv")):
         for line in path.read_text().splitlines():
             nodeid, cpu_s, wall_s = line.split("\t")
             rows.append((nodeid, float(cpu_s), float(wall_s)))
+    return rows
+
+
+def module_cpu_s(folder: Path) -> dict[str, float]:
+    """CPU seconds per test module (its tests summed, module fixtures included), costliest first."""
+    modules: collections.Counter[str] = collections.Counter()
+    for nodeid, cpu_s, _ in _rows(folder):
+        modules[nodeid.split("::")[0]] += cpu_s
+    return {name: round(cpu_s, 1) for name, cpu_s in modules.most_common()}
+
+
+def summary(folder: Path, most: int = 30) -> str:
+    """The number of tests, their CPU and wall seconds summed, and the ``most`` costliest modules and tests."""
+    rows = _rows(folder)
     modules: dict[str, list[float]] = collections.defaultdict(lambda: [0.0, 0.0, 0])
     for nodeid, cpu_s, wall_s in rows:
         module = modules[nodeid.split("::")[0]]
@@ -61,5 +77,18 @@ def summary(folder: Path, most: int = 30) -> str:
     return "\n".join(lines)
 
 
+def main(argv: list[str]) -> None:
+    parser = argparse.ArgumentParser(prog="python -m tests.cpu_log", description=__doc__.split("\n\n")[0])
+    parser.add_argument("folder", type=Path, help="the CPULOG_DIR of a suite run")
+    parser.add_argument("most", type=int, nargs="?", default=30, help="modules and tests to list")
+    parser.add_argument("--write", type=Path, help="write the modules' CPU seconds to this JSON file")
+    args = parser.parse_args(argv)
+    print(summary(args.folder, args.most))
+    if args.write:
+        tmp = args.write.with_name(f".{args.write.name}.partial")
+        tmp.write_text(json.dumps(module_cpu_s(args.folder), indent=0) + "\n")
+        os.replace(tmp, args.write)
+
+
 if __name__ == "__main__":
-    print(summary(Path(sys.argv[1]), int(sys.argv[2]) if len(sys.argv) > 2 else 30))
+    main(sys.argv[1:])

@@ -312,9 +312,9 @@ def served_file(path: Path) -> Iterator[str]:
 
 
 @contextlib.contextmanager
-def process_group(argv: Sequence[str], log_path: Path) -> Iterator[subprocess.Popen[bytes]]:
+def process_group(argv: Sequence[str], log_path: Path, grace_s: float = 5.0) -> Iterator[subprocess.Popen[bytes]]:
     """Run ``argv`` in a new session (its own process group), output to ``log_path``; on exit SIGTERM the
-    whole group, then SIGKILL whatever is left after 5 s, and reap the leader."""
+    whole group, then SIGKILL whatever is left after ``grace_s``, and reap the leader."""
     with open(log_path, "wb") as log:
         proc = subprocess.Popen(
             list(argv), stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True
@@ -322,16 +322,16 @@ def process_group(argv: Sequence[str], log_path: Path) -> Iterator[subprocess.Po
     try:
         yield proc
     finally:
-        _kill_group(proc)
+        _kill_group(proc, grace_s)
 
 
-def _kill_group(proc: subprocess.Popen[bytes]) -> None:
-    """SIGTERM the process group led by ``proc``, SIGKILL it if anything is still running 5 s later, and reap
-    the leader."""
+def _kill_group(proc: subprocess.Popen[bytes], grace_s: float) -> None:
+    """SIGTERM the process group led by ``proc``, SIGKILL it if anything is still running ``grace_s`` later,
+    and reap the leader."""
     for sig in (signal.SIGTERM, signal.SIGKILL):
         with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, sig)
-        deadline = time.monotonic() + 5.0
+        deadline = time.monotonic() + grace_s
         while group_members(proc.pid) and time.monotonic() < deadline:
             with contextlib.suppress(subprocess.TimeoutExpired):
                 proc.wait(timeout=0.1)
@@ -480,17 +480,19 @@ def check_recording(
     viewport: tuple[int, int] = DEFAULT_VIEWPORT,
     timeout_s: float = 420.0,
     poll_s: float = 4.0,
+    settle_poll_s: float = 1.5,
     chromium: Path = CHROMIUM,
     work_dir: Path | None = None,
 ) -> WebCheckResult:
     """Serve ``rrd`` with Rerun's web viewer, open it in headless Chromium and write a PNG screenshot to
     ``out``.
 
-    Screenshots are taken every ``poll_s`` seconds after navigation until every one of the ``n_views`` 3D-view
-    regions (``view_regions``) looks rendered and the page has settled (SETTLED_SHOTS shots in a row without
-    an ingestion backlog and nearly unchanged), or ``timeout_s`` passes; ``out`` holds the last shot either
-    way (so a failure can be looked at). Server logs and the browser profile go to ``work_dir`` (a temp dir
-    if None). Raises WebCheckError when a server does not start.
+    Screenshots are taken every ``poll_s`` seconds after navigation, every ``settle_poll_s`` once the viewer's
+    state shows everything loaded (the viewer idles then: a shot costs little, and waiting costs the worker),
+    until every one of the ``n_views`` 3D-view regions (``view_regions``) looks rendered and the page has settled
+    (SETTLED_SHOTS shots in a row without an ingestion backlog), or ``timeout_s`` passes; ``out`` holds the last
+    shot either way (so a failure can be looked at). Server logs and the browser profile go to ``work_dir`` (a
+    temp dir if None). Raises WebCheckError when a server does not start.
     """
     rrd, out = Path(rrd).absolute(), Path(out).absolute()
     if not rrd.is_file():
@@ -547,7 +549,7 @@ def check_recording(
         stats: tuple[RegionStats, ...] = ()
         state = ViewerState(None, frozenset(), {})
         while True:
-            time.sleep(poll_s)
+            time.sleep(poll_s if loaded is None else settle_poll_s)
             elapsed = time.monotonic() - navigated
             try:
                 raw = devtools.call("Runtime.evaluate", expression=VIEWER_STATE_JS, returnByValue=True)

@@ -81,7 +81,7 @@ def test_backlog_readout() -> None:
 
 def test_process_group_is_killed_with_its_children(tmp_path: Path) -> None:
     script = "sleep 60 & sleep 60 & trap '' TERM; sleep 60"  # the leader ignores SIGTERM: SIGKILL follows
-    with process_group(["sh", "-c", script], tmp_path / "log") as proc:
+    with process_group(["sh", "-c", script], tmp_path / "log", grace_s=0.5) as proc:
         for _ in range(100):
             if len(group_members(proc.pid)) >= 3:
                 break
