@@ -125,7 +125,6 @@ def run_view(
     from viz.timeline import PLAIN_CLOCK, Clock
 
     scene, frame_range = inputs.scene, inputs.frame_range
-    caps = {t: inputs.capabilities(t) for t in inputs.trackers}
     bar = progress if progress is not None else SilentProgress()
     with bar:
         tasks = {t: bar.add_task(f"{scene.name} {t}", total=len(frame_range)) for t in inputs.trackers}
@@ -171,7 +170,7 @@ def run_view(
             blueprint = default_blueprint(
                 inputs.trackers,
                 inputs.classes,
-                caps=caps,
+                caps=inputs.caps,
                 opening=opening,
                 failure_index=bool(reports),
                 frames=shown,
@@ -223,7 +222,7 @@ def run_view(
                     log_frames=shown if focus is not None else None,
                     focus_tracks=set(focus.track_ids.get(run.name, ())) if focus is not None else None,
                     flush_frames=None if inputs.save is not None else FLUSH_FRAMES,
-                    has_existence=caps[run.name].has_existence,
+                    has_existence=inputs.caps[run.name].has_existence,
                     focus_class=focus.class_name if focus is not None else None,
                     facts=run.facts,
                     label_tracks=focus is not None,  # a full recording labels only what its failures note
@@ -282,7 +281,7 @@ def run_view(
                         inputs.classes,
                         focus,
                         legends,
-                        caps,
+                        inputs.caps,
                         cameras=channels,
                         focus_camera=sight.best_channel if sight is not None else None,
                     ),

@@ -46,14 +46,14 @@ def track_run(
 ) -> TrackingRun:
     """Run ``name`` of ``inputs`` over its frames, its events to ``sink``; the run is named ``name``."""
     from gnnpmb.foreign import replay
-    from gnnpmb.pipeline import run_tracker
+    from gnnpmb.pipeline import track_frames
 
     spec, foreign = inputs.spec(name), inputs.foreign.get(name)
     if foreign is not None:
         return replay(
             foreign, inputs.scene, inputs.frame_detections, inputs.classes, inputs.frame_range, sink, on_frame
         )
-    run = run_tracker(
+    run = track_frames(
         inputs.scene,
         inputs.own_frames.get(name, inputs.frame_detections),
         str(spec.tracker),
@@ -71,13 +71,11 @@ def run_one(inputs: Inputs, name: str, *, record: bool, on_frame: Callable[[], N
     from gnnpmb.events import ListSink, TeeSink
     from gnnpmb.why.facts import FactSink
 
-    caps = inputs.capabilities(name)
-    if not record:
-        return Run(track_run(inputs, name, on_frame=on_frame))
-    facts = FactSink(name, has_existence=caps.has_existence, output_only=caps.output_only)
+    caps = inputs.caps[name]
+    facts = FactSink(name, has_existence=caps.has_existence, output_only=caps.output_only) if record else None
     events = ListSink()
-    tracking = track_run(inputs, name, TeeSink(facts, events), on_frame)
-    return Run(tracking, tuple(events.events), facts.facts)
+    tracking = track_run(inputs, name, TeeSink(facts, events) if facts is not None else None, on_frame)
+    return Run(tracking, tuple(events.events), facts.facts) if facts is not None else Run(tracking)
 
 
 def run_all(
