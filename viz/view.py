@@ -17,8 +17,7 @@ from gnnpmb.stages.findings import (
     all_evidence,
     compare_runs,
     explain_focus,
-    opening_focus,
-    request_focus,
+    where_to_open,
 )
 from gnnpmb.stages.inputs import Inputs
 from gnnpmb.stages.runs import provenance_of, run_all, run_digests
@@ -129,13 +128,11 @@ def run_view(
     with bar:
         tasks = {t: bar.add_task(f"{scene.name} {t}", total=len(frame_range)) for t in inputs.trackers}
         runs = run_all(inputs, record=True, on_frame=lambda t: lambda: bar.advance(tasks[t]))
-        focus, opening, reports, notices = None, None, {}, []
-        if inputs.focus is not None:
+        start, reports, notices = None, {}, []
+        if inputs.focus is not None or failures:  # a full recording opens at its first failure worth a look
             reports, notices = find_reports(inputs, runs)
-            focus = request_focus(inputs, runs, reports, notices)
-        elif failures:  # a full recording opens at its first failure worth a look (viz.opening)
-            reports, notices = find_reports(inputs, runs)
-            opening = opening_focus(inputs, runs, reports)
+            start = where_to_open(inputs, runs, reports, notices)
+        focus, opening = (start, None) if inputs.focus is not None else (None, start)
         shown = focus.window(frame_range) if focus is not None else frame_range
         # Missing LiDAR files are drawn around, said once (gnnpmb.data.sensor_files); damaged ones stay an error.
         lidar = lidar_presence(scene, shown)
@@ -162,7 +159,6 @@ def run_view(
             sight = focus_sight(focus, scene, sensors)
         sensor_note = lidar_notice(lidar)  # the sensor data first, then what is said of it
         notices = [*notices, *([sensor_note] if sensor_note is not None else []), *camera_notices]
-        start = focus or opening
         clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
         # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
         blueprint = None
