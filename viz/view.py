@@ -141,7 +141,7 @@ def run_view(
             points_loader = (
                 load_lidar_points if lidar.complete else lambda k: load_lidar_points(k) if lidar.has(k.index) else None
             )
-        sensors, channels, sight, camera_notices = None, (), None, []
+        sensors, channels, camera_notices = None, (), []
         if cameras or sweeps:
             from gnnpmb.data.sensors import absent_reason, load_scene_sensors
 
@@ -153,10 +153,6 @@ def run_view(
                 channels = sensors.channels
             if sweeps and not sensors.sweeps:
                 camera_notices.append("sweeps absent: the dataset has no LiDAR sweeps between this scene's keyframes")
-        if focus is not None and channels:
-            from gnnpmb.focus_cameras import focus_sight
-
-            sight = focus_sight(focus, scene, sensors)
         sensor_note = lidar_notice(lidar)  # the sensor data first, then what is said of it
         notices = [*notices, *([sensor_note] if sensor_note is not None else []), *camera_notices]
         clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
@@ -265,8 +261,10 @@ def run_view(
             if notes is not None:
                 notes.send(stream, clock, scene)
             if focus is not None:
+                from gnnpmb.focus_cameras import focus_sight
                 from viz.focus import focus_legends, log_focus, tracker_views
 
+                sight = focus_sight(focus, scene, sensors) if channels and sensors is not None else None
                 evidence = all_evidence(inputs, runs, reports)
                 finding = explain_focus(inputs, focus, evidence, first_frame=shown.start)
                 log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding, sight)
