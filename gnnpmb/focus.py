@@ -139,6 +139,25 @@ def resolve_focus(
     return tracked.from_failure(failure, first, spec.strip())
 
 
+def opening_focus(
+    scene: SceneData,
+    reports: Mapping[str, FailureReport],
+    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
+    frames: range,
+) -> FocusTarget | None:
+    """Where a full recording opens: the first failure worth a look of the first tracker in ``frames``
+    (``FailureReport.first_worth_opening``) as a focus target, named by its failure id; None with no failure or no
+    report. Arguments as ``resolve_focus``'s."""
+    first = next(iter(reports), None)
+    if first is None:
+        return None
+    failure_id = reports[first].first_worth_opening(frames)
+    failure = reports[first].by_id(failure_id) if failure_id is not None else None
+    if failure is None:
+        return None
+    return _Tracked(scene, reports, estimates, frames).from_failure(failure, first, failure_id)
+
+
 @dataclass(frozen=True, slots=True)
 class _Tracked:
     """What a focus is found in (``resolve_focus``'s arguments)."""

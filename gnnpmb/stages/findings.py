@@ -75,18 +75,14 @@ def where_to_open(
     """Where a recording opens: the focus ``inputs.focus`` names in these runs (raises a one-line GnnpmbError when
     it names nothing), else the first failure worth a look of the first run (``FailureReport.first_worth_opening``)
     as a focus target; None without a focus when there is no failure or no ground truth."""
-    from gnnpmb.focus import resolve_focus
+    from gnnpmb.focus import opening_focus, resolve_focus
 
     estimates = _estimates(runs)
-    spec = inputs.focus
-    if spec is not None and not reports and not spec.startswith("track:"):
-        raise GnnpmbError(f"--focus {spec} needs ground truth: {'; '.join(notices)}")
-    if spec is None:
-        report = reports.get(inputs.trackers[0])
-        spec = report.first_worth_opening(inputs.frame_range) if report is not None else None
-    if spec is None:
-        return None
-    return resolve_focus(spec, inputs.scene, reports, estimates, inputs.frame_range)
+    if inputs.focus is not None:
+        if not reports and not inputs.focus.startswith("track:"):
+            raise GnnpmbError(f"--focus {inputs.focus} needs ground truth: {'; '.join(notices)}")
+        return resolve_focus(inputs.focus, inputs.scene, reports, estimates, inputs.frame_range)
+    return opening_focus(inputs.scene, reports, estimates, inputs.frame_range)
 
 
 def compare_runs(runs: Sequence[Run]) -> Comparison:
