@@ -16,6 +16,7 @@ focus frame, so a comparison recording highlights what each tracker did at the s
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
@@ -24,7 +25,6 @@ import numpy as np
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport, short_id
-from gnnpmb.stages.request import parse_focus
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.findings import FRAMES_BEFORE, NEAR_M
 
@@ -34,6 +34,8 @@ FRAMES_AFTER after it."""
 NEAR_FRAMES = 4
 """... and so are tracks that were that close to it in this many keyframes before the failure (a track that
 followed the object with too low a score to be counted is often the failure's cause)."""
+_FOCUS_RE = re.compile(r"^(?P<kind>[a-z_]+):(?P<ref>\S+)$")
+_DIFF_REF = re.compile(r"^(fixed|introduced|kept):[1-9][0-9]*$")
 _KIND_ORDER = (
     FailureKind.IDENTITY_THEFT,
     FailureKind.ID_SWITCH,
@@ -78,6 +80,22 @@ class FocusTarget:
         return range(start, min(frames.stop, self.frame_index + FRAMES_AFTER + 1))
 
 
+def parse_focus(spec: str) -> tuple[str, str]:
+    """``kind:ref`` -> (kind, ref), checked; raises GnnpmbError naming the accepted forms."""
+    match = _FOCUS_RE.match(spec.strip())
+    kinds = {k.value for k in FailureKind}
+    if match is None or (match["kind"] not in kinds | {"track", "gt", "diff"}):
+        raise GnnpmbError(
+            f"bad --focus '{spec}': use track:ID, gt:TOKEN, a failure id such as id_switch:1 "
+            f"(gnnpmb failures SCENE --tracker T lists them) or a change such as diff:introduced:1 (gnnpmb diff A B)"
+        )
+    if match["kind"] == "track" and not match["ref"].isdigit():
+        raise GnnpmbError(f"bad --focus '{spec}': track:ID takes a track number, e.g. track:802")
+    if match["kind"] == "diff" and not _DIFF_REF.match(match["ref"]):
+        raise GnnpmbError(f"bad --focus '{spec}': use diff:fixed:N, diff:introduced:N or diff:kept:N")
+    return match["kind"], match["ref"]
+
+
 def resolve_focus(
     spec: str,
     scene: SceneData,
@@ -119,6 +137,25 @@ def resolve_focus(
             f"gnnpmb failures {scene.name} --tracker {first}{same} lists them"
         )
     return tracked.from_failure(failure, first, spec.strip())
+
+
+def opening_focus(
+    scene: SceneData,
+    reports: Mapping[str, FailureReport],
+    estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
+    frames: range,
+) -> FocusTarget | None:
+    """Where a full recording opens: the first failure worth a look of the first tracker in ``frames``
+    (``FailureReport.first_worth_opening``) as a focus target, named by its failure id; None with no failure or no
+    report. Arguments as ``resolve_focus``'s."""
+    first = next(iter(reports), None)
+    if first is None:
+        return None
+    failure_id = reports[first].first_worth_opening(frames)
+    failure = reports[first].by_id(failure_id) if failure_id is not None else None
+    if failure is None:
+        return None
+    return _Tracked(scene, reports, estimates, frames).from_failure(failure, first, failure_id)
 
 
 @dataclass(frozen=True, slots=True)

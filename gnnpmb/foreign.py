@@ -250,9 +250,10 @@ def replay(
     """The results as a ``TrackingRun`` named ``results.name`` over ``frame_range`` (default all keyframes), its
     output-only events sent to ``sink`` (module docstring)."""
     sink = sink or NullSink()
+    received = [given_detections(frame) for frame in frames]
     out: list[FrameResult] = []
     for i, keyframe, dt_s in keyframe_steps(scene, frame_range):
-        given = given_detections(frames[i])
+        given = received[i]
         estimates = results.estimates[i]
         if sink.enabled:
             sink.emit(FrameStarted(results.name, i, keyframe.sample_token, keyframe.timestamp_us, dt_s))

@@ -2,7 +2,7 @@
 box.
 
 * the **opening**: the first failure worth a look of the first run (``FailureReport.first_worth_opening``, found
-  before anything is logged, ``gnnpmb.stages.findings.opening_focus``); the recording opens at its frame (its ``focus``
+  before anything is logged, ``gnnpmb.stages.findings.where_to_open``); the recording opens at its frame (its ``focus``
   timeline ends there, ``viz.timeline.Clock``) and its per-track plots show the tracks around it
   (``viz.blueprint``);
 * ``trackers/<run>/failure_index`` (static TextDocument, ``log_failure_index``): every failure with its ``--focus``

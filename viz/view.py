@@ -17,8 +17,7 @@ from gnnpmb.stages.findings import (
     all_evidence,
     compare_runs,
     explain_focus,
-    opening_focus,
-    request_focus,
+    where_to_open,
 )
 from gnnpmb.stages.inputs import Inputs
 from gnnpmb.stages.runs import provenance_of, run_all, run_digests
@@ -125,18 +124,15 @@ def run_view(
     from viz.timeline import PLAIN_CLOCK, Clock
 
     scene, frame_range = inputs.scene, inputs.frame_range
-    caps = {t: inputs.capabilities(t) for t in inputs.trackers}
     bar = progress if progress is not None else SilentProgress()
     with bar:
         tasks = {t: bar.add_task(f"{scene.name} {t}", total=len(frame_range)) for t in inputs.trackers}
         runs = run_all(inputs, record=True, on_frame=lambda t: lambda: bar.advance(tasks[t]))
-        focus, opening, reports, notices = None, None, {}, []
-        if inputs.focus is not None:
+        start, reports, notices = None, {}, []
+        if inputs.focus is not None or failures:  # a full recording opens at its first failure worth a look
             reports, notices = find_reports(inputs, runs)
-            focus = request_focus(inputs, runs, reports, notices)
-        elif failures:  # a full recording opens at its first failure worth a look (viz.opening)
-            reports, notices = find_reports(inputs, runs)
-            opening = opening_focus(inputs, runs, reports)
+            start = where_to_open(inputs, runs, reports, notices)
+        focus, opening = (start, None) if inputs.focus is not None else (None, start)
         shown = focus.window(frame_range) if focus is not None else frame_range
         # Missing LiDAR files are drawn around, said once (gnnpmb.data.sensor_files); damaged ones stay an error.
         lidar = lidar_presence(scene, shown)
@@ -145,7 +141,7 @@ def run_view(
             points_loader = (
                 load_lidar_points if lidar.complete else lambda k: load_lidar_points(k) if lidar.has(k.index) else None
             )
-        sensors, channels, sight, camera_notices = None, (), None, []
+        sensors, channels, camera_notices = None, (), []
         if cameras or sweeps:
             from gnnpmb.data.sensors import absent_reason, load_scene_sensors
 
@@ -157,13 +153,8 @@ def run_view(
                 channels = sensors.channels
             if sweeps and not sensors.sweeps:
                 camera_notices.append("sweeps absent: the dataset has no LiDAR sweeps between this scene's keyframes")
-        if focus is not None and channels:
-            from gnnpmb.focus_cameras import focus_sight
-
-            sight = focus_sight(focus, scene, sensors)
         sensor_note = lidar_notice(lidar)  # the sensor data first, then what is said of it
         notices = [*notices, *([sensor_note] if sensor_note is not None else []), *camera_notices]
-        start = focus or opening
         clock = Clock(focus_end=start.frame_index) if start is not None else PLAIN_CLOCK
         # A focus recording gets its layout once its series are known, so their legends can be placed clear of them.
         blueprint = None
@@ -171,7 +162,7 @@ def run_view(
             blueprint = default_blueprint(
                 inputs.trackers,
                 inputs.classes,
-                caps=caps,
+                caps=inputs.caps,
                 opening=opening,
                 failure_index=bool(reports),
                 frames=shown,
@@ -223,7 +214,7 @@ def run_view(
                     log_frames=shown if focus is not None else None,
                     focus_tracks=set(focus.track_ids.get(run.name, ())) if focus is not None else None,
                     flush_frames=None if inputs.save is not None else FLUSH_FRAMES,
-                    has_existence=caps[run.name].has_existence,
+                    has_existence=inputs.caps[run.name].has_existence,
                     focus_class=focus.class_name if focus is not None else None,
                     facts=run.facts,
                     label_tracks=focus is not None,  # a full recording labels only what its failures note
@@ -270,8 +261,10 @@ def run_view(
             if notes is not None:
                 notes.send(stream, clock, scene)
             if focus is not None:
+                from gnnpmb.focus_cameras import focus_sight
                 from viz.focus import focus_legends, log_focus, tracker_views
 
+                sight = focus_sight(focus, scene, sensors) if channels and sensors is not None else None
                 evidence = all_evidence(inputs, runs, reports)
                 finding = explain_focus(inputs, focus, evidence, first_frame=shown.start)
                 log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding, sight)
@@ -282,7 +275,7 @@ def run_view(
                         inputs.classes,
                         focus,
                         legends,
-                        caps,
+                        inputs.caps,
                         cameras=channels,
                         focus_camera=sight.best_channel if sight is not None else None,
                     ),

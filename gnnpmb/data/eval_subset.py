@@ -48,8 +48,9 @@ def eval_location(location: DatasetLocation, scene_names: Sequence[str]) -> Data
     key = hashlib.sha256(json.dumps([index.key, list(scene_names), custom.decode(errors="replace")]).encode())
     folder = cache_root() / EVALROOT_FOLDER / key.hexdigest()[:24]
     if not _complete(folder):
+        tables = subset_tables(index, scene_names)
         shutil.rmtree(folder, ignore_errors=True)
-        _write(folder, location.version, subset_tables(index, scene_names), custom)
+        _write(folder, location.version, tables, custom)
         _drop_oldest(folder.parent, KEEP_FOLDERS)
     return DatasetLocation(dataroot=folder, version=location.version, synthetic=location.synthetic)
 

@@ -45,13 +45,14 @@ def report_key(
     on ``keyframes`` only (None: the whole scene)."""
     from gnnpmb.provenance import code_version, tables_fingerprint
 
+    boxes = results_digest(results)
     blob = {
         "dataroot": str(location.dataroot),
         "version": location.version,
         "tables": tables_fingerprint(location),
         "scene": scene_name,
         "tracker": tracker,
-        "results": results_digest(results),
+        "results": boxes,
         "code": code_version(),
     }
     if keyframes is not None:

@@ -69,29 +69,20 @@ def _estimates(runs: Sequence[Run]) -> dict:
     return {run.name: [f.estimates for f in run.tracking.frames] for run in runs}
 
 
-def request_focus(
+def where_to_open(
     inputs: Inputs, runs: Sequence[Run], reports: Mapping[str, FailureReport], notices: Sequence[str]
-) -> FocusTarget:
-    """The focus ``inputs.focus`` names in these runs; raises a one-line GnnpmbError when it names nothing."""
-    from gnnpmb.focus import resolve_focus
+) -> FocusTarget | None:
+    """Where a recording opens: the focus ``inputs.focus`` names in these runs (raises a one-line GnnpmbError when
+    it names nothing), else the first failure worth a look of the first run (``FailureReport.first_worth_opening``)
+    as a focus target; None without a focus when there is no failure or no ground truth."""
+    from gnnpmb.focus import opening_focus, resolve_focus
 
-    if inputs.focus is None:
-        raise ValueError("the inputs have no focus")
-    if not reports and not inputs.focus.startswith("track:"):
-        raise GnnpmbError(f"--focus {inputs.focus} needs ground truth: {'; '.join(notices)}")
-    return resolve_focus(inputs.focus, inputs.scene, reports, _estimates(runs), inputs.frame_range)
-
-
-def opening_focus(inputs: Inputs, runs: Sequence[Run], reports: Mapping[str, FailureReport]) -> FocusTarget | None:
-    """Where a full recording opens: the first failure worth a look of the first run
-    (``FailureReport.first_worth_opening``) as a focus target; None with no failure or no ground truth."""
-    from gnnpmb.focus import resolve_focus
-
-    report = reports.get(inputs.trackers[0])
-    first = report.first_worth_opening(inputs.frame_range) if report is not None else None
-    if first is None:
-        return None
-    return resolve_focus(first, inputs.scene, reports, _estimates(runs), inputs.frame_range)
+    estimates = _estimates(runs)
+    if inputs.focus is not None:
+        if not reports and not inputs.focus.startswith("track:"):
+            raise GnnpmbError(f"--focus {inputs.focus} needs ground truth: {'; '.join(notices)}")
+        return resolve_focus(inputs.focus, inputs.scene, reports, estimates, inputs.frame_range)
+    return opening_focus(inputs.scene, reports, estimates, inputs.frame_range)
 
 
 def compare_runs(runs: Sequence[Run]) -> Comparison:

@@ -36,7 +36,8 @@ class Inputs:
     trackers: the names of the runs (``gnnpmb.runs``), in order; runs: each one's spec (built-in tracker or
     results file; empty: every name is a registry tracker with ``config``); foreign: the loaded results of each
     results run; configs: the parameters of each run with a file of its own; own_frames: the detections of a run
-    whose parameters preprocess them otherwise; source: where the detections came from, with their hash; seed:
+    whose parameters preprocess them otherwise; caps: what each run can show (``runs.capabilities``, found once
+    here); source: where the detections came from, with their hash; seed:
     the simulated detector's seed; argv: the command line, for the provenance; serve: the ports of the web viewer
     (None: save or spawn); notices: what the user should know (e.g. boxes of a results file left out).
     """
@@ -59,6 +60,7 @@ class Inputs:
     foreign: Mapping[str, ForeignResults] = field(default_factory=dict)
     configs: Mapping[str, TrackerConfig] = field(default_factory=dict)
     own_frames: Mapping[str, list[FrameDetections]] = field(default_factory=dict)
+    caps: Mapping[str, Capabilities] = field(default_factory=dict)
     notices: tuple[str, ...] = ()
 
     def spec(self, name: str) -> RunSpec:
@@ -67,7 +69,7 @@ class Inputs:
 
     def capabilities(self, name: str) -> Capabilities:
         """What run ``name`` can show (``runs.capabilities``)."""
-        return capabilities(self.spec(name))
+        return self.caps[name] if name in self.caps else capabilities(self.spec(name))
 
     @property
     def evaluated_keyframes(self) -> range | None:
@@ -147,8 +149,9 @@ def _run_inputs(
     frames: list[FrameDetections],
     classes: Sequence[str],
 ) -> dict[str, Any]:
-    """What the runs bring of their own (the ``Inputs`` fields ``foreign``, ``configs``, ``own_frames`` and
-    ``notices``): each results file read and checked for ``scene`` (``gnnpmb.foreign``), each parameter file."""
+    """What the runs bring of their own (the ``Inputs`` fields ``foreign``, ``configs``, ``own_frames``, ``caps``
+    and ``notices``): each results file read and checked for ``scene`` (``gnnpmb.foreign``), each parameter file,
+    what each run can show."""
     from gnnpmb.config import load_config
     from gnnpmb.data.nuscenes import all_sample_tokens
     from gnnpmb.foreign import read_results, scene_results
@@ -167,7 +170,8 @@ def _run_inputs(
             own = configs[spec.name] = load_config(spec.params)
             if own.preprocess_by_class() != config.preprocess_by_class():
                 own_frames[spec.name] = preprocess_frames(scene, detections, own, classes)
-    return {"foreign": foreign, "configs": configs, "own_frames": own_frames, "notices": tuple(notices)}
+    caps = {spec.name: capabilities(spec) for spec in specs}
+    return {"foreign": foreign, "configs": configs, "own_frames": own_frames, "caps": caps, "notices": tuple(notices)}
 
 
 YOUNG_COLLECTION_THRESHOLD = 20_000

@@ -27,8 +27,6 @@ if TYPE_CHECKING:
 DEFAULT_TRACKER = "gnnpmb"
 DEFAULT_DETECTOR = "centerpoint"
 _FRAMES_RE = re.compile(r"^\s*(\d*)\s*:\s*(\d*)\s*$")
-_FOCUS_RE = re.compile(r"^(?P<kind>[a-z_]+):(?P<ref>\S+)$")
-_DIFF_REF = re.compile(r"^(fixed|introduced|kept):[1-9][0-9]*$")
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,7 +36,8 @@ class Request:
     runs: each run's spec (``gnnpmb.runs``), in command-line order; frame_bounds: --frames as (start, end), either
     None; config: the parameters of --params (the defaults without it); detector: the simulated preset (used when
     ``detections_file`` is None); save: the checked absolute output path; serve: the web viewer's ports (None: save
-    or spawn); focus: the --focus spelling, checked by ``parse_focus``; argv: the command line, for the provenance.
+    or spawn); focus: the --focus spelling, checked by ``gnnpmb.focus.parse_focus``; argv: the command line, for the
+    provenance.
     """
 
     scene_name: str
@@ -78,24 +77,6 @@ def parse_classes(text: str | None) -> tuple[str, ...]:
     return tuple(dict.fromkeys(check_classes(names)))
 
 
-def parse_focus(spec: str) -> tuple[str, str]:
-    """``kind:ref`` -> (kind, ref), checked; raises GnnpmbError naming the accepted forms."""
-    from gnnpmb.eval.failures import FailureKind
-
-    match = _FOCUS_RE.match(spec.strip())
-    kinds = {k.value for k in FailureKind}
-    if match is None or (match["kind"] not in kinds | {"track", "gt", "diff"}):
-        raise GnnpmbError(
-            f"bad --focus '{spec}': use track:ID, gt:TOKEN, a failure id such as id_switch:1 "
-            f"(gnnpmb failures SCENE --tracker T lists them) or a change such as diff:introduced:1 (gnnpmb diff A B)"
-        )
-    if match["kind"] == "track" and not match["ref"].isdigit():
-        raise GnnpmbError(f"bad --focus '{spec}': track:ID takes a track number, e.g. track:802")
-    if match["kind"] == "diff" and not _DIFF_REF.match(match["ref"]):
-        raise GnnpmbError(f"bad --focus '{spec}': use diff:fixed:N, diff:introduced:N or diff:kept:N")
-    return match["kind"], match["ref"]
-
-
 def check_request(
     scene_name: str,
     trackers: Sequence[str],
@@ -133,6 +114,8 @@ def check_request(
     if serve is not None:
         check_serve_ports(serve)
     if focus is not None:
+        from gnnpmb.focus import parse_focus
+
         parse_focus(focus)
 
     from gnnpmb.config import load_config

@@ -41,43 +41,36 @@ class Run:
             sink.emit(event)
 
 
-def track_run(
-    inputs: Inputs, name: str, sink: EventSink | None = None, on_frame: Callable[[], None] | None = None
-) -> TrackingRun:
-    """Run ``name`` of ``inputs`` over its frames, its events to ``sink``; the run is named ``name``."""
-    from gnnpmb.foreign import replay
-    from gnnpmb.pipeline import run_tracker
-
-    spec, foreign = inputs.spec(name), inputs.foreign.get(name)
-    if foreign is not None:
-        return replay(
-            foreign, inputs.scene, inputs.frame_detections, inputs.classes, inputs.frame_range, sink, on_frame
-        )
-    run = run_tracker(
-        inputs.scene,
-        inputs.own_frames.get(name, inputs.frame_detections),
-        str(spec.tracker),
-        inputs.configs.get(name, inputs.config),
-        sink=sink,
-        classes=inputs.classes,
-        frame_range=inputs.frame_range,
-        on_frame=on_frame,
-    )
-    return run if run.tracker == name else replace(run, tracker=name)
-
-
 def run_one(inputs: Inputs, name: str, *, record: bool, on_frame: Callable[[], None] | None = None) -> Run:
-    """Run ``name`` once; with ``record`` its events and facts are kept (module docstring)."""
+    """Run ``name`` of ``inputs`` once over its frames (a results file replayed, a tracker tracking with its own
+    parameters and detections when it has them); with ``record`` its events and facts are kept (module
+    docstring). on_frame: called after each frame."""
     from gnnpmb.events import ListSink, TeeSink
+    from gnnpmb.foreign import replay
+    from gnnpmb.pipeline import track_frames
     from gnnpmb.why.facts import FactSink
 
-    caps = inputs.capabilities(name)
-    if not record:
-        return Run(track_run(inputs, name, on_frame=on_frame))
-    facts = FactSink(name, has_existence=caps.has_existence, output_only=caps.output_only)
+    spec, foreign, caps = inputs.spec(name), inputs.foreign.get(name), inputs.caps[name]
+    facts = FactSink(name, has_existence=caps.has_existence, output_only=caps.output_only) if record else None
     events = ListSink()
-    tracking = track_run(inputs, name, TeeSink(facts, events), on_frame)
-    return Run(tracking, tuple(events.events), facts.facts)
+    sink = TeeSink(facts, events) if facts is not None else None
+    if foreign is not None:
+        tracking = replay(
+            foreign, inputs.scene, inputs.frame_detections, inputs.classes, inputs.frame_range, sink, on_frame
+        )
+    else:
+        tracking = track_frames(
+            inputs.scene,
+            inputs.own_frames.get(name, inputs.frame_detections),
+            str(spec.tracker),
+            inputs.configs.get(name, inputs.config),
+            sink=sink,
+            classes=inputs.classes,
+            frame_range=inputs.frame_range,
+            on_frame=on_frame,
+        )
+        tracking = tracking if tracking.tracker == name else replace(tracking, tracker=name)
+    return Run(tracking, tuple(events.events), facts.facts) if facts is not None else Run(tracking)
 
 
 def run_all(

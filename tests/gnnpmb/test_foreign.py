@@ -11,9 +11,9 @@ import pytest
 
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.foreign import NEAREST_M, OnHow, box_on
-from gnnpmb.stages.runs import track_run
+from gnnpmb.stages.runs import run_one
 from gnnpmb.types import Boxes
-from gnnpmb.why.facts import FactSink, UseMode, Went
+from gnnpmb.why.facts import UseMode, Went
 from tests.pipeline import prepare
 
 SCENE = "scene-0103"
@@ -56,16 +56,17 @@ def test_results_of_a_scene_are_checked_and_replayed(demo_dataroot: Path, cv_res
     assert any("samples outside scene-0103 left out" in n for n in request.notices)  # scene-0916's, reported
     foreign = request.foreign["cv"]
     assert len(foreign.estimates) == len(request.scene.keyframes) and not foreign.original_ids
-    sink = FactSink("cv", output_only=True)
-    run = track_run(request, "cv", sink)
+    recorded = run_one(request, "cv", record=True)
+    run, facts = recorded.tracking, recorded.facts
+    assert facts is not None
     assert [fr.keyframe.index for fr in run.frames] == list(range(12)) and run.tracker == "cv"
     assert all(fr.detections.kept.all() for fr in run.frames)  # every detection given: its own filter is unknown
-    use = sink.facts.use(5, "car")
-    assert use.mode is UseMode.OUTPUT and not sink.facts.has_existence
+    use = facts.use(5, "car")
+    assert use.mode is UseMode.OUTPUT and not facts.has_existence
     on = [e for e in run.frames[5].estimates if e.class_name == "car" and e.meas_index >= 0]
     assert on and all(use.destinations[e.meas_index].went is Went.TRACK for e in on)
     assert any(d.went is Went.NO_OUTPUT for d in use.destinations.values())
-    assert sink.facts.decisions(5, "car") is None and sink.facts.hypotheses(5, "car") is None
+    assert facts.decisions(5, "car") is None and facts.hypotheses(5, "car") is None
 
 
 def test_ids_that_are_not_plain_integers_are_numbered(demo_dataroot: Path, cv_results: Path, tmp_path: Path) -> None:
