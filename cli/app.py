@@ -19,7 +19,6 @@ a display for the spawned viewer; without one it stops at once with a hint inste
 from __future__ import annotations
 
 import functools
-import gc
 import os
 import sys
 from collections.abc import Sequence
@@ -44,6 +43,7 @@ from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.runs import parse_runs
 from gnnpmb.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, check_display, serve_target
+from gnnpmb.stages.inputs import collect_rarely
 from gnnpmb.stages.request import DEFAULT_TRACKER, check_request
 
 tidy_help()
@@ -201,7 +201,7 @@ def main(argv: Sequence[str] | None = None) -> None:
     the viewer command (typer cannot have a positional SCENE beside a subcommand). As the script (``argv``
     None) a failed run exits at once (``cli.errors.exit_now_on_failure``)."""
     if argv is None:
-        gc.disable()  # no collection until the inputs are loaded (stages.inputs.freeze_loaded): all made stays alive
+        collect_rarely()
         exit_now_on_failure(lambda: _main(sys.argv[1:]))
     else:
         _main(list(argv))

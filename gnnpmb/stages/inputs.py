@@ -175,26 +175,31 @@ def _run_inputs(
 
 
 YOUNG_COLLECTION_THRESHOLD = 20_000
-"""``gnnpmb-viz``'s threshold of the garbage collector's first generation once its inputs are loaded (CPython's:
-700). Tracking and drawing make many short-lived containers: on the warm demo 700 gave 336 collections (65-80
-ms of CPU), 20,000 gives 21 (25 ms), with the same peak memory."""
+"""``gnnpmb-viz``'s threshold of the garbage collector's first generation (CPython's: 700). Loading, tracking
+and drawing make many short-lived containers: on the warm demo 700 gave 336 collections (65-80 ms of CPU), 20,000
+gives 21 (25 ms), with the same peak memory."""
+
+
+def collect_rarely() -> None:
+    """The ``gnnpmb-viz`` script's collector (``cli.app.main``): the first generation collected every
+    ``YOUNG_COLLECTION_THRESHOLD`` allocations, and no full collection before the loaded objects are frozen
+    (``freeze_loaded``). It stays on while loading: switched off, a reference cycle made then was never freed,
+    and one holds much: the devkit's first import (matplotlib, pyparsing) catches exceptions whose tracebacks keep
+    their frames, and the frames their callers' locals (on a cold run the index build's tables): 1.83 against
+    1.54 GB of peak memory on a full-size cold ``gnnpmb-viz`` (``benchmarks/full_scale.py``)."""
+    gc.set_threshold(YOUNG_COLLECTION_THRESHOLD, *gc.get_threshold()[1:])
 
 
 def freeze_loaded() -> None:
     """Move every object alive (the devkit's tables, the scene, the frames) out of the garbage collector's reach
     (``gc.freeze``): they live as long as the process, and a full collection walking them cost ~130 ms in the
     middle of tracking. Objects frozen are still freed by reference counting; only reference cycles among them
-    would outlive their use. The collector is on afterwards. The ``gnnpmb-viz`` script keeps it off while it
-    imports and loads (``cli.app.main``): then nothing is collected before freezing either, as its cycles are
-    the imports' leftovers (~7,300 objects, 1.7 MB on the warm demo) and collecting them walked all 140,000
-    objects for ~85 ms, and the collector runs less often afterwards (``YOUNG_COLLECTION_THRESHOLD``); with
-    the collector on (the Python API, tests) garbage is collected first and the thresholds are left alone."""
-    if gc.isenabled():
+    would outlive their use. With the script's collector (``collect_rarely``) nothing is collected first: the
+    cycles left then are the imports' (~7,300 objects, 1.7 MB on the warm demo), and collecting them walked all
+    140,000 objects for ~85 ms; otherwise (the Python API, tests) garbage is collected first."""
+    if gc.get_threshold()[0] < YOUNG_COLLECTION_THRESHOLD:
         gc.collect()
-    else:
-        gc.set_threshold(YOUNG_COLLECTION_THRESHOLD, *gc.get_threshold()[1:])
     gc.freeze()
-    gc.enable()
 
 
 def reproduction_inputs(
