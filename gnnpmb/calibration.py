@@ -17,7 +17,9 @@ Kirubarajan 2001, sec. 5.2 for the Gaussian noise; Mahler 2007, ch. 9 for P_D, c
 - detection probability P_D: the share of annotations matched by a detection at or above the score threshold
   (also per range bin, and the precision of each score bin, written as comments); the PMB trackers take it as
   the cap of a missed Bernoulli's P_D (``[pmb] miss_p_detect_max``; its last detection's score below it), so
-  that a miss lowers the existence as much as this detector's misses mean;
+  that a miss lowers the existence as much as this detector's misses mean, written with ``miss_p_detect_online =
+  0``: learnt from annotations, it replaces the estimate the trackers learn from their own tracks
+  (``gnnpmb.pmb.miss_detection``);
 - clutter intensity kappa: detections at or above the threshold left unmatched, per keyframe, per m^2 of the
   class's evaluated disc (pi range^2), per score bin as comments; its velocity density (PMB with the velocity
   measured): the mean of a Gaussian fitted to those detections' velocities, 1 / (4 pi sigma_vx sigma_vy);
@@ -303,6 +305,7 @@ def learn_class(cls: str, s: ClassSamples, base: TrackerConfig) -> list[Learnt]:
         out.append(
             Learnt(pmb, "miss_p_detect_max", p_d, f"the P_D above, the cap of a missed Bernoulli's P_D; {source}")
         )
+        out.append(Learnt(pmb, "miss_p_detect_online", 0, "the cap above is kept, not learnt again from the tracks"))
     frames = max(s.frames, 1)
     clutter = s.clutter_score[s.clutter_score >= t]
     area_m2 = math.pi * s.range_m**2

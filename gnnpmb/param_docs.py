@@ -28,9 +28,10 @@ _DEFAULTS_HEADER = """\
 # gnnpmb-viz tracker parameters: the GNN-PMB paper defaults (Liu et al., IEEE T-IV 2023, sec. V-B, Table II)
 # and the per-class noise of the authors' code, except [models] p_survive, birth_weight and [pmb]
 # extraction_threshold, miss_p_detect_max, chosen on the demo mini_train split, and [pmb] measure_velocity,
-# clutter_velocity_density, [pmbm] n_hypotheses and the two-wheelers' q_x, q_y, chosen on the mini_train splits
-# of the demo and the dev set (see gnnpmb/config.py; gnnpmb/params/paper.toml has the paper's). [models] holds
-# what every tracker shares; these keys are also accepted under [pmb], where they were before.
+# clutter_velocity_density, the miss_p_detect_online cap, [pmbm] n_hypotheses and the two-wheelers' q_x, q_y,
+# chosen on the mini_train splits of the demo and the dev set (see gnnpmb/config.py; gnnpmb/params/paper.toml has
+# the paper's). [models] holds what every tracker shares; these keys are also accepted under [pmb], where they
+# were before.
 # Copy this file, edit it and pass it with --params FILE. Any subset of keys may be given; unknown keys are an
 # error. [classes.<class>] may also override any key of the shared sections for that class, e.g.
 # [classes.pedestrian] birth_weight = 0.1 (p_detect, in two sections, goes in [classes.<class>.phd] or .vector).

@@ -34,6 +34,7 @@ from gnnpmb.events import (
 from gnnpmb.models import MotionModel, birth_covariance, clutter_intensity, measurement_birth, motion_model
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
+from gnnpmb.pmb.miss_detection import MissDetectionCounts
 from gnnpmb.pmb.poisson import NewTrackHypotheses, birth_update, new_track_hypotheses
 from gnnpmb.skeleton import ClassFilter, Gating, TrackView
 from gnnpmb.types import STATE_DIM, IdAllocator, Measurements, TrackEstimate
@@ -437,6 +438,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         model = motion_model(0.0, self.class_params, self.models, self.params.measure_velocity == 1)
         self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty(model.state_dim))]
         self.frame_serial = 0
+        self.miss_counts = MissDetectionCounts.empty(self.params.miss_p_detect_bins)
         self.birth_update = birth_update(birth_covariance(self.models, self.turn_rate), model.R)
 
     @property
@@ -478,6 +480,8 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         posteriors = self.strategy.update(prior.hypotheses, prior.locals_, ctx)
         self.hypotheses = self._prune(prior.hypotheses, posteriors, ctx, sink)
         best = self.hypotheses[0].bernoullis
+        if self.params.miss_p_detect_online == 1:
+            self.miss_counts.count(best.track_id, best.misses)
         if sink.enabled:
             self._emit_born(best, ctx, sink)
         return best
@@ -509,6 +513,15 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     def posterior_view(self, posterior: Bernoullis) -> TrackView:
         return _view(posterior)
 
+    def miss_p_detect_max(self, prior: Bernoullis) -> float | np.ndarray:
+        """This frame's cap of the P_D of the predicted Bernoullis ``prior`` when missed: ``[pmb]
+        miss_p_detect_max``, or with ``[pmb] miss_p_detect_online = 1`` the class's P_D learnt from the frames
+        before, per Bernoulli by the frames it has been missed in a row (``miss_detection``), (K,)."""
+        p = self.params
+        if p.miss_p_detect_online != 1:
+            return p.miss_p_detect_max
+        return self.miss_counts.p_detect(p.miss_p_detect_max, p.miss_p_detect_prior_frames, prior.misses - 1)
+
     def _predict_and_localise(self, meas: Measurements, model: MotionModel, new: NewTrackHypotheses) -> PmbPrior:
         """Predicted prior hypotheses and their local hypotheses. Global hypotheses share most Bernoullis
         (equal ``local_key`` = identical component), so with several hypotheses every distinct Bernoulli is
@@ -523,7 +536,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
                 new,
                 model.R,
                 p.gate_chi2,
-                self.params.miss_p_detect_max,
+                self.miss_p_detect_max(prior),
                 self.box,
                 self.params.gate_giou_min,
             )

@@ -36,6 +36,7 @@ def test_the_file_is_read_by_the_parameter_reader_and_changes_each_class(calibra
         assert 0.0 < own.r_x < 1.0 and 0.0 < own.r_vx < 5.0
         assert 0.0 < view.phd.p_detect < 1.0 and view.phd.p_detect == view.vector.p_detect
         assert view.pmb.miss_p_detect_max == view.phd.p_detect  # a PMB miss means what this detector's misses mean
+        assert view.pmb.miss_p_detect_online == 0  # the learnt cap is kept, not learnt again from the tracks
         assert view.pmb.heading_std_rad > 0.0 and view.models.clutter_intensity > 0.0
     assert config.box_noise["car"].r_x != load_config(None).box_noise["car"].r_x
 

@@ -1,0 +1,71 @@
+"""A class's P_D for a missed Bernoulli, learnt online from the tracker's own tracks (``[pmb] miss_p_detect_online``).
+
+An object missed for g frames and then detected again on the same track was present while missed. Over the tracks
+of one class seen so far (one scene, causal: frames up to the previous one), the detection probability of a present
+object that has been missed n frames in a row is estimated from D_n, the detections of existing tracks that had
+been missed n frames in a row, and G_n, the misses at position n + 1 of gaps a later detection closed (a gap still
+open, or a track that never came back, says nothing about presence and is not counted). n runs over N bins
+(``[pmb] miss_p_detect_bins``), the last pooling every n >= N - 1; N = 1 pools every frame of the class. With the
+cap c = ``[pmb] miss_p_detect_max`` as a Beta prior of w = ``miss_p_detect_prior_frames`` pseudo-frames (mean c),
+the posterior mean
+
+    P_D(n) = (w c + D_n) / (w + D_n + G_n)
+
+replaces the fixed cap: a missed Bernoulli's P_D is min(its last detection's score, P_D(n)) (``cost.local_hypotheses``).
+With N > 1 a detector whose misses come in long runs (occlusions) gets a lower P_D after the first misses than
+after none, so a track coasts through a run the class's tracks were seen to come back from.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def pooled_p_detect(prior_mean: float, prior_frames: float, detected: np.ndarray, missed: np.ndarray) -> np.ndarray:
+    """(N,) (w c + D_n) / (w + D_n + G_n): the Beta posterior mean of P_D per bin (module docstring); the prior
+    mean c where nothing is counted yet."""
+    return (prior_frames * prior_mean + detected) / (prior_frames + detected + missed)
+
+
+@dataclass(slots=True)
+class MissDetectionCounts:
+    """D_n and G_n of one class, (N,) each (module docstring), counted on the most likely hypothesis frame by frame.
+
+    ``last_ids`` (L,) sorted and ``last_misses`` (L,): the track ids of the previous frame's most likely
+    hypothesis and the frames each had been missed in a row then (0: detected), so a detection now closes a gap
+    of that many misses.
+    """
+
+    detected: np.ndarray
+    missed: np.ndarray
+    last_ids: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    last_misses: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    @staticmethod
+    def empty(n_bins: int) -> MissDetectionCounts:
+        return MissDetectionCounts(np.zeros(n_bins, dtype=np.int64), np.zeros(n_bins, dtype=np.int64))
+
+    def p_detect(self, prior_mean: float, prior_frames: float, misses: np.ndarray) -> np.ndarray:
+        """(K,) the P_D of K predicted Bernoullis missed ``misses`` (K,) frames in a row before this frame
+        (``pooled_p_detect`` of their bins)."""
+        by_bin = pooled_p_detect(prior_mean, prior_frames, self.detected, self.missed)
+        return by_bin[np.minimum(misses, len(by_bin) - 1)]
+
+    def count(self, track_id: np.ndarray, misses: np.ndarray) -> None:
+        """Count one frame's most likely posterior: K Bernoullis' distinct track ids (K,) and frames missed in a
+        row (K,) (0: detected this frame). A detected track that was in the previous frame's, missed g frames in
+        a row then, adds 1 to D_g and 1 to each G_n, n < g (bins as ``p_detect``); a new track adds nothing (its
+        first detection says nothing about a miss)."""
+        seen = track_id[misses == 0]
+        at = np.searchsorted(self.last_ids, seen)
+        known = at < len(self.last_ids)
+        known[known] = self.last_ids[at[known]] == seen[known]
+        gaps = self.last_misses[at[known]]
+        last_bin = len(self.detected) - 1
+        self.detected += np.bincount(np.minimum(gaps, last_bin), minlength=last_bin + 1)
+        self.missed[:last_bin] += (gaps[:, None] > np.arange(last_bin)).sum(axis=0)
+        self.missed[last_bin] += np.maximum(gaps - last_bin, 0).sum()
+        order = np.argsort(track_id, kind="stable")
+        self.last_ids, self.last_misses = track_id[order], misses[order]

@@ -1,0 +1,99 @@
+"""The P_D of a missed Bernoulli learnt online per class (``gnnpmb.pmb.miss_detection``, ``[pmb]
+miss_p_detect_online``): hand-computed counts, and the value the tracker's cost events report is the one it used."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gnnpmb.config import TrackerConfig, with_params
+from gnnpmb.events import CostMatrix, ListSink, NullSink
+from gnnpmb.pmb.core import PmbCore
+from gnnpmb.pmb.gnnpmb import BestAssignment
+from gnnpmb.pmb.miss_detection import MissDetectionCounts
+from gnnpmb.types import IdAllocator
+from tests.gnnpmb.pmb.helpers import make_measurements
+
+
+def _counted(n_bins: int) -> MissDetectionCounts:
+    """Tracks 1 and 2 over four frames: both detected at frame 1; 1 missed at frames 2 and 3 and detected again
+    at 4; 2 detected at every frame; 5 born at frame 4."""
+    counts = MissDetectionCounts.empty(n_bins)
+    ids = np.array([1, 2])
+    counts.count(ids, np.array([0, 0]))  # frame 1: no previous frame, nothing counted
+    counts.count(ids, np.array([1, 0]))  # track 2 detected after a detection: D_0 + 1
+    counts.count(ids[::-1], np.array([0, 2]))  # the same, rows in another order
+    counts.count(np.array([5, 1, 2]), np.array([0, 0, 0]))  # 1 closes a gap of 2: D_2 + 1, G_0 + 1, G_1 + 1
+    return counts
+
+
+def test_counts_and_estimate_by_gap_position_by_hand() -> None:
+    """Three bins: D = [3, 0, 1] (track 2 three times after a detection; track 1 once after two misses), G = [1,
+    1, 0] (track 1's closed gap: a miss at position 1 and one at 2); the new track 5 adds nothing. With the cap 0.3
+    as a prior of 10 frames: P_D = [(3 + 3) / (10 + 3 + 1), (3 + 0) / (10 + 0 + 1), (3 + 1) / (10 + 1 + 0)]."""
+    counts = _counted(3)
+    assert counts.detected.tolist() == [3, 0, 1] and counts.missed.tolist() == [1, 1, 0]
+    p = counts.p_detect(0.3, 10.0, np.array([0, 1, 2, 5]))
+    np.testing.assert_allclose(p, [6 / 14, 3 / 11, 4 / 11, 4 / 11])
+
+
+def test_one_bin_pools_every_frame_and_two_bins_pool_the_tail() -> None:
+    """One bin: D = 4 detections, G = 2 misses, P_D = (3 + 4) / (10 + 6). Two bins: the gap of 2 ends in the
+    last bin (D = [3, 1]) and its second miss falls in it too (G = [1, 1])."""
+    one = _counted(1)
+    assert one.detected.tolist() == [4] and one.missed.tolist() == [2]
+    np.testing.assert_allclose(one.p_detect(0.3, 10.0, np.array([0, 7])), [7 / 16, 7 / 16])
+    two = _counted(2)
+    assert two.detected.tolist() == [3, 1] and two.missed.tolist() == [1, 1]
+    np.testing.assert_allclose(two.p_detect(0.3, 10.0, np.array([0, 1, 4])), [6 / 14, 4 / 12, 4 / 12])
+
+
+def test_nothing_counted_gives_the_prior_mean() -> None:
+    np.testing.assert_allclose(MissDetectionCounts.empty(3).p_detect(0.3, 10.0, np.array([0, 1, 9])), [0.3] * 3)
+
+
+def _car(t: int) -> object:
+    return make_measurements([(1.0 * t, 0.0)], 0.8, velocity=[(2.0, 0.0)])
+
+
+def _run(cfg: TrackerConfig) -> tuple[PmbCore, float]:
+    """A car detected at frames 0-2, missed at 3 and 4, detected at 5, then missed at 6 (a far detection starts
+    another track): the P_D its miss used at frame 6, read from that frame's ``CostMatrix`` event."""
+    core = PmbCore("car", cfg, BestAssignment(), IdAllocator())
+    frames = [_car(0), _car(1), _car(2), make_measurements([], 0.8), make_measurements([], 0.8), _car(5)]
+    for t, meas in enumerate(frames):
+        core.step(meas, 0.5 if t else 0.0, NullSink())
+    (track,) = core.hypotheses[0].bernoullis.track_id.tolist()
+    sink = ListSink()
+    core.step(make_measurements([(80.0, 0.0)], 0.8, velocity=[(2.0, 0.0)]), 0.5, sink)
+    (costs,) = [e for e in sink.events if isinstance(e, CostMatrix)]
+    terms = costs.terms
+    assert terms is not None
+    col = terms.column_of(track)
+    assert col is not None
+    return core, terms.pair(0, col).p_detect
+
+
+def test_the_tracker_misses_with_the_learnt_p_d_and_its_event_reports_it() -> None:
+    """One bin, prior 0.3 of 10 frames: detections at frames 1, 2, 5 of the existing track (D = 3) and the two
+    misses of the gap frame 5 closed (G = 2): P_D = (3 + 3) / (10 + 5) = 0.4 at frame 6, below the last score
+    0.8, so the miss uses 0.4 and the cost event says 0.4."""
+    cfg = with_params(TrackerConfig(), {"pmb.miss_p_detect_online": 1, "pmb.miss_p_detect_bins": 1})
+    core, p_detect = _run(cfg)
+    assert core.miss_counts.detected.tolist() == [3] and core.miss_counts.missed.tolist() == [2]
+    assert p_detect == pytest.approx(0.4, rel=1e-9)
+
+
+def test_a_class_s_fixed_cap_wins_over_the_online_estimate() -> None:
+    """``gnnpmb calibrate`` writes a learnt cap with ``miss_p_detect_online = 0`` per class: that class misses
+    with its cap (0.72 here) whatever the default does."""
+    cfg = with_params(
+        TrackerConfig(),
+        {
+            "pmb.miss_p_detect_online": 1,
+            "classes.car.pmb.miss_p_detect_max": 0.72,
+            "classes.car.pmb.miss_p_detect_online": 0,
+        },
+    )
+    _, p_detect = _run(cfg.resolved("car"))
+    assert p_detect == pytest.approx(0.72, rel=1e-9)
