@@ -6,19 +6,17 @@ from __future__ import annotations
 
 import csv
 import json
-import os
 import signal
 import stat
 import subprocess
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 from tests.cli.test_faults import _fault_env, _one_line, _start, _wait_for
 from tests.cli.test_user_errors import _snapshot
-from tests.inprocess import run_script_with
+from tests.inprocess import run_script_with, umask
 
 SWEEP = "gnnpmb sweep --dataroot {root} --out {out} --no-progress --detector pointpillars"
 
@@ -28,20 +26,9 @@ def _rows(out: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(f))
 
 
-@pytest.fixture
-def umask_022() -> Iterator[None]:
-    """This process's file-creation mask at 022 (a shell's usual one) for the test, restored after."""
-    before = os.umask(0o022)
-    try:
-        yield
-    finally:
-        os.umask(before)
-
-
 def test_a_second_grid_joins_the_table_and_another_study_is_refused(
     tiny_dataroot: Path,
     tmp_path: Path,
-    umask_022: None,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
@@ -50,7 +37,8 @@ def test_a_second_grid_joins_the_table_and_another_study_is_refused(
     sweep = SWEEP.format(root=tiny_dataroot, out=out) + " --workers 1"
 
     def _run(command: str, env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess[str]:
-        return run_script_with(command.split(), env, cwd, monkeypatch, capsys)
+        with umask(0o022):  # a shell's usual mask, as the real processes had it
+            return run_script_with(command.split(), env, cwd, monkeypatch, capsys)
 
     first = _run(f"{sweep} --param models.birth_weight=0.1,0.3", env, tmp_path)
     assert first.returncode == 0 and first.stderr == "", first.stderr
