@@ -120,7 +120,7 @@ UNMEASURED_TEST_CPU_S = 0.3
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Modules in the order the workers should take them (``scripts/test.sh`` runs ``--dist loadscope
     --no-loadscope-reorder``: a worker that runs out of work takes the next module): first those opening the web
-    viewer in Chromium (``browser``: a minute of software WebGL each, so they start at once, one per worker), then
+    viewer in Chromium (``browser``: a minute or two of software WebGL, so it starts at once), then
     the rest costliest first by ``MODULE_CPU_S`` (longest processing time first: the modules left at the end are
     the cheap ones, so the workers finish together rather than one running a 40 s module while the other idles);
     a module's tests keep their order."""

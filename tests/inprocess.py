@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
 import subprocess
 import traceback
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 import pytest
@@ -74,3 +75,14 @@ def run_script_with(
     monkeypatch.setenv("RUST_LOG", os.environ.get("RUST_LOG", "off"))  # gnnpmb-viz sets it for Rerun
     monkeypatch.chdir(cwd)
     return run_script(argv, capsys)
+
+
+@contextlib.contextmanager
+def umask(mask: int) -> Iterator[None]:
+    """This process's file-creation mask set to ``mask`` (as a shell would have it for a new process), restored
+    after."""
+    before = os.umask(mask)
+    try:
+        yield
+    finally:
+        os.umask(before)

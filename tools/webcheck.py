@@ -241,7 +241,8 @@ class WebCheckResult:
     everything loaded, no backlog, every 3D-view region rendered); seconds from navigation until the viewer's
     state showed everything loaded, to the first shot with rendered views and to the ready shot (None if
     never); shots taken; total wall time; the last shot's region stats; the server and browser process
-    groups; the viewer's last state."""
+    groups; the viewer's last state; the CPU seconds Chromium's processes (browser, renderer, GPU: the
+    software WebGL) and the web-viewer server used, read just before they were stopped (``group_cpu_s``)."""
 
     screenshot: Path
     rendered: bool
@@ -253,6 +254,8 @@ class WebCheckResult:
     regions: tuple[RegionStats, ...]
     process_groups: tuple[int, ...]
     state: ViewerState
+    browser_cpu_s: float
+    server_cpu_s: float
 
     def describe(self) -> str:
         parts = ", ".join(
@@ -266,7 +269,8 @@ class WebCheckResult:
             )
         else:
             when = f"NOT ready (loaded: {self.seconds_to_load})"
-        return f"{when} ({self.shots} shots, {self.total_s:.1f} s in all); 3D views: {parts}; {self.screenshot}"
+        cpu = f"CPU: Chromium {self.browser_cpu_s:.1f} s, web-viewer server {self.server_cpu_s:.1f} s"
+        return f"{when} ({self.shots} shots, {self.total_s:.1f} s in all; {cpu}); 3D views: {parts}; {self.screenshot}"
 
 
 def free_port() -> int:
@@ -341,18 +345,28 @@ def _kill_group(proc: subprocess.Popen[bytes], grace_s: float) -> None:
         proc.wait(timeout=5.0)
 
 
-def group_members(pgid: int) -> list[int]:
-    """Pids of the running (not zombie) processes in process group ``pgid``, from ``/proc``."""
-    members = []
+def _running_in_group(pgid: int) -> Iterator[tuple[int, list[str]]]:
+    """(pid, the fields of ``/proc/PID/stat`` after the command name) of each running (not zombie) process in
+    process group ``pgid``."""
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
             fields = stat.read_text().rsplit(")", 1)[1].split()
         except (OSError, IndexError):
             continue  # the process ended while we looked
-        state, pgrp = fields[0], int(fields[2])
-        if pgrp == pgid and state not in ("Z", "X"):
-            members.append(int(stat.parent.name))
-    return members
+        if int(fields[2]) == pgid and fields[0] not in ("Z", "X"):
+            yield int(stat.parent.name), fields
+
+
+def group_members(pgid: int) -> list[int]:
+    """Pids of the running (not zombie) processes in process group ``pgid``, from ``/proc``."""
+    return [pid for pid, _ in _running_in_group(pgid)]
+
+
+def group_cpu_s(pgid: int) -> float:
+    """CPU seconds (user + system) used so far by the running processes of group ``pgid`` and by the children
+    they have reaped, from ``/proc`` (a process that left the group, or ended unreaped by it, is not counted)."""
+    ticks = sum(sum(int(f) for f in fields[11:15]) for _, fields in _running_in_group(pgid))  # u, s, cu, cs time
+    return ticks / os.sysconf("SC_CLK_TCK")
 
 
 def _wait_for_http(url: str, timeout_s: float, proc: subprocess.Popen[bytes], what: str, log: Path) -> bytes:
@@ -472,6 +486,40 @@ def _page_websocket(debug_port: int, proc: subprocess.Popen[bytes], log: Path, t
         time.sleep(0.25)
 
 
+@dataclass(frozen=True, slots=True)
+class Chromium:
+    """A running headless Chromium (``proc`` leads its process group) and the DevTools client of its one page,
+    whose viewport is ``viewport``."""
+
+    proc: subprocess.Popen[bytes]
+    devtools: DevTools
+    viewport: tuple[int, int]
+
+
+@contextlib.contextmanager
+def headless_chromium(
+    work: Path, viewport: tuple[int, int] = DEFAULT_VIEWPORT, chromium: Path = CHROMIUM
+) -> Iterator[Chromium]:
+    """Headless Chromium with a fresh profile under ``work`` (its log there too), its page sized ``viewport``;
+    its whole process group is killed on exit. Several recordings checked in one browser share its GPU process,
+    where software WebGL compiles the web viewer's shaders once."""
+    if not chromium.is_file():
+        raise WebCheckError(f"chromium is not installed at {chromium}")
+    width, height = viewport
+    debug_port, log = free_port(), work / "chromium.log"
+    argv = [str(chromium), *CHROMIUM_FLAGS, f"--remote-debugging-port={debug_port}"]
+    argv += [f"--user-data-dir={work / 'chromium-profile'}", f"--window-size={width},{height}", "about:blank"]
+    with process_group(argv, log) as proc:
+        devtools = DevTools(_page_websocket(debug_port, proc, log, 60.0))
+        try:
+            devtools.call(
+                "Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False
+            )
+            yield Chromium(proc, devtools, viewport)
+        finally:
+            devtools.close()
+
+
 def check_recording(
     rrd: Path,
     out: Path,
@@ -483,6 +531,7 @@ def check_recording(
     settle_poll_s: float = 1.5,
     chromium: Path = CHROMIUM,
     work_dir: Path | None = None,
+    browser: Chromium | None = None,
 ) -> WebCheckResult:
     """Serve ``rrd`` with Rerun's web viewer, open it in headless Chromium and write a PNG screenshot to
     ``out``.
@@ -498,15 +547,13 @@ def check_recording(
     if not rrd.is_file():
         raise WebCheckError(f"recording {rrd} does not exist")
     expected = expected_state(rrd)
-    if not chromium.is_file():
-        raise WebCheckError(f"chromium is not installed at {chromium}")
-    width, height = viewport
     start = time.monotonic()
+    own_browser = browser is None
     with contextlib.ExitStack() as stack:
         work = Path(work_dir) if work_dir is not None else Path(stack.enter_context(tempfile.TemporaryDirectory()))
         work.mkdir(parents=True, exist_ok=True)
-        web_port, debug_port = free_port(), free_port()
-        serve_log, browser_log = work / "rerun-serve.log", work / "chromium.log"
+        web_port = free_port()
+        serve_log = work / f"rerun-serve-{rrd.stem}.log"
         rrd_url = stack.enter_context(served_file(rrd))
         server = stack.enter_context(
             process_group(
@@ -516,29 +563,11 @@ def check_recording(
             )
         )
         _wait_for_http(f"http://127.0.0.1:{web_port}/", 60.0, server, "rerun --serve-web", serve_log)
-        profile = work / "chromium-profile"
-        browser = stack.enter_context(
-            process_group(
-                [
-                    str(chromium),
-                    *CHROMIUM_FLAGS,
-                    f"--remote-debugging-port={debug_port}",
-                    f"--user-data-dir={profile}",
-                    f"--window-size={width},{height}",
-                    "about:blank",
-                ],
-                browser_log,
-            )
-        )
-        devtools = DevTools(_page_websocket(debug_port, browser, browser_log, 60.0))
-        stack.callback(devtools.close)
-        devtools.call(
-            "Emulation.setDeviceMetricsOverride",
-            width=width,
-            height=height,
-            deviceScaleFactor=1,
-            mobile=False,
-        )
+        if browser is None:
+            browser = stack.enter_context(headless_chromium(work, viewport, chromium))
+        width, height = browser.viewport
+        devtools = browser.devtools
+        cpu_before_s = group_cpu_s(browser.proc.pid)
         url = f"http://127.0.0.1:{web_port}/?url={urllib.parse.quote(rrd_url, safe='')}"
         devtools.call("Page.navigate", url=url)
         navigated = time.monotonic()
@@ -576,6 +605,7 @@ def check_recording(
                 break
             if server.poll() is not None:
                 raise WebCheckError(f"rerun --serve-web exited with code {server.returncode}; see {serve_log}")
+        browser_cpu_s, server_cpu_s = group_cpu_s(browser.proc.pid) - cpu_before_s, group_cpu_s(server.pid)
     done = settled >= SETTLED_SHOTS
     return WebCheckResult(
         out,
@@ -586,8 +616,10 @@ def check_recording(
         shots,
         time.monotonic() - start,
         stats,
-        (server.pid, browser.pid),
+        (server.pid, browser.proc.pid) if own_browser else (server.pid,),
         state,
+        browser_cpu_s,
+        server_cpu_s,
     )
 
 

@@ -15,6 +15,7 @@ import signal
 import stat
 import subprocess
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -24,7 +25,7 @@ from gnnpmb import atomic
 from gnnpmb.data.demo import GENERATOR_VERSION
 from tests.cli.test_user_errors import BIN, VIZ, _env, _snapshot, _work_folder
 from tests.gnnpmb.study.test_runner import FakeHead
-from tests.inprocess import run_script_with
+from tests.inprocess import run_script_with, umask
 
 QUICK_VIZ = f"{VIZ} scene-0103 --tracker gnn --frames 0:3 --no-failures --no-progress"
 
@@ -253,14 +254,22 @@ def test_frames_evaluates_and_numbers_failures_within_the_window(
     )
 
 
-def test_a_gate_at_the_float_limit_and_new_outputs_follow_one_mode(demo_dataroot: Path, tmp_path: Path) -> None:
-    """``gate_chi2 = 1e308`` draws without a numpy warning; a new recording gets 0644 under umask 022."""
+def test_a_gate_at_the_float_limit_and_new_outputs_follow_one_mode(
+    demo_dataroot: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``gate_chi2 = 1e308`` draws without a numpy warning; a new recording gets 0644 under umask 022. In-process
+    (``tests.inprocess``): the drawing and the file, not the process, are under test; every warning is recorded
+    (pytest would otherwise keep them from stderr)."""
     (tmp_path / "big.toml").write_text("[models]\ngate_chi2 = 1e308\n")
     command = (
         f"{VIZ} scene-0103 --tracker gnnpmb --frames 0:3 --no-failures --params big.toml --save g.rrd --no-progress"
     )
-    proc = _run(command, _fault_env(demo_dataroot, tmp_path / "cache"), tmp_path)
+    env = _fault_env(demo_dataroot, tmp_path / "cache")
+    with umask(0o022), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        proc = run_script_with(command.split(), env, tmp_path, monkeypatch, capsys)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert [str(w.message) for w in caught] == []
     assert _mode(tmp_path / "g.rrd") == 0o644
 
 

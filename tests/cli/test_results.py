@@ -87,7 +87,8 @@ def test_a_focus_recording_of_a_results_run(
         (["--results", "gnnpmb={f}"], "results name 'gnnpmb' is a built-in tracker's"),
         (["--results", "mine={missing}"], "results file not found"),
         (["--results", "mine"], "bad --results 'mine': use NAME=FILE.json"),
-        (["--results", "a={f}", "--tracker", "a={f}"], ""),  # the same run twice is one run
+        # the same run twice is one run (not "two runs are named 'a'"); a window of frames is enough to see it
+        (["--results", "a={f}", "--tracker", "a={f}", "--frames", "0:5"], ""),
         (["--results", "a={f}", "--tracker", "a=gnnpmb"], "two runs are named 'a'"),
     ],
 )

@@ -26,7 +26,7 @@ from gnnpmb.data.nuscenes import load_scene, resolve_dataroot, sample_tokens
 from gnnpmb.data.scene import SceneData
 from gnnpmb.data.simdet import PRESETS
 from gnnpmb.eval.submission import build_submission, run_results
-from gnnpmb.pipeline import get_detections, run_tracker
+from gnnpmb.pipeline import TrackingRun, get_detections, run_tracker
 from gnnpmb.registry import TRACKER_NAMES
 
 DIGESTS_PATH = Path(__file__).with_name("submission_digests.json")
@@ -51,10 +51,14 @@ def submission_bytes(
     """The submission ``gnnpmb track --tracker TRACKER --detector PRESET --seed 0`` writes for ``scenes`` (with
     ``--params gnnpmb/params/paper.toml`` when ``paper``)."""
     config = paper_config() if paper else TrackerConfig()
-    parts = [
-        run_results(run_tracker(scene, get_detections(scene, None, preset, SEED), tracker, config)) for scene in scenes
-    ]
-    text = json.dumps(build_submission(parts, tokens), allow_nan=False, separators=(",", ":"))
+    runs = [run_tracker(scene, get_detections(scene, None, preset, SEED), tracker, config) for scene in scenes]
+    return submission_of(runs, tokens)
+
+
+def submission_of(runs: Sequence[TrackingRun], tokens: Sequence[str]) -> bytes:
+    """The submission bytes of one run per scene (``SEED``'s detections), as ``gnnpmb track`` writes them."""
+    submission = build_submission([run_results(run) for run in runs], tokens)
+    text = json.dumps(submission, allow_nan=False, separators=(",", ":"))
     return text.encode("utf-8")
 
 

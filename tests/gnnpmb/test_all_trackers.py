@@ -1,5 +1,6 @@
 """Every tracker on both demo mini_val scenes with every detector preset (PMBM: the most cluttered one): valid
-numbers throughout.
+numbers throughout, and the submission of the same runs byte-identical to its committed digest (these cells'
+digests are checked here rather than in ``test_submission_digests.py``: one run for both checks).
 
 Checks what the viewer would show: no NaN anywhere, probabilities (existence, marginals, cardinality, hypothesis
 weights) within [0, 1] and normalised where they should be, covariances symmetric positive-definite, and track
@@ -8,11 +9,13 @@ ids unique per frame.
 
 from __future__ import annotations
 
+import hashlib
+import json
+
 import numpy as np
 import pytest
 
 from gnnpmb.config import TrackerConfig
-from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
 from gnnpmb.events import (
     Cardinality,
     Extracted,
@@ -25,14 +28,15 @@ from gnnpmb.events import (
 )
 from gnnpmb.pipeline import get_detections, run_tracker
 from gnnpmb.registry import TRACKER_NAMES
+from tests.gnnpmb.submission_digests import DIGESTS_PATH, SEED, digest_key, load_demo_scenes, submission_of
 
 PRESETS = ("centerpoint", "megvii", "pointpillars")
 
 
 @pytest.fixture(scope="module")
-def scenes(demo_dataroot):
-    location = resolve_dataroot(demo_dataroot, "v1.0-mini")
-    return [load_scene(location, name) for name in ("scene-0103", "scene-0916")]
+def scenes_and_tokens(demo_dataroot):
+    """The demo mini_val scenes and their sample tokens, as ``test_submission_digests`` loads them."""
+    return load_demo_scenes(demo_dataroot)
 
 
 def assert_spd(cov: np.ndarray, what: str) -> None:
@@ -49,14 +53,23 @@ def assert_probability(p: np.ndarray, what: str) -> None:
     assert (p >= 0).all() and (p <= 1 + 1e-9).all(), f"{what}: outside [0, 1]"
 
 
+def quick_preset(tracker: str) -> str:
+    """The preset ``tracker`` is checked with in the default run: the presets taken in turn, so each is used;
+    PMBM, the slow one at 2 s per preset and scene, with the most cluttered one."""
+    return "pointpillars" if tracker == "pmbm" else PRESETS[TRACKER_NAMES.index(tracker) % len(PRESETS)]
+
+
+QUICK_CELLS = frozenset((tracker, quick_preset(tracker)) for tracker in TRACKER_NAMES)
+"""(tracker, preset) of the default run's cells, whose submissions' digests are checked here."""
+
+
 def _cases() -> list:
-    """Every tracker with one preset in the default run (the presets taken in turn, so each is used; PMBM, the slow
-    one at 2 s per preset and scene, with the most cluttered one); every other pair is marked ``exhaustive``
+    """Every tracker with its ``quick_preset`` in the default run; every other pair is marked ``exhaustive``
     (``-m exhaustive``). Whatever a tracker outputs on any preset is also held byte for byte by
     ``test_submission_digests``."""
     cases = []
-    for i, tracker in enumerate(TRACKER_NAMES):
-        quick = "pointpillars" if tracker == "pmbm" else PRESETS[i % len(PRESETS)]
+    for tracker in TRACKER_NAMES:
+        quick = quick_preset(tracker)
         for preset in PRESETS:
             marks = () if preset == quick else (pytest.mark.exhaustive,)
             cases.append(pytest.param(tracker, preset, marks=marks, id=f"{tracker}-{preset}"))
@@ -67,11 +80,14 @@ CASES = _cases()
 
 
 @pytest.mark.parametrize(("tracker", "preset"), CASES)
-def test_tracker_outputs_are_valid(scenes, tracker, preset):
+def test_tracker_outputs_are_valid(scenes_and_tokens, tracker, preset):
     config = TrackerConfig()
+    scenes, tokens = scenes_and_tokens
+    runs = []
     for scene in scenes:
         sink = ListSink()
-        run = run_tracker(scene, get_detections(scene, None, preset, seed=0), tracker, config, sink=sink)
+        run = run_tracker(scene, get_detections(scene, None, preset, seed=SEED), tracker, config, sink=sink)
+        runs.append(run)
         assert len(run.frames) == len(scene.keyframes)
         n_tracks = 0
         for frame in run.frames:
@@ -103,3 +119,9 @@ def test_tracker_outputs_are_valid(scenes, tracker, preset):
                 assert np.isfinite(ev.weights).all() and (ev.weights >= 0).all(), where
             elif isinstance(ev, Extracted):
                 assert all(e.class_name == ev.class_name for e in ev.estimates), where
+    # The same runs (the sink only listens) give the committed submission, byte for byte.
+    digest = hashlib.sha256(submission_of(runs, tokens)).hexdigest()
+    assert digest == json.loads(DIGESTS_PATH.read_text(encoding="utf-8"))[digest_key(tracker, preset)], (
+        f"{digest_key(tracker, preset)}: the submission changed (if deliberate, regenerate the digests: "
+        "uv run python -m tests.gnnpmb.submission_digests --write)"
+    )

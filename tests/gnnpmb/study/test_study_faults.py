@@ -1,6 +1,6 @@
-"""Faults of issue 22 in a study folder, in real processes on the tiny data: a second grid joins the table (or is
-refused), a damaged cache entry is scored again, outputs get one file mode, and SIGTERM during a Ray sweep keeps
-what finished."""
+"""Faults of issue 22 in a study folder on the tiny data: a second grid joins the table (or is refused), a damaged
+cache entry is scored again, outputs get one file mode (the folder's commands in-process: the folder, not the
+process, is under test), and SIGTERM during a Ray sweep keeps what finished (a real process: the signal is)."""
 
 from __future__ import annotations
 
@@ -8,11 +8,15 @@ import csv
 import json
 import signal
 import stat
+import subprocess
 import time
 from pathlib import Path
 
-from tests.cli.test_faults import _fault_env, _one_line, _run, _start, _wait_for
+import pytest
+
+from tests.cli.test_faults import _fault_env, _one_line, _start, _wait_for
 from tests.cli.test_user_errors import _snapshot
+from tests.inprocess import run_script_with, umask
 
 SWEEP = "gnnpmb sweep --dataroot {root} --out {out} --no-progress --detector pointpillars"
 
@@ -22,10 +26,20 @@ def _rows(out: Path) -> list[dict[str, str]]:
         return list(csv.DictReader(f))
 
 
-def test_a_second_grid_joins_the_table_and_another_study_is_refused(tiny_dataroot: Path, tmp_path: Path) -> None:
+def test_a_second_grid_joins_the_table_and_another_study_is_refused(
+    tiny_dataroot: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     out = tmp_path / "sw"
     env = _fault_env(tiny_dataroot, tmp_path / "cache")
     sweep = SWEEP.format(root=tiny_dataroot, out=out) + " --workers 1"
+
+    def _run(command: str, env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess[str]:
+        with umask(0o022):  # a shell's usual mask, as the real processes had it
+            return run_script_with(command.split(), env, cwd, monkeypatch, capsys)
+
     first = _run(f"{sweep} --param models.birth_weight=0.1,0.3", env, tmp_path)
     assert first.returncode == 0 and first.stderr == "", first.stderr
     second = _run(f"{sweep} --param car.q_x=0.2", env, tmp_path)
