@@ -1,17 +1,18 @@
 """A real-browser check of a saved recording: serve it with Rerun's web viewer, open it in headless Chromium
 and screenshot it once the viewer has taken in the whole recording and the 3D views show the scene.
 
-The recording is served over HTTP from a thread of this process and ``rerun URL --serve-web`` hosts the web viewer
-that opens it (both bound to 127.0.0.1, on free ports). Not ``rerun FILE.rrd --serve-web``: its gRPC proxy spins on
-one core while idle (Rerun 0.41, rerun-io/rerun#10944; 65 s of CPU in one check here), which a 2-core machine
-rendering WebGL in software cannot spare. Chromium runs headless with WebGL2 on SwiftShader (no GPU) and a fresh
-profile; it is driven over the DevTools protocol (``websocket-client``): set the viewport, navigate, then poll
-every few seconds. Ready means, in this order: the viewer's own state (``WebHandle.viewer_state()``, read with
-``read_viewer_state``) shows the recording open with every view of its blueprint and every timeline of the file
-loaded to its last time; the viewer's ingestion-backlog readout is gone; and the 3D-view regions hold many varied,
-non-background pixels (LiDAR points, coloured boxes) in two shots in a row. Pixels alone are not enough: panels can
-still be empty while the 3D views look finished. Both servers run in their own process groups and are killed
-(group-wide) on every exit path; the file server stops with the check.
+The recording is served over HTTP from a thread of this process and ``rerun URL --serve-web`` hosts the web viewer that
+opens it (both bound to 127.0.0.1, on free ports). Not ``rerun FILE.rrd --serve-web``: its gRPC proxy spins on one core
+while idle (Rerun 0.41, rerun-io/rerun#10944; 65 s of CPU in one check here), which a 2-core machine rendering WebGL in
+software cannot spare. Chromium runs headless with WebGL2 on SwiftShader (no GPU) and a fresh profile; it is driven over
+the DevTools protocol (``websocket-client``): navigate at a small viewport (``LOADING_VIEWPORT``), poll the viewer's
+state every few seconds without screenshots until it shows everything loaded, screenshot until the small views look
+rendered, then resize to the full viewport and screenshot until ready. Ready means, in this order: the viewer's own
+state (``WebHandle.viewer_state()``, read with ``read_viewer_state``) shows the recording open with every view of its
+blueprint and every timeline of the file loaded to its last time; the viewer's ingestion-backlog readout is gone; and
+the 3D-view regions hold many varied, non-background pixels (LiDAR points, coloured boxes) in two shots in a row. Pixels
+alone are not enough: panels can still be empty while the 3D views look finished. Both servers run in their own process
+groups and are killed (group-wide) on every exit path; the file server stops with the check.
 
 By hand: ``uv run python -m tools.webcheck FILE.rrd --out shot.png [--views 2]``.
 """
@@ -60,6 +61,17 @@ CHROMIUM_FLAGS: tuple[str, ...] = (
 """Headless Chromium that renders WebGL2 on SwiftShader and talks to nothing but localhost."""
 
 DEFAULT_VIEWPORT = (1920, 1080)
+LOADING_VIEWPORT = (640, 360)
+"""The page's size until the viewer's state shows everything loaded and a shot shows its views rendered at this size;
+then it goes to the full viewport for the pixel checks that decide readiness and for the screenshot. Chromium renders
+WebGL in software (SwiftShader's worker threads in its GPU process take nearly all its CPU) for as long as the viewer
+draws, and at 1920x1080 each frame and shot costs more and the viewer takes longer to take the data in. Measured
+(demo then focus recording in one browser, ``check_recording`` back to back on the shared 2-core machine; Chromium's
+CPU seconds): small until loaded, then full: 79 vs 104, 80 vs 121 and 76 vs 90 at full size throughout; small until
+rendered too (kept): 61 vs 90, 58 vs 95 and 58 vs 115 (wall 40-41 s vs 56-72 s)."""
+SMALL_RENDER_WAIT_S = 30.0
+"""Seconds after the viewer's state showed everything loaded that a small page may take to show its views rendered;
+then the page goes to the full viewport anyway (readiness is decided there)."""
 BACKGROUND_TOLERANCE = 12
 """A pixel is background when each channel is within this of the region's most common colour."""
 SATURATION_MIN = 60
@@ -237,12 +249,13 @@ class RegionStats:
 
 @dataclass(frozen=True, slots=True)
 class WebCheckResult:
-    """Outcome of ``check_recording``: the screenshot written; whether it is ready (the viewer's state shows
-    everything loaded, no backlog, every 3D-view region rendered); seconds from navigation until the viewer's
-    state showed everything loaded, to the first shot with rendered views and to the ready shot (None if
-    never); shots taken; total wall time; the last shot's region stats; the server and browser process
-    groups; the viewer's last state; the CPU seconds Chromium's processes (browser, renderer, GPU: the
-    software WebGL) and the web-viewer server used, read just before they were stopped (``group_cpu_s``)."""
+    """Outcome of ``check_recording``: the screenshot written; whether it is ready (the viewer's state shows everything
+    loaded, no backlog, every 3D-view region rendered); seconds from navigation until the viewer's state showed
+    everything loaded, to the first full-size shot with rendered views (taken once the small views rendered, unless
+    ``loading_viewport`` is None) and to the ready shot (None if never); shots taken; total wall time; the last shot's
+    region stats; the server and browser process groups; the viewer's last state; the CPU seconds Chromium's processes
+    (browser, renderer, GPU: the software WebGL) and the web-viewer server used, read just before they were stopped
+    (``group_cpu_s``)."""
 
     screenshot: Path
     rendered: bool
@@ -527,17 +540,22 @@ def check_recording(
     n_views: int = 2,
     viewport: tuple[int, int] = DEFAULT_VIEWPORT,
     timeout_s: float = 420.0,
-    poll_s: float = 4.0,
+    poll_s: float = 1.0,
     settle_poll_s: float = 1.5,
     chromium: Path = CHROMIUM,
     work_dir: Path | None = None,
     browser: Chromium | None = None,
+    loading_viewport: tuple[int, int] | None = LOADING_VIEWPORT,
 ) -> WebCheckResult:
     """Serve ``rrd`` with Rerun's web viewer, open it in headless Chromium and write a PNG screenshot to
     ``out``.
 
-    Screenshots are taken every ``poll_s`` seconds after navigation, every ``settle_poll_s`` once the viewer's
-    state shows everything loaded (the viewer idles then: a shot costs little, and waiting costs the worker),
+    The page is ``loading_viewport`` in size (the browser's full viewport if None) until the viewer's state,
+    read every ``poll_s`` seconds (a read costs next to nothing; every 1 s rather than 4 s saw the load 2-4 s
+    sooner, and Chromium's CPU for both recordings was 47 and 44 s against 48 and 53 s), shows everything
+    loaded and a shot of it (one every ``settle_poll_s`` seconds) shows every view region rendered; then it is
+    the full viewport and a screenshot is taken every ``settle_poll_s`` seconds (the viewer idles then: a shot
+    costs little, waiting costs the worker),
     until every one of the ``n_views`` 3D-view regions (``view_regions``) looks rendered and the page has settled
     (SETTLED_SHOTS shots in a row without an ingestion backlog), or ``timeout_s`` passes; ``out`` holds the last
     shot either way (so a failure can be looked at). Server logs and the browser profile go to ``work_dir`` (a
@@ -569,10 +587,13 @@ def check_recording(
         devtools = browser.devtools
         cpu_before_s = group_cpu_s(browser.proc.pid)
         url = f"http://127.0.0.1:{web_port}/?url={urllib.parse.quote(rrd_url, safe='')}"
+        if loading_viewport is not None:
+            _set_viewport(devtools, loading_viewport)
         devtools.call("Page.navigate", url=url)
         navigated = time.monotonic()
         boxes = view_regions(width, height, n_views)
         shots, settled = 0, 0
+        small = loading_viewport is not None
         first_rendered: float | None = None
         loaded: float | None = None
         stats: tuple[RegionStats, ...] = ()
@@ -587,10 +608,21 @@ def check_recording(
                     state = read_viewer_state(base64.b64decode(value))
                     if loaded is None and expected.met_by(state):
                         loaded = elapsed
+                if loaded is None and small and elapsed <= timeout_s:
+                    continue
                 png = base64.b64decode(devtools.call("Page.captureScreenshot", format="png")["data"])
             except DevToolsBusy:
                 if elapsed > timeout_s:
                     break
+                continue
+            if small:
+                shots += 1
+                image = decode_png(png)
+                small_boxes = view_regions(image.shape[1], image.shape[0], n_views)
+                rendered_small = all(region_stats(image, b).rendered for b in small_boxes)
+                if rendered_small or elapsed > min(timeout_s, (loaded or 0.0) + SMALL_RENDER_WAIT_S):
+                    _set_viewport(devtools, (width, height))
+                    small = False
                 continue
             shots += 1
             _write_atomic(out, png)
@@ -621,6 +653,11 @@ def check_recording(
         browser_cpu_s,
         server_cpu_s,
     )
+
+
+def _set_viewport(devtools: DevTools, viewport: tuple[int, int]) -> None:
+    width, height = viewport
+    devtools.call("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False)
 
 
 def _write_atomic(path: Path, data: bytes) -> None:

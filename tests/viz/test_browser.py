@@ -2,7 +2,8 @@
 headless Chromium), and the pieces of ``tools.webcheck`` that decide whether a screenshot shows the rendered
 scene. Both recordings open in one Chromium, one after the other: software WebGL compiles the viewer's shaders
 in Chromium's GPU process, and the second recording reuses them (measured here: the focus check took 32 s of
-Chromium's CPU after the demo in the same browser, 58 s in a browser of its own)."""
+Chromium's CPU after the demo in the same browser, 58 s in a browser of its own). Each page loads and first renders at
+a small size, and is checked and shot at 1920x1080 (``tools.webcheck.LOADING_VIEWPORT``)."""
 
 from __future__ import annotations
 
@@ -193,6 +194,8 @@ def test_the_full_demo_recording_loads_and_renders_in_headless_chromium(
     assert result.state.timeline_max["focus"] == report.by_id(report.first_worth_opening()).frame_index
     for pgid in result.process_groups:
         assert group_members(pgid) == [], f"process group {pgid} still has processes"
+    width, height = DEFAULT_VIEWPORT
+    assert decode_png(shot.read_bytes()).shape == (height, width, 3)
 
 
 @pytest.mark.slow
