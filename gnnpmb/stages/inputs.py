@@ -181,23 +181,32 @@ gives 21 (25 ms), with the same peak memory."""
 
 
 def collect_rarely() -> None:
-    """The ``gnnpmb-viz`` script's collector (``cli.app.main``): the first generation collected every
-    ``YOUNG_COLLECTION_THRESHOLD`` allocations, and no full collection before the loaded objects are frozen
-    (``freeze_loaded``). It stays on while loading: switched off, a reference cycle made then was never freed,
-    and one holds much: the devkit's first import (matplotlib, pyparsing) catches exceptions whose tracebacks keep
-    their frames, and the frames their callers' locals (on a cold run the index build's tables): 1.83 against
-    1.54 GB of peak memory on a full-size cold ``gnnpmb-viz`` (``benchmarks/full_scale.py``)."""
-    gc.set_threshold(YOUNG_COLLECTION_THRESHOLD, *gc.get_threshold()[1:])
+    """The ``gnnpmb-viz`` script's collector while it imports and loads (``cli.app.main``): only the young
+    generation, every ``YOUNG_COLLECTION_THRESHOLD`` allocations, until ``freeze_loaded``. Young collections free
+    what a cold run's load leaves in reference cycles: the devkit's first import (matplotlib, pyparsing) catches
+    exceptions whose tracebacks keep their frames, and the frames their callers' locals (the index build's tables);
+    with the collector off they stayed to the end (1.83 against 1.54 GB of peak memory on a full-size cold
+    ``gnnpmb-viz``, ``benchmarks/full_scale.py``). The older generations, which a warm run's load would walk whole
+    (~140,000 objects), are left to the freeze."""
+    gc.set_threshold(YOUNG_COLLECTION_THRESHOLD, LOADING_NEVER, LOADING_NEVER)
+
+
+LOADING_NEVER = 1_000_000_000
+"""An older generation's threshold that is never reached while loading (``collect_rarely``)."""
 
 
 def freeze_loaded() -> None:
     """Move every object alive (the devkit's tables, the scene, the frames) out of the garbage collector's reach
     (``gc.freeze``): they live as long as the process, and a full collection walking them cost ~130 ms in the
     middle of tracking. Objects frozen are still freed by reference counting; only reference cycles among them
-    would outlive their use. With the script's collector (``collect_rarely``) nothing is collected first: the
-    cycles left then are the imports' (~7,300 objects, 1.7 MB on the warm demo), and collecting them walked all
-    140,000 objects for ~85 ms; otherwise (the Python API, tests) garbage is collected first."""
-    if gc.get_threshold()[0] < YOUNG_COLLECTION_THRESHOLD:
+    would outlive their use. With the script's loading collector (``collect_rarely``) nothing is collected first
+    (a full collection walked all 140,000 objects of the warm demo for ~85 ms) and the older generations are
+    collected again from here (CPython's thresholds, the young one kept); otherwise (the Python API, tests)
+    garbage is collected first."""
+    young, older, oldest = gc.get_threshold()
+    if older == LOADING_NEVER:
+        gc.set_threshold(young, 10, 10)
+    else:
         gc.collect()
     gc.freeze()
 

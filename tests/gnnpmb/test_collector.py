@@ -30,7 +30,7 @@ def test_a_cycle_made_while_loading_is_collected_and_the_loaded_objects_are_froz
         kept = _Big()
         freeze_loaded()
         assert gc.get_freeze_count() > 0 and gc.isenabled()
-        assert gc.get_threshold()[0] == YOUNG_COLLECTION_THRESHOLD and kept is not None
+        assert gc.get_threshold() == (YOUNG_COLLECTION_THRESHOLD, 10, 10) and kept is not None
     finally:
         gc.unfreeze()
         gc.set_threshold(*thresholds)
