@@ -185,7 +185,7 @@ def collect_rarely() -> None:
     generation, every ``YOUNG_COLLECTION_THRESHOLD`` allocations, until ``freeze_loaded``. Young collections free
     what a cold run's load leaves in reference cycles: the devkit's first import (matplotlib, pyparsing) catches
     exceptions whose tracebacks keep their frames, and the frames their callers' locals (the index build's tables);
-    with the collector off they stayed to the end (1.83 against 1.54 GB of peak memory on a full-size cold
+    with the collector off they stayed to the end (1.83 against 1.53 GB of peak memory on a full-size cold
     ``gnnpmb-viz``, ``benchmarks/full_scale.py``). The older generations, which a warm run's load would walk whole
     (~140,000 objects), are left to the freeze."""
     gc.set_threshold(YOUNG_COLLECTION_THRESHOLD, LOADING_NEVER, LOADING_NEVER)
