@@ -17,6 +17,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -41,7 +42,7 @@ from viz.blueprint import (
     focus_world,
     reading_guide_doc,
 )
-from viz.callouts import M_PER_PX_PER_HEIGHT, Callout, log_callouts
+from viz.callouts import FOV_Y_DEG, M_PER_PX_PER_HEIGHT, Callout, log_callouts
 from viz.cameras import SCENE_HEIGHT_WITH_CAMERAS
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
@@ -100,13 +101,15 @@ def log_focus(
     gt_ids = set(focus.gt_ids)
     evaluated = evaluated_offsets(focus, reports.get(focus.failure_tracker or ""))
     reach_m = range_near_focus(focus, scene)
-    height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
+    eye_height_m = height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
     if sight is not None:  # a camera view below: the bird's-eye view is shorter, a pixel more metres
         height_m /= SCENE_HEIGHT_WITH_CAMERAS
     if len(loggers) > 1:  # runs compared: the comparison panel takes a share of the scene's height
         height_m /= COMPARED_SCENE_SHARE
     half_view_m = 0.5 * FOCUS_VIEW_WIDTH_PX / max(len(loggers), 1) * M_PER_PX_PER_HEIGHT * height_m
     view_x_m = (focus.center_xy_m[0] - half_view_m, focus.center_xy_m[0] + half_view_m)
+    half_tall_m = eye_height_m * math.tan(math.radians(0.5 * FOV_Y_DEG))  # the eye's vertical field of view
+    view_y_m = (focus.center_xy_m[1] - half_tall_m, focus.center_xy_m[1] + half_tall_m)
     for i in shown:
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
@@ -190,6 +193,7 @@ def log_focus(
                 + ghosts,
                 height_m,
                 view_x_m,
+                view_y_m,
             )
         if meas and detections is not None:
             given = sorted(meas)

@@ -142,6 +142,9 @@ def claims(f: Finding) -> list[Claim]:
             add("born", d.frame, c, d.went, int(ch.meas.ref))
         elif d.went >= 0:
             add("went", d.frame, c, int(ch.meas.ref), "track", d.went, 1.0)
+    for k in f.key_decisions:
+        if k.alternative_took is not None and k.choice.alternative is not None:
+            add("went", k.frame, c, k.alternative_took, "track", int(k.choice.alternative.ref), 1.0)
     if f.switch is not None:
         add("parent", f.switch.frame, c, f.switch.parent)
     if f.false_output is not None:

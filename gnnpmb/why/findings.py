@@ -290,12 +290,15 @@ class HypothesisTrack:
 class KeyDecision:
     """A choice up to the failure that sent a detection away from an involved track that was its next best, or
     gave one to an involved track by a close call: the frame, the choice, and where the detection went
-    (track id, -1: none; born: it started that track)."""
+    (track id, -1: none; born: it started that track); alternative_took: the detection the next best (a track)
+    took in the same assignment, when it took one (its lower cost then did not decide alone: the lower total
+    did), else None."""
 
     frame: int
     choice: PairChoice
     went: int
     born: bool
+    alternative_took: int | None = None
 
 
 @dataclass(frozen=True, slots=True)

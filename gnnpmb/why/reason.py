@@ -24,7 +24,7 @@ from gnnpmb.foreign import BoxOn
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.counterfactual import would_take
-from gnnpmb.why.facts import TrackerFacts, TrackStep
+from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode
 from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
     FRAMES_BEFORE,
@@ -697,8 +697,15 @@ class _Context:
             chosen_involved = c.chosen.kind is AxisKind.TRACK and c.chosen.ref in involved
             if (alt_involved and not chosen_involved) or (chosen_involved and c.close_call):
                 went, is_born = _went(c.chosen, born.get(int(c.meas.ref)))
-                out.append(KeyDecision(f, c, went, is_born))
+                took = self.took(f, int(alt.ref)) if alt is not None and alt.kind is AxisKind.TRACK else None
+                out.append(KeyDecision(f, c, went, is_born, took))
         return tuple(out)
+
+    def took(self, f: int, track_id: int) -> int | None:
+        """The detection track ``track_id`` was assigned at frame ``f`` (None: none, or not an assignment)."""
+        use = self.facts.use(f, self.class_name)
+        step = use.tracks.get(track_id) if use is not None and use.mode is UseMode.ASSIGNED else None
+        return None if step is None else step.dominant
 
     def choices(self) -> Iterator[tuple[int, PairChoice, dict[int, int]]]:
         """(frame, choice, the frame's detection -> track born of it) of every conflict's choice in the window."""

@@ -234,12 +234,16 @@ def _would_have(w: WouldTake, name: str, meas: str) -> str:
     return f"Within d² {w.needed:.{w.digits}f} (instead of {w.now:.{w.digits}f}), {name} would have taken {meas}"
 
 
-def choice_text(frame: int, c: PairChoice, went: int, born: bool) -> str:
+def choice_text(frame: int, c: PairChoice, went: int, born: bool, alternative_took: int | None = None) -> str:
     """One solver choice: ``frame 19: m2 (score 0.75) → **new track 315** (cost 6.75) over track 61 (7.06 at
-    existence 0.05, ±2.6 m, d² 0.1), margin 0.31`` (costs on the tracker's scale)."""
+    existence 0.05, ±2.6 m, d² 0.1), margin 0.31`` (costs on the tracker's scale); with ``alternative_took``,
+    the detection the next best took in the same assignment: ``over track 20 (8.68 ...), which took m6 (the lower
+    total wins), margin 2.01``."""
     other = "(no other)"
     if c.alternative is not None:
         other = f"over {column_name(c.alternative)} ({cost_value(c.alternative_cost, c)}{_brief(c.alternative_terms)})"
+        if alternative_took is not None:
+            other += f", which took {meas_name(alternative_took)} (the lower total wins)"
     terms = c.chosen_terms or c.alternative_terms
     score = f" (score {terms.score:.2f})" if terms is not None and terms.score is not None else ""
     return (
@@ -255,7 +259,7 @@ def cost_named(value: float, c: PairChoice) -> str:
 
 
 def key_text(k: KeyDecision) -> str:
-    return choice_text(k.frame, k.choice, k.went, k.born)
+    return choice_text(k.frame, k.choice, k.went, k.born, k.alternative_took)
 
 
 # How an update used detections.

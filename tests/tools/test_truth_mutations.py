@@ -199,6 +199,18 @@ def test_a_capped_or_wrong_margin_is_caught_and_the_solvers_margin_passes() -> N
     assert [c.kind for c in _found(planted).found] == ["misleading"]
 
 
+def test_what_the_cheaper_next_best_took_instead_is_checked_against_the_assignment() -> None:
+    _, m, a = _world(None)  # TAKEN: m0 goes to track 5 though track 7 is cheaper; track 7 took m1
+    d = explain(m, a)
+    choice = next(ch for c in d.conflicts for ch in c.choices if ch.meas.ref == 0)
+    assert choice.alternative.ref == 7 and choice.alternative_cost < choice.chosen_cost
+    true = "then, " + choice_text(3, choice, int(choice.chosen.ref), False, alternative_took=1).replace("**", "")
+    assert "over track 7 (" in true and "), which took m1 (the lower total wins), margin" in true
+    assert _found(true).found == []
+    planted = true.replace("which took m1", "which took m0")
+    assert [c.kind for c in _found(planted).found] == ["misleading"]
+
+
 @pytest.mark.parametrize("existence", [None, np.array([0.1, 0.5, 0.9])], ids=["gnn", "pmb"])
 @pytest.mark.parametrize("d2", [TAKEN, FREE], ids=["rival taken", "rival free"])
 def test_the_explainers_own_because_holds_when_replayed(d2: np.ndarray, existence: np.ndarray | None) -> None:

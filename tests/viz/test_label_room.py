@@ -56,3 +56,19 @@ def test_when_neither_side_has_room_the_column_goes_where_less_is_cut() -> None:
     chars = np.array([40])  # a column about 12 m wide at 18 m: wider than either side of a 5 m view
     assert column_positions(anchors, chars, 18.0, (-2.0, 3.0))[0, 0] > 0.0  # more room on the right
     assert column_positions(anchors, chars, 18.0, (-3.0, 2.0))[0, 0] < 0.0  # more room on the left
+
+
+def test_in_a_view_too_narrow_for_either_side_the_column_stacks_above_the_objects_inside_the_view() -> None:
+    anchors = np.array([[0.0, 0.0], [1.0, -1.0]])
+    chars = np.array([24, 9])
+    height_m = 16.0
+    half_label_m = 0.5 * CHAR_PX * 24 * M_PER_PX_PER_HEIGHT * height_m
+    view_x_m, view_y_m = (-1.5 * half_label_m, 1.2 * half_label_m), (-8.0, 8.0)  # no side holds a label whole
+    out = column_positions(anchors, chars, height_m, view_x_m, view_y_m)
+    assert np.all(out[:, 1] > anchors[:, 1].max())  # above the objects
+    assert np.all(out[:, 0] - half_label_m >= view_x_m[0]) and np.all(out[:, 0] + half_label_m <= view_x_m[1])
+    assert out[0, 1] > out[1, 1]  # the higher object's label on the upper row
+    low = column_positions(anchors, chars, height_m, view_x_m, (-8.0, 0.5))  # no room above: below
+    assert np.all(low[:, 1] < anchors[:, 1].min()) and np.all(low[:, 1] - 0.5 >= -8.0)
+    side = column_positions(anchors, chars, height_m, view_x_m)  # the view's height unknown: the side cut less
+    assert np.allclose(side[:, 0], side[0, 0]) and side[0, 0] < anchors[:, 0].min()

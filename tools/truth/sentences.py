@@ -120,7 +120,8 @@ COULD_NOT = re.compile(
 )
 CHOICE = re.compile(
     r"frame (\d+): m(\d+)(?: \(score [\d.]+\))? → ([^(]+?) \([^()]*\) "
-    r"(?:over (track \d+|new|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)|\(no other\)), margin (inf|\d+\.\d+)"
+    r"(?:over (track \d+|new|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)"
+    r"(?:, which took m(\d+) \(the lower total wins\))?|\(no other\)), margin (inf|\d+\.\d+)"
     r"((?: [a-zA-Z]+)? or more)?"
 )
 THEFT = re.compile(
@@ -449,11 +450,17 @@ def _check_counterfactuals(x: int, para: str, c: str, raw: RawEvents, out: Tally
 
 
 def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
-    x, meas, alt, printed, at_least = int(m[1]), int(m[2]), m[4], m[5], m[6] is not None
+    x, meas, alt, took, printed, at_least = int(m[1]), int(m[2]), m[4], m[5], m[6], m[7] is not None
     found = raw.deciding(x, c)
     if found is None:
         return
     mat, a = found
+    if took is not None:  # "over track U (...), which took mK": the assignment gave track U detection K
+        t = int(alt.split()[1])
+        out.checked["misleading"] += 1
+        other = [int(r.ref) for r, k in a.pairs if k.kind is AxisKind.TRACK and int(k.ref) == t]
+        if other != [int(took)]:
+            bad("misleading", m[0], f"the assignment of frame {x} gave track {t} {other or 'no detection'}")
     row, col = replay.row_of(mat, meas), replay.chosen_col(mat, a, meas)
     if row is None or col is None:
         return
