@@ -787,8 +787,9 @@ new track had been false), so a run with either did not 'not fail here'."""
 
 
 def _same_place(f: Failure, gt_id: str | None, xy: np.ndarray | None) -> bool:
-    """Whether failure ``f`` is about the object ``gt_id``, or, without one, lies within ``NEAR_M`` of ``xy``."""
-    if gt_id is not None:
+    """Whether failure ``f`` is about the object ``gt_id``, or, without one (or when ``f`` names no object: a
+    false track), lies within ``NEAR_M`` of ``xy``."""
+    if gt_id is not None and f.gt_ids:
         return gt_id in f.gt_ids
     if xy is None:
         return False

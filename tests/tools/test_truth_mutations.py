@@ -359,6 +359,23 @@ def test_an_interpolated_box_said_output_and_a_start_without_a_birth_are_caught(
     assert [c.kind for c in handed] == ["misleading"]
 
 
+def test_another_runs_false_track_near_an_object_the_evaluation_had_no_box_of_is_a_failure_of_its_own() -> None:
+    from tools.truth.scene import Annotation, SceneTruth
+
+    ev, other = _eval(), _eval()
+    other.pred_xy[(C, 3)] = {"5": (0.3, 0.0), "7": (9.0, 0.0)}  # its track 5: a false positive 0.3 m from GT A
+    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (0.0, 0.0), 0)}] * 4)
+    at = Context(C, 3, GT_A, kind="false_track", track=11)  # a false track beside GT A, whose box was dropped
+    planted = "pmbm on the same detections did not have this failure"
+    found = check_text(planted, at, None, ev, scene=scene, others={"pmbm": other}).found
+    assert [c.kind for c in found] == ["other run"]  # what the explainer said before it compared false tracks by place
+    fair = "pmbm on the same detections failed here too"
+    assert check_text(fair, at, None, ev, scene=scene, others={"pmbm": other}).found == []
+    other.pred_xy[(C, 3)] = {"7": (9.0, 0.0)}  # no false positive near GT A: now the other sentence is the lie
+    assert [c.kind for c in check_text(fair, at, None, ev, scene=scene, others={"pmbm": other}).found] == ["other run"]
+    assert check_text(planted, at, None, ev, scene=scene, others={"pmbm": other}).found == []
+
+
 def test_another_runs_false_track_and_an_empty_place_are_checked_where_the_false_box_lies() -> None:
     ev, other = _eval(), _eval()
     ev.boxes[3] = [("11", C, (0.0, 0.0)), ("12", C, (10.0, 0.0))]

@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from tools.truth.scene import NEAR_M
+
 MATCHED = ("MATCH", "SWITCH")
 
 
@@ -60,6 +62,19 @@ class EvalFacts:
 
     def matched_gt(self, class_name: str, frame: int, track_id: str) -> str | None:
         return self.track_to_gt.get((class_name, frame), {}).get(track_id)
+
+    def false_near(self, frame: int, place_xy_m) -> list[str]:
+        """The track ids (any class) the accumulator counted as false positives at ``frame`` with a scored box
+        within ``NEAR_M`` of ``place_xy_m``."""
+        return sorted(
+            t
+            for (k, y), tracks in self.track_to_gt.items()
+            if y == frame
+            for t, g in tracks.items()
+            if g is None
+            and (xy := self.pred_xy.get((k, y), {}).get(t)) is not None
+            and math.dist(xy, place_xy_m) < NEAR_M
+        )
 
 
 def _split_of(nusc, scene_name: str) -> str:

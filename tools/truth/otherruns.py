@@ -67,6 +67,9 @@ def check_others(
             continue
         matched = ev.matched_track(c, x, gt)
         failed = _failed(ev, kind, c, x, gt)
+        if kind == "false_track":  # near an object the evaluation had no box of: a false positive near it
+            a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
+            failed = None if a is None else bool(ev.false_near(x, a.xy_m))
         out.checked["other run"] += 1
         said = m[2]
         if said == "failed here too":
@@ -141,14 +144,6 @@ def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapp
         if ev is None:
             continue
         out.checked["other run"] += 1
-        false = sorted(
-            t
-            for (k, y), tracks in ev.track_to_gt.items()
-            if y == x
-            for t, g in tracks.items()
-            if g is None
-            and (xy := ev.pred_xy.get((k, y), {}).get(t)) is not None
-            and math.hypot(xy[0] - place_xy_m[0], xy[1] - place_xy_m[1]) < NEAR_M
-        )
+        false = ev.false_near(x, place_xy_m)
         if bool(false) != m[2].startswith("had a false"):
             bad("other run", m[0], f"{m[1]}'s false positives within {NEAR_M} m at frame {x}: {false}")
