@@ -20,6 +20,7 @@ import re
 from collections.abc import Mapping
 
 from tools.truth.devkit import EvalFacts
+from tools.truth.fields import failed_here
 from tools.truth.scene import NEAR_M
 
 OTHER = re.compile(
@@ -33,28 +34,6 @@ MATCHED_TO = re.compile(r"track (\d+) to (?:(\w+) GT (\w+)|no object)")
 LOST_KINDS = ("id_switch", "identity_theft", "fragmentation")
 
 
-def _failed(ev: EvalFacts, kind: str, c: str, x: int, gt: str) -> bool | None:
-    """Whether the other run had a failure of ``kind`` on ``gt`` at ``x`` by the devkit's events (None: unknown)."""
-    here = ev.gt_to_track.get((c, x), {})
-    if gt not in here:
-        return None
-    if kind == "miss":
-        return here[gt] is None
-    if kind in ("id_switch", "identity_theft"):
-        return gt in ev.switches.get((c, x), set())
-    if kind == "fragmentation":  # the devkit's FRAG: tracked, then missed here, tracked again later
-        present = sorted(y for (k, y), objs in ev.gt_to_track.items() if k == c and gt in objs)
-        before = [y for y in present if y < x]
-        after = [y for y in present if y > x]
-        return (
-            here[gt] is None
-            and bool(before)
-            and ev.matched_track(c, before[-1], gt) is not None
-            and any(ev.matched_track(c, y, gt) is not None for y in after)
-        )
-    return None
-
-
 def check_others(
     text: str, kind: str, c: str, x: int, gt: str | None, others: Mapping[str, EvalFacts], scene, out, bad
 ) -> None:
@@ -66,10 +45,11 @@ def check_others(
         if ev is None:
             continue
         matched = ev.matched_track(c, x, gt)
-        failed = _failed(ev, kind, c, x, gt)
+        a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
         if kind == "false_track":  # near an object the evaluation had no box of: a false positive near it
-            a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
-            failed = None if a is None else bool(ev.false_near(x, a.xy_m))
+            failed = None if a is None else failed_here(ev, kind, c, x, gt, a.xy_m)
+        else:  # None: the evaluation scored no box of the object here (nothing to decide)
+            failed = failed_here(ev, kind, c, x, gt, None) if gt in ev.gt_to_track.get((c, x), {}) else None
         out.checked["other run"] += 1
         said = m[2]
         if said == "failed here too":
