@@ -24,7 +24,9 @@ from gnnpmb.types import TRACKING_CLASSES, Boxes, FrameDetections, TrackEstimate
 
 @dataclass(frozen=True, slots=True)
 class FrameResult:
-    """One keyframe's preprocessed detections, the tracker's output, and the tracker's step time."""
+    """One keyframe's preprocessed detections, the tracker's output, and the tracker's step time (at the first
+    keyframe it includes making the seven per-class filters, ``tracker.MultiClassTracker``: 0.03 to 1.5 ms
+    measured, and 0.1 to 0.2 s more in a process that has not imported the tracker's module yet)."""
 
     keyframe: Keyframe
     detections: FrameDetections

@@ -435,11 +435,14 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         p = self.params
         box = BoxShapeModel(p.heading_std_rad, p.size_log_std, p.size_log_spread, p.box_outlier_prob)
         self.box = box if box.enabled else None
-        model = motion_model(0.0, self.class_params, self.models, self.params.measure_velocity == 1)
-        self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty(model.state_dim))]
         self.frame_serial = 0
         self.miss_counts = MissDetectionCounts.empty(self.params.miss_p_detect_bins)
-        self.birth_update = birth_update(birth_covariance(self.models, self.turn_rate), model.R)
+        state_dim = STATE_DIM + int(self.turn_rate)  # [x, y, vx, vy], and omega for the coordinated turn
+        self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty(state_dim))]
+        self.birth_update = birth_update(
+            birth_covariance(self.models, self.turn_rate),
+            motion_model(0.0, self.class_params, self.models, self.params.measure_velocity == 1).R,
+        )
 
     @property
     def panels(self) -> tuple[Panel, ...]:
