@@ -87,12 +87,17 @@ def test_iou_square_rotated_45_degrees():
     assert iou_of((0, 0, 0, 2, 2, 1, 0), (1 + np.sqrt(2), 0, 0, 2, 2, 1, np.pi / 4)) == pytest.approx(0.0)
 
 
+def _random_pairs(seed: int, n: int, dims: int, centre_m: float, size_m: tuple[float, float]) -> tuple[np.ndarray, ...]:
+    """Two sets of ``n`` random boxes, centres (n, dims) within +-``centre_m``, sizes (n, dims) in ``size_m``, yaws
+    (n,) in +-pi: (centres a, centres b, sizes a, sizes b, yaws a, yaws b)."""
+    rng = np.random.default_rng(seed)
+    centres = rng.uniform(-centre_m, centre_m, (n, dims)), rng.uniform(-centre_m, centre_m, (n, dims))
+    sizes = rng.uniform(*size_m, (n, dims)), rng.uniform(*size_m, (n, dims))
+    return *centres, *sizes, rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+
+
 def test_intersection_area_matches_shapely():
-    rng = np.random.default_rng(7)
-    n = 3000
-    xy_a, xy_b = rng.uniform(-3, 3, (n, 2)), rng.uniform(-3, 3, (n, 2))
-    s_a, s_b = rng.uniform(0.3, 6, (n, 2)), rng.uniform(0.3, 6, (n, 2))
-    y_a, y_b = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+    xy_a, xy_b, s_a, s_b, y_a, y_b = _random_pairs(7, 3000, 2, 3.0, (0.3, 6.0))
     # Degenerate cases: identical boxes, and axis-aligned boxes sharing edge directions.
     xy_b[:200], s_b[:200], y_b[:200] = xy_a[:200], s_a[:200], y_a[:200]
     y_a[200:400] = y_b[200:400] = 0.0
@@ -102,11 +107,7 @@ def test_intersection_area_matches_shapely():
 
 
 def test_iou_3d_symmetric_and_bounded():
-    rng = np.random.default_rng(3)
-    n = 500
-    t_a, t_b = rng.uniform(-2, 2, (n, 3)), rng.uniform(-2, 2, (n, 3))
-    s_a, s_b = rng.uniform(0.5, 4, (n, 3)), rng.uniform(0.5, 4, (n, 3))
-    y_a, y_b = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+    t_a, t_b, s_a, s_b, y_a, y_b = _random_pairs(3, 500, 3, 2.0, (0.5, 4.0))
     ab = iou_3d(t_a, s_a, y_a, t_b, s_b, y_b)
     np.testing.assert_allclose(ab, iou_3d(t_b, s_b, y_b, t_a, s_a, y_a), atol=1e-12)
     assert np.all((ab >= 0) & (ab <= 1))
