@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from gnnpmb.events import AxisKind, Born
 from tools.truth import costs, detector, hypotheses, lost, otherruns, output, place, replay, shares
 from tools.truth.devkit import EvalFacts
+from tools.truth.printing import BECAUSE
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import SceneTruth
 
@@ -100,7 +101,6 @@ class Tally:
 
 _NUM = r"[-\d.e+]+"
 GONE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it; track (\d+) was gone\)")
-BECAUSE = re.compile(r"Because \(frame (\d+)[^)]*\): (.*)")
 OUTSIDE = re.compile(r"m(\d+) was outside the gate of track (\d+), which had the object")
 WITHIN = re.compile(rf"Within d² ({_NUM}) \(instead of ({_NUM})\), track (\d+) would have taken m(\d+)")
 ABOVE = re.compile(
