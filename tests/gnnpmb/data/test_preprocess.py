@@ -4,12 +4,12 @@ import shapely
 
 from gnnpmb.config import PreprocessParams
 from gnnpmb.data.boxes3d import (
+    UprightBoxes,
     bev_corners,
-    box_corners_3d,
     convex_intersection_area,
     iou_3d,
+    iou_3d_pairs,
     overlap_candidates,
-    pairwise_iou_3d,
     quat_wxyz_from_yaw,
     yaw_from_quat_wxyz,
 )
@@ -32,6 +32,17 @@ def make_boxes(rows, classes=None, scores=None) -> Boxes:
     )
 
 
+def pairwise_iou_3d(translation_m: np.ndarray, size_wlh_m: np.ndarray, quat_wxyz: np.ndarray) -> np.ndarray:
+    """(N, N) symmetric 3D IoU matrix of N boxes (diagonal 1 for boxes with a volume)."""
+    boxes = UprightBoxes.of(translation_m, size_wlh_m, yaw_from_quat_wxyz(quat_wxyz))
+    n = len(boxes)
+    out = np.zeros((n, n))
+    i, j = overlap_candidates(boxes.centre, boxes.size_wlh)
+    out[i, j] = out[j, i] = iou_3d_pairs(boxes, boxes, i, j)
+    out[np.arange(n), np.arange(n)] = (np.prod(boxes.size_wlh, axis=1) > 0).astype(float)
+    return out
+
+
 def iou_of(a, b) -> float:
     boxes = make_boxes([a, b])
     return float(pairwise_iou_3d(boxes.translation_m, boxes.size_wlh_m, boxes.quat_wxyz)[0, 1])
@@ -50,14 +61,6 @@ def test_bev_corners_follow_heading():
     np.testing.assert_allclose(corners, [[9.0, 7.0], [9.0, 3.0], [11.0, 3.0], [11.0, 7.0]], atol=1e-12)
     signed_area = 0.5 * np.sum(corners[:, 0] * np.roll(corners[:, 1], -1) - np.roll(corners[:, 0], -1) * corners[:, 1])
     assert signed_area == pytest.approx(8.0)  # counter-clockwise
-
-
-def test_box_corners_3d_bottom_then_top():
-    corners = box_corners_3d(np.array([[0.0, 0.0, 1.0]]), np.array([[2.0, 4.0, 2.0]]), quat_wxyz_from_yaw([0.0]))
-    assert corners.shape == (1, 8, 3)
-    np.testing.assert_allclose(corners[0, :4, 2], 0.0)
-    np.testing.assert_allclose(corners[0, 4:, 2], 2.0)
-    np.testing.assert_allclose(corners[0, 0], [2.0, 1.0, 0.0])
 
 
 def test_iou_identical_boxes_is_one():
