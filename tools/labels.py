@@ -80,10 +80,6 @@ class View3D:
     """Width and height of the view's content at 1920 x 1080, laid out from the blueprint (``layout_px``)."""
 
     @property
-    def birds_eye(self) -> bool:
-        return self.name.endswith("bird's-eye")
-
-    @property
     def camera(self) -> bool:
         """A 2D view on a camera (its origin a pinhole entity, ``world/ego_vehicle/CAM_*``)."""
         return self.eye is None and "/CAM_" in self.origin

@@ -156,16 +156,6 @@ def _band_hue(u: np.ndarray) -> np.ndarray:
     return starts[band] + (u - edges[band]) * widths.sum()
 
 
-def hue_of(rgb: np.ndarray) -> np.ndarray:
-    """(N,) hue in [0, 1) of (N, 3) RGB colours (0-255); 0 for greys."""
-    c = np.asarray(rgb, dtype=np.float64).reshape(-1, 3) / 255.0
-    mx, mn = c.max(axis=1), c.min(axis=1)
-    d = np.where(mx > mn, mx - mn, 1.0)
-    r, g, b = c.T
-    h = np.where(mx == r, np.mod((g - b) / d, 6.0), np.where(mx == g, (b - r) / d + 2.0, (r - g) / d + 4.0))
-    return np.where(mx > mn, h / 6.0, 0.0)
-
-
 def _hsv_to_rgb(h: np.ndarray, s: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(N, 3) RGB in [0, 1] from (N,) hue, saturation, value in [0, 1] (standard hexcone model)."""
     k = np.mod(np.array([5.0, 3.0, 1.0])[None, :] + h[:, None] * 6.0, 6.0)

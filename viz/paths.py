@@ -9,6 +9,8 @@ so several trackers fit in one recording and a view can show one of them with a 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 ROOT = "/"
 WORLD = "world"
 EGO = f"{WORLD}/ego_vehicle"
@@ -55,25 +57,39 @@ def tracker_world(tracker: str) -> str:
     return f"{WORLD_TRACKERS}/{_name(tracker)}"
 
 
-def focus_callouts(tracker: str) -> str:
-    """Points3D labels and leader lines of a focus recording's involved objects in one tracker's views."""
-    return f"{tracker_world(tracker)}/focus/callouts"
+# Non-spatial, per tracker.
+def tracker_root(tracker: str) -> str:
+    return f"{TRACKERS}/{_name(tracker)}"
 
 
-def tracks(tracker: str, class_name: str) -> str:
-    """Parent of the extracted tracks of one class (one entity per track, ``track``)."""
-    return f"{tracker_world(tracker)}/tracks/{_name(class_name)}"
+@dataclass(frozen=True, slots=True)
+class Family:
+    """A tracker's entities of one kind: ``root(tracker)`` holds them all (a view's origin, or one entity alone),
+    one per class (``family(tracker, class_name)``) or per class and track (``family.track(tracker, class_name,
+    track_id)``); under ``tracker_world`` (spatial, global frame) or ``tracker_root`` (plots, tensors, logs)."""
+
+    part: str
+    spatial: bool = False
+
+    def root(self, tracker: str) -> str:
+        return f"{tracker_world(tracker) if self.spatial else tracker_root(tracker)}/{self.part}"
+
+    def __call__(self, tracker: str, class_name: str) -> str:
+        return f"{self.root(tracker)}/{_name(class_name)}"
+
+    def track(self, tracker: str, class_name: str, track_id: int) -> str:
+        return f"{self(tracker, class_name)}/{int(track_id)}"
 
 
-def track(tracker: str, class_name: str, track_id: int) -> str:
-    """One extracted track: its Boxes3D (while it is reported) and its trail (LineStrips3D of recent
-    positions); one entity per track, so a click selects it and hover names it."""
-    return f"{tracks(tracker, class_name)}/{int(track_id)}"
-
-
-def predicted(tracker: str, class_name: str) -> str:
-    """Points3D of the predicted means (prior) of the tracks of one class worth a gate (not candidates)."""
-    return f"{tracker_world(tracker)}/predicted/{_name(class_name)}"
+focus_callouts = Family("focus/callouts", spatial=True).root
+"""Points3D labels and leader lines of a focus recording's involved objects in one tracker's views."""
+tracks = Family("tracks", spatial=True)
+"""Parent of the extracted tracks of one class (one entity per track, ``track``)."""
+track = tracks.track
+"""One extracted track: its Boxes3D (while it is reported) and its trail (LineStrips3D of recent positions); one
+entity per track, so a click selects it and hover names it."""
+predicted = Family("predicted", spatial=True)
+"""Points3D of the predicted means (prior) of the tracks of one class worth a gate (not candidates)."""
 
 
 def predicted_focus(tracker: str, class_name: str) -> str:
@@ -82,165 +98,71 @@ def predicted_focus(tracker: str, class_name: str) -> str:
     return f"{predicted(tracker, class_name)}/focus"
 
 
-def candidates_world(tracker: str, class_name: str) -> str:
-    """Points3D of the predicted means of candidate Bernoullis (low existence, e.g. born on clutter); hidden by
-    default in the views, one click away."""
-    return f"{tracker_world(tracker)}/candidates/{_name(class_name)}"
-
-
-def associations(tracker: str, class_name: str) -> str:
-    """LineStrips3D: one line per chosen (track, detection) pair, from the track's predicted position to the
-    detection, in the track's colour."""
-    return f"{tracker_world(tracker)}/associations/{_name(class_name)}"
-
-
-def weak_associations(tracker: str, class_name: str) -> str:
-    """LineStrips3D: dimmed lines for (track, detection) pairs a soft update used with a share below one half
-    (an association probability or PHD weight, in the label)."""
-    return f"{tracker_world(tracker)}/associations_weak/{_name(class_name)}"
-
-
-def gated_pairs(tracker: str, class_name: str) -> str:
-    """LineStrips3D: dimmed lines for (track, detection) pairs inside the gate that the solver did not choose."""
-    return f"{tracker_world(tracker)}/gated_pairs/{_name(class_name)}"
-
-
-def gates(tracker: str, class_name: str) -> str:
-    """LineStrips3D of the gate ellipses of one class."""
-    return f"{tracker_world(tracker)}/gates/{_name(class_name)}"
-
-
-def failures_world(tracker: str, kind: str) -> str:
-    """3D markers of one kind of tracking failure (e.g. id switches, false tracks)."""
-    return f"{tracker_world(tracker)}/failures/{_name(kind)}"
-
-
-# Non-spatial, per tracker.
-def tracker_root(tracker: str) -> str:
-    return f"{TRACKERS}/{_name(tracker)}"
-
-
-def failure_index_doc(tracker: str) -> str:
-    """TextDocument: a run's failures with their ``--focus`` ids (``viz.opening``; static)."""
-    return f"{tracker_root(tracker)}/failure_index"
-
-
-def decisions(tracker: str) -> str:
-    """TextDocument: the frame's conflicts per class, chosen pairs, best alternatives and margins."""
-    return f"{tracker_root(tracker)}/decisions"
-
-
-def decision_matrix(tracker: str) -> str:
-    """2D: the conflicts' cost cells (Boxes2D labelled with their cost), row and column labels, chosen cells."""
-    return f"{tracker_root(tracker)}/decision_matrix"
-
-
-def existence_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/existence"
-
-
-def existence(tracker: str, class_name: str, track_id: int) -> str:
-    """Scalars: the existence probability of one track over time."""
-    return f"{existence_root(tracker)}/{_name(class_name)}/{int(track_id)}"
+candidates_world = Family("candidates", spatial=True)
+"""Points3D of the predicted means of candidate Bernoullis (low existence, e.g. born on clutter); hidden by default
+in the views, one click away."""
+associations = Family("associations", spatial=True)
+"""LineStrips3D: one line per chosen (track, detection) pair, from the track's predicted position to the detection,
+in the track's colour."""
+weak_associations = Family("associations_weak", spatial=True)
+"""LineStrips3D: dimmed lines for (track, detection) pairs a soft update used with a share below one half (an
+association probability or PHD weight, in the label)."""
+gated_pairs = Family("gated_pairs", spatial=True)
+"""LineStrips3D: dimmed lines for (track, detection) pairs inside the gate that the solver did not choose."""
+gates = Family("gates", spatial=True)
+"""LineStrips3D of the gate ellipses of one class."""
+failures_world = Family("failures", spatial=True)
+"""3D markers of one kind of tracking failure (e.g. id switches, false tracks), one entity per kind."""
+failure_index_doc = Family("failure_index").root
+"""TextDocument: a run's failures with their ``--focus`` ids (``viz.opening``; static)."""
+decisions = Family("decisions").root
+"""TextDocument: the frame's conflicts per class, chosen pairs, best alternatives and margins."""
+decision_matrix = Family("decision_matrix").root
+"""2D: the conflicts' cost cells (Boxes2D labelled with their cost), row and column labels, chosen cells."""
+involved_story = Family("involved_story").root
+"""TextLog of a focus recording: the story lines of one tracker that name an involved track."""
+_EXISTENCE = Family("existence")
+existence_root = _EXISTENCE.root
+existence = _EXISTENCE.track
+"""Scalars: the existence probability of one track over time."""
 
 
 def extraction_threshold(tracker: str, class_name: str) -> str:
     """Scalars: the existence a Bernoulli of this class needs to be reported, drawn beside the existence lines."""
-    return f"{existence_root(tracker)}/{_name(class_name)}/threshold"
+    return f"{_EXISTENCE(tracker, class_name)}/threshold"
 
 
-def nis_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/nis"
-
-
-def nis(tracker: str, class_name: str, track_id: int) -> str:
-    """Scalars: normalised innovation squared (z - H m)^T S^-1 (z - H m) of the detection a track was given."""
-    return f"{nis_root(tracker)}/{_name(class_name)}/{int(track_id)}"
-
-
-def chosen_cost_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/chosen_cost"
-
-
-def chosen_cost(tracker: str, class_name: str, track_id: int) -> str:
-    """Scalars: the assignment cost of the pair chosen for a track (lower = more likely)."""
-    return f"{chosen_cost_root(tracker)}/{_name(class_name)}/{int(track_id)}"
-
-
-def candidates_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/candidates"
-
-
-def candidate_count(tracker: str, class_name: str) -> str:
-    """Scalars: how many candidate Bernoullis (never output as tracks) a class holds per frame; their
-    individual series would be thousands of short lines (and chunks)."""
-    return f"{candidates_root(tracker)}/{_name(class_name)}"
-
-
-def events_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/events"
-
-
-def involved_story(tracker: str) -> str:
-    """TextLog of a focus recording: the story lines of one tracker that name an involved track."""
-    return f"{tracker_root(tracker)}/involved_story"
-
-
-def events(tracker: str, class_name: str) -> str:
-    """TextLog of births, prunings, assignments, confirmations and merges of one class."""
-    return f"{events_root(tracker)}/{_name(class_name)}"
-
-
-def hypotheses_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/hypotheses"
-
-
-def hypothesis_weights(tracker: str, class_name: str) -> str:
-    """Scalars: log weights of the best PMBM global hypotheses of one class, one line per rank (h0, h1, ...)."""
-    return f"{hypotheses_root(tracker)}/{_name(class_name)}"
-
-
-def marginals(tracker: str, class_name: str) -> str:
-    """Tensor of marginal association probabilities (TO-PMB, JPDA)."""
-    return f"{tracker_root(tracker)}/marginals/{_name(class_name)}"
-
-
-def cardinality_pmf_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/cardinality/pmf"
-
-
-def cardinality_pmf(tracker: str, class_name: str) -> str:
-    """BarChart of the CPHD cardinality distribution."""
-    return f"{cardinality_pmf_root(tracker)}/{_name(class_name)}"
-
-
-def cardinality_mean_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/cardinality/expected"
-
-
-def cardinality_mean(tracker: str, class_name: str) -> str:
-    """Scalars: expected number of targets under the CPHD cardinality distribution."""
-    return f"{cardinality_mean_root(tracker)}/{_name(class_name)}"
-
-
-def intensity_weights_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/intensity/weights"
-
-
-def intensity_weights(tracker: str, class_name: str) -> str:
-    """BarChart of GM-PHD / CPHD component weights."""
-    return f"{intensity_weights_root(tracker)}/{_name(class_name)}"
-
-
-def intensity_total_root(tracker: str) -> str:
-    return f"{tracker_root(tracker)}/intensity/total"
-
-
-def intensity_total(tracker: str, class_name: str) -> str:
-    """Scalars: total intensity weight (the PHD's expected number of targets)."""
-    return f"{intensity_total_root(tracker)}/{_name(class_name)}"
-
-
-def failure_count(tracker: str, kind: str) -> str:
-    """Scalars: number of failures of one kind per frame."""
-    return f"{tracker_root(tracker)}/failures/{_name(kind)}"
+_NIS = Family("nis")
+nis_root = _NIS.root
+nis = _NIS.track
+"""Scalars: normalised innovation squared (z - H m)^T S^-1 (z - H m) of the detection a track was given."""
+_CHOSEN_COST = Family("chosen_cost")
+chosen_cost_root = _CHOSEN_COST.root
+chosen_cost = _CHOSEN_COST.track
+"""Scalars: the assignment cost of the pair chosen for a track (lower = more likely)."""
+candidate_count = Family("candidates")
+"""Scalars: how many candidate Bernoullis (never output as tracks) a class holds per frame; their individual series
+would be thousands of short lines (and chunks)."""
+candidates_root = candidate_count.root
+events = Family("events")
+"""TextLog of births, prunings, assignments, confirmations and merges of one class."""
+events_root = events.root
+hypothesis_weights = Family("hypotheses")
+"""Scalars: log weights of the best PMBM global hypotheses of one class, one line per rank (h0, h1, ...)."""
+hypotheses_root = hypothesis_weights.root
+marginals = Family("marginals")
+"""Tensor of marginal association probabilities (TO-PMB, JPDA)."""
+cardinality_pmf = Family("cardinality/pmf")
+"""BarChart of the CPHD cardinality distribution."""
+cardinality_pmf_root = cardinality_pmf.root
+cardinality_mean = Family("cardinality/expected")
+"""Scalars: expected number of targets under the CPHD cardinality distribution."""
+cardinality_mean_root = cardinality_mean.root
+intensity_weights = Family("intensity/weights")
+"""BarChart of GM-PHD / CPHD component weights."""
+intensity_weights_root = intensity_weights.root
+intensity_total = Family("intensity/total")
+"""Scalars: total intensity weight (the PHD's expected number of targets)."""
+intensity_total_root = intensity_total.root
+failure_count = Family("failures")
+"""Scalars: number of failures of one kind per frame, one entity per kind."""

@@ -63,16 +63,6 @@ def bev_corners(xy: np.ndarray, size_wl_m: np.ndarray, yaw_rad: np.ndarray) -> n
     return np.stack([x, y], axis=-1)
 
 
-def box_corners_3d(translation_m: np.ndarray, size_wlh_m: np.ndarray, quat_wxyz: np.ndarray) -> np.ndarray:
-    """(N, 8, 3) corners of N boxes: 4 bottom corners (counter-clockwise from front-left), then 4 top ones."""
-    t = np.asarray(translation_m, dtype=float)
-    size = np.asarray(size_wlh_m, dtype=float)
-    bev = bev_corners(t[:, :2], size[:, :2], yaw_from_quat_wxyz(quat_wxyz))
-    z_bottom = np.repeat((t[:, 2] - 0.5 * size[:, 2])[:, None, None], 4, axis=1)
-    z_top = z_bottom + size[:, 2][:, None, None]
-    return np.concatenate([np.concatenate([bev, z_bottom], -1), np.concatenate([bev, z_top], -1)], axis=1)
-
-
 def _inside_convex(
     px: np.ndarray, py: np.ndarray, vx: np.ndarray, vy: np.ndarray, ex: np.ndarray, ey: np.ndarray
 ) -> np.ndarray:
@@ -236,17 +226,6 @@ def overlap_candidates(
     i, j = np.nonzero(near)
     upper = i < j
     return i[upper], j[upper]
-
-
-def pairwise_iou_3d(translation_m: np.ndarray, size_wlh_m: np.ndarray, quat_wxyz: np.ndarray) -> np.ndarray:
-    """(N, N) symmetric 3D IoU matrix of N boxes (diagonal 1 for boxes with a volume)."""
-    boxes = UprightBoxes.of(translation_m, size_wlh_m, yaw_from_quat_wxyz(quat_wxyz))
-    n = len(boxes)
-    out = np.zeros((n, n))
-    i, j = overlap_candidates(boxes.centre, boxes.size_wlh)
-    out[i, j] = out[j, i] = iou_3d_pairs(boxes, boxes, i, j)
-    out[np.arange(n), np.arange(n)] = (np.prod(boxes.size_wlh, axis=1) > 0).astype(float)
-    return out
 
 
 def of_arrays(pairs: Callable[[UprightBoxes, UprightBoxes, np.ndarray, np.ndarray], np.ndarray], doc: str):

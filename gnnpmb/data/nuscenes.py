@@ -182,11 +182,6 @@ def open_nuscenes(location: DatasetLocation) -> NuScenes:
     return _OPENED[key]
 
 
-def list_scenes(nusc: NuScenes) -> list[str]:
-    """Scene names in table order."""
-    return [s["name"] for s in nusc.scene]
-
-
 _INDEXES: dict[tuple[Path, str], DatasetIndex] = {}
 
 

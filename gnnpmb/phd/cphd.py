@@ -84,34 +84,6 @@ def _esf_tables(log_x: np.ndarray, order: int) -> tuple[np.ndarray, np.ndarray]:
     return tables[0], tables[1][::-1]
 
 
-def log_esf(log_x: np.ndarray, order: int) -> np.ndarray:
-    """(order + 1,) log e_j(x), j = 0..order, of x = exp(log_x) (M,); -inf where e_j = 0 (j > M)."""
-    out = np.full(order + 1, -np.inf)
-    out[0] = 0.0
-    for lx in np.asarray(log_x, dtype=float).tolist():
-        out[1:] = np.logaddexp(out[1:], lx + out[:-1])
-    return out
-
-
-def log_esf_leave_one_out(log_x: np.ndarray, order: int) -> np.ndarray:
-    """(M, order + 1) log e_j(x without x_i): the convolution of the prefix ESF of x_0..x_{i-1} and the suffix
-    ESF of x_{i+1}..x_{M-1}, e_j^(-i) = sum_k e_k(pre_i) e_{j-k}(suf_{i+1})."""
-    return _leave_one_out(*_esf_tables(np.asarray(log_x, dtype=float), order))
-
-
-def _leave_one_out_terms(pre: np.ndarray, suf: np.ndarray) -> np.ndarray:
-    """(M, J, K) log e_k(x_0..x_{i-1}) + log e_{j-k}(x_{i+1}..x_{M-1}), -inf where k > j (J = K = order + 1)."""
-    lag, valid = _lags(pre.shape[1] - 1)
-    terms = pre[:-1, None, :] + suf[1:][:, lag]
-    terms[:, ~valid] = -np.inf
-    return terms
-
-
-def _leave_one_out(pre: np.ndarray, suf: np.ndarray) -> np.ndarray:
-    """(M, order + 1) leave-one-out log-ESFs from the prefix and suffix tables of ``_esf_tables``."""
-    return log_sum_exp(_leave_one_out_terms(pre, suf), axis=2)
-
-
 def _contract_leave_one_out(pre: np.ndarray, log_x: np.ndarray, log_gamma: np.ndarray) -> np.ndarray:
     """(M,) log sum_j gamma_j e_j(x without x_i), in O(M N) instead of the O(M N^2) of expanding every
     leave-one-out ESF.

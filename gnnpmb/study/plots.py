@@ -60,11 +60,29 @@ def _numeric(values: Sequence[Any]) -> bool:
     return all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
 
 
+def _pyplot() -> Any:
+    """``matplotlib.pyplot`` drawing off screen (Agg), imported only by a study that plots."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
 def _save(fig: Any, path: Path) -> None:
+    """Write ``fig`` to ``path`` (a PNG, atomically) and close it."""
     from gnnpmb.atomic import atomic_path
 
     with atomic_path(path, ".png") as tmp:
         fig.savefig(tmp, dpi=110)
+    _pyplot().close(fig)
+
+
+def _mark_base(ax: Any, base: Any) -> None:
+    """A dotted grey line at the key's base value (none without one)."""
+    if base is not None:
+        ax.axvline(base, color="grey", linestyle=":", linewidth=1)
 
 
 def plot_file_name(key: str) -> str:
@@ -81,11 +99,7 @@ def plot_sweep(
     title: str,
 ) -> list[Path]:
     """One PNG per swept key in ``out_dir``: overall AMOTA (bold) and each class's AMOTA against the key."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = _pyplot()
     written = []
     for key in keys:
         fig, ax = plt.subplots(figsize=(7.0, 4.2))
@@ -107,8 +121,7 @@ def plot_sweep(
             ax.plot(xs(overall), [s for _, s in overall], marker="s", color="black", linewidth=2.5, label="overall")
         if numeric:
             _scale_x(ax, values)
-            if base_values.get(key) is not None:
-                ax.axvline(base_values[key], color="grey", linestyle=":", linewidth=1)
+            _mark_base(ax, base_values.get(key))
         else:
             ax.set_xticks(range(len(values)), [str(v) for v in values])
         ax.set_xlabel(key)
@@ -119,7 +132,6 @@ def plot_sweep(
         fig.tight_layout()
         path = Path(out_dir) / plot_file_name(key)
         _save(fig, path)
-        plt.close(fig)
         written.append(path)
     return written
 
@@ -132,11 +144,7 @@ def plot_ablation(
     title: str,
 ) -> Path:
     """All keys of a one-at-a-time study in one figure (one panel per key, overall AMOTA and per class)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = _pyplot()
     fig, axes = plt.subplots(1, len(keys), figsize=(3.6 * len(keys), 3.6), sharey=True, squeeze=False)
     for ax, key in zip(axes[0], keys, strict=True):
         for class_name in TRACKING_CLASSES:
@@ -150,8 +158,7 @@ def plot_ablation(
             [v for v, _ in overall], [s for _, s in overall], marker="s", color="black", linewidth=2.5, label="overall"
         )
         _scale_x(ax, [v for v, _ in overall])
-        if base_values.get(key) is not None:
-            ax.axvline(base_values[key], color="grey", linestyle=":", linewidth=1)
+        _mark_base(ax, base_values.get(key))
         ax.set_xlabel(key)
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel("AMOTA")
@@ -161,5 +168,4 @@ def plot_ablation(
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     _save(fig, path)
-    plt.close(fig)
     return path

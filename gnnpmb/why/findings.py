@@ -219,10 +219,6 @@ class LostTrack:
     def step(self, frame: int) -> TrackStep | None:
         return next((s for s in self.steps if s.frame == frame), None)
 
-    @property
-    def output_frames(self) -> tuple[int, ...]:
-        return tuple(s.frame for s in self.steps if s.output is not None)
-
 
 @dataclass(frozen=True, slots=True)
 class Origin:

@@ -23,7 +23,7 @@ import pytest
 
 from gnnpmb import atomic
 from gnnpmb.data.demo import GENERATOR_VERSION
-from tests.cli.test_user_errors import BIN, VIZ, _env, _snapshot, _work_folder
+from tests.cli.test_user_errors import BIN, VIZ, _env, _snapshot, _start, _work_folder
 from tests.gnnpmb.study.test_runner import FakeHead
 from tests.inprocess import run_script_with, umask
 
@@ -33,18 +33,6 @@ QUICK_VIZ = f"{VIZ} scene-0103 --tracker gnn --frames 0:3 --no-failures --no-pro
 def _fault_env(demo: Path, cache: Path, **extra: str) -> dict[str, str]:
     env = _env(demo) | {"GNNPMB_CACHE_DIR": str(cache), "PATH": f"{BIN}{os.pathsep}{os.environ['PATH']}"}
     return env | extra
-
-
-def _start(argv: list[str], env: dict[str, str], cwd: Path) -> subprocess.Popen[str]:
-    return subprocess.Popen(
-        [str(BIN / argv[0]), *argv[1:]],
-        cwd=cwd,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        preexec_fn=lambda: (signal.signal(signal.SIGINT, signal.SIG_DFL), os.umask(0o022)),
-    )
 
 
 def _run(command: str, env: dict[str, str], cwd: Path, timeout: float = 180) -> subprocess.CompletedProcess[str]:

@@ -21,12 +21,21 @@ import socket
 import subprocess
 import time
 from collections.abc import Iterator
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 
-from tests.cli.test_user_errors import BIN, VIZ, _check, _env, _scene_tokens, _snapshot, _work_folder
+from tests.cli.test_user_errors import (
+    VIZ,
+    _check,
+    _env,
+    _problems_in_real_processes,
+    _run,
+    _scene_tokens,
+    _snapshot,
+    _start,
+    _work_folder,
+)
 from tests.inprocess import run_script_with
 
 DATASET_INPUT = "the dataset's files are inputs"
@@ -35,11 +44,6 @@ LOOP = "is a symlink loop"
 
 def _cache_env(demo: Path, cache: Path, **extra: str) -> dict[str, str]:
     return _env(demo) | {"GNNPMB_CACHE_DIR": str(cache)} | extra
-
-
-def _run(command: list[str], env: dict[str, str], cwd: Path, timeout: float = 300) -> subprocess.CompletedProcess:
-    exe = str(BIN / command[0])
-    return subprocess.run([exe, *command[1:]], capture_output=True, text=True, env=env, cwd=cwd, timeout=timeout)
 
 
 INDEXES_OPENED = (("gnnpmb.data.nuscenes", "_INDEXES"), ("gnnpmb.data.detections", "_opened"))
@@ -203,17 +207,11 @@ def test_early_refusals_in_real_processes(demo_dataroot: Path, tmp_path: Path) -
     cases = [c for c in EARLY_CASES if c[0] in EARLY_REAL_PROCESS]
     assert len(cases) == len(EARLY_REAL_PROCESS)
 
-    def one(case: tuple[str, str, str]) -> list[str]:
+    def one(case: tuple[str, str, str]) -> tuple[str, Path, list[str], str]:
         work = _early_work(case, tmp_path, demo_dataroot)
-        before = _snapshot(work)
-        problems = _check(case[0], _run(case[1].format(demo=demo_dataroot).split(), env, work), case[2])
-        if _snapshot(work) != before:
-            problems.append(f"{case[0]}: files changed")
-        return problems
+        return case[0], work, case[1].format(demo=demo_dataroot).split(), case[2]
 
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        problems = [p for found in pool.map(one, cases) for p in found]
-    assert problems == []
+    assert _problems_in_real_processes(cases, one, env) == []
     assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
 
 
@@ -238,7 +236,7 @@ def test_a_port_taken_on_ipv6_loopback_counts_as_in_use(demo_dataroot: Path, tmp
             pytest.skip("no ::1 here")
         taken.listen()
         port = taken.getsockname()[1]
-        proc = _run([VIZ, "scene-0103", "--serve", "--web-port", str(port)], _env(demo_dataroot), tmp_path)
+        proc = _run([VIZ, "scene-0103", "--serve", "--web-port", str(port)], _env(demo_dataroot), cwd=tmp_path)
     assert _check("port on ::1", proc, f"--web-port {port}: the port is in use on ::1") == []
 
 
@@ -248,12 +246,18 @@ def test_a_port_taken_on_ipv6_loopback_counts_as_in_use(demo_dataroot: Path, tmp
 # --- case 2: caches key on content ------------------------------------------------------------------------------------
 
 
+def _tracking_own_detections(demo: Path, folder: Path) -> tuple[dict[str, str], list[str]]:
+    """A cache folder and a detection file (``_detections``) in ``folder``: the environment and the ``gnnpmb track``
+    command line that reads that file, its output name to be appended."""
+    _detections(folder / "det.json", demo)
+    env = _cache_env(demo, folder / "cache")
+    return env, ["gnnpmb", "track", "--detections", "det.json", "--tracker", "gnn", "--no-progress", "--out"]
+
+
 def test_a_detection_file_edited_in_place_with_its_old_mtime_is_read_again(
     demo_dataroot: Path, tmp_path: Path, run_in: _InProcess
 ) -> None:
-    env = _cache_env(demo_dataroot, tmp_path / "cache")
-    _detections(tmp_path / "det.json", demo_dataroot)
-    track = ["gnnpmb", "track", "--detections", "det.json", "--tracker", "gnn", "--no-progress", "--out"]
+    env, track = _tracking_own_detections(demo_dataroot, tmp_path)
     first = run_in([*track, "a.json"], env, tmp_path)
     assert first.returncode == 0, first.stderr
     _edit_in_place(tmp_path / "det.json", b"[601.0, 1600.0", b"[951.0, 1600.0")
@@ -304,9 +308,7 @@ def test_a_damaged_dataset_index_side_file_is_rebuilt(
 def test_a_damaged_detection_index_side_file_is_rebuilt(
     demo_dataroot: Path, tmp_path: Path, run_in: _InProcess
 ) -> None:
-    env = _cache_env(demo_dataroot, tmp_path / "cache")
-    _detections(tmp_path / "det.json", demo_dataroot)
-    track = ["gnnpmb", "track", "--detections", "det.json", "--tracker", "gnn", "--no-progress", "--out"]
+    env, track = _tracking_own_detections(demo_dataroot, tmp_path)
     assert run_in([*track, "a.json"], env, tmp_path).returncode == 0
     (index,) = (tmp_path / "cache" / "index").glob("detections-*")
     intact = (index / "samples.json").read_bytes()
@@ -408,14 +410,7 @@ def test_a_second_sweep_into_a_folder_waits_for_the_first(demo_dataroot: Path, t
     assert holder.stdout.readline().strip() == "held"
     sweep = ["gnnpmb", "sweep", "--out", "study", "--tracker", "gnn", "--param", "models.gate_chi2=20"]
     sweep += ["--workers", "1", "--no-progress"]
-    proc = subprocess.Popen(
-        [str(BIN / sweep[0]), *sweep[1:]],
-        env=env,
-        cwd=tmp_path,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    proc = _start(sweep, env, tmp_path)
     first = proc.stderr.readline()
     assert first.startswith(f"note: another sweep is writing {study}; waiting"), first
     time.sleep(1.0)
@@ -476,9 +471,9 @@ def test_reproduce_names_a_change_of_code(demo_dataroot: Path, tmp_path: Path) -
         f.write("# an edit\n")
     env = _cache_env(demo_dataroot, tmp_path / "cache")
     record = [VIZ, "scene-0103", "--tracker", "gnn", "--frames", "0:3", "--no-failures", "--no-progress"]
-    proc = _run([*record, "--save", "run.rrd"], env | {"PYTHONPATH": str(copy)}, tmp_path)
+    proc = _run([*record, "--save", "run.rrd"], env | {"PYTHONPATH": str(copy)}, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
-    proc = _run([VIZ, "reproduce", "run.rrd"], env, tmp_path)
+    proc = _run([VIZ, "reproduce", "run.rrd"], env, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert "note: recorded with other gnnpmb code (source digest" in proc.stderr
     assert "gnn: identical" in proc.stdout

@@ -17,10 +17,11 @@ import socket
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import pytest
 
@@ -28,6 +29,7 @@ from tests.inprocess import run_script_with
 
 BIN = Path(sys.executable).parent
 GOOD = b"a good output from an earlier run\n"
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -254,6 +256,19 @@ def _run(argv: list[str], env: dict[str, str], **kwargs) -> subprocess.Completed
     return subprocess.run([exe, *argv[1:]], capture_output=True, text=True, env=env, timeout=300, **kwargs)
 
 
+def _start(argv: list[str], env: dict[str, str], cwd: Path) -> subprocess.Popen[str]:
+    """An installed script started in a real process (SIGINT at its default, umask 022), its output piped."""
+    return subprocess.Popen(
+        [str(BIN / argv[0]), *argv[1:]],
+        cwd=cwd,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: (signal.signal(signal.SIGINT, signal.SIG_DFL), os.umask(0o022)),
+    )
+
+
 def _env(demo: Path) -> dict[str, str]:
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
     env["NUSCENES_DATAROOT"] = str(demo)  # never build a demo in the user's cache
@@ -274,6 +289,24 @@ def _check(name: str, proc: subprocess.CompletedProcess[str], expected: str) -> 
     if "Traceback" in proc.stderr + proc.stdout:
         problems.append("traceback")
     return [f"{name}: {p}" for p in problems]
+
+
+def _problems_in_real_processes(
+    cases: Sequence[T], one: Callable[[T], tuple[str, Path, list[str], str]], env: dict[str, str]
+) -> list[str]:
+    """Each case run in a real process, two at a time: ``one(case)`` prepares its work folder and gives (name,
+    work folder, command line, expected error); the problems of every case whose outcome or files were wrong."""
+
+    def run(case: T) -> list[str]:
+        name, work, argv, expected = one(case)
+        before = _snapshot(work)
+        problems = _check(name, _run(argv, env, cwd=work), expected)
+        if _snapshot(work) != before:
+            problems.append(f"{name}: files changed")
+        return problems
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        return [p for found in pool.map(run, cases) for p in found]
 
 
 @pytest.fixture(scope="module")
@@ -325,17 +358,10 @@ def test_mistakes_in_real_processes_are_one_line(demo_dataroot: Path, tmp_path: 
     cases = [c for c in CASES_BEFORE_DATA if c.name in REAL_PROCESS]
     assert len(cases) == len(REAL_PROCESS)
 
-    def one(case: Case) -> list[str]:
-        work, argv = _case_work(tmp_path, case, busy_port)
-        before = _snapshot(work)
-        problems = _check(case.name, _run(argv, env, cwd=work), case.expected)
-        if _snapshot(work) != before:
-            problems.append(f"{case.name}: files changed")
-        return problems
+    def one(case: Case) -> tuple[str, Path, list[str], str]:
+        return case.name, *_case_work(tmp_path, case, busy_port), case.expected
 
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        problems = [p for found in pool.map(one, cases) for p in found]
-    assert problems == []
+    assert _problems_in_real_processes(cases, one, env) == []
 
 
 @pytest.mark.parametrize("case", CASES_WITH_DATA, ids=lambda c: c.name)
@@ -385,15 +411,8 @@ def test_a_full_disk_is_one_line_and_leaves_no_partial_file(
 def test_ctrl_c_while_saving_leaves_no_partial_file(demo_dataroot: Path, tmp_path: Path) -> None:
     work = _work_folder(tmp_path / "w")
     before = _snapshot(work)
-    argv = [str(BIN / VIZ), "scene-0103", "--tracker", "gnn", "--save", str(work / "good.rrd"), "--no-progress"]
-    proc = subprocess.Popen(
-        argv,
-        env=_env(demo_dataroot),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
+    argv = [VIZ, "scene-0103", "--tracker", "gnn", "--save", str(work / "good.rrd"), "--no-progress"]
+    proc = _start(argv, _env(demo_dataroot), work)
     deadline = time.monotonic() + 120
     while not any(p.name.endswith(".partial") for p in work.iterdir()) and time.monotonic() < deadline:
         time.sleep(0.05)

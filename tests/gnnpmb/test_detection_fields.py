@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from gnnpmb.detection_fields import DetectionFields
-from gnnpmb.types import Boxes, Measurements, TrackEstimate, track_estimates
+from gnnpmb.types import Measurements, TrackEstimate, track_estimates
+from tests.gnnpmb.test_types import random_boxes
 
 
 def fields(rng: np.random.Generator, k: int) -> DetectionFields:
@@ -18,16 +19,7 @@ def fields(rng: np.random.Generator, k: int) -> DetectionFields:
 
 
 def measurements(rng: np.random.Generator, m: int) -> Measurements:
-    boxes = Boxes(
-        translation_m=rng.random((m, 3)),
-        size_wlh_m=rng.random((m, 3)),
-        quat_wxyz=rng.random((m, 4)),
-        velocity_mps=rng.random((m, 2)),
-        score=rng.random(m),
-        class_name=np.array(["car"] * m, dtype=object),
-        instance_id=np.array([""] * m, dtype=object),
-    )
-    return Measurements(boxes, np.arange(10, 10 + m))
+    return Measurements(random_boxes(rng, m), np.arange(10, 10 + m))
 
 
 def test_to_estimates_copies_every_field_of_every_item():

@@ -1,17 +1,28 @@
+import dataclasses
+
 import numpy as np
 import pytest
 
 from gnnpmb.types import TRACKING_CLASSES, Boxes, FrameDetections, Measurements
 
 
-def frame(rng: np.random.Generator, n: int) -> FrameDetections:
-    names = np.array([*TRACKING_CLASSES, "barrier"], dtype=object)
-    boxes = Boxes(
+def random_boxes(rng: np.random.Generator, n: int) -> Boxes:
+    """``n`` cars with random numbers in [0, 1) and no instance ids."""
+    return Boxes(
         translation_m=rng.random((n, 3)),
         size_wlh_m=rng.random((n, 3)),
         quat_wxyz=rng.random((n, 4)),
         velocity_mps=rng.random((n, 2)),
         score=rng.random(n),
+        class_name=np.array(["car"] * n, dtype=object),
+        instance_id=np.array([""] * n, dtype=object),
+    )
+
+
+def frame(rng: np.random.Generator, n: int) -> FrameDetections:
+    names = np.array([*TRACKING_CLASSES, "barrier"], dtype=object)
+    boxes = dataclasses.replace(
+        random_boxes(rng, n),
         class_name=rng.choice(names, size=n),
         instance_id=np.array([f"i{i}" for i in range(n)], dtype=object),
     )

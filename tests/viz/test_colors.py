@@ -18,6 +18,16 @@ from viz.colors import (
 )
 
 
+def hue_of(rgb: np.ndarray) -> np.ndarray:
+    """(N,) hue in [0, 1) of (N, 3) RGB colours (0-255); 0 for greys."""
+    c = np.asarray(rgb, dtype=np.float64).reshape(-1, 3) / 255.0
+    mx, mn = c.max(axis=1), c.min(axis=1)
+    d = np.where(mx > mn, mx - mn, 1.0)
+    r, g, b = c.T
+    h = np.where(mx == r, np.mod((g - b) / d, 6.0), np.where(mx == g, (b - r) / d + 2.0, (r - g) / d + 4.0))
+    return np.where(mx > mn, h / 6.0, 0.0)
+
+
 def test_every_class_has_a_distinct_id_and_colour() -> None:
     assert set(CLASS_IDS) == set(CLASS_COLORS) == set(TRACKING_CLASSES)
     assert sorted(CLASS_IDS.values()) == list(range(1, 8))
@@ -74,7 +84,7 @@ def test_packed_colours_of_negative_ids_are_their_own_not_a_wrapped_table_entry(
 
 
 def test_involved_tracks_get_distinct_palette_colours_no_marker_uses() -> None:
-    from viz.colors import INVOLVED_PALETTE, TRACK_HUE_BANDS, hue_of, involved_track_colors
+    from viz.colors import INVOLVED_PALETTE, TRACK_HUE_BANDS, involved_track_colors
 
     assert involved_track_colors([212, 26, 123]) == {
         26: INVOLVED_PALETTE[0],

@@ -17,21 +17,19 @@ import math
 import re
 
 from tools.truth import replay
-from tools.truth.lost import printed
+from tools.truth.printing import BECAUSE, NUMBER, printed
 
 _N = r"-?\d+\.\d+"
-_E = r"\d+(?:\.\d+)?(?:e-?\d+)?"
-BECAUSE = re.compile(r"Because \(frame (\d+)[^)]*\): ([^\n]*)")
 BREAKDOWN = re.compile(
     rf"Track (\d+)(?:'s|, which had the object, would have cost) ({_N}) = ({_N} for .+?)(?=\. [A-Z]|\.$|$)"
 )
 PART = re.compile(rf"({_N}) for ")
-EXISTENCE = re.compile(rf"for its predicted existence ({_E})")
+EXISTENCE = re.compile(rf"for its predicted existence ({NUMBER})")
 DISTANCE = re.compile(rf"for the distance to m(\d+) \(d² ({_N})\)")
 SCORE = re.compile(rf"for m(\d+)'s score ({_N})")
 CHOICE = re.compile(
     rf"frame (\d+): m(\d+)(?: \(score ({_N})\))? → (?:new track \d+|track \d+|new|missed \d+) \(cost ({_N})\) "
-    rf"over track (\d+) \(({_N})(?: at (?:existence ({_E}), )?±[\d.]+ m, d² ({_N}))?\)"
+    rf"over track (\d+) \(({_N})(?: at (?:existence ({NUMBER}), )?±[\d.]+ m, d² ({_N}))?\)"
 )
 
 

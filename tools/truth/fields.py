@@ -559,13 +559,7 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             if str(f.lost.track_id) not in on or len(on) < 2:
                 return "not two tracks on the object"
         elif name == "COVERED_TWO" and f.kind.value in ("miss", "fragmentation"):
-            threshold = src.ev.thresholds.get(c) or 0.0
-            counted = [
-                t
-                for t in _boxes_on(src, x, c, xy)
-                if x in src.kept_frames(int(t)) and src.ev.averaged.get(t, (0, -math.inf))[1] >= threshold
-            ]
-            if not counted:
+            if not _counted_on(src, x, c, xy):
                 return "no counted track lies within reach"
         elif name == "NO_EVAL_BOX":
             gt_id = f.false_output.nearest_own[0] if f.false_output and f.false_output.nearest_own else f.gt_id
@@ -591,13 +585,19 @@ def _interpolated_decided(src: Sources, x: int, c: str, gt_id: str) -> bool:
         return False
     if math.dist(at, xy) >= EVALUATED_OFFSET_M:
         return True
+    counted = _counted_on(src, x, c, xy)
+    return any(math.dist(next(p for tt, _, p in src.ev.boxes[x] if tt == t), at) >= NEAR_M for t in counted)
+
+
+def _counted_on(src: Sources, x: int, c: str, xy: np.ndarray) -> list[str]:
+    """The track boxes of class ``c`` on the place ``xy`` at ``x`` (``_boxes_on``) kept at ``x`` whose averaged
+    score passes the class threshold: the tracks the evaluation counted there."""
     threshold = src.ev.thresholds.get(c) or 0.0
-    counted = [
+    return [
         t
         for t in _boxes_on(src, x, c, xy)
         if x in src.kept_frames(int(t)) and src.ev.averaged.get(t, (0, -math.inf))[1] >= threshold
     ]
-    return any(math.dist(next(p for tt, _, p in src.ev.boxes[x] if tt == t), at) >= NEAR_M for t in counted)
 
 
 def _boxes_on(src: Sources, x: int, c: str, xy: np.ndarray | None) -> list[str]:

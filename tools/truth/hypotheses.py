@@ -20,10 +20,9 @@ import re
 import numpy as np
 
 from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses
-from tools.truth.lost import printed
+from tools.truth.printing import NUMBER, printed
 
 _P = r"\d+\.\d+"
-_E = r"\d+(?:\.\d+)?(?:e-?\d+)?"
 SWITCHED = re.compile(
     rf"at frame (\d+) the best hypothesis switched: it descends from prior hypothesis (\d+) \(probability ({_P}) "
     rf"after frame (\d+), against ({_P}) for the best\), not from a cost choice within the best(?: \(([^\n]*?)\))?"
@@ -31,9 +30,9 @@ SWITCHED = re.compile(
 )
 TRACK_ROW = re.compile(r"track (\d+): ([^;]*)")
 SINCE = re.compile(r"track (\d+)(?::| had existed) (?:held by a kept hypothesis )?since frame (\d+)")
-IN_PARENT = re.compile(rf"predicted existence ({_E}) in hypothesis (\d+)")
-IN_BEST = re.compile(rf"({_E}) in the previous best")
-AFTER = re.compile(rf"after the update ({_E}) in the chosen hypothesis, ({_E}) over all kept ones")
+IN_PARENT = re.compile(rf"predicted existence ({NUMBER}) in hypothesis (\d+)")
+IN_BEST = re.compile(rf"({NUMBER}) in the previous best")
+AFTER = re.compile(rf"after the update ({NUMBER}) in the chosen hypothesis, ({NUMBER}) over all kept ones")
 
 
 def _hyp(raw, x: int, c: str) -> GlobalHypotheses | None:

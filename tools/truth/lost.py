@@ -46,10 +46,10 @@ from gnnpmb.events import (
     TrackLogic,
     TrackLogicAction,
 )
+from tools.truth.printing import NUMBER, printed
 
-_V = r"\d+(?:\.\d+)?(?:e-?\d+)?"
-WENT_FROM = re.compile(rf"its (existence|weight) went from ({_V}) \(frame (\d+)\) to ({_V}) \(frame (\d+)\)")
-WAS = re.compile(rf"its (existence|weight) was ({_V}) \(frames? (\d+)(?:–(\d+))?\)")
+WENT_FROM = re.compile(rf"its (existence|weight) went from ({NUMBER}) \(frame (\d+)\) to ({NUMBER}) \(frame (\d+)\)")
+WAS = re.compile(rf"its (existence|weight) was ({NUMBER}) \(frames? (\d+)(?:–(\d+))?\)")
 NOT_OUTPUT = re.compile(r"it was not output at (frames? [\d–, ]*\d)")
 DELETED = re.compile(
     r"its track logic deleted it at frame (\d+)(?: \((?:(\d+) of (\d+) hits|no hit in its last (\d+) frames)\))?"
@@ -60,7 +60,7 @@ ENDED = re.compile(
     r"track (\d+) could not take it: its column's cost for it was infinite \([^)]*\), and it ended at frame (\d+)"
 )
 USED = re.compile(
-    rf"at frame (\d+) it (used|was given) (m\d+(?: \(p {_V}\))?(?:, m\d+(?: \(p {_V}\))?)?)(?: \+(\d+) more)?"
+    rf"at frame (\d+) it (used|was given) (m\d+(?: \(p {NUMBER}\))?(?:, m\d+(?: \(p {NUMBER}\))?)?)(?: \+(\d+) more)?"
 )
 GATE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it, in track (\d+)'s gate at NIS (\d+\.\d)\)")
 STAYED = re.compile(r"track (\d+)'s existence stayed below (\d+(?:\.\d+)?) \(the views draw tracks from")
@@ -96,11 +96,6 @@ def frames_of(text: str) -> list[int]:
         lo, _, hi = part.partition("–")
         out += list(range(int(lo), int(hi or lo) + 1))
     return out
-
-
-def printed(r: float) -> str:
-    """An existence as the text prints one: two decimals, one significant digit below 0.01."""
-    return f"{r:.2f}" if r >= 0.01 or r == 0 else f"{r:.1g}"
 
 
 def _existence(raw, x: int, c: str, track: int) -> float | None:
@@ -233,7 +228,7 @@ def _merged(raw, x: int, c: str, track: int) -> bool:
 
 def _check_used(m: re.Match, c: str, lost: int, raw, out, bad) -> None:
     x = int(m[1])
-    said = [(int(a), b or None) for a, b in re.findall(rf"m(\d+)(?: \(p ({_V})\))?", m[3])]
+    said = [(int(a), b or None) for a, b in re.findall(rf"m(\d+)(?: \(p ({NUMBER})\))?", m[3])]
     more = int(m[4] or 0)
     if m[2] == "was given":
         found = raw.of_kind(x, c, Assignment)

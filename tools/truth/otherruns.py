@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 
 from tools.truth.devkit import EvalFacts
 from tools.truth.fields import failed_here
@@ -34,16 +34,22 @@ MATCHED_TO = re.compile(r"track (\d+) to (?:(\w+) GT (\w+)|no object)")
 LOST_KINDS = ("id_switch", "identity_theft", "fragmentation")
 
 
+def _named_runs(
+    pattern: re.Pattern, text: str, others: Mapping[str, EvalFacts]
+) -> Iterator[tuple[re.Match, EvalFacts]]:
+    """Each match of ``pattern`` in ``text`` whose first group names one of the ``others`` runs, with its facts."""
+    for m in pattern.finditer(text):
+        if (ev := others.get(m[1])) is not None:
+            yield m, ev
+
+
 def check_others(
     text: str, kind: str, c: str, x: int, gt: str | None, others: Mapping[str, EvalFacts], scene, out, bad
 ) -> None:
     """Each other-run sentence of ``text`` about object ``gt`` (``out``: the ``Tally``; ``bad``)."""
     if gt is None:
         return
-    for m in OTHER.finditer(text):
-        ev = others.get(m[1])
-        if ev is None:
-            continue
+    for m, ev in _named_runs(OTHER, text, others):
         matched = ev.matched_track(c, x, gt)
         a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
         if kind == "false_track":  # near an object the evaluation had no box of: a false positive near it
@@ -119,10 +125,7 @@ def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapp
     box within ``NEAR_M`` of the place (the object, or the false box) as a false positive at frame x."""
     if place_xy_m is None:
         return
-    for m in FALSE_HERE.finditer(text):
-        ev = others.get(m[1])
-        if ev is None:
-            continue
+    for m, ev in _named_runs(FALSE_HERE, text, others):
         out.checked["other run"] += 1
         false = ev.false_near(x, place_xy_m)
         if bool(false) != m[2].startswith("had a false"):

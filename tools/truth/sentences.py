@@ -24,12 +24,13 @@ from __future__ import annotations
 import math
 import re
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 
-from gnnpmb.events import AxisKind, Born
+from gnnpmb.events import AxisKind, Born, CostMatrix
 from tools.truth import costs, detector, hypotheses, lost, otherruns, output, place, replay, shares
 from tools.truth.devkit import EvalFacts
+from tools.truth.printing import BECAUSE
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import SceneTruth
 
@@ -100,7 +101,6 @@ class Tally:
 
 _NUM = r"[-\d.e+]+"
 GONE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it; track (\d+) was gone\)")
-BECAUSE = re.compile(r"Because \(frame (\d+)[^)]*\): (.*)")
 OUTSIDE = re.compile(r"m(\d+) was outside the gate of track (\d+), which had the object")
 WITHIN = re.compile(rf"Within d² ({_NUM}) \(instead of ({_NUM})\), track (\d+) would have taken m(\d+)")
 ABOVE = re.compile(
@@ -390,26 +390,25 @@ def _check_counterfactuals(x: int, para: str, c: str, raw: RawEvents, out: Tally
             out.refuted += 1
             bad("counterfactual", sentence, truth)
 
-    for m in WITHIN.finditer(para):
-        stated, now, t, meas = float(m[1]), float(m[2]), int(m[3]), int(m[4])
-        s = setup(meas, t)
-        if s is None:
-            verdict(m[0], False, f"no matrix of frame {x} has m{meas} and track {t}")
-            continue
-        mat, _, row, col = s
+    def stated_against(pattern: re.Pattern) -> Iterator[tuple[re.Match, float, float, int, int, CostMatrix, int, int]]:
+        """Each sentence "… VALUE (instead of NOW), track T would have taken mN" with the deciding matrix of
+        (mN, track T) and their row and column; one without such a matrix is refuted here."""
+        for m in pattern.finditer(para):
+            value, now, t, meas = float(m[1]), float(m[2]), int(m[3]), int(m[4])
+            s = setup(meas, t)
+            if s is None:
+                verdict(m[0], False, f"no matrix of frame {x} has m{meas} and track {t}")
+            else:
+                yield m, value, now, t, meas, s[0], s[2], s[3]
+
+    for m, stated, now, t, meas, mat, row, col in stated_against(WITHIN):
         if stated >= now:
             verdict(m[0], False, f"the stated d² {stated} is not below the current {now}")
             continue
         verdict(
             m[0], replay.replay_d2(mat, row, col, stated), f"re-solved at d² {stated}, m{meas} does not go to track {t}"
         )
-    for m in ABOVE.finditer(para):
-        stated, now, t, meas = float(m[1]), float(m[2]), int(m[3]), int(m[4])
-        s = setup(meas, t)
-        if s is None:
-            verdict(m[0], False, f"no matrix of frame {x} has m{meas} and track {t}")
-            continue
-        mat, _, row, col = s
+    for m, stated, now, t, meas, mat, row, col in stated_against(ABOVE):
         if stated <= now:
             verdict(m[0], False, f"the stated existence {stated} is not above the current {now}")
             continue

@@ -15,7 +15,6 @@ from gnnpmb.data.demo_staged import STAGED_SCENES
 from gnnpmb.data.nuscenes import (
     DatasetLocation,
     check_dataroot,
-    list_scenes,
     load_lidar_points,
     load_scene,
     open_nuscenes,
@@ -122,7 +121,7 @@ def test_open_wraps_devkit_errors(tables_only: Path) -> None:
 
 def test_open_is_cached(location: DatasetLocation) -> None:
     assert open_nuscenes(location) is open_nuscenes(location)
-    assert list_scenes(open_nuscenes(location)) == list(DEMO_SCENES + STAGED_SCENES)
+    assert [s["name"] for s in open_nuscenes(location).scene] == list(DEMO_SCENES + STAGED_SCENES)
 
 
 def test_unknown_scene_lists_available(location: DatasetLocation) -> None:

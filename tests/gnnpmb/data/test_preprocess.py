@@ -4,12 +4,12 @@ import shapely
 
 from gnnpmb.config import PreprocessParams
 from gnnpmb.data.boxes3d import (
+    UprightBoxes,
     bev_corners,
-    box_corners_3d,
     convex_intersection_area,
     iou_3d,
+    iou_3d_pairs,
     overlap_candidates,
-    pairwise_iou_3d,
     quat_wxyz_from_yaw,
     yaw_from_quat_wxyz,
 )
@@ -32,6 +32,17 @@ def make_boxes(rows, classes=None, scores=None) -> Boxes:
     )
 
 
+def pairwise_iou_3d(translation_m: np.ndarray, size_wlh_m: np.ndarray, quat_wxyz: np.ndarray) -> np.ndarray:
+    """(N, N) symmetric 3D IoU matrix of N boxes (diagonal 1 for boxes with a volume)."""
+    boxes = UprightBoxes.of(translation_m, size_wlh_m, yaw_from_quat_wxyz(quat_wxyz))
+    n = len(boxes)
+    out = np.zeros((n, n))
+    i, j = overlap_candidates(boxes.centre, boxes.size_wlh)
+    out[i, j] = out[j, i] = iou_3d_pairs(boxes, boxes, i, j)
+    out[np.arange(n), np.arange(n)] = (np.prod(boxes.size_wlh, axis=1) > 0).astype(float)
+    return out
+
+
 def iou_of(a, b) -> float:
     boxes = make_boxes([a, b])
     return float(pairwise_iou_3d(boxes.translation_m, boxes.size_wlh_m, boxes.quat_wxyz)[0, 1])
@@ -50,14 +61,6 @@ def test_bev_corners_follow_heading():
     np.testing.assert_allclose(corners, [[9.0, 7.0], [9.0, 3.0], [11.0, 3.0], [11.0, 7.0]], atol=1e-12)
     signed_area = 0.5 * np.sum(corners[:, 0] * np.roll(corners[:, 1], -1) - np.roll(corners[:, 0], -1) * corners[:, 1])
     assert signed_area == pytest.approx(8.0)  # counter-clockwise
-
-
-def test_box_corners_3d_bottom_then_top():
-    corners = box_corners_3d(np.array([[0.0, 0.0, 1.0]]), np.array([[2.0, 4.0, 2.0]]), quat_wxyz_from_yaw([0.0]))
-    assert corners.shape == (1, 8, 3)
-    np.testing.assert_allclose(corners[0, :4, 2], 0.0)
-    np.testing.assert_allclose(corners[0, 4:, 2], 2.0)
-    np.testing.assert_allclose(corners[0, 0], [2.0, 1.0, 0.0])
 
 
 def test_iou_identical_boxes_is_one():
@@ -87,12 +90,17 @@ def test_iou_square_rotated_45_degrees():
     assert iou_of((0, 0, 0, 2, 2, 1, 0), (1 + np.sqrt(2), 0, 0, 2, 2, 1, np.pi / 4)) == pytest.approx(0.0)
 
 
+def _random_pairs(seed: int, n: int, dims: int, centre_m: float, size_m: tuple[float, float]) -> tuple[np.ndarray, ...]:
+    """Two sets of ``n`` random boxes, centres (n, dims) within +-``centre_m``, sizes (n, dims) in ``size_m``, yaws
+    (n,) in +-pi: (centres a, centres b, sizes a, sizes b, yaws a, yaws b)."""
+    rng = np.random.default_rng(seed)
+    centres = rng.uniform(-centre_m, centre_m, (n, dims)), rng.uniform(-centre_m, centre_m, (n, dims))
+    sizes = rng.uniform(*size_m, (n, dims)), rng.uniform(*size_m, (n, dims))
+    return *centres, *sizes, rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+
+
 def test_intersection_area_matches_shapely():
-    rng = np.random.default_rng(7)
-    n = 3000
-    xy_a, xy_b = rng.uniform(-3, 3, (n, 2)), rng.uniform(-3, 3, (n, 2))
-    s_a, s_b = rng.uniform(0.3, 6, (n, 2)), rng.uniform(0.3, 6, (n, 2))
-    y_a, y_b = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+    xy_a, xy_b, s_a, s_b, y_a, y_b = _random_pairs(7, 3000, 2, 3.0, (0.3, 6.0))
     # Degenerate cases: identical boxes, and axis-aligned boxes sharing edge directions.
     xy_b[:200], s_b[:200], y_b[:200] = xy_a[:200], s_a[:200], y_a[:200]
     y_a[200:400] = y_b[200:400] = 0.0
@@ -102,11 +110,7 @@ def test_intersection_area_matches_shapely():
 
 
 def test_iou_3d_symmetric_and_bounded():
-    rng = np.random.default_rng(3)
-    n = 500
-    t_a, t_b = rng.uniform(-2, 2, (n, 3)), rng.uniform(-2, 2, (n, 3))
-    s_a, s_b = rng.uniform(0.5, 4, (n, 3)), rng.uniform(0.5, 4, (n, 3))
-    y_a, y_b = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+    t_a, t_b, s_a, s_b, y_a, y_b = _random_pairs(3, 500, 3, 2.0, (0.5, 4.0))
     ab = iou_3d(t_a, s_a, y_a, t_b, s_b, y_b)
     np.testing.assert_allclose(ab, iou_3d(t_b, s_b, y_b, t_a, s_a, y_a), atol=1e-12)
     assert np.all((ab >= 0) & (ab <= 1))

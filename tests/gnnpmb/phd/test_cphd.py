@@ -13,18 +13,33 @@ from gnnpmb.config import ConfigError, paper_config
 from gnnpmb.events import Cardinality, Extracted, ListSink, NullSink
 from gnnpmb.phd.cphd import (
     CphdTracker,
+    _esf_tables,
+    _lags,
     cphd_update,
-    log_esf,
-    log_esf_leave_one_out,
     poisson_pmf,
     predict_cardinality,
     trim_pmf,
 )
-from gnnpmb.phd.gmphd import phd_update
+from gnnpmb.phd.gmphd import log_sum_exp, phd_update
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = paper_config()  # hand computations use the paper's values (sec. V-B)
+
+
+def log_esf(log_x: np.ndarray, order: int) -> np.ndarray:
+    """(order + 1,) log e_j(x), j = 0..order, of x = exp(log_x) (M,): the last prefix row of ``_esf_tables``."""
+    return _esf_tables(np.asarray(log_x, dtype=float), order)[0][-1]
+
+
+def log_esf_leave_one_out(log_x: np.ndarray, order: int) -> np.ndarray:
+    """(M, order + 1) log e_j(x without x_i) expanded, e_j^(-i) = sum_k e_k(pre_i) e_{j-k}(suf_{i+1}) from the
+    prefix and suffix tables of ``_esf_tables``: the O(M N^2) sum ``_contract_leave_one_out`` shortens."""
+    pre, suf = _esf_tables(np.asarray(log_x, dtype=float), order)
+    lag, valid = _lags(order)
+    terms = pre[:-1, None, :] + suf[1:][:, lag]
+    terms[:, ~valid] = -np.inf
+    return log_sum_exp(terms, axis=2)
 
 
 def brute_esf(x: np.ndarray, order: int) -> np.ndarray:
@@ -212,8 +227,7 @@ def test_zero_clutter_is_rejected_before_the_cphd_sees_it():
 
 
 def test_leave_one_out_contraction_equals_the_expanded_sum():
-    from gnnpmb.phd.cphd import _contract_leave_one_out, _esf_tables
-    from gnnpmb.phd.gmphd import log_sum_exp
+    from gnnpmb.phd.cphd import _contract_leave_one_out
 
     rng = np.random.default_rng(4)
     for m, order in [(1, 3), (6, 4), (30, 50)]:
