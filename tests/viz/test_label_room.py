@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from gnnpmb.data.scene import Pose
-from viz.callouts import CHAR_PX, M_PER_PX_PER_HEIGHT, column_positions
+from viz.callouts import M_PER_PX_PER_HEIGHT, column_positions, half_widths_m
 from viz.label_room import Candidate, eyes, keep_apart, px_per_m
 
 IDENTITY = Pose(np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
@@ -37,7 +37,7 @@ def test_the_callout_column_goes_left_when_only_there_it_stays_in_view() -> None
     height_m = 18.0
     free = column_positions(anchors, chars, height_m)
     assert np.all(free[:, 0] > anchors[:, 0].max())
-    half_label_m = 0.5 * CHAR_PX * 30 * M_PER_PX_PER_HEIGHT * height_m
+    half_label_m = half_widths_m(np.array([30]), M_PER_PX_PER_HEIGHT * height_m)[0]
     tight = column_positions(anchors, chars, height_m, (-5.0, free[0, 0] + half_label_m - 1.0))  # right cut
     assert np.all(tight[:, 0] < anchors[:, 0].min())
 
@@ -62,7 +62,7 @@ def test_in_a_view_too_narrow_for_either_side_the_column_stacks_above_the_object
     anchors = np.array([[0.0, 0.0], [1.0, -1.0]])
     chars = np.array([24, 9])
     height_m = 16.0
-    half_label_m = 0.5 * CHAR_PX * 24 * M_PER_PX_PER_HEIGHT * height_m
+    half_label_m = half_widths_m(np.array([24]), M_PER_PX_PER_HEIGHT * height_m)[0]
     view_x_m, view_y_m = (-1.5 * half_label_m, 1.2 * half_label_m), (-8.0, 8.0)  # no side holds a label whole
     out = column_positions(anchors, chars, height_m, view_x_m, view_y_m)
     assert np.all(out[:, 1] > anchors[:, 1].max())  # above the objects
@@ -71,4 +71,5 @@ def test_in_a_view_too_narrow_for_either_side_the_column_stacks_above_the_object
     low = column_positions(anchors, chars, height_m, view_x_m, (-8.0, 0.5))  # no room above: below
     assert np.all(low[:, 1] < anchors[:, 1].min()) and np.all(low[:, 1] - 0.5 >= -8.0)
     side = column_positions(anchors, chars, height_m, view_x_m)  # the view's height unknown: the side cut less
-    assert np.allclose(side[:, 0], side[0, 0]) and side[0, 0] < anchors[:, 0].min()
+    right_ends = side[:, 0] + half_widths_m(chars, M_PER_PX_PER_HEIGHT * height_m)
+    assert np.ptp(right_ends) < 1e-9 and right_ends[0] < anchors[:, 0].min()  # left of the objects, ends aligned
