@@ -34,7 +34,7 @@ from gnnpmb.events import (
 from gnnpmb.models import MotionModel, birth_covariance, clutter_intensity, measurement_birth, motion_model
 from gnnpmb.pmb.bernoulli import Bernoullis, predict_bernoullis
 from gnnpmb.pmb.cost import LocalHypotheses, detected_means, local_hypotheses
-from gnnpmb.pmb.miss_detection import MissDetectionCounts
+from gnnpmb.pmb.miss_detection import MissDetectionCounts, crowded
 from gnnpmb.pmb.poisson import NewTrackHypotheses, birth_update, new_track_hypotheses
 from gnnpmb.skeleton import ClassFilter, Gating, TrackView
 from gnnpmb.types import STATE_DIM, IdAllocator, Measurements, TrackEstimate
@@ -519,11 +519,20 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
     def miss_p_detect_max(self, prior: Bernoullis) -> float | np.ndarray:
         """This frame's cap of the P_D of the predicted Bernoullis ``prior`` when missed: ``[pmb]
         miss_p_detect_max``, or with ``[pmb] miss_p_detect_online = 1`` the class's P_D learnt from the frames
-        before, per Bernoulli by the frames it has been missed in a row (``miss_detection``), (K,)."""
+        before, per Bernoulli by the frames it has been missed in a row (``miss_detection``), (K,); a Bernoulli
+        with another track of its class near it keeps ``miss_p_detect_max`` (``miss_detection.crowded``)."""
         p = self.params
         if p.miss_p_detect_online != 1:
             return p.miss_p_detect_max
-        return self.miss_counts.p_detect(p.miss_p_detect_max, p.miss_p_detect_prior_frames, prior.misses - 1)
+        learnt = self.miss_counts.p_detect(p.miss_p_detect_max, p.miss_p_detect_prior_frames, prior.misses - 1)
+        near = crowded(
+            prior.mean[:, :2],
+            prior.existence,
+            prior.track_id,
+            p.miss_p_detect_neighbour_m,
+            p.miss_p_detect_neighbour_existence,
+        )
+        return np.where(near, p.miss_p_detect_max, learnt)
 
     def _predict_and_localise(self, meas: Measurements, model: MotionModel, new: NewTrackHypotheses) -> PmbPrior:
         """Predicted prior hypotheses and their local hypotheses. Global hypotheses share most Bernoullis

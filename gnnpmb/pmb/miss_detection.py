@@ -14,6 +14,12 @@ the posterior mean
 replaces the fixed cap: a missed Bernoulli's P_D is min(its last detection's score, P_D(n)) (``cost.local_hypotheses``).
 With N > 1 a detector whose misses come in long runs (occlusions) gets a lower P_D after the first misses than
 after none, so a track coasts through a run the class's tracks were seen to come back from.
+
+A Bernoulli with another of its class near it (``crowded``: another track, existence >= r_n, within d metres,
+``[pmb] miss_p_detect_neighbour_m`` and ``miss_p_detect_neighbour_existence``) keeps the fixed cap c instead of
+P_D(n): next to another object a miss is often an occlusion, or the detector's one box for two, rather than the
+object gone, and the learnt P_D (mostly from lone objects) made such a track fade and its neighbour's track take
+its detections (issue 32, Round 7 of ``docs/results.md``).
 """
 
 from __future__ import annotations
@@ -69,3 +75,18 @@ class MissDetectionCounts:
         self.missed[last_bin] += np.maximum(gaps - last_bin, 0).sum()
         order = np.argsort(track_id, kind="stable")
         self.last_ids, self.last_misses = track_id[order], misses[order]
+
+
+def crowded(
+    xy_m: np.ndarray, existence: np.ndarray, track_id: np.ndarray, near_m: float, min_existence: float
+) -> np.ndarray:
+    """(K,) whether each of K Bernoullis (centres ``xy_m`` (K, 2), ``existence`` (K,), ``track_id`` (K,)) has
+    another track's Bernoulli of existence >= ``min_existence`` closer than ``near_m`` metres (the same track in
+    other global hypotheses is not a neighbour); all False when ``near_m`` is 0."""
+    out = np.zeros(len(xy_m), dtype=bool)
+    sure = np.flatnonzero(existence >= min_existence)
+    if near_m <= 0.0 or len(xy_m) < 2 or not len(sure):
+        return out
+    dist_m = np.linalg.norm(xy_m[:, None, :] - xy_m[None, sure, :], axis=2)
+    dist_m[track_id[:, None] == track_id[None, sure]] = np.inf
+    return dist_m.min(axis=1) < near_m

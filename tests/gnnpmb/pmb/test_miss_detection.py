@@ -1,5 +1,6 @@
 """The P_D of a missed Bernoulli learnt online per class (``gnnpmb.pmb.miss_detection``, ``[pmb]
-miss_p_detect_online``): hand-computed counts, and the value the tracker's cost events report is the one it used."""
+miss_p_detect_online``): hand-computed counts, and the value the tracker's cost events report is the one it used; a
+Bernoulli with a neighbour of its class keeps the fixed cap (``miss_detection.crowded``)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from gnnpmb.config import TrackerConfig, with_params
 from gnnpmb.events import CostMatrix, ListSink, NullSink
 from gnnpmb.pmb.core import PmbCore
 from gnnpmb.pmb.gnnpmb import BestAssignment
-from gnnpmb.pmb.miss_detection import MissDetectionCounts
+from gnnpmb.pmb.miss_detection import MissDetectionCounts, crowded
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
@@ -97,3 +98,47 @@ def test_a_class_s_fixed_cap_wins_over_the_online_estimate() -> None:
     )
     _, p_detect = _run(cfg.resolved("car"))
     assert p_detect == pytest.approx(0.72, rel=1e-9)
+
+
+def test_crowded_by_hand() -> None:
+    """Four Bernoullis on a line at x = 0, 1.5, 10, 11 m, existence 0.9, 0.9, 0.9, 0.3; neighbours within 2 m of
+    existence >= 0.5: the first two see each other; the third's only neighbour (1 m) has r = 0.3, so it is alone;
+    the fourth sees the third. The same track in another hypothesis is no neighbour, and 0 m turns it off."""
+    xy = np.array([[0.0, 0.0], [1.5, 0.0], [10.0, 0.0], [11.0, 0.0]])
+    r = np.array([0.9, 0.9, 0.9, 0.3])
+    assert crowded(xy, r, np.array([1, 2, 3, 4]), 2.0, 0.5).tolist() == [True, True, False, True]
+    assert crowded(xy, r, np.array([1, 1, 3, 4]), 2.0, 0.5).tolist() == [False, False, False, True]
+    assert crowded(xy, r, np.array([1, 2, 3, 4]), 1.4, 0.5).tolist() == [False, False, False, True]
+    assert not crowded(xy, r, np.array([1, 2, 3, 4]), 0.0, 0.5).any()
+
+
+def _pair_p_detect(cfg: TrackerConfig) -> tuple[PmbCore, float]:
+    """Cars A at y = 0 and B at y = 1.8 m, side by side: both detected at frames 0-2, A missed at 3 and 4 and
+    detected at 5, B detected at every frame; at frame 6 A is missed again: the P_D its miss used (``CostMatrix``)."""
+    core = PmbCore("car", cfg, BestAssignment(), IdAllocator())
+
+    def frame(t: int, with_a: bool) -> object:
+        xy = [(1.0 * t, 0.0), (1.0 * t, 1.8)] if with_a else [(1.0 * t, 1.8)]
+        return make_measurements(xy, 0.8, velocity=[(2.0, 0.0)] * len(xy))
+
+    for t in range(6):
+        core.step(frame(t, t not in (3, 4)), 0.5 if t else 0.0, NullSink())
+    a = int(core.hypotheses[0].bernoullis.track_id[np.argmin(core.hypotheses[0].bernoullis.mean[:, 1])])
+    sink = ListSink()
+    core.step(frame(6, False), 0.5, sink)
+    (costs,) = [e for e in sink.events if isinstance(e, CostMatrix)]
+    assert costs.terms is not None
+    col = costs.terms.column_of(a)
+    assert col is not None
+    return core, costs.terms.pair(0, col).p_detect
+
+
+def test_a_missed_track_next_to_another_keeps_the_fixed_cap() -> None:
+    """One bin, prior 0.3 of 10 frames. Counts before frame 6: D = 8 (B detected after a detection at frames
+    1-5, A at 1 and 2, and A's return at 5), G = 2 (A's gap): the learnt P_D is (3 + 8) / (10 + 10) = 0.55, which
+    A's miss uses with the neighbour rule off; with it (B, r = 1, 1.8 m away, within 2 m) A keeps the cap 0.3."""
+    base = {"pmb.miss_p_detect_online": 1, "pmb.miss_p_detect_bins": 1}
+    _, p_off = _pair_p_detect(with_params(TrackerConfig(), {**base, "pmb.miss_p_detect_neighbour_m": 0.0}))
+    assert p_off == pytest.approx(0.55, rel=1e-9)
+    _, p_on = _pair_p_detect(with_params(TrackerConfig(), {**base, "pmb.miss_p_detect_neighbour_m": 2.0}))
+    assert p_on == pytest.approx(0.3, rel=1e-9)
