@@ -25,9 +25,10 @@ parameter is its dotted path: ``pmb.gate_chi2``, ``classes.car.birth_weight``, `
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import re
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import MISSING, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -656,12 +657,21 @@ for _section, _kind in _SECTIONS.items():
         _SECTIONS_OF_KEY[_f.name] = (*_SECTIONS_OF_KEY.get(_f.name, ()), _section)
 
 
+def unknown_parameter(where: str, key: str, known: Iterable[str]) -> str:
+    """The message for a parameter name the place does not know: the closest name it or any section declares, if
+    one is close (a typo: ``neighbor`` for ``neighbour``), then every name the place knows."""
+    names = sorted(known)
+    close = difflib.get_close_matches(key, sorted({*names, *_SECTIONS_OF_KEY}), n=1, cutoff=0.8)
+    hint = f"; did you mean '{close[0]}'?" if close else ""
+    return f"{where}: unknown parameter '{key}'{hint} (known: {', '.join(names)})"
+
+
 def _typed_value(kind: type, key: str, value: Any, where: str) -> float | int:
     """``value`` as the declared type of parameter ``key`` of section ``kind``, checked against its declared
     range, or a ``ConfigError``."""
     known = {d.name: d for d in declared(kind)}
     if key not in known:
-        raise ConfigError(f"{where}: unknown parameter '{key}' (known: {', '.join(sorted(known))})")
+        raise ConfigError(unknown_parameter(where, key, known))
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ConfigError(f"{where} {key}: expected a number, got {value!r}")
     if known[key].type is int and not float(value).is_integer():
@@ -699,7 +709,7 @@ def _class_table(name: str, values: Any, params: ClassParams, overrides: dict[st
         sections = _SECTIONS_OF_KEY.get(key, ())
         if not sections:
             known = sorted(own | set(_SECTIONS_OF_KEY))
-            raise ConfigError(f"{where}: unknown parameter '{key}' (known: {', '.join(known)})")
+            raise ConfigError(unknown_parameter(where, key, known))
         if len(sections) > 1:
             raise ConfigError(
                 f"{where}: '{key}' is a parameter of several sections ({', '.join(sections)}); set it in a "

@@ -37,7 +37,9 @@ def test_partial_override(tmp_path):
 
 
 BAD_FILES = [
-    ("[pmb]\np_surive = 0.9\n", "unknown parameter 'p_surive'"),
+    ("[pmb]\np_surive = 0.9\n", "unknown parameter 'p_surive'; did you mean 'p_survive'\\?"),
+    ("[pmb]\nmiss_p_detect_neighbor_m = 2\n", "did you mean 'miss_p_detect_neighbour_m'\\?"),
+    ("[pmb]\nspeed = 2\n", r"unknown parameter 'speed' \(known: "),
     ("[classes.boat]\nq_x = 1\n", "unknown class"),
     ("[pmb]\np_survive = 'high'\n", "expected a number"),
     ("[pmbm]\nn_hypotheses = 2.5\n", "expected an integer"),
@@ -65,7 +67,7 @@ OUT_OF_RANGE = [
     ("[classes.pedestrian]\nbirth_weight = -1\n", r"\[classes.pedestrian\] birth_weight must be > 0, got -1"),
     ("[classes.car]\np_detect = 0.8\n", r"several sections \(phd, vector\); set it in a sub-table"),
     ("[classes.car.vector]\np_detect = 1.0\n", r"\[classes.car.vector\] p_detect must be in \(0, 1\)"),
-    ("[classes.car]\nbirth_wieght = 1\n", "unknown parameter 'birth_wieght'"),
+    ("[classes.car]\nbirth_wieght = 1\n", "unknown parameter 'birth_wieght'; did you mean 'birth_weight'\\?"),
     ("[classes.car.vector]\nconfirm_m = 5\n", "confirm_m <= confirm_n"),
     ("[greedy]\nmax_age = 0\n", r"\[greedy\] max_age must be >= 1, got 0"),
 ]
