@@ -767,3 +767,12 @@ def test_another_runs_track_on_the_object_said_to_keep_it_where_its_evaluation_m
     ctx3 = Context(C, 3, GT_A, kind="id_switch")
     to_11 = to_it.replace("track 7", "track 11")
     assert check_text(to_11, ctx3, None, _eval(), scene=scene, others={"pmbm": ev}).found == []
+
+
+def test_a_because_sentence_no_pattern_reads_is_left_out_of_coverage() -> None:
+    """The pattern that cuts a Because paragraph out matches all of it; neither it nor a module's import of it may
+    count its sentences as read (every clause of a Because paragraph was counted read that way)."""
+    from tools.truth.sentences import coverage
+
+    clauses, unchecked = coverage("  Because (frame 3): the moon was full. Track 5 sang a song.")
+    assert clauses == 2 and sum(unchecked.values()) == 2, unchecked

@@ -275,9 +275,12 @@ def check_text(
 
 
 def _patterns() -> list[re.Pattern]:
+    """Every pattern a checker reads a sentence with, each once; not ``BECAUSE``, which only cuts a paragraph out
+    (it matches the whole paragraph, so counting it, or a module's import of it, would read every clause)."""
     mods = (detector, otherruns, shares, lost, place, costs, hypotheses, output)
-    here = [v for v in globals().values() if isinstance(v, re.Pattern) and v is not BECAUSE]
-    return here + [v for mod in mods for v in vars(mod).values() if isinstance(v, re.Pattern)]
+    found = [v for v in globals().values() if isinstance(v, re.Pattern)]
+    found += [v for mod in mods for v in vars(mod).values() if isinstance(v, re.Pattern)]
+    return list({id(p): p for p in found if p is not BECAUSE}.values())
 
 
 def clause_kind(clause: str) -> str:
