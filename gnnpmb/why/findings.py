@@ -9,7 +9,7 @@ so a test can check every assertion against independent facts.
 
 The tests of ``Blame`` (``Rule``) are stated once, here:
 
-* **the detector's**: in a frame that decided the failure, no detection of any class and score within
+* **the detector's**: in a frame that decided the failure, no detection of a tracked class (any score) within
   ``NEAR_M`` of the object while it had LiDAR or radar points (``NO_DETECTION``), only detections of another
   class (``OTHER_CLASS``), or the false
   track was output on a detection that lies within ``NEAR_M`` of no object (``DETECTION_OF_NOTHING``);

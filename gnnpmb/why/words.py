@@ -491,7 +491,7 @@ def _detector_gaps(f: Finding) -> list[str]:
         if b.rule is Rule.NO_DETECTION:
             points = [by[x].points for x in b.frames if x in by]
             out.append(
-                f"at {frames_text(b.frames)} the detector gave no detection of any class within {NEAR_M:.0f} m, "
+                f"at {frames_text(b.frames)} the detector gave no detection of a tracked class within {NEAR_M:.0f} m, "
                 f"though it had {_span(points)} LiDAR and radar points"
             )
         elif b.rule is Rule.OTHER_CLASS:
@@ -508,8 +508,8 @@ def _hidden(f: Finding) -> list[str]:
     if not hidden:
         return []
     return [
-        f"at {frames_text(hidden)} it had no LiDAR or radar points (no detector could see it) and no detection within "
-        f"{NEAR_M:.0f} m"
+        f"at {frames_text(hidden)} it had no LiDAR or radar points (no detector could see it) and no detection of a "
+        f"tracked class within {NEAR_M:.0f} m"
     ]
 
 
@@ -1020,12 +1020,12 @@ def _miss(f: Finding) -> list[str]:
         carried = "" if s.on_it else ", and no track carried it through"  # said only of an object no track was on
         parts.append(
             f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and no detection "
-            f"within {NEAR_M:.0f} m{carried}"
+            f"of a tracked class within {NEAR_M:.0f} m{carried}"
         )
     elif s.nearest_any is None:
         parts.append(
-            f"at frame {f.frame} the detector gave no detection within {NEAR_M:.0f} m of {name} ({inside}): the "
-            "detector missed it"
+            f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
+            f"({inside}): the detector missed it"
         )
     elif s.nearest_own is None and s.nearest_any.class_name != f.class_name:
         n = s.nearest_any

@@ -292,7 +292,8 @@ PLANTED_FACTS = {
     "detector: no detection though one was in reach": (
         "at frame 3 the detector gave no car detection within 2 m of car GT bbbbbb (0 LiDAR and radar points in its "
         "box), but a truck detection, m1 (score 0.40), 1.0 m away",
-        "at frame 3 the detector gave no detection within 2 m of car GT aaaaaa (12 LiDAR and radar points in its box)",
+        "at frame 3 the detector gave no detection of a tracked class within 2 m of car GT aaaaaa (12 LiDAR and radar "
+        "points in its box)",
         (),
     ),
     "detector: range side": (
@@ -776,3 +777,24 @@ def test_a_because_sentence_no_pattern_reads_is_left_out_of_coverage() -> None:
 
     clauses, unchecked = coverage("  Because (frame 3): the moon was full. Track 5 sang a song.")
     assert clauses == 2 and sum(unchecked.values()) == 2, unchecked
+
+
+def test_no_detection_said_with_no_class_beside_a_box_of_an_untracked_class_is_caught() -> None:
+    """Dev set scene-0553 centerpoint gnnpmb miss:2: a barrier box (0.53) lay within 2 m of the pedestrian, which
+    the explainer, given only the tracked classes' boxes, said had "no detection within 2 m"."""
+    from tools.truth.scene import Detection
+
+    scene = _scene()
+    scene.untracked = [[], [], [Detection("barrier", 0.53, (30.5, 0.0))], []]
+    ctx = Context(C, 2, GT_B, kind="miss")
+    said = (
+        "at frame 2 the detector gave no detection{} within 2 m of car GT bbbbbb (0 LiDAR and radar points in its box)",
+        "at frame 2 car GT bbbbbb had no LiDAR or radar points (no detector could see it) and no detection{} "
+        "within 2 m",
+        "at frame 2 the detector gave no detection of {} class within 2 m, though it had 12",
+    )
+    for sentence in said:
+        untracked, tracked = ("any", "a tracked") if "of {}" in sentence else ("", " of a tracked class")
+        false, true = sentence.format(untracked), sentence.format(tracked)
+        assert check_text(true, ctx, None, _eval(), scene=scene).found == [], true
+        assert [c.kind for c in check_text(false, ctx, None, _eval(), scene=scene).found] == ["detector"], false

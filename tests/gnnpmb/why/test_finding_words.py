@@ -246,7 +246,7 @@ def test_an_unseen_object_a_track_was_on_is_not_said_to_be_carried_by_no_track()
     )
     alone = Sighting(13, 0, g, None, None, None, ())
     (line, _) = why_lines(finding(FailureKind.MISS, sightings=(alone,), blame=(Blame(Rule.UNSEEN, (13,)),)))
-    assert "no detection within 2 m, and no track carried it through" in line
+    assert "no detection of a tracked class within 2 m, and no track carried it through" in line
 
 
 def test_a_coalesced_objects_interpolated_box_is_said_where_it_makes_the_finding_the_evaluations() -> None:
