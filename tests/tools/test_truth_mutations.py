@@ -798,3 +798,15 @@ def test_no_detection_said_with_no_class_beside_a_box_of_an_untracked_class_is_c
         false, true = sentence.format(untracked), sentence.format(tracked)
         assert check_text(true, ctx, None, _eval(), scene=scene).found == [], true
         assert [c.kind for c in check_text(false, ctx, None, _eval(), scene=scene).found] == ["detector"], false
+
+
+def test_one_track_for_two_objects_said_of_a_track_out_of_reach_of_the_scored_box_is_caught() -> None:
+    """Dev set scene-0061 megvii gnnpmb miss at frame 9: track 72, matched to another object, lay 0.3 m from the
+    annotation but 2.9 m from the box the devkit interpolated for the object: it could not have had the object."""
+    said = "track 7 lay within 2 m of it and was counted, but the evaluation matched it to another object"
+    ev = _eval()
+    ev.pred_xy[(C, 3)] = {"7": (0.0, 0.0)}
+    ev.evaluated_gt[(3, GT_B)] = (1.0, 0.0)
+    assert check_text(said, CTX, None, ev).found == []
+    ev.evaluated_gt[(3, GT_B)] = (2.9, 0.0)
+    assert [c.kind for c in check_text(said, CTX, None, ev).found] == ["misleading"]
