@@ -810,3 +810,17 @@ def test_one_track_for_two_objects_said_of_a_track_out_of_reach_of_the_scored_bo
     assert check_text(said, CTX, None, ev).found == []
     ev.evaluated_gt[(3, GT_B)] = (2.9, 0.0)
     assert [c.kind for c in check_text(said, CTX, None, ev).found] == ["misleading"]
+
+
+def test_another_run_whose_coalescence_matched_the_object_is_not_said_to_fail_on_it() -> None:
+    """Dev set scene-1077 pointpillars: gnn's coalescence missed pedestrian a2d371; jpda's coalescence there matched
+    a2d371 (its track also covered a neighbour, which it missed): "jpda ... failed here too" was false."""
+    ev, other = _eval(), EvalFacts(thresholds={C: 0.5})
+    other.evaluated_gt.update({(3, GT_A): (0.0, 0.0), (3, GT_B): (1.0, 0.0)})
+    other.pred_xy[(C, 3)] = {"7": (0.9, 0.0)}
+    other.gt_to_track[(C, 3)] = {GT_B: "7", GT_A: None}  # its track 7 on GT B (the finding's object), GT A missed
+    ctx = Context(C, 3, GT_B, covered=(GT_A,), kind="coalescence")
+    said = "pmbm on the same detections failed here too"
+    assert [c.kind for c in check_text(said, ctx, None, ev, others={"pmbm": other}).found] == ["other run"]
+    other.gt_to_track[(C, 3)] = {GT_A: "7", GT_B: None}  # now it matched GT A and missed the finding's object
+    assert check_text(said, ctx, None, ev, others={"pmbm": other}).found == []

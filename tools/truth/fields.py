@@ -234,8 +234,8 @@ def failed_here(ev: EvalFacts, kind: str, c: str, x: int, gt_id: str | None, pla
             return False
         before = [f for f in steps if f < x]
         return bool(before) and not missed[before[-1]] and any(not missed[f] for f in steps if f > x)
-    if kind == "coalescence":
-        return gt_id in _coalesced(ev, c, x)
+    if kind == "coalescence":  # the object missed beside a matched one (matched itself, the run kept it)
+        return gt_id in _coalesced(ev, c, x) and gt_id in pairs and pairs[gt_id] is None
     return None
 
 

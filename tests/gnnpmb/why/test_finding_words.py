@@ -382,3 +382,16 @@ def test_a_track_out_of_reach_of_the_box_the_evaluation_scored_is_not_said_to_co
     blame = (Blame(Rule.INTERPOLATED, (9,)), Blame(Rule.COVERED_TWO, (9,)))
     (line, _) = why_lines(finding(FailureKind.MISS, frame=9, sightings=(seen,), blame=blame, reach=reach))
     assert "track 50 lay within 2 m of it and was counted, but the evaluation matched it to another object" in line
+
+
+def test_another_runs_coalescence_is_the_same_failure_only_when_it_missed_the_same_object() -> None:
+    # dev set scene-1077 pointpillars gnn coalescence at frame 21 missed pedestrian a2d371; jpda's coalescence there
+    # matched a2d371 and missed a neighbour: "jpda on the same detections failed here too" was false
+    from gnnpmb.eval.failures import Failure
+    from gnnpmb.why.reason import _same_place
+
+    theirs = Failure(FailureKind.COALESCENCE, 21, "s", "pedestrian", ("a2d371", "80d062"), ("273",), ())
+    assert not _same_place(theirs, "a2d371", None)
+    assert _same_place(theirs, "80d062", None)
+    miss = Failure(FailureKind.MISS, 21, "s", "pedestrian", ("a2d371",), (), ())
+    assert _same_place(miss, "a2d371", None)
