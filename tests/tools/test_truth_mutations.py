@@ -796,7 +796,8 @@ def test_no_detection_said_with_no_class_beside_a_box_of_an_untracked_class_is_c
     for sentence in said:
         untracked, tracked = ("any", "a tracked") if "of {}" in sentence else ("", " of a tracked class")
         false, true = sentence.format(untracked), sentence.format(tracked)
-        assert check_text(true, ctx, None, _eval(), scene=scene).found == [], true
+        read = check_text(true, ctx, None, _eval(), scene=scene)
+        assert read.found == [] and read.checked["detector"] == 1 and not read.unchecked, true
         assert [c.kind for c in check_text(false, ctx, None, _eval(), scene=scene).found] == ["detector"], false
 
 

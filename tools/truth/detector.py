@@ -30,8 +30,8 @@ NONE_ANY = re.compile(
     rf"at ({_FRAMES}) the detector gave no detection of (any|a tracked) class within 2 m, though it had"
 )
 HIDDEN = re.compile(
-    rf"at ({_FRAMES}) (?:\w+ GT (\w+)|it) had no LiDAR or radar points \(no detector could see it\) and no detection "
-    r"( of a tracked class)? ?within 2 m"
+    rf"at ({_FRAMES}) (?:\w+ GT (\w+)|it) had no LiDAR or radar points \(no detector could see it\) and no detection"
+    r"( of a tracked class)? within 2 m"
 )
 UNUSED = re.compile(rf"at frame (\d+) m(\d+) \((?:(\w+), )?score ({_F}), ({_F}) m from it")
 OUTPUT_ON = re.compile(rf"at frame (\d+) track \d+ \((\w+)\) was output on detection m(\d+) \((\w+), score ({_F})\)")
