@@ -23,7 +23,7 @@ class Claim:
 
 CLAIM_KINDS = (
     "detection near",  # (gt, meas, class, score, distance_m): that detection lies that far from the object
-    "no detection near",  # (gt,): no detection of any class and score within NEAR_M of the object
+    "no detection near",  # (gt,): no detection of a tracked class (any score) within NEAR_M of the object
     "nearest own",  # (gt, meas): the nearest kept detection of the failure's class within NEAR_M
     "no own near",  # (gt,): no kept detection of the class within NEAR_M
     "points",  # (gt, n): LiDAR + radar points in its box

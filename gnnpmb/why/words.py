@@ -29,6 +29,7 @@ from gnnpmb.why.findings import (
     OtherRun,
     Rule,
     Sighting,
+    covering,
 )
 
 SHOW_MIN_EXISTENCE = 0.5
@@ -491,7 +492,7 @@ def _detector_gaps(f: Finding) -> list[str]:
         if b.rule is Rule.NO_DETECTION:
             points = [by[x].points for x in b.frames if x in by]
             out.append(
-                f"at {frames_text(b.frames)} the detector gave no detection of any class within {NEAR_M:.0f} m, "
+                f"at {frames_text(b.frames)} the detector gave no detection of a tracked class within {NEAR_M:.0f} m, "
                 f"though it had {_span(points)} LiDAR and radar points"
             )
         elif b.rule is Rule.OTHER_CLASS:
@@ -508,8 +509,8 @@ def _hidden(f: Finding) -> list[str]:
     if not hidden:
         return []
     return [
-        f"at {frames_text(hidden)} it had no LiDAR or radar points (no detector could see it) and no detection within "
-        f"{NEAR_M:.0f} m"
+        f"at {frames_text(hidden)} it had no LiDAR or radar points (no detector could see it) and no detection of a "
+        f"tracked class within {NEAR_M:.0f} m"
     ]
 
 
@@ -738,7 +739,7 @@ def _lost_object(f: Finding) -> list[str]:
         s = f.sighting(f.frame)
         for b in f.blame:
             if b.rule is Rule.COVERED_TWO and s is not None:
-                ids = _covering(s)
+                ids = _covering(f, s)
                 parts.append(
                     f"at frame {f.frame} track {ids} lay within {NEAR_M:.0f} m of it and was counted, but the "
                     "evaluation matched it to another object: one track for two objects"
@@ -963,14 +964,9 @@ def _no_box_reason(g: GtFrame | None) -> str:
     return f"{why}, so its box was dropped, and no box could be interpolated"
 
 
-def _covering(s: Sighting) -> str:
-    """The counted tracks on the object that the evaluation matched to another object: no false track there, and
-    their box kept by the evaluation (one it dropped was matched to nothing)."""
-    return ", ".join(
-        str(o.track_id)
-        for o in s.on_it
-        if o.counted and not o.false_here and o.evaluated is not None and s.frame in o.evaluated.kept
-    )
+def _covering(f: Finding, s: Sighting) -> str:
+    """The counted tracks on the object that the evaluation matched to another object (``findings.covering``)."""
+    return ", ".join(str(o.track_id) for o in covering(s, f.reach))
 
 
 def _not_counted_on_it(f: Finding, s: Sighting) -> list[str]:
@@ -1020,12 +1016,12 @@ def _miss(f: Finding) -> list[str]:
         carried = "" if s.on_it else ", and no track carried it through"  # said only of an object no track was on
         parts.append(
             f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and no detection "
-            f"within {NEAR_M:.0f} m{carried}"
+            f"of a tracked class within {NEAR_M:.0f} m{carried}"
         )
     elif s.nearest_any is None:
         parts.append(
-            f"at frame {f.frame} the detector gave no detection within {NEAR_M:.0f} m of {name} ({inside}): the "
-            "detector missed it"
+            f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
+            f"({inside}): the detector missed it"
         )
     elif s.nearest_own is None and s.nearest_any.class_name != f.class_name:
         n = s.nearest_any
@@ -1052,7 +1048,7 @@ def _miss(f: Finding) -> list[str]:
     if s.nearest_own is not None and not s.on_it:
         parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
     if any(b.rule is Rule.COVERED_TWO for b in f.blame):
-        covering = _covering(s)
+        covering = _covering(f, s)
         parts.append(
             f"track {covering} lay within {NEAR_M:.0f} m of it and was counted, but the evaluation matched it to "
             "another object: one track for two objects"

@@ -19,17 +19,19 @@ _F = r"[\d.]+"
 _FRAMES = r"frames? [\d–, ]*\d"
 SCORE_AT = re.compile(rf"at frame (\d+) detection m(\d+) \(score ({_F})\) lay ({_F}) m from (\w+) GT (\w+)")
 NO_DETECTION = re.compile(
-    r"at frame (\d+) the detector gave no detection within 2 m of (\w+) GT (\w+) \((\d+) LiDAR and radar points in "
-    r"its box\)"
+    r"at frame (\d+) the detector gave no detection( of a tracked class)? within 2 m of (\w+) GT (\w+) \((\d+) LiDAR "
+    r"and radar points in its box\)"
 )
 WRONG_CLASS = re.compile(
     rf"at frame (\d+) the detector gave no (\w+) detection within 2 m of \w+ GT (\w+) \((\d+) LiDAR and radar points "
     rf"in its box\), but a (\w+) detection, m(\d+) \(score ({_F})\), ({_F}) m away"
 )
-NONE_ANY = re.compile(rf"at ({_FRAMES}) the detector gave no detection of any class within 2 m, though it had")
+NONE_ANY = re.compile(
+    rf"at ({_FRAMES}) the detector gave no detection of (any|a tracked) class within 2 m, though it had"
+)
 HIDDEN = re.compile(
-    rf"at ({_FRAMES}) (?:\w+ GT (\w+)|it) had no LiDAR or radar points \(no detector could see it\) and no detection "
-    r"within 2 m"
+    rf"at ({_FRAMES}) (?:\w+ GT (\w+)|it) had no LiDAR or radar points \(no detector could see it\) and no detection"
+    r"( of a tracked class)? within 2 m"
 )
 UNUSED = re.compile(rf"at frame (\d+) m(\d+) \((?:(\w+), )?score ({_F}), ({_F}) m from it")
 OUTPUT_ON = re.compile(rf"at frame (\d+) track \d+ \((\w+)\) was output on detection m(\d+) \((\w+), score ({_F})\)")
@@ -122,12 +124,14 @@ def check_detector(
         if d is None or d.class_name != m[4] or not _close(m[5], d.score):
             bad("detector", m[0], f"the file's m{m[3]} at frame {x}: {d}")
     for m in NO_DETECTION.finditer(text):
-        x, ann = int(m[1]), gt_xy(int(m[1]), m[3])
+        x, ann = int(m[1]), gt_xy(int(m[1]), m[4])
         out.checked["detector"] += 1
         if ann is None:
-            bad("detector", m[0], f"no annotation of GT {m[3]} at frame {x}")
-        elif scene.near(x, ann.xy_m) or ann.points != int(m[4]):
+            bad("detector", m[0], f"no annotation of GT {m[4]} at frame {x}")
+        elif scene.near(x, ann.xy_m) or ann.points != int(m[5]):
             bad("detector", m[0], f"detections within {NEAR_M} m: {scene.near(x, ann.xy_m)}; points {ann.points}")
+        elif not m[2] and scene.untracked_near(x, ann.xy_m):
+            bad("detector", m[0], f"the file has {scene.untracked_near(x, ann.xy_m)} within {NEAR_M} m (untracked)")
     for m in WRONG_CLASS.finditer(text):
         x, ann = int(m[1]), gt_xy(int(m[1]), m[3])
         out.checked["detector"] += 1
@@ -138,6 +142,8 @@ def check_detector(
     for m in NONE_ANY.finditer(text):
         out.checked["detector"] += 1
         seen = {x: scene.near(x, a.xy_m) for x in frames_of(m[1]) if (a := gt_xy(x)) is not None}
+        if m[2] == "any":
+            seen = {x: [*v, *scene.untracked_near(x, gt_xy(x).xy_m)] for x, v in seen.items()}
         if any(seen.values()):
             bad("detector", m[0], f"detections within {NEAR_M} m by frame: {seen}")
     for m in HIDDEN.finditer(text):
@@ -145,8 +151,9 @@ def check_detector(
         wrong = {}
         for x in frames_of(m[1]):
             a = gt_xy(x, m[2])
-            if a is None or a.points != 0 or scene.near(x, a.xy_m):
-                wrong[x] = None if a is None else (a.points, scene.near(x, a.xy_m))
+            near = [] if a is None else [*scene.near(x, a.xy_m), *([] if m[3] else scene.untracked_near(x, a.xy_m))]
+            if a is None or a.points != 0 or near:
+                wrong[x] = None if a is None else (a.points, near)
         if wrong:
             bad("detector", m[0], f"(points, detections within reach) by frame: {wrong}")
     for m in OTHER_CLASS.finditer(text):

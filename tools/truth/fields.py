@@ -234,8 +234,8 @@ def failed_here(ev: EvalFacts, kind: str, c: str, x: int, gt_id: str | None, pla
             return False
         before = [f for f in steps if f < x]
         return bool(before) and not missed[before[-1]] and any(not missed[f] for f in steps if f > x)
-    if kind == "coalescence":
-        return gt_id in _coalesced(ev, c, x)
+    if kind == "coalescence":  # the object missed beside a matched one (matched itself, the run kept it)
+        return gt_id in _coalesced(ev, c, x) and gt_id in pairs and pairs[gt_id] is None
     return None
 
 
@@ -559,8 +559,16 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             if str(f.lost.track_id) not in on or len(on) < 2:
                 return "not two tracks on the object"
         elif name == "COVERED_TWO" and f.kind.value in ("miss", "fragmentation"):
-            if not _counted_on(src, x, c, xy):
-                return "no counted track lies within reach"
+            at = src.status(x, f.gt_id)[1]  # the box the devkit scored the object at: only it decides a match
+            taken = [
+                t
+                for t in _counted_on(src, x, c, xy)
+                if at is not None
+                and math.dist(next(p for tt, _, p in src.ev.boxes[x] if tt == t), at) < NEAR_M
+                and src.ev.matched_gt(c, x, t) not in (None, f.gt_id)
+            ]
+            if not taken:
+                return "no counted track within reach of the box the evaluation scored was matched to another object"
         elif name == "NO_EVAL_BOX":
             gt_id = f.false_output.nearest_own[0] if f.false_output and f.false_output.nearest_own else f.gt_id
             if src.status(x, gt_id)[0] in ("scored", "interpolated"):

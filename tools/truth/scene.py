@@ -10,6 +10,7 @@ the ground plane (x, y), in metres.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,6 +45,9 @@ class SceneTruth:
     objects: list[dict[str, Annotation]]
     ego_xy_m: list[tuple[float, float]] | None = None
     """Per keyframe, the ego pose of its LIDAR_TOP sample data (as the devkit's ``add_center_dist`` takes it)."""
+    untracked: list[list[Detection]] | None = None
+    """Per keyframe, the file's boxes of a class no tracker follows (barrier, traffic cone): no ``mN`` names them,
+    but "no detection within 2 m" said with no class is false beside one."""
 
     @classmethod
     def read(cls, nusc, scene_name: str, detection_file: Path) -> SceneTruth:
@@ -51,23 +55,22 @@ class SceneTruth:
 
         results = json.loads(Path(detection_file).read_text(encoding="utf-8"))["results"]
         scene = next(s for s in nusc.scene if s["name"] == scene_name)
-        detections, objects, ego, token = [], [], [], scene["first_sample_token"]
+        detections, objects, ego, untracked, token = [], [], [], [], scene["first_sample_token"]
         while token:
             sample = nusc.get("sample", token)
             pose = nusc.get("ego_pose", nusc.get("sample_data", sample["data"]["LIDAR_TOP"])["ego_pose_token"])
             ego.append((float(pose["translation"][0]), float(pose["translation"][1])))
-            detections.append(
-                [
-                    Detection(
-                        b["detection_name"],
-                        float(b["detection_score"]),
-                        tuple(map(float, b["translation"][:2])),
-                        tuple(map(float, [*b["size"], *b["rotation"], b["translation"][2]])),
-                    )
-                    for b in results.get(token, [])
-                    if b["detection_name"] in TRACKING
-                ]
-            )
+            boxes = [
+                Detection(
+                    b["detection_name"],
+                    float(b["detection_score"]),
+                    tuple(map(float, b["translation"][:2])),
+                    tuple(map(float, [*b["size"], *b["rotation"], b["translation"][2]])),
+                )
+                for b in results.get(token, [])
+            ]
+            detections.append([d for d in boxes if d.class_name in TRACKING])
+            untracked.append([d for d in boxes if d.class_name not in TRACKING])
             here: dict[str, Annotation] = {}
             for a in (nusc.get("sample_annotation", t) for t in sample["anns"]):
                 name = category_to_tracking_name(a["category_name"])
@@ -76,7 +79,7 @@ class SceneTruth:
                     here[a["instance_token"]] = Annotation(name, tuple(map(float, a["translation"][:2])), points)
             objects.append(here)
             token = sample["next"]
-        return cls(detections, objects, ego)
+        return cls(detections, objects, ego, untracked)
 
     def object_of(self, frame: int, short_id: str) -> tuple[str, Annotation] | None:
         """The annotation at ``frame`` whose instance token starts with ``short_id`` (as the text prints it)."""
@@ -93,6 +96,11 @@ class SceneTruth:
         if not dets:
             return np.zeros(0)
         return np.hypot(*(np.array([d.xy_m for d in dets]) - np.asarray(xy_m)).T)
+
+    def untracked_near(self, frame: int, xy_m: tuple[float, float]) -> list[str]:
+        """The file's boxes of an untracked class within ``NEAR_M`` of ``xy_m`` at ``frame``: "class score"."""
+        boxes = self.untracked[frame] if self.untracked is not None and frame < len(self.untracked) else []
+        return [f"{d.class_name} {d.score:.2f}" for d in boxes if math.dist(d.xy_m, xy_m) < NEAR_M]
 
     def near(self, frame: int, xy_m: tuple[float, float], class_name: str | None = None) -> list[int]:
         """Detections of ``frame`` within ``NEAR_M`` of ``xy_m`` (of ``class_name`` only, if given)."""

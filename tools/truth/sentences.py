@@ -275,9 +275,12 @@ def check_text(
 
 
 def _patterns() -> list[re.Pattern]:
+    """Every pattern a checker reads a sentence with, each once; not ``BECAUSE``, which only cuts a paragraph out
+    (it matches the whole paragraph, so counting it, or a module's import of it, would read every clause)."""
     mods = (detector, otherruns, shares, lost, place, costs, hypotheses, output)
-    here = [v for v in globals().values() if isinstance(v, re.Pattern) and v is not BECAUSE]
-    return here + [v for mod in mods for v in vars(mod).values() if isinstance(v, re.Pattern)]
+    found = [v for v in globals().values() if isinstance(v, re.Pattern)]
+    found += [v for mod in mods for v in vars(mod).values() if isinstance(v, re.Pattern)]
+    return list({id(p): p for p in found if p is not BECAUSE}.values())
 
 
 def clause_kind(clause: str) -> str:
@@ -320,8 +323,17 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None
         for t in (s.strip() for s in m[1].split(",")):
             out.checked["matched"] += 1
             got = ev.matched_gt(c, ctx.frame, t)
+            scored = ev.evaluated_gt.get((ctx.frame, ctx.gt_id or ""))
+            box = ev.pred_xy.get((c, ctx.frame), {}).get(t)
             if got is None or got == ctx.gt_id:
                 bad("matched", m[0], f"the devkit matched track {t} at frame {ctx.frame} to {got}")
+            elif scored is not None and box is not None and math.dist(scored, box) >= 2.0:
+                bad(
+                    "misleading",
+                    m[0],
+                    f"the devkit scored the object {math.dist(scored, box):.2f} m from track {t}'s box: out of its "
+                    "reach, so its match elsewhere did not take this object from it",
+                )
     for m in COALESCED.finditer(text):
         x, t = int(m[1]), m[2]
         for g in ctx.covered:
