@@ -735,7 +735,11 @@ class _Context:
                 xy = np.asarray(self.failure.boxes[0].translation_m[:2])
             kinds = SAME_FAILURE.get(self.failure.kind, {self.failure.kind})
             failed = any(
-                f.kind in kinds and f.frame_index == self.f and _same_place(f, gt_id, xy) for f in ev.report.failures
+                f.kind in kinds
+                and f.frame_index == self.f
+                and _same_place(f, gt_id, xy)
+                and (f.kind is not FailureKind.FALSE_TRACK or f.class_name == self.class_name)  # a false car is not
+                for f in ev.report.failures  # a false bicycle (dev scene-0655: immortal's car beside a bicycle)
             )
             on_it = self.on_object(ev.report, fr, xy) if xy is not None else ()
             place = (float(xy[0]), float(xy[1])) if xy is not None else None

@@ -1126,7 +1126,11 @@ def _others(f: Finding) -> list[str]:
         counted = [x for x in o.on_it if x.counted]
         who = _other_name(f, o)
         if f.gt_id is None:  # a false track on no object: the same mistake at the same place, or not
-            same = "had a false track here too" if o.failed_same else "had no false track here"
+            same = (
+                f"had a false {f.class_name} track here too"
+                if o.failed_same
+                else f"had no false {f.class_name} track here"
+            )
             out.append(f"{who} {same}")
         elif o.failed_same:
             out.append(f"{who} failed here too")

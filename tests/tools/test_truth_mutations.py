@@ -382,10 +382,15 @@ def test_another_runs_false_track_and_an_empty_place_are_checked_where_the_false
     ev.boxes[3] = [("11", C, (0.0, 0.0)), ("12", C, (10.0, 0.0))]
     other.pred_xy[(C, 3)] = {"5": (0.5, 0.0), "7": (0.0, 0.0)}  # its track 5 is a false positive beside the box
     at = Context(C, 3, None, kind="false_track", track=11)
-    fair = "pmbm on the same detections had a false track here too"
+    fair = "pmbm on the same detections had a false car track here too"
     assert check_text(fair, at, None, ev, others={"pmbm": other}).found == []
-    planted = "pmbm on the same detections had no false track here"
+    planted = "pmbm on the same detections had no false car track here"
     assert [c.kind for c in check_text(planted, at, None, ev, others={"pmbm": other}).found] == ["other run"]
+    walker = _eval()  # its only false positive there a pedestrian: another failure than a false car
+    walker.track_to_gt[("pedestrian", 3)] = {"9": None}
+    walker.pred_xy[("pedestrian", 3)] = {"9": (0.2, 0.0)}
+    assert check_text(planted, at, None, ev, others={"pmbm": walker}).found == []
+    assert [c.kind for c in check_text(fair, at, None, ev, others={"pmbm": walker}).found] == ["other run"]
     empty = "no object of a tracked class lies within 2 m of it"
     assert [c.kind for c in check_text(empty, at, None, ev, scene=_scene()).found] == ["detector"]  # GT A is there
     away = Context(C, 3, None, kind="false_track", track=12)

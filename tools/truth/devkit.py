@@ -63,13 +63,13 @@ class EvalFacts:
     def matched_gt(self, class_name: str, frame: int, track_id: str) -> str | None:
         return self.track_to_gt.get((class_name, frame), {}).get(track_id)
 
-    def false_near(self, frame: int, place_xy_m) -> list[str]:
-        """The track ids (any class) the accumulator counted as false positives at ``frame`` with a scored box
-        within ``NEAR_M`` of ``place_xy_m``."""
+    def false_near(self, frame: int, place_xy_m, class_name: str) -> list[str]:
+        """The track ids of ``class_name`` the accumulator counted as false positives at ``frame`` with a scored box
+        within ``NEAR_M`` of ``place_xy_m`` (a false track of another class is another failure)."""
         return sorted(
             t
             for (k, y), tracks in self.track_to_gt.items()
-            if y == frame
+            if y == frame and k == class_name
             for t, g in tracks.items()
             if g is None
             and (xy := self.pred_xy.get((k, y), {}).get(t)) is not None

@@ -216,15 +216,15 @@ def _update_of(src: Sources, x: int, c: str, track: int) -> int | None:
 
 def failed_here(ev: EvalFacts, kind: str, c: str, x: int, gt_id: str | None, place) -> bool | None:
     """Whether a run (its devkit bookkeeping ``ev``) had a failure of ``kind`` at frame ``x`` on object ``gt_id``
-    of class ``c`` (a false track: a false positive of any class within ``NEAR_M`` of ``place``); None: a kind the
+    of class ``c`` (a false track: a false positive of class ``c`` within ``NEAR_M`` of ``place``); None: a kind the
     bookkeeping does not decide here."""
     pairs = ev.gt_to_track.get((c, x), {})
     if kind in ("id_switch", "identity_theft"):
         return gt_id is not None and gt_id in ev.switches.get((c, x), set())
     if kind == "miss":
         return gt_id is not None and gt_id in pairs and pairs[gt_id] is None
-    if kind == "false_track":  # a false track of any class within reach of the place (near the object, if named)
-        return place is not None and bool(ev.false_near(x, place))
+    if kind == "false_track":  # a false track of the class within reach of the place (near the object, if named)
+        return place is not None and bool(ev.false_near(x, place, c))
     if gt_id is None:
         return False
     if kind == "fragmentation":

@@ -117,16 +117,19 @@ def _check_matched_elsewhere(m: re.Match, c: str, x: int, gt: str, ev: EvalFacts
         bad("other run", m[0], f"{m[1]}'s evaluation matched them at frame {x} to {got}")
 
 
-FALSE_HERE = re.compile(r"(\w+) on the same detections (had a false track here too|had no false track here)")
+FALSE_HERE = re.compile(
+    r"(\w+) on the same detections (had a false (?:\w+ )?track here too|had no false (?:\w+ )?track here)"
+)
 
 
 def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapping[str, EvalFacts], out, bad) -> None:
     """ "Had a false track here too / had no false track here": whether the other run's accumulator counted a track
-    box within ``NEAR_M`` of the place (the object, or the false box) as a false positive at frame x."""
+    box of class ``c`` within ``NEAR_M`` of the place (the object, or the false box) as a false positive at frame
+    x."""
     if place_xy_m is None:
         return
     for m, ev in _named_runs(FALSE_HERE, text, others):
         out.checked["other run"] += 1
-        false = ev.false_near(x, place_xy_m)
+        false = ev.false_near(x, place_xy_m, c)
         if bool(false) != m[2].startswith("had a false"):
             bad("other run", m[0], f"{m[1]}'s false positives within {NEAR_M} m at frame {x}: {false}")
