@@ -739,11 +739,7 @@ def _lost_object(f: Finding) -> list[str]:
         s = f.sighting(f.frame)
         for b in f.blame:
             if b.rule is Rule.COVERED_TWO and s is not None:
-                ids = _covering(f, s)
-                parts.append(
-                    f"at frame {f.frame} track {ids} lay within {NEAR_M:.0f} m of it and was counted, but the "
-                    "evaluation matched it to another object: one track for two objects"
-                )
+                parts.append(f"at frame {f.frame} {_covering(f, s)}")
             elif b.rule is Rule.NOT_COUNTED and s is not None:
                 parts += [
                     f"track {o.track_id} was output on it, but {averaged_text(o.evaluated)}, is below the "
@@ -965,8 +961,16 @@ def _no_box_reason(g: GtFrame | None) -> str:
 
 
 def _covering(f: Finding, s: Sighting) -> str:
-    """The counted tracks on the object that the evaluation matched to another object (``findings.covering``)."""
-    return ", ".join(str(o.track_id) for o in covering(s, f.reach))
+    """``track 50 lay within 2 m of it and was counted, but the evaluation matched it to another object: one track
+    for two objects`` (``tracks 50, 49 ... were ... each``): the counted tracks on the object that the evaluation
+    matched to another object (``findings.covering``)."""
+    ids = [str(o.track_id) for o in covering(s, f.reach)]
+    several = len(ids) > 1
+    return (
+        f"{'tracks' if several else 'track'} {', '.join(ids)} lay within {NEAR_M:.0f} m of it and "
+        f"{'were' if several else 'was'} counted, but the evaluation matched {'each' if several else 'it'} to "
+        "another object: one track for two objects"
+    )
 
 
 def _not_counted_on_it(f: Finding, s: Sighting) -> list[str]:
@@ -1048,11 +1052,7 @@ def _miss(f: Finding) -> list[str]:
     if s.nearest_own is not None and not s.on_it:
         parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
     if any(b.rule is Rule.COVERED_TWO for b in f.blame):
-        covering = _covering(f, s)
-        parts.append(
-            f"track {covering} lay within {NEAR_M:.0f} m of it and was counted, but the evaluation matched it to "
-            "another object: one track for two objects"
-        )
+        parts.append(_covering(f, s))
     g = s.evaluated
     if g is not None and g.status is GtStatus.INTERPOLATED and g.offset_m >= 0.05:
         parts.append(f"the evaluation scored it at a box it interpolated, {g.offset_m:.1f} m from the annotation")

@@ -816,6 +816,14 @@ def test_one_track_for_two_objects_said_of_a_track_out_of_reach_of_the_scored_bo
     assert check_text(said, CTX, None, ev).found == []
     ev.evaluated_gt[(3, GT_B)] = (2.9, 0.0)
     assert [c.kind for c in check_text(said, CTX, None, ev).found] == ["misleading"]
+    ev.evaluated_gt[(3, GT_B)] = (1.0, 0.0)
+    both = "tracks 7, 11 lay within 2 m of it and were counted, but the evaluation matched each to another object"
+    ev.pred_xy[(C, 3)]["11"] = (0.5, 0.0)
+    caught = check_text(both, CTX, None, ev).found  # track 11 was matched to no object: each named track is read
+    assert [(c.kind, c.truth) for c in caught] == [("matched", "the devkit matched track 11 at frame 3 to None")]
+    ev.track_to_gt[(C, 3)]["11"] = GT_A
+    found = check_text(both, CTX, None, ev)
+    assert found.found == [] and found.checked["matched"] == 2
 
 
 def test_another_run_whose_coalescence_matched_the_object_is_not_said_to_fail_on_it() -> None:

@@ -128,7 +128,10 @@ THEFT = re.compile(
     r"track (\d+) had been a false track at [^(]+\(matched to no object: the evaluation still gave GT (\w+) to "
     r"track (\d+)\)"
 )
-COVERED = re.compile(r"track ([\d, ]+) lay within \d m of it and was counted, but the evaluation matched it to another")
+COVERED = re.compile(
+    r"tracks? ([\d, ]+) lay within \d m of it and (?:was|were) counted, but the evaluation matched (?:it|each) to "
+    r"another"
+)
 COALESCED = re.compile(r"at frame (\d+) track (\d+) was matched to (GT \w+(?:, GT \w+)*) and also lay within")
 MATCHED_INSTEAD = re.compile(r"the evaluation matched it to another track \(track (\d+)\)")
 NOT_COUNTED = re.compile(

@@ -382,6 +382,8 @@ def test_a_track_out_of_reach_of_the_box_the_evaluation_scored_is_not_said_to_co
     blame = (Blame(Rule.INTERPOLATED, (9,)), Blame(Rule.COVERED_TWO, (9,)))
     (line, _) = why_lines(finding(FailureKind.MISS, frame=9, sightings=(seen,), blame=blame, reach=reach))
     assert "track 50 lay within 2 m of it and was counted, but the evaluation matched it to another object" in line
+    (both, _) = why_lines(finding(FailureKind.MISS, frame=9, sightings=(seen,), blame=blame))  # no reach known
+    assert "tracks 72, 50 lay within 2 m of it and were counted, but the evaluation matched each to another" in both
 
 
 def test_another_runs_coalescence_is_the_same_failure_only_when_it_missed_the_same_object() -> None:
