@@ -735,11 +735,8 @@ class _Context:
                 xy = np.asarray(self.failure.boxes[0].translation_m[:2])
             kinds = SAME_FAILURE.get(self.failure.kind, {self.failure.kind})
             failed = any(
-                f.kind in kinds
-                and f.frame_index == self.f
-                and _same_place(f, gt_id, xy)
-                and (f.kind is not FailureKind.FALSE_TRACK or f.class_name == self.class_name)  # a false car is not
-                for f in ev.report.failures  # a false bicycle (dev scene-0655: immortal's car beside a bicycle)
+                f.kind in kinds and f.frame_index == self.f and _same_place(f, gt_id, xy, self.class_name)
+                for f in ev.report.failures
             )
             on_it = self.on_object(ev.report, fr, xy) if xy is not None else ()
             place = (float(xy[0]), float(xy[1])) if xy is not None else None
@@ -795,14 +792,15 @@ SAME_FAILURE = {
 new track had been false), so a run with either did not 'not fail here'."""
 
 
-def _same_place(f: Failure, gt_id: str | None, xy: np.ndarray | None) -> bool:
+def _same_place(f: Failure, gt_id: str | None, xy: np.ndarray | None, class_name: str) -> bool:
     """Whether failure ``f`` is about the object ``gt_id`` (a coalescence's missed object: the one it matched
     there, it kept: dev set scene-1077 pointpillars, gnn's coalescence missing pedestrian a2d371 was said to be
     jpda's too, whose coalescence matched a2d371 and missed its neighbour), or, without one (or when ``f`` names no
-    object: a false track), lies within ``NEAR_M`` of ``xy``."""
+    object: a false track), is of ``class_name`` and lies within ``NEAR_M`` of ``xy`` (a false car is not a false
+    bicycle: dev set scene-0655, immortal's false car beside gnnpmb's false bicycle)."""
     if gt_id is not None and f.gt_ids:
         return gt_id in (f.gt_ids[1:] if f.kind is FailureKind.COALESCENCE else f.gt_ids)
-    if xy is None:
+    if xy is None or f.class_name != class_name:
         return False
     return any(np.hypot(*(np.asarray(b.translation_m[:2]) - xy)) < NEAR_M for b in f.boxes)
 

@@ -393,7 +393,7 @@ def test_another_runs_coalescence_is_the_same_failure_only_when_it_missed_the_sa
     from gnnpmb.why.reason import _same_place
 
     theirs = Failure(FailureKind.COALESCENCE, 21, "s", "pedestrian", ("a2d371", "80d062"), ("273",), ())
-    assert not _same_place(theirs, "a2d371", None)
-    assert _same_place(theirs, "80d062", None)
+    assert not _same_place(theirs, "a2d371", None, "pedestrian")
+    assert _same_place(theirs, "80d062", None, "pedestrian")
     miss = Failure(FailureKind.MISS, 21, "s", "pedestrian", ("a2d371",), (), ())
-    assert _same_place(miss, "a2d371", None)
+    assert _same_place(miss, "a2d371", None, "pedestrian")
