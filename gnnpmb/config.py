@@ -28,7 +28,7 @@ import dataclasses
 import difflib
 import re
 import tomllib
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import MISSING, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -780,28 +780,35 @@ def load_config(path: Path | None) -> TrackerConfig:
 
 
 def _toml_value(value: Any) -> str:
-    return repr(value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return repr(value)
+    if isinstance(value, str):
+        import json
+
+        return json.dumps(value)
+    raise ConfigError(f"cannot write {value!r} to TOML")
+
+
+def dump_toml(data: Mapping[str, Any], header: Sequence[str] = ()) -> str:
+    """TOML text of a nested dict of tables and scalars, ``header`` lines first as ``#`` comments; a table of
+    tables only gets no header line of its own."""
+    lines = [f"# {h}".rstrip() for h in header]
+
+    def table(path: tuple[str, ...], node: Mapping[str, Any]) -> None:
+        scalars = [(k, v) for k, v in node.items() if not isinstance(v, Mapping)]
+        if scalars and path:
+            lines.extend(["", f"[{'.'.join(path)}]"] if lines else [f"[{'.'.join(path)}]"])
+        lines.extend(f"{k} = {_toml_value(v)}" for k, v in scalars)
+        for k, v in node.items():
+            if isinstance(v, Mapping):
+                table((*path, k), v)
+
+    table((), data)
+    return "\n".join(lines) + "\n"
 
 
 def dump_config(cfg: TrackerConfig) -> str:
     """TOML text of ``cfg`` that ``load_config`` reads back to an equal config."""
-    out: list[str] = []
-    d = cfg.as_dict()
-    for section in _SECTIONS:
-        out.append(f"[{section}]")
-        out.extend(f"{k} = {_toml_value(v)}" for k, v in d[section].items())
-        out.append("")
-    for name, values in d["classes"].items():
-        out.append(f"[classes.{name}]")
-        out.extend(f"{k} = {_toml_value(v)}" for k, v in values.items() if not isinstance(v, dict))
-        out.append("")
-        for section, sub in values.items():
-            if isinstance(sub, dict):
-                out.append(f"[classes.{name}.{section}]")
-                out.extend(f"{k} = {_toml_value(v)}" for k, v in sub.items())
-                out.append("")
-    for name, values in d["box_noise"].items():
-        out.append(f"[box_noise.{name}]")
-        out.extend(f"{k} = {_toml_value(v)}" for k, v in values.items())
-        out.append("")
-    return "\n".join(out)
+    return dump_toml(cfg.as_dict())
