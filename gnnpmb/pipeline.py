@@ -94,13 +94,29 @@ def run_tracker(
     ``detections``: the scene's detections per sample token (preprocessed here for ``classes``), or frames
     already preprocessed by ``preprocess_frames`` (one per keyframe), to share them between trackers.
     """
-    frames = preprocess_frames(scene, detections, config, classes) if isinstance(detections, Mapping) else detections
+    if isinstance(detections, Mapping):
+        detections = preprocess_frames(scene, detections, config, classes)
+    return track_frames(scene, detections, tracker, config, sink, classes, frame_range, on_frame)
+
+
+def track_frames(
+    scene: SceneData,
+    frames: Sequence[FrameDetections],
+    tracker: str,
+    config: TrackerConfig,
+    sink: EventSink | None = None,
+    classes: Sequence[str] = TRACKING_CLASSES,
+    frame_range: range | None = None,
+    on_frame: Callable[[], None] | None = None,
+) -> TrackingRun:
+    """``run_tracker`` on frames already preprocessed (``preprocess_frames``, one per keyframe of ``scene``)."""
     if len(frames) != len(scene.keyframes):
         raise ValueError(f"{len(frames)} preprocessed frames for the {len(scene.keyframes)} keyframes of {scene.name}")
     sink = sink or NullSink()
+    steps = keyframe_steps(scene, frame_range)
     mot = MultiClassTracker(tracker, config, classes)
     results: list[FrameResult] = []
-    for i, keyframe, dt_s in keyframe_steps(scene, frame_range):
+    for i, keyframe, dt_s in steps:
         if sink.enabled:
             sink.emit(FrameStarted(tracker, i, keyframe.sample_token, keyframe.timestamp_us, dt_s))
         start = time.perf_counter()
