@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import Annotated
 
 import typer
 
@@ -36,9 +36,6 @@ from cli.tune import register as register_tune
 from gnnpmb.eval.nuscenes_eval import default_split
 from gnnpmb.outputs import check_output_dir, check_output_file
 from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER
-
-if TYPE_CHECKING:  # rich, numpy and the devkit load only on the paths that use them (fast --help)
-    pass
 
 __all__ = ["app", "default_split", "main"]
 

@@ -88,13 +88,6 @@ def usage_line(exc: Exception) -> str:
     return f"{text}; see '{command} --help'" if command else text
 
 
-def os_error_line(exc: OSError) -> str:
-    """An OSError while reading or writing a user's path as one line (``gnnpmb.os_errors``)."""
-    from gnnpmb.os_errors import os_error_line as line
-
-    return line(exc)
-
-
 def symlink_loop_line(exc: RuntimeError) -> str | None:
     """pathlib's ``RuntimeError("Symlink loop from '<path>'")`` (Python 3.11's ``Path.resolve``) as one line, or
     None for any other RuntimeError."""
@@ -143,6 +136,8 @@ def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
     except BrokenPipeError:
         _quiet_broken_pipe()
     except OSError as exc:
+        from gnnpmb.os_errors import os_error_line
+
         _fail(os_error_line(exc))
     except RuntimeError as exc:
         line = symlink_loop_line(exc)

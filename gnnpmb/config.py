@@ -28,7 +28,7 @@ import dataclasses
 import difflib
 import re
 import tomllib
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import MISSING, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -99,16 +99,11 @@ PAPER_CLASS_PARAMS: dict[str, ClassParams] = {
 et al. 2021; an earlier CenterPoint version: car 3, trailer 2, motorcycle 4, bicycle 2.5 m)."""
 
 TWO_WHEELER_Q = 0.1
-"""Default process noise q_x = q_y of bicycles and motorcycles (m^2 per keyframe; the authors' code: 0.02-0.04).
-Chosen on the mini_train splits (issue 32): a cyclist that brakes or turns while missed left the authors' Q
-behind; its returning detection fell outside the gate and started a new track (dev set scene-0061 frames 35-38,
-bicycle a11305: tracks 26 -> 119). gnnpmb dev mini_train centerpoint bicycle AMOTA 0.767 -> 0.859, motorcycle
-0.825 -> 0.903; the demo's unchanged."""
+"""Default process noise q_x = q_y of bicycles and motorcycles (m^2 per keyframe; the authors' code: 0.02-0.04),
+chosen on the mini_train splits (issue 32, ``docs/results.md``)."""
 LARGE_VEHICLE_Q_SCALE = 2.0
-"""Default process noise of trucks and buses: the authors' q_x, q_y times this. Chosen on the mini_train splits
-(issue 32): after one miss a truck's prediction was 3.0 m off and its returning detection (NIS 25.6) started a new
-track (dev set scene-0655 frame 16, truck 8e5770: track 13 -> 59). Dev mini_train gnnpmb 0.872 -> 0.882, the
-demo's unchanged; doubling the Q of cars too lost on the demo."""
+"""Default process noise of trucks and buses: the authors' q_x, q_y times this, chosen on the mini_train splits
+(issue 32, ``docs/results.md``)."""
 DEFAULT_CLASS_PARAMS: dict[str, ClassParams] = {
     **PAPER_CLASS_PARAMS,
     **{
@@ -231,18 +226,11 @@ class PreprocessParams(Section):
 @dataclass(frozen=True, slots=True)
 class ModelParams(Section):
     """The models every tracker shares (``gnnpmb.models``): survival P_S, the gate, the clutter intensity and the
-    measurement-driven birth, birth covariance diag(s_p^2, s_p^2, s_v^2, s_v^2) (paper sec. V-B). The detection
-    probability is the detection's score for the PMB family and ``p_detect`` of ``[phd]`` / ``[vector]`` for the
-    others. Two defaults differ from the paper's (``gnnpmb/params/paper.toml``), chosen on the demo
-    ``mini_train`` split only (``benchmarks/tune_mini_train.py``):
-
-    - p_survive 0.95 (paper 0.7 per 0.5 s keyframe, a mean lifetime of 1.7 s): with 0.7 a track occluded for a
-      few frames decays so far that its object comes back under a new id.
-    - birth_weight 0.3 (paper 0.1): the prior rate of new objects per detection; a larger one makes a detection's
-      first Bernoulli more likely (r_new = w s N / (c + w s N)), so a new object's first box is scored higher.
-
-    The coordinated-turn model (``motion_model = 1``) has state [x, y, vx, vy, omega] and the extended Kalman
-    predict (``gnnpmb.models.ct_model``); a new track's turn rate starts at 0.
+    measurement-driven birth, birth covariance diag(s_p^2, s_p^2, s_v^2, s_v^2) (paper sec. V-B). P_D is the
+    detection's score for the PMB family and ``p_detect`` of ``[phd]`` / ``[vector]`` for the others. p_survive and
+    birth_weight differ from the paper's, chosen on the demo ``mini_train`` split (``docs/architecture.md``). The
+    coordinated-turn model (``motion_model = 1``) has state [x, y, vx, vy, omega] and the extended Kalman predict
+    (``gnnpmb.models.ct_model``); a new track's turn rate starts at 0.
     """
 
     SECTION = "models"
@@ -268,53 +256,16 @@ class ModelParams(Section):
 class PmbParams(Section):
     """The Poisson multi-Bernoulli family (GNN-PMB, PMBM, TO-PMB), beyond the shared ``[models]``.
 
-    extraction_threshold 0.01 (paper 0.9, chosen on the demo ``mini_train`` split like ``ModelParams``): every
-    Bernoulli with r >= 0.01 is output with tracking score = its detection score x r. With 0.9 a new object is
-    reported only from its second detection (a new Bernoulli starts at r ~ 0.065 s with the paper's birth model)
-    and a missed track not at all. AMOTA sweeps the score threshold, so low-r boxes scored s r rank below every
-    confident track and only add recall.
-    miss_p_detect_max 0.3 (paper: no cap, 1.0): with the paper's rule (r' = r (1 - P_D) / (1 - r P_D) after
-    P_S = 0.95) a track last detected at 0.9 falls 0.95 -> 0.48 -> 0.08 -> 0.01 in three missed frames; with the
-    cap 0.3, 0.95 -> 0.87 -> 0.76 -> 0.65. A returning object's detection then updates its track instead of
-    starting a new one (seen with ``--focus identity_theft:1`` on scene-0103 pointpillars: "m2 -> new track 315
-    over track 61, margin 0.31"). 0.3 was chosen on the demo ``mini_train`` split among 1.0 / 0.7 / 0.5 / 0.3
-    (gnnpmb AMOTA centerpoint 0.878 / 0.912 / 0.926 / 0.925, pointpillars 0.799 / 0.803 / 0.802 / 0.828; IDS
-    27 -> 4 and 18 -> 4).
-    miss_p_detect_online 1, miss_p_detect_prior_frames 10, miss_p_detect_bins 2 (issue 32, Round 6 in
-    ``docs/results.md``): the cap is learnt per class while the tracker runs, from the gaps its own tracks closed
-    (``gnnpmb.pmb.miss_detection``: after no miss and after one or more, 0.3 its prior mean of 10 frames), so a
-    detector whose objects stay while missed (the demo's two-wheelers, learnt ~0.2-0.35) keeps coasting and one
-    whose misses mostly mean gone (the dev set's, ~0.6-0.8 after no miss) lets a missed track fade. Chosen on
-    the mini_train splits of both worlds (screen, gnnpmb mean AMOTA demo 0.8917 -> 0.8956, IDS 2.7 -> 2.8; dev
-    0.8816 -> 0.8846, IDS 11.3 -> 12.3) among 1, 2, 3, 4, 6 bins and prior weights 3, 10, 30. ``gnnpmb
-    calibrate`` writes its learnt cap with miss_p_detect_online = 0 per class, so a calibrated file keeps it.
-    miss_p_detect_neighbour_m 2, miss_p_detect_neighbour_existence 0.5 (issue 32, Round 7): a missed Bernoulli
-    with another Bernoulli of its class (existence >= 0.5, another track) within 2 m keeps the fixed cap
-    miss_p_detect_max instead of the online P_D (``miss_detection.crowded``): next to another object a miss is
-    often an occlusion or one detection for two, not a departure (dev set scene-0553 megvii, three walkers in
-    frames 14-23: with the learnt P_D one track covered two of them and a duplicate track started at frame 21).
-    Chosen on the mini_train splits of both worlds (screen, gnnpmb mean AMOTA dev 0.8846 -> 0.8884, demo 0.8956
-    -> 0.8960, IDS unchanged; 1, 2 and 3 m within 0.0001).
-    measure_velocity 1 (R adds r_vx = r_vy = 0.5 (m/s)^2; the default since issue 32) won on the mini_train split
-    of both worlds: the demo over the three presets and detector seeds 0, 1, 2 (gnnpmb mean AMOTA 0.8695 ->
-    0.8883, better on every preset, IDS 4.2 -> 2.7, ``benchmarks/tune_models.py``) and the dev set
-    (``../shared/devset``, centerpoint 0.833 -> 0.886, IDS 18 -> 15; ``docs/results.md``). With it the clutter
-    intensity is per m^2 per (m/s)^2: clutter_intensity x clutter_velocity_density. Default 0.02 (before: uniform
-    over a 20 x 20 m/s square, 1/400): ``gnnpmb calibrate`` finds clutter velocities spread by sigma 0.3-3.7 m/s
-    (mean density 0.008-0.58 per class, both worlds, mini_train), and with 1/400 a clutter detection started a
-    Bernoulli of existence ~0.8, output as a track at once (527 tracks of existence >= 0.5 on demo scene-0103
-    against 42 with 0.02, and three times the chunks of a recording).
-    miss_score_decay d: a Bernoulli missed for n frames in a row is output with tracking score s r d^n; its
-    predicted box stays in the output while r >= the extraction threshold, ranked below the boxes of detected
-    tracks (Poly-MOT's score decay of unmatched tracks, Li et al. 2023).
-    output_max_misses n: a Bernoulli missed more than n frames in a row is kept but not output (ImmortalTracker
-    outputs a missed track once; the evaluation interpolates a track's gaps). Default: no limit. Issue 32
-    (``docs/results.md``): n = 2 gained on the dev set's mini_train (mean AMOTA 0.883 -> 0.902) and lost on the
-    demo's (centerpoint seed 0: 0.939 -> 0.881; n = 4: 0.927), whose detectors miss visible bicycles for several
-    frames, so it is not the default.
-    Heading and size model (``gnnpmb.box_likelihood``): a sigma of 0 leaves that part out (the paper).
-    gate_giou_min: the predicted box is the track's filtered centre with its last detection's size and heading;
-    Poly-MOT and SimpleTrack gate on GIoU alone.
+    A Bernoulli with existence r >= extraction_threshold is output with tracking score s r (s: its detection
+    score); a missed track's P_D is its last detection score capped at miss_p_detect_max, or at the cap learnt per
+    class from the gaps its tracks closed (miss_p_detect_online, ``gnnpmb.pmb.miss_detection``), except beside a
+    neighbour of its class (miss_p_detect_neighbour_m). measure_velocity adds [vx, vy] to the measurement (R adds
+    r_vx, r_vy; clutter intensity x clutter_velocity_density per (m/s)^2). A Bernoulli missed n frames in a row is
+    scored s r d^n (miss_score_decay d) and not output beyond output_max_misses. Heading and size likelihood
+    (``gnnpmb.box_likelihood``): a sigma of 0 leaves that part out. gate_giou_min gates on the bird's-eye GIoU of
+    the predicted box (the filtered centre with the last detection's size and heading). Defaults that differ from
+    the paper's were chosen on the mini_train splits: why and the figures, ``docs/results.md`` and
+    ``docs/architecture.md``.
     """
 
     SECTION = "pmb"
@@ -382,18 +333,9 @@ class PmbParams(Section):
 class PmbmParams(Section):
     """PMBM hypothesis management (``gnnpmb.pmb.pmbm``; García-Fernández et al. 2018, sec. V).
 
-    Prior hypothesis h of weight w_h gets its ceil(N_h w_h) best assignments (Murty). Default N_h = 10, the
-    per-frame hypothesis budget: with the position-only model N_h = 20 gave the AMOTA of the paper's N_h = 100
-    (``params/paper.toml``) on the demo mini_train scenes to 4 decimals at less than half the time per frame; with
-    the velocity measured (the default) N_h = 10 gave that of N_h = 20 (mean over 3 presets x 3 seeds 0.8881 vs
-    0.8878) in 16 % less time. N_h = 1 is exactly GNN-PMB.
-    n_scan N > 0: after each update only the hypotheses descending from the best one's ancestor N frames back
-    are kept (N-scan pruning), so an alternative (e.g. "track missed, its detection starts a duplicate
-    Bernoulli") must become the best within N frames or is dropped. Default 1 (issue 32, ``docs/results.md``):
-    without it a duplicate Bernoulli born in a non-best hypothesis lived on for frames and, when the object's
-    motion changed, that hypothesis became the best and the output switched track (dev set scene-0796 truck
-    60c31f, frames 5-8: track 58 -> 66; scene-0061 motorcycle ca38f8, frames 23-27). Chosen on the mini_train
-    splits of both worlds among N = 0, 1, 2, 3 (dev centerpoint 0.902 / 0.918 / 0.910 / 0.909).
+    Prior hypothesis h of weight w_h gets its ceil(N_h w_h) best assignments (Murty); N_h = 1 is exactly GNN-PMB.
+    n_scan N > 0: after each update only the hypotheses descending from the best one's ancestor N frames back are
+    kept (N-scan pruning). N_h = 10 and N = 1 were chosen on the mini_train splits (``docs/results.md``).
     """
 
     SECTION = "pmbm"
@@ -838,28 +780,35 @@ def load_config(path: Path | None) -> TrackerConfig:
 
 
 def _toml_value(value: Any) -> str:
-    return repr(value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return repr(value)
+    if isinstance(value, str):
+        import json
+
+        return json.dumps(value)
+    raise ConfigError(f"cannot write {value!r} to TOML")
+
+
+def dump_toml(data: Mapping[str, Any], header: Sequence[str] = ()) -> str:
+    """TOML text of a nested dict of tables and scalars, ``header`` lines first as ``#`` comments; a table of
+    tables only gets no header line of its own."""
+    lines = [f"# {h}".rstrip() for h in header]
+
+    def table(path: tuple[str, ...], node: Mapping[str, Any]) -> None:
+        scalars = [(k, v) for k, v in node.items() if not isinstance(v, Mapping)]
+        if scalars and path:
+            lines.extend(["", f"[{'.'.join(path)}]"] if lines else [f"[{'.'.join(path)}]"])
+        lines.extend(f"{k} = {_toml_value(v)}" for k, v in scalars)
+        for k, v in node.items():
+            if isinstance(v, Mapping):
+                table((*path, k), v)
+
+    table((), data)
+    return "\n".join(lines) + "\n"
 
 
 def dump_config(cfg: TrackerConfig) -> str:
     """TOML text of ``cfg`` that ``load_config`` reads back to an equal config."""
-    out: list[str] = []
-    d = cfg.as_dict()
-    for section in _SECTIONS:
-        out.append(f"[{section}]")
-        out.extend(f"{k} = {_toml_value(v)}" for k, v in d[section].items())
-        out.append("")
-    for name, values in d["classes"].items():
-        out.append(f"[classes.{name}]")
-        out.extend(f"{k} = {_toml_value(v)}" for k, v in values.items() if not isinstance(v, dict))
-        out.append("")
-        for section, sub in values.items():
-            if isinstance(sub, dict):
-                out.append(f"[classes.{name}.{section}]")
-                out.extend(f"{k} = {_toml_value(v)}" for k, v in sub.items())
-                out.append("")
-    for name, values in d["box_noise"].items():
-        out.append(f"[box_noise.{name}]")
-        out.extend(f"{k} = {_toml_value(v)}" for k, v in values.items())
-        out.append("")
-    return "\n".join(out)
+    return dump_toml(cfg.as_dict())

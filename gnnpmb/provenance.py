@@ -22,6 +22,7 @@ detections are hashed from the generated boxes (``boxes_sha256``), stored next t
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 from collections.abc import Mapping, Sequence
@@ -143,8 +144,17 @@ def frame_digest(estimates: Sequence[TrackEstimate]) -> str:
     return hashlib.sha256("\n".join(lines).encode()).hexdigest()
 
 
+class _Fields:
+    """``to_json``: a frozen dataclass as JSON-ready data, field names as keys (nested dataclasses likewise)."""
+
+    __slots__ = ()
+
+    def to_json(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)  # type: ignore[call-overload]
+
+
 @dataclass(frozen=True, slots=True)
-class TrackDigest:
+class TrackDigest(_Fields):
     """Digest of one tracker's output: ``frames`` (F,) per-frame digests of the keyframes ``frame_indices``,
     ``overall`` over all of them."""
 
@@ -170,13 +180,6 @@ class TrackDigest:
         theirs = dict(zip(other.frame_indices, other.frames, strict=True))
         return sum(mine.get(i) != theirs.get(i) for i in set(mine) | set(theirs))
 
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "overall": self.overall,
-            "frame_indices": list(self.frame_indices),
-            "frames": list(self.frames),
-        }
-
     @staticmethod
     def from_json(data: Mapping[str, Any]) -> TrackDigest:
         return TrackDigest(
@@ -198,7 +201,7 @@ def track_digest(frame_indices: Sequence[int], frames: Sequence[Sequence[TrackEs
 
 
 @dataclass(frozen=True, slots=True)
-class DetectionsSource:
+class DetectionsSource(_Fields):
     """Where the detections came from: ``kind`` "file" (``path``) or "simulated" (``preset``, ``seed``), and
     the SHA-256 of the file bytes or of the generated boxes."""
 
@@ -217,15 +220,6 @@ class DetectionsSource:
             return f"file {self.path} (sha256 {self.sha256[:12]})"
         return f"simulated {self.preset} detector, seed {self.seed} (sha256 {self.sha256[:12]})"
 
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "kind": self.kind,
-            "sha256": self.sha256,
-            "path": self.path,
-            "preset": self.preset,
-            "seed": self.seed,
-        }
-
     @staticmethod
     def from_json(data: Mapping[str, Any]) -> DetectionsSource:
         seed = data.get("seed")
@@ -239,7 +233,7 @@ class DetectionsSource:
 
 
 @dataclass(frozen=True, slots=True)
-class Provenance:
+class Provenance(_Fields):
     """Everything a recording was made from (see the module docstring). frame_start/frame_end: the keyframes
     ``range(frame_start, frame_end)``; config: ``TrackerConfig.as_dict()``; track_digests: tracker ->
     digest."""
@@ -269,26 +263,6 @@ class Provenance:
     def data_source(self) -> str:
         """ "synthetic demo" or "nuScenes <version>"."""
         return "synthetic demo" if self.synthetic else f"nuScenes {self.version}"
-
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "format_version": self.format_version,
-            "argv": list(self.argv),
-            "versions": dict(self.versions),
-            "config": self.config,
-            "dataroot": self.dataroot,
-            "version": self.version,
-            "synthetic": self.synthetic,
-            "scene_name": self.scene_name,
-            "scene_token": self.scene_token,
-            "detections": self.detections.to_json(),
-            "seed": self.seed,
-            "frame_start": self.frame_start,
-            "frame_end": self.frame_end,
-            "classes": list(self.classes),
-            "trackers": list(self.trackers),
-            "track_digests": {name: d.to_json() for name, d in self.track_digests.items()},
-        }
 
     def dumps(self) -> str:
         """Canonical JSON text (sorted keys, no spaces)."""

@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 from rerun.chunk import RrdReader
+from scipy.spatial.transform import Rotation
 
 MAX_NUM_LABELS_PER_ENTITY = 30
 """Rerun hides the labels of a batch with this many instances or more unless ``show_labels`` says otherwise."""
@@ -370,7 +371,7 @@ class Recording:
             ego_point = np.asarray(label.anchor_m, dtype=np.float64)
             if not label.entity.startswith("world/ego_vehicle"):
                 pose = self.ego.get(frame) or self.ego[max(f for f in self.ego if f <= frame)]
-                ego_point = _rotation_xyzw(pose[1]).T @ (ego_point - pose[0])
+                ego_point = Rotation.from_quat(pose[1]).as_matrix().T @ (ego_point - pose[0])
             p = at[0].T @ (ego_point - at[1])
             if p[2] <= 0:
                 return None
@@ -383,7 +384,7 @@ class Recording:
         if label.entity.startswith("world/ego_vehicle") or view.origin != "world/ego_vehicle":
             return p
         pose = self.ego.get(frame) or self.ego[max(f for f in self.ego if f <= frame)]
-        return _rotation_xyzw(pose[1]).T @ (p - pose[0])
+        return Rotation.from_quat(pose[1]).as_matrix().T @ (p - pose[0])
 
 
 def _anchor(value: Any) -> tuple[float, float, float]:
@@ -392,17 +393,6 @@ def _anchor(value: Any) -> tuple[float, float, float]:
         pts = np.asarray(value, dtype=np.float64)
         return tuple(0.5 * (pts.min(axis=0) + pts.max(axis=0)))
     return tuple(float(v) for v in value)
-
-
-def _rotation_xyzw(q: np.ndarray) -> np.ndarray:
-    x, y, z, w = (float(v) for v in q)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
 
 
 def screen_boxes(

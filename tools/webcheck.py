@@ -45,6 +45,8 @@ from typing import Any
 
 import numpy as np
 
+from gnnpmb.atomic import write_bytes
+
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_FLAGS: tuple[str, ...] = (
     "--headless",
@@ -625,7 +627,7 @@ def check_recording(
                     small = False
                 continue
             shots += 1
-            _write_atomic(out, png)
+            write_bytes(out, png)
             image = decode_png(png)
             stats = tuple(region_stats(image, b) for b in boxes)
             if all(s.rendered for s in stats):
@@ -658,12 +660,6 @@ def check_recording(
 def _set_viewport(devtools: DevTools, viewport: tuple[int, int]) -> None:
     width, height = viewport
     devtools.call("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1, mobile=False)
-
-
-def _write_atomic(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.partial")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -137,7 +137,7 @@ def _matrix_view(origin: str, name: str) -> rrb.TensorView:
 
 
 def _hypotheses_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Container:
-    return rrb.TimeSeriesView(origin=paths.hypotheses_root(tracker), name=f"{tracker} hypothesis log w")
+    return rrb.TimeSeriesView(origin=paths.hypothesis_weights.root(tracker), name=f"{tracker} hypothesis log w")
 
 
 def _marginals_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Container:
@@ -149,16 +149,16 @@ def _marginals_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Cont
 
 def _cardinality_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Container:
     return rrb.Vertical(
-        rrb.TimeSeriesView(origin=paths.cardinality_mean_root(tracker), name="expected count"),
-        rrb.BarChartView(origin=paths.cardinality_pmf_root(tracker), name="cardinality pmf"),
+        rrb.TimeSeriesView(origin=paths.cardinality_mean.root(tracker), name="expected count"),
+        rrb.BarChartView(origin=paths.cardinality_pmf.root(tracker), name="cardinality pmf"),
         name=f"{tracker} cardinality",
     )
 
 
 def _intensity_view(tracker: str, classes: Sequence[str]) -> rrb.View | rrb.Container:
     return rrb.Vertical(
-        rrb.TimeSeriesView(origin=paths.intensity_total_root(tracker), name="total intensity"),
-        rrb.BarChartView(origin=paths.intensity_weights_root(tracker), name="component weights"),
+        rrb.TimeSeriesView(origin=paths.intensity_total.root(tracker), name="total intensity"),
+        rrb.BarChartView(origin=paths.intensity_weights.root(tracker), name="component weights"),
         name=f"{tracker} intensity",
     )
 
@@ -238,7 +238,7 @@ def story_view(tracker: str, focus: FocusTarget | None = None, *, involved: bool
     """The tracker's story log: every class; with a focus its class, or (``involved``) only the lines that name
     an involved track."""
     if focus is None:
-        origin, name = paths.events_root(tracker), f"{tracker} story"
+        origin, name = paths.events.root(tracker), f"{tracker} story"
     elif involved:
         origin, name = paths.involved_story(tracker), f"{tracker} story (involved tracks)"
     else:
@@ -279,7 +279,7 @@ def tracker_panel(
     caps = caps or tracker_capabilities(tracker)
     candidates = []
     if caps.has_existence:
-        candidates = [rrb.TimeSeriesView(origin=paths.candidates_root(tracker), name=f"{tracker} candidates")]
+        candidates = [rrb.TimeSeriesView(origin=paths.candidate_count.root(tracker), name=f"{tracker} candidates")]
     series = rrb.Tabs(
         *track_series_views(tracker, focus, legends, caps, opening),
         *candidates,

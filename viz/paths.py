@@ -143,26 +143,19 @@ chosen_cost = _CHOSEN_COST.track
 candidate_count = Family("candidates")
 """Scalars: how many candidate Bernoullis (never output as tracks) a class holds per frame; their individual series
 would be thousands of short lines (and chunks)."""
-candidates_root = candidate_count.root
 events = Family("events")
 """TextLog of births, prunings, assignments, confirmations and merges of one class."""
-events_root = events.root
 hypothesis_weights = Family("hypotheses")
 """Scalars: log weights of the best PMBM global hypotheses of one class, one line per rank (h0, h1, ...)."""
-hypotheses_root = hypothesis_weights.root
 marginals = Family("marginals")
 """Tensor of marginal association probabilities (TO-PMB, JPDA)."""
 cardinality_pmf = Family("cardinality/pmf")
 """BarChart of the CPHD cardinality distribution."""
-cardinality_pmf_root = cardinality_pmf.root
 cardinality_mean = Family("cardinality/expected")
 """Scalars: expected number of targets under the CPHD cardinality distribution."""
-cardinality_mean_root = cardinality_mean.root
 intensity_weights = Family("intensity/weights")
 """BarChart of GM-PHD / CPHD component weights."""
-intensity_weights_root = intensity_weights.root
 intensity_total = Family("intensity/total")
 """Scalars: total intensity weight (the PHD's expected number of targets)."""
-intensity_total_root = intensity_total.root
 failure_count = Family("failures")
 """Scalars: number of failures of one kind per frame, one entity per kind."""

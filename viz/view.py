@@ -9,8 +9,7 @@ its logger, which draws from the run's facts (``gnnpmb.why.facts``); a focus rec
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from types import TracebackType
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING
 
 from gnnpmb.stages.evaluation import find_reports
 from gnnpmb.stages.findings import (
@@ -24,43 +23,12 @@ from gnnpmb.stages.runs import provenance_of, run_all, run_digests
 from viz.opening import timeline_rows
 
 if TYPE_CHECKING:
+    from rich.progress import Progress
+
     from gnnpmb.compare import Comparison
     from gnnpmb.eval.failures import FailureReport
     from gnnpmb.focus import FocusTarget
     from gnnpmb.provenance import TrackDigest
-
-
-class ProgressBar(Protocol):
-    """What ``run_view`` needs of a progress display (a rich ``Progress`` has it): a context manager with
-    tasks that advance."""
-
-    def __enter__(self) -> Any: ...
-
-    def __exit__(
-        self, kind: type[BaseException] | None, value: BaseException | None, traceback: TracebackType | None
-    ) -> Any: ...
-
-    def add_task(self, description: str, total: float | None = ...) -> Any: ...
-
-    def advance(self, task_id: Any, advance: float = ...) -> None: ...
-
-
-class SilentProgress:
-    """A progress display that shows nothing."""
-
-    def __enter__(self) -> SilentProgress:
-        return self
-
-    def __exit__(
-        self, kind: type[BaseException] | None, value: BaseException | None, traceback: TracebackType | None
-    ) -> None:
-        return None
-
-    def add_task(self, description: str, total: float | None = None) -> int:
-        return 0
-
-    def advance(self, task_id: Any, advance: float = 1) -> None:
-        return None
 
 
 @dataclass(frozen=True, slots=True)
@@ -89,7 +57,7 @@ def recording_name(inputs: Inputs, focus: FocusTarget | None = None) -> str:
 def run_view(
     inputs: Inputs,
     *,
-    progress: ProgressBar | None = None,
+    progress: Progress | None = None,
     failures: bool = True,
     cameras: bool = True,
     sweeps: bool = False,
@@ -97,11 +65,11 @@ def run_view(
     """Run every tracker once with its events recorded, find the failures (with ``failures``, or for a focus), the
     focus or the opening failure and the comparison, then log the scene, replay each run's events into its logger
     and log failures and provenance. With ``inputs.focus`` the recording holds the keyframes around the focus,
-    opens on it and explains it (``focus/summary``). ``progress``: a progress display (e.g. a rich ``Progress``;
-    none by default). ``cameras``: the camera images with the boxes projected into them (``viz.cameras``; where the
-    dataset has them, else a notice); ``sweeps``: also the LiDAR sweeps between keyframes (a notice when there are
-    none)."""
+    opens on it and explains it (``focus/summary``). ``progress``: a rich ``Progress`` (none by default).
+    ``cameras``: the camera images with the boxes projected into them (``viz.cameras``; where the dataset has them,
+    else a notice); ``sweeps``: also the LiDAR sweeps between keyframes (a notice when there are none)."""
     import numpy as np
+    from rich.progress import Progress
 
     from gnnpmb.data.nuscenes import load_lidar_points
     from gnnpmb.data.sensor_files import lidar_presence
@@ -124,7 +92,7 @@ def run_view(
     from viz.timeline import PLAIN_CLOCK, Clock
 
     scene, frame_range = inputs.scene, inputs.frame_range
-    bar = progress if progress is not None else SilentProgress()
+    bar = progress if progress is not None else Progress(disable=True)
     with bar:
         tasks = {t: bar.add_task(f"{scene.name} {t}", total=len(frame_range)) for t in inputs.trackers}
         runs = run_all(inputs, record=True, on_frame=lambda t: lambda: bar.advance(tasks[t]))

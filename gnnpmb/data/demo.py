@@ -70,7 +70,7 @@ from gnnpmb.data.demo_staged import (
     staged_scene,
 )
 from gnnpmb.data.demo_train import LAYOUT_SEEDS, TRAIN_SCENES, train_scene
-from gnnpmb.data.raycast import LidarSpec, SceneBoxes, cast_scan
+from gnnpmb.data.raycast import LidarSpec, Scan, SceneBoxes, cast_scan
 from gnnpmb.errors import DataError
 
 DEMO_VERSION = "v1.0-mini"
@@ -528,6 +528,58 @@ def _link(rows: list[dict]) -> None:
         row["next"] = rows[i + 1]["token"] if i + 1 < len(rows) else ""
 
 
+def _sweep(
+    spec: SceneSpec,
+    traj: Trajectories,
+    j: int,
+    timestamp: int,
+    out: tuple[Path, str, dict[str, list[dict]]],
+    tokens: tuple[str, str, str],
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, Scan, dict]:
+    """One LIDAR_TOP sweep at state ``j`` of ``traj``: the indices of the objects in reach (C,), their scan, its
+    ``.pcd.bin`` in ``out`` = (dataroot, folder, tables), its ``ego_pose`` row added to the tables and its
+    ``sample_data`` row returned; tokens: (its ego pose's, its own, its sample's)."""
+    dataroot, folder, tables = out
+    sizes = np.array([o.size_wlh_m for o in spec.objects], dtype=float)
+    calib_t = np.array(LIDAR_TRANSLATION_M)
+    reach = LIDAR.max_range_m + 0.5 * np.linalg.norm(sizes, axis=1) + np.linalg.norm(calib_t[:2])
+    ego_t = np.array([traj.ego_xy[j, 0], traj.ego_xy[j, 1], 0.0])
+    ego_r = _yaw_matrix(float(traj.ego_yaw[j]))
+    cast = np.flatnonzero(np.linalg.norm(traj.xy[:, j] - traj.ego_xy[j], axis=1) <= reach)
+    boxes = SceneBoxes(
+        centre_m=np.column_stack([traj.xy[cast, j], 0.5 * sizes[cast, 2:]]),
+        size_wlh_m=sizes[cast],
+        yaw_rad=traj.yaw[cast, j],
+        intensity=np.array([o.intensity for o in spec.objects])[cast],
+    )
+    scan = cast_scan(LIDAR, ego_t + ego_r @ calib_t, ego_r @ _yaw_matrix(LIDAR_YAW_RAD), boxes, rng)
+    filename = f"{folder}/LIDAR_TOP/gnnpmb-demo-{spec.name}__LIDAR_TOP__{timestamp}.pcd.bin"
+    (dataroot / filename).write_bytes(scan.points.astype("<f4").tobytes())
+    pose_token, row_token, sample_token = tokens
+    rotation = _yaw_quat_wxyz(float(traj.ego_yaw[j]))
+    pose = {
+        "token": pose_token,
+        "timestamp": timestamp,
+        "rotation": rotation,
+        "translation": [*map(float, ego_t[:2]), 0.0],
+    }
+    tables["ego_pose"].append(pose)
+    row = {
+        "token": row_token,
+        "sample_token": sample_token,
+        "ego_pose_token": pose_token,
+        "calibrated_sensor_token": token("calibrated_sensor", spec.name, "LIDAR_TOP"),
+        "timestamp": timestamp,
+        "fileformat": "pcd",
+        "is_key_frame": folder == "samples",
+        "height": 0,
+        "width": 0,
+        "filename": filename,
+    }
+    return cast, scan, row
+
+
 def _write_scene(
     spec: SceneSpec,
     tables: dict[str, list[dict]],
@@ -561,62 +613,26 @@ def _write_scene(
             "camera_intrinsic": [],
         },
     )
-    calib_t = np.array(LIDAR_TRANSLATION_M)
-    calib_r = _yaw_matrix(LIDAR_YAW_RAD)
-
     sizes = np.array([o.size_wlh_m for o in spec.objects], dtype=float)
-    intensity = np.array([o.intensity for o in spec.objects])
     centres = np.concatenate([traj.xy, np.broadcast_to(0.5 * sizes[:, None, 2:], traj.xy.shape[:2] + (1,))], axis=2)
-    distance = np.linalg.norm(traj.xy - traj.ego_xy[None], axis=2)
-    annotated = np.array([_annotated_span(d) for d in distance])
-    reach = LIDAR.max_range_m + 0.5 * np.linalg.norm(sizes, axis=1) + np.linalg.norm(calib_t[:2])
+    annotated = np.array([_annotated_span(d) for d in np.linalg.norm(traj.xy - traj.ego_xy[None], axis=2)])
     num_pts = np.zeros(annotated.shape, dtype=np.int64)
     visible = np.zeros(annotated.shape)
 
     samples, sweeps = [], []
     for k in range(KEYFRAMES_PER_SCENE):
-        ego_t = np.array([traj.ego_xy[k, 0], traj.ego_xy[k, 1], 0.0])
-        ego_r = _yaw_matrix(float(traj.ego_yaw[k]))
-        cast = np.flatnonzero(distance[:, k] <= reach)
-        boxes = SceneBoxes(
-            centre_m=centres[cast, k], size_wlh_m=sizes[cast], yaw_rad=traj.yaw[cast, k], intensity=intensity[cast]
-        )
-        scan = cast_scan(LIDAR, ego_t + ego_r @ calib_t, ego_r @ calib_r, boxes, rng)
+        timestamp = int(times_us[k])
+        sample_token = token("sample", spec.name, k)
+        lidar_tokens = (token("ego_pose", spec.name, k), token("sample_data", spec.name, "LIDAR_TOP", k), sample_token)
+        cast, scan, row = _sweep(spec, traj, k, timestamp, (dataroot, "samples", tables), lidar_tokens, rng)
         num_pts[cast, k] = scan.num_pts
         visible[cast, k] = scan.visible_fraction
-
-        timestamp = int(times_us[k])
-        filename = f"samples/LIDAR_TOP/{log_name}__LIDAR_TOP__{timestamp}.pcd.bin"
-        (dataroot / filename).write_bytes(scan.points.astype("<f4").tobytes())
-        sample_token = token("sample", spec.name, k)
-        pose_token = token("ego_pose", spec.name, k)
-        tables["ego_pose"].append(
-            {
-                "token": pose_token,
-                "timestamp": timestamp,
-                "rotation": _yaw_quat_wxyz(float(traj.ego_yaw[k])),
-                "translation": [float(ego_t[0]), float(ego_t[1]), 0.0],
-            },
-        )
         samples.append({"token": sample_token, "timestamp": timestamp, "scene_token": token("scene", spec.name)})
-        sweeps.append(
-            {
-                "token": token("sample_data", spec.name, "LIDAR_TOP", k),
-                "sample_token": sample_token,
-                "ego_pose_token": pose_token,
-                "calibrated_sensor_token": calib_token,
-                "timestamp": timestamp,
-                "fileformat": "pcd",
-                "is_key_frame": True,
-                "height": 0,
-                "width": 0,
-                "filename": filename,
-            }
-        )
+        sweeps.append(row)
     _link(samples)
     if sweep_rng is not None:
         sweeps = sorted(
-            sweeps + _intermediate_sweeps(spec, tables, dataroot, sweep_rng, samples, calib_token),
+            sweeps + _intermediate_sweeps(spec, tables, dataroot, sweep_rng, samples),
             key=lambda r: r["timestamp"],
         )
     _link(sweeps)
@@ -683,12 +699,7 @@ SWEEPS_ENV = "GNNPMB_DEMO_SWEEPS"
 
 
 def _intermediate_sweeps(
-    spec: SceneSpec,
-    tables: dict[str, list[dict]],
-    dataroot: Path,
-    rng: np.random.Generator,
-    samples: list[dict],
-    calib_token: str,
+    spec: SceneSpec, tables: dict[str, list[dict]], dataroot: Path, rng: np.random.Generator, samples: list[dict]
 ) -> list[dict]:
     """The non-keyframe LIDAR_TOP sweeps between consecutive keyframes (``SWEEPS_PER_INTERVAL`` each, evenly
     spaced), each with its ego pose; a sweep belongs to the next keyframe's sample, as in nuScenes."""
@@ -696,47 +707,15 @@ def _intermediate_sweeps(
     offsets = np.arange(1, SWEEPS_PER_INTERVAL + 1) * step_s
     times_s = (keyframe_times_s()[:-1, None] + offsets[None]).reshape(-1)
     traj = scene_trajectories(spec, times_s)
-    sizes = np.array([o.size_wlh_m for o in spec.objects], dtype=float)
-    intensity = np.array([o.intensity for o in spec.objects])
-    centres = np.concatenate([traj.xy, np.broadcast_to(0.5 * sizes[:, None, 2:], traj.xy.shape[:2] + (1,))], axis=2)
-    calib_t, calib_r = np.array(LIDAR_TRANSLATION_M), _yaw_matrix(LIDAR_YAW_RAD)
-    reach = LIDAR.max_range_m + 0.5 * np.linalg.norm(sizes, axis=1) + np.linalg.norm(calib_t[:2])
-    log_name = f"gnnpmb-demo-{spec.name}"
     rows = []
     for j, t_s in enumerate(times_s):
-        ego_t = np.array([traj.ego_xy[j, 0], traj.ego_xy[j, 1], 0.0])
-        ego_r = _yaw_matrix(float(traj.ego_yaw[j]))
-        cast = np.flatnonzero(np.linalg.norm(traj.xy[:, j] - traj.ego_xy[j], axis=1) <= reach)
-        boxes = SceneBoxes(
-            centre_m=centres[cast, j], size_wlh_m=sizes[cast], yaw_rad=traj.yaw[cast, j], intensity=intensity[cast]
-        )
-        scan = cast_scan(LIDAR, ego_t + ego_r @ calib_t, ego_r @ calib_r, boxes, rng)
         timestamp = spec.start_us + int(round(t_s * 1e6))
-        filename = f"sweeps/LIDAR_TOP/{log_name}__LIDAR_TOP__{timestamp}.pcd.bin"
-        (dataroot / filename).write_bytes(scan.points.astype("<f4").tobytes())
-        pose_token = token("ego_pose", spec.name, "LIDAR_TOP", "sweep", j)
-        tables["ego_pose"].append(
-            {
-                "token": pose_token,
-                "timestamp": timestamp,
-                "rotation": _yaw_quat_wxyz(float(traj.ego_yaw[j])),
-                "translation": [float(ego_t[0]), float(ego_t[1]), 0.0],
-            },
+        tokens = (
+            token("ego_pose", spec.name, "LIDAR_TOP", "sweep", j),
+            token("sample_data", spec.name, "LIDAR_TOP", "sweep", j),
+            samples[j // SWEEPS_PER_INTERVAL + 1]["token"],
         )
-        rows.append(
-            {
-                "token": token("sample_data", spec.name, "LIDAR_TOP", "sweep", j),
-                "sample_token": samples[j // SWEEPS_PER_INTERVAL + 1]["token"],
-                "ego_pose_token": pose_token,
-                "calibrated_sensor_token": calib_token,
-                "timestamp": timestamp,
-                "fileformat": "pcd",
-                "is_key_frame": False,
-                "height": 0,
-                "width": 0,
-                "filename": filename,
-            }
-        )
+        rows.append(_sweep(spec, traj, j, timestamp, (dataroot, "sweeps", tables), tokens, rng)[2])
     return rows
 
 

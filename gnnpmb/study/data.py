@@ -15,17 +15,13 @@ import json
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from gnnpmb.config import TrackerConfig
 from gnnpmb.data.nuscenes import DatasetLocation
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.types import Boxes
-
-if TYPE_CHECKING:
-    from gnnpmb.events import EventSink
-    from gnnpmb.pipeline import TrackingRun
 
 
 @dataclass(frozen=True, slots=True)
@@ -126,26 +122,6 @@ def study_inputs(data: StudyData, scene_name: str) -> SceneInputs:
     return inputs[scene_name]
 
 
-def run_inputs(
-    inputs: SceneInputs,
-    tracker: str,
-    config: TrackerConfig,
-    detector: str,
-    seed: int,
-    sink: EventSink | None = None,
-    on_frame: Callable[[], None] | None = None,
-    frame_range: range | None = None,
-) -> TrackingRun:
-    """Track every keyframe of one scene (all 7 classes; ``frame_range``: only those), the tracker's events to
-    ``sink``."""
-    from gnnpmb.pipeline import get_detections, run_tracker
-
-    detections = inputs.detections
-    if detections is None:
-        detections = get_detections(inputs.scene, None, detector, seed)
-    return run_tracker(inputs.scene, detections, tracker, config, sink=sink, on_frame=on_frame, frame_range=frame_range)
-
-
 def track_inputs(
     inputs: SceneInputs,
     tracker: str,
@@ -156,8 +132,12 @@ def track_inputs(
 ) -> SceneRun:
     """Track every keyframe of one scene (all 7 classes) into submission boxes."""
     from gnnpmb.eval.submission import run_results
+    from gnnpmb.pipeline import get_detections, run_tracker
 
-    run = run_inputs(inputs, tracker, config, detector, seed, on_frame=on_frame)
+    detections = inputs.detections
+    if detections is None:
+        detections = get_detections(inputs.scene, None, detector, seed)
+    run = run_tracker(inputs.scene, detections, tracker, config, on_frame=on_frame)
     return SceneRun(
         scene_name=inputs.scene.name,
         results=run_results(run),

@@ -14,14 +14,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from gnnpmb.config import TrackerConfig
 from gnnpmb.study.data import SceneInputs, SceneRun, StudyData, load_inputs, track_inputs
 from gnnpmb.study.runner import Execution, run_tasks, session
-
-if TYPE_CHECKING:
-    pass
 
 IN_PROCESS = Execution(workers=1)
 TASKS_PER_WORKER = 4

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from gnnpmb.config import config_from_dict, load_config
+from gnnpmb.config import config_from_dict, dump_toml, load_config
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.study.data import StudyData, for_scoring
 from gnnpmb.study.evaluate import ConfigJob, class_column, score_config
@@ -347,36 +347,6 @@ def run_tune(
     best = choose_best(dims, done)
     final_row = score_config(_job(len(done), best, base, tracker, data))
     return TuneResult(trials=done, best=best, final_row=final_row, interrupted=interrupted)
-
-
-def _toml_value(value: Any) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int | float):
-        return repr(value)
-    if isinstance(value, str):
-        import json
-
-        return json.dumps(value)
-    raise StudyError(f"cannot write {value!r} to TOML")
-
-
-def dump_toml(data: Mapping[str, Any], header: Sequence[str] = ()) -> str:
-    """TOML text of a nested dict of tables and scalars, ``header`` lines first as ``#`` comments."""
-    lines = [f"# {h}".rstrip() for h in header]
-
-    def table(path: tuple[str, ...], node: Mapping[str, Any]) -> None:
-        scalars = [(k, v) for k, v in node.items() if not isinstance(v, Mapping)]
-        if scalars and path:
-            lines.append("")
-            lines.append(f"[{'.'.join(path)}]")
-        lines.extend(f"{k} = {_toml_value(v)}" for k, v in scalars)
-        for k, v in node.items():
-            if isinstance(v, Mapping):
-                table((*path, k), v)
-
-    table((), data)
-    return "\n".join(lines) + "\n"
 
 
 def write_params(path: Path, toml: Mapping[str, Any], header: Sequence[str]) -> None:

@@ -148,7 +148,7 @@ def test_comparison_blueprint_is_stored(saved: tuple[Path, str]) -> None:
     stored = stored_views(saved[0])
     assert stored["gnnpmb 3D"] == ("3D", paths.EGO) and stored["gnn 3D"] == ("3D", paths.EGO)
     assert stored["disagreements"] == ("TextLog", compare.log_path())
-    assert stored["gnn story"] == ("TextLog", paths.events_root("gnn"))
+    assert stored["gnn story"] == ("TextLog", paths.events.root("gnn"))
     assert stored["gnnpmb decisions"] == ("TextDocument", paths.decisions("gnnpmb"))
     assert stored["gnn bird's-eye"] == ("3D", paths.EGO)
 

@@ -72,13 +72,13 @@ def test_decision_story_existence_failure_and_log_views_per_tracker() -> None:
         assert ("TimeSeriesView", paths.existence_root(t)) in origins
         assert ("TimeSeriesView", paths.nis_root(t)) in origins
         assert ("TimeSeriesView", paths.chosen_cost_root(t)) in origins
-        assert ("TimeSeriesView", paths.candidates_root(t)) in origins
+        assert ("TimeSeriesView", paths.candidate_count.root(t)) in origins
         assert ("TimeSeriesView", failures_root(t)) in origins
-        assert ("TextLogView", paths.events_root(t)) in origins
+        assert ("TextLogView", paths.events.root(t)) in origins
         assert ("TextLogView", failure_log(t)) in origins
     assert failures_root("pmbm") == paths.failure_count("pmbm", "miss").rsplit("/", 1)[0]
-    assert ("TimeSeriesView", paths.hypotheses_root("pmbm")) in origins
-    assert ("TimeSeriesView", paths.hypotheses_root("gnnpmb")) not in origins
+    assert ("TimeSeriesView", paths.hypothesis_weights.root("pmbm")) in origins
+    assert ("TimeSeriesView", paths.hypothesis_weights.root("gnnpmb")) not in origins
 
 
 def test_comparison_panel_only_with_several_trackers() -> None:
@@ -98,8 +98,8 @@ def test_comparison_panel_only_with_several_trackers() -> None:
 def test_tracker_specific_views() -> None:
     origins = {v.origin for v in views(default_blueprint(["topmb", "cphd"], ["car"]))}
     assert paths.marginals("topmb", "car") in origins
-    assert {paths.cardinality_pmf_root("cphd"), paths.cardinality_mean_root("cphd")} <= origins
-    assert {paths.intensity_total_root("cphd"), paths.intensity_weights_root("cphd")} <= origins
+    assert {paths.cardinality_pmf.root("cphd"), paths.cardinality_mean.root("cphd")} <= origins
+    assert {paths.intensity_total.root("cphd"), paths.intensity_weights.root("cphd")} <= origins
     with pytest.raises(ValueError, match="at least one tracker"):
         default_blueprint([], ["car"])
 
@@ -154,7 +154,7 @@ def test_an_existence_plot_only_for_trackers_whose_tracks_have_an_existence_prob
     origins = {v.origin for v in views(default_blueprint(["gnnpmb", "gnn"], ["car"]))}
     assert paths.existence_root("gnnpmb") in origins and paths.existence_root("gnn") not in origins
     assert paths.nis_root("gnn") in origins and paths.chosen_cost_root("gnn") in origins
-    assert paths.candidates_root("gnnpmb") in origins and paths.candidates_root("gnn") not in origins
+    assert paths.candidate_count.root("gnnpmb") in origins and paths.candidate_count.root("gnn") not in origins
 
 
 def test_no_innovation_plot_for_a_tracker_without_gates() -> None:

@@ -24,8 +24,8 @@ def test_non_spatial_entities_live_under_the_tracker() -> None:
     assert paths.hypothesis_weights("pmbm", "car") == "trackers/pmbm/hypotheses/car"
     assert paths.existence("gnnpmb", "car", 17) == "trackers/gnnpmb/existence/car/17"
     assert paths.events("jpda", "truck") == "trackers/jpda/events/truck"
-    assert paths.cardinality_pmf("cphd", "car").startswith(paths.cardinality_pmf_root("cphd") + "/")
-    assert paths.intensity_total("phd", "car").startswith(paths.intensity_total_root("phd") + "/")
+    assert paths.cardinality_pmf("cphd", "car").startswith(paths.cardinality_pmf.root("cphd") + "/")
+    assert paths.intensity_total("phd", "car").startswith(paths.intensity_total.root("phd") + "/")
 
 
 def test_every_tracker_entity_sits_in_its_own_subtree() -> None:

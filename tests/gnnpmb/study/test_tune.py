@@ -1,4 +1,4 @@
-"""Search space, per-class choice and the written TOML (``gnnpmb.study.tune``)."""
+"""Search space, per-class choice and the written TOML (``gnnpmb.study.tune``, ``gnnpmb.config.dump_toml``)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from gnnpmb.config import load_config
+from gnnpmb.config import ConfigError, dump_toml, load_config
 from gnnpmb.study.grid import StudyError
 from gnnpmb.study.tune import (
     SearchDim,
@@ -14,7 +14,6 @@ from gnnpmb.study.tune import (
     check_space,
     choose_best,
     default_space,
-    dump_toml,
     parse_space,
     write_params,
 )
@@ -63,5 +62,5 @@ def test_written_params_load_back(tmp_path: Path) -> None:
     write_params(path, toml, ["x"])
     config = load_config(path)
     assert config.models.gate_chi2 == 30.0 and config.classes["car"].q_x == 0.25 and config.classes["car"].r_y == 0.125
-    with pytest.raises(StudyError):
+    with pytest.raises(ConfigError):
         dump_toml({"pmb": {"gate_chi2": [1, 2]}})
