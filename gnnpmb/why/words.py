@@ -1008,6 +1008,15 @@ def _out_of_reach_on_it(f: Finding, s: Sighting) -> list[str]:
     ]
 
 
+def _went_unshown(s: Sighting) -> list[str]:
+    """``track 41 was not output on it``: the track the object's detection went to (or started) was not among
+    those output on the object, said wherever the detection's destination is (a box tracker's tentative track,
+    a PHD label below extraction), lest "started new track 41" read as the object being covered."""
+    if s.went is not None and s.went.track_id >= 0 and s.went.track_id not in {o.track_id for o in s.on_it}:
+        return [f"track {s.went.track_id} was not output on it"]
+    return []
+
+
 def _miss(f: Finding) -> list[str]:
     s = f.sighting(f.frame)
     if s is None or f.gt_id is None:
@@ -1046,8 +1055,7 @@ def _miss(f: Finding) -> list[str]:
             f"at frame {f.frame} detection {meas_name(n.meas)} (score {n.score:.2f}) lay {n.distance_m:.1f} m from "
             f"{name} and {went_phrase(s.went, mode)}"
         )
-        if s.went is not None and s.went.track_id >= 0 and s.went.track_id not in {o.track_id for o in s.on_it}:
-            parts.append(f"track {s.went.track_id} was not output on it")
+        parts += _went_unshown(s)
     parts += _not_counted_on_it(f, s)
     if s.nearest_own is not None and not s.on_it:
         parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
@@ -1106,6 +1114,7 @@ def _coalescence(f: Finding) -> list[str]:
             f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) "
             f"{went_phrase(s.went, mode)}"
         )
+        parts += _went_unshown(s)
     elif s.nearest_any.class_name != f.class_name:
         n = s.nearest_any
         parts.append(

@@ -838,3 +838,26 @@ def test_another_run_whose_coalescence_matched_the_object_is_not_said_to_fail_on
     assert [c.kind for c in check_text(said, ctx, None, ev, others={"pmbm": other}).found] == ["other run"]
     other.gt_to_track[(C, 3)] = {GT_A: "7", GT_B: None}  # now it matched GT A and missed the finding's object
     assert check_text(said, ctx, None, ev, others={"pmbm": other}).found == []
+
+
+def test_a_track_the_objects_detection_started_left_unsaid_off_the_object_is_caught() -> None:
+    # independent audit r42, dev set scene-0553 megvii ab3dmot coalescence at frame 12: "its detection m4 (score
+    # 0.74, 0.1 m away) started new track 148", a tentative track never output, read as covering the object
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 0)}])
+    ev = _eval()
+    ev.boxes[3] = [("150", C, (0.0, 0.5))]
+    ctx = Context(C, 3, GT_A, kind="coalescence")
+
+    def misleading(text: str) -> list[str]:  # the scene has no detections: the detector's checks object apart
+        return [c.truth for c in check_text(text, ctx, None, ev, scene=scene).found if c.kind == "misleading"]
+
+    for said in (
+        "its detection m4 (score 0.74, 0.1 m away) started new track 148",
+        "at frame 3 detection m4 (score 0.74) lay 0.1 m from car GT aaaaaa and went to track 148",
+    ):
+        assert misleading(said) == ["track 148 has no box within 2 m of the object at frame 3, unsaid"], said
+        assert misleading(f"{said}; track 148 was not output on it") == []
+    on_it = "its detection m4 (score 0.74, 0.1 m away) went to track 150"
+    assert misleading(on_it) == []

@@ -397,3 +397,16 @@ def test_another_runs_coalescence_is_the_same_failure_only_when_it_missed_the_sa
     assert _same_place(theirs, "80d062", None, "pedestrian")
     miss = Failure(FailureKind.MISS, 21, "s", "pedestrian", ("a2d371",), (), ())
     assert _same_place(miss, "a2d371", None, "pedestrian")
+
+
+def test_a_coalesced_objects_detection_that_started_a_track_never_output_on_it_is_said_so() -> None:
+    # dev set scene-0553 megvii ab3dmot coalescence at frame 12: "its detection m4 (score 0.74, 0.1 m away) started
+    # new track 148", a tentative track the tracker never output, read as if the object were covered
+    from gnnpmb.eval.evaluated import GtFrame, GtStatus
+
+    g = GtFrame(13, GtStatus.SCORED, (0.0, 0.0), (0.0, 0.0), None, 30, 20.0, 40.0)
+    went = Destination(4, Went.NEW_TRACK, 148)
+    seen = Sighting(13, 30, g, Near(4, "bicycle", 0.74, 0.1, True), Near(4, "bicycle", 0.74, 0.1, True), went, ())
+    f = finding(FailureKind.COALESCENCE, sightings=(seen,), blame=(Blame(Rule.COVERED_TWO, (13,)),), covered=(GT,))
+    (line, _) = why_lines(f)
+    assert "its detection m4 (score 0.74, 0.1 m away) started new track 148; track 148 was not output on it" in line
