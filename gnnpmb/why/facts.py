@@ -19,7 +19,8 @@ Facts are about the events as emitted: nothing here re-runs tracker math.
 from __future__ import annotations
 
 import enum
-from collections.abc import Iterable, Mapping
+import math
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -50,6 +51,7 @@ from gnnpmb.events import (
     UpdateWeights,
 )
 from gnnpmb.explain import Decisions, explain
+from gnnpmb.foreign import NEAREST_M
 from gnnpmb.types import TrackEstimate
 
 USED_SHARE = 0.01
@@ -552,7 +554,8 @@ def frame_use(cf: ClassFrame) -> FrameUse | None:
 def output_use(cf: ClassFrame) -> FrameUse | None:
     """An output-only run (``UseMode.OUTPUT``): each output track "used" the detection its box sits on
     (``TrackEstimate.meas_index``; share 1, none: missed 1); a detection went to the track whose box sits on it
-    (the lowest id when several do), else under no output box."""
+    (the lowest id when several do), else under no output box: ``track_id`` then names the nearest box of the
+    class within ``foreign.NEAREST_M`` of it (a box that sat on another detection), -1 for none."""
     if cf.extracted is None:
         return None
     tracks: dict[int, Use] = {}
@@ -563,9 +566,18 @@ def output_use(cf: ClassFrame) -> FrameUse | None:
         if on:
             destinations.setdefault(e.meas_index, Destination(e.meas_index, Went.TRACK, e.track_id))
     received = np.asarray(cf.meas.meas_indices).tolist() if cf.meas is not None else []
-    for m in received:
-        destinations.setdefault(m, Destination(m, Went.NO_OUTPUT))
+    boxes = sorted(cf.extracted.estimates, key=lambda e: e.track_id)
+    for j, m in enumerate(received):
+        if m not in destinations:
+            destinations[m] = Destination(m, Went.NO_OUTPUT, _box_beside(boxes, np.asarray(cf.meas.xyz_m)[j, :2]))
     return FrameUse(UseMode.OUTPUT, tracks, destinations)
+
+
+def _box_beside(boxes: Sequence[TrackEstimate], xy_m: np.ndarray) -> int:
+    """The track whose box centre lies nearest ``xy_m`` (2,), BEV, within ``foreign.NEAREST_M``; -1: none."""
+    near = [(math.dist(e.translation_m[:2], xy_m), e.track_id) for e in boxes]
+    near = [x for x in near if x[0] < NEAREST_M]
+    return min(near)[1] if near else -1
 
 
 def _new(m: int, born: Mapping[int, int], share: float = 1.0) -> Destination:

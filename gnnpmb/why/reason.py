@@ -24,7 +24,7 @@ from gnnpmb.foreign import BoxOn
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.counterfactual import would_take
-from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode
+from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode, Went
 from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
     FRAMES_BEFORE,
@@ -669,7 +669,7 @@ class _Context:
         elif own is not None:
             on_ids = {o.track_id for o in s.on_it}
             went = s.went
-            if went is None or went.track_id < 0:
+            if went is None or went.track_id < 0 or went.went is Went.NO_OUTPUT:  # NO_OUTPUT: a box beside it
                 out.append(Blame(Rule.DETECTION_UNUSED, f))
             elif went.track_id not in on_ids:
                 out.append(Blame(Rule.NOT_OUTPUT, f))
@@ -681,7 +681,11 @@ class _Context:
         if s is not None:
             uncovered = self.blame_uncovered(s)
             blame += uncovered
-            if s.went is not None and s.went.track_id == int(self.failure.track_ids[0]):
+            if (
+                s.went is not None
+                and s.went.went is not Went.NO_OUTPUT
+                and s.went.track_id == int(self.failure.track_ids[0])
+            ):
                 blame.append(Blame(Rule.COVERED_TWO, (self.f,)))
         t = int(self.failure.track_ids[0])
         ev = self.report.track_evals.get(str(t))

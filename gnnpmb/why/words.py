@@ -299,6 +299,8 @@ def destination_name(d: Destination | None, mode: UseMode) -> str:
     (started no track: a candidate or clutter)``, ``not received (dropped by preprocessing)``; for a run known by its
     output only, the box on it: ``under track 26's box``, ``under no output box``."""
     if mode is UseMode.OUTPUT:
+        if d is not None and d.went is Went.NO_OUTPUT and d.track_id >= 0:  # beside a box placed on another one
+            return f"under track {d.track_id}'s box, which sat on another detection"
         if d is None or d.went is not Went.TRACK:
             return "under no output box"
         return f"under track {d.track_id}'s box"
@@ -1012,8 +1014,13 @@ def _went_unshown(s: Sighting) -> list[str]:
     """``track 41 was not output on it``: the track the object's detection went to (or started) was not among
     those output on the object, said wherever the detection's destination is (a box tracker's tentative track,
     a PHD label below extraction), lest "started new track 41" read as the object being covered."""
-    if s.went is not None and s.went.track_id >= 0 and s.went.track_id not in {o.track_id for o in s.on_it}:
-        return [f"track {s.went.track_id} was not output on it"]
+    went = s.went
+    if (
+        went is not None
+        and went.went in (Went.TRACK, Went.NEW_TRACK)
+        and went.track_id not in {o.track_id for o in s.on_it}
+    ):
+        return [f"track {went.track_id} was not output on it"]
     return []
 
 

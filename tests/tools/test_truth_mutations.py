@@ -861,3 +861,27 @@ def test_a_track_the_objects_detection_started_left_unsaid_off_the_object_is_cau
         assert misleading(f"{said}; track 148 was not output on it") == []
     on_it = "its detection m4 (score 0.74, 0.1 m away) went to track 150"
     assert misleading(on_it) == []
+
+
+def test_a_results_files_detection_said_under_no_box_beside_one_on_another_detection_is_caught() -> None:
+    # independent audit r42, dev set scene-1094 pointpillars (cbmot's output as a results file): "detection m14
+    # (score 0.29) lay 0.7 m from pedestrian GT 9a6fb4 and lay under no output box", 0.02 m from track 358's box
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    box = (1.8, 4.5, 1.6, 1.0, 0.0, 0.0, 0.0, 0.9)
+    other = (1.7, 4.2, 1.5, 1.0, 0.0, 0.0, 0.0, 0.5)
+    dets = [Detection(C, 0.9, (0.3, 0.0), box), Detection(C, 0.5, (0.32, 0.0), other)]
+    scene = SceneTruth([dets] * 4, [{GT_A: Annotation(C, (0.0, 0.0), 9)}] * 4)
+    ev = _eval()
+    ev.boxes[3] = [("11", C, (0.3, 0.0))]
+    ev.geometry = {(3, "11"): box}
+    ev.submitted = {3: {"11"}}
+    ctx = Context(C, 3, GT_A, kind="miss")
+    miss = "at frame 3 detection m1 (score 0.50) lay 0.3 m from car GT aaaaaa and lay under "
+    coalesced = "its detection m1 (score 0.50, 0.3 m away) lay under "
+    for head in (miss, coalesced, "at frame 3 m1 (score 0.50, 0.3 m from it) lay under "):
+        true, false = head + "track 11's box, which sat on another detection", head + "no output box"
+        assert check_text(true, ctx, None, ev, scene=scene).found == [], true
+        assert [c.kind for c in check_text(false, ctx, None, ev, scene=scene).found] == ["output"], false
+    ev.boxes[3] = [("11", C, (0.3, 0.6))]  # 0.6 m away: no box beside it
+    assert check_text(miss + "no output box", ctx, None, ev, scene=scene).found == []

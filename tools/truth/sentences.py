@@ -235,7 +235,7 @@ def check_text(
     lost.check_two_tracks(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     lost.check_averaged(text, ctx.track, ev, out, bad)
     if raw is None:  # a results file: where its boxes sit
-        output.check_output(text, c, ctx.lost, scene, ev, out, bad)
+        output.check_output(text, c, ctx.lost, scene, ev, out, bad, ctx.frame)
         return out
     started = [(int(m[2]), int(m[1]), int(m[3]), m[0]) for m in STARTED.finditer(text)]
     started += [(int(m[1]), int(m[3]), int(m[2]), m[0]) for m in STARTED_NEW.finditer(text)]

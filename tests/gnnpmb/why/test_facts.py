@@ -184,3 +184,29 @@ def test_a_tracker_that_emits_births_names_the_track_a_detection_started() -> No
     ]
     d = facts_of(events).destination(0, "car", 3)
     assert (d.went, d.track_id) == (Went.NEW_TRACK, 17)
+
+
+def test_a_results_files_detection_beside_a_box_that_sat_on_another_is_named_with_that_box() -> None:
+    # independent audit r42, dev set scene-1094 pointpillars, cbmot's output as a results file: "detection m14
+    # (score 0.29) lay 0.7 m from pedestrian GT 9a6fb4 and lay under no output box" of a detection 0.02 m from
+    # track 358's box (which sat on m0)
+    from gnnpmb.events import Extracted, MeasurementsReceived
+    from gnnpmb.why.facts import ClassFrame, output_use
+    from gnnpmb.why.words import went_phrase
+
+    def box(track_id: int, x: float, meas: int) -> TrackEstimate:
+        return TrackEstimate(
+            track_id, "car", (x, 0.0, 0.0), (2.0, 4.0, 1.5), (1.0, 0, 0, 0), (0.0, 0.0), 0.7, 1.0, meas
+        )
+
+    meas = MeasurementsReceived(
+        "car", np.array([0, 14, 3]), np.array([[0.0, 0, 0], [0.02, 0, 0], [9.0, 0, 0]]), np.ones(3)
+    )
+    cf = ClassFrame(meas=meas, extracted=Extracted("car", (box(358, 0.0, 0),), 0.5))
+    use = output_use(cf)
+    assert went_phrase(use.destinations[0], UseMode.OUTPUT) == "lay under track 358's box"
+    assert (
+        went_phrase(use.destinations[14], UseMode.OUTPUT) == "lay under track 358's box, which sat on another detection"
+    )
+    assert use.destinations[14].went is Went.NO_OUTPUT
+    assert went_phrase(use.destinations[3], UseMode.OUTPUT) == "lay under no output box"
