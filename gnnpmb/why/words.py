@@ -851,8 +851,8 @@ def _counted_unshown(f: Finding, lost: LostTrack) -> list[str]:
     else:
         versus = f"is above the {f.class_name} threshold {threshold:.3f}"
     return [
-        f"track {lost.track_id}'s existence stayed below {SHOW_MIN_EXISTENCE:g} (the views draw tracks from "
-        f"{SHOW_MIN_EXISTENCE:g} up), yet the evaluation counted it: {averaged_text(ev)}, {versus}"
+        f"track {lost.track_id}'s {_existence_word(UseMode(f.mode))} stayed below {SHOW_MIN_EXISTENCE:g} (the views "
+        f"draw tracks from {SHOW_MIN_EXISTENCE:g} up), yet the evaluation counted it: {averaged_text(ev)}, {versus}"
     ]
 
 

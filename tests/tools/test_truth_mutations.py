@@ -885,3 +885,19 @@ def test_a_results_files_detection_said_under_no_box_beside_one_on_another_detec
         assert [c.kind for c in check_text(false, ctx, None, ev, scene=scene).found] == ["output"], false
     ev.boxes[3] = [("11", C, (0.3, 0.6))]  # 0.6 m away: no box beside it
     assert check_text(miss + "no output box", ctx, None, ev, scene=scene).found == []
+
+
+def test_an_unshown_phd_labels_existence_is_caught_as_misleading_and_its_weight_passes() -> None:
+    # independent audit r42, dev set scene-0061 centerpoint cphd fragmentation:3: "track 38's existence stayed below
+    # 0.5" of a CPHD label (its heaviest component's weight, 0.30, was what the line called "its weight")
+    from gnnpmb.events import IntensityWeights
+
+    ev = _eval()
+    ev.submitted = {1: {"38"}, 2: set()}
+    raw = _frames({1: [IntensityWeights(C, np.array([38, 38]), np.array([0.30, 0.25]))]})
+    ctx = Context(C, 2, GT_A, lost=38)
+    said = "track 38's {} stayed below 0.5 (the views draw tracks from 0.5 up), yet the evaluation counted it"
+    assert check_text(said.format("weight"), ctx, raw, ev).found == []
+    assert [c.kind for c in check_text(said.format("existence"), ctx, raw, ev).found] == ["misleading"]
+    posterior = _frames({1: [_posterior(38, 0.3)]})
+    assert [c.kind for c in check_text(said.format("weight"), ctx, posterior, ev).found] == ["misleading"]

@@ -63,7 +63,7 @@ USED = re.compile(
     rf"at frame (\d+) it (used|was given) (m\d+(?: \(p {NUMBER}\))?(?:, m\d+(?: \(p {NUMBER}\))?)?)(?: \+(\d+) more)?"
 )
 GATE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it, in track (\d+)'s gate at NIS (\d+\.\d)\)")
-STAYED = re.compile(r"track (\d+)'s existence stayed below (\d+(?:\.\d+)?) \(the views draw tracks from")
+STAYED = re.compile(r"track (\d+)'s (existence|weight) stayed below (\d+(?:\.\d+)?) \(the views draw tracks from")
 AVERAGED = re.compile(
     r"(?:track (\d+)[^;:]*?|the evaluation counted the track: |track (\d+)'s existence stayed below [^;]*?counted it: )"
     r"its score averaged over (?:its (\d+) frames?|the (\d+) "
@@ -196,10 +196,15 @@ def check_averaged(text: str, track: int | None, ev, out, bad) -> None:
 
 def check_stayed_below(text: str, c: str, raw, ev, out, bad) -> None:
     """ "track T's existence stayed below E (…)": its ``Posterior`` existence at every frame the submission has its
-    box is below E."""
+    box is below E; "weight" of a GM-PHD / CPHD label (its frames have ``IntensityWeights``), "existence" of any other
+    track (else ``misleading``)."""
     for m in STAYED.finditer(text):
         out.checked["tracker"] += 1
-        t, below = int(m[1]), float(m[2])
+        t, below = int(m[1]), float(m[3])
+        phd = any(raw.of_kind(x, c, IntensityWeights) for x in ev.submitted if str(t) in ev.submitted[x])
+        out.checked["misleading"] += 1
+        if (m[2] == "weight") != phd:
+            bad("misleading", m[0], f"a {'PHD label has a weight' if phd else 'track has an existence'}, not a {m[2]}")
         above = {
             x: v
             for x in sorted(ev.submitted)

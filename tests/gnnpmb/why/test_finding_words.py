@@ -62,6 +62,10 @@ def test_a_track_never_shown_is_said_to_count_when_its_average_reaches_the_thres
     # output before the window too (dev-set scene-0103 pointpillars cphd id_switch:9, shown at frames 11-12): not said
     before = LostTrack(26, 7, steps[2:], None, evaluated, 0.037)
     assert "stayed below" not in why_lines(finding(FailureKind.ID_SWITCH, before))[0]
+    # independent audit r42, dev set scene-0061 centerpoint cphd fragmentation:3: "track 38's existence stayed below
+    # 0.5" of a PHD track the same line called by its weight ("its weight went from 0.30 ...")
+    (line, _) = why_lines(finding(FailureKind.ID_SWITCH, lost, mode=UseMode.WEIGHTS.value))
+    assert "track 26's weight stayed below 0.5 (the views draw tracks from 0.5 up)" in line
 
 
 def test_the_averaged_score_names_the_frames_the_evaluation_kept_when_not_all() -> None:
