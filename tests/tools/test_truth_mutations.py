@@ -901,3 +901,28 @@ def test_an_unshown_phd_labels_existence_is_caught_as_misleading_and_its_weight_
     assert [c.kind for c in check_text(said.format("existence"), ctx, raw, ev).found] == ["misleading"]
     posterior = _frames({1: [_posterior(38, 0.3)]})
     assert [c.kind for c in check_text(said.format("weight"), ctx, posterior, ev).found] == ["misleading"]
+
+
+def test_a_focus_documents_story_line_with_a_wrong_value_or_symbol_is_caught() -> None:
+    # independent audit r42, dev set scene-0061 centerpoint cphd id_switch:1: "frame 2: track 18 no longer shown
+    # (r=0.02 fell below 0.50)" of a CPHD label whose heaviest component weighed 0.22
+    from gnnpmb.events import IntensityWeights
+    from tools.truth.lost import check_story
+    from tools.truth.sentences import Tally
+
+    phd = _frames({2: [IntensityWeights(C, np.array([18, 18, 18]), np.array([0.22, 0.211, 0.024]))]})
+    bernoulli = _frames({2: [_posterior(18, 0.22)]})
+
+    def found(section: str, raw) -> list[str]:
+        out = Tally()
+        check_story(section, C, raw, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    gone = "- frame 2: track 18 no longer shown ({}={} fell below 0.50)\n"
+    hidden = "- frame 2: track 18 (not shown, {0} < 0.5): started by m7, {0}={1}\n"
+    for line in (gone, hidden):
+        assert found(line.format("w", "0.22"), phd) == []
+        assert found(line.format("w", "0.02"), phd) == ["tracker"]
+        assert found(line.format("r", "0.22"), phd) == ["misleading"]
+        assert found(line.format("r", "0.22"), bernoulli) == []
+        assert found(line.format("w", "0.22"), bernoulli) == ["misleading"]

@@ -65,7 +65,8 @@ USED = re.compile(
 GATE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it, in track (\d+)'s gate at NIS (\d+\.\d)\)")
 STAYED = re.compile(r"track (\d+)'s (existence|weight) stayed below (\d+(?:\.\d+)?) \(the views draw tracks from")
 AVERAGED = re.compile(
-    r"(?:track (\d+)[^;:]*?|the evaluation counted the track: |track (\d+)'s existence stayed below [^;]*?counted it: )"
+    r"(?:track (\d+)[^;:]*?|the evaluation counted the track: |track (\d+)'s (?:existence|weight) stayed below "
+    r"[^;]*?counted it: )"
     r"its score averaged over (?:its (\d+) frames?|the (\d+) "
     r"of its (\d+) frames the evaluation kept \(within the class range\)), (\d+\.\d{3})"
 )
@@ -356,3 +357,31 @@ def check_two_tracks(text: str, class_name: str, frame: int, gt_id: str | None, 
         d = math.hypot(box[0] - a.xy_m[0], box[1] - a.xy_m[1])
         if abs(d - distance) > 0.05 + 1e-9 or d >= 2.0:
             bad("output", m[0], f"the submission's box of track {t} lies {d:.2f} m from the annotation")
+
+
+STORY_SHOWN = re.compile(r"frame (\d+): track (\d+) (?:no longer shown \(|confirmed \()([rw])=(\d+\.\d+)")
+STORY_HIDDEN = re.compile(r"frame (\d+): track (\d+) \(not shown, ([rw]) < [\d.]+\): [^\n]*?, [rw]=(\d+(?:\.\d+)?)\n")
+
+
+def check_story(section: str, c: str, raw, out, bad) -> None:
+    """A focus document's story lines of one run (``section``): "track T confirmed (r=V, …)", "track T no longer
+    shown (r=V fell below …)", "track T (not shown, r < …): …, r=V": V is the track's existence after frame x's
+    update (a GM-PHD / CPHD label's heaviest ``IntensityWeights`` component), and the symbol is ``w`` for such a
+    label, ``r`` for an existence (else ``misleading``)."""
+    if raw is None:
+        return
+    found = [(m[0], int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_SHOWN.finditer(section)]
+    found += [(m[0].strip(), int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_HIDDEN.finditer(section + "\n")]
+    for sentence, x, t, symbol, said in found:
+        out.checked["tracker"] += 1
+        got = _existence(raw, x, c, t)
+        digits = len(said.split(".")[1]) if "." in said else 0
+        if got is None or f"{got:.{digits}f}" != said:
+            bad("tracker", sentence, f"its existence (heaviest PHD component) after frame {x}: {got}")
+        out.checked["misleading"] += 1
+        if (symbol == "w") != bool(raw.of_kind(x, c, IntensityWeights)):
+            bad(
+                "misleading",
+                sentence,
+                f"'{symbol}=' of a {'PHD label' if symbol == 'r' else 'track with an existence'}",
+            )

@@ -210,3 +210,29 @@ def test_a_results_files_detection_beside_a_box_that_sat_on_another_is_named_wit
     )
     assert use.destinations[14].went is Went.NO_OUTPUT
     assert went_phrase(use.destinations[3], UseMode.OUTPUT) == "lay under no output box"
+
+
+def test_a_phd_labels_story_gives_its_heaviest_components_weight_as_w() -> None:
+    # independent audit r42, dev set scene-0061 centerpoint cphd id_switch:1: "track 18 no longer shown (r=0.02 fell
+    # below 0.50)": the last of its three components' rows (0.22, 0.211, 0.024), read as an existence
+    from gnnpmb.events import Extracted, IntensityWeights, Posterior
+
+    def posterior(ids: list[int], w: list[float]) -> tuple[Posterior, IntensityWeights]:
+        k = len(ids)
+        cov = np.tile(np.eye(4), (k, 1, 1))
+        return Posterior("car", np.array(ids), np.zeros((k, 4)), cov, np.array(w)), IntensityWeights(
+            "car", np.array(ids), np.array(w)
+        )
+
+    events = [
+        frame(0),
+        received([0]),
+        *posterior([18, 18], [0.88, 0.09]),
+        Extracted("car", (estimate(18, 0, 0.88),), 0.5),
+    ]
+    events += [frame(1), received([0]), *posterior([18, 18, 18], [0.22, 0.211, 0.024]), Extracted("car", (), 0.5)]
+    teller = Storyteller(facts_of(events), involved=frozenset({18}))
+    (confirmed,) = [line.text for line in teller.frame_lines(0) if line.kind is StoryKind.CONFIRMED]
+    assert confirmed == "track 18 confirmed (w=0.88, from m0)"
+    (gone,) = [line.text for line in teller.frame_lines(1) if line.kind is StoryKind.NO_LONGER_SHOWN]
+    assert gone == "track 18 no longer shown (w=0.22 fell below 0.50)"
