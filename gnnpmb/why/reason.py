@@ -755,7 +755,11 @@ class _Context:
                 ),
                 None,
             )
-            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed, matched))
+            switched = gt_id is not None and any(
+                f.kind in SWITCHES and f.frame_index == self.f and _same_place(f, gt_id, xy, self.class_name)
+                for f in ev.report.failures
+            )
+            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed, matched, switched))
         return tuple(out)
 
 
@@ -788,10 +792,9 @@ def key_decisions(
     return _Context(evidence, scene, frames.stop - 1, class_name, frames.start).key_decisions(involved)
 
 
-SAME_FAILURE = {
-    FailureKind.ID_SWITCH: {FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT},
-    FailureKind.IDENTITY_THEFT: {FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT},
-}
+SWITCHES = frozenset({FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT})
+"""The devkit's SWITCH of an object: an ID switch, or a theft (a switch whose new track had been false)."""
+SAME_FAILURE = {FailureKind.ID_SWITCH: SWITCHES, FailureKind.IDENTITY_THEFT: SWITCHES}
 """Kinds that are one failure for another run: both are the devkit's SWITCH of the object (a theft is a switch whose
 new track had been false), so a run with either did not 'not fail here'."""
 

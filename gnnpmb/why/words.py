@@ -1150,6 +1150,9 @@ def _others(f: Finding) -> list[str]:
             out.append(f"{who} {same}")
         elif o.failed_same:
             out.append(f"{who} failed here too")
+        elif o.switched:  # a failure of another kind on the object: not "did not fail"
+            took = f": the evaluation matched the object to its track {o.matched}" if o.matched is not None else ""
+            out.append(f"{who} switched the object's track here instead{took}")
         elif counted and o.matched in {x.track_id for x in counted}:
             out.append(f"{who} did not fail here: {_its_tracks(counted)} output on the object and counted")
         elif counted and o.missed:  # on the annotation, but the evaluation matched them elsewhere or to nothing

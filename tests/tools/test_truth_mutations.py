@@ -926,3 +926,26 @@ def test_a_focus_documents_story_line_with_a_wrong_value_or_symbol_is_caught() -
         assert found(line.format("r", "0.22"), phd) == ["misleading"]
         assert found(line.format("r", "0.22"), bernoulli) == []
         assert found(line.format("w", "0.22"), bernoulli) == ["misleading"]
+
+
+def test_another_run_said_not_to_fail_where_its_devkit_switched_the_objects_track_is_caught() -> None:
+    # independent audit r42, dev set scene-0553 megvii prob3dmot fragmentation at frame 23 (ab3dmot's evaluation had a
+    # SWITCH of the object to track 241 there)
+    from tools.truth.scene import Annotation, SceneTruth
+
+    other = _eval()  # GT A matched to the other run's track 7 at frame 3, by a SWITCH
+    other.switches[(C, 3)] = {GT_A}
+    other.boxes[3] = [("7", C, (0.0, 0.3))]
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 9)}])
+    ctx = Context(C, 3, GT_A, kind="fragmentation")
+
+    def kinds(text: str, ev: EvalFacts = other) -> list[str]:
+        return [c.kind for c in check_text(text, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found]
+
+    head = "pmbm on the same detections "
+    assert kinds(head + "did not fail here: its track 7 was output on the object and counted") == ["other run"]
+    assert kinds(head + "did not have this failure") == ["other run"]
+    true = head + "switched the object's track here instead: the evaluation matched the object to its track 7"
+    assert kinds(true) == []
+    assert kinds(true.replace("track 7", "track 8")) == ["other run"]
+    assert kinds(true, _eval()) == ["other run"]  # no SWITCH in its events

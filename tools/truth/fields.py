@@ -406,6 +406,12 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
                 return ""
             got = other.matched_track(c, x, v[1])
             return "" if got == (None if v[2] is None else str(v[2])) else f"its evaluation matched it to {got}"
+        case "other switched":
+            other = src.others.get(v[0])
+            if other is None:
+                return ""
+            switched = v[1] in other.switches.get((c, x), set())
+            return "" if switched == v[2] else f"its devkit events {'have' if switched else 'have no'} SWITCH of it"
         case "blame":
             return check_blame(v[0], v[1], f, src)
         case "deciding":

@@ -414,3 +414,21 @@ def test_a_coalesced_objects_detection_that_started_a_track_never_output_on_it_i
     f = finding(FailureKind.COALESCENCE, sightings=(seen,), blame=(Blame(Rule.COVERED_TWO, (13,)),), covered=(GT,))
     (line, _) = why_lines(f)
     assert "its detection m4 (score 0.74, 0.1 m away) started new track 148; track 148 was not output on it" in line
+
+
+def test_another_run_that_switched_the_objects_track_here_is_not_said_not_to_fail() -> None:
+    # independent audit r42, dev set scene-0553 megvii prob3dmot fragmentation at frame 23: "ab3dmot on the same
+    # detections did not fail here: its track 241 was output on the object and counted", where ab3dmot's own
+    # evaluation had a SWITCH of the object to track 241 at that frame
+    from gnnpmb.why.findings import OnObject, OtherRun
+
+    kept = TrackEval((23,), (23,), (), 0.9, 0.9, ((23, GT),))
+    on = (OnObject(241, 0.3, 0.9, -1, kept, 0.3),)
+    lost = LostTrack(62, 22, (), None, None, None)
+    run = OtherRun("ab3dmot", False, on, matched=241, switched=True)
+    (line, _) = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=23, others=(run,)))
+    assert "did not fail" not in line
+    assert (
+        "ab3dmot on the same detections switched the object's track here instead: the evaluation matched the object "
+        "to its track 241" in line
+    )
