@@ -419,8 +419,8 @@ class TrackerFacts:
         if cf is None:
             return None
         prior_r = xy = None
-        if cf.predicted is not None:
-            row = _row_of(cf.predicted.track_ids, t)
+        if cf.predicted is not None:  # a GM-PHD / CPHD label has a row per component: its heaviest one
+            row = _heaviest_row(cf.predicted.track_ids, cf.predicted.existence, t)
             if row is not None:
                 prior_r = float(cf.predicted.existence[row])
                 xy = (float(cf.predicted.mean[row, 0]), float(cf.predicted.mean[row, 1]))
@@ -498,6 +498,12 @@ class TrackerFacts:
 def _row_of(ids: np.ndarray, t: int) -> int | None:
     hit = np.flatnonzero(np.asarray(ids) == t)
     return int(hit[0]) if hit.size else None
+
+
+def _heaviest_row(ids: np.ndarray, weights: np.ndarray, t: int) -> int | None:
+    """The row of ``t`` with the largest weight (a track's only row; a PHD label's heaviest component)."""
+    hit = np.flatnonzero(np.asarray(ids) == t)
+    return int(hit[np.argmax(np.asarray(weights)[hit])]) if hit.size else None
 
 
 def _ending(cf: ClassFrame, t: int) -> TrackEnd | None:

@@ -949,3 +949,30 @@ def test_another_run_said_not_to_fail_where_its_devkit_switched_the_objects_trac
     assert kinds(true) == []
     assert kinds(true.replace("track 7", "track 8")) == ["other run"]
     assert kinds(true, _eval()) == ["other run"]  # no SWITCH in its events
+
+
+def test_a_focus_documents_track_table_with_a_wrong_word_or_value_is_caught() -> None:
+    # independent audit r42, dev set scene-0757 centerpoint phd: "r before update" / "r after" 1.10 of a PHD label
+    from gnnpmb.events import IntensityWeights, Predicted
+    from tools.truth.lost import check_track_tables
+    from tools.truth.sentences import Tally
+
+    predicted = Predicted(
+        C, np.array([39, 39]), np.zeros((2, 4)), np.tile(np.eye(4), (2, 1, 1)), np.array([0.03, 0.94])
+    )
+    phd = _frames({16: [predicted, IntensityWeights(C, np.array([39, 39]), np.array([1.10, 0.02]))]})
+
+    def found(word: str, before: str, after: str) -> list[str]:
+        table = "Track 39, frame by frame:\n\n"
+        table += f"| frame | {word} before update | in gate (NIS) | used | {word} after | output |\n"
+        table += (
+            f"|---|---|---|---|---|---|\n| 16 | {before} | m17 (0.2) | m17 (91 % of its weight) | {after} | yes |\n"
+        )
+        out = Tally()
+        check_track_tables(table, C, phd, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    assert found("weight", "0.94", "1.10") == []
+    assert found("r", "0.94", "1.10") == ["misleading"]
+    assert found("weight", "0.03", "1.10") == ["tracker"]
+    assert found("weight", "0.94", "0.02") == ["tracker"]

@@ -181,6 +181,7 @@ def _check_focus(
     for name, raw in (raws or {}).items():
         section = doc.split(f"\n## {name}\n", 1)[1].split("\n## ", 1)[0] if f"\n## {name}\n" in doc else ""
         lost.check_story(section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a)))
+        lost.check_track_tables(section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a)))
     out.checked["misleading"] += 1
     doc = doc.replace("?url=", "")
     if "?" in doc:

@@ -41,6 +41,7 @@ from gnnpmb.events import (
     Marginals,
     Merged,
     Posterior,
+    Predicted,
     Pruned,
     PruneReason,
     TrackLogic,
@@ -385,3 +386,39 @@ def check_story(section: str, c: str, raw, out, bad) -> None:
                 sentence,
                 f"'{symbol}=' of a {'PHD label' if symbol == 'r' else 'track with an existence'}",
             )
+
+
+TRACK_TABLE = re.compile(
+    r"Track (\d+), frame by frame:\n\n\| frame \| (r|weight) before update \| in gate \(NIS\) \| used \| (?:r|weight) "
+    r"after \| output \|\n\|[-|]+\|\n((?:\|.*\|\n)+)"
+)
+
+
+def check_track_tables(section: str, c: str, raw, out, bad) -> None:
+    """A focus document's per-track tables of one run: "r" / "weight" before and after each update against the raw
+    events (the track's ``Predicted`` row, its ``Posterior`` existence; a GM-PHD / CPHD label's heaviest component,
+    predicted and after ``IntensityWeights``), and the word: "weight" for such a label (else ``misleading``)."""
+    if raw is None:
+        return
+    for table in TRACK_TABLE.finditer(section):
+        t, word = int(table[1]), table[2]
+        for row in table[3].strip().splitlines():
+            cells = [x.strip() for x in row.strip("|").split("|")]
+            x, before, after = int(cells[0]), cells[1].split(" ")[0], cells[4]
+            phd = bool(raw.of_kind(x, c, IntensityWeights))
+            out.checked["misleading"] += 1
+            if (word == "weight") != phd:
+                bad("misleading", f"Track {t}: {word} before update", f"{'a PHD label' if phd else 'an existence'}")
+            predicted = [
+                float(w)
+                for e in raw.of_kind(x, c, Predicted)
+                for i, w in zip(np.asarray(e.track_ids).tolist(), np.asarray(e.existence).tolist(), strict=True)
+                if i == t
+            ]
+            for said, got in ((before, max(predicted) if predicted else None), (after, _existence(raw, x, c, t))):
+                if said in ("—", "ended"):
+                    continue
+                out.checked["tracker"] += 1
+                digits = len(said.split(".")[1]) if "." in said else 0
+                if got is None or f"{got:.{digits}f}" != said:
+                    bad("tracker", f"Track {t} at frame {x}: {said}", f"the raw events give {got}")

@@ -236,3 +236,40 @@ def test_a_phd_labels_story_gives_its_heaviest_components_weight_as_w() -> None:
     assert confirmed == "track 18 confirmed (w=0.88, from m0)"
     (gone,) = [line.text for line in teller.frame_lines(1) if line.kind is StoryKind.NO_LONGER_SHOWN]
     assert gone == "track 18 no longer shown (w=0.22 fell below 0.50)"
+
+
+def test_a_phd_labels_table_says_weight_of_its_heaviest_components_before_and_after_the_update() -> None:
+    # independent audit r42, dev set scene-0757 centerpoint phd (diff:introduced:1's focus document): "r before
+    # update" / "r after" 1.10 of a PHD label (a weight, not an existence), and "before" read off its first row
+    from types import SimpleNamespace
+
+    from gnnpmb.events import Extracted, Gated, IntensityWeights, Posterior
+    from viz.focus_summary import _steps_markdown
+
+    def rows(kind, ids: list[int], w: list[float]):
+        k = len(ids)
+        return kind("car", np.array(ids), np.zeros((k, 4)), np.tile(np.eye(4), (k, 1, 1)), np.array(w))
+
+    weights = UpdateWeights(
+        "car", np.array([39]), np.array([0]), np.array([1.0]), np.array([0.1]), np.array([[0.9]]), np.array([0.1])
+    )
+    gated = Gated(
+        "car",
+        np.array([39]),
+        np.array([0]),
+        np.array([[True]]),
+        np.zeros((1, 2)),
+        np.tile(np.eye(2), (1, 1, 1)),
+        9.0,
+        np.array([[0.2]]),
+    )
+    events = [frame(0), received([0]), rows(Predicted, [39, 39], [0.03, 0.94]), gated, weights]
+    events += [
+        rows(Posterior, [39, 39], [1.10, 0.02]),
+        IntensityWeights("car", np.array([39, 39]), np.array([1.10, 0.02])),
+    ]
+    events += [Extracted("car", (estimate(39, 0, 1.0),), 0.5)]
+    view = SimpleNamespace(facts=facts_of(events), has_gates=True)
+    table = "\n".join(_steps_markdown(view, "car", [39], range(0, 1)))
+    assert "| frame | weight before update | in gate (NIS) | used | weight after | output |" in table
+    assert "| 0 | 0.94 |" in table and "| 1.10 | yes |" in table
