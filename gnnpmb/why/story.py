@@ -94,6 +94,15 @@ class Storyteller:
             lines.append(StoryLine(frame, class_name, kind, level, ids, text))
 
         r = "w" if cf.intensity is not None else "r"  # the symbol: a GM-PHD / CPHD label's weight, else an existence
+        posterior_r: dict[int, float] = {}
+        if cf.posterior is not None:  # a GM-PHD / CPHD label has a row per component: its heaviest one's weight
+            ids, rs = np.asarray(cf.posterior.track_ids).tolist(), np.asarray(cf.posterior.existence).tolist()
+            for t, value in zip(ids, rs, strict=True):
+                posterior_r[t] = max(value, posterior_r.get(t, value))
+        if cf.intensity is not None:  # uncapped (the Posterior and the estimates hold min(w, 1))
+            ids, ws = np.asarray(cf.intensity.labels).tolist(), np.asarray(cf.intensity.weights).tolist()
+            for t, value in zip(ids, ws, strict=True):
+                posterior_r[t] = max(value, posterior_r.get(t, value))
         extracted = cf.extracted.estimates if cf.extracted is not None else ()
         now = {e.track_id: e for e in extracted if e.existence >= self.show_min}
         known = self.shown_ever
@@ -101,6 +110,7 @@ class Storyteller:
         output_only = self.facts.output_only
         for t, e in now.items():
             via = f"from {meas_name(e.meas_index)}" if e.meas_index >= 0 else "without a detection"
+            weight = posterior_r.get(t, e.existence) if cf.intensity is not None else e.existence
             if output_only:  # a results file: only where its boxes were is known
                 if t not in known:
                     on = f"on {meas_name(e.meas_index)}" if e.meas_index >= 0 else "on no detection"
@@ -116,19 +126,14 @@ class Storyteller:
                         f": the best hypothesis now descends from prior hypothesis {hyp.best_parent}, in which it "
                         f"has existed since frame {since}"
                     )
-                say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} confirmed ({self._r(e.existence, r)}{via}){why}")
+                say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} confirmed ({self._r(weight, r)}{via}){why}")
             elif e.meas_index < 0:
                 say(
                     StoryKind.MISSED,
                     "INFO",
                     (t,),
-                    f"track {t} missed this frame, still reported{self._r_in(e.existence, r)}",
+                    f"track {t} missed this frame, still reported{self._r_in(weight, r)}",
                 )
-        posterior_r: dict[int, float] = {}
-        if cf.posterior is not None:  # a GM-PHD / CPHD label has a row per component: its heaviest one's weight
-            ids, rs = np.asarray(cf.posterior.track_ids).tolist(), np.asarray(cf.posterior.existence).tolist()
-            for t, value in zip(ids, rs, strict=True):
-                posterior_r[t] = max(value, posterior_r.get(t, value))
         for t in sorted((self.involved & set(posterior_r)) - known - set(now)):
             step = self.facts.steps(t, class_name).get(frame)
             if step is None:

@@ -376,8 +376,7 @@ def check_story(section: str, c: str, raw, out, bad) -> None:
     for sentence, x, t, symbol, said in found:
         out.checked["tracker"] += 1
         got = _existence(raw, x, c, t)
-        digits = len(said.split(".")[1]) if "." in said else 0
-        if got is None or f"{got:.{digits}f}" != said:
+        if not _reads(got, said):
             bad("tracker", sentence, f"its existence (heaviest PHD component) after frame {x}: {got}")
         out.checked["misleading"] += 1
         if (symbol == "w") != bool(raw.of_kind(x, c, IntensityWeights)):
@@ -419,6 +418,14 @@ def check_track_tables(section: str, c: str, raw, out, bad) -> None:
                 if said in ("—", "ended"):
                     continue
                 out.checked["tracker"] += 1
-                digits = len(said.split(".")[1]) if "." in said else 0
-                if got is None or f"{got:.{digits}f}" != said:
+                if not _reads(got, said):
                     bad("tracker", f"Track {t} at frame {x}: {said}", f"the raw events give {got}")
+
+
+def _reads(got: float | None, said: str) -> bool:
+    """Whether ``said`` prints ``got``: as ``printed`` does (one significant digit below 0.01), or with said's own
+    decimals."""
+    if got is None:
+        return False
+    digits = len(said.split(".")[1]) if "." in said and "e" not in said else 0
+    return said == printed(got) or ("e" not in said and f"{got:.{digits}f}" == said)

@@ -220,20 +220,20 @@ def test_a_phd_labels_story_gives_its_heaviest_components_weight_as_w() -> None:
     def posterior(ids: list[int], w: list[float]) -> tuple[Posterior, IntensityWeights]:
         k = len(ids)
         cov = np.tile(np.eye(4), (k, 1, 1))
-        return Posterior("car", np.array(ids), np.zeros((k, 4)), cov, np.array(w)), IntensityWeights(
+        return Posterior("car", np.array(ids), np.zeros((k, 4)), cov, np.minimum(w, 1.0)), IntensityWeights(
             "car", np.array(ids), np.array(w)
         )
 
     events = [
         frame(0),
         received([0]),
-        *posterior([18, 18], [0.88, 0.09]),
-        Extracted("car", (estimate(18, 0, 0.88),), 0.5),
+        *posterior([18, 18], [1.04, 0.09]),  # the Posterior and the estimate hold min(w, 1): the story says 1.04
+        Extracted("car", (estimate(18, 0, 1.0),), 0.5),
     ]
     events += [frame(1), received([0]), *posterior([18, 18, 18], [0.22, 0.211, 0.024]), Extracted("car", (), 0.5)]
     teller = Storyteller(facts_of(events), involved=frozenset({18}))
     (confirmed,) = [line.text for line in teller.frame_lines(0) if line.kind is StoryKind.CONFIRMED]
-    assert confirmed == "track 18 confirmed (w=0.88, from m0)"
+    assert confirmed == "track 18 confirmed (w=1.04, from m0)"
     (gone,) = [line.text for line in teller.frame_lines(1) if line.kind is StoryKind.NO_LONGER_SHOWN]
     assert gone == "track 18 no longer shown (w=0.22 fell below 0.50)"
 
