@@ -812,7 +812,7 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
     on = f", on {meas_name(off.meas)}" if off.meas >= 0 else ""
     before = ""
     if off.earlier:
-        away = ", ".join(f"{x} ({meas_name(m)})" for x, m in off.earlier)
+        away = ", ".join(f"{x} ({meas_name(m)}{_share_of(lost, x, m, UseMode(f.mode))})" for x, m in off.earlier)
         verb = "its box had sat on" if f.output_only else "it had used"
         before = (
             f"; {verb} detections {NEAR_M:.0f} m or more from the object at frame"
@@ -823,6 +823,15 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
         f"{short_id(f.gt_id or '')}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the "
         f"object{before}"
     )
+
+
+def _share_of(lost: LostTrack, frame: int, meas: int, mode: UseMode) -> str:
+    """``, 24 % of its weight`` / ``, p 0.24``: the share of a soft update the lost track took from ``meas`` at
+    ``frame`` (a minor share reads as the detection that led it off otherwise); nothing for an assignment."""
+    step = lost.step(frame)
+    share = next((v for m, v in step.use.shares if m == meas), None) if step and step.use else None
+    extra = share_text(share, mode) if share is not None else ""
+    return f", {extra}" if extra else ""
 
 
 def averaged_text(ev: TrackEval) -> str:

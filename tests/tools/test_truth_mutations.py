@@ -976,3 +976,28 @@ def test_a_focus_documents_track_table_with_a_wrong_word_or_value_is_caught() ->
     assert found("r", "0.94", "1.10") == ["misleading"]
     assert found("weight", "0.03", "1.10") == ["tracker"]
     assert found("weight", "0.94", "0.02") == ["tracker"]
+
+
+def test_a_far_detection_the_lost_track_used_is_checked_and_its_soft_share_must_be_said() -> None:
+    # independent audit r42, dev set scene-1100 centerpoint cphd fragmentation:1: "it had used detections 2 m or more
+    # from the object at frame 5 (m5)", 24 % of its weight (72 % from m11, 0.9 m from the object)
+    from gnnpmb.events import UpdateWeights
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    box = (1.8, 4.5, 1.6, 1.0, 0.0, 0.0, 0.0, 0.9)
+    dets = [Detection(C, 0.8, (4.1, 0.0), box), Detection(C, 0.5, (0.9, 0.0), box)]
+    scene = SceneTruth([dets] * 6, [{GT_A: Annotation(C, (0.0, 0.0), 9)}] * 6)
+    weights = UpdateWeights(
+        C, np.array([9]), np.array([0, 1]), np.array([1.0]), np.array([0.04]), np.array([[0.24, 0.72]]), np.zeros(2)
+    )
+    raw = _frames({5: [weights]})
+    ctx = Context(C, 5, GT_A, kind="fragmentation", lost=9)
+
+    def kinds(text: str) -> list[str]:
+        return [x.kind for x in check_text(text, ctx, raw, _eval(), scene=scene).found if x.kind != "detector"]
+
+    head = "it had used detections 2 m or more from the object at frame 5 "
+    assert kinds(head + "(m0, 24 % of its weight)") == []
+    assert kinds(head + "(m0)") == ["misleading"]
+    assert kinds(head + "(m0, 72 % of its weight)") == ["misleading"]
+    assert kinds(head + "(m1, 72 % of its weight)") == ["tracker"]  # 0.9 m from the object

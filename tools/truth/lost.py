@@ -46,6 +46,7 @@ from gnnpmb.events import (
     PruneReason,
     TrackLogic,
     TrackLogicAction,
+    UpdateWeights,
 )
 from tools.truth.printing import NUMBER, printed
 
@@ -429,3 +430,59 @@ def _reads(got: float | None, said: str) -> bool:
         return False
     digits = len(said.split(".")[1]) if "." in said and "e" not in said else 0
     return said == printed(got) or ("e" not in said and f"{got:.{digits}f}" == said)
+
+
+USED_AWAY = re.compile(r"it had used detections 2 m or more from the object at frames? ((?:\d+ \(m\d+[^)]*\)(?:, )?)+)")
+USED_ITEM = re.compile(r"(\d+) \(m(\d+)(?:, (?:p (\d\.\d+)|(\d+) % of its weight))?\)")
+
+
+def check_used_away(text: str, c: str, lost: int | None, gt: str | None, scene, raw, out, bad) -> None:
+    """ "it had used detections 2 m or more from the object at frames x (mN[, p P | Q % of its weight]), …": the
+    lost track's update at x used mN (the frame's ``Assignment``, its ``Marginals`` row, or its share of the
+    ``UpdateWeights``), with the share said where the update is soft (else ``misleading``), and mN lies 2 m or more
+    from the object's annotation in the files."""
+    if lost is None or gt is None or scene is None:
+        return
+    for m in USED_AWAY.finditer(text):
+        for item in USED_ITEM.finditer(m[1]):
+            x, meas = int(item[1]), int(item[2])
+            out.checked["tracker"] += 1
+            share, soft = _share(raw, x, c, lost, meas)
+            a = scene.objects[x].get(gt) if x < len(scene.objects) else None
+            d = scene.detections[x][meas] if x < len(scene.detections) and meas < len(scene.detections[x]) else None
+            far = a is not None and d is not None and math.hypot(d.xy_m[0] - a.xy_m[0], d.xy_m[1] - a.xy_m[1]) >= 2.0
+            if not share or not far:
+                bad("tracker", item[0], f"track {lost}'s share of m{meas} at frame {x}: {share}; 2 m or more: {far}")
+                continue
+            out.checked["misleading"] += 1
+            if item[3]:
+                stated = f"{share:.2f}" == item[3]
+            elif item[4]:
+                stated = f"{100 * share:.0f}" == item[4]
+            else:  # unsaid: right for an assignment only
+                stated = not soft
+            if not stated:
+                bad("misleading", item[0], f"its share of m{meas} was {share:.3f} ({'soft' if soft else 'assigned'})")
+
+
+def _share(raw, x: int, c: str, track: int, meas: int) -> tuple[float, bool]:
+    """(the track's share of detection ``meas`` in frame x's update, whether the update is soft): 1 for an assigned
+    pair, its ``Marginals`` probability, or its ``UpdateWeights`` share of its own weight; 0: not used."""
+    for e in raw.of_kind(x, c, UpdateWeights):
+        labels, refs = np.asarray(e.labels).tolist(), np.asarray(e.meas_indices).tolist()
+        if track in labels and meas in refs:
+            i = labels.index(track)
+            total = float(e.missed[i] + np.asarray(e.detected)[i].sum())
+            return (float(e.detected[i, refs.index(meas)]) / total if total > 0 else 0.0), True
+    for e in raw.of_kind(x, c, Marginals):
+        rows = [int(r.ref) for r in e.rows]
+        cols = [k for k, col in enumerate(e.cols) if col.kind is AxisKind.MEASUREMENT and col.ref == meas]
+        if track in rows and cols:
+            return float(np.asarray(e.probs)[rows.index(track), cols[0]]), True
+    pairs = {
+        (int(r.ref), int(col.ref))
+        for e in raw.of_kind(x, c, Assignment)
+        for r, col in e.pairs
+        if col.kind is AxisKind.TRACK
+    }
+    return (1.0 if (meas, track) in pairs else 0.0), False

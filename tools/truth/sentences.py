@@ -275,6 +275,7 @@ def check_text(
         _check_choice(m, c, raw, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
     lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
+    lost.check_used_away(text, c, ctx.lost, ctx.gt_id, scene, raw, out, bad)
     lost.check_gates(text, c, raw, out, bad)
     lost.check_stayed_below(text, c, raw, ev, out, bad)
     costs.check_costs(text, c, raw, scene, out, bad)

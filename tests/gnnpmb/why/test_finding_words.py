@@ -97,6 +97,13 @@ def test_a_lost_track_output_away_from_its_object_is_traced_to_the_detections_th
         "at frame 11 track 25 was output 5.4 m from GT bf3d85, on m0: beyond the evaluation's 2 m, so it no longer "
         "matched the object; it had used detections 2 m or more from the object at frame 10 (m0)" in line
     )
+    # independent audit r42, dev set scene-1100 centerpoint cphd fragmentation:1: "it had used detections 2 m or
+    # more from the object at frame 5 (m5)", 24 % of its weight (72 % from m11, 0.9 m from the object): the share
+    # of a soft update is said
+    soft = TrackStep(5, 1.0, (0.0, 0.0), (), Use(((11, 0.72), (5, 0.24)), 0.04, UseMode.WEIGHTS), None, 1.0, None)
+    lost = LostTrack(9, 6, (soft,), OffObject(3.8, 8, ((5, 5),)), None, None)
+    line = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=7, mode=UseMode.WEIGHTS.value))[0]
+    assert "it had used detections 2 m or more from the object at frame 5 (m5, 24 % of its weight)" in line
 
 
 def test_a_soft_update_is_told_in_its_own_terms_never_as_no_detection() -> None:
