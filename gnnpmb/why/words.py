@@ -1174,7 +1174,7 @@ def _others(f: Finding) -> list[str]:
                 f"{who} did not match the object here: {_its_tracks(counted)} output on the object and counted, "
                 f"but the evaluation matched {elsewhere}"
             )
-        elif counted and o.matched is not None:  # matched to a track of its off the annotation (an interpolation)
+        elif o.matched is not None:  # matched to a track of its off the annotation, or to a box the devkit interpolated
             out.append(f"{who} did not fail here: the evaluation matched the object to its track {o.matched}")
         elif o.missed:  # its evaluation counted a miss there: it lost the object too
             out.append(f"{who} had no counted track on the object here either")

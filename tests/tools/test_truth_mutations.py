@@ -1001,3 +1001,14 @@ def test_a_far_detection_the_lost_track_used_is_checked_and_its_soft_share_must_
     assert kinds(head + "(m0)") == ["misleading"]
     assert kinds(head + "(m0, 72 % of its weight)") == ["misleading"]
     assert kinds(head + "(m1, 72 % of its weight)") == ["tracker"]  # 0.9 m from the object
+
+
+def test_another_run_said_not_to_have_the_failure_where_its_evaluation_matched_the_object_is_caught() -> None:
+    # independent audit r42, dev set scene-1094 pointpillars cbmot fragmentation:2 (greedy's evaluation matched the
+    # object to a box it interpolated for its track 50)
+    other = _eval()  # GT A matched to its track 7 at frame 3
+    ctx = Context(C, 3, GT_A, kind="fragmentation")
+    vague = "pmbm on the same detections did not have this failure"
+    assert [c.kind for c in check_text(vague, ctx, None, _eval(), others={"pmbm": other}).found] == ["misleading"]
+    named = "pmbm on the same detections did not fail here: the evaluation matched the object to its track 7"
+    assert check_text(named, ctx, None, _eval(), others={"pmbm": other}).found == []

@@ -12,7 +12,8 @@ no object)" and "did not fail here: the evaluation matched the object to its tra
 run's matches. "Did not have this failure" said of a run that had no track matched to the object at x is the
 issue's class 4: that run lost the object too; "did not fail here" / "did not have this failure" of a run whose
 devkit events have a SWITCH of the object at x is false ("switched the object's track here instead" is checked
-against those events and the track matched).
+against those events and the track matched); "did not have this failure" of a run whose evaluation matched the
+object at x (a box it interpolated for a track not output there included) misleads: the track is named instead.
 """
 
 from __future__ import annotations
@@ -100,6 +101,9 @@ def check_others(
             elif matched is None and kind in LOST_KINDS:
                 out.checked["misleading"] += 1
                 bad("misleading", m[0], f"{m[1]} had no track matched to the object at frame {x}: it lost it too")
+            elif matched is not None and kind != "false_track":  # the evaluation kept the object: say with which track
+                out.checked["misleading"] += 1
+                bad("misleading", m[0], f"{m[1]}'s evaluation matched the object at frame {x} to its track {matched}")
 
 
 def _near(ev: EvalFacts, c: str, x: int, gt: str, scene) -> set[str]:

@@ -439,3 +439,16 @@ def test_another_run_that_switched_the_objects_track_here_is_not_said_not_to_fai
         "ab3dmot on the same detections switched the object's track here instead: the evaluation matched the object "
         "to its track 241" in line
     )
+
+
+def test_another_run_matched_at_a_box_it_did_not_output_names_the_track_the_evaluation_matched() -> None:
+    # independent audit r42, dev set scene-1094 pointpillars cbmot fragmentation:2: "greedy on the same detections did
+    # not have this failure", where greedy's evaluation matched the object to a box it interpolated for its track 50
+    # (not output there): the track is named, as the evaluation matched it
+    from gnnpmb.why.findings import OtherRun
+
+    lost = LostTrack(89, 5, (), None, None, None)
+    (line, _) = why_lines(
+        finding(FailureKind.FRAGMENTATION, lost, frame=6, others=(OtherRun("greedy", False, (), matched=50),))
+    )
+    assert "greedy on the same detections did not fail here: the evaluation matched the object to its track 50" in line
