@@ -319,9 +319,10 @@ def _used_cell(s: TrackStep) -> str:
 
 
 def _steps_markdown(view: TrackerView, class_name: str, track_ids: list[int], frames: range) -> list[str]:
-    """Per involved track, a table of its frames: existence before the update (and, when it differs, in the PMBM
-    hypothesis its detection was decided in) and after it (trackers with existences), the detections in its gate
-    with their NIS (trackers with gates), the ones its update used, and whether it was output."""
+    """Per involved track, a table of its frames: existence (a PHD label's weight) before the update (and, when it
+    differs, in the PMBM hypothesis its detection was decided in) and after it (trackers with existences), the
+    detections in its gate with their NIS (trackers with gates), the ones its update used, and whether it was
+    output."""
     out: list[str] = []
     facts = view.facts
     for t in track_ids:
@@ -335,9 +336,10 @@ def _steps_markdown(view: TrackerView, class_name: str, track_ids: list[int], fr
             out += ["| frame | used | output |", "|---|---|---|"]
         elif not facts.has_existence:
             out += ["| frame | in gate (NIS) | used | output |", "|---|---|---|---|"]
-        else:
+        else:  # a GM-PHD / CPHD label's heaviest component's weight (may exceed 1), else an existence
+            r = "weight" if facts.mode(class_name, frames) is UseMode.WEIGHTS else "r"
             out += [
-                "| frame | r before update | in gate (NIS) | used | r after | output |",
+                f"| frame | {r} before update | in gate (NIS) | used | {r} after | output |",
                 "|---|---|---|---|---|---|",
             ]
         for s in steps:

@@ -45,6 +45,7 @@ CLAIM_KINDS = (
     "false at",  # (track, frames): the evaluation counted it a false track at these frames
     "other failed",  # (tracker, kind, gt, place xy, failed): at the object (or, without one, the place)
     "other matched",  # (tracker, gt, track): that run's evaluation matched the object to this track (None: none)
+    "other switched",  # (tracker, gt, switched): that run's evaluation switched the object's track at this frame
     "blame",  # (rule, frames): the stated test held at each frame
     "deciding",  # (track, gt, frames): the frames after the track was last output on the object, up to the failure
     "matched away",  # (track, gt, since, ((other gt, frames), ...)): the evaluation last matched the object before
@@ -170,6 +171,7 @@ def claims(f: Finding) -> list[Claim]:
         add("other failed", f.frame, other.tracker, f.kind.value, f.gt_id, other.place_xy_m, other.failed_same)
         if f.gt_id is not None:
             add("other matched", f.frame, other.tracker, f.gt_id, other.matched)
+            add("other switched", f.frame, other.tracker, f.gt_id, other.switched)
     for frame, track, on in f.boxes_on:
         add("output on", frame, track, on.meas, on.how.value, on.distance_m)
     for b in f.blame:

@@ -19,7 +19,8 @@ Facts are about the events as emitted: nothing here re-runs tracker math.
 from __future__ import annotations
 
 import enum
-from collections.abc import Iterable, Mapping
+import math
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -50,6 +51,7 @@ from gnnpmb.events import (
     UpdateWeights,
 )
 from gnnpmb.explain import Decisions, explain
+from gnnpmb.foreign import NEAREST_M
 from gnnpmb.types import TrackEstimate
 
 USED_SHARE = 0.01
@@ -417,8 +419,8 @@ class TrackerFacts:
         if cf is None:
             return None
         prior_r = xy = None
-        if cf.predicted is not None:
-            row = _row_of(cf.predicted.track_ids, t)
+        if cf.predicted is not None:  # a GM-PHD / CPHD label has a row per component: its heaviest one
+            row = _heaviest_row(cf.predicted.track_ids, cf.predicted.existence, t)
             if row is not None:
                 prior_r = float(cf.predicted.existence[row])
                 xy = (float(cf.predicted.mean[row, 0]), float(cf.predicted.mean[row, 1]))
@@ -498,6 +500,12 @@ def _row_of(ids: np.ndarray, t: int) -> int | None:
     return int(hit[0]) if hit.size else None
 
 
+def _heaviest_row(ids: np.ndarray, weights: np.ndarray, t: int) -> int | None:
+    """The row of ``t`` with the largest weight (a track's only row; a PHD label's heaviest component)."""
+    hit = np.flatnonzero(np.asarray(ids) == t)
+    return int(hit[np.argmax(np.asarray(weights)[hit])]) if hit.size else None
+
+
 def _ending(cf: ClassFrame, t: int) -> TrackEnd | None:
     """How track ``t`` ended in this frame's events, None if it did not."""
     for p in cf.pruned:
@@ -552,7 +560,8 @@ def frame_use(cf: ClassFrame) -> FrameUse | None:
 def output_use(cf: ClassFrame) -> FrameUse | None:
     """An output-only run (``UseMode.OUTPUT``): each output track "used" the detection its box sits on
     (``TrackEstimate.meas_index``; share 1, none: missed 1); a detection went to the track whose box sits on it
-    (the lowest id when several do), else under no output box."""
+    (the lowest id when several do), else under no output box: ``track_id`` then names the nearest box of the
+    class within ``foreign.NEAREST_M`` of it (a box that sat on another detection), -1 for none."""
     if cf.extracted is None:
         return None
     tracks: dict[int, Use] = {}
@@ -563,9 +572,18 @@ def output_use(cf: ClassFrame) -> FrameUse | None:
         if on:
             destinations.setdefault(e.meas_index, Destination(e.meas_index, Went.TRACK, e.track_id))
     received = np.asarray(cf.meas.meas_indices).tolist() if cf.meas is not None else []
-    for m in received:
-        destinations.setdefault(m, Destination(m, Went.NO_OUTPUT))
+    boxes = sorted(cf.extracted.estimates, key=lambda e: e.track_id)
+    for j, m in enumerate(received):
+        if m not in destinations:
+            destinations[m] = Destination(m, Went.NO_OUTPUT, _box_beside(boxes, np.asarray(cf.meas.xyz_m)[j, :2]))
     return FrameUse(UseMode.OUTPUT, tracks, destinations)
+
+
+def _box_beside(boxes: Sequence[TrackEstimate], xy_m: np.ndarray) -> int:
+    """The track whose box centre lies nearest ``xy_m`` (2,), BEV, within ``foreign.NEAREST_M``; -1: none."""
+    near = [(math.dist(e.translation_m[:2], xy_m), e.track_id) for e in boxes]
+    near = [x for x in near if x[0] < NEAREST_M]
+    return min(near)[1] if near else -1
 
 
 def _new(m: int, born: Mapping[int, int], share: float = 1.0) -> Destination:

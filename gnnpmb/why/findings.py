@@ -354,7 +354,8 @@ class OtherRun:
     near the annotated box: the evaluation may have scored an interpolated box elsewhere); matched: the track its
     evaluation matched the object to there (None: none), and each of ``on_it`` carries its own matches
     (``OnObject.evaluated``), so a track on the object that the evaluation matched elsewhere is not said to have
-    kept it."""
+    kept it; switched: its evaluation switched the object's track at that frame (an ID switch or identity theft, a
+    failure of another kind than a fragmentation's, a miss's or a coalescence's), so it is not said not to fail."""
 
     tracker: str
     failed_same: bool
@@ -363,6 +364,7 @@ class OtherRun:
     output_only: bool = False
     missed: bool = False
     matched: int | None = None
+    switched: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -24,7 +24,7 @@ from gnnpmb.foreign import BoxOn
 from gnnpmb.pipeline import FrameResult, TrackingRun
 from gnnpmb.types import TrackEstimate
 from gnnpmb.why.counterfactual import would_take
-from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode
+from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode, Went
 from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
     FRAMES_BEFORE,
@@ -669,7 +669,7 @@ class _Context:
         elif own is not None:
             on_ids = {o.track_id for o in s.on_it}
             went = s.went
-            if went is None or went.track_id < 0:
+            if went is None or went.track_id < 0 or went.went is Went.NO_OUTPUT:  # NO_OUTPUT: a box beside it
                 out.append(Blame(Rule.DETECTION_UNUSED, f))
             elif went.track_id not in on_ids:
                 out.append(Blame(Rule.NOT_OUTPUT, f))
@@ -681,7 +681,11 @@ class _Context:
         if s is not None:
             uncovered = self.blame_uncovered(s)
             blame += uncovered
-            if s.went is not None and s.went.track_id == int(self.failure.track_ids[0]):
+            if (
+                s.went is not None
+                and s.went.went is not Went.NO_OUTPUT
+                and s.went.track_id == int(self.failure.track_ids[0])
+            ):
                 blame.append(Blame(Rule.COVERED_TWO, (self.f,)))
         t = int(self.failure.track_ids[0])
         ev = self.report.track_evals.get(str(t))
@@ -751,7 +755,11 @@ class _Context:
                 ),
                 None,
             )
-            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed, matched))
+            switched = gt_id is not None and any(
+                f.kind in SWITCHES and f.frame_index == self.f and _same_place(f, gt_id, xy, self.class_name)
+                for f in ev.report.failures
+            )
+            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed, matched, switched))
         return tuple(out)
 
 
@@ -784,10 +792,9 @@ def key_decisions(
     return _Context(evidence, scene, frames.stop - 1, class_name, frames.start).key_decisions(involved)
 
 
-SAME_FAILURE = {
-    FailureKind.ID_SWITCH: {FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT},
-    FailureKind.IDENTITY_THEFT: {FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT},
-}
+SWITCHES = frozenset({FailureKind.ID_SWITCH, FailureKind.IDENTITY_THEFT})
+"""The devkit's SWITCH of an object: an ID switch, or a theft (a switch whose new track had been false)."""
+SAME_FAILURE = {FailureKind.ID_SWITCH: SWITCHES, FailureKind.IDENTITY_THEFT: SWITCHES}
 """Kinds that are one failure for another run: both are the devkit's SWITCH of the object (a theft is a switch whose
 new track had been false), so a run with either did not 'not fail here'."""
 

@@ -93,6 +93,16 @@ class Storyteller:
         def say(kind: StoryKind, level: str, ids: tuple[int, ...], text: str) -> None:
             lines.append(StoryLine(frame, class_name, kind, level, ids, text))
 
+        r = "w" if cf.intensity is not None else "r"  # the symbol: a GM-PHD / CPHD label's weight, else an existence
+        posterior_r: dict[int, float] = {}
+        if cf.posterior is not None:  # a GM-PHD / CPHD label has a row per component: its heaviest one's weight
+            ids, rs = np.asarray(cf.posterior.track_ids).tolist(), np.asarray(cf.posterior.existence).tolist()
+            for t, value in zip(ids, rs, strict=True):
+                posterior_r[t] = max(value, posterior_r.get(t, value))
+        if cf.intensity is not None:  # uncapped (the Posterior and the estimates hold min(w, 1))
+            ids, ws = np.asarray(cf.intensity.labels).tolist(), np.asarray(cf.intensity.weights).tolist()
+            for t, value in zip(ids, ws, strict=True):
+                posterior_r[t] = max(value, posterior_r.get(t, value))
         extracted = cf.extracted.estimates if cf.extracted is not None else ()
         now = {e.track_id: e for e in extracted if e.existence >= self.show_min}
         known = self.shown_ever
@@ -100,6 +110,7 @@ class Storyteller:
         output_only = self.facts.output_only
         for t, e in now.items():
             via = f"from {meas_name(e.meas_index)}" if e.meas_index >= 0 else "without a detection"
+            weight = posterior_r.get(t, e.existence) if cf.intensity is not None else e.existence
             if output_only:  # a results file: only where its boxes were is known
                 if t not in known:
                     on = f"on {meas_name(e.meas_index)}" if e.meas_index >= 0 else "on no detection"
@@ -115,30 +126,21 @@ class Storyteller:
                         f": the best hypothesis now descends from prior hypothesis {hyp.best_parent}, in which it "
                         f"has existed since frame {since}"
                     )
-                say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} confirmed ({self._r(e.existence)}{via}){why}")
+                say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} confirmed ({self._r(weight, r)}{via}){why}")
             elif e.meas_index < 0:
                 say(
                     StoryKind.MISSED,
                     "INFO",
                     (t,),
-                    f"track {t} missed this frame, still reported{self._r_in(e.existence)}",
+                    f"track {t} missed this frame, still reported{self._r_in(weight, r)}",
                 )
-        posterior_r: dict[int, float] = {}
-        if cf.posterior is not None:
-            posterior_r = dict(
-                zip(
-                    np.asarray(cf.posterior.track_ids).tolist(),
-                    np.asarray(cf.posterior.existence).tolist(),
-                    strict=True,
-                )
-            )
         for t in sorted((self.involved & set(posterior_r)) - known - set(now)):
             step = self.facts.steps(t, class_name).get(frame)
             if step is None:
                 continue
             via = f"started by {meas_name(step.born_from)}" if step.born_from is not None else use_text(step)
             text = (
-                f"track {t} (not shown, r < {self.show_min:g}): {via}, r={existence_text(posterior_r[t])}"
+                f"track {t} (not shown, {r} < {self.show_min:g}): {via}, {r}={existence_text(posterior_r[t])}"
                 if self.has_existence
                 else f"track {t} (not output): {via}"
             )
@@ -151,7 +153,7 @@ class Storyteller:
                 say(StoryKind.NO_LONGER_SHOWN, "WARN", (t,), f"track {t} no longer output")
             elif t in posterior_r:
                 text = (
-                    f"track {t} no longer shown (r={posterior_r[t]:.2f} fell below {limit:.2f})"
+                    f"track {t} no longer shown ({r}={posterior_r[t]:.2f} fell below {limit:.2f})"
                     if self.has_existence
                     else f"track {t} no longer shown (not output this frame)"
                 )
@@ -159,7 +161,7 @@ class Storyteller:
         candidates_pruned = 0
         for p in cf.pruned:
             if p.track_id in known:
-                last = f" (last r={p.last_existence:.3g})" if self.has_existence else ""
+                last = f" (last {r}={p.last_existence:.3g})" if self.has_existence else ""
                 say(StoryKind.ENDED, "WARN", (p.track_id,), f"track {p.track_id} ended: {p.reason.value}{last}")
             else:
                 candidates_pruned += 1
@@ -253,8 +255,8 @@ class Storyteller:
                 )
         return out
 
-    def _r(self, existence: float) -> str:
-        return f"r={existence:.2f}, " if self.has_existence else ""
+    def _r(self, existence: float, symbol: str = "r") -> str:
+        return f"{symbol}={existence:.2f}, " if self.has_existence else ""
 
-    def _r_in(self, existence: float) -> str:
-        return f" (r={existence:.2f})" if self.has_existence else ""
+    def _r_in(self, existence: float, symbol: str = "r") -> str:
+        return f" ({symbol}={existence:.2f})" if self.has_existence else ""

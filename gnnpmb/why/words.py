@@ -299,6 +299,8 @@ def destination_name(d: Destination | None, mode: UseMode) -> str:
     (started no track: a candidate or clutter)``, ``not received (dropped by preprocessing)``; for a run known by its
     output only, the box on it: ``under track 26's box``, ``under no output box``."""
     if mode is UseMode.OUTPUT:
+        if d is not None and d.went is Went.NO_OUTPUT and d.track_id >= 0:  # beside a box placed on another one
+            return f"under track {d.track_id}'s box, which sat on another detection"
         if d is None or d.went is not Went.TRACK:
             return "under no output box"
         return f"under track {d.track_id}'s box"
@@ -810,7 +812,7 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
     on = f", on {meas_name(off.meas)}" if off.meas >= 0 else ""
     before = ""
     if off.earlier:
-        away = ", ".join(f"{x} ({meas_name(m)})" for x, m in off.earlier)
+        away = ", ".join(f"{x} ({meas_name(m)}{_share_of(lost, x, m, UseMode(f.mode))})" for x, m in off.earlier)
         verb = "its box had sat on" if f.output_only else "it had used"
         before = (
             f"; {verb} detections {NEAR_M:.0f} m or more from the object at frame"
@@ -821,6 +823,15 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
         f"{short_id(f.gt_id or '')}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the "
         f"object{before}"
     )
+
+
+def _share_of(lost: LostTrack, frame: int, meas: int, mode: UseMode) -> str:
+    """``, 24 % of its weight`` / ``, p 0.24``: the share of a soft update the lost track took from ``meas`` at
+    ``frame`` (a minor share reads as the detection that led it off otherwise); nothing for an assignment."""
+    step = lost.step(frame)
+    share = next((v for m, v in step.use.shares if m == meas), None) if step and step.use else None
+    extra = share_text(share, mode) if share is not None else ""
+    return f", {extra}" if extra else ""
 
 
 def averaged_text(ev: TrackEval) -> str:
@@ -849,8 +860,8 @@ def _counted_unshown(f: Finding, lost: LostTrack) -> list[str]:
     else:
         versus = f"is above the {f.class_name} threshold {threshold:.3f}"
     return [
-        f"track {lost.track_id}'s existence stayed below {SHOW_MIN_EXISTENCE:g} (the views draw tracks from "
-        f"{SHOW_MIN_EXISTENCE:g} up), yet the evaluation counted it: {averaged_text(ev)}, {versus}"
+        f"track {lost.track_id}'s {_existence_word(UseMode(f.mode))} stayed below {SHOW_MIN_EXISTENCE:g} (the views "
+        f"draw tracks from {SHOW_MIN_EXISTENCE:g} up), yet the evaluation counted it: {averaged_text(ev)}, {versus}"
     ]
 
 
@@ -1008,6 +1019,20 @@ def _out_of_reach_on_it(f: Finding, s: Sighting) -> list[str]:
     ]
 
 
+def _went_unshown(s: Sighting) -> list[str]:
+    """``track 41 was not output on it``: the track the object's detection went to (or started) was not among
+    those output on the object, said wherever the detection's destination is (a box tracker's tentative track,
+    a PHD label below extraction), lest "started new track 41" read as the object being covered."""
+    went = s.went
+    if (
+        went is not None
+        and went.went in (Went.TRACK, Went.NEW_TRACK)
+        and went.track_id not in {o.track_id for o in s.on_it}
+    ):
+        return [f"track {went.track_id} was not output on it"]
+    return []
+
+
 def _miss(f: Finding) -> list[str]:
     s = f.sighting(f.frame)
     if s is None or f.gt_id is None:
@@ -1046,8 +1071,7 @@ def _miss(f: Finding) -> list[str]:
             f"at frame {f.frame} detection {meas_name(n.meas)} (score {n.score:.2f}) lay {n.distance_m:.1f} m from "
             f"{name} and {went_phrase(s.went, mode)}"
         )
-        if s.went is not None and s.went.track_id >= 0 and s.went.track_id not in {o.track_id for o in s.on_it}:
-            parts.append(f"track {s.went.track_id} was not output on it")
+        parts += _went_unshown(s)
     parts += _not_counted_on_it(f, s)
     if s.nearest_own is not None and not s.on_it:
         parts.append(f"no {f.class_name} track was output within {NEAR_M:.0f} m of it")
@@ -1106,6 +1130,7 @@ def _coalescence(f: Finding) -> list[str]:
             f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) "
             f"{went_phrase(s.went, mode)}"
         )
+        parts += _went_unshown(s)
     elif s.nearest_any.class_name != f.class_name:
         n = s.nearest_any
         parts.append(
@@ -1134,6 +1159,9 @@ def _others(f: Finding) -> list[str]:
             out.append(f"{who} {same}")
         elif o.failed_same:
             out.append(f"{who} failed here too")
+        elif o.switched:  # a failure of another kind on the object: not "did not fail"
+            took = f": the evaluation matched the object to its track {o.matched}" if o.matched is not None else ""
+            out.append(f"{who} switched the object's track here instead{took}")
         elif counted and o.matched in {x.track_id for x in counted}:
             out.append(f"{who} did not fail here: {_its_tracks(counted)} output on the object and counted")
         elif counted and o.missed:  # on the annotation, but the evaluation matched them elsewhere or to nothing
@@ -1146,7 +1174,7 @@ def _others(f: Finding) -> list[str]:
                 f"{who} did not match the object here: {_its_tracks(counted)} output on the object and counted, "
                 f"but the evaluation matched {elsewhere}"
             )
-        elif counted and o.matched is not None:  # matched to a track of its off the annotation (an interpolation)
+        elif o.matched is not None:  # matched to a track of its off the annotation, or to a box the devkit interpolated
             out.append(f"{who} did not fail here: the evaluation matched the object to its track {o.matched}")
         elif o.missed:  # its evaluation counted a miss there: it lost the object too
             out.append(f"{who} had no counted track on the object here either")

@@ -838,3 +838,177 @@ def test_another_run_whose_coalescence_matched_the_object_is_not_said_to_fail_on
     assert [c.kind for c in check_text(said, ctx, None, ev, others={"pmbm": other}).found] == ["other run"]
     other.gt_to_track[(C, 3)] = {GT_A: "7", GT_B: None}  # now it matched GT A and missed the finding's object
     assert check_text(said, ctx, None, ev, others={"pmbm": other}).found == []
+
+
+def test_a_track_the_objects_detection_started_left_unsaid_off_the_object_is_caught() -> None:
+    # independent audit r42, dev set scene-0553 megvii ab3dmot coalescence at frame 12: "its detection m4 (score
+    # 0.74, 0.1 m away) started new track 148", a tentative track never output, read as covering the object
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 0)}])
+    ev = _eval()
+    ev.boxes[3] = [("150", C, (0.0, 0.5))]
+    ctx = Context(C, 3, GT_A, kind="coalescence")
+
+    def misleading(text: str) -> list[str]:  # the scene has no detections: the detector's checks object apart
+        return [c.truth for c in check_text(text, ctx, None, ev, scene=scene).found if c.kind == "misleading"]
+
+    for said in (
+        "its detection m4 (score 0.74, 0.1 m away) started new track 148",
+        "at frame 3 detection m4 (score 0.74) lay 0.1 m from car GT aaaaaa and went to track 148",
+    ):
+        assert misleading(said) == ["track 148 has no box within 2 m of the object at frame 3, unsaid"], said
+        assert misleading(f"{said}; track 148 was not output on it") == []
+    on_it = "its detection m4 (score 0.74, 0.1 m away) went to track 150"
+    assert misleading(on_it) == []
+
+
+def test_a_results_files_detection_said_under_no_box_beside_one_on_another_detection_is_caught() -> None:
+    # independent audit r42, dev set scene-1094 pointpillars (cbmot's output as a results file): "detection m14
+    # (score 0.29) lay 0.7 m from pedestrian GT 9a6fb4 and lay under no output box", 0.02 m from track 358's box
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    box = (1.8, 4.5, 1.6, 1.0, 0.0, 0.0, 0.0, 0.9)
+    other = (1.7, 4.2, 1.5, 1.0, 0.0, 0.0, 0.0, 0.5)
+    dets = [Detection(C, 0.9, (0.3, 0.0), box), Detection(C, 0.5, (0.32, 0.0), other)]
+    scene = SceneTruth([dets] * 4, [{GT_A: Annotation(C, (0.0, 0.0), 9)}] * 4)
+    ev = _eval()
+    ev.boxes[3] = [("11", C, (0.3, 0.0))]
+    ev.geometry = {(3, "11"): box}
+    ev.submitted = {3: {"11"}}
+    ctx = Context(C, 3, GT_A, kind="miss")
+    miss = "at frame 3 detection m1 (score 0.50) lay 0.3 m from car GT aaaaaa and lay under "
+    coalesced = "its detection m1 (score 0.50, 0.3 m away) lay under "
+    for head in (miss, coalesced, "at frame 3 m1 (score 0.50, 0.3 m from it) lay under "):
+        true, false = head + "track 11's box, which sat on another detection", head + "no output box"
+        assert check_text(true, ctx, None, ev, scene=scene).found == [], true
+        assert [c.kind for c in check_text(false, ctx, None, ev, scene=scene).found] == ["output"], false
+    ev.boxes[3] = [("11", C, (0.3, 0.6))]  # 0.6 m away: no box beside it
+    assert check_text(miss + "no output box", ctx, None, ev, scene=scene).found == []
+
+
+def test_an_unshown_phd_labels_existence_is_caught_as_misleading_and_its_weight_passes() -> None:
+    # independent audit r42, dev set scene-0061 centerpoint cphd fragmentation:3: "track 38's existence stayed below
+    # 0.5" of a CPHD label (its heaviest component's weight, 0.30, was what the line called "its weight")
+    from gnnpmb.events import IntensityWeights
+
+    ev = _eval()
+    ev.submitted = {1: {"38"}, 2: set()}
+    raw = _frames({1: [IntensityWeights(C, np.array([38, 38]), np.array([0.30, 0.25]))]})
+    ctx = Context(C, 2, GT_A, lost=38)
+    said = "track 38's {} stayed below 0.5 (the views draw tracks from 0.5 up), yet the evaluation counted it"
+    assert check_text(said.format("weight"), ctx, raw, ev).found == []
+    assert [c.kind for c in check_text(said.format("existence"), ctx, raw, ev).found] == ["misleading"]
+    posterior = _frames({1: [_posterior(38, 0.3)]})
+    assert [c.kind for c in check_text(said.format("weight"), ctx, posterior, ev).found] == ["misleading"]
+
+
+def test_a_focus_documents_story_line_with_a_wrong_value_or_symbol_is_caught() -> None:
+    # independent audit r42, dev set scene-0061 centerpoint cphd id_switch:1: "frame 2: track 18 no longer shown
+    # (r=0.02 fell below 0.50)" of a CPHD label whose heaviest component weighed 0.22
+    from gnnpmb.events import IntensityWeights
+    from tools.truth.lost import check_story
+    from tools.truth.sentences import Tally
+
+    phd = _frames({2: [IntensityWeights(C, np.array([18, 18, 18]), np.array([0.22, 0.211, 0.024]))]})
+    bernoulli = _frames({2: [_posterior(18, 0.22)]})
+
+    def found(section: str, raw) -> list[str]:
+        out = Tally()
+        check_story(section, C, raw, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    gone = "- frame 2: track 18 no longer shown ({}={} fell below 0.50)\n"
+    hidden = "- frame 2: track 18 (not shown, {0} < 0.5): started by m7, {0}={1}\n"
+    for line in (gone, hidden):
+        assert found(line.format("w", "0.22"), phd) == []
+        assert found(line.format("w", "0.02"), phd) == ["tracker"]
+        assert found(line.format("r", "0.22"), phd) == ["misleading"]
+        assert found(line.format("r", "0.22"), bernoulli) == []
+        assert found(line.format("w", "0.22"), bernoulli) == ["misleading"]
+
+
+def test_another_run_said_not_to_fail_where_its_devkit_switched_the_objects_track_is_caught() -> None:
+    # independent audit r42, dev set scene-0553 megvii prob3dmot fragmentation at frame 23 (ab3dmot's evaluation had a
+    # SWITCH of the object to track 241 there)
+    from tools.truth.scene import Annotation, SceneTruth
+
+    other = _eval()  # GT A matched to the other run's track 7 at frame 3, by a SWITCH
+    other.switches[(C, 3)] = {GT_A}
+    other.boxes[3] = [("7", C, (0.0, 0.3))]
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 9)}])
+    ctx = Context(C, 3, GT_A, kind="fragmentation")
+
+    def kinds(text: str, ev: EvalFacts = other) -> list[str]:
+        return [c.kind for c in check_text(text, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found]
+
+    head = "pmbm on the same detections "
+    assert kinds(head + "did not fail here: its track 7 was output on the object and counted") == ["other run"]
+    assert kinds(head + "did not have this failure") == ["other run"]
+    true = head + "switched the object's track here instead: the evaluation matched the object to its track 7"
+    assert kinds(true) == []
+    assert kinds(true.replace("track 7", "track 8")) == ["other run"]
+    assert kinds(true, _eval()) == ["other run"]  # no SWITCH in its events
+
+
+def test_a_focus_documents_track_table_with_a_wrong_word_or_value_is_caught() -> None:
+    # independent audit r42, dev set scene-0757 centerpoint phd: "r before update" / "r after" 1.10 of a PHD label
+    from gnnpmb.events import IntensityWeights, Predicted
+    from tools.truth.lost import check_track_tables
+    from tools.truth.sentences import Tally
+
+    predicted = Predicted(
+        C, np.array([39, 39]), np.zeros((2, 4)), np.tile(np.eye(4), (2, 1, 1)), np.array([0.03, 0.94])
+    )
+    phd = _frames({16: [predicted, IntensityWeights(C, np.array([39, 39]), np.array([1.10, 0.02]))]})
+
+    def found(word: str, before: str, after: str) -> list[str]:
+        table = "Track 39, frame by frame:\n\n"
+        table += f"| frame | {word} before update | in gate (NIS) | used | {word} after | output |\n"
+        table += (
+            f"|---|---|---|---|---|---|\n| 16 | {before} | m17 (0.2) | m17 (91 % of its weight) | {after} | yes |\n"
+        )
+        out = Tally()
+        check_track_tables(table, C, phd, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    assert found("weight", "0.94", "1.10") == []
+    assert found("r", "0.94", "1.10") == ["misleading"]
+    assert found("weight", "0.03", "1.10") == ["tracker"]
+    assert found("weight", "0.94", "0.02") == ["tracker"]
+
+
+def test_a_far_detection_the_lost_track_used_is_checked_and_its_soft_share_must_be_said() -> None:
+    # independent audit r42, dev set scene-1100 centerpoint cphd fragmentation:1: "it had used detections 2 m or more
+    # from the object at frame 5 (m5)", 24 % of its weight (72 % from m11, 0.9 m from the object)
+    from gnnpmb.events import UpdateWeights
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    box = (1.8, 4.5, 1.6, 1.0, 0.0, 0.0, 0.0, 0.9)
+    dets = [Detection(C, 0.8, (4.1, 0.0), box), Detection(C, 0.5, (0.9, 0.0), box)]
+    scene = SceneTruth([dets] * 6, [{GT_A: Annotation(C, (0.0, 0.0), 9)}] * 6)
+    weights = UpdateWeights(
+        C, np.array([9]), np.array([0, 1]), np.array([1.0]), np.array([0.04]), np.array([[0.24, 0.72]]), np.zeros(2)
+    )
+    raw = _frames({5: [weights]})
+    ctx = Context(C, 5, GT_A, kind="fragmentation", lost=9)
+
+    def kinds(text: str) -> list[str]:
+        return [x.kind for x in check_text(text, ctx, raw, _eval(), scene=scene).found if x.kind != "detector"]
+
+    head = "it had used detections 2 m or more from the object at frame 5 "
+    assert kinds(head + "(m0, 24 % of its weight)") == []
+    assert kinds(head + "(m0)") == ["misleading"]
+    assert kinds(head + "(m0, 72 % of its weight)") == ["misleading"]
+    assert kinds(head + "(m1, 72 % of its weight)") == ["tracker"]  # 0.9 m from the object
+
+
+def test_another_run_said_not_to_have_the_failure_where_its_evaluation_matched_the_object_is_caught() -> None:
+    # independent audit r42, dev set scene-1094 pointpillars cbmot fragmentation:2 (greedy's evaluation matched the
+    # object to a box it interpolated for its track 50)
+    other = _eval()  # GT A matched to its track 7 at frame 3
+    ctx = Context(C, 3, GT_A, kind="fragmentation")
+    vague = "pmbm on the same detections did not have this failure"
+    assert [c.kind for c in check_text(vague, ctx, None, _eval(), others={"pmbm": other}).found] == ["misleading"]
+    named = "pmbm on the same detections did not fail here: the evaluation matched the object to its track 7"
+    assert check_text(named, ctx, None, _eval(), others={"pmbm": other}).found == []

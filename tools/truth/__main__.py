@@ -16,7 +16,7 @@ from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from tools.truth import fields
+from tools.truth import fields, lost
 from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
 
 DEVSET = next(
@@ -124,6 +124,9 @@ def run_scene(
         others = {n: ev_of(n) for n in rest}
         tally = Tally()
         report = reports[tracker]
+        raws = (
+            {n: None if n in results else RawEvents.of(list(runs[n].events)) for n in [tracker, *rest]} if focus else {}
+        )
         for fid, failure in zip(report.ids(), report.failures, strict=True):
             start = max(request.frame_range.start, failure.frame_index - FRAMES_BEFORE)
             f = explain_failure(fid, evidence[tracker], request.scene, [evidence[n] for n in rest], first_frame=start)
@@ -143,7 +146,11 @@ def run_scene(
             sources = fields.Sources(truth, raw, ev, others, keeps[tracker])
             fields.check_fields(f, sources, one, found(one))
             if focus:
-                _check_focus(fid, f, request, {n: reports[n] for n in [tracker, *rest]}, evidence, one)
+                raws = {
+                    n: raw if n == tracker else None if n in results else RawEvents.of(list(runs[n].events))
+                    for n in [tracker, *rest]
+                }
+                _check_focus(fid, f, request, {n: reports[n] for n in [tracker, *rest]}, evidence, one, raws)
             if seen is not None:
                 seen(f, sources)
             tally.add(one)
@@ -152,9 +159,12 @@ def run_scene(
     return out
 
 
-def _check_focus(fid: str, finding, request, reports: Mapping, evidence: Mapping, out: Tally) -> None:
+def _check_focus(
+    fid: str, finding, request, reports: Mapping, evidence: Mapping, out: Tally, raws: Mapping | None = None
+) -> None:
     """The focus document of failure ``fid`` (its summary, as ``gnnpmb-viz --focus`` shows it with the runs of
-    ``reports``) holds no ``?`` placeholder."""
+    ``reports``) holds no ``?`` placeholder, and each run's story lines (``lost.check_story``) hold against that
+    run's raw events (``raws``: by run name, None for a results file)."""
     from gnnpmb.focus import resolve_focus
     from gnnpmb.why.story import Storyteller
     from viz.focus_summary import TrackerView, focus_markdown
@@ -168,6 +178,10 @@ def _check_focus(fid: str, finding, request, reports: Mapping, evidence: Mapping
     estimates = {n: [fr.estimates for fr in evidence[n].run.frames] for n in reports}
     target = resolve_focus(fid, request.scene, reports, estimates, request.frame_range)
     doc = focus_markdown(target, finding, views, target.window(request.frame_range), request.scene)
+    for name, raw in (raws or {}).items():
+        section = doc.split(f"\n## {name}\n", 1)[1].split("\n## ", 1)[0] if f"\n## {name}\n" in doc else ""
+        lost.check_story(section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a)))
+        lost.check_track_tables(section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a)))
     out.checked["misleading"] += 1
     doc = doc.replace("?url=", "")
     if "?" in doc:

@@ -33,7 +33,7 @@ from gnnpmb.events import (
     UpdateWeights,
 )
 from tools.truth.devkit import EvalFacts
-from tools.truth.output import placed
+from tools.truth.output import NEAREST_M, placed
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import NEAR_M, SceneTruth
 
@@ -156,14 +156,20 @@ def used_of(src: Sources, x: int, c: str, track: int) -> tuple[tuple[tuple[int, 
 
 def went_of(src: Sources, x: int, c: str, meas: int) -> tuple[str, int, float] | None:
     """Where detection ``meas`` went at ``x``: (went, track, share) from the raw events; a results file: the
-    lowest-numbered track whose box sits on it, else 'under no output box'."""
+    lowest-numbered track whose box sits on it, else 'under no output box' with the nearest box of its class within
+    ``NEAREST_M`` (one that sat on another detection; -1: none)."""
     if src.output_only:
+        boxes = src.ev.boxes.get(x, [])
         on = sorted(
             int(t)
-            for t, cls, _ in src.ev.boxes.get(x, [])
+            for t, cls, _ in boxes
             if cls == c and (p := placed(x, t, src.scene, src.ev)) is not None and p[0] == meas
         )
-        return ("track", on[0], 1.0) if on else ("under no output box", -1, 1.0)
+        if on:
+            return ("track", on[0], 1.0)
+        d = src.scene.detections[x][meas].xy_m
+        near = sorted((math.hypot(xy[0] - d[0], xy[1] - d[1]), int(t)) for t, cls, xy in boxes if cls == c)
+        return ("under no output box", near[0][1] if near and near[0][0] < NEAREST_M else -1, 1.0)
     born = {
         int(m): int(t)
         for b in src.raw.of_kind(x, c, Born)
@@ -400,6 +406,12 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
                 return ""
             got = other.matched_track(c, x, v[1])
             return "" if got == (None if v[2] is None else str(v[2])) else f"its evaluation matched it to {got}"
+        case "other switched":
+            other = src.others.get(v[0])
+            if other is None:
+                return ""
+            switched = v[1] in other.switches.get((c, x), set())
+            return "" if switched == v[2] else f"its devkit events {'have' if switched else 'have no'} SWITCH of it"
         case "blame":
             return check_blame(v[0], v[1], f, src)
         case "deciding":

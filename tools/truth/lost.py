@@ -41,10 +41,12 @@ from gnnpmb.events import (
     Marginals,
     Merged,
     Posterior,
+    Predicted,
     Pruned,
     PruneReason,
     TrackLogic,
     TrackLogicAction,
+    UpdateWeights,
 )
 from tools.truth.printing import NUMBER, printed
 
@@ -63,9 +65,10 @@ USED = re.compile(
     rf"at frame (\d+) it (used|was given) (m\d+(?: \(p {NUMBER}\))?(?:, m\d+(?: \(p {NUMBER}\))?)?)(?: \+(\d+) more)?"
 )
 GATE = re.compile(r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it, in track (\d+)'s gate at NIS (\d+\.\d)\)")
-STAYED = re.compile(r"track (\d+)'s existence stayed below (\d+(?:\.\d+)?) \(the views draw tracks from")
+STAYED = re.compile(r"track (\d+)'s (existence|weight) stayed below (\d+(?:\.\d+)?) \(the views draw tracks from")
 AVERAGED = re.compile(
-    r"(?:track (\d+)[^;:]*?|the evaluation counted the track: |track (\d+)'s existence stayed below [^;]*?counted it: )"
+    r"(?:track (\d+)[^;:]*?|the evaluation counted the track: |track (\d+)'s (?:existence|weight) stayed below "
+    r"[^;]*?counted it: )"
     r"its score averaged over (?:its (\d+) frames?|the (\d+) "
     r"of its (\d+) frames the evaluation kept \(within the class range\)), (\d+\.\d{3})"
 )
@@ -196,10 +199,15 @@ def check_averaged(text: str, track: int | None, ev, out, bad) -> None:
 
 def check_stayed_below(text: str, c: str, raw, ev, out, bad) -> None:
     """ "track T's existence stayed below E (…)": its ``Posterior`` existence at every frame the submission has its
-    box is below E."""
+    box is below E; "weight" of a GM-PHD / CPHD label (its frames have ``IntensityWeights``), "existence" of any other
+    track (else ``misleading``)."""
     for m in STAYED.finditer(text):
         out.checked["tracker"] += 1
-        t, below = int(m[1]), float(m[2])
+        t, below = int(m[1]), float(m[3])
+        phd = any(raw.of_kind(x, c, IntensityWeights) for x in ev.submitted if str(t) in ev.submitted[x])
+        out.checked["misleading"] += 1
+        if (m[2] == "weight") != phd:
+            bad("misleading", m[0], f"a {'PHD label has a weight' if phd else 'track has an existence'}, not a {m[2]}")
         above = {
             x: v
             for x in sorted(ev.submitted)
@@ -351,3 +359,130 @@ def check_two_tracks(text: str, class_name: str, frame: int, gt_id: str | None, 
         d = math.hypot(box[0] - a.xy_m[0], box[1] - a.xy_m[1])
         if abs(d - distance) > 0.05 + 1e-9 or d >= 2.0:
             bad("output", m[0], f"the submission's box of track {t} lies {d:.2f} m from the annotation")
+
+
+STORY_SHOWN = re.compile(r"frame (\d+): track (\d+) (?:no longer shown \(|confirmed \()([rw])=(\d+\.\d+)")
+STORY_HIDDEN = re.compile(r"frame (\d+): track (\d+) \(not shown, ([rw]) < [\d.]+\): [^\n]*?, [rw]=(\d+(?:\.\d+)?)\n")
+
+
+def check_story(section: str, c: str, raw, out, bad) -> None:
+    """A focus document's story lines of one run (``section``): "track T confirmed (r=V, …)", "track T no longer
+    shown (r=V fell below …)", "track T (not shown, r < …): …, r=V": V is the track's existence after frame x's
+    update (a GM-PHD / CPHD label's heaviest ``IntensityWeights`` component), and the symbol is ``w`` for such a
+    label, ``r`` for an existence (else ``misleading``)."""
+    if raw is None:
+        return
+    found = [(m[0], int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_SHOWN.finditer(section)]
+    found += [(m[0].strip(), int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_HIDDEN.finditer(section + "\n")]
+    for sentence, x, t, symbol, said in found:
+        out.checked["tracker"] += 1
+        got = _existence(raw, x, c, t)
+        if not _reads(got, said):
+            bad("tracker", sentence, f"its existence (heaviest PHD component) after frame {x}: {got}")
+        out.checked["misleading"] += 1
+        if (symbol == "w") != bool(raw.of_kind(x, c, IntensityWeights)):
+            bad(
+                "misleading",
+                sentence,
+                f"'{symbol}=' of a {'PHD label' if symbol == 'r' else 'track with an existence'}",
+            )
+
+
+TRACK_TABLE = re.compile(
+    r"Track (\d+), frame by frame:\n\n\| frame \| (r|weight) before update \| in gate \(NIS\) \| used \| (?:r|weight) "
+    r"after \| output \|\n\|[-|]+\|\n((?:\|.*\|\n)+)"
+)
+
+
+def check_track_tables(section: str, c: str, raw, out, bad) -> None:
+    """A focus document's per-track tables of one run: "r" / "weight" before and after each update against the raw
+    events (the track's ``Predicted`` row, its ``Posterior`` existence; a GM-PHD / CPHD label's heaviest component,
+    predicted and after ``IntensityWeights``), and the word: "weight" for such a label (else ``misleading``)."""
+    if raw is None:
+        return
+    for table in TRACK_TABLE.finditer(section):
+        t, word = int(table[1]), table[2]
+        for row in table[3].strip().splitlines():
+            cells = [x.strip() for x in row.strip("|").split("|")]
+            x, before, after = int(cells[0]), cells[1].split(" ")[0], cells[4]
+            phd = bool(raw.of_kind(x, c, IntensityWeights))
+            out.checked["misleading"] += 1
+            if (word == "weight") != phd:
+                bad("misleading", f"Track {t}: {word} before update", f"{'a PHD label' if phd else 'an existence'}")
+            predicted = [
+                float(w)
+                for e in raw.of_kind(x, c, Predicted)
+                for i, w in zip(np.asarray(e.track_ids).tolist(), np.asarray(e.existence).tolist(), strict=True)
+                if i == t
+            ]
+            for said, got in ((before, max(predicted) if predicted else None), (after, _existence(raw, x, c, t))):
+                if said in ("—", "ended"):
+                    continue
+                out.checked["tracker"] += 1
+                if not _reads(got, said):
+                    bad("tracker", f"Track {t} at frame {x}: {said}", f"the raw events give {got}")
+
+
+def _reads(got: float | None, said: str) -> bool:
+    """Whether ``said`` prints ``got``: as ``printed`` does (one significant digit below 0.01), or with said's own
+    decimals."""
+    if got is None:
+        return False
+    digits = len(said.split(".")[1]) if "." in said and "e" not in said else 0
+    return said == printed(got) or ("e" not in said and f"{got:.{digits}f}" == said)
+
+
+USED_AWAY = re.compile(r"it had used detections 2 m or more from the object at frames? ((?:\d+ \(m\d+[^)]*\)(?:, )?)+)")
+USED_ITEM = re.compile(r"(\d+) \(m(\d+)(?:, (?:p (\d\.\d+)|(\d+) % of its weight))?\)")
+
+
+def check_used_away(text: str, c: str, lost: int | None, gt: str | None, scene, raw, out, bad) -> None:
+    """ "it had used detections 2 m or more from the object at frames x (mN[, p P | Q % of its weight]), …": the
+    lost track's update at x used mN (the frame's ``Assignment``, its ``Marginals`` row, or its share of the
+    ``UpdateWeights``), with the share said where the update is soft (else ``misleading``), and mN lies 2 m or more
+    from the object's annotation in the files."""
+    if lost is None or gt is None or scene is None:
+        return
+    for m in USED_AWAY.finditer(text):
+        for item in USED_ITEM.finditer(m[1]):
+            x, meas = int(item[1]), int(item[2])
+            out.checked["tracker"] += 1
+            share, soft = _share(raw, x, c, lost, meas)
+            a = scene.objects[x].get(gt) if x < len(scene.objects) else None
+            d = scene.detections[x][meas] if x < len(scene.detections) and meas < len(scene.detections[x]) else None
+            far = a is not None and d is not None and math.hypot(d.xy_m[0] - a.xy_m[0], d.xy_m[1] - a.xy_m[1]) >= 2.0
+            if not share or not far:
+                bad("tracker", item[0], f"track {lost}'s share of m{meas} at frame {x}: {share}; 2 m or more: {far}")
+                continue
+            out.checked["misleading"] += 1
+            if item[3]:
+                stated = f"{share:.2f}" == item[3]
+            elif item[4]:
+                stated = f"{100 * share:.0f}" == item[4]
+            else:  # unsaid: right for an assignment only
+                stated = not soft
+            if not stated:
+                bad("misleading", item[0], f"its share of m{meas} was {share:.3f} ({'soft' if soft else 'assigned'})")
+
+
+def _share(raw, x: int, c: str, track: int, meas: int) -> tuple[float, bool]:
+    """(the track's share of detection ``meas`` in frame x's update, whether the update is soft): 1 for an assigned
+    pair, its ``Marginals`` probability, or its ``UpdateWeights`` share of its own weight; 0: not used."""
+    for e in raw.of_kind(x, c, UpdateWeights):
+        labels, refs = np.asarray(e.labels).tolist(), np.asarray(e.meas_indices).tolist()
+        if track in labels and meas in refs:
+            i = labels.index(track)
+            total = float(e.missed[i] + np.asarray(e.detected)[i].sum())
+            return (float(e.detected[i, refs.index(meas)]) / total if total > 0 else 0.0), True
+    for e in raw.of_kind(x, c, Marginals):
+        rows = [int(r.ref) for r in e.rows]
+        cols = [k for k, col in enumerate(e.cols) if col.kind is AxisKind.MEASUREMENT and col.ref == meas]
+        if track in rows and cols:
+            return float(np.asarray(e.probs)[rows.index(track), cols[0]]), True
+    pairs = {
+        (int(r.ref), int(col.ref))
+        for e in raw.of_kind(x, c, Assignment)
+        for r, col in e.pairs
+        if col.kind is AxisKind.TRACK
+    }
+    return (1.0 if (meas, track) in pairs else 0.0), False

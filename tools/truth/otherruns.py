@@ -10,7 +10,10 @@ the other run's submission has T's box within 2 m of the object's annotation at 
 object here: its track T was output on the object and counted, but the evaluation matched track T to C GT X (to
 no object)" and "did not fail here: the evaluation matched the object to its track M" are checked against that
 run's matches. "Did not have this failure" said of a run that had no track matched to the object at x is the
-issue's class 4: that run lost the object too.
+issue's class 4: that run lost the object too; "did not fail here" / "did not have this failure" of a run whose
+devkit events have a SWITCH of the object at x is false ("switched the object's track here instead" is checked
+against those events and the track matched); "did not have this failure" of a run whose evaluation matched the
+object at x (a box it interpolated for a track not output there included) misleads: the track is named instead.
 """
 
 from __future__ import annotations
@@ -24,7 +27,8 @@ from tools.truth.fields import failed_here
 from tools.truth.scene import NEAR_M
 
 OTHER = re.compile(
-    r"(\w+) on the same detections (failed here too|did not have this failure|had no counted track on the object "
+    r"(\w+) on the same detections (failed here too|switched the object's track here instead(?:: the evaluation "
+    r"matched the object to its track (?:\d+))?|did not have this failure|had no counted track on the object "
     r"here either|did not fail here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted"
     r"|did not fail here: the evaluation matched the object to its track (\d+)"
     r"|did not match the object here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted, but the "
@@ -58,6 +62,15 @@ def check_others(
             failed = failed_here(ev, kind, c, x, gt, None) if gt in ev.gt_to_track.get((c, x), {}) else None
         out.checked["other run"] += 1
         said = m[2]
+        switched = gt in ev.switches.get((c, x), set())
+        if said.startswith("switched"):
+            took = re.search(r"its track (\d+)", said)
+            if not switched or (took is not None and matched != took[1]):
+                bad("other run", m[0], f"{m[1]}'s devkit events at frame {x}: SWITCH {switched}, matched {matched}")
+            continue
+        if said.startswith(("did not fail here", "did not have this failure")) and switched:
+            bad("other run", m[0], f"the devkit's events of {m[1]} have a SWITCH of the object at frame {x}")
+            continue
         if said == "failed here too":
             if failed is False:
                 bad("other run", m[0], f"the devkit's events of {m[1]} have no {kind} of the object at frame {x}")
@@ -88,6 +101,9 @@ def check_others(
             elif matched is None and kind in LOST_KINDS:
                 out.checked["misleading"] += 1
                 bad("misleading", m[0], f"{m[1]} had no track matched to the object at frame {x}: it lost it too")
+            elif matched is not None and kind != "false_track":  # the evaluation kept the object: say with which track
+                out.checked["misleading"] += 1
+                bad("misleading", m[0], f"{m[1]}'s evaluation matched the object at frame {x} to its track {matched}")
 
 
 def _near(ev: EvalFacts, c: str, x: int, gt: str, scene) -> set[str]:

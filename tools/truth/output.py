@@ -9,7 +9,10 @@ on none.
   / "…; mN is the nearest C detection, D m from its box (none carries …)" / "was output on no detection (…)";
 * "at frame x it was output on mN" / "… on no detection" (the lost track), "its box had sat on detections 2 m or
   more from the object at frames x (mN), …";
-* "at frame x mN (…) lay under track T's box" (the lowest id of the boxes on mN) / "lay under no output box";
+* "at frame x mN (…) lay under track T's box" (the lowest id of the boxes on mN), "… lay under track T's box, which
+  sat on another detection" (no box on mN; T's the nearest box of the class within ``NEAREST_M``, on another
+  detection) / "lay under no output box" (no box on mN, none of its class within ``NEAREST_M``); the same of a
+  miss's "detection mN … lay D m from C GT H and lay under …" and a coalescence's "its detection mN (…) lay under …";
 * "track T was first output at frame x": the file's first box of T is at x.
 """
 
@@ -30,7 +33,11 @@ ON = re.compile(
 ON_NONE = re.compile(r"at frame (\d+) track (\d+) \((\w+)\) was output on no detection \(none of its class carries")
 IT_ON = re.compile(r"at frame (\d+) it was output on (?:m(\d+)|no detection)")
 SAT_ON = re.compile(r"its box had sat on detections 2 m or more from the object at frames? ((?:\d+ \(m\d+\)(?:, )?)+)")
-UNDER = re.compile(r"at frame (\d+) m(\d+) \([^()]*\) lay under (?:track (\d+)'s box|no output box)")
+UNDER = re.compile(
+    r"(?:at frame (\d+) m(\d+) \([^()]*\)|at frame (\d+) detection m(\d+) \(score [\d.]+\) lay [\d.]+ m from \w+ "
+    r"GT \w+ and|its detection m(\d+) \(score [\d.]+, [\d.]+ m away\)) lay under (?:track (\d+)'s box(, which sat on "
+    r"another detection)?|no output box)"
+)
 FIRST = re.compile(r"track (\d+) was first output at frame (\d+)")
 
 
@@ -52,8 +59,9 @@ def placed(x: int, track: str, scene, ev) -> tuple[int, bool, float] | None:
     return best
 
 
-def check_output(text: str, c: str, lost: int | None, scene, ev, out, bad) -> None:
-    """A results file's sentences (module docstring); ``lost``: the track the Why follows."""
+def check_output(text: str, c: str, lost: int | None, scene, ev, out, bad, frame: int = -1) -> None:
+    """A results file's sentences (module docstring); ``lost``: the track the Why follows; ``frame``: the
+    finding's (a coalescence's "its detection" is of that frame)."""
     if scene is None:
         return
     for m in ON.finditer(text):
@@ -87,12 +95,24 @@ def check_output(text: str, c: str, lost: int | None, scene, ev, out, bad) -> No
                 bad("output", m[0], f"track {lost}'s box at frame {x} sits on {got}")
     for m in UNDER.finditer(text):
         out.checked["output"] += 1
-        x, meas = int(m[1]), int(m[2])
+        x = int(m[1] or m[3] or frame)
+        meas = int(m[2] or m[4] or m[5])
+        said = int(m[6]) if m[6] else None
         on = sorted(
             int(t) for t, cls, _ in ev.boxes.get(x, []) if cls == c and (p := placed(x, t, scene, ev)) and p[0] == meas
         )
-        if (on[0] if on else None) != (int(m[3]) if m[3] else None):
-            bad("output", m[0], f"the boxes on m{meas}: {on}")
+        beside = None
+        if not on and x < len(scene.detections) and meas < len(scene.detections[x]):
+            d = scene.detections[x][meas].xy_m
+            near = sorted(
+                (math.hypot(xy[0] - d[0], xy[1] - d[1]), int(t))
+                for t, cls, xy in ev.boxes.get(x, [])
+                if cls == c and math.hypot(xy[0] - d[0], xy[1] - d[1]) < NEAREST_M
+            )
+            beside = near[0][1] if near else None
+        truth = (on[0], False) if on else (beside, beside is not None)
+        if (said, m[7] is not None) != truth:
+            bad("output", m[0], f"the boxes on m{meas}: {on}; the nearest of its class within {NEAREST_M} m: {beside}")
     for m in FIRST.finditer(text):
         out.checked["output"] += 1
         t, x = m[1], int(m[2])

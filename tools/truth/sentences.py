@@ -151,6 +151,11 @@ STARTED_NEW = re.compile(
     r" →) new track (\d+)"
 )
 STARTED = re.compile(r"track (\d+) had been started at frame (\d+) by m(\d+)")
+# the object's own detection and the track it went to or started (a miss's or a coalescence's)
+WENT_TO = re.compile(
+    r"(?:its detection m\d+ \(score [\d.]+, [\d.]+ m away\)|detection m\d+ \(score [\d.]+\) lay [\d.]+ m from \w+ GT "
+    r"\w+ and) (?:started new track|went to track) (\d+)"
+)
 
 
 def check_text(
@@ -230,7 +235,7 @@ def check_text(
     lost.check_two_tracks(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     lost.check_averaged(text, ctx.track, ev, out, bad)
     if raw is None:  # a results file: where its boxes sit
-        output.check_output(text, c, ctx.lost, scene, ev, out, bad)
+        output.check_output(text, c, ctx.lost, scene, ev, out, bad, ctx.frame)
         return out
     started = [(int(m[2]), int(m[1]), int(m[3]), m[0]) for m in STARTED.finditer(text)]
     started += [(int(m[1]), int(m[3]), int(m[2]), m[0]) for m in STARTED_NEW.finditer(text)]
@@ -270,6 +275,7 @@ def check_text(
         _check_choice(m, c, raw, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
     lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
+    lost.check_used_away(text, c, ctx.lost, ctx.gt_id, scene, raw, out, bad)
     lost.check_gates(text, c, raw, out, bad)
     lost.check_stayed_below(text, c, raw, ev, out, bad)
     costs.check_costs(text, c, raw, scene, out, bad)
@@ -380,6 +386,10 @@ def _check_on_it(text: str, ctx: Context, scene: SceneTruth, ev: EvalFacts, out:
         for t, cls, xy in ev.boxes.get(ctx.frame, [])
         if cls == ctx.class_name and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < 2.0
     }
+    for m in WENT_TO.finditer(text):  # a track not on the object, left unsaid, reads as covering it
+        out.checked["misleading"] += 1
+        if m[1] not in near and f"track {m[1]} was not output on it" not in text:
+            bad("misleading", m[0], f"track {m[1]} has no box within 2 m of the object at frame {ctx.frame}, unsaid")
     for m in ON_IT.finditer(text):
         out.checked["output"] += 1
         if (m[1] in near) == bool(m[2]):

@@ -184,3 +184,92 @@ def test_a_tracker_that_emits_births_names_the_track_a_detection_started() -> No
     ]
     d = facts_of(events).destination(0, "car", 3)
     assert (d.went, d.track_id) == (Went.NEW_TRACK, 17)
+
+
+def test_a_results_files_detection_beside_a_box_that_sat_on_another_is_named_with_that_box() -> None:
+    # independent audit r42, dev set scene-1094 pointpillars, cbmot's output as a results file: "detection m14
+    # (score 0.29) lay 0.7 m from pedestrian GT 9a6fb4 and lay under no output box" of a detection 0.02 m from
+    # track 358's box (which sat on m0)
+    from gnnpmb.events import Extracted, MeasurementsReceived
+    from gnnpmb.why.facts import ClassFrame, output_use
+    from gnnpmb.why.words import went_phrase
+
+    def box(track_id: int, x: float, meas: int) -> TrackEstimate:
+        return TrackEstimate(
+            track_id, "car", (x, 0.0, 0.0), (2.0, 4.0, 1.5), (1.0, 0, 0, 0), (0.0, 0.0), 0.7, 1.0, meas
+        )
+
+    meas = MeasurementsReceived(
+        "car", np.array([0, 14, 3]), np.array([[0.0, 0, 0], [0.02, 0, 0], [9.0, 0, 0]]), np.ones(3)
+    )
+    cf = ClassFrame(meas=meas, extracted=Extracted("car", (box(358, 0.0, 0),), 0.5))
+    use = output_use(cf)
+    assert went_phrase(use.destinations[0], UseMode.OUTPUT) == "lay under track 358's box"
+    assert (
+        went_phrase(use.destinations[14], UseMode.OUTPUT) == "lay under track 358's box, which sat on another detection"
+    )
+    assert use.destinations[14].went is Went.NO_OUTPUT
+    assert went_phrase(use.destinations[3], UseMode.OUTPUT) == "lay under no output box"
+
+
+def test_a_phd_labels_story_gives_its_heaviest_components_weight_as_w() -> None:
+    # independent audit r42, dev set scene-0061 centerpoint cphd id_switch:1: "track 18 no longer shown (r=0.02 fell
+    # below 0.50)": the last of its three components' rows (0.22, 0.211, 0.024), read as an existence
+    from gnnpmb.events import Extracted, IntensityWeights, Posterior
+
+    def posterior(ids: list[int], w: list[float]) -> tuple[Posterior, IntensityWeights]:
+        k = len(ids)
+        cov = np.tile(np.eye(4), (k, 1, 1))
+        return Posterior("car", np.array(ids), np.zeros((k, 4)), cov, np.minimum(w, 1.0)), IntensityWeights(
+            "car", np.array(ids), np.array(w)
+        )
+
+    events = [
+        frame(0),
+        received([0]),
+        *posterior([18, 18], [1.04, 0.09]),  # the Posterior and the estimate hold min(w, 1): the story says 1.04
+        Extracted("car", (estimate(18, 0, 1.0),), 0.5),
+    ]
+    events += [frame(1), received([0]), *posterior([18, 18, 18], [0.22, 0.211, 0.024]), Extracted("car", (), 0.5)]
+    teller = Storyteller(facts_of(events), involved=frozenset({18}))
+    (confirmed,) = [line.text for line in teller.frame_lines(0) if line.kind is StoryKind.CONFIRMED]
+    assert confirmed == "track 18 confirmed (w=1.04, from m0)"
+    (gone,) = [line.text for line in teller.frame_lines(1) if line.kind is StoryKind.NO_LONGER_SHOWN]
+    assert gone == "track 18 no longer shown (w=0.22 fell below 0.50)"
+
+
+def test_a_phd_labels_table_says_weight_of_its_heaviest_components_before_and_after_the_update() -> None:
+    # independent audit r42, dev set scene-0757 centerpoint phd (diff:introduced:1's focus document): "r before
+    # update" / "r after" 1.10 of a PHD label (a weight, not an existence), and "before" read off its first row
+    from types import SimpleNamespace
+
+    from gnnpmb.events import Extracted, Gated, IntensityWeights, Posterior
+    from viz.focus_summary import _steps_markdown
+
+    def rows(kind, ids: list[int], w: list[float]):
+        k = len(ids)
+        return kind("car", np.array(ids), np.zeros((k, 4)), np.tile(np.eye(4), (k, 1, 1)), np.array(w))
+
+    weights = UpdateWeights(
+        "car", np.array([39]), np.array([0]), np.array([1.0]), np.array([0.1]), np.array([[0.9]]), np.array([0.1])
+    )
+    gated = Gated(
+        "car",
+        np.array([39]),
+        np.array([0]),
+        np.array([[True]]),
+        np.zeros((1, 2)),
+        np.tile(np.eye(2), (1, 1, 1)),
+        9.0,
+        np.array([[0.2]]),
+    )
+    events = [frame(0), received([0]), rows(Predicted, [39, 39], [0.03, 0.94]), gated, weights]
+    events += [
+        rows(Posterior, [39, 39], [1.10, 0.02]),
+        IntensityWeights("car", np.array([39, 39]), np.array([1.10, 0.02])),
+    ]
+    events += [Extracted("car", (estimate(39, 0, 1.0),), 0.5)]
+    view = SimpleNamespace(facts=facts_of(events), has_gates=True)
+    table = "\n".join(_steps_markdown(view, "car", [39], range(0, 1)))
+    assert "| frame | weight before update | in gate (NIS) | used | weight after | output |" in table
+    assert "| 0 | 0.94 |" in table and "| 1.10 | yes |" in table

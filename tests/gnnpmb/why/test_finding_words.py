@@ -62,6 +62,10 @@ def test_a_track_never_shown_is_said_to_count_when_its_average_reaches_the_thres
     # output before the window too (dev-set scene-0103 pointpillars cphd id_switch:9, shown at frames 11-12): not said
     before = LostTrack(26, 7, steps[2:], None, evaluated, 0.037)
     assert "stayed below" not in why_lines(finding(FailureKind.ID_SWITCH, before))[0]
+    # independent audit r42, dev set scene-0061 centerpoint cphd fragmentation:3: "track 38's existence stayed below
+    # 0.5" of a PHD track the same line called by its weight ("its weight went from 0.30 ...")
+    (line, _) = why_lines(finding(FailureKind.ID_SWITCH, lost, mode=UseMode.WEIGHTS.value))
+    assert "track 26's weight stayed below 0.5 (the views draw tracks from 0.5 up)" in line
 
 
 def test_the_averaged_score_names_the_frames_the_evaluation_kept_when_not_all() -> None:
@@ -93,6 +97,13 @@ def test_a_lost_track_output_away_from_its_object_is_traced_to_the_detections_th
         "at frame 11 track 25 was output 5.4 m from GT bf3d85, on m0: beyond the evaluation's 2 m, so it no longer "
         "matched the object; it had used detections 2 m or more from the object at frame 10 (m0)" in line
     )
+    # independent audit r42, dev set scene-1100 centerpoint cphd fragmentation:1: "it had used detections 2 m or
+    # more from the object at frame 5 (m5)", 24 % of its weight (72 % from m11, 0.9 m from the object): the share
+    # of a soft update is said
+    soft = TrackStep(5, 1.0, (0.0, 0.0), (), Use(((11, 0.72), (5, 0.24)), 0.04, UseMode.WEIGHTS), None, 1.0, None)
+    lost = LostTrack(9, 6, (soft,), OffObject(3.8, 8, ((5, 5),)), None, None)
+    line = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=7, mode=UseMode.WEIGHTS.value))[0]
+    assert "it had used detections 2 m or more from the object at frame 5 (m5, 24 % of its weight)" in line
 
 
 def test_a_soft_update_is_told_in_its_own_terms_never_as_no_detection() -> None:
@@ -397,3 +408,47 @@ def test_another_runs_coalescence_is_the_same_failure_only_when_it_missed_the_sa
     assert _same_place(theirs, "80d062", None, "pedestrian")
     miss = Failure(FailureKind.MISS, 21, "s", "pedestrian", ("a2d371",), (), ())
     assert _same_place(miss, "a2d371", None, "pedestrian")
+
+
+def test_a_coalesced_objects_detection_that_started_a_track_never_output_on_it_is_said_so() -> None:
+    # dev set scene-0553 megvii ab3dmot coalescence at frame 12: "its detection m4 (score 0.74, 0.1 m away) started
+    # new track 148", a tentative track the tracker never output, read as if the object were covered
+    from gnnpmb.eval.evaluated import GtFrame, GtStatus
+
+    g = GtFrame(13, GtStatus.SCORED, (0.0, 0.0), (0.0, 0.0), None, 30, 20.0, 40.0)
+    went = Destination(4, Went.NEW_TRACK, 148)
+    seen = Sighting(13, 30, g, Near(4, "bicycle", 0.74, 0.1, True), Near(4, "bicycle", 0.74, 0.1, True), went, ())
+    f = finding(FailureKind.COALESCENCE, sightings=(seen,), blame=(Blame(Rule.COVERED_TWO, (13,)),), covered=(GT,))
+    (line, _) = why_lines(f)
+    assert "its detection m4 (score 0.74, 0.1 m away) started new track 148; track 148 was not output on it" in line
+
+
+def test_another_run_that_switched_the_objects_track_here_is_not_said_not_to_fail() -> None:
+    # independent audit r42, dev set scene-0553 megvii prob3dmot fragmentation at frame 23: "ab3dmot on the same
+    # detections did not fail here: its track 241 was output on the object and counted", where ab3dmot's own
+    # evaluation had a SWITCH of the object to track 241 at that frame
+    from gnnpmb.why.findings import OnObject, OtherRun
+
+    kept = TrackEval((23,), (23,), (), 0.9, 0.9, ((23, GT),))
+    on = (OnObject(241, 0.3, 0.9, -1, kept, 0.3),)
+    lost = LostTrack(62, 22, (), None, None, None)
+    run = OtherRun("ab3dmot", False, on, matched=241, switched=True)
+    (line, _) = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=23, others=(run,)))
+    assert "did not fail" not in line
+    assert (
+        "ab3dmot on the same detections switched the object's track here instead: the evaluation matched the object "
+        "to its track 241" in line
+    )
+
+
+def test_another_run_matched_at_a_box_it_did_not_output_names_the_track_the_evaluation_matched() -> None:
+    # independent audit r42, dev set scene-1094 pointpillars cbmot fragmentation:2: "greedy on the same detections did
+    # not have this failure", where greedy's evaluation matched the object to a box it interpolated for its track 50
+    # (not output there): the track is named, as the evaluation matched it
+    from gnnpmb.why.findings import OtherRun
+
+    lost = LostTrack(89, 5, (), None, None, None)
+    (line, _) = why_lines(
+        finding(FailureKind.FRAGMENTATION, lost, frame=6, others=(OtherRun("greedy", False, (), matched=50),))
+    )
+    assert "greedy on the same detections did not fail here: the evaluation matched the object to its track 50" in line
