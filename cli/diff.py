@@ -159,6 +159,9 @@ def print_diff(result: DiffResult, options: str, console: Console) -> None:
         first, last = group[0], group[-1]
         ids = first.diff_id if len(group) == 1 else f"{first.diff_id}-{last.diff_id.rsplit(':', 1)[1]}"
         runs = [_span([e.before for e in group]), _span([e.after for e in group])]
+        instead = list(dict.fromkeys(i for e in group for i in e.instead))
+        if instead:  # the run without the failure had another one about the same object there
+            runs[1 if first.change is Change.FIXED else 0] += f" ({_span(instead)} there instead)"
         what = first.what if len(group) == 1 else f"{first.what.split(' (', 1)[0]} ({len(group)} frames)"
         changes.add_row(
             first.scene, ids, frames_text(e.frame for e in group).split(" ", 1)[1], first.kind.value, what, *runs

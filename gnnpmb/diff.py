@@ -5,7 +5,9 @@ detections. Per scene, each failure of A is matched with one of B by what it is 
 two runs number their tracks independently): the same kind, frame and class and the same object (ID switch,
 fragmentation, miss, identity theft: the object; coalescence: the objects it missed) or, for a false track, a
 false track of B within ``NEAR_M`` (BEV) of its box, nearest first. A failure of A alone was **fixed** by B, one
-of B alone **introduced**, a matched pair **kept**. Each change has an id per scene, ``diff:<change>:<n>``
+of B alone **introduced**, a matched pair **kept**. A fixed or introduced failure about objects also names the
+other run's failures about the same objects at that frame (``instead``: a fragmentation B "fixed" by losing the
+object for good is a miss of B there). Each change has an id per scene, ``diff:<change>:<n>``
 (numbered by kind, association errors first, then object and frame: ``scene_diff``), which
 ``gnnpmb-viz SCENE --tracker A --tracker B --focus diff:introduced:1`` opens with both runs side by side
 (``diff_failure``).
@@ -39,8 +41,9 @@ class Change(enum.Enum):
 @dataclass(frozen=True, slots=True)
 class DiffEntry:
     """One failure's change on one scene: ``diff_id`` (``diff:<change>:<n>``), its kind, class and frame, the
-    failure ids in A and B (None where the run does not have it) and what it is (B's description, A's for a fixed
-    one)."""
+    failure ids in A and B (None where the run does not have it), what it is (B's description, A's for a fixed
+    one) and ``instead``: the ids of the other run's failures about the same objects at the same frame (a fixed
+    one's in B, an introduced one's in A; () for a kept one or a false track)."""
 
     scene: str
     diff_id: str
@@ -51,6 +54,7 @@ class DiffEntry:
     before: str | None
     after: str | None
     what: str
+    instead: tuple[str, ...] = ()
 
     def to_json(self) -> dict[str, object]:
         return {
@@ -63,6 +67,7 @@ class DiffEntry:
             "a": self.before,
             "b": self.after,
             "what": self.what,
+            "instead": list(self.instead),
         }
 
 
@@ -131,6 +136,8 @@ def scene_diff(scene: str, a: FailureReport, b: FailureReport) -> list[DiffEntry
     out = []
     for change, x, y, f in changed:
         seen[change] += 1
+        other = b if change is Change.FIXED else a
+        instead = () if change is Change.KEPT else _about_same(other, f)
         out.append(
             DiffEntry(
                 scene,
@@ -142,9 +149,21 @@ def scene_diff(scene: str, a: FailureReport, b: FailureReport) -> list[DiffEntry
                 x[0] if x is not None else None,
                 y[0] if y is not None else None,
                 f.describe(),
+                instead,
             )
         )
     return out
+
+
+def _about_same(report: FailureReport, f: Failure) -> tuple[str, ...]:
+    """The ids of ``report``'s failures at ``f``'s frame about any object ``f`` is about (none for a false
+    track)."""
+    objects = set(_about(f))
+    return tuple(
+        fid
+        for fid, g in zip(report.ids(), report.failures, strict=True)
+        if g.frame_index == f.frame_index and objects & set(_about(g))
+    )
 
 
 def _subject(f: Failure) -> tuple[str, ...]:

@@ -58,6 +58,20 @@ def test_failures_are_matched_by_what_they_are_about_not_by_track_ids() -> None:
     assert [e.change for e in entries] == [Change.KEPT, Change.KEPT, Change.INTRODUCED, Change.FIXED]
 
 
+def test_a_fixed_failure_names_what_the_other_run_had_there_instead() -> None:
+    """dev set scene-0757 centerpoint, phd -> cphd: a fragmentation of car 96bc69 "fixed by B" where B lost the car
+    for good; without ``instead`` the row read as if B had tracked it."""
+    a = _report([_failure(FailureKind.FRAGMENTATION, 4, ("g3",), ("5",)), _failure(FailureKind.MISS, 4, ("g4",), ())])
+    b = _report([_failure(FailureKind.MISS, 4, ("g3",), ())])
+    entries = {e.diff_id: e for e in scene_diff("scene-x", a, b)}
+    assert {k: (e.kind.value, e.instead) for k, e in entries.items()} == {
+        "diff:fixed:1": ("fragmentation", ("miss:1",)),
+        "diff:fixed:2": ("miss", ()),
+        "diff:introduced:1": ("miss", ("fragmentation:1",)),
+    }
+    assert entries["diff:fixed:1"].to_json()["instead"] == ["miss:1"]
+
+
 def test_diff_of_the_papers_parameters_and_the_defaults(
     demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
