@@ -33,7 +33,8 @@ from viz import paths
 from viz.colors import faded, packed_track_colors
 from viz.failure_style import KIND_COLORS, KIND_LABELS
 from viz.geometry import estimate_boxes
-from viz.label_room import Candidate, Eye, eyes
+from viz.label_room import CLEARANCE_PX, Candidate, Eye, eyes
+from viz.label_size import HEIGHT_PX, width_px
 from viz.timeline import FOCUS, FRAME, Clock
 
 LOST_LOOKBACK = 20
@@ -385,10 +386,9 @@ LABEL_SPAN = 7.0
 """Least keyframes' worth of room on the left of the failure timeline for the row names (``label_span``)."""
 SCENE_COLUMN_PX = 0.9 * 1920 * 3 / 5
 """Width the runs' views share at 1920 px (the scene column, ``viz.blueprint`` 3:2, less a tenth for borders)."""
-NAME_CHAR_PX = 7.0
-"""Width of one character of a row name (egui's default font)."""
-ROW_PX = 24.0
-"""Height one row of the failure timeline needs: a row name (18 px) and air, so names of adjacent rows never touch."""
+ROW_PX = HEIGHT_PX + CLEARANCE_PX
+"""Height one row of the failure timeline needs: a row name (``viz.label_size``) and air, so names of adjacent rows
+never touch."""
 VIEW_TITLE_PX = 24.0
 """Height of a view's title bar."""
 RUN_COLUMN_PX = {False: 815.0, True: 489.0}
@@ -418,9 +418,9 @@ def label_span(frames: range, runs: int = 1) -> float:
     """Keyframes' worth of room on the left of the failure timeline for the longest row name ("identity theft
     (999)"), centred there: the view is as wide as the scene column shared by ``runs`` runs and shows the frames
     plus this room, so the room is the name's width over the width left for the frames."""
-    text_px = NAME_CHAR_PX * (LONGEST_NAME + 2)
-    width_px = SCENE_COLUMN_PX / max(runs, 1)
-    return max(LABEL_SPAN, text_px * (len(frames) + 0.5) / max(width_px - text_px, text_px))
+    text_px = float(width_px(LONGEST_NAME)) + 2.0 * CLEARANCE_PX  # and air either side
+    view_px = SCENE_COLUMN_PX / max(runs, 1)
+    return max(LABEL_SPAN, text_px * (len(frames) + 0.5) / max(view_px - text_px, text_px))
 
 
 def strip_share(rows: int, cameras: bool = False) -> float:

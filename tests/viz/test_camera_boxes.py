@@ -174,7 +174,7 @@ def test_a_light_failure_colour_is_darkened_for_its_camera_label_the_box_keeps_i
 
 def test_a_label_wider_than_the_image_is_centred_on_it_and_a_narrow_one_kept_inside() -> None:
     """A text wider than the image runs into the margins of a letterboxed view evenly, not off its right edge."""
-    from viz.label_room import text_box
+    from viz.label_size import text_box
 
     wide = "simpletrack: fragmentation: missed gt bf3d85"
     x0, _, x1, _ = (c / CAMERA_VIEW_SCALE for c in text_box(wide, 0.0, 0.0))
