@@ -47,7 +47,14 @@ from viz.cameras import SCENE_HEIGHT_WITH_CAMERAS
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
 from viz.focus_summary import TrackerView, focus_markdown
-from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
+from viz.geometry import (
+    RerunBoxes,
+    estimate_boxes,
+    footprint_corners_xy,
+    quat_wxyz_to_xyzw,
+    rerun_boxes,
+    size_wlh_to_xyz,
+)
 from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
 from viz.logger import TrackerLogger
 from viz.markers import send_text_lines
@@ -125,6 +132,7 @@ def log_focus(
             for r, label in zip(rows.tolist(), labels, strict=True)
         ]
         z_m = float(gt.translation_m[rows[0], 2]) if rows.size else scene.ground_z_m
+        gt_corners = footprint_corners_xy(RerunBoxes(centers[0], sizes[0], quats[0]), SCALE, MARGIN_M)
         if i == focus.frame_index:
             gt_callouts += [
                 Callout(
@@ -184,16 +192,20 @@ def log_focus(
             detections = frame.detections.boxes
             use = facts.use(i, focus.class_name)
             mode = use.mode if use is not None else UseMode.ASSIGNED
+            named = [gt_corners, footprint_corners_xy(boxes, SCALE, MARGIN_M)]
+            if detections is not None and given:
+                named.append(footprint_corners_xy(rerun_boxes(detections.subset(np.array(sorted(given))))))
             log_callouts(
                 stream,
                 paths.focus_callouts(tracker),
                 gt_callouts
                 + _detection_callouts(detections, sorted(given), facts, i, focus.class_name, mode)
-                + _prediction_callouts(steps, z_m, palette, facts.has_existence)
+                + _prediction_callouts(steps, z_m, palette, facts.has_existence, mode)
                 + ghosts,
                 height_m,
                 view_x_m,
                 view_y_m,
+                np.concatenate(named),
             )
         if meas and detections is not None:
             given = sorted(meas)
@@ -384,23 +396,26 @@ def _prediction_callouts(
     z_m: float,
     palette: Mapping[int, tuple[int, int, int]],
     has_existence: bool,
+    mode: UseMode = UseMode.ASSIGNED,
 ) -> list[Callout]:
     """``<id> predicted r=<existence> → m<idx>`` (the detection its update used most, with its share for a soft
     update) or ``, missed`` at each focused track's predicted position this frame, in the track's involved colour
     (``palette``). The existence is the predicted one; for PMBM, when the frame's assignment was decided in another
-    prior hypothesis, the one there, with the best hypothesis's beside it. Without existences: ``<id> predicted
-    → m<idx>``."""
+    prior hypothesis, the one there, with the best hypothesis's beside it. A PHD's or CPHD's track (``mode``
+    ``WEIGHTS``) has a weight, not an existence: ``<id> predicted weight <w> → m<idx>``. Without existences:
+    ``<id> predicted → m<idx>``."""
     out = []
+    name = " weight " if mode is UseMode.WEIGHTS else " r="
     for t, step in steps.items():
         if step is None or step.predicted_xy_m is None:
             continue
         r = ""
         if has_existence and step.prior_existence is not None:
-            r = f" r={existence_text(step.prior_existence)}"
+            r = f"{name}{existence_text(step.prior_existence)}"
             decided = step.decided_existence
             if decided is not None and existence_text(decided) != existence_text(step.prior_existence):
                 best = existence_text(step.prior_existence)
-                r = f" r={existence_text(decided)} in the deciding hypothesis ({best} in the best)"
+                r = f"{name}{existence_text(decided)} in the deciding hypothesis ({best} in the best)"
         use = step.use
         if use is not None and use.shares:
             m, share = use.shares[0]
