@@ -40,7 +40,6 @@ DEFAULT_FOCUS_HEIGHT_M = 40.0
 """The same for the other classes."""
 COMPARED_ROW_SHARES = (4, 1)
 """With two runs or more, the left column's rows: the scene views, the comparison panel below them."""
-COMPARED_SCENE_SHARE = COMPARED_ROW_SHARES[0] / sum(COMPARED_ROW_SHARES)
 STORY_COLUMNS = rrb.TextLogColumns(
     text_log_columns=[
         rrb.components.TextLogColumn(kind="LogLevel", visible=True),

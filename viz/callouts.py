@@ -17,19 +17,30 @@ from dataclasses import dataclass
 import numpy as np
 import rerun as rr
 
-from viz.label_size import width_px
+from viz.colors import readable_text
+from viz.label_size import CLEARANCE_PX, HEIGHT_PX, width_px
 
 FOV_Y_DEG = 55.0
 """Vertical field of view of the bird's-eye view's eye (Rerun's default)."""
 FOCUS_BEV_HEIGHT_PX = 683.0
 """Height of a focus recording's bird's-eye view of one run without a camera view, at 1920 x 1080 (measured in the
-web viewer: dev set scene-0103 simpletrack fragmentation:9; two runs and a camera view below shorten it,
-``viz.focus``)."""
+web viewer: dev set scene-0103 simpletrack fragmentation:9); ``focus_bev_height_px`` for the other layouts."""
+COMPARED_CAMERA_HEIGHTS_PX = {
+    (False, False): FOCUS_BEV_HEIGHT_PX,
+    (True, False): 547.0,
+    (False, True): 404.0,
+    (True, True): 318.0,
+}
+"""(runs compared, a camera view below) -> the bird's-eye view's height in pixels at 1920 x 1080, laid out from the
+focus blueprint as ``tools.labels.layout_px`` does (689 px there for ``FOCUS_BEV_HEIGHT_PX``). The shares they
+were estimated from (0.55 with a camera, 0.8 compared) made a three-run view with a camera 300 px tall, not 318:
+the views were thought 6 % wider in metres than they are and their callouts ran past the edge (demo scene-0103,
+pointpillars, cphd beside ab3dmot and pmbm, ``--focus id_switch:1``)."""
 M_PER_PX_PER_HEIGHT = 2.0 * math.tan(math.radians(FOV_Y_DEG / 2.0)) / FOCUS_BEV_HEIGHT_PX
 """Metres per screen pixel per metre of camera height in that view (a pinhole looking straight down: 18 m ->
 0.027 m; it was a measured 0.0022, true of a shorter view, so a column could sit past a taller view's edge)."""
-LINE_PX = 22.0
-"""Rows of the column are this many pixels apart (a label is about 16 px tall)."""
+LINE_PX = HEIGHT_PX + CLEARANCE_PX
+"""Rows of the column are this many pixels apart: a label's height and air (``viz.label_size``)."""
 GAP_PX = 40.0
 """Clear space between the rightmost object and the labels' aligned left ends (and between the objects and a
 column stacked above or below them)."""
@@ -64,8 +75,9 @@ def column_positions(
     through a label. When neither side holds the column whole (a narrow view: three runs side by side) and
     ``view_y_m`` (the y range the view shows) leaves room above the anchors, or else below them, the column goes
     there, just right (else left) of the anchors, inside the view; only when no place holds it does it go to the
-    side that cuts less. ``clear_xy_m`` (M, 2): more points the column keeps clear of as of the anchors (the
-    corners of the boxes the labels name: a long truck's box reaches metres past its centre)."""
+    side that cuts less, pushed inside the view when the view is wider than the column. ``clear_xy_m`` (M, 2):
+    more points the column keeps clear of as of the anchors (the corners of the boxes the labels name: a long
+    truck's box reaches metres past its centre)."""
     n = len(anchors_xy_m)
     if n == 0:
         return np.zeros((0, 2))
@@ -85,6 +97,10 @@ def column_positions(
         stacked = _stacked(extent_xy_m, n, width_m, gap_m, line_m, STACK_GAP_PX * m_per_px, view_x_m, view_y_m)
         if min(over_left, over_right) > 0.0 and stacked is not None:
             edge, side, rows_y = stacked
+        elif min(over_left, over_right) > 0.0 and width_m <= view_x_m[1] - view_x_m[0]:
+            # no place holds it: pushed back inside the view, over the objects (a label over a box can be read,
+            # one past the view's edge cannot)
+            edge = view_x_m[1] - width_m if side > 0 else view_x_m[0] + width_m
     out = np.empty((n, 2))
     out[:, 0] = edge + side * halves_m
     out[order, 1] = rows_y
@@ -126,6 +142,13 @@ def _stacked(
     return view_x_m[1] - width_m, 1.0, rows
 
 
+def focus_height_m(eye_height_m: float, compared: bool, camera: bool) -> float:
+    """The height ``column_positions`` takes for a focus bird's-eye view whose eye is ``eye_height_m`` above the
+    ground: the one at which ``FOCUS_BEV_HEIGHT_PX`` tall would show as many metres per pixel as the layout's view
+    (``COMPARED_CAMERA_HEIGHTS_PX``) does from ``eye_height_m``."""
+    return eye_height_m * FOCUS_BEV_HEIGHT_PX / COMPARED_CAMERA_HEIGHTS_PX[compared, camera]
+
+
 def half_widths_m(chars: np.ndarray, m_per_px: float) -> np.ndarray:
     """(N,) half widths in metres of labels of ``chars`` (N,) characters, with their background."""
     return 0.5 * width_px(np.asarray(chars, dtype=np.float64)) * m_per_px
@@ -149,21 +172,24 @@ def log_callouts(
     view_y_m: tuple[float, float] | None = None,
     clear_xy_m: np.ndarray | None = None,
 ) -> None:
-    """The callouts as labelled points (``path``) and leader lines (``path/leaders``) at the current time; an
-    empty list clears both. ``view_x_m`` / ``view_y_m``: the x / y range the bird's-eye view shows; ``clear_xy_m``
-    (M, 2): the corners of the boxes the column keeps clear of (``column_positions``)."""
+    """The callouts as labelled points (``path``; the text in its colour darkened to be read on the label's pale
+    background, ``colors.readable_text``: a truck's light cyan was not) and leader lines (``path/leaders``, in the
+    colour itself) at the current time; an empty list clears both. ``view_x_m`` / ``view_y_m``: the x / y range
+    the bird's-eye view shows; ``clear_xy_m`` (M, 2): the corners of the boxes the column keeps clear of
+    (``column_positions``)."""
     anchors = np.array([c.anchor_m for c in callouts], dtype=np.float64).reshape(-1, 3)
     chars = np.array([len(c.text) for c in callouts], dtype=np.int64)
     xy = column_positions(anchors[:, :2], chars, height_m, view_x_m, view_y_m, clear_xy_m)
     labels_at = np.concatenate([xy, anchors[:, 2:]], axis=1)
     ends = np.concatenate([leader_ends(anchors[:, :2], xy, chars, height_m), anchors[:, 2:]], axis=1)
     colors = np.array([c.color for c in callouts], dtype=np.uint8).reshape(-1, 3)
+    text_colors = np.array([readable_text(c.color) for c in callouts], dtype=np.uint8).reshape(-1, 3)
     stream.log(
         path,
         rr.Points3D(
             labels_at,
             labels=[c.text for c in callouts],
-            colors=colors,
+            colors=text_colors,
             radii=POINT_RADIUS_M,
             show_labels=True,
         ),

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.data.scene import Pose
-from viz.label_size import text_box
+from viz.label_size import CLEARANCE_PX, text_box
 
 BEV_EYE_POSITION_M = (6.0, 0.0, 80.0)
 BEV_TARGET_M = (6.0, 0.0, 0.0)
@@ -44,8 +44,6 @@ PERSPECTIVE_HEIGHT_PX = 255.0
 """The same for the perspective view (its share 4 against the bird's-eye view's 6)."""
 VIEW_WIDTH_PX = 576.0
 """Width of each run's 3D views in a two-run recording at 1920 x 1080 (3/5 of the width, halved)."""
-CLEARANCE_PX = 4.0
-"""Air kept between two labels' text boxes."""
 LABEL_Z_M = 1.0
 """Height above the ego frame's ground a label's anchor (a box centre) is taken at."""
 

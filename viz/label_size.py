@@ -17,6 +17,8 @@ PAD_PX = 11.0
 """The label's background beyond its text on each side, in pixels."""
 HEIGHT_PX = 22.0
 """Height of a label with its background, in pixels."""
+CLEARANCE_PX = 4.0
+"""Air kept between two labels' boxes (and between a label and a view's edge)."""
 BELOW_ANCHOR_PX = 3.0
 """The label's top edge lies this far below its anchor."""
 

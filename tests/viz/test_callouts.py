@@ -6,6 +6,7 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
+from rerun.chunk import RrdReader
 
 from viz.callouts import LINE_PX, M_PER_PX_PER_HEIGHT, column_positions, half_widths_m, leader_ends
 
@@ -45,6 +46,7 @@ def test_the_column_clears_the_boxes_it_names_not_only_their_centres(saved_strea
     lies right of the box's footprint."""
     from tests.viz.rrd import read_rows
     from viz.callouts import Callout, log_callouts
+    from viz.colors import TEXT_LUMINANCE_MAX, luminance
     from viz.geometry import RerunBoxes, footprint_corners_xy
 
     stream, path = saved_stream
@@ -56,12 +58,19 @@ def test_the_column_clears_the_boxes_it_names_not_only_their_centres(saved_strea
     )
     corners = footprint_corners_xy(truck)
     assert corners.shape == (4, 2) and np.isclose(corners[:, 0].max(), 6.0 * np.cos(yaw) + 1.5 * np.sin(yaw))
-    callouts = [Callout((0.0, 0.0, 1.0), "GT f4b6a9", (0, 200, 200)), Callout((0.5, 0.2, 1.0), "m1 0.81", (0, 0, 0))]
+    cyan = (120, 230, 240)  # a truck's class colour: light on the label's pale background
+    callouts = [Callout((0.0, 0.0, 1.0), "GT f4b6a9", cyan), Callout((0.5, 0.2, 1.0), "m1 0.81", (0, 0, 0))]
     stream.set_time("frame", sequence=0)
     log_callouts(stream, "world/callouts", callouts, HEIGHT_M, clear_xy_m=corners)
     stream.disconnect()
     rows = read_rows(path)
-    assert rows["world/callouts"][-1]["Points3D:labels"] == ["GT f4b6a9", "m1 0.81"]
+    labels = rows["world/callouts"][-1]
+    assert labels["Points3D:labels"] == ["GT f4b6a9", "m1 0.81"]
+    (chunk,) = [c for c in RrdReader(path).store().stream() if c.entity_path == "/world/callouts"]
+    packed = chunk.to_record_batch().column("Points3D:colors").to_pylist()[-1]
+    text_rgb = [((c >> 24) & 0xFF, (c >> 16) & 0xFF, (c >> 8) & 0xFF) for c in packed]
+    assert all(luminance(c) <= TEXT_LUMINANCE_MAX for c in text_rgb) and text_rgb[1] == (0, 0, 0)  # darkened to read
+    assert rows["world/callouts/leaders"][-1]["LineStrips3D:colors"][0] >> 8 == (120 << 16) | (230 << 8) | 240
     strips = np.array(rows["world/callouts/leaders"][-1]["LineStrips3D:strips"])  # anchor -> the label's near end
     assert np.all(strips[:, 1, 0] > corners[:, 0].max())  # every label's left end right of the truck's box
 

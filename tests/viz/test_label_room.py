@@ -70,6 +70,20 @@ def test_in_a_view_too_narrow_for_either_side_the_column_stacks_above_the_object
     assert out[0, 1] > out[1, 1]  # the higher object's label on the upper row
     low = column_positions(anchors, chars, height_m, view_x_m, (-8.0, 0.5))  # no room above: below
     assert np.all(low[:, 1] < anchors[:, 1].min()) and np.all(low[:, 1] - 0.5 >= -8.0)
-    side = column_positions(anchors, chars, height_m, view_x_m)  # the view's height unknown: the side cut less
-    right_ends = side[:, 0] + half_widths_m(chars, M_PER_PX_PER_HEIGHT * height_m)
-    assert np.ptp(right_ends) < 1e-9 and right_ends[0] < anchors[:, 0].min()  # left of the objects, ends aligned
+    side = column_positions(anchors, chars, height_m, view_x_m)  # the view's height unknown: on the side cut less,
+    right_ends = side[:, 0] + half_widths_m(chars, M_PER_PX_PER_HEIGHT * height_m)  # pushed inside the view
+    assert np.ptp(right_ends) < 1e-9 and side[0, 0] - half_label_m >= view_x_m[0] - 1e-9  # ends aligned
+
+
+def test_when_no_place_holds_the_column_it_is_pushed_inside_a_view_wide_enough() -> None:
+    """Three runs side by side, a tall object in the middle: neither side, above nor below holds the column, but
+    the view is wider than it: over the object it can be read, past the edge it could not (demo scene-0103,
+    cphd beside ab3dmot and pmbm, ``--focus id_switch:1``)."""
+    anchors = np.array([[0.0, 0.0]])
+    clear = np.array([[-1.0, -9.0], [1.0, 9.0]])  # a box from the view's bottom to its top
+    chars = np.array([27])
+    height_m = 16.0
+    half_label_m = half_widths_m(chars, M_PER_PX_PER_HEIGHT * height_m)[0]
+    view_x_m = (-1.2 * half_label_m, 1.2 * half_label_m)
+    out = column_positions(anchors, chars, height_m, view_x_m, (-8.0, 8.0), clear)
+    assert view_x_m[0] <= out[0, 0] - half_label_m and out[0, 0] + half_label_m <= view_x_m[1] + 1e-9
