@@ -181,6 +181,13 @@ def _caps(tracker: str, caps: Mapping[str, Capabilities] | None) -> Capabilities
     return given if given is not None else tracker_capabilities(tracker)
 
 
+def existence_word(caps: Capabilities) -> str:
+    """What a run's per-track value is called in its plot: ``weight`` for a PHD or CPHD filter (the trackers whose
+    tracks are intensity components, ``Panel.INTENSITY``: an expected number of objects, which may exceed 1),
+    ``existence`` (a probability) for the others."""
+    return "weight" if Panel.INTENSITY in caps.panels else "existence"
+
+
 def failure_counts_view(tracker: str) -> rrb.TimeSeriesView:
     return rrb.TimeSeriesView(origin=failures_root(tracker), name=f"{tracker} failures per frame")
 
@@ -212,7 +219,7 @@ def track_series_views(
     tracks at the failure it opens at (``opening``), with a legend naming them (placed by ``legends``, keyed by
     the view's origin). caps: what the run can show (default: the registry's)."""
     caps = caps or tracker_capabilities(tracker)
-    existence = [(paths.existence_root(tracker), "existence")] if caps.has_existence else []
+    existence = [(paths.existence_root(tracker), existence_word(caps))] if caps.has_existence else []
     nis = [(paths.nis_root(tracker), "NIS (innovation²/S)")] if caps.has_gates else []
     cost = [(paths.chosen_cost_root(tracker), "chosen cost")] if caps.has_costs else []
     near = focus or opening

@@ -369,3 +369,24 @@ def test_no_existence_series_or_story_existence_for_a_tracker_without_existence_
     story = rows[paths.events(T, "car")]
     assert ("track 1 confirmed (from m0)", "INFO") in lines(story, 0)
     assert ("track 1 ended: existence below pruning threshold", "WARN") in lines(story, 2)
+
+
+def test_a_phd_filters_series_name_a_weight(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
+    """A PHD track's value is an expected number of objects (1.10 on the dev set), not an existence probability:
+    its series and its plot say "weight" (dev set scene-0916, megvii, phd, ``--focus id_switch:1``)."""
+    from gnnpmb.runs import tracker_capabilities
+    from tests.viz.test_blueprint import stored_views
+    from viz.blueprint import default_blueprint, existence_word
+
+    stream, path = saved_stream
+    log_all(stream, scripted_events(), existence_word=existence_word(tracker_capabilities("phd")))
+    stream.disconnect()
+    rows = read_rows(path)
+    assert [r for r in rows[paths.existence(T, "car", 1)] if r["static"]][0]["SeriesLines:names"] == ["1 car weight"]
+    bp = path.with_name("bp.rrd")
+    out = rr.RecordingStream("bp-test")
+    out.save(bp, default_blueprint=default_blueprint(["phd", "cphd", "gnnpmb"], ["car"]))
+    out.disconnect()
+    names = stored_views(bp)
+    assert names["phd weight"][1] == paths.existence_root("phd") and "cphd weight" in names
+    assert names["gnnpmb existence"][1] == paths.existence_root("gnnpmb") and "phd existence" not in names
