@@ -18,7 +18,7 @@ import numpy as np
 import rerun as rr
 
 from viz.colors import readable_text
-from viz.label_size import CLEARANCE_PX, HEIGHT_PX, width_px
+from viz.label_size import BELOW_ANCHOR_PX, CLEARANCE_PX, HEIGHT_PX, width_px
 
 FOV_Y_DEG = 55.0
 """Vertical field of view of the bird's-eye view's eye (Rerun's default)."""
@@ -75,7 +75,8 @@ def column_positions(
     through a label. When neither side holds the column whole (a narrow view: three runs side by side) and
     ``view_y_m`` (the y range the view shows) leaves room above the anchors, or else below them, the column goes
     there, just right (else left) of the anchors, inside the view; only when no place holds it does it go to the
-    side that cuts less, pushed inside the view when the view is wider than the column. ``clear_xy_m`` (M, 2):
+    side that cuts less, pushed inside the view when the view is wider than the column. Near the view's top or
+    bottom edge (``view_y_m``) the rows move as a block to stay inside it. ``clear_xy_m`` (M, 2):
     more points the column keeps clear of as of the anchors (the corners of the boxes the labels name: a long
     truck's box reaches metres past its centre)."""
     n = len(anchors_xy_m)
@@ -101,10 +102,25 @@ def column_positions(
             # no place holds it: pushed back inside the view, over the objects (a label over a box can be read,
             # one past the view's edge cannot)
             edge = view_x_m[1] - width_m if side > 0 else view_x_m[0] + width_m
+    if view_y_m is not None:  # near the view's top or bottom edge (frames before the failure): rows kept inside
+        rows_y = _inside(rows_y, view_y_m, (BELOW_ANCHOR_PX + HEIGHT_PX) * m_per_px)
     out = np.empty((n, 2))
     out[:, 0] = edge + side * halves_m
     out[order, 1] = rows_y
     return out
+
+
+def _inside(rows_y: np.ndarray, view_y_m: tuple[float, float], hang_m: float) -> np.ndarray:
+    """Rows' y (their labels' anchors; each label hangs ``hang_m`` below its anchor) shifted as a block so that
+    every label lies inside ``view_y_m``, when the view is tall enough for them."""
+    low, high = float(np.min(rows_y)) - hang_m, float(np.max(rows_y))
+    if high - low > view_y_m[1] - view_y_m[0]:
+        return rows_y
+    if low < view_y_m[0]:
+        return rows_y + (view_y_m[0] - low)
+    if high > view_y_m[1]:
+        return rows_y - (high - view_y_m[1])
+    return rows_y
 
 
 def _stacked(

@@ -87,3 +87,18 @@ def test_when_no_place_holds_the_column_it_is_pushed_inside_a_view_wide_enough()
     view_x_m = (-1.2 * half_label_m, 1.2 * half_label_m)
     out = column_positions(anchors, chars, height_m, view_x_m, (-8.0, 8.0), clear)
     assert view_x_m[0] <= out[0, 0] - half_label_m and out[0, 0] + half_label_m <= view_x_m[1] + 1e-9
+
+
+def test_near_the_views_bottom_edge_the_column_moves_up_to_stay_inside() -> None:
+    """Frames before the failure: the object near the bottom of the fixed bird's-eye view, its labels hanging
+    below it would run past the edge (demo scene-0916, centerpoint, cbmot, ``--focus id_switch:1``, frame 24)."""
+    from viz.label_size import BELOW_ANCHOR_PX, HEIGHT_PX
+
+    anchors = np.array([[0.0, -7.9], [0.3, -7.8]])
+    chars = np.array([9, 20])
+    height_m = 16.0
+    m_per_px = M_PER_PX_PER_HEIGHT * height_m
+    out = column_positions(anchors, chars, height_m, (-20.0, 20.0), (-8.0, 8.0))
+    assert out[:, 1].min() - (BELOW_ANCHOR_PX + HEIGHT_PX) * m_per_px >= -8.0 - 1e-9
+    free = column_positions(anchors, chars, height_m, (-20.0, 20.0), (-20.0, 20.0))
+    np.testing.assert_allclose(free[:, 1].mean(), anchors[:, 1].mean())  # with room: centred on the objects
