@@ -30,7 +30,7 @@ from gnnpmb.types import TrackEstimate
 from gnnpmb.why.facts import TrackerFacts
 from gnnpmb.why.words import SHOW_MIN_EXISTENCE, consecutive_runs, frames_text
 from viz import paths
-from viz.colors import faded, packed_track_colors
+from viz.colors import faded, pack_rgba, packed_track_colors, readable_text, track_color
 from viz.failure_style import KIND_COLORS, KIND_LABELS
 from viz.geometry import estimate_boxes
 from viz.label_room import CLEARANCE_PX, Candidate, Eye, eyes
@@ -137,7 +137,9 @@ class LabelNotes:
         return key in self.drawn.get(tracker, {}) or key in self.ghosts.get(tracker, ())
 
     def send(self, stream: rr.RecordingStream, clock: Clock, scene: SceneData) -> None:
-        """Each noted track's label at its noted frames: ``<id> · <note>; <note>`` (one call per track entity)."""
+        """Each noted track's label at its noted frames: ``<id> · <note>; <note>`` (one call per track entity), its
+        box there in its colour darkened to be read (Rerun writes a label in its box's colour: a pale olive track's
+        "13 · ID switch: …" could not be read on the label's pale background, dev set scene-0916 pmbm)."""
         for tracker, notes in self.notes.items():
             by_track: dict[tuple[str, int], list[tuple[int, str]]] = defaultdict(list)
             for (frame, t), texts in sorted(notes.items()):
@@ -147,13 +149,16 @@ class LabelNotes:
                 frames = np.array([f for f, _ in rows], dtype=np.int64)
                 stamps = np.array([scene.keyframes[f].timestamp_us for f in frames.tolist()], dtype=np.int64)
                 labels = [text for _, text in rows]
+                dark = pack_rgba(np.array([readable_text(track_color(t))], dtype=np.uint8))
                 clock.send(
                     stream,
                     paths.track(tracker, class_name, t),
                     frames,
                     stamps,
-                    lambda sel, labels=labels: rr.Boxes3D.columns(
-                        labels=[labels[i] for i in sel], show_labels=np.ones(len(sel), dtype=bool)
+                    lambda sel, labels=labels, dark=dark: rr.Boxes3D.columns(
+                        labels=[labels[i] for i in sel],
+                        show_labels=np.ones(len(sel), dtype=bool),
+                        colors=np.repeat(dark, len(sel)),
                     ),
                 )
 

@@ -153,3 +153,22 @@ def test_the_failure_timeline_leaves_room_for_its_longest_row_name(runs: int) ->
     px_per_frame = SCENE_COLUMN_PX / runs / (x1 - x0)
     assert label_span(frames, runs) * px_per_frame >= width_px(LONGEST_NAME)
     assert x0 == frames.start - label_span(frames, runs) and x1 == frames.stop + 0.5
+
+
+def test_a_noted_tracks_label_is_dark_enough_to_read(recorded) -> None:
+    """Rerun writes a box's label in the box's colour on a pale background: where a failure notes a track, its box
+    takes its colour darkened (``colors.readable_text``); a pale olive "13 · ID switch: …" could not be read."""
+    from viz.colors import TEXT_LUMINANCE_MAX, luminance
+
+    _, rows, _ = recorded
+    noted = [
+        r
+        for path, entity in rows.items()
+        if "/tracks/" in path
+        for r in entity
+        if any(" · " in text for text in r.get("Boxes3D:labels") or [])
+    ]
+    assert noted
+    for r in noted:
+        (packed,) = r["Boxes3D:colors"]
+        assert luminance(((packed >> 24) & 0xFF, (packed >> 16) & 0xFF, (packed >> 8) & 0xFF)) <= TEXT_LUMINANCE_MAX
