@@ -183,9 +183,15 @@ def _caps(tracker: str, caps: Mapping[str, Capabilities] | None) -> Capabilities
 
 def existence_word(caps: Capabilities) -> str:
     """What a run's per-track value is called in its plot: ``weight`` for a PHD or CPHD filter (the trackers whose
-    tracks are intensity components, ``Panel.INTENSITY``: an expected number of objects, which may exceed 1),
-    ``existence`` (a probability) for the others."""
+    tracks are intensity components, ``Panel.INTENSITY``: an expected number of objects, which its events carry
+    capped at 1, ``gnnpmb.phd.gmphd``), ``existence`` (a probability) for the others."""
     return "weight" if Panel.INTENSITY in caps.panels else "existence"
+
+
+def _series_title(caps: Capabilities) -> str:
+    """The per-track value's plot title: a PHD weight says that the plot caps it (the focus text gives 1.10)."""
+    word = existence_word(caps)
+    return "weight (capped at 1)" if word == "weight" else word
 
 
 def failure_counts_view(tracker: str) -> rrb.TimeSeriesView:
@@ -219,7 +225,7 @@ def track_series_views(
     tracks at the failure it opens at (``opening``), with a legend naming them (placed by ``legends``, keyed by
     the view's origin). caps: what the run can show (default: the registry's)."""
     caps = caps or tracker_capabilities(tracker)
-    existence = [(paths.existence_root(tracker), existence_word(caps))] if caps.has_existence else []
+    existence = [(paths.existence_root(tracker), _series_title(caps))] if caps.has_existence else []
     nis = [(paths.nis_root(tracker), "NIS (innovation²/S)")] if caps.has_gates else []
     cost = [(paths.chosen_cost_root(tracker), "chosen cost")] if caps.has_costs else []
     near = focus or opening

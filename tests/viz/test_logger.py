@@ -373,7 +373,8 @@ def test_no_existence_series_or_story_existence_for_a_tracker_without_existence_
 
 def test_a_phd_filters_series_name_a_weight(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
     """A PHD track's value is an expected number of objects (1.10 on the dev set), not an existence probability:
-    its series and its plot say "weight" (dev set scene-0916, megvii, phd, ``--focus id_switch:1``)."""
+    its series and its plot say "weight", and the plot that the events cap it at 1 (dev set scene-0916, megvii,
+    phd, ``--focus id_switch:1``)."""
     from gnnpmb.runs import tracker_capabilities
     from tests.viz.test_blueprint import stored_views
     from viz.blueprint import default_blueprint, existence_word
@@ -388,5 +389,5 @@ def test_a_phd_filters_series_name_a_weight(saved_stream: tuple[rr.RecordingStre
     out.save(bp, default_blueprint=default_blueprint(["phd", "cphd", "gnnpmb"], ["car"]))
     out.disconnect()
     names = stored_views(bp)
-    assert names["phd weight"][1] == paths.existence_root("phd") and "cphd weight" in names
+    assert names["phd weight (capped at 1)"][1] == paths.existence_root("phd") and "cphd weight (capped at 1)" in names
     assert names["gnnpmb existence"][1] == paths.existence_root("gnnpmb") and "phd existence" not in names
