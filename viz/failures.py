@@ -96,7 +96,8 @@ def _keep_apart(
         for k, (box, text) in enumerate(zip(boxes, labels, strict=True)):
             if text:
                 xy = (float(box.translation_m[0]), float(box.translation_m[1]))
-                markers.append((int(frame_of[k]), Candidate(rank, ("marker", kind, k), text, xy)))
+                z = float(box.translation_m[2])
+                markers.append((int(frame_of[k]), Candidate(rank, ("marker", kind, k), text, xy, z)))
     dropped = notes.keep_apart(tracker, scene, markers)
     for _, kind, k in dropped:
         drawn[kind][1][k] = ""

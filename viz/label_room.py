@@ -51,12 +51,14 @@ LABEL_Z_M = 1.0
 @dataclass(frozen=True, slots=True)
 class Candidate:
     """A label that would be shown: its rank (lower is kept first), a key the caller knows it by, its text and
-    its anchor's global x, y (metres)."""
+    its anchor's global x, y (and z) in metres."""
 
     rank: int
     key: object
     text: str
     xy_global_m: tuple[float, float]
+    z_global_m: float | None = None
+    """The anchor's height (a box centre's); None: ``LABEL_Z_M`` above the ego frame's ground."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -133,7 +135,8 @@ def keep_apart(candidates: Sequence[Candidate], ego: Pose, views: Sequence[Eye] 
     for eye in views if views is not None else eyes():
         boxes = []
         for c in candidates:
-            at = eye.screen_px(to_ego(c.xy_global_m, ego))
+            z_m = LABEL_Z_M if c.z_global_m is None else c.z_global_m - float(ego.translation_m[2])
+            at = eye.screen_px(to_ego(c.xy_global_m, ego, z_m))
             if at is None:
                 continue
             box = text_box(c.text, *at)

@@ -110,7 +110,8 @@ class LabelNotes:
             e = self.drawn[tracker][key]
             text = f"{key[1]} · {'; '.join(texts)}"
             xy = (float(e.translation_m[0]), float(e.translation_m[1]))
-            by_frame[key[0]].append(Candidate(self.ranks[tracker][key], ("drawn", key), text, xy))
+            z = float(e.translation_m[2])
+            by_frame[key[0]].append(Candidate(self.ranks[tracker][key], ("drawn", key), text, xy, z))
         ghosts = self.ghosts.get(tracker, {})
         for key, texts in self.ghost_notes[tracker].items():
             at = ghosts[key][1]

@@ -4,10 +4,11 @@ the bird's-eye view, and never cut off by a view's edge; the focus callouts' col
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from gnnpmb.data.scene import Pose
 from viz.callouts import M_PER_PX_PER_HEIGHT, column_positions, half_widths_m
-from viz.label_room import Candidate, eyes, keep_apart, px_per_m
+from viz.label_room import LABEL_Z_M, Candidate, eyes, keep_apart, px_per_m
 
 IDENTITY = Pose(np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
 
@@ -102,3 +103,22 @@ def test_near_the_views_bottom_edge_the_column_moves_up_to_stay_inside() -> None
     assert out[:, 1].min() - (BELOW_ANCHOR_PX + HEIGHT_PX) * m_per_px >= -8.0 - 1e-9
     free = column_positions(anchors, chars, height_m, (-20.0, 20.0), (-20.0, 20.0))
     np.testing.assert_allclose(free[:, 1].mean(), anchors[:, 1].mean())  # with room: centred on the objects
+
+
+def test_a_labels_anchor_is_taken_at_its_boxs_height() -> None:
+    """A truck's box centre 1.56 m up, just inside the perspective view's bottom edge: its label would run past
+    the edge; taken at the default 1 m the anchor was below the edge and the label kept (dev set scene-0916,
+    pmbm, full recording, frame 24: 'false track 13' cut)."""
+    _, perspective = eyes()
+    half_h = 0.5 * perspective.height_px
+    places = [(x, y) for x in np.linspace(-30.0, 40.0, 701) for y in np.linspace(-20.0, 20.0, 41)]
+    for x, y in places:  # on the ground near the view's bottom edge
+        high = perspective.screen_px(np.array([x, y, 1.56]))
+        low = perspective.screen_px(np.array([x, y, LABEL_Z_M]))
+        if high is not None and low is not None and abs(high[0]) < 100 and half_h - 3.0 < high[1] <= half_h < low[1]:
+            break
+    else:
+        pytest.fail("no such place")
+    at = Candidate(0, "truck", "false track 13", (x, y), 1.56)
+    assert keep_apart([at], IDENTITY, (perspective,)) == set()
+    assert keep_apart([Candidate(0, "truck", "false track 13", (x, y))], IDENTITY, (perspective,)) == {"truck"}
