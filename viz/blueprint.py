@@ -198,11 +198,14 @@ def failure_counts_view(tracker: str) -> rrb.TimeSeriesView:
     return rrb.TimeSeriesView(origin=failures_root(tracker), name=f"{tracker} failures per frame")
 
 
-def _series_contents(root: str, focus: FocusTarget | None, tracker: str) -> list[str] | str:
-    """Every series, or with a focus the involved tracks' (and their class's extraction threshold)."""
-    if focus is None or not focus.track_ids.get(tracker):
-        return "$origin/**"
-    return [f"+ {root}/{focus.class_name}/{t}" for t in (*focus.track_ids[tracker], "threshold")]
+def _series_contents(root: str, near: FocusTarget | None, tracker: str, focused: bool = False) -> list[str] | str:
+    """Every series, or near a failure (a focus, or the one a full recording opens at) the involved tracks' (and
+    their class's extraction threshold). In a focus recording (``focused``) a run with no involved track shows only
+    the threshold: not every track of the scene (a spaghetti of 40 lines beside the failure of the other run,
+    dev set scene-0103 ``--focus diff:introduced:1``)."""
+    if near is None or not near.track_ids.get(tracker):
+        return f"+ {root}/{near.class_name}/threshold" if focused and near is not None else "$origin/**"
+    return [f"+ {root}/{near.class_name}/{t}" for t in (*near.track_ids[tracker], "threshold")]
 
 
 def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visible: bool) -> dict:
@@ -234,7 +237,7 @@ def track_series_views(
     return [
         rrb.TimeSeriesView(
             origin=root,
-            contents=_series_contents(root, near, tracker),
+            contents=_series_contents(root, near, tracker, focused=focus is not None),
             name=f"{tracker} {what}{at}",
             **_legend_args(root, legends, few or focus is not None),
         )

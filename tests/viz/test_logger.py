@@ -391,3 +391,13 @@ def test_a_phd_filters_series_name_a_weight(saved_stream: tuple[rr.RecordingStre
     names = stored_views(bp)
     assert names["phd weight (capped at 1)"][1] == paths.existence_root("phd") and "cphd weight (capped at 1)" in names
     assert names["gnnpmb existence"][1] == paths.existence_root("gnnpmb") and "phd existence" not in names
+
+
+def test_in_a_focus_a_run_with_no_involved_track_labels_none(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
+    """The other run of ``--focus diff:introduced:1`` (dev set scene-0103) has no involved track: it labelled every
+    track, 15 a frame, overlapping; a focus recording labels its involved tracks only."""
+    stream, path = saved_stream
+    log_all(stream, scripted_events(), clock=Clock(focus_end=1), log_frames=range(1, 3), focus_tracks=set())
+    stream.disconnect()
+    (box,) = [r for r in at_frame(read_rows(path)[paths.track(T, "car", 1)], 1) if "Boxes3D:labels" in r]
+    assert box["Boxes3D:labels"] == ["1"] and box["Boxes3D:show_labels"] == [False]
