@@ -10,9 +10,9 @@ batch of many instances is drawn once. Empty texts are not counted.
 
 Overlap is decided in the default camera of the bird's-eye and perspective views: the label's anchor (box centre,
 point, strip midpoint) projected with the view's eye (Rerun's default vertical field of view, ``FOV_Y_DEG``) into
-the view's rectangle, the text box as Rerun places it (centred under the anchor), ``CHAR_PX`` per character. The view's
-size in pixels is laid out from the blueprint's containers at 1920 x 1080 (``layout_px``); the text size is an
-estimate of egui's text metrics, so the check keeps ``MARGIN_PX`` of air.
+the view's rectangle, the text box as Rerun places it (centred under the anchor; its size the one
+``viz.label_size`` measured in the web viewer). The view's size in pixels is laid out from the blueprint's
+containers at 1920 x 1080 (``layout_px``); the check keeps ``MARGIN_PX`` of air.
 
 Camera views (2D views on a ``Pinhole`` camera entity) count the labels of 2D entities under the camera whose
 anchor lies in the image, and of 3D entities their contents include projected through the keyframe's ego pose, the
@@ -38,14 +38,12 @@ import numpy as np
 from rerun.chunk import RrdReader
 from scipy.spatial.transform import Rotation
 
+from viz.label_size import text_box
+
 MAX_NUM_LABELS_PER_ENTITY = 30
 """Rerun hides the labels of a batch with this many instances or more unless ``show_labels`` says otherwise."""
 FOV_Y_DEG = 55.0
 """Vertical field of view of a 3D view's default eye (Rerun's ``DEFAULT_FOV_Y``)."""
-CHAR_PX = 7.0
-LABEL_HEIGHT_PX = 18.0
-LABEL_PAD_PX = 4.0
-"""Text box of a label: this many pixels per character plus padding, this tall (egui's default 12.5 px font)."""
 MARGIN_PX = 2.0
 """Two text boxes closer than this count as overlapping."""
 ANCHORS = {
@@ -419,8 +417,7 @@ def screen_boxes(
         y = 0.5 * h - focal * float(d @ screen_up) / depth
         if not (0 <= x <= w and 0 <= y <= h):
             continue
-        half = 0.5 * (CHAR_PX * len(label.text) + 2 * LABEL_PAD_PX)
-        out.append((label, (x - half, y + 3.0, x + half, y + 3.0 + LABEL_HEIGHT_PX)))
+        out.append((label, text_box(label.text, x, y)))
     return out
 
 
@@ -437,8 +434,7 @@ def camera_boxes(rec: Recording, view: View3D, frame: int) -> list[tuple[Label, 
     for label in rec.labels(view, frame):
         u, v = rec.pixel(view, frame, label)
         x, y = u * scale, v * scale
-        half = 0.5 * (CHAR_PX * len(label.text) + 2 * LABEL_PAD_PX)
-        out.append((label, (x - half, y + 3.0, x + half, y + 3.0 + LABEL_HEIGHT_PX)))
+        out.append((label, text_box(label.text, x, y)))
     return out
 
 

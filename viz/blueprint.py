@@ -40,7 +40,6 @@ DEFAULT_FOCUS_HEIGHT_M = 40.0
 """The same for the other classes."""
 COMPARED_ROW_SHARES = (4, 1)
 """With two runs or more, the left column's rows: the scene views, the comparison panel below them."""
-COMPARED_SCENE_SHARE = COMPARED_ROW_SHARES[0] / sum(COMPARED_ROW_SHARES)
 STORY_COLUMNS = rrb.TextLogColumns(
     text_log_columns=[
         rrb.components.TextLogColumn(kind="LogLevel", visible=True),
@@ -182,15 +181,31 @@ def _caps(tracker: str, caps: Mapping[str, Capabilities] | None) -> Capabilities
     return given if given is not None else tracker_capabilities(tracker)
 
 
+def existence_word(caps: Capabilities) -> str:
+    """What a run's per-track value is called in its plot: ``weight`` for a PHD or CPHD filter (the trackers whose
+    tracks are intensity components, ``Panel.INTENSITY``: an expected number of objects, which its events carry
+    capped at 1, ``gnnpmb.phd.gmphd``), ``existence`` (a probability) for the others."""
+    return "weight" if Panel.INTENSITY in caps.panels else "existence"
+
+
+def _series_title(caps: Capabilities) -> str:
+    """The per-track value's plot title: a PHD weight says that the plot caps it (the focus text gives 1.10)."""
+    word = existence_word(caps)
+    return "weight (capped at 1)" if word == "weight" else word
+
+
 def failure_counts_view(tracker: str) -> rrb.TimeSeriesView:
     return rrb.TimeSeriesView(origin=failures_root(tracker), name=f"{tracker} failures per frame")
 
 
-def _series_contents(root: str, focus: FocusTarget | None, tracker: str) -> list[str] | str:
-    """Every series, or with a focus the involved tracks' (and their class's extraction threshold)."""
-    if focus is None or not focus.track_ids.get(tracker):
-        return "$origin/**"
-    return [f"+ {root}/{focus.class_name}/{t}" for t in (*focus.track_ids[tracker], "threshold")]
+def _series_contents(root: str, near: FocusTarget | None, tracker: str, focused: bool = False) -> list[str] | str:
+    """Every series, or near a failure (a focus, or the one a full recording opens at) the involved tracks' (and
+    their class's extraction threshold). In a focus recording (``focused``) a run with no involved track shows only
+    the threshold: not every track of the scene (a spaghetti of 40 lines beside the failure of the other run,
+    dev set scene-0103 ``--focus diff:introduced:1``)."""
+    if near is None or not near.track_ids.get(tracker):
+        return f"+ {root}/{near.class_name}/threshold" if focused and near is not None else "$origin/**"
+    return [f"+ {root}/{near.class_name}/{t}" for t in (*near.track_ids[tracker], "threshold")]
 
 
 def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visible: bool) -> dict:
@@ -213,7 +228,7 @@ def track_series_views(
     tracks at the failure it opens at (``opening``), with a legend naming them (placed by ``legends``, keyed by
     the view's origin). caps: what the run can show (default: the registry's)."""
     caps = caps or tracker_capabilities(tracker)
-    existence = [(paths.existence_root(tracker), "existence")] if caps.has_existence else []
+    existence = [(paths.existence_root(tracker), _series_title(caps))] if caps.has_existence else []
     nis = [(paths.nis_root(tracker), "NIS (innovation²/S)")] if caps.has_gates else []
     cost = [(paths.chosen_cost_root(tracker), "chosen cost")] if caps.has_costs else []
     near = focus or opening
@@ -222,7 +237,7 @@ def track_series_views(
     return [
         rrb.TimeSeriesView(
             origin=root,
-            contents=_series_contents(root, near, tracker),
+            contents=_series_contents(root, near, tracker, focused=focus is not None),
             name=f"{tracker} {what}{at}",
             **_legend_args(root, legends, few or focus is not None),
         )

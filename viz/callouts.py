@@ -17,27 +17,35 @@ from dataclasses import dataclass
 import numpy as np
 import rerun as rr
 
+from viz.colors import readable_text
+from viz.label_size import BELOW_ANCHOR_PX, CLEARANCE_PX, HEIGHT_PX, width_px
+
 FOV_Y_DEG = 55.0
 """Vertical field of view of the bird's-eye view's eye (Rerun's default)."""
 FOCUS_BEV_HEIGHT_PX = 683.0
 """Height of a focus recording's bird's-eye view of one run without a camera view, at 1920 x 1080 (measured in the
-web viewer: dev set scene-0103 simpletrack fragmentation:9; two runs and a camera view below shorten it,
-``viz.focus``)."""
+web viewer: dev set scene-0103 simpletrack fragmentation:9); ``focus_bev_height_px`` for the other layouts."""
+COMPARED_CAMERA_HEIGHTS_PX = {
+    (False, False): FOCUS_BEV_HEIGHT_PX,
+    (True, False): 547.0,
+    (False, True): 404.0,
+    (True, True): 318.0,
+}
+"""(runs compared, a camera view below) -> the bird's-eye view's height in pixels at 1920 x 1080, laid out from the
+focus blueprint as ``tools.labels.layout_px`` does (689 px there for ``FOCUS_BEV_HEIGHT_PX``). The shares they
+were estimated from (0.55 with a camera, 0.8 compared) made a three-run view with a camera 300 px tall, not 318:
+the views were thought 6 % wider in metres than they are and their callouts ran past the edge (demo scene-0103,
+pointpillars, cphd beside ab3dmot and pmbm, ``--focus id_switch:1``)."""
 M_PER_PX_PER_HEIGHT = 2.0 * math.tan(math.radians(FOV_Y_DEG / 2.0)) / FOCUS_BEV_HEIGHT_PX
 """Metres per screen pixel per metre of camera height in that view (a pinhole looking straight down: 18 m ->
 0.027 m; it was a measured 0.0022, true of a shorter view, so a column could sit past a taller view's edge)."""
-LINE_PX = 22.0
-"""Rows of the column are this many pixels apart (a label is about 16 px tall)."""
-CHAR_PX = 5.8
-"""Width of one label character in pixels, and ``PAD_PX`` the label's background beyond its text on each side:
-measured in the web viewer at 1920 x 1080 (dev set scene-0916, megvii, ``diff:introduced:38``: labels of 9, 19, 20
-and 37 characters 74, 135, 140 and 236 px wide with their background)."""
+LINE_PX = HEIGHT_PX + CLEARANCE_PX
+"""Rows of the column are this many pixels apart: a label's height and air (``viz.label_size``)."""
 GAP_PX = 40.0
 """Clear space between the rightmost object and the labels' aligned left ends (and between the objects and a
 column stacked above or below them)."""
 STACK_GAP_PX = 8.0
 """Beside the objects, between the rightmost one and the aligned left ends of a column stacked above them."""
-PAD_PX = 11.0
 POINT_RADIUS_M = 0.08
 LEADER_RADIUS_M = 0.05
 
@@ -57,6 +65,7 @@ def column_positions(
     height_m: float,
     view_x_m: tuple[float, float] | None = None,
     view_y_m: tuple[float, float] | None = None,
+    clear_xy_m: np.ndarray | None = None,
 ) -> np.ndarray:
     """(N, 2) label centres for N callouts at (N, 2) anchors with (N,) text lengths: one column right of the
     rightmost anchor, its labels' left ends aligned ``GAP_PX`` from it (left of the leftmost anchor, right ends
@@ -66,33 +75,57 @@ def column_positions(
     through a label. When neither side holds the column whole (a narrow view: three runs side by side) and
     ``view_y_m`` (the y range the view shows) leaves room above the anchors, or else below them, the column goes
     there, just right (else left) of the anchors, inside the view; only when no place holds it does it go to the
-    side that cuts less."""
+    side that cuts less, pushed inside the view when the view is wider than the column. Near the view's top or
+    bottom edge (``view_y_m``) the rows move as a block to stay inside it. ``clear_xy_m`` (M, 2):
+    more points the column keeps clear of as of the anchors (the corners of the boxes the labels name: a long
+    truck's box reaches metres past its centre)."""
     n = len(anchors_xy_m)
     if n == 0:
         return np.zeros((0, 2))
+    extent_xy_m = anchors_xy_m if clear_xy_m is None else np.concatenate([anchors_xy_m, clear_xy_m.reshape(-1, 2)])
     m_per_px = M_PER_PX_PER_HEIGHT * height_m
     halves_m = half_widths_m(chars, m_per_px)
     width_m = 2.0 * float(np.max(halves_m))
     gap_m, line_m = GAP_PX * m_per_px, LINE_PX * m_per_px
     order = np.argsort(-anchors_xy_m[:, 1], kind="stable")
     rows_y = float(np.mean(anchors_xy_m[:, 1])) + line_m * (0.5 * (n - 1) - np.arange(n))
-    edge, side = float(np.max(anchors_xy_m[:, 0])) + gap_m, 1.0  # the column's near edge; +1: it runs right
+    edge, side = float(np.max(extent_xy_m[:, 0])) + gap_m, 1.0  # the column's near edge; +1: it runs right
     if view_x_m is not None and edge + width_m > view_x_m[1]:
-        left_edge = float(np.min(anchors_xy_m[:, 0])) - gap_m
+        left_edge = float(np.min(extent_xy_m[:, 0])) - gap_m
         over_right, over_left = edge + width_m - view_x_m[1], view_x_m[0] - (left_edge - width_m)
         if over_left < over_right:
             edge, side = left_edge, -1.0
-        stacked = _stacked(anchors_xy_m, width_m, gap_m, line_m, STACK_GAP_PX * m_per_px, view_x_m, view_y_m)
+        stacked = _stacked(extent_xy_m, n, width_m, gap_m, line_m, STACK_GAP_PX * m_per_px, view_x_m, view_y_m)
         if min(over_left, over_right) > 0.0 and stacked is not None:
             edge, side, rows_y = stacked
+        elif min(over_left, over_right) > 0.0 and width_m <= view_x_m[1] - view_x_m[0]:
+            # no place holds it: pushed back inside the view, over the objects (a label over a box can be read,
+            # one past the view's edge cannot)
+            edge = view_x_m[1] - width_m if side > 0 else view_x_m[0] + width_m
+    if view_y_m is not None:  # near the view's top or bottom edge (frames before the failure): rows kept inside
+        rows_y = _inside(rows_y, view_y_m, (BELOW_ANCHOR_PX + HEIGHT_PX) * m_per_px)
     out = np.empty((n, 2))
     out[:, 0] = edge + side * halves_m
     out[order, 1] = rows_y
     return out
 
 
+def _inside(rows_y: np.ndarray, view_y_m: tuple[float, float], hang_m: float) -> np.ndarray:
+    """Rows' y (their labels' anchors; each label hangs ``hang_m`` below its anchor) shifted as a block so that
+    every label lies inside ``view_y_m``, when the view is tall enough for them."""
+    low, high = float(np.min(rows_y)) - hang_m, float(np.max(rows_y))
+    if high - low > view_y_m[1] - view_y_m[0]:
+        return rows_y
+    if low < view_y_m[0]:
+        return rows_y + (view_y_m[0] - low)
+    if high > view_y_m[1]:
+        return rows_y - (high - view_y_m[1])
+    return rows_y
+
+
 def _stacked(
-    anchors_xy_m: np.ndarray,
+    extent_xy_m: np.ndarray,
+    n: int,
     width_m: float,
     gap_m: float,
     line_m: float,
@@ -100,34 +133,41 @@ def _stacked(
     view_x_m: tuple[float, float],
     view_y_m: tuple[float, float] | None,
 ) -> tuple[float, float, np.ndarray] | None:
-    """(near edge, +1 / -1: the column runs right / left from it, rows' y top-down) of a column above the
-    anchors, else below them, that the view holds whole, its near edge ``near_m`` right of the rightmost anchor
-    (else left of the leftmost one; else at the view's right edge, where a leader may cross a label); None when
-    neither above nor below holds it (or the view's y range is unknown, or a label is wider than the view)."""
+    """(near edge, +1 / -1: the column runs right / left from it, rows' y top-down) of a column of ``n`` labels
+    above the objects (``extent_xy_m`` (M, 2): the anchors and the points to keep clear of), else below them, that
+    the view holds whole, its near edge ``near_m`` right of the rightmost point (else left of the leftmost one;
+    else at the view's right edge, where a leader may cross a label); None when neither above nor below holds it
+    (or the view's y range is unknown, or a label is wider than the view)."""
     if view_y_m is None or width_m > view_x_m[1] - view_x_m[0]:
         return None
-    n = len(anchors_xy_m)
     steps = line_m * np.arange(n)
-    top = float(np.max(anchors_xy_m[:, 1])) + gap_m + line_m * (n - 0.5)  # the top row's centre, above
-    first = float(np.min(anchors_xy_m[:, 1])) - gap_m - 0.5 * line_m  # the top row's centre, below
+    top = float(np.max(extent_xy_m[:, 1])) + gap_m + line_m * (n - 0.5)  # the top row's centre, above
+    first = float(np.min(extent_xy_m[:, 1])) - gap_m - 0.5 * line_m  # the top row's centre, below
     if top + 0.5 * line_m <= view_y_m[1]:
         rows = top - steps
     elif first - line_m * (n - 0.5) >= view_y_m[0]:
         rows = first - steps
     else:
         return None
-    right = float(np.max(anchors_xy_m[:, 0])) + near_m
+    right = float(np.max(extent_xy_m[:, 0])) + near_m
     if right + width_m <= view_x_m[1]:
         return right, 1.0, rows
-    left = float(np.min(anchors_xy_m[:, 0])) - near_m
+    left = float(np.min(extent_xy_m[:, 0])) - near_m
     if left - width_m >= view_x_m[0]:
         return left, -1.0, rows
     return view_x_m[1] - width_m, 1.0, rows
 
 
+def focus_height_m(eye_height_m: float, compared: bool, camera: bool) -> float:
+    """The height ``column_positions`` takes for a focus bird's-eye view whose eye is ``eye_height_m`` above the
+    ground: the one at which ``FOCUS_BEV_HEIGHT_PX`` tall would show as many metres per pixel as the layout's view
+    (``COMPARED_CAMERA_HEIGHTS_PX``) does from ``eye_height_m``."""
+    return eye_height_m * FOCUS_BEV_HEIGHT_PX / COMPARED_CAMERA_HEIGHTS_PX[compared, camera]
+
+
 def half_widths_m(chars: np.ndarray, m_per_px: float) -> np.ndarray:
     """(N,) half widths in metres of labels of ``chars`` (N,) characters, with their background."""
-    return (0.5 * CHAR_PX * np.asarray(chars, dtype=np.float64) + PAD_PX) * m_per_px
+    return 0.5 * width_px(np.asarray(chars, dtype=np.float64)) * m_per_px
 
 
 def leader_ends(anchors_xy_m: np.ndarray, labels_xy_m: np.ndarray, chars: np.ndarray, height_m: float) -> np.ndarray:
@@ -146,22 +186,26 @@ def log_callouts(
     height_m: float,
     view_x_m: tuple[float, float] | None = None,
     view_y_m: tuple[float, float] | None = None,
+    clear_xy_m: np.ndarray | None = None,
 ) -> None:
-    """The callouts as labelled points (``path``) and leader lines (``path/leaders``) at the current time; an
-    empty list clears both. ``view_x_m`` / ``view_y_m``: the x / y range the bird's-eye view shows
+    """The callouts as labelled points (``path``; the text in its colour darkened to be read on the label's pale
+    background, ``colors.readable_text``: a truck's light cyan was not) and leader lines (``path/leaders``, in the
+    colour itself) at the current time; an empty list clears both. ``view_x_m`` / ``view_y_m``: the x / y range
+    the bird's-eye view shows; ``clear_xy_m`` (M, 2): the corners of the boxes the column keeps clear of
     (``column_positions``)."""
     anchors = np.array([c.anchor_m for c in callouts], dtype=np.float64).reshape(-1, 3)
     chars = np.array([len(c.text) for c in callouts], dtype=np.int64)
-    xy = column_positions(anchors[:, :2], chars, height_m, view_x_m, view_y_m)
+    xy = column_positions(anchors[:, :2], chars, height_m, view_x_m, view_y_m, clear_xy_m)
     labels_at = np.concatenate([xy, anchors[:, 2:]], axis=1)
     ends = np.concatenate([leader_ends(anchors[:, :2], xy, chars, height_m), anchors[:, 2:]], axis=1)
     colors = np.array([c.color for c in callouts], dtype=np.uint8).reshape(-1, 3)
+    text_colors = np.array([readable_text(c.color) for c in callouts], dtype=np.uint8).reshape(-1, 3)
     stream.log(
         path,
         rr.Points3D(
             labels_at,
             labels=[c.text for c in callouts],
-            colors=colors,
+            colors=text_colors,
             radii=POINT_RADIUS_M,
             show_labels=True,
         ),

@@ -33,7 +33,8 @@ from viz.box_projection import CameraFrame, project_boxes, take_lines
 from viz.colors import class_colors, readable_text, track_color
 from viz.failure_style import KIND_COLORS
 from viz.failures import failure_label
-from viz.label_room import keep_clear, text_box
+from viz.label_room import keep_clear
+from viz.label_size import text_box
 from viz.rows import flat_strips_array
 from viz.timeline import Clock
 

@@ -31,9 +31,6 @@ from viz.timeline import TIMESTAMP, Clock
 
 SCENE_ROW_SHARES = (3.0, 2.0)
 """Row shares of the scene views and the camera views below them."""
-SCENE_HEIGHT_WITH_CAMERAS = 0.55
-"""A scene view's height with the camera views below it over its height without: 3/5 of the rows, less the
-title bars (0.57 for the focus bird's-eye view laid out at 1920 x 1080, ``tools.labels.layout_px``)."""
 IMAGE_PLANE_DISTANCE_M = 1.5
 """How far in front of a camera its image is drawn in a 3D view (Rerun's frustum)."""
 

@@ -44,11 +44,13 @@ def failure_log(tracker: str) -> str:
 
 
 def failure_label(kind: FailureKind, box: FailureBox) -> str:
-    """``ID switch: old track 26``; a role that already names the kind is not repeated (``false track 20``)."""
+    """``ID switch: old track 26``; a role that already names the kind is not repeated (``false track 20``); an
+    object is ``GT a1b2c3`` as everywhere else in the viewer (the report's role says ``gt``)."""
     name = short_id(box.object_id) if box.is_gt else box.object_id
+    role = f"{box.role[:-2]}GT" if box.is_gt else box.role
     if box.role.startswith(KIND_LABELS[kind]):
-        return f"{box.role} {name}"
-    return f"{KIND_LABELS[kind]}: {box.role} {name}"
+        return f"{role} {name}"
+    return f"{KIND_LABELS[kind]}: {role} {name}"
 
 
 def _frame_boxes(
@@ -94,7 +96,8 @@ def _keep_apart(
         for k, (box, text) in enumerate(zip(boxes, labels, strict=True)):
             if text:
                 xy = (float(box.translation_m[0]), float(box.translation_m[1]))
-                markers.append((int(frame_of[k]), Candidate(rank, ("marker", kind, k), text, xy)))
+                z = float(box.translation_m[2])
+                markers.append((int(frame_of[k]), Candidate(rank, ("marker", kind, k), text, xy, z)))
     dropped = notes.keep_apart(tracker, scene, markers)
     for _, kind, k in dropped:
         drawn[kind][1][k] = ""

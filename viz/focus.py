@@ -35,19 +35,25 @@ from gnnpmb.why.findings import Finding
 from gnnpmb.why.words import existence_text, share_text, went_text
 from viz import compare, paths
 from viz.blueprint import (
-    COMPARED_SCENE_SHARE,
     DEFAULT_FOCUS_HEIGHT_M,
     FOCUS_HEIGHT_M,
     focus_doc,
     focus_world,
     reading_guide_doc,
 )
-from viz.callouts import FOV_Y_DEG, M_PER_PX_PER_HEIGHT, Callout, log_callouts
-from viz.cameras import SCENE_HEIGHT_WITH_CAMERAS
+from viz.callouts import FOV_Y_DEG, M_PER_PX_PER_HEIGHT, Callout, focus_height_m, log_callouts
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
 from viz.focus_summary import TrackerView, focus_markdown
-from viz.geometry import estimate_boxes, quat_wxyz_to_xyzw, size_wlh_to_xyz
+from viz.geometry import (
+    RerunBoxes,
+    estimate_boxes,
+    footprint_corners_xy,
+    quat_wxyz_to_xyzw,
+    rerun_boxes,
+    size_wlh_to_xyz,
+)
+from viz.label_size import CLEARANCE_PX
 from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
 from viz.logger import TrackerLogger
 from viz.markers import send_text_lines
@@ -101,15 +107,7 @@ def log_focus(
     gt_ids = set(focus.gt_ids)
     evaluated = evaluated_offsets(focus, reports.get(focus.failure_tracker or ""))
     reach_m = range_near_focus(focus, scene)
-    eye_height_m = height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
-    if sight is not None:  # a camera view below: the bird's-eye view is shorter, a pixel more metres
-        height_m /= SCENE_HEIGHT_WITH_CAMERAS
-    if len(loggers) > 1:  # runs compared: the comparison panel takes a share of the scene's height
-        height_m /= COMPARED_SCENE_SHARE
-    half_view_m = 0.5 * FOCUS_VIEW_WIDTH_PX / max(len(loggers), 1) * M_PER_PX_PER_HEIGHT * height_m
-    view_x_m = (focus.center_xy_m[0] - half_view_m, focus.center_xy_m[0] + half_view_m)
-    half_tall_m = eye_height_m * math.tan(math.radians(0.5 * FOV_Y_DEG))  # the eye's vertical field of view
-    view_y_m = (focus.center_xy_m[1] - half_tall_m, focus.center_xy_m[1] + half_tall_m)
+    eye_height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
     for i in shown:
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
@@ -125,6 +123,9 @@ def log_focus(
             for r, label in zip(rows.tolist(), labels, strict=True)
         ]
         z_m = float(gt.translation_m[rows[0], 2]) if rows.size else scene.ground_z_m
+        gt_corners = footprint_corners_xy(RerunBoxes(centers[0], sizes[0], quats[0]), SCALE, MARGIN_M)
+        depth_m = max(eye_height_m - z_m, 1.0)  # the eye sits at eye_height_m in the global frame
+        height_m, view_x_m, view_y_m = _callout_room(focus, depth_m, len(loggers), sight is not None)
         if i == focus.frame_index:
             gt_callouts += [
                 Callout(
@@ -184,16 +185,20 @@ def log_focus(
             detections = frame.detections.boxes
             use = facts.use(i, focus.class_name)
             mode = use.mode if use is not None else UseMode.ASSIGNED
+            named = [gt_corners, footprint_corners_xy(boxes, SCALE, MARGIN_M)]
+            if detections is not None and given:
+                named.append(footprint_corners_xy(rerun_boxes(detections.subset(np.array(sorted(given))))))
             log_callouts(
                 stream,
                 paths.focus_callouts(tracker),
                 gt_callouts
                 + _detection_callouts(detections, sorted(given), facts, i, focus.class_name, mode)
-                + _prediction_callouts(steps, z_m, palette, facts.has_existence)
+                + _prediction_callouts(steps, z_m, palette, facts.has_existence, mode)
                 + ghosts,
                 height_m,
                 view_x_m,
                 view_y_m,
+                np.concatenate(named),
             )
         if meas and detections is not None:
             given = sorted(meas)
@@ -218,6 +223,21 @@ def log_focus(
         )
         if evaluated:
             log_evaluated(stream, focus, scene, evaluated if i == focus.frame_index else {})
+
+
+def _callout_room(
+    focus: FocusTarget, depth_m: float, runs: int, camera: bool
+) -> tuple[float, tuple[float, float], tuple[float, float]]:
+    """(the height ``viz.callouts`` sizes the column with, the x range and the y range the bird's-eye view shows)
+    for callouts ``depth_m`` below its eye: labels drawn at the objects' height are nearer the eye than the ground
+    (a pedestrian's 0.9 m under a 16 m eye: 6 % larger on screen), and a camera view below or the comparison
+    panel makes the view shorter (``viz.callouts.focus_height_m``); ``CLEARANCE_PX`` inside its edges."""
+    height_m = focus_height_m(depth_m, runs > 1, camera)
+    m_per_px = M_PER_PX_PER_HEIGHT * height_m
+    half_wide_m = (0.5 * FOCUS_VIEW_WIDTH_PX / max(runs, 1) - CLEARANCE_PX) * m_per_px
+    half_tall_m = depth_m * math.tan(math.radians(0.5 * FOV_Y_DEG)) - CLEARANCE_PX * m_per_px  # its vertical FOV
+    x, y = focus.center_xy_m
+    return height_m, (x - half_wide_m, x + half_wide_m), (y - half_tall_m, y + half_tall_m)
 
 
 def tracker_views(evidence: Mapping[str, object], loggers: Mapping[str, TrackerLogger]) -> dict[str, TrackerView]:
@@ -384,23 +404,26 @@ def _prediction_callouts(
     z_m: float,
     palette: Mapping[int, tuple[int, int, int]],
     has_existence: bool,
+    mode: UseMode = UseMode.ASSIGNED,
 ) -> list[Callout]:
     """``<id> predicted r=<existence> → m<idx>`` (the detection its update used most, with its share for a soft
     update) or ``, missed`` at each focused track's predicted position this frame, in the track's involved colour
     (``palette``). The existence is the predicted one; for PMBM, when the frame's assignment was decided in another
-    prior hypothesis, the one there, with the best hypothesis's beside it. Without existences: ``<id> predicted
-    → m<idx>``."""
+    prior hypothesis, the one there, with the best hypothesis's beside it. A PHD's or CPHD's track (``mode``
+    ``WEIGHTS``) has a weight, not an existence: ``<id> predicted weight <w> → m<idx>``. Without existences:
+    ``<id> predicted → m<idx>``."""
     out = []
+    name = " weight " if mode is UseMode.WEIGHTS else " r="
     for t, step in steps.items():
         if step is None or step.predicted_xy_m is None:
             continue
         r = ""
         if has_existence and step.prior_existence is not None:
-            r = f" r={existence_text(step.prior_existence)}"
+            r = f"{name}{existence_text(step.prior_existence)}"
             decided = step.decided_existence
             if decided is not None and existence_text(decided) != existence_text(step.prior_existence):
                 best = existence_text(step.prior_existence)
-                r = f" r={existence_text(decided)} in the deciding hypothesis ({best} in the best)"
+                r = f"{name}{existence_text(decided)} in the deciding hypothesis ({best} in the best)"
         use = step.use
         if use is not None and use.shares:
             m, share = use.shares[0]

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from gnnpmb.types import Boxes, TrackEstimate
 
@@ -62,3 +63,16 @@ def lift_xy(xy: np.ndarray, z_m: float | np.ndarray) -> np.ndarray:
     xy = np.asarray(xy, dtype=np.float64)
     z = np.broadcast_to(np.asarray(z_m, dtype=np.float64), xy.shape[:-1])
     return np.concatenate([xy, z[..., None]], axis=-1)
+
+
+def footprint_corners_xy(boxes: RerunBoxes, scale: float = 1.0, margin_m: float = 0.0) -> np.ndarray:
+    """(4 N, 2) BEV corners of N boxes drawn at ``sizes * scale + margin_m`` (rotated by their quaternions)."""
+    n = len(boxes)
+    if n == 0:
+        return np.zeros((0, 2))
+    half = 0.5 * (boxes.sizes_xyz_m * scale + margin_m)
+    signs = np.array([[1.0, 1.0, 0.0], [1.0, -1.0, 0.0], [-1.0, 1.0, 0.0], [-1.0, -1.0, 0.0]])
+    offsets = half[:, None, :] * signs[None, :, :]  # (N, 4, 3) in each box's frame
+    rotation = Rotation.from_quat(np.asarray(boxes.quat_xyzw, dtype=np.float64).reshape(n, 4))
+    out = np.stack([boxes.centers_m[:, :2] + rotation.apply(offsets[:, k])[:, :2] for k in range(4)], axis=1)
+    return out.reshape(-1, 2)

@@ -10,8 +10,8 @@ kinds' order, ``gnnpmb.eval.failures.OPEN_FIRST``) and keeps one only if its tex
 camera in the ego frame, stays clear of the ones already kept in every view; a label left out keeps its box,
 colour and marker, and its words stay a click away (Rerun shows them on hover).
 
-The text box is estimated as ``tools.labels`` does it for the check: ``CHAR_PX`` per character, ``HEIGHT_PX``
-tall, in views as tall as the layout at 1920 x 1080 makes them (``VIEW_HEIGHT_PX`` for the bird's-eye view without
+The text box is the one ``viz.label_size`` measured in the web viewer (``tools.labels`` checks with it too), in
+views as tall as the layout at 1920 x 1080 makes them (``VIEW_HEIGHT_PX`` for the bird's-eye view without
 cameras; ``viz.opening.view_heights_px`` for the layout at hand).
 """
 
@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnnpmb.data.scene import Pose
+from viz.label_size import CLEARANCE_PX, text_box
 
 BEV_EYE_POSITION_M = (6.0, 0.0, 80.0)
 BEV_TARGET_M = (6.0, 0.0, 0.0)
@@ -43,11 +44,6 @@ PERSPECTIVE_HEIGHT_PX = 255.0
 """The same for the perspective view (its share 4 against the bird's-eye view's 6)."""
 VIEW_WIDTH_PX = 576.0
 """Width of each run's 3D views in a two-run recording at 1920 x 1080 (3/5 of the width, halved)."""
-CHAR_PX = 7.0
-HEIGHT_PX = 18.0
-PAD_PX = 4.0
-CLEARANCE_PX = 4.0
-"""Air kept between two labels' text boxes."""
 LABEL_Z_M = 1.0
 """Height above the ego frame's ground a label's anchor (a box centre) is taken at."""
 
@@ -55,12 +51,14 @@ LABEL_Z_M = 1.0
 @dataclass(frozen=True, slots=True)
 class Candidate:
     """A label that would be shown: its rank (lower is kept first), a key the caller knows it by, its text and
-    its anchor's global x, y (metres)."""
+    its anchor's global x, y (and z) in metres."""
 
     rank: int
     key: object
     text: str
     xy_global_m: tuple[float, float]
+    z_global_m: float | None = None
+    """The anchor's height (a box centre's); None: ``LABEL_Z_M`` above the ego frame's ground."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,10 +73,12 @@ class Eye:
 
     def cuts(self, box: tuple[float, float, float, float], anchor: tuple[float, float]) -> bool:
         """Whether the view's edge cuts off a text box (screen pixels from the view's centre) whose anchor is
-        inside the view."""
+        inside the view, or leaves it less than ``CLEARANCE_PX`` (the anchor's height is an estimate,
+        ``LABEL_Z_M``: a pixel either way)."""
         w, h = 0.5 * self.width_px, 0.5 * self.height_px
         if not (-w <= anchor[0] <= w and -h <= anchor[1] <= h):
             return False
+        w, h = w - CLEARANCE_PX, h - CLEARANCE_PX
         return box[0] < -w or box[2] > w or box[1] < -h or box[3] > h
 
     def screen_px(self, point_ego_m: np.ndarray) -> tuple[float, float] | None:
@@ -135,7 +135,8 @@ def keep_apart(candidates: Sequence[Candidate], ego: Pose, views: Sequence[Eye] 
     for eye in views if views is not None else eyes():
         boxes = []
         for c in candidates:
-            at = eye.screen_px(to_ego(c.xy_global_m, ego))
+            z_m = LABEL_Z_M if c.z_global_m is None else c.z_global_m - float(ego.translation_m[2])
+            at = eye.screen_px(to_ego(c.xy_global_m, ego, z_m))
             if at is None:
                 continue
             box = text_box(c.text, *at)
@@ -146,12 +147,6 @@ def keep_apart(candidates: Sequence[Candidate], ego: Pose, views: Sequence[Eye] 
         shown = keep_clear([b for b in sorted(boxes, key=lambda b: b[0]) if b[1] in kept])
         kept = {c.key for c in candidates if c.key in shown or c.key not in {b[1] for b in boxes}} & kept
     return kept
-
-
-def text_box(text: str, x_px: float, y_px: float) -> tuple[float, float, float, float]:
-    """(x0, y0, x1, y1): the text box Rerun draws for ``text`` anchored at screen pixel (x, y), centred under it."""
-    half = 0.5 * (CHAR_PX * len(text) + 2 * PAD_PX)
-    return x_px - half, y_px + 3.0, x_px + half, y_px + 3.0 + HEIGHT_PX
 
 
 def keep_clear(boxes: Sequence[tuple[int, object, tuple[float, float, float, float]]]) -> set[object]:

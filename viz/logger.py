@@ -118,7 +118,8 @@ class TrackerLogger:
     (``colors.involved_track_colors``, away from the colour of ``focus_class``, their class). flush_frames: send
     buffered rows every this many frames (None: only at the end). has_existence: False for a tracker whose
     tracks have no existence probability (``registry.tracker_has_existence``; its events carry 1): no existence
-    series (flat lines at 1, a chunk pair per track) and no existence in the story. facts: the tracker's facts,
+    series (flat lines at 1, a chunk pair per track) and no existence in the story. existence_word: what the
+    series' legend calls the value (``weight`` for a PHD filter). facts: the tracker's facts,
     fed by a ``why.facts.FactSink`` placed before this logger in a ``TeeSink`` (None: the logger keeps and feeds
     its own). Call ``finish()`` after the last frame: it sends what is buffered and the time series.
     """
@@ -143,6 +144,7 @@ class TrackerLogger:
         focus_class: str | None = None,
         facts: TrackerFacts | None = None,
         label_tracks: bool = True,
+        existence_word: str = "existence",
     ) -> None:
         paths.tracker_root(tracker_name)  # rejects names that cannot be an entity-path segment
         self.stream = stream
@@ -160,6 +162,8 @@ class TrackerLogger:
         notes (``viz.opening.LabelNotes``: its failures at that frame) are shown."""
         self.flush_frames = flush_frames
         self.has_existence = has_existence
+        self.existence_word = existence_word
+        """What its per-track value is called in the plot's legend (``viz.blueprint.existence_word``)."""
         self.facts = facts if facts is not None else TrackerFacts(tracker_name, has_existence=has_existence)
         """What the tracker did (``why.facts``): the logger draws from it."""
         self._feeds_facts = facts is None
@@ -635,7 +639,7 @@ class TrackerLogger:
         for k, (x, y) in zip(follow, xy, strict=True):
             t = id_list[k]
             if self.has_existence:
-                self._track_sample(paths.existence, class_name, t, r_list[k], "existence")
+                self._track_sample(paths.existence, class_name, t, r_list[k], self.existence_word)
             trail = self._trails.get(t)
             if trail is None:
                 trail = self._trails[t] = deque(maxlen=TRAIL_FRAMES)
@@ -706,10 +710,11 @@ class TrackerLogger:
 
     def _labelled(self, estimates: list[TrackEstimate]) -> bool:
         """Whether a track's box shows its id: with ``label_tracks``, and in a focus recording only the focus's
-        tracks (the others are dimmed boxes whose id is a click away)."""
+        tracks (the others are dimmed boxes whose id is a click away; a run with no involved track labels none:
+        it labelled all of them, 15 a frame, dev set scene-0103 ``--focus diff:introduced:1``)."""
         if not self.label_tracks:
             return False
-        return not self.focus_tracks or all(e.track_id in self.focus_tracks for e in estimates)
+        return self.focus_tracks is None or all(e.track_id in self.focus_tracks for e in estimates)
 
     # The decision view.
     def _draw_decisions(

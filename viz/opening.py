@@ -30,10 +30,11 @@ from gnnpmb.types import TrackEstimate
 from gnnpmb.why.facts import TrackerFacts
 from gnnpmb.why.words import SHOW_MIN_EXISTENCE, consecutive_runs, frames_text
 from viz import paths
-from viz.colors import faded, packed_track_colors
+from viz.colors import faded, pack_rgba, packed_track_colors, readable_text, track_color
 from viz.failure_style import KIND_COLORS, KIND_LABELS
 from viz.geometry import estimate_boxes
-from viz.label_room import Candidate, Eye, eyes
+from viz.label_room import CLEARANCE_PX, Candidate, Eye, eyes
+from viz.label_size import HEIGHT_PX, width_px
 from viz.timeline import FOCUS, FRAME, Clock
 
 LOST_LOOKBACK = 20
@@ -109,7 +110,8 @@ class LabelNotes:
             e = self.drawn[tracker][key]
             text = f"{key[1]} · {'; '.join(texts)}"
             xy = (float(e.translation_m[0]), float(e.translation_m[1]))
-            by_frame[key[0]].append(Candidate(self.ranks[tracker][key], ("drawn", key), text, xy))
+            z = float(e.translation_m[2])
+            by_frame[key[0]].append(Candidate(self.ranks[tracker][key], ("drawn", key), text, xy, z))
         ghosts = self.ghosts.get(tracker, {})
         for key, texts in self.ghost_notes[tracker].items():
             at = ghosts[key][1]
@@ -136,7 +138,9 @@ class LabelNotes:
         return key in self.drawn.get(tracker, {}) or key in self.ghosts.get(tracker, ())
 
     def send(self, stream: rr.RecordingStream, clock: Clock, scene: SceneData) -> None:
-        """Each noted track's label at its noted frames: ``<id> · <note>; <note>`` (one call per track entity)."""
+        """Each noted track's label at its noted frames: ``<id> · <note>; <note>`` (one call per track entity), its
+        box there in its colour darkened to be read (Rerun writes a label in its box's colour: a pale olive track's
+        "13 · ID switch: …" could not be read on the label's pale background, dev set scene-0916 pmbm)."""
         for tracker, notes in self.notes.items():
             by_track: dict[tuple[str, int], list[tuple[int, str]]] = defaultdict(list)
             for (frame, t), texts in sorted(notes.items()):
@@ -146,13 +150,16 @@ class LabelNotes:
                 frames = np.array([f for f, _ in rows], dtype=np.int64)
                 stamps = np.array([scene.keyframes[f].timestamp_us for f in frames.tolist()], dtype=np.int64)
                 labels = [text for _, text in rows]
+                dark = pack_rgba(np.array([readable_text(track_color(t))], dtype=np.uint8))
                 clock.send(
                     stream,
                     paths.track(tracker, class_name, t),
                     frames,
                     stamps,
-                    lambda sel, labels=labels: rr.Boxes3D.columns(
-                        labels=[labels[i] for i in sel], show_labels=np.ones(len(sel), dtype=bool)
+                    lambda sel, labels=labels, dark=dark: rr.Boxes3D.columns(
+                        labels=[labels[i] for i in sel],
+                        show_labels=np.ones(len(sel), dtype=bool),
+                        colors=np.repeat(dark, len(sel)),
                     ),
                 )
 
@@ -385,10 +392,9 @@ LABEL_SPAN = 7.0
 """Least keyframes' worth of room on the left of the failure timeline for the row names (``label_span``)."""
 SCENE_COLUMN_PX = 0.9 * 1920 * 3 / 5
 """Width the runs' views share at 1920 px (the scene column, ``viz.blueprint`` 3:2, less a tenth for borders)."""
-NAME_CHAR_PX = 7.0
-"""Width of one character of a row name (egui's default font)."""
-ROW_PX = 24.0
-"""Height one row of the failure timeline needs: a row name (18 px) and air, so names of adjacent rows never touch."""
+ROW_PX = HEIGHT_PX + CLEARANCE_PX
+"""Height one row of the failure timeline needs: a row name (``viz.label_size``) and air, so names of adjacent rows
+never touch."""
 VIEW_TITLE_PX = 24.0
 """Height of a view's title bar."""
 RUN_COLUMN_PX = {False: 815.0, True: 489.0}
@@ -418,9 +424,9 @@ def label_span(frames: range, runs: int = 1) -> float:
     """Keyframes' worth of room on the left of the failure timeline for the longest row name ("identity theft
     (999)"), centred there: the view is as wide as the scene column shared by ``runs`` runs and shows the frames
     plus this room, so the room is the name's width over the width left for the frames."""
-    text_px = NAME_CHAR_PX * (LONGEST_NAME + 2)
-    width_px = SCENE_COLUMN_PX / max(runs, 1)
-    return max(LABEL_SPAN, text_px * (len(frames) + 0.5) / max(width_px - text_px, text_px))
+    text_px = float(width_px(LONGEST_NAME)) + 2.0 * CLEARANCE_PX  # and air either side
+    view_px = SCENE_COLUMN_PX / max(runs, 1)
+    return max(LABEL_SPAN, text_px * (len(frames) + 0.5) / max(view_px - text_px, text_px))
 
 
 def strip_share(rows: int, cameras: bool = False) -> float:

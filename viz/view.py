@@ -73,7 +73,7 @@ def run_view(
 
     from gnnpmb.data.nuscenes import load_lidar_points
     from gnnpmb.data.sensor_files import lidar_presence
-    from viz.blueprint import default_blueprint
+    from viz.blueprint import default_blueprint, existence_word
     from viz.compare import log_comparison
     from viz.failures import log_failures
     from viz.logger import FLUSH_FRAMES, TrackerLogger
@@ -183,6 +183,7 @@ def run_view(
                     focus_tracks=set(focus.track_ids.get(run.name, ())) if focus is not None else None,
                     flush_frames=None if inputs.save is not None else FLUSH_FRAMES,
                     has_existence=inputs.caps[run.name].has_existence,
+                    existence_word=existence_word(inputs.caps[run.name]),
                     focus_class=focus.class_name if focus is not None else None,
                     facts=run.facts,
                     label_tracks=focus is not None,  # a full recording labels only what its failures note

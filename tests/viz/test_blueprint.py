@@ -166,3 +166,29 @@ def test_no_innovation_plot_for_a_tracker_without_gates() -> None:
     origins = {v.origin for v in views(default_blueprint(["gnn", "greedy"], ["car"]))}
     assert paths.nis_root("gnn") in origins and paths.nis_root("greedy") not in origins
     assert paths.chosen_cost_root("greedy") in origins
+
+
+def test_in_a_focus_a_run_with_no_involved_track_plots_no_track(tmp_path: Path) -> None:
+    """``--focus diff:introduced:1`` on the dev set's scene-0103: the failure is B's, A has no involved track, and
+    A's existence plot held every track of the scene (40 lines); now only its class's threshold."""
+    import rerun as rr
+
+    from gnnpmb.focus import FocusTarget
+
+    focus = FocusTarget("t", 5, (0.0, 0.0), "car", {"gnnpmb": (1,), "pmbm": ()}, ("abc",))
+    path = tmp_path / "bp.rrd"
+    stream = rr.RecordingStream("bp-test")
+    stream.save(path, default_blueprint=default_blueprint(["gnnpmb", "pmbm"], ["car"], focus))
+    stream.disconnect()
+    reader = RrdReader(path)
+    (blueprint,) = reader.blueprints()
+    queries = [
+        row["ViewContents:query"]
+        for chunk in reader.stream(store=blueprint)
+        for row in chunk.to_record_batch().to_pylist()
+        if row.get("ViewContents:query") and "/existence/" in str(row["ViewContents:query"])
+    ]
+    assert sorted(queries) == [
+        [f"+ {paths.existence_root('gnnpmb')}/car/1", f"+ {paths.existence_root('gnnpmb')}/car/threshold"],
+        [f"+ {paths.existence_root('pmbm')}/car/threshold"],
+    ]

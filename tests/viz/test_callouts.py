@@ -3,7 +3,10 @@ labels' near ends aligned so that no leader runs through a label."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
+from rerun.chunk import RrdReader
 
 from viz.callouts import LINE_PX, M_PER_PX_PER_HEIGHT, column_positions, half_widths_m, leader_ends
 
@@ -35,3 +38,60 @@ def test_a_longer_label_reaches_further_out_and_a_higher_camera_spreads_the_colu
     high = column_positions(anchors, np.array([4, 4]), 2 * HEIGHT_M)
     assert np.ptp(high[:, 1]) == 2 * np.ptp(short[:, 1])
     assert column_positions(np.zeros((0, 2)), np.zeros(0, dtype=int), HEIGHT_M).shape == (0, 2)
+
+
+def test_the_column_clears_the_boxes_it_names_not_only_their_centres(saved_stream) -> None:
+    """A 12 m truck: a column placed from its centre alone ran over its box (dev set scene-0916, phd,
+    ``--focus id_switch:1``); read back from the recording, every label's near end (where its leader meets it)
+    lies right of the box's footprint."""
+    from tests.viz.rrd import read_rows
+    from viz.callouts import Callout, log_callouts
+    from viz.colors import TEXT_LUMINANCE_MAX, luminance
+    from viz.geometry import RerunBoxes, footprint_corners_xy
+
+    stream, path = saved_stream
+    yaw = 0.6
+    truck = RerunBoxes(
+        np.array([[0.0, 0.0, 1.0]]),
+        np.array([[12.0, 3.0, 3.5]]),
+        np.array([[0.0, 0.0, np.sin(yaw / 2), np.cos(yaw / 2)]]),
+    )
+    corners = footprint_corners_xy(truck)
+    assert corners.shape == (4, 2) and np.isclose(corners[:, 0].max(), 6.0 * np.cos(yaw) + 1.5 * np.sin(yaw))
+    cyan = (120, 230, 240)  # a truck's class colour: light on the label's pale background
+    callouts = [Callout((0.0, 0.0, 1.0), "GT f4b6a9", cyan), Callout((0.5, 0.2, 1.0), "m1 0.81", (0, 0, 0))]
+    stream.set_time("frame", sequence=0)
+    log_callouts(stream, "world/callouts", callouts, HEIGHT_M, clear_xy_m=corners)
+    stream.disconnect()
+    rows = read_rows(path)
+    labels = rows["world/callouts"][-1]
+    assert labels["Points3D:labels"] == ["GT f4b6a9", "m1 0.81"]
+    (chunk,) = [c for c in RrdReader(path).store().stream() if c.entity_path == "/world/callouts"]
+    packed = chunk.to_record_batch().column("Points3D:colors").to_pylist()[-1]
+    text_rgb = [((c >> 24) & 0xFF, (c >> 16) & 0xFF, (c >> 8) & 0xFF) for c in packed]
+    assert all(luminance(c) <= TEXT_LUMINANCE_MAX for c in text_rgb) and text_rgb[1] == (0, 0, 0)  # darkened to read
+    assert rows["world/callouts/leaders"][-1]["LineStrips3D:colors"][0] >> 8 == (120 << 16) | (230 << 8) | 240
+    strips = np.array(rows["world/callouts/leaders"][-1]["LineStrips3D:strips"])  # anchor -> the label's near end
+    assert np.all(strips[:, 1, 0] > corners[:, 0].max())  # every label's left end right of the truck's box
+
+
+def test_a_phd_tracks_prediction_callout_names_a_weight_not_an_existence() -> None:
+    from gnnpmb.why.facts import Use, UseMode
+    from viz.focus import _prediction_callouts
+
+    step = SimpleNamespace(
+        predicted_xy_m=(1.0, 2.0),
+        prior_existence=0.79,
+        decided_existence=None,
+        use=Use(((1, 0.78),), 0.1, UseMode.WEIGHTS),
+    )
+    (weights,) = _prediction_callouts({8: step}, 1.0, {8: (0, 0, 255)}, True, UseMode.WEIGHTS)
+    assert weights.text == "8 predicted weight 0.79 → m1 (78 % of its weight)"
+    step = SimpleNamespace(
+        predicted_xy_m=(1.0, 2.0),
+        prior_existence=0.79,
+        decided_existence=None,
+        use=Use(((1, 1.0),), 0.0, UseMode.ASSIGNED),
+    )
+    (existence,) = _prediction_callouts({8: step}, 1.0, {8: (0, 0, 255)}, True)
+    assert existence.text == "8 predicted r=0.79 → m1"

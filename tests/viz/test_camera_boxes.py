@@ -107,7 +107,7 @@ def test_only_the_frames_failures_are_labelled_with_the_run_a_track_belongs_to()
     ]
     missed = _failure(FailureKind.MISS, 2, "missed gt", "4ab7b6aaaa", 20.0, 0.0)
     both = {"a": SimpleNamespace(failures=(missed,)), "b": SimpleNamespace(failures=(missed,))}
-    assert [x.label for x in failure_boxes(both, {2})] == ["missed gt 4ab7b6"]  # one object, both runs missed it
+    assert [x.label for x in failure_boxes(both, {2})] == ["missed GT 4ab7b6"]  # one object, both runs missed it
 
 
 @pytest.fixture
@@ -174,9 +174,9 @@ def test_a_light_failure_colour_is_darkened_for_its_camera_label_the_box_keeps_i
 
 def test_a_label_wider_than_the_image_is_centred_on_it_and_a_narrow_one_kept_inside() -> None:
     """A text wider than the image runs into the margins of a letterboxed view evenly, not off its right edge."""
-    from viz.label_room import text_box
+    from viz.label_size import text_box
 
-    wide = "simpletrack: fragmentation: missed gt bf3d85"
+    wide = "simpletrack: fragmentation: missed GT bf3d85"
     x0, _, x1, _ = (c / CAMERA_VIEW_SCALE for c in text_box(wide, 0.0, 0.0))
     assert x1 - x0 > 1600.0
     assert _inside_image(wide, 10.0, 300.0, 1600, 900)[0] == 800.0

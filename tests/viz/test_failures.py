@@ -73,7 +73,7 @@ def test_failures_are_logged_per_kind_and_frame(saved_stream, tiny_scene) -> Non
     assert [len(r.get("Boxes3D:centers") or []) for r in switch_rows] == [0, 3, 0]
     frame1 = at_frame(switch_rows, 1)[0]
     assert frame1["Boxes3D:labels"] == [
-        "ID switch: gt a1b2c3",
+        "ID switch: GT a1b2c3",
         "ID switch: new track 9",
         "ID switch: old track 4",
     ]
@@ -87,9 +87,9 @@ def test_failures_are_logged_per_kind_and_frame(saved_stream, tiny_scene) -> Non
     miss_rows = [r for r in rows[paths.failures_world(T, "miss")] if not r["static"]]
     assert [r for r in rows[paths.failures_world(T, "miss")] if r["static"]][0]["Boxes3D:show_labels"] == [False]
     assert [r["Boxes3D:labels"] for r in miss_rows] == [
-        ["missed gt a1b2c3", "missed gt p9"],  # the role names the kind: not "miss: missed gt"
+        ["missed GT a1b2c3", "missed GT p9"],  # the role names the kind: not "miss: missed gt"
         [],
-        ["missed gt p9"],
+        ["missed GT p9"],
     ]
 
     counts = {
@@ -177,7 +177,8 @@ def test_a_failure_at_an_interpolated_gt_box_is_named_and_suggested_last(tiny_sc
 
 def test_a_marker_label_does_not_repeat_the_kind() -> None:
     assert failure_label(FailureKind.FALSE_TRACK, fbox("false track", "20", 0.0)) == "false track 20"
-    assert failure_label(FailureKind.FRAGMENTATION, fbox("missed gt", GT_ID, 0.0)) == "fragmentation: missed gt a1b2c3"
+    assert failure_label(FailureKind.FRAGMENTATION, fbox("missed gt", GT_ID, 0.0)) == "fragmentation: missed GT a1b2c3"
+    assert failure_label(FailureKind.ID_SWITCH, fbox("gt", GT_ID, 0.0)) == "ID switch: GT a1b2c3"  # as in the camera
     assert failure_label(FailureKind.IDENTITY_THEFT, fbox("thief track", "9", 0.0)) == "identity theft: thief track 9"
 
 

@@ -4,10 +4,11 @@ the bird's-eye view, and never cut off by a view's edge; the focus callouts' col
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from gnnpmb.data.scene import Pose
 from viz.callouts import M_PER_PX_PER_HEIGHT, column_positions, half_widths_m
-from viz.label_room import Candidate, eyes, keep_apart, px_per_m
+from viz.label_room import LABEL_Z_M, Candidate, eyes, keep_apart, px_per_m
 
 IDENTITY = Pose(np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
 
@@ -70,6 +71,54 @@ def test_in_a_view_too_narrow_for_either_side_the_column_stacks_above_the_object
     assert out[0, 1] > out[1, 1]  # the higher object's label on the upper row
     low = column_positions(anchors, chars, height_m, view_x_m, (-8.0, 0.5))  # no room above: below
     assert np.all(low[:, 1] < anchors[:, 1].min()) and np.all(low[:, 1] - 0.5 >= -8.0)
-    side = column_positions(anchors, chars, height_m, view_x_m)  # the view's height unknown: the side cut less
-    right_ends = side[:, 0] + half_widths_m(chars, M_PER_PX_PER_HEIGHT * height_m)
-    assert np.ptp(right_ends) < 1e-9 and right_ends[0] < anchors[:, 0].min()  # left of the objects, ends aligned
+    side = column_positions(anchors, chars, height_m, view_x_m)  # the view's height unknown: on the side cut less,
+    right_ends = side[:, 0] + half_widths_m(chars, M_PER_PX_PER_HEIGHT * height_m)  # pushed inside the view
+    assert np.ptp(right_ends) < 1e-9 and side[0, 0] - half_label_m >= view_x_m[0] - 1e-9  # ends aligned
+
+
+def test_when_no_place_holds_the_column_it_is_pushed_inside_a_view_wide_enough() -> None:
+    """Three runs side by side, a tall object in the middle: neither side, above nor below holds the column, but
+    the view is wider than it: over the object it can be read, past the edge it could not (demo scene-0103,
+    cphd beside ab3dmot and pmbm, ``--focus id_switch:1``)."""
+    anchors = np.array([[0.0, 0.0]])
+    clear = np.array([[-1.0, -9.0], [1.0, 9.0]])  # a box from the view's bottom to its top
+    chars = np.array([27])
+    height_m = 16.0
+    half_label_m = half_widths_m(chars, M_PER_PX_PER_HEIGHT * height_m)[0]
+    view_x_m = (-1.2 * half_label_m, 1.2 * half_label_m)
+    out = column_positions(anchors, chars, height_m, view_x_m, (-8.0, 8.0), clear)
+    assert view_x_m[0] <= out[0, 0] - half_label_m and out[0, 0] + half_label_m <= view_x_m[1] + 1e-9
+
+
+def test_near_the_views_bottom_edge_the_column_moves_up_to_stay_inside() -> None:
+    """Frames before the failure: the object near the bottom of the fixed bird's-eye view, its labels hanging
+    below it would run past the edge (demo scene-0916, centerpoint, cbmot, ``--focus id_switch:1``, frame 24)."""
+    from viz.label_size import BELOW_ANCHOR_PX, HEIGHT_PX
+
+    anchors = np.array([[0.0, -7.9], [0.3, -7.8]])
+    chars = np.array([9, 20])
+    height_m = 16.0
+    m_per_px = M_PER_PX_PER_HEIGHT * height_m
+    out = column_positions(anchors, chars, height_m, (-20.0, 20.0), (-8.0, 8.0))
+    assert out[:, 1].min() - (BELOW_ANCHOR_PX + HEIGHT_PX) * m_per_px >= -8.0 - 1e-9
+    free = column_positions(anchors, chars, height_m, (-20.0, 20.0), (-20.0, 20.0))
+    np.testing.assert_allclose(free[:, 1].mean(), anchors[:, 1].mean())  # with room: centred on the objects
+
+
+def test_a_labels_anchor_is_taken_at_its_boxs_height() -> None:
+    """A truck's box centre 1.56 m up, just inside the perspective view's bottom edge: its label would run past
+    the edge; taken at the default 1 m the anchor was below the edge and the label kept (dev set scene-0916,
+    pmbm, full recording, frame 24: 'false track 13' cut)."""
+    _, perspective = eyes()
+    half_h = 0.5 * perspective.height_px
+    places = [(x, y) for x in np.linspace(-30.0, 40.0, 701) for y in np.linspace(-20.0, 20.0, 41)]
+    for x, y in places:  # on the ground near the view's bottom edge
+        high = perspective.screen_px(np.array([x, y, 1.56]))
+        low = perspective.screen_px(np.array([x, y, LABEL_Z_M]))
+        if high is not None and low is not None and abs(high[0]) < 100 and half_h - 3.0 < high[1] <= half_h < low[1]:
+            break
+    else:
+        pytest.fail("no such place")
+    at = Candidate(0, "truck", "false track 13", (x, y), 1.56)
+    assert keep_apart([at], IDENTITY, (perspective,)) == set()
+    assert keep_apart([Candidate(0, "truck", "false track 13", (x, y))], IDENTITY, (perspective,)) == {"truck"}

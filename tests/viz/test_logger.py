@@ -369,3 +369,35 @@ def test_no_existence_series_or_story_existence_for_a_tracker_without_existence_
     story = rows[paths.events(T, "car")]
     assert ("track 1 confirmed (from m0)", "INFO") in lines(story, 0)
     assert ("track 1 ended: existence below pruning threshold", "WARN") in lines(story, 2)
+
+
+def test_a_phd_filters_series_name_a_weight(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
+    """A PHD track's value is an expected number of objects (1.10 on the dev set), not an existence probability:
+    its series and its plot say "weight", and the plot that the events cap it at 1 (dev set scene-0916, megvii,
+    phd, ``--focus id_switch:1``)."""
+    from gnnpmb.runs import tracker_capabilities
+    from tests.viz.test_blueprint import stored_views
+    from viz.blueprint import default_blueprint, existence_word
+
+    stream, path = saved_stream
+    log_all(stream, scripted_events(), existence_word=existence_word(tracker_capabilities("phd")))
+    stream.disconnect()
+    rows = read_rows(path)
+    assert [r for r in rows[paths.existence(T, "car", 1)] if r["static"]][0]["SeriesLines:names"] == ["1 car weight"]
+    bp = path.with_name("bp.rrd")
+    out = rr.RecordingStream("bp-test")
+    out.save(bp, default_blueprint=default_blueprint(["phd", "cphd", "gnnpmb"], ["car"]))
+    out.disconnect()
+    names = stored_views(bp)
+    assert names["phd weight (capped at 1)"][1] == paths.existence_root("phd") and "cphd weight (capped at 1)" in names
+    assert names["gnnpmb existence"][1] == paths.existence_root("gnnpmb") and "phd existence" not in names
+
+
+def test_in_a_focus_a_run_with_no_involved_track_labels_none(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
+    """The other run of ``--focus diff:introduced:1`` (dev set scene-0103) has no involved track: it labelled every
+    track, 15 a frame, overlapping; a focus recording labels its involved tracks only."""
+    stream, path = saved_stream
+    log_all(stream, scripted_events(), clock=Clock(focus_end=1), log_frames=range(1, 3), focus_tracks=set())
+    stream.disconnect()
+    (box,) = [r for r in at_frame(read_rows(path)[paths.track(T, "car", 1)], 1) if "Boxes3D:labels" in r]
+    assert box["Boxes3D:labels"] == ["1"] and box["Boxes3D:show_labels"] == [False]

@@ -145,10 +145,30 @@ def test_labels_only_where_they_carry_the_story(recorded) -> None:
 def test_the_failure_timeline_leaves_room_for_its_longest_row_name(runs: int) -> None:
     """The row names are centred in the room left of frame 0; the view spans that room and the frames over its
     width (the scene column shared by ``runs``), so the longest name fits: "oalescence (8)" was clipped."""
-    from viz.opening import LONGEST_NAME, NAME_CHAR_PX, SCENE_COLUMN_PX, label_span
+    from viz.label_size import width_px
+    from viz.opening import LONGEST_NAME, SCENE_COLUMN_PX, label_span
 
     frames = range(40)
     (x0, x1), _ = timeline_bounds(frames, 4, runs)
     px_per_frame = SCENE_COLUMN_PX / runs / (x1 - x0)
-    assert label_span(frames, runs) * px_per_frame >= NAME_CHAR_PX * LONGEST_NAME
+    assert label_span(frames, runs) * px_per_frame >= width_px(LONGEST_NAME)
     assert x0 == frames.start - label_span(frames, runs) and x1 == frames.stop + 0.5
+
+
+def test_a_noted_tracks_label_is_dark_enough_to_read(recorded) -> None:
+    """Rerun writes a box's label in the box's colour on a pale background: where a failure notes a track, its box
+    takes its colour darkened (``colors.readable_text``); a pale olive "13 · ID switch: …" could not be read."""
+    from viz.colors import TEXT_LUMINANCE_MAX, luminance
+
+    _, rows, _ = recorded
+    noted = [
+        r
+        for path, entity in rows.items()
+        if "/tracks/" in path
+        for r in entity
+        if any(" · " in text for text in r.get("Boxes3D:labels") or [])
+    ]
+    assert noted
+    for r in noted:
+        (packed,) = r["Boxes3D:colors"]
+        assert luminance(((packed >> 24) & 0xFF, (packed >> 16) & 0xFF, (packed >> 8) & 0xFF)) <= TEXT_LUMINANCE_MAX

@@ -11,7 +11,8 @@ import rerun as rr
 from gnnpmb.data.sensors import CAMERA_ORDER
 from tools.labels import read_views
 from viz.blueprint import default_blueprint
-from viz.label_room import CLEARANCE_PX, HEIGHT_PX
+from viz.label_room import CLEARANCE_PX
+from viz.label_size import HEIGHT_PX
 from viz.opening import row_step, timeline_bounds
 
 
