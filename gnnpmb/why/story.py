@@ -134,16 +134,19 @@ class Storyteller:
                     (t,),
                     f"track {t} missed this frame, still reported{self._r_in(weight, r)}",
                 )
+        output_ids = {e.track_id for e in extracted}  # the submission's tracks: down to the output threshold
         for t in sorted((self.involved & set(posterior_r)) - known - set(now)):
             step = self.facts.steps(t, class_name).get(frame)
             if step is None:
                 continue
             via = f"started by {meas_name(step.born_from)}" if step.born_from is not None else use_text(step)
-            text = (
-                f"track {t} (not shown, {r} < {self.show_min:g}): {via}, {r}={existence_text(posterior_r[t])}"
-                if self.has_existence
-                else f"track {t} (not output): {via}"
-            )
+            value = f"{r}={existence_text(posterior_r[t])}"
+            if not self.has_existence:
+                text = f"track {t} (not output): {via}"
+            elif t in output_ids:  # below the viewer's line, but in the submission: the evaluation may match it
+                text = f"track {t} (output; {r} below the display threshold {self.show_min:g}): {via}, {value}"
+            else:
+                text = f"track {t} (not output): {via}, {value}"
             say(StoryKind.HIDDEN, "INFO", (t,), text)
         pruned_ids = {p.track_id for p in cf.pruned}
         limit = max(cf.extracted.threshold if cf.extracted is not None else 0.0, self.show_min)
@@ -152,11 +155,15 @@ class Storyteller:
             if output_only:
                 say(StoryKind.NO_LONGER_SHOWN, "WARN", (t,), f"track {t} no longer output")
             elif t in posterior_r:
-                text = (
-                    f"track {t} no longer shown ({r}={posterior_r[t]:.2f} fell below {limit:.2f})"
-                    if self.has_existence
-                    else f"track {t} no longer shown (not output this frame)"
-                )
+                if not self.has_existence:
+                    text = f"track {t} no longer output"
+                elif t in output_ids:  # "not shown" would read as not output: the evaluation still scores it
+                    text = (
+                        f"track {t} fell below the display threshold ({r}={posterior_r[t]:.2f} < "
+                        f"{self.show_min:.2f}), still output"
+                    )
+                else:
+                    text = f"track {t} no longer output ({r}={posterior_r[t]:.2f} fell below {limit:.2f})"
                 say(StoryKind.NO_LONGER_SHOWN, "WARN", (t,), text)
         candidates_pruned = 0
         for p in cf.pruned:

@@ -596,13 +596,16 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         after = held if held is not None else -1
         away = [s.frame for s in steps if after < s.frame < f.frame and s.output is not None]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
-        # "on it" reads as the evaluation's match: said only where the devkit's last match was that output
+        # "on it" reads as the evaluation's match: said only where the devkit's last match was that output, and
+        # "last output on it" not of a track still output on the annotated object at the failure's frame
+        now = f.sighting(f.frame)
+        last_on = held == matched and not (now is not None and t in {o.track_id for o in now.on_it})
         last = (
             f"track {t} was last output on it at frame {held}"
-            if held == matched
+            if last_on
             else f"the evaluation last matched track {t} to it at frame {matched}"
         )
-        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}{_matched_away(f, lost, held == matched)}")
+        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}{_matched_away(f, lost, last_on)}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]

@@ -361,15 +361,37 @@ def check_two_tracks(text: str, class_name: str, frame: int, gt_id: str | None, 
             bad("output", m[0], f"the submission's box of track {t} lies {d:.2f} m from the annotation")
 
 
-STORY_SHOWN = re.compile(r"frame (\d+): track (\d+) (?:no longer shown \(|confirmed \()([rw])=(\d+\.\d+)")
-STORY_HIDDEN = re.compile(r"frame (\d+): track (\d+) \(not shown, ([rw]) < [\d.]+\): [^\n]*?, [rw]=(\d+(?:\.\d+)?)\n")
+STORY_SHOWN = re.compile(
+    r"frame (\d+): track (\d+) (?:no longer (?:shown|output) \(|fell below the display threshold \(|confirmed \()"
+    r"([rw])=(\d+\.\d+)"
+)
+STORY_HIDDEN = re.compile(
+    r"frame (\d+): track (\d+) \((?:not shown, [rw] < [\d.]+|output; [rw] below the display threshold [\d.]+|not "
+    r"output)\): [^\n]*?, ([rw])=(\d+(?:\.\d+)?)\n"
+)
+STORY_OUTPUT = re.compile(
+    r"frame (\d+): track (\d+) (?:(no longer shown|\(not shown)|(no longer output|\(not output)|(fell below the "
+    r"display threshold \([^)]*\), still output|\(output;))"
+)
 
 
-def check_story(section: str, c: str, raw, out, bad) -> None:
+def check_story(section: str, c: str, raw, out, bad, submitted=None) -> None:
     """A focus document's story lines of one run (``section``): "track T confirmed (r=V, …)", "track T no longer
-    shown (r=V fell below …)", "track T (not shown, r < …): …, r=V": V is the track's existence after frame x's
-    update (a GM-PHD / CPHD label's heaviest ``IntensityWeights`` component), and the symbol is ``w`` for such a
-    label, ``r`` for an existence (else ``misleading``)."""
+    output (r=V fell below …)", "track T fell below the display threshold (r=V < …), still output", "track T
+    (output; r below the display threshold …): …, r=V", "track T (not output): …, r=V": V is the track's existence
+    after frame x's update (a GM-PHD / CPHD label's heaviest ``IntensityWeights`` component), and the symbol is
+    ``w`` for such a label, ``r`` for an existence (else ``misleading``). With the run's submission (``submitted``:
+    frame -> track ids with a box there): "output" / "not output" as it has the track's box or not, and "not shown"
+    of a track it output is ``misleading`` (the viewer's display threshold is not the submission's)."""
+    if submitted is not None:
+        for m in STORY_OUTPUT.finditer(section):
+            x, t = int(m[1]), m[2]
+            out.checked["output"] += 1
+            boxed = t in submitted.get(x, set())
+            if m[3] and boxed:  # "not shown": true of the view, misleading of a track output
+                bad("misleading", m[0], f"the submission has a box of track {t} at frame {x}: it was output")
+            elif (m[4] and boxed) or (m[5] and not boxed):
+                bad("output", m[0], f"the submission {'has' if boxed else 'has no'} box of track {t} at frame {x}")
     if raw is None:
         return
     found = [(m[0], int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_SHOWN.finditer(section)]

@@ -230,6 +230,12 @@ def check_text(
         out.checked["misleading"] += 1
         if t not in ev.submitted.get(x, set()):
             bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
+    if scene is not None and ctx.gt_id is not None:
+        for m in LAST_OUTPUT.finditer(text):
+            later = _output_on_after(scene, ev, m[1], ctx.gt_id, int(m[2]), ctx.frame)
+            out.checked["output"] += 1
+            if later:
+                bad("output", m[0], f"the submission's box of track {m[1]} lay within 2 m of the annotation at {later}")
     lost.check_not_output(text, ctx.lost, ev, out, bad)
     lost.check_last_match(text, c, ctx.frame, ctx.gt_id, ev, out, bad)
     lost.check_two_tracks(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
@@ -506,3 +512,16 @@ def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
         return
     if (math.isinf(true) and not math.isinf(shown)) or (math.isfinite(true) and abs(shown - true) > 0.006):
         bad("misleading", m[0], f"re-solved without the pair, the total rises by {true:.3f}")
+
+
+def _output_on_after(scene: SceneTruth, ev: EvalFacts, t: str, gt_id: str, last: int, frame: int) -> list[int]:
+    """The frames after ``last`` up to ``frame`` at which the submission's box of track ``t`` lay within 2 m of
+    object ``gt_id``'s annotation ("last output on it at frame ``last``" is false there)."""
+    later = []
+    for x in range(last + 1, frame + 1):
+        a = scene.objects[x].get(gt_id) if x < len(scene.objects) else None
+        if a is None:
+            continue
+        if any(i == t and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < 2.0 for i, _, xy in ev.boxes.get(x, [])):
+            later.append(x)
+    return later

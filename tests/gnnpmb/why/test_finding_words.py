@@ -216,6 +216,24 @@ def test_last_on_it_is_said_only_of_the_evaluations_last_match_else_that_match_i
     assert "last output on it" not in line and "last matched" not in line
 
 
+def test_a_track_still_output_on_the_object_at_the_failures_frame_is_not_said_to_have_been_last_on_it_before() -> None:
+    # viewer review, demo scene-0103 pointpillars pmbm fragmentation:1: "track 26 was last output on it at frame
+    # 14, ..., at frame 15 track 26 was still output 0.0 m from the annotated object" (the evaluation scored an
+    # interpolated box 4.0 m away at 15: its last match was at 14, but the track had not left the object)
+    from gnnpmb.why.findings import OnObject
+
+    steps = (step(14, output=estimate(26, 0.9)), step(15, output=estimate(26, 0.9)))
+    lost = LostTrack(26, 14, steps, None, None, None, matched_until=14)
+    on_it = Sighting(15, 0, None, None, None, None, (OnObject(26, 0.0, 0.5, -1, None, None),))
+    kind = FailureKind.FRAGMENTATION
+    line = why_lines(finding(kind, lost, frame=15, window=(14, 15), sightings=(on_it,), has_existence=False))[0]
+    assert "last output on it" not in line
+    assert "the evaluation last matched track 26 to it at frame 14" in line
+    left = Sighting(15, 0, None, None, None, None, ())
+    line = why_lines(finding(kind, lost, frame=15, window=(14, 15), sightings=(left,), has_existence=False))[0]
+    assert "track 26 was last output on it at frame 14" in line
+
+
 def test_last_on_it_says_where_the_evaluation_scored_the_object_out_of_the_tracks_reach_and_only_there() -> None:
     # dev set scene-0061 centerpoint gnnpmb fragmentation:3 (independent audit): the aside named frames 8, 9, 11
     # where the evaluation's box was interpolated 2.6, 1.3, 1.3 m off, though at 9 and 11 the track (on the
