@@ -24,6 +24,7 @@ from gnnpmb.why.words import (
     hits_text,
     margin_value,
     meas_name,
+    threshold_held,
     use_text,
 )
 
@@ -248,6 +249,13 @@ class Storyteller:
                     went = column_name(c.chosen)
                 else:
                     went = destination_text(b if b is not None else -1, True, c.chosen)
+                chosen = threshold_held(c.chosen, c.chosen_cost, c) or cost_named(c.chosen_cost, c)
+                held = threshold_held(c.alternative, c.alternative_cost, c)
+                other = (
+                    f"a new track ({held})"
+                    if held is not None
+                    else f"{column_name(c.alternative)} ({cost_value(c.alternative_cost, c)})"
+                )
                 out.append(
                     StoryLine(
                         frame,
@@ -255,8 +263,7 @@ class Storyteller:
                         StoryKind.CLOSE_CALL,
                         "INFO",
                         tuple(sorted(tracks | ({b} if b is not None else set()))),
-                        f"close call: {meas_name(c.meas.ref)} → {went} ({cost_named(c.chosen_cost, c)}) over "
-                        f"{column_name(c.alternative)} ({cost_value(c.alternative_cost, c)}), margin "
+                        f"close call: {meas_name(c.meas.ref)} → {went} ({chosen}) over {other}, margin "
                         f"{margin_value(c.margin, c)}",
                     )
                 )

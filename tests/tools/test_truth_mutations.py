@@ -1064,3 +1064,37 @@ def test_another_run_said_not_to_have_the_failure_where_its_evaluation_matched_t
     assert [c.kind for c in check_text(vague, ctx, None, _eval(), others={"pmbm": other}).found] == ["misleading"]
     named = "pmbm on the same detections did not fail here: the evaluation matched the object to its track 7"
     assert check_text(named, ctx, None, _eval(), others={"pmbm": other}).found == []
+
+
+def test_a_new_track_column_said_as_a_cost_where_it_holds_the_threshold_or_a_wrong_threshold_is_caught() -> None:
+    # viewer review, demo scene-0103 pointpillars ab3dmot: "m0 → track 210 (3D IoU 0.10) over new (3D IoU 0.10),
+    # margin 0.00": AB3DMOT's new-track column holds its IoU threshold (cost 1 - 0.1), no new track's IoU
+    from gnnpmb.events import CostScale
+    from tools.truth.costs import check_thresholds
+    from tools.truth.sentences import Tally
+
+    iou = CostScale("1 - IoU (3D)", "", 0.05, threshold=0.9, similarity="3D IoU")
+    rows = axis_labels(AxisKind.MEASUREMENT, [0])
+    cols = axis_labels(AxisKind.TRACK, [210]) + axis_labels(AxisKind.NEW_TRACK, [0])
+    mat = CostMatrix(C, np.array([[0.8999, 0.9]]), rows, cols, scale=iou)
+    raw = _frames({12: [mat, Assignment(C, ((rows[0], cols[0]),), 0.8999, ())]})
+
+    def found(line: str, events: RawEvents = raw) -> list[str]:
+        out = Tally()
+        check_thresholds(line, C, events, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    took = "- frame 12: m0 → **track 210** (3D IoU 0.10) over {}, margin 0.00 of 3D IoU"
+    assert found(took.format("new (3D IoU 0.10)")) == ["misleading"]
+    assert found(took.format("a new track (the 3D IoU threshold 0.10)")) == []
+    assert found(took.format("a new track (the 3D IoU threshold 0.30)")) == ["cost"]
+    assert found("- frame 12: close call: m0 → track 210 (3D IoU 0.10) over new (3D IoU 0.10), margin 0.00") == [
+        "misleading"
+    ]
+    assert found("- frame 12: m0 → **new track 9** (the 3D IoU threshold 0.20) over track 210 (3D IoU 0.10)") == [
+        "cost"
+    ]
+    nats = CostMatrix(C, np.array([[6.0, 6.5]]), rows, cols)  # no threshold: a new track's cost is a cost
+    plain = _frames({12: [nats, Assignment(C, ((rows[0], cols[0]),), 6.0, ())]})
+    assert found("- frame 12: m0 → **track 210** (cost 6.00) over new (6.50), margin 0.50", plain) == []
+    assert found(took.format("a new track (the 3D IoU threshold 0.10)"), plain) == ["cost"]

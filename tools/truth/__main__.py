@@ -16,7 +16,7 @@ from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from tools.truth import fields, lost
+from tools.truth import costs, fields, lost
 from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
 
 DEVSET = next(
@@ -198,6 +198,11 @@ def _check_focus(
             (submitted or {}).get(name),
         )
         lost.check_track_tables(section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a)))
+        header = f"**Key decisions of {name}**"
+        key = doc.split(header, 1)[1].split("\n\n")[1] if header in doc else ""
+        costs.check_thresholds(
+            key + "\n" + section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a))
+        )
     out.checked["misleading"] += 1
     doc = doc.replace("?url=", "")
     if "?" in doc:

@@ -470,3 +470,29 @@ def test_another_run_matched_at_a_box_it_did_not_output_names_the_track_the_eval
         finding(FailureKind.FRAGMENTATION, lost, frame=6, others=(OtherRun("greedy", False, (), matched=50),))
     )
     assert "greedy on the same detections did not fail here: the evaluation matched the object to its track 50" in line
+
+
+def test_a_new_track_column_that_holds_the_cost_threshold_is_called_the_threshold_not_a_cost() -> None:
+    # viewer review, demo scene-0103 pointpillars ab3dmot's key decision: "m0 → track 210 (3D IoU 0.10) over new
+    # (3D IoU 0.10), margin 0.00": the new-track column holds the IoU threshold (1 - 0.1), not a new track's IoU
+    from gnnpmb.events import AxisKind, AxisLabel, CostScale
+    from gnnpmb.explain import PairChoice
+    from gnnpmb.why.words import choice_text
+
+    iou = CostScale("1 - IoU (3D)", "", 0.05, threshold=0.9, similarity="3D IoU")
+    m0, t210, new = AxisLabel(AxisKind.MEASUREMENT, 0), AxisLabel(AxisKind.TRACK, 210), AxisLabel(AxisKind.NEW_TRACK, 0)
+    took = PairChoice(m0, t210, 0.8999, new, 0.9, 0.0001, scale=iou)
+    assert choice_text(12, took, 210, False) == (
+        "frame 12: m0 → **track 210** (3D IoU 0.10) over a new track (the 3D IoU threshold 0.10), margin 0.00 of 3D IoU"
+    )
+    started = PairChoice(m0, new, 0.9, t210, 0.95, 0.05, scale=iou)
+    assert choice_text(12, started, 338, True) == (
+        "frame 12: m0 → **new track 338** (the 3D IoU threshold 0.10) over track 210 (3D IoU 0.05), margin 0.05 of "
+        "3D IoU"
+    )
+    metres = CostScale("distance", "m", 0.5, threshold=2.0)
+    assert "over a new track (the distance threshold 2.00 m)" in choice_text(
+        3, PairChoice(m0, t210, 1.9, new, 2.0, 0.1, scale=metres), 210, False
+    )
+    nats = PairChoice(m0, t210, 6.0, new, 6.5, 0.5)  # no threshold: a new track's cost is a cost
+    assert "over new (6.50)" in choice_text(3, nats, 210, False)
