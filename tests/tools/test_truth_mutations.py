@@ -1098,3 +1098,26 @@ def test_a_new_track_column_said_as_a_cost_where_it_holds_the_threshold_or_a_wro
     plain = _frames({12: [nats, Assignment(C, ((rows[0], cols[0]),), 6.0, ())]})
     assert found("- frame 12: m0 → **track 210** (cost 6.00) over new (6.50), margin 0.50", plain) == []
     assert found(took.format("a new track (the 3D IoU threshold 0.10)"), plain) == ["cost"]
+
+
+def test_a_focus_naming_another_runs_track_its_views_do_not_highlight_is_caught() -> None:
+    # viewer review: the run without the failure of a diff focus highlighted no track though the text named its
+    # track (dev scene-0916 megvii phd -> cphd diff:fixed:20, phd's false_track:5: cphd's track 27 named, none
+    # involved)
+    from tools.truth.otherruns import check_involved
+    from tools.truth.sentences import Tally
+
+    doc = (
+        "**Why** (phd): ...; cphd on the same detections did not fail here: its tracks 27, 31 were output on the "
+        "object and counted; gnnpmb on the same detections did not fail here: the evaluation matched the object to "
+        "its track 50.\n"
+    )
+
+    def found(track_ids: dict) -> list[str]:
+        out = Tally()
+        check_involved(doc, track_ids, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    assert found({"phd": (12,), "cphd": (27, 31), "gnnpmb": (50, 51)}) == []
+    assert found({"phd": (12,), "cphd": (), "gnnpmb": (50,)}) == ["misleading"]
+    assert found({"phd": (12,), "cphd": (27, 31), "gnnpmb": (51,)}) == ["misleading"]

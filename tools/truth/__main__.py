@@ -16,7 +16,7 @@ from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from tools.truth import costs, fields, lost
+from tools.truth import costs, fields, lost, otherruns
 from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
 
 DEVSET = next(
@@ -187,6 +187,7 @@ def _check_focus(
         story = tuple(line for x in ev.facts.frame_indices for line in teller.frame_lines(x))
         views[name] = TrackerView(ev, request.capabilities(name).has_gates, story, frozenset(teller.shown_ever))
     doc = focus_markdown(target, finding, views, target.window(request.frame_range), request.scene)
+    otherruns.check_involved(doc, target.track_ids, out, lambda *a: out.found.append(Contradiction(*a)))
     for name, raw in (raws or {}).items():
         section = doc.split(f"\n## {name}\n", 1)[1].split("\n## ", 1)[0] if f"\n## {name}\n" in doc else ""
         lost.check_story(
