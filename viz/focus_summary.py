@@ -355,7 +355,13 @@ def _steps_markdown(view: TrackerView, class_name: str, track_ids: list[int], fr
             before = "—" if s.prior_existence is None else existence_text(s.prior_existence)
             if s.decided_existence is not None and existence_text(s.decided_existence) != before:
                 before += f" ({existence_text(s.decided_existence)} in the hypothesis its detection was decided in)"
-            after = "ended" if s.ended is not None else existence_text(s.posterior_existence or 0.0)
+            after = (
+                "ended"
+                if s.ended is not None
+                else "—"
+                if s.posterior_existence is None  # e.g. a copy a GM-PHD extraction made: no component of its own
+                else existence_text(s.posterior_existence)
+            )
             out.append(f"| {s.frame} | {before} | {gated} | {used} | {after} | {output} |")
         out.append("")
     return out

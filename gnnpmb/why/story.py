@@ -127,6 +127,14 @@ class Storyteller:
                         f": the best hypothesis now descends from prior hypothesis {hyp.best_parent}, in which it "
                         f"has existed since frame {since}"
                     )
+                copy_of = _copied(e, extracted, posterior_r) if cf.intensity is not None else None
+                if copy_of is not None:  # Vo & Ma's round(w) copies of a heavy component: no weight of its own
+                    said = (
+                        f"track {t} confirmed (a copy of track {copy_of}'s component, {r}={posterior_r[copy_of]:.2f}, "
+                        f"which the extraction outputs round({r}) times; {via})"
+                    )
+                    say(StoryKind.CONFIRMED, "INFO", (t,), said)
+                    continue
                 say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} confirmed ({self._r(weight, r)}{via}){why}")
             elif e.meas_index < 0:
                 say(
@@ -274,3 +282,16 @@ class Storyteller:
 
     def _r_in(self, existence: float, symbol: str = "r") -> str:
         return f" ({symbol}={existence:.2f})" if self.has_existence else ""
+
+
+def _copied(e, extracted, weights: dict[int, float]) -> int | None:
+    """The label whose component estimate ``e`` copies (a GM-PHD extraction outputs a component round(w) times, the
+    extra copies under ids of their own: Vo & Ma 2006, Table III), None when ``e`` has a component of its own or
+    no estimate at its place has one."""
+    if e.track_id in weights:
+        return None
+    at = np.asarray(e.translation_m, dtype=np.float64)
+    for other in extracted:
+        if other.track_id in weights and np.allclose(np.asarray(other.translation_m, dtype=np.float64), at):
+            return other.track_id
+    return None

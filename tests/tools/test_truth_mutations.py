@@ -1121,3 +1121,57 @@ def test_a_focus_naming_another_runs_track_its_views_do_not_highlight_is_caught(
     assert found({"phd": (12,), "cphd": (27, 31), "gnnpmb": (50, 51)}) == []
     assert found({"phd": (12,), "cphd": (), "gnnpmb": (50,)}) == ["misleading"]
     assert found({"phd": (12,), "cphd": (27, 31), "gnnpmb": (51,)}) == ["misleading"]
+
+
+def test_a_focus_documents_choice_line_with_a_wrong_value_or_margin_on_any_scale_is_caught() -> None:
+    # the key decisions and close calls of a focus document were read by no check (their 3D IoU and nats values,
+    # "over new (V)", and a close call's margin): each value against the deciding matrix, the margin re-solved
+    from gnnpmb.events import CostScale
+    from tools.truth.sentences import Tally, check_choice_lines
+
+    iou = CostScale("1 - IoU (3D)", "", 0.05, threshold=0.9, similarity="3D IoU")
+    rows = axis_labels(AxisKind.MEASUREMENT, [0, 1])
+    cols = axis_labels(AxisKind.TRACK, [210]) + axis_labels(AxisKind.NEW_TRACK, [0, 1])
+    cost = np.array([[0.7, 0.9, np.inf], [np.inf, np.inf, 0.9]])
+    pairs = ((rows[0], cols[0]), (rows[1], cols[2]))
+    raw = _frames({12: [CostMatrix(C, cost, rows, cols, scale=iou), Assignment(C, pairs, 1.6, ())]})
+    nats = np.array([[10.39, 10.71, np.inf], [np.inf, np.inf, 9.0]])
+    plain = _frames({18: [CostMatrix(C, nats, rows, cols), Assignment(C, pairs, 19.39, ())]})
+
+    def found(line: str, events: RawEvents = raw) -> list[str]:
+        out = Tally()
+        check_choice_lines(line, C, events, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    true = (
+        "- frame 12: m0 → **track 210** (3D IoU 0.30) over a new track (the 3D IoU threshold 0.10), margin 0.20 of "
+        "3D IoU"
+    )
+    assert found(true) == []
+    assert found(true.replace("(3D IoU 0.30)", "(3D IoU 0.70)")) == ["cost"]
+    assert found(true.replace("margin 0.20", "margin 0.05")) == ["misleading"]
+    close = "- frame 18: close call: m0 → track 210 (cost 10.39) over new (10.71), margin 0.32"
+    assert found(close, plain) == []
+    assert found(close.replace("(10.71)", "(10.17)"), plain) == ["cost"]
+    assert found(close.replace("margin 0.32", "margin 0.50"), plain) == ["misleading"]
+
+
+def test_a_phd_copy_said_with_a_weight_of_its_own_or_a_wrong_source_is_caught() -> None:
+    # dev set scene-0916 megvii phd: "frame 29: track 44 confirmed (w=1.00, from m3)" of the extraction's second
+    # copy of label 40's component (weight 1.62): no component is labelled 44
+    from gnnpmb.events import IntensityWeights
+    from tools.truth.lost import check_story
+    from tools.truth.sentences import Tally
+
+    raw = _frames({29: [IntensityWeights(C, np.array([40, 41]), np.array([1.62, 0.9]))]})
+
+    def found(section: str) -> list[str]:
+        out = Tally()
+        check_story(section, C, raw, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    assert found("- frame 29: track 44 confirmed (w=1.00, from m3)\n") == ["tracker"]
+    copy = "- frame 29: track 44 confirmed (a copy of track {}'s component, w={}, which the extraction outputs"
+    assert found(copy.format(40, "1.62")) == []
+    assert found(copy.format(41, "0.90")) == ["tracker"]  # too light to be copied
+    assert found(copy.format(40, "1.00")) == ["tracker"]

@@ -16,8 +16,8 @@ from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from tools.truth import costs, fields, lost, otherruns
-from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
+from tools.truth import fields, lost, otherruns
+from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_choice_lines, check_text
 
 DEVSET = next(
     (p for p in (Path(__file__).resolve().parents[3] / "shared" / "devset", Path("/work/shared/devset")) if p.is_dir()),
@@ -201,7 +201,7 @@ def _check_focus(
         lost.check_track_tables(section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a)))
         header = f"**Key decisions of {name}**"
         key = doc.split(header, 1)[1].split("\n\n")[1] if header in doc else ""
-        costs.check_thresholds(
+        check_choice_lines(
             key + "\n" + section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a))
         )
     out.checked["misleading"] += 1

@@ -53,6 +53,43 @@ def check_costs(text: str, c: str, raw, scene, out, bad) -> None:
     for m in CHOICE.finditer(text):
         _check_choice_costs(m, c, raw, scene, out, bad)
     check_thresholds(text, c, raw, out, bad)
+    check_choice_values(text, c, raw, out, bad)
+
+
+VALUES = re.compile(
+    rf"frame (\d+): (?:close call: )?m(\d+)(?: \(score {_N}\))? → \**(?:new track \d+|track \d+|new|missed \d+)\** "
+    rf"\((?:cost |the [^()\n]+? threshold |[\w ]*?[A-Za-z] )?({_N})(?: m)?[^()\n]*\) over (?:track (\d+)|new|a new "
+    rf"track) \((?:the [^()\n]+? threshold |[\w ]*?[A-Za-z] )?({_N})"
+)
+
+
+def check_choice_values(text: str, c: str, raw, out, bad) -> None:
+    """Every choice line's two values ("→ X (V) over Y (W)", on any scale: nats, metres, a similarity such as
+    3D IoU, a threshold) against the deciding matrix: V the entry of the column the assignment gave the
+    detection, W that of track Y or of the row's new-track column; a similarity prints 1 - the entry."""
+    if raw is None:
+        return
+    for m in VALUES.finditer(text):
+        found = raw.deciding(int(m[1]), c)
+        if found is None:
+            continue
+        mat, a = found
+        meas = int(m[2])
+        row, chosen = replay.row_of(mat, meas), replay.chosen_col(mat, a, meas)
+        if row is None or chosen is None:
+            continue
+        alt = replay.track_col(mat, int(m[4])) if m[4] else None
+        other = float(mat.cost[row, alt]) if alt is not None else None if m[4] else _new_entry(mat, row, meas)
+        similar = mat.scale is not None and mat.scale.similarity is not None
+        out.checked["cost"] += 1
+        entry, after = _as_printed(float(mat.cost[row, chosen]), similar), _as_printed(other, similar)
+        if entry != m[3] or after != m[5]:
+            bad("cost", m[0][:160], f"the deciding matrix gives {entry} for the chosen, {after} for the other")
+
+
+def _as_printed(value: float | None, similar: bool) -> str | None:
+    """A matrix entry as a choice line prints it: two decimals, of 1 - it for a similarity (None: no entry)."""
+    return None if value is None else f"{1.0 - value:.2f}" if similar else f"{value:.2f}"
 
 
 def check_thresholds(text: str, c: str, raw, out, bad) -> None:

@@ -369,6 +369,7 @@ STORY_HIDDEN = re.compile(
     r"frame (\d+): track (\d+) \((?:not shown, [rw] < [\d.]+|output; [rw] below the display threshold [\d.]+|not "
     r"output)\): [^\n]*?, ([rw])=(\d+(?:\.\d+)?)\n"
 )
+STORY_COPY = re.compile(r"frame (\d+): track (\d+) confirmed \(a copy of track (\d+)'s component, ([rw])=(\d+\.\d+)")
 STORY_OUTPUT = re.compile(
     r"frame (\d+): track (\d+) (?:(no longer shown|\(not shown)|(no longer output|\(not output)|(fell below the "
     r"display threshold \([^)]*\), still output|\(output;))"
@@ -382,7 +383,9 @@ def check_story(section: str, c: str, raw, out, bad, submitted=None) -> None:
     after frame x's update (a GM-PHD / CPHD label's heaviest ``IntensityWeights`` component), and the symbol is
     ``w`` for such a label, ``r`` for an existence (else ``misleading``). With the run's submission (``submitted``:
     frame -> track ids with a box there): "output" / "not output" as it has the track's box or not, and "not shown"
-    of a track it output is ``misleading`` (the viewer's display threshold is not the submission's)."""
+    of a track it output is ``misleading`` (the viewer's display threshold is not the submission's). "track T
+    confirmed (a copy of track S's component, w=V, …)": T has no component of its own at x, S's weighs V (1.5 or
+    more: two copies or more)."""
     if submitted is not None:
         for m in STORY_OUTPUT.finditer(section):
             x, t = int(m[1]), m[2]
@@ -394,6 +397,12 @@ def check_story(section: str, c: str, raw, out, bad, submitted=None) -> None:
                 bad("output", m[0], f"the submission {'has' if boxed else 'has no'} box of track {t} at frame {x}")
     if raw is None:
         return
+    for m in STORY_COPY.finditer(section):  # a GM-PHD copy: no component of its own, its source's weight
+        x, t, source = int(m[1]), int(m[2]), int(m[3])
+        out.checked["tracker"] += 1
+        own, got = _existence(raw, x, c, t), _existence(raw, x, c, source)
+        if own is not None or not _reads(got, m[5]) or got < 1.5:
+            bad("tracker", m[0], f"track {t}'s own weight {own}; track {source}'s {got} (copies from 1.5)")
     found = [(m[0], int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_SHOWN.finditer(section)]
     found += [(m[0].strip(), int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_HIDDEN.finditer(section + "\n")]
     for sentence, x, t, symbol, said in found:

@@ -119,8 +119,8 @@ COULD_NOT = re.compile(
     r"it was infinite"
 )
 CHOICE = re.compile(
-    r"frame (\d+): m(\d+)(?: \(score [\d.]+\))? → ([^(]+?) \([^()]*\) "
-    r"(?:over (track \d+|new|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)"
+    r"frame (\d+): (?:close call: )?m(\d+)(?: \(score [\d.]+\))? → ([^(]+?) \([^()]*\) "
+    r"(?:over (track \d+|new|a new track|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)"
     r"(?:, which took m(\d+) \(the lower total wins\))?|\(no other\)), margin (inf|\d+\.\d+)"
     r"((?: [a-zA-Z]+)? or more)?"
 )
@@ -525,3 +525,14 @@ def _output_on_after(scene: SceneTruth, ev: EvalFacts, t: str, gt_id: str, last:
         if any(i == t and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < 2.0 for i, _, xy in ev.boxes.get(x, [])):
             later.append(x)
     return later
+
+
+def check_choice_lines(text: str, c: str, raw: RawEvents | None, out: Tally, bad) -> None:
+    """A focus document's key decisions and story close calls: each line's margin re-solved (as the Why's), its
+    two values and a new-track column said as a threshold against the deciding matrix (``costs``)."""
+    if raw is None:
+        return
+    for m in CHOICE.finditer(text):
+        _check_choice(m, c, raw, out, bad)
+    costs.check_thresholds(text, c, raw, out, bad)
+    costs.check_choice_values(text, c, raw, out, bad)

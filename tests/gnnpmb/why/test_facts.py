@@ -300,3 +300,26 @@ def test_a_phd_labels_table_says_weight_of_its_heaviest_components_before_and_af
     table = "\n".join(_steps_markdown(view, "car", [39], range(0, 1)))
     assert "| frame | weight before update | in gate (NIS) | used | weight after | output |" in table
     assert "| 0 | 0.94 |" in table and "| 1.10 | yes |" in table
+
+
+def test_a_phd_extractions_extra_copy_of_a_heavy_component_is_said_a_copy_with_no_weight_of_its_own() -> None:
+    # tools.truth on the dev set, scene-0916 megvii phd: "frame 29: track 44 confirmed (w=1.00, from m…)" of an
+    # estimate with no component labelled 44: the extraction output label 40's component (weight 1.62) twice, the
+    # copy under id 44; the focus table gave it "weight after 0.00"
+    from gnnpmb.events import Extracted, IntensityWeights, Posterior
+
+    cov = np.eye(4)[None]
+    events = [
+        frame(0),
+        received([0]),
+        Posterior("car", np.array([40]), np.zeros((1, 4)), cov, np.array([1.0])),
+        IntensityWeights("car", np.array([40]), np.array([1.62])),
+        Extracted("car", (estimate(40, 0, 1.0), estimate(44, 0, 1.0)), 0.5),
+    ]
+    teller = Storyteller(facts_of(events))
+    texts = [line.text for line in teller.frame_lines(0) if line.kind is StoryKind.CONFIRMED]
+    assert texts == [
+        "track 40 confirmed (w=1.62, from m0)",
+        "track 44 confirmed (a copy of track 40's component, w=1.62, which the extraction outputs round(w) times; "
+        "from m0)",
+    ]
