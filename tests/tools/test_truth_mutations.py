@@ -18,6 +18,7 @@ from gnnpmb.events import (
     CostMatrix,
     CostTerms,
     FrameStarted,
+    Gated,
     Predicted,
     axis_labels,
 )
@@ -1012,14 +1013,23 @@ def test_a_focus_documents_track_table_with_a_wrong_word_or_value_is_caught() ->
     predicted = Predicted(
         C, np.array([39, 39]), np.zeros((2, 4)), np.tile(np.eye(4), (2, 1, 1)), np.array([0.03, 0.94])
     )
-    phd = _frames({16: [predicted, IntensityWeights(C, np.array([39, 39]), np.array([1.10, 0.02]))]})
+    gated = Gated(
+        C,
+        np.array([39, 39]),
+        np.array([17, 4]),
+        np.array([[True, False], [False, True]]),
+        np.zeros((2, 2)),
+        np.tile(np.eye(2), (2, 1, 1)),
+        40.0,
+        np.array([[0.2, 50.0], [60.0, 3.1]]),
+    )
+    intensity = IntensityWeights(C, np.array([39, 39]), np.array([1.10, 0.02]))
+    phd = _frames({16: [predicted, gated, intensity]})
 
-    def found(word: str, before: str, after: str) -> list[str]:
+    def found(word: str, before: str, after: str, gate: str = "m17 (0.2)") -> list[str]:
         table = "Track 39, frame by frame:\n\n"
         table += f"| frame | {word} before update | in gate (NIS) | used | {word} after | output |\n"
-        table += (
-            f"|---|---|---|---|---|---|\n| 16 | {before} | m17 (0.2) | m17 (91 % of its weight) | {after} | yes |\n"
-        )
+        table += f"|---|---|---|---|---|---|\n| 16 | {before} | {gate} | m17 (91 % of its weight) | {after} | yes |\n"
         out = Tally()
         check_track_tables(table, C, phd, out, lambda kind, sentence, why: out.found.append(kind))
         return out.found
@@ -1028,6 +1038,11 @@ def test_a_focus_documents_track_table_with_a_wrong_word_or_value_is_caught() ->
     assert found("r", "0.94", "1.10") == ["misleading"]
     assert found("weight", "0.03", "1.10") == ["tracker"]
     assert found("weight", "0.94", "0.02") == ["tracker"]
+    # the gate column against the Gated rows of the label (a row per component)
+    assert found("weight", "0.94", "1.10", "m4 (3.1)") == []
+    assert found("weight", "0.94", "1.10", "m17 (0.4)") == ["tracker"]
+    assert found("weight", "0.94", "1.10", "m17 (0.2), m4 (3.1)") == ["tracker"]  # no one row gates both
+    assert found("weight", "0.94", "1.10", "nothing") == ["tracker"]
 
 
 def test_a_far_detection_the_lost_track_used_is_checked_and_its_soft_share_must_be_said() -> None:

@@ -446,12 +446,33 @@ def check_track_tables(section: str, c: str, raw, out, bad) -> None:
                 for i, w in zip(np.asarray(e.track_ids).tolist(), np.asarray(e.existence).tolist(), strict=True)
                 if i == t
             ]
+            if len(cells) == 6:  # "in gate (NIS)": "m15 (1.2), m3 (4.0)" or "nothing", against a Gated row of T
+                _check_gate_cell(cells[2], raw, x, c, t, out, bad)
             for said, got in ((before, max(predicted) if predicted else None), (after, _existence(raw, x, c, t))):
                 if said in ("—", "ended"):
                     continue
                 out.checked["tracker"] += 1
                 if not _reads(got, said):
                     bad("tracker", f"Track {t} at frame {x}: {said}", f"the raw events give {got}")
+
+
+GATE_ITEM = re.compile(r"m(\d+) \((\d+\.\d)\)")
+
+
+def _check_gate_cell(cell: str, raw, x: int, c: str, t: int, out, bad) -> None:
+    """A table's gate cell: the detections inside track ``t``'s gate at frame x with their d² (one decimal),
+    exactly those of one of its rows of the frame's ``Gated`` event (a PHD label has a row per component); "nothing"
+    where a row of it gates none, or it has no row."""
+    said = sorted((int(m), d2) for m, d2 in GATE_ITEM.findall(cell))
+    rows = []
+    for e in raw.of_kind(x, c, Gated):
+        refs = np.asarray(e.meas_indices).tolist()
+        for k in np.flatnonzero(np.asarray(e.track_ids) == t).tolist():
+            inside = np.flatnonzero(np.asarray(e.inside)[k]).tolist()
+            rows.append(sorted((int(refs[j]), f"{float(np.asarray(e.d2)[k, j]):.1f}") for j in inside))
+    out.checked["tracker"] += 1
+    if said not in rows and not (not said and not rows):
+        bad("tracker", f"Track {t} at frame {x}: in gate {cell}", f"its Gated rows: {rows}")
 
 
 def _reads(got: float | None, said: str) -> bool:
