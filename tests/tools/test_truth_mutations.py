@@ -1190,3 +1190,35 @@ def test_a_phd_copy_said_with_a_weight_of_its_own_or_a_wrong_source_is_caught() 
     assert found(copy.format(40, "1.62")) == []
     assert found(copy.format(41, "0.90")) == ["tracker"]  # too light to be copied
     assert found(copy.format(40, "1.00")) == ["tracker"]
+
+
+def test_the_test_an_infinite_cost_is_said_to_stand_for_is_checked_against_the_gate_and_the_threshold() -> None:
+    # "track T could not take it: its column's cost for it was infinite (outside its gate / beyond its K
+    # threshold)": the kind said was read by no check
+    from gnnpmb.events import CostScale
+
+    rows = axis_labels(AxisKind.MEASUREMENT, [3])
+    cols = axis_labels(AxisKind.TRACK, [7]) + axis_labels(AxisKind.NEW_TRACK, [3])
+    gated = Gated(
+        C, np.array([7]), np.array([3]), np.array([[False]]), np.zeros((1, 2)), np.eye(2)[None], 9.2, np.array([[30.0]])
+    )
+    metres = CostScale("distance", "m", 0.5, threshold=2.0)
+    say = (
+        "at frame 4 m3 (score 0.50, 0.4 m from it; track 7 could not take it: its column's cost for it was infinite "
+        "({}))"
+    )
+    ctx = Context(C, 4, GT_A, kind="fragmentation", lost=7)
+
+    def kinds(events: list, test: str) -> list[str]:
+        raw = _frames({4: events})
+        return [k.kind for k in check_text(say.format(test), ctx, raw, _eval()).found if k.kind == "gone"]
+
+    gate_only = [gated, CostMatrix(C, np.array([[np.inf, 1.0]]), rows, cols)]
+    assert kinds(gate_only, "outside its gate") == []
+    assert kinds(gate_only, "beyond its distance threshold") == ["gone"]
+    inside = Gated(
+        C, np.array([7]), np.array([3]), np.array([[True]]), np.zeros((1, 2)), np.eye(2)[None], 9.2, np.array([[1.0]])
+    )
+    threshold = [inside, CostMatrix(C, np.array([[np.inf, 2.0]]), rows, cols, scale=metres)]
+    assert kinds(threshold, "beyond its distance threshold") == []
+    assert kinds(threshold, "outside its gate") == ["gone"]

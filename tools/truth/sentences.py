@@ -27,7 +27,9 @@ from collections import Counter
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 
-from gnnpmb.events import AxisKind, Born, CostMatrix
+import numpy as np
+
+from gnnpmb.events import AxisKind, Born, CostMatrix, Gated
 from tools.truth import costs, detector, hypotheses, lost, otherruns, output, place, replay, shares
 from tools.truth.devkit import EvalFacts
 from tools.truth.printing import BECAUSE
@@ -118,6 +120,33 @@ COULD_NOT = re.compile(
     r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it; track (\d+) could not take it: its column's cost for "
     r"it was infinite"
 )
+TEST_KIND = re.compile(
+    r"at frame (\d+) m(\d+) \([^;]*; track (\d+) could not take it(?: in the hypothesis the tracker chose \(|: )"
+    r"its column's cost (?:there|for it) was infinite,? \(?(outside its gate|beyond its ([^\n]+?) threshold)"
+)
+
+
+def _check_test_kind(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
+    """The test an infinite cost is said to stand for: "outside its gate" where a ``Gated`` row of the track has
+    the detection outside; "beyond its K threshold" where the frame's matrix has a cost threshold named K and no
+    ``Gated`` row has the detection outside the track's gate (else the gate stopped it first)."""
+    x, meas, t, kind, name = int(m[1]), int(m[2]), int(m[3]), m[4], m[5]
+    outside = inside = False
+    for e in raw.of_kind(x, c, Gated):
+        refs = np.asarray(e.meas_indices).tolist()
+        if meas not in refs:
+            continue
+        for k in np.flatnonzero(np.asarray(e.track_ids) == t).tolist():
+            hit = bool(np.asarray(e.inside)[k, refs.index(meas)])
+            inside, outside = inside or hit, outside or not hit
+    named = {mat.scale.name for mat in raw.matrices(x, c) if mat.scale is not None and mat.scale.threshold is not None}
+    out.checked["gone"] += 1
+    if kind == "outside its gate" and not (outside and not inside):
+        bad("gone", m[0], f"the Gated rows of track {t} at frame {x}: outside {outside}, inside {inside}")
+    elif name is not None and (name not in named or (outside and not inside)):
+        bad("gone", m[0], f"the frame's thresholds: {sorted(named)}; Gated outside {outside}, inside {inside}")
+
+
 CHOICE = re.compile(
     r"frame (\d+): (?:close call: )?m(\d+)(?: \(score [\d.]+\))? → ([^(]+?) \([^()]*\) "
     r"(?:over (track \d+|new|a new track|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)"
@@ -267,6 +296,8 @@ def check_text(
         out.checked["gone"] += 1
         if not raw.could_not_take(x, c, meas, t):
             bad("gone", m[0], f"(m{meas}, track {t}) at frame {x}: cost {raw.entry(x, c, meas, t)}")
+    for m in TEST_KIND.finditer(text):
+        _check_test_kind(m, c, raw, out, bad)
     for b in BECAUSE.finditer(text):
         x, para = int(b[1]), b[2]
         for m in OUTSIDE.finditer(para):
