@@ -137,12 +137,13 @@ class Storyteller:
                     continue
                 say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} confirmed ({self._r(weight, r)}{via}){why}")
             elif e.meas_index < 0:
-                say(
-                    StoryKind.MISSED,
-                    "INFO",
-                    (t,),
-                    f"track {t} missed this frame, still reported{self._r_in(weight, r)}",
+                copy_of = _copied(e, extracted, posterior_r) if cf.intensity is not None else None
+                value = (
+                    f" (a copy of track {copy_of}'s component, {r}={posterior_r[copy_of]:.2f})"
+                    if copy_of is not None
+                    else self._r_in(weight, r)
                 )
+                say(StoryKind.MISSED, "INFO", (t,), f"track {t} missed this frame, still reported{value}")
         output_ids = {e.track_id for e in extracted}  # the submission's tracks: down to the output threshold
         for t in sorted((self.involved & set(posterior_r)) - known - set(now)):
             step = self.facts.steps(t, class_name).get(frame)

@@ -323,3 +323,14 @@ def test_a_phd_extractions_extra_copy_of_a_heavy_component_is_said_a_copy_with_n
         "track 44 confirmed (a copy of track 40's component, w=1.62, which the extraction outputs round(w) times; "
         "from m0)",
     ]
+    events += [
+        frame(1),
+        received([]),
+        Posterior("car", np.array([40]), np.zeros((1, 4)), cov, np.array([1.0])),
+        IntensityWeights("car", np.array([40]), np.array([1.55])),
+        Extracted("car", (estimate(40, -1, 1.0), estimate(44, -1, 1.0)), 0.5),
+    ]
+    teller = Storyteller(facts_of(events))
+    teller.frame_lines(0)
+    texts = [line.text for line in teller.frame_lines(1) if line.kind is StoryKind.MISSED]
+    assert texts[1] == "track 44 missed this frame, still reported (a copy of track 40's component, w=1.55)"
