@@ -516,13 +516,22 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         threshold = self.params.extraction_threshold
         b = posterior
         keep = (b.existence >= threshold) & (b.misses <= self.params.output_max_misses)
-        if not keep.all():
-            b = b.subset(keep.nonzero()[0])
         score = coasting_scores(b, self.params.miss_score_mean_min_frames)
+        det, track_id, mean, existence, misses = b.det, b.track_id, b.mean, b.existence, b.misses
+        if not keep.all():
+            sel = keep.nonzero()[0]
+            det, track_id, mean, existence, misses, score = (
+                det.subset(sel),
+                track_id[sel],
+                mean[sel],
+                existence[sel],
+                misses[sel],
+                score[sel],
+            )
         decay = self.params.miss_score_decay
         if decay < 1.0:
-            score = score * decay ** b.misses.astype(float)
-        estimates = b.det.to_estimates(self.class_name, b.track_id, b.mean, score, b.existence)
+            score = score * decay ** misses.astype(float)
+        estimates = det.to_estimates(self.class_name, track_id, mean, score, existence)
         return estimates, threshold
 
     def posterior_view(self, posterior: Bernoullis) -> TrackView:
