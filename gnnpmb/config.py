@@ -261,10 +261,11 @@ class PmbParams(Section):
     class from the gaps its tracks closed (miss_p_detect_online, ``gnnpmb.pmb.miss_detection``), except beside a
     neighbour of its class (miss_p_detect_neighbour_m). measure_velocity adds [vx, vy] to the measurement (R adds
     r_vx, r_vy; clutter intensity x clutter_velocity_density per (m/s)^2). A Bernoulli missed n frames in a row is
-    scored s r d^n (miss_score_decay d) and not output beyond output_max_misses. Heading and size likelihood
-    (``gnnpmb.box_likelihood``): a sigma of 0 leaves that part out. gate_giou_min gates on the bird's-eye GIoU of
-    the predicted box (the filtered centre with the last detection's size and heading). Defaults that differ from
-    the paper's were chosen on the mini_train splits: why and the figures, ``docs/results.md`` and
+    scored s r d^n (miss_score_decay d; with miss_score_mean_min_frames N > 0, one born or detected on at least N
+    frames max(s, m) r d^n, m its mean score on those frames) and not output beyond output_max_misses. Heading and
+    size likelihood (``gnnpmb.box_likelihood``): a sigma of 0 leaves that part out. gate_giou_min gates on the
+    bird's-eye GIoU of the predicted box (the filtered centre with the last detection's size and heading). Defaults
+    that differ from the paper's were chosen on the mini_train splits: why and the figures, ``docs/results.md`` and
     ``docs/architecture.md``.
     """
 
@@ -312,6 +313,12 @@ class PmbParams(Section):
     )
     miss_score_decay: float = param(
         1.0, "d: a track missed n frames is scored s r d^n (1: the paper's s r)", unit_interval(False, True), paper=1.0
+    )
+    miss_score_mean_min_frames: int = param(
+        0,
+        "N > 0: a missed Bernoulli born or detected on >= N frames is scored max(s, m) r, m its mean score on them"
+        " (0: s r)",
+        at_least(0),
     )
     output_max_misses: int = param(
         1000, "a Bernoulli missed more than this many frames in a row is not output (kept in the filter)", at_least(0)

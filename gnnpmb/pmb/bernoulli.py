@@ -28,7 +28,10 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
     det: the last associated detection's fields (``score``, ``z_m``, ... read through as the Bernoullis' own);
     misses: (K,) int64, frames since the last detection (0 for a Bernoulli detected this frame; the prediction
     adds 1), which sets the decayed output score of a missed track (``PmbParams.miss_score_decay``) and whether it
-    is output at all (``PmbParams.output_max_misses``).
+    is output at all (``PmbParams.output_max_misses``);
+    detected_score_sum: (K,) the sum of the Bernoulli's output scores on the frames it was born (s r_b) or detected
+    (s), and detected_frames: (K,) int64 the count of those frames: their ratio m is the track's mean score before
+    any coasting (``PmbParams.miss_score_mean_min_frames``).
     """
 
     track_id: np.ndarray
@@ -38,6 +41,8 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
     cov: np.ndarray
     det: DetectionFields
     misses: np.ndarray
+    detected_score_sum: np.ndarray
+    detected_frames: np.ndarray
 
     def __len__(self) -> int:
         return len(self.track_id)
@@ -52,6 +57,8 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
             cov=np.zeros((0, state_dim, state_dim)),
             det=DetectionFields.empty(),
             misses=np.zeros(0, dtype=np.int64),
+            detected_score_sum=np.zeros(0),
+            detected_frames=np.zeros(0, dtype=np.int64),
         )
 
 
@@ -61,7 +68,17 @@ def predict_bernoullis(b: Bernoullis, model: MotionModel, p_survive: float) -> B
     if not len(b):
         return b
     mean, cov = predict(b.mean, b.cov, model)
-    return Bernoullis(b.track_id, b.local_key, p_survive * b.existence, mean, cov, b.det.undetected(), b.misses + 1)
+    return Bernoullis(
+        b.track_id,
+        b.local_key,
+        p_survive * b.existence,
+        mean,
+        cov,
+        b.det.undetected(),
+        b.misses + 1,
+        b.detected_score_sum,
+        b.detected_frames,
+    )
 
 
 def missed_update(existence: np.ndarray, p_detect: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

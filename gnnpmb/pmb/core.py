@@ -328,6 +328,10 @@ def updated_bernoullis(
     track_id, parent, outcome = prior.track_id[rows], prior.local_key[rows], outcome
     misses = _gather(prior.misses, np.zeros(len(new.existence), dtype=np.int64), source, n_new)
     misses[det] = 0
+    score_sum = _gather(prior.detected_score_sum, local.meas.boxes.score * new.existence, source, n_new)
+    score_sum[det] += fields.score[det]
+    frames = _gather(prior.detected_frames, np.ones(len(new.existence), dtype=np.int64), source, n_new)
+    frames[det] += 1
     if n_new:
         births = np.array([ctx.birth_id(j) for j in new_j.tolist()], dtype=np.int64)
         track_id = np.concatenate([track_id, births])
@@ -341,7 +345,23 @@ def updated_bernoullis(
         cov=cov,
         det=fields,
         misses=misses,
+        detected_score_sum=score_sum,
+        detected_frames=frames,
     )
+
+
+def coasting_scores(b: Bernoullis, mean_min_frames: int) -> np.ndarray:
+    """(K,) output scores s r (s the last detection's score, r the existence). With ``mean_min_frames`` N > 0
+    (``[pmb] miss_score_mean_min_frames``), a missed Bernoulli born or detected on at least N frames is scored
+    max(s, m) r instead, m = ``detected_score_sum / detected_frames`` its mean output score on those frames (s r_b
+    at birth, s after each detection), so that one low last detection does not rank a long, sure track's
+    coasting boxes below its detected ones."""
+    score = b.det.score * b.existence
+    if mean_min_frames <= 0:
+        return score
+    coasting = (b.misses > 0) & (b.detected_frames >= mean_min_frames)
+    mean = b.detected_score_sum / np.maximum(b.detected_frames, 1)
+    return np.where(coasting, np.maximum(score, mean * b.existence), score)
 
 
 def _gather(own: np.ndarray, born: np.ndarray, source: np.ndarray, n_new: int) -> np.ndarray:
@@ -491,22 +511,23 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
 
     def extract(self, posterior: Bernoullis, sink: EventSink) -> tuple[list[TrackEstimate], float]:
         """Step 6: Bernoullis with r >= the extraction threshold, missed at most ``[pmb] output_max_misses`` frames
-        in a row; tracking score = detection score x r, times d^n for a Bernoulli missed n frames in a row
-        (``[pmb] miss_score_decay`` d)."""
+        in a row; tracking score = detection score x r (``coasting_scores`` for a missed one), times d^n for a
+        Bernoulli missed n frames in a row (``[pmb] miss_score_decay`` d)."""
         threshold = self.params.extraction_threshold
         b = posterior
         keep = (b.existence >= threshold) & (b.misses <= self.params.output_max_misses)
+        score = coasting_scores(b, self.params.miss_score_mean_min_frames)
         det, track_id, mean, existence, misses = b.det, b.track_id, b.mean, b.existence, b.misses
         if not keep.all():
             sel = keep.nonzero()[0]
-            det, track_id, mean, existence, misses = (
+            det, track_id, mean, existence, misses, score = (
                 det.subset(sel),
                 track_id[sel],
                 mean[sel],
                 existence[sel],
                 misses[sel],
+                score[sel],
             )
-        score = det.score * existence
         decay = self.params.miss_score_decay
         if decay < 1.0:
             score = score * decay ** misses.astype(float)

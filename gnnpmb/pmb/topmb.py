@@ -160,6 +160,8 @@ def merged_bernoullis(local: LocalHypotheses, marg: AssociationMarginals) -> tup
         cov=symmetrize(cov),
         det=prior.det.undetected().take(hit, DetectionFields.from_measurements(meas, hit_j)),
         misses=np.where(best > 0, 0, prior.misses),
+        detected_score_sum=prior.detected_score_sum + np.bincount(hit, meas.boxes.score[hit_j], minlength=k),
+        detected_frames=prior.detected_frames + (best > 0),
     )
     return tracks, comp
 

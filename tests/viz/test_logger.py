@@ -107,7 +107,7 @@ def scripted_events() -> list:
         Merged("car", 1, (1, 3), (0.7, 0.3)),
         frame(2),
         Posterior("car", np.zeros(0, int), np.zeros((0, 4)), np.zeros((0, 4, 4)), np.zeros(0)),
-        Pruned("car", 1, PruneReason.LOW_EXISTENCE, 0.05),
+        Pruned("car", 1, PruneReason.LOW_WEIGHT, 0.05),  # frame 2 is a PHD's (IntensityWeights): a weight
         Extracted("car", (), 0.9),
         Marginals("car", np.array([[0.8, 0.2]]), (track(5),), (missed(), meas(0)), "lbp", 7),
         Cardinality("car", np.array([0.1, 0.6, 0.3])),
@@ -224,8 +224,7 @@ def test_story_log_tells_each_reported_track_and_aggregates_candidates(logged: t
     assert ("0 new candidates; 1 candidates pruned", "DEBUG") in frame1
     assert ("merged 1, 3 into track 1 (weights 0.7, 0.3)", "INFO") in frame1
     assert any(t.startswith("2 detections: 2 updated tracks, 0 new or clutter") for t, _ in frame1)
-    # frame 2 carries an IntensityWeights event (a PHD's): its value is a weight, w
-    assert ("track 1 ended: existence below pruning threshold (last w=0.05)", "WARN") in lines(rows, 2)
+    assert ("track 1 ended: mixture weight below pruning threshold (last w=0.05)", "WARN") in lines(rows, 2)
     assert max(len(t) for r in rows if "TextLog:text" in r for t in r["TextLog:text"]) < 200
 
 
@@ -369,7 +368,7 @@ def test_no_existence_series_or_story_existence_for_a_tracker_without_existence_
     # The story names no existence either (a track-logic tracker's events carry 1).
     story = rows[paths.events(T, "car")]
     assert ("track 1 confirmed (from m0)", "INFO") in lines(story, 0)
-    assert ("track 1 ended: existence below pruning threshold", "WARN") in lines(story, 2)
+    assert ("track 1 ended: mixture weight below pruning threshold", "WARN") in lines(story, 2)
 
 
 def test_a_phd_filters_series_name_a_weight(saved_stream: tuple[rr.RecordingStream, Path]) -> None:

@@ -28,6 +28,8 @@ def bernoullis(xy: list[tuple[float, float]]) -> Bernoullis:
         cov=np.broadcast_to(np.eye(4), (k, 4, 4)).copy(),
         det=DetectionFields(np.full(k, 0.8), np.zeros(k), np.ones((k, 3)), np.zeros((k, 4)), np.full(k, -1)),
         misses=np.zeros(k, dtype=np.int64),
+        detected_score_sum=np.zeros(k),
+        detected_frames=np.zeros(k, dtype=np.int64),
     )
 
 

@@ -28,6 +28,8 @@ def random_store(rng: np.random.Generator, n: int, keys: np.ndarray) -> Bernoull
             meas_index=rng.integers(-1, 5, size=n),
         ),
         misses=np.zeros(n, dtype=np.int64),
+        detected_score_sum=np.zeros(n),
+        detected_frames=np.zeros(n, dtype=np.int64),
     )
 
 

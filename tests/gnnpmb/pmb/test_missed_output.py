@@ -64,3 +64,27 @@ def test_turn_state_runs_through_every_pmb_strategy(strategy):
     assert b.mean.shape[1] == 5 and abs(b.mean[best, 4] - w) < 0.15
     shown = [e for e in sink.events if isinstance(e, Predicted | Posterior)]
     assert shown and all(e.mean.shape[1:] == (4,) and e.cov.shape[1:] == (4, 4) for e in shown)
+
+
+STRATEGIES = [BestAssignment, lambda: KBest(TrackerConfig().pmbm), lambda: MarginalMerge(TrackerConfig().lbp)]
+
+
+@pytest.mark.parametrize("strategy", STRATEGIES)
+@pytest.mark.parametrize("min_frames", [0, 3, 4])
+def test_a_missed_track_is_scored_by_the_better_of_its_last_and_mean_score(strategy, min_frames):
+    """Born at 0.9 (output 0.9 r_b), detected at 0.9 then 0.3, then missed: with miss_score_mean_min_frames N <= 3
+    (the three frames it was born or detected) it is output at max(0.3, m) r, m = (0.9 r_b + 0.9 + 0.3) / 3;
+    with N = 4 or N = 0 (off) at 0.3 r, as a detected track always is."""
+    cfg = with_params(TrackerConfig(), {"pmb.miss_score_mean_min_frames": min_frames})
+    core = PmbCore("car", cfg, strategy(), IdAllocator())
+    (born,) = core.step(make_measurements([(0.0, 0.0)], 0.9, velocity=[(2.0, 0.0)]), 0.0, NullSink())
+    for t, score in ((1, 0.9), (2, 0.3)):
+        (est,) = core.step(make_measurements([(1.0 * t, 0.0)], score, velocity=[(2.0, 0.0)]), 0.5, NullSink())
+    assert est.score == pytest.approx(0.3 * est.existence, rel=1e-12)
+    (missed,) = core.step(make_measurements([], 0.8), 0.5, NullSink())  # TO-PMB keeps unsure births unshown
+    b = core.hypotheses[0].bernoullis
+    (row,) = np.flatnonzero(b.track_id == born.track_id)
+    assert missed.track_id == born.track_id and b.detected_frames[row] == 3 and b.misses[row] == 1
+    mean = (0.9 * born.existence + 0.9 + 0.3) / 3
+    expected = max(0.3, mean) if 0 < min_frames <= 3 else 0.3
+    assert missed.score == pytest.approx(expected * missed.existence, rel=1e-12)

@@ -42,6 +42,8 @@ def one_track(score: float = 0.9, pos_var: float = 0.1, vel_var: float = 0.5) ->
             meas_index=np.array([-1]),
         ),
         misses=np.zeros(1, dtype=np.int64),
+        detected_score_sum=np.zeros(1),
+        detected_frames=np.zeros(1, dtype=np.int64),
     )
 
 

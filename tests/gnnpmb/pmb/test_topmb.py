@@ -45,6 +45,8 @@ def make_prior(means, existence, cov_diag=(0.5, 0.5, 1.0, 1.0), score=0.8) -> Be
             meas_index=np.full(k, -1),
         ),
         misses=np.zeros(k, dtype=np.int64),
+        detected_score_sum=np.zeros(k),
+        detected_frames=np.zeros(k, dtype=np.int64),
     )
 
 
