@@ -181,6 +181,8 @@ class _Tracked:
             start = self.frames.start
             for i in range(max(start, failure.frame_index - NEAR_FRAMES), failure.frame_index + 1):
                 near |= _tracks_near(per_frame[i - start], failure.class_name, gt_xy(self.scene, i, failure.gt_ids))
+            if name != tracker and failure.frame_index in self.frames:
+                near |= self._named(name, failure, per_frame[failure.frame_index - start])
             ids[name] = tuple(sorted(own | near))
         label = failure_id or failure.kind.value
         return FocusTarget(
@@ -195,6 +197,22 @@ class _Tracked:
             failure_tracker=tracker,
             failure_tracks=tuple(int(t) for t in failure.track_ids),
         )
+
+    def _named(self, name: str, failure: Failure, estimates: Sequence[TrackEstimate]) -> set[int]:
+        """The tracks of another run the failure's explanation names (``why.reason.others``) that ``_tracks_near``
+        does not find: the track its evaluation matched the object to at the failure's frame (at a box it
+        interpolated, possibly 2 m or more from the annotation), and for a failure with no annotated object (a
+        false track) its tracks output within ``NEAR_M`` of the failure's box."""
+        out: set[int] = set()
+        report = self.reports.get(name)
+        if report is not None and failure.gt_ids:
+            out |= {
+                int(t) for t, e in report.track_evals.items() if e.matched_at(failure.frame_index) in failure.gt_ids
+            }
+        if not len(gt_xy(self.scene, failure.frame_index, failure.gt_ids)) and failure.boxes:
+            box = np.asarray(failure.boxes[0].translation_m[:2], dtype=np.float64).reshape(1, 2)
+            out |= _tracks_near(estimates, failure.class_name, box)
+        return out
 
     def first_failure(self, involved: Callable[[Failure], bool]) -> FocusTarget | None:
         """The focus on the first failure satisfying ``involved``, by kind priority then frame (None: no such)."""

@@ -35,6 +35,7 @@ from gnnpmb.why.words import (
     on_object_text,
     share_text,
     sighting_points,
+    threshold_held,
     use_text,
     went_text,
     why_lines,
@@ -183,12 +184,17 @@ def _parting(focus: FocusTarget, views: Mapping[str, TrackerView]) -> list[str]:
             labels = [ch.chosen] if ch.alternative is None else [ch.chosen, ch.alternative]
             touches |= any(label.kind is AxisKind.TRACK and label.ref in ids for label in labels)
             other = ""
-            if ch.alternative is not None:
+            held = threshold_held(ch.alternative, ch.alternative_cost, ch)
+            if held is not None:  # a new-track column holding the tracker's cost threshold: no cost of a track
+                other = f"; next a new track, {held}"
+            elif ch.alternative is not None:
                 brief = cost_brief(ch.alternative_terms)
                 other = f"; next {column_name(ch.alternative)} {cost_value(ch.alternative_cost, ch)}"
                 other += f" at {brief}" if brief else ""
             brief = cost_brief(ch.chosen_terms)
-            chosen = cost_value(ch.chosen_cost, ch) + (f" at {brief}" if brief else "")
+            chosen = threshold_held(ch.chosen, ch.chosen_cost, ch) or cost_value(ch.chosen_cost, ch) + (
+                f" at {brief}" if brief else ""
+            )
             parts.append(f"{t}: {meas_name(m)} → **{text}** ({chosen}{other})")
         if touches:
             out.append(" · ".join(parts))
@@ -355,7 +361,13 @@ def _steps_markdown(view: TrackerView, class_name: str, track_ids: list[int], fr
             before = "—" if s.prior_existence is None else existence_text(s.prior_existence)
             if s.decided_existence is not None and existence_text(s.decided_existence) != before:
                 before += f" ({existence_text(s.decided_existence)} in the hypothesis its detection was decided in)"
-            after = "ended" if s.ended is not None else existence_text(s.posterior_existence or 0.0)
+            after = (
+                "ended"
+                if s.ended is not None
+                else "—"
+                if s.posterior_existence is None  # e.g. a copy a GM-PHD extraction made: no component of its own
+                else existence_text(s.posterior_existence)
+            )
             out.append(f"| {s.frame} | {before} | {gated} | {used} | {after} | {output} |")
         out.append("")
     return out

@@ -630,10 +630,14 @@ class TrackerLogger:
         mean = np.asarray(post.mean, dtype=np.float64).reshape(-1, 4)
         reported, focused = self._extracted_ids, self._focused
         id_list, r_list = ids.tolist(), existence.tolist()
+        heaviest: dict[int, int] = {}  # a GM-PHD / CPHD label has a row per component: its heaviest one's sample
+        for k, t in enumerate(id_list):
+            if t not in heaviest or r_list[k] > r_list[heaviest[t]]:
+                heaviest[t] = k
         follow = [
             k
-            for k, (t, r) in enumerate(zip(id_list, r_list, strict=True))
-            if r >= self.gate_min_existence or t in reported or t in focused
+            for k in sorted(heaviest.values())
+            if r_list[k] >= self.gate_min_existence or id_list[k] in reported or id_list[k] in focused
         ]
         xy = mean[follow, :2].tolist()
         for k, (x, y) in zip(follow, xy, strict=True):

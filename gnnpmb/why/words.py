@@ -241,15 +241,18 @@ def choice_text(frame: int, c: PairChoice, went: int, born: bool, alternative_to
     the detection the next best took in the same assignment: ``over track 20 (8.68 ...), which took m6 (the lower
     total wins), margin 2.01``."""
     other = "(no other)"
-    if c.alternative is not None:
+    if c.alternative is not None and (held := threshold_held(c.alternative, c.alternative_cost, c)) is not None:
+        other = f"over a new track ({held})"
+    elif c.alternative is not None:
         other = f"over {column_name(c.alternative)} ({cost_value(c.alternative_cost, c)}{_brief(c.alternative_terms)})"
         if alternative_took is not None:
             other += f", which took {meas_name(alternative_took)} (the lower total wins)"
     terms = c.chosen_terms or c.alternative_terms
     score = f" (score {terms.score:.2f})" if terms is not None and terms.score is not None else ""
+    chosen = threshold_held(c.chosen, c.chosen_cost, c) or cost_named(c.chosen_cost, c)
     return (
         f"frame {frame}: {meas_name(c.meas.ref)}{score} → **{destination_text(went, born, c.chosen)}** "
-        f"({cost_named(c.chosen_cost, c)}) {other}, margin {margin_value(c.margin, c)}"
+        f"({chosen}) {other}, margin {margin_value(c.margin, c)}"
     )
 
 
@@ -257,6 +260,20 @@ def cost_named(value: float, c: PairChoice) -> str:
     """``cost 6.75`` / ``cost 1.20 m``; a similarity needs no word (``GIoU -0.21``)."""
     text = cost_value(value, c)
     return text if c.scale.similarity is not None else f"cost {text}"
+
+
+def threshold_held(label: AxisLabel | None, value: float, c: PairChoice) -> str | None:
+    """``the 3D IoU threshold 0.10`` / ``the distance threshold 2.00 m``: what a new-track column's entry is where
+    the matrix has a cost threshold (``CostScale.threshold``: every new-track column holds it, so a detection
+    starts a track unless a track is cheaper); None for any other column or scale, whose entry is a cost."""
+    scale = c.scale
+    if label is None or label.kind is not AxisKind.NEW_TRACK or scale.threshold is None:
+        return None
+    if not math.isclose(value, scale.threshold, rel_tol=1e-9, abs_tol=1e-12):
+        return None
+    if scale.similarity is not None:
+        return f"the {scale.similarity} threshold {1.0 - value:.2f}"
+    return f"the {scale.name} threshold {cost_value(value, c)}"
 
 
 def key_text(k: KeyDecision) -> str:
@@ -596,13 +613,16 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         after = held if held is not None else -1
         away = [s.frame for s in steps if after < s.frame < f.frame and s.output is not None]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
-        # "on it" reads as the evaluation's match: said only where the devkit's last match was that output
+        # "on it" reads as the evaluation's match: said only where the devkit's last match was that output, and
+        # "last output on it" not of a track still output on the annotated object at the failure's frame
+        now = f.sighting(f.frame)
+        last_on = held == matched and not (now is not None and t in {o.track_id for o in now.on_it})
         last = (
             f"track {t} was last output on it at frame {held}"
-            if held == matched
+            if last_on
             else f"the evaluation last matched track {t} to it at frame {matched}"
         )
-        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}{_matched_away(f, lost, held == matched)}")
+        parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}{_matched_away(f, lost, last_on)}")
     if f.has_existence and steps:
         word = _existence_word(mode)
         alive = [s for s in steps if s.posterior_existence is not None]

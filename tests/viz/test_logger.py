@@ -401,3 +401,18 @@ def test_in_a_focus_a_run_with_no_involved_track_labels_none(saved_stream: tuple
     stream.disconnect()
     (box,) = [r for r in at_frame(read_rows(path)[paths.track(T, "car", 1)], 1) if "Boxes3D:labels" in r]
     assert box["Boxes3D:labels"] == ["1"] and box["Boxes3D:show_labels"] == [False]
+
+
+def test_a_phd_labels_plot_takes_its_heaviest_components_weight(saved_stream: tuple[rr.RecordingStream, Path]) -> None:
+    """A GM-PHD label with two components (0.319, 0.088) is one series: the plot showed the last row's 0.09 where
+    the focus text and the story gave the label's 0.32 (viewer review, dev set scene-0916 megvii phd id_switch:1,
+    track 8 at frame 13)."""
+    stream, path = saved_stream
+    mean = np.array([[10.0, 2.0, 0.0, 0.0], [12.0, 2.0, 0.0, 0.0]])
+    cov = np.tile(np.eye(4), (2, 1, 1))
+    events = [frame(0), received([10.0]), Posterior("car", np.array([8, 8]), mean, cov, np.array([0.319, 0.088]))]
+    events += [Extracted("car", (), 0.5)]
+    log_all(stream, events, focus_tracks={8})
+    stream.disconnect()
+    samples = [r["Scalars:scalars"][0] for r in at_frame(read_rows(path)[paths.existence(T, "car", 8)], 0)]
+    assert samples == pytest.approx([0.319])

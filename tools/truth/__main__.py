@@ -16,8 +16,8 @@ from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from tools.truth import fields, lost
-from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_text
+from tools.truth import fields, lost, otherruns
+from tools.truth.sentences import CLASSES, Context, Contradiction, Tally, check_choice_lines, check_text
 
 DEVSET = next(
     (p for p in (Path(__file__).resolve().parents[3] / "shared" / "devset", Path("/work/shared/devset")) if p.is_dir()),
@@ -150,7 +150,8 @@ def run_scene(
                     n: raw if n == tracker else None if n in results else RawEvents.of(list(runs[n].events))
                     for n in [tracker, *rest]
                 }
-                _check_focus(fid, f, request, {n: reports[n] for n in [tracker, *rest]}, evidence, one, raws)
+                subs = {n: ev_of(n).submitted for n in [tracker, *rest]}
+                _check_focus(fid, f, request, {n: reports[n] for n in [tracker, *rest]}, evidence, one, raws, subs)
             if seen is not None:
                 seen(f, sources)
             tally.add(one)
@@ -160,28 +161,49 @@ def run_scene(
 
 
 def _check_focus(
-    fid: str, finding, request, reports: Mapping, evidence: Mapping, out: Tally, raws: Mapping | None = None
+    fid: str,
+    finding,
+    request,
+    reports: Mapping,
+    evidence: Mapping,
+    out: Tally,
+    raws: Mapping | None = None,
+    submitted: Mapping | None = None,
 ) -> None:
     """The focus document of failure ``fid`` (its summary, as ``gnnpmb-viz --focus`` shows it with the runs of
     ``reports``) holds no ``?`` placeholder, and each run's story lines (``lost.check_story``) hold against that
-    run's raw events (``raws``: by run name, None for a results file)."""
+    run's raw events (``raws``: by run name, None for a results file) and its submission (``submitted``: by run
+    name, frame -> the track ids it has a box of)."""
     from gnnpmb.focus import resolve_focus
     from gnnpmb.why.story import Storyteller
     from viz.focus_summary import TrackerView, focus_markdown
 
+    estimates = {n: [fr.estimates for fr in evidence[n].run.frames] for n in reports}
+    target = resolve_focus(fid, request.scene, reports, estimates, request.frame_range)
     views = {}
     for name in reports:
         ev = evidence[name]
-        teller = Storyteller(ev.facts)
+        teller = Storyteller(ev.facts, involved=frozenset(target.track_ids.get(name, ())))  # as the viewer tells it
         story = tuple(line for x in ev.facts.frame_indices for line in teller.frame_lines(x))
         views[name] = TrackerView(ev, request.capabilities(name).has_gates, story, frozenset(teller.shown_ever))
-    estimates = {n: [fr.estimates for fr in evidence[n].run.frames] for n in reports}
-    target = resolve_focus(fid, request.scene, reports, estimates, request.frame_range)
     doc = focus_markdown(target, finding, views, target.window(request.frame_range), request.scene)
+    otherruns.check_involved(doc, target.track_ids, out, lambda *a: out.found.append(Contradiction(*a)))
     for name, raw in (raws or {}).items():
         section = doc.split(f"\n## {name}\n", 1)[1].split("\n## ", 1)[0] if f"\n## {name}\n" in doc else ""
-        lost.check_story(section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a)))
+        lost.check_story(
+            section,
+            finding.class_name,
+            raw,
+            out,
+            lambda *a: out.found.append(Contradiction(*a)),
+            (submitted or {}).get(name),
+        )
         lost.check_track_tables(section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a)))
+        header = f"**Key decisions of {name}**"
+        key = doc.split(header, 1)[1].split("\n\n")[1] if header in doc else ""
+        check_choice_lines(
+            key + "\n" + section, finding.class_name, raw, out, lambda *a: out.found.append(Contradiction(*a))
+        )
     out.checked["misleading"] += 1
     doc = doc.replace("?url=", "")
     if "?" in doc:

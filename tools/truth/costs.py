@@ -6,7 +6,12 @@ the detection file.
   matrix's entry (mN, track T); the parts add up to C (as printed); E is the matrix's predicted existence of T
   (its ``CostTerms``), D its d²[T, mN], S' the detection file's score of mN;
 * a choice, "frame x: mN (score S) → track T (cost C) over track U (C' at existence E, ±S m, d² D)": C is the
-  entry of the column the assignment gave mN, C' the entry (mN, U), E and D U's terms, S the file's score.
+  entry of the column the assignment gave mN, C' the entry (mN, U), E and D U's terms, S the file's score;
+* a new-track column said as a threshold, "→ new track T (the K threshold V)" / "over a new track (the K threshold
+  V)" (also in a close call): the row's new-track entry is the matrix's cost threshold (its scale's, the value
+  every track entry beyond it was set +inf against) and V prints it (1 - it for a similarity such as 3D IoU); a
+  new-track column that holds the threshold said as a cost ("over new (3D IoU 0.10)") is ``misleading`` (it reads
+  as a new track's IoU).
 
 Printed values are compared as printed: two decimals for costs, existences and scores, one for d².
 """
@@ -33,6 +38,13 @@ CHOICE = re.compile(
 )
 
 
+HELD = re.compile(
+    rf"frame (\d+): (?:close call: )?m(\d+)(?: \(score {_N}\))? → [^(\n]*?(?:\(([^()\n]*)\) )?over "
+    rf"(?:a new track \(the ([^()\n]+?) threshold ({_N})(?: m)?\)|new \(([^()\n]*)\)|track \d+)"
+)
+CHOSEN_HELD = re.compile(rf"the ([^()\n]+?) threshold ({_N})(?: m)?")
+
+
 def check_costs(text: str, c: str, raw, scene, out, bad) -> None:
     for b in BECAUSE.finditer(text):
         x = int(b[1])
@@ -40,6 +52,86 @@ def check_costs(text: str, c: str, raw, scene, out, bad) -> None:
             _check_breakdown(m, x, c, raw, scene, out, bad)
     for m in CHOICE.finditer(text):
         _check_choice_costs(m, c, raw, scene, out, bad)
+    check_thresholds(text, c, raw, out, bad)
+    check_choice_values(text, c, raw, out, bad)
+
+
+VALUES = re.compile(
+    rf"frame (\d+): (?:close call: )?m(\d+)(?: \(score {_N}\))? → \**(?:new track \d+|track \d+|new|missed \d+)\** "
+    rf"\((?:cost |the [^()\n]+? threshold |[\w ]*?[A-Za-z] )?({_N})(?: m)?[^()\n]*\) over (?:track (\d+)|new|a new "
+    rf"track) \((?:the [^()\n]+? threshold |[\w ]*?[A-Za-z] )?({_N})"
+)
+
+
+def check_choice_values(text: str, c: str, raw, out, bad) -> None:
+    """Every choice line's two values ("→ X (V) over Y (W)", on any scale: nats, metres, a similarity such as
+    3D IoU, a threshold) against the deciding matrix: V the entry of the column the assignment gave the
+    detection, W that of track Y or of the row's new-track column; a similarity prints 1 - the entry."""
+    if raw is None:
+        return
+    for m in VALUES.finditer(text):
+        found = raw.deciding(int(m[1]), c)
+        if found is None:
+            continue
+        mat, a = found
+        meas = int(m[2])
+        row, chosen = replay.row_of(mat, meas), replay.chosen_col(mat, a, meas)
+        if row is None or chosen is None:
+            continue
+        alt = replay.track_col(mat, int(m[4])) if m[4] else None
+        other = float(mat.cost[row, alt]) if alt is not None else None if m[4] else _new_entry(mat, row, meas)
+        similar = mat.scale is not None and mat.scale.similarity is not None
+        out.checked["cost"] += 1
+        entry, after = _as_printed(float(mat.cost[row, chosen]), similar), _as_printed(other, similar)
+        if entry != m[3] or after != m[5]:
+            bad("cost", m[0][:160], f"the deciding matrix gives {entry} for the chosen, {after} for the other")
+
+
+def _as_printed(value: float | None, similar: bool) -> str | None:
+    """A matrix entry as a choice line prints it: two decimals, of 1 - it for a similarity (None: no entry)."""
+    return None if value is None else f"{1.0 - value:.2f}" if similar else f"{value:.2f}"
+
+
+def check_thresholds(text: str, c: str, raw, out, bad) -> None:
+    """The choice lines (and a story's close calls) whose new-track column is said as a threshold, or said as a
+    cost where it holds one (module docstring)."""
+    if raw is None:
+        return
+    for m in HELD.finditer(text):
+        found = raw.deciding(int(m[1]), c)
+        if found is None:
+            continue
+        mat, _ = found
+        row = replay.row_of(mat, int(m[2]))
+        entry = _new_entry(mat, row, int(m[2])) if row is not None else None
+        if entry is None:
+            continue
+        threshold = mat.scale.threshold if mat.scale is not None else None
+        holds = threshold is not None and math.isclose(entry, threshold, rel_tol=1e-9, abs_tol=1e-12)
+        similar = mat.scale is not None and mat.scale.similarity is not None
+        shown = f"{1.0 - entry:.2f}" if similar else f"{entry:.2f}"
+        said = [(m[4], m[5])] if m[4] else []
+        chosen = CHOSEN_HELD.fullmatch(m[3] or "")
+        if chosen is not None:
+            said.append((chosen[1], chosen[2]))
+        for _, value in said:
+            out.checked["cost"] += 1
+            if not holds or value != shown:
+                bad("cost", m[0], f"m{m[2]}'s new-track entry is {entry:.4f}, the matrix's threshold {threshold}")
+        if m[6] is not None:  # "over new (V)": a cost, or a threshold said as one
+            out.checked["misleading"] += 1
+            if holds:
+                bad("misleading", m[0], f"the new-track entry {entry:.4f} is the matrix's threshold, not a cost")
+
+
+def _new_entry(mat, row: int, meas: int) -> float | None:
+    """The entry of detection ``meas``'s new-track column in ``row`` (its own, else the row's finite one)."""
+    from gnnpmb.events import AxisKind
+
+    cols = [k for k, col in enumerate(mat.cols) if col.kind is AxisKind.NEW_TRACK]
+    own = [k for k in cols if int(mat.cols[k].ref) == meas]
+    finite = [k for k in own or cols if math.isfinite(float(mat.cost[row, k]))]
+    return float(mat.cost[row, finite[0]]) if finite else None
 
 
 def _terms_of(mat, row: int, t: int) -> tuple[float | None, float | None]:

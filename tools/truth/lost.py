@@ -361,17 +361,48 @@ def check_two_tracks(text: str, class_name: str, frame: int, gt_id: str | None, 
             bad("output", m[0], f"the submission's box of track {t} lies {d:.2f} m from the annotation")
 
 
-STORY_SHOWN = re.compile(r"frame (\d+): track (\d+) (?:no longer shown \(|confirmed \()([rw])=(\d+\.\d+)")
-STORY_HIDDEN = re.compile(r"frame (\d+): track (\d+) \(not shown, ([rw]) < [\d.]+\): [^\n]*?, [rw]=(\d+(?:\.\d+)?)\n")
+STORY_SHOWN = re.compile(
+    r"frame (\d+): track (\d+) (?:no longer (?:shown|output) \(|fell below the display threshold \(|confirmed \()"
+    r"([rw])=(\d+\.\d+)"
+)
+STORY_HIDDEN = re.compile(
+    r"frame (\d+): track (\d+) \((?:not shown, [rw] < [\d.]+|output; [rw] below the display threshold [\d.]+|not "
+    r"output)\): [^\n]*?, ([rw])=(\d+(?:\.\d+)?)\n"
+)
+STORY_COPY = re.compile(r"frame (\d+): track (\d+) confirmed \(a copy of track (\d+)'s component, ([rw])=(\d+\.\d+)")
+STORY_OUTPUT = re.compile(
+    r"frame (\d+): track (\d+) (?:(no longer shown|\(not shown)|(no longer output|\(not output)|(fell below the "
+    r"display threshold \([^)]*\), still output|\(output;))"
+)
 
 
-def check_story(section: str, c: str, raw, out, bad) -> None:
+def check_story(section: str, c: str, raw, out, bad, submitted=None) -> None:
     """A focus document's story lines of one run (``section``): "track T confirmed (r=V, …)", "track T no longer
-    shown (r=V fell below …)", "track T (not shown, r < …): …, r=V": V is the track's existence after frame x's
-    update (a GM-PHD / CPHD label's heaviest ``IntensityWeights`` component), and the symbol is ``w`` for such a
-    label, ``r`` for an existence (else ``misleading``)."""
+    output (r=V fell below …)", "track T fell below the display threshold (r=V < …), still output", "track T
+    (output; r below the display threshold …): …, r=V", "track T (not output): …, r=V": V is the track's existence
+    after frame x's update (a GM-PHD / CPHD label's heaviest ``IntensityWeights`` component), and the symbol is
+    ``w`` for such a label, ``r`` for an existence (else ``misleading``). With the run's submission (``submitted``:
+    frame -> track ids with a box there): "output" / "not output" as it has the track's box or not, and "not shown"
+    of a track it output is ``misleading`` (the viewer's display threshold is not the submission's). "track T
+    confirmed (a copy of track S's component, w=V, …)": T has no component of its own at x, S's weighs V (1.5 or
+    more: two copies or more)."""
+    if submitted is not None:
+        for m in STORY_OUTPUT.finditer(section):
+            x, t = int(m[1]), m[2]
+            out.checked["output"] += 1
+            boxed = t in submitted.get(x, set())
+            if m[3] and boxed:  # "not shown": true of the view, misleading of a track output
+                bad("misleading", m[0], f"the submission has a box of track {t} at frame {x}: it was output")
+            elif (m[4] and boxed) or (m[5] and not boxed):
+                bad("output", m[0], f"the submission {'has' if boxed else 'has no'} box of track {t} at frame {x}")
     if raw is None:
         return
+    for m in STORY_COPY.finditer(section):  # a GM-PHD copy: no component of its own, its source's weight
+        x, t, source = int(m[1]), int(m[2]), int(m[3])
+        out.checked["tracker"] += 1
+        own, got = _existence(raw, x, c, t), _existence(raw, x, c, source)
+        if own is not None or not _reads(got, m[5]) or got < 1.5:
+            bad("tracker", m[0], f"track {t}'s own weight {own}; track {source}'s {got} (copies from 1.5)")
     found = [(m[0], int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_SHOWN.finditer(section)]
     found += [(m[0].strip(), int(m[1]), int(m[2]), m[3], m[4]) for m in STORY_HIDDEN.finditer(section + "\n")]
     for sentence, x, t, symbol, said in found:
@@ -415,12 +446,33 @@ def check_track_tables(section: str, c: str, raw, out, bad) -> None:
                 for i, w in zip(np.asarray(e.track_ids).tolist(), np.asarray(e.existence).tolist(), strict=True)
                 if i == t
             ]
+            if len(cells) == 6:  # "in gate (NIS)": "m15 (1.2), m3 (4.0)" or "nothing", against a Gated row of T
+                _check_gate_cell(cells[2], raw, x, c, t, out, bad)
             for said, got in ((before, max(predicted) if predicted else None), (after, _existence(raw, x, c, t))):
                 if said in ("—", "ended"):
                     continue
                 out.checked["tracker"] += 1
                 if not _reads(got, said):
                     bad("tracker", f"Track {t} at frame {x}: {said}", f"the raw events give {got}")
+
+
+GATE_ITEM = re.compile(r"m(\d+) \((\d+\.\d)\)")
+
+
+def _check_gate_cell(cell: str, raw, x: int, c: str, t: int, out, bad) -> None:
+    """A table's gate cell: the detections inside track ``t``'s gate at frame x with their d² (one decimal),
+    exactly those of one of its rows of the frame's ``Gated`` event (a PHD label has a row per component); "nothing"
+    where a row of it gates none, or it has no row."""
+    said = sorted((int(m), d2) for m, d2 in GATE_ITEM.findall(cell))
+    rows = []
+    for e in raw.of_kind(x, c, Gated):
+        refs = np.asarray(e.meas_indices).tolist()
+        for k in np.flatnonzero(np.asarray(e.track_ids) == t).tolist():
+            inside = np.flatnonzero(np.asarray(e.inside)[k]).tolist()
+            rows.append(sorted((int(refs[j]), f"{float(np.asarray(e.d2)[k, j]):.1f}") for j in inside))
+    out.checked["tracker"] += 1
+    if said not in rows and not (not said and not rows):
+        bad("tracker", f"Track {t} at frame {x}: in gate {cell}", f"its Gated rows: {rows}")
 
 
 def _reads(got: float | None, said: str) -> bool:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 
 from tools.truth.devkit import EvalFacts
 from tools.truth.fields import failed_here
@@ -149,3 +149,20 @@ def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapp
         false = ev.false_near(x, place_xy_m, c)
         if bool(false) != m[2].startswith("had a false"):
             bad("other run", m[0], f"{m[1]}'s false positives within {NEAR_M} m at frame {x}: {false}")
+
+
+TRACKS_NAMED = re.compile(r"\btracks? (\d+(?:(?:, | and )\d+)*)")
+"""The tracks a clause about another run names (``its track 50``, ``its tracks 7, 9 were output``)."""
+
+
+def check_involved(doc: str, track_ids: Mapping[str, Sequence[int]], out, bad) -> None:
+    """A focus document's clauses about another run ("pmbm on the same detections did not fail here: the
+    evaluation matched the object to its track 50"): every track they name is one of that run's involved tracks
+    (``track_ids``, the focus target's: the tracks its views highlight and label), else ``misleading`` (the text
+    names a track the views do not show among the involved)."""
+    for name, ids in track_ids.items():
+        for clause in re.finditer(rf"\b{re.escape(name)} on the same detections [^;\n]*", doc):
+            named = {int(t) for said in TRACKS_NAMED.findall(clause[0]) for t in re.findall(r"\d+", said)}
+            out.checked["misleading"] += 1
+            if named - set(ids):
+                bad("misleading", clause[0][:160], f"{name}'s involved tracks (highlighted in its views) are {ids}")

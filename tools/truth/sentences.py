@@ -27,7 +27,9 @@ from collections import Counter
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 
-from gnnpmb.events import AxisKind, Born, CostMatrix
+import numpy as np
+
+from gnnpmb.events import AxisKind, Born, CostMatrix, Gated
 from tools.truth import costs, detector, hypotheses, lost, otherruns, output, place, replay, shares
 from tools.truth.devkit import EvalFacts
 from tools.truth.printing import BECAUSE
@@ -118,9 +120,36 @@ COULD_NOT = re.compile(
     r"at frame (\d+) m(\d+) \(score [\d.]+, [\d.]+ m from it; track (\d+) could not take it: its column's cost for "
     r"it was infinite"
 )
+TEST_KIND = re.compile(
+    r"at frame (\d+) m(\d+) \([^;]*; track (\d+) could not take it(?: in the hypothesis the tracker chose \(|: )"
+    r"its column's cost (?:there|for it) was infinite,? \(?(outside its gate|beyond its ([^\n]+?) threshold)"
+)
+
+
+def _check_test_kind(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
+    """The test an infinite cost is said to stand for: "outside its gate" where a ``Gated`` row of the track has
+    the detection outside; "beyond its K threshold" where the frame's matrix has a cost threshold named K and no
+    ``Gated`` row has the detection outside the track's gate (else the gate stopped it first)."""
+    x, meas, t, kind, name = int(m[1]), int(m[2]), int(m[3]), m[4], m[5]
+    outside = inside = False
+    for e in raw.of_kind(x, c, Gated):
+        refs = np.asarray(e.meas_indices).tolist()
+        if meas not in refs:
+            continue
+        for k in np.flatnonzero(np.asarray(e.track_ids) == t).tolist():
+            hit = bool(np.asarray(e.inside)[k, refs.index(meas)])
+            inside, outside = inside or hit, outside or not hit
+    named = {mat.scale.name for mat in raw.matrices(x, c) if mat.scale is not None and mat.scale.threshold is not None}
+    out.checked["gone"] += 1
+    if kind == "outside its gate" and not (outside and not inside):
+        bad("gone", m[0], f"the Gated rows of track {t} at frame {x}: outside {outside}, inside {inside}")
+    elif name is not None and (name not in named or (outside and not inside)):
+        bad("gone", m[0], f"the frame's thresholds: {sorted(named)}; Gated outside {outside}, inside {inside}")
+
+
 CHOICE = re.compile(
-    r"frame (\d+): m(\d+)(?: \(score [\d.]+\))? → ([^(]+?) \([^()]*\) "
-    r"(?:over (track \d+|new|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)"
+    r"frame (\d+): (?:close call: )?m(\d+)(?: \(score [\d.]+\))? → ([^(]+?) \([^()]*\) "
+    r"(?:over (track \d+|new|a new track|missed \d+) \([^()]*(?:\([^()]*\)[^()]*)*\)"
     r"(?:, which took m(\d+) \(the lower total wins\))?|\(no other\)), margin (inf|\d+\.\d+)"
     r"((?: [a-zA-Z]+)? or more)?"
 )
@@ -230,6 +259,12 @@ def check_text(
         out.checked["misleading"] += 1
         if t not in ev.submitted.get(x, set()):
             bad("misleading", sentence, f"the submission has no box of track {t} at frame {x} (an interpolation)")
+    if scene is not None and ctx.gt_id is not None:
+        for m in LAST_OUTPUT.finditer(text):
+            later = _output_on_after(scene, ev, m[1], ctx.gt_id, int(m[2]), ctx.frame)
+            out.checked["output"] += 1
+            if later:
+                bad("output", m[0], f"the submission's box of track {m[1]} lay within 2 m of the annotation at {later}")
     lost.check_not_output(text, ctx.lost, ev, out, bad)
     lost.check_last_match(text, c, ctx.frame, ctx.gt_id, ev, out, bad)
     lost.check_two_tracks(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
@@ -261,6 +296,8 @@ def check_text(
         out.checked["gone"] += 1
         if not raw.could_not_take(x, c, meas, t):
             bad("gone", m[0], f"(m{meas}, track {t}) at frame {x}: cost {raw.entry(x, c, meas, t)}")
+    for m in TEST_KIND.finditer(text):
+        _check_test_kind(m, c, raw, out, bad)
     for b in BECAUSE.finditer(text):
         x, para = int(b[1]), b[2]
         for m in OUTSIDE.finditer(para):
@@ -506,3 +543,27 @@ def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
         return
     if (math.isinf(true) and not math.isinf(shown)) or (math.isfinite(true) and abs(shown - true) > 0.006):
         bad("misleading", m[0], f"re-solved without the pair, the total rises by {true:.3f}")
+
+
+def _output_on_after(scene: SceneTruth, ev: EvalFacts, t: str, gt_id: str, last: int, frame: int) -> list[int]:
+    """The frames after ``last`` up to ``frame`` at which the submission's box of track ``t`` lay within 2 m of
+    object ``gt_id``'s annotation ("last output on it at frame ``last``" is false there)."""
+    later = []
+    for x in range(last + 1, frame + 1):
+        a = scene.objects[x].get(gt_id) if x < len(scene.objects) else None
+        if a is None:
+            continue
+        if any(i == t and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < 2.0 for i, _, xy in ev.boxes.get(x, [])):
+            later.append(x)
+    return later
+
+
+def check_choice_lines(text: str, c: str, raw: RawEvents | None, out: Tally, bad) -> None:
+    """A focus document's key decisions and story close calls: each line's margin re-solved (as the Why's), its
+    two values and a new-track column said as a threshold against the deciding matrix (``costs``)."""
+    if raw is None:
+        return
+    for m in CHOICE.finditer(text):
+        _check_choice(m, c, raw, out, bad)
+    costs.check_thresholds(text, c, raw, out, bad)
+    costs.check_choice_values(text, c, raw, out, bad)

@@ -216,6 +216,24 @@ def test_last_on_it_is_said_only_of_the_evaluations_last_match_else_that_match_i
     assert "last output on it" not in line and "last matched" not in line
 
 
+def test_a_track_still_output_on_the_object_at_the_failures_frame_is_not_said_to_have_been_last_on_it_before() -> None:
+    # viewer review, demo scene-0103 pointpillars pmbm fragmentation:1: "track 26 was last output on it at frame
+    # 14, ..., at frame 15 track 26 was still output 0.0 m from the annotated object" (the evaluation scored an
+    # interpolated box 4.0 m away at 15: its last match was at 14, but the track had not left the object)
+    from gnnpmb.why.findings import OnObject
+
+    steps = (step(14, output=estimate(26, 0.9)), step(15, output=estimate(26, 0.9)))
+    lost = LostTrack(26, 14, steps, None, None, None, matched_until=14)
+    on_it = Sighting(15, 0, None, None, None, None, (OnObject(26, 0.0, 0.5, -1, None, None),))
+    kind = FailureKind.FRAGMENTATION
+    line = why_lines(finding(kind, lost, frame=15, window=(14, 15), sightings=(on_it,), has_existence=False))[0]
+    assert "last output on it" not in line
+    assert "the evaluation last matched track 26 to it at frame 14" in line
+    left = Sighting(15, 0, None, None, None, None, ())
+    line = why_lines(finding(kind, lost, frame=15, window=(14, 15), sightings=(left,), has_existence=False))[0]
+    assert "track 26 was last output on it at frame 14" in line
+
+
 def test_last_on_it_says_where_the_evaluation_scored_the_object_out_of_the_tracks_reach_and_only_there() -> None:
     # dev set scene-0061 centerpoint gnnpmb fragmentation:3 (independent audit): the aside named frames 8, 9, 11
     # where the evaluation's box was interpolated 2.6, 1.3, 1.3 m off, though at 9 and 11 the track (on the
@@ -452,3 +470,29 @@ def test_another_run_matched_at_a_box_it_did_not_output_names_the_track_the_eval
         finding(FailureKind.FRAGMENTATION, lost, frame=6, others=(OtherRun("greedy", False, (), matched=50),))
     )
     assert "greedy on the same detections did not fail here: the evaluation matched the object to its track 50" in line
+
+
+def test_a_new_track_column_that_holds_the_cost_threshold_is_called_the_threshold_not_a_cost() -> None:
+    # viewer review, demo scene-0103 pointpillars ab3dmot's key decision: "m0 → track 210 (3D IoU 0.10) over new
+    # (3D IoU 0.10), margin 0.00": the new-track column holds the IoU threshold (1 - 0.1), not a new track's IoU
+    from gnnpmb.events import AxisKind, AxisLabel, CostScale
+    from gnnpmb.explain import PairChoice
+    from gnnpmb.why.words import choice_text
+
+    iou = CostScale("1 - IoU (3D)", "", 0.05, threshold=0.9, similarity="3D IoU")
+    m0, t210, new = AxisLabel(AxisKind.MEASUREMENT, 0), AxisLabel(AxisKind.TRACK, 210), AxisLabel(AxisKind.NEW_TRACK, 0)
+    took = PairChoice(m0, t210, 0.8999, new, 0.9, 0.0001, scale=iou)
+    assert choice_text(12, took, 210, False) == (
+        "frame 12: m0 → **track 210** (3D IoU 0.10) over a new track (the 3D IoU threshold 0.10), margin 0.00 of 3D IoU"
+    )
+    started = PairChoice(m0, new, 0.9, t210, 0.95, 0.05, scale=iou)
+    assert choice_text(12, started, 338, True) == (
+        "frame 12: m0 → **new track 338** (the 3D IoU threshold 0.10) over track 210 (3D IoU 0.05), margin 0.05 of "
+        "3D IoU"
+    )
+    metres = CostScale("distance", "m", 0.5, threshold=2.0)
+    assert "over a new track (the distance threshold 2.00 m)" in choice_text(
+        3, PairChoice(m0, t210, 1.9, new, 2.0, 0.1, scale=metres), 210, False
+    )
+    nats = PairChoice(m0, t210, 6.0, new, 6.5, 0.5)  # no threshold: a new track's cost is a cost
+    assert "over new (6.50)" in choice_text(3, nats, 210, False)
