@@ -153,14 +153,26 @@ def _scale_notes(decisions: Sequence[Decisions]) -> list[str]:
                 if (scale.threshold is not None)
                 else ""
             )
+            new = (
+                f"**new** holds the threshold {scale.threshold:g} = 1 − {scale.similarity} {1 - scale.threshold:g}: "
+                "the detection starts a track unless a track is cheaper"
+                if scale.threshold is not None
+                else "**new** = the detection starts a track"
+            )
             out.append(
-                f"cost = 1 − {scale.similarity} (lower = more overlap;{never} **new** = the detection starts a track). "
+                f"cost = 1 − {scale.similarity} (lower = more overlap;{never} {new}). "
                 f"margin = how much worse {how}, in {scale.similarity} (a close call below {scale.close_call:g})."
             )
         else:
             how = "the best assignment gets" if scale.optimal else "the detection's next closest column is"
+            new = (
+                f"**new** holds the threshold {scale.threshold:g} {scale.unit}: the detection starts a track unless a "
+                "track is closer"
+                if scale.threshold is not None
+                else "**new** = the detection starts a track"
+            )
             out.append(
-                f"cost = {scale.name} in {scale.unit} (lower = closer; **new** = the detection starts a track). margin "
+                f"cost = {scale.name} in {scale.unit} (lower = closer; {new}). margin "
                 f"= how much worse {how} (a close call below {scale.close_call:g} {scale.unit})."
             )
     return out or [

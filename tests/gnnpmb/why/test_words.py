@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 
-from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostTerms
+from gnnpmb.events import Assignment, AxisKind, AxisLabel, CostMatrix, CostScale, CostTerms
 from gnnpmb.explain import explain
 from gnnpmb.why.counterfactual import would_take
 from gnnpmb.why.words import choice_why, frames_text, track_why
-from viz.decisions import _tracks_phrase
+from viz.decisions import _scale_notes, _tracks_phrase
 
 
 def test_conflict_headings_count_tracks_and_candidates() -> None:
@@ -139,3 +140,14 @@ def test_frame_lists_join_consecutive_runs_of_three_or_more() -> None:
     assert frames_text([13, 7]) == "frames 7, 13"
     assert frames_text([12, 13, 14, 16]) == "frames 12–14, 16"
     assert frames_text([9, 10, 15, 16]) == "frames 9, 10, 15, 16"
+
+
+def test_the_decision_legend_says_a_new_column_holds_the_threshold() -> None:
+    """ab3dmot's grid: its "new" column holds 0.90 = 1 - 3D IoU 0.10, the threshold, not a new track's cost (the
+    focus text said "over new (3D IoU 0.10)" of the same entry)."""
+    iou = CostScale("1 - 3D IoU", "3D IoU", 0.05, True, threshold=0.9, similarity="3D IoU")
+    (note,) = _scale_notes([SimpleNamespace(scale=iou)])
+    assert "**new** holds the threshold 0.9 = 1 − 3D IoU 0.1: the detection starts a track unless a track is" in note
+    metres = CostScale("distance", "m", 0.5, False, threshold=2.0)
+    (note,) = _scale_notes([SimpleNamespace(scale=metres)])
+    assert "**new** holds the threshold 2 m: the detection starts a track unless a track is closer" in note
