@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterator
 
+from gnnpmb.events import Assignment, CostMatrix
 from tools.truth import replay
 from tools.truth.printing import BECAUSE, NUMBER, printed
 
@@ -67,13 +69,7 @@ def check_choice_values(text: str, c: str, raw, out, bad) -> None:
     """Every choice line's two values ("→ X (V) over Y (W)", on any scale: nats, metres, a similarity such as
     3D IoU, a threshold) against the deciding matrix: V the entry of the column the assignment gave the
     detection, W that of track Y or of the row's new-track column; a similarity prints 1 - the entry."""
-    if raw is None:
-        return
-    for m in VALUES.finditer(text):
-        found = raw.deciding(int(m[1]), c)
-        if found is None:
-            continue
-        mat, a = found
+    for m, mat, a in _decided(VALUES, text, c, raw):
         meas = int(m[2])
         row, chosen = replay.row_of(mat, meas), replay.chosen_col(mat, a, meas)
         if row is None or chosen is None:
@@ -87,6 +83,19 @@ def check_choice_values(text: str, c: str, raw, out, bad) -> None:
             bad("cost", m[0][:160], f"the deciding matrix gives {entry} for the chosen, {after} for the other")
 
 
+def _decided(
+    pattern: re.Pattern[str], text: str, c: str, raw
+) -> Iterator[tuple[re.Match[str], CostMatrix, Assignment]]:
+    """Each match of ``pattern`` (its group 1 a frame) with the frame's deciding matrix and assignment of class
+    ``c`` (``raw.deciding``); none without raw events."""
+    if raw is None:
+        return
+    for m in pattern.finditer(text):
+        found = raw.deciding(int(m[1]), c)
+        if found is not None:
+            yield m, *found
+
+
 def _as_printed(value: float | None, similar: bool) -> str | None:
     """A matrix entry as a choice line prints it: two decimals, of 1 - it for a similarity (None: no entry)."""
     return None if value is None else f"{1.0 - value:.2f}" if similar else f"{value:.2f}"
@@ -95,13 +104,7 @@ def _as_printed(value: float | None, similar: bool) -> str | None:
 def check_thresholds(text: str, c: str, raw, out, bad) -> None:
     """The choice lines (and a story's close calls) whose new-track column is said as a threshold, or said as a
     cost where it holds one (module docstring)."""
-    if raw is None:
-        return
-    for m in HELD.finditer(text):
-        found = raw.deciding(int(m[1]), c)
-        if found is None:
-            continue
-        mat, _ = found
+    for m, mat, _ in _decided(HELD, text, c, raw):
         row = replay.row_of(mat, int(m[2]))
         entry = _new_entry(mat, row, int(m[2])) if row is not None else None
         if entry is None:
