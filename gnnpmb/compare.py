@@ -66,18 +66,18 @@ class Disagreement:
     quat_wxyz: tuple[float, float, float, float]
 
     def describe(self) -> str:
-        """One readable line naming trackers and ids."""
+        """One readable line naming trackers and ids, short enough for a log row beside the views (about 80
+        characters with its kind)."""
         gt = f"{self.class_name} GT {short_id(self.gt_id)}"
         match self.kind:
             case DisagreementKind.MISSED_BY_ONE:
-                return f"{gt}: {self.tracker} shows track {self.track_ids[0]} on it, {self.other} shows no track on it"
+                return f"{gt}: {self.tracker} has track {self.track_ids[0]} on it, {self.other} none"
             case DisagreementKind.ID_CHANGE:
                 old, new, kept = self.track_ids
-                return f"{gt}: {self.tracker} switched track {old} -> {new}, {self.other} kept track {kept}"
+                return f"{gt}: {self.tracker} switched track {old} -> {new}, {self.other} kept {kept}"
             case DisagreementKind.ONLY_IN_ONE:
                 return (
-                    f"{self.class_name} track {self.track_ids[0]} of {self.tracker} matches no GT; "
-                    f"{self.other} shows no {self.class_name} track there"
+                    f"{self.class_name} track {self.track_ids[0]} of {self.tracker} on no GT; {self.other} none there"
                 )
         raise AssertionError(self.kind)
 

@@ -352,7 +352,7 @@ def test_log_comparison_of_a_hand_made_case(tmp_path: Path) -> None:
     assert log[3] == (
         5,
         "WARN",
-        "id changed in one only: car GT g1-tok: A switched track 1 -> 5, B kept track 11",
+        "id changed in one only: car GT g1-tok: A switched track 1 -> 5, B kept 11",
     )
     assert len(log) == len(comparison.disagreements) == 8
     assert rows[compare.log_path()][0]["timestamp"] == np.datetime64(3_000_000, "us")

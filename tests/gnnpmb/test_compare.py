@@ -87,12 +87,12 @@ def test_disagreement_boxes_and_descriptions() -> None:
     comparison = compare_trackers([GT] * 3, {"A": A_FRAMES, "B": B_FRAMES})
     switch = comparison.of_kind(ID_CHANGE)[0]
     assert switch.translation_m == (0.0, 0.0, 1.0) and switch.size_wlh_m == (2.0, 4.5, 1.6)
-    assert switch.describe() == "car GT g1-tok: A switched track 1 -> 5, B kept track 11"
+    assert switch.describe() == "car GT g1-tok: A switched track 1 -> 5, B kept 11"
     lone = comparison.of_kind(ONLY)[-1]
     assert lone.translation_m == (20.0, 5.0, 1.0)
-    assert lone.describe() == "car track 8 of A matches no GT; B shows no car track there"
+    assert lone.describe() == "car track 8 of A on no GT; B none there"
     missed = comparison.of_kind(MISSED)[0]
-    assert missed.describe() == "car GT g2: A shows track 2 on it, B shows no track on it"
+    assert missed.describe() == "car GT g2: A has track 2 on it, B none"
 
 
 def test_identical_trackers_agree_and_three_trackers_compare_pairwise() -> None:

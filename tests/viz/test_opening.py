@@ -132,7 +132,7 @@ def test_labels_only_where_they_carry_the_story(recorded) -> None:
             labels = rec.labels(view, frame)
             assert len(labels) <= MOST_LABELS, (view.name, frame, [label.text for label in labels])
             for label in labels:
-                assert not label.text.startswith("only ") and "shows no track" not in label.text
+                assert not label.text.startswith("only ") and "on it, " not in label.text
                 if "/tracks/" in label.entity:
                     assert (frame, label.entity.rsplit("/", 1)[1]) in failing[run], (view.name, frame, label.text)
             boxes = camera_boxes(rec, view, frame) if view.camera else screen_boxes(rec, view, frame, view.size_px)
