@@ -370,7 +370,11 @@ def _tracker_views(
     """The bird's-eye view above the perspective view; with a focus the bird's-eye view, where the failure is
     read, takes more of the height; with ``strip`` (a full recording whose failures were found: its frames) the
     failures over those frames below them, in ``rows`` rows (``viz.opening.log_failure_timeline``), the view as
-    tall as ``strip_rows`` rows need (the most any run has; with ``cameras`` below, ``viz.opening.strip_share``)."""
+    tall as ``strip_rows`` rows need (the most any run has; with ``cameras`` below, ``viz.opening.strip_share``).
+    A focus on several ``runs`` puts the perspective view in a tab behind the bird's-eye view: a third of the width
+    and a third of the height left it a strip no one could read (demo scene-0103, three runs: 110 px tall)."""
+    if focus is not None and runs > 1:
+        return rrb.Tabs(bev_view(tracker, focus), spatial_view(tracker, focus), active_tab=0)
     if focus is not None:
         return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[7, 3])
     if strip is not None:

@@ -27,15 +27,16 @@ FOCUS_BEV_HEIGHT_PX = 683.0
 web viewer: dev set scene-0103 simpletrack fragmentation:9); ``focus_bev_height_px`` for the other layouts."""
 COMPARED_CAMERA_HEIGHTS_PX = {
     (False, False): FOCUS_BEV_HEIGHT_PX,
-    (True, False): 547.0,
+    (True, False): 791.0,
     (False, True): 404.0,
-    (True, True): 318.0,
+    (True, True): 465.0,
 }
 """(runs compared, a camera view below) -> the bird's-eye view's height in pixels at 1920 x 1080, laid out from the
 focus blueprint as ``tools.labels.layout_px`` does (689 px there for ``FOCUS_BEV_HEIGHT_PX``). The shares they
 were estimated from (0.55 with a camera, 0.8 compared) made a three-run view with a camera 300 px tall, not 318:
 the views were thought 6 % wider in metres than they are and their callouts ran past the edge (demo scene-0103,
-pointpillars, cphd beside ab3dmot and pmbm, ``--focus id_switch:1``)."""
+pointpillars, cphd beside ab3dmot and pmbm, ``--focus id_switch:1``). Runs compared keep their perspective views
+in tabs behind these (``viz.blueprint``), so their bird's-eye views are the scene's whole height."""
 M_PER_PX_PER_HEIGHT = 2.0 * math.tan(math.radians(FOV_Y_DEG / 2.0)) / FOCUS_BEV_HEIGHT_PX
 """Metres per screen pixel per metre of camera height in that view (a pinhole looking straight down: 18 m ->
 0.027 m; it was a measured 0.0022, true of a shorter view, so a column could sit past a taller view's edge)."""

@@ -6,7 +6,8 @@ from gnnpmb.why.words import SHOW_MIN_EXISTENCE
 
 READING_GUIDE = f"""# How to read the views
 
-**Bird's-eye and 3D views** (one pair per tracker)
+**Bird's-eye and 3D views** (one pair per tracker; with several trackers the 3D view is the tab behind the
+bird's-eye view)
 
 - **Detections**: thin boxes in class colours, labelled `m<idx> <score>` (the same `m<idx>` everywhere: lines,
   tables, logs).
