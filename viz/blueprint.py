@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
 
+import rerun as rr
 import rerun.blueprint as rrb
 
 from gnnpmb.data.sensors import CAMERA_ORDER
@@ -29,7 +30,7 @@ from viz import compare, paths
 from viz.cameras import with_cameras
 from viz.failures import failure_log
 from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M, BEV_UP, EYE_POSITION_M, EYE_TARGET_M
-from viz.legend import LegendPlacement
+from viz.legend import FOCUS_PAST_FRAMES, LegendPlacement
 
 if TYPE_CHECKING:
     from gnnpmb.focus import FocusTarget
@@ -215,6 +216,15 @@ def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visib
     return placed.view_args() if placed is not None else {"plot_legend": rrb.PlotLegend(visible=visible)}
 
 
+_FOCUS_AXIS = rrb.TimeAxis(
+    view_range=rr.TimeRange(
+        start=rr.TimeRangeBoundary.infinite(), end=rr.TimeRangeBoundary.cursor_relative(FOCUS_PAST_FRAMES)
+    )
+)
+"""A focus recording's plots run past the failure frame, where they open: a track started at that frame (one
+point) sat on the plot's edge, half cut (dev set scene-0916 megvii phd id_switch:1, track 24)."""
+
+
 def track_series_views(
     tracker: str,
     focus: FocusTarget | None = None,
@@ -239,6 +249,7 @@ def track_series_views(
             origin=root,
             contents=_series_contents(root, near, tracker, focused=focus is not None),
             name=f"{tracker} {what}{at}",
+            axis_x=_FOCUS_AXIS if focus is not None else None,
             **_legend_args(root, legends, few or focus is not None),
         )
         for root, what in (

@@ -54,7 +54,7 @@ from viz.geometry import (
     size_wlh_to_xyz,
 )
 from viz.label_size import CLEARANCE_PX
-from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
+from viz.legend import COMPARISON_PLOT_HEIGHT_PX, FOCUS_PAST_FRAMES, LegendPlacement, existence_range, place_legend
 from viz.logger import TrackerLogger
 from viz.markers import send_text_lines
 from viz.reading_guide import READING_GUIDE
@@ -301,7 +301,7 @@ def focus_legends(
             if root == paths.existence_root(tracker):
                 tracks = [logger.sent_series[p] for p in series[:-1] if p in logger.sent_series]  # not the threshold
                 fixed = existence_range([v[f <= last] for f, v in tracks])
-            out[root] = place_legend(lines, len(sent), y_range=fixed)
+            out[root] = place_legend(lines, len(sent), y_range=fixed, past_frames=FOCUS_PAST_FRAMES)
     if comparison is not None:
         frames = np.asarray(comparison.frame_indices)
         upto = frames <= last

@@ -53,6 +53,13 @@ SAMPLES = 200
 """Points per line at which the legend's box is tested (lines are straight between logged points)."""
 CORNER_ORDER = (Corner.RightTop, Corner.LeftTop, Corner.RightBottom, Corner.LeftBottom)
 """Preference among corners that are equally empty."""
+FOCUS_PAST_FRAMES = 1
+"""A focus recording's track plots run this many frames past the failure frame, where they open
+(``viz.blueprint``), so a line's point at that frame is not on the plot's edge."""
+LAST_FRAME_WEIGHT = 20
+"""When every corner of a fixed-range plot holds data, a sample within half a frame of the lines' last frame (a
+focus plot's failure frame) counts this many times: the legend may hide the story's past, not its end (dev set
+scene-0916 megvii phd id_switch:1: it covered track 8's weight falling below the threshold at frame 13)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,11 +87,14 @@ def place_legend(
     n_entries: int | None = None,
     plot_height_px: float = PLOT_HEIGHT_PX,
     y_range: tuple[float, float] | None = None,
+    past_frames: int = 0,
 ) -> LegendPlacement:
     """The corner for the legend of a plot of ``lines`` ((K,) x, (K,) y each; NaN values are gaps): the first
     of ``CORNER_ORDER`` whose legend box no line passes through. If there is none: with a fixed ``y_range``
-    (e.g. a probability's [0, 1]) the corner that covers the fewest line samples; else the top right with a y
-    range whose upper part is left free for it. ``n_entries``: legend rows (default: one per line)."""
+    (e.g. a probability's [0, 1]) the corner that covers the fewest line samples (those at the last frame count
+    ``LAST_FRAME_WEIGHT`` times); else the top right with a y range whose upper part is left free for it.
+    ``n_entries``: legend rows (default: one per line); ``past_frames``: the plot's x axis runs this many frames
+    past the lines' last x (``FOCUS_PAST_FRAMES``)."""
     drawn = [(np.asarray(x, np.float64), np.asarray(y, np.float64)) for x, y in lines]
     drawn = [(x[np.isfinite(y)], y[np.isfinite(y)]) for x, y in drawn]
     drawn = [(x, y) for x, y in drawn if x.size]
@@ -92,7 +102,8 @@ def place_legend(
         return LegendPlacement(CORNER_ORDER[0], y_range)
     height = legend_height(len(lines) if n_entries is None else n_entries, plot_height_px)
     x_lo = min(float(x.min()) for x, _ in drawn)
-    x_hi = max(float(x.max()) for x, _ in drawn)
+    last = max(float(x.max()) for x, _ in drawn)
+    x_hi = last + past_frames
     if y_range is None:
         y_lo = min(float(y.min()) for _, y in drawn)
         y_hi = max(float(y.max()) for _, y in drawn)
@@ -101,13 +112,14 @@ def place_legend(
     else:
         y_lo, y_hi = y_range
     u, v = _normalised(drawn, (x_lo, x_hi), (y_lo, y_hi))
+    weight = np.where(u >= (last - 0.5 - x_lo) / ((x_hi - x_lo) or 1.0), LAST_FRAME_WEIGHT, 1)
     covered = []
     for corner in CORNER_ORDER:
         left = corner in (Corner.LeftTop, Corner.LeftBottom)
         top = corner in (Corner.LeftTop, Corner.RightTop)
         in_x = u <= LEGEND_WIDTH if left else u >= 1.0 - LEGEND_WIDTH
         in_y = v >= 1.0 - height if top else v <= height
-        covered.append(int(np.count_nonzero(in_x & in_y)))
+        covered.append(int(weight[in_x & in_y].sum()))
         if covered[-1] == 0:
             return LegendPlacement(corner, y_range)
     if y_range is not None:
