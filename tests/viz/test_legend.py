@@ -76,6 +76,19 @@ def test_a_fixed_range_is_kept_and_the_least_covered_corner_taken() -> None:
     assert crowded.corner in (Corner.RightBottom, Corner.LeftBottom)  # the top holds two lines, the bottom one
 
 
+def test_with_every_corner_taken_the_legend_spares_the_last_frame(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The dev set's phd id_switch:1 shape: a line at the top, a dip early at the bottom left, and a fall below
+    the threshold at the failure frame, the last, at the bottom right."""
+    weight = line([1, 2, 3, 4, 11, 12, 13], [1.0, 0.1, 0.87, 1.0, 1.0, 0.83, 0.32])
+    threshold = line([0, 13], [0.5, 0.5])
+    started = line([13], [0.64])
+    lines = [weight, threshold, started]
+    assert place_legend(lines, 3, y_range=(-0.02, 1.02), past_frames=1).corner is Corner.LeftBottom
+    # Counted as any other sample, the fall (fewer samples in the box than the early dip's) would be covered.
+    monkeypatch.setattr("viz.legend.LAST_FRAME_WEIGHT", 1)
+    assert place_legend(lines, 3, y_range=(-0.02, 1.02), past_frames=1).corner is Corner.RightBottom
+
+
 def test_an_existence_plot_of_tracks_that_all_stay_low_is_zoomed_to_them() -> None:
     assert existence_range([np.array([0.1, 0.9]), np.array([0.02])]) == PROBABILITY_RANGE
     low = existence_range([np.array([0.03, 0.01]), np.array([0.07, 0.0]), np.array([])])
