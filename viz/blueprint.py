@@ -27,6 +27,7 @@ from gnnpmb.data.sensors import CAMERA_ORDER
 from gnnpmb.events import Panel
 from gnnpmb.runs import Capabilities, tracker_capabilities
 from viz import compare, paths
+from viz.callouts import COMPARED_CAMERA_HEIGHTS_PX, FOCUS_VIEW_WIDTH_PX
 from viz.cameras import with_cameras
 from viz.failures import failure_log
 from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M, BEV_UP, EYE_POSITION_M, EYE_TARGET_M
@@ -39,6 +40,22 @@ FOCUS_HEIGHT_M: dict[str, float] = {"pedestrian": 16.0, "bicycle": 18.0, "motorc
 """Height of the bird's-eye camera above a focused place by class (small objects closer)."""
 DEFAULT_FOCUS_HEIGHT_M = 40.0
 """The same for the other classes."""
+
+
+def focus_eye_height_m(class_name: str, runs: int, camera: bool) -> float:
+    """Height of a focus bird's-eye view's eye above the focused place: the class's (``FOCUS_HEIGHT_M``), raised in
+    a view taller than wide (runs side by side, ``viz.callouts.COMPARED_CAMERA_HEIGHTS_PX``) so that its width
+    shows ``NARROW_VIEW_WIDTH`` times the metres the class's height shows up and down."""
+    tall_px = COMPARED_CAMERA_HEIGHTS_PX[runs > 1, camera]
+    wide_px = FOCUS_VIEW_WIDTH_PX / max(runs, 1)
+    return FOCUS_HEIGHT_M.get(class_name, DEFAULT_FOCUS_HEIGHT_M) * max(1.0, NARROW_VIEW_WIDTH * tall_px / wide_px)
+
+
+NARROW_VIEW_WIDTH = 1.25
+"""A narrow focus view's width in metres over the height in metres the class's eye height shows. At 1.0 (the
+width as wide as a square view's) an object moving across the two-run view (576 x 791 px) took its labels past
+the sides at 3 of 13 recorded frames in dev set scene-0916 megvii phd / cphd ``--focus diff:fixed:20``; at 1.25,
+0 and 2 (``tools.labels``)."""
 COMPARED_ROW_SHARES = (4, 1)
 """With two runs or more, the left column's rows: the scene views, the comparison panel below them."""
 STORY_COLUMNS = rrb.TextLogColumns(
@@ -108,15 +125,16 @@ def spatial_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3
     )
 
 
-def bev_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3DView:
-    """Top-down view without LiDAR: tracks, trails, association lines, gates, detections, ground truth."""
+def bev_view(tracker: str, focus: FocusTarget | None = None, runs: int = 1, camera: bool = False) -> rrb.Spatial3DView:
+    """Top-down view without LiDAR: tracks, trails, association lines, gates, detections, ground truth; a focus
+    view's eye is placed for ``runs`` side by side with a ``camera`` view below (``focus_eye_height_m``)."""
     if focus is None:
         origin = paths.EGO
         eye = rrb.EyeControls3D(position=BEV_EYE_POSITION_M, look_target=BEV_TARGET_M, eye_up=BEV_UP)
     else:
         x, y = focus.center_xy_m
         origin = paths.WORLD
-        height = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
+        height = focus_eye_height_m(focus.class_name, runs, camera)
         eye = rrb.EyeControls3D(position=(x, y, height), look_target=(x, y, 0.0), eye_up=(0, 1, 0))
     return rrb.Spatial3DView(
         origin=origin,
@@ -385,9 +403,9 @@ def _tracker_views(
     A focus on several ``runs`` puts the perspective view in a tab behind the bird's-eye view: a third of the width
     and a third of the height left it a strip no one could read (demo scene-0103, three runs: 110 px tall)."""
     if focus is not None and runs > 1:
-        return rrb.Tabs(bev_view(tracker, focus), spatial_view(tracker, focus), active_tab=0)
+        return rrb.Tabs(bev_view(tracker, focus, runs, cameras), spatial_view(tracker, focus), active_tab=0)
     if focus is not None:
-        return rrb.Vertical(bev_view(tracker, focus), spatial_view(tracker, focus), row_shares=[7, 3])
+        return rrb.Vertical(bev_view(tracker, focus, runs, cameras), spatial_view(tracker, focus), row_shares=[7, 3])
     if strip is not None:
         from viz.opening import SCENE_SHARES, failure_timeline, strip_share, timeline_bounds
 

@@ -37,6 +37,8 @@ were estimated from (0.55 with a camera, 0.8 compared) made a three-run view wit
 the views were thought 6 % wider in metres than they are and their callouts ran past the edge (demo scene-0103,
 pointpillars, cphd beside ab3dmot and pmbm, ``--focus id_switch:1``). Runs compared keep their perspective views
 in tabs behind these (``viz.blueprint``), so their bird's-eye views are the scene's whole height."""
+FOCUS_VIEW_WIDTH_PX = 1920 * 3 / 5
+"""Width the runs' bird's-eye views share in a focus recording at 1920 x 1080 (the scene column, ``viz.blueprint``)."""
 M_PER_PX_PER_HEIGHT = 2.0 * math.tan(math.radians(FOV_Y_DEG / 2.0)) / FOCUS_BEV_HEIGHT_PX
 """Metres per screen pixel per metre of camera height in that view (a pinhole looking straight down: 18 m ->
 0.027 m; it was a measured 0.0022, true of a shorter view, so a column could sit past a taller view's edge)."""

@@ -18,14 +18,14 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 
 import numpy as np
 import rerun as rr
 
 from gnnpmb.compare import Comparison, DisagreementKind
 from gnnpmb.data.scene import SceneData
-from gnnpmb.eval.failures import short_id
+from gnnpmb.eval.failures import FailureReport, short_id
 from gnnpmb.focus import FocusTarget
 from gnnpmb.focus_cameras import FocusSight
 from gnnpmb.pipeline import FrameResult
@@ -35,15 +35,15 @@ from gnnpmb.why.findings import Finding
 from gnnpmb.why.words import existence_text, share_text, went_text
 from viz import compare, paths
 from viz.blueprint import (
-    DEFAULT_FOCUS_HEIGHT_M,
-    FOCUS_HEIGHT_M,
     focus_doc,
+    focus_eye_height_m,
     focus_world,
     reading_guide_doc,
 )
-from viz.callouts import FOV_Y_DEG, M_PER_PX_PER_HEIGHT, Callout, focus_height_m, log_callouts
+from viz.callouts import FOCUS_VIEW_WIDTH_PX, FOV_Y_DEG, M_PER_PX_PER_HEIGHT, Callout, focus_height_m, log_callouts
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
 from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
+from viz.failures import FOCUS_MARGIN_M, MARKER_MARGIN_M, MARKER_SCALE
 from viz.focus_summary import TrackerView, focus_markdown
 from viz.geometry import (
     RerunBoxes,
@@ -76,10 +76,6 @@ def tracker_focus(tracker: str) -> str:
     return f"{paths.tracker_world(tracker)}/focus"
 
 
-FOCUS_VIEW_WIDTH_PX = 1920 * 3 / 5
-"""Width the runs' bird's-eye views share in a focus recording at 1920 x 1080 (the scene column, ``viz.blueprint``)."""
-
-
 def log_focus(
     stream: rr.RecordingStream,
     focus: FocusTarget,
@@ -107,7 +103,7 @@ def log_focus(
     gt_ids = set(focus.gt_ids)
     evaluated = evaluated_offsets(focus, reports.get(focus.failure_tracker or ""))
     reach_m = range_near_focus(focus, scene)
-    eye_height_m = FOCUS_HEIGHT_M.get(focus.class_name, DEFAULT_FOCUS_HEIGHT_M)
+    eye_height_m = focus_eye_height_m(focus.class_name, len(loggers), sight is not None)
     for i in shown:
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
@@ -185,7 +181,11 @@ def log_focus(
             detections = frame.detections.boxes
             use = facts.use(i, focus.class_name)
             mode = use.mode if use is not None else UseMode.ASSIGNED
-            named = [gt_corners, footprint_corners_xy(boxes, SCALE, MARGIN_M)]
+            named = [
+                gt_corners,
+                footprint_corners_xy(boxes, SCALE, MARGIN_M),
+                _marker_corners(reports.get(tracker), i, ids),
+            ]
             if detections is not None and given:
                 named.append(footprint_corners_xy(rerun_boxes(detections.subset(np.array(sorted(given))))))
             log_callouts(
@@ -272,6 +272,27 @@ def _log_involved_story(
         [line.text for line in lines],
         [line.level for line in lines],
     )
+
+
+def _marker_corners(report: FailureReport | None, frame: int, track_ids: Collection[int]) -> np.ndarray:
+    """(M, 2) footprint corners of the failure markers drawn at ``frame`` around the focus's tracks, as wide as the
+    focused failure's (``viz.failures``). A track's marker stands where the evaluation saw it, which may be a box it
+    interpolated and the track never output (dev set scene-0916 megvii phd diff:fixed:20: a label ran over the false
+    track's marker)."""
+    ids = {str(t) for t in track_ids}
+    boxes = (
+        [b for f in report.failures if f.frame_index == frame for b in f.boxes if not b.is_gt and b.object_id in ids]
+        if report is not None
+        else []
+    )
+    if not boxes:
+        return np.zeros((0, 2))
+    drawn = RerunBoxes(
+        np.array([b.translation_m for b in boxes], dtype=np.float64),
+        size_wlh_to_xyz(np.array([b.size_wlh_m for b in boxes], dtype=np.float64)),
+        quat_wxyz_to_xyzw(np.array([b.quat_wxyz for b in boxes], dtype=np.float64)),
+    )
+    return footprint_corners_xy(drawn, MARKER_SCALE, MARKER_MARGIN_M + FOCUS_MARGIN_M)
 
 
 def focus_legends(
