@@ -71,14 +71,13 @@ class Disagreement:
         gt = f"{self.class_name} GT {short_id(self.gt_id)}"
         match self.kind:
             case DisagreementKind.MISSED_BY_ONE:
-                return f"{gt}: {self.tracker} has track {self.track_ids[0]} on it, {self.other} none"
+                return f"{gt}: {self.tracker} shows track {self.track_ids[0]} on it, {self.other} none"
             case DisagreementKind.ID_CHANGE:
                 old, new, kept = self.track_ids
                 return f"{gt}: {self.tracker} switched track {old} -> {new}, {self.other} kept {kept}"
             case DisagreementKind.ONLY_IN_ONE:
-                return (
-                    f"{self.class_name} track {self.track_ids[0]} of {self.tracker} on no GT; {self.other} none there"
-                )
+                lone = f"{self.class_name} track {self.track_ids[0]} of {self.tracker}"
+                return f"{lone} on no GT; {self.other} shows none there"
         raise AssertionError(self.kind)
 
 

@@ -90,9 +90,9 @@ def test_disagreement_boxes_and_descriptions() -> None:
     assert switch.describe() == "car GT g1-tok: A switched track 1 -> 5, B kept 11"
     lone = comparison.of_kind(ONLY)[-1]
     assert lone.translation_m == (20.0, 5.0, 1.0)
-    assert lone.describe() == "car track 8 of A on no GT; B none there"
+    assert lone.describe() == "car track 8 of A on no GT; B shows none there"
     missed = comparison.of_kind(MISSED)[0]
-    assert missed.describe() == "car GT g2: A has track 2 on it, B none"
+    assert missed.describe() == "car GT g2: A shows track 2 on it, B none"
 
 
 def test_identical_trackers_agree_and_three_trackers_compare_pairwise() -> None:
