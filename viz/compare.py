@@ -74,7 +74,10 @@ def marker_label(d: Disagreement) -> str:
     """Short box label naming the trackers and ids."""
     match d.kind:
         case DisagreementKind.MISSED_BY_ONE:
-            return f"only {d.tracker} tracks GT {short_id(d.gt_id)} (track {d.track_ids[0]})"
+            mine = f"only {d.tracker} tracks GT {short_id(d.gt_id)} (track {d.track_ids[0]})"
+            if d.elsewhere is None:
+                return mine
+            return f"{mine}; {d.other}'s track {d.elsewhere[0]} is on GT {short_id(d.elsewhere[1])}"
         case DisagreementKind.ID_CHANGE:
             old, new, kept = d.track_ids
             return f"{d.tracker} {old}->{new}, {d.other} kept {kept}: GT {short_id(d.gt_id)}"

@@ -22,7 +22,8 @@ bird's-eye view)
   yellow identity theft, grey miss. This failure's box encloses the others on the same objects; failures of
   other objects at the same frame are pale.
 - **Disagreements** (several trackers): boxes around the object in sky blue where only one tracker shows a track
-  on it, violet where one changed its id and the other kept it, pink around a track only one shows. Shown means
+  on it (one track an object: the other's track between two objects counts on the nearer, and the line says
+  so), violet where one changed its id and the other kept it, pink around a track only one shows. Shown means
   an existence of {SHOW_MIN_EXISTENCE:g} or more (output, for GNN, JPDA and greedy, which have no existences):
   an involved track below that is drawn here all the same, but counts as not shown in the comparison (and is
   not drawn in the full recording).

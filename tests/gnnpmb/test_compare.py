@@ -95,6 +95,18 @@ def test_disagreement_boxes_and_descriptions() -> None:
     assert missed.describe() == "car GT g2: A shows track 2 on it, B none"
 
 
+def test_a_track_between_two_objects_is_named_where_it_went_not_called_none() -> None:
+    """Two pedestrians 1.2 m apart: A has a track on each, B one track between them, which the one-to-one matching
+    gives to the nearer. B does not miss the other 'with none': its track beside it is on the first (dev set
+    scene-0655 centerpoint: 'jpda none' where jpda's track 43 stood 1 m away)."""
+    gt = gt_boxes([("ped-a", "pedestrian", 0.0, 0.0), ("ped-b", "pedestrian", 1.2, 0.0)])
+    a = [[est(1, "pedestrian", 0.0, 0.0), est(2, "pedestrian", 1.2, 0.0)]]
+    b = [[est(43, "pedestrian", 0.4, 0.0)]]
+    (missed,) = compare_trackers([gt], {"A": a, "B": b}).of_kind(MISSED)
+    assert (missed.gt_id, missed.elsewhere) == ("ped-b", (43, "ped-a"))
+    assert missed.describe() == "pedestrian GT ped-b: A shows track 2 on it, B's track 43 beside it is on GT ped-a"
+
+
 def test_identical_trackers_agree_and_three_trackers_compare_pairwise() -> None:
     assert compare_trackers([GT] * 3, {"A": A_FRAMES, "A2": A_FRAMES}).disagreements == ()
     only_g1 = [[est(21, "car", 0.0, 0.0)]] * 3
