@@ -52,9 +52,11 @@ class Disagreement:
     there. gt_id: the GT instance ("" for ``only_in_one``). track_ids: ``missed_by_one`` (tracker's track,),
     ``id_change`` (tracker's previous id, its new id, other's id), ``only_in_one`` (tracker's track,).
     translation_m (3,), size_wlh_m (3,), quat_wxyz (4,): the GT box, or the lone track's box (global frame).
-    elsewhere (``missed_by_one``): other's track within the match distance of the object that the one-to-one
+    elsewhere: for ``missed_by_one``, other's track within the match distance of the object that the one-to-one
     matching gave to another object, and that object's GT id (two objects close together, one track between them:
-    "other none" would be false, dev set scene-0655 centerpoint jpda, 74 of 907 lines).
+    "other none" would be false, dev set scene-0655 centerpoint jpda, 74 of 907 lines); for ``only_in_one``, an
+    object of the lone track's class within the match distance that tracker's other track is matched to (a
+    duplicate: "on no GT" would be false, dev set scene-0061 pointpillars topmb), as (that track, the GT id).
     """
 
     kind: DisagreementKind
@@ -85,6 +87,10 @@ class Disagreement:
                 return f"{gt}: {self.tracker} switched track {old} -> {new}, {self.other} kept {kept}"
             case DisagreementKind.ONLY_IN_ONE:
                 lone = f"{self.class_name} track {self.track_ids[0]} of {self.tracker}"
+                if self.elsewhere is not None:
+                    track, gt_id = self.elsewhere
+                    lone += f" beside GT {short_id(gt_id)}, which its track {track} is on"
+                    return f"{lone}; {self.other} shows none there"
                 return f"{lone} on no GT; {self.other} shows none there"
         raise AssertionError(self.kind)
 
@@ -207,8 +213,8 @@ def compare_trackers(
             out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, a, b, max_dist_m)
             out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, b, a, max_dist_m)
             out += _id_changes(frame_index, gt_boxes, gt_ids, frames, last_id, a, b)
-            out += _only_in_one(frame_index, frames, a, b, max_dist_m)
-            out += _only_in_one(frame_index, frames, b, a, max_dist_m)
+            out += _only_in_one(frame_index, gt_boxes, gt_ids, frames, a, b, max_dist_m)
+            out += _only_in_one(frame_index, gt_boxes, gt_ids, frames, b, a, max_dist_m)
         for n, fr in frames.items():
             for g in np.flatnonzero(fr.gt_track >= 0).tolist():
                 last_id[n][gt_ids[g]] = int(fr.ids[fr.gt_track[g]])
@@ -296,7 +302,7 @@ def _id_changes(
 
 
 def _only_in_one(
-    frame_index: int, frames: Mapping[str, _Frame], a: str, b: str, max_dist_m: float
+    frame_index: int, gt: Boxes, gt_ids: list[str], frames: Mapping[str, _Frame], a: str, b: str, max_dist_m: float
 ) -> list[Disagreement]:
     fa, fb = frames[a], frames[b]
     unmatched = np.ones(len(fa.ids), dtype=bool)
@@ -321,6 +327,20 @@ def _only_in_one(
                 tuple(float(v) for v in e.translation_m),
                 tuple(float(v) for v in e.size_wlh_m),
                 tuple(float(v) for v in e.quat_wxyz),
+                elsewhere=_beside(fa, k, gt, gt_ids, max_dist_m),
             )
         )
     return out
+
+
+def _beside(fa: _Frame, k: int, gt: Boxes, gt_ids: list[str], max_dist_m: float) -> tuple[int, str] | None:
+    """(id of ``fa``'s track matched to it, its GT id) of the object of lone track ``k``'s class nearest it within
+    ``max_dist_m`` (one within reach and unmatched would have been matched to ``k``); None when there is none."""
+    if not len(gt_ids):
+        return None
+    dist = np.linalg.norm(np.asarray(gt.xy, dtype=np.float64) - fa.xy[k], axis=1)
+    dist[(np.asarray(gt.class_name, dtype=object) != fa.classes[k]) | (dist >= max_dist_m)] = np.inf
+    g = int(np.argmin(dist))
+    if not np.isfinite(dist[g]) or fa.gt_track[g] < 0:
+        return None
+    return int(fa.ids[fa.gt_track[g]]), gt_ids[g]

@@ -107,6 +107,17 @@ def test_a_track_between_two_objects_is_named_where_it_went_not_called_none() ->
     assert missed.describe() == "pedestrian GT ped-b: A shows track 2 on it, B's track 43 beside it is on GT ped-a"
 
 
+def test_a_duplicate_track_is_named_beside_its_object_not_on_no_gt() -> None:
+    """A has two tracks on one car (the matching gives the car the nearer); the other is a track only A shows, but
+    it stands 1 m from the car, not on no GT (dev set scene-0061 pointpillars topmb, bicycle track 334)."""
+    gt = gt_boxes([("car-1", "car", 0.0, 0.0)])
+    a = [[est(1, "car", 0.2, 0.0), est(2, "car", 1.0, 0.0)]]
+    b = [[est(9, "car", -3.0, 0.0)]]  # more than 2 m from A's second track (and from the car: lone in B too)
+    (lone,) = [d for d in compare_trackers([gt], {"A": a, "B": b}).of_kind(ONLY) if d.tracker == "A"]
+    assert (lone.track_ids, lone.elsewhere) == ((2,), (1, "car-1"))
+    assert lone.describe() == "car track 2 of A beside GT car-1, which its track 1 is on; B shows none there"
+
+
 def test_identical_trackers_agree_and_three_trackers_compare_pairwise() -> None:
     assert compare_trackers([GT] * 3, {"A": A_FRAMES, "A2": A_FRAMES}).disagreements == ()
     only_g1 = [[est(21, "car", 0.0, 0.0)]] * 3
