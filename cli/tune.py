@@ -33,7 +33,7 @@ from cli.study import (
     train_split,
 )
 from gnnpmb.errors import GnnpmbError
-from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER
+from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER, parse_classes
 
 if TYPE_CHECKING:
     from gnnpmb.study.data import StudyData
@@ -86,16 +86,12 @@ def register(app: typer.Typer) -> None:
         from gnnpmb.study.grid import config_toml
         from gnnpmb.study.runner import execution, session
         from gnnpmb.study.tune import check_space, default_space, parse_space, run_tune, write_params
-        from gnnpmb.types import TRACKING_CLASSES
 
         check_tracker(tracker)
         target = check_output_file(out, "--out", inputs=(("--detections", detections), ("--params", params)))
         preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
         base = base_params(params)
-        class_names = TRACKING_CLASSES if classes is None else tuple(c.strip() for c in classes.split(",") if c)
-        unknown = [c for c in class_names if c not in TRACKING_CLASSES]
-        if unknown or not class_names:
-            raise GnnpmbError(f"unknown class {', '.join(unknown) or '(none)'}; known: {', '.join(TRACKING_CLASSES)}")
+        class_names = parse_classes(classes)
         dims = [parse_space(s) for s in space] if space else default_space(class_names, base)
         check_space(dims, base)
         if trials < 1:
