@@ -94,9 +94,7 @@ def run_tracker(
     ``detections``: the scene's detections per sample token (preprocessed here for ``classes``), or frames
     already preprocessed by ``preprocess_frames`` (one per keyframe), to share them between trackers.
     """
-    if isinstance(detections, Mapping):
-        detections = preprocess_frames(scene, detections, config, classes)
-    frames = detections
+    frames = preprocess_frames(scene, detections, config, classes) if isinstance(detections, Mapping) else detections
     if len(frames) != len(scene.keyframes):
         raise ValueError(f"{len(frames)} preprocessed frames for the {len(scene.keyframes)} keyframes of {scene.name}")
     sink = sink or NullSink()
