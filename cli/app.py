@@ -32,6 +32,7 @@ from cli.options import (
     DEFAULT_SOURCE,
     ProgressOption,
     ResultsOption,
+    RunsOption,
     SceneArgument,
     Source,
     source_options,
@@ -40,7 +41,6 @@ from cli.options import (
 from cli.progress import progress_bar
 from cli.reproduce import COMMAND_LINE, PROG, command_line, reproduce_app
 from gnnpmb.classes import TRACKING_CLASSES
-from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.runs import parse_runs
 from gnnpmb.serve import DEFAULT_GRPC_PORT, DEFAULT_WEB_PORT, check_display, serve_target
 from gnnpmb.stages.inputs import collect_rarely
@@ -68,16 +68,7 @@ VIEW_HELP = (
 @source_options
 def view(
     scene: SceneArgument,
-    tracker: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--tracker",
-            "-t",
-            metavar="NAME",
-            help=f"Tracker to run; repeat to compare several side by side ({', '.join(TRACKER_NAMES)}); "
-            "TRACKER:PARAMS.toml runs it with its own parameters, NAME=FILE.json is a results file.",
-        ),
-    ] = None,
+    tracker: RunsOption = None,
     results: ResultsOption = None,
     source: Source = DEFAULT_SOURCE,
     classes: Annotated[

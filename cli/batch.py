@@ -33,11 +33,10 @@ from cli.options import (
 )
 from cli.study import register
 from cli.tune import register as register_tune
-from gnnpmb.eval.nuscenes_eval import default_split
 from gnnpmb.outputs import check_output_dir, check_output_file
 from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER
 
-__all__ = ["app", "default_split", "main"]
+__all__ = ["app", "main"]
 
 app = typer.Typer(
     add_completion=False,
@@ -81,7 +80,7 @@ def track(
     run = execution(workers, address, verbose)
     if source.detections is not None:  # a bad file fails before a dataset is looked for
         check_detection_file(source.detections)
-    data = source.split_data(split, preset, default_split)
+    data = source.split_data(split, preset)
     with progress_bar(progress, transient=True) as bar:
         scenes_task = bar.add_task("scenes", total=len(data.scene_names))
         frames_task = bar.add_task("frames", total=None, visible=not run.uses_ray)
@@ -124,13 +123,13 @@ def evaluate(
     """Score a tracking submission with the official nuScenes evaluation (tracking_nips_2019)."""
     from rich.table import Table
 
-    from gnnpmb.data.nuscenes import resolve_dataroot
     from gnnpmb.eval.nuscenes_eval import (
         DEVKIT_FILES,
         TABLE_METRICS,
         default_eval_dir,
         evaluate_submission,
         format_metric,
+        resolve_split,
     )
     from gnnpmb.eval.submission import check_results_file
 
@@ -141,8 +140,7 @@ def evaluate(
         files=DEVKIT_FILES,
         inputs=(("RESULTS.json", results),),
     )
-    location = resolve_dataroot(dataroot, version, (split,) if split else ())
-    split = split or default_split(location.version)
+    location, split = resolve_split(dataroot, version, split)
     start = time.perf_counter()
     scores = evaluate_submission(results, location, split, out)
     table = Table(title=f"{results.name} on {split} ({location.version})")

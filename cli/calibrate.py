@@ -39,17 +39,16 @@ def calibrate(
     from gnnpmb.calibration import calibration_toml
     from gnnpmb.config import TrackerConfig
     from gnnpmb.data.detections import check_detection_file
-    from gnnpmb.data.nuscenes import load_scene, resolve_dataroot, split_scenes
+    from gnnpmb.data.nuscenes import load_scene, split_scenes
     from gnnpmb.data.simdet_presets import detector_choice
-    from gnnpmb.eval.nuscenes_eval import default_split, tracking_config
+    from gnnpmb.eval.nuscenes_eval import resolve_split, tracking_config
     from gnnpmb.pipeline import get_detections
 
     target = check_output_file(out, "--out", ".toml", inputs=(("--detections", detections),))
     preset = detector_choice(detections, detector, "centerpoint")
     if detections is not None:
         check_detection_file(detections)
-    location = resolve_dataroot(dataroot, version, (split,) if split else ())
-    split = split or default_split(location.version)
+    location, split = resolve_split(dataroot, version, split)
     scenes = [load_scene(location, name) for name in split_scenes(split, location)]
     dets = [get_detections(scene, detections, preset, seed) for scene in scenes]
     cfg = tracking_config()

@@ -140,14 +140,13 @@ class Source:
             parts += ["--seed", str(self.seed)]
         return shlex.join(parts)
 
-    def split_data(self, split: str | None, preset: str | None, default_split: Callable[[str], str]) -> StudyData:
-        """The scenes of ``split`` (None: ``default_split`` of the dataset's version) and their detections: the
-        file, else the simulated detector ``preset`` (``gnnpmb.study.data.resolve_study_data``)."""
-        from gnnpmb.data.nuscenes import resolve_dataroot
+    def split_data(self, split: str | None, preset: str | None) -> StudyData:
+        """The scenes of ``split`` (None: the dataset version's evaluation split) and their detections: the file,
+        else the simulated detector ``preset`` (``gnnpmb.study.data.resolve_study_data``)."""
+        from gnnpmb.eval.nuscenes_eval import resolve_split
         from gnnpmb.study.data import resolve_study_data
 
-        location = resolve_dataroot(self.dataroot, self.version, (split,) if split else ())
-        split = split or default_split(location.version)
+        location, split = resolve_split(self.dataroot, self.version, split)
         return resolve_study_data(location, split, self.detections, preset, self.seed)
 
 

@@ -129,7 +129,6 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Score every configuration of a parameter grid with the official evaluation (cached, resumable)."""
         from gnnpmb.data.simdet_presets import detector_choice
-        from gnnpmb.eval.nuscenes_eval import default_split
         from gnnpmb.registry import check_tracker
         from gnnpmb.study.cache import CACHE_FOLDER, ResultCache
         from gnnpmb.study.folder import check_study_dir, drop_stale_plots, identity, merge_study, read_study
@@ -146,7 +145,7 @@ def register(app: typer.Typer) -> None:
         base = base_params(source.params)
         folder = check_study_dir(out, [p.key for p in swept], source.input_files)
         run = execution(workers, address, verbose)
-        data = source.split_data(split, preset, default_split)
+        data = source.split_data(split, preset)
         plan = plan_sweep(tracker, data, base, swept, one_at_a_time)
         rows_seen: list[dict[str, Any]] = []
         with session(run):  # Ray is up (or one error line) before the folder is touched

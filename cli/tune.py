@@ -13,15 +13,13 @@ from rich.table import Table
 
 from cli.errors import announce_stop
 from cli.options import (
+    DEFAULT_SOURCE,
     AddressOption,
-    DatarootOption,
-    DetectionsOption,
-    DetectorOption,
-    ParamsOption,
     ProgressOption,
+    Source,
     TrackerOption,
     VerboseOption,
-    VersionOption,
+    source_options,
     stdout_console,
 )
 from cli.study import (
@@ -33,7 +31,7 @@ from cli.study import (
     train_split,
 )
 from gnnpmb.errors import GnnpmbError
-from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER
+from gnnpmb.stages.request import DEFAULT_DETECTOR, DEFAULT_TRACKER, parse_classes
 
 if TYPE_CHECKING:
     from gnnpmb.study.data import StudyData
@@ -45,6 +43,7 @@ def register(app: typer.Typer) -> None:
     """Add ``tune`` to the ``gnnpmb`` app."""
 
     @app.command()
+    @source_options
     def tune(
         out: Annotated[Path, typer.Option(metavar="FILE.toml", help="Where to write the best parameters.")],
         tracker: TrackerOption = DEFAULT_TRACKER,
@@ -60,24 +59,18 @@ def register(app: typer.Typer) -> None:
                 help="Searched key and range (repeatable); replaces the default per-class space.",
             ),
         ] = None,
-        dataroot: DatarootOption = None,
-        version: VersionOption = None,
+        source: Source = DEFAULT_SOURCE,
         split: Annotated[
             str | None,
-            typer.Option(help="Split to tune on (default: mini_train for *mini versions, else train)."),
+            typer.Option(metavar="NAME", help="Split to tune on (default: mini_train for *mini versions, else train)."),
         ] = None,
-        detections: DetectionsOption = None,
-        detector: DetectorOption = None,
-        seed: Annotated[
-            int, typer.Option(metavar="N", min=0, help="Seed of the simulated detector and the sampler (0 or more).")
-        ] = 0,
-        params: ParamsOption = None,
         workers: WorkersOption = None,
         address: AddressOption = None,
         progress: ProgressOption = True,
         verbose: VerboseOption = False,
     ) -> None:
-        """Search per-class parameters (Optuna TPE on Ray Tune) and write the best as a --params TOML."""
+        """Search per-class parameters (Optuna TPE on Ray Tune) and write the best as a --params TOML; --seed
+        seeds the sampler too."""
         from gnnpmb.data.nuscenes import resolve_dataroot
         from gnnpmb.data.simdet_presets import detector_choice
         from gnnpmb.outputs import check_output_file
@@ -86,24 +79,22 @@ def register(app: typer.Typer) -> None:
         from gnnpmb.study.grid import config_toml
         from gnnpmb.study.runner import execution, session
         from gnnpmb.study.tune import check_space, default_space, parse_space, run_tune, write_params
-        from gnnpmb.types import TRACKING_CLASSES
 
         check_tracker(tracker)
-        target = check_output_file(out, "--out", inputs=(("--detections", detections), ("--params", params)))
-        preset = detector_choice(detections, detector, DEFAULT_DETECTOR)
-        base = base_params(params)
-        class_names = TRACKING_CLASSES if classes is None else tuple(c.strip() for c in classes.split(",") if c)
-        unknown = [c for c in class_names if c not in TRACKING_CLASSES]
-        if unknown or not class_names:
-            raise GnnpmbError(f"unknown class {', '.join(unknown) or '(none)'}; known: {', '.join(TRACKING_CLASSES)}")
+        target = check_output_file(out, "--out", inputs=source.input_files)
+        preset = detector_choice(source.detections, source.detector, DEFAULT_DETECTOR)
+        base = base_params(source.params)
+        class_names = parse_classes(classes)
         dims = [parse_space(s) for s in space] if space else default_space(class_names, base)
         check_space(dims, base)
         if trials < 1:
             raise GnnpmbError(f"--trials must be at least 1, got {trials}")
         run = execution(workers, address, verbose)
         # the demo generates its train scenes only when asked for them; tuning defaults to a train split
-        location = resolve_dataroot(dataroot, version, (split or "mini_train",))
-        data = resolve_study_data(location, split or train_split(location.version), detections, preset, seed)
+        location = resolve_dataroot(source.dataroot, source.version, (split or "mini_train",))
+        data = resolve_study_data(
+            location, split or train_split(location.version), source.detections, preset, source.seed
+        )
         seen: list[float] = []
         with session(run), study_progress(progress, trials, "trials") as bar:  # the bar once Ray is up
 
@@ -112,9 +103,9 @@ def register(app: typer.Typer) -> None:
                     seen.append(trial.row["amota"])
                 bar.update(bar.task_ids[0], advance=1, description=best_label("trials", max(seen, default=None)))
 
-            result = run_tune(tracker, data, base, dims, trials, seed, run, on_trial)
+            result = run_tune(tracker, data, base, dims, trials, source.seed, run, on_trial)
         final = result.final_row
-        header = _provenance(tracker, data, dims, trials, seed, run, result, params)
+        header = _provenance(tracker, data, dims, trials, source.seed, run, result, source.params)
         write_params(target, config_toml(base, result.best), header)
         _print_tune(stdout_console(), result, class_names, dims)
         typer.echo(

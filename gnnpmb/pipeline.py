@@ -94,22 +94,7 @@ def run_tracker(
     ``detections``: the scene's detections per sample token (preprocessed here for ``classes``), or frames
     already preprocessed by ``preprocess_frames`` (one per keyframe), to share them between trackers.
     """
-    if isinstance(detections, Mapping):
-        detections = preprocess_frames(scene, detections, config, classes)
-    return track_frames(scene, detections, tracker, config, sink, classes, frame_range, on_frame)
-
-
-def track_frames(
-    scene: SceneData,
-    frames: Sequence[FrameDetections],
-    tracker: str,
-    config: TrackerConfig,
-    sink: EventSink | None = None,
-    classes: Sequence[str] = TRACKING_CLASSES,
-    frame_range: range | None = None,
-    on_frame: Callable[[], None] | None = None,
-) -> TrackingRun:
-    """``run_tracker`` on frames already preprocessed (``preprocess_frames``, one per keyframe of ``scene``)."""
+    frames = preprocess_frames(scene, detections, config, classes) if isinstance(detections, Mapping) else detections
     if len(frames) != len(scene.keyframes):
         raise ValueError(f"{len(frames)} preprocessed frames for the {len(scene.keyframes)} keyframes of {scene.name}")
     sink = sink or NullSink()

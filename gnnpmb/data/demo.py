@@ -105,6 +105,14 @@ class ClutterHotspot:
     radius_m: float
     frames: tuple[int, ...]
 
+    @staticmethod
+    def at(
+        spec: SceneSpec, centre_sd_m: tuple[float, float], radius_m: float, frames: tuple[int, ...]
+    ) -> ClutterHotspot:
+        """The hotspot of scene ``spec`` around road point ``centre_sd_m`` (s, d), its global x, y to the millimetre."""
+        x, y = spec.to_global(np.array(centre_sd_m[0]), np.array(centre_sd_m[1]))
+        return ClutterHotspot(spec.name, (round(float(x), 3), round(float(y), 3)), radius_m, frames)
+
 
 CATEGORIES: tuple[tuple[str, str], ...] = (
     ("human.pedestrian.adult", "Adult subcategory."),
@@ -412,14 +420,8 @@ def _train_hotspots() -> tuple[ClutterHotspot, ...]:
         spec, roadworks = train_scene(name)
         if roadworks is None:
             continue
-        centre = spec.to_global(np.array(roadworks.centre_sd_m[0]), np.array(roadworks.centre_sd_m[1]))
         out.append(
-            ClutterHotspot(
-                scene_name=name,
-                xy_global=(round(float(centre[0]), 3), round(float(centre[1]), 3)),
-                radius_m=roadworks.radius_m,
-                frames=tuple(range(KEYFRAMES_PER_SCENE)),
-            )
+            ClutterHotspot.at(spec, roadworks.centre_sd_m, roadworks.radius_m, tuple(range(KEYFRAMES_PER_SCENE)))
         )
     return tuple(out)
 
@@ -438,28 +440,12 @@ def _clutter_hotspots() -> tuple[ClutterHotspot, ...]:
     bus = next(i for i, o in enumerate(spec.objects) if o.name == "bus")
     centre = spec.to_global(np.array(_ROADWORKS_CENTRE_SD[0]), np.array(_ROADWORKS_CENTRE_SD[1]))
     near = np.linalg.norm(traj.xy[bus] - centre, axis=1) <= 15.0
-    return (
-        ClutterHotspot(
-            scene_name=spec.name,
-            xy_global=(round(float(centre[0]), 3), round(float(centre[1]), 3)),
-            radius_m=7.0,
-            frames=tuple(int(k) for k in np.flatnonzero(near)),
-        ),
-    )
+    return (ClutterHotspot.at(spec, _ROADWORKS_CENTRE_SD, 7.0, tuple(int(k) for k in np.flatnonzero(near))),)
 
 
 def _staged_hotspots() -> tuple[ClutterHotspot, ...]:
     """The false pedestrians just ahead of the staged scene's file of pedestrians (``demo_staged``)."""
-    spec = staged_scene()
-    centre = spec.to_global(np.array(hotspot_sd()[0]), np.array(hotspot_sd()[1]))
-    return (
-        ClutterHotspot(
-            scene_name=spec.name,
-            xy_global=(round(float(centre[0]), 3), round(float(centre[1]), 3)),
-            radius_m=HOTSPOT_RADIUS_M,
-            frames=HOTSPOT_FRAMES,
-        ),
-    )
+    return (ClutterHotspot.at(staged_scene(), hotspot_sd(), HOTSPOT_RADIUS_M, HOTSPOT_FRAMES),)
 
 
 CLUTTER_HOTSPOTS: tuple[ClutterHotspot, ...] = _clutter_hotspots() + _train_hotspots() + _staged_hotspots()

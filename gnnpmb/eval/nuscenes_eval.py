@@ -128,6 +128,15 @@ def default_split(version: str) -> str:
     return "val"
 
 
+def resolve_split(dataroot: Path | None, version: str | None, split: str | None) -> tuple[DatasetLocation, str]:
+    """The dataset (``data.nuscenes.resolve_dataroot``, asked for ``split`` when one is named) and the split:
+    ``split``, else the version's evaluation split (``default_split``)."""
+    from gnnpmb.data.nuscenes import resolve_dataroot
+
+    location = resolve_dataroot(dataroot, version, (split,) if split else ())
+    return location, split or default_split(location.version)
+
+
 def check_split_version(split: str, version: str) -> None:
     """The devkit evaluates mini splits only on a ``*mini`` version, train/val on ``*trainval``, test on
     ``*test``; custom splits (``splits.json``) on any version."""

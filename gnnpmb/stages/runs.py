@@ -47,7 +47,7 @@ def run_one(inputs: Inputs, name: str, *, record: bool, on_frame: Callable[[], N
     docstring). on_frame: called after each frame."""
     from gnnpmb.events import ListSink, TeeSink
     from gnnpmb.foreign import replay
-    from gnnpmb.pipeline import track_frames
+    from gnnpmb.pipeline import run_tracker
     from gnnpmb.why.facts import FactSink
 
     spec, foreign, caps = inputs.spec(name), inputs.foreign.get(name), inputs.caps[name]
@@ -59,7 +59,7 @@ def run_one(inputs: Inputs, name: str, *, record: bool, on_frame: Callable[[], N
             foreign, inputs.scene, inputs.frame_detections, inputs.classes, inputs.frame_range, sink, on_frame
         )
     else:
-        tracking = track_frames(
+        tracking = run_tracker(
             inputs.scene,
             inputs.own_frames.get(name, inputs.frame_detections),
             str(spec.tracker),

@@ -11,8 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from cli.batch import app, default_split
+from cli.batch import app
 from cli.errors import run_app
+from gnnpmb.eval.nuscenes_eval import default_split
 from gnnpmb.eval.submission import check_submission
 from tests.inprocess import run_main
 

@@ -177,7 +177,7 @@ def test_tune_refuses_a_bad_space_before_any_work(
     for extra, message in (
         (["--space", "car.q_x=1:0.1"], "need LOW < HIGH"),
         (["--space", "car.nope=0.1:1"], "unknown parameter 'nope'"),
-        (["--classes", "boat"], "unknown class boat"),
+        (["--classes", "boat"], "unknown class 'boat'"),
         (["--trials", "0"], "--trials must be at least 1"),
     ):
         code, _, stderr = run([*base, *extra], capsys)
