@@ -57,6 +57,9 @@ class Disagreement:
     "other none" would be false, dev set scene-0655 centerpoint jpda, 74 of 907 lines); for ``only_in_one``, an
     object of the lone track's class within the match distance that tracker's other track is matched to (a
     duplicate: "on no GT" would be false, dev set scene-0061 pointpillars topmb), as (that track, the GT id).
+    unshown (``missed_by_one``): other's track within the match distance of the object that other output but
+    below the show floor (``compare_trackers``), which the evaluation may well have matched to it (dev set
+    scene-0655 centerpoint gnnpmb, truck 8e5770 at frame 16: track 59 at existence 0.49).
     """
 
     kind: DisagreementKind
@@ -70,6 +73,7 @@ class Disagreement:
     size_wlh_m: tuple[float, float, float]
     quat_wxyz: tuple[float, float, float, float]
     elsewhere: tuple[int, str] | None = None
+    unshown: int | None = None
 
     def describe(self) -> str:
         """One readable line naming trackers and ids, short enough for a log row beside the views (about 80
@@ -81,6 +85,10 @@ class Disagreement:
                 if self.elsewhere is not None:
                     track, other_gt = self.elsewhere
                     return f"{mine}, {self.other}'s track {track} beside it is on GT {short_id(other_gt)}"
+                if self.unshown is not None:
+                    return (
+                        f"{mine}, {self.other}'s track {self.unshown} on it is output but below the display threshold"
+                    )
                 return f"{mine}, {self.other} none"
             case DisagreementKind.ID_CHANGE:
                 old, new, kept = self.track_ids
@@ -158,22 +166,25 @@ def match_to_gt(
 
 @dataclass(frozen=True, slots=True)
 class _Frame:
-    """One tracker's estimates of one frame as arrays: xy (K, 2), class (K,), ids (K,), and the match
-    gt_track (G,) (track index per GT object, -1 if none)."""
+    """One tracker's shown estimates of one frame as arrays: xy (K, 2), class (K,), ids (K,), and the match
+    gt_track (G,) (track index per GT object, -1 if none); unshown: its estimates below the show floor."""
 
     estimates: Sequence[TrackEstimate]
     xy: np.ndarray
     classes: np.ndarray
     ids: np.ndarray
     gt_track: np.ndarray
+    unshown: Sequence[TrackEstimate] = ()
 
 
-def _frame(estimates: Sequence[TrackEstimate], gt: Boxes, max_dist_m: float) -> _Frame:
+def _frame(output: Sequence[TrackEstimate], gt: Boxes, max_dist_m: float, show_min_existence: float) -> _Frame:
+    estimates = [e for e in output if e.existence >= show_min_existence]
+    unshown = [e for e in output if e.existence < show_min_existence]
     k = len(estimates)
     xy = np.array([e.translation_m[:2] for e in estimates], dtype=np.float64).reshape(k, 2)
     classes = np.array([e.class_name for e in estimates], dtype=object)
     ids = np.array([e.track_id for e in estimates], dtype=np.int64)
-    return _Frame(estimates, xy, classes, ids, match_to_gt(gt.xy, gt.class_name, xy, classes, max_dist_m))
+    return _Frame(estimates, xy, classes, ids, match_to_gt(gt.xy, gt.class_name, xy, classes, max_dist_m), unshown)
 
 
 def _gt_box(gt: Boxes, g: int) -> tuple[tuple[float, float, float], ...]:
@@ -189,10 +200,12 @@ def compare_trackers(
     estimates: Mapping[str, Sequence[Sequence[TrackEstimate]]],
     frame_indices: Sequence[int] | None = None,
     max_dist_m: float = MATCH_DISTANCE_M,
+    show_min_existence: float = 0.0,
 ) -> Comparison:
-    """Disagreements between the trackers of ``estimates`` (tracker -> per-frame estimates, in time order)
-    over frames whose ground truth is ``gt`` (per frame; ``instance_id`` names the objects). frame_indices:
-    the keyframe index of each frame (default 0, 1, ...). See the module docstring for the kinds."""
+    """Disagreements between the trackers of ``estimates`` (tracker -> per-frame output, in time order) over
+    frames whose ground truth is ``gt`` (per frame; ``instance_id`` names the objects), between the estimates
+    shown (existence at least ``show_min_existence``; the others only named, ``Disagreement.unshown``).
+    frame_indices: the keyframe index of each frame (default 0, 1, ...). See the module docstring for the kinds."""
     names = tuple(estimates)
     if len(names) < 2:
         raise ValueError(f"comparing needs at least two trackers, got {len(names)}")
@@ -207,7 +220,9 @@ def compare_trackers(
     for frame_index, gt_boxes, per_tracker in zip(
         indices, gt, zip(*(estimates[n] for n in names), strict=True), strict=True
     ):
-        frames = {n: _frame(e, gt_boxes, max_dist_m) for n, e in zip(names, per_tracker, strict=True)}
+        frames = {
+            n: _frame(e, gt_boxes, max_dist_m, show_min_existence) for n, e in zip(names, per_tracker, strict=True)
+        }
         gt_ids = [str(i) for i in gt_boxes.instance_id]
         for a, b in itertools.combinations(names, 2):
             out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, a, b, max_dist_m)
@@ -248,9 +263,21 @@ def _missed_by_one(
             (int(fa.ids[fa.gt_track[g]]),),
             *_gt_box(gt, g),
             elsewhere=_elsewhere(fb, gt, gt_ids, g, max_dist_m),
+            unshown=_unshown(fb, gt, g, max_dist_m),
         )
         for g in np.flatnonzero((fa.gt_track >= 0) & (fb.gt_track < 0)).tolist()
     ]
+
+
+def _unshown(fb: _Frame, gt: Boxes, g: int, max_dist_m: float) -> int | None:
+    """Id of ``fb``'s unshown estimate of object ``g``'s class nearest it within ``max_dist_m``, or None."""
+    near = [
+        (float(np.hypot(*(np.asarray(e.translation_m[:2]) - gt.xy[g]))), e.track_id)
+        for e in fb.unshown
+        if e.class_name == gt.class_name[g]
+    ]
+    near = [(d, t) for d, t in near if d < max_dist_m]
+    return min(near)[1] if near else None
 
 
 def _elsewhere(fb: _Frame, gt: Boxes, gt_ids: list[str], g: int, max_dist_m: float) -> tuple[int, str] | None:

@@ -75,9 +75,11 @@ def marker_label(d: Disagreement) -> str:
     match d.kind:
         case DisagreementKind.MISSED_BY_ONE:
             mine = f"only {d.tracker} tracks GT {short_id(d.gt_id)} (track {d.track_ids[0]})"
-            if d.elsewhere is None:
-                return mine
-            return f"{mine}; {d.other}'s track {d.elsewhere[0]} is on GT {short_id(d.elsewhere[1])}"
+            if d.elsewhere is not None:
+                return f"{mine}; {d.other}'s track {d.elsewhere[0]} is on GT {short_id(d.elsewhere[1])}"
+            if d.unshown is not None:
+                return f"{mine}; {d.other}'s track {d.unshown} is below the display threshold"
+            return mine
         case DisagreementKind.ID_CHANGE:
             old, new, kept = d.track_ids
             return f"{d.tracker} {old}->{new}, {d.other} kept {kept}: GT {short_id(d.gt_id)}"

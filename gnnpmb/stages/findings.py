@@ -94,9 +94,7 @@ def compare_runs(runs: Sequence[Run]) -> Comparison:
     frames = runs[0].tracking.frames
     return compare_trackers(
         [f.keyframe.gt for f in frames],
-        {
-            run.name: [tuple(e for e in f.estimates if e.existence >= SHOW_MIN_EXISTENCE) for f in run.tracking.frames]
-            for run in runs
-        },
+        {run.name: [tuple(f.estimates) for f in run.tracking.frames] for run in runs},
         frame_indices=[f.keyframe.index for f in frames],
+        show_min_existence=SHOW_MIN_EXISTENCE,
     )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -116,6 +118,20 @@ def test_a_duplicate_track_is_named_beside_its_object_not_on_no_gt() -> None:
     (lone,) = [d for d in compare_trackers([gt], {"A": a, "B": b}).of_kind(ONLY) if d.tracker == "A"]
     assert (lone.track_ids, lone.elsewhere) == ((2,), (1, "car-1"))
     assert lone.describe() == "car track 2 of A beside GT car-1, which its track 1 is on; B shows none there"
+
+
+def test_a_track_output_below_the_show_floor_is_named_not_called_none() -> None:
+    """B's track on the truck is output at existence 0.49, under the floor of 0.5: B does not show it, and the line
+    says so instead of 'B none' (dev set scene-0655 centerpoint gnnpmb, track 59, which the evaluation matched)."""
+    gt = gt_boxes([("truck-1", "truck", 0.0, 0.0)])
+    a = [[est(13, "truck", 0.3, 0.0)]]
+    b = [[dataclasses.replace(est(59, "truck", 0.1, 0.0), existence=0.49)]]
+    (missed,) = compare_trackers([gt], {"A": a, "B": b}, show_min_existence=0.5).disagreements
+    assert (missed.kind, missed.unshown) == (MISSED, 59)
+    assert missed.describe() == (
+        "truck GT truck-1: A shows track 13 on it, B's track 59 on it is output but below the display threshold"
+    )
+    assert compare_trackers([gt], {"A": a, "B": b}).disagreements == ()  # with no floor both show it
 
 
 def test_identical_trackers_agree_and_three_trackers_compare_pairwise() -> None:
