@@ -1222,3 +1222,34 @@ def test_the_test_an_infinite_cost_is_said_to_stand_for_is_checked_against_the_g
     threshold = [inside, CostMatrix(C, np.array([[np.inf, 2.0]]), rows, cols, scale=metres)]
     assert kinds(threshold, "beyond its distance threshold") == []
     assert kinds(threshold, "outside its gate") == ["gone"]
+
+
+def test_a_parting_line_where_the_runs_only_number_their_tracks_differently_is_caught() -> None:
+    # dev set scene-0655 megvii gnnpmb beside pmbm: "Where the trackers part" listed "gnnpmb: m9 → **track 104** ·
+    # pmbm: m9 → **track 231**" though both tracks were started by m11 at frame 14 (61 of 63 lines)
+    from gnnpmb.events import Born
+    from tools.truth.otherruns import check_parting
+    from tools.truth.sentences import Tally
+
+    def run(births: dict[int, tuple[int, int]]) -> RawEvents:
+        events = []
+        for frame in sorted({f for f, _ in births.values()}):
+            events.append(FrameStarted("t", frame, "s", 0, 0.5))
+            born = [(t, m) for t, (f, m) in births.items() if f == frame]
+            ids, meas = zip(*born, strict=True)
+            events.append(Born(C, np.array(ids), np.array(meas), np.zeros((len(ids), 4)), np.ones(len(ids))))
+        return RawEvents.of(events)
+
+    def found(line: str, raws: dict) -> list[str]:
+        doc = f"**Where the trackers part** at frame 15 (...):\n\n- {line}\n\n**Involved** (car): ...\n"
+        out = Tally()
+        check_parting(doc, 15, C, raws, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    same = {"gnnpmb": run({104: (14, 11)}), "pmbm": run({231: (14, 11)})}
+    other = {"gnnpmb": run({104: (14, 11)}), "pmbm": run({231: (12, 10)})}
+    tracks = "gnnpmb: m9 → **track 104** (2.34; next new 10.4) · pmbm: m9 → **track 231** (2.34; next new 10.4)"
+    assert found(tracks, same) == ["misleading"]
+    assert found(tracks, other) == []
+    assert found("gnnpmb: m11 → **new track 104** · pmbm: m11 → **new track 231**", same) == ["misleading"]
+    assert found("gnnpmb: m11 → **new track 104** · pmbm: m11 → **track 231**", other) == []
