@@ -13,7 +13,11 @@ against the annotation files and the devkit's own boxes.
   box it interpolated O m from the annotation, out of the track's reach": T's submitted box lies D m from the
   annotation (under 2 m), the devkit did not keep the annotation there and scored a box O m from it, 2 m or more
   from T's box;
-* "…, and no track carried it through": no submitted box of the object's class lies within 2 m of its annotation.
+* "…, and no track carried it through": no submitted box of the object's class lies within 2 m of its annotation;
+* a false track's "C GT H lies D m away, but the evaluation has it interpolated O m from the annotation, out of the
+  track's reach" cites nuscenes-devkit issue #1141 as "(see …)" only where the box interpolated the right way lies
+  within 2 m of the false box, says "weighted the right way (…) it would still lie E m from the track" only where it
+  lies E m (2 m or more) from it, and cites nothing only where the devkit's box is the right way's (under 0.05 m).
 """
 
 from __future__ import annotations
@@ -170,3 +174,34 @@ def check_swapped(text: str, x: int, gt_id: str | None, scene, ev, out, bad) -> 
             bad("evaluation", m[0], f"interpolated in time the box lies {_d(right_way, here.xy_m):.2f} m away")
         elif _d(right_way, scored) < 0.05:
             bad("evaluation", m[0], "the devkit's box is the one interpolated the right way")
+
+
+REACH_1141 = re.compile(
+    r"GT (\w{6}) lies \d+\.\d m away, but the evaluation has it interpolated \d+\.\d m from the annotation, out of "
+    r"the track's reach( \(see nuscenes-devkit issue #1141\)|, and weighted the right way \(nuscenes-devkit issue "
+    r"#1141\) it would still lie (\d+\.\d) m from the track)?"
+)
+
+
+def check_reach_1141(text: str, x: int, place, scene, ev, out, bad) -> None:
+    """A false track's interpolated object and what nuscenes-devkit issue #1141 did to it (module docstring), the
+    false box at ``place``."""
+    for m in REACH_1141.finditer(text) if place is not None and scene is not None else ():
+        out.checked["misleading"] += 1
+        hit = scene.object_of(x, m[1])
+        ends = _ends(ev, hit[0], x) if hit is not None else None
+        scored = ev.evaluated_gt.get((x, hit[0])) if hit is not None else None
+        a, b = (scene.objects[f].get(hit[0]) for f in ends) if ends is not None else (None, None)
+        if a is None or b is None or scored is None:
+            bad("misleading", m[0], "no interpolation of the object the devkit scored here")
+            continue
+        left, right = ends
+        w = (ev.stamps[x] - ev.stamps[left]) / (ev.stamps[right] - ev.stamps[left])
+        right_way = (a.xy_m[0] + w * (b.xy_m[0] - a.xy_m[0]), a.xy_m[1] + w * (b.xy_m[1] - a.xy_m[1]))
+        swapped, reach = _d(right_way, scored) >= 0.05, _d(right_way, place)
+        if m[3] is not None:
+            ok = swapped and reach >= NEAR_M and f"{reach:.1f}" == m[3]
+        else:
+            ok = swapped and reach < NEAR_M if m[2] is not None else not swapped
+        if not ok:
+            bad("misleading", m[0], f"weighted the right way the box lies {reach:.2f} m from the track ({swapped=})")

@@ -25,7 +25,7 @@ import math
 import re
 from collections import Counter
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -215,6 +215,7 @@ def check_text(
     if ctx.gt_id is None:
         place.check_place(text, c, ctx.frame, where, scene, out, bad)
     place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)
+    place.check_reach_1141(text, ctx.frame, _place(replace(ctx, gt_id=None), ev, scene), scene, ev, out, bad)
     place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
     place.check_out_of_reach(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     place.check_none_of_its_own(text, ctx.frame, scene, out, bad)

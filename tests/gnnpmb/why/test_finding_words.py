@@ -496,3 +496,23 @@ def test_a_new_track_column_that_holds_the_cost_threshold_is_called_the_threshol
     )
     nats = PairChoice(m0, t210, 6.0, new, 6.5, 0.5)  # no threshold: a new track's cost is a cost
     assert "over new (6.50)" in choice_text(3, nats, 210, False)
+
+
+def test_a_false_track_cites_issue_1141_only_where_the_box_weighted_the_right_way_was_within_its_reach() -> None:
+    # dev set scene-1094 megvii prob3dmot false_track:6: "truck GT 225a60 lies 1.5 m away, but the evaluation has it
+    # interpolated 14.7 m from the annotation, out of the track's reach (see nuscenes-devkit issue #1141)", though
+    # the box weighted the right way lay 2.6 m from the track: out of its reach too
+    from gnnpmb.eval.evaluated import GtFrame, GtStatus
+    from gnnpmb.why.findings import FalseOutput
+
+    def said(unswapped: tuple[float, float] | None) -> str:
+        g = GtFrame(13, GtStatus.INTERPOLATED, (0.0, 0.0), (14.7, 0.0), None, 0, 20.0, 40.0, (12, 19), unswapped)
+        out = FalseOutput(30, None, (1.5, 0.0), None, (GT, 1.5, g), None, None, None, None)
+        f = finding(FailureKind.FALSE_TRACK, blame=(Blame(Rule.INTERPOLATED, (13,)),), false_output=out)
+        return why_lines(f)[0]
+
+    on = "but the evaluation has it interpolated 14.7 m from the annotation, out of the track's reach"
+    still = ", and weighted the right way (nuscenes-devkit issue #1141) it would still lie 2.7 m from the track"
+    assert f"{on}{still}" in said((-1.2, 0.0))
+    assert f"{on} (see nuscenes-devkit issue #1141)" in said((0.3, 0.0))
+    assert said((14.7, 0.0)).endswith(f"{on}.")  # the devkit's box is the one weighted the right way
