@@ -174,11 +174,13 @@ class Sighting:
 class OffObject:
     """The lost track output ``NEAR_M`` or more from the object at the failure's frame: how far, on which
     detection (-1: none), and the earlier frames whose detection it used lay that far from the object
-    ((frame, detection) pairs)."""
+    ((frame, detection) pairs); scored_m: how far from the box the evaluation interpolated for the object there
+    (None: it scored the annotation, or no box)."""
 
     distance_m: float
     meas: int
     earlier: tuple[tuple[int, int], ...]
+    scored_m: float | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -327,7 +327,11 @@ class _Context:
                         continue
                     boxes = fr.detections.boxes
                     earlier += [(s.frame, m) for m in s.used if np.hypot(*(boxes.translation_m[m, :2] - at)) >= NEAR_M]
-                off = OffObject(gap, e.meas_index, tuple(earlier))
+                g = self.report.gt_frames.get(gt_id, {}).get(self.f)
+                scored = None
+                if g is not None and g.status is GtStatus.INTERPOLATED and g.evaluated_xy_m is not None:
+                    scored = float(np.hypot(*(np.asarray(e.translation_m[:2]) - g.evaluated_xy_m)))
+                off = OffObject(gap, e.meas_index, tuple(earlier), scored)
         elsewhere = tuple(f for f in self.window if f not in steps and self.has_column(f, track_id))
         evaluated = self.report.track_evals.get(str(track_id))
         finite = self.finite_elsewhere(track_id, steps)

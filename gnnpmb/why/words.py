@@ -854,11 +854,11 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
             f"; {verb} detections {NEAR_M:.0f} m or more from the object at frame"
             f"{'s' if len(off.earlier) > 1 else ''} {away}"
         )
-    return (
-        f"at frame {f.frame} track {lost.track_id} was output {off.distance_m:.1f} m from GT "
-        f"{short_id(f.gt_id or '')}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the "
-        f"object{before}"
-    )
+    head = f"at frame {f.frame} track {lost.track_id} was output {off.distance_m:.1f} m from GT "
+    head += short_id(f.gt_id or "")
+    if off.scored_m is not None and off.scored_m < NEAR_M:  # yet within reach of the box the evaluation scored
+        return f"{head}{on}, {off.scored_m:.1f} m from the box the evaluation interpolated for it{before}"
+    return f"{head}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the object{before}"
 
 
 def _share_of(lost: LostTrack, frame: int, meas: int, mode: UseMode) -> str:

@@ -1281,3 +1281,25 @@ def test_a_false_tracks_issue_1141_citation_is_checked_against_the_box_weighted_
     assert found(2.0, still + "would still lie 2.5 m from the track") == []
     assert found(2.0, still + "would still lie 2.0 m from the track") == ["misleading"]
     assert found(3.0, "") == ["misleading"]  # the swap decided, unsaid
+
+
+def test_a_track_said_beyond_the_evaluations_reach_while_within_reach_of_its_interpolated_box_is_caught() -> None:
+    # dev set scene-1077 centerpoint topmb id_switch:1: track 455 2.3 m from the annotation, 1.8 m from the box the
+    # devkit interpolated, was said "beyond the evaluation's 2 m, so it no longer matched the object"
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (0.0, 0.0), 0)}] * 4)
+    ev = _eval()
+    ev.boxes[3] = [("455", C, (2.3, 0.0))]
+    ev.submitted = {3: {"455"}}
+    ev.evaluated_gt[(3, GT_A)] = (0.5, 0.0)
+    beyond = "at frame 3 track 455 was output 2.3 m from GT aaaaaa, on m7: beyond the evaluation's 2 m, so it no "
+    beyond += "longer matched the object"
+    within = "at frame 3 track 455 was output 2.3 m from GT aaaaaa, on m7, 1.8 m from the box the evaluation "
+    within += "interpolated for it"
+    ctx = Context(C, 3, GT_A)
+    assert [c.kind for c in check_text(beyond, ctx, None, ev, scene=scene).found] == ["evaluation"]
+    assert check_text(within, ctx, None, ev, scene=scene).found == []
+    ev.evaluated_gt[(3, GT_A)] = (-0.5, 0.0)  # 2.8 m from the track: out of reach of both
+    assert check_text(beyond, ctx, None, ev, scene=scene).found == []
+    assert [c.kind for c in check_text(within, ctx, None, ev, scene=scene).found] == ["evaluation"]

@@ -14,6 +14,10 @@ against the annotation files and the devkit's own boxes.
   annotation (under 2 m), the devkit did not keep the annotation there and scored a box O m from it, 2 m or more
   from T's box;
 * "…, and no track carried it through": no submitted box of the object's class lies within 2 m of its annotation;
+* "at frame x track T was output D m from GT H(, on mN): beyond the evaluation's 2 m, so it no longer matched the
+  object": T's submitted box lies D m (2 m or more) from H's annotation and 2 m or more from the box the devkit
+  scored H at; "…, on mN, E m from the box the evaluation interpolated for it": the devkit did not keep H's
+  annotation there and scored a box E m (under 2 m) from T's;
 * a false track's "C GT H lies D m away, but the evaluation has it interpolated O m from the annotation, out of the
   track's reach" cites nuscenes-devkit issue #1141 as "(see …)" only where the box interpolated the right way lies
   within 2 m of the false box, says "weighted the right way (…) it would still lie E m from the track" only where it
@@ -205,3 +209,30 @@ def check_reach_1141(text: str, x: int, place, scene, ev, out, bad) -> None:
             ok = swapped and reach < NEAR_M if m[2] is not None else not swapped
         if not ok:
             bad("misleading", m[0], f"weighted the right way the box lies {reach:.2f} m from the track ({swapped=})")
+
+
+OFF = re.compile(
+    r"at frame (\d+) track (\d+) was output (\d+\.\d) m from GT (\w{6})(?:, on m\d+)?(?:: beyond the evaluation's 2 m, "
+    r"so it no longer matched the object|, (\d+\.\d) m from the box the evaluation interpolated for it)"
+)
+
+
+def check_off(text: str, scene, ev, out, bad) -> None:
+    """A lost track output 2 m or more from its object at the failure's frame (module docstring)."""
+    for m in OFF.finditer(text) if scene is not None else ():
+        out.checked["evaluation"] += 1
+        x, t = int(m[1]), m[2]
+        hit = scene.object_of(x, m[4])
+        box = next((xy for tt, _, xy in ev.boxes.get(x, []) if tt == t), None)
+        scored = ev.evaluated_gt.get((x, hit[0])) if hit is not None else None
+        if hit is None or box is None:
+            bad("evaluation", m[0], f"no annotation of GT {m[4]} or no box of track {t} at frame {x}")
+            continue
+        gap, reach = _d(box, hit[1].xy_m), _d(box, scored) if scored is not None else math.inf
+        ok = f"{gap:.1f}" == m[3] and gap >= NEAR_M
+        if m[5] is None:
+            ok = ok and reach >= NEAR_M
+        else:
+            ok = ok and (x, hit[0]) not in ev.kept_gt and f"{reach:.1f}" == m[5] and reach < NEAR_M
+        if not ok:
+            bad("evaluation", m[0], f"box {gap:.2f} m from the annotation, {reach:.2f} m from the devkit's box")

@@ -218,6 +218,7 @@ def check_text(
     place.check_reach_1141(text, ctx.frame, _place(replace(ctx, gt_id=None), ev, scene), scene, ev, out, bad)
     place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
     place.check_out_of_reach(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
+    place.check_off(text, scene, ev, out, bad)
     place.check_none_of_its_own(text, ctx.frame, scene, out, bad)
     out.checked["misleading"] += 2
     if "?" in text:

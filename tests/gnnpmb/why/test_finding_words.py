@@ -516,3 +516,27 @@ def test_a_false_track_cites_issue_1141_only_where_the_box_weighted_the_right_wa
     assert f"{on}{still}" in said((-1.2, 0.0))
     assert f"{on} (see nuscenes-devkit issue #1141)" in said((0.3, 0.0))
     assert said((14.7, 0.0)).endswith(f"{on}.")  # the devkit's box is the one weighted the right way
+
+
+def test_a_track_off_the_annotation_but_within_reach_of_the_interpolated_box_is_not_said_beyond_reach() -> None:
+    # dev set scene-1077 centerpoint topmb id_switch:1: "at frame 30 track 455 was output 2.3 m from GT a2d371, on
+    # m7: beyond the evaluation's 2 m, so it no longer matched the object", though the evaluation scored the object
+    # at a box it interpolated 1.8 m from the track (it kept the track matched to another object)
+    from gnnpmb.why.findings import OffObject
+
+    steps = (step(12, output=estimate(455, 1.0)), step(13, output=estimate(455, 1.0)))
+    for scored, said in (
+        (
+            1.76,
+            "at frame 13 track 455 was output 2.3 m from GT bf3d85, on m7, 1.8 m from the box the evaluation "
+            "interpolated for it",
+        ),
+        (
+            2.4,
+            "at frame 13 track 455 was output 2.3 m from GT bf3d85, on m7: beyond the evaluation's 2 m, so it no "
+            "longer matched the object",
+        ),
+        (None, "on m7: beyond the evaluation's 2 m, so it no longer matched the object"),
+    ):
+        lost = LostTrack(455, 12, steps, OffObject(2.29, 7, (), scored), None, None, matched_until=12)
+        assert said in why_lines(finding(FailureKind.ID_SWITCH, lost))[0], scored
