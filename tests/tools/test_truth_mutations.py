@@ -1253,6 +1253,9 @@ def test_a_parting_line_where_the_runs_only_number_their_tracks_differently_is_c
     assert found(tracks, other) == []
     assert found("gnnpmb: m11 → **new track 104** · pmbm: m11 → **new track 231**", same) == ["misleading"]
     assert found("gnnpmb: m11 → **new track 104** · pmbm: m11 → **track 231**", other) == []
+    shares = "gnnpmb: m9 → **track 104 (98 % of m9)** · pmbm: m9 → **track 231 (p 0.70)**"  # a soft update's share
+    assert found(shares, same) == ["misleading"]
+    assert found(shares, other) == []
 
 
 def test_a_false_tracks_issue_1141_citation_is_checked_against_the_box_weighted_the_right_way() -> None:

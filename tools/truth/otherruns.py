@@ -168,8 +168,9 @@ def check_involved(doc: str, track_ids: Mapping[str, Sequence[int]], out, bad) -
                 bad("misleading", clause[0][:160], f"{name}'s involved tracks (highlighted in its views) are {ids}")
 
 
-PART = re.compile(r"(\w[\w-]*): m(\d+)(?: →)? \*\*(new )?track (\d+)\*\*")
-"""One run's destination in a "Where the trackers part" line: ``gnnpmb: m11 → **new track 104**``."""
+PART = re.compile(r"(\w[\w-]*): m(\d+)(?: →)? \*\*(new )?track (\d+)(?: \([^)]*\))?\*\*")
+"""One run's destination in a "Where the trackers part" line: ``gnnpmb: m11 → **new track 104**``, ``phd: m9 →
+**track 29 (98 % of m9)**``."""
 
 
 def check_parting(doc: str, frame: int, class_name: str, raws: Mapping, out, bad) -> None:
