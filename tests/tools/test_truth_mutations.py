@@ -1222,6 +1222,26 @@ def test_the_test_an_infinite_cost_is_said_to_stand_for_is_checked_against_the_g
     threshold = [inside, CostMatrix(C, np.array([[np.inf, 2.0]]), rows, cols, scale=metres)]
     assert kinds(threshold, "beyond its distance threshold") == []
     assert kinds(threshold, "outside its gate") == ["gone"]
+    # prob3dmot's threshold is its gate's own test (Mahalanobis distance 11, gate d² 121): both words hold (dev set
+    # scene-1094 megvii prob3dmot id_switch:4 was flagged)
+    mahalanobis = CostScale("Mahalanobis distance", "", 0.5, threshold=11.0)
+    same = Gated(
+        C,
+        np.array([7]),
+        np.array([3]),
+        np.array([[False]]),
+        np.zeros((1, 2)),
+        np.eye(2)[None],
+        121.0,
+        np.array([[384.0]]),
+    )
+    both = [same, CostMatrix(C, np.array([[np.inf, 11.0]]), rows, cols, scale=mahalanobis)]
+    assert kinds(both, "beyond its Mahalanobis distance threshold") == []
+    assert kinds(both, "outside its gate") == []
+    assert kinds(
+        gate_only + [CostMatrix(C, np.array([[np.inf, 11.0]]), rows, cols, 1, scale=mahalanobis)],
+        "beyond its Mahalanobis distance threshold",
+    ) == ["gone"]
 
 
 def test_a_parting_line_where_the_runs_only_number_their_tracks_differently_is_caught() -> None:
