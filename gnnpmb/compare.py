@@ -49,7 +49,8 @@ class Disagreement:
 
     tracker: the tracker that covers the object (``missed_by_one``), switched its id (``id_change``) or
     reports the lone track (``only_in_one``); other: the tracker that misses it, kept its id, or has nothing
-    there. gt_id: the GT instance ("" for ``only_in_one``). track_ids: ``missed_by_one`` (tracker's track,),
+    there. gt_id: the GT instance ("" for ``only_in_one``). track_ids: ``missed_by_one`` (tracker's track, then
+    other's tracks of the class within ``MATCH_DISTANCE_M`` of the object, which its matching gave to others),
     ``id_change`` (tracker's previous id, its new id, other's id), ``only_in_one`` (tracker's track,).
     translation_m (3,), size_wlh_m (3,), quat_wxyz (4,): the GT box, or the lone track's box (global frame).
     """
@@ -70,7 +71,16 @@ class Disagreement:
         gt = f"{self.class_name} GT {short_id(self.gt_id)}"
         match self.kind:
             case DisagreementKind.MISSED_BY_ONE:
-                return f"{gt}: {self.tracker} shows track {self.track_ids[0]} on it, {self.other} shows no track on it"
+                shown = f"{gt}: {self.tracker} shows track {self.track_ids[0]} on it"
+                near = self.track_ids[1:]
+                if not near:
+                    return f"{shown}, {self.other} shows no track on it"
+                many = len(near) > 1
+                ids = ", ".join(map(str, near))
+                there = (
+                    f"tracks {ids} there are on other objects" if many else f"track {ids} there is on another object"
+                )
+                return f"{shown}; {self.other}'s {there}"
             case DisagreementKind.ID_CHANGE:
                 old, new, kept = self.track_ids
                 return f"{gt}: {self.tracker} switched track {old} -> {new}, {self.other} kept track {kept}"
@@ -197,8 +207,8 @@ def compare_trackers(
         frames = {n: _frame(e, gt_boxes, max_dist_m) for n, e in zip(names, per_tracker, strict=True)}
         gt_ids = [str(i) for i in gt_boxes.instance_id]
         for a, b in itertools.combinations(names, 2):
-            out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, a, b)
-            out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, b, a)
+            out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, a, b, max_dist_m)
+            out += _missed_by_one(frame_index, gt_boxes, gt_ids, frames, b, a, max_dist_m)
             out += _id_changes(frame_index, gt_boxes, gt_ids, frames, last_id, a, b)
             out += _only_in_one(frame_index, frames, a, b, max_dist_m)
             out += _only_in_one(frame_index, frames, b, a, max_dist_m)
@@ -221,22 +231,31 @@ def compare_trackers(
 
 
 def _missed_by_one(
-    frame_index: int, gt: Boxes, gt_ids: list[str], frames: Mapping[str, _Frame], a: str, b: str
+    frame_index: int, gt: Boxes, gt_ids: list[str], frames: Mapping[str, _Frame], a: str, b: str, max_dist_m: float
 ) -> list[Disagreement]:
+    """Objects a covers and b does not; b's tracks of the class nearer than ``max_dist_m`` to one (its one-to-one
+    matching gave them to other objects) follow a's track in ``track_ids``."""
     fa, fb = frames[a], frames[b]
-    return [
-        Disagreement(
-            DisagreementKind.MISSED_BY_ONE,
-            frame_index,
-            str(gt.class_name[g]),
-            a,
-            b,
-            gt_ids[g],
-            (int(fa.ids[fa.gt_track[g]]),),
-            *_gt_box(gt, g),
+    out = []
+    for g in np.flatnonzero((fa.gt_track >= 0) & (fb.gt_track < 0)).tolist():
+        d = np.hypot(*(fb.xy - gt.xy[g]).T) if len(fb.ids) else np.zeros(0)
+        near = [
+            int(t) for t, c, x in zip(fb.ids, fb.classes, d, strict=True) if c == gt.class_name[g] and x < max_dist_m
+        ]
+        track_ids = (int(fa.ids[fa.gt_track[g]]), *sorted(near))
+        out.append(
+            Disagreement(
+                DisagreementKind.MISSED_BY_ONE,
+                frame_index,
+                str(gt.class_name[g]),
+                a,
+                b,
+                gt_ids[g],
+                track_ids,
+                *_gt_box(gt, g),
+            )
         )
-        for g in np.flatnonzero((fa.gt_track >= 0) & (fb.gt_track < 0)).tolist()
-    ]
+    return out
 
 
 def _id_changes(
