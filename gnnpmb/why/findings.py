@@ -135,7 +135,7 @@ class OnObject:
     """A track output within ``NEAR_M`` of an object: its id, distance, output score, the detection its box sits
     on (-1: none this frame) and how the evaluation took it (``TrackEval``; None: not evaluated) against the
     class's threshold (None: every box counts); false_here: the evaluation matched it to no object at this frame
-    (a false track there)."""
+    (a false track there); xy_m: its box's BEV centre (global)."""
 
     track_id: int
     distance_m: float
@@ -144,6 +144,7 @@ class OnObject:
     evaluated: TrackEval | None
     threshold: float | None
     false_here: bool = False
+    xy_m: tuple[float, float] | None = None
 
     @property
     def counted(self) -> bool:

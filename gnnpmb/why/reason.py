@@ -161,7 +161,8 @@ class _Context:
             if d < NEAR_M:
                 evaluated = report.track_evals.get(str(e.track_id))
                 false_here = self.false_at(report, fr.keyframe.index, e.track_id)
-                out.append(OnObject(e.track_id, d, e.score, e.meas_index, evaluated, threshold, false_here))
+                xy_m = (float(e.translation_m[0]), float(e.translation_m[1]))
+                out.append(OnObject(e.track_id, d, e.score, e.meas_index, evaluated, threshold, false_here, xy_m))
         return tuple(sorted(out, key=lambda o: o.distance_m))
 
     def sightings(self, gt_id: str) -> tuple[Sighting, ...]:

@@ -445,20 +445,40 @@ def _between(g: GtFrame) -> str:
     return text
 
 
+def _right_way_m(g: GtFrame | None, track_xy_m: tuple[float, float] | None) -> float | None:
+    """How far from a track's box the interpolated box would lie weighted the right way (nuscenes-devkit issue
+    #1141); None when the devkit's box is that one (its ends unknown, or the swap moved it under 0.05 m)."""
+    if g is None or g.unswapped_xy_m is None or g.evaluated_xy_m is None or track_xy_m is None:
+        return None
+    ux, uy = g.unswapped_xy_m
+    if math.hypot(ux - g.evaluated_xy_m[0], uy - g.evaluated_xy_m[1]) < 0.05:
+        return None
+    return math.hypot(ux - track_xy_m[0], uy - track_xy_m[1])
+
+
 def _swap_reach(g: GtFrame | None, track_xy_m: tuple[float, float]) -> str:
     """What nuscenes-devkit issue #1141 did to a track out of reach of an interpolated box: `` (see ...)`` when the
     box weighted the right way lies within ``NEAR_M`` of the track, ``, and weighted the right way (...) it would
     still lie 2.6 m from the track`` when not (dev set scene-1094 megvii prob3dmot false_track:6), "" when the
-    devkit's box is the one weighted the right way (its ends unknown, or the swap moved it under 0.05 m)."""
-    if g is None or g.unswapped_xy_m is None or g.evaluated_xy_m is None:
+    devkit's box is the one weighted the right way."""
+    d = _right_way_m(g, track_xy_m)
+    if d is None:
         return ""
-    ux, uy = g.unswapped_xy_m
-    if math.hypot(ux - g.evaluated_xy_m[0], uy - g.evaluated_xy_m[1]) < 0.05:
-        return ""
-    d = math.hypot(ux - track_xy_m[0], uy - track_xy_m[1])
     if d < NEAR_M:
         return " (see nuscenes-devkit issue #1141)"
     return f", and weighted the right way (nuscenes-devkit issue #1141) it would still lie {d:.1f} m from the track"
+
+
+def _still_away(g: GtFrame | None, track_xy_m: tuple[float, float] | None) -> str:
+    """``, and weighted the right way it would still lie 2.6 m from the track``: after "out of the track's reach",
+    where the #1141 note before it names the swap but the box weighted the right way is out of reach too (dev set
+    scene-1094 megvii prob3dmot miss:61); "" otherwise."""
+    d = _right_way_m(g, track_xy_m)
+    return (
+        f", and weighted the right way it would still lie {d:.1f} m from the track"
+        if d is not None and d >= NEAR_M
+        else ""
+    )
 
 
 def because_text(f: Finding) -> str | None:
@@ -740,7 +760,7 @@ def _still_on_annotated(f: Finding, lost: LostTrack) -> list[str]:
     return [
         f"at frame {f.frame} track {lost.track_id} was still output {on.distance_m:.1f} m from the annotated object, "
         f"but the evaluation scored the object at a box it interpolated {r.offset_m:.1f} m from the annotation, "
-        "out of the track's reach"
+        f"out of the track's reach{_still_away(s.evaluated, on.xy_m)}"
     ]
 
 
@@ -1050,7 +1070,7 @@ def _out_of_reach_on_it(f: Finding, s: Sighting) -> list[str]:
     return [
         f"at frame {f.frame} track {o.track_id} was output {o.distance_m:.1f} m from the annotated object, but the "
         f"evaluation scored the object at a box it interpolated {r.offset_m:.1f} m from the annotation, out of the "
-        "track's reach"
+        f"track's reach{_still_away(s.evaluated, o.xy_m)}"
         for o in away
     ]
 

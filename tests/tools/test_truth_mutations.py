@@ -1326,3 +1326,32 @@ def test_a_track_said_beyond_the_evaluations_reach_while_within_reach_of_its_int
     ev.evaluated_gt[(3, GT_A)] = (-0.5, 0.0)  # 2.8 m from the track: out of reach of both
     assert check_text(beyond, ctx, None, ev, scene=scene).found == []
     assert [c.kind for c in check_text(within, ctx, None, ev, scene=scene).found] == ["evaluation"]
+
+
+def test_a_track_out_of_reach_of_an_interpolated_box_says_whether_the_right_way_would_reach_it() -> None:
+    # dev set scene-1094 megvii prob3dmot miss:61: "out of the track's reach" beside the #1141 note, though the box
+    # weighted the right way lay 2.6 m from the track. GT A at x 0, 4, 10 m (frames 1-3), the devkit's box at frame
+    # 2 at x 5.45, weighted the right way x 4.55
+    from tools.truth.place import check_out_of_reach
+    from tools.truth.scene import Annotation, SceneTruth
+    from tools.truth.sentences import Tally
+
+    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (x, 0.0), 9)} for x in (0.0, 0.0, 4.0, 10.0)])
+    ev = _eval()
+    ev.kept_gt = {(0, GT_A), (1, GT_A), (3, GT_A)}
+    ev.stamps = {0: 0, 1: 500_000, 2: 1_000_000, 3: 1_600_000}
+    ev.evaluated_gt[(2, GT_A)] = (10.0 * 6 / 11, 0.0)
+    out = "at frame 2 track 30 was output {} m from the annotated object, but the evaluation scored the object at a "
+    out += "box it interpolated 1.5 m from the annotation, out of the track's reach"
+    still = ", and weighted the right way it would still lie {} m from the track"
+
+    def found(track_x: float, text: str) -> list[str]:
+        ev.boxes[2] = [("30", C, (track_x, 0.0))]
+        tally = Tally()
+        check_out_of_reach(text, C, 2, GT_A, scene, ev, tally, lambda kind, s, why: tally.found.append(kind))
+        return tally.found
+
+    assert found(3.0, out.format("1.0")) == []  # 1.5 m from the box weighted the right way: the swap decided
+    assert found(3.0, out.format("1.0") + still.format("1.5")) == ["misleading"]
+    assert found(2.4, out.format("1.6") + still.format("2.1")) == []
+    assert found(2.4, out.format("1.6")) == ["misleading"]  # out of reach either way, unsaid

@@ -13,6 +13,8 @@ against the annotation files and the devkit's own boxes.
   box it interpolated O m from the annotation, out of the track's reach": T's submitted box lies D m from the
   annotation (under 2 m), the devkit did not keep the annotation there and scored a box O m from it, 2 m or more
   from T's box;
+  and ", and weighted the right way it would still lie E m from the track" follows it exactly where the devkit's
+  swap moved the box and the box interpolated the right way lies E m (2 m or more) from T's;
 * "…, and no track carried it through": no submitted box of the object's class lies within 2 m of its annotation;
 * "at frame x track T was output D m from GT H(, on mN): beyond the evaluation's 2 m, so it no longer matched the
   object": T's submitted box lies D m (2 m or more) from H's annotation and 2 m or more from the box the devkit
@@ -52,6 +54,7 @@ PREDICTED = re.compile(
 OUT_OF_REACH = re.compile(
     r"at frame (\d+) track (\d+) was (?:still )?output (\d+\.\d) m from the annotated object, but the evaluation "
     r"scored the object at a box it interpolated (\d+\.\d) m from the annotation, out of the track's reach"
+    r"(?:, and weighted the right way it would still lie (\d+\.\d) m from the track)?"
 )
 NOT_CARRIED = "and no track carried it through"
 
@@ -75,6 +78,15 @@ def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, 
         if not (on < NEAR_M and f"{on:.1f}" == m[3] and f"{off:.1f}" == m[4] and away >= NEAR_M):
             said = f"box {on:.2f} m from the annotation, {away:.2f} m from the devkit's ({off:.2f} off)"
             bad("evaluation", m[0], said)
+            continue
+        right = _right_way(scene, ev, gt_id, y)
+        if right is not None and math.dist(right, scored) >= 0.05:  # the swap moved it: out of reach weighted so?
+            still = math.dist(right, box)
+            out.checked["misleading"] += 1
+            if (m[5] is None) != (still < NEAR_M) or (m[5] is not None and f"{still:.1f}" != m[5]):
+                bad("misleading", m[0], f"weighted the right way the box lies {still:.2f} m from the track")
+        elif m[5] is not None:
+            bad("misleading", m[0], "the devkit's box is the one weighted the right way")
     if NOT_CARRIED in text:
         out.checked["output"] += 1
         near = [t for t, cls, xy in ev.boxes.get(x, []) if cls == c and math.dist(xy, a.xy_m) < NEAR_M]
@@ -112,6 +124,18 @@ def check_place(text: str, c: str, x: int, place, scene, out, bad) -> None:
             bad("detector", m[0], f"{m[1]} annotations within 2 m: {own}")
         elif hit is None or hit[1].class_name != m[2] or f"{_d(hit[1].xy_m, place):.1f}" != m[4]:
             bad("detector", m[0], f"GT {m[3]} is {hit[1] if hit else 'not annotated here'}")
+
+
+def _right_way(scene, ev, gt_id: str, x: int) -> tuple[float, float] | None:
+    """The object's box at ``x`` interpolated linearly in time between its annotations at the frames the devkit
+    kept around x (None: no such ends)."""
+    ends = _ends(ev, gt_id, x)
+    a, b = (scene.objects[f].get(gt_id) for f in ends) if ends is not None else (None, None)
+    if a is None or b is None:
+        return None
+    left, right = ends
+    w = (ev.stamps[x] - ev.stamps[left]) / (ev.stamps[right] - ev.stamps[left])
+    return a.xy_m[0] + w * (b.xy_m[0] - a.xy_m[0]), a.xy_m[1] + w * (b.xy_m[1] - a.xy_m[1])
 
 
 def _ends(ev, gt_id: str, x: int) -> tuple[int, int] | None:
@@ -193,15 +217,11 @@ def check_reach_1141(text: str, x: int, place, scene, ev, out, bad) -> None:
     for m in REACH_1141.finditer(text) if place is not None and scene is not None else ():
         out.checked["misleading"] += 1
         hit = scene.object_of(x, m[1])
-        ends = _ends(ev, hit[0], x) if hit is not None else None
         scored = ev.evaluated_gt.get((x, hit[0])) if hit is not None else None
-        a, b = (scene.objects[f].get(hit[0]) for f in ends) if ends is not None else (None, None)
-        if a is None or b is None or scored is None:
+        right_way = _right_way(scene, ev, hit[0], x) if hit is not None else None
+        if right_way is None or scored is None:
             bad("misleading", m[0], "no interpolation of the object the devkit scored here")
             continue
-        left, right = ends
-        w = (ev.stamps[x] - ev.stamps[left]) / (ev.stamps[right] - ev.stamps[left])
-        right_way = (a.xy_m[0] + w * (b.xy_m[0] - a.xy_m[0]), a.xy_m[1] + w * (b.xy_m[1] - a.xy_m[1]))
         swapped, reach = _d(right_way, scored) >= 0.05, _d(right_way, place)
         if m[3] is not None:
             ok = swapped and reach >= NEAR_M and f"{reach:.1f}" == m[3]

@@ -540,3 +540,26 @@ def test_a_track_off_the_annotation_but_within_reach_of_the_interpolated_box_is_
     ):
         lost = LostTrack(455, 12, steps, OffObject(2.29, 7, (), scored), None, None, matched_until=12)
         assert said in why_lines(finding(FailureKind.ID_SWITCH, lost))[0], scored
+
+
+def test_a_track_out_of_reach_says_when_the_box_weighted_the_right_way_would_be_out_of_reach_too() -> None:
+    # dev set scene-1094 megvii prob3dmot miss:61: after "weighted the right way the box would lie 1.2 m from the
+    # annotation", "track 30 was output 1.5 m from the annotated object, but the evaluation scored the object at a
+    # box it interpolated 14.7 m from the annotation, out of the track's reach" read as if the swap alone put the
+    # object out of reach; weighted the right way it would still have lain 2.6 m from the track
+    from gnnpmb.eval.evaluated import GtFrame, GtStatus
+    from gnnpmb.why.findings import EvaluatedReach, OnObject
+
+    kept = TrackEval((9,), (9,), (), 0.7, 0.7)
+
+    def said(unswapped: tuple[float, float]) -> str:
+        g = GtFrame(9, GtStatus.INTERPOLATED, (0.0, 0.0), (14.7, 0.0), None, 0, 20.0, 40.0, (8, 15), unswapped)
+        seen = Sighting(9, 0, g, None, None, None, (OnObject(30, 1.5, 0.7, -1, kept, 0.3, xy_m=(-1.5, 0.0)),))
+        blame = (Blame(Rule.INTERPOLATED, (9,)),)
+        reach = EvaluatedReach(14.7, (), (30,))
+        return why_lines(finding(FailureKind.MISS, frame=9, sightings=(seen,), blame=blame, reach=reach))[0]
+
+    out = "track 30 was output 1.5 m from the annotated object, but the evaluation scored the object at a box it "
+    out += "interpolated 14.7 m from the annotation, out of the track's reach"
+    assert f"{out}, and weighted the right way it would still lie 2.7 m from the track" in said((1.2, 0.0))
+    assert f"{out};" in said((-1.2, 0.0)) or said((-1.2, 0.0)).endswith(f"{out}.")  # within reach weighted so
