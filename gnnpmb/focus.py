@@ -175,6 +175,7 @@ class _Tracked:
         place = gt_centers if len(gt_centers) else centers
         center = place.mean(axis=0) if len(place) else _ego_xy(self.scene, failure.frame_index)
         ids: dict[str, tuple[int, ...]] = {}
+        gt_ids = failure.gt_ids or _gt_under_false_track(failure, self.scene)
         for name, per_frame in self.estimates.items():
             own = {int(t) for t in failure.track_ids} if name == tracker else set()
             near: set[int] = set()
@@ -182,7 +183,7 @@ class _Tracked:
             for i in range(max(start, failure.frame_index - NEAR_FRAMES), failure.frame_index + 1):
                 near |= _tracks_near(per_frame[i - start], failure.class_name, gt_xy(self.scene, i, failure.gt_ids))
             if name != tracker and failure.frame_index in self.frames:
-                near |= self._named(name, failure, per_frame[failure.frame_index - start])
+                near |= self._named(name, failure, gt_ids, per_frame[failure.frame_index - start])
             ids[name] = tuple(sorted(own | near))
         label = failure_id or failure.kind.value
         return FocusTarget(
@@ -191,25 +192,28 @@ class _Tracked:
             center_xy_m=(float(center[0]), float(center[1])),
             class_name=failure.class_name,
             track_ids=ids,
-            gt_ids=failure.gt_ids or _gt_under_false_track(failure, self.scene),
+            gt_ids=gt_ids,
             failure_id=failure_id,
             failure_kind=failure.kind,
             failure_tracker=tracker,
             failure_tracks=tuple(int(t) for t in failure.track_ids),
         )
 
-    def _named(self, name: str, failure: Failure, estimates: Sequence[TrackEstimate]) -> set[int]:
+    def _named(
+        self, name: str, failure: Failure, gt_ids: Sequence[str], estimates: Sequence[TrackEstimate]
+    ) -> set[int]:
         """The tracks of another run the failure's explanation names (``why.reason.others``) that ``_tracks_near``
         does not find: the track its evaluation matched the object to at the failure's frame (at a box it
-        interpolated, possibly 2 m or more from the annotation), and for a failure with no annotated object (a
-        false track) its tracks output within ``NEAR_M`` of the failure's box."""
+        interpolated, possibly 2 m or more from the annotation), for a false track its tracks output within
+        ``NEAR_M`` of the object under it (``gt_ids``: the failure's objects, or that one), and with no annotated
+        object its tracks output within ``NEAR_M`` of the failure's box."""
         out: set[int] = set()
         report = self.reports.get(name)
-        if report is not None and failure.gt_ids:
-            out |= {
-                int(t) for t, e in report.track_evals.items() if e.matched_at(failure.frame_index) in failure.gt_ids
-            }
-        if not len(gt_xy(self.scene, failure.frame_index, failure.gt_ids)) and failure.boxes:
+        if report is not None and gt_ids:
+            out |= {int(t) for t, e in report.track_evals.items() if e.matched_at(failure.frame_index) in gt_ids}
+        under = gt_xy(self.scene, failure.frame_index, gt_ids)
+        out |= _tracks_near(estimates, failure.class_name, under)
+        if not len(under) and failure.boxes:
             box = np.asarray(failure.boxes[0].translation_m[:2], dtype=np.float64).reshape(1, 2)
             out |= _tracks_near(estimates, failure.class_name, box)
         return out

@@ -17,7 +17,7 @@ from gnnpmb.eval.failures import short_id
 from gnnpmb.events import AxisKind
 from gnnpmb.focus import FocusTarget
 from gnnpmb.focus_cameras import FocusSight
-from gnnpmb.why.facts import Ending, TrackerFacts, TrackStep, UseMode, Went
+from gnnpmb.why.facts import Destination, Ending, TrackerFacts, TrackStep, UseMode, Went
 from gnnpmb.why.findings import NEAR_M, Finding, Sighting
 from gnnpmb.why.reason import Evidence, key_decisions, object_frames
 from gnnpmb.why.story import StoryLine
@@ -153,8 +153,9 @@ def camera_lines(sight: FocusSight | None) -> list[str]:
 
 def _parting(focus: FocusTarget, views: Mapping[str, TrackerView]) -> list[str]:
     """With several trackers: each detection of the focus frame that went to different places in different
-    trackers, with an involved track chosen, next best or sharing it in one of them: each tracker's destination
-    and, where it chose from a cost matrix, the cost and the next best."""
+    trackers (another kind of destination, or a track started by another detection: ``_same_place``), with an
+    involved track chosen, next best or sharing it in one of them: each tracker's destination and, where it chose
+    from a cost matrix, the cost and the next best."""
     if len(views) < 2:
         return []
     f, c = focus.frame_index, focus.class_name
@@ -167,8 +168,7 @@ def _parting(focus: FocusTarget, views: Mapping[str, TrackerView]) -> list[str]:
     out = []
     for m in metas:
         went = {t: (u.destinations.get(m) if u is not None else None) for t, u in uses.items()}
-        keys = {(d.went, d.track_id) if d is not None else None for d in went.values()}
-        if len(keys) < 2:
+        if len({_same_place(t, d, views[t], c) for t, d in went.items()}) < 2:
             continue
         touches, parts = False, []
         for t in views:
@@ -199,6 +199,14 @@ def _parting(focus: FocusTarget, views: Mapping[str, TrackerView]) -> list[str]:
         if touches:
             out.append(" · ".join(parts))
     return out
+
+
+def _same_place(tracker: str, d: Destination | None, view: TrackerView, class_name: str) -> object:
+    """What a destination is across runs, whose track ids differ: its kind, and for an existing track the birth
+    that started it (a track id of this run alone when no birth names it)."""
+    if d is None or d.went is not Went.TRACK:
+        return None if d is None else d.went
+    return d.went, view.facts.origin(d.track_id, class_name) or (tracker, d.track_id)
 
 
 def _diagnosis(view: TrackerView, class_name: str, track_ids: list[int], frames: range) -> list[str]:

@@ -297,6 +297,7 @@ class TrackerFacts:
         self._decisions: dict[int, dict[str, Decisions | None]] = {}
         self._hypotheses: dict[int, dict[str, HypothesisFrame | None]] = {}
         self._steps: dict[tuple[int, str], dict[int, TrackStep]] = {}
+        self._origins: dict[str, dict[int, tuple[int, int]]] = {}
 
     def add(self, event: Event) -> None:
         """File one event under the current frame (a ``FrameStarted`` opens a frame)."""
@@ -329,6 +330,7 @@ class TrackerFacts:
             cache.pop(frame, None)
         if self._steps:
             self._steps.clear()
+        self._origins.clear()
 
     # What the events say, per frame and class.
     def frame(self, frame: int, class_name: str) -> ClassFrame | None:
@@ -399,6 +401,18 @@ class TrackerFacts:
             if h is not None and h.holding(track_id):
                 return f
         return None
+
+    def origin(self, track_id: int, class_name: str) -> tuple[int, int] | None:
+        """(frame, detection source index) of the birth that started ``track_id``: what names the same track in
+        runs that number their tracks differently (None: no ``Born`` event names it, e.g. a GM-PHD label)."""
+        if class_name not in self._origins:
+            found: dict[int, tuple[int, int]] = {}
+            for f in self.frame_indices:
+                cf = self.frame(f, class_name)
+                for m, t in (cf.born_of() if cf is not None else {}).items():
+                    found.setdefault(t, (f, m))
+            self._origins[class_name] = found
+        return self._origins[class_name].get(track_id)
 
     def output(self, frame: int, class_name: str) -> tuple[TrackEstimate, ...]:
         cf = self.frame(frame, class_name)

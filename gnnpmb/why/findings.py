@@ -135,7 +135,7 @@ class OnObject:
     """A track output within ``NEAR_M`` of an object: its id, distance, output score, the detection its box sits
     on (-1: none this frame) and how the evaluation took it (``TrackEval``; None: not evaluated) against the
     class's threshold (None: every box counts); false_here: the evaluation matched it to no object at this frame
-    (a false track there)."""
+    (a false track there); xy_m: its box's BEV centre (global)."""
 
     track_id: int
     distance_m: float
@@ -144,6 +144,7 @@ class OnObject:
     evaluated: TrackEval | None
     threshold: float | None
     false_here: bool = False
+    xy_m: tuple[float, float] | None = None
 
     @property
     def counted(self) -> bool:
@@ -174,11 +175,13 @@ class Sighting:
 class OffObject:
     """The lost track output ``NEAR_M`` or more from the object at the failure's frame: how far, on which
     detection (-1: none), and the earlier frames whose detection it used lay that far from the object
-    ((frame, detection) pairs)."""
+    ((frame, detection) pairs); scored_m: how far from the box the evaluation interpolated for the object there
+    (None: it scored the annotation, or no box)."""
 
     distance_m: float
     meas: int
     earlier: tuple[tuple[int, int], ...]
+    scored_m: float | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -161,7 +161,8 @@ class _Context:
             if d < NEAR_M:
                 evaluated = report.track_evals.get(str(e.track_id))
                 false_here = self.false_at(report, fr.keyframe.index, e.track_id)
-                out.append(OnObject(e.track_id, d, e.score, e.meas_index, evaluated, threshold, false_here))
+                xy_m = (float(e.translation_m[0]), float(e.translation_m[1]))
+                out.append(OnObject(e.track_id, d, e.score, e.meas_index, evaluated, threshold, false_here, xy_m))
         return tuple(sorted(out, key=lambda o: o.distance_m))
 
     def sightings(self, gt_id: str) -> tuple[Sighting, ...]:
@@ -327,7 +328,11 @@ class _Context:
                         continue
                     boxes = fr.detections.boxes
                     earlier += [(s.frame, m) for m in s.used if np.hypot(*(boxes.translation_m[m, :2] - at)) >= NEAR_M]
-                off = OffObject(gap, e.meas_index, tuple(earlier))
+                g = self.report.gt_frames.get(gt_id, {}).get(self.f)
+                scored = None
+                if g is not None and g.status is GtStatus.INTERPOLATED and g.evaluated_xy_m is not None:
+                    scored = float(np.hypot(*(np.asarray(e.translation_m[:2]) - g.evaluated_xy_m)))
+                off = OffObject(gap, e.meas_index, tuple(earlier), scored)
         elsewhere = tuple(f for f in self.window if f not in steps and self.has_column(f, track_id))
         evaluated = self.report.track_evals.get(str(track_id))
         finite = self.finite_elsewhere(track_id, steps)

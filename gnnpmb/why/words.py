@@ -445,6 +445,42 @@ def _between(g: GtFrame) -> str:
     return text
 
 
+def _right_way_m(g: GtFrame | None, track_xy_m: tuple[float, float] | None) -> float | None:
+    """How far from a track's box the interpolated box would lie weighted the right way (nuscenes-devkit issue
+    #1141); None when the devkit's box is that one (its ends unknown, or the swap moved it under 0.05 m)."""
+    if g is None or g.unswapped_xy_m is None or g.evaluated_xy_m is None or track_xy_m is None:
+        return None
+    ux, uy = g.unswapped_xy_m
+    if math.hypot(ux - g.evaluated_xy_m[0], uy - g.evaluated_xy_m[1]) < 0.05:
+        return None
+    return math.hypot(ux - track_xy_m[0], uy - track_xy_m[1])
+
+
+def _swap_reach(g: GtFrame | None, track_xy_m: tuple[float, float]) -> str:
+    """What nuscenes-devkit issue #1141 did to a track out of reach of an interpolated box: `` (see ...)`` when the
+    box weighted the right way lies within ``NEAR_M`` of the track, ``, and weighted the right way (...) it would
+    still lie 2.6 m from the track`` when not (dev set scene-1094 megvii prob3dmot false_track:6), "" when the
+    devkit's box is the one weighted the right way."""
+    d = _right_way_m(g, track_xy_m)
+    if d is None:
+        return ""
+    if d < NEAR_M:
+        return " (see nuscenes-devkit issue #1141)"
+    return f", and weighted the right way (nuscenes-devkit issue #1141) it would still lie {d:.1f} m from the track"
+
+
+def _still_away(g: GtFrame | None, track_xy_m: tuple[float, float] | None) -> str:
+    """``, and weighted the right way it would still lie 2.6 m from the track``: after "out of the track's reach",
+    where the #1141 note before it names the swap but the box weighted the right way is out of reach too (dev set
+    scene-1094 megvii prob3dmot miss:61); "" otherwise."""
+    d = _right_way_m(g, track_xy_m)
+    return (
+        f", and weighted the right way it would still lie {d:.1f} m from the track"
+        if d is not None and d >= NEAR_M
+        else ""
+    )
+
+
 def because_text(f: Finding) -> str | None:
     """The deciding choice's costs taken apart, and the lost track's own cost when it was neither of the compared
     columns; None without a deciding choice whose next best was a track with known cost terms."""
@@ -724,7 +760,7 @@ def _still_on_annotated(f: Finding, lost: LostTrack) -> list[str]:
     return [
         f"at frame {f.frame} track {lost.track_id} was still output {on.distance_m:.1f} m from the annotated object, "
         f"but the evaluation scored the object at a box it interpolated {r.offset_m:.1f} m from the annotation, "
-        "out of the track's reach"
+        f"out of the track's reach{_still_away(s.evaluated, on.xy_m)}"
     ]
 
 
@@ -838,11 +874,11 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
             f"; {verb} detections {NEAR_M:.0f} m or more from the object at frame"
             f"{'s' if len(off.earlier) > 1 else ''} {away}"
         )
-    return (
-        f"at frame {f.frame} track {lost.track_id} was output {off.distance_m:.1f} m from GT "
-        f"{short_id(f.gt_id or '')}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the "
-        f"object{before}"
-    )
+    head = f"at frame {f.frame} track {lost.track_id} was output {off.distance_m:.1f} m from GT "
+    head += short_id(f.gt_id or "")
+    if off.scored_m is not None and off.scored_m < NEAR_M:  # yet within reach of the box the evaluation scored
+        return f"{head}{on}, {off.scored_m:.1f} m from the box the evaluation interpolated for it{before}"
+    return f"{head}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the object{before}"
 
 
 def _share_of(lost: LostTrack, frame: int, meas: int, mode: UseMode) -> str:
@@ -920,7 +956,7 @@ def _false_track(f: Finding) -> list[str]:
         elif Rule.INTERPOLATED in tests:
             parts.append(
                 f"{on}, but the evaluation has it interpolated {g.offset_m:.1f} m from the annotation, out of the "
-                "track's reach (see nuscenes-devkit issue #1141)"
+                f"track's reach{_swap_reach(g, o.output_xy_m)}"
             )
         elif o.object_missed:  # the evaluation matched the object to no track: nothing was matched instead
             parts.append(f"{on}, but the evaluation matched neither to the other (it counted the object missed)")
@@ -1034,7 +1070,7 @@ def _out_of_reach_on_it(f: Finding, s: Sighting) -> list[str]:
     return [
         f"at frame {f.frame} track {o.track_id} was output {o.distance_m:.1f} m from the annotated object, but the "
         f"evaluation scored the object at a box it interpolated {r.offset_m:.1f} m from the annotation, out of the "
-        "track's reach"
+        f"track's reach{_still_away(s.evaluated, o.xy_m)}"
         for o in away
     ]
 

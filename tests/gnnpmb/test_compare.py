@@ -163,3 +163,16 @@ def test_bad_input() -> None:
         compare_trackers([GT], {"A": A_FRAMES[:1]})
     with pytest.raises(ValueError, match="B has 2 frames"):
         compare_trackers([GT] * 3, {"A": A_FRAMES, "B": B_FRAMES[:2]})
+
+
+def test_a_track_the_other_shows_near_the_object_but_gives_to_another_is_named() -> None:
+    # dev set scene-0655 megvii, gnnpmb beside pmbm, frame 20: "pedestrian GT 2e96cc: pmbm shows track 90 on it,
+    # gnnpmb shows no track on it", though gnnpmb showed track 104 1.05 m from it (on GT 6b4853, 0.26 m away)
+    gt = gt_boxes([("2e96cc", "pedestrian", 0.0, 0.0), ("6b4853", "pedestrian", 1.2, 0.0)])
+    a = [[est(90, "pedestrian", 0.1, 0.0), est(231, "pedestrian", 1.2, 0.1)]]
+    b = [[est(104, "pedestrian", 1.05, 0.0)]]
+    (missed,) = compare_trackers([gt], {"pmbm": a, "gnnpmb": b}).of_kind(MISSED)
+    assert (missed.track_ids, missed.elsewhere) == ((90,), (104, "6b4853"))
+    assert missed.describe() == (
+        "pedestrian GT 2e96cc: pmbm shows track 90 on it, gnnpmb's track 104 beside it is on GT 6b4853"
+    )

@@ -1222,3 +1222,136 @@ def test_the_test_an_infinite_cost_is_said_to_stand_for_is_checked_against_the_g
     threshold = [inside, CostMatrix(C, np.array([[np.inf, 2.0]]), rows, cols, scale=metres)]
     assert kinds(threshold, "beyond its distance threshold") == []
     assert kinds(threshold, "outside its gate") == ["gone"]
+    # prob3dmot's threshold is its gate's own test (Mahalanobis distance 11, gate d² 121): both words hold (dev set
+    # scene-1094 megvii prob3dmot id_switch:4 was flagged)
+    mahalanobis = CostScale("Mahalanobis distance", "", 0.5, threshold=11.0)
+    same = Gated(
+        C,
+        np.array([7]),
+        np.array([3]),
+        np.array([[False]]),
+        np.zeros((1, 2)),
+        np.eye(2)[None],
+        121.0,
+        np.array([[384.0]]),
+    )
+    both = [same, CostMatrix(C, np.array([[np.inf, 11.0]]), rows, cols, scale=mahalanobis)]
+    assert kinds(both, "beyond its Mahalanobis distance threshold") == []
+    assert kinds(both, "outside its gate") == []
+    assert kinds(
+        gate_only + [CostMatrix(C, np.array([[np.inf, 11.0]]), rows, cols, 1, scale=mahalanobis)],
+        "beyond its Mahalanobis distance threshold",
+    ) == ["gone"]
+
+
+def test_a_parting_line_where_the_runs_only_number_their_tracks_differently_is_caught() -> None:
+    # dev set scene-0655 megvii gnnpmb beside pmbm: "Where the trackers part" listed "gnnpmb: m9 → **track 104** ·
+    # pmbm: m9 → **track 231**" though both tracks were started by m11 at frame 14 (61 of 63 lines)
+    from gnnpmb.events import Born
+    from tools.truth.otherruns import check_parting
+    from tools.truth.sentences import Tally
+
+    def run(births: dict[int, tuple[int, int]]) -> RawEvents:
+        events = []
+        for frame in sorted({f for f, _ in births.values()}):
+            events.append(FrameStarted("t", frame, "s", 0, 0.5))
+            born = [(t, m) for t, (f, m) in births.items() if f == frame]
+            ids, meas = zip(*born, strict=True)
+            events.append(Born(C, np.array(ids), np.array(meas), np.zeros((len(ids), 4)), np.ones(len(ids))))
+        return RawEvents.of(events)
+
+    def found(line: str, raws: dict) -> list[str]:
+        doc = f"**Where the trackers part** at frame 15 (...):\n\n- {line}\n\n**Involved** (car): ...\n"
+        out = Tally()
+        check_parting(doc, 15, C, raws, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    same = {"gnnpmb": run({104: (14, 11)}), "pmbm": run({231: (14, 11)})}
+    other = {"gnnpmb": run({104: (14, 11)}), "pmbm": run({231: (12, 10)})}
+    tracks = "gnnpmb: m9 → **track 104** (2.34; next new 10.4) · pmbm: m9 → **track 231** (2.34; next new 10.4)"
+    assert found(tracks, same) == ["misleading"]
+    assert found(tracks, other) == []
+    assert found("gnnpmb: m11 → **new track 104** · pmbm: m11 → **new track 231**", same) == ["misleading"]
+    assert found("gnnpmb: m11 → **new track 104** · pmbm: m11 → **track 231**", other) == []
+    shares = "gnnpmb: m9 → **track 104 (98 % of m9)** · pmbm: m9 → **track 231 (p 0.70)**"  # a soft update's share
+    assert found(shares, same) == ["misleading"]
+    assert found(shares, other) == []
+
+
+def test_a_false_tracks_issue_1141_citation_is_checked_against_the_box_weighted_the_right_way() -> None:
+    # dev set scene-1094 megvii prob3dmot false_track:6 cited issue #1141 though the box weighted the right way lay
+    # 2.6 m from the track, out of its reach too. Scene as in the planted #1141 note: GT A at x 0, 4, 10 m (frames
+    # 1-3), the devkit's box at frame 2 at x 5.45, weighted the right way x 4.55
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (x, 0.0), 9)} for x in (0.0, 0.0, 4.0, 10.0)])
+    ev = _eval()
+    ev.kept_gt = {(0, GT_A), (1, GT_A), (3, GT_A)}
+    ev.stamps = {0: 0, 1: 500_000, 2: 1_000_000, 3: 1_600_000}
+    ev.evaluated_gt[(2, GT_A)] = (10.0 * 6 / 11, 0.0)
+    head = "car GT aaaaaa lies {} m away, but the evaluation has it interpolated 1.5 m from the annotation, out of the "
+    head += "track's reach"
+    see = " (see nuscenes-devkit issue #1141)"
+    still = ", and weighted the right way (nuscenes-devkit issue #1141) it "
+
+    def found(track_x: float, tail: str) -> list[str]:
+        ev.pred_xy[(C, 2)] = {"30": (track_x, 0.0)}
+        text = head.format(f"{abs(track_x - 4.0):.1f}") + tail
+        return [c.kind for c in check_text(text, Context(C, 2, GT_A, track=30), None, ev, scene=scene).found]
+
+    assert found(3.0, see) == []  # 1.5 m from the box weighted the right way: the swap put it out of reach
+    assert found(2.0, see) == ["misleading"]  # 2.5 m from it: out of reach either way
+    assert found(2.0, still + "would still lie 2.5 m from the track") == []
+    assert found(2.0, still + "would still lie 2.0 m from the track") == ["misleading"]
+    assert found(3.0, "") == ["misleading"]  # the swap decided, unsaid
+
+
+def test_a_track_said_beyond_the_evaluations_reach_while_within_reach_of_its_interpolated_box_is_caught() -> None:
+    # dev set scene-1077 centerpoint topmb id_switch:1: track 455 2.3 m from the annotation, 1.8 m from the box the
+    # devkit interpolated, was said "beyond the evaluation's 2 m, so it no longer matched the object"
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (0.0, 0.0), 0)}] * 4)
+    ev = _eval()
+    ev.boxes[3] = [("455", C, (2.3, 0.0))]
+    ev.submitted = {3: {"455"}}
+    ev.evaluated_gt[(3, GT_A)] = (0.5, 0.0)
+    beyond = "at frame 3 track 455 was output 2.3 m from GT aaaaaa, on m7: beyond the evaluation's 2 m, so it no "
+    beyond += "longer matched the object"
+    within = "at frame 3 track 455 was output 2.3 m from GT aaaaaa, on m7, 1.8 m from the box the evaluation "
+    within += "interpolated for it"
+    ctx = Context(C, 3, GT_A)
+    assert [c.kind for c in check_text(beyond, ctx, None, ev, scene=scene).found] == ["evaluation"]
+    assert check_text(within, ctx, None, ev, scene=scene).found == []
+    ev.evaluated_gt[(3, GT_A)] = (-0.5, 0.0)  # 2.8 m from the track: out of reach of both
+    assert check_text(beyond, ctx, None, ev, scene=scene).found == []
+    assert [c.kind for c in check_text(within, ctx, None, ev, scene=scene).found] == ["evaluation"]
+
+
+def test_a_track_out_of_reach_of_an_interpolated_box_says_whether_the_right_way_would_reach_it() -> None:
+    # dev set scene-1094 megvii prob3dmot miss:61: "out of the track's reach" beside the #1141 note, though the box
+    # weighted the right way lay 2.6 m from the track. GT A at x 0, 4, 10 m (frames 1-3), the devkit's box at frame
+    # 2 at x 5.45, weighted the right way x 4.55
+    from tools.truth.place import check_out_of_reach
+    from tools.truth.scene import Annotation, SceneTruth
+    from tools.truth.sentences import Tally
+
+    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (x, 0.0), 9)} for x in (0.0, 0.0, 4.0, 10.0)])
+    ev = _eval()
+    ev.kept_gt = {(0, GT_A), (1, GT_A), (3, GT_A)}
+    ev.stamps = {0: 0, 1: 500_000, 2: 1_000_000, 3: 1_600_000}
+    ev.evaluated_gt[(2, GT_A)] = (10.0 * 6 / 11, 0.0)
+    out = "at frame 2 track 30 was output {} m from the annotated object, but the evaluation scored the object at a "
+    out += "box it interpolated 1.5 m from the annotation, out of the track's reach"
+    still = ", and weighted the right way it would still lie {} m from the track"
+
+    def found(track_x: float, text: str) -> list[str]:
+        ev.boxes[2] = [("30", C, (track_x, 0.0))]
+        tally = Tally()
+        check_out_of_reach(text, C, 2, GT_A, scene, ev, tally, lambda kind, s, why: tally.found.append(kind))
+        return tally.found
+
+    assert found(3.0, out.format("1.0")) == []  # 1.5 m from the box weighted the right way: the swap decided
+    assert found(3.0, out.format("1.0") + still.format("1.5")) == ["misleading"]
+    assert found(2.4, out.format("1.6") + still.format("2.1")) == []
+    assert found(2.4, out.format("1.6")) == ["misleading"]  # out of reach either way, unsaid

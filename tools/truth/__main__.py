@@ -188,6 +188,9 @@ def _check_focus(
         views[name] = TrackerView(ev, request.capabilities(name).has_gates, story, frozenset(teller.shown_ever))
     doc = focus_markdown(target, finding, views, target.window(request.frame_range), request.scene)
     otherruns.check_involved(doc, target.track_ids, out, lambda *a: out.found.append(Contradiction(*a)))
+    otherruns.check_parting(
+        doc, target.frame_index, target.class_name, raws or {}, out, lambda *a: out.found.append(Contradiction(*a))
+    )
     for name, raw in (raws or {}).items():
         section = doc.split(f"\n## {name}\n", 1)[1].split("\n## ", 1)[0] if f"\n## {name}\n" in doc else ""
         lost.check_story(

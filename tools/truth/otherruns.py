@@ -166,3 +166,31 @@ def check_involved(doc: str, track_ids: Mapping[str, Sequence[int]], out, bad) -
             out.checked["misleading"] += 1
             if named - set(ids):
                 bad("misleading", clause[0][:160], f"{name}'s involved tracks (highlighted in its views) are {ids}")
+
+
+PART = re.compile(r"(\w[\w-]*): m(\d+)(?: →)? \*\*(new )?track (\d+)(?: \([^)]*\))?\*\*")
+"""One run's destination in a "Where the trackers part" line: ``gnnpmb: m11 → **new track 104**``, ``phd: m9 →
+**track 29 (98 % of m9)**``."""
+
+
+def check_parting(doc: str, frame: int, class_name: str, raws: Mapping, out, bad) -> None:
+    """Each "Where the trackers part" line of a focus document names places that differ by the runs' raw events,
+    not by their numbering alone: a line where every run started a new track from the detection, or where every
+    run's track was started by the same detection at the same frame (``RawEvents.birth``), is ``misleading``
+    (dev set scene-0655 megvii gnnpmb beside pmbm: "m11 → new track 104 · m11 → new track 231"). A run without
+    raw events (a results file) is not checked."""
+    if "**Where the trackers part**" not in doc:
+        return
+    block = doc.split("**Where the trackers part**", 1)[1].split("\n\n", 2)[1]
+    for line in (x for x in block.splitlines() if x.startswith("- ")):
+        places = set()
+        for name, _, new, track in PART.findall(line):
+            raw = raws.get(name)
+            if raw is None:
+                break
+            places.add("new" if new else raw.birth(class_name, int(track)) or (name, int(track)))
+        else:
+            if len(PART.findall(line)) == line.count(" · ") + 1:
+                out.checked["misleading"] += 1
+                if len(places) < 2:
+                    bad("misleading", line[:160], f"at frame {frame} the runs went to the same place: {places}")

@@ -13,7 +13,17 @@ against the annotation files and the devkit's own boxes.
   box it interpolated O m from the annotation, out of the track's reach": T's submitted box lies D m from the
   annotation (under 2 m), the devkit did not keep the annotation there and scored a box O m from it, 2 m or more
   from T's box;
-* "…, and no track carried it through": no submitted box of the object's class lies within 2 m of its annotation.
+  and ", and weighted the right way it would still lie E m from the track" follows it exactly where the devkit's
+  swap moved the box and the box interpolated the right way lies E m (2 m or more) from T's;
+* "…, and no track carried it through": no submitted box of the object's class lies within 2 m of its annotation;
+* "at frame x track T was output D m from GT H(, on mN): beyond the evaluation's 2 m, so it no longer matched the
+  object": T's submitted box lies D m (2 m or more) from H's annotation and 2 m or more from the box the devkit
+  scored H at; "…, on mN, E m from the box the evaluation interpolated for it": the devkit did not keep H's
+  annotation there and scored a box E m (under 2 m) from T's;
+* a false track's "C GT H lies D m away, but the evaluation has it interpolated O m from the annotation, out of the
+  track's reach" cites nuscenes-devkit issue #1141 as "(see …)" only where the box interpolated the right way lies
+  within 2 m of the false box, says "weighted the right way (…) it would still lie E m from the track" only where it
+  lies E m (2 m or more) from it, and cites nothing only where the devkit's box is the right way's (under 0.05 m).
 """
 
 from __future__ import annotations
@@ -44,6 +54,7 @@ PREDICTED = re.compile(
 OUT_OF_REACH = re.compile(
     r"at frame (\d+) track (\d+) was (?:still )?output (\d+\.\d) m from the annotated object, but the evaluation "
     r"scored the object at a box it interpolated (\d+\.\d) m from the annotation, out of the track's reach"
+    r"(?:, and weighted the right way it would still lie (\d+\.\d) m from the track)?"
 )
 NOT_CARRIED = "and no track carried it through"
 
@@ -67,6 +78,15 @@ def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, 
         if not (on < NEAR_M and f"{on:.1f}" == m[3] and f"{off:.1f}" == m[4] and away >= NEAR_M):
             said = f"box {on:.2f} m from the annotation, {away:.2f} m from the devkit's ({off:.2f} off)"
             bad("evaluation", m[0], said)
+            continue
+        right = _right_way(scene, ev, gt_id, y)
+        if right is not None and math.dist(right, scored) >= 0.05:  # the swap moved it: out of reach weighted so?
+            still = math.dist(right, box)
+            out.checked["misleading"] += 1
+            if (m[5] is None) != (still < NEAR_M) or (m[5] is not None and f"{still:.1f}" != m[5]):
+                bad("misleading", m[0], f"weighted the right way the box lies {still:.2f} m from the track")
+        elif m[5] is not None:
+            bad("misleading", m[0], "the devkit's box is the one weighted the right way")
     if NOT_CARRIED in text:
         out.checked["output"] += 1
         near = [t for t, cls, xy in ev.boxes.get(x, []) if cls == c and math.dist(xy, a.xy_m) < NEAR_M]
@@ -104,6 +124,18 @@ def check_place(text: str, c: str, x: int, place, scene, out, bad) -> None:
             bad("detector", m[0], f"{m[1]} annotations within 2 m: {own}")
         elif hit is None or hit[1].class_name != m[2] or f"{_d(hit[1].xy_m, place):.1f}" != m[4]:
             bad("detector", m[0], f"GT {m[3]} is {hit[1] if hit else 'not annotated here'}")
+
+
+def _right_way(scene, ev, gt_id: str, x: int) -> tuple[float, float] | None:
+    """The object's box at ``x`` interpolated linearly in time between its annotations at the frames the devkit
+    kept around x (None: no such ends)."""
+    ends = _ends(ev, gt_id, x)
+    a, b = (scene.objects[f].get(gt_id) for f in ends) if ends is not None else (None, None)
+    if a is None or b is None:
+        return None
+    left, right = ends
+    w = (ev.stamps[x] - ev.stamps[left]) / (ev.stamps[right] - ev.stamps[left])
+    return a.xy_m[0] + w * (b.xy_m[0] - a.xy_m[0]), a.xy_m[1] + w * (b.xy_m[1] - a.xy_m[1])
 
 
 def _ends(ev, gt_id: str, x: int) -> tuple[int, int] | None:
@@ -170,3 +202,57 @@ def check_swapped(text: str, x: int, gt_id: str | None, scene, ev, out, bad) -> 
             bad("evaluation", m[0], f"interpolated in time the box lies {_d(right_way, here.xy_m):.2f} m away")
         elif _d(right_way, scored) < 0.05:
             bad("evaluation", m[0], "the devkit's box is the one interpolated the right way")
+
+
+REACH_1141 = re.compile(
+    r"GT (\w{6}) lies \d+\.\d m away, but the evaluation has it interpolated \d+\.\d m from the annotation, out of "
+    r"the track's reach( \(see nuscenes-devkit issue #1141\)|, and weighted the right way \(nuscenes-devkit issue "
+    r"#1141\) it would still lie (\d+\.\d) m from the track)?"
+)
+
+
+def check_reach_1141(text: str, x: int, place, scene, ev, out, bad) -> None:
+    """A false track's interpolated object and what nuscenes-devkit issue #1141 did to it (module docstring), the
+    false box at ``place``."""
+    for m in REACH_1141.finditer(text) if place is not None and scene is not None else ():
+        out.checked["misleading"] += 1
+        hit = scene.object_of(x, m[1])
+        scored = ev.evaluated_gt.get((x, hit[0])) if hit is not None else None
+        right_way = _right_way(scene, ev, hit[0], x) if hit is not None else None
+        if right_way is None or scored is None:
+            bad("misleading", m[0], "no interpolation of the object the devkit scored here")
+            continue
+        swapped, reach = _d(right_way, scored) >= 0.05, _d(right_way, place)
+        if m[3] is not None:
+            ok = swapped and reach >= NEAR_M and f"{reach:.1f}" == m[3]
+        else:
+            ok = swapped and reach < NEAR_M if m[2] is not None else not swapped
+        if not ok:
+            bad("misleading", m[0], f"weighted the right way the box lies {reach:.2f} m from the track ({swapped=})")
+
+
+OFF = re.compile(
+    r"at frame (\d+) track (\d+) was output (\d+\.\d) m from GT (\w{6})(?:, on m\d+)?(?:: beyond the evaluation's 2 m, "
+    r"so it no longer matched the object|, (\d+\.\d) m from the box the evaluation interpolated for it)"
+)
+
+
+def check_off(text: str, scene, ev, out, bad) -> None:
+    """A lost track output 2 m or more from its object at the failure's frame (module docstring)."""
+    for m in OFF.finditer(text) if scene is not None else ():
+        out.checked["evaluation"] += 1
+        x, t = int(m[1]), m[2]
+        hit = scene.object_of(x, m[4])
+        box = next((xy for tt, _, xy in ev.boxes.get(x, []) if tt == t), None)
+        scored = ev.evaluated_gt.get((x, hit[0])) if hit is not None else None
+        if hit is None or box is None:
+            bad("evaluation", m[0], f"no annotation of GT {m[4]} or no box of track {t} at frame {x}")
+            continue
+        gap, reach = _d(box, hit[1].xy_m), _d(box, scored) if scored is not None else math.inf
+        ok = f"{gap:.1f}" == m[3] and gap >= NEAR_M
+        if m[5] is None:
+            ok = ok and reach >= NEAR_M
+        else:
+            ok = ok and (x, hit[0]) not in ev.kept_gt and f"{reach:.1f}" == m[5] and reach < NEAR_M
+        if not ok:
+            bad("evaluation", m[0], f"box {gap:.2f} m from the annotation, {reach:.2f} m from the devkit's box")

@@ -7,7 +7,8 @@ Definitions, each by what the events of that frame and class say (nothing of ``g
   gone: the track was there and could not take the detection);
 * a track **could not take** detection m at x when it has a column and every matrix of x gives (m, it) +inf
   (outside its gate, below an overlap test, beyond a distance threshold);
-* a track **is deleted** at x when a ``Pruned`` or a delete ``TrackLogic`` event of x names it.
+* a track **is deleted** at x when a ``Pruned`` or a delete ``TrackLogic`` event of x names it;
+* a track's **birth** is the first ``Born`` event naming it: (its frame, the detection that started it).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import numpy as np
 from gnnpmb.events import (
     Assignment,
     AxisKind,
+    Born,
     CostMatrix,
     FrameStarted,
     MeasurementsReceived,
@@ -101,3 +103,19 @@ class RawEvents:
         a = done[-1]
         same = [m for m in self.matrices(frame, class_name) if m.hypothesis == a.hypothesis]
         return (same[-1], a) if same else None
+
+    def born(self, frame: int, class_name: str) -> dict[int, int]:
+        """Detection -> the track it started at ``frame``."""
+        return {
+            int(m): int(t)
+            for b in self.of_kind(frame, class_name, Born)
+            for t, m in zip(np.asarray(b.track_ids), np.asarray(b.meas_indices), strict=True)
+        }
+
+    def birth(self, class_name: str, track: int) -> tuple[int, int] | None:
+        """(frame, detection) of the first ``Born`` event naming ``track``; None when none does."""
+        for frame in sorted({f for f, c in self.by if c == class_name}):
+            for m, t in self.born(frame, class_name).items():
+                if t == track:
+                    return frame, m
+        return None

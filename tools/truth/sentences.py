@@ -25,7 +25,7 @@ import math
 import re
 from collections import Counter
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -140,10 +140,17 @@ def _check_test_kind(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> No
             hit = bool(np.asarray(e.inside)[k, refs.index(meas)])
             inside, outside = inside or hit, outside or not hit
     named = {mat.scale.name for mat in raw.matrices(x, c) if mat.scale is not None and mat.scale.threshold is not None}
+    # a threshold that is the gate's own test (a Mahalanobis distance of at most T: the gate d² < T², prob3dmot)
+    gates = {float(e.threshold) for e in raw.of_kind(x, c, Gated)}
+    same_test = any(
+        mat.scale.name == name and any(math.isclose(mat.scale.threshold**2, g, rel_tol=1e-9) for g in gates)
+        for mat in raw.matrices(x, c)
+        if mat.scale is not None and mat.scale.threshold is not None
+    )
     out.checked["gone"] += 1
     if kind == "outside its gate" and not (outside and not inside):
         bad("gone", m[0], f"the Gated rows of track {t} at frame {x}: outside {outside}, inside {inside}")
-    elif name is not None and (name not in named or (outside and not inside)):
+    elif name is not None and (name not in named or (outside and not inside and not same_test)):
         bad("gone", m[0], f"the frame's thresholds: {sorted(named)}; Gated outside {outside}, inside {inside}")
 
 
@@ -215,8 +222,10 @@ def check_text(
     if ctx.gt_id is None:
         place.check_place(text, c, ctx.frame, where, scene, out, bad)
     place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)
+    place.check_reach_1141(text, ctx.frame, _place(replace(ctx, gt_id=None), ev, scene), scene, ev, out, bad)
     place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
     place.check_out_of_reach(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
+    place.check_off(text, scene, ev, out, bad)
     place.check_none_of_its_own(text, ctx.frame, scene, out, bad)
     out.checked["misleading"] += 2
     if "?" in text:

@@ -496,3 +496,70 @@ def test_a_new_track_column_that_holds_the_cost_threshold_is_called_the_threshol
     )
     nats = PairChoice(m0, t210, 6.0, new, 6.5, 0.5)  # no threshold: a new track's cost is a cost
     assert "over new (6.50)" in choice_text(3, nats, 210, False)
+
+
+def test_a_false_track_cites_issue_1141_only_where_the_box_weighted_the_right_way_was_within_its_reach() -> None:
+    # dev set scene-1094 megvii prob3dmot false_track:6: "truck GT 225a60 lies 1.5 m away, but the evaluation has it
+    # interpolated 14.7 m from the annotation, out of the track's reach (see nuscenes-devkit issue #1141)", though
+    # the box weighted the right way lay 2.6 m from the track: out of its reach too
+    from gnnpmb.eval.evaluated import GtFrame, GtStatus
+    from gnnpmb.why.findings import FalseOutput
+
+    def said(unswapped: tuple[float, float] | None) -> str:
+        g = GtFrame(13, GtStatus.INTERPOLATED, (0.0, 0.0), (14.7, 0.0), None, 0, 20.0, 40.0, (12, 19), unswapped)
+        out = FalseOutput(30, None, (1.5, 0.0), None, (GT, 1.5, g), None, None, None, None)
+        f = finding(FailureKind.FALSE_TRACK, blame=(Blame(Rule.INTERPOLATED, (13,)),), false_output=out)
+        return why_lines(f)[0]
+
+    on = "but the evaluation has it interpolated 14.7 m from the annotation, out of the track's reach"
+    still = ", and weighted the right way (nuscenes-devkit issue #1141) it would still lie 2.7 m from the track"
+    assert f"{on}{still}" in said((-1.2, 0.0))
+    assert f"{on} (see nuscenes-devkit issue #1141)" in said((0.3, 0.0))
+    assert said((14.7, 0.0)).endswith(f"{on}.")  # the devkit's box is the one weighted the right way
+
+
+def test_a_track_off_the_annotation_but_within_reach_of_the_interpolated_box_is_not_said_beyond_reach() -> None:
+    # dev set scene-1077 centerpoint topmb id_switch:1: "at frame 30 track 455 was output 2.3 m from GT a2d371, on
+    # m7: beyond the evaluation's 2 m, so it no longer matched the object", though the evaluation scored the object
+    # at a box it interpolated 1.8 m from the track (it kept the track matched to another object)
+    from gnnpmb.why.findings import OffObject
+
+    steps = (step(12, output=estimate(455, 1.0)), step(13, output=estimate(455, 1.0)))
+    for scored, said in (
+        (
+            1.76,
+            "at frame 13 track 455 was output 2.3 m from GT bf3d85, on m7, 1.8 m from the box the evaluation "
+            "interpolated for it",
+        ),
+        (
+            2.4,
+            "at frame 13 track 455 was output 2.3 m from GT bf3d85, on m7: beyond the evaluation's 2 m, so it no "
+            "longer matched the object",
+        ),
+        (None, "on m7: beyond the evaluation's 2 m, so it no longer matched the object"),
+    ):
+        lost = LostTrack(455, 12, steps, OffObject(2.29, 7, (), scored), None, None, matched_until=12)
+        assert said in why_lines(finding(FailureKind.ID_SWITCH, lost))[0], scored
+
+
+def test_a_track_out_of_reach_says_when_the_box_weighted_the_right_way_would_be_out_of_reach_too() -> None:
+    # dev set scene-1094 megvii prob3dmot miss:61: after "weighted the right way the box would lie 1.2 m from the
+    # annotation", "track 30 was output 1.5 m from the annotated object, but the evaluation scored the object at a
+    # box it interpolated 14.7 m from the annotation, out of the track's reach" read as if the swap alone put the
+    # object out of reach; weighted the right way it would still have lain 2.6 m from the track
+    from gnnpmb.eval.evaluated import GtFrame, GtStatus
+    from gnnpmb.why.findings import EvaluatedReach, OnObject
+
+    kept = TrackEval((9,), (9,), (), 0.7, 0.7)
+
+    def said(unswapped: tuple[float, float]) -> str:
+        g = GtFrame(9, GtStatus.INTERPOLATED, (0.0, 0.0), (14.7, 0.0), None, 0, 20.0, 40.0, (8, 15), unswapped)
+        seen = Sighting(9, 0, g, None, None, None, (OnObject(30, 1.5, 0.7, -1, kept, 0.3, xy_m=(-1.5, 0.0)),))
+        blame = (Blame(Rule.INTERPOLATED, (9,)),)
+        reach = EvaluatedReach(14.7, (), (30,))
+        return why_lines(finding(FailureKind.MISS, frame=9, sightings=(seen,), blame=blame, reach=reach))[0]
+
+    out = "track 30 was output 1.5 m from the annotated object, but the evaluation scored the object at a box it "
+    out += "interpolated 14.7 m from the annotation, out of the track's reach"
+    assert f"{out}, and weighted the right way it would still lie 2.7 m from the track" in said((1.2, 0.0))
+    assert f"{out};" in said((-1.2, 0.0)) or said((-1.2, 0.0)).endswith(f"{out}.")  # within reach weighted so
