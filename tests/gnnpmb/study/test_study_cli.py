@@ -1,15 +1,20 @@
 """``gnnpmb sweep``, ``tune`` and ``track --workers`` end to end on one demo scene cut to 6 keyframes.
 
-Ray tests share one local Ray session per module (``ray_local``); in-process runs (``--workers 1``) need none.
+Ray tests share one local Ray session per module (``ray_local``); in-process runs (``--workers 1``) need none. The
+one-worker sweep of ``SWEEP`` is run once (``one_worker_sweep``): its output is checked, resumed, compared with the
+tracker's own output and with two Ray workers.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import functools
+import io
 import json
 import tomllib
 from pathlib import Path
+from typing import NamedTuple
 
 import pytest
 
@@ -33,12 +38,37 @@ def scores(rows: list[dict]) -> list[dict]:
     return [{k: v for k, v in r.items() if k not in TIME_COLUMNS} for r in rows]
 
 
-def test_sweep_writes_results_and_a_second_run_does_no_work(
-    tiny_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    out = tmp_path / "sweep"
+class OneWorkerSweep(NamedTuple):
+    argv: list[str]
+    code: int
+    stdout: str
+    stderr: str
+    out: Path
+    rows: list[dict]
+    """The rows of ``results.json`` as the sweep first wrote them."""
+
+
+@pytest.fixture(scope="module")
+def one_worker_sweep(tiny_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> OneWorkerSweep:
+    """``gnnpmb sweep ... --workers 1`` with ``SWEEP`` on the tiny data in-process, run once for the module (the
+    tests below read its first run's output; only the resume check runs it again, into the same folder)."""
+    out = tmp_path_factory.mktemp("one_worker") / "sweep"
     argv = ["sweep", "--dataroot", str(tiny_dataroot), "--out", str(out), "--workers", "1", *SWEEP]
-    code, stdout, stderr = run(argv, capsys)
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        try:
+            run_app(app, argv)
+            code = 0
+        except SystemExit as exc:
+            code = int(exc.code or 0)
+    rows = json.loads((out / "results.json").read_text())["rows"] if code == 0 else []
+    return OneWorkerSweep(argv, code, stdout.getvalue(), stderr.getvalue(), out, rows)
+
+
+def test_sweep_writes_results_and_a_second_run_does_no_work(
+    one_worker_sweep: OneWorkerSweep, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv, code, stdout, stderr, out, _ = one_worker_sweep
     assert code == 0, stderr
     assert "2 of 2 configurations (0 from cache, 2 run)" in stdout
     with open(out / "results.csv", newline="") as f:
@@ -62,7 +92,7 @@ def test_sweep_writes_results_and_a_second_run_does_no_work(
 
 
 def test_a_lower_extraction_threshold_reports_at_least_as_many_boxes(
-    tiny_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tiny_dataroot: Path, one_worker_sweep: OneWorkerSweep
 ) -> None:
     """Extraction only filters what is reported, so every box reported at threshold 0.9 is also reported at 0.5.
     Checked on the tracker's output: the devkit's tp + fp in the sweep rows are counted at each run's best-MOTA
@@ -71,10 +101,8 @@ def test_a_lower_extraction_threshold_reports_at_least_as_many_boxes(
     from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
     from gnnpmb.pipeline import get_detections, run_tracker
 
-    out = tmp_path / "sweep"
-    argv = ["sweep", "--dataroot", str(tiny_dataroot), "--out", str(out), "--workers", "1", *SWEEP]
-    assert run(argv, capsys)[0] == 0
-    low, high = json.loads((out / "results.json").read_text())["rows"]
+    assert one_worker_sweep.code == 0, one_worker_sweep.stderr
+    low, high = one_worker_sweep.rows
     assert low["tp"] + low["fn"] == high["tp"] + high["fn"]  # the same ground truth
     location = resolve_dataroot(tiny_dataroot, None)
     scene = load_scene(location, "scene-0103")
@@ -191,17 +219,16 @@ def test_sweep_and_track_on_two_ray_workers_equal_one_worker(
     ray_local: None,
     tiny_dataroot: Path,
     demo_dataroot: Path,
+    one_worker_sweep: OneWorkerSweep,
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    rows = {}
-    for workers in ("1", "2"):
-        out = tmp_path / f"sweep{workers}"
-        argv = ["sweep", "--dataroot", str(tiny_dataroot), "--out", str(out), "--workers", workers, *SWEEP]
-        code, _, stderr = run(argv, capsys)
-        assert code == 0, stderr
-        rows[workers] = json.loads((out / "results.json").read_text())["rows"]
-    assert scores(rows["1"]) == scores(rows["2"])
+    assert one_worker_sweep.code == 0, one_worker_sweep.stderr
+    out = tmp_path / "sweep2"
+    argv = ["sweep", "--dataroot", str(tiny_dataroot), "--out", str(out), "--workers", "2", *SWEEP]
+    code, _, stderr = run(argv, capsys)
+    assert code == 0, stderr
+    assert scores(json.loads((out / "results.json").read_text())["rows"]) == scores(one_worker_sweep.rows)
 
     submissions = {}
     for workers in ("1", "2"):
