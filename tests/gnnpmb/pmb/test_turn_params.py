@@ -1,8 +1,10 @@
-"""``gnnpmb/params/turn.toml``: the coordinated-turn model for every class but bicycles (issue 32, Round 10), read
-as a user's parameter file is, and what it changes: a turning car missed for a frame is predicted on its turn."""
+"""``gnnpmb/params/turn.toml``: the coordinated-turn model with a decaying turn rate (issue 32, Round 10), read as
+a user's parameter file is, and what it changes: a turning car keeps its track and is predicted on its turn when
+missed, and a long-coasting track's predicted position does not spread along every possible turn."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -48,27 +50,49 @@ def follow_the_circle(config: TrackerConfig, class_name: str = "car") -> tuple[l
     return holder, miss_error_m, b.mean.shape[1]
 
 
-def test_turn_toml_sets_the_turn_model_for_every_class_but_bicycles():
-    assert TURN.models.motion_model == 1
+def test_turn_toml_sets_the_turn_model_with_a_decaying_turn_rate():
+    assert TURN.models.motion_model == 1 and TURN.models.turn_rate_decay == 0.8
     assert TURN.models.turn_rate_std_rps == 0.05 and TURN.models.birth_turn_rate_std_rps == 0.05
-    assert TURN.resolved("car").models.motion_model == 1
-    assert TURN.resolved("motorcycle").models.motion_model == 1
-    assert TURN.resolved("bicycle").models.motion_model == 0
-    assert TrackerConfig().models.motion_model == 0  # not the default
+    assert all(TURN.resolved(c).models.motion_model == 1 for c in ("car", "bicycle", "pedestrian"))
+    assert TrackerConfig().models.motion_model == 0 and TrackerConfig().models.turn_rate_decay == 1.0
 
 
 def test_a_turning_car_keeps_its_track_and_is_predicted_on_its_turn_when_missed():
     """Constant velocity lags the rotating velocity: by keyframe 6 the car's prediction is so far off its turn that
     its own detection starts a new track (an ID switch with exact detections). The turn model learns the 0.4 rad/s
-    from the measured velocity, keeps one track, and predicts the missed keyframe 8 within 0.2 m of the car."""
-    cv_holder, _, cv_dim = follow_the_circle(TrackerConfig())
+    from the measured velocity (damped by the decay: the estimate settles below it), keeps one track, and predicts
+    the missed keyframe 8 within 1 m of the car, where the first constant-velocity track is more than 4 m off."""
+    cv_holder, cv_miss_error_m, cv_dim = follow_the_circle(TrackerConfig())
     ct_holder, ct_miss_error_m, ct_dim = follow_the_circle(TURN)
     assert (cv_dim, ct_dim) == (4, 5)
     assert len(set(cv_holder)) > 1
     assert set(ct_holder) == {1}
-    assert ct_miss_error_m < 0.2
+    assert ct_miss_error_m < 1.0 and cv_miss_error_m > 4.0
 
 
-def test_bicycles_keep_constant_velocity():
-    assert follow_the_circle(TURN, "bicycle") == follow_the_circle(TrackerConfig(), "bicycle")
-    assert follow_the_circle(TURN, "bicycle")[2] == 4
+def test_a_long_coasting_track_spreads_less_with_the_decaying_turn_rate():
+    """The car of the circle, then missed for 12 keyframes (6 s): with a constant turn rate its turn-rate variance
+    grows by sigma_w^2 each keyframe and its predicted position spreads with it; with the decay it stays below
+    sigma_w^2 / (1 - a^2), and the position's spread is smaller."""
+
+    def coasted(config: TrackerConfig) -> tuple[float, float]:
+        core = PmbCore("car", config.resolved("car"), BestAssignment(), IdAllocator())
+        for k in range(8):
+            xy, v = on_circle(k * DT_S)
+            core.step(make_measurements([xy], 0.9, velocity=[v]), DT_S if k else 0.0, NullSink())
+        for _ in range(12):
+            core.step(make_measurements([]), DT_S, NullSink())
+        b = core.hypotheses[0].bernoullis
+        assert len(b) == 1 and b.misses[0] == 12
+        return float(np.trace(b.cov[0, :2, :2])), float(b.cov[0, 4, 4])
+
+    constant = load_config_with(turn_rate_decay=1.0)
+    position_decay, omega_decay = coasted(TURN)
+    position_constant, omega_constant = coasted(constant)
+    assert omega_decay < 0.05**2 / (1 - 0.8**2) < omega_constant
+    assert position_decay < position_constant
+
+
+def load_config_with(**models: float) -> TrackerConfig:
+    """``TURN`` with some of its ``[models]`` values replaced."""
+    return TURN.replace(models=dataclasses.replace(TURN.models, **models))
