@@ -14,6 +14,7 @@ from gnnpmb.config import TrackerConfig, load_config
 from gnnpmb.events import NullSink
 from gnnpmb.pmb.core import PmbCore
 from gnnpmb.pmb.gnnpmb import BestAssignment
+from gnnpmb.pmb.topmb import MarginalMerge
 from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
@@ -96,3 +97,16 @@ def test_a_long_coasting_track_spreads_less_with_the_decaying_turn_rate():
 def load_config_with(**models: float) -> TrackerConfig:
     """``TURN`` with some of its ``[models]`` values replaced."""
     return TURN.replace(models=dataclasses.replace(TURN.models, **models))
+
+
+def test_topmb_keeps_the_turn_state_through_frames_without_births():
+    """TO-PMB with the turn model: a frame with no detection, then one whose detection is born, keep every
+    Bernoulli 5-dimensional (an empty birth set once gave the posterior the 4-D default, and the next birth
+    failed on the shape)."""
+    core = PmbCore("car", TURN.resolved("car"), MarginalMerge(TURN.lbp), IdAllocator())
+    core.step(make_measurements([]), 0.0, NullSink())
+    core.step(make_measurements([(1.0, 2.0)], 0.9, velocity=[(3.0, 0.0)]), DT_S, NullSink())
+    core.step(make_measurements([]), DT_S, NullSink())
+    core.step(make_measurements([(40.0, 2.0)], 0.9, velocity=[(0.0, 3.0)]), DT_S, NullSink())
+    b = core.hypotheses[0].bernoullis
+    assert len(b) == 2 and b.mean.shape == (2, 5) and b.cov.shape == (2, 5, 5)
