@@ -250,6 +250,9 @@ class ModelParams(Section):
         0.2, "the turn rate's process noise per keyframe", NON_NEGATIVE, "rad/s", limit=STD_LIMIT
     )
     birth_turn_rate_std_rps: float = param(0.5, "a new track's turn-rate std", POSITIVE, "rad/s", limit=STD_LIMIT)
+    turn_rate_decay: float = param(
+        1.0, "a: the turn rate is multiplied by a each keyframe (1: a constant turn rate)", unit_interval(False, True)
+    )
 
 
 @dataclass(frozen=True, slots=True)

@@ -12,10 +12,13 @@ process of intensity kappa per m^2 (per m^2 per (m/s)^2 when the PMB variant als
 Coordinated turn (``[models] motion_model = 1``; Bar-Shalom, Li & Kirubarajan 2001, sec. 11.7.1, eq. 11.7.1-4;
 constant turn rate and velocity, CTRV, in Cartesian velocity): state [x, y, vx, vy, omega],
   x' = x + (sin(w T) vx - (1 - cos(w T)) vy) / w,   vx' = cos(w T) vx - sin(w T) vy,
-  y' = y + ((1 - cos(w T)) vx + sin(w T) vy) / w,   vy' = sin(w T) vx + cos(w T) vy,   w' = w,
+  y' = y + ((1 - cos(w T)) vx + sin(w T) vy) / w,   vy' = sin(w T) vx + cos(w T) vy,   w' = a w,
 with the limits sin(w T) / w -> T, (1 - cos(w T)) / w -> 0 as w -> 0 (so omega = 0 is the CV model exactly);
-Q = diag(q_x, q_y, q_x, q_y, sigma_w^2). It is predicted with the extended Kalman filter
-(``kalman.predict`` with ``MotionModel.transition``); the measurement is the same [x, y] (or [x, y, vx, vy]).
+Q = diag(q_x, q_y, q_x, q_y, sigma_w^2). The turn rate is a first-order Markov process (``[models]
+turn_rate_decay`` a in (0, 1]; a = 1: constant turn rate): while a track coasts, its turn rate returns to 0 and its
+variance to at most sigma_w^2 / (1 - a^2), so a long-missed track is not spread along every possible turn. It is
+predicted with the extended Kalman filter (``kalman.predict`` with ``MotionModel.transition``); the measurement is
+the same [x, y] (or [x, y, vx, vy]).
 """
 
 from __future__ import annotations
@@ -81,7 +84,8 @@ def ct_model(dt_s: float, params: ClassParams, models: ModelParams, measure_velo
     """The coordinated-turn model over ``dt_s`` (module docstring): Q (5, 5), R as ``cv_model``'s, F the CV
     transition with omega appended (the Jacobian at omega = 0), ``transition`` = ``coordinated_turn``."""
     Q, R = _ct_noise(params, models.turn_rate_std_rps, measure_velocity)
-    return MotionModel(F=_ct_linear(dt_s), Q=Q, R=R, transition=functools.partial(coordinated_turn, dt_s=dt_s))
+    transition = functools.partial(coordinated_turn, dt_s=dt_s, decay=models.turn_rate_decay)
+    return MotionModel(F=_ct_linear(dt_s, models.turn_rate_decay), Q=Q, R=R, transition=transition)
 
 
 def motion_model(dt_s: float, params: ClassParams, models: ModelParams, measure_velocity: bool = False) -> MotionModel:
@@ -96,10 +100,11 @@ _SMALL_TURN = 1e-4
 """Below this |omega T| (rad) the coordinated-turn coefficients are taken from their Taylor series."""
 
 
-def coordinated_turn(mean: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+def coordinated_turn(mean: np.ndarray, dt_s: float, decay: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """f(m) (K, 5) and its Jacobian (K, 5, 5) of the coordinated-turn model (module docstring) at K states
-    [x, y, vx, vy, omega]. With a = sin(w T) / w, b = (1 - cos(w T)) / w, c = cos(w T), s = sin(w T):
-    d(a)/dw = (T c - a) / w, d(b)/dw = (T s - b) / w, d(c)/dw = -T s, d(s)/dw = T c (series for small w T)."""
+    [x, y, vx, vy, omega]; the turn rate steps to ``decay`` w. With a = sin(w T) / w, b = (1 - cos(w T)) / w,
+    c = cos(w T), s = sin(w T): d(a)/dw = (T c - a) / w, d(b)/dw = (T s - b) / w, d(c)/dw = -T s, d(s)/dw = T c
+    (series for small w T)."""
     vx, vy, w = mean[:, 2], mean[:, 3], mean[:, 4]
     T = dt_s
     wt = w * T
@@ -116,9 +121,10 @@ def coordinated_turn(mean: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndar
     out[:, 1] = mean[:, 1] + b * vx + a * vy
     out[:, 2] = c * vx - s * vy
     out[:, 3] = s * vx + c * vy
-    out[:, 4] = w
+    out[:, 4] = decay * w
     J = np.zeros((len(mean), 5, 5))
-    J[:, 0, 0] = J[:, 1, 1] = J[:, 4, 4] = 1.0
+    J[:, 0, 0] = J[:, 1, 1] = 1.0
+    J[:, 4, 4] = decay
     J[:, 0, 2], J[:, 0, 3], J[:, 0, 4] = a, -b, da * vx - db * vy
     J[:, 1, 2], J[:, 1, 3], J[:, 1, 4] = b, a, db * vx + da * vy
     J[:, 2, 2], J[:, 2, 3], J[:, 2, 4] = c, -s, -T * (s * vx + c * vy)
@@ -127,10 +133,12 @@ def coordinated_turn(mean: np.ndarray, dt_s: float) -> tuple[np.ndarray, np.ndar
 
 
 @functools.lru_cache(maxsize=64)
-def _ct_linear(dt_s: float) -> np.ndarray:
-    """(5, 5) the coordinated-turn Jacobian at omega = 0 and zero velocity: the CV F with omega kept, read-only."""
+def _ct_linear(dt_s: float, decay: float = 1.0) -> np.ndarray:
+    """(5, 5) the coordinated-turn Jacobian at omega = 0 and zero velocity: the CV F, omega times ``decay``,
+    read-only."""
     F = np.eye(5)
     F[:4, :4] = _transition(dt_s)
+    F[4, 4] = decay
     F.flags.writeable = False
     return F
 

@@ -373,9 +373,10 @@ def _gather(own: np.ndarray, born: np.ndarray, source: np.ndarray, n_new: int) -
 
 
 def new_bernoullis(local: LocalHypotheses, new_j: np.ndarray, ctx: UpdateContext) -> Bernoullis:
-    """The Bernoullis started by local measurements ``new_j`` (existence r_j from ``poisson``)."""
+    """The Bernoullis started by local measurements ``new_j`` (existence r_j from ``poisson``); none of the
+    class's state dimension (4, or 5 with the turn rate) when nothing is born."""
     if len(new_j) == 0:
-        return Bernoullis.empty()
+        return Bernoullis.empty(local.new.mean.shape[1])
     none = np.zeros(0, dtype=np.int64)
     return updated_bernoullis(local, none, none, new_j, ctx)
 

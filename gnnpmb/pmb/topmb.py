@@ -91,7 +91,8 @@ class MarginalMerge:
         births = replace(births, existence=r_new[new_j]) if len(new_j) else births
         if ctx.sink.enabled:
             _emit(local, marg, components, ctx)
-        return [GlobalHypothesis(0.0, _capped(Bernoullis.concatenate([tracks, births]), self.max_bernoullis, ctx))]
+        posterior = Bernoullis.concatenate([tracks, births]) if len(births) else tracks  # keeps the state dimension
+        return [GlobalHypothesis(0.0, _capped(posterior, self.max_bernoullis, ctx))]
 
 
 def _capped(bernoullis: Bernoullis, limit: int, ctx: UpdateContext) -> Bernoullis:

@@ -99,3 +99,25 @@ def test_birth_of_the_turn_state_starts_at_zero_turn_rate():
     assert birth.mean.shape == (2, 5) and np.array_equal(birth.mean[:, 4], [0.0, 0.0])
     assert np.isclose(birth_covariance(models, True)[4, 4], models.birth_turn_rate_std_rps**2)
     assert motion_model(0.5, CAR, ModelParams()).state_dim == 4 and motion_model(0.5, CAR, models).state_dim == 5
+
+
+def test_a_decaying_turn_rate_by_hand():
+    """w' = a w and d(w')/dw = a; the [x, y, vx, vy] step still turns by the current w (module docstring)."""
+    m = np.array([[1.0, -2.0, 3.0, 0.0, 0.4]])
+    kept, J_kept = coordinated_turn(m, 0.5)
+    out, J = coordinated_turn(m, 0.5, decay=0.8)
+    assert np.allclose(out[0], [*kept[0, :4], 0.32], rtol=0, atol=1e-12)
+    assert J[0, 4, 4] == 0.8 and np.array_equal(J[0, :4], J_kept[0, :4]) and np.array_equal(J[0, 4, :4], [0] * 4)
+
+
+def test_a_coasting_turn_rate_variance_stays_below_its_stationary_bound():
+    """Predicted alone, P_ww follows P' = a^2 P + sigma^2: from 0 it rises to sigma^2 (1 - a^(2n)) / (1 - a^2),
+    below sigma^2 / (1 - a^2); with a = 1 it grows as n sigma^2 without bound."""
+    a, sigma, n = 0.8, 0.05, 30
+    for decay, expected in ((a, sigma**2 * (1 - a ** (2 * n)) / (1 - a**2)), (1.0, n * sigma**2)):
+        model = ct_model(0.5, CAR, ModelParams(motion_model=1, turn_rate_std_rps=sigma, turn_rate_decay=decay))
+        mean, cov = np.zeros((1, 5)), np.zeros((1, 5, 5))
+        for _ in range(n):
+            mean, cov = predict(mean, cov, model)
+        assert np.isclose(cov[0, 4, 4], expected, rtol=1e-12)
+    assert cov[0, 4, 4] > sigma**2 / (1 - a**2)
