@@ -229,8 +229,10 @@ class ModelParams(Section):
     measurement-driven birth, birth covariance diag(s_p^2, s_p^2, s_v^2, s_v^2) (paper sec. V-B). P_D is the
     detection's score for the PMB family and ``p_detect`` of ``[phd]`` / ``[vector]`` for the others. p_survive and
     birth_weight differ from the paper's, chosen on the demo ``mini_train`` split (``docs/architecture.md``). The
-    coordinated-turn model (``motion_model = 1``) has state [x, y, vx, vy, omega] and the extended Kalman predict
-    (``gnnpmb.models.ct_model``); a new track's turn rate starts at 0.
+    coordinated-turn model (``motion_model = 1``, the PMB family's default since issue 32 Round 10: objects turning
+    while missed; the paper's is constant velocity) has state [x, y, vx, vy, omega] and the extended Kalman predict
+    (``gnnpmb.models.ct_model``); a new track's turn rate starts at 0 and decays by ``turn_rate_decay`` a keyframe.
+    Its four values were chosen on the mini_train splits of the demo and the dev set (``docs/results.md``).
     """
 
     SECTION = "models"
@@ -244,14 +246,14 @@ class ModelParams(Section):
     birth_pos_std_m: float = param(15.0, "s_p, a new track's position std", POSITIVE, "m", limit=STD_LIMIT)
     birth_vel_std_mps: float = param(1.0, "s_v, a new track's velocity std", POSITIVE, "m/s", limit=STD_LIMIT)
     motion_model: int = param(
-        0, "0 = constant velocity (the paper's), 1 = coordinated turn (PMB family)", SWITCH, paper=0
+        1, "0 = constant velocity (the paper's), 1 = coordinated turn (PMB family)", SWITCH, paper=0
     )
     turn_rate_std_rps: float = param(
-        0.2, "the turn rate's process noise per keyframe", NON_NEGATIVE, "rad/s", limit=STD_LIMIT
+        0.05, "the turn rate's process noise per keyframe", NON_NEGATIVE, "rad/s", limit=STD_LIMIT
     )
-    birth_turn_rate_std_rps: float = param(0.5, "a new track's turn-rate std", POSITIVE, "rad/s", limit=STD_LIMIT)
+    birth_turn_rate_std_rps: float = param(0.05, "a new track's turn-rate std", POSITIVE, "rad/s", limit=STD_LIMIT)
     turn_rate_decay: float = param(
-        1.0, "a: the turn rate is multiplied by a each keyframe (1: a constant turn rate)", unit_interval(False, True)
+        0.8, "a: the turn rate is multiplied by a each keyframe (1: a constant turn rate)", unit_interval(False, True)
     )
 
 

@@ -98,7 +98,8 @@ def test_birth_of_the_turn_state_starts_at_zero_turn_rate():
     birth = measurement_birth(make_measurements([(1.0, 2.0), (3.0, 4.0)], 0.8), models, with_turn_rate=True)
     assert birth.mean.shape == (2, 5) and np.array_equal(birth.mean[:, 4], [0.0, 0.0])
     assert np.isclose(birth_covariance(models, True)[4, 4], models.birth_turn_rate_std_rps**2)
-    assert motion_model(0.5, CAR, ModelParams()).state_dim == 4 and motion_model(0.5, CAR, models).state_dim == 5
+    cv = ModelParams(motion_model=0)
+    assert motion_model(0.5, CAR, cv).state_dim == 4 and motion_model(0.5, CAR, models).state_dim == 5
 
 
 def test_a_decaying_turn_rate_by_hand():

@@ -49,8 +49,18 @@ def test_a_track_missed_beyond_output_max_misses_stays_in_the_filter_but_is_not_
     "strategy", [BestAssignment, lambda: KBest(TrackerConfig().pmbm), lambda: MarginalMerge(TrackerConfig().lbp)]
 )
 def test_turn_state_runs_through_every_pmb_strategy(strategy):
-    """A car on a circle (radius 10 m, 4 m/s): the five-state filter follows it; events carry 4-D states."""
-    cfg = with_params(TrackerConfig(), {"models.motion_model": 1})
+    """A car on a circle (radius 10 m, 4 m/s): the five-state filter follows it and learns its turn rate (with a
+    constant turn rate and issue 24's noise: the default decay holds the estimate below it); events carry 4-D
+    states."""
+    cfg = with_params(
+        TrackerConfig(),
+        {
+            "models.motion_model": 1,
+            "models.turn_rate_std_rps": 0.2,
+            "models.birth_turn_rate_std_rps": 0.5,
+            "models.turn_rate_decay": 1.0,
+        },
+    )
     core = PmbCore("car", cfg, strategy(), IdAllocator())
     w = 0.4
     sink = ListSink()

@@ -1,6 +1,7 @@
-"""``gnnpmb/params/turn.toml``: the coordinated-turn model with a decaying turn rate (issue 32, Round 10), read as
-a user's parameter file is, and what it changes: a turning car keeps its track and is predicted on its turn when
-missed, and a long-coasting track's predicted position does not spread along every possible turn."""
+"""``gnnpmb/params/turn.toml`` (the defaults since issue 32 Round 10): the coordinated-turn model with a decaying
+turn rate, read as a user's parameter file is, and what it changes: a turning car keeps its track and is predicted
+on its turn when missed, and a long-coasting track's predicted position does not spread along every possible
+turn."""
 
 from __future__ import annotations
 
@@ -19,6 +20,8 @@ from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 TURN = load_config(Path(__file__).resolve().parents[3] / "gnnpmb" / "params" / "turn.toml")
+CV = dataclasses.replace(TrackerConfig(), models=dataclasses.replace(TrackerConfig().models, motion_model=0))
+"""The defaults with the paper's constant-velocity motion model."""
 
 RADIUS_M, SPEED_MPS, DT_S = 20.0, 8.0, 0.5
 """A car on a circle of 20 m at 8 m/s: turn rate 0.4 rad/s, 0.2 rad per keyframe."""
@@ -55,7 +58,7 @@ def test_turn_toml_sets_the_turn_model_with_a_decaying_turn_rate():
     assert TURN.models.motion_model == 1 and TURN.models.turn_rate_decay == 0.8
     assert TURN.models.turn_rate_std_rps == 0.05 and TURN.models.birth_turn_rate_std_rps == 0.05
     assert all(TURN.resolved(c).models.motion_model == 1 for c in ("car", "bicycle", "pedestrian"))
-    assert TrackerConfig().models.motion_model == 0 and TrackerConfig().models.turn_rate_decay == 1.0
+    assert TURN.models == TrackerConfig().models  # the defaults since issue 32 Round 10
 
 
 def test_a_turning_car_keeps_its_track_and_is_predicted_on_its_turn_when_missed():
@@ -63,7 +66,7 @@ def test_a_turning_car_keeps_its_track_and_is_predicted_on_its_turn_when_missed(
     its own detection starts a new track (an ID switch with exact detections). The turn model learns the 0.4 rad/s
     from the measured velocity (damped by the decay: the estimate settles below it), keeps one track, and predicts
     the missed keyframe 8 within 1 m of the car, where the first constant-velocity track is more than 4 m off."""
-    cv_holder, cv_miss_error_m, cv_dim = follow_the_circle(TrackerConfig())
+    cv_holder, cv_miss_error_m, cv_dim = follow_the_circle(CV)
     ct_holder, ct_miss_error_m, ct_dim = follow_the_circle(TURN)
     assert (cv_dim, ct_dim) == (4, 5)
     assert len(set(cv_holder)) > 1

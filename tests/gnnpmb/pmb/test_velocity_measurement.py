@@ -19,7 +19,13 @@ from tests.gnnpmb.pmb.helpers import make_measurements
 
 CFG = with_params(
     TrackerConfig(),
-    {"pmb.measure_velocity": 1, "pmb.birth_weight": 50.0, "classes.car.r_vx": 0.3, "classes.car.r_vy": 0.4},
+    {
+        "pmb.measure_velocity": 1,
+        "pmb.birth_weight": 50.0,
+        "classes.car.r_vx": 0.3,
+        "classes.car.r_vy": 0.4,
+        "models.motion_model": 0,  # the hand computation is the constant-velocity filter's
+    },
 )
 P = CFG.models
 CAR = CFG.for_class("car")
