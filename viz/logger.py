@@ -420,6 +420,7 @@ class TrackerLogger:
         focused = np.isin(ids, list(self.focus_tracks)) if self.focus_tracks else np.zeros(ids.size, dtype=bool)
         worthy = (existence >= self.gate_min_existence) | focused
         xy = np.asarray(cf.predicted.mean, dtype=np.float64).reshape(-1, 4)[:, :2]
+        lighter = _lighter(ids, existence)
         if self.log_predicted:
             for path, sel in (
                 (paths.predicted(self.tracker, class_name), np.flatnonzero(worthy & ~focused)),
@@ -437,6 +438,7 @@ class TrackerLogger:
                     z=self._z_of(ids[sel]),
                     ids=ids[sel],
                     existence=existence[sel],
+                    lighter=lighter[sel],
                 )
         if (~worthy).any():
             sel = np.flatnonzero(~worthy)
@@ -449,6 +451,7 @@ class TrackerLogger:
                 xy=xy[sel],
                 ids=ids[sel],
                 existence=existence[sel],
+                lighter=lighter[sel],
             )
         if self.has_existence:  # a track-logic tracker has no candidates (every existence is 1)
             self._sample(
@@ -487,7 +490,7 @@ class TrackerLogger:
             "positions": lift_xy(raw["xy"], raw["z"]),
             "colors": self._track_colors(raw["ids"]),
             "radii": np.full(n, PREDICTED_POINT_RADIUS_M, dtype=np.float32),
-            "labels": _labels("%d predicted r=%.2f", raw["ids"], raw["existence"]),
+            "labels": self._point_labels("%d predicted {}=%.2f", raw),
         }
 
     def _candidate_points(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
@@ -497,8 +500,18 @@ class TrackerLogger:
             "positions": lift_xy(raw["xy"], self.gate_z_m),
             "colors": np.full(n, CANDIDATE_COLOR, dtype=np.uint32),
             "radii": np.full(n, CANDIDATE_POINT_RADIUS_M, dtype=np.float32),
-            "labels": _labels("candidate %d, r=%.3f", raw["ids"], raw["existence"]),
+            "labels": self._point_labels("candidate %d, {}=%.3f", raw),
         }
+
+    def _point_labels(self, template: str, raw: dict[str, np.ndarray]) -> list[str]:
+        """``template`` with the run's symbol (``r``, or ``w`` for a PHD weight) per predicted point; a PHD
+        component lighter than another of its label says whose it is instead (a track's id names its heaviest
+        component, as the story and the focus text do)."""
+        if self.existence_word != "weight":
+            return _labels(template.format("r"), raw["ids"], raw["existence"])
+        heaviest = _labels(template.format("w"), raw["ids"], raw["existence"])
+        part = _labels("a lighter component of %d, w=%.3f", raw["ids"], raw["existence"])
+        return [p if light else h for h, p, light in zip(heaviest, part, raw["lighter"].tolist(), strict=True)]
 
     def _gate_outlines(self, raw: dict[str, np.ndarray]) -> dict[str, object]:
         """LineStrips3D of gate ellipses {z : (z - c)^T S^-1 (z - c) = threshold} (``ellipse_outline``) of
@@ -879,6 +892,17 @@ def _pair_lines(pred_xy: np.ndarray, pred_rows: list[int], xyz: np.ndarray, meas
 def _one_per_row(values: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """The ``Scalars`` field of a series of (R,) values, one per row (``viz.rows.EntityRows``)."""
     return {"scalars": (values, np.ones(values.size, dtype=np.int64))}
+
+
+def _lighter(ids: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """(N,) bool: the row is not the heaviest of the rows with its id (the first of equal weights is), for (N,) ids
+    and weights."""
+    order = np.lexsort((np.arange(ids.size), -weight, ids))
+    first = np.ones(ids.size, dtype=bool)
+    first[1:] = ids[order][1:] != ids[order][:-1]
+    out = np.ones(ids.size, dtype=bool)
+    out[order[first]] = False
+    return out
 
 
 def _labels(template: str, track_ids: np.ndarray, existence: np.ndarray) -> list[str]:

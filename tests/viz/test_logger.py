@@ -416,3 +416,22 @@ def test_a_phd_labels_plot_takes_its_heaviest_components_weight(saved_stream: tu
     stream.disconnect()
     samples = [r["Scalars:scalars"][0] for r in at_frame(read_rows(path)[paths.existence(T, "car", 8)], 0)]
     assert samples == pytest.approx([0.319])
+
+
+def test_a_phd_component_lighter_than_another_of_its_label_says_whose_it_is() -> None:
+    """A PHD track's id names its heaviest component (as the story and the focus text do); its lighter components
+    say they are its, with w, not r, for a weight (dev set scene-0553 phd: '29 predicted r=0.14' beside 29's 1.00)."""
+    from types import SimpleNamespace
+
+    from viz.logger import TrackerLogger, _lighter
+
+    ids, weight = np.array([29, 29, 7]), np.array([0.14, 1.0, 0.6])
+    raw = {"ids": ids, "existence": weight, "lighter": _lighter(ids, weight)}
+    phd = SimpleNamespace(existence_word="weight")
+    assert TrackerLogger._point_labels(phd, "%d predicted {}=%.2f", raw) == [
+        "a lighter component of 29, w=0.140",
+        "29 predicted w=1.00",
+        "7 predicted w=0.60",
+    ]
+    pmb = SimpleNamespace(existence_word="existence")
+    assert TrackerLogger._point_labels(pmb, "candidate %d, {}=%.3f", raw)[0] == "candidate 29, r=0.140"
