@@ -1,5 +1,5 @@
 """The models every tracker shares: constant-velocity motion, measurement-driven birth, clutter and survival;
-the coordinated-turn motion model of the PMB family.
+the coordinated-turn motion model of the PMB family (its default; the paper's is constant velocity).
 
 Parameters: per-class noise ``[classes.<class>]`` (``ClassParams``) and the shared ``[models]`` section
 (``ModelParams``: P_S, gate, clutter intensity, birth). Motion x_k = F x_{k-1} + w, w ~ N(0, Q),
