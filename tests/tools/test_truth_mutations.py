@@ -28,6 +28,7 @@ from gnnpmb.why.words import choice_text, choice_why
 from tools.truth import replay
 from tools.truth.devkit import EvalFacts
 from tools.truth.rawevents import RawEvents
+from tools.truth.scene import SceneTruth
 from tools.truth.sentences import Context, check_text
 
 C = "car"
@@ -521,17 +522,25 @@ def test_a_planted_place_of_a_false_box_is_caught() -> None:
     assert [c.kind for c in check_text(planted, car, None, ev, scene=_scene()).found] == ["detector"]
 
 
-def test_a_planted_issue_1141_note_is_caught() -> None:
-    """GT A annotated at x = 0, 4, 10 m at frames 1-3 (0.5, 1.0, 1.6 s); the devkit kept frames 1 and 3 and
-    interpolated frame 2 with the ends swapped (x 5.45): weighted the right way, x 4.55, 0.5 m from the
-    annotation."""
-    from tools.truth.scene import Annotation, SceneTruth
+def _swapped_interpolation() -> tuple[SceneTruth, EvalFacts]:
+    """GT A at x 0, 4, 10 m (frames 1-3) with no points at frame 2, where the devkit's interpolated box (weights
+    swapped, nuscenes-devkit issue #1141) is at x 5.45 and the box weighted the right way at x 4.55: the scene and
+    the evaluation's facts."""
+    from tools.truth.scene import Annotation
 
     scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (x, 0.0), 9)} for x in (0.0, 0.0, 4.0, 10.0)])
     ev = _eval()
     ev.kept_gt = {(0, GT_A), (1, GT_A), (3, GT_A)}
     ev.stamps = {0: 0, 1: 500_000, 2: 1_000_000, 3: 1_600_000}
     ev.evaluated_gt[(2, GT_A)] = (10.0 * 6 / 11, 0.0)
+    return scene, ev
+
+
+def test_a_planted_issue_1141_note_is_caught() -> None:
+    """GT A annotated at x = 0, 4, 10 m at frames 1-3 (0.5, 1.0, 1.6 s); the devkit kept frames 1 and 3 and
+    interpolated frame 2 with the ends swapped (x 5.45): weighted the right way, x 4.55, 0.5 m from the
+    annotation."""
+    scene, ev = _swapped_interpolation()
     ctx = Context(C, 2, GT_A)
     note = "from frames {} and 3, weighting the two ends the wrong way round (nuscenes-devkit issue #1141): weighted "
     note += "the right way the box would lie {} m from the annotation"
@@ -1282,13 +1291,7 @@ def test_a_false_tracks_issue_1141_citation_is_checked_against_the_box_weighted_
     # dev set scene-1094 megvii prob3dmot false_track:6 cited issue #1141 though the box weighted the right way lay
     # 2.6 m from the track, out of its reach too. Scene as in the planted #1141 note: GT A at x 0, 4, 10 m (frames
     # 1-3), the devkit's box at frame 2 at x 5.45, weighted the right way x 4.55
-    from tools.truth.scene import Annotation, SceneTruth
-
-    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (x, 0.0), 9)} for x in (0.0, 0.0, 4.0, 10.0)])
-    ev = _eval()
-    ev.kept_gt = {(0, GT_A), (1, GT_A), (3, GT_A)}
-    ev.stamps = {0: 0, 1: 500_000, 2: 1_000_000, 3: 1_600_000}
-    ev.evaluated_gt[(2, GT_A)] = (10.0 * 6 / 11, 0.0)
+    scene, ev = _swapped_interpolation()
     head = "car GT aaaaaa lies {} m away, but the evaluation has it interpolated 1.5 m from the annotation, out of the "
     head += "track's reach"
     see = " (see nuscenes-devkit issue #1141)"
@@ -1333,14 +1336,9 @@ def test_a_track_out_of_reach_of_an_interpolated_box_says_whether_the_right_way_
     # weighted the right way lay 2.6 m from the track. GT A at x 0, 4, 10 m (frames 1-3), the devkit's box at frame
     # 2 at x 5.45, weighted the right way x 4.55
     from tools.truth.place import check_out_of_reach
-    from tools.truth.scene import Annotation, SceneTruth
     from tools.truth.sentences import Tally
 
-    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (x, 0.0), 9)} for x in (0.0, 0.0, 4.0, 10.0)])
-    ev = _eval()
-    ev.kept_gt = {(0, GT_A), (1, GT_A), (3, GT_A)}
-    ev.stamps = {0: 0, 1: 500_000, 2: 1_000_000, 3: 1_600_000}
-    ev.evaluated_gt[(2, GT_A)] = (10.0 * 6 / 11, 0.0)
+    scene, ev = _swapped_interpolation()
     out = "at frame 2 track 30 was output {} m from the annotated object, but the evaluation scored the object at a "
     out += "box it interpolated 1.5 m from the annotation, out of the track's reach"
     still = ", and weighted the right way it would still lie {} m from the track"
