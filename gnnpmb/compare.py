@@ -269,30 +269,32 @@ def _missed_by_one(
     ]
 
 
+def _nearest(xy: np.ndarray, classes: np.ndarray, at_xy: np.ndarray, class_name: str, max_dist_m: float) -> int | None:
+    """Index of the nearest of the (N, 2) points ``xy`` of ``classes`` (N,) equal to ``class_name`` closer than
+    ``max_dist_m`` to ``at_xy`` (2,), or None."""
+    if not len(xy):
+        return None
+    dist = np.linalg.norm(np.asarray(xy, dtype=np.float64).reshape(-1, 2) - np.asarray(at_xy, dtype=np.float64), axis=1)
+    dist[(np.asarray(classes, dtype=object) != class_name) | (dist >= max_dist_m)] = np.inf
+    k = int(np.argmin(dist))
+    return k if np.isfinite(dist[k]) else None
+
+
 def _unshown(fb: _Frame, gt: Boxes, g: int, max_dist_m: float) -> int | None:
     """Id of ``fb``'s unshown estimate of object ``g``'s class nearest it within ``max_dist_m``, or None."""
-    near = [
-        (float(np.hypot(*(np.asarray(e.translation_m[:2]) - gt.xy[g]))), e.track_id)
-        for e in fb.unshown
-        if e.class_name == gt.class_name[g]
-    ]
-    near = [(d, t) for d, t in near if d < max_dist_m]
-    return min(near)[1] if near else None
+    xy = np.array([e.translation_m[:2] for e in fb.unshown], dtype=np.float64)
+    classes = np.array([e.class_name for e in fb.unshown], dtype=object)
+    k = _nearest(xy, classes, gt.xy[g], gt.class_name[g], max_dist_m)
+    return None if k is None else fb.unshown[k].track_id
 
 
 def _elsewhere(fb: _Frame, gt: Boxes, gt_ids: list[str], g: int, max_dist_m: float) -> tuple[int, str] | None:
     """(id, GT id of the object it is matched to) of ``fb``'s nearest track of object ``g``'s class within
     ``max_dist_m`` of it, which the matching gave to another object (one within reach and free would have been
     given to ``g``); None when there is none."""
-    if not len(fb.ids):
-        return None
-    dist = np.linalg.norm(fb.xy - np.asarray(gt.xy[g], dtype=np.float64), axis=1)
-    dist[(fb.classes != gt.class_name[g]) | (dist >= max_dist_m)] = np.inf
-    k = int(np.argmin(dist))
-    owner = np.flatnonzero(fb.gt_track == k)
-    if not np.isfinite(dist[k]) or not owner.size:
-        return None
-    return int(fb.ids[k]), gt_ids[int(owner[0])]
+    k = _nearest(fb.xy, fb.classes, gt.xy[g], gt.class_name[g], max_dist_m)
+    owner = np.flatnonzero(fb.gt_track == k) if k is not None else ()
+    return (int(fb.ids[k]), gt_ids[int(owner[0])]) if len(owner) else None
 
 
 def _id_changes(
@@ -363,11 +365,7 @@ def _only_in_one(
 def _beside(fa: _Frame, k: int, gt: Boxes, gt_ids: list[str], max_dist_m: float) -> tuple[int, str] | None:
     """(id of ``fa``'s track matched to it, its GT id) of the object of lone track ``k``'s class nearest it within
     ``max_dist_m`` (one within reach and unmatched would have been matched to ``k``); None when there is none."""
-    if not len(gt_ids):
-        return None
-    dist = np.linalg.norm(np.asarray(gt.xy, dtype=np.float64) - fa.xy[k], axis=1)
-    dist[(np.asarray(gt.class_name, dtype=object) != fa.classes[k]) | (dist >= max_dist_m)] = np.inf
-    g = int(np.argmin(dist))
-    if not np.isfinite(dist[g]) or fa.gt_track[g] < 0:
+    g = _nearest(gt.xy, gt.class_name, fa.xy[k], fa.classes[k], max_dist_m)
+    if g is None or fa.gt_track[g] < 0:
         return None
     return int(fa.ids[fa.gt_track[g]]), gt_ids[g]
