@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 
+from tools.truth.printing import frames_of
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import NEAR_M, SceneTruth
 
@@ -57,19 +58,6 @@ def _class_range() -> dict[str, float]:
 
 RANGE_M = _class_range()
 """The devkit's evaluation range per class (``tracking_nips_2019``), metres from the ego pose."""
-
-
-def frames_of(text: str) -> list[int]:
-    """``frame 3`` / ``frames 1–4, 7, 9`` -> [1, 2, 3, 4, 7, 9]."""
-    out: list[int] = []
-    for part in text.split(" ", 1)[1].split(","):
-        part = part.strip()
-        if "–" in part:
-            lo, hi = part.split("–")
-            out += range(int(lo), int(hi) + 1)
-        elif part:
-            out.append(int(part))
-    return out
 
 
 def _close(printed: str, value: float) -> bool:

@@ -93,8 +93,7 @@ class Sources:
         return d, np.flatnonzero(d < NEAR_M).tolist()
 
     def one(self, x: int, c: str, kind: type):
-        found = self.raw.of_kind(x, c, kind) if self.raw is not None else []
-        return found[-1] if found else None
+        return self.raw.last(x, c, kind) if self.raw is not None else None
 
     def carries(self, x: int, track: int, m: int) -> bool:
         """Whether the track's box at ``x`` repeats detection ``m``'s size, heading and height."""
@@ -170,11 +169,7 @@ def went_of(src: Sources, x: int, c: str, meas: int) -> tuple[str, int, float] |
         d = src.scene.detections[x][meas].xy_m
         near = sorted((math.hypot(xy[0] - d[0], xy[1] - d[1]), int(t)) for t, cls, xy in boxes if cls == c)
         return ("under no output box", near[0][1] if near and near[0][0] < NEAREST_M else -1, 1.0)
-    born = {
-        int(m): int(t)
-        for b in src.raw.of_kind(x, c, Born)
-        for t, m in zip(np.asarray(b.track_ids).tolist(), np.asarray(b.meas_indices).tolist(), strict=True)
-    }
+    born = src.raw.born(x, c)
 
     def new(share: float) -> tuple[str, int, float]:
         return ("new track", born[meas], share) if meas in born else ("new", -1, share)

@@ -35,14 +35,9 @@ IN_BEST = re.compile(rf"({NUMBER}) in the previous best")
 AFTER = re.compile(rf"after the update ({NUMBER}) in the chosen hypothesis, ({NUMBER}) over all kept ones")
 
 
-def _hyp(raw, x: int, c: str) -> GlobalHypotheses | None:
-    found = raw.of_kind(x, c, GlobalHypotheses)
-    return found[-1] if found else None
-
-
 def _first_held(raw, c: str, t: int, upto: int) -> int | None:
     for y in range(upto + 1):
-        h = _hyp(raw, y, c)
+        h = raw.last(y, c, GlobalHypotheses)
         if h is not None and any(t in ids for ids in h.members):
             return y
     return None
@@ -71,22 +66,22 @@ def check_hypotheses(text: str, c: str, raw, out, bad) -> None:
 def _check_switch(m: re.Match, c: str, raw, out, bad) -> None:
     x, parent, p, before, q = int(m[1]), int(m[2]), m[3], int(m[4]), m[5]
     out.checked["hypothesis"] += 1
-    a = raw.of_kind(x, c, Assignment)
-    prior = _hyp(raw, before, c)
-    if not a or prior is None or before != x - 1:
+    a = raw.last(x, c, Assignment)
+    prior = raw.last(before, c, GlobalHypotheses)
+    if a is None or prior is None or before != x - 1:
         bad("hypothesis", m[0][:120], f"no assignment at frame {x} or no hypotheses after frame {x - 1}")
         return
     w = np.exp(np.asarray(prior.log_weights, dtype=float))
-    if a[-1].hypothesis != parent or parent == 0 or parent >= len(w):
+    if a.hypothesis != parent or parent == 0 or parent >= len(w):
         bad(
             "hypothesis",
             m[0][:120],
-            f"the best hypothesis of frame {x} was solved in prior hypothesis {a[-1].hypothesis}",
+            f"the best hypothesis of frame {x} was solved in prior hypothesis {a.hypothesis}",
         )
         return
     if f"{w[parent]:.2f}" != p or f"{w[0]:.2f}" != q:
         bad("hypothesis", m[0][:120], f"after frame {before}: hypothesis {parent} {w[parent]:.3f}, best {w[0]:.3f}")
-    post = _hyp(raw, x, c)
+    post = raw.last(x, c, GlobalHypotheses)
     for row in TRACK_ROW.finditer(m[6] or ""):
         t, said = int(row[1]), row[2]
         out.checked["hypothesis"] += 1

@@ -48,7 +48,7 @@ from gnnpmb.events import (
     TrackLogicAction,
     UpdateWeights,
 )
-from tools.truth.printing import NUMBER, printed
+from tools.truth.printing import NUMBER, frames_of, printed
 
 WENT_FROM = re.compile(rf"its (existence|weight) went from ({NUMBER}) \(frame (\d+)\) to ({NUMBER}) \(frame (\d+)\)")
 WAS = re.compile(rf"its (existence|weight) was ({NUMBER}) \(frames? (\d+)(?:–(\d+))?\)")
@@ -92,28 +92,19 @@ USED_SHARE = 0.01
 """The checker's own copy of the share from which an update is said to have used a detection."""
 
 
-def frames_of(text: str) -> list[int]:
-    """``frame 7``, ``frames 7, 13``, ``frames 12–14, 20`` -> the frames."""
-    out: list[int] = []
-    for part in text.split(" ", 1)[1].split(", "):
-        lo, _, hi = part.partition("–")
-        out += list(range(int(lo), int(hi or lo) + 1))
-    return out
-
-
 def _existence(raw, x: int, c: str, track: int) -> float | None:
     """The track's existence after the update of frame ``x``; a GM-PHD / CPHD label's weight is its heaviest
     ``IntensityWeights`` component (a PHD weight is an expected number and may exceed 1; the ``Posterior`` event
     holds min(w, 1))."""
-    intensity = raw.of_kind(x, c, IntensityWeights)
-    if intensity:
-        mine = np.asarray(intensity[-1].weights)[np.asarray(intensity[-1].labels) == track]
+    intensity = raw.last(x, c, IntensityWeights)
+    if intensity is not None:
+        mine = np.asarray(intensity.weights)[np.asarray(intensity.labels) == track]
         return float(mine.max()) if mine.size else None
-    found = raw.of_kind(x, c, Posterior)
-    if not found:
+    found = raw.last(x, c, Posterior)
+    if found is None:
         return None
-    ids = np.asarray(found[-1].track_ids).tolist()
-    return float(np.asarray(found[-1].existence)[ids.index(track)]) if track in ids else None
+    ids = np.asarray(found.track_ids).tolist()
+    return float(np.asarray(found.existence)[ids.index(track)]) if track in ids else None
 
 
 def check_lost(text: str, c: str, lost: int | None, raw, ev, out, bad) -> None:
@@ -171,9 +162,8 @@ def check_gates(text: str, c: str, raw, out, bad) -> None:
     """ "mN (…, in track T's gate at NIS V)": the frame's ``Gated`` event has mN inside T's gate at that d²."""
     for m in GATE.finditer(text):
         x, meas, t = int(m[1]), int(m[2]), int(m[3])
-        found = raw.of_kind(x, c, Gated)
         out.checked["tracker"] += 1
-        g = found[-1] if found else None
+        g = raw.last(x, c, Gated)
         rows = np.flatnonzero(np.asarray(g.track_ids) == t) if g is not None else []
         cols = np.flatnonzero(np.asarray(g.meas_indices) == meas) if g is not None else []
         if len(rows) == 0 or len(cols) == 0 or not bool(np.asarray(g.inside)[rows[0], cols[0]]):
@@ -239,19 +229,18 @@ def _check_used(m: re.Match, c: str, lost: int, raw, out, bad) -> None:
     said = [(int(a), b or None) for a, b in re.findall(rf"m(\d+)(?: \(p ({NUMBER})\))?", m[3])]
     more = int(m[4] or 0)
     if m[2] == "was given":
-        found = raw.of_kind(x, c, Assignment)
-        if not found:
+        a = raw.last(x, c, Assignment)
+        if a is None:
             return
         out.checked["tracker"] += 1
-        given = [int(r.ref) for r, k in found[-1].pairs if k.kind is AxisKind.TRACK and int(k.ref) == lost]
+        given = [int(r.ref) for r, k in a.pairs if k.kind is AxisKind.TRACK and int(k.ref) == lost]
         if [s for s, _ in said] != given or more:
             bad("tracker", m[0], f"the assignment of frame {x} gave track {lost} {given}")
         return
-    found = raw.of_kind(x, c, Marginals)
-    if not found:
+    marg = raw.last(x, c, Marginals)
+    if marg is None:
         return
     out.checked["tracker"] += 1
-    marg = found[-1]
     rows = [i for i, r in enumerate(marg.rows) if int(r.ref) == lost]
     if not rows:
         bad("tracker", m[0], f"the Marginals of frame {x} have no row of track {lost}")

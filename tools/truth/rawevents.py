@@ -54,6 +54,11 @@ class RawEvents:
     def of_kind(self, frame: int, class_name: str, kind: type) -> list:
         return self.by.get((frame, class_name), {}).get(kind, [])
 
+    def last(self, frame: int, class_name: str, kind: type):
+        """The last event of ``kind`` at ``frame`` for ``class_name``; None when there is none."""
+        found = self.of_kind(frame, class_name, kind)
+        return found[-1] if found else None
+
     def matrices(self, frame: int, class_name: str) -> list[CostMatrix]:
         return self.of_kind(frame, class_name, CostMatrix)
 
@@ -97,10 +102,9 @@ class RawEvents:
 
     def deciding(self, frame: int, class_name: str) -> tuple[CostMatrix, Assignment] | None:
         """The matrix the frame's (last) assignment indexes, with that assignment; None without one."""
-        done = self.of_kind(frame, class_name, Assignment)
-        if not done:
+        a = self.last(frame, class_name, Assignment)
+        if a is None:
             return None
-        a = done[-1]
         same = [m for m in self.matrices(frame, class_name) if m.hypothesis == a.hypothesis]
         return (same[-1], a) if same else None
 

@@ -485,21 +485,16 @@ def _check_counterfactuals(x: int, para: str, c: str, raw: RawEvents, out: Tally
             continue
         holds = replay.replay_existence(mat, row, col, min(stated * (1 + replay.ABOVE), 1.0))
         verdict(m[0], holds, f"re-solved with existence just above {stated}, m{meas} does not go to track {t}")
-    for m in NO_EXISTENCE.finditer(para):
-        meas, t = int(m[1]), int(m[2])
-        s = setup(meas, t)
-        if s is None:
-            continue
-        mat, _, row, col = s
-        holds = replay.replay_existence(mat, row, col, 1.0 - 1e-9)
-        verdict(m[0], holds is False, f"with existence 1, m{meas} goes to track {t}")
-    for m in EVEN_AT_ZERO.finditer(para):
-        meas, t = int(m[1]), int(m[2])
-        s = setup(meas, t)
-        if s is None:
-            continue
-        mat, _, row, col = s
-        verdict(m[0], replay.replay_d2(mat, row, col, 0.0) is False, f"at d² 0, m{meas} goes to track {t}")
+    extremes = (  # "mN would not have gone to track T even with …": re-solved at that extreme, it still does not
+        (NO_EXISTENCE, lambda mat, row, col: replay.replay_existence(mat, row, col, 1.0 - 1e-9), "with existence 1"),
+        (EVEN_AT_ZERO, lambda mat, row, col: replay.replay_d2(mat, row, col, 0.0), "at d² 0"),
+    )
+    for pattern, replayed, extreme in extremes:
+        for m in pattern.finditer(para):
+            meas, t = int(m[1]), int(m[2])
+            if (s := setup(meas, t)) is not None:
+                mat, _, row, col = s
+                verdict(m[0], replayed(mat, row, col) is False, f"{extreme}, m{meas} goes to track {t}")
     for m in RIVAL_TAKEN.finditer(para):
         meas, t, k = int(m[1]), int(m[3]), int(m[4])
         if found is None:

@@ -21,15 +21,10 @@ WENT = re.compile(
 )
 
 
-def _weights(raw, x: int, c: str):
-    found = raw.of_kind(x, c, UpdateWeights)
-    return found[-1] if found else None
-
-
 def check_shares(text: str, c: str, lost: int | None, raw, out, bad) -> None:
     """Each percentage of ``text`` (``out``: the ``Tally``; ``bad``); ``lost``: the track the Why follows."""
     for m in TOOK.finditer(text):
-        w = _weights(raw, int(m[1]), c)
+        w = raw.last(int(m[1]), c, UpdateWeights)
         if w is None or lost is None:
             continue
         out.checked["share"] += 1
@@ -43,7 +38,7 @@ def check_shares(text: str, c: str, lost: int | None, raw, out, bad) -> None:
         if abs(share - int(m[2])) > 0.5 + 1e-9:
             bad("share", m[0], f"track {lost} took {share:.2f} % of its weight from m{m[3]}")
     for m in WENT.finditer(text):
-        w = _weights(raw, int(m[1]), c)
+        w = raw.last(int(m[1]), c, UpdateWeights)
         if w is None:
             continue
         out.checked["share"] += 1
