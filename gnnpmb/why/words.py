@@ -1218,8 +1218,10 @@ def _others(f: Finding) -> list[str]:
         elif o.switched:  # a failure of another kind on the object: not "did not fail"
             took = f": the evaluation matched the object to its track {o.matched}" if o.matched is not None else ""
             out.append(f"{who} switched the object's track here instead{took}")
-        elif counted and o.matched in {x.track_id for x in counted}:
-            out.append(f"{who} did not fail here: {_its_tracks(counted)} output on the object and counted")
+        elif counted and o.matched in {x.track_id for x in counted}:  # only the track it matched: the others near
+            # the annotation went to neighbours (a crowd), and naming them would put them on this object
+            held = [x for x in counted if x.track_id == o.matched]
+            out.append(f"{who} did not fail here: {_its_tracks(held)} output on the object and counted")
         elif counted and o.missed:  # on the annotation, but the evaluation matched them elsewhere or to nothing
             elsewhere = " and ".join(
                 f"track {x.track_id} to "
