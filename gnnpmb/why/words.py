@@ -43,6 +43,11 @@ def meas_name(ref: int) -> str:
     return f"m{int(ref)}"
 
 
+OFF_BOX_M = 0.25
+"""A false track's box this far or farther from the detection its update used is not said to be "on" it (a filtering
+tracker's box lies between its prediction and the detection: dev set scene-0553 centerpoint prob3dmot, 0.9 m)."""
+
+
 def column_name(label: AxisLabel) -> str:
     """``track 802``, ``new`` (start a track / clutter) or ``missed``."""
     match label.kind:
@@ -945,6 +950,11 @@ def _false_track(f: Finding) -> list[str]:
             head += _output_on_text(f, f.frame, o.track_id, o.on)
         else:
             head += f"detection {_near_text(o.on)}" if o.on is not None else "no detection this frame (a predicted box)"
+            if o.on is not None and o.on.distance_m >= OFF_BOX_M:  # a filtered box between prediction and detection
+                head = (
+                    f"at frame {f.frame} track {o.track_id} ({f.class_name}) was output {o.on.distance_m:.1f} m from "
+                    f"detection {_near_text(o.on)}, the one its update used"
+                )
     parts = [head]
     if o.nearest_own is not None:
         gt_id, d, g = o.nearest_own

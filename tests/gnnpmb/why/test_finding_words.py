@@ -581,3 +581,20 @@ def test_another_run_that_kept_the_object_names_only_the_track_its_evaluation_ma
     )
     assert "gnn on the same detections did not fail here: its track 374 was output on the object and counted" in line
     assert "460" not in line
+
+
+def test_a_false_tracks_filtered_box_far_from_the_detection_it_used_is_not_said_to_sit_on_it() -> None:
+    # truth45 checker, dev set scene-0553 centerpoint prob3dmot false_track:3: "at frame 3 track 21 (truck) was output
+    # on detection m15 (truck, score 0.57)", though its filtered box lay 0.87 m from m15
+    from gnnpmb.why.findings import FalseOutput, Near
+
+    def said(distance_m: float) -> str:
+        out = FalseOutput(21, Near(15, "truck", 0.57, distance_m, True), (0.0, 0.0), None, None, None, None, None, None)
+        f = finding(FailureKind.FALSE_TRACK, frame=3, class_name="truck", gt_id=None, false_output=out)
+        return why_lines(f)[0]
+
+    assert (
+        "at frame 3 track 21 (truck) was output 0.9 m from detection m15 (truck, score 0.57), the one its update used"
+        in (said(0.87))
+    )
+    assert "at frame 3 track 21 (truck) was output on detection m15 (truck, score 0.57)" in said(0.0)
