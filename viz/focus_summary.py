@@ -296,7 +296,7 @@ def _gt_markdown(focus: FocusTarget, view: TrackerView, gt_id: str, seen: tuple[
             sent = "—"
         else:
             nearest, sent = "none", "—"
-        on = ", ".join(on_object_text(o) for o in s.on_it) or "none"
+        on = ", ".join(on_object_text(o, s.frame, gt_id) for o in s.on_it) or "none"
         rows.append(f"| {s.frame} | {sighting_points(s)} | {nearest} | {sent} | {on} |")
     report = view.evidence.report
     threshold = report.threshold_of(focus.class_name)

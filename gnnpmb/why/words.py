@@ -1275,15 +1275,19 @@ def plain(markdown: str) -> str:
     return markdown.replace("**", "")
 
 
-def on_object_text(o: OnObject) -> str:
-    """A track output on an object, for the object's table: ``62 (0.92; track average 0.69)``."""
-    if o.threshold is None:
-        return f"{o.track_id} ({o.score:.2f})"
+def on_object_text(o: OnObject, frame: int | None = None, gt_id: str | None = None) -> str:
+    """A track output on an object, for the object's table: ``62 (0.92; track average 0.69)``; with the frame
+    and the object, a track the evaluation matched to another object there says so (``; matched to GT 4f67ad``):
+    in a crowd a track within ``NEAR_M`` of one object is often another's."""
     ev = o.evaluated
+    other = ev.matched_at(frame) if ev is not None and frame is not None else None
+    elsewhere = f"; matched to GT {short_id(other)}" if other is not None and other != gt_id else ""
+    if o.threshold is None:
+        return f"{o.track_id} ({o.score:.2f}{elsewhere})"
     if ev is None or ev.averaged_score is None:
         return f"{o.track_id} ({o.score:.2f}; not evaluated: beyond the class range)"
     return f"{o.track_id} ({o.score:.2f}; track average {ev.averaged_score:.2f}" + (
-        ", not counted)" if not o.counted else ")"
+        ", not counted)" if not o.counted else f"{elsewhere})"
     )
 
 
