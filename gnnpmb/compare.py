@@ -9,7 +9,9 @@ Then, for every pair of trackers (A, B), in either role:
 
 * ``missed_by_one``: a GT object A's estimates cover and B's do not.
 * ``id_change``: a GT object both cover, where A now gives it another id than the last time A covered it while
-  B gives it the same id as the last time B covered it (one tracker switched, the other kept its id).
+  B gives it the same id as the last time B covered it (one tracker switched, the other kept its id); A's old
+  track must have left the object (no longer output within the match distance, shown or not), as the devkit keeps
+  a pair still within reach.
 * ``only_in_one``: an estimate of A matched to no GT object with no estimate of B of its class closer than
   ``MATCH_DISTANCE_M`` (a track only A reports).
 
