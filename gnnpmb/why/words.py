@@ -43,6 +43,11 @@ def meas_name(ref: int) -> str:
     return f"m{int(ref)}"
 
 
+OFF_BOX_M = 0.25
+"""A false track's box this far or farther from the detection its update used is not said to be "on" it (a filtering
+tracker's box lies between its prediction and the detection: dev set scene-0553 centerpoint prob3dmot, 0.9 m)."""
+
+
 def column_name(label: AxisLabel) -> str:
     """``track 802``, ``new`` (start a track / clutter) or ``missed``."""
     match label.kind:
@@ -945,6 +950,11 @@ def _false_track(f: Finding) -> list[str]:
             head += _output_on_text(f, f.frame, o.track_id, o.on)
         else:
             head += f"detection {_near_text(o.on)}" if o.on is not None else "no detection this frame (a predicted box)"
+            if o.on is not None and o.on.distance_m >= OFF_BOX_M:  # a filtered box between prediction and detection
+                head = (
+                    f"at frame {f.frame} track {o.track_id} ({f.class_name}) was output {o.on.distance_m:.1f} m from "
+                    f"detection {_near_text(o.on)}, the one its update used"
+                )
     parts = [head]
     if o.nearest_own is not None:
         gt_id, d, g = o.nearest_own
@@ -1218,8 +1228,10 @@ def _others(f: Finding) -> list[str]:
         elif o.switched:  # a failure of another kind on the object: not "did not fail"
             took = f": the evaluation matched the object to its track {o.matched}" if o.matched is not None else ""
             out.append(f"{who} switched the object's track here instead{took}")
-        elif counted and o.matched in {x.track_id for x in counted}:
-            out.append(f"{who} did not fail here: {_its_tracks(counted)} output on the object and counted")
+        elif counted and o.matched in {x.track_id for x in counted}:  # only the track it matched: the others near
+            # the annotation went to neighbours (a crowd), and naming them would put them on this object
+            held = [x for x in counted if x.track_id == o.matched]
+            out.append(f"{who} did not fail here: {_its_tracks(held)} output on the object and counted")
         elif counted and o.missed:  # on the annotation, but the evaluation matched them elsewhere or to nothing
             elsewhere = " and ".join(
                 f"track {x.track_id} to "
@@ -1263,15 +1275,19 @@ def plain(markdown: str) -> str:
     return markdown.replace("**", "")
 
 
-def on_object_text(o: OnObject) -> str:
-    """A track output on an object, for the object's table: ``62 (0.92; track average 0.69)``."""
-    if o.threshold is None:
-        return f"{o.track_id} ({o.score:.2f})"
+def on_object_text(o: OnObject, frame: int | None = None, gt_id: str | None = None) -> str:
+    """A track output on an object, for the object's table: ``62 (0.92; track average 0.69)``; with the frame
+    and the object, a track the evaluation matched to another object there says so (``; matched to GT 4f67ad``):
+    in a crowd a track within ``NEAR_M`` of one object is often another's."""
     ev = o.evaluated
+    other = ev.matched_at(frame) if ev is not None and frame is not None else None
+    elsewhere = f"; matched to GT {short_id(other)}" if other is not None and other != gt_id else ""
+    if o.threshold is None:
+        return f"{o.track_id} ({o.score:.2f}{elsewhere})"
     if ev is None or ev.averaged_score is None:
         return f"{o.track_id} ({o.score:.2f}; not evaluated: beyond the class range)"
     return f"{o.track_id} ({o.score:.2f}; track average {ev.averaged_score:.2f}" + (
-        ", not counted)" if not o.counted else ")"
+        ", not counted)" if not o.counted else f"{elsewhere})"
     )
 
 

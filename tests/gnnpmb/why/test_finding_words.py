@@ -563,3 +563,38 @@ def test_a_track_out_of_reach_says_when_the_box_weighted_the_right_way_would_be_
     out += "interpolated 14.7 m from the annotation, out of the track's reach"
     assert f"{out}, and weighted the right way it would still lie 2.7 m from the track" in said((1.2, 0.0))
     assert f"{out};" in said((-1.2, 0.0)) or said((-1.2, 0.0)).endswith(f"{out}.")  # within reach weighted so
+
+
+def test_another_run_that_kept_the_object_names_only_the_track_its_evaluation_matched_to_it() -> None:
+    # truth45 checker, dev set scene-0061 pointpillars phd id_switch at frame 35: "gnn on the same detections did not
+    # fail here: its tracks 460, 374 were output on the object and counted", where gnn's evaluation matched the
+    # object to track 374 and track 460, 1.5 m off, to the neighbouring pedestrian 25b23b (288 of 1,528 such lines)
+    from gnnpmb.why.findings import OnObject, OtherRun
+
+    neighbour = "25b23b" + "1" * 26
+    on_neighbour = TrackEval((35,), (35,), (), 0.9, 0.9, ((35, neighbour),))
+    on_this = TrackEval((35,), (35,), (), 0.9, 0.9, ((35, GT),))
+    on = (OnObject(460, 1.5, 0.9, -1, on_neighbour, 0.3), OnObject(374, 0.2, 0.9, -1, on_this, 0.3))
+    lost = LostTrack(62, 34, (), None, None, None)
+    (line, _) = why_lines(
+        finding(FailureKind.ID_SWITCH, lost, frame=35, others=(OtherRun("gnn", False, on, matched=374),))
+    )
+    assert "gnn on the same detections did not fail here: its track 374 was output on the object and counted" in line
+    assert "460" not in line
+
+
+def test_a_false_tracks_filtered_box_far_from_the_detection_it_used_is_not_said_to_sit_on_it() -> None:
+    # truth45 checker, dev set scene-0553 centerpoint prob3dmot false_track:3: "at frame 3 track 21 (truck) was output
+    # on detection m15 (truck, score 0.57)", though its filtered box lay 0.87 m from m15
+    from gnnpmb.why.findings import FalseOutput, Near
+
+    def said(distance_m: float) -> str:
+        out = FalseOutput(21, Near(15, "truck", 0.57, distance_m, True), (0.0, 0.0), None, None, None, None, None, None)
+        f = finding(FailureKind.FALSE_TRACK, frame=3, class_name="truck", gt_id=None, false_output=out)
+        return why_lines(f)[0]
+
+    assert (
+        "at frame 3 track 21 (truck) was output 0.9 m from detection m15 (truck, score 0.57), the one its update used"
+        in (said(0.87))
+    )
+    assert "at frame 3 track 21 (truck) was output on detection m15 (truck, score 0.57)" in said(0.0)

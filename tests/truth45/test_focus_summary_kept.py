@@ -1,0 +1,44 @@
+"""The focus summary's object table names the nearest detection preprocessing kept as such (truth45 checker)."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+from gnnpmb.eval.evaluated import GtFrame, GtStatus
+from gnnpmb.focus import FocusTarget
+from gnnpmb.why.facts import Destination, UseMode, Went
+from gnnpmb.why.findings import Near, Sighting
+from viz.focus_summary import _gt_markdown
+
+
+def test_the_object_table_says_its_nearest_detection_is_the_nearest_kept_one() -> None:
+    # dev set scene-1077 megvii cphd identity_theft:2, frame 23: "nearest detection: m20 at 0.2 m (score 0.46)"
+    # while m26 (score 0.24) lay 0.1 m from the object; NMS had removed it beside m20
+    g = GtFrame(23, GtStatus.SCORED, (0.0, 0.0), (0.0, 0.0), None, 9, 20.0, 40.0)
+    kept, removed = Near(20, "pedestrian", 0.46, 0.2, True), Near(26, "pedestrian", 0.24, 0.1, False)
+    seen = (Sighting(23, 9, g, removed, kept, Destination(20, Went.TRACK, 107, 0.94), (), removed),)
+    view = SimpleNamespace(
+        facts=SimpleNamespace(mode=lambda c, frames: UseMode.WEIGHTS),
+        evidence=SimpleNamespace(report=SimpleNamespace(threshold_of=lambda c: 0.452)),
+    )
+    focus = FocusTarget("t", 23, (0.0, 0.0), "pedestrian", {"cphd": (107,)}, ())
+    text = "\n".join(_gt_markdown(focus, view, "ceb713" + "0" * 26, seen))
+    assert "| frame | points in box | nearest kept detection |" in text
+    assert "a kept pedestrian detection within 2 m at frame 23." in text
+    assert "| 23 | 9 | m20 at 0.2 m (score 0.46) |" in text
+
+
+def test_the_object_table_says_which_object_the_evaluation_matched_a_track_on_it_to() -> None:
+    # truth45 checker, 14 focus documents (dev and demo): 35 of 89 tracks listed as "output on it" within 2 m of a
+    # pedestrian were matched by the devkit to a neighbour, e.g. dev scene-1077 megvii cphd identity_theft:2, frame
+    # 23: "107 (0.46; track average 0.63), 112 (...), 83 (...), 94 (...)" around GT ceb713
+    from gnnpmb.eval.evaluated import TrackEval
+    from gnnpmb.why.findings import OnObject
+    from gnnpmb.why.words import on_object_text
+
+    gt, neighbour = "ceb713" + "0" * 26, "4f67ad" + "0" * 26
+    mine = OnObject(107, 0.2, 0.46, 20, TrackEval((23,), (23,), (), 0.63, 0.63, ((23, gt),)), 0.452)
+    theirs = OnObject(94, 1.4, 0.64, 13, TrackEval((23,), (23,), (), 0.64, 0.64, ((23, neighbour),)), 0.452)
+    assert on_object_text(mine, 23, gt) == "107 (0.46; track average 0.63)"
+    assert on_object_text(theirs, 23, gt) == "94 (0.64; track average 0.64; matched to GT 4f67ad)"
+    assert on_object_text(theirs) == "94 (0.64; track average 0.64)"  # no frame: nothing said of the match
