@@ -88,8 +88,8 @@ bird's-eye view)
   within 2 m of an object that had LiDAR or radar points, or only one of another class, or a false track sat on a
   detection of nothing; the tracker's when a detection was there and the update of the track that had the object
   did not use it, the track was not output, output 2 m or more away, not counted, or covered two objects; the
-  evaluation's when it scored the object at an interpolated box 0.5 m or more from the annotation, had no box for
-  it, or made the false box up between two of the track's. Several can hold at once.
+  evaluation's when it scored the object at an interpolated box 0.5 m or more from the annotation (2 m for a
+  miss), had no box for it, or made the false box up between two of the track's. Several can hold at once.
 - **p**, **% of its weight**: a JPDA or TO-PMB association probability; the share of a PHD component's weight the
   update took from a detection.
 """

@@ -23,7 +23,8 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   (``COVERED_TWO``), or the object had no LiDAR or radar points, so no detector could see it, and no track carried
   it (``UNSEEN``);
 * **the evaluation's**: the box the object was scored against is an interpolation ``EVALUATED_OFFSET_M`` or more
-  from the annotation, or one that put a counted track output within ``NEAR_M`` of the annotation out of the
+  from the annotation (for a miss ``NEAR_M`` or more: a nearer box would still match a track on the object), or one
+  that put a counted track output within ``NEAR_M`` of the annotation out of the
   devkit's ``NEAR_M`` (``INTERPOLATED``), or the evaluation has no box of the object there, beyond its range or
   for want of points (``NO_EVAL_BOX``), or the false track's box is one the evaluation interpolated between two of
   the track's boxes, at a frame the tracker did not output it (``TRACK_INTERPOLATED``), or a track output on the

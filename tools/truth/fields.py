@@ -539,7 +539,9 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             if status != "interpolated" or not far:
                 return "the evaluation's box of the object is within the track's reach"
         elif name == "INTERPOLATED":
-            if f.gt_id is None or not _interpolated_decided(src, x, c, f.gt_id):
+            # a miss: a box interpolated nearer than 2 m would still match a counted track on the annotation
+            least_m = NEAR_M if f.kind.value == "miss" else EVALUATED_OFFSET_M
+            if f.gt_id is None or not _interpolated_decided(src, x, c, f.gt_id, least_m):
                 return "the evaluation scored no far interpolated box, nor one out of a counted track's reach"
         elif name == "DETECTION_UNUSED":
             if xy is None:
@@ -596,14 +598,14 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
     return ""
 
 
-def _interpolated_decided(src: Sources, x: int, c: str, gt_id: str) -> bool:
-    """Whether the devkit scored object ``gt_id`` at ``x`` at an interpolated box ``EVALUATED_OFFSET_M`` or more
-    from its annotation, or 2 m or more from a counted track's box within 2 m of the annotation."""
+def _interpolated_decided(src: Sources, x: int, c: str, gt_id: str, least_m: float) -> bool:
+    """Whether the devkit scored object ``gt_id`` at ``x`` at an interpolated box ``least_m`` or more from its
+    annotation, or 2 m or more from a counted track's box within 2 m of the annotation."""
     status, at = src.status(x, gt_id)
     xy = src.gt_xy(x, gt_id)
     if status != "interpolated" or xy is None:
         return False
-    if math.dist(at, xy) >= EVALUATED_OFFSET_M:
+    if math.dist(at, xy) >= least_m:
         return True
     counted = _counted_on(src, x, c, xy)
     return any(math.dist(next(p for tt, _, p in src.ev.boxes[x] if tt == t), at) >= NEAR_M for t in counted)
