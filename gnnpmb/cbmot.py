@@ -25,7 +25,7 @@ import numpy as np
 
 from gnnpmb.assign.greedy import greedy_rows
 from gnnpmb.config import TrackerConfig
-from gnnpmb.events import CostScale, PruneReason, ScoreOnHit, ScoreRule
+from gnnpmb.events import PruneReason, ScoreOnHit, ScoreRule
 from gnnpmb.greedy import GreedyTracker, GreedyTracks
 from gnnpmb.track_scores import fuse_confidence, step_down
 from gnnpmb.types import IdAllocator
@@ -38,7 +38,6 @@ class CbmotTracker(GreedyTracker):
     def __init__(self, class_name: str, config: TrackerConfig, ids: IdAllocator):
         super().__init__(class_name, config, ids)
         self.params = config.cbmot
-        self.scale = CostScale("distance", "m", 0.3, optimal=False, threshold=self.max_distance_m)
         self.score_rule = ScoreRule(
             ScoreOnHit.FUSED, decay_step=self.params.score_decay, delete_at=self.params.delete_score
         )

@@ -47,7 +47,6 @@ from gnnpmb.soa import StructOfArrays
 from gnnpmb.types import IdAllocator, Measurements, TrackEstimate
 
 COST_DESCRIPTION = "distance (m) from the detection's centre minus velocity x dt; new-track column = threshold"
-COST_SCALE = CostScale("distance", "m", 0.3, optimal=False)
 """Greedy's costs are metres and its matching is greedy, not optimal: a margin is the detection's next closest
 column minus its chosen one, and a close call one under 0.3 m, about the detectors' mean translation error
 (mATE 0.29-0.34 m on nuScenes val, docs/demo-data.md "Simulated detectors")."""
@@ -143,7 +142,8 @@ class GreedyTracker(ClassFilter[GreedyPrior, tuple[GreedyTracks, Measurements]])
         self.max_distance_m = self.distance_threshold_m()
         self.max_age = config.greedy.max_age
         self.description = COST_DESCRIPTION
-        self.scale = COST_SCALE
+        # the class's distance threshold d_class: an infinite entry is a pair beyond it (there is no gate)
+        self.scale = CostScale("distance", "m", 0.3, optimal=False, threshold=self.max_distance_m)
         self.tracks = GreedyTracks.empty()
 
     def distance_threshold_m(self) -> float:

@@ -85,11 +85,12 @@ bird's-eye view)
 - **counted**: the evaluation keeps a track only if its score averaged over the whole track reaches the class's
   threshold (chosen for the best MOTA), at all its frames or at none.
 - **whose doing**: the detector's when, in a frame that decided the failure, no detection of a tracked class lay
-  within 2 m of an object that had LiDAR or radar points, or only one of another class, or a false track sat on a
+  within 2 m of an object that had LiDAR or radar points (a detection nearer another object is that one's), or
+  only one of another class, or a false track sat on a
   detection of nothing; the tracker's when a detection was there and the update of the track that had the object
   did not use it, the track was not output, output 2 m or more away, not counted, or covered two objects; the
-  evaluation's when it scored the object at an interpolated box 0.5 m or more from the annotation, had no box for
-  it, or made the false box up between two of the track's. Several can hold at once.
+  evaluation's when it scored the object at an interpolated box 0.5 m or more from the annotation (2 m for a
+  miss), had no box for it, or made the false box up between two of the track's. Several can hold at once.
 - **p**, **% of its weight**: a JPDA or TO-PMB association probability; the share of a PHD component's weight the
   update took from a detection.
 """

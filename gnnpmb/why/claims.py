@@ -22,7 +22,8 @@ class Claim:
 
 
 CLAIM_KINDS = (
-    "detection near",  # (gt, meas, class, score, distance_m): that detection lies that far from the object
+    "detection near",  # (gt, meas, class, score, distance_m, other gt): that detection lies that far from the object,
+    # and nearer that other annotated object (None: the object's own detection)
     "no detection near",  # (gt,): no detection of a tracked class (any score) within NEAR_M of the object
     "nearest own",  # (gt, meas): the nearest kept detection of the failure's class within NEAR_M
     "no own near",  # (gt,): no kept detection of the class within NEAR_M
@@ -70,7 +71,8 @@ def claims(f: Finding) -> list[Claim]:
             add("no detection near", s.frame, f.gt_id)
         else:
             n = s.nearest_any
-            add("detection near", s.frame, f.gt_id, n.meas, n.class_name, n.score, n.distance_m)
+            other = n.on_other[0] if n.on_other is not None else None
+            add("detection near", s.frame, f.gt_id, n.meas, n.class_name, n.score, n.distance_m, other)
         if s.nearest_own is None:
             add("no own near", s.frame, f.gt_id)
         else:

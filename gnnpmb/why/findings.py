@@ -10,7 +10,8 @@ so a test can check every assertion against independent facts.
 The tests of ``Blame`` (``Rule``) are stated once, here:
 
 * **the detector's**: in a frame that decided the failure, no detection of a tracked class (any score) within
-  ``NEAR_M`` of the object while it had LiDAR or radar points (``NO_DETECTION``), only detections of another
+  ``NEAR_M`` of the object while it had LiDAR or radar points, or only detections that lie nearer another annotated
+  object (``NO_DETECTION``: they are that object's, ``Near.on_other``), only detections of its own of another
   class (``OTHER_CLASS``), or the false
   track was output on a detection that lies within ``NEAR_M`` of no object (``DETECTION_OF_NOTHING``);
 * **the tracker's**: a detection of the object's class was within ``NEAR_M`` and the update of the track that had
@@ -23,7 +24,8 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   (``COVERED_TWO``), or the object had no LiDAR or radar points, so no detector could see it, and no track carried
   it (``UNSEEN``);
 * **the evaluation's**: the box the object was scored against is an interpolation ``EVALUATED_OFFSET_M`` or more
-  from the annotation, or one that put a counted track output within ``NEAR_M`` of the annotation out of the
+  from the annotation (for a miss ``NEAR_M`` or more: a nearer box would still match a track on the object), or one
+  that put a counted track output within ``NEAR_M`` of the annotation out of the
   devkit's ``NEAR_M`` (``INTERPOLATED``), or the evaluation has no box of the object there, beyond its range or
   for want of points (``NO_EVAL_BOX``), or the false track's box is one the evaluation interpolated between two of
   the track's boxes, at a frame the tracker did not output it (``TRACK_INTERPOLATED``), or a track output on the
@@ -121,13 +123,22 @@ class Blame:
 @dataclass(frozen=True, slots=True)
 class Near:
     """A detection near an object: its source index, class, score, BEV distance (m) and whether preprocessing
-    kept it (score threshold, NMS)."""
+    kept it (score threshold, NMS); on_other: the annotated object (id, class, BEV distance m) the detection lies
+    nearer than this one, when it does: then it is that object's detection, not a sight of this one (dev set
+    scene-1094 centerpoint ab3dmot: a car detection 1.8 m from a truck and 0.1 m from a car was said to be the
+    truck seen as a car)."""
 
     meas: int
     class_name: str
     score: float
     distance_m: float
     kept: bool
+    on_other: tuple[str, str, float] | None = None
+
+    @property
+    def of_it(self) -> bool:
+        """Whether the detection is this object's: no other annotated object lies nearer it."""
+        return self.on_other is None
 
 
 @dataclass(frozen=True, slots=True)
@@ -169,6 +180,18 @@ class Sighting:
     went: Destination | None
     on_it: tuple[OnObject, ...]
     removed_own: Near | None = None
+
+    @property
+    def seen(self) -> Near | None:
+        """The nearest detection of any class that is this object's (``Near.of_it``); None where every detection
+        within ``NEAR_M`` lies nearer another annotated object, or none does."""
+        n = self.nearest_any
+        return n if n is not None and n.of_it else None
+
+    @property
+    def undetected(self) -> bool:
+        """No detection of it: none of its class kept within ``NEAR_M`` and none of any class that is its own."""
+        return self.nearest_own is None and self.seen is None
 
 
 @dataclass(frozen=True, slots=True)

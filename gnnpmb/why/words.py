@@ -552,11 +552,11 @@ def _detector_gaps(f: Finding) -> list[str]:
         if b.rule is Rule.NO_DETECTION:
             points = [by[x].points for x in b.frames if x in by]
             out.append(
-                f"at {frames_text(b.frames)} the detector gave no detection of a tracked class within {NEAR_M:.0f} m, "
+                f"at {frames_text(b.frames)} the detector gave {no_detection([by[x] for x in b.frames if x in by])}, "
                 f"though it had {_span(points)} LiDAR and radar points"
             )
         elif b.rule is Rule.OTHER_CLASS:
-            seen = [by[x].nearest_any for x in b.frames if x in by and by[x].nearest_any is not None]
+            seen = [by[x].seen for x in b.frames if x in by and by[x].seen is not None]
             what = ", ".join(f"{n.class_name} {meas_name(n.meas)} {n.distance_m:.2f} m away" for n in seen)
             out.append(f"at {frames_text(b.frames)} the detector saw it only as another class ({what})")
     return out
@@ -565,13 +565,32 @@ def _detector_gaps(f: Finding) -> list[str]:
 def _hidden(f: Finding) -> list[str]:
     """The deciding frames where the object had no LiDAR or radar points and no detection: no detector could see
     it."""
-    hidden = [s.frame for s in f.sightings if s.frame in f.deciding and s.points == 0 and s.nearest_any is None]
+    hidden = [s for s in f.sightings if s.frame in f.deciding and s.points == 0 and s.undetected]
     if not hidden:
         return []
     return [
-        f"at {frames_text(hidden)} it had no LiDAR or radar points (no detector could see it) and no detection of a "
-        f"tracked class within {NEAR_M:.0f} m"
+        f"at {frames_text([s.frame for s in hidden])} it had no LiDAR or radar points (no detector could see it) and "
+        f"{no_detection(hidden)}"
     ]
+
+
+def no_detection(sightings: Sequence[Sighting]) -> str:
+    """``no detection of a tracked class within 2 m``, or where detections lay that near but each nearer another
+    annotated object (``Near.on_other``): ``no detection of its own within 2 m (at frame 3 car m4, 1.8 m away,
+    lay 0.1 m from car GT 26e63e)``: that object's detection, not a sight of this one."""
+    others = [s for s in sightings if s.nearest_any is not None and s.nearest_any.on_other is not None]
+    if not others:
+        return f"no detection of a tracked class within {NEAR_M:.0f} m"
+    where = []
+    for s in others:
+        n = s.nearest_any
+        gt_id, cls, d = n.on_other
+        at = f"at frame {s.frame} " if len(sightings) > 1 else ""
+        where.append(
+            f"{at}{n.class_name} {meas_name(n.meas)}, {n.distance_m:.1f} m away, lay {d:.1f} m from {cls} GT "
+            f"{short_id(gt_id)}"
+        )
+    return f"no detection of its own within {NEAR_M:.0f} m ({'; '.join(where)})"
 
 
 def _out_of_reach(lost: LostTrack, s: Sighting) -> bool:
@@ -716,7 +735,7 @@ def _unused(f: Finding) -> list[tuple[tuple[int, int], str]]:
                 continue
             n = s.nearest_own
             if n is None:
-                m = s.nearest_any
+                m = s.seen
                 text = (
                     f"at frame {x} {meas_name(m.meas)} ({f.class_name}, score {m.score:.2f}, {m.distance_m:.1f} m "
                     "from it) was dropped by preprocessing (score threshold or NMS)"
@@ -1107,26 +1126,28 @@ def _miss(f: Finding) -> list[str]:
     mode = UseMode(f.mode)
     inside = f"{s.points} LiDAR and radar points in its box"
     parts = []
-    if s.nearest_any is None and s.points == 0:
+    if s.undetected and s.points == 0:
         carried = "" if s.on_it else ", and no track carried it through"  # said only of an object no track was on
         parts.append(
-            f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and no detection "
-            f"of a tracked class within {NEAR_M:.0f} m{carried}"
+            f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and "
+            f"{no_detection([s])}{carried}"
         )
-    elif s.nearest_any is None:
+    elif s.undetected and s.nearest_any is None:
         parts.append(
             f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
             f"({inside}): the detector missed it"
         )
-    elif s.nearest_own is None and s.nearest_any.class_name != f.class_name:
-        n = s.nearest_any
+    elif s.undetected:
+        parts.append(f"at frame {f.frame} the detector gave {name} ({inside}) {no_detection([s])}: it missed it")
+    elif s.nearest_own is None and s.seen.class_name != f.class_name:
+        n = s.seen
         parts.append(
             f"at frame {f.frame} the detector gave no {f.class_name} detection within {NEAR_M:.0f} m of {name} "
             f"({inside}), but a {n.class_name} detection, {meas_name(n.meas)} (score {n.score:.2f}), "
             f"{n.distance_m:.1f} m away: the detector gave it the wrong class"
         )
     elif s.nearest_own is None:
-        n = s.nearest_any
+        n = s.seen
         parts.append(
             f"at frame {f.frame} detection {meas_name(n.meas)} (score {n.score:.2f}) lay {n.distance_m:.1f} m from "
             f"{name} but was dropped by preprocessing (score threshold or NMS)"
@@ -1185,7 +1206,7 @@ def _coalescence(f: Finding) -> list[str]:
         )
         parts += _out_of_reach_on_it(f, s)
     mode = UseMode(f.mode)
-    if s.nearest_any is None:
+    if s.undetected:
         parts.append(
             f"the detector gave GT {short_id(f.gt_id or '')} no detection of its own within {NEAR_M:.0f} m "
             f"({s.points} LiDAR and radar points): one detection, or none, for two objects"
@@ -1197,13 +1218,13 @@ def _coalescence(f: Finding) -> list[str]:
             f"{went_phrase(s.went, mode)}"
         )
         parts += _went_unshown(s)
-    elif s.nearest_any.class_name != f.class_name:
-        n = s.nearest_any
+    elif s.seen.class_name != f.class_name:
+        n = s.seen
         parts.append(
             f"the detector saw it only as another class ({n.class_name} {meas_name(n.meas)}, score {n.score:.2f})"
         )
     else:
-        n = s.nearest_any
+        n = s.seen
         parts.append(
             f"its detection {meas_name(n.meas)} (score {n.score:.2f}, {n.distance_m:.1f} m away) was dropped by "
             "preprocessing (score threshold or NMS)"

@@ -52,6 +52,9 @@ def test_every_detection_is_output_with_its_box_and_score_and_matches_keep_the_i
     assert est[0].translation_m == (21.0, 0.5, 1.0) and est[0].score == 0.2
     assert est[1].velocity_mps == (2.0, 0.0) and est[1].meas_index == 1
     cost = sink.of_type(CostMatrix)[0]
+    # an infinite entry is beyond the class's distance threshold (dev set scene-1077 megvii greedy id_switch:1 said
+    # "outside its gate" of a tracker with no gate)
+    assert cost.scale.unit == "m" and cost.scale.threshold == 4.0
     assert [c.kind for c in cost.cols] == [AxisKind.TRACK] * 2 + [AxisKind.NEW_TRACK] * 2
     assert cost.cost[1, 0] == pytest.approx(0.0) and cost.cost[0, 1] == pytest.approx(np.hypot(1.0, 0.5))
     assert cost.cost[0, 2] == 4.0 and np.isinf(cost.cost[0, 3])

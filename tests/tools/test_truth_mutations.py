@@ -118,6 +118,14 @@ PLANTED = {
         "at frame 3 track 7 was matched to GT aaaaaa and also lay within 2 m of GT bbbbbb",
         "at frame 3 track 5 was matched to GT aaaaaa and also lay within 2 m of GT bbbbbb",
     ),
+    # dev set square (python -m tools.truth --square --all-scenes): 14 clauses of a coalescence matched at a box the
+    # devkit interpolated for a track not output there were read by no checker
+    "matched: coalescence at a box the evaluation interpolated for the track": (
+        "at frame 3 track 7 was not output; the box the evaluation interpolated for it in its place was matched to "
+        "GT aaaaaa and also lay within 2 m of GT bbbbbb",
+        "at frame 3 track 7 was output beyond the evaluation's range for the class, so its box was dropped; the box "
+        "the evaluation interpolated for it in its place was matched to GT aaaaaa and also lay within 2 m of GT bbbbbb",
+    ),
     "matched: not counted": (
         "track 5 was output on it, but its score averaged over its 3 frames, 0.40, is below the car threshold "
         "0.500: the evaluation did not count it",
@@ -319,6 +327,32 @@ def test_each_planted_detector_statement_is_caught_against_the_files(name: str) 
     assert check_text(true, ctx, raw, _eval(), scene=_scene()).found == [], true
     caught = check_text(false, ctx, raw, _eval(), scene=_scene()).found
     assert [c.kind for c in caught][:1] == [name.split(":")[0]], (false, caught)
+
+
+def test_another_objects_detection_said_to_be_a_sight_of_this_one_is_caught() -> None:
+    """A truck (GT cccccc) 0.1 m from m1 at frame 3: m1 is the truck's detection, not car GT B seen as a truck (dev set
+    scene-1094 centerpoint ab3dmot, a car detection 0.1 m from a car called a bicycle's wrong class)."""
+    from tools.truth.scene import Annotation
+
+    scene = _scene()
+    scene.objects[3]["c" * 32] = Annotation("truck", (31.1, 0.0), 40)
+    ctx = Context(C, 3, GT_B)
+    wrong_class = (
+        "at frame 3 the detector gave no car detection within 2 m of car GT bbbbbb (0 LiDAR and radar points in its "
+        "box), but a truck detection, m1 (score 0.40), 1.0 m away"
+    )
+    assert [c.kind for c in check_text(wrong_class, ctx, None, _eval(), scene=scene).found] == ["detector"]
+    seen_as = "at frame 3 the detector saw it only as another class (truck m1 1.00 m away)"
+    assert [c.kind for c in check_text(seen_as, ctx, None, _eval(), scene=scene).found] == ["detector"]
+    true = (
+        "at frame 3 the detector gave car GT bbbbbb (0 LiDAR and radar points in its box) no detection of its own "
+        "within 2 m (truck m1, 1.0 m away, lay 0.1 m from truck GT cccccc): it missed it"
+    )
+    assert check_text(true, ctx, None, _eval(), scene=scene).found == []
+    for planted in (true.replace("lay 0.1 m", "lay 0.6 m"), true.replace("truck GT cccccc", "truck GT aaaaaa")):
+        assert [c.kind for c in check_text(planted, ctx, None, _eval(), scene=scene).found] == ["detector"], planted
+    # without the truck, m1 is the car's own: "no detection of its own" is false
+    assert [c.kind for c in check_text(true, ctx, None, _eval(), scene=_scene()).found] == ["detector"]
 
 
 def test_another_run_said_not_to_have_a_switch_it_had_no_track_for_is_caught() -> None:

@@ -10,6 +10,7 @@ out without saying so is the issue's class 4 ("misleading").
 
 from __future__ import annotations
 
+import math
 import re
 
 from tools.truth.printing import frames_of
@@ -39,6 +40,14 @@ OUTPUT_ON = re.compile(rf"at frame (\d+) track \d+ \((\w+)\) was output on detec
 ITS_DETECTION = re.compile(rf"its detection m(\d+) \(score ({_F}), ({_F}) m away\)")
 OTHER_CLASS = re.compile(rf"at ({_FRAMES}) the detector saw it only as another class \(([^)]*)\)")
 OTHER_ITEM = re.compile(rf"(\w+) m(\d+) ({_F}) m away")
+NOT_ITS_OWN = re.compile(
+    rf"at ({_FRAMES}) (?:the detector gave (?:\w+ GT (\w+) \(\d+ LiDAR and radar points in its box\) )?|(?:\w+ GT "
+    rf"(\w+)|it) had no LiDAR or radar points \(no detector could see it\) and )no detection of its own within 2 m "
+    rf"\(((?:[^()]|\([^()]*\))*)\)"
+)
+"""Detections within 2 m of an object, each nearer another annotated object: ``(at frame 3 car m4, 1.8 m away, lay
+0.1 m from car GT 26e63e; ...)``."""
+ITS_OWN_ITEM = re.compile(rf"(?:at frame (\d+) )?(\w+) m(\d+), ({_F}) m away, lay ({_F}) m from \w+ GT (\w+)")
 EGO = re.compile(rf"it lies ({_F}) m from the ego vehicle, (inside|beyond) the evaluation's ({_F}) m range")
 INTERPOLATED_AT = re.compile(
     rf"the evaluation scored (?:it|GT \w{{6}}) at a box it interpolated, ({_F}) m from the annotation"
@@ -126,6 +135,8 @@ def check_detector(
         if ann is None or scene.near(x, ann.xy_m, m[2]) or ann.points != int(m[4]):
             own = scene.near(x, ann.xy_m, m[2]) if ann else None
             bad("detector", m[0], f"{m[2]} detections within reach: {own}; points {ann.points if ann else None}")
+        elif (o := scene.owner(x, int(m[6]), ann.xy_m)) is not None:
+            bad("detector", m[0], f"m{m[6]} lies nearer GT {o[0][:6]} ({o[1]:.2f} m): that object's detection")
         score_distance(m[0], x, int(m[6]), m[7], m[8], ann, m[5])
     for m in NONE_ANY.finditer(text):
         out.checked["detector"] += 1
@@ -144,6 +155,25 @@ def check_detector(
                 wrong[x] = None if a is None else (a.points, near)
         if wrong:
             bad("detector", m[0], f"(points, detections within reach) by frame: {wrong}")
+    for m in NOT_ITS_OWN.finditer(text):
+        frames, short = frames_of(m[1]), m[2] or m[3]
+        out.checked["detector"] += 1
+        owners = {}
+        for x in frames:
+            a = gt_xy(x, short)
+            owners[x] = {j: scene.owner(x, j, a.xy_m) for j in scene.near(x, a.xy_m)} if a is not None else None
+        if any(o is None or None in o.values() for o in owners.values()):
+            bad("detector", m[0], f"within 2 m by frame, each detection's nearer object (None: the object's): {owners}")
+            continue
+        for item in ITS_OWN_ITEM.finditer(m[4]):
+            out.checked["detector"] += 1
+            x = int(item[1]) if item[1] else frames[0]
+            a, d, o = gt_xy(x, short), det(x, int(item[3])), owners.get(x, {}).get(int(item[3]))
+            if d is None or a is None or o is None or d.class_name != item[2] or not o[0].startswith(item[6]):
+                bad("detector", item[0], f"m{item[3]} at frame {x}: {d}, nearer {o}")
+            elif not _close(item[4], math.dist(d.xy_m, a.xy_m)) or not _close(item[5], o[1]):
+                away = math.dist(d.xy_m, a.xy_m)
+                bad("detector", item[0], f"m{item[3]} lies {away:.2f} m away, {o[1]:.2f} m from the other object")
     for m in OTHER_CLASS.finditer(text):
         frames = frames_of(m[1])
         for item in OTHER_ITEM.finditer(m[2]):
@@ -153,7 +183,11 @@ def check_detector(
                 d, a = det(x, int(item[2])), gt_xy(x)
                 if d is not None and a is not None and d.class_name == item[1] and d.class_name != class_name:
                     dist = ((d.xy_m[0] - a.xy_m[0]) ** 2 + (d.xy_m[1] - a.xy_m[1]) ** 2) ** 0.5
-                    ok = ok or (_close(item[3], dist) and not scene.near(x, a.xy_m, class_name))
+                    ok = ok or (
+                        _close(item[3], dist)
+                        and not scene.near(x, a.xy_m, class_name)
+                        and scene.owner(x, int(item[2]), a.xy_m) is None  # this object's, not another's
+                    )
             if not ok:
                 bad("detector", item[0], f"no frame of {frames} has it so with no {class_name} detection in reach")
     for m in PRESENCE.finditer(text):

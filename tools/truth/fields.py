@@ -281,9 +281,13 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
             if what == "no detection near":
                 return "" if not near else f"detections within {NEAR_M} m: {near}"
             if what == "detection near":
-                m = v[1]
-                if not near or min(near, key=lambda j: d[j]) != m:
-                    return "not the nearest detection within reach"
+                m, owner = v[1], {j: src.scene.owner(x, j, tuple(xy)) for j in near}
+                owner = {j: o[0] if o is not None else None for j, o in owner.items()}
+                own = [j for j in near if owner[j] is None]  # the detections nearer this object than any other
+                if not near or min(own or near, key=lambda j: d[j]) != m:
+                    return "not the nearest detection within reach (of this object's, where it has one)"
+                if owner[m] != v[5]:
+                    return f"the detection lies nearer GT {owner[m]}" if owner[m] else "the detection is the object's"
                 ok = dets[m].class_name == v[2] and abs(dets[m].score - v[3]) < ATOL and abs(d[m] - v[4]) < ATOL
                 return "" if ok else "class, score or distance differ"
             own = [j for j in near if dets[j].class_name == c]
@@ -515,12 +519,16 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
     false_track = f.false_output.track_id if f.false_output is not None else None
     for x in frames:
         xy = src.gt_xy(x, f.gt_id)
-        if name in ("NO_DETECTION", "UNSEEN"):
-            if xy is None or src.near(x, xy)[1]:
-                return f"a detection lies within reach at frame {x}"
+        if name in ("NO_DETECTION", "UNSEEN"):  # none of its own: each one within reach lies nearer another object
+            if xy is None or _own_near(src, x, xy):
+                return f"a detection of the object lies within reach at frame {x}"
             hidden = src.points(x, f.gt_id) == 0
             if hidden != (name == "UNSEEN"):
                 return f"the object {'had no' if hidden else 'had'} points at frame {x}"
+        elif name == "OTHER_CLASS" and f.false_output is None:  # the object's own detections: another class only
+            mine = _own_near(src, x, xy) if xy is not None else []
+            if not mine or any(src.scene.detections[x][j].class_name == c for j in mine):
+                return f"no detection of the object's own of another class only at frame {x}"
         elif name == "NOT_OUTPUT" and f.lost is not None:
             if src.box(x, f.lost.track_id) is not None:
                 return f"track {f.lost.track_id} was output at frame {x}"
@@ -534,7 +542,9 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             if status != "interpolated" or not far:
                 return "the evaluation's box of the object is within the track's reach"
         elif name == "INTERPOLATED":
-            if f.gt_id is None or not _interpolated_decided(src, x, c, f.gt_id):
+            # a miss: a box interpolated nearer than 2 m would still match a counted track on the annotation
+            least_m = NEAR_M if f.kind.value == "miss" else EVALUATED_OFFSET_M
+            if f.gt_id is None or not _interpolated_decided(src, x, c, f.gt_id, least_m):
                 return "the evaluation scored no far interpolated box, nor one out of a counted track's reach"
         elif name == "DETECTION_UNUSED":
             if xy is None:
@@ -581,24 +591,33 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             if src.status(x, gt_id)[0] in ("scored", "interpolated"):
                 return "the evaluation has a box"
     if name == "NO_DETECTION" and f.lost is not None:  # complete: every deciding frame without a detection
+        # of its own, nor one of its class within reach (which the text names, however near another object it lies)
         gaps = [
             x
             for x in f.deciding
-            if (xy := src.gt_xy(x, f.gt_id)) is not None and not src.near(x, xy)[1] and src.points(x, f.gt_id) > 0
+            if (xy := src.gt_xy(x, f.gt_id)) is not None
+            and not _own_near(src, x, xy)
+            and not any(src.scene.detections[x][j].class_name == c for j in src.near(x, xy)[1])
+            and src.points(x, f.gt_id) > 0
         ]
         if tuple(gaps) != tuple(frames):
-            return f"frames without a detection: {gaps}"
+            return f"frames without a detection of the object's own: {gaps}"
     return ""
 
 
-def _interpolated_decided(src: Sources, x: int, c: str, gt_id: str) -> bool:
-    """Whether the devkit scored object ``gt_id`` at ``x`` at an interpolated box ``EVALUATED_OFFSET_M`` or more
-    from its annotation, or 2 m or more from a counted track's box within 2 m of the annotation."""
+def _own_near(src: Sources, x: int, xy: np.ndarray) -> list[int]:
+    """The detections within reach of the object at ``xy`` that lie nearer it than any other annotated object."""
+    return [j for j in src.near(x, xy)[1] if src.scene.owner(x, j, (float(xy[0]), float(xy[1]))) is None]
+
+
+def _interpolated_decided(src: Sources, x: int, c: str, gt_id: str, least_m: float) -> bool:
+    """Whether the devkit scored object ``gt_id`` at ``x`` at an interpolated box ``least_m`` or more from its
+    annotation, or 2 m or more from a counted track's box within 2 m of the annotation."""
     status, at = src.status(x, gt_id)
     xy = src.gt_xy(x, gt_id)
     if status != "interpolated" or xy is None:
         return False
-    if math.dist(at, xy) >= EVALUATED_OFFSET_M:
+    if math.dist(at, xy) >= least_m:
         return True
     counted = _counted_on(src, x, c, xy)
     return any(math.dist(next(p for tt, _, p in src.ev.boxes[x] if tt == t), at) >= NEAR_M for t in counted)

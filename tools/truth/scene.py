@@ -102,6 +102,15 @@ class SceneTruth:
         boxes = self.untracked[frame] if self.untracked is not None and frame < len(self.untracked) else []
         return [f"{d.class_name} {d.score:.2f}" for d in boxes if math.dist(d.xy_m, xy_m) < NEAR_M]
 
+    def owner(self, frame: int, m: int, xy_m: tuple[float, float]) -> tuple[str, float] | None:
+        """The annotated object (id, distance m) nearest detection ``m`` at ``frame`` when it lies nearer the
+        detection than the object at ``xy_m`` does, else None (the detection is that object's)."""
+        d = self.detections[frame][m].xy_m
+        best = min(self.objects[frame].items(), key=lambda kv: math.dist(kv[1].xy_m, d), default=None)
+        if best is None or math.dist(best[1].xy_m, d) >= math.dist(xy_m, d) - 1e-6:
+            return None
+        return best[0], math.dist(best[1].xy_m, d)
+
     def near(self, frame: int, xy_m: tuple[float, float], class_name: str | None = None) -> list[int]:
         """Detections of ``frame`` within ``NEAR_M`` of ``xy_m`` (of ``class_name`` only, if given)."""
         d = self.distances(frame, xy_m)

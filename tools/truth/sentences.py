@@ -168,7 +168,11 @@ COVERED = re.compile(
     r"tracks? ([\d, ]+) lay within \d m of it and (?:was|were) counted, but the evaluation matched (?:it|each) to "
     r"another"
 )
-COALESCED = re.compile(r"at frame (\d+) track (\d+) was matched to (GT \w+(?:, GT \w+)*) and also lay within")
+COALESCED = re.compile(
+    r"at frame (\d+) track (\d+) (?:(was not output|was output beyond the evaluation's range for the class, so its "
+    r"box was dropped); the box the evaluation interpolated for it in its place )?was matched to "
+    r"(GT \w+(?:, GT \w+)*) and also lay within"
+)
 MATCHED_INSTEAD = re.compile(r"the evaluation matched it to another track \(track (\d+)\)")
 NOT_COUNTED = re.compile(
     r"track (\d+) was output on it(?: \(score [\d.]+\))?, but [^:]*?: the evaluation did not count it"
@@ -391,6 +395,11 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None
                 )
     for m in COALESCED.finditer(text):
         x, t = int(m[1]), m[2]
+        if m[3] is not None:  # the box matched is one the devkit interpolated: the track's own was not kept there
+            out.checked["matched"] += 1
+            output = t in ev.submitted.get(x, set())
+            if x in ev.kept_frames.get(t, ()) or output != m[3].startswith("was output beyond"):
+                bad("matched", m[0], f"track {t} at frame {x}: submitted {output}, kept by the devkit's filters")
         for g in ctx.covered:
             out.checked["matched"] += 1
             got = ev.matched_track(c, x, g)

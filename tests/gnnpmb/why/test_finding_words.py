@@ -598,3 +598,25 @@ def test_a_false_tracks_filtered_box_far_from_the_detection_it_used_is_not_said_
         in (said(0.87))
     )
     assert "at frame 3 track 21 (truck) was output on detection m15 (truck, score 0.57)" in said(0.0)
+
+
+def test_a_detection_nearer_another_object_is_said_to_be_that_ones() -> None:
+    # dev set scene-1094 centerpoint ab3dmot: "the detector gave no bicycle detection within 2 m of bicycle GT
+    # d40890 (90 LiDAR and radar points in its box), but a car detection, m14 (score 0.84), 1.8 m away: the detector
+    # gave it the wrong class", of a car detection 0.1 m from car GT 26e63e
+    car = Near(14, "car", 0.84, 1.79, True, ("26e63e" + "0" * 26, "car", 0.13))
+    seen = Sighting(13, 90, None, car, None, None, ())
+    f = finding(FailureKind.MISS, sightings=(seen,), blame=(Blame(Rule.NO_DETECTION, (13,)),))
+    line = why_lines(f)[0]
+    assert (
+        "at frame 13 the detector gave bicycle GT bf3d85 (90 LiDAR and radar points in its box) no detection of its "
+        "own within 2 m (car m14, 1.8 m away, lay 0.1 m from car GT 26e63e): it missed it" in line
+    )
+    assert "wrong class" not in line
+    lost = LostTrack(26, 11, (), None, None, None)
+    both = (seen, Sighting(12, 80, None, None, None, None, ()))
+    f = finding(FailureKind.ID_SWITCH, lost, sightings=both, blame=(Blame(Rule.NO_DETECTION, (12, 13)),))
+    assert (
+        "at frames 12, 13 the detector gave no detection of its own within 2 m (at frame 13 car m14, 1.8 m away, lay "
+        "0.1 m from car GT 26e63e), though it had 80–90 LiDAR and radar points" in why_lines(f)[0]
+    )

@@ -1,4 +1,5 @@
-"""The focus summary's object table names the nearest detection preprocessing kept as such (truth45 checker)."""
+"""The focus summary's object table: the nearest detection preprocessing kept, named as such, and a track on the
+object that the evaluation matched to a neighbour."""
 
 from __future__ import annotations
 
