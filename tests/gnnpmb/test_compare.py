@@ -179,7 +179,7 @@ def test_a_track_the_other_shows_near_the_object_but_gives_to_another_is_named()
 
 
 def test_a_track_still_on_the_object_that_the_matching_gave_to_a_neighbour_is_no_id_change() -> None:
-    # truth45 checker, dev set scene-0553 centerpoint (two bicycles side by side): "cbmot switched track 43 -> 49"
+    # independent audit r45, dev set scene-0553 centerpoint (two bicycles side by side): "cbmot switched track 43 -> 49"
     # where track 43 still lay within 2 m of the object and the devkit kept matching it there; the one-to-one
     # matching had only given 43 to the neighbour this frame
     gt = gt_boxes([("near", "bicycle", 0.0, 0.0), ("next", "bicycle", 1.5, 0.0)])
@@ -196,7 +196,7 @@ def test_a_track_still_on_the_object_that_the_matching_gave_to_a_neighbour_is_no
 
 
 def test_a_track_still_output_on_the_object_below_the_show_floor_is_no_id_change() -> None:
-    # truth45 checker, dev set scene-1077 megvii cphd: "cphd switched track 94 -> 107" at frame 34, where track 94
+    # independent audit r45, dev set scene-1077 megvii cphd: "cphd switched track 94 -> 107" at frame 34, where track 94
     # was still output 0.05 m from the pedestrian at a weight below the show floor and the devkit matched it there
     gt = gt_boxes([("ped", "pedestrian", 0.0, 0.0)])
     faint = dataclasses.replace(est(94, "pedestrian", 0.05, 0.0), existence=0.3)

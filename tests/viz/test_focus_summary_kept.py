@@ -30,7 +30,7 @@ def test_the_object_table_says_its_nearest_detection_is_the_nearest_kept_one() -
 
 
 def test_the_object_table_says_which_object_the_evaluation_matched_a_track_on_it_to() -> None:
-    # truth45 checker, 14 focus documents (dev and demo): 35 of 89 tracks listed as "output on it" within 2 m of a
+    # independent audit r45, 14 focus documents (dev and demo): 35 of 89 tracks listed as "output on it" within 2 m of a
     # pedestrian were matched by the devkit to a neighbour, e.g. dev scene-1077 megvii cphd identity_theft:2, frame
     # 23: "107 (0.46; track average 0.63), 112 (...), 83 (...), 94 (...)" around GT ceb713
     from gnnpmb.eval.evaluated import TrackEval
