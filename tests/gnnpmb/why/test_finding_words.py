@@ -566,7 +566,7 @@ def test_a_track_out_of_reach_says_when_the_box_weighted_the_right_way_would_be_
 
 
 def test_another_run_that_kept_the_object_names_only_the_track_its_evaluation_matched_to_it() -> None:
-    # independent audit r45, dev set scene-0061 pointpillars phd id_switch at frame 35: "gnn on the same detections did not
+    # audit r45, dev set scene-0061 pointpillars phd id_switch at frame 35: "gnn on the same detections did not
     # fail here: its tracks 460, 374 were output on the object and counted", where gnn's evaluation matched the
     # object to track 374 and track 460, 1.5 m off, to the neighbouring pedestrian 25b23b (288 of 1,528 such lines)
     from gnnpmb.why.findings import OnObject, OtherRun
@@ -584,7 +584,7 @@ def test_another_run_that_kept_the_object_names_only_the_track_its_evaluation_ma
 
 
 def test_a_false_tracks_filtered_box_far_from_the_detection_it_used_is_not_said_to_sit_on_it() -> None:
-    # independent audit r45, dev set scene-0553 centerpoint prob3dmot false_track:3: "at frame 3 track 21 (truck) was output
+    # audit r45, dev set scene-0553 centerpoint prob3dmot false_track:3: "at frame 3 track 21 (truck) was output
     # on detection m15 (truck, score 0.57)", though its filtered box lay 0.87 m from m15
     from gnnpmb.why.findings import FalseOutput, Near
 
