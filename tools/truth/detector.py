@@ -36,7 +36,9 @@ HIDDEN = re.compile(
     r"( of a tracked class)? within 2 m"
 )
 UNUSED = re.compile(rf"at frame (\d+) m(\d+) \((?:(\w+), )?score ({_F}), ({_F}) m from it")
-OUTPUT_ON = re.compile(rf"at frame (\d+) track \d+ \((\w+)\) was output on detection m(\d+) \((\w+), score ({_F})\)")
+OUTPUT_ON = re.compile(
+    rf"at frame (\d+) track \d+ \((\w+)\) was output (?:on|{_F} m from) detection m(\d+) \((\w+), score ({_F})\)"
+)
 ITS_DETECTION = re.compile(rf"its detection m(\d+) \(score ({_F}), ({_F}) m away\)")
 OTHER_CLASS = re.compile(rf"at ({_FRAMES}) the detector saw it only as another class \(([^)]*)\)")
 OTHER_ITEM = re.compile(rf"(\w+) m(\d+) ({_F}) m away")
