@@ -1138,7 +1138,9 @@ def _miss(f: Finding) -> list[str]:
             f"({inside}): the detector missed it"
         )
     elif s.undetected:
-        parts.append(f"at frame {f.frame} the detector gave {name} ({inside}) {no_detection([s])}: it missed it")
+        parts.append(
+            f"at frame {f.frame} the detector gave {name} ({inside}) {no_detection([s])}: the detector missed it"
+        )
     elif s.nearest_own is None and s.seen.class_name != f.class_name:
         n = s.seen
         parts.append(

@@ -346,7 +346,7 @@ def test_another_objects_detection_said_to_be_a_sight_of_this_one_is_caught() ->
     assert [c.kind for c in check_text(seen_as, ctx, None, _eval(), scene=scene).found] == ["detector"]
     true = (
         "at frame 3 the detector gave car GT bbbbbb (0 LiDAR and radar points in its box) no detection of its own "
-        "within 2 m (truck m1, 1.0 m away, lay 0.1 m from truck GT cccccc): it missed it"
+        "within 2 m (truck m1, 1.0 m away, lay 0.1 m from truck GT cccccc): the detector missed it"
     )
     assert check_text(true, ctx, None, _eval(), scene=scene).found == []
     for planted in (true.replace("lay 0.1 m", "lay 0.6 m"), true.replace("truck GT cccccc", "truck GT aaaaaa")):

@@ -610,7 +610,7 @@ def test_a_detection_nearer_another_object_is_said_to_be_that_ones() -> None:
     line = why_lines(f)[0]
     assert (
         "at frame 13 the detector gave bicycle GT bf3d85 (90 LiDAR and radar points in its box) no detection of its "
-        "own within 2 m (car m14, 1.8 m away, lay 0.1 m from car GT 26e63e): it missed it" in line
+        "own within 2 m (car m14, 1.8 m away, lay 0.1 m from car GT 26e63e): the detector missed it" in line
     )
     assert "wrong class" not in line
     lost = LostTrack(26, 11, (), None, None, None)
