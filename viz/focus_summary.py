@@ -292,6 +292,8 @@ def _gt_markdown(focus: FocusTarget, view: TrackerView, gt_id: str, seen: tuple[
         elif s.nearest_any is not None:
             n = s.nearest_any
             why = "another class" if n.class_name != focus.class_name else "dropped by preprocessing"
+            if n.on_other is not None:  # nearer another object: that one's detection, not a sight of this one
+                why += f"; {n.on_other[2]:.1f} m from {n.on_other[1]} GT {short_id(n.on_other[0])}"
             nearest = f"none; m{n.meas} {n.class_name} at {n.distance_m:.1f} m (score {n.score:.2f}, {why})"
             sent = "—"
         else:

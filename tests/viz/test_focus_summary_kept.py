@@ -43,3 +43,18 @@ def test_the_object_table_says_which_object_the_evaluation_matched_a_track_on_it
     assert on_object_text(mine, 23, gt) == "107 (0.46; track average 0.63)"
     assert on_object_text(theirs, 23, gt) == "94 (0.64; track average 0.64; matched to GT 4f67ad)"
     assert on_object_text(theirs) == "94 (0.64; track average 0.64)"  # no frame: nothing said of the match
+
+
+def test_the_object_table_says_whose_a_detection_of_another_class_beside_it_is() -> None:
+    # dev set scene-1094 centerpoint ab3dmot miss:8, frame 3: "none; m14 car at 1.8 m (score 0.66, another class)"
+    # of a car detection 0.1 m from car GT 26e63e beside the bicycle
+    g = GtFrame(3, GtStatus.SCORED, (0.0, 0.0), (0.0, 0.0), None, 90, 20.0, 40.0)
+    car = Near(14, "car", 0.66, 1.8, True, ("26e63e" + "0" * 26, "car", 0.1))
+    seen = (Sighting(3, 90, g, car, None, None, ()),)
+    view = SimpleNamespace(
+        facts=SimpleNamespace(mode=lambda c, frames: UseMode.ASSIGNED),
+        evidence=SimpleNamespace(report=SimpleNamespace(threshold_of=lambda c: None)),
+    )
+    focus = FocusTarget("t", 3, (0.0, 0.0), "bicycle", {"ab3dmot": (23,)}, ())
+    text = "\n".join(_gt_markdown(focus, view, "d40890" + "0" * 26, seen))
+    assert "| 3 | 90 | none; m14 car at 1.8 m (score 0.66, another class; 0.1 m from car GT 26e63e) |" in text
