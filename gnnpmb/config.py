@@ -267,7 +267,8 @@ class PmbParams(Section):
     neighbour of its class (miss_p_detect_neighbour_m). measure_velocity adds [vx, vy] to the measurement (R adds
     r_vx, r_vy; clutter intensity x clutter_velocity_density per (m/s)^2). A Bernoulli missed n frames in a row is
     scored s r d^n (miss_score_decay d; with miss_score_mean_min_frames N > 0, one born or detected on at least N
-    frames max(s, m) r d^n, m its mean score on those frames) and not output beyond output_max_misses. Heading and
+    frames max(s, m) r d^n, m its mean score on those frames) and not output beyond output_max_misses, nor
+    while missed with r below coasting_min_existence. Heading and
     size likelihood (``gnnpmb.box_likelihood``): a sigma of 0 leaves that part out. gate_giou_min gates on the
     bird's-eye GIoU of the predicted box (the filtered centre with the last detection's size and heading). Defaults
     that differ from the paper's were chosen on the mini_train splits: why and the figures, ``docs/results.md`` and
@@ -308,6 +309,11 @@ class PmbParams(Section):
     miss_p_detect_neighbour_existence: float = param(
         0.5, "least existence r of such a neighbour", unit_interval(True, True)
     )
+    miss_p_detect_last_score: int = param(
+        1,
+        "1 = a missed track's P_D is min(its last detection score, the cap) (the paper's), 0 = the cap alone",
+        SWITCH,
+    )
     measure_velocity: int = param(1, "1 = measure [x, y, vx, vy], 0 = the paper's [x, y]", SWITCH, paper=0)
     clutter_velocity_density: float = param(
         0.02,
@@ -327,6 +333,11 @@ class PmbParams(Section):
     )
     output_max_misses: int = param(
         1000, "a Bernoulli missed more than this many frames in a row is not output (kept in the filter)", at_least(0)
+    )
+    coasting_min_existence: float = param(
+        0.0,
+        "a Bernoulli missed this frame is output only while its existence r is at least this (0: off)",
+        unit_interval(True, True),
     )
     heading_std_rad: float = param(
         0.0, "sigma_psi of a detection's heading (0: heading not used)", Range(0.0, 1.5, True, True), "rad", paper=0.0

@@ -517,6 +517,8 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         threshold = self.params.extraction_threshold
         b = posterior
         keep = (b.existence >= threshold) & (b.misses <= self.params.output_max_misses)
+        if self.params.coasting_min_existence > 0.0:
+            keep &= (b.misses == 0) | (b.existence >= self.params.coasting_min_existence)
         score = coasting_scores(b, self.params.miss_score_mean_min_frames)
         det, track_id, mean, existence, misses = b.det, b.track_id, b.mean, b.existence, b.misses
         if not keep.all():
@@ -573,6 +575,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
                 self.miss_p_detect_max(prior),
                 self.box,
                 self.params.gate_giou_min,
+                self.params.miss_p_detect_last_score == 1,
             )
 
         if len(self.hypotheses) == 1:

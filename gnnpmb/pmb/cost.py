@@ -140,12 +140,14 @@ def local_hypotheses(
     miss_p_detect_max: float | np.ndarray = 1.0,
     box: BoxShapeModel | None = None,
     gate_giou_min: float = -1.0,
+    last_score: bool = True,
 ) -> LocalHypotheses:
     """Gate every (track, measurement) pair and compute the local hypothesis likelihoods (module docstring); a
     missed track's P_D is its last detection score capped at ``miss_p_detect_max`` (``PmbParams``; one cap, or (K,)
     one per Bernoulli, ``PmbCore.miss_p_detect_max``); ``box``: the
     heading and size model (None or disabled: position only); ``gate_giou_min`` > -1: a pair must also overlap
-    with bird's-eye GIoU >= it (``overlap_gate``)."""
+    with bird's-eye GIoU >= it (``overlap_gate``); ``last_score`` False: a missed track's P_D is the cap alone
+    (``[pmb] miss_p_detect_last_score = 0``)."""
     gating = gate_tracks(prior.mean, prior.cov, R, meas.z, gate_chi2)
     inn, d2, inside = gating.inn, gating.d2, gating.inside
     giou = None
@@ -153,7 +155,12 @@ def local_hypotheses(
         giou = overlap_gate(prior, meas, inside)
         inside = inside & (giou >= gate_giou_min)
     # missed_update caps P_D below 1 itself: a cap at or above 1 changes nothing
-    p_detect = prior.score if np.all(miss_p_detect_max >= 1.0) else np.minimum(prior.score, miss_p_detect_max)
+    if not last_score:
+        p_detect = np.broadcast_to(np.asarray(miss_p_detect_max, dtype=float), prior.score.shape)
+    elif np.all(miss_p_detect_max >= 1.0):
+        p_detect = prior.score
+    else:
+        p_detect = np.minimum(prior.score, miss_p_detect_max)
     miss_log_lik, miss_existence = missed_update(prior.existence, p_detect)
     with np.errstate(divide="ignore"):
         det = np.log(prior.existence)[:, None] + np.log(meas.boxes.score)[None, :] + log_likelihood(inn, d2)
