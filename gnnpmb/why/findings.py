@@ -381,7 +381,9 @@ class OtherRun:
     evaluation matched the object to there (None: none), and each of ``on_it`` carries its own matches
     (``OnObject.evaluated``), so a track on the object that the evaluation matched elsewhere is not said to have
     kept it; switched: its evaluation switched the object's track at that frame (an ID switch or identity theft, a
-    failure of another kind than a fragmentation's, a miss's or a coalescence's), so it is not said not to fail."""
+    failure of another kind than a fragmentation's, a miss's or a coalescence's), so it is not said not to fail;
+    unscored: no score threshold of its reached the evaluation's lowest recall in the class, so the evaluation
+    counted none of its tracks of the class (its failures there are outside the devkit's counts)."""
 
     tracker: str
     failed_same: bool
@@ -391,6 +393,7 @@ class OtherRun:
     missed: bool = False
     matched: int | None = None
     switched: bool = False
+    unscored: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -787,7 +787,10 @@ class _Context:
                 f.kind in SWITCHES and f.frame_index == self.f and _same_place(f, gt_id, xy, self.class_name)
                 for f in ev.report.failures
             )
-            out.append(OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed, matched, switched))
+            unscored = any(c.class_name == self.class_name and c.threshold is None for c in ev.report.classes)
+            out.append(
+                OtherRun(ev.tracker, failed, on_it, place, ev.facts.output_only, missed, matched, switched, unscored)
+            )
         return tuple(out)
 
 

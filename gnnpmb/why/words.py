@@ -1239,7 +1239,12 @@ def _others(f: Finding) -> list[str]:
     for o in f.others:
         counted = [x for x in o.on_it if x.counted]
         who = _other_name(f, o)
-        if f.gt_id is None:  # a false track on no object: the same mistake at the same place, or not
+        if o.unscored:  # its failures of the class are what matching every box finds, not the devkit's counts
+            out.append(
+                f"{who} reached no score threshold at the evaluation's lowest recall for {f.class_name}s: the "
+                f"evaluation counted none of its {f.class_name} tracks"
+            )
+        elif f.gt_id is None:  # a false track on no object: the same mistake at the same place, or not
             same = (
                 f"had a false {f.class_name} track here too"
                 if o.failed_same

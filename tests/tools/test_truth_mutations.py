@@ -1387,3 +1387,15 @@ def test_a_track_out_of_reach_of_an_interpolated_box_says_whether_the_right_way_
     assert found(3.0, out.format("1.0") + still.format("1.5")) == ["misleading"]
     assert found(2.4, out.format("1.6") + still.format("2.1")) == []
     assert found(2.4, out.format("1.6")) == ["misleading"]  # out of reach either way, unsaid
+
+
+def test_another_run_said_to_count_no_track_of_a_class_it_scored_is_caught() -> None:
+    """An unscored class: no threshold of the other run reached the devkit's lowest recall (``thresholds[c]`` None)."""
+    said = (
+        "pmbm on the same detections reached no score threshold at the evaluation's lowest recall for cars: the "
+        "evaluation counted none of its car tracks"
+    )
+    unscored = EvalFacts(thresholds={C: None})
+    assert check_text(said, CTX, None, _eval(), others={"pmbm": unscored}).found == []
+    caught = check_text(said, CTX, None, _eval(), others={"pmbm": _eval()}).found  # its cars scored at 0.5
+    assert [c.kind for c in caught] == ["other run"]

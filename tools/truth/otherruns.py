@@ -138,6 +138,21 @@ FALSE_HERE = re.compile(
 )
 
 
+UNSCORED = re.compile(
+    r"(\w+) on the same detections reached no score threshold at the evaluation's lowest recall for (\w+)s: the "
+    r"evaluation counted none of its \w+ tracks"
+)
+
+
+def check_other_unscored(text: str, c: str, others: Mapping[str, EvalFacts], out, bad) -> None:
+    """ "Reached no score threshold at the evaluation's lowest recall": the other run's devkit evaluation of class
+    ``c`` has no best-MOTA threshold (``devkit.EvalFacts.thresholds``), so it counted none of its tracks."""
+    for m, ev in _named_runs(UNSCORED, text, others):
+        out.checked["other run"] += 1
+        if m[2] != c or c not in ev.thresholds or ev.thresholds[c] is not None:
+            bad("other run", m[0], f"{m[1]}'s devkit evaluation of {c} has the threshold {ev.thresholds.get(c)}")
+
+
 def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapping[str, EvalFacts], out, bad) -> None:
     """ "Had a false track here too / had no false track here": whether the other run's accumulator counted a track
     box of class ``c`` within ``NEAR_M`` of the place (the object, or the false box) as a false positive at frame

@@ -223,6 +223,7 @@ def check_text(
     otherruns.check_others(text, ctx.kind, c, ctx.frame, ctx.gt_id, others or {}, scene, out, bad)
     where = _place(ctx, ev, scene)
     otherruns.check_other_false_tracks(text, c, ctx.frame, where, others or {}, out, bad)
+    otherruns.check_other_unscored(text, c, others or {}, out, bad)
     if ctx.gt_id is None:
         place.check_place(text, c, ctx.frame, where, scene, out, bad)
     place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)

@@ -620,3 +620,19 @@ def test_a_detection_nearer_another_object_is_said_to_be_that_ones() -> None:
         "at frames 12, 13 the detector gave no detection of its own within 2 m (at frame 13 car m14, 1.8 m away, lay "
         "0.1 m from car GT 26e63e), though it had 80–90 LiDAR and radar points" in why_lines(f)[0]
     )
+
+
+def test_another_run_whose_class_reached_no_recall_threshold_is_said_to_have_counted_none() -> None:
+    # audit r45, demo scene-0916 pointpillars: "ab3dmot on the same detections had a false bicycle track here too"
+    # where ab3dmot's bicycles reached no recall threshold, so the devkit counted none of its bicycle tracks (its
+    # failure list there is what matching every box finds)
+    from gnnpmb.why.findings import FalseOutput, OtherRun
+
+    out = FalseOutput(21, None, (0.0, 0.0), None, None, None, None, None, 0.5)
+    others = (OtherRun("ab3dmot", True, (), unscored=True),)
+    line = why_lines(finding(FailureKind.FALSE_TRACK, gt_id=None, false_output=out, others=others))[0]
+    assert (
+        "ab3dmot on the same detections reached no score threshold at the evaluation's lowest recall for bicycles: "
+        "the evaluation counted none of its bicycle tracks" in line
+    )
+    assert "false bicycle track here too" not in line
