@@ -232,6 +232,7 @@ class ModelParams(Section):
     coordinated-turn model (``motion_model = 1``, the PMB family's default since issue 32 Round 10: objects turning
     while missed; the paper's is constant velocity) has state [x, y, vx, vy, omega] and the extended Kalman predict
     (``gnnpmb.models.ct_model``); a new track's turn rate starts at 0 and decays by ``turn_rate_decay`` a keyframe.
+    ``coast_velocity_decay`` b < 1 slows a coasting Bernoulli (missed at its last update): v' = b v.
     Its four values were chosen on the mini_train splits of the demo and the dev set (``docs/results.md``).
     """
 
@@ -254,6 +255,11 @@ class ModelParams(Section):
     birth_turn_rate_std_rps: float = param(0.05, "a new track's turn-rate std", POSITIVE, "rad/s", limit=STD_LIMIT)
     turn_rate_decay: float = param(
         0.8, "a: the turn rate is multiplied by a each keyframe (1: a constant turn rate)", unit_interval(False, True)
+    )
+    coast_velocity_decay: float = param(
+        1.0,
+        "b: a PMB Bernoulli missed at its last update has its velocity multiplied by b each keyframe (1: off)",
+        unit_interval(False, True),
     )
 
 

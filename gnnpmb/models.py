@@ -19,10 +19,16 @@ turn_rate_decay`` a in (0, 1]; a = 1: constant turn rate): while a track coasts,
 variance to at most sigma_w^2 / (1 - a^2), so a long-missed track is not spread along every possible turn. It is
 predicted with the extended Kalman filter (``kalman.predict`` with ``MotionModel.transition``); the measurement is
 the same [x, y] (or [x, y, vx, vy]).
+
+Coasting (``[models] coast_velocity_decay`` b in (0, 1]; 1 = off): a Bernoulli missed at its last update is
+predicted with x' = f(x) followed by v' = b v (the velocity rows of f and of its Jacobian times b, as the turn
+rate's w' = a w), so a lost object's predicted box slows down rather than running on at its last velocity; a
+detected one is predicted as above (``MotionModel.coast``, ``pmb.bernoulli.predict_bernoullis``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -40,12 +46,14 @@ Transition = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 class MotionModel:
     """F (n, n), Q (n, n), R (D, D) for one class and one time step; transition: the non-linear f and its
     Jacobian (extended Kalman predict, ``kalman.predict``), None for a linear model x' = F x (F is then the
-    model; for a non-linear one F is its Jacobian at omega = 0, for display only)."""
+    model; for a non-linear one F is its Jacobian at omega = 0, for display only); coast: the model of a track
+    missed at its last update (``coasting``), None when ``[models] coast_velocity_decay`` is 1."""
 
     F: np.ndarray
     Q: np.ndarray
     R: np.ndarray
     transition: Transition | None = None
+    coast: MotionModel | None = None
 
     @property
     def state_dim(self) -> int:
@@ -91,9 +99,31 @@ def ct_model(dt_s: float, params: ClassParams, models: ModelParams, measure_velo
 def motion_model(dt_s: float, params: ClassParams, models: ModelParams, measure_velocity: bool = False) -> MotionModel:
     """``cv_model`` or ``ct_model`` as ``[models] motion_model`` says (the PMB family's; the other families'
     states are [x, y, vx, vy] and they use ``cv_model``)."""
-    if models.motion_model == 1:
-        return ct_model(dt_s, params, models, measure_velocity)
-    return cv_model(dt_s, params, measure_velocity)
+    model = (
+        ct_model(dt_s, params, models, measure_velocity)
+        if models.motion_model == 1
+        else cv_model(dt_s, params, measure_velocity)
+    )
+    if models.coast_velocity_decay == 1.0:
+        return model
+    return dataclasses.replace(model, coast=coasting(model, models.coast_velocity_decay))
+
+
+def coasting(model: MotionModel, decay: float) -> MotionModel:
+    """``model`` followed by v' = ``decay`` v: F (or f and its Jacobian) with its velocity rows times ``decay``;
+    Q and R unchanged (module docstring, coasting)."""
+    D = np.ones(model.state_dim)
+    D[2:4] = decay
+    F = D[:, None] * model.F
+    F.flags.writeable = False
+    transition = None if model.transition is None else functools.partial(_slowed, model.transition, D)
+    return MotionModel(F=F, Q=model.Q, R=model.R, transition=transition)
+
+
+def _slowed(transition: Transition, D: np.ndarray, mean: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """diag(D) f(m) and diag(D) J (``coasting``)."""
+    out, J = transition(mean)
+    return out * D, J * D[:, None]
 
 
 _SMALL_TURN = 1e-4

@@ -64,10 +64,14 @@ class Bernoullis(CarriesDetectionFields, StructOfArrays):
 
 def predict_bernoullis(b: Bernoullis, model: MotionModel, p_survive: float) -> Bernoullis:
     """Prediction: r' = P_S r, (m', P') = Kalman predict (García-Fernández et al. 2018, eq. 8-9); one more
-    frame since the last detection."""
+    frame since the last detection. A Bernoulli missed at its last update (misses >= 1) is predicted with
+    ``model.coast`` when there is one (its velocity slowed, ``gnnpmb.models.coasting``)."""
     if not len(b):
         return b
     mean, cov = predict(b.mean, b.cov, model)
+    coasting = b.misses >= 1
+    if model.coast is not None and coasting.any():
+        mean[coasting], cov[coasting] = predict(b.mean[coasting], b.cov[coasting], model.coast)
     return Bernoullis(
         b.track_id,
         b.local_key,
