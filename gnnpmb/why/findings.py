@@ -125,8 +125,8 @@ class Near:
     """A detection near an object: its source index, class, score, BEV distance (m) and whether preprocessing
     kept it (score threshold, NMS); on_other: the annotated object (id, class, BEV distance m) the detection lies
     nearer than this one, when it does: then it is that object's detection, not a sight of this one (dev set
-    scene-1094 centerpoint ab3dmot: a car detection 1.8 m from a truck and 0.1 m from a car was said to be the
-    truck seen as a car)."""
+    scene-1094 centerpoint ab3dmot: a car detection 1.8 m from a bicycle and 0.1 m from a car was said to be the
+    bicycle seen as a car)."""
 
     meas: int
     class_name: str
