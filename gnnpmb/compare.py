@@ -169,24 +169,26 @@ def match_to_gt(
 @dataclass(frozen=True, slots=True)
 class _Frame:
     """One tracker's shown estimates of one frame as arrays: xy (K, 2), class (K,), ids (K,), and the match
-    gt_track (G,) (track index per GT object, -1 if none); unshown: its estimates below the show floor."""
+    gt_track (G,) (track index per GT object, -1 if none); every: its whole output (N estimates, those below the
+    show floor too) as (xy (N, 2), class (N,), ids (N,), shown (N,) bool)."""
 
     estimates: Sequence[TrackEstimate]
     xy: np.ndarray
     classes: np.ndarray
     ids: np.ndarray
     gt_track: np.ndarray
-    unshown: Sequence[TrackEstimate] = ()
+    every: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 
 def _frame(output: Sequence[TrackEstimate], gt: Boxes, max_dist_m: float, show_min_existence: float) -> _Frame:
-    estimates = [e for e in output if e.existence >= show_min_existence]
-    unshown = [e for e in output if e.existence < show_min_existence]
-    k = len(estimates)
-    xy = np.array([e.translation_m[:2] for e in estimates], dtype=np.float64).reshape(k, 2)
-    classes = np.array([e.class_name for e in estimates], dtype=object)
-    ids = np.array([e.track_id for e in estimates], dtype=np.int64)
-    return _Frame(estimates, xy, classes, ids, match_to_gt(gt.xy, gt.class_name, xy, classes, max_dist_m), unshown)
+    n = len(output)
+    xy = np.array([e.translation_m[:2] for e in output], dtype=np.float64).reshape(n, 2)
+    classes = np.array([e.class_name for e in output], dtype=object)
+    ids = np.array([e.track_id for e in output], dtype=np.int64)
+    shown = np.array([e.existence >= show_min_existence for e in output], dtype=bool)
+    estimates = [e for e, s in zip(output, shown, strict=True) if s]
+    gt_track = match_to_gt(gt.xy, gt.class_name, xy[shown], classes[shown], max_dist_m)
+    return _Frame(estimates, xy[shown], classes[shown], ids[shown], gt_track, (xy, classes, ids, shown))
 
 
 def _gt_box(gt: Boxes, g: int) -> tuple[tuple[float, float, float], ...]:
@@ -284,10 +286,9 @@ def _nearest(xy: np.ndarray, classes: np.ndarray, at_xy: np.ndarray, class_name:
 
 def _unshown(fb: _Frame, gt: Boxes, g: int, max_dist_m: float) -> int | None:
     """Id of ``fb``'s unshown estimate of object ``g``'s class nearest it within ``max_dist_m``, or None."""
-    xy = np.array([e.translation_m[:2] for e in fb.unshown], dtype=np.float64)
-    classes = np.array([e.class_name for e in fb.unshown], dtype=object)
-    k = _nearest(xy, classes, gt.xy[g], gt.class_name[g], max_dist_m)
-    return None if k is None else fb.unshown[k].track_id
+    xy, classes, ids, shown = fb.every
+    k = _nearest(xy[~shown], classes[~shown], gt.xy[g], gt.class_name[g], max_dist_m)
+    return None if k is None else int(ids[~shown][k])
 
 
 def _elsewhere(fb: _Frame, gt: Boxes, gt_ids: list[str], g: int, max_dist_m: float) -> tuple[int, str] | None:
@@ -342,12 +343,9 @@ def _still_on(fr: _Frame, track_id: int, gt: Boxes, g: int, max_dist_m: float) -
     """Whether ``fr`` outputs track ``track_id`` of object ``g``'s class within ``max_dist_m`` of it, shown or
     below the show floor (the evaluation may still match it there: dev set scene-1077 megvii cphd, track 94 at
     weight below 0.5, 0.05 m from pedestrian 80d062)."""
-    return any(
-        e.track_id == track_id
-        and e.class_name == gt.class_name[g]
-        and np.hypot(*(np.asarray(e.translation_m[:2]) - gt.xy[g])) < max_dist_m
-        for e in (*fr.estimates, *fr.unshown)
-    )
+    xy, classes, ids, _ = fr.every
+    mine = (ids == track_id) & (classes == gt.class_name[g])
+    return bool(np.any(np.linalg.norm(xy[mine] - gt.xy[g], axis=1) < max_dist_m))
 
 
 def _only_in_one(
