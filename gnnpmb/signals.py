@@ -1,7 +1,7 @@
 """SIGTERM handled like Ctrl-C: what ``timeout``, ``docker stop`` and job schedulers send stops a run the same way.
 
 ``install`` makes SIGTERM raise ``KeyboardInterrupt`` in the main thread, so every path that already cleans up
-after Ctrl-C (a recording's temporary file deleted, a sweep's finished rows written, Ray's tasks cancelled and
+after Ctrl-C (a recording's temporary file deleted, a sweep's finished rows written, Ray's tasks stopped and
 its local instance shut down) does the same after SIGTERM. Only the first SIGTERM interrupts: a second one while
 cleaning up is ignored (SIGKILL is the way to stop at once). ``exit_code`` and ``stop_reason`` then tell the two
 apart: 130 and "Ctrl-C" after SIGINT, 143 and "SIGTERM" after SIGTERM (128 + the signal number, as shells do).

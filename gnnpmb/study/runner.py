@@ -5,8 +5,9 @@ Ray runs locally by default (``ray.init(num_cpus=workers)``, no dashboard, quiet
 that does not answer like a Ray head within ``connect.PROBE_TIMEOUT_S`` is refused before Ray is asked (Ray
 itself retries an unreachable head for minutes), and joining is bounded by ``connect.JOIN_DEADLINE_S``; Ray's
 own log lines stay out of the terminal unless ``verbose`` (``connect``). Results are yielded as tasks finish;
-Ctrl-C (or SIGTERM, ``gnnpmb.signals``) cancels the tasks still running and re-raises, so the caller keeps
-whatever already finished.
+Ctrl-C (or SIGTERM, ``gnnpmb.signals``) re-raises, so the caller keeps whatever already finished, and the tasks
+still running end with the session (``ray.shutdown``: the local instance's workers are killed; on a cluster the
+driver's job ends and Ray stops its tasks).
 """
 
 from __future__ import annotations
@@ -133,7 +134,10 @@ def run_tasks(fn: Callable[[T], R], items: Iterable[T], run: Execution) -> Itera
     consumed lazily, one item per task submitted (a task's inputs are read just before it is sent).
 
     Must be iterated inside ``ray_session(run)`` when ``run.uses_ray``. Closing the iterator early (or Ctrl-C)
-    cancels the tasks still running.
+    leaves the tasks still running to the session's end. They are not cancelled one by one: in Ray 2.60
+    ``ray.cancel`` of a task whose result is arriving at that moment aborts the driver process (a failed
+    ``RAY_CHECK``, "Tried to complete task that was not pending", in the driver's log only; the race of
+    ray-project/ray#54798), which ended a sweep stopped by SIGTERM with exit 1, no message and no results file.
     """
     if not run.uses_ray:
         for i, item in enumerate(items):
@@ -145,31 +149,27 @@ def run_tasks(fn: Callable[[T], R], items: Iterable[T], run: Execution) -> Itera
     pending: dict[Any, int] = {}
     queue = enumerate(items)
     left = True
-    try:
-        while left or pending:
-            while left and len(pending) < cap:
-                nxt = next(queue, None)
-                if nxt is None:
-                    left = False
-                    break
-                i, item = nxt
-                pending[remote.remote(item)] = i
-            if not pending:
+    while left or pending:
+        while left and len(pending) < cap:
+            nxt = next(queue, None)
+            if nxt is None:
+                left = False
                 break
-            with signals.deferred():  # SIGTERM stops the run here, not inside Ray's wait
-                done, _ = ray.wait(list(pending), num_returns=1, timeout=_WAIT_S)
-            signals.check()
-            if not done:
-                continue
-            ref = done[0]
-            i = pending.pop(ref)
-            with signals.deferred():  # nor inside Ray's get
-                try:
-                    result = ray.get(ref)
-                except ray.exceptions.RayTaskError as exc:
-                    raise _unwrap(exc) from None
-            signals.check()
-            yield i, result
-    finally:
-        for ref in pending:
-            ray.cancel(ref, force=True)
+            i, item = nxt
+            pending[remote.remote(item)] = i
+        if not pending:
+            break
+        with signals.deferred():  # SIGTERM stops the run here, not inside Ray's wait
+            done, _ = ray.wait(list(pending), num_returns=1, timeout=_WAIT_S)
+        signals.check()
+        if not done:
+            continue
+        ref = done[0]
+        i = pending.pop(ref)
+        with signals.deferred():  # nor inside Ray's get
+            try:
+                result = ray.get(ref)
+            except ray.exceptions.RayTaskError as exc:
+                raise _unwrap(exc) from None
+        signals.check()
+        yield i, result
