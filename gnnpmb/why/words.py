@@ -677,10 +677,13 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         # "last output on it" not of a track still output on the annotated object at the failure's frame
         now = f.sighting(f.frame)
         last_on = held == matched and not (now is not None and t in {o.track_id for o in now.on_it})
+        # a match at a frame the track has no box of its own was the devkit's interpolation between two of its boxes
+        interpolated = lost.evaluated is not None and matched in lost.evaluated.interpolated
         last = (
             f"track {t} was last output on it at frame {held}"
             if last_on
             else f"the evaluation last matched track {t} to it at frame {matched}"
+            + (" (a box it interpolated for the track)" if interpolated else "")
         )
         parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}{_matched_away(f, lost, last_on)}")
     if f.has_existence and steps:

@@ -702,6 +702,20 @@ def test_a_last_output_on_the_object_the_devkit_did_not_match_there_is_caught() 
         assert [c.kind for c in check_text(said, ctx, None, ev).found] == ["matched"], said
 
 
+def test_a_last_match_at_a_box_the_devkit_interpolated_left_unsaid_is_misleading() -> None:
+    # independent audit truth46, dev set scene-0757 pointpillars greedy fragmentation:5: "the evaluation last
+    # matched track 16 to it at frame 12" where the submission has no box of track 16 at 12 (an interpolation)
+    ev = _eval()
+    ev.gt_to_track[(C, 1)] = {GT_A: "7"}
+    ev.submitted.update({0: {"7"}, 2: {"7"}})  # no box of track 7 at frame 1: the devkit matched its interpolation
+    ctx = Context(C, 3, GT_A, kind="fragmentation", lost=7)
+    said = "the evaluation last matched track 7 to it at frame 1"
+    assert [c.kind for c in check_text(said, ctx, None, ev).found] == ["misleading"]
+    assert check_text(said + " (a box it interpolated for the track)", ctx, None, ev).found == []
+    ev.submitted[1] = {"7"}
+    assert check_text(said, ctx, None, ev).found == []
+
+
 def test_no_track_carrying_an_object_a_track_was_on_and_a_reach_the_devkit_did_not_take_are_caught() -> None:
     # dev set scene-0757 megvii prob3dmot miss:133 (track 200 1.8 m from the annotation, 2.1 m from the devkit's box)
     from tools.truth.scene import Annotation, SceneTruth

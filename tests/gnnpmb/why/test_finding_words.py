@@ -636,3 +636,18 @@ def test_another_run_whose_class_reached_no_recall_threshold_is_said_to_have_cou
         "the evaluation counted none of its bicycle tracks" in line
     )
     assert "false bicycle track here too" not in line
+
+
+def test_a_last_match_at_a_box_the_evaluation_interpolated_for_the_track_says_so() -> None:
+    # independent audit truth46, dev set scene-0757 pointpillars greedy fragmentation:5: "the evaluation last
+    # matched track 16 to it at frame 12, it was not output at frame 12" (the devkit matched a box it interpolated
+    # between the track's boxes at frames 11 and 13: read as a contradiction, or as the track still being there)
+    steps = (step(11, output=estimate(16, 0.9)), step(12), step(13, output=estimate(16, 0.9)))
+    kind = FailureKind.FRAGMENTATION
+    evaluated = TrackEval((11, 13), (11, 13), (12,), 0.5, 0.5)
+    lost = LostTrack(16, 11, steps, None, evaluated, None, matched_until=12)
+    line = why_lines(finding(kind, lost, frame=13, window=(11, 13), deciding=(12, 13), has_existence=False))[0]
+    assert "the evaluation last matched track 16 to it at frame 12 (a box it interpolated for the track)," in line
+    output = LostTrack(16, 11, steps, None, TrackEval((11, 12, 13), (11, 12, 13), (), 0.5, 0.5), None, matched_until=12)
+    line = why_lines(finding(kind, output, frame=13, window=(11, 13), deciding=(12, 13), has_existence=False))[0]
+    assert "the evaluation last matched track 16 to it at frame 12," in line and "interpolated for" not in line
