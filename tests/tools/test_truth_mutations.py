@@ -737,6 +737,28 @@ def test_no_track_carrying_an_object_a_track_was_on_and_a_reach_the_devkit_did_n
     assert [c.kind for c in check_text(reach, ctx, None, ev, scene=scene).found] == ["evaluation"]
 
 
+def test_a_track_out_of_reach_that_the_devkit_matched_to_the_object_beside_it_is_misleading() -> None:
+    # independent audit truth46, dev set scene-0655 centerpoint immortal miss:18: track 8 1.2 m from the annotation,
+    # 3.0 m from the devkit's interpolated box, and 0.1 m from the pedestrian beside it, which the devkit matched it to
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 0)}])
+    ev = _eval()
+    ev.boxes[3] = [("8", C, (1.2, 0.0))]
+    ev.submitted[3] = {"8"}
+    ev.evaluated_gt[(3, GT_A)] = (0.0, 3.0)
+    ev.evaluated_gt[(3, GT_B)] = (1.2, 0.1)
+    ev.track_to_gt[(C, 3)] = {"8": GT_B}
+    ctx = Context(C, 3, GT_A, kind="miss")
+    reach = (
+        "at frame 3 track 8 was output 1.2 m from the annotated object, but the evaluation scored the object at a "
+        "box it interpolated 3.0 m from the annotation, out of the track's reach"
+    )
+    assert [c.kind for c in check_text(reach, ctx, None, ev, scene=scene).found] == ["misleading"]
+    ev.evaluated_gt[(3, GT_B)] = (3.0, 0.0)  # the object it was matched to lies farther than this one: the reach held
+    assert check_text(reach, ctx, None, ev, scene=scene).found == []
+
+
 def _matched_away_world():
     """Track 7 matched to GT A at frame 1, to GT B at frames 2 and 3 (GT A missed at 2), track 11 to GT A at 3; the
     files: GT A at the origin at frame 3, track 7's box 0.5 m from it, track 11's 0.7 m."""
