@@ -242,6 +242,7 @@ class _Context:
             others=self.others(others, gt_id),
             reach=self.reach(gt_id, parts["blame"]),
             boxes_on=boxes_on,
+            unscored=any(c.class_name == self.class_name and c.threshold is None for c in self.report.classes),
             **parts,
         )
 

@@ -385,6 +385,11 @@ def why_lines(f: Finding) -> list[str]:
             parts = _coalescence(f)
         case _:
             raise AssertionError(f.kind)
+    if f.unscored and f.kind is not FailureKind.MISS:  # the devkit counted every object missed and nothing else
+        parts.append(
+            f"outside the evaluation's counts: {f.tracker} reached no score threshold at its lowest recall for "
+            f"{f.class_name}s"
+        )
     parts += _others(f)
     lines = [f"**Why** ({f.tracker}, {whose_text(f)}): " + "; ".join(p for p in parts if p) + ".", ""]
     because = because_text(f)

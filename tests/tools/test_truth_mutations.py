@@ -366,6 +366,20 @@ def test_another_run_said_not_to_have_a_switch_it_had_no_track_for_is_caught() -
     assert [c.kind for c in check_text(wrong, ctx, None, _eval(), others={"pmbm": other}).found] == ["other run"]
 
 
+def test_a_failure_the_devkit_did_not_count_in_an_unscored_class_must_say_so() -> None:
+    # independent audit truth46, dev set scene-0103 pointpillars jpda false_track:2 (bicycle): jpda reached no
+    # bicycle score threshold at the lowest recall, so the devkit counted no false bicycle track of it
+    ctx = Context(C, 3, GT_B, kind="false_track")
+    unscored = _eval()
+    unscored.thresholds[C] = None
+    plain = "a clause no checker reads"
+    said = f"{plain}; outside the evaluation's counts: jpda reached no score threshold at its lowest recall for {C}s"
+    assert [c.kind for c in check_text(plain, ctx, None, unscored).found] == ["misleading"]
+    assert check_text(said, ctx, None, unscored).found == []
+    assert [c.kind for c in check_text(said, ctx, None, _eval()).found] == ["evaluation"]  # a scored class
+    assert check_text(plain, Context(C, 3, GT_B, kind="miss"), None, unscored).found == []  # every miss counts
+
+
 def test_a_bare_percentage_and_a_wrong_one_are_caught() -> None:
     from gnnpmb.events import UpdateWeights
 
@@ -906,6 +920,23 @@ def test_one_track_for_two_objects_said_of_a_track_out_of_reach_of_the_scored_bo
     ev.track_to_gt[(C, 3)]["11"] = GT_A
     found = check_text(both, CTX, None, ev)
     assert found.found == [] and found.checked["matched"] == 2
+
+
+def test_one_track_for_two_objects_holds_of_a_track_the_devkit_matched_to_the_object_beside_it() -> None:
+    # independent audit truth46, dev set scene-0655 centerpoint immortal miss:18: track 8 1.2 m from GT B's
+    # annotation, 4.2 m from the box the devkit interpolated for it, and 0.1 m from GT A, which the devkit matched
+    # it to: the neighbour's track (with B's box where it belongs the devkit still matches it to A)
+    from tools.truth.scene import Annotation, SceneTruth
+
+    said = "track 7 lay within 2 m of it and was counted, but the evaluation matched it to another object"
+    ev = _eval()
+    ev.pred_xy[(C, 3)] = {"7": (1.2, 0.0)}
+    ev.evaluated_gt[(3, GT_B)] = (0.0, 4.0)
+    ev.evaluated_gt[(3, GT_A)] = (1.3, 0.0)
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_B: Annotation(C, (0.0, 0.0), 0)}])
+    assert check_text(said, CTX, None, ev, scene=scene).found == []
+    ev.evaluated_gt[(3, GT_A)] = (2.5, 1.0)  # GT A scored farther from the track than B's annotation: misleading
+    assert [c.kind for c in check_text(said, CTX, None, ev, scene=scene).found] == ["misleading"]
 
 
 def test_another_run_whose_coalescence_matched_the_object_is_not_said_to_fail_on_it() -> None:

@@ -651,3 +651,19 @@ def test_a_last_match_at_a_box_the_evaluation_interpolated_for_the_track_says_so
     output = LostTrack(16, 11, steps, None, TrackEval((11, 12, 13), (11, 12, 13), (), 0.5, 0.5), None, matched_until=12)
     line = why_lines(finding(kind, output, frame=13, window=(11, 13), deciding=(12, 13), has_existence=False))[0]
     assert "the evaluation last matched track 16 to it at frame 12," in line and "interpolated for" not in line
+
+
+def test_a_failure_in_a_class_the_evaluation_counted_none_of_says_it_is_outside_its_counts() -> None:
+    # independent audit truth46, dev set scene-0103 pointpillars jpda false_track:2 (bicycle): "the evaluation's
+    # doing: ... the evaluation interpolated it ..., and that box matched no object", yet no bicycle score
+    # threshold of jpda reached the lowest recall, so the devkit counted every bicycle missed and no false track
+    lost = LostTrack(26, 12, (step(12, output=estimate(26, 0.9)),), None, None, None, matched_until=12)
+    for kind in (FailureKind.ID_SWITCH, FailureKind.FRAGMENTATION, FailureKind.COALESCENCE):
+        (line, _) = why_lines(finding(kind, lost, unscored=True))
+        assert (
+            "outside the evaluation's counts: gnnpmb reached no score threshold at its lowest recall for bicycles"
+            in (line)
+        ), kind
+        assert "outside the evaluation's counts" not in why_lines(finding(kind, lost))[0]
+    # a miss is counted: the devkit counts every object of such a class missed
+    assert "outside the evaluation's counts" not in why_lines(finding(FailureKind.MISS, lost, unscored=True))[0]
