@@ -410,7 +410,9 @@ class Finding:
     interpolated object against its annotation; mode: how the tracker's update uses detections (``facts.UseMode``
     value; "output only" for a results file: nothing is said of its update), has_existence: whether its tracks have
     existences; boxes_on: for a results file, how each output box named was placed on a detection (frame, track
-    id, ``foreign.BoxOn``).
+    id, ``foreign.BoxOn``); unscored: no score threshold of this run reached the evaluation's lowest recall in the
+    class, so the devkit counted none of its tracks of the class (every object missed, no false track, switch or
+    fragmentation): a failure other than a miss is what matching every box finds, outside the devkit's counts.
     """
 
     failure_id: str
@@ -436,6 +438,7 @@ class Finding:
     others: tuple[OtherRun, ...] = ()
     reach: EvaluatedReach | None = None
     boxes_on: tuple[tuple[int, int, BoxOn], ...] = ()
+    unscored: bool = False
 
     @property
     def output_only(self) -> bool:

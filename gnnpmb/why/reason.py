@@ -242,6 +242,7 @@ class _Context:
             others=self.others(others, gt_id),
             reach=self.reach(gt_id, parts["blame"]),
             boxes_on=boxes_on,
+            unscored=any(c.class_name == self.class_name and c.threshold is None for c in self.report.classes),
             **parts,
         )
 
@@ -262,16 +263,35 @@ class _Context:
         """With the blame ``INTERPOLATED``: the tracks within reach of the evaluated and of the annotated box."""
         if gt_id is None or not any(b.rule is Rule.INTERPOLATED for b in blame):
             return None
-        return self.reach_of(self.report.gt_frame(gt_id, self.f))
+        return self.reach_of(self.report.gt_frame(gt_id, self.f), gt_id)
 
-    def reach_of(self, g: GtFrame | None) -> EvaluatedReach | None:
-        """The tracks within reach of the box the evaluation scored ``g`` at and of its annotated box (None: it
-        scored no box there)."""
+    def reach_of(self, g: GtFrame | None, gt_id: str | None) -> EvaluatedReach | None:
+        """The tracks within reach of the box the evaluation scored object ``gt_id`` at (``g``) and of its annotated
+        box (None: it scored no box there). A track on the annotation that the evaluation matched there to another
+        object whose box lies nearer the track is that object's, not one the interpolation put out of reach: with the
+        box where it belongs the devkit would still match it there (independent audit truth46, dev set scene-0655
+        centerpoint immortal miss:18, track 8 1.2 m from the annotation and 0.1 m from the pedestrian beside it)."""
         fr = self.frames.get(g.frame) if g is not None else None
         if g is None or g.evaluated_xy_m is None or fr is None:
             return None
-        near = [self.on_object(self.report, fr, np.asarray(xy)) for xy in (g.evaluated_xy_m, g.annotated_xy_m)]
-        return EvaluatedReach(g.offset_m, *(tuple(o.track_id for o in n) for n in near))
+        evaluated = self.on_object(self.report, fr, np.asarray(g.evaluated_xy_m))
+        annotated = self.on_object(self.report, fr, np.asarray(g.annotated_xy_m))
+        return EvaluatedReach(
+            g.offset_m,
+            tuple(o.track_id for o in evaluated),
+            tuple(o.track_id for o in annotated if not self.neighbours(o, g.frame, gt_id)),
+        )
+
+    def neighbours(self, o: OnObject, frame: int, gt_id: str | None) -> bool:
+        """Whether the evaluation matched track ``o`` at ``frame`` to an object other than ``gt_id`` whose
+        evaluated box lies nearer the track than ``gt_id``'s annotation does."""
+        other = o.evaluated.matched_at(frame) if o.evaluated is not None else None
+        if other is None or other == gt_id or o.xy_m is None:
+            return False
+        g = self.report.gt_frame(other, frame)
+        if g is None or g.evaluated_xy_m is None:
+            return False
+        return math.hypot(o.xy_m[0] - g.evaluated_xy_m[0], o.xy_m[1] - g.evaluated_xy_m[1]) < o.distance_m
 
     def involved(self, sightings: tuple[Sighting, ...]) -> set[int]:
         """The failure's own tracks and every track output on the object in the window."""
@@ -473,11 +493,11 @@ class _Context:
             g = self.report.gt_frame(gt_id, self.f)
             if g is None:
                 continue
-            if g.status is GtStatus.INTERPOLATED and (g.offset_m >= least_offset_m or self.put_out_of_reach(g)):
+            if g.status is GtStatus.INTERPOLATED and (g.offset_m >= least_offset_m or self.put_out_of_reach(g, gt_id)):
                 out.append(Blame(Rule.INTERPOLATED, (self.f,)))
         return tuple(dict.fromkeys(out))
 
-    def put_out_of_reach(self, g: GtFrame) -> bool:
+    def put_out_of_reach(self, g: GtFrame, gt_id: str) -> bool:
         """Whether the object's interpolated box ``g`` lies ``NEAR_M`` or more from a counted track of the class
         output within ``NEAR_M`` of the annotation (however near the interpolation is to the annotation, it decided
         the match: dev set scene-0757 megvii prob3dmot fragmentation:18, a track 1.8 m from the annotation and 2.1 m
@@ -485,7 +505,11 @@ class _Context:
         fr = self.frames.get(self.f)
         if g.evaluated_xy_m is None or fr is None:
             return False
-        on = {o.track_id for o in self.on_object(self.report, fr, np.asarray(g.annotated_xy_m)) if o.counted}
+        on = {
+            o.track_id
+            for o in self.on_object(self.report, fr, np.asarray(g.annotated_xy_m))
+            if o.counted and not self.neighbours(o, self.f, gt_id)
+        }
         near = {o.track_id for o in self.on_object(self.report, fr, np.asarray(g.evaluated_xy_m))}
         return bool(on - near)
 
@@ -689,7 +713,9 @@ class _Context:
             out.append(Blame(Rule.TRACK_DROPPED, f))
         if any(not o.counted for o in s.on_it if o not in dropped):
             out.append(Blame(Rule.NOT_COUNTED, f))
-        if covering(s, self.reach_of(s.evaluated)):  # matched to another object while this one was in reach
+        if covering(
+            s, self.reach_of(s.evaluated, self.object_of())
+        ):  # matched to another object while this one was in reach
             out.append(Blame(Rule.COVERED_TWO, f))
         own = s.nearest_own
         if own is None and s.seen is not None and s.seen.class_name == self.class_name:

@@ -385,6 +385,11 @@ def why_lines(f: Finding) -> list[str]:
             parts = _coalescence(f)
         case _:
             raise AssertionError(f.kind)
+    if f.unscored and f.kind is not FailureKind.MISS:  # the devkit counted every object missed and nothing else
+        parts.append(
+            f"outside the evaluation's counts: {f.tracker} reached no score threshold at its lowest recall for "
+            f"{f.class_name}s"
+        )
     parts += _others(f)
     lines = [f"**Why** ({f.tracker}, {whose_text(f)}): " + "; ".join(p for p in parts if p) + ".", ""]
     because = because_text(f)
@@ -677,10 +682,13 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         # "last output on it" not of a track still output on the annotated object at the failure's frame
         now = f.sighting(f.frame)
         last_on = held == matched and not (now is not None and t in {o.track_id for o in now.on_it})
+        # a match at a frame the track has no box of its own was the devkit's interpolation between two of its boxes
+        interpolated = lost.evaluated is not None and matched in lost.evaluated.interpolated
         last = (
             f"track {t} was last output on it at frame {held}"
             if last_on
             else f"the evaluation last matched track {t} to it at frame {matched}"
+            + (" (a box it interpolated for the track)" if interpolated else "")
         )
         parts.append(f"{last}{elsewhere}{_scored_away(f, lost)}{_matched_away(f, lost, last_on)}")
     if f.has_existence and steps:

@@ -92,7 +92,7 @@ def test_disagreement_boxes_and_descriptions() -> None:
     assert switch.describe() == "car GT g1-tok: A switched track 1 -> 5, B kept 11"
     lone = comparison.of_kind(ONLY)[-1]
     assert lone.translation_m == (20.0, 5.0, 1.0)
-    assert lone.describe() == "car track 8 of A on no GT; B shows none there"
+    assert lone.describe() == "car track 8 of A on no car GT; B shows no car track there"
     missed = comparison.of_kind(MISSED)[0]
     assert missed.describe() == "car GT g2: A shows track 2 on it, B none"
 
@@ -117,7 +117,7 @@ def test_a_duplicate_track_is_named_beside_its_object_not_on_no_gt() -> None:
     b = [[est(9, "car", -3.0, 0.0)]]  # more than 2 m from A's second track (and from the car: lone in B too)
     (lone,) = [d for d in compare_trackers([gt], {"A": a, "B": b}).of_kind(ONLY) if d.tracker == "A"]
     assert (lone.track_ids, lone.elsewhere) == ((2,), (1, "car-1"))
-    assert lone.describe() == "car track 2 of A beside GT car-1, which its track 1 is on; B shows none there"
+    assert lone.describe() == "car track 2 of A beside GT car-1, which its track 1 is on; B shows no car track there"
 
 
 def test_a_track_output_below_the_show_floor_is_named_not_called_none() -> None:
@@ -206,3 +206,14 @@ def test_a_track_still_output_on_the_object_below_the_show_floor_is_no_id_change
     gone = [a[0], [est(107, "pedestrian", 0.3, 0.0)]]
     (change,) = compare_trackers([gt] * 2, {"A": gone, "B": b}, show_min_existence=0.5).of_kind(ID_CHANGE)
     assert change.describe() == "pedestrian GT ped: A switched track 94 -> 107, B kept 7"
+
+
+def test_a_lone_track_on_an_object_of_another_class_is_on_no_gt_of_its_own_class_only() -> None:
+    """Independent audit truth46, dev set scene-0916 pointpillars: simpletrack's truck track 48 stood 0.1 m from a
+    car that cphd showed a car track on; "truck track 48 of simpletrack on no GT; cphd shows none there" read as a
+    track where nothing was. The matching is per class: said so."""
+    gt = gt_boxes([("car-1", "car", 0.0, 0.0)])
+    a = [[est(48, "truck", 0.1, 0.0)]]
+    b = [[est(8, "car", 0.0, 0.0)]]
+    (lone,) = [d for d in compare_trackers([gt], {"A": a, "B": b}).of_kind(ONLY) if d.tracker == "A"]
+    assert lone.describe() == "truck track 48 of A on no truck GT; B shows no truck track there"

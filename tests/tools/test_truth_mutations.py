@@ -366,6 +366,20 @@ def test_another_run_said_not_to_have_a_switch_it_had_no_track_for_is_caught() -
     assert [c.kind for c in check_text(wrong, ctx, None, _eval(), others={"pmbm": other}).found] == ["other run"]
 
 
+def test_a_failure_the_devkit_did_not_count_in_an_unscored_class_must_say_so() -> None:
+    # independent audit truth46, dev set scene-0103 pointpillars jpda false_track:2 (bicycle): jpda reached no
+    # bicycle score threshold at the lowest recall, so the devkit counted no false bicycle track of it
+    ctx = Context(C, 3, GT_B, kind="false_track")
+    unscored = _eval()
+    unscored.thresholds[C] = None
+    plain = "a clause no checker reads"
+    said = f"{plain}; outside the evaluation's counts: jpda reached no score threshold at its lowest recall for {C}s"
+    assert [c.kind for c in check_text(plain, ctx, None, unscored).found] == ["misleading"]
+    assert check_text(said, ctx, None, unscored).found == []
+    assert [c.kind for c in check_text(said, ctx, None, _eval()).found] == ["evaluation"]  # a scored class
+    assert check_text(plain, Context(C, 3, GT_B, kind="miss"), None, unscored).found == []  # every miss counts
+
+
 def test_a_bare_percentage_and_a_wrong_one_are_caught() -> None:
     from gnnpmb.events import UpdateWeights
 
@@ -702,6 +716,20 @@ def test_a_last_output_on_the_object_the_devkit_did_not_match_there_is_caught() 
         assert [c.kind for c in check_text(said, ctx, None, ev).found] == ["matched"], said
 
 
+def test_a_last_match_at_a_box_the_devkit_interpolated_left_unsaid_is_misleading() -> None:
+    # independent audit truth46, dev set scene-0757 pointpillars greedy fragmentation:5: "the evaluation last
+    # matched track 16 to it at frame 12" where the submission has no box of track 16 at 12 (an interpolation)
+    ev = _eval()
+    ev.gt_to_track[(C, 1)] = {GT_A: "7"}
+    ev.submitted.update({0: {"7"}, 2: {"7"}})  # no box of track 7 at frame 1: the devkit matched its interpolation
+    ctx = Context(C, 3, GT_A, kind="fragmentation", lost=7)
+    said = "the evaluation last matched track 7 to it at frame 1"
+    assert [c.kind for c in check_text(said, ctx, None, ev).found] == ["misleading"]
+    assert check_text(said + " (a box it interpolated for the track)", ctx, None, ev).found == []
+    ev.submitted[1] = {"7"}
+    assert check_text(said, ctx, None, ev).found == []
+
+
 def test_no_track_carrying_an_object_a_track_was_on_and_a_reach_the_devkit_did_not_take_are_caught() -> None:
     # dev set scene-0757 megvii prob3dmot miss:133 (track 200 1.8 m from the annotation, 2.1 m from the devkit's box)
     from tools.truth.scene import Annotation, SceneTruth
@@ -721,6 +749,28 @@ def test_no_track_carrying_an_object_a_track_was_on_and_a_reach_the_devkit_did_n
     assert check_text(reach, ctx, None, ev, scene=scene).found == []
     ev.evaluated_gt[(3, GT_A)] = (0.0, -0.3)  # 1.5 m from the track's box: within the devkit's reach
     assert [c.kind for c in check_text(reach, ctx, None, ev, scene=scene).found] == ["evaluation"]
+
+
+def test_a_track_out_of_reach_that_the_devkit_matched_to_the_object_beside_it_is_misleading() -> None:
+    # independent audit truth46, dev set scene-0655 centerpoint immortal miss:18: track 8 1.2 m from the annotation,
+    # 3.0 m from the devkit's interpolated box, and 0.1 m from the pedestrian beside it, which the devkit matched it to
+    from tools.truth.scene import Annotation, SceneTruth
+
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_A: Annotation(C, (0.0, 0.0), 0)}])
+    ev = _eval()
+    ev.boxes[3] = [("8", C, (1.2, 0.0))]
+    ev.submitted[3] = {"8"}
+    ev.evaluated_gt[(3, GT_A)] = (0.0, 3.0)
+    ev.evaluated_gt[(3, GT_B)] = (1.2, 0.1)
+    ev.track_to_gt[(C, 3)] = {"8": GT_B}
+    ctx = Context(C, 3, GT_A, kind="miss")
+    reach = (
+        "at frame 3 track 8 was output 1.2 m from the annotated object, but the evaluation scored the object at a "
+        "box it interpolated 3.0 m from the annotation, out of the track's reach"
+    )
+    assert [c.kind for c in check_text(reach, ctx, None, ev, scene=scene).found] == ["misleading"]
+    ev.evaluated_gt[(3, GT_B)] = (3.0, 0.0)  # the object it was matched to lies farther than this one: the reach held
+    assert check_text(reach, ctx, None, ev, scene=scene).found == []
 
 
 def _matched_away_world():
@@ -870,6 +920,23 @@ def test_one_track_for_two_objects_said_of_a_track_out_of_reach_of_the_scored_bo
     ev.track_to_gt[(C, 3)]["11"] = GT_A
     found = check_text(both, CTX, None, ev)
     assert found.found == [] and found.checked["matched"] == 2
+
+
+def test_one_track_for_two_objects_holds_of_a_track_the_devkit_matched_to_the_object_beside_it() -> None:
+    # independent audit truth46, dev set scene-0655 centerpoint immortal miss:18: track 8 1.2 m from GT B's
+    # annotation, 4.2 m from the box the devkit interpolated for it, and 0.1 m from GT A, which the devkit matched
+    # it to: the neighbour's track (with B's box where it belongs the devkit still matches it to A)
+    from tools.truth.scene import Annotation, SceneTruth
+
+    said = "track 7 lay within 2 m of it and was counted, but the evaluation matched it to another object"
+    ev = _eval()
+    ev.pred_xy[(C, 3)] = {"7": (1.2, 0.0)}
+    ev.evaluated_gt[(3, GT_B)] = (0.0, 4.0)
+    ev.evaluated_gt[(3, GT_A)] = (1.3, 0.0)
+    scene = SceneTruth([[]] * 4, [{}, {}, {}, {GT_B: Annotation(C, (0.0, 0.0), 0)}])
+    assert check_text(said, CTX, None, ev, scene=scene).found == []
+    ev.evaluated_gt[(3, GT_A)] = (2.5, 1.0)  # GT A scored farther from the track than B's annotation: misleading
+    assert [c.kind for c in check_text(said, CTX, None, ev, scene=scene).found] == ["misleading"]
 
 
 def test_another_run_whose_coalescence_matched_the_object_is_not_said_to_fail_on_it() -> None:

@@ -577,13 +577,14 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
                 return "not two tracks on the object"
         elif name == "COVERED_TWO" and f.kind.value in ("miss", "fragmentation"):
             at = src.status(x, f.gt_id)[1]  # the box the devkit scored the object at: only it decides a match
-            taken = [
-                t
-                for t in _counted_on(src, x, c, xy)
-                if at is not None
-                and math.dist(next(p for tt, _, p in src.ev.boxes[x] if tt == t), at) < NEAR_M
-                and src.ev.matched_gt(c, x, t) not in (None, f.gt_id)
-            ]
+            taken = []
+            for t in _counted_on(src, x, c, xy):
+                box, other = next(p for tt, _, p in src.ev.boxes[x] if tt == t), src.ev.matched_gt(c, x, t)
+                if at is None or other in (None, f.gt_id):
+                    continue
+                there = src.status(x, other)[1]  # matched to an object scored nearer it than this one's annotation
+                if math.dist(box, at) < NEAR_M or (there is not None and math.dist(box, there) < math.dist(box, xy)):
+                    taken.append(t)
             if not taken:
                 return "no counted track within reach of the box the evaluation scored was matched to another object"
         elif name == "NO_EVAL_BOX":

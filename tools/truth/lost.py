@@ -15,6 +15,8 @@
 * "track T was last output on it at frame F" / "the evaluation last matched track T to it at frame F": the last
   frame before the failure's at which the devkit's accumulator matched the object (MATCH or SWITCH) is F, and to
   track T ("on it" reads as the evaluation's match; where the track was last within 2 m is the tracker's business);
+  where the submission has no box of T at F (the devkit matched its interpolation) and the text does not say "(a box
+  it interpolated for the track)", misleading;
   ", then (the evaluation) matched track T to C GT X at frames …( and to C GT Y at frames …)": after that frame,
   up to the failure's, the accumulator matched T to exactly those other objects at exactly those frames; and where
   it matched T to another object there and the text leaves that out, the last-match sentence is misleading (it
@@ -75,6 +77,8 @@ AVERAGED = re.compile(
 LAST_ON_IT = re.compile(
     r"(?:track (\d+) was last output on it|the evaluation last matched track (\d+) to it) at frame (\d+)"
 )
+INTERPOLATED = " (a box it interpolated for the track)"
+"""What follows "the evaluation last matched track T to it at frame F" where the submission has no box of T at F."""
 AWAY = re.compile(
     r"then (?:the evaluation )?matched track (\d+) (to \w+ GT \w+ at frames? [\d–, ]*\d"
     r"(?: and to \w+ GT \w+ at frames? [\d–, ]*\d)*)"
@@ -297,6 +301,14 @@ def check_last_match(text: str, class_name: str, frame: int, gt_id: str | None, 
                 f"the devkit last matched the object before frame {frame} at frame {last} (to track {track})",
             )
             continue
+        out.checked["misleading"] += 1
+        if m[2] is not None and t not in ev.submitted.get(said, set()) and not text[m.end() :].startswith(INTERPOLATED):
+            bad(
+                "misleading",
+                m[0],
+                f"left unsaid: the submission has no box of track {t} at frame {said} (the devkit matched its "
+                "interpolation)",
+            )
         away = _matched_away(ev, class_name, t, gt_id, last, frame)
         told = [a for a in AWAY.finditer(text) if a[1] == t]
         out.checked["misleading"] += 1

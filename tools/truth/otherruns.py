@@ -153,6 +153,27 @@ def check_other_unscored(text: str, c: str, others: Mapping[str, EvalFacts], out
             bad("other run", m[0], f"{m[1]}'s devkit evaluation of {c} has the threshold {ev.thresholds.get(c)}")
 
 
+OWN_UNSCORED = re.compile(
+    r"outside the evaluation's counts: (\w+) reached no score threshold at its lowest recall for (\w+)s"
+)
+
+
+def check_own_unscored(text: str, kind: str, c: str, ev: EvalFacts, out, bad) -> None:
+    """ "Outside the evaluation's counts: T reached no score threshold at its lowest recall for Cs": the run's own
+    devkit evaluation of class ``c`` has no best-MOTA threshold, so it counted every object missed and no false
+    track, switch or fragmentation; a failure of another kind there that does not say so reads as one the devkit
+    counted (misleading)."""
+    unscored = c in ev.thresholds and ev.thresholds[c] is None
+    said = [m for m in OWN_UNSCORED.finditer(text) if m[2] == c]
+    if kind in ("", "miss"):
+        return
+    out.checked["misleading"] += 1
+    if unscored and not said:
+        bad("misleading", kind, f"the devkit's evaluation of {c} reached no threshold: it counted no {kind} of it")
+    for m in said if not unscored else ():
+        bad("evaluation", m[0], f"the devkit's best-MOTA threshold of {c} is {ev.thresholds.get(c)}")
+
+
 def check_other_false_tracks(text: str, c: str, x: int, place_xy_m, others: Mapping[str, EvalFacts], out, bad) -> None:
     """ "Had a false track here too / had no false track here": whether the other run's accumulator counted a track
     box of class ``c`` within ``NEAR_M`` of the place (the object, or the false box) as a false positive at frame

@@ -12,7 +12,8 @@ against the annotation files and the devkit's own boxes.
 * "at frame x track T was (still) output D m from the annotated object, but the evaluation scored the object at a
   box it interpolated O m from the annotation, out of the track's reach": T's submitted box lies D m from the
   annotation (under 2 m), the devkit did not keep the annotation there and scored a box O m from it, 2 m or more
-  from T's box;
+  from T's box; misleading where the devkit matched T there to another object whose box lies nearer T than the
+  annotation (T was that object's: with the box where it belongs the devkit would match T there still);
   and ", and weighted the right way it would still lie E m from the track" follows it exactly where the devkit's
   swap moved the box and the box interpolated the right way lies E m (2 m or more) from T's;
 * "…, and no track carried it through": no submitted box of the object's class lies within 2 m of its annotation;
@@ -78,6 +79,16 @@ def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, 
         if not (on < NEAR_M and f"{on:.1f}" == m[3] and f"{off:.1f}" == m[4] and away >= NEAR_M):
             said = f"box {on:.2f} m from the annotation, {away:.2f} m from the devkit's ({off:.2f} off)"
             bad("evaluation", m[0], said)
+            continue
+        other = ev.matched_gt(c, y, t)
+        elsewhere = ev.evaluated_gt.get((y, other)) if other is not None and other != gt_id else None
+        out.checked["misleading"] += 1
+        if elsewhere is not None and math.dist(box, elsewhere) < on:
+            bad(
+                "misleading",
+                m[0],
+                f"the devkit matched track {t} to GT {other[:6]}, {math.dist(box, elsewhere):.2f} m away",
+            )
             continue
         right = _right_way(scene, ev, gt_id, y)
         if right is not None and math.dist(right, scored) >= 0.05:  # the swap moved it: out of reach weighted so?

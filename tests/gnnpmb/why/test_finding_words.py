@@ -636,3 +636,34 @@ def test_another_run_whose_class_reached_no_recall_threshold_is_said_to_have_cou
         "the evaluation counted none of its bicycle tracks" in line
     )
     assert "false bicycle track here too" not in line
+
+
+def test_a_last_match_at_a_box_the_evaluation_interpolated_for_the_track_says_so() -> None:
+    # independent audit truth46, dev set scene-0757 pointpillars greedy fragmentation:5: "the evaluation last
+    # matched track 16 to it at frame 12, it was not output at frame 12" (the devkit matched a box it interpolated
+    # between the track's boxes at frames 11 and 13: read as a contradiction, or as the track still being there)
+    steps = (step(11, output=estimate(16, 0.9)), step(12), step(13, output=estimate(16, 0.9)))
+    kind = FailureKind.FRAGMENTATION
+    evaluated = TrackEval((11, 13), (11, 13), (12,), 0.5, 0.5)
+    lost = LostTrack(16, 11, steps, None, evaluated, None, matched_until=12)
+    line = why_lines(finding(kind, lost, frame=13, window=(11, 13), deciding=(12, 13), has_existence=False))[0]
+    assert "the evaluation last matched track 16 to it at frame 12 (a box it interpolated for the track)," in line
+    output = LostTrack(16, 11, steps, None, TrackEval((11, 12, 13), (11, 12, 13), (), 0.5, 0.5), None, matched_until=12)
+    line = why_lines(finding(kind, output, frame=13, window=(11, 13), deciding=(12, 13), has_existence=False))[0]
+    assert "the evaluation last matched track 16 to it at frame 12," in line and "interpolated for" not in line
+
+
+def test_a_failure_in_a_class_the_evaluation_counted_none_of_says_it_is_outside_its_counts() -> None:
+    # independent audit truth46, dev set scene-0103 pointpillars jpda false_track:2 (bicycle): "the evaluation's
+    # doing: ... the evaluation interpolated it ..., and that box matched no object", yet no bicycle score
+    # threshold of jpda reached the lowest recall, so the devkit counted every bicycle missed and no false track
+    lost = LostTrack(26, 12, (step(12, output=estimate(26, 0.9)),), None, None, None, matched_until=12)
+    for kind in (FailureKind.ID_SWITCH, FailureKind.FRAGMENTATION, FailureKind.COALESCENCE):
+        (line, _) = why_lines(finding(kind, lost, unscored=True))
+        assert (
+            "outside the evaluation's counts: gnnpmb reached no score threshold at its lowest recall for bicycles"
+            in (line)
+        ), kind
+        assert "outside the evaluation's counts" not in why_lines(finding(kind, lost))[0]
+    # a miss is counted: the devkit counts every object of such a class missed
+    assert "outside the evaluation's counts" not in why_lines(finding(FailureKind.MISS, lost, unscored=True))[0]

@@ -85,3 +85,43 @@ def test_a_detection_that_lies_on_another_object_is_not_a_sight_of_this_one() ->
     assert rules(ctx.blame_uncovered(s)) == [Rule.NO_DETECTION]
     # seen from the car, the same detection is its own
     assert ctx.near(3, np.array([1.9, 0.0]), own=False).of_it
+
+
+def test_a_track_the_evaluation_matched_to_the_object_beside_it_was_not_put_out_of_reach_by_the_interpolation() -> None:
+    # independent audit truth46, dev set scene-0655 centerpoint immortal miss:18 (frame 27): two pedestrians 1.2 m
+    # apart, this one's box interpolated 3.0 m off; track 8 lay 1.2 m from its annotation and 0.1 m from the other
+    # pedestrian, which the evaluation matched it to. "track 8 ... out of the track's reach" pinned the miss on the
+    # interpolation, yet the devkit run with the box weighted the right way still matches track 8 to the neighbour
+    from gnnpmb.eval.evaluated import TrackEval
+    from gnnpmb.types import TrackEstimate
+
+    other = "2e96cc" + "0" * 26
+    mine = GtFrame(27, GtStatus.INTERPOLATED, (0.0, 0.0), (0.0, 3.0), None, 0, 20.0, 40.0, (20, 28))
+    beside = GtFrame(27, GtStatus.SCORED, (1.2, 0.0), (1.2, 0.0), None, 4, 20.0, 40.0)
+    frames = {(GT, 27): mine, (other, 27): beside}
+
+    def ctx_with(matched_to: str) -> _Context:
+        ctx = _Context.__new__(_Context)
+        track = TrackEval((26, 27), (26, 27), (), 0.5, 0.5, ((27, matched_to),))
+        ctx.report = SimpleNamespace(
+            gt_frame=lambda gt_id, frame: frames.get((gt_id, frame)),
+            threshold_of=lambda class_name: 0.3,
+            track_evals={"8": track},
+            of_kind=lambda kind: (),
+        )
+        ctx.failure = SimpleNamespace(kind=FailureKind.MISS, gt_ids=(GT,))
+        box = TrackEstimate(
+            8, "pedestrian", (1.2, 0.1, 0.0), (1.0, 1.0, 1.0), (1.0, 0.0, 0.0, 0.0), (0.0, 0.0), 0.5, 1.0
+        )
+        ctx.f, ctx.class_name = 27, "pedestrian"
+        ctx.frames = {27: SimpleNamespace(estimates=(box,), keyframe=SimpleNamespace(index=27))}
+        return ctx
+
+    neighbour = ctx_with(other)
+    assert neighbour.reach_of(mine, GT).near_annotated == ()
+    assert not neighbour.put_out_of_reach(mine, GT)
+    assert rules(neighbour.evaluation_blame()) == [Rule.INTERPOLATED]  # 3.0 m off: still the evaluation's box
+    # matched to nothing there (or to this object): the interpolation did put it out of reach
+    alone = ctx_with(GT)
+    assert alone.reach_of(mine, GT).near_annotated == (8,)
+    assert alone.put_out_of_reach(mine, GT)
