@@ -15,7 +15,11 @@ forbidden (re-solved with the Hungarian algorithm), capped at ``LINK_SLACK``: a 
 the usual cause of an ID switch. A greedy matcher's choices are not a best total (``CostScale.optimal`` False):
 its margin is the detection's next cheapest column that no other detection took minus its chosen one (a cheaper
 column another detection took was not there to take). What counts as close is the matrix's own
-``CostScale.close_call`` (nats, metres, ...).
+``CostScale.close_call`` (nats, metres, ...). A box tracker's Hungarian runs over every pair and then drops the
+pairs past its threshold (``assign.matching.solve_then_threshold``), while the matrix it reports holds those
+pairs as +inf: its choice can then cost more than the best assignment of the matrix (a choice *undercut*: the
+cheaper column went, in the solve, to a detection whose pair was then dropped). Such a choice is no close call,
+and its margin (clipped at 0) says nothing.
 """
 
 from __future__ import annotations
@@ -34,15 +38,20 @@ _REF = operator.attrgetter("ref")
 LINK_SLACK = 5.0
 """Pairs costlier than the measurement's new-track cost plus this do not link a conflict; margins are capped at
 it (in cost units: nats for the PMB family)."""
+UNDERCUT_TOL = 1e-9
+"""How far below the chosen total a best total without the pair must lie for the choice to count as undercut
+(rounding in the solver's sums is far below it)."""
 
 
 @dataclass(frozen=True, slots=True)
 class PairChoice:
     """One measurement's decision: the chosen column and its cost; the row's cheapest other column
     (None if it had no other) and its cost; margin = best total without this pair minus the chosen total
-    (inf when no other assignment is possible). terms: the matrix's ``CostTerms`` (None if it has none), read
-    at this row (``row``) and the chosen / alternative columns (``chosen_col``, ``alternative_col``; -1: none)
-    by ``chosen_terms`` and ``alternative_terms``, only when asked."""
+    (inf when no other assignment is possible); undercut: the best total without this pair is lower than the
+    chosen total (module docstring: the solver ran before a threshold dropped pairs). terms: the matrix's
+    ``CostTerms`` (None if it has none), read at this row (``row``) and the chosen / alternative columns
+    (``chosen_col``, ``alternative_col``; -1: none) by ``chosen_terms`` and ``alternative_terms``, only when
+    asked."""
 
     meas: AxisLabel
     chosen: AxisLabel
@@ -55,11 +64,13 @@ class PairChoice:
     chosen_col: int = -1
     alternative_col: int = -1
     scale: CostScale = NATS
+    undercut: bool = False
 
     @property
     def close_call(self) -> bool:
-        """Whether another column came within the matrix's close-call margin (``CostScale.close_call``)."""
-        return self.alternative is not None and self.margin < self.scale.close_call
+        """Whether another column came within the matrix's close-call margin (``CostScale.close_call``); an
+        undercut choice is not one (module docstring)."""
+        return self.alternative is not None and self.margin < self.scale.close_call and not self.undercut
 
     @property
     def chosen_terms(self) -> PairTerms | None:
@@ -234,7 +245,7 @@ def _conflict(
         chosen_costs, best_costs = [sub_row[j]], [others[k]]
         total = sub_row[j]
         rest = others if j >= 0 else sub_row[:-1]  # the row without its chosen entry (as np.delete(row, j))
-        margins = [_capped(min(rest) if len(sub_row) > 1 else math.inf, total)]
+        bests = [min(rest) if len(sub_row) > 1 else math.inf]
     else:
         cols = np.concatenate([tcols, n_tracks + rows])
         sub = cost[np.ix_(rows, cols)]
@@ -252,13 +263,15 @@ def _conflict(
         cols_list, chosen_list, best_list = cols.tolist(), chosen_sub.tolist(), best.tolist()
         chosen_costs, best_costs = chosen_cost.tolist(), masked[at, best].tolist()
         if matrix.scale.optimal:
-            margins = [_margin(sub, i, j, total) for i, j in enumerate(chosen_list)]
+            bests = [_best_without(sub, i, j) for i, j in enumerate(chosen_list)]
         else:  # a greedy matcher: the row's next cheapest free entry against its chosen one
-            margins = [_capped(b, c) for b, c in zip(masked[at, best].tolist(), chosen_cost.tolist(), strict=True)]
+            bests = masked[at, best].tolist()
+    # what each margin is measured from: the conflict's total (an optimal solver), the row's own cost (greedy)
+    froms = [total] * len(bests) if matrix.scale.optimal or rows.size == 1 else chosen_costs
     mrows, mcols = matrix.rows, matrix.cols
     choices = []
-    for r, j, k, c_chosen, c_best, margin in zip(
-        rows.tolist(), chosen_list, best_list, chosen_costs, best_costs, margins, strict=True
+    for r, j, k, c_chosen, c_best, b, base in zip(
+        rows.tolist(), chosen_list, best_list, chosen_costs, best_costs, bests, froms, strict=True
     ):
         has_alt = math.isfinite(c_best)
         choices.append(
@@ -268,12 +281,13 @@ def _conflict(
                 chosen_cost=c_chosen,
                 alternative=mcols[cols_list[k]] if has_alt else None,
                 alternative_cost=c_best if has_alt else math.inf,
-                margin=margin,
+                margin=_capped(b, base),
                 terms=matrix.terms,
                 row=r,
                 chosen_col=cols_list[j],
                 alternative_col=cols_list[k] if has_alt else -1,
                 scale=matrix.scale,
+                undercut=b < base - UNDERCUT_TOL,
             )
         )
     used = {cols_list[j] for j in chosen_list if cols_list[j] < n_tracks}
@@ -296,14 +310,19 @@ def _capped(best: float, total: float) -> float:
 
 
 def _margin(sub: np.ndarray, i: int, j: int, total: float) -> float:
-    """Best total of ``sub`` with entry (i, j) forbidden, minus ``total`` (inf if then infeasible). A one-row
-    ``sub`` (one detection) needs no solver: its best total is its cheapest other entry."""
+    """Best total of ``sub`` with entry (i, j) forbidden, minus ``total``, clipped (``_capped``)."""
+    return _capped(_best_without(sub, i, j), total)
+
+
+def _best_without(sub: np.ndarray, i: int, j: int) -> float:
+    """Best total of ``sub`` with entry (i, j) forbidden (inf if then infeasible). A one-row ``sub`` (one
+    detection) needs no solver: its best total is its cheapest other entry."""
     if sub.shape[0] == 1:
-        return _capped(float(np.min(np.delete(sub[0], j))) if sub.shape[1] > 1 else math.inf, total)
+        return float(np.min(np.delete(sub[0], j))) if sub.shape[1] > 1 else math.inf
     forbidden = sub.copy()
     forbidden[i, j] = np.inf
     try:
         _, best = solve(forbidden)
     except InfeasibleAssignment:
         return math.inf
-    return _capped(best, total)
+    return float(best)

@@ -713,9 +713,8 @@ class _Context:
             out.append(Blame(Rule.TRACK_DROPPED, f))
         if any(not o.counted for o in s.on_it if o not in dropped):
             out.append(Blame(Rule.NOT_COUNTED, f))
-        if covering(
-            s, self.reach_of(s.evaluated, self.object_of())
-        ):  # matched to another object while this one was in reach
+        # matched to another object while this one was in reach
+        if covering(s, self.reach_of(s.evaluated, self.object_of())):
             out.append(Blame(Rule.COVERED_TWO, f))
         own = s.nearest_own
         if own is None and s.seen is not None and s.seen.class_name == self.class_name:

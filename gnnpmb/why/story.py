@@ -25,6 +25,7 @@ from gnnpmb.why.words import (
     margin_value,
     meas_name,
     threshold_held,
+    undercut_text,
     use_text,
 )
 
@@ -43,6 +44,7 @@ class StoryKind(enum.Enum):
     CANDIDATES = "candidates"
     SUMMARY = "summary"
     CLOSE_CALL = "close call"
+    DROPPED_PAIR = "dropped pair"  # a choice undercut by a solve before the threshold (``explain``)
     BUDGET = "budget"
 
 
@@ -251,7 +253,7 @@ class Storyteller:
                     for label in (c.chosen, c.alternative)
                     if label is not None and label.kind is AxisKind.TRACK
                 }
-                if not c.close_call or not tracks & self.shown_ever:
+                if not (c.close_call or c.undercut) or not tracks & self.shown_ever:
                     continue
                 b = born.get(int(c.meas.ref))
                 if c.chosen.kind is AxisKind.TRACK:
@@ -259,6 +261,20 @@ class Storyteller:
                 else:
                     went = destination_text(b if b is not None else -1, True, c.chosen)
                 chosen = threshold_held(c.chosen, c.chosen_cost, c) or cost_named(c.chosen_cost, c)
+                if c.undercut:  # no close call: a solve before the threshold decided it (``explain``)
+                    taken = {int(o.meas.ref) for o in conflict.choices if o is not c and o.chosen == c.alternative}
+                    out.append(
+                        StoryLine(
+                            frame,
+                            class_name,
+                            StoryKind.DROPPED_PAIR,
+                            "INFO",
+                            tuple(sorted(tracks | ({b} if b is not None else set()))),
+                            f"{meas_name(c.meas.ref)} → {went} ({chosen}), "
+                            + undercut_text(c, next(iter(taken), None)),
+                        )
+                    )
+                    continue
                 held = threshold_held(c.alternative, c.alternative_cost, c)
                 other = (
                     f"a new track ({held})"

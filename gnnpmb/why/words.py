@@ -246,7 +246,9 @@ def choice_text(frame: int, c: PairChoice, went: int, born: bool, alternative_to
     the detection the next best took in the same assignment: ``over track 20 (8.68 ...), which took m6 (the lower
     total wins), margin 2.01``."""
     other = "(no other)"
-    if c.alternative is not None and (held := threshold_held(c.alternative, c.alternative_cost, c)) is not None:
+    if c.undercut:
+        other = undercut_text(c, alternative_took)
+    elif c.alternative is not None and (held := threshold_held(c.alternative, c.alternative_cost, c)) is not None:
         other = f"over a new track ({held})"
     elif c.alternative is not None:
         other = f"over {column_name(c.alternative)} ({cost_value(c.alternative_cost, c)}{_brief(c.alternative_terms)})"
@@ -255,10 +257,31 @@ def choice_text(frame: int, c: PairChoice, went: int, born: bool, alternative_to
     terms = c.chosen_terms or c.alternative_terms
     score = f" (score {terms.score:.2f})" if terms is not None and terms.score is not None else ""
     chosen = threshold_held(c.chosen, c.chosen_cost, c) or cost_named(c.chosen_cost, c)
-    return (
-        f"frame {frame}: {meas_name(c.meas.ref)}{score} → **{destination_text(went, born, c.chosen)}** "
-        f"({chosen}) {other}, margin {margin_value(c.margin, c)}"
-    )
+    tail = f", {other}" if c.undercut else f" {other}, margin {margin_value(c.margin, c)}"
+    went_to = destination_text(went, born, c.chosen)
+    return f"frame {frame}: {meas_name(c.meas.ref)}{score} → **{went_to}** ({chosen}){tail}"
+
+
+def undercut_text(c: PairChoice, alternative_took: int | None = None) -> str:
+    """What an undercut choice (``explain``: the solver ran over every pair before its threshold dropped the
+    pairs past it) passed over: ``not track 24 (GIoU -0.41): the solver matched every pair before dropping
+    those past the GIoU threshold -0.50, and gave track 24 to a detection whose pair it dropped``. A free track
+    column cheaper than the chosen one is left only so: an optimal solve would otherwise have taken it (dev set
+    scene-0916 pointpillars simpletrack, frame 10, m11)."""
+    scale = c.scale
+    if scale.threshold is None:
+        limit = "its threshold"
+    elif scale.similarity is not None:
+        limit = f"the {scale.similarity} threshold {1.0 - scale.threshold:.2f}"
+    else:
+        limit = f"the {scale.name} threshold {cost_value(scale.threshold, c)}"
+    dropped = f"the solver matched every pair before dropping those past {limit}"
+    alt = c.alternative
+    if alt is None or alt.kind is not AxisKind.TRACK or alternative_took is not None:
+        return f"not the cheapest on these costs: {dropped}"
+    name = column_name(alt)
+    gave = f"and gave {name} to a detection whose pair it dropped"
+    return f"not {name} ({cost_value(c.alternative_cost, c)}): {dropped}, {gave}"
 
 
 def cost_named(value: float, c: PairChoice) -> str:

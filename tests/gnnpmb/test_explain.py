@@ -196,3 +196,43 @@ def test_a_greedy_choice_is_not_said_to_pass_over_a_column_another_detection_too
     (conflict,) = explain(matrix, Assignment("car", pairs, 4.0, ())).conflicts
     m1 = next(c for c in conflict.choices if c.meas.ref == 1)
     assert m1.alternative == cols[3] and m1.alternative_cost == 9.0 and m1.margin == LINK_SLACK
+
+
+def test_a_choice_the_solve_before_the_threshold_made_is_undercut_not_a_close_call() -> None:
+    """SimpleTrack's Hungarian runs over every pair, then drops those past GIoU -0.5 (cost 1.5); the matrix it
+    reports holds them as +inf. m11 costs 1.49 to track 4 and 1.41 to track 24; m7 costs 1.6 to track 24 and 3.0
+    to track 4. The solve takes m11 -> 4 and m7 -> 24 (3.09 < 4.41), then drops m7 -> 24: track 24 is left free
+    though cheaper for m11, so m11's margin on the reported matrix is -0.08 (dev set scene-0916 pointpillars
+    simpletrack frame 10 read "m11 → track 4 (GIoU -0.49) over track 24 (GIoU -0.41), margin 0.00")."""
+    from gnnpmb.assign.matching import BoundedCosts, Solver, solve_then_threshold
+    from gnnpmb.box.cost import OneMinusGiou3d
+    from gnnpmb.why.words import choice_text
+
+    full = np.array([[1.49, 1.41], [3.0, 1.6]])
+    max_cost = 1.5
+    chosen = solve_then_threshold(BoundedCosts.of(full.copy()), max_cost, Solver.HUNGARIAN)
+    assert chosen.tolist() == [0, -1]
+    scale = OneMinusGiou3d(-0.5).scale
+    reported = np.full((2, 4), INF)
+    reported[:, :2] = np.where(full <= max_cost, full, INF)
+    reported[[0, 1], [2, 3]] = max_cost
+    rows, cols = (meas(11), meas(7)), (track(4), track(24), new(11), new(7))
+    matrix = CostMatrix("car", reported, rows, cols, scale=scale)
+    assignment = Assignment("car", ((meas(11), track(4)), (meas(7), new(7))), 2.99, (24,))
+    d = explain(matrix, assignment)
+    assert d is not None
+    (conflict,) = d.conflicts
+    (choice,) = conflict.choices
+    assert (choice.chosen, choice.alternative, choice.alternative_cost) == (track(4), track(24), 1.41)
+    assert choice.undercut and not choice.close_call and not conflict.close_call
+    assert choice_text(10, choice, 4, False) == (
+        "frame 10: m11 → **track 4** (GIoU -0.49), not track 24 (GIoU -0.41): the solver matched every pair before "
+        "dropping those past the GIoU threshold -0.50, and gave track 24 to a detection whose pair it dropped"
+    )
+
+
+def test_an_optimal_choice_is_not_undercut() -> None:
+    matrix, assignment = staged()
+    d = explain(matrix, assignment)
+    assert d is not None
+    assert not any(c.undercut for conflict in d.conflicts for c in conflict.choices)
