@@ -268,6 +268,9 @@ def _conflict(
             bests = masked[at, best].tolist()
     # what each margin is measured from: the conflict's total (an optimal solver), the row's own cost (greedy)
     froms = [total] * len(bests) if matrix.scale.optimal or rows.size == 1 else chosen_costs
+    # only a solve over every pair before a threshold leaves a choice dearer than the reported matrix's best
+    # (a Murty hypothesis other than the best, PMBM's, is another matter and keeps its clipped margin)
+    solved_before_threshold = matrix.scale.optimal and matrix.scale.threshold is not None
     mrows, mcols = matrix.rows, matrix.cols
     choices = []
     for r, j, k, c_chosen, c_best, b, base in zip(
@@ -287,7 +290,7 @@ def _conflict(
                 chosen_col=cols_list[j],
                 alternative_col=cols_list[k] if has_alt else -1,
                 scale=matrix.scale,
-                undercut=b < base - UNDERCUT_TOL,
+                undercut=solved_before_threshold and b < base - UNDERCUT_TOL,
             )
         )
     used = {cols_list[j] for j in chosen_list if cols_list[j] < n_tracks}

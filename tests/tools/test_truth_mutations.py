@@ -1466,3 +1466,29 @@ def test_another_run_said_to_count_no_track_of_a_class_it_scored_is_caught() -> 
     assert check_text(said, CTX, None, _eval(), others={"pmbm": unscored}).found == []
     caught = check_text(said, CTX, None, _eval(), others={"pmbm": _eval()}).found  # its cars scored at 0.5
     assert [c.kind for c in caught] == ["other run"]
+
+
+def _undercut_world():
+    """A box tracker's frame (SimpleTrack's GIoU, threshold cost 1.5): the solve over every pair gave m0 track 5
+    (1.49) and m1 track 7 (1.6, then dropped), so the reported matrix leaves track 7 free and cheaper for m0 (1.41)."""
+    from gnnpmb.box.cost import OneMinusGiou3d
+
+    rows = axis_labels(AxisKind.MEASUREMENT, [0, 1])
+    cols = axis_labels(AxisKind.TRACK, [5, 7]) + axis_labels(AxisKind.NEW_TRACK, [0, 1])
+    cost = np.array([[1.49, 1.41, 1.5, np.inf], [np.inf, np.inf, np.inf, 1.5]])
+    m = CostMatrix(C, cost, rows, cols, scale=OneMinusGiou3d(-0.5).scale)
+    a = Assignment(C, ((rows[0], cols[0]), (rows[1], cols[3])), 2.99, (7,))
+    return RawEvents.of([FrameStarted("t", 3, "token", 0, 0.5), m, a]), m, a
+
+
+def test_an_undercut_choice_said_with_a_margin_is_caught_and_said_as_undercut_passes() -> None:
+    raw, m, a = _undercut_world()
+    (conflict,) = explain(m, a).conflicts
+    (choice,) = conflict.choices
+    said = "then, " + choice_text(3, choice, 5, False).replace("**", "")
+    assert "not track 7 (GIoU -0.41): the solver matched every pair" in said
+    assert check_text(said, CTX, raw, _eval()).found == []
+    old = "then, frame 3: m0 → track 5 (GIoU -0.49) over track 7 (GIoU -0.41), margin 0.00 of GIoU"
+    assert [c.kind for c in check_text(old, CTX, raw, _eval()).found] == ["misleading"]
+    wrong = said.replace("not track 7 (GIoU -0.41)", "not track 5 (GIoU -0.49)").replace("gave track 7", "gave track 5")
+    assert [c.kind for c in check_text(wrong, CTX, raw, _eval()).found] == ["misleading"]

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from gnnpmb.assign.hungarian import solve
 from gnnpmb.events import AxisKind, Born, CostMatrix, Gated
 from tools.truth import costs, detector, hypotheses, lost, otherruns, output, place, replay, shares
 from tools.truth.devkit import EvalFacts
@@ -160,6 +161,12 @@ CHOICE = re.compile(
     r"(?:, which took m(\d+) \(the lower total wins\))?|\(no other\)), margin (inf|\d+\.\d+)"
     r"((?: [a-zA-Z]+)? or more)?"
 )
+UNDERCUT = re.compile(
+    r"frame (\d+): m(\d+)(?: \(score [\d.]+\))? → [^(\n]+? \([^()\n]*\), not (?:track (\d+) \([^()\n]*\): the "
+    r"solver matched every pair before dropping those past [^\n]+?, and gave track \d+ to a detection whose pair it "
+    r"dropped|the cheapest on these costs: the solver matched every pair before dropping those past)"
+)
+UNDERCUT_TOL = 1e-9
 THEFT = re.compile(
     r"track (\d+) had been a false track at [^(]+\(matched to no object: the evaluation still gave GT (\w+) to "
     r"track (\d+)\)"
@@ -325,6 +332,8 @@ def check_text(
         _check_counterfactuals(x, para, c, raw, out, bad)
     for m in CHOICE.finditer(text):
         _check_choice(m, c, raw, out, bad)
+    for m in UNDERCUT.finditer(text):
+        _check_undercut(m, c, raw, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
     lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
     lost.check_used_away(text, c, ctx.lost, ctx.gt_id, scene, raw, out, bad)
@@ -562,6 +571,10 @@ def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
             if other and other[0] != meas:
                 bad("misleading", m[0], f"greedy: track {t} had been given m{other[0]}")
         return
+    cheaper = _free_cheaper(mat, a, row, col)
+    if cheaper is not None:  # the assignment is no optimum of this matrix: a margin measured on it says nothing
+        bad("misleading", m[0], f"column {cheaper} was free and cheaper for m{meas} than the chosen one")
+        return
     true = replay.margin(mat, row, col)
     if math.isnan(true):
         return
@@ -572,6 +585,47 @@ def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
         return
     if (math.isinf(true) and not math.isinf(shown)) or (math.isfinite(true) and abs(shown - true) > 0.006):
         bad("misleading", m[0], f"re-solved without the pair, the total rises by {true:.3f}")
+
+
+def _used_cols(mat: CostMatrix, a) -> set[int]:
+    return {k for r, _ in a.pairs if (k := replay.chosen_col(mat, a, int(r.ref))) is not None}
+
+
+def _free_cheaper(mat: CostMatrix, a, row: int, col: int) -> int | None:
+    """A column no detection took whose cost for ``row`` lies below the chosen ``col``'s (None: there is none)."""
+    cost = np.asarray(mat.cost, dtype=float)
+    used = _used_cols(mat, a)
+    free = [k for k in range(cost.shape[1]) if k not in used and cost[row, k] < cost[row, col] - UNDERCUT_TOL]
+    return free[0] if free else None
+
+
+def _check_undercut(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
+    """ "m11 → track 4 (...), not track 24 (...): the solver matched every pair before dropping those past the
+    threshold, and gave track 24 to a detection whose pair it dropped": the matrix has a threshold and an optimal
+    solver, track 24's column is free in the assignment and cheaper for m11 than the chosen one (the generic form:
+    the assignment costs more than the matrix's optimum)."""
+    x, meas, t = int(m[1]), int(m[2]), m[3]
+    found = raw.deciding(x, c)
+    if found is None:
+        return
+    mat, a = found
+    row, col = replay.row_of(mat, meas), replay.chosen_col(mat, a, meas)
+    if row is None or col is None:
+        return
+    out.checked["misleading"] += 1
+    if not mat.scale.optimal or mat.scale.threshold is None:
+        bad("misleading", m[0], "the matrix has no threshold dropped after an optimal solve")
+        return
+    if t is None:
+        cost = np.asarray(mat.cost, dtype=float)
+        chosen = sum(cost[replay.row_of(mat, int(r.ref)), replay.chosen_col(mat, a, int(r.ref))] for r, _ in a.pairs)
+        _, best = solve(cost)
+        if not chosen > best + UNDERCUT_TOL:
+            bad("misleading", m[0], f"the assignment's total {chosen:.3f} is the matrix's optimum {best:.3f}")
+        return
+    k = replay.track_col(mat, int(t))
+    if k is None or k in _used_cols(mat, a) or not mat.cost[row, k] < mat.cost[row, col] - UNDERCUT_TOL:
+        bad("misleading", m[0], f"track {t}'s column at frame {x} is not a free one cheaper for m{meas}")
 
 
 def _output_on_after(scene: SceneTruth, ev: EvalFacts, t: str, gt_id: str, last: int, frame: int) -> list[int]:
@@ -594,5 +648,7 @@ def check_choice_lines(text: str, c: str, raw: RawEvents | None, out: Tally, bad
         return
     for m in CHOICE.finditer(text):
         _check_choice(m, c, raw, out, bad)
+    for m in UNDERCUT.finditer(text):
+        _check_undercut(m, c, raw, out, bad)
     costs.check_thresholds(text, c, raw, out, bad)
     costs.check_choice_values(text, c, raw, out, bad)
