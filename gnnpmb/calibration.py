@@ -33,15 +33,12 @@ Kirubarajan 2001, sec. 5.2 for the Gaussian noise; Mahler 2007, ch. 9 for P_D, c
 - the box Kalman noise of ``prob3dmot`` (``gnnpmb.box.noise``).
 
 A statistic with fewer than ``MIN_SAMPLES`` samples keeps the value of the base configuration. Process noise,
-clutter intensity and the birth weight are never written below the base configuration's (the comment then gives
-the learnt value): the trackers' models are cruder than the data (a Gaussian for heavy-tailed manoeuvres; a birth
-component at every detection), and on the dev set's ``mini_train`` the learnt values below the defaults lost
-AMOTA in-sample (issue 32 in ``docs/results.md``: Q of 1e-4 from the mostly parked objects, 0.92 -> 0.77; the
-learnt clutter, ~40 times below the default, made clutter detections tracks at once). With the velocity measured
-the PMB trackers' clutter intensity is the product kappa d, and the floor holds for that product: d is written
-so that the written kappa times it is max(kappa d, the base's kappa_b d_b) (``clutter_velocity_density``).
-Raising each factor to its own floor had made the dev set's pedestrian clutter (centerpoint) 10 times the learnt
-product and 13 times the base's (Round 13).
+clutter intensity (and its velocity density) and the birth weight are never written below the base
+configuration's (the comment then gives the learnt value): the trackers' models are cruder than the data (a
+Gaussian for heavy-tailed manoeuvres; a birth component at every detection), and on the dev set's ``mini_train``
+the learnt values below the defaults lost AMOTA in-sample (issue 32 in ``docs/results.md``: Q of 1e-4 from the
+mostly parked objects, 0.92 -> 0.77; the learnt clutter, ~40 times below the default, made clutter detections
+tracks at once).
 """
 
 from __future__ import annotations
@@ -312,9 +309,8 @@ def learn_class(cls: str, s: ClassSamples, base: TrackerConfig) -> list[Learnt]:
     frames = max(s.frames, 1)
     clutter = s.clutter_score[s.clutter_score >= t]
     area_m2 = math.pi * s.range_m**2
-    kappa = len(clutter) / frames / area_m2
     if len(s.detection_score) >= MIN_SAMPLES:
-        floor = base.resolved(cls).models.clutter_intensity
+        kappa, floor = len(clutter) / frames / area_m2, base.resolved(cls).models.clutter_intensity
         out.append(
             Learnt(
                 own,
@@ -327,15 +323,14 @@ def learn_class(cls: str, s: ClassSamples, base: TrackerConfig) -> list[Learnt]:
     if len(clutter) >= MIN_SAMPLES:
         v = s.clutter_velocity_mps[s.clutter_score >= t]
         sx, sy = np.maximum(np.std(v, axis=0), 0.1).tolist()
-        density = 1.0 / (4.0 * math.pi * sx * sy)
-        written, source = clutter_velocity_density(kappa, density, base.resolved(cls))
+        density, floor = 1.0 / (4.0 * math.pi * sx * sy), base.resolved(cls).pmb.clutter_velocity_density
         out.append(
             Learnt(
                 pmb,
                 "clutter_velocity_density",
-                written,
+                max(density, floor),
                 f"mean density 1/(4 pi sx sy) of a Gaussian fitted to {len(v)} clutter velocities, sx {sx:.2f}, "
-                f"sy {sy:.2f} m/s, {density:.3g} (1/(m/s)^2); {source}",
+                f"sy {sy:.2f} m/s (1/(m/s)^2){_raised(density, floor)}",
             )
         )
     kept = np.sum(s.detection_score >= t)
@@ -357,24 +352,6 @@ def learn_class(cls: str, s: ClassSamples, base: TrackerConfig) -> list[Learnt]:
             )
         )
     return out
-
-
-def clutter_velocity_density(kappa: float, density: float, base: TrackerConfig) -> tuple[float, str]:
-    """The velocity density d to write beside the clutter intensity, and what it was learnt from. With the velocity
-    measured the PMB trackers' clutter intensity is the product kappa d (per m^2 and (m/s)^2,
-    ``models.clutter_intensity``), so the floor of the module docstring holds for that product: the written kappa'
-    = max(kappa, kappa_b) times the written d' equals max(kappa d, kappa_b d_b). Raising kappa and d each to its
-    own floor would raise the product by both factors (issue 32, Round 13 of ``docs/results.md``: dev pedestrians,
-    centerpoint, learnt kappa 9.7e-5 raised to 0.001 beside d 0.26, 10 times the learnt product, 13 times the
-    base's)."""
-    kappa_b, density_b = base.models.clutter_intensity, base.pmb.clutter_velocity_density
-    product = max(kappa * density, kappa_b * density_b)
-    written = product / max(kappa, kappa_b)
-    source = (
-        f"written so that clutter_intensity x it = max(learnt {kappa:.3g} x {density:.3g}, the base's "
-        f"{kappa_b:g} x {density_b:g}) = {product:.3g} (1/(m^2 (m/s)^2))"
-    )
-    return written, source
 
 
 def _raised(learnt: float, floor: float) -> str:
