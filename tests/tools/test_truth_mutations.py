@@ -1492,3 +1492,32 @@ def test_an_undercut_choice_said_with_a_margin_is_caught_and_said_as_undercut_pa
     assert [c.kind for c in check_text(old, CTX, raw, _eval()).found] == ["misleading"]
     wrong = said.replace("not track 7 (GIoU -0.41)", "not track 5 (GIoU -0.49)").replace("gave track 7", "gave track 5")
     assert [c.kind for c in check_text(wrong, CTX, raw, _eval()).found] == ["misleading"]
+
+
+def test_a_cphd_track_said_to_fall_below_a_threshold_is_caught_and_the_map_cardinality_form_is_checked() -> None:
+    # viewer review, dev set scene-0916 pointpillars cphd id_switch:1: "track 15 no longer output (w=0.14 fell below
+    # 1.20)" a frame after it was output at w=0.72 (a CPHD outputs the MAP cardinality's heaviest components)
+    from gnnpmb.events import Cardinality, Extracted, IntensityWeights, TrackEstimate
+    from tools.truth.lost import check_story
+    from tools.truth.sentences import Tally
+
+    def est(t: int) -> TrackEstimate:
+        return TrackEstimate(t, C, (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (1.0, 0, 0, 0), (0.0, 0.0), 0.5, 1.0, 0)
+
+    weights = IntensityWeights(C, np.array([15, 7]), np.array([0.14, 1.2]))
+    cphd = _frames({5: [weights, Cardinality(C, np.array([0.2, 0.7, 0.1])), Extracted(C, (est(7),), 1.2)]})
+    phd = _frames({5: [weights, Extracted(C, (est(7),), 0.5)]})
+
+    def found(section: str, raw) -> list[str]:
+        out = Tally()
+        check_story(section, C, raw, out, lambda kind, sentence, why: out.found.append(kind))
+        return out.found
+
+    fell = "- frame 5: track 15 no longer output (w=0.14 fell below {})\n"
+    assert found(fell.format("1.20"), cphd) == ["misleading"]
+    assert found(fell.format("0.50"), phd) == []
+    kept = "- frame 5: track 15 no longer output (w=0.14; the MAP cardinality {} kept the {} heaviest components, the "
+    kept += "lightest at w={})\n"
+    assert found(kept.format(1, 1, "1.20"), cphd) == []
+    assert found(kept.format(2, 2, "1.20"), cphd) == ["tracker"]
+    assert found(kept.format(1, 1, "0.14"), cphd) == ["tracker"]

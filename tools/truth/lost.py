@@ -38,6 +38,8 @@ import numpy as np
 from gnnpmb.events import (
     Assignment,
     AxisKind,
+    Cardinality,
+    Extracted,
     Gated,
     IntensityWeights,
     Marginals,
@@ -376,6 +378,41 @@ STORY_OUTPUT = re.compile(
     r"display threshold \([^)]*\), still output|\(output;))"
 )
 
+STORY_FELL = re.compile(r"frame (\d+): track (\d+) no longer output \([rw]=(\d+\.\d+) fell below (\d+\.\d+|inf)\)")
+STORY_MAP = re.compile(
+    r"frame (\d+): track (\d+) no longer output \([rw]=\d+\.\d+; the MAP cardinality (?:(\d+) kept the \d+ heaviest "
+    r"components, the lightest at w=(\d+\.\d+)|was 0)\)"
+)
+
+
+def check_no_longer_output(section: str, c: str, raw, out, bad) -> None:
+    """ "track T no longer output (r=V fell below L)": a threshold fixed beforehand, so no CPHD (whose output is the
+    MAP cardinality's heaviest components: ``Cardinality`` events), and V below L. "…; the MAP cardinality n kept
+    the n heaviest components, the lightest at w=W)" / "…; the MAP cardinality was 0)": a CPHD frame, n the argmax
+    of its cardinality pmf and the number of the class's estimates, W the lightest weight among them."""
+    if raw is None:
+        return
+    for m in STORY_FELL.finditer(section):
+        x = int(m[1])
+        out.checked["misleading"] += 1
+        if raw.last(x, c, Cardinality) is not None:
+            bad("misleading", m[0], "a CPHD outputs its MAP cardinality's heaviest components: no fixed threshold")
+        elif not float(m[3]) < float(m[4]):
+            bad("misleading", m[0], f"{m[3]} is not below {m[4]}")
+    for m in STORY_MAP.finditer(section):
+        x = int(m[1])
+        out.checked["tracker"] += 1
+        pmf, extracted = raw.last(x, c, Cardinality), raw.last(x, c, Extracted)
+        if pmf is None or extracted is None:
+            bad("tracker", m[0], f"no Cardinality or Extracted event of {c} at frame {x}")
+            continue
+        n_map, ids = int(np.argmax(np.asarray(pmf.pmf))), [e.track_id for e in extracted.estimates]
+        said = 0 if m[3] is None else int(m[3])
+        weights = [w for t in ids if (w := _existence(raw, x, c, t)) is not None]
+        lightest_ok = said == 0 or (weights and abs(min(weights) - float(m[4])) < 0.006)
+        if said != n_map or said != len(ids) or not lightest_ok:
+            bad("tracker", m[0], f"MAP cardinality {n_map}, {len(ids)} estimates, weights {sorted(weights)[:3]}")
+
 
 def check_story(section: str, c: str, raw, out, bad, submitted=None) -> None:
     """A focus document's story lines of one run (``section``): "track T confirmed (r=V, …)", "track T no longer
@@ -398,6 +435,7 @@ def check_story(section: str, c: str, raw, out, bad, submitted=None) -> None:
                 bad("output", m[0], f"the submission {'has' if boxed else 'has no'} box of track {t} at frame {x}")
     if raw is None:
         return
+    check_no_longer_output(section, c, raw, out, bad)
     for m in STORY_COPY.finditer(section):  # a GM-PHD copy: no component of its own, its source's weight
         x, t, source = int(m[1]), int(m[2]), int(m[3])
         out.checked["tracker"] += 1

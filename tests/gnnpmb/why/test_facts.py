@@ -3,6 +3,8 @@ how tracks ended, PMBM's hypotheses, and close calls on each tracker's own cost 
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -236,6 +238,43 @@ def test_a_phd_labels_story_gives_its_heaviest_components_weight_as_w() -> None:
     assert confirmed == "track 18 confirmed (w=1.04, from m0)"
     (gone,) = [line.text for line in teller.frame_lines(1) if line.kind is StoryKind.NO_LONGER_SHOWN]
     assert gone == "track 18 no longer output (w=0.22 fell below 0.50)"
+
+
+def test_a_cphd_track_no_longer_output_is_said_left_out_by_the_map_cardinality_not_below_a_threshold() -> None:
+    # viewer review, dev set scene-0916 pointpillars cphd id_switch:1: "track 15 no longer output (w=0.14 fell below
+    # 1.20)" a frame after it was output at w=0.72: a CPHD outputs its MAP cardinality's heaviest components, and
+    # Extracted.threshold is the lightest of them, no threshold fixed beforehand
+    from gnnpmb.events import Cardinality, Extracted, IntensityWeights, Posterior
+
+    def posterior(ids: list[int], w: list[float]) -> tuple[Posterior, IntensityWeights]:
+        k = len(ids)
+        cov = np.tile(np.eye(4), (k, 1, 1))
+        return Posterior("car", np.array(ids), np.zeros((k, 4)), cov, np.minimum(w, 1.0)), IntensityWeights(
+            "car", np.array(ids), np.array(w)
+        )
+
+    pmf = Cardinality("car", np.array([0.1, 0.6, 0.3]))
+    events = [frame(0), received([0]), *posterior([15, 7], [0.72, 0.6]), pmf]
+    events += [Extracted("car", (estimate(15, 0, 0.72), estimate(7, 0, 0.6)), 0.6)]
+    events += [
+        frame(1),
+        received([0]),
+        *posterior([15, 7], [0.14, 1.2]),
+        pmf,
+        Extracted("car", (estimate(7, 0, 1.0),), 1.2),
+    ]
+    events += [frame(2), received([0]), *posterior([7], [0.3]), Cardinality("car", np.array([0.9, 0.1]))]
+    events += [Extracted("car", (), math.inf)]
+    teller = Storyteller(facts_of(events), involved=frozenset({15, 7}))
+    gone = [[line.text for line in teller.frame_lines(f) if line.kind is StoryKind.NO_LONGER_SHOWN] for f in range(3)]
+    assert gone == [
+        [],
+        [
+            "track 15 no longer output (w=0.14; the MAP cardinality 1 kept the 1 heaviest components, the lightest "
+            "at w=1.20)"
+        ],
+        ["track 7 no longer output (w=0.30; the MAP cardinality was 0)"],
+    ]
 
 
 def test_a_track_output_below_the_display_threshold_is_said_output_not_hidden() -> None:
