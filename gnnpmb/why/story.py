@@ -35,6 +35,7 @@ MAX_NAMED = 12
 
 class StoryKind(enum.Enum):
     CONFIRMED = "confirmed"  # first shown
+    SHOWN_AGAIN = "shown again"  # shown after frames it was not
     MISSED = "missed"  # shown without a detection this frame
     HIDDEN = "hidden"  # an involved track below the show floor, every frame
     NO_LONGER_SHOWN = "no longer shown"
@@ -78,6 +79,7 @@ class Storyteller:
         self.involved = involved
         self.shown_ever: set[int] = set()
         self._shown_before: dict[str, set[int]] = {}
+        self._output_before: dict[str, set[int]] = {}
 
     @property
     def has_existence(self) -> bool:
@@ -109,6 +111,7 @@ class Storyteller:
         extracted = cf.extracted.estimates if cf.extracted is not None else ()
         now = {e.track_id: e for e in extracted if e.existence >= self.show_min}
         known = self.shown_ever
+        shown_last, output_last = self._shown_before.get(class_name, set()), self._output_before.get(class_name, set())
         hyp = self.facts.hypotheses(frame, class_name)
         output_only = self.facts.output_only
         for t, e in now.items():
@@ -138,6 +141,9 @@ class Storyteller:
                     say(StoryKind.CONFIRMED, "INFO", (t,), said)
                     continue
                 say(StoryKind.CONFIRMED, "INFO", (t,), f"track {t} confirmed ({self._r(weight, r)}{via}){why}")
+            elif t not in shown_last:  # back after a gap the story reported ("no longer output", "fell below")
+                back = "back above the display threshold" if t in output_last else "output again"
+                say(StoryKind.SHOWN_AGAIN, "INFO", (t,), f"track {t} {back} ({self._r(weight, r)}{via})")
             elif e.meas_index < 0:
                 copy_of = _copied(e, extracted, posterior_r) if cf.intensity is not None else None
                 value = (
@@ -238,6 +244,7 @@ class Storyteller:
         lines += self._close_calls(frame, class_name, cf)
         self.shown_ever |= set(now)
         self._shown_before[class_name] = set(now)
+        self._output_before[class_name] = output_ids
         return lines
 
     def _close_calls(self, frame: int, class_name: str, cf: ClassFrame) -> list[StoryLine]:

@@ -1073,6 +1073,11 @@ def test_a_story_line_calling_a_track_the_submission_output_not_shown_or_not_out
     for key in ("gone", "none"):
         assert found(lines[key], not_output) == []
         assert found(lines[key], output) == ["output"]
+    for again in ("output again", "back above the display threshold"):  # a track back after a gap
+        line = f"- frame 17: track 72 {again} (r=0.41, from m7)\n"
+        assert found(line, output) == []
+        assert found(line, not_output) == ["output"]
+        assert found(line.replace("0.41", "0.61"), output) == ["tracker"]
 
 
 def test_last_output_on_it_of_a_track_the_submission_still_had_on_the_annotation_later_is_caught() -> None:

@@ -365,8 +365,8 @@ def check_two_tracks(text: str, class_name: str, frame: int, gt_id: str | None, 
 
 
 STORY_SHOWN = re.compile(
-    r"frame (\d+): track (\d+) (?:no longer (?:shown|output) \(|fell below the display threshold \(|confirmed \()"
-    r"([rw])=(\d+\.\d+)"
+    r"frame (\d+): track (\d+) (?:no longer (?:shown|output) \(|fell below the display threshold \(|confirmed \(|"
+    r"output again \(|back above the display threshold \()([rw])=(\d+\.\d+)"
 )
 STORY_HIDDEN = re.compile(
     r"frame (\d+): track (\d+) \((?:not shown, [rw] < [\d.]+|output; [rw] below the display threshold [\d.]+|not "
@@ -375,7 +375,7 @@ STORY_HIDDEN = re.compile(
 STORY_COPY = re.compile(r"frame (\d+): track (\d+) confirmed \(a copy of track (\d+)'s component, ([rw])=(\d+\.\d+)")
 STORY_OUTPUT = re.compile(
     r"frame (\d+): track (\d+) (?:(no longer shown|\(not shown)|(no longer output|\(not output)|(fell below the "
-    r"display threshold \([^)]*\), still output|\(output;))"
+    r"display threshold \([^)]*\), still output|\(output;|output again|back above the display threshold))"
 )
 
 STORY_FELL = re.compile(r"frame (\d+): track (\d+) no longer output \([rw]=(\d+\.\d+) fell below (\d+\.\d+|inf)\)")

@@ -240,6 +240,30 @@ def test_a_phd_labels_story_gives_its_heaviest_components_weight_as_w() -> None:
     assert gone == "track 18 no longer output (w=0.22 fell below 0.50)"
 
 
+def test_a_track_back_after_a_gap_is_said_output_again() -> None:
+    # viewer review, dev set scene-0655 centerpoint jpda id_switch:1: "track 43 no longer output" at frames 13, 15 and
+    # 17 with nothing said of its return at frames 14 and 16 (the submission has its box there)
+    from gnnpmb.events import Extracted, Posterior
+
+    def post(w: float) -> Posterior:
+        return Posterior("car", np.array([43]), np.zeros((1, 4)), np.eye(4)[None], np.array([w]))
+
+    events = [frame(0), received([0]), post(0.9), Extracted("car", (estimate(43, 0, 0.9),), 0.1)]
+    events += [frame(1), received([]), post(0.05), Extracted("car", (), 0.1)]
+    events += [frame(2), received([3]), post(0.8), Extracted("car", (estimate(43, 3, 0.8),), 0.1)]
+    events += [frame(3), received([]), post(0.3), Extracted("car", (estimate(43, -1, 0.3),), 0.1)]
+    events += [frame(4), received([5]), post(0.7), Extracted("car", (estimate(43, 5, 0.7),), 0.1)]
+    teller = Storyteller(facts_of(events), involved=frozenset({43}))
+    said = [[line.text for line in teller.frame_lines(f) if line.kind is not StoryKind.SUMMARY] for f in range(5)]
+    assert said == [
+        ["track 43 confirmed (r=0.90, from m0)"],
+        ["track 43 no longer output (r=0.05 fell below 0.50)"],
+        ["track 43 output again (r=0.80, from m3)"],
+        ["track 43 fell below the display threshold (r=0.30 < 0.50), still output"],
+        ["track 43 back above the display threshold (r=0.70, from m5)"],
+    ]
+
+
 def test_a_cphd_track_no_longer_output_is_said_left_out_by_the_map_cardinality_not_below_a_threshold() -> None:
     # viewer review, dev set scene-0916 pointpillars cphd id_switch:1: "track 15 no longer output (w=0.14 fell below
     # 1.20)" a frame after it was output at w=0.72: a CPHD outputs its MAP cardinality's heaviest components, and
