@@ -123,10 +123,10 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(demo_dataroot: P
     assert "frame by frame (the evaluation counted " in summary and "tracks output on it (score)" in summary
     # "Counted" is the evaluation's: the track's score averaged over the whole track against the threshold.
     threshold = report.threshold_of(failure.class_name)
-    listed = re.findall(r"(\d+) \((\d\.\d\d); track average (\d\.\d\d)(, not counted)?\)", summary)
+    listed = re.findall(r"(\d+) \((\d\.\d\d); track average (\d\.\d{3,4})(, not counted)?\)", summary)
     assert listed
     for track_id, _score, average, not_counted in listed:
-        assert average == f"{report.track_scores[track_id]:.2f}"
+        assert average == f"{report.track_scores[track_id]:.{len(average) - 2}f}"
         assert bool(not_counted) == (report.track_scores[track_id] < threshold)
     followed = [t for t in failure.track_ids if paths.existence("gnnpmb", failure.class_name, t) in rows]
     assert followed, f"no existence series for the involved tracks {failure.track_ids}"
