@@ -55,6 +55,17 @@ def estimate(t: int, meas: int, existence: float = 1.0) -> TrackEstimate:
     return TrackEstimate(t, "car", (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (1.0, 0, 0, 0), (0.0, 0.0), 0.8, existence, meas)
 
 
+def phd_posterior(ids: list[int], w: list[float]) -> tuple:
+    """A GM-PHD / CPHD frame's ``Posterior`` (existence min(w, 1)) and ``IntensityWeights`` (w) of ``ids``."""
+    from gnnpmb.events import IntensityWeights, Posterior
+
+    k = len(ids)
+    cov = np.tile(np.eye(4), (k, 1, 1))
+    return Posterior("car", np.array(ids), np.zeros((k, 4)), cov, np.minimum(w, 1.0)), IntensityWeights(
+        "car", np.array(ids), np.array(w)
+    )
+
+
 def facts_of(events: list):
     sink = FactSink("t")
     for e in events:
@@ -217,22 +228,15 @@ def test_a_results_files_detection_beside_a_box_that_sat_on_another_is_named_wit
 def test_a_phd_labels_story_gives_its_heaviest_components_weight_as_w() -> None:
     # independent audit r42, dev set scene-0061 centerpoint cphd id_switch:1: "track 18 no longer shown (r=0.02 fell
     # below 0.50)": the last of its three components' rows (0.22, 0.211, 0.024), read as an existence
-    from gnnpmb.events import Extracted, IntensityWeights, Posterior
-
-    def posterior(ids: list[int], w: list[float]) -> tuple[Posterior, IntensityWeights]:
-        k = len(ids)
-        cov = np.tile(np.eye(4), (k, 1, 1))
-        return Posterior("car", np.array(ids), np.zeros((k, 4)), cov, np.minimum(w, 1.0)), IntensityWeights(
-            "car", np.array(ids), np.array(w)
-        )
+    from gnnpmb.events import Extracted
 
     events = [
         frame(0),
         received([0]),
-        *posterior([18, 18], [1.04, 0.09]),  # the Posterior and the estimate hold min(w, 1): the story says 1.04
+        *phd_posterior([18, 18], [1.04, 0.09]),  # the Posterior and the estimate hold min(w, 1): the story says 1.04
         Extracted("car", (estimate(18, 0, 1.0),), 0.5),
     ]
-    events += [frame(1), received([0]), *posterior([18, 18, 18], [0.22, 0.211, 0.024]), Extracted("car", (), 0.5)]
+    events += [frame(1), received([0]), *phd_posterior([18, 18, 18], [0.22, 0.211, 0.024]), Extracted("car", (), 0.5)]
     teller = Storyteller(facts_of(events), involved=frozenset({18}))
     (confirmed,) = [line.text for line in teller.frame_lines(0) if line.kind is StoryKind.CONFIRMED]
     assert confirmed == "track 18 confirmed (w=1.04, from m0)"
@@ -268,26 +272,19 @@ def test_a_cphd_track_no_longer_output_is_said_left_out_by_the_map_cardinality_n
     # viewer review, dev set scene-0916 pointpillars cphd id_switch:1: "track 15 no longer output (w=0.14 fell below
     # 1.20)" a frame after it was output at w=0.72: a CPHD outputs its MAP cardinality's heaviest components, and
     # Extracted.threshold is the lightest of them, no threshold fixed beforehand
-    from gnnpmb.events import Cardinality, Extracted, IntensityWeights, Posterior
-
-    def posterior(ids: list[int], w: list[float]) -> tuple[Posterior, IntensityWeights]:
-        k = len(ids)
-        cov = np.tile(np.eye(4), (k, 1, 1))
-        return Posterior("car", np.array(ids), np.zeros((k, 4)), cov, np.minimum(w, 1.0)), IntensityWeights(
-            "car", np.array(ids), np.array(w)
-        )
+    from gnnpmb.events import Cardinality, Extracted
 
     pmf = Cardinality("car", np.array([0.1, 0.6, 0.3]))
-    events = [frame(0), received([0]), *posterior([15, 7], [0.72, 0.6]), pmf]
+    events = [frame(0), received([0]), *phd_posterior([15, 7], [0.72, 0.6]), pmf]
     events += [Extracted("car", (estimate(15, 0, 0.72), estimate(7, 0, 0.6)), 0.6)]
     events += [
         frame(1),
         received([0]),
-        *posterior([15, 7], [0.14, 1.2]),
+        *phd_posterior([15, 7], [0.14, 1.2]),
         pmf,
         Extracted("car", (estimate(7, 0, 1.0),), 1.2),
     ]
-    events += [frame(2), received([0]), *posterior([7], [0.3]), Cardinality("car", np.array([0.9, 0.1]))]
+    events += [frame(2), received([0]), *phd_posterior([7], [0.3]), Cardinality("car", np.array([0.9, 0.1]))]
     events += [Extracted("car", (), math.inf)]
     teller = Storyteller(facts_of(events), involved=frozenset({15, 7}))
     gone = [[line.text for line in teller.frame_lines(f) if line.kind is StoryKind.NO_LONGER_SHOWN] for f in range(3)]
