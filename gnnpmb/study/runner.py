@@ -136,8 +136,9 @@ def run_tasks(fn: Callable[[T], R], items: Iterable[T], run: Execution) -> Itera
     Must be iterated inside ``ray_session(run)`` when ``run.uses_ray``. Closing the iterator early (or Ctrl-C)
     leaves the tasks still running to the session's end. They are not cancelled one by one: in Ray 2.60
     ``ray.cancel`` of a task whose result is arriving at that moment aborts the driver process (a failed
-    ``RAY_CHECK``, "Tried to complete task that was not pending", in the driver's log only; the race of
-    ray-project/ray#54798), which ended a sweep stopped by SIGTERM with exit 1, no message and no results file.
+    ``RAY_CHECK``, "Tried to complete task that was not pending", in the driver's log only: the cancel-versus-reply
+    race ray-project/ray#54798 fixed on the retry path), which ended a sweep stopped by SIGTERM with exit 1, no
+    message and no results file.
     """
     if not run.uses_ray:
         for i, item in enumerate(items):
