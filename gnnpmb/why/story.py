@@ -316,9 +316,9 @@ def _map_cardinality(cf: ClassFrame) -> str:
     0``. Its ``Extracted.threshold`` is that lightest weight, no threshold fixed beforehand (dev set scene-0916
     pointpillars cphd, track 15: "w=0.14 fell below 1.20" a frame after it was output at w=0.72)."""
     extracted = cf.extracted
-    n = len(extracted.estimates) if extracted is not None else 0
-    if n == 0 or extracted is None:
+    if extracted is None or not extracted.estimates:
         return "the MAP cardinality was 0"
+    n = len(extracted.estimates)
     return f"the MAP cardinality {n} kept the {n} heaviest components, the lightest at w={extracted.threshold:.2f}"
 
 

@@ -268,13 +268,8 @@ def undercut_text(c: PairChoice, alternative_took: int | None = None) -> str:
     those past the GIoU threshold -0.50, and gave track 24 to a detection whose pair it dropped``. A free track
     column cheaper than the chosen one is left only so: an optimal solve would otherwise have taken it (dev set
     scene-0916 pointpillars simpletrack, frame 10, m11)."""
-    scale = c.scale
-    if scale.threshold is None:
-        limit = "its threshold"
-    elif scale.similarity is not None:
-        limit = f"the {scale.similarity} threshold {1.0 - scale.threshold:.2f}"
-    else:
-        limit = f"the {scale.name} threshold {cost_value(scale.threshold, c)}"
+    threshold = c.scale.threshold  # set on every matrix an undercut choice comes from (``explain``)
+    limit = threshold_name(threshold, c) if threshold is not None else "its threshold"
     dropped = f"the solver matched every pair before dropping those past {limit}"
     alt = c.alternative
     if alt is None or alt.kind is not AxisKind.TRACK or alternative_took is not None:
@@ -299,6 +294,13 @@ def threshold_held(label: AxisLabel | None, value: float, c: PairChoice) -> str 
         return None
     if not math.isclose(value, scale.threshold, rel_tol=1e-9, abs_tol=1e-12):
         return None
+    return threshold_name(value, c)
+
+
+def threshold_name(value: float, c: PairChoice) -> str:
+    """``the GIoU threshold -0.50`` / ``the distance threshold 2.00 m``: a cost threshold ``value`` on the matrix's
+    scale, as a similarity where the scale has one."""
+    scale = c.scale
     if scale.similarity is not None:
         return f"the {scale.similarity} threshold {1.0 - value:.2f}"
     return f"the {scale.name} threshold {cost_value(value, c)}"
