@@ -2,23 +2,30 @@
 ``TrackingEval`` through ``gnnpmb.eval.nuscenes_eval``), which gives the overall and the per-class metrics.
 
 Runs wherever the task lands (this process or a Ray worker); the submission and the devkit's files go to a
-temporary folder on that machine and are removed afterwards.
+temporary folder on that machine and are removed afterwards (those of a task that was killed, by the next
+scoring on that machine: ``scratch_folder``).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import shutil
 import tempfile
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from gnnpmb.atomic import sweep_leftovers, temp_prefix
 from gnnpmb.config import TrackerConfig
 from gnnpmb.study.data import StudyData, track_scene
 from gnnpmb.study.grid import Assignment
 from gnnpmb.types import TRACKING_CLASSES
+
+if TYPE_CHECKING:
+    from gnnpmb.eval.nuscenes_eval import TrackingScores
 
 OVERALL_METRICS: tuple[str, ...] = ("amota", "amotp", "mota", "ids", "frag", "tp", "fp", "fn")
 """Overall metrics kept per configuration (the devkit's names)."""
@@ -73,28 +80,46 @@ def _empty_row(track_s: float, wall_s: float) -> dict[str, Any]:
     return row
 
 
-def score_config(job: ConfigJob) -> dict[str, Any]:
-    """Track and score one configuration: the overall metrics, AMOTA per class, and the times spent (s)."""
+def official_scores(data: StudyData, parts: list[dict[str, list[dict[str, Any]]]]) -> TrackingScores:
+    """The official evaluation of the tracked scenes ``parts`` (sample token -> submission boxes, one per scene of
+    ``data``), in a temporary folder on this machine that is removed afterwards."""
     from gnnpmb.eval.nuscenes_eval import run_tracking_eval
     from gnnpmb.eval.submission import build_submission, write_submission
 
+    with scratch_folder() as scratch:
+        results_path = scratch / "results.json"
+        write_submission(results_path, build_submission(parts, data.sample_tokens))
+        evaluated = data.evaluation or data.location
+        return run_tracking_eval(results_path, evaluated.dataroot, evaluated.version, data.split, scratch / "eval")
+
+
+SCRATCH_NAME = "gnnpmb-study"
+
+
+@contextlib.contextmanager
+def scratch_folder(root: Path | None = None) -> Iterator[Path]:
+    """A new folder in ``root`` (the system's temporary folder), removed at the end of the block. Its name carries
+    this process (``gnnpmb.atomic``), and the folders of processes that are gone are removed first: a stopped
+    sweep's Ray workers are killed (``runner.run_tasks``) before their ``finally`` runs."""
+    root = Path(tempfile.gettempdir()) if root is None else root
+    sweep_leftovers(root)
+    scratch = Path(tempfile.mkdtemp(prefix=temp_prefix(root / SCRATCH_NAME, "build"), dir=root))
+    try:
+        yield scratch
+    finally:
+        shutil.rmtree(scratch, ignore_errors=True)
+
+
+def score_config(job: ConfigJob) -> dict[str, Any]:
+    """Track and score one configuration: the overall metrics, AMOTA per class, and the times spent (s)."""
     start = time.perf_counter()
     parts = [track_scene(job.data, name, job.tracker, job.config).results for name in job.data.scene_names]
     track_s = time.perf_counter() - start
     if not any(boxes for part in parts for boxes in part.values()):
         return _empty_row(track_s, time.perf_counter() - start)
-    scratch = Path(tempfile.mkdtemp(prefix="gnnpmb-study-"))
-    try:
-        results_path = scratch / "results.json"
-        write_submission(results_path, build_submission(parts, job.data.sample_tokens))
-        eval_start = time.perf_counter()
-        evaluated = job.data.evaluation or job.data.location
-        scores = run_tracking_eval(
-            results_path, evaluated.dataroot, evaluated.version, job.data.split, scratch / "eval"
-        )
-        eval_s = time.perf_counter() - eval_start
-    finally:
-        shutil.rmtree(scratch, ignore_errors=True)
+    eval_start = time.perf_counter()
+    scores = official_scores(job.data, parts)
+    eval_s = time.perf_counter() - eval_start
     row: dict[str, Any] = {m: _number(scores.overall[m], m in COUNTS) for m in OVERALL_METRICS}
     for class_name in TRACKING_CLASSES:
         metrics = scores.per_class.get(class_name)
