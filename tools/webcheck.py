@@ -38,7 +38,7 @@ import time
 import urllib.error
 import urllib.parse
 import urllib.request
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -331,12 +331,20 @@ def served_file(path: Path) -> Iterator[str]:
 
 
 @contextlib.contextmanager
-def process_group(argv: Sequence[str], log_path: Path, grace_s: float = 5.0) -> Iterator[subprocess.Popen[bytes]]:
-    """Run ``argv`` in a new session (its own process group), output to ``log_path``; on exit SIGTERM the
-    whole group, then SIGKILL whatever is left after ``grace_s``, and reap the leader."""
+def process_group(
+    argv: Sequence[str], log_path: Path, grace_s: float = 5.0, env: Mapping[str, str] | None = None
+) -> Iterator[subprocess.Popen[bytes]]:
+    """Run ``argv`` in a new session (its own process group) with ``env`` (default: this process's), output to
+    ``log_path``; on exit SIGTERM the whole group, then SIGKILL whatever is left after ``grace_s``, and reap the
+    leader."""
     with open(log_path, "wb") as log:
         proc = subprocess.Popen(
-            list(argv), stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True
+            list(argv),
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+            env=None if env is None else dict(env),
         )
     try:
         yield proc
@@ -515,8 +523,8 @@ class Chromium:
 def headless_chromium(
     work: Path, viewport: tuple[int, int] = DEFAULT_VIEWPORT, chromium: Path = CHROMIUM
 ) -> Iterator[Chromium]:
-    """Headless Chromium with a fresh profile under ``work`` (its log there too), its page sized ``viewport``;
-    its whole process group is killed on exit. Several recordings checked in one browser share its GPU process,
+    """Headless Chromium with a fresh profile and its temporary folders under ``work`` (its log there too), its
+    page sized ``viewport``; its whole process group is killed on exit. Several recordings checked in one browser share its GPU process,
     where software WebGL compiles the web viewer's shaders once."""
     if not chromium.is_file():
         raise WebCheckError(f"chromium is not installed at {chromium}")
@@ -524,7 +532,9 @@ def headless_chromium(
     debug_port, log = free_port(), work / "chromium.log"
     argv = [str(chromium), *CHROMIUM_FLAGS, f"--remote-debugging-port={debug_port}"]
     argv += [f"--user-data-dir={work / 'chromium-profile'}", f"--window-size={width},{height}", "about:blank"]
-    with process_group(argv, log) as proc:
+    # TMPDIR: Chromium's own temporary folders (org.chromium.Chromium.*, left in /tmp when it is killed) go
+    # under ``work`` too
+    with process_group(argv, log, env={**os.environ, "TMPDIR": str(work)}) as proc:
         devtools = DevTools(_page_websocket(debug_port, proc, log, 60.0))
         try:
             devtools.call(

@@ -164,7 +164,10 @@ def chromium(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Chromium]:
     """One headless Chromium for the module's browser checks; once they are done, its whole process group is
     gone."""
     require_chromium()
-    with headless_chromium(tmp_path_factory.mktemp("chromium")) as browser:
+    work = tmp_path_factory.mktemp("chromium")
+    with headless_chromium(work) as browser:
+        # Chromium's own temporary folders go under the work folder, not into /tmp, where a killed run leaves them
+        assert list(work.glob("org.chromium.Chromium.*")), f"no Chromium temporary folder under {work}"
         yield browser
     assert group_members(browser.proc.pid) == [], f"Chromium's process group {browser.proc.pid} is still running"
 
