@@ -429,10 +429,15 @@ _BOX_NOISE_SOURCE = {
 
 
 def calibration_toml(
-    learnt: Mapping[str, list[Learnt]], notes: Mapping[str, list[str]], with_box_noise: TrackerConfig, header: str
+    learnt: Mapping[str, list[Learnt]],
+    notes: Mapping[str, list[str]],
+    with_box_noise: TrackerConfig,
+    header: str,
+    withheld: Mapping[str, list[Learnt]] | None = None,
 ) -> str:
-    """The parameter file: ``header`` (comment lines), then per class its tables with a comment per value, then
-    ``prob3dmot``'s ``[box_noise.<class>]`` tables."""
+    """The parameter file: ``header`` (comment lines), then per class its tables with a comment per value and the
+    ``withheld`` values (learnt, not written: ``calibration_check``) as comment lines, then ``prob3dmot``'s
+    ``[box_noise.<class>]`` tables."""
     lines = [f"# {line}" for line in header.splitlines()]
     for cls in TRACKING_CLASSES:
         tables: dict[str, list[Learnt]] = defaultdict(list)
@@ -440,6 +445,8 @@ def calibration_toml(
             tables[item.table].append(item)
         lines.append("")
         lines.extend(f"# {cls}: {note}" for note in notes[cls])
+        kept_back = (withheld or {}).get(cls, [])
+        lines.extend(f"# not written: [{i.table}] {i.key} = {i.value!r}  ({i.source})" for i in kept_back)
         for table, items in sorted(tables.items(), key=lambda kv: kv[0].count(".")):
             lines.append(f"[{table}]")
             lines.extend(f"{i.key} = {i.value!r}  # {i.source}" for i in items)

@@ -393,7 +393,7 @@ def test_a_second_sweep_into_a_folder_waits_for_the_first(demo_dataroot: Path, t
 
     from tests.gnnpmb.study.conftest import TINY_FRAMES, TINY_SCENE, cut_dataset
 
-    tiny = cut_dataset(demo_dataroot, tmp_path / "tiny", TINY_SCENE, TINY_FRAMES)
+    tiny = cut_dataset(demo_dataroot, tmp_path / "tiny", [TINY_SCENE], TINY_FRAMES)
     env = _cache_env(tiny, tmp_path / "cache")
     study = tmp_path / "study"
     holder = subprocess.Popen(

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import pytest
@@ -21,19 +21,21 @@ def _cut(records: list[dict], keep: set[str], links: tuple[str, ...] = ("prev", 
     return kept
 
 
-def cut_dataset(src: Path, dst: Path, scene_name: str, n_frames: int) -> Path:
-    """A copy of the dataset at ``src`` with only ``scene_name``'s first ``n_frames`` keyframes (the devkit
-    loads and evaluates it as a normal dataset; LiDAR files are shared by a symlink)."""
+def cut_dataset(src: Path, dst: Path, scene_names: Sequence[str], n_frames: int) -> Path:
+    """A copy of the dataset at ``src`` with only the first ``n_frames`` keyframes of each of ``scene_names`` (the
+    devkit loads and evaluates it as a normal dataset; LiDAR files are shared by a symlink)."""
     version = "v1.0-mini"
     tables = {p.stem: json.loads(p.read_text()) for p in (src / version).glob("*.json")}
-    scene = next(s for s in tables["scene"] if s["name"] == scene_name)
     by_token = {s["token"]: s for s in tables["sample"]}
-    samples, token = [], scene["first_sample_token"]
-    while token and len(samples) < n_frames:
-        samples.append(token)
-        token = by_token[token]["next"]
-    keep_samples = set(samples)
-    tables["scene"] = [{**scene, "nbr_samples": len(samples), "last_sample_token": samples[-1]}]
+    scenes, keep_samples = [], set()
+    for scene in (s for s in tables["scene"] if s["name"] in scene_names):
+        samples, token = [], scene["first_sample_token"]
+        while token and len(samples) < n_frames:
+            samples.append(token)
+            token = by_token[token]["next"]
+        keep_samples.update(samples)
+        scenes.append({**scene, "nbr_samples": len(samples), "last_sample_token": samples[-1]})
+    tables["scene"] = scenes
     tables["sample"] = _cut(tables["sample"], keep_samples)
     tables["sample_data"] = _cut(
         tables["sample_data"], {d["token"] for d in tables["sample_data"] if d["sample_token"] in keep_samples}
@@ -73,7 +75,14 @@ def cut_dataset(src: Path, dst: Path, scene_name: str, n_frames: int) -> Path:
 @pytest.fixture(scope="session")
 def tiny_dataroot(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The demo's scene-0103 cut to 6 keyframes: split mini_val holds just this scene."""
-    return cut_dataset(demo_dataroot, tmp_path_factory.mktemp("tiny") / "nuscenes", TINY_SCENE, TINY_FRAMES)
+    return cut_dataset(demo_dataroot, tmp_path_factory.mktemp("tiny") / "nuscenes", [TINY_SCENE], TINY_FRAMES)
+
+
+@pytest.fixture(scope="session")
+def two_scene_dataroot(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The demo's two mini_val scenes cut to 6 keyframes each: split mini_val holds both."""
+    cut = tmp_path_factory.mktemp("two_scenes") / "nuscenes"
+    return cut_dataset(demo_dataroot, cut, ["scene-0103", "scene-0916"], TINY_FRAMES)
 
 
 @pytest.fixture(scope="module")
