@@ -39,6 +39,9 @@ Gaussian for heavy-tailed manoeuvres; a birth component at every detection), and
 the learnt values below the defaults lost AMOTA in-sample (issue 32 in ``docs/results.md``: Q of 1e-4 from the
 mostly parked objects, 0.92 -> 0.77; the learnt clutter, ~40 times below the default, made clutter detections
 tracks at once).
+
+Which of these values the parameter file holds is decided per class by ``calibration_check``: a cross-validation
+on the same split against the defaults.
 """
 
 from __future__ import annotations
