@@ -524,8 +524,8 @@ def headless_chromium(
     work: Path, viewport: tuple[int, int] = DEFAULT_VIEWPORT, chromium: Path = CHROMIUM
 ) -> Iterator[Chromium]:
     """Headless Chromium with a fresh profile and its temporary folders under ``work`` (its log there too), its
-    page sized ``viewport``; its whole process group is killed on exit. Several recordings checked in one browser share its GPU process,
-    where software WebGL compiles the web viewer's shaders once."""
+    page sized ``viewport``; its whole process group is killed on exit. Several recordings checked in one browser
+    share its GPU process, where software WebGL compiles the web viewer's shaders once."""
     if not chromium.is_file():
         raise WebCheckError(f"chromium is not installed at {chromium}")
     width, height = viewport
