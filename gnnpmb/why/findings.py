@@ -169,8 +169,9 @@ class OnObject:
 class Sighting:
     """The object at one frame: its LiDAR + radar points, how the evaluation saw it, the nearest detection of any
     class (within ``NEAR_M``, kept or not), the nearest kept detection of its class and where that went, the
-    tracks of its class output on it, and the nearest detection of its class within ``NEAR_M`` that preprocessing
-    removed (score threshold or NMS)."""
+    tracks of its class output on it, the nearest detection of its class within ``NEAR_M`` that preprocessing
+    removed (score threshold or NMS), and how many of ``points`` are radar returns (a box with no LiDAR return
+    and a few radar ones is nothing a LiDAR detector can see)."""
 
     frame: int
     points: int
@@ -180,6 +181,11 @@ class Sighting:
     went: Destination | None
     on_it: tuple[OnObject, ...]
     removed_own: Near | None = None
+    radar_points: int = 0
+
+    @property
+    def lidar_points(self) -> int:
+        return self.points - self.radar_points
 
     @property
     def seen(self) -> Near | None:

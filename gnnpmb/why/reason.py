@@ -130,6 +130,12 @@ class _Context:
         hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
         return int(self.scene.keyframes[frame].gt_num_pts[hit[0]]) if hit.size else 0
 
+    def radar_points(self, gt_id: str, frame: int) -> int:
+        """The radar returns among ``points`` (0 where the dataset gives none)."""
+        kf = self.scene.keyframes[frame]
+        hit = np.flatnonzero(kf.gt.instance_id.astype(str) == gt_id)
+        return int(kf.gt_num_radar_pts[hit[0]]) if hit.size and kf.gt_num_radar_pts is not None else 0
+
     def near(self, frame: int, xy: np.ndarray, *, own: bool, kept_only: bool = True) -> Near | None:
         """The nearest detection within ``NEAR_M`` of ``xy`` at ``frame``: any class and score (own False), or one of
         the failure's class (own True) that preprocessing kept (kept_only) or removed (not kept_only). Of any class,
@@ -200,6 +206,7 @@ class _Context:
                     went,
                     self.on_object(self.report, self.frames[f], xy),
                     self.near(f, xy, own=True, kept_only=False),
+                    self.radar_points(gt_id, f),
                 )
             )
         return tuple(out)

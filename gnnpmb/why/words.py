@@ -580,10 +580,9 @@ def _detector_gaps(f: Finding) -> list[str]:
     by = {s.frame: s for s in f.sightings}
     for b in f.blame:
         if b.rule is Rule.NO_DETECTION:
-            points = [by[x].points for x in b.frames if x in by]
+            seen = [by[x] for x in b.frames if x in by]
             out.append(
-                f"at {frames_text(b.frames)} the detector gave {no_detection([by[x] for x in b.frames if x in by])}, "
-                f"though it had {_span(points)} LiDAR and radar points"
+                f"at {frames_text(b.frames)} the detector gave {no_detection(seen)}, though it had {points_text(seen)}"
             )
         elif b.rule is Rule.OTHER_CLASS:
             seen = [by[x].seen for x in b.frames if x in by and by[x].seen is not None]
@@ -1157,7 +1156,7 @@ def _miss(f: Finding) -> list[str]:
         return []
     name = f"{f.class_name} GT {short_id(f.gt_id)}"
     mode = UseMode(f.mode)
-    inside = f"{s.points} LiDAR and radar points in its box"
+    inside = f"{points_text([s])} in its box"
     parts = []
     if s.undetected and s.points == 0:
         carried = "" if s.on_it else ", and no track carried it through"  # said only of an object no track was on
@@ -1244,7 +1243,7 @@ def _coalescence(f: Finding) -> list[str]:
     if s.undetected:
         parts.append(
             f"the detector gave GT {short_id(f.gt_id or '')} no detection of its own within {NEAR_M:.0f} m "
-            f"({s.points} LiDAR and radar points): one detection, or none, for two objects"
+            f"({points_text([s])}): one detection, or none, for two objects"
         )
     elif s.nearest_own is not None:
         n = s.nearest_own
@@ -1363,18 +1362,30 @@ def beside_threshold(value: float, threshold: float) -> str:
     return f"{value:.4f}"
 
 
+def points_text(sightings: Sequence[Sighting]) -> str:
+    """``12 LiDAR and radar points`` (a span over several frames: ``2–5``), or where any box had radar returns,
+    the two counts apart: ``0 LiDAR and 3 radar points`` (a box with radar returns only is empty to a LiDAR
+    detector, which the sum would hide)."""
+    if not any(s.radar_points for s in sightings):
+        return f"{_span([s.points for s in sightings])} LiDAR and radar points"
+    lidar, radar = _span([s.lidar_points for s in sightings]), _span([s.radar_points for s in sightings])
+    return f"{lidar} LiDAR and {radar} radar points"
+
+
 def sighting_points(s: Sighting) -> str:
-    """The table's "points in box" cell: the count and how the evaluation scored the object there."""
+    """The table's "points in box" cell: the count (``0 LiDAR + 3 radar`` where the box had radar returns) and
+    how the evaluation scored the object there."""
     g = s.evaluated
+    n = f"{s.lidar_points} LiDAR + {s.radar_points} radar" if s.radar_points else f"{s.points}"
     if g is None:
-        return f"{s.points}"
+        return n
     match g.status:
         case GtStatus.SCORED:
-            return f"{s.points}"
+            return n
         case GtStatus.INTERPOLATED:
-            return f"{s.points}: interpolated by the evaluation ({g.offset_m:.1f} m off)"
+            return f"{n}: interpolated by the evaluation ({g.offset_m:.1f} m off)"
         case GtStatus.BEYOND_RANGE:
-            return f"{s.points}: beyond the {g.range_m:g} m range, not scored"
+            return f"{n}: beyond the {g.range_m:g} m range, not scored"
         case GtStatus.NO_BOX:
-            return f"{s.points}: no box ({g.dropped.value if g.dropped else 'dropped'}), not scored"
+            return f"{n}: no box ({g.dropped.value if g.dropped else 'dropped'}), not scored"
     raise AssertionError(g.status)

@@ -892,7 +892,7 @@ def test_no_detection_said_with_no_class_beside_a_box_of_an_untracked_class_is_c
         "at frame 2 the detector gave no detection{} within 2 m of car GT bbbbbb (0 LiDAR and radar points in its box)",
         "at frame 2 car GT bbbbbb had no LiDAR or radar points (no detector could see it) and no detection{} "
         "within 2 m",
-        "at frame 2 the detector gave no detection of {} class within 2 m, though it had 12",
+        "at frame 2 the detector gave no detection of {} class within 2 m, though it had 0 LiDAR and radar points",
     )
     for sentence in said:
         untracked, tracked = ("any", "a tracked") if "of {}" in sentence else ("", " of a tracked class")
@@ -1526,3 +1526,33 @@ def test_a_cphd_track_said_to_fall_below_a_threshold_is_caught_and_the_map_cardi
     assert found(kept.format(1, 1, "1.20"), cphd) == []
     assert found(kept.format(2, 2, "1.20"), cphd) == ["tracker"]
     assert found(kept.format(1, 1, "0.14"), cphd) == ["tracker"]
+
+
+def test_a_sum_of_points_that_hides_radar_returns_is_caught() -> None:
+    """World3 (/tmp/truth47: the dev set with radar-only boxes, as real nuScenes has): "(3 LiDAR and radar points in
+    its box): the detector missed it" of a box with no LiDAR return and 3 radar ones read as a LiDAR detector's
+    oversight. The sum of a box with radar returns is misleading, the two counts apart hold, a wrong split is
+    caught, and a sum over LiDAR-only boxes still holds (both the miss and the span of a lost track's frames)."""
+    from tools.truth.scene import Annotation
+
+    scene = _scene()
+    scene.objects[1][GT_B] = Annotation(C, (30.0, 0.0), 2, radar=2)  # 0 LiDAR and 2 radar points
+    scene.objects[2][GT_B] = Annotation(C, (30.0, 0.0), 2, radar=1)  # 1 LiDAR and 1 radar point
+    ctx = Context(C, 2, GT_B, kind="miss")
+    miss = "at frame 1 the detector gave no detection of a tracked class within 2 m of car GT bbbbbb ({} in its box)"
+    cases = {
+        "2 LiDAR and radar points": ["misleading"],
+        "0 LiDAR and 2 radar points": [],
+        "1 LiDAR and 1 radar points": ["detector"],
+    }
+    for said, kinds in cases.items():
+        assert [c.kind for c in check_text(miss.format(said), ctx, None, _eval(), scene=scene).found] == kinds, said
+    span = "at frames 1–2 the detector gave no detection of a tracked class within 2 m, though it had {}"
+    for said, kinds in {
+        "2 LiDAR and radar points": ["misleading"],
+        "0–1 LiDAR and 1–2 radar points": [],
+        "0 LiDAR and 2 radar points": ["detector"],
+    }.items():
+        assert [c.kind for c in check_text(span.format(said), ctx, None, _eval(), scene=scene).found] == kinds, said
+    plain = "at frame 0 the detector gave no detection of a tracked class within 2 m of car GT bbbbbb (0 LiDAR and "
+    assert [c.kind for c in check_text(plain + "radar points in its box)", ctx, None, _eval(), scene=scene).found] == []
