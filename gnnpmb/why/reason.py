@@ -397,7 +397,15 @@ class _Context:
             for x, g in self.report.gt_frames.get(gt_id, {}).items()
             if first <= x < self.f and g.evaluated_xy_m is not None and x not in missed
         ]
-        return max(scored, default=None)
+        # frames the object has no annotation at (it left view and came back): the devkit scores a box it
+        # interpolated there and its accumulator's matches are the only record of them
+        unannotated = [
+            x
+            for ev in self.report.track_evals.values()
+            for x, g in ev.matches
+            if g == gt_id and first <= x < self.f and x not in self.report.gt_frames.get(gt_id, {})
+        ]
+        return max(scored + unannotated, default=None)
 
     def finite_elsewhere(self, track_id: int, steps: Mapping[int, TrackStep]) -> tuple[tuple[int, int], ...]:
         """(frame, detection) pairs of the window that track ``track_id`` could not take in its step's matrix (an

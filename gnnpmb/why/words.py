@@ -569,8 +569,12 @@ def _presence(f: Finding) -> str:
         if removed
         else ""
     )
+    # the frames it was annotated at: one span, or where it left view and came back, each run apart
+    span = ", ".join(f"{r[0]}–{r[-1]}" if len(r) > 1 else f"{r[0]}" for r in consecutive_runs([s.frame for s in seen]))
+    if len(seen) == 1:
+        span = f"{seen[0].frame}–{seen[0].frame}"
     return (
-        f"in the {len(seen)} recorded frames up to {f.frame} ({seen[0].frame}–{seen[-1].frame}), GT "
+        f"in the {len(seen)} recorded frames up to {f.frame} ({span}), GT "
         f"{short_id(f.gt_id)} had a {f.class_name} detection {kept}within {NEAR_M:.0f} m at {at}{only}{also}"
     )
 
@@ -690,6 +694,15 @@ def _two_tracks(f: Finding, lost: LostTrack) -> str:
     )
 
 
+def _unannotated(f: Finding, after: int) -> list[int]:
+    """The frames after ``after`` before the failure's at which the object had no annotation while it had one on
+    either side (it left view and came back; ``f.sightings`` holds the annotated frames of the window)."""
+    seen = sorted(s.frame for s in f.sightings)
+    if not seen:
+        return []
+    return [x for x in range(max(after + 1, seen[0]), min(f.frame, seen[-1])) if x not in seen]
+
+
 def _lost_story(f: Finding, lost: LostTrack) -> str:
     """What the lost track did over the window, in the tracker's terms."""
     mode = UseMode(f.mode)
@@ -700,8 +713,11 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     if matched is not None:
         # "last on it" is not "last output": say where it was output after, away from the object
         after = held if held is not None else -1
-        away = [s.frame for s in steps if after < s.frame < f.frame and s.output is not None]
+        gap = _unannotated(f, after)
+        away = [s.frame for s in steps if after < s.frame < f.frame and s.output is not None and s.frame not in gap]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
+        if gap:  # no annotation there to be near or far from: the evaluation scored boxes it interpolated
+            elsewhere += f" (it was not annotated at {frames_text(gap)}: the evaluation scored boxes it interpolated)"
         # "on it" reads as the evaluation's match: said only where the devkit's last match was that output, and
         # "last output on it" not of a track still output on the annotated object at the failure's frame
         now = f.sighting(f.frame)

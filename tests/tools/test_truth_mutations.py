@@ -1556,3 +1556,29 @@ def test_a_sum_of_points_that_hides_radar_returns_is_caught() -> None:
         assert [c.kind for c in check_text(span.format(said), ctx, None, _eval(), scene=scene).found] == kinds, said
     plain = "at frame 0 the detector gave no detection of a tracked class within 2 m of car GT bbbbbb (0 LiDAR and "
     assert [c.kind for c in check_text(plain + "radar points in its box)", ctx, None, _eval(), scene=scene).found] == []
+
+
+def test_a_lost_track_said_far_from_an_object_with_no_annotation_there_is_caught() -> None:
+    """World3 (/tmp/truth47: the dev set with annotation gaps) scene-0757 centerpoint pmbm fragmentation:4: "track
+    266 was last output on it at frame 26 (output farther than 2 m from it at frames 27–31)" of a pedestrian with no
+    annotation at 27-31 (the devkit matched track 266 to its interpolated box at 30-31), and "in the 4 recorded
+    frames up to 32 (24–32)" over those same unannotated frames. Here GT B is unannotated at frame 2."""
+    scene = _scene()
+    del scene.objects[2][GT_B]
+    ev = _eval()
+    ev.boxes = {x: [("9", C, (34.0, 0.0))] for x in range(4)}  # 4 m from GT B's annotation
+    ev.submitted = {x: {"9"} for x in range(4)}
+    ctx = Context(C, 3, GT_B, kind="fragmentation")
+
+    def kinds(text: str) -> list[str]:  # the devkit's own last match is not set up here: its check left aside
+        return [c.kind for c in check_text(text, ctx, None, ev, scene=scene).found if c.kind != "matched"]
+
+    last = "the evaluation last matched track 9 to it at frame 0"
+    assert kinds(last + " (output farther than 2 m from it at frames 1, 2)") == ["output"]
+    assert kinds(last + " (output farther than 2 m from it at frame 1)") == []
+    gap = " (it was not annotated at frame {}: the evaluation scored boxes it interpolated)"
+    assert kinds(last + " (output farther than 2 m from it at frame 1)" + gap.format(2)) == []
+    assert kinds(last + gap.format(1)) == ["output"]
+    seen = "in the 3 recorded frames up to 3 ({}), GT bbbbbb had a car detection within 2 m at no frame"
+    assert "misleading" in kinds(seen.format("0–3"))
+    assert kinds(seen.format("0–1, 3")) == []

@@ -56,7 +56,7 @@ INTERPOLATED_AT = re.compile(
     rf"the evaluation scored (?:it|GT \w{{6}}) at a box it interpolated, ({_F}) m from the annotation"
 )
 PRESENCE = re.compile(
-    rf"in the (\d+) recorded frames up to (\d+) \((\d+)–(\d+)\), GT (\w+) had an? (\w+) detection "
+    rf"in the (\d+) recorded frames up to (\d+) \(([\d–, ]+)\), GT (\w+) had an? (\w+) detection "
     rf"(?:the tracker kept )?within 2 m at ({_FRAMES}|no frame)(?: only)?"
     rf"(?:,? and at ({_FRAMES}) only one? (?:that )?(?:its )?preprocessing removed)?"
 )
@@ -232,9 +232,15 @@ def check_detector(
 
 
 def _check_presence(m: re.Match, gt_id, class_name: str, scene: SceneTruth, raw: RawEvents | None, out, bad) -> None:
-    first, last, cls = int(m[3]), int(m[4]), m[6]
-    stated = set(frames_of(m[7])) if m[7] != "no frame" else set()
-    stated_removed = set(frames_of(m[8])) if m[8] else set()
+    said_frames = frames_of(f"frames {m[3]}")
+    first, last, cls = said_frames[0], said_frames[-1], m[5]
+    stated = set(frames_of(m[6])) if m[6] != "no frame" else set()
+    stated_removed = set(frames_of(m[7])) if m[7] else set()
+    out.checked["misleading"] += 1
+    annotated = [x for x in range(first, last + 1) if x < len(scene.objects) and (gt_id or "") in scene.objects[x]]
+    if said_frames != annotated or int(m[1]) != len(annotated):
+        # the recorded frames are the annotated ones: a span over frames without an annotation hides that it left
+        bad("misleading", m[0], f"the object was annotated at frames {annotated} of {first}–{last}")
     any_near, kept_near = set(), set()
     for x in range(first, last + 1):
         a = scene.objects[x].get(gt_id or "") if x < len(scene.objects) else None
