@@ -695,12 +695,13 @@ def _two_tracks(f: Finding, lost: LostTrack) -> str:
 
 
 def _unannotated(f: Finding, after: int) -> list[int]:
-    """The frames after ``after`` before the failure's at which the object had no annotation while it had one on
-    either side (it left view and came back; ``f.sightings`` holds the annotated frames of the window)."""
-    seen = sorted(s.frame for s in f.sightings)
+    """The frames after ``after`` before the failure's at which the object had no annotation, after its first one
+    (it left view and came back: the evaluation scores boxes it interpolates only between two annotations, and the
+    failure's frame may lie in that gap too; ``f.sightings`` holds the annotated frames of the window)."""
+    seen = {s.frame for s in f.sightings}
     if not seen:
         return []
-    return [x for x in range(max(after + 1, seen[0]), min(f.frame, seen[-1])) if x not in seen]
+    return [x for x in range(max(after + 1, min(seen)), f.frame) if x not in seen]
 
 
 def _lost_story(f: Finding, lost: LostTrack) -> str:
@@ -717,7 +718,8 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
         away = [s.frame for s in steps if after < s.frame < f.frame and s.output is not None and s.frame not in gap]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
         if gap:  # no annotation there to be near or far from: the evaluation scored boxes it interpolated
-            elsewhere += f" (it was not annotated at {frames_text(gap)}: the evaluation scored boxes it interpolated)"
+            boxes = "boxes" if len(gap) > 1 else "a box"
+            elsewhere += f" (it was not annotated at {frames_text(gap)}: the evaluation scored {boxes} it interpolated)"
         # "on it" reads as the evaluation's match: said only where the devkit's last match was that output, and
         # "last output on it" not of a track still output on the annotated object at the failure's frame
         now = f.sighting(f.frame)

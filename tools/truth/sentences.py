@@ -197,7 +197,7 @@ OFF_AFTER = re.compile(
     r"(?:track (\d+) was last output on it|the evaluation last matched track (\d+) to it) at frame \d+"
     r"(?: \(a box it interpolated for the track\))?"
     r"(?: \(output farther than 2 m from it at (frames? [\d–, ]*\d)\))?"
-    r"(?: \(it was not annotated at (frames? [\d–, ]*\d): the evaluation scored boxes it interpolated\))?"
+    r"(?: \(it was not annotated at (frames? [\d–, ]*\d): the evaluation scored (?:boxes|a box) it interpolated\))?"
 )
 """A lost track's last frame on the object, then where it was output away from the annotation and the frames
 without one."""

@@ -667,3 +667,16 @@ def test_a_failure_in_a_class_the_evaluation_counted_none_of_says_it_is_outside_
         assert "outside the evaluation's counts" not in why_lines(finding(kind, lost))[0]
     # a miss is counted: the devkit counts every object of such a class missed
     assert "outside the evaluation's counts" not in why_lines(finding(FailureKind.MISS, lost, unscored=True))[0]
+
+
+def test_a_track_lost_inside_an_annotation_gap_is_not_said_far_from_the_unannotated_object() -> None:
+    # world3 (/tmp/truth47) scene-0061 nohead ab3dmot fragmentation:5: car 732475 unannotated at frames 11-14, the
+    # failure at 12 inside the gap; the devkit matched track 7 to the interpolated box at 11, which read "(output
+    # farther than 2 m from it at frame 11)" beside "the evaluation last matched track 7 to it at frame 11"
+    seen = tuple(Sighting(x, 40, None, None, None, None, ()) for x in (9, 10))
+    steps = (step(10, output=estimate(7, 0.9)), step(11, output=estimate(7, 0.9)), step(12))
+    lost = LostTrack(7, 10, steps, None, None, None, matched_until=11)
+    line = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=12, sightings=seen, has_existence=False))[0]
+    said = "the evaluation last matched track 7 to it at frame 11 (it was not annotated at frame 11: the evaluation "
+    assert said + "scored a box it interpolated)" in line, line
+    assert "farther than 2 m" not in line
