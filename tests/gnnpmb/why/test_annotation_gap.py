@@ -89,3 +89,28 @@ def test_a_track_lost_over_an_annotation_gap_is_not_said_to_be_far_from_an_unann
     assert "in the 4 recorded frames up to 32 (24–26, 32), GT 10bbe5" in why, why
     assert "the evaluation last matched track 266 to it at frame 31 (it was not annotated at frames 27–31" in why
     assert "farther than 2 m from it at frames 27" not in why
+
+
+def test_the_focus_tables_name_the_keyframes_the_object_had_no_annotation_at(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The focus document's object table skips the keyframes without an annotation; its heading said "in the 2
+    frames of the table (26–32)" without saying why 27-31 are missing."""
+    from tests.viz.rrd import read_rows
+    from viz.blueprint import focus_doc
+
+    root, detections = _with_gap(tmp_path / "gap")
+    args = [SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
+    proc = run_script(["gnnpmb", "failures", *args, "--json", str(tmp_path / "report.json")], capsys)
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads((tmp_path / "report.json").read_text(encoding="utf-8"))
+    frags = [f for f in report["failures"] if f["kind"] == "fragmentation"]
+    n = next(k for k, f in enumerate(frags, 1) if f["frame_index"] == 32 and f["gt_ids"][0].startswith(GT))
+    out = tmp_path / "focus.rrd"
+    proc = run_script(
+        ["gnnpmb-viz", *args, "--focus", f"fragmentation:{n}", "--save", str(out), "--no-progress"], capsys
+    )
+    assert proc.returncode == 0, proc.stderr
+    summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
+    assert f"**GT {GT}**, in the 2 frames of the table (26–32; not annotated at frames 27–31)" in summary, summary
+    assert "the evaluation last matched track 266 to it at frame 31 (it was not annotated at frames 27–31" in summary
