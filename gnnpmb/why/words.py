@@ -694,14 +694,16 @@ def _two_tracks(f: Finding, lost: LostTrack) -> str:
     )
 
 
-def _unannotated(f: Finding, after: int) -> list[int]:
-    """The frames after ``after`` before the failure's at which the object had no annotation, after its first one
-    (it left view and came back: the evaluation scores boxes it interpolates only between two annotations, and the
-    failure's frame may lie in that gap too; ``f.sightings`` holds the annotated frames of the window)."""
+def _unannotated(f: Finding, held: int | None) -> list[int]:
+    """The frames after ``held`` (the lost track's last frame on the annotated object; None: from the object's first
+    annotation in the window) before the failure's at which the object had no annotation (it left view and came
+    back: the evaluation scores boxes it interpolates only between two annotations, and the failure's frame may lie
+    in that gap too; ``f.sightings`` holds the annotated frames of the window, which starts at ``held + 1``)."""
     seen = {s.frame for s in f.sightings}
     if not seen:
         return []
-    return [x for x in range(max(after + 1, min(seen)), f.frame) if x not in seen]
+    start = max(held + 1, f.window[0]) if held is not None else min(seen)
+    return [x for x in range(start, f.frame) if x not in seen]
 
 
 def _lost_story(f: Finding, lost: LostTrack) -> str:
@@ -714,7 +716,7 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     if matched is not None:
         # "last on it" is not "last output": say where it was output after, away from the object
         after = held if held is not None else -1
-        gap = _unannotated(f, after)
+        gap = _unannotated(f, held)
         away = [s.frame for s in steps if after < s.frame < f.frame and s.output is not None and s.frame not in gap]
         elsewhere = f" (output farther than {NEAR_M:.0f} m from it at {frames_text(away)})" if away else ""
         if gap:  # no annotation there to be near or far from: the evaluation scored boxes it interpolated

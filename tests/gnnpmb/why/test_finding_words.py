@@ -680,3 +680,14 @@ def test_a_track_lost_inside_an_annotation_gap_is_not_said_far_from_the_unannota
     said = "the evaluation last matched track 7 to it at frame 11 (it was not annotated at frame 11: the evaluation "
     assert said + "scored a box it interpolated)" in line, line
     assert "farther than 2 m" not in line
+
+
+def test_the_frames_between_the_last_on_it_and_the_objects_return_count_as_unannotated() -> None:
+    # world3 scene-0061 nohead ab3dmot id_switch:13: car 579f8e unannotated at 19-23, track 123 last on it at 18 and
+    # matched by the devkit to the interpolated box at 19; the window's first annotated frame is 24
+    seen = tuple(Sighting(x, 40, None, None, None, None, ()) for x in (14, 15))
+    steps = (step(10, output=estimate(7, 0.9)), step(11, output=estimate(7, 0.9)), step(12))
+    lost = LostTrack(7, 10, steps, None, None, None, matched_until=11)
+    line = why_lines(finding(FailureKind.ID_SWITCH, lost, frame=15, sightings=seen, window=(10, 15)))[0]
+    assert "(it was not annotated at frames 11–13: the evaluation scored boxes it interpolated)" in line, line
+    assert "farther than 2 m" not in line
