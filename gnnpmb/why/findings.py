@@ -29,7 +29,9 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   devkit's ``NEAR_M`` (``INTERPOLATED``), or the evaluation has no box of the object there, beyond its range or
   for want of points (``NO_EVAL_BOX``), or the false track's box is one the evaluation interpolated between two of
   the track's boxes, at a frame the tracker did not output it (``TRACK_INTERPOLATED``), or a track output on the
-  object was dropped there by the evaluation's range or bike-rack filter (``TRACK_DROPPED``).
+  object was dropped there by the evaluation's range or bike-rack filter (``TRACK_DROPPED``), or the object had no
+  annotation at all at the failure's frame (it left view and came back) and the evaluation scored a box it
+  interpolated between its annotations (``UNANNOTATED``).
 
 The frames that decide a failure: for a miss, a false track and a coalescence, the failure's frame; for a
 fragmentation, an ID switch and an identity theft, the frames from the one after the lost track last lay within
@@ -83,6 +85,7 @@ class Rule(enum.Enum):
     NO_EVAL_BOX = "no evaluated box"
     TRACK_INTERPOLATED = "track interpolated"
     TRACK_DROPPED = "track dropped"
+    UNANNOTATED = "not annotated"
 
     @property
     def party(self) -> Party:
@@ -105,6 +108,7 @@ _PARTY = {
     Rule.NO_EVAL_BOX: Party.EVALUATION,
     Rule.TRACK_INTERPOLATED: Party.EVALUATION,
     Rule.TRACK_DROPPED: Party.EVALUATION,
+    Rule.UNANNOTATED: Party.EVALUATION,
 }
 
 

@@ -231,6 +231,8 @@ class _Context:
             parts = self.coalescence(sightings)
         else:
             raise AssertionError(kind)
+        if gt_id is not None and self.gt_xy(gt_id, self.f) is None:  # scored where it had no annotation
+            parts["blame"] = (Blame(Rule.UNANNOTATED, (self.f,)), *parts.get("blame", ()))
         involved = self.involved(sightings)
         boxes_on = self.boxes_on(sightings, parts) if self.facts.output_only else ()
         return Finding(

@@ -410,6 +410,12 @@ def why_lines(f: Finding) -> list[str]:
             parts = _coalescence(f)
         case _:
             raise AssertionError(f.kind)
+    if any(b.rule is Rule.UNANNOTATED for b in f.blame) and f.gt_id is not None:
+        parts.insert(
+            0,
+            f"at frame {f.frame} {f.class_name} GT {short_id(f.gt_id)} had no annotation, though it had some before "
+            "and after: the evaluation scored a box it interpolated between them there",
+        )
     if f.unscored and f.kind is not FailureKind.MISS:  # the devkit counted every object missed and nothing else
         parts.append(
             f"outside the evaluation's counts: {f.tracker} reached no score threshold at its lowest recall for "

@@ -1609,3 +1609,20 @@ def test_another_runs_track_said_matched_elsewhere_with_the_scored_box_out_of_it
     assert kinds(told + note, far) == []
     assert kinds(told + note, near) == ["misleading"]
     assert kinds(told, near) == []
+
+
+def test_a_failure_said_to_be_at_a_frame_without_annotation_is_checked_against_the_tables() -> None:
+    """World3's annotation gaps: "at frame F C GT H had no annotation, though it had some before and after: the
+    evaluation scored a box it interpolated between them there" holds where the object has no annotation at F, one
+    on each side, and the devkit scored a box of it at F; planted at an annotated frame, it is caught."""
+    scene = _scene()
+    del scene.objects[2][GT_B]
+    ev = _eval()
+    ev.evaluated_gt[(2, GT_B)] = (30.0, 0.5)
+    said = (
+        "at frame {} car GT bbbbbb had no annotation, though it had some before and after: the evaluation scored a "
+        "box it interpolated between them there"
+    )
+    assert check_text(said.format(2), Context(C, 2, GT_B, kind="miss"), None, ev, scene=scene).found == []
+    caught = check_text(said.format(1), Context(C, 1, GT_B, kind="miss"), None, ev, scene=scene).found
+    assert [c.kind for c in caught] == ["evaluation"]

@@ -193,6 +193,11 @@ COUNTED_AT = re.compile(
 )
 OUTPUT_AT = re.compile(r"at frame (\d+) track (\d+) (?:\(\w+\) )?was (?:still )?output (?:on|[\d.]+ m from)")
 LAST_OUTPUT = re.compile(r"track (\d+) was last output on it at frame (\d+)")
+UNANNOTATED = re.compile(
+    r"at frame (\d+) \w+ GT (\w{6}) had no annotation, though it had some before and after: the evaluation scored a "
+    r"box it interpolated between them there"
+)
+"""A failure at a keyframe the object had no annotation at (``Rule.UNANNOTATED``)."""
 OFF_AFTER = re.compile(
     r"(?:track (\d+) was last output on it|the evaluation last matched track (\d+) to it) at frame \d+"
     r"(?: \(a box it interpolated for the track\))?"
@@ -297,6 +302,13 @@ def check_text(
                 bad("output", m[0], f"the submission's box of track {m[1]} lay within 2 m of the annotation at {later}")
     if scene is not None and ctx.gt_id is not None:
         _check_off_and_unannotated(text, ctx.gt_id, scene, ev, out, bad)
+        for m in UNANNOTATED.finditer(text):
+            out.checked["evaluation"] += 1
+            x, have = int(m[1]), [y for y, objs in enumerate(scene.objects) if ctx.gt_id in objs]
+            if not ctx.gt_id.startswith(m[2]) or x in have or not have or not have[0] < x < have[-1]:
+                bad("evaluation", m[0], f"the object is annotated at frames {have}")
+            elif (x, ctx.gt_id) not in ev.evaluated_gt:
+                bad("evaluation", m[0], f"the devkit scored no box of the object at frame {x}")
     lost.check_not_output(text, ctx.lost, ev, out, bad)
     lost.check_last_match(text, c, ctx.frame, ctx.gt_id, ev, out, bad)
     lost.check_two_tracks(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)

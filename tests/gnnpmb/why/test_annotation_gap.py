@@ -114,3 +114,22 @@ def test_the_focus_tables_name_the_keyframes_the_object_had_no_annotation_at(
     summary = read_rows(out)[focus_doc()][0]["TextDocument:text"][0]
     assert f"**GT {GT}**, in the 2 frames of the table (26–32; not annotated at frames 27–31)" in summary, summary
     assert "the evaluation last matched track 266 to it at frame 31 (it was not annotated at frames 27–31" in summary
+
+
+def test_a_failure_where_the_object_had_no_annotation_is_explained_not_left_unknown(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """World3: 90 findings at keyframes where their object had no annotation read "cause unknown" (the dev set: 0);
+    the devkit scored its interpolated box there. They now say so, as the evaluation's doing."""
+    root, detections = _with_gap(tmp_path / "gap")
+    argv = ["gnnpmb", "failures", SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
+    proc = run_script([*argv, "--why"], capsys)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    heads = [(h, w) for h, w in zip(lines, lines[1:], strict=False) if w.lstrip().startswith("Why (")]
+    gap = [(h, w) for h, w in heads if f"GT {GT} had no annotation" in w]
+    assert {int(h.split("frame ")[1].split(",")[0]) for h, _ in gap} >= {27, 28, 29}, gap
+    for head, why in gap:
+        assert head.endswith("the evaluation's doing"), head
+        assert "though it had some before and after: the evaluation scored a box it interpolated between them" in why
+    assert not [h for h, _ in heads if h.endswith("cause unknown")]
