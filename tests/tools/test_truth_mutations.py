@@ -1626,3 +1626,20 @@ def test_a_failure_said_to_be_at_a_frame_without_annotation_is_checked_against_t
     assert check_text(said.format(2), Context(C, 2, GT_B, kind="miss"), None, ev, scene=scene).found == []
     caught = check_text(said.format(1), Context(C, 1, GT_B, kind="miss"), None, ev, scene=scene).found
     assert [c.kind for c in caught] == ["evaluation"]
+
+
+def test_another_runs_track_on_an_object_with_no_annotation_is_judged_at_the_devkits_box() -> None:
+    """World3 scene-0061 nohead ab3dmot fragmentation:5 beside pmbm: at frame 12 car 732475 had no annotation and
+    pmbm's track 7 lay on the box the devkit interpolated for it (and was matched there): "its track 7 was output
+    on the object and counted" holds against that box; a track 3 m from it is caught."""
+    ev, scene, _ = _matched_away_world()  # GT A annotated at frame 3 only: none at frame 2
+    ev.evaluated_gt[(2, GT_A)] = (5.0, 0.0)
+    ev.counted[C] = {"7", "11"}
+    ev.gt_to_track[(C, 2)] = {GT_A: "7"}
+    ev.track_to_gt[(C, 2)] = {"7": GT_A}
+    ctx = Context(C, 2, GT_A, kind="miss")
+    said = "pmbm on the same detections did not fail here: its track 7 was output on the object and counted"
+    for xy, kinds in (((5.3, 0.0), []), ((8.0, 0.0), ["other run"])):
+        ev.boxes[2] = [("7", C, xy)]
+        found = check_text(said, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found
+        assert [c.kind for c in found if c.kind == "other run"] == kinds, (xy, found)

@@ -110,12 +110,14 @@ def check_others(
 
 
 def _near(ev: EvalFacts, c: str, x: int, gt: str, scene) -> set[str]:
-    """The other run's track ids of class ``c`` with a box within ``NEAR_M`` of the object's annotation at ``x``."""
+    """The other run's track ids of class ``c`` with a box within ``NEAR_M`` of the object's annotation at ``x``, or
+    where it had none there (it left view and came back), of the box the devkit interpolated for it."""
     a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
+    at = a.xy_m if a is not None else ev.evaluated_gt.get((x, gt))
     return {
         t
         for t, cls, xy in ev.boxes.get(x, [])
-        if a is not None and cls == c and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < NEAR_M
+        if at is not None and cls == c and math.hypot(xy[0] - at[0], xy[1] - at[1]) < NEAR_M
     }
 
 
