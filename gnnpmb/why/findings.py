@@ -48,7 +48,7 @@ from gnnpmb.eval.failures import FailureKind
 from gnnpmb.explain import PairChoice
 from gnnpmb.foreign import BoxOn
 from gnnpmb.why.counterfactual import WouldTake
-from gnnpmb.why.facts import Destination, TrackStep
+from gnnpmb.why.facts import Destination, TrackStep, Use
 
 NEAR_M = 2.0
 """A detection or track within this BEV distance of an object is on it: the devkit's match distance
@@ -339,7 +339,8 @@ class FalseOutput:
     not output at all), where the box lies, the frames of the track's own boxes the evaluation interpolated this
     one between (None: the tracker output it), the nearest object of its class (gt id, distance, how the evaluation
     saw it), the nearest of any class, and the track the evaluation matched to that object instead (None: none);
-    object_missed: the evaluation matched that object to no track at this frame."""
+    object_missed: the evaluation matched that object to no track at this frame; use: how the track's update used
+    the frame's detections there (None: not known)."""
 
     track_id: int
     on: Near | None
@@ -351,6 +352,7 @@ class FalseOutput:
     evaluated: TrackEval | None
     threshold: float | None
     object_missed: bool = False
+    use: Use | None = None
 
 
 @dataclass(frozen=True, slots=True)

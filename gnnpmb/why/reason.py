@@ -656,6 +656,7 @@ class _Context:
             self.report.track_evals.get(str(t)),
             self.threshold,
             nearest_own is not None and self.missed_at(nearest_own[0], self.f),
+            step.use if (step := self.facts.steps(t, self.class_name).get(self.f)) is not None else None,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
 

@@ -1643,3 +1643,17 @@ def test_another_runs_track_on_an_object_with_no_annotation_is_judged_at_the_dev
         ev.boxes[2] = [("7", C, xy)]
         found = check_text(said, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found
         assert [c.kind for c in found if c.kind == "other run"] == kinds, (xy, found)
+
+
+def test_a_soft_updates_minor_detection_called_the_one_it_used_is_caught() -> None:
+    """World3 scene-1100 megvii jpda false_track:1: JPDA weighted m0 p 0.37 for track 7 (missed p 0.34, another
+    detection p 0.29): "the one its update used" is misleading there, and holds at p 0.9."""
+    from gnnpmb.events import AxisKind, AxisLabel, Marginals
+
+    said = "at frame 3 track 7 (car) was output 2.2 m from detection m0 (car, score 0.90), the one its update used"
+    cols = (AxisLabel(AxisKind.MISSED, -1), AxisLabel(AxisKind.MEASUREMENT, 0), AxisLabel(AxisKind.MEASUREMENT, 5))
+    for p, kinds in ((0.37, ["misleading"]), (0.9, [])):
+        probs = np.array([[0.63 - p * 0.5, p, 0.37 - p * 0.5]])
+        marg = Marginals(C, probs, (AxisLabel(AxisKind.TRACK, 7),), cols, "exact")
+        found = check_text(said, Context(C, 3, None, kind="false_track"), _raw_with(marg), _eval(), scene=_scene())
+        assert [c.kind for c in found.found if "soft update" in c.truth] == kinds, (p, found.found)

@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 import re
 
+import numpy as np
+
 from tools.truth.printing import frames_of
 from tools.truth.rawevents import RawEvents
 from tools.truth.scene import NEAR_M, POINTS, SceneTruth, points_problem
@@ -39,6 +41,10 @@ UNUSED = re.compile(rf"at frame (\d+) m(\d+) \((?:(\w+), )?score ({_F}), ({_F}) 
 OUTPUT_ON = re.compile(
     rf"at frame (\d+) track \d+ \((\w+)\) was output (?:on|{_F} m from) detection m(\d+) \((\w+), score ({_F})\)"
 )
+USED_ONE = re.compile(
+    rf"at frame (\d+) track (\d+) \((\w+)\) was output {_F} m from detection m(\d+) \([^)]*\), the one its update used"
+)
+"""A false track's box off the detection its update used: of a soft update, that detection must carry most of it."""
 ITS_DETECTION = re.compile(rf"its detection m(\d+) \(score ({_F}), ({_F}) m away\)")
 OTHER_CLASS = re.compile(rf"at ({_FRAMES}) the detector saw it only as another class \(([^)]*)\)")
 OTHER_ITEM = re.compile(rf"(\w+) m(\d+) ({_F}) m away")
@@ -132,6 +138,11 @@ def check_detector(
             bad(problem[0], sentence, problem[1])
         return problem is not None and problem[0] != "misleading"
 
+    for m in USED_ONE.finditer(text) if raw is not None else ():
+        share = _soft_share(raw, int(m[1]), m[3], int(m[2]), int(m[4]))
+        out.checked["misleading"] += 1
+        if share is not None and share < 0.5:
+            bad("misleading", m[0], f"a soft update: m{m[4]} carried {share:.2f} of track {m[2]}'s")
     for m in NO_DETECTION.finditer(text):
         x, ann = int(m[1]), gt_xy(int(m[1]), m[4])
         out.checked["detector"] += 1
@@ -229,6 +240,31 @@ def check_detector(
             bad("matched", m[0], f"the devkit scored no box of the object at frame {frame}")
         elif not _close(m[1], ((box[0] - a.xy_m[0]) ** 2 + (box[1] - a.xy_m[1]) ** 2) ** 0.5):
             bad("matched", m[0], f"the devkit's box lies {box} against the annotation {a.xy_m}")
+
+
+def _soft_share(raw: RawEvents, x: int, c: str, track: int, meas: int) -> float | None:
+    """Detection ``meas``'s share of track ``track``'s update at ``x`` from the raw ``Marginals`` (JPDA, TO-PMB) or
+    ``UpdateWeights`` (GM-PHD, CPHD) event; None: an assignment (no such event) or not in it."""
+    from gnnpmb.events import AxisKind, Marginals, UpdateWeights
+
+    mg = raw.last(x, c, Marginals)
+    if mg is not None:
+        rows = [i for i, r in enumerate(mg.rows) if r.kind is AxisKind.TRACK and int(r.ref) == track]
+        cols = [j for j, k in enumerate(mg.cols) if k.kind is AxisKind.MEASUREMENT and int(k.ref) == meas]
+        if rows and cols:
+            return float(np.asarray(mg.probs)[rows[0], cols[0]])
+        rows_t = [i for i, k in enumerate(mg.cols) if k.kind is AxisKind.TRACK and int(k.ref) == track]
+        cols_m = [j for j, r in enumerate(mg.rows) if r.kind is AxisKind.MEASUREMENT and int(r.ref) == meas]
+        return float(np.asarray(mg.probs)[cols_m[0], rows_t[0]]) if rows_t and cols_m else None
+    w = raw.last(x, c, UpdateWeights)
+    if w is None:
+        return None
+    labels, refs = np.asarray(w.labels).tolist(), np.asarray(w.meas_indices).tolist()
+    if track not in labels or meas not in refs:
+        return None
+    k = labels.index(track)
+    total = float(np.asarray(w.missed)[k] + np.asarray(w.detected)[k].sum())
+    return float(np.asarray(w.detected)[k, refs.index(meas)]) / total if total > 0 else None
 
 
 def _check_presence(m: re.Match, gt_id, class_name: str, scene: SceneTruth, raw: RawEvents | None, out, bad) -> None:

@@ -691,3 +691,19 @@ def test_the_frames_between_the_last_on_it_and_the_objects_return_count_as_unann
     line = why_lines(finding(FailureKind.ID_SWITCH, lost, frame=15, sightings=seen, window=(10, 15)))[0]
     assert "(it was not annotated at frames 11–13: the evaluation scored boxes it interpolated)" in line, line
     assert "farther than 2 m" not in line
+
+
+def test_a_false_tracks_detection_that_carried_a_minor_share_of_a_soft_update_is_not_the_one_it_used() -> None:
+    # world3 (/tmp/truth47) scene-1100 megvii jpda false_track:1: "output 2.2 m from detection m2 (truck, score
+    # 0.84), the one its update used" where JPDA weighted m2 p 0.37, m7 p 0.30 and the missed hypothesis p 0.34
+    from gnnpmb.why.findings import FalseOutput
+
+    on = Near(2, "bicycle", 0.84, 2.2, True)
+    soft = Use(((2, 0.37), (7, 0.30)), 0.33, UseMode.PROBABILITIES)
+    out = FalseOutput(28, on, (0.0, 0.0), None, None, None, None, None, None, use=soft)
+    line = why_lines(finding(FailureKind.FALSE_TRACK, false_output=out, gt_id=None))[0]
+    said = "was output 2.2 m from detection m2 (bicycle, score 0.84), one of the detections its update used (m2 p 0.37"
+    assert said + ", m7 p 0.30, missed p 0.33)" in line, line
+    sure = FalseOutput(28, on, (0.0, 0.0), None, None, None, None, None, None, use=Use(((2, 0.9),), 0.1, soft.mode))
+    line = why_lines(finding(FailureKind.FALSE_TRACK, false_output=sure, gt_id=None))[0]
+    assert "m2 (bicycle, score 0.84), the one its update used" in line
