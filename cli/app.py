@@ -171,8 +171,10 @@ def view(
             spec = inputs.spec(name).text()
             how = f"add --focus {first}" if k == 0 else f"give --tracker {spec} first and add --focus {first}"
             interpolated = sum(f.gt_interpolated for f in report.failures)
+            gap = any(not b.annotated for f in report.failures for b in f.boxes if b.is_gt and b.interpolated)
             at_interpolated = (
-                f" ({interpolated} at a GT box the evaluation interpolated: the object had no points)"
+                f" ({interpolated} at a GT box the evaluation interpolated: the object had no points"
+                f"{' or no annotation there' if gap else ''})"
                 if interpolated
                 else ""
             )

@@ -310,8 +310,12 @@ def _gt_markdown(focus: FocusTarget, view: TrackerView, gt_id: str, seen: tuple[
     )
     detected = [s.frame for s in seen if s.nearest_own is not None]
     sent_to = "output box on its detection" if mode is UseMode.OUTPUT else "sent to"
+    rows_at = {s.frame for s in seen}
+    gap = [x for x in range(seen[0].frame, seen[-1].frame) if x not in rows_at]  # it left view and came back
+    unannotated = f"; not annotated at {frames_text(gap)}" if gap else ""
     return [
-        f"**GT {short_id(gt_id)}**, in the {len(seen)} frames of the table ({seen[0].frame}–{seen[-1].frame}): a kept "
+        f"**GT {short_id(gt_id)}**, in the {len(seen)} frames of the table ({seen[0].frame}–{seen[-1].frame}"
+        f"{unannotated}): a kept "
         f"{focus.class_name} detection within {NEAR_M:.0f} m at "
         f"{frames_text(detected) if detected else 'no frame'}.",
         "",

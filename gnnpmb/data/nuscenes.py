@@ -244,11 +244,13 @@ def _columns(batch: pa.RecordBatch, prefix: str, n: int) -> np.ndarray:
     return np.column_stack([batch.column(f"{prefix}_{i}").to_numpy() for i in range(n)]).reshape(-1, n)
 
 
-def _gt_boxes(anns: pa.RecordBatch, rows: np.ndarray, fields: dict[str, np.ndarray]) -> tuple[Boxes, np.ndarray]:
-    """Ground truth of the 7 tracking classes among annotation ``rows`` (global frame) and each box's LiDAR +
-    radar points."""
+def _gt_boxes(
+    anns: pa.RecordBatch, rows: np.ndarray, fields: dict[str, np.ndarray]
+) -> tuple[Boxes, np.ndarray, np.ndarray]:
+    """Ground truth of the 7 tracking classes among annotation ``rows`` (global frame), each box's LiDAR + radar
+    points and its radar points."""
     if rows.size == 0:
-        return Boxes.empty(), np.zeros(0, dtype=np.int64)
+        return Boxes.empty(), np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
     boxes = Boxes(
         translation_m=fields["translation"][rows],
         size_wlh_m=fields["size"][rows],
@@ -258,7 +260,7 @@ def _gt_boxes(anns: pa.RecordBatch, rows: np.ndarray, fields: dict[str, np.ndarr
         class_name=np.array(fields["tracking_name"][rows], dtype=object),
         instance_id=np.array(fields["instance_token"][rows], dtype=object),
     )
-    return boxes, fields["num_pts"][rows]
+    return boxes, fields["num_pts"][rows], fields["num_radar_pts"][rows]
 
 
 def load_scene(location: DatasetLocation, scene_name: str) -> SceneData:
@@ -291,6 +293,7 @@ def _scene_data(location: DatasetLocation, part: SceneSlice) -> SceneData:
         "tracking_name": np.array(tracking.to_pylist(), dtype=object),
         "instance_token": np.array(anns.column("instance_token").to_pylist(), dtype=object),
         "num_pts": anns.column("num_lidar_pts").to_numpy() + anns.column("num_radar_pts").to_numpy(),
+        "num_radar_pts": anns.column("num_radar_pts").to_numpy(),
     }
     kept = tracking.is_valid().to_numpy(zero_copy_only=False)
     sample_index = part.ann_sample_index()
@@ -300,7 +303,7 @@ def _scene_data(location: DatasetLocation, part: SceneSlice) -> SceneData:
     timestamps = samples.column("timestamp").to_pylist()
     keyframes = []
     for k, token in enumerate(tokens):
-        gt, gt_num_pts = _gt_boxes(anns, np.flatnonzero((sample_index == k) & kept), fields)
+        gt, gt_num_pts, gt_num_radar_pts = _gt_boxes(anns, np.flatnonzero((sample_index == k) & kept), fields)
         keyframes.append(
             Keyframe(
                 index=k,
@@ -311,6 +314,7 @@ def _scene_data(location: DatasetLocation, part: SceneSlice) -> SceneData:
                 lidar_path=location.dataroot / filenames[k],
                 gt=gt,
                 gt_num_pts=gt_num_pts,
+                gt_num_radar_pts=gt_num_radar_pts,
             )
         )
     description = str(part.scene.row["description"])

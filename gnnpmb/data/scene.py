@@ -29,7 +29,8 @@ class Keyframe:
     ego_pose: ego vehicle in the global frame at the LiDAR timestamp; lidar_calib: LIDAR_TOP in the ego frame;
     lidar_path: the keyframe's ``.pcd.bin`` (float32 x 5 per point, sensor frame);
     gt: ground-truth boxes of the 7 tracking classes in the global frame (instance_id = instance token, score 1);
-    gt_num_pts: (N,) LiDAR + radar points in each GT box (the devkit's eval drops boxes with 0).
+    gt_num_pts: (N,) LiDAR + radar points in each GT box (the devkit's eval drops boxes with 0);
+    gt_num_radar_pts: (N,) the radar points among them (None: not known, e.g. the demo, which has no radar).
     """
 
     index: int
@@ -40,6 +41,7 @@ class Keyframe:
     lidar_path: Path
     gt: Boxes
     gt_num_pts: np.ndarray
+    gt_num_radar_pts: np.ndarray | None = None
 
 
 @dataclass(frozen=True, slots=True)

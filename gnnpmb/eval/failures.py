@@ -31,7 +31,7 @@ import json
 import math
 from collections import defaultdict
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -87,7 +87,9 @@ class FailureBox:
     role: "gt" or "track" plus what it did (e.g. "missed gt", "old track"); object_id: instance token or
     tracking id; translation_m (3,), size_wlh_m (3,), quat_wxyz (4,) in the global frame; interpolated: a
     ground-truth box the evaluation made up between annotated frames because the object had no LiDAR or radar
-    points at this one (the devkit drops such boxes, then interpolates its tracks over the gap).
+    points at this one (the devkit drops such boxes, then interpolates its tracks over the gap); annotated: False
+    where the object had no annotation at all at this keyframe (it left view and came back: the gap is in the
+    annotations, not in the points).
     """
 
     role: str
@@ -96,6 +98,7 @@ class FailureBox:
     size_wlh_m: tuple[float, float, float]
     quat_wxyz: tuple[float, float, float, float]
     interpolated: bool = False
+    annotated: bool = True
 
     @property
     def is_gt(self) -> bool:
@@ -119,13 +122,18 @@ class Failure:
 
     def describe(self) -> str:
         """One readable line naming the ids (and saying when a ground-truth box was interpolated)."""
-        made_up = list(dict.fromkeys(b.object_id for b in self.boxes if b.is_gt and b.interpolated))
+        made_up = {b.object_id: b.annotated for b in self.boxes if b.is_gt and b.interpolated}
         if not made_up:
             return self._what()
+        why = {True: "no points", False: "not annotated"}  # an annotation without points, or none at all
         if len(self.gt_ids) == 1:
-            return self._what() + " (GT box interpolated by the evaluation: no points)"
-        named = ", ".join(f"GT {short_id(g)}" for g in made_up)  # of several objects, the one(s) it concerns
-        return self._what() + f" ({named}: box interpolated by the evaluation, no points)"
+            return self._what() + f" (GT box interpolated by the evaluation: {why[next(iter(made_up.values()))]})"
+        parts = []  # of several objects, the one(s) it concerns
+        for annotated in (True, False):
+            named = ", ".join(f"GT {short_id(g)}" for g, a in made_up.items() if a is annotated)
+            if named:
+                parts.append(f"{named}: box interpolated by the evaluation, {why[annotated]}")
+        return self._what() + f" ({'; '.join(parts)})"
 
     @property
     def gt_interpolated(self) -> bool:
@@ -170,6 +178,7 @@ class Failure:
                     "size": list(b.size_wlh_m),
                     "rotation": list(b.quat_wxyz),
                     "interpolated": b.interpolated,
+                    "annotated": b.annotated,
                 }
                 for b in self.boxes
             ],
@@ -193,6 +202,7 @@ class Failure:
                     size_wlh_m=tuple(b["size"]),
                     quat_wxyz=tuple(b["rotation"]),
                     interpolated=bool(b.get("interpolated", False)),
+                    annotated=bool(b.get("annotated", True)),
                 )
                 for b in data["boxes"]
             ),
@@ -348,6 +358,18 @@ class FailureReport:
             frames=None if data.get("frames") is None else (int(data["frames"][0]), int(data["frames"][1])),
             scores=None if data.get("scores") is None else OfficialScores.from_json(data["scores"]),
         )
+
+
+def _unannotated(failure: Failure, annotated: Mapping[str, Mapping[int, Any]]) -> Failure:
+    """``failure`` with each interpolated ground-truth box of an object that had no annotation at its keyframe
+    marked so (``annotated``: object -> the frames it was annotated at, ``gt_frames``)."""
+    boxes = tuple(
+        replace(b, annotated=False)
+        if b.is_gt and b.interpolated and failure.frame_index not in annotated.get(b.object_id, {})
+        else b
+        for b in failure.boxes
+    )
+    return failure if boxes == failure.boxes else replace(failure, boxes=boxes)
 
 
 def _box(role: str, box: TrackingBox) -> FailureBox:
@@ -682,15 +704,16 @@ def find_failures(
         str(b.tracking_id): float(b.tracking_score) for boxes in tracks_pred[scene_token].values() for b in boxes
     }
     whole = len(window) == len(tokens)
+    annotated = gt_frames(raw_gt, kept_gt, tracks_gt[scene_token], frame_of_timestamp, tokens, cfg.class_range)
     return FailureReport(
         scene_name,
         tracker,
         tuple(tokens),
         tuple(classes),
-        tuple(failures),
+        tuple(_unannotated(f, annotated) for f in failures),
         coalescence_radius_m,
         track_scores,
-        gt_frames(raw_gt, kept_gt, tracks_gt[scene_token], frame_of_timestamp, tokens, cfg.class_range),
+        annotated,
         track_evals(results, kept_pred, tracks_pred[scene_token], track_scores, frame_of_timestamp, tokens, matches),
         None if whole else (window.start, window.stop),
         scores,

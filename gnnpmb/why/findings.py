@@ -29,7 +29,9 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   devkit's ``NEAR_M`` (``INTERPOLATED``), or the evaluation has no box of the object there, beyond its range or
   for want of points (``NO_EVAL_BOX``), or the false track's box is one the evaluation interpolated between two of
   the track's boxes, at a frame the tracker did not output it (``TRACK_INTERPOLATED``), or a track output on the
-  object was dropped there by the evaluation's range or bike-rack filter (``TRACK_DROPPED``).
+  object was dropped there by the evaluation's range or bike-rack filter (``TRACK_DROPPED``), or the object had no
+  annotation at all at the failure's frame (it left view and came back) and the evaluation scored a box it
+  interpolated between its annotations (``UNANNOTATED``).
 
 The frames that decide a failure: for a miss, a false track and a coalescence, the failure's frame; for a
 fragmentation, an ID switch and an identity theft, the frames from the one after the lost track last lay within
@@ -46,7 +48,7 @@ from gnnpmb.eval.failures import FailureKind
 from gnnpmb.explain import PairChoice
 from gnnpmb.foreign import BoxOn
 from gnnpmb.why.counterfactual import WouldTake
-from gnnpmb.why.facts import Destination, TrackStep
+from gnnpmb.why.facts import Destination, TrackStep, Use
 
 NEAR_M = 2.0
 """A detection or track within this BEV distance of an object is on it: the devkit's match distance
@@ -83,6 +85,7 @@ class Rule(enum.Enum):
     NO_EVAL_BOX = "no evaluated box"
     TRACK_INTERPOLATED = "track interpolated"
     TRACK_DROPPED = "track dropped"
+    UNANNOTATED = "not annotated"
 
     @property
     def party(self) -> Party:
@@ -105,6 +108,7 @@ _PARTY = {
     Rule.NO_EVAL_BOX: Party.EVALUATION,
     Rule.TRACK_INTERPOLATED: Party.EVALUATION,
     Rule.TRACK_DROPPED: Party.EVALUATION,
+    Rule.UNANNOTATED: Party.EVALUATION,
 }
 
 
@@ -169,8 +173,9 @@ class OnObject:
 class Sighting:
     """The object at one frame: its LiDAR + radar points, how the evaluation saw it, the nearest detection of any
     class (within ``NEAR_M``, kept or not), the nearest kept detection of its class and where that went, the
-    tracks of its class output on it, and the nearest detection of its class within ``NEAR_M`` that preprocessing
-    removed (score threshold or NMS)."""
+    tracks of its class output on it, the nearest detection of its class within ``NEAR_M`` that preprocessing
+    removed (score threshold or NMS), and how many of ``points`` are radar returns (a box with no LiDAR return
+    and a few radar ones is nothing a LiDAR detector can see)."""
 
     frame: int
     points: int
@@ -180,6 +185,11 @@ class Sighting:
     went: Destination | None
     on_it: tuple[OnObject, ...]
     removed_own: Near | None = None
+    radar_points: int = 0
+
+    @property
+    def lidar_points(self) -> int:
+        return self.points - self.radar_points
 
     @property
     def seen(self) -> Near | None:
@@ -329,7 +339,8 @@ class FalseOutput:
     not output at all), where the box lies, the frames of the track's own boxes the evaluation interpolated this
     one between (None: the tracker output it), the nearest object of its class (gt id, distance, how the evaluation
     saw it), the nearest of any class, and the track the evaluation matched to that object instead (None: none);
-    object_missed: the evaluation matched that object to no track at this frame."""
+    object_missed: the evaluation matched that object to no track at this frame; use: how the track's update used
+    the frame's detections there (None: not known)."""
 
     track_id: int
     on: Near | None
@@ -341,6 +352,7 @@ class FalseOutput:
     evaluated: TrackEval | None
     threshold: float | None
     object_missed: bool = False
+    use: Use | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -130,6 +130,12 @@ class _Context:
         hit = np.flatnonzero(gt.instance_id.astype(str) == gt_id)
         return int(self.scene.keyframes[frame].gt_num_pts[hit[0]]) if hit.size else 0
 
+    def radar_points(self, gt_id: str, frame: int) -> int:
+        """The radar returns among ``points`` (0 where the dataset gives none)."""
+        kf = self.scene.keyframes[frame]
+        hit = np.flatnonzero(kf.gt.instance_id.astype(str) == gt_id)
+        return int(kf.gt_num_radar_pts[hit[0]]) if hit.size and kf.gt_num_radar_pts is not None else 0
+
     def near(self, frame: int, xy: np.ndarray, *, own: bool, kept_only: bool = True) -> Near | None:
         """The nearest detection within ``NEAR_M`` of ``xy`` at ``frame``: any class and score (own False), or one of
         the failure's class (own True) that preprocessing kept (kept_only) or removed (not kept_only). Of any class,
@@ -200,6 +206,7 @@ class _Context:
                     went,
                     self.on_object(self.report, self.frames[f], xy),
                     self.near(f, xy, own=True, kept_only=False),
+                    self.radar_points(gt_id, f),
                 )
             )
         return tuple(out)
@@ -224,6 +231,8 @@ class _Context:
             parts = self.coalescence(sightings)
         else:
             raise AssertionError(kind)
+        if gt_id is not None and self.gt_xy(gt_id, self.f) is None:  # scored where it had no annotation
+            parts["blame"] = (Blame(Rule.UNANNOTATED, (self.f,)), *parts.get("blame", ()))
         involved = self.involved(sightings)
         boxes_on = self.boxes_on(sightings, parts) if self.facts.output_only else ()
         return Finding(
@@ -390,7 +399,15 @@ class _Context:
             for x, g in self.report.gt_frames.get(gt_id, {}).items()
             if first <= x < self.f and g.evaluated_xy_m is not None and x not in missed
         ]
-        return max(scored, default=None)
+        # frames the object has no annotation at (it left view and came back): the devkit scores a box it
+        # interpolated there and its accumulator's matches are the only record of them
+        unannotated = [
+            x
+            for ev in self.report.track_evals.values()
+            for x, g in ev.matches
+            if g == gt_id and first <= x < self.f and x not in self.report.gt_frames.get(gt_id, {})
+        ]
+        return max(scored + unannotated, default=None)
 
     def finite_elsewhere(self, track_id: int, steps: Mapping[int, TrackStep]) -> tuple[tuple[int, int], ...]:
         """(frame, detection) pairs of the window that track ``track_id`` could not take in its step's matrix (an
@@ -639,6 +656,7 @@ class _Context:
             self.report.track_evals.get(str(t)),
             self.threshold,
             nearest_own is not None and self.missed_at(nearest_own[0], self.f),
+            step.use if (step := self.facts.steps(t, self.class_name).get(self.f)) is not None else None,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
 

@@ -13,23 +13,25 @@ from __future__ import annotations
 import math
 import re
 
+import numpy as np
+
 from tools.truth.printing import frames_of
 from tools.truth.rawevents import RawEvents
-from tools.truth.scene import NEAR_M, SceneTruth
+from tools.truth.scene import NEAR_M, POINTS, SceneTruth, points_problem
 
 _F = r"[\d.]+"
 _FRAMES = r"frames? [\d–, ]*\d"
 SCORE_AT = re.compile(rf"at frame (\d+) detection m(\d+) \(score ({_F})\) lay ({_F}) m from (\w+) GT (\w+)")
 NO_DETECTION = re.compile(
-    r"at frame (\d+) the detector gave no detection( of a tracked class)? within 2 m of (\w+) GT (\w+) \((\d+) LiDAR "
-    r"and radar points in its box\)"
+    rf"at frame (\d+) the detector gave no detection( of a tracked class)? within 2 m of (\w+) GT (\w+) \({POINTS} in "
+    r"its box\)"
 )
 WRONG_CLASS = re.compile(
-    rf"at frame (\d+) the detector gave no (\w+) detection within 2 m of \w+ GT (\w+) \((\d+) LiDAR and radar points "
-    rf"in its box\), but a (\w+) detection, m(\d+) \(score ({_F})\), ({_F}) m away"
+    rf"at frame (\d+) the detector gave no (\w+) detection within 2 m of \w+ GT (\w+) \({POINTS} in its box\), but "
+    rf"a (\w+) detection, m(\d+) \(score ({_F})\), ({_F}) m away"
 )
 NONE_ANY = re.compile(
-    rf"at ({_FRAMES}) the detector gave no detection of (any|a tracked) class within 2 m, though it had"
+    rf"at ({_FRAMES}) the detector gave no detection of (any|a tracked) class within 2 m, though it had {POINTS}"
 )
 HIDDEN = re.compile(
     rf"at ({_FRAMES}) (?:\w+ GT (\w+)|it) had no LiDAR or radar points \(no detector could see it\) and no detection"
@@ -39,12 +41,17 @@ UNUSED = re.compile(rf"at frame (\d+) m(\d+) \((?:(\w+), )?score ({_F}), ({_F}) 
 OUTPUT_ON = re.compile(
     rf"at frame (\d+) track \d+ \((\w+)\) was output (?:on|{_F} m from) detection m(\d+) \((\w+), score ({_F})\)"
 )
+USED_ONE = re.compile(
+    rf"at frame (\d+) track (\d+) \((\w+)\) was output {_F} m from detection m(\d+) \([^)]*\), the one its update used"
+)
+"""A false track's box off the detection its update used: of a soft update, that detection must carry most of it."""
 ITS_DETECTION = re.compile(rf"its detection m(\d+) \(score ({_F}), ({_F}) m away\)")
 OTHER_CLASS = re.compile(rf"at ({_FRAMES}) the detector saw it only as another class \(([^)]*)\)")
 OTHER_ITEM = re.compile(rf"(\w+) m(\d+) ({_F}) m away")
 NOT_ITS_OWN = re.compile(
-    rf"at ({_FRAMES}) (?:the detector gave (?:\w+ GT (\w+) \(\d+ LiDAR and radar points in its box\) )?|(?:\w+ GT "
-    rf"(\w+)|it) had no LiDAR or radar points \(no detector could see it\) and )no detection of its own within 2 m "
+    rf"at ({_FRAMES}) (?:the detector gave (?:\w+ GT (\w+) \([\d,–]+ LiDAR and (?:[\d,–]+ )?radar points in its "
+    rf"box\) )?|(?:\w+ GT (\w+)|it) had no LiDAR or radar points \(no detector could see it\) and )no detection of "
+    rf"its own within 2 m "
     rf"\(((?:[^()]|\([^()]*\))*)\)"
 )
 """Detections within 2 m of an object, each nearer another annotated object: ``(at frame 3 car m4, 1.8 m away, lay
@@ -55,7 +62,7 @@ INTERPOLATED_AT = re.compile(
     rf"the evaluation scored (?:it|GT \w{{6}}) at a box it interpolated, ({_F}) m from the annotation"
 )
 PRESENCE = re.compile(
-    rf"in the (\d+) recorded frames up to (\d+) \((\d+)–(\d+)\), GT (\w+) had an? (\w+) detection "
+    rf"in the (\d+) recorded frames up to (\d+) \(([\d–, ]+)\), GT (\w+) had an? (\w+) detection "
     rf"(?:the tracker kept )?within 2 m at ({_FRAMES}|no frame)(?: only)?"
     rf"(?:,? and at ({_FRAMES}) only one? (?:that )?(?:its )?preprocessing removed)?"
 )
@@ -122,31 +129,52 @@ def check_detector(
         d = det(x, int(m[3]))
         if d is None or d.class_name != m[4] or not _close(m[5], d.score):
             bad("detector", m[0], f"the file's m{m[3]} at frame {x}: {d}")
+
+    def wrong_points(sentence: str, anns: list, said: str, radar_said: str | None) -> bool:
+        """Whether the points said of ``anns`` are wrong (reported; a sum that hides radar returns is reported as
+        misleading and the sentence's other facts still checked)."""
+        problem = points_problem(anns, said, radar_said)
+        if problem is not None:
+            bad(problem[0], sentence, problem[1])
+        return problem is not None and problem[0] != "misleading"
+
+    for m in USED_ONE.finditer(text) if raw is not None else ():
+        share = _soft_share(raw, int(m[1]), m[3], int(m[2]), int(m[4]))
+        out.checked["misleading"] += 1
+        if share is not None and share < 0.5:
+            bad("misleading", m[0], f"a soft update: m{m[4]} carried {share:.2f} of track {m[2]}'s")
     for m in NO_DETECTION.finditer(text):
         x, ann = int(m[1]), gt_xy(int(m[1]), m[4])
         out.checked["detector"] += 1
         if ann is None:
             bad("detector", m[0], f"no annotation of GT {m[4]} at frame {x}")
-        elif scene.near(x, ann.xy_m) or ann.points != int(m[5]):
-            bad("detector", m[0], f"detections within {NEAR_M} m: {scene.near(x, ann.xy_m)}; points {ann.points}")
+        elif scene.near(x, ann.xy_m):
+            bad("detector", m[0], f"detections within {NEAR_M} m: {scene.near(x, ann.xy_m)}")
+        elif wrong_points(m[0], [ann], m[5], m[6]):
+            continue
         elif not m[2] and scene.untracked_near(x, ann.xy_m):
             bad("detector", m[0], f"the file has {scene.untracked_near(x, ann.xy_m)} within {NEAR_M} m (untracked)")
     for m in WRONG_CLASS.finditer(text):
         x, ann = int(m[1]), gt_xy(int(m[1]), m[3])
         out.checked["detector"] += 1
-        if ann is None or scene.near(x, ann.xy_m, m[2]) or ann.points != int(m[4]):
+        if ann is None or scene.near(x, ann.xy_m, m[2]):
             own = scene.near(x, ann.xy_m, m[2]) if ann else None
             bad("detector", m[0], f"{m[2]} detections within reach: {own}; points {ann.points if ann else None}")
-        elif (o := scene.owner(x, int(m[6]), ann.xy_m)) is not None:
-            bad("detector", m[0], f"m{m[6]} lies nearer GT {o[0][:6]} ({o[1]:.2f} m): that object's detection")
-        score_distance(m[0], x, int(m[6]), m[7], m[8], ann, m[5])
+        elif wrong_points(m[0], [ann], m[4], m[5]):
+            continue
+        elif (o := scene.owner(x, int(m[7]), ann.xy_m)) is not None:
+            bad("detector", m[0], f"m{m[7]} lies nearer GT {o[0][:6]} ({o[1]:.2f} m): that object's detection")
+        score_distance(m[0], x, int(m[7]), m[8], m[9], ann, m[6])
     for m in NONE_ANY.finditer(text):
         out.checked["detector"] += 1
-        seen = {x: scene.near(x, a.xy_m) for x in frames_of(m[1]) if (a := gt_xy(x)) is not None}
+        anns = {x: a for x in frames_of(m[1]) if (a := gt_xy(x)) is not None}
+        seen = {x: scene.near(x, a.xy_m) for x, a in anns.items()}
         if m[2] == "any":
-            seen = {x: [*v, *scene.untracked_near(x, gt_xy(x).xy_m)] for x, v in seen.items()}
+            seen = {x: [*v, *scene.untracked_near(x, anns[x].xy_m)] for x, v in seen.items()}
         if any(seen.values()):
             bad("detector", m[0], f"detections within {NEAR_M} m by frame: {seen}")
+        else:
+            wrong_points(m[0], list(anns.values()), m[3], m[4])
     for m in HIDDEN.finditer(text):
         out.checked["detector"] += 1
         wrong = {}
@@ -214,10 +242,41 @@ def check_detector(
             bad("matched", m[0], f"the devkit's box lies {box} against the annotation {a.xy_m}")
 
 
+def _soft_share(raw: RawEvents, x: int, c: str, track: int, meas: int) -> float | None:
+    """Detection ``meas``'s share of track ``track``'s update at ``x`` from the raw ``Marginals`` (JPDA, TO-PMB) or
+    ``UpdateWeights`` (GM-PHD, CPHD) event; None: an assignment (no such event) or not in it."""
+    from gnnpmb.events import AxisKind, Marginals, UpdateWeights
+
+    mg = raw.last(x, c, Marginals)
+    if mg is not None:
+        rows = [i for i, r in enumerate(mg.rows) if r.kind is AxisKind.TRACK and int(r.ref) == track]
+        cols = [j for j, k in enumerate(mg.cols) if k.kind is AxisKind.MEASUREMENT and int(k.ref) == meas]
+        if rows and cols:
+            return float(np.asarray(mg.probs)[rows[0], cols[0]])
+        rows_t = [i for i, k in enumerate(mg.cols) if k.kind is AxisKind.TRACK and int(k.ref) == track]
+        cols_m = [j for j, r in enumerate(mg.rows) if r.kind is AxisKind.MEASUREMENT and int(r.ref) == meas]
+        return float(np.asarray(mg.probs)[cols_m[0], rows_t[0]]) if rows_t and cols_m else None
+    w = raw.last(x, c, UpdateWeights)
+    if w is None:
+        return None
+    labels, refs = np.asarray(w.labels).tolist(), np.asarray(w.meas_indices).tolist()
+    if track not in labels or meas not in refs:
+        return None
+    k = labels.index(track)
+    total = float(np.asarray(w.missed)[k] + np.asarray(w.detected)[k].sum())
+    return float(np.asarray(w.detected)[k, refs.index(meas)]) / total if total > 0 else None
+
+
 def _check_presence(m: re.Match, gt_id, class_name: str, scene: SceneTruth, raw: RawEvents | None, out, bad) -> None:
-    first, last, cls = int(m[3]), int(m[4]), m[6]
-    stated = set(frames_of(m[7])) if m[7] != "no frame" else set()
-    stated_removed = set(frames_of(m[8])) if m[8] else set()
+    said_frames = frames_of(f"frames {m[3]}")
+    first, last, cls = said_frames[0], said_frames[-1], m[5]
+    stated = set(frames_of(m[6])) if m[6] != "no frame" else set()
+    stated_removed = set(frames_of(m[7])) if m[7] else set()
+    out.checked["misleading"] += 1
+    annotated = [x for x in range(first, last + 1) if x < len(scene.objects) and (gt_id or "") in scene.objects[x]]
+    if said_frames != annotated or int(m[1]) != len(annotated):
+        # the recorded frames are the annotated ones: a span over frames without an annotation hides that it left
+        bad("misleading", m[0], f"the object was annotated at frames {annotated} of {first}–{last}")
     any_near, kept_near = set(), set()
     for x in range(first, last + 1):
         a = scene.objects[x].get(gt_id or "") if x < len(scene.objects) else None

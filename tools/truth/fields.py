@@ -519,7 +519,11 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
     false_track = f.false_output.track_id if f.false_output is not None else None
     for x in frames:
         xy = src.gt_xy(x, f.gt_id)
-        if name in ("NO_DETECTION", "UNSEEN"):  # none of its own: each one within reach lies nearer another object
+        if name == "UNANNOTATED":  # no annotation there, one before and one after (the devkit interpolates between)
+            have = [y for y in range(len(src.scene.objects)) if (f.gt_id or "") in src.scene.objects[y]]
+            if xy is not None or not any(y < x for y in have) or not any(y > x for y in have):
+                return f"the object is annotated at frame {x}, or not on both sides of it"
+        elif name in ("NO_DETECTION", "UNSEEN"):  # none of its own: each one within reach lies nearer another object
             if xy is None or _own_near(src, x, xy):
                 return f"a detection of the object lies within reach at frame {x}"
             hidden = src.points(x, f.gt_id) == 0

@@ -34,6 +34,9 @@ OTHER = re.compile(
     r"|did not match the object here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted, but the "
     r"evaluation matched (track \d+ to (?:\w+ GT \w+|no object)(?: and track \d+ to (?:\w+ GT \w+|no object))*))"
 )
+REACH_NOTE = " (the box it scored for this object, interpolated"
+"""What follows "but the evaluation matched track T to ..." where the box the devkit scored for the object lay out
+of the 2 m of each named track."""
 MATCHED_TO = re.compile(r"track (\d+) to (?:(\w+) GT (\w+)|no object)")
 LOST_KINDS = ("id_switch", "identity_theft", "fragmentation")
 
@@ -107,12 +110,14 @@ def check_others(
 
 
 def _near(ev: EvalFacts, c: str, x: int, gt: str, scene) -> set[str]:
-    """The other run's track ids of class ``c`` with a box within ``NEAR_M`` of the object's annotation at ``x``."""
+    """The other run's track ids of class ``c`` with a box within ``NEAR_M`` of the object's annotation at ``x``, or
+    where it had none there (it left view and came back), of the box the devkit interpolated for it."""
     a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
+    at = a.xy_m if a is not None else ev.evaluated_gt.get((x, gt))
     return {
         t
         for t, cls, xy in ev.boxes.get(x, [])
-        if a is not None and cls == c and math.hypot(xy[0] - a.xy_m[0], xy[1] - a.xy_m[1]) < NEAR_M
+        if at is not None and cls == c and math.hypot(xy[0] - at[0], xy[1] - at[1]) < NEAR_M
     }
 
 
@@ -127,6 +132,16 @@ def _check_matched_elsewhere(m: re.Match, c: str, x: int, gt: str, ev: EvalFacts
     near = _near(ev, c, x, gt, scene)
     if not named <= near & ev.counted.get(c, set()):
         bad("other run", m[0], f"{m[1]}'s counted tracks within {NEAR_M} m at frame {x}: {sorted(near)}")
+    box = ev.evaluated_gt.get((x, gt))
+    a = scene.objects[x].get(gt) if scene is not None and x < len(scene.objects) else None
+    tracks = {t: xy for t, cls, xy in ev.boxes.get(x, []) if cls == c and t in named}
+    if box is not None and a is not None and tracks and math.dist(box, a.xy_m) > 1e-6:  # an interpolated box
+        out.checked["misleading"] += 1
+        out_of_reach = all(math.dist(xy, box) >= NEAR_M for xy in tracks.values())
+        if out_of_reach != (REACH_NOTE in m.string[m.end() : m.end() + len(REACH_NOTE) + 2]):
+            lay = {t: round(math.dist(xy, box), 2) for t, xy in tracks.items()}
+            where = "out of" if out_of_reach else "within"
+            bad("misleading", m[0], f"the box the devkit scored for the object lies {lay} m away: {where} their 2 m")
     got = {t: (g if len(g) <= 8 else g[:6]) if (g := ev.matched_gt(c, x, t)) else None for t in named}
     out.checked["other run"] += 1
     if said != got:

@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 import re
 
-from tools.truth.scene import NEAR_M
+from tools.truth.scene import NEAR_M, POINTS, points_problem
 
 AWAY = re.compile(r"(\w+) GT (\w{6}) lies (\d+\.\d) m away")
 OTHER_CLASS = re.compile(r"no (\w+) GT lies within 2 m, but GT (\w+) (\w{6}) does \((\d+\.\d) m\)")
@@ -105,9 +105,7 @@ def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, 
             bad("output", NOT_CARRIED, f"tracks {near} were output within 2 m of it at frame {x}")
 
 
-NONE_OF_ITS_OWN = re.compile(
-    r"the detector gave GT (\w{6}) no detection of its own within 2 m \((\d+) LiDAR and radar points\)"
-)
+NONE_OF_ITS_OWN = re.compile(rf"the detector gave GT (\w{{6}}) no detection of its own within 2 m \({POINTS}\)")
 
 
 def _d(a: tuple[float, float], b: tuple[float, float]) -> float:
@@ -185,8 +183,10 @@ def check_none_of_its_own(text: str, x: int, scene, out, bad) -> None:
         out.checked["detector"] += 1
         hit = scene.object_of(x, m[1])
         near = scene.near(x, hit[1].xy_m) if hit is not None else None
-        if hit is None or near or hit[1].points != int(m[2]):
+        if hit is None or near:
             bad("detector", m[0], f"detections within 2 m: {near}; points {hit[1].points if hit else None}")
+        elif (problem := points_problem([hit[1]], m[2], m[3])) is not None:
+            bad(problem[0], m[0], problem[1])
 
 
 def check_swapped(text: str, x: int, gt_id: str | None, scene, ev, out, bad) -> None:

@@ -31,9 +31,41 @@ class Detection:
 
 @dataclass(frozen=True)
 class Annotation:
+    """points: LiDAR + radar returns in the box (the devkit drops a box with none); radar: those of them radar."""
+
     class_name: str
     xy_m: tuple[float, float]
     points: int
+    radar: int = 0
+
+
+POINTS = r"([\d,]+(?:–[\d,]+)?) LiDAR and (?:([\d,]+(?:–[\d,]+)?) )?radar points"
+"""A box's points as the text says them: ``12 LiDAR and radar points`` (the sum) or ``0 LiDAR and 3 radar points``
+(apart); a span ``2–5`` over several frames. Groups: the sum or the LiDAR count, the radar count (None: the sum)."""
+
+
+def _span(values: list[int]) -> str:
+    lo, hi = min(values), max(values)
+    return f"{lo:,}" if lo == hi else f"{lo:,}–{hi:,}"
+
+
+def points_problem(anns: list[Annotation], said: str, radar_said: str | None) -> tuple[str, str] | None:
+    """(kind, the truth) where the points said of the boxes ``anns`` (one per frame) are wrong ("detector") or
+    the sum hides that some were radar returns only ("misleading": a LiDAR detector had nothing to see there);
+    None where they hold."""
+    total, radar = [a.points for a in anns], [a.radar for a in anns]
+    lidar = [t - r for t, r in zip(total, radar, strict=True)]
+    if not anns:
+        return "detector", "no annotation"
+    if radar_said is None:
+        if said != _span(total):
+            return "detector", f"points {_span(total)}"
+        if any(radar):
+            return "misleading", f"{_span(lidar)} LiDAR and {_span(radar)} radar points: the sum hides the radar"
+        return None
+    if said != _span(lidar) or radar_said != _span(radar):
+        return "detector", f"{_span(lidar)} LiDAR and {_span(radar)} radar points"
+    return None
 
 
 @dataclass
@@ -76,7 +108,8 @@ class SceneTruth:
                 name = category_to_tracking_name(a["category_name"])
                 if name is not None:
                     points = int(a["num_lidar_pts"]) + int(a["num_radar_pts"])
-                    here[a["instance_token"]] = Annotation(name, tuple(map(float, a["translation"][:2])), points)
+                    xy = tuple(map(float, a["translation"][:2]))
+                    here[a["instance_token"]] = Annotation(name, xy, points, int(a["num_radar_pts"]))
             objects.append(here)
             token = sample["next"]
         return cls(detections, objects, ego, untracked)

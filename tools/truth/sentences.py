@@ -33,9 +33,9 @@ from gnnpmb.assign.hungarian import solve
 from gnnpmb.events import AxisKind, Born, CostMatrix, Gated
 from tools.truth import costs, detector, hypotheses, lost, otherruns, output, place, replay, shares
 from tools.truth.devkit import EvalFacts
-from tools.truth.printing import BECAUSE
+from tools.truth.printing import BECAUSE, frames_of
 from tools.truth.rawevents import RawEvents
-from tools.truth.scene import SceneTruth
+from tools.truth.scene import NEAR_M, SceneTruth
 
 CLASSES = (
     "matched",
@@ -193,6 +193,19 @@ COUNTED_AT = re.compile(
 )
 OUTPUT_AT = re.compile(r"at frame (\d+) track (\d+) (?:\(\w+\) )?was (?:still )?output (?:on|[\d.]+ m from)")
 LAST_OUTPUT = re.compile(r"track (\d+) was last output on it at frame (\d+)")
+UNANNOTATED = re.compile(
+    r"at frame (\d+) \w+ GT (\w{6}) had no annotation, though it had some before and after: the evaluation scored a "
+    r"box it interpolated between them there"
+)
+"""A failure at a keyframe the object had no annotation at (``Rule.UNANNOTATED``)."""
+OFF_AFTER = re.compile(
+    r"(?:track (\d+) was last output on it|the evaluation last matched track (\d+) to it) at frame \d+"
+    r"(?: \(a box it interpolated for the track\))?"
+    r"(?: \(output farther than 2 m from it at (frames? [\d–, ]*\d)\))?"
+    r"(?: \(it was not annotated at (frames? [\d–, ]*\d): the evaluation scored (?:boxes|a box) it interpolated\))?"
+)
+"""A lost track's last frame on the object, then where it was output away from the annotation and the frames
+without one."""
 STARTED_NEW = re.compile(
     r"at frame (\d+) (?:detection )?m(\d+) \([^()]*(?:\([^()]*\)[^()]*)*\)(?: lay [\d.]+ m from \w+ GT \w+ and started|"
     r" →) new track (\d+)"
@@ -287,6 +300,15 @@ def check_text(
             out.checked["output"] += 1
             if later:
                 bad("output", m[0], f"the submission's box of track {m[1]} lay within 2 m of the annotation at {later}")
+    if scene is not None and ctx.gt_id is not None:
+        _check_off_and_unannotated(text, ctx.gt_id, scene, ev, out, bad)
+        for m in UNANNOTATED.finditer(text):
+            out.checked["evaluation"] += 1
+            x, have = int(m[1]), [y for y, objs in enumerate(scene.objects) if ctx.gt_id in objs]
+            if not ctx.gt_id.startswith(m[2]) or x in have or not have or not have[0] < x < have[-1]:
+                bad("evaluation", m[0], f"the object is annotated at frames {have}")
+            elif (x, ctx.gt_id) not in ev.evaluated_gt:
+                bad("evaluation", m[0], f"the devkit scored no box of the object at frame {x}")
     lost.check_not_output(text, ctx.lost, ev, out, bad)
     lost.check_last_match(text, c, ctx.frame, ctx.gt_id, ev, out, bad)
     lost.check_two_tracks(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
@@ -626,6 +648,29 @@ def _check_undercut(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> Non
     k = replay.track_col(mat, int(t))
     if k is None or k in _used_cols(mat, a) or not mat.cost[row, k] < mat.cost[row, col] - UNDERCUT_TOL:
         bad("misleading", m[0], f"track {t}'s column at frame {x} is not a free one cheaper for m{meas}")
+
+
+def _check_off_and_unannotated(text: str, gt_id: str, scene: SceneTruth, ev: EvalFacts, out: Tally, bad) -> None:
+    """A lost track's "(output farther than 2 m from it at frames F)": the object was annotated at each of F and
+    the submission's box of the track lay 2 m or more from the annotation; "(it was not annotated at frames G: ...)":
+    the object had no annotation at any of G (world3: a track said far from an object that had no annotation there,
+    which the devkit matched to its interpolated box)."""
+    for m in OFF_AFTER.finditer(text):
+        t, wrong = m[1] or m[2], {}
+        if m[3]:
+            out.checked["output"] += 1
+        for x in frames_of(m[3]) if m[3] else ():
+            a = scene.objects[x].get(gt_id) if x < len(scene.objects) else None
+            box = next((xy for i, _, xy in ev.boxes.get(x, []) if i == t), None)
+            if a is None or box is None or math.hypot(box[0] - a.xy_m[0], box[1] - a.xy_m[1]) < NEAR_M:
+                wrong[x] = "no annotation" if a is None else "no box" if box is None else "within 2 m"
+        if wrong:
+            bad("output", m[0], f"track {t} by frame: {wrong}")
+        if m[4]:
+            out.checked["output"] += 1
+            there = [x for x in frames_of(m[4]) if x < len(scene.objects) and gt_id in scene.objects[x]]
+            if there:
+                bad("output", m[0], f"the object was annotated at frames {there}")
 
 
 def _output_on_after(scene: SceneTruth, ev: EvalFacts, t: str, gt_id: str, last: int, frame: int) -> list[int]:

@@ -667,3 +667,43 @@ def test_a_failure_in_a_class_the_evaluation_counted_none_of_says_it_is_outside_
         assert "outside the evaluation's counts" not in why_lines(finding(kind, lost))[0]
     # a miss is counted: the devkit counts every object of such a class missed
     assert "outside the evaluation's counts" not in why_lines(finding(FailureKind.MISS, lost, unscored=True))[0]
+
+
+def test_a_track_lost_inside_an_annotation_gap_is_not_said_far_from_the_unannotated_object() -> None:
+    # world3 (/tmp/truth47) scene-0061 nohead ab3dmot fragmentation:5: car 732475 unannotated at frames 11-14, the
+    # failure at 12 inside the gap; the devkit matched track 7 to the interpolated box at 11, which read "(output
+    # farther than 2 m from it at frame 11)" beside "the evaluation last matched track 7 to it at frame 11"
+    seen = tuple(Sighting(x, 40, None, None, None, None, ()) for x in (9, 10))
+    steps = (step(10, output=estimate(7, 0.9)), step(11, output=estimate(7, 0.9)), step(12))
+    lost = LostTrack(7, 10, steps, None, None, None, matched_until=11)
+    line = why_lines(finding(FailureKind.FRAGMENTATION, lost, frame=12, sightings=seen, has_existence=False))[0]
+    said = "the evaluation last matched track 7 to it at frame 11 (it was not annotated at frame 11: the evaluation "
+    assert said + "scored a box it interpolated)" in line, line
+    assert "farther than 2 m" not in line
+
+
+def test_the_frames_between_the_last_on_it_and_the_objects_return_count_as_unannotated() -> None:
+    # world3 scene-0061 nohead ab3dmot id_switch:13: car 579f8e unannotated at 19-23, track 123 last on it at 18 and
+    # matched by the devkit to the interpolated box at 19; the window's first annotated frame is 24
+    seen = tuple(Sighting(x, 40, None, None, None, None, ()) for x in (14, 15))
+    steps = (step(10, output=estimate(7, 0.9)), step(11, output=estimate(7, 0.9)), step(12))
+    lost = LostTrack(7, 10, steps, None, None, None, matched_until=11)
+    line = why_lines(finding(FailureKind.ID_SWITCH, lost, frame=15, sightings=seen, window=(10, 15)))[0]
+    assert "(it was not annotated at frames 11–13: the evaluation scored boxes it interpolated)" in line, line
+    assert "farther than 2 m" not in line
+
+
+def test_a_false_tracks_detection_that_carried_a_minor_share_of_a_soft_update_is_not_the_one_it_used() -> None:
+    # world3 (/tmp/truth47) scene-1100 megvii jpda false_track:1: "output 2.2 m from detection m2 (truck, score
+    # 0.84), the one its update used" where JPDA weighted m2 p 0.37, m7 p 0.30 and the missed hypothesis p 0.34
+    from gnnpmb.why.findings import FalseOutput
+
+    on = Near(2, "bicycle", 0.84, 2.2, True)
+    soft = Use(((2, 0.37), (7, 0.30)), 0.33, UseMode.PROBABILITIES)
+    out = FalseOutput(28, on, (0.0, 0.0), None, None, None, None, None, None, use=soft)
+    line = why_lines(finding(FailureKind.FALSE_TRACK, false_output=out, gt_id=None))[0]
+    said = "was output 2.2 m from detection m2 (bicycle, score 0.84), one of the detections its update used (m2 p 0.37"
+    assert said + ", m7 p 0.30, missed p 0.33)" in line, line
+    sure = FalseOutput(28, on, (0.0, 0.0), None, None, None, None, None, None, use=Use(((2, 0.9),), 0.1, soft.mode))
+    line = why_lines(finding(FailureKind.FALSE_TRACK, false_output=sure, gt_id=None))[0]
+    assert "m2 (bicycle, score 0.84), the one its update used" in line
