@@ -42,6 +42,20 @@ def evaluated_offsets(focus: FocusTarget, report: FailureReport | None) -> dict[
     return out
 
 
+def unannotated_evaluated(focus: FocusTarget, report: FailureReport | None) -> dict[str, tuple[float, float, float]]:
+    """The involved objects with no annotation at the focus frame (they left view and came back) that the focused
+    failure scored at a box the evaluation interpolated between their annotations: that box's centre (m, global),
+    from the failure's own boxes. Nothing of the object is drawn there otherwise."""
+    failure = report.by_id(focus.failure_id) if report is not None and focus.failure_id is not None else None
+    if failure is None or failure.frame_index != focus.frame_index:
+        return {}
+    return {
+        str(b.object_id): b.translation_m
+        for b in failure.boxes
+        if b.is_gt and b.interpolated and not b.annotated and str(b.object_id) in focus.gt_ids
+    }
+
+
 def evaluated_world() -> str:
     """Where the evaluation put the involved objects it interpolated, at the focus frame."""
     return f"{focus_world()}/as_evaluated"

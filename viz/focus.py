@@ -42,7 +42,13 @@ from viz.blueprint import (
 )
 from viz.callouts import FOCUS_VIEW_WIDTH_PX, FOV_Y_DEG, M_PER_PX_PER_HEIGHT, Callout, focus_height_m, log_callouts
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
-from viz.evaluated import evaluated_offsets, log_evaluated, log_evaluation_range, range_near_focus
+from viz.evaluated import (
+    evaluated_offsets,
+    log_evaluated,
+    log_evaluation_range,
+    range_near_focus,
+    unannotated_evaluated,
+)
 from viz.failures import FOCUS_MARGIN_M, MARKER_MARGIN_M, MARKER_SCALE
 from viz.focus_summary import TrackerView, focus_markdown
 from viz.geometry import (
@@ -102,6 +108,7 @@ def log_focus(
     frames = {t: {f.keyframe.index: f for f in v.evidence.run.frames} for t, v in views.items()}
     gt_ids = set(focus.gt_ids)
     evaluated = evaluated_offsets(focus, reports.get(focus.failure_tracker or ""))
+    unannotated = unannotated_evaluated(focus, reports.get(focus.failure_tracker or ""))
     reach_m = range_near_focus(focus, scene)
     eye_height_m = focus_eye_height_m(focus.class_name, len(loggers), sight is not None)
     for i in shown:
@@ -130,6 +137,14 @@ def log_focus(
                     CLASS_COLORS.get(focus.class_name, GREY),
                 )
                 for gt_id, seen in evaluated.items()
+            ]
+            gt_callouts += [
+                Callout(
+                    at,
+                    f"GT {short_id(gt_id)} as evaluated (no annotation here)",
+                    CLASS_COLORS.get(focus.class_name, GREY),
+                )
+                for gt_id, at in unannotated.items()
             ]
         if reach_m is not None:
             label_at = log_evaluation_range(stream, focus, scene, i, reach_m, z_m)

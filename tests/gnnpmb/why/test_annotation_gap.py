@@ -133,3 +133,31 @@ def test_a_failure_where_the_object_had_no_annotation_is_explained_not_left_unkn
         assert head.endswith("the evaluation's doing"), head
         assert "though it had some before and after: the evaluation scored a box it interpolated between them" in why
     assert not [h for h, _ in heads if h.endswith("cause unknown")]
+
+
+def test_the_focus_view_labels_where_the_evaluation_scored_an_object_it_had_no_annotation_of(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """At a failure where the object had no annotation, no GT box of it is drawn; the failure's marker is the box
+    the evaluation scored it at, and it carried no label (world3 scene-0757 pmbm fragmentation:2 at frame 27: an
+    unlabelled orange box 3.4 m from track 266). It is now labelled as the evaluated object."""
+    from tests.viz.rrd import read_rows
+    from viz import paths
+
+    root, detections = _with_gap(tmp_path / "gap")
+    args = [SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
+    proc = run_script(["gnnpmb", "failures", *args, "--json", str(tmp_path / "report.json")], capsys)
+    assert proc.returncode == 0, proc.stderr
+    report = json.loads((tmp_path / "report.json").read_text(encoding="utf-8"))
+    kinds: dict[str, int] = {}
+    target = None
+    for f in report["failures"]:
+        kinds[f["kind"]] = kinds.get(f["kind"], 0) + 1
+        if target is None and f["frame_index"] in GONE and f["gt_ids"] and f["gt_ids"][0].startswith(GT):
+            target = (f"{f['kind']}:{kinds[f['kind']]}", f["frame_index"])
+    assert target is not None
+    out = tmp_path / "focus.rrd"
+    proc = run_script(["gnnpmb-viz", *args, "--focus", target[0], "--save", str(out), "--no-progress"], capsys)
+    assert proc.returncode == 0, proc.stderr
+    callouts = [r for r in read_rows(out)[paths.focus_callouts("pmbm")] if r.get("frame") == target[1]][0]
+    assert f"GT {GT} as evaluated (no annotation here)" in callouts["Points3D:labels"]
