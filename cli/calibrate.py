@@ -94,8 +94,8 @@ def calibrate(
             f"--folds {folds}: the check cuts the {len(names)} scenes of split {split} into {most} folds "
             "(or use --no-check to write the learnt values unchecked)"
             if len(names) >= 2
-            else f"split {split} has {len(names)} scene: the check needs 2 or more (use --no-check to write the "
-            "learnt values unchecked)"
+            else f"split {split} has {len(names)} scene{'' if len(names) == 1 else 's'}: the check needs 2 or more "
+            "(use --no-check to write the learnt values unchecked)"
         )
     run = execution(workers, address, verbose) if check else None
     scenes = [load_scene(location, name) for name in names]

@@ -39,7 +39,6 @@ CHECK_TRACKER = "gnnpmb"
 """The tracker the candidates are scored with."""
 MARGIN_AMOTA = 0.01
 """A class keeps the defaults unless a candidate's mean AMOTA over the folds is at least this much higher."""
-DEFAULT_FOLDS = 2
 GROUPS: dict[str, frozenset[str]] = {
     "box likelihood": frozenset({"heading_std_rad", "size_log_std", "box_outlier_prob", "size_log_spread"}),
     "velocity noise": frozenset({"r_vx", "r_vy"}),
