@@ -100,37 +100,25 @@ class FoldJob:
     data: StudyData
 
 
-@dataclass(frozen=True, slots=True)
-class ClassScore:
-    """One class's official AMOTA and IDS on one fold (None: no annotations of the class there)."""
-
-    amota: float | None
-    ids: int | None
-
-
-def score_fold(job: FoldJob) -> dict[str, ClassScore]:
-    """Per class, the official AMOTA and IDS of ``job``'s candidate on its fold (runs in a Ray worker or here)."""
+def score_fold(job: FoldJob) -> dict[str, float | None]:
+    """Per class, the official AMOTA of ``job``'s candidate on its fold (None: no annotations of the class there);
+    runs in a Ray worker or here."""
     from gnnpmb.study.evaluate import official_scores
 
     parts = [track_scene(job.data, name, CHECK_TRACKER, job.config).results for name in job.data.scene_names]
     if not any(boxes for part in parts for boxes in part.values()):  # the devkit refuses an empty submission
-        return {c: ClassScore(0.0, 0) for c in TRACKING_CLASSES}
+        return dict.fromkeys(TRACKING_CLASSES, 0.0)
     scores = official_scores(job.data, parts)
-    out = {}
-    for c in TRACKING_CLASSES:
-        metrics = scores.per_class.get(c, {})
-        amota, ids = metrics.get("amota", math.nan), metrics.get("ids", math.nan)
-        out[c] = ClassScore(None if math.isnan(amota) else amota, None if math.isnan(ids) else int(round(ids)))
-    return out
+    amota = {c: scores.per_class.get(c, {}).get("amota", math.nan) for c in TRACKING_CLASSES}
+    return {c: None if math.isnan(v) else v for c, v in amota.items()}
 
 
 @dataclass(frozen=True, slots=True)
 class CheckResult:
     """The cross-validation: per candidate and class, the mean AMOTA over the folds with annotations of the class
-    (None: none) and the IDS summed over the folds; per class the chosen candidate; the folds' scenes."""
+    (None: none); per class the chosen candidate; the folds' scenes."""
 
     amota: dict[str, dict[str, float | None]]
-    ids: dict[str, dict[str, int]]
     chosen: dict[str, str]
     folds: tuple[tuple[str, ...], ...]
 
@@ -145,7 +133,7 @@ class CheckResult:
             group = pick.removeprefix("without ")
             what = "everything learnt" if pick == LEARNT else f"everything learnt but the {group}"
             return f"{what} written: {k}-fold AMOTA {scores[pick][cls]:.3f} against the defaults' {base:.3f}"
-        best = max(candidates(), key=lambda n: _key(scores[n][cls]))
+        best = _best(scores, cls)
         if best == DEFAULTS:
             return f"the defaults kept: they scored highest ({k}-fold AMOTA {base:.3f})"
         return (
@@ -154,8 +142,9 @@ class CheckResult:
         )
 
 
-def _key(value: float | None) -> float:
-    return -math.inf if value is None else value
+def _best(amota: Mapping[str, Mapping[str, float | None]], cls: str) -> str:
+    """The candidate with the highest mean AMOTA for ``cls``, the earlier one on a tie (None counts lowest)."""
+    return max(candidates(), key=lambda n: -math.inf if amota[n][cls] is None else amota[n][cls])
 
 
 def choose(amota: Mapping[str, Mapping[str, float | None]]) -> dict[str, str]:
@@ -164,7 +153,7 @@ def choose(amota: Mapping[str, Mapping[str, float | None]]) -> dict[str, str]:
     out = {}
     for c in TRACKING_CLASSES:
         base = amota[DEFAULTS][c]
-        best = max(candidates(), key=lambda n: _key(amota[n][c]))
+        best = _best(amota, c)
         beats = base is not None and amota[best][c] is not None and amota[best][c] >= base + MARGIN_AMOTA
         out[c] = best if beats else DEFAULTS
     return out
@@ -207,20 +196,18 @@ def cross_validate(
         for name in candidates():
             chosen = {c: candidate_values(name, learnt[c]) for c in TRACKING_CLASSES}
             jobs.append(FoldJob(f, name, config_from_dict(as_params(chosen), base), fold_data))
-    per_job: dict[int, dict[str, ClassScore]] = {}
+    per_job: dict[int, dict[str, float | None]] = {}
     for i, scores in run_tasks(score_fold, jobs, run):
         per_job[i] = scores
         on_done()
     amota: dict[str, dict[str, float | None]] = {}
-    ids: dict[str, dict[str, int]] = {}
     for name in candidates():
         mine = [per_job[i] for i, job in enumerate(jobs) if job.candidate == name]
-        amota[name], ids[name] = {}, {}
+        amota[name] = {}
         for c in TRACKING_CLASSES:
-            values = [s[c].amota for s in mine if s[c].amota is not None]
+            values = [s[c] for s in mine if s[c] is not None]
             amota[name][c] = sum(values) / len(values) if values else None
-            ids[name][c] = sum(s[c].ids or 0 for s in mine)
-    return CheckResult(amota=amota, ids=ids, chosen=choose(amota), folds=tuple(folds))
+    return CheckResult(amota=amota, chosen=choose(amota), folds=tuple(folds))
 
 
 def check_jobs(n_folds: int) -> int:

@@ -107,8 +107,9 @@ def log_focus(
         _log_involved_story(stream, clock, scene, focus, tracker, logger)
     frames = {t: {f.keyframe.index: f for f in v.evidence.run.frames} for t, v in views.items()}
     gt_ids = set(focus.gt_ids)
-    evaluated = evaluated_offsets(focus, reports.get(focus.failure_tracker or ""))
-    unannotated = unannotated_evaluated(focus, reports.get(focus.failure_tracker or ""))
+    failure_report = reports.get(focus.failure_tracker or "")
+    evaluated = evaluated_offsets(focus, failure_report)
+    unannotated = unannotated_evaluated(focus, failure_report)
     reach_m = range_near_focus(focus, scene)
     eye_height_m = focus_eye_height_m(focus.class_name, len(loggers), sight is not None)
     for i in shown:

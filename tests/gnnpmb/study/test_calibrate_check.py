@@ -54,8 +54,7 @@ def test_a_class_keeps_the_defaults_unless_a_candidate_beats_them_by_the_margin(
     assert chosen["trailer"] == "defaults"
     assert chosen["bicycle"] == "defaults"
     assert chosen["pedestrian"] == chosen["motorcycle"] == "defaults"  # all equal
-    ids = {n: dict.fromkeys(TRACKING_CLASSES, 0) for n in candidates()}
-    result = CheckResult(amota=amota, ids=ids, chosen=chosen, folds=(("a",), ("b",)))
+    result = CheckResult(amota=amota, chosen=chosen, folds=(("a",), ("b",)))
     assert result.reason("car") == "everything learnt written: 2-fold AMOTA 0.510 against the defaults' 0.500"
     assert (
         result.reason("bus")
