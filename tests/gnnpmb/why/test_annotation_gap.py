@@ -13,14 +13,18 @@ object had no annotation.
 
 from __future__ import annotations
 
+import contextlib
+import functools
+import io
 import json
 import math
 import os
 from pathlib import Path
+from typing import NamedTuple
 
 import pytest
 
-from tests.inprocess import run_script
+from tests.inprocess import FRESH_PROCESS_STATE, run_script
 
 DEVSET = Path(os.environ.get("GNNPMB_DEVSET", str(Path(__file__).resolve().parents[4] / "shared" / "devset")))
 if not (DEVSET / "v1.0-mini").is_dir():
@@ -70,14 +74,42 @@ def _with_gap(to: Path) -> tuple[Path, Path]:
     return to, path
 
 
+class GapRun(NamedTuple):
+    """The gap data and ``gnnpmb failures SCENE -t pmbm --why --json`` on it: its stdout and its report."""
+
+    args: list[str]
+    stdout: str
+    report: dict
+
+
+@pytest.fixture(scope="module")
+def gap_run(tmp_path_factory: pytest.TempPathFactory) -> GapRun:
+    """Made once for the module's tests (building the data and tracking the scene is most of their time)."""
+    from cli.batch import app
+    from cli.errors import run_app
+    from gnnpmb import outputs
+
+    tmp = tmp_path_factory.mktemp("gap")
+    root, detections = _with_gap(tmp / "gap")
+    args = [SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
+    argv = ["failures", *args, "--why", "--json", str(tmp / "r.json")]
+    stdout, stderr = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr), pytest.MonkeyPatch.context() as patch:
+        for name in FRESH_PROCESS_STATE:  # as run_script: what an earlier command in this process would have left
+            patch.setattr(outputs, name, [])
+        try:
+            run_app(functools.partial(app, prog_name="gnnpmb"), argv)
+            code = 0
+        except SystemExit as exc:
+            code = int(exc.code or 0)
+    assert code == 0, stderr.getvalue()
+    return GapRun(args, stdout.getvalue(), json.loads((tmp / "r.json").read_text(encoding="utf-8")))
+
+
 def test_a_track_lost_over_an_annotation_gap_is_not_said_to_be_far_from_an_unannotated_object(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    gap_run: GapRun,
 ) -> None:
-    root, detections = _with_gap(tmp_path / "gap")
-    argv = ["gnnpmb", "failures", SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
-    proc = run_script([*argv, "--why", "--json", str(tmp_path / "report.json")], capsys)
-    assert proc.returncode == 0, proc.stderr
-    report = json.loads((tmp_path / "report.json").read_text(encoding="utf-8"))
+    report = gap_run.report
     notes = {
         (f["frame_index"], f["description"].rsplit("(", 1)[1])
         for f in report["failures"]
@@ -85,25 +117,21 @@ def test_a_track_lost_over_an_annotation_gap_is_not_said_to_be_far_from_an_unann
     }
     assert {x for x, _ in notes} >= {27, 28, 29}, notes  # missed there: the devkit scored its interpolation
     assert all(note == "GT box interpolated by the evaluation: not annotated)" for x, note in notes if x in GONE)
-    why = next(line for line in proc.stdout.splitlines() if "recorded frames up to 32 (24" in line and GT in line)
+    why = next(line for line in gap_run.stdout.splitlines() if "recorded frames up to 32 (24" in line and GT in line)
     assert "in the 4 recorded frames up to 32 (24–26, 32), GT 10bbe5" in why, why
     assert "the evaluation last matched track 266 to it at frame 31 (it was not annotated at frames 27–31" in why
     assert "farther than 2 m from it at frames 27" not in why
 
 
 def test_the_focus_tables_name_the_keyframes_the_object_had_no_annotation_at(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    gap_run: GapRun, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The focus document's object table skips the keyframes without an annotation; its heading said "in the 2
     frames of the table (26–32)" without saying why 27-31 are missing."""
     from tests.viz.rrd import read_rows
     from viz.blueprint import focus_doc
 
-    root, detections = _with_gap(tmp_path / "gap")
-    args = [SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
-    proc = run_script(["gnnpmb", "failures", *args, "--json", str(tmp_path / "report.json")], capsys)
-    assert proc.returncode == 0, proc.stderr
-    report = json.loads((tmp_path / "report.json").read_text(encoding="utf-8"))
+    args, report = gap_run.args, gap_run.report
     frags = [f for f in report["failures"] if f["kind"] == "fragmentation"]
     n = next(k for k, f in enumerate(frags, 1) if f["frame_index"] == 32 and f["gt_ids"][0].startswith(GT))
     out = tmp_path / "focus.rrd"
@@ -116,16 +144,10 @@ def test_the_focus_tables_name_the_keyframes_the_object_had_no_annotation_at(
     assert "the evaluation last matched track 266 to it at frame 31 (it was not annotated at frames 27–31" in summary
 
 
-def test_a_failure_where_the_object_had_no_annotation_is_explained_not_left_unknown(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_a_failure_where_the_object_had_no_annotation_is_explained_not_left_unknown(gap_run: GapRun) -> None:
     """World3: 90 findings at keyframes where their object had no annotation read "cause unknown" (the dev set: 0);
     the devkit scored its interpolated box there. They now say so, as the evaluation's doing."""
-    root, detections = _with_gap(tmp_path / "gap")
-    argv = ["gnnpmb", "failures", SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
-    proc = run_script([*argv, "--why"], capsys)
-    assert proc.returncode == 0, proc.stderr
-    lines = proc.stdout.splitlines()
+    lines = gap_run.stdout.splitlines()
     heads = [(h, w) for h, w in zip(lines, lines[1:], strict=False) if w.lstrip().startswith("Why (")]
     gap = [(h, w) for h, w in heads if f"GT {GT} had no annotation" in w]
     assert {int(h.split("frame ")[1].split(",")[0]) for h, _ in gap} >= {27, 28, 29}, gap
@@ -136,7 +158,7 @@ def test_a_failure_where_the_object_had_no_annotation_is_explained_not_left_unkn
 
 
 def test_the_focus_view_labels_where_the_evaluation_scored_an_object_it_had_no_annotation_of(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    gap_run: GapRun, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """At a failure where the object had no annotation, no GT box of it is drawn; the failure's marker is the box
     the evaluation scored it at, and it carried no label (world3 scene-0757 pmbm fragmentation:2 at frame 27: an
@@ -144,11 +166,7 @@ def test_the_focus_view_labels_where_the_evaluation_scored_an_object_it_had_no_a
     from tests.viz.rrd import read_rows
     from viz import paths
 
-    root, detections = _with_gap(tmp_path / "gap")
-    args = [SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
-    proc = run_script(["gnnpmb", "failures", *args, "--json", str(tmp_path / "report.json")], capsys)
-    assert proc.returncode == 0, proc.stderr
-    report = json.loads((tmp_path / "report.json").read_text(encoding="utf-8"))
+    args, report = gap_run.args, gap_run.report
     kinds: dict[str, int] = {}
     target = None
     for f in report["failures"]:
