@@ -87,7 +87,8 @@ class ClassSamples:
     [width, length]; matched_score (N,); gt_log_size (G, 2); gt_range_m (G,) and gt_best_score (G,), the score of
     its matched detection (0 when unmatched); clutter_score (U,), clutter_velocity_mps (U, 2); detection_score
     (all detections, (D,)); births: new objects after a scene's first keyframe, birth_range_m their ranges;
-    keyframes: keyframes after a scene's first; frames: all keyframes; range_m: the class range."""
+    keyframes: keyframes after a scene's first; frames: all keyframes; objects: the annotated instances with at least
+    one counted box; range_m: the class range."""
 
     position_residual_m: np.ndarray
     velocity_residual_mps: np.ndarray
@@ -103,6 +104,7 @@ class ClassSamples:
     birth_range_m: np.ndarray
     later_keyframes: int
     frames: int
+    objects: int
     range_m: float
 
 
@@ -137,7 +139,7 @@ def collect(
     """The samples of every tracking class over ``scenes`` and their detections (sample token -> boxes, one
     mapping per scene)."""
     parts: dict[str, dict[str, list]] = {c: defaultdict(list) for c in TRACKING_CLASSES}
-    counts = {c: {"later": 0, "frames": 0} for c in TRACKING_CLASSES}
+    counts = {c: {"later": 0, "frames": 0, "objects": 0} for c in TRACKING_CLASSES}
     for scene, dets in zip(scenes, detections, strict=True):
         velocities = annotation_velocities(scene)
         seen: dict[str, set[str]] = defaultdict(set)
@@ -175,6 +177,8 @@ def collect(
                 unmatched = np.setdiff1d(d, di)
                 p["clutter_score"].extend(boxes.score[unmatched].tolist())
                 p["clutter_velocity"].extend(boxes.velocity_mps[unmatched].tolist())
+        for cls in TRACKING_CLASSES:
+            counts[cls]["objects"] += len(seen[cls])
 
     def arr(values: list, width: int = 0) -> np.ndarray:
         a = np.array(values, dtype=float)
@@ -196,6 +200,7 @@ def collect(
             birth_range_m=arr(p["birth_range"]),
             later_keyframes=counts[c]["later"],
             frames=counts[c]["frames"],
+            objects=counts[c]["objects"],
             range_m=float(class_range_m[c]),
         )
         for c, p in parts.items()
@@ -384,8 +389,9 @@ def process_noise(cls: str, velocity_change_mps: np.ndarray, base: TrackerConfig
 
 
 def curves(s: ClassSamples, threshold: float) -> list[str]:
-    """Comment lines: P_D per range bin, precision and clutter per score bin."""
-    lines = []
+    """Comment lines: how many annotated objects and boxes the values rest on, P_D per range bin, precision and
+    clutter per score bin."""
+    lines = [f"learnt from {s.objects} annotated objects ({len(s.gt_range_m)} boxes the evaluation counts)"]
     cells = []
     for lo, hi in zip(RANGE_BINS_M[:-1], RANGE_BINS_M[1:], strict=True):
         in_bin = (s.gt_range_m >= lo) & (s.gt_range_m < hi)

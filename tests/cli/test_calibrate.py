@@ -56,6 +56,28 @@ def test_every_learnt_value_says_what_it_was_learnt_from(calibrated: tuple[Path,
     assert "2 m centre distance" in text
 
 
+def test_each_class_says_how_many_objects_its_values_rest_on(calibrated: tuple[Path, str], demo_dataroot: Path) -> None:
+    """The count the file states is the devkit's own: distinct annotated instances of the class with a box that
+    its ``filter_eval_boxes`` keeps on the split."""
+    from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes, load_gt
+    from nuscenes.eval.tracking.data_classes import TrackingBox
+
+    from gnnpmb.data.nuscenes import open_nuscenes, resolve_dataroot
+    from gnnpmb.eval.nuscenes_eval import quiet_devkit, tracking_config
+
+    nusc = open_nuscenes(resolve_dataroot(demo_dataroot, None))
+    cfg = tracking_config()  # it also tells the devkit's box class the tracking names
+    with quiet_devkit():
+        gt = load_gt(nusc, "mini_val", TrackingBox)
+        gt = filter_eval_boxes(nusc, add_center_dist(nusc, gt), cfg.class_range, verbose=False)
+    text = calibrated[0].read_text()
+    for cls in TRACKING_CLASSES:
+        ids = {b.tracking_id for b in gt.all if b.tracking_name == cls}
+        boxes = sum(b.tracking_name == cls for b in gt.all)
+        line = f"# {cls}: learnt from {len(ids)} annotated objects ({boxes} boxes the evaluation counts)"
+        assert line in text.splitlines(), (cls, [x for x in text.splitlines() if x.startswith(f"# {cls}: learnt")])
+
+
 def test_a_wrong_output_suffix_is_one_error_line(demo_dataroot: Path, tmp_path: Path) -> None:
     out = tmp_path / "params.json"
     argv = [str(SCRIPT), "calibrate", "--dataroot", str(demo_dataroot), "--split", "mini_val", "--out", str(out)]
