@@ -25,7 +25,7 @@ import time
 from pathlib import Path
 
 from gnnpmb.data.nuscenes import resolve_dataroot
-from gnnpmb.study.cache import ResultCache
+from gnnpmb.eval.result_cache import ResultCache
 from gnnpmb.study.data import resolve_study_data
 from gnnpmb.study.grid import parse_param
 from gnnpmb.study.runner import Execution, session

@@ -16,7 +16,8 @@ from pathlib import Path
 
 from gnnpmb.data.nuscenes import resolve_dataroot, split_scenes
 from gnnpmb.eval.nuscenes_eval import format_metric
-from gnnpmb.study.cache import CACHE_FOLDER, ResultCache
+from gnnpmb.eval.result_cache import ResultCache
+from gnnpmb.study.cache import CACHE_FOLDER
 from gnnpmb.study.data import resolve_study_data
 from gnnpmb.study.grid import parse_param
 from gnnpmb.study.plots import plot_ablation, plot_sweep

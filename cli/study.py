@@ -129,8 +129,9 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Score every configuration of a parameter grid with the official evaluation (cached, resumable)."""
         from gnnpmb.data.simdet_presets import detector_choice
+        from gnnpmb.eval.result_cache import ResultCache
         from gnnpmb.registry import check_tracker
-        from gnnpmb.study.cache import CACHE_FOLDER, ResultCache
+        from gnnpmb.study.cache import CACHE_FOLDER
         from gnnpmb.study.folder import check_study_dir, drop_stale_plots, identity, merge_study, read_study
         from gnnpmb.study.grid import parse_param
         from gnnpmb.study.lock import hold_study_folder

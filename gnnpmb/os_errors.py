@@ -35,7 +35,7 @@ def os_error_line(exc: OSError, path: Path | str | None = None) -> str:
 
 def room_hint(path: str) -> str:
     """What to do when the file system of ``path`` is full: free space, or (for the cache) move the cache."""
-    from gnnpmb.data.demo import CACHE_ENV, cache_root
+    from gnnpmb.cache_folder import CACHE_ENV, cache_root
 
     with contextlib.suppress(OSError, ValueError):
         if Path(path).absolute().is_relative_to(cache_root().absolute()):

@@ -58,6 +58,7 @@ from pathlib import Path
 import numpy as np
 
 from gnnpmb.atomic import sweep_leftovers, temp_prefix
+from gnnpmb.cache_folder import CACHE_ENV, cache_root
 from gnnpmb.data import demo_cameras
 from gnnpmb.data.demo_spec import SYNTHETIC_MARKER, Motion, ObjectSpec, SceneSpec, Segment
 from gnnpmb.data.demo_staged import (
@@ -80,8 +81,6 @@ GENERATOR_VERSION = 4
 """Bump when the generated data changes, so cached copies (``demo-v<N>``) are regenerated."""
 """Every demo scene description starts with this."""
 MARKER_FILE = "gnnpmb-demo.json"
-CACHE_ENV = "GNNPMB_CACHE_DIR"
-
 KEYFRAMES_PER_SCENE = 40
 KEYFRAME_INTERVAL_US = 500_000
 ANNOTATION_RANGE_M = 65.0
@@ -933,16 +932,6 @@ def generate_demo_dataset(
     finally:
         shutil.rmtree(build, ignore_errors=True)
     return out_dir
-
-
-def cache_root() -> Path:
-    """gnnpmb-viz's cache folder: ``$GNNPMB_CACHE_DIR`` or the user cache dir of gnnpmb-viz."""
-    root = os.environ.get(CACHE_ENV)
-    if not root:
-        import platformdirs
-
-        root = platformdirs.user_cache_dir("gnnpmb-viz")
-    return Path(root).expanduser()
 
 
 def demo_cache_dir(full: bool = False) -> Path:

@@ -221,7 +221,7 @@ def _read_error(path: Path, exc: Exception) -> DataError:
 def _index(path: Path) -> DetectionIndex:
     """The file's index (``gnnpmb.data.detection_index``: parsed once per file and kept in the user cache),
     opened once per process while the file is unchanged."""
-    from gnnpmb.data.demo import cache_root
+    from gnnpmb.cache_folder import cache_root
     from gnnpmb.data.detection_index import open_detection_index
 
     refuse_symlink_loop(path, "detections file")

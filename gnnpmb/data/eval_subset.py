@@ -40,7 +40,7 @@ KEEP_FOLDERS = 50
 
 def eval_location(location: DatasetLocation, scene_names: Sequence[str]) -> DatasetLocation:
     """A dataroot whose ``location.version`` folder holds only what evaluating ``scene_names`` reads."""
-    from gnnpmb.data.demo import cache_root
+    from gnnpmb.cache_folder import cache_root
 
     index = dataset_index(location)
     splits = location.dataroot / location.version / "splits.json"

@@ -189,8 +189,8 @@ def dataset_index(location: DatasetLocation, *, fresh: bool = False) -> DatasetI
     """The persistent index of ``location`` (``gnnpmb.data.dataset_index``), opened once per process; built on
     first use (a damaged cached demo is generated again first). ``fresh`` drops the index and builds it again
     (it was found damaged)."""
+    from gnnpmb.cache_folder import cache_root
     from gnnpmb.data.dataset_index import index_folder, open_dataset_index
-    from gnnpmb.data.demo import cache_root
 
     key = (location.dataroot, location.version)
     if fresh:

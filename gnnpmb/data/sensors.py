@@ -181,7 +181,7 @@ def load_scene_sensors(scene: SceneData, frames: range | None = None) -> SceneSe
     """The camera images of ``scene``'s keyframes and its LiDAR sweeps between keyframes (from the sensor index,
     built on first use). A demo scene's missing images of the keyframes ``frames`` (default: all) are rendered
     first (``gnnpmb.data.demo.ensure_scene_images``)."""
-    from gnnpmb.data.demo import cache_root
+    from gnnpmb.cache_folder import cache_root
 
     dataroot, version = Path(scene.dataroot), scene.version
     sources = source_identity([dataroot / version / f"{t}.json" for t in TABLES])

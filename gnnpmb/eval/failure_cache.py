@@ -24,7 +24,7 @@ import numpy as np
 
 from gnnpmb.errors import DataError
 from gnnpmb.eval.failures import FailureReport
-from gnnpmb.study.cache import ResultCache
+from gnnpmb.eval.result_cache import ResultCache
 
 if TYPE_CHECKING:
     from gnnpmb.data.nuscenes import DatasetLocation
@@ -135,7 +135,7 @@ def scene_report(
 ) -> FailureReport:
     """The failure report of one scene's tracking results (on ``keyframes`` only, None: all): stored, else found by
     the devkit's evaluation on a version folder holding only that scene (``gnnpmb.data.eval_subset``)."""
-    from gnnpmb.data.demo import cache_root
+    from gnnpmb.cache_folder import cache_root
     from gnnpmb.data.eval_subset import eval_location
     from gnnpmb.data.nuscenes import open_nuscenes
     from gnnpmb.eval.failures import find_failures

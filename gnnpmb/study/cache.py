@@ -1,4 +1,5 @@
-"""The resumable cache of a study: one JSON file per finished configuration under ``DIR/cache/``.
+"""The resumable cache of a study: one JSON file per finished configuration under ``DIR/cache/``
+(``gnnpmb.eval.result_cache.ResultCache``).
 
 The file name is the SHA-256 of (tracker, the configuration's full parameter TOML, the inputs fingerprint, the
 code version), so a configuration is rerun only if one of them changed. Files are written atomically, each with
@@ -11,10 +12,7 @@ from __future__ import annotations
 import hashlib
 import json
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any
-
-from gnnpmb.eval.submission import write_json
 
 CACHE_FOLDER = "cache"
 
@@ -23,32 +21,3 @@ def config_key(tracker: str, toml: Mapping[str, Any], inputs: str, code: str) ->
     """Cache key (hex SHA-256) of one configuration."""
     blob = {"tracker": tracker, "params": toml, "inputs": inputs, "code": code}
     return hashlib.sha256(json.dumps(blob, sort_keys=True, default=str).encode()).hexdigest()
-
-
-class ResultCache:
-    """Finished rows keyed by ``config_key`` in ``folder``."""
-
-    def __init__(self, folder: Path) -> None:
-        self.folder = Path(folder)
-
-    def _path(self, key: str) -> Path:
-        return self.folder / f"{key}.json"
-
-    def get(self, key: str) -> dict[str, Any] | None:
-        """The stored row, or None if absent, unreadable or not matching its digest (a damaged file counts as not
-        cached)."""
-        try:
-            data = json.loads(self._path(key).read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            return None
-        if not isinstance(data, dict) or not isinstance(data.get("row"), dict):
-            return None
-        return data["row"] if data.get("sha256") == _row_digest(data["row"]) else None
-
-    def put(self, key: str, row: Mapping[str, Any]) -> None:
-        write_json(self._path(key), {"sha256": _row_digest(row), "row": dict(row)})
-
-
-def _row_digest(row: Mapping[str, Any]) -> str:
-    """SHA-256 of a row's canonical JSON (sorted keys): the same for the row written and the row read back."""
-    return hashlib.sha256(json.dumps(row, sort_keys=True, allow_nan=False).encode()).hexdigest()

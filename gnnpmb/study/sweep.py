@@ -10,8 +10,9 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from gnnpmb.eval.result_cache import ResultCache
 from gnnpmb.provenance import code_version
-from gnnpmb.study.cache import ResultCache, config_key
+from gnnpmb.study.cache import config_key
 from gnnpmb.study.data import StudyData, for_scoring, inputs_fingerprint
 from gnnpmb.study.evaluate import ConfigJob, is_complete_row, score_config
 from gnnpmb.study.grid import (

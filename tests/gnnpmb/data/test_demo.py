@@ -18,6 +18,7 @@ from nuscenes.utils.geometry_utils import points_in_box
 from pyquaternion import Quaternion
 from shapely.geometry import Polygon
 
+from gnnpmb.cache_folder import CACHE_ENV
 from gnnpmb.data import demo
 from gnnpmb.data.demo import (
     CLUTTER_HOTSPOTS,
@@ -303,7 +304,7 @@ def test_refuses_a_foreign_folder_and_regenerates_a_demo(demo_dataroot: Path, tm
 def test_ensure_demo_dataset_generates_once_into_the_cache(
     demo_dataroot: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setenv(demo.CACHE_ENV, str(tmp_path / "cache"))
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
     expected = tmp_path / "cache" / f"demo-v{demo.GENERATOR_VERSION}"
     shutil.copytree(demo_dataroot, expected)
 

@@ -9,7 +9,7 @@ import pytest
 
 from gnnpmb.config import ModelParams
 from gnnpmb.data.nuscenes import resolve_dataroot
-from gnnpmb.study.cache import ResultCache
+from gnnpmb.eval.result_cache import ResultCache
 from gnnpmb.study.data import resolve_study_data
 from gnnpmb.study.grid import parse_param
 from gnnpmb.study.runner import Execution

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from gnnpmb.study.cache import ResultCache
+from gnnpmb.eval.result_cache import ResultCache
 
 
 def test_a_row_edited_in_place_is_not_served(tmp_path: Path) -> None:
