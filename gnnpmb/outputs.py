@@ -10,7 +10,7 @@ be created in it (permission bits say nothing to root; a read-only mount or an i
 The leftovers of killed runs in the output's folder are swept on the way (``gnnpmb.atomic``).
 
 A nuScenes dataset's files are inputs of every command, whether or not an option names them: an output that is a
-table, the splits file or a sensor file of any dataset (by its place, ``gnnpmb.data.dataset_files``) is refused
+table, the splits file or a sensor file of any dataset (by its place, ``gnnpmb.dataset_files``) is refused
 here, and every output checked in this process is compared again with the dataset a command opens
 (``check_dataset_inputs``, called when a dataroot is checked), which finds hard links too. A symlink loop, a name
 longer than the file system allows (the temporary name included) are refused here too, naming the path.
@@ -25,7 +25,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from gnnpmb.atomic import NAME_MAX_BYTES, sweep_leftovers, temp_name_bytes
-from gnnpmb.data.dataset_files import dataset_file_of, linked_dataset_file
+from gnnpmb.dataset_files import dataset_file_of, linked_dataset_file
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.symlinks import is_symlink_loop, loop_line
 
