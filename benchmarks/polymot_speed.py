@@ -61,10 +61,17 @@ def detection_records(sample_token: str, boxes: Boxes) -> list[dict]:
     ]
 
 
-def polymot_cpu_ms(
-    python: str, polymot_dir: Path, scenes: list[SceneData], detections: list[dict[str, Boxes]], work: Path
-) -> np.ndarray:
-    """Poly-MOT's CPU ms per frame (``polymot_driver.py``), in time order, scene after scene."""
+def run_polymot(
+    python: str,
+    polymot_dir: Path,
+    scenes: list[SceneData],
+    detections: list[dict[str, Boxes]],
+    work: Path,
+    results_path: Path | None = None,
+) -> dict:
+    """Run Poly-MOT's own tracker (``polymot_driver.py`` with ``python``) on ``detections``, written in time order
+    with its first-token table under ``work``; returns the driver's figures (``cpu_ms`` per frame in time order,
+    scene after scene). ``results_path``: also write its tracks there as a tracking submission."""
     results = {
         k.sample_token: detection_records(k.sample_token, dets[k.sample_token])
         for scene, dets in zip(scenes, detections, strict=True)
@@ -74,8 +81,9 @@ def polymot_cpu_ms(
     det_path.write_text(json.dumps({"results": results, "meta": {"use_lidar": True}}))
     first_path.write_text(json.dumps([s.keyframes[0].sample_token for s in scenes]))
     command = [python, str(DRIVER), str(polymot_dir), str(det_path), str(first_path), str(out_path)]
+    command += [str(results_path)] if results_path is not None else []
     subprocess.run(command, check=True, env=os.environ.copy())
-    return np.array(json.loads(out_path.read_text())["cpu_ms"])
+    return json.loads(out_path.read_text())
 
 
 def tracker_cpu_ms(
@@ -120,10 +128,10 @@ def main() -> None:
     print(f"demo {args.split}: {len(scenes)} scenes, {n_frames} frames, preset {args.preset}, seed {args.seed}")
     if args.work:
         args.work.mkdir(parents=True, exist_ok=True)
-        poly = polymot_cpu_ms(args.polymot_python, args.polymot, scenes, detections, args.work)
+        poly = np.array(run_polymot(args.polymot_python, args.polymot, scenes, detections, args.work)["cpu_ms"])
     else:
         with tempfile.TemporaryDirectory(prefix="gnnpmb-polymot-") as work:
-            poly = polymot_cpu_ms(args.polymot_python, args.polymot, scenes, detections, Path(work))
+            poly = np.array(run_polymot(args.polymot_python, args.polymot, scenes, detections, Path(work))["cpu_ms"])
     print(
         f"{'polymot':8s} CPU ms/frame median {np.median(poly):7.2f} mean {poly.mean():7.2f} "
         f"(max {poly.max():.0f} ms: numba compiles on first use)"
