@@ -79,8 +79,8 @@ DEMO_SCENES: tuple[str, ...] = ("scene-0103", "scene-0916")
 DEMO_SEED = 0
 GENERATOR_VERSION = 4
 """Bump when the generated data changes, so cached copies (``demo-v<N>``) are regenerated."""
-"""Every demo scene description starts with this."""
 MARKER_FILE = "gnnpmb-demo.json"
+
 KEYFRAMES_PER_SCENE = 40
 KEYFRAME_INTERVAL_US = 500_000
 ANNOTATION_RANGE_M = 65.0
