@@ -278,7 +278,8 @@ class Deciding:
     when it is neither of the compared columns and had a column in the frame's matrix (None otherwise: a track
     without a column is not said to be outside a gate), and whether its column could take the detection (a finite
     cost); would / lost_would: what change of the next best's / the lost track's cost would have given it the
-    detection, re-solved (``counterfactual.WouldTake``; None: nothing is said)."""
+    detection, re-solved (``counterfactual.WouldTake``; None: nothing is said); alternative_took: the detection
+    the next best (a track) took in the same assignment (None: none), as ``KeyDecision`` has it."""
 
     frame: int
     choice: PairChoice
@@ -288,6 +289,7 @@ class Deciding:
     lost_in_gate: bool = False
     would: WouldTake | None = None
     lost_would: WouldTake | None = None
+    alternative_took: int | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -557,7 +557,8 @@ class _Context:
         would = None
         if matrix is not None and assignment is not None and c.alternative is not None:
             would = would_take(matrix, assignment, int(c.meas.ref), int(c.alternative.ref))
-        return Deciding(f, c, went, is_born, lost, in_gate, would, lost_would)
+        took = self.took(f, int(c.alternative.ref))
+        return Deciding(f, c, went, is_born, lost, in_gate, would, lost_would, took)
 
     def switch(self, tracks: set[int], deciding: tuple[int, ...]) -> HypothesisSwitch | None:
         """A PMBM hypothesis switch in the deciding frames: the best hypothesis descends from another prior

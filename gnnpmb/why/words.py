@@ -859,7 +859,8 @@ def _lost_object(f: Finding) -> list[str]:
     if f.switch is not None:
         parts.append(_switch_text(f))
     if f.decision is not None:
-        parts.append(f"then, {choice_text(f.decision.frame, f.decision.choice, f.decision.went, f.decision.born)}")
+        d = f.decision  # the next best's own detection in the same assignment: the lower total decided, not its cost
+        parts.append(f"then, {choice_text(d.frame, d.choice, d.went, d.born, d.alternative_took)}")
         parts += _where_from(f)
     elif f.taker is not None and f.taker.frame >= 0:
         o = f.taker

@@ -219,6 +219,10 @@ def test_what_the_cheaper_next_best_took_instead_is_checked_against_the_assignme
     assert _found(true).found == []
     planted = true.replace("which took m1", "which took m0")
     assert [c.kind for c in _found(planted).found] == ["misleading"]
+    # world4 scene-0061 centerpoint gnnpmb id_switch:3: the Why's deciding choice left "which took" out, so a cost
+    # 10.50 was chosen over a cheaper 6.30 "by a margin 0.07" with nothing said of why
+    bare = "then, " + choice_text(3, choice, int(choice.chosen.ref), False).replace("**", "")
+    assert [c.kind for c in _found(bare).found] == ["misleading"]
 
 
 @pytest.mark.parametrize("existence", [None, np.array([0.1, 0.5, 0.9])], ids=["gnn", "pmb"])
