@@ -150,7 +150,9 @@ class OnObject:
     """A track output within ``NEAR_M`` of an object: its id, distance, output score, the detection its box sits
     on (-1: none this frame) and how the evaluation took it (``TrackEval``; None: not evaluated) against the
     class's threshold (None: every box counts); false_here: the evaluation matched it to no object at this frame
-    (a false track there); xy_m: its box's BEV centre (global)."""
+    (a false track there); xy_m: its box's BEV centre (global); matched_m: its distance to the annotation of the
+    object the evaluation matched it to at this frame (None: matched to none, or that object not annotated here).
+    Two parked cars 1.7 m apart (world4): a track within 2 m of one is often the other's."""
 
     track_id: int
     distance_m: float
@@ -160,6 +162,7 @@ class OnObject:
     threshold: float | None
     false_here: bool = False
     xy_m: tuple[float, float] | None = None
+    matched_m: float | None = None
 
     @property
     def counted(self) -> bool:

@@ -875,6 +875,36 @@ def test_another_runs_track_on_the_object_said_to_keep_it_where_its_evaluation_m
     assert check_text(to_11, ctx3, None, _eval(), scene=scene, others={"pmbm": ev}).found == []
 
 
+def test_another_runs_track_on_the_object_beside_it_said_to_be_on_this_one_is_caught() -> None:
+    # world4 scene-1100 megvii cphd id_switch:12: jpda's track, 1.1 m from one of two parked cars 1.7 m apart and
+    # 0.6 m from the other (matched there), was said "output on the object": it was the neighbour's
+    from tools.truth.scene import Annotation
+
+    ev, scene, _ = _matched_away_world()  # at frame 2 GT A is missed and track 7 matched to GT B
+    ev.boxes[2] = [("7", C, (1.1, 0.0))]
+    ev.counted[C] = {"7"}
+    scene.objects[2].update({GT_A: Annotation(C, (0.0, 0.0), 0), GT_B: Annotation(C, (1.7, 0.0), 0)})
+    ctx = Context(C, 2, GT_A, kind="id_switch")
+
+    def found(text: str) -> list[str]:
+        return [c.kind for c in check_text(text, ctx, None, _eval(), scene=scene, others={"pmbm": ev}).found]
+
+    on_it = (
+        "pmbm on the same detections did not match the object here: its track 7 was output on the object and "
+        "counted, but the evaluation matched track 7 to car GT bbbbbb"
+    )
+    assert found(on_it) == ["misleading"]
+    beside = (
+        "pmbm on the same detections did not match the object here: its track 7 was output on the car beside it and "
+        "counted: the evaluation matched track 7 to car GT bbbbbb, {} m from the track (1.1 m from this one)"
+    )
+    assert found(beside.format("0.6")) == []
+    assert found(beside.format("0.2")) == ["other run"]
+    ev.boxes[2] = [("7", C, (0.5, 0.0))]  # nearer this car: "on the object" holds, "beside it" does not
+    assert found(on_it) == []
+    assert found(beside.format("1.2").replace("1.1 m from this", "0.5 m from this")) == ["other run"]
+
+
 def test_a_because_sentence_no_pattern_reads_is_left_out_of_coverage() -> None:
     """The pattern that cuts a Because paragraph out matches all of it; neither it nor a module's import of it may
     count its sentences as read (every clause of a Because paragraph was counted read that way)."""

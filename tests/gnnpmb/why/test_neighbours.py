@@ -7,13 +7,15 @@ from __future__ import annotations
 import numpy as np
 
 from gnnpmb.assign.hungarian import solve
+from gnnpmb.eval.evaluated import TrackEval
 from gnnpmb.eval.failures import FailureKind
 from gnnpmb.events import Assignment, AxisKind, CostMatrix, CostTerms, axis_labels
 from gnnpmb.explain import explain
-from gnnpmb.why.findings import Deciding, Finding, LostTrack
+from gnnpmb.why.findings import Deciding, Finding, LostTrack, OnObject, OtherRun
 from gnnpmb.why.words import why_lines
 
 GT = "1419ed" + "0" * 26
+PAIR = "188906" + "1" * 26
 
 
 def finding(**kw) -> Finding:
@@ -59,3 +61,22 @@ def test_the_deciding_choice_over_a_cheaper_track_says_what_that_track_took() ->
     (line, *_) = why_lines(finding(decision=deciding))
     assert "then, frame 13: m0 → **track 5** (cost " in line
     assert "over track 7 (" in line and "), which took m1 (the lower total wins), margin " in line
+
+
+def test_another_runs_track_on_the_neighbouring_car_is_not_said_to_be_on_this_one() -> None:
+    # world4 scene-1100 megvii cphd id_switch:12: jpda's track 55, 1.1 m from car 6203bb and 0.6 m from the parked
+    # car beside it (01ffcf, 1.7 m away), which the evaluation matched it to, was said "output on the object"
+    there = TrackEval((13,), (13,), (), 0.9, 0.9, ((13, PAIR),))
+    beside = OnObject(55, 1.1, 0.8, -1, there, 0.3, matched_m=0.6)
+    (line, *_) = why_lines(finding(others=(OtherRun("jpda", False, (beside,), missed=True),)))
+    assert (
+        "jpda on the same detections did not match the object here: its track 55 was output on the car beside it "
+        "and counted: the evaluation matched track 55 to car GT 188906, 0.6 m from the track (1.1 m from this one)"
+    ) in line
+    assert "output on the object" not in line
+    nearer_this = OnObject(55, 0.5, 0.8, -1, there, 0.3, matched_m=1.2)  # matched away, but nearer this car
+    (line, *_) = why_lines(finding(others=(OtherRun("jpda", False, (nearer_this,), missed=True),)))
+    assert (
+        "jpda on the same detections did not match the object here: its track 55 was output on the object and "
+        "counted, but the evaluation matched track 55 to car GT 188906"
+    ) in line
