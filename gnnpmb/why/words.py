@@ -1339,6 +1339,7 @@ def _others(f: Finding) -> list[str]:
         elif counted and o.missed and all(_beside(x, f.frame) for x in counted):  # on a neighbour, matched there
             out.append(f"{who} did not match the object here: {_on_neighbours(f, counted)}")
         elif counted and o.missed:  # on the annotation, but the evaluation matched them elsewhere or to nothing
+            counted = [x for x in counted if not _beside(x, f.frame)]  # a neighbour's track is not named on this one
             elsewhere = " and ".join(
                 f"track {x.track_id} to "
                 + (f"{f.class_name} GT {short_id(g)}" if (g := _matched_at(x, f.frame)) is not None else "no object")

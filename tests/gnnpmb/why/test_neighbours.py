@@ -80,3 +80,12 @@ def test_another_runs_track_on_the_neighbouring_car_is_not_said_to_be_on_this_on
         "jpda on the same detections did not match the object here: its track 55 was output on the object and "
         "counted, but the evaluation matched track 55 to car GT 188906"
     ) in line
+    # two tracks, one on this car and one on the car beside it (world4 scene-0061 pointpillars gnn fragmentation:14):
+    # only the one on this car is named "on the object"
+    here = OnObject(30, 0.3, 0.8, -1, there, 0.3, matched_m=1.9)
+    (line, *_) = why_lines(finding(others=(OtherRun("jpda", False, (here, beside), missed=True),)))
+    assert (
+        "jpda on the same detections did not match the object here: its track 30 was output on the object and "
+        "counted, but the evaluation matched track 30 to car GT 188906."
+    ) in line
+    assert "track 55" not in line
