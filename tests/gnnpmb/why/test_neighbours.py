@@ -89,3 +89,25 @@ def test_another_runs_track_on_the_neighbouring_car_is_not_said_to_be_on_this_on
         "counted, but the evaluation matched track 30 to car GT 188906."
     ) in line
     assert "track 55" not in line
+
+
+def test_a_close_call_over_a_cheaper_track_says_what_that_track_took() -> None:
+    # world4 scene-0061 centerpoint gnnpmb, the focus story: "close call: m18 → new track 74 (cost 10.50) over track
+    # 50 (6.30), margin 0.07" -- track 50 was cheaper for m18 and lost it because it took m17
+    from gnnpmb.events import Extracted
+    from gnnpmb.why.story import StoryKind, Storyteller
+    from tests.gnnpmb.why.test_facts import estimate, facts_of, frame, label, predicted, received
+
+    rows = (label(AxisKind.MEASUREMENT, 0), label(AxisKind.MEASUREMENT, 1))
+    cols = tuple(label(AxisKind.TRACK, t) for t in (1, 2)) + tuple(label(AxisKind.NEW_TRACK, j) for j in (0, 1))
+    cost = np.array([[4.0, 3.5, 4.5, np.inf], [np.inf, 0.5, np.inf, 10.0]])  # m0 → 1 (4.0) + m1 → 2 (0.5): 4.5
+    shown = Extracted("car", (estimate(1, 0), estimate(2, 1)), 0.0)
+    events = [frame(0), received([0, 1]), predicted([1, 2], [1.0, 1.0]), shown, frame(1), received([0, 1])]
+    events += [predicted([1, 2], [1.0, 1.0]), CostMatrix("car", cost, rows, cols)]
+    events += [Assignment("car", ((rows[0], cols[0]), (rows[1], cols[1])), 4.5, ()), shown]
+    teller = Storyteller(facts_of(events))
+    teller.frame_lines(0)
+    (call,) = [line for line in teller.frame_lines(1) if line.kind is StoryKind.CLOSE_CALL]
+    assert call.text == (
+        "close call: m0 → track 1 (cost 4.00) over track 2 (3.50), which took m1 (the lower total wins), margin 0.50"
+    )
