@@ -150,7 +150,9 @@ class OnObject:
     """A track output within ``NEAR_M`` of an object: its id, distance, output score, the detection its box sits
     on (-1: none this frame) and how the evaluation took it (``TrackEval``; None: not evaluated) against the
     class's threshold (None: every box counts); false_here: the evaluation matched it to no object at this frame
-    (a false track there); xy_m: its box's BEV centre (global)."""
+    (a false track there); xy_m: its box's BEV centre (global); matched_m: its distance to the annotation of the
+    object the evaluation matched it to at this frame (None: matched to none, or that object not annotated here).
+    Two parked cars 1.7 m apart (world4): a track within 2 m of one is often the other's."""
 
     track_id: int
     distance_m: float
@@ -160,6 +162,7 @@ class OnObject:
     threshold: float | None
     false_here: bool = False
     xy_m: tuple[float, float] | None = None
+    matched_m: float | None = None
 
     @property
     def counted(self) -> bool:
@@ -278,7 +281,8 @@ class Deciding:
     when it is neither of the compared columns and had a column in the frame's matrix (None otherwise: a track
     without a column is not said to be outside a gate), and whether its column could take the detection (a finite
     cost); would / lost_would: what change of the next best's / the lost track's cost would have given it the
-    detection, re-solved (``counterfactual.WouldTake``; None: nothing is said)."""
+    detection, re-solved (``counterfactual.WouldTake``; None: nothing is said); alternative_took: the detection
+    the next best (a track) took in the same assignment (None: none), as ``KeyDecision`` has it."""
 
     frame: int
     choice: PairChoice
@@ -288,6 +292,7 @@ class Deciding:
     lost_in_gate: bool = False
     would: WouldTake | None = None
     lost_would: WouldTake | None = None
+    alternative_took: int | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -185,7 +185,12 @@ class _Context:
                 evaluated = report.track_evals.get(str(e.track_id))
                 false_here = self.false_at(report, fr.keyframe.index, e.track_id)
                 xy_m = (float(e.translation_m[0]), float(e.translation_m[1]))
-                out.append(OnObject(e.track_id, d, e.score, e.meas_index, evaluated, threshold, false_here, xy_m))
+                matched = evaluated.matched_at(fr.keyframe.index) if evaluated is not None else None
+                there = self.gt_xy(matched, fr.keyframe.index) if matched is not None else None
+                matched_m = None if there is None else math.dist(xy_m, (float(there[0]), float(there[1])))
+                out.append(
+                    OnObject(e.track_id, d, e.score, e.meas_index, evaluated, threshold, false_here, xy_m, matched_m)
+                )
         return tuple(sorted(out, key=lambda o: o.distance_m))
 
     def sightings(self, gt_id: str) -> tuple[Sighting, ...]:
@@ -557,7 +562,8 @@ class _Context:
         would = None
         if matrix is not None and assignment is not None and c.alternative is not None:
             would = would_take(matrix, assignment, int(c.meas.ref), int(c.alternative.ref))
-        return Deciding(f, c, went, is_born, lost, in_gate, would, lost_would)
+        took = self.took(f, int(c.alternative.ref))
+        return Deciding(f, c, went, is_born, lost, in_gate, would, lost_would, took)
 
     def switch(self, tracks: set[int], deciding: tuple[int, ...]) -> HypothesisSwitch | None:
         """A PMBM hypothesis switch in the deciding frames: the best hypothesis descends from another prior

@@ -290,6 +290,10 @@ class Storyteller:
                     if held is not None
                     else f"{column_name(c.alternative)} ({cost_value(c.alternative_cost, c)})"
                 )
+                pairs = cf.assignment.pairs if cf.assignment is not None else ()
+                took = [int(r.ref) for r, k in pairs if k == c.alternative and int(r.ref) != int(c.meas.ref)]
+                if held is None and took and c.alternative_cost < c.chosen_cost:  # the cheaper one had its own
+                    other += f", which took {meas_name(took[0])} (the lower total wins)"  # world4's parked pair
                 out.append(
                     StoryLine(
                         frame,

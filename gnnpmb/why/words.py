@@ -859,7 +859,8 @@ def _lost_object(f: Finding) -> list[str]:
     if f.switch is not None:
         parts.append(_switch_text(f))
     if f.decision is not None:
-        parts.append(f"then, {choice_text(f.decision.frame, f.decision.choice, f.decision.went, f.decision.born)}")
+        d = f.decision  # the next best's own detection in the same assignment: the lower total decided, not its cost
+        parts.append(f"then, {choice_text(d.frame, d.choice, d.went, d.born, d.alternative_took)}")
         parts += _where_from(f)
     elif f.taker is not None and f.taker.frame >= 0:
         o = f.taker
@@ -1335,7 +1336,10 @@ def _others(f: Finding) -> list[str]:
             # the annotation went to neighbours (a crowd), and naming them would put them on this object
             held = [x for x in counted if x.track_id == o.matched]
             out.append(f"{who} did not fail here: {_its_tracks(held)} output on the object and counted")
+        elif counted and o.missed and all(_beside(x, f.frame) for x in counted):  # on a neighbour, matched there
+            out.append(f"{who} did not match the object here: {_on_neighbours(f, counted)}")
         elif counted and o.missed:  # on the annotation, but the evaluation matched them elsewhere or to nothing
+            counted = [x for x in counted if not _beside(x, f.frame)]  # a neighbour's track is not named on this one
             elsewhere = " and ".join(
                 f"track {x.track_id} to "
                 + (f"{f.class_name} GT {short_id(g)}" if (g := _matched_at(x, f.frame)) is not None else "no object")
@@ -1352,6 +1356,26 @@ def _others(f: Finding) -> list[str]:
         else:
             out.append(f"{who} did not have this failure")
     return out
+
+
+def _beside(o: OnObject, frame: int) -> bool:
+    """Whether track ``o`` (within ``NEAR_M`` of the object) lay nearer the annotation of the object the evaluation
+    matched it to at ``frame``: it was that neighbour's track, not this object's."""
+    return _matched_at(o, frame) is not None and o.matched_m is not None and o.matched_m < o.distance_m
+
+
+def _on_neighbours(f: Finding, on: Sequence[OnObject]) -> str:
+    """``its track 55 was output on the car beside it and counted: the evaluation matched track 55 to car GT 01ffcf,
+    0.6 m from the track (1.1 m from this one)``: other runs' tracks within ``NEAR_M`` of the object that lay nearer
+    the neighbour the evaluation matched them to (world4's parked pair 1.7 m apart: "output on the object" put the
+    neighbour's track on this one)."""
+    where = f"the {f.class_name} beside it" if len(on) == 1 else "the objects beside it"
+    matched = " and ".join(
+        f"track {x.track_id} to {f.class_name} GT {short_id(_matched_at(x, f.frame) or '')}, {x.matched_m:.1f} m "
+        f"from the track ({x.distance_m:.1f} m from this one)"
+        for x in on
+    )
+    return f"{_its_tracks(on)} output on {where} and counted: the evaluation matched {matched}"
 
 
 def _scored_out_of_reach(f: Finding, on: Sequence[OnObject]) -> str:

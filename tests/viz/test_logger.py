@@ -220,7 +220,10 @@ def test_story_log_tells_each_reported_track_and_aggregates_candidates(logged: t
     assert ("2 new candidates from m0, m1; 0 candidates pruned", "DEBUG") in frame0
     assert ("track 1 deleted (no hit in its last 4 frames)", "WARN") in frame0
     frame1 = lines(rows, 1)
-    assert ("close call: m1 → track 2 (cost -4.50) over track 1 (-5.00), margin 0.50", "INFO") in frame1
+    took = (
+        "close call: m1 → track 2 (cost -4.50) over track 1 (-5.00), which took m0 (the lower total wins), margin 0.50"
+    )
+    assert (took, "INFO") in frame1  # the cheaper track 1 lost m1 because it took m0: said (truth48)
     assert ("0 new candidates; 1 candidates pruned", "DEBUG") in frame1
     assert ("merged 1, 3 into track 1 (weights 0.7, 0.3)", "INFO") in frame1
     assert any(t.startswith("2 detections: 2 updated tracks, 0 new or clutter") for t, _ in frame1)

@@ -32,8 +32,12 @@ OTHER = re.compile(
     r"here either|did not fail here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted"
     r"|did not fail here: the evaluation matched the object to its track (\d+)"
     r"|did not match the object here: its tracks? ([\d, ]+) (?:was|were) output on the object and counted, but the "
-    r"evaluation matched (track \d+ to (?:\w+ GT \w+|no object)(?: and track \d+ to (?:\w+ GT \w+|no object))*))"
+    r"evaluation matched (track \d+ to (?:\w+ GT \w+|no object)(?: and track \d+ to (?:\w+ GT \w+|no object))*)"
+    r"|did not match the object here: its tracks? ([\d, ]+) (?:was|were) output on the (?:\w+|objects) beside it and "
+    r"counted: the evaluation matched (track \d+ to \w+ GT \w+, [\d.]+ m from the track \([\d.]+ m from this one\)"
+    r"(?: and track \d+ to \w+ GT \w+, [\d.]+ m from the track \([\d.]+ m from this one\))*))"
 )
+BESIDE = re.compile(r"track (\d+) to (\w+) GT (\w+), ([\d.]+) m from the track \(([\d.]+) m from this one\)")
 REACH_NOTE = " (the box it scored for this object, interpolated"
 """What follows "but the evaluation matched track T to ..." where the box the devkit scored for the object lay out
 of the 2 m of each named track."""
@@ -83,6 +87,8 @@ def check_others(
         elif said.startswith("did not fail here: the evaluation"):
             if failed or matched != m[4]:
                 bad("other run", m[0], f"{m[1]}'s evaluation matched the object at frame {x} to track {matched}")
+        elif said.startswith("did not match the object") and m[7] is not None:  # on a neighbour, matched there
+            _check_beside(m, c, x, gt, ev, scene, out, bad)
         elif said.startswith("did not match the object"):  # on it and counted, but matched elsewhere or to nothing
             _check_matched_elsewhere(m, c, x, gt, ev, scene, out, bad)
         elif said.startswith("did not fail here"):  # its named tracks lay within reach of the object, counted
@@ -146,6 +152,45 @@ def _check_matched_elsewhere(m: re.Match, c: str, x: int, gt: str, ev: EvalFacts
     out.checked["other run"] += 1
     if said != got:
         bad("other run", m[0], f"{m[1]}'s evaluation matched them at frame {x} to {got}")
+    beside = _beside_of(ev, c, x, gt, scene, named)
+    out.checked["misleading"] += 1
+    if beside:  # a named track lay nearer the neighbour it was matched to: the neighbour's, not on this object
+        bad("misleading", m[0], f"{m[1]}'s tracks lay nearer the objects matched to them: {beside}: not on this one")
+
+
+def _beside_of(ev: EvalFacts, c: str, x: int, gt: str, scene, named: set[str]) -> dict[str, tuple[str, float, float]]:
+    """Of the other run's tracks ``named``, those the devkit matched at ``x`` to another object of class ``c`` whose
+    annotation their box lies nearer than this object's: track -> (that object's id, distance to it, to this one)."""
+    objects = scene.objects[x] if scene is not None and x < len(scene.objects) else {}
+    a = objects.get(gt)
+    out = {}
+    for t, cls, xy in ev.boxes.get(x, []):
+        g = ev.matched_gt(c, x, t) if t in named and cls == c else None
+        if a is None or g is None or g == gt or (b := objects.get(g)) is None:
+            continue
+        if math.dist(xy, b.xy_m) < math.dist(xy, a.xy_m):
+            out[t] = (g[:6], round(math.dist(xy, b.xy_m), 2), round(math.dist(xy, a.xy_m), 2))
+    return out
+
+
+def _check_beside(m: re.Match, c: str, x: int, gt: str, ev: EvalFacts, scene, out, bad) -> None:
+    """ "Did not match the object here: its track T was output on the <class> beside it and counted: the evaluation
+    matched track T to C GT X, D m from the track (E m from this one)": the devkit missed the object at x, T is
+    counted, within 2 m of it, matched at x to X, and its box lies D m from X's annotation and E m from this one's,
+    D < E."""
+    named = {t.strip() for t in m[7].split(",")}
+    out.checked["other run"] += 1
+    if gt not in ev.gt_to_track.get((c, x), {}) or ev.matched_track(c, x, gt) is not None:
+        bad("other run", m[0], f"{m[1]}'s evaluation matched the object at frame {x} to {ev.matched_track(c, x, gt)}")
+    near = _near(ev, c, x, gt, scene)
+    if not named <= near & ev.counted.get(c, set()):
+        bad("other run", m[0], f"{m[1]}'s counted tracks within {NEAR_M} m at frame {x}: {sorted(near)}")
+    beside = _beside_of(ev, c, x, gt, scene, named)
+    for t, cls, g, d_track, d_this in BESIDE.findall(m[8]):
+        got = beside.get(t)
+        ok = cls == c and got is not None and got[0] == g[:6]
+        if not ok or abs(got[1] - float(d_track)) > 0.051 or abs(got[2] - float(d_this)) > 0.051:
+            bad("other run", m[0], f"{m[1]}'s track {t} at frame {x}: matched to and beside {got}")
 
 
 FALSE_HERE = re.compile(

@@ -585,6 +585,15 @@ def _check_choice(m: re.Match, c: str, raw: RawEvents, out: Tally, bad) -> None:
     row, col = replay.row_of(mat, meas), replay.chosen_col(mat, a, meas)
     if row is None or col is None:
         return
+    if took is None and alt and alt.startswith("track ") and mat.scale.optimal:  # "over track U (cheaper), margin"
+        t = int(alt.split()[1])
+        other = [int(r.ref) for r, k in a.pairs if k.kind is AxisKind.TRACK and int(k.ref) == t]
+        alt_col = replay.track_col(mat, t)
+        out.checked["misleading"] += 1
+        cost = np.asarray(mat.cost, dtype=float)
+        if other and other[0] != meas and alt_col is not None and cost[row, alt_col] < cost[row, col]:
+            bad("misleading", m[0], f"the cheaper track {t} took m{other[0]} in the same assignment: unsaid")
+            return
     out.checked["misleading"] += 1
     if not mat.scale.optimal:
         if alt and alt.startswith("track "):

@@ -115,6 +115,12 @@ def test_a_track_the_evaluation_matched_to_the_object_beside_it_was_not_put_out_
         )
         ctx.f, ctx.class_name = 27, "pedestrian"
         ctx.frames = {27: SimpleNamespace(estimates=(box,), keyframe=SimpleNamespace(index=27))}
+        gt = Table(  # the two annotations at frame 27 (where a track the evaluation matched lies from its object)
+            instance_id=np.array([GT, other]),
+            class_name=np.array(["pedestrian", "pedestrian"]),
+            translation_m=np.array([[0.0, 0.0, 0.0], [1.2, 0.0, 0.0]]),
+        )
+        ctx.scene = SimpleNamespace(keyframes={27: SimpleNamespace(gt=gt)})
         return ctx
 
     neighbour = ctx_with(other)
