@@ -11,6 +11,7 @@ per class and the counterfactual replays checked / refuted; exit 1 when any cont
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 from collections import defaultdict
 from collections.abc import Callable, Mapping, Sequence
@@ -282,31 +283,37 @@ def main(argv: Sequence[str] | None = None) -> int:
         scenes = tuple(args.scene or DEMO_SCENES + STAGED_SCENES)
         dataroot = args.dataroot or ensure_demo_dataset(DEMO_SCENES + STAGED_SCENES)
         folder = Path(tempfile.mkdtemp(prefix="truth-demo-"))
-    files = {spec.split("=", 1)[0]: Path(spec.split("=", 1)[1]) for spec in args.results}
-    todo = cells(scenes, args.detector or PRESETS, args.tracker or ([] if files else TRACKER_NAMES), args.square)
-    todo += [(s, p, name) for s in scenes for p in args.detector or PRESETS for name in files]
-    rows: dict[tuple[str, str], dict[str, str | None]] = defaultdict(dict)
-    for scene, preset, tracker in todo:
-        rows[(scene, preset)][tracker] = None if args.other == "none" else other_of(tracker, args.other)
-    for (scene, preset), row in rows.items():
-        here: list[tuple[str, Contradiction]] = []
-        detections = demo_detections(dataroot, scene, preset, folder) if folder is not None else None
-        focus = args.focus or args.demo
-        done = run_scene(scene, preset, row, dataroot, where=here, results=files, detections=detections, focus=focus)
-        for tracker, (tally, n) in done.items():
-            per[tracker].add(tally)
-            findings[tracker] += n
-            line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)
-            print(
-                f"checked {tracker} {scene} {preset}: {n} findings; false/checked {line}; replays "
-                f"{tally.replays} refuted {tally.refuted}; clauses {tally.clauses - sum(tally.unchecked.values())}/"
-                f"{tally.clauses} read",
-                file=sys.stderr,
-                flush=True,
+    try:
+        files = {spec.split("=", 1)[0]: Path(spec.split("=", 1)[1]) for spec in args.results}
+        todo = cells(scenes, args.detector or PRESETS, args.tracker or ([] if files else TRACKER_NAMES), args.square)
+        todo += [(s, p, name) for s in scenes for p in args.detector or PRESETS for name in files]
+        rows: dict[tuple[str, str], dict[str, str | None]] = defaultdict(dict)
+        for scene, preset, tracker in todo:
+            rows[(scene, preset)][tracker] = None if args.other == "none" else other_of(tracker, args.other)
+        for (scene, preset), row in rows.items():
+            here: list[tuple[str, Contradiction]] = []
+            detections = demo_detections(dataroot, scene, preset, folder) if folder is not None else None
+            focus = args.focus or args.demo
+            done = run_scene(
+                scene, preset, row, dataroot, where=here, results=files, detections=detections, focus=focus
             )
-        for place, c in here:
-            print(f"  {place}: [{c.kind}] {c.sentence!r} -- {c.truth}", file=sys.stderr, flush=True)
-        where += here
+            for tracker, (tally, n) in done.items():
+                per[tracker].add(tally)
+                findings[tracker] += n
+                line = " ".join(f"{k} {sum(c.kind == k for c in tally.found)}/{tally.checked[k]}" for k in CLASSES)
+                print(
+                    f"checked {tracker} {scene} {preset}: {n} findings; false/checked {line}; replays "
+                    f"{tally.replays} refuted {tally.refuted}; clauses {tally.clauses - sum(tally.unchecked.values())}/"
+                    f"{tally.clauses} read",
+                    file=sys.stderr,
+                    flush=True,
+                )
+            for place, c in here:
+                print(f"  {place}: [{c.kind}] {c.sentence!r} -- {c.truth}", file=sys.stderr, flush=True)
+            where += here
+    finally:
+        if folder is not None:  # the demo's detection files written for this run
+            shutil.rmtree(folder, ignore_errors=True)
     head = " ".join(f"{k:>14}" for k in CLASSES)
     print(f"{'tracker':12} {'findings':>8} {head} {'replays':>8} {'refuted':>8}")
     total = Tally()
