@@ -37,6 +37,7 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
     cpu_s, wall_s = _cpu_s(), time.monotonic()
     yield
     if folder:
+        Path(folder).mkdir(parents=True, exist_ok=True)
         with open(Path(folder) / f"{os.getpid()}.tsv", "a") as f:
             f.write(f"{item.nodeid}\t{_cpu_s() - cpu_s:.3f}\t{time.monotonic() - wall_s:.3f}\n")
 
