@@ -7,8 +7,9 @@
 * ``world/trackers/<tracker>/focus``: that tracker's involved tracks, enlarged, in their colours (their own
   boxes carry the id labels);
 * ``world/trackers/<tracker>/focus/callouts``: the labels of the involved objects (``GT 8bccf2``,
-  ``m10 0.83 → track 26``, ``26 predicted r=0.04 → m10``, ``31 predicted r=0.02, missed``) in a column beside
-  them with leader lines (``viz.callouts``), so labels of objects on one spot do not cover each other;
+  ``m10 0.83 → track 26``, ``26 predicted r=0.04``, ``31 predicted r=0.02, missed``) in a column beside them with
+  leader lines (``viz.callouts``), so labels of objects on one spot do not cover each other; each assignment is
+  said once, on the detection;
 * ``world/focus/as_evaluated``: where the evaluation put an object it interpolated (``viz.evaluated``);
 * ``world/focus/evaluation_range``: the evaluation's range around the ego vehicle, when the failure lies near it.
 
@@ -30,7 +31,7 @@ from gnnpmb.focus import FocusTarget
 from gnnpmb.focus_cameras import FocusSight
 from gnnpmb.pipeline import FrameResult
 from gnnpmb.types import Boxes
-from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode
+from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode, Went
 from gnnpmb.why.findings import Finding
 from gnnpmb.why.words import existence_text, share_text, went_text
 from viz import compare, paths
@@ -209,7 +210,9 @@ def log_focus(
                 paths.focus_callouts(tracker),
                 gt_callouts
                 + _detection_callouts(detections, sorted(given), facts, i, focus.class_name, mode)
-                + _prediction_callouts(steps, z_m, palette, facts.has_existence, mode)
+                + _prediction_callouts(
+                    steps, z_m, palette, facts.has_existence, mode, _said(given, facts, i, focus.class_name, mode)
+                )
                 + ghosts,
                 height_m,
                 view_x_m,
@@ -366,6 +369,22 @@ def _detection_callouts(
     return out
 
 
+def _said(
+    given: Collection[int], facts: TrackerFacts, frame: int, class_name: str, mode: UseMode
+) -> set[tuple[int, int]]:
+    """The (detection, track) pairs the labels of detections ``given`` state: ``m24 0.54 → track 12``, ``→ track 55
+    (p 1.00)``. None for a PHD's weights (``track 96 (54 % of m16)`` is the detection's share, not the track's) or a
+    run known by its output only (``under track 12's box`` says where a box lay, not what an update used)."""
+    if mode in (UseMode.OUTPUT, UseMode.WEIGHTS):
+        return set()
+    out = set()
+    for m in given:
+        d = facts.destination(frame, class_name, m)
+        if d is not None and d.went is Went.TRACK:
+            out.add((m, d.track_id))
+    return out
+
+
 def predicted_ghosts(tracker: str) -> str:
     """Boxes3D of one tracker's involved tracks that are predicted but not output this frame."""
     return f"{tracker_focus(tracker)}/predicted"
@@ -442,13 +461,16 @@ def _prediction_callouts(
     palette: Mapping[int, tuple[int, int, int]],
     has_existence: bool,
     mode: UseMode = UseMode.ASSIGNED,
+    said: Collection[tuple[int, int]] = (),
 ) -> list[Callout]:
     """``<id> predicted r=<existence> → m<idx>`` (the detection its update used most, with its share for a soft
     update) or ``, missed`` at each focused track's predicted position this frame, in the track's involved colour
     (``palette``). The existence is the predicted one; for PMBM, when the frame's assignment was decided in another
     prior hypothesis, the one there, with the best hypothesis's beside it. A PHD's or CPHD's track (``mode``
     ``WEIGHTS``) has a weight, not an existence: ``<id> predicted weight <w> → m<idx>``. Without existences:
-    ``<id> predicted → m<idx>``."""
+    ``<id> predicted → m<idx>``. The ``→ m<idx>`` part is left out when the detection's own label already says it
+    went to this track (``said``: (detection, track) pairs; ``m24 0.54 → track 12`` beside ``12 predicted r=0.95``):
+    each assignment is read once."""
     out = []
     name = " weight " if mode is UseMode.WEIGHTS else " r="
     for t, step in steps.items():
@@ -465,7 +487,7 @@ def _prediction_callouts(
         if use is not None and use.shares:
             m, share = use.shares[0]
             extra = share_text(share, use.mode)
-            went = f" → m{m}" + (f" ({extra})" if extra else "")
+            went = "" if (m, t) in said else f" → m{m}" + (f" ({extra})" if extra else "")
         else:
             went = ", missed"
         out.append(Callout((*step.predicted_xy_m, z_m), f"{t} predicted{r}{went}", palette[t]))

@@ -29,9 +29,11 @@ bird's-eye view)
   not drawn in the full recording).
 - **Involved objects**: drawn enlarged; their labels stand in a column beside them, with a line to each object.
   A detection's label says where it went (`m2 0.75 → track 26`, `→ new track 212`, `→ track 62 (p 1.00)`); a
-  track's predicted position, its predicted existence (for PMBM, in the hypothesis its detection was decided in
-  when that differs, with the best hypothesis's beside it) and the detection its update used most
-  (`26 predicted r=0.40 → m2`, `62 predicted → m0 (p 1.00)`) or `missed`.
+  track's label, at its predicted position, its predicted existence (for PMBM, in the hypothesis its detection was
+  decided in when that differs, with the best hypothesis's beside it: `26 predicted r=0.40`) and `missed`, or the
+  detection its update used most unless that detection's label already says it went to this track
+  (`26 predicted r=0.40 → m5`); a PHD's track always names it, with its share of the weight
+  (`8 predicted weight 0.79 → m1 (78 % of its weight)`).
   An involved track kept but not output this frame is a pale box at its predicted position, in the shape of its
   last output box: where the tracker expected the object.
   The involved tracks take distinct colours (blue, green, black, light blue, lime, … in order of their ids,

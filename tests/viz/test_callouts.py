@@ -95,3 +95,6 @@ def test_a_phd_tracks_prediction_callout_names_a_weight_not_an_existence() -> No
     )
     (existence,) = _prediction_callouts({8: step}, 1.0, {8: (0, 0, 255)}, True)
     assert existence.text == "8 predicted r=0.79 → m1"
+    # m1's own label says it went to track 8 ("m1 0.81 → track 8"): the track's label does not say it again
+    (once,) = _prediction_callouts({8: step}, 1.0, {8: (0, 0, 255)}, True, said={(1, 8)})
+    assert once.text == "8 predicted r=0.79"
