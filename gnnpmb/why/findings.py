@@ -264,13 +264,15 @@ class Origin:
     """Where the track that took the object came from: born at ``frame`` from detection ``meas`` (frame -1: before
     the window), and the frames it was a false track before the failure (identity theft); victim_held: at each of those
     frames the evaluation matched the object (no miss of it) and the victim was no false track, so the victim held
-    it."""
+    it; of_no_object: no annotated object of a tracked class lay within ``NEAR_M`` of that detection at ``frame``
+    (a false detection started the track)."""
 
     track_id: int
     frame: int
     meas: int
     false_frames: tuple[int, ...] = ()
     victim_held: bool = False
+    of_no_object: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -282,7 +284,8 @@ class Deciding:
     without a column is not said to be outside a gate), and whether its column could take the detection (a finite
     cost); would / lost_would: what change of the next best's / the lost track's cost would have given it the
     detection, re-solved (``counterfactual.WouldTake``; None: nothing is said); alternative_took: the detection
-    the next best (a track) took in the same assignment (None: none), as ``KeyDecision`` has it."""
+    the next best (a track) took in the same assignment (None: none), as ``KeyDecision`` has it; meas_of_no_object:
+    the detection lay farther than ``NEAR_M`` from every annotated object of a tracked class."""
 
     frame: int
     choice: PairChoice
@@ -293,6 +296,7 @@ class Deciding:
     would: WouldTake | None = None
     lost_would: WouldTake | None = None
     alternative_took: int | None = None
+    meas_of_no_object: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -466,7 +466,19 @@ class _Context:
             and not self.false_at(self.report, x, int(victim))
             for x in false
         )
-        return Origin(track_id, born[0], born[1], false, held)
+        return Origin(track_id, born[0], born[1], false, held, self.of_no_object(born[0], born[1]))
+
+    def of_no_object(self, frame: int, meas: int) -> bool:
+        """Whether detection ``meas`` of ``frame`` lay farther than ``NEAR_M`` from every annotated object of a
+        tracked class (False when unknown: no such detection or frame)."""
+        fr = self.frames.get(frame)
+        if meas < 0 or fr is None or meas >= len(fr.detections.boxes.score):
+            return False
+        gt = self.scene.keyframes[frame].gt
+        if not len(gt):
+            return True
+        xy = fr.detections.boxes.translation_m[meas, :2]
+        return bool(np.hypot(*(gt.translation_m[:, :2] - xy).T).min() >= NEAR_M)
 
     def blame_lost(self, sightings: tuple[Sighting, ...], deciding: tuple[int, ...], lost: LostTrack) -> tuple:
         seen = {s.frame: s for s in sightings}
@@ -563,7 +575,8 @@ class _Context:
         if matrix is not None and assignment is not None and c.alternative is not None:
             would = would_take(matrix, assignment, int(c.meas.ref), int(c.alternative.ref))
         took = self.took(f, int(c.alternative.ref))
-        return Deciding(f, c, went, is_born, lost, in_gate, would, lost_would, took)
+        no_object = self.of_no_object(f, int(c.meas.ref))
+        return Deciding(f, c, went, is_born, lost, in_gate, would, lost_would, took, no_object)
 
     def switch(self, tracks: set[int], deciding: tuple[int, ...]) -> HypothesisSwitch | None:
         """A PMBM hypothesis switch in the deciding frames: the best hypothesis descends from another prior

@@ -860,14 +860,28 @@ def _lost_object(f: Finding) -> list[str]:
         parts.append(_switch_text(f))
     if f.decision is not None:
         d = f.decision  # the next best's own detection in the same assignment: the lower total decided, not its cost
-        parts.append(f"then, {choice_text(d.frame, d.choice, d.went, d.born, d.alternative_took)}")
+        # "then" only at the failure's own frame: the clauses before it run up to that frame (world5 scene-0553 gnn:
+        # "it was not output at frames 13–20 ...; at frame 20 m25 → track 48; then, frame 15: ..." read as if
+        # frame 15 came after frame 20); "earlier" is earlier than the failure's frame
+        lead = "then" if d.frame >= f.frame else "the deciding choice was earlier"
+        parts.append(f"{lead}, {choice_text(d.frame, d.choice, d.went, d.born, d.alternative_took)}")
+        if d.meas_of_no_object:  # truth49 world5 scene-0553 gnn: m24 was the false bus, nowhere said
+            parts.append(
+                f"{meas_name(d.choice.meas.ref)} at frame {d.frame} was a detection of no object (none of a tracked "
+                f"class within {NEAR_M:.0f} m)"
+            )
         parts += _where_from(f)
     elif f.taker is not None and f.taker.frame >= 0:
         o = f.taker
         if f.output_only:
             parts.append(f"track {o.track_id} was first output at frame {o.frame}")
         elif o.meas >= 0:
-            parts.append(f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}")
+            # audit truth49 (world5 scene-0553, a false bus beside a bus's path): the thief's first detection was
+            # of no object; the story needs it said where it started, not only its later false frames
+            false = (
+                f", a detection of no object (none of a tracked class within {NEAR_M:.0f} m)" if o.of_no_object else ""
+            )
+            parts.append(f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}{false}")
         elif f.switch is not None:
             parts.append(f"track {o.track_id} had existed since frame {o.frame} in a hypothesis other than the best")
     if lost is not None and lost.off is not None:

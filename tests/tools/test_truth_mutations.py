@@ -1691,3 +1691,33 @@ def test_a_soft_updates_minor_detection_called_the_one_it_used_is_caught() -> No
         marg = Marginals(C, probs, (AxisLabel(AxisKind.TRACK, 7),), cols, "exact")
         found = check_text(said, Context(C, 3, None, kind="false_track"), _raw_with(marg), _eval(), scene=_scene())
         assert [c.kind for c in found.found if "soft update" in c.truth] == kinds, (p, found.found)
+
+
+def test_a_deciding_choice_led_by_the_wrong_word_and_a_detection_of_no_object_said_or_unsaid_wrongly_are_caught() -> (
+    None
+):
+    # audit truth49, world5 scene-0553 (a false bus took the real bus's ID): "at frame 20 m25 → track 48; then,
+    # frame 15: m24 → track 48 ..." (frame 15 told as after frame 20), and neither the thief's start m30 nor m24 said
+    # to be a detection of no object
+    from gnnpmb.events import Born
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    objects = [{GT_A: Annotation(C, (0.0, 0.0), 9)}] * 4
+    scene = SceneTruth([[Detection(C, 0.9, (0.3, 0.0)), Detection(C, 0.7, (5.0, 0.0))]] * 4, objects)
+    choice = "frame 2: m1 → track 11 (cost 1.00) over track 7 (2.00), margin 1.00"
+    at = Context(C, 3, GT_A)
+
+    def kinds(text: str, raw=None) -> list[str]:
+        return [c.kind for c in check_text(text, at, raw or _raw_with(), _eval(), scene=scene).found]
+
+    no_object = "m1 at frame 2 was a detection of no object (none of a tracked class within 2 m)"
+    assert kinds(f"the deciding choice was earlier, {choice}; {no_object}") == []
+    assert kinds(f"then, {choice}; {no_object}") == ["misleading"]  # frame 2 before the failure's frame 3
+    assert kinds(f"the deciding choice was earlier, {choice}") == ["misleading"]  # m1 lies 5 m from GT A: unsaid
+    assert kinds("then, frame 3: m0 → track 7 (cost 1.00) over track 5 (2.00), margin 1.00") == []
+    planted = "the deciding choice was earlier, frame 2: m0 → track 7 (cost 1.00) over track 5 (2.00), margin 1.00"
+    assert kinds(f"{planted}; m0 at frame 2 was a detection of no object") == ["detector"]  # m0: 0.3 m from GT A
+    born = _raw_with(Born(C, np.array([11]), np.array([1]), np.zeros((1, 4)), np.ones(1)))
+    started = "track 11 had been started at frame 3 by m1"
+    assert kinds(f"{started}, a detection of no object (none of a tracked class within 2 m)", born) == []
+    assert kinds(started, born) == ["misleading"]

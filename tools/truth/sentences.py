@@ -356,6 +356,7 @@ def check_text(
         _check_choice(m, c, raw, out, bad)
     for m in UNDERCUT.finditer(text):
         _check_undercut(m, c, raw, out, bad)
+    _check_lead_and_no_object(text, ctx.frame, scene, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
     lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
     lost.check_used_away(text, c, ctx.lost, ctx.gt_id, scene, raw, out, bad)
@@ -364,6 +365,53 @@ def check_text(
     costs.check_costs(text, c, raw, scene, out, bad)
     hypotheses.check_hypotheses(text, c, raw, out, bad)
     return out
+
+
+LEAD = re.compile(r"(then|the deciding choice was earlier), frame (\d+): (?:close call: )?m(\d+)\b")
+"""A lost object's deciding choice as a Why introduces it: "then" reads as after the frames told before it (which
+run up to the failure's frame), "earlier" as before the failure's frame."""
+NO_OBJECT = re.compile(
+    r"(?:track \d+ had been started at frame (\d+) by m(\d+)|\bm(\d+) at frame (\d+) was)"
+    r"(, a detection of no object| a detection of no object)?"
+)
+"""A thief's starting detection, or a deciding detection said of no object: of no object exactly when no annotation
+of a tracked class lies within 2 m of it (audit truth49, world5: a false bus that took a real bus's ID)."""
+
+
+def _check_lead_and_no_object(text: str, frame: int, scene: SceneTruth | None, out: Tally, bad) -> None:
+    """The deciding choice's lead word against the failure's frame; "a detection of no object" (said, or left
+    unsaid of a thief's start or a deciding detection) against the annotations within ``NEAR_M``."""
+    deciding = []
+    for m in LEAD.finditer(text):
+        x = int(m[2])
+        out.checked["misleading"] += 1
+        if (m[1] == "then") != (x >= frame):
+            bad("misleading", m[0], f"the deciding choice is at frame {x}, the failure at frame {frame}")
+        deciding.append((x, int(m[3]), m))
+    if scene is None:
+        return
+    said = {}
+    for m in NO_OBJECT.finditer(text):
+        x, meas = (int(m[1]), int(m[2])) if m[1] is not None else (int(m[4]), int(m[3]))
+        said[(x, meas)] = said.get((x, meas), False) or m[5] is not None
+        between = text.startswith(" instead of", m.end())  # a track between the two (``_where_from``): not the thief
+        if (m[1] is not None and not between) or m[5] is not None:
+            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad)
+    for x, meas, m in deciding:
+        if (x, meas) not in said:
+            _no_object(x, meas, False, m[0], scene, out, bad)
+
+
+def _no_object(x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, out: Tally, bad) -> None:
+    if x >= len(scene.detections) or meas >= len(scene.detections[x]):
+        return
+    out.checked["detector"] += 1
+    xy = scene.detections[x][meas].xy_m
+    near = min((math.dist(a.xy_m, xy) for a in scene.objects[x].values()), default=math.inf)
+    if said and near < NEAR_M:
+        bad("detector", sentence, f"m{meas} at frame {x} lies {near:.2f} m from an annotated object")
+    elif not said and near >= NEAR_M:
+        bad("misleading", sentence, f"m{meas} at frame {x} lies {near:.2f} m from every annotated object: unsaid")
 
 
 def _patterns() -> list[re.Pattern]:

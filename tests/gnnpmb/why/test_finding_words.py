@@ -707,3 +707,65 @@ def test_a_false_tracks_detection_that_carried_a_minor_share_of_a_soft_update_is
     sure = FalseOutput(28, on, (0.0, 0.0), None, None, None, None, None, None, use=Use(((2, 0.9),), 0.1, soft.mode))
     line = why_lines(finding(FailureKind.FALSE_TRACK, false_output=sure, gt_id=None))[0]
     assert "m2 (bicycle, score 0.84), the one its update used" in line
+
+
+def test_a_deciding_choice_before_a_frame_already_told_is_not_introduced_by_then() -> None:
+    # audit truth49, world5 scene-0553 centerpoint gnn id_switch:1: "at frame 20 m25 (...) → track 48; then, frame
+    # 15: m24 → track 48 (cost -7.56) over track 36 (...)" read as if frame 15 came after frame 20
+    from gnnpmb.events import AxisKind, AxisLabel
+    from gnnpmb.explain import PairChoice
+    from gnnpmb.why.findings import Deciding
+
+    ended = TrackEnd(Ending.DELETED, PruneReason.TRACK_LOGIC, 1.0, 0, 3)
+    steps = (step(11, used=11, output=estimate(62, 1.0), r=1.0), step(14, r=1.0, ended=ended))
+    lost = LostTrack(62, 11, steps, None, None, None)
+    near = Near(0, "bicycle", 0.89, 0.1, True)
+    sighting = Sighting(15, 1731, None, near, near, Destination(0, Went.TRACK, 348), ())
+    m1, t348, t62 = AxisLabel(AxisKind.MEASUREMENT, 1), AxisLabel(AxisKind.TRACK, 348), AxisLabel(AxisKind.TRACK, 62)
+
+    def line(frame: int) -> str:
+        decision = Deciding(frame, PairChoice(m1, t348, -7.5, t62, -4.0, 3.5), 348, False)
+        f = finding(
+            FailureKind.ID_SWITCH,
+            lost,
+            frame=16,
+            deciding=(12, 13, 14, 15, 16),
+            sightings=(sighting,),
+            blame=(Blame(Rule.DETECTION_UNUSED, (15,)), Blame(Rule.NOT_OUTPUT, (12, 13, 14, 15, 16))),
+            decision=decision,
+        )
+        return why_lines(f)[0]
+
+    earlier = line(13)
+    assert "at frame 15 m0 (score 0.89, 0.1 m from it" in earlier
+    assert "then, frame 13" not in earlier
+    assert "the deciding choice was earlier, frame 13: m1 → **track 348** (cost -7.50) over track 62" in earlier
+    assert "the deciding choice was earlier, frame 15: m1" in line(15)  # "it was not output at frames 12–16" before
+    assert "then, frame 16: m1 → **track 348**" in line(16)  # at the failure's frame: "then" holds
+
+
+def test_a_thief_started_by_a_detection_of_no_object_and_a_deciding_detection_of_no_object_are_said_so() -> None:
+    # audit truth49, world5 scene-0553 centerpoint cphd identity_theft:1 (a false bus took the real bus's ID):
+    # "track 42 had been started at frame 9 by m28" never said m28 was a detection of no object
+    from gnnpmb.events import AxisKind, AxisLabel
+    from gnnpmb.explain import PairChoice
+    from gnnpmb.why.findings import Deciding
+
+    lost = LostTrack(61, 13, (), None, None, None)
+    said = why_lines(finding(FailureKind.IDENTITY_THEFT, lost, taker=Origin(315, 9, 28, (12, 13), of_no_object=True)))
+    assert (
+        "track 315 had been started at frame 9 by m28, a detection of no object (none of a tracked class within 2 m)"
+        in said[0]
+    )
+    assert said[0].count("a detection of no object") == 1
+    plain = why_lines(finding(FailureKind.IDENTITY_THEFT, lost, taker=Origin(315, 9, 28, (12, 13))))[0]
+    assert "track 315 had been started at frame 9 by m28;" in plain and "of no object" not in plain
+    m24, t48, t36 = AxisLabel(AxisKind.MEASUREMENT, 24), AxisLabel(AxisKind.TRACK, 48), AxisLabel(AxisKind.TRACK, 36)
+    choice = PairChoice(m24, t48, -7.56, t36, -4.05, 3.52)
+    for no_object in (True, False):
+        decision = Deciding(15, choice, 48, False, meas_of_no_object=no_object)
+        line = why_lines(finding(FailureKind.ID_SWITCH, lost, decision=decision))[0]
+        assert "frame 15: m24 → **track 48** (cost -7.56) over track 36" in line
+        assert (
+            "m24 at frame 15 was a detection of no object (none of a tracked class within 2 m)" in line
+        ) is no_object

@@ -131,3 +131,13 @@ def test_a_track_the_evaluation_matched_to_the_object_beside_it_was_not_put_out_
     alone = ctx_with(GT)
     assert alone.reach_of(mine, GT).near_annotated == (8,)
     assert alone.put_out_of_reach(mine, GT)
+
+
+def test_a_detection_is_of_no_object_only_beyond_two_metres_of_every_object_of_any_tracked_class() -> None:
+    # audit truth49, world5 scene-0553: a false bus started the track that later took the real bus's ID; the story
+    # said "started at frame 8 by m30" and nothing of m30 being a detection of no object
+    ctx = detections_beside_two_objects()
+    assert not ctx.of_no_object(3, 0)  # 0.1 m from the car (1.8 m from the bicycle)
+    ctx.frames[3].detections.boxes.translation_m = np.array([[1.9, 2.1, 0.0]])
+    assert ctx.of_no_object(3, 0)  # 2.1 m from the car, 2.8 m from the bicycle
+    assert not ctx.of_no_object(4, 0) and not ctx.of_no_object(3, -1)  # unknown frame or no detection: not said
