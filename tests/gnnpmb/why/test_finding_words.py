@@ -128,10 +128,27 @@ def test_whose_doing_names_every_party_whose_test_held_in_order() -> None:
     assert whose_text(finding(FailureKind.MISS, blame=(Blame(Rule.INTERPOLATED, (13,)),))) == "the evaluation's doing"
 
 
-def test_a_deleted_track_and_a_detection_that_started_another_are_both_said() -> None:
+def deleted_track_62() -> LostTrack:
+    """Track 62, detected (m11) at frame 11 and deleted by its track logic at frame 14."""
     ended = TrackEnd(Ending.DELETED, PruneReason.TRACK_LOGIC, 1.0, 0, 3)
     steps = (step(11, used=11, output=estimate(62, 1.0), r=1.0), step(14, r=1.0, ended=ended))
-    lost = LostTrack(62, 11, steps, None, None, None)
+    return LostTrack(62, 11, steps, None, None, None)
+
+
+def switch_at_16(sighting: Sighting, **kw) -> Finding:
+    """The bicycle passes from track 62 (``deleted_track_62``) to track 348 at frame 16; ``sighting`` at frame 15."""
+    return finding(
+        FailureKind.ID_SWITCH,
+        deleted_track_62(),
+        frame=16,
+        deciding=(12, 13, 14, 15, 16),
+        sightings=(sighting,),
+        blame=(Blame(Rule.DETECTION_UNUSED, (15,)), Blame(Rule.NOT_OUTPUT, (12, 13, 14, 15, 16))),
+        **kw,
+    )
+
+
+def test_a_deleted_track_and_a_detection_that_started_another_are_both_said() -> None:
     sighting = Sighting(
         15,
         1731,
@@ -141,16 +158,7 @@ def test_a_deleted_track_and_a_detection_that_started_another_are_both_said() ->
         Destination(0, Went.NEW_TRACK, 348),
         (),
     )
-    f = finding(
-        FailureKind.ID_SWITCH,
-        lost,
-        frame=16,
-        deciding=(12, 13, 14, 15, 16),
-        sightings=(sighting,),
-        blame=(Blame(Rule.DETECTION_UNUSED, (15,)), Blame(Rule.NOT_OUTPUT, (12, 13, 14, 15, 16))),
-        mode="association probabilities",
-        has_existence=False,
-    )
+    f = switch_at_16(sighting, mode="association probabilities", has_existence=False)
     line = why_lines(f)[0]
     assert "its track logic deleted it at frame 14 (no hit in its last 3 frames)" in line
     assert "at frame 15 m0 (score 0.89, 0.1 m from it; track 62 was gone) → new track 348" in line
@@ -716,25 +724,13 @@ def test_a_deciding_choice_before_a_frame_already_told_is_not_introduced_by_then
     from gnnpmb.explain import PairChoice
     from gnnpmb.why.findings import Deciding
 
-    ended = TrackEnd(Ending.DELETED, PruneReason.TRACK_LOGIC, 1.0, 0, 3)
-    steps = (step(11, used=11, output=estimate(62, 1.0), r=1.0), step(14, r=1.0, ended=ended))
-    lost = LostTrack(62, 11, steps, None, None, None)
     near = Near(0, "bicycle", 0.89, 0.1, True)
     sighting = Sighting(15, 1731, None, near, near, Destination(0, Went.TRACK, 348), ())
     m1, t348, t62 = AxisLabel(AxisKind.MEASUREMENT, 1), AxisLabel(AxisKind.TRACK, 348), AxisLabel(AxisKind.TRACK, 62)
 
     def line(frame: int) -> str:
         decision = Deciding(frame, PairChoice(m1, t348, -7.5, t62, -4.0, 3.5), 348, False)
-        f = finding(
-            FailureKind.ID_SWITCH,
-            lost,
-            frame=16,
-            deciding=(12, 13, 14, 15, 16),
-            sightings=(sighting,),
-            blame=(Blame(Rule.DETECTION_UNUSED, (15,)), Blame(Rule.NOT_OUTPUT, (12, 13, 14, 15, 16))),
-            decision=decision,
-        )
-        return why_lines(f)[0]
+        return why_lines(switch_at_16(sighting, decision=decision))[0]
 
     earlier = line(13)
     assert "at frame 15 m0 (score 0.89, 0.1 m from it" in earlier

@@ -13,30 +13,16 @@ from gnnpmb.events import Assignment, AxisKind, CostMatrix, CostTerms, axis_labe
 from gnnpmb.explain import explain
 from gnnpmb.why.findings import Deciding, Finding, LostTrack, OnObject, OtherRun
 from gnnpmb.why.words import why_lines
+from tests.gnnpmb.why.test_finding_words import finding as id_switch
 
 GT = "1419ed" + "0" * 26
 PAIR = "188906" + "1" * 26
 
 
 def finding(**kw) -> Finding:
-    base = dict(
-        failure_id="id_switch:1",
-        kind=FailureKind.ID_SWITCH,
-        tracker="gnnpmb",
-        frame=13,
-        class_name="car",
-        gt_id=GT,
-        track_ids=(18, 19),
-        window=(5, 13),
-        deciding=(13,),
-        blame=(),
-        sightings=(),
-        mode="assigned",
-        has_existence=True,
-        lost=LostTrack(18, 12, (), None, None, None),
-    )
-    base.update(kw)
-    return Finding(**base)
+    """A car's id switch at frame 13, track 18 to 19 (``test_finding_words.finding``'s other fields)."""
+    base = dict(class_name="car", gt_id=GT, track_ids=(18, 19), lost=LostTrack(18, 12, (), None, None, None))
+    return id_switch(FailureKind.ID_SWITCH, **(base | kw))
 
 
 def test_the_deciding_choice_over_a_cheaper_track_says_what_that_track_took() -> None:
