@@ -1301,7 +1301,7 @@ def _coalescence(f: Finding) -> list[str]:
     if s.undetected:
         parts.append(
             f"the detector gave GT {short_id(f.gt_id or '')} no detection of its own within {NEAR_M:.0f} m "
-            f"({points_text([s])}): one detection, or none, for two objects"
+            f"({points_text([s])}): one object seen, or none, where there were two"
         )
     elif s.nearest_own is not None:
         n = s.nearest_own

@@ -699,6 +699,15 @@ def test_a_coalesced_object_said_to_have_no_detection_of_its_own_is_checked() ->
         assert [c.kind for c in check_text(said.format(gt, points), at2, None, _eval(), scene=_scene()).found] == [
             "detector"
         ]
+    # A detection within 2 m that lies nearer the neighbour is the neighbour's, not the object's own (dev set
+    # scene-0916 megvii gnn coalescence:2: 1.96 m from GT 55f69d, 0.13 m from GT c1ad9f)
+    from tools.truth.scene import Annotation
+
+    pair = _scene()
+    pair.objects[2]["cccccc" + GT_A[6:]] = Annotation(C, (1.9, 0.0), 7)  # m0: 0.3 m from A, 1.6 m from C
+    assert check_text(said.format("cccccc", 7), at2, None, _eval(), scene=pair).found == []
+    pair.objects[2][GT_A] = Annotation(C, (-5.0, 0.0), 12)  # now m0 is C's own (1.6 m against 5.3 m)
+    assert [c.kind for c in check_text(said.format("cccccc", 7), at2, None, _eval(), scene=pair).found] == ["detector"]
 
 
 def test_a_last_output_on_the_object_the_devkit_did_not_match_there_is_caught() -> None:
