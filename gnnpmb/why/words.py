@@ -866,10 +866,7 @@ def _lost_object(f: Finding) -> list[str]:
         lead = "then" if d.frame >= f.frame else "the deciding choice was earlier"
         parts.append(f"{lead}, {choice_text(d.frame, d.choice, d.went, d.born, d.alternative_took)}")
         if d.meas_of_no_object:  # truth49 world5 scene-0553 gnn: m24 was the false bus, nowhere said
-            parts.append(
-                f"{meas_name(d.choice.meas.ref)} at frame {d.frame} was a detection of no object (none of a tracked "
-                f"class within {NEAR_M:.0f} m)"
-            )
+            parts.append(f"{meas_name(d.choice.meas.ref)} at frame {d.frame} was {_of_no_object()}")
         parts += _where_from(f)
     elif f.taker is not None and f.taker.frame >= 0:
         o = f.taker
@@ -878,9 +875,7 @@ def _lost_object(f: Finding) -> list[str]:
         elif o.meas >= 0:
             # audit truth49 (world5 scene-0553, a false bus beside a bus's path): the thief's first detection was
             # of no object; the story needs it said where it started, not only its later false frames
-            false = (
-                f", a detection of no object (none of a tracked class within {NEAR_M:.0f} m)" if o.of_no_object else ""
-            )
+            false = f", {_of_no_object()}" if o.of_no_object else ""
             parts.append(f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}{false}")
         elif f.switch is not None:
             parts.append(f"track {o.track_id} had existed since frame {o.frame} in a hypothesis other than the best")
@@ -1370,6 +1365,12 @@ def _others(f: Finding) -> list[str]:
         else:
             out.append(f"{who} did not have this failure")
     return out
+
+
+def _of_no_object() -> str:
+    """What a detection with no annotated object of a tracked class within ``NEAR_M`` was (audit truth49: a false
+    bus's detections)."""
+    return f"a detection of no object (none of a tracked class within {NEAR_M:.0f} m)"
 
 
 def _beside(o: OnObject, frame: int) -> bool:
