@@ -304,6 +304,11 @@ class PmbParams(Section):
     miss_p_detect_bins: int = param(
         2, "N: the online cap is learnt apart after 0, 1, ..., N - 1 or more misses in a row", at_least(1)
     )
+    miss_p_detect_score_split: float = param(
+        0.0,
+        "s > 0: the online cap is learnt apart for tracks whose last detection scored below s and at least s (0: one)",
+        unit_interval(True, False),
+    )
     miss_p_detect_neighbour_m: float = param(
         2.0,
         "a missed Bernoulli with another of its class this near keeps the fixed cap, not the online one (0: off)",

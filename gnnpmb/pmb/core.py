@@ -457,7 +457,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         box = BoxShapeModel(p.heading_std_rad, p.size_log_std, p.size_log_spread, p.box_outlier_prob)
         self.box = box if box.enabled else None
         self.frame_serial = 0
-        self.miss_counts = MissDetectionCounts.empty(self.params.miss_p_detect_bins)
+        self.miss_counts = MissDetectionCounts.empty(p.miss_p_detect_bins, p.miss_p_detect_score_split)
         state_dim = STATE_DIM + int(self.turn_rate)  # [x, y, vx, vy], and omega for the coordinated turn
         self.hypotheses: list[GlobalHypothesis] = [GlobalHypothesis(0.0, Bernoullis.empty(state_dim))]
         self.birth_update = birth_update(
@@ -505,7 +505,7 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         self.hypotheses = self._prune(prior.hypotheses, posteriors, ctx, sink)
         best = self.hypotheses[0].bernoullis
         if self.params.miss_p_detect_online == 1:
-            self.miss_counts.count(best.track_id, best.misses)
+            self.miss_counts.count(best.track_id, best.misses, best.score)
         if sink.enabled:
             self._emit_born(best, ctx, sink)
         return best
@@ -548,7 +548,9 @@ class PmbCore(ClassFilter[PmbPrior, Bernoullis]):
         p = self.params
         if p.miss_p_detect_online != 1:
             return p.miss_p_detect_max
-        learnt = self.miss_counts.p_detect(p.miss_p_detect_max, p.miss_p_detect_prior_frames, prior.misses - 1)
+        learnt = self.miss_counts.p_detect(
+            p.miss_p_detect_max, p.miss_p_detect_prior_frames, prior.misses - 1, prior.score
+        )
         near = crowded(
             prior.mean[:, :2],
             prior.existence,

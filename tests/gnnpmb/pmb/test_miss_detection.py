@@ -4,10 +4,12 @@ Bernoulli with a neighbour of its class keeps the fixed cap (``miss_detection.cr
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from gnnpmb.config import TrackerConfig, with_params
+from gnnpmb.config import TrackerConfig, load_config, with_params
 from gnnpmb.events import CostMatrix, ListSink, NullSink
 from gnnpmb.pmb.core import PmbCore
 from gnnpmb.pmb.gnnpmb import BestAssignment
@@ -16,15 +18,16 @@ from gnnpmb.types import IdAllocator
 from tests.gnnpmb.pmb.helpers import make_measurements
 
 
-def _counted(n_bins: int) -> MissDetectionCounts:
-    """Tracks 1 and 2 over four frames: both detected at frame 1; 1 missed at frames 2 and 3 and detected again
-    at 4; 2 detected at every frame; 5 born at frame 4."""
-    counts = MissDetectionCounts.empty(n_bins)
-    ids = np.array([1, 2])
-    counts.count(ids, np.array([0, 0]))  # frame 1: no previous frame, nothing counted
-    counts.count(ids, np.array([1, 0]))  # track 2 detected after a detection: D_0 + 1
-    counts.count(ids[::-1], np.array([0, 2]))  # the same, rows in another order
-    counts.count(np.array([5, 1, 2]), np.array([0, 0, 0]))  # 1 closes a gap of 2: D_2 + 1, G_0 + 1, G_1 + 1
+def _counted(n_bins: int, score_split: float = 0.0) -> MissDetectionCounts:
+    """Tracks 1 and 2 over four frames: both detected at frame 1; 1 (last score 0.4) missed at frames 2 and 3 and
+    detected again at 4; 2 (score 0.9) detected at every frame; 5 born at frame 4."""
+    counts = MissDetectionCounts.empty(n_bins, score_split)
+    ids, scores = np.array([1, 2]), np.array([0.4, 0.9])
+    counts.count(ids, np.array([0, 0]), scores)  # frame 1: no previous frame, nothing counted
+    counts.count(ids, np.array([1, 0]), scores)  # track 2 detected after a detection: D_0 + 1
+    counts.count(ids[::-1], np.array([0, 2]), scores[::-1])  # the same, rows in another order
+    # 1 closes a gap of 2: D_2 + 1, G_0 + 1, G_1 + 1
+    counts.count(np.array([5, 1, 2]), np.array([0, 0, 0]), np.array([0.7, 0.4, 0.9]))
     return counts
 
 
@@ -33,8 +36,8 @@ def test_counts_and_estimate_by_gap_position_by_hand() -> None:
     1, 0] (track 1's closed gap: a miss at position 1 and one at 2); the new track 5 adds nothing. With the cap 0.3
     as a prior of 10 frames: P_D = [(3 + 3) / (10 + 3 + 1), (3 + 0) / (10 + 0 + 1), (3 + 1) / (10 + 1 + 0)]."""
     counts = _counted(3)
-    assert counts.detected.tolist() == [3, 0, 1] and counts.missed.tolist() == [1, 1, 0]
-    p = counts.p_detect(0.3, 10.0, np.array([0, 1, 2, 5]))
+    assert counts.detected.tolist() == [[3, 0, 1]] and counts.missed.tolist() == [[1, 1, 0]]
+    p = counts.p_detect(0.3, 10.0, np.array([0, 1, 2, 5]), np.array([0.1, 0.9, 0.5, 0.5]))
     np.testing.assert_allclose(p, [6 / 14, 3 / 11, 4 / 11, 4 / 11])
 
 
@@ -42,15 +45,29 @@ def test_one_bin_pools_every_frame_and_two_bins_pool_the_tail() -> None:
     """One bin: D = 4 detections, G = 2 misses, P_D = (3 + 4) / (10 + 6). Two bins: the gap of 2 ends in the
     last bin (D = [3, 1]) and its second miss falls in it too (G = [1, 1])."""
     one = _counted(1)
-    assert one.detected.tolist() == [4] and one.missed.tolist() == [2]
-    np.testing.assert_allclose(one.p_detect(0.3, 10.0, np.array([0, 7])), [7 / 16, 7 / 16])
+    assert one.detected.tolist() == [[4]] and one.missed.tolist() == [[2]]
+    np.testing.assert_allclose(one.p_detect(0.3, 10.0, np.array([0, 7]), np.array([0.2, 0.8])), [7 / 16, 7 / 16])
     two = _counted(2)
-    assert two.detected.tolist() == [3, 1] and two.missed.tolist() == [1, 1]
-    np.testing.assert_allclose(two.p_detect(0.3, 10.0, np.array([0, 1, 4])), [6 / 14, 4 / 12, 4 / 12])
+    assert two.detected.tolist() == [[3, 1]] and two.missed.tolist() == [[1, 1]]
+    p = two.p_detect(0.3, 10.0, np.array([0, 1, 4]), np.ones(3))
+    np.testing.assert_allclose(p, [6 / 14, 4 / 12, 4 / 12])
+
+
+def test_a_score_split_counts_weak_and_strong_tracks_apart() -> None:
+    """Split 0.5, two miss bins: track 1 (last score 0.4, below the split) closed its gap of 2 (D_00 = 0, D_01 =
+    1, G_00 = G_01 = 1); track 2 (0.9) was detected three times after a detection (D_10 = 3). A weak track after
+    no miss: (3 + 0) / (10 + 0 + 1); after misses: (3 + 1) / (10 + 1 + 1); a strong one after no miss:
+    (3 + 3) / (10 + 3), after misses the prior 0.3. The bin is the score of the track's last detection before
+    the gap: a score at the split is strong."""
+    counts = _counted(2, 0.5)
+    assert counts.detected.tolist() == [[0, 1], [3, 0]] and counts.missed.tolist() == [[1, 1], [0, 0]]
+    p = counts.p_detect(0.3, 10.0, np.array([0, 3, 0, 1]), np.array([0.49, 0.2, 0.5, 0.9]))
+    np.testing.assert_allclose(p, [3 / 11, 4 / 12, 6 / 13, 0.3])
 
 
 def test_nothing_counted_gives_the_prior_mean() -> None:
-    np.testing.assert_allclose(MissDetectionCounts.empty(3).p_detect(0.3, 10.0, np.array([0, 1, 9])), [0.3] * 3)
+    empty = MissDetectionCounts.empty(3, 0.5)
+    np.testing.assert_allclose(empty.p_detect(0.3, 10.0, np.array([0, 1, 9]), np.array([0.1, 0.6, 0.9])), [0.3] * 3)
 
 
 def _car(t: int) -> object:
@@ -81,7 +98,7 @@ def test_the_tracker_misses_with_the_learnt_p_d_and_its_event_reports_it() -> No
     0.8, so the miss uses 0.4 and the cost event says 0.4."""
     cfg = with_params(TrackerConfig(), {"pmb.miss_p_detect_online": 1, "pmb.miss_p_detect_bins": 1})
     core, p_detect = _run(cfg)
-    assert core.miss_counts.detected.tolist() == [3] and core.miss_counts.missed.tolist() == [2]
+    assert core.miss_counts.detected.tolist() == [[3]] and core.miss_counts.missed.tolist() == [[2]]
     assert p_detect == pytest.approx(0.4, rel=1e-9)
 
 
@@ -142,3 +159,11 @@ def test_a_missed_track_next_to_another_keeps_the_fixed_cap() -> None:
     assert p_off == pytest.approx(0.55, rel=1e-9)
     _, p_on = _pair_p_detect(with_params(TrackerConfig(), {**base, "pmb.miss_p_detect_neighbour_m": 2.0}))
     assert p_on == pytest.approx(0.3, rel=1e-9)
+
+
+def test_the_round_17_record_reads_as_screened() -> None:
+    """``gnnpmb/params/miss_pd_score_split.toml`` (Issue 32, Round 17, not adopted) sets the split and drops the
+    score cap for every class."""
+    cfg = load_config(Path(__file__).resolve().parents[3] / "gnnpmb" / "params" / "miss_pd_score_split.toml")
+    car = cfg.resolved("car").pmb
+    assert car.miss_p_detect_score_split == 0.5 and car.miss_p_detect_last_score == 0
