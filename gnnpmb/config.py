@@ -269,7 +269,8 @@ class PmbParams(Section):
 
     A Bernoulli with existence r >= extraction_threshold is output with tracking score s r (s: its detection
     score); a missed track's P_D is its last detection score capped at miss_p_detect_max, or at the cap learnt per
-    class from the gaps its tracks closed (miss_p_detect_online, ``gnnpmb.pmb.miss_detection``), except beside a
+    class from the gaps its tracks closed (miss_p_detect_online, ``gnnpmb.pmb.miss_detection``; apart for weak and
+    strong last detections with miss_p_detect_score_split), except beside a
     neighbour of its class (miss_p_detect_neighbour_m). measure_velocity adds [vx, vy] to the measurement (R adds
     r_vx, r_vy; clutter intensity x clutter_velocity_density per (m/s)^2). A Bernoulli missed n frames in a row is
     scored s r d^n (miss_score_decay d; with miss_score_mean_min_frames N > 0, one born or detected on at least N
