@@ -93,6 +93,11 @@ def _box_problem(entry: Any) -> str | None:
     """What is wrong with one box entry, or None."""
     if not isinstance(entry, dict):
         return f"is a {type(entry).__name__}, not an object"
+    if "detection_name" not in entry and "tracking_name" in entry:
+        return (
+            "is a track (tracking_name, no detection_name): this is a tracking results file, not detections; "
+            "open it with --results NAME=FILE.json, score it with gnnpmb eval FILE.json"
+        )
     for name, length in VECTOR_FIELDS:
         if name not in entry:
             return f"has no '{name}' field"

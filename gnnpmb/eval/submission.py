@@ -220,6 +220,11 @@ def _box_problem(token: str, box: Any) -> str | None:
     """What is wrong with one submission box, or None (the devkit's TrackingBox checks, and finiteness)."""
     if not isinstance(box, dict):
         return f"is a {type(box).__name__}, not an object"
+    if "tracking_name" not in box and "detection_name" in box:
+        return (
+            "is a detection (detection_name, no tracking_name): this is a detection file, not tracking results; "
+            "pass it as --detections FILE.json (gnnpmb track --detections FILE.json --out results.json tracks it)"
+        )
     for name in _REQUIRED_FIELDS + tuple(n for n, _ in VECTOR_FIELDS):
         if name not in box:
             return f"has no '{name}' field"

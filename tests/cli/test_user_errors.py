@@ -220,9 +220,41 @@ def _box_case(field: str, value: object, expected: str) -> DataCase:
     )
 
 
+def _swapped_file(path: Path, demo: Path, kind: str) -> None:
+    """A well-formed file of the other kind than the command expects, for the demo's mini_val samples: a detection
+    file (``kind`` "detection") or a tracking submission ("tracking")."""
+    meta = {"use_camera": False, "use_lidar": True, "use_radar": False, "use_map": False, "use_external": False}
+    box = {"translation": [600.0, 1600.0, 1.0], "size": [2.0, 4.5, 1.6], "rotation": [1.0, 0.0, 0.0, 0.0]}
+    box |= {"velocity": [0.0, 0.0]}
+    if kind == "detection":
+        box |= {"detection_name": "car", "detection_score": 0.9}
+    else:
+        box |= {"tracking_name": "car", "tracking_score": 0.9, "tracking_id": "1"}
+    results = {t: [box | {"sample_token": t}] for t in _split_tokens(demo)}
+    path.write_text(json.dumps({"meta": meta, "results": results}))
+
+
 CASES_WITH_DATA: tuple[DataCase, ...] = (
     # the other field checks are unit tests (tests/gnnpmb/data/test_detections.py)
     _box_case("size", [2.0, -4.5, 1.6], "field 'size' must be positive"),
+    DataCase(
+        "eval a detection file",
+        lambda path, demo: _swapped_file(path, demo, "detection"),
+        "gnnpmb eval {w}/input.json --split mini_val --out {w}/ev",
+        "this is a detection file, not tracking results; pass it as --detections FILE.json",
+    ),
+    DataCase(
+        "results run of a detection file",
+        lambda path, demo: _swapped_file(path, demo, "detection"),
+        "gnnpmb failures scene-0103 --results mine={w}/input.json",
+        "this is a detection file, not tracking results",
+    ),
+    DataCase(
+        "tracking results as detections",
+        lambda path, demo: _swapped_file(path, demo, "tracking"),
+        f"{VIZ} scene-0103 --detections {{w}}/input.json {SAVE} --no-progress",
+        "this is a tracking results file, not detections; open it with --results NAME=FILE.json",
+    ),
     # duplicate ids: tests/gnnpmb/eval/test_submission.py
     DataCase(
         "eval empty submission",
