@@ -267,3 +267,26 @@ def test_a_stop_that_click_turned_into_abort_still_exits_130_with_its_line(capsy
         run_app(app, [])
     assert stop.value.code == 130
     assert capsys.readouterr().err.strip() == "interrupted by Ctrl-C: unfinished outputs were not written"
+
+
+def test_classes_are_the_only_ones_evaluated_in_failures_and_the_viewer(
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--classes car``: the failures are the cars' alone (the other classes, not tracked, are no one's misses),
+    the same in ``gnnpmb failures`` and in ``gnnpmb-viz``'s summary, so the ids one lists the other opens."""
+    from tests.inprocess import run_script
+
+    common = ["scene-0103", "--classes", "car", "--frames", "0:10", "--dataroot", str(demo_dataroot)]
+    listed = run_script(["gnnpmb", "failures", *common, "--json", str(tmp_path / "f.json")], capsys)
+    assert listed.returncode == 0, listed.stderr
+    report = json.loads((tmp_path / "f.json").read_text())
+    assert [c["class_name"] for c in report["classes"]] == ["car"]
+    assert {f["class_name"] for f in report["failures"]} <= {"car"}
+    (car,) = report["classes"]
+    assert report["totals"]["miss"] == car["fn"]
+    (totals,) = re.findall(
+        r"scene-0103, gnnpmb in keyframes 0:10 \(only those were tracked and evaluated\): (.*)", listed.stdout
+    )
+    shown = run_script(["gnnpmb-viz", *common, "--save", str(tmp_path / "x.rrd"), "--no-progress"], capsys)
+    assert shown.returncode == 0, shown.stderr
+    assert f"gnnpmb failures in keyframes 0:10 (only those were tracked and evaluated): {totals}" in shown.stdout
