@@ -290,3 +290,15 @@ def test_classes_are_the_only_ones_evaluated_in_failures_and_the_viewer(
     shown = run_script(["gnnpmb-viz", *common, "--save", str(tmp_path / "x.rrd"), "--no-progress"], capsys)
     assert shown.returncode == 0, shown.stderr
     assert f"gnnpmb failures in keyframes 0:10 (only those were tracked and evaluated): {totals}" in shown.stdout
+
+
+@pytest.mark.parametrize("command", ["eval {r} --split staged", "diff mine={r} greedy --split staged"])
+def test_a_results_file_of_another_split_names_that_split(
+    command: str, tracked: tuple[Path, str], demo_dataroot: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A submission of mini_val scored or diffed on another split: the error line names the split it holds."""
+    argv = [*command.format(r=tracked[0]).split(), "--dataroot", str(demo_dataroot)]
+    code, out, err = run(argv, capsys)
+    assert code == 2 and out == ""
+    assert err.startswith("error: results.json ") and len(err.splitlines()) == 1, err
+    assert err.rstrip().endswith(f"It holds the {N_SAMPLES} samples of split mini_val: pass --split mini_val")
