@@ -302,3 +302,25 @@ def test_a_results_file_of_another_split_names_that_split(
     assert code == 2 and out == ""
     assert err.startswith("error: results.json ") and len(err.splitlines()) == 1, err
     assert err.rstrip().endswith(f"It holds the {N_SAMPLES} samples of split mini_val: pass --split mini_val")
+
+
+def test_a_failed_track_prints_its_error_line_alone(
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With the progress bar on (the default) and stderr no terminal (a pipe, a CI log), a track that fails
+    prints its one ``error:`` line and nothing else: no empty line left by the bar."""
+    detections = tmp_path / "det.json"
+    detections.write_text(json.dumps({"meta": {}, "results": {"0" * 32: []}}))
+    argv = [
+        "track",
+        "--dataroot",
+        str(demo_dataroot),
+        "--detections",
+        str(detections),
+        "--out",
+        str(tmp_path / "r.json"),
+    ]
+    code, out, err = run(argv, capsys)
+    assert (code, out) == (2, "")
+    assert err.startswith("error: detections file det.json has no boxes entry") and err.count("\n") == 1, repr(err)
+    assert not (tmp_path / "r.json").exists()
