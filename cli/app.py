@@ -180,13 +180,23 @@ def view(
             )
             typer.echo(
                 f"{name} failures{report.scope_text()}: {report.totals_text()}{at_interpolated}. To open {first} at "
-                f"its frame, {how} to this command; to list them all: gnnpmb failures {inputs.scene.name} "
-                f"--tracker {spec} (same options)."
+                f"its frame, {how} to this command; to list them all: "
+                f"{failures_command(inputs.scene.name, spec, source, frames, classes)}"
             )
     if request.serve is not None:
         from viz.serving import wait_for_ctrl_c
 
         wait_for_ctrl_c(request.serve)
+
+
+def failures_command(scene: str, spec: str, source: Source, frames: str | None, classes: str | None) -> str:
+    """The ``gnnpmb failures`` command that lists run ``spec``'s failures with this command's data options."""
+    import shlex
+
+    words = ["gnnpmb", "failures", scene, "--tracker", spec]
+    words += [w for flag, value in (("--frames", frames), ("--classes", classes)) if value for w in (flag, value)]
+    options = source.shell_words()
+    return shlex.join(words) + (f" {options}" if options else "")
 
 
 def main(argv: Sequence[str] | None = None) -> None:

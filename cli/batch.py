@@ -73,6 +73,7 @@ def track(
     from cli.progress import progress_bar
     from gnnpmb.config import load_config
     from gnnpmb.data.detections import check_detection_file
+    from gnnpmb.stages.inputs import simulated_note
     from gnnpmb.study.runner import execution
     from gnnpmb.study.track import track_to_file
 
@@ -81,6 +82,9 @@ def track(
     if source.detections is not None:  # a bad file fails before a dataset is looked for
         check_detection_file(source.detections)
     data = source.split_data(split, preset)
+    note = simulated_note(data.location, None if data.detections else data.detector, data.seed)
+    if note:
+        typer.echo(f"note: {note}", err=True)
     with progress_bar(progress, transient=True) as bar:
         scenes_task = bar.add_task("scenes", total=len(data.scene_names))
         frames_task = bar.add_task("frames", total=None, visible=not run.uses_ray)

@@ -14,12 +14,13 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from cli.options import DEFAULT_SOURCE, Source, source_options
-from gnnpmb.errors import GnnpmbError
+from gnnpmb.errors import GnnpmbError, NotThisDatasetError
 from gnnpmb.outputs import check_output_file
 
 if TYPE_CHECKING:
     from rich.console import Console
 
+    from gnnpmb.data.nuscenes import DatasetLocation
     from gnnpmb.diff import DiffEntry, DiffResult
 
 DIFF_HELP = (
@@ -32,6 +33,20 @@ DIFF_HELP = (
 RunArgument = Annotated[
     str, typer.Argument(metavar="RUN", help="TRACKER, TRACKER:PARAMS.toml or NAME=FILE.json.", show_default=False)
 ]
+
+
+def _results_split_hint(location: DatasetLocation, runs: tuple[str, str], split: str) -> str:
+    """Where a results run's file holds exactly another split's samples: which split (``split_hint``)."""
+    from gnnpmb.eval.nuscenes_eval import split_hint
+    from gnnpmb.eval.submission import read_submission
+    from gnnpmb.runs import parse_run
+
+    for spec in (parse_run(r) for r in runs):
+        if spec.results is not None:
+            hint = split_hint(location, read_submission(spec.results).get("results"), split)
+            if hint:
+                return hint
+    return ""
 
 
 def register(app: typer.Typer) -> None:
@@ -77,15 +92,19 @@ def diff(
         scenes, where = split_scenes(split, location), f"split {split}"
         if not scenes:
             raise GnnpmbError(f"split {split} has no scenes in {location.dataroot / location.version}")
-    result = diff_runs(
-        a,
-        b,
-        scenes,
-        where,
-        scene_inputs=lambda name, runs: load_inputs(check_request(name, runs, **source.request_args())),
-        split_tokens=sample_tokens(location, scenes),  # an unknown scene is one line here
-        dataset_tokens=all_sample_tokens(location),
-    )
+    try:
+        result = diff_runs(
+            a,
+            b,
+            scenes,
+            where,
+            scene_inputs=lambda name, runs: load_inputs(check_request(name, runs, **source.request_args())),
+            split_tokens=sample_tokens(location, scenes),  # an unknown scene is one line here
+            dataset_tokens=all_sample_tokens(location),
+        )
+    except NotThisDatasetError as exc:
+        hint = _results_split_hint(location, (a, b), split) if scene is None and split is not None else ""
+        raise NotThisDatasetError(f"{exc}{hint}") from None
     options = source.shell_words()
     for notice in result.notices:
         typer.echo(f"note: {notice}", err=True)

@@ -102,6 +102,23 @@ def symlink_loop_line(exc: RuntimeError) -> str | None:
 _PATHLIB_LOOP = "Symlink loop from "
 
 
+def demo_hint(exc: GnnpmbError, args: Sequence[str]) -> str:
+    """What to add to the line of an input file that does not fit the dataset (``NotThisDatasetError``) when the
+    dataset was the built-in demo only because neither --dataroot nor $NUSCENES_DATAROOT was given: most likely
+    the user's own file, read against the demo's samples. Empty otherwise."""
+    from gnnpmb.data.nuscenes import DATAROOT_ENV
+    from gnnpmb.errors import NotThisDatasetError
+
+    if not isinstance(exc, NotThisDatasetError) or os.environ.get(DATAROOT_ENV):
+        return ""
+    if any(a == "--dataroot" or a.startswith("--dataroot=") for a in args):
+        return ""
+    return (
+        f" (no --dataroot or ${DATAROOT_ENV} was given, so this is the built-in demo dataset: for your own data "
+        "pass --dataroot DIR, the folder that holds v1.0-*/)"
+    )
+
+
 _ANNOUNCED: list[str] = []
 """The stop line printed by this run, if any (``announce_stop``)."""
 
@@ -124,7 +141,7 @@ def run_app(app: Callable[..., object], argv: list[str] | None = None) -> None:
     try:
         code = app(args=argv, standalone_mode=False)
     except GnnpmbError as exc:
-        _fail(str(exc))
+        _fail(str(exc) + demo_hint(exc, sys.argv[1:] if argv is None else argv))
     except KeyboardInterrupt:
         _stopped()
     except typer.Exit as exc:

@@ -58,6 +58,14 @@ def register(app: typer.Typer) -> None:
                 "ids are those gnnpmb-viz --frames START:END --focus takes.",
             ),
         ] = None,
+        classes: Annotated[
+            str | None,
+            typer.Option(
+                metavar="CLASS,...",
+                help="Track and evaluate only these classes (default all), as gnnpmb-viz --classes does; the ids are "
+                "those gnnpmb-viz --classes CLASS,... --focus takes.",
+            ),
+        ] = None,
     ) -> None:
         """Track one scene and list its failures per frame: ID switches, fragmentations, false tracks, misses,
         coalescence and cascading identity theft (scored with the devkit's own matching). With several runs (--tracker,
@@ -74,6 +82,7 @@ def register(app: typer.Typer) -> None:
             source,
             why=why,
             frames=frames,
+            classes=classes,
         )
         foreign = {name: r.original_ids for name, r in loaded.foreign.items() if r.original_ids}
         if json_target is not None:
@@ -97,11 +106,12 @@ def failure_reports(
     *,
     why: bool,
     frames: str | None = None,
+    classes: str | None = None,
 ) -> "tuple[dict[str, FailureReport], dict[str, list[Finding]], Inputs]":
     """Every run's failure report on ``scene`` in order, its findings (with ``why``; each explained with the
     other runs' evidence beside it) and the loaded inputs; notices go to stderr. Raises a one-line error when
     the scene cannot be evaluated (no ground truth, in no split). frames: ``--frames START:END``, the keyframes
-    tracked and evaluated."""
+    tracked and evaluated; classes: ``--classes a,b``, the classes tracked and evaluated."""
     import typer
 
     from gnnpmb.stages.evaluation import find_reports
@@ -116,6 +126,7 @@ def failure_reports(
         results=results,
         **source.request_args(),
         frames=frames,
+        classes=classes,
     )
     inputs = load_inputs(request)
     for notice in inputs.notices:

@@ -9,7 +9,8 @@ its prediction with its last box's size, heading and height and half its score; 
 track. Ids are unique across classes.
 
 Usage: ``uv run python -m examples.cv_tracker --split mini_val --detector centerpoint --out cv.json``
-(``--scene scene-0103`` for one scene; ``--dataroot``/``--nuscenes-version`` for real data).
+(``--scene scene-0103`` for one scene; ``--dataroot``/``--nuscenes-version`` and ``--detections FILE.json`` for
+real data).
 """
 
 from __future__ import annotations
@@ -112,9 +113,15 @@ def _detection_box(token: str, det: Boxes, m: int, track_id: int) -> dict[str, A
 
 
 def track_scenes(
-    scene_names: Sequence[str], dataroot: Path | None, version: str | None, detector: str, seed: int = 0
+    scene_names: Sequence[str],
+    dataroot: Path | None,
+    version: str | None,
+    detector: str,
+    seed: int = 0,
+    detections_file: Path | None = None,
 ) -> dict[str, list[dict[str, Any]]]:
-    """Boxes by sample token of every keyframe of ``scene_names`` (each scene tracked on its own)."""
+    """Boxes by sample token of every keyframe of ``scene_names`` (each scene tracked on its own), on the
+    detections of ``detections_file``, else of the simulated ``detector``."""
     from gnnpmb.data.nuscenes import load_scene, resolve_dataroot
     from gnnpmb.pipeline import get_detections
 
@@ -122,7 +129,7 @@ def track_scenes(
     results: dict[str, list[dict[str, Any]]] = {}
     for name in scene_names:
         scene = load_scene(location, name)
-        detections = get_detections(scene, None, detector, seed)
+        detections = get_detections(scene, detections_file, detector, seed)
         tracker, previous = ConstantVelocityTracker(), None
         for k in scene.keyframes:
             dt_s = 0.0 if previous is None else (k.timestamp_us - previous) * 1e-6
@@ -133,6 +140,7 @@ def track_scenes(
 
 def main(argv: Sequence[str] | None = None) -> None:
     from gnnpmb.data.nuscenes import resolve_dataroot, split_scenes
+    from gnnpmb.errors import GnnpmbError
     from gnnpmb.eval.submission import SUBMISSION_META, write_json
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -140,14 +148,18 @@ def main(argv: Sequence[str] | None = None) -> None:
     where.add_argument("--scene", action="append", help="scene name (repeatable)")
     where.add_argument("--split", default="mini_val", help="split (default mini_val)")
     parser.add_argument("--detector", default="centerpoint", help="simulated detector preset")
+    parser.add_argument("--detections", type=Path, help="nuScenes detection results .json (instead of --detector)")
     parser.add_argument("--dataroot", type=Path)
     parser.add_argument("--nuscenes-version")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--out", type=Path, required=True)
     args = parser.parse_args(argv)
-    scenes = args.scene or split_scenes(args.split, resolve_dataroot(args.dataroot, args.nuscenes_version))
-    results = track_scenes(scenes, args.dataroot, args.nuscenes_version, args.detector, args.seed)
-    write_json(args.out, {"meta": dict(SUBMISSION_META), "results": results})
+    try:
+        scenes = args.scene or split_scenes(args.split, resolve_dataroot(args.dataroot, args.nuscenes_version))
+        results = track_scenes(scenes, args.dataroot, args.nuscenes_version, args.detector, args.seed, args.detections)
+        write_json(args.out, {"meta": dict(SUBMISSION_META), "results": results})
+    except GnnpmbError as exc:
+        parser.exit(2, f"error: {exc}\n")
     boxes = sum(len(b) for b in results.values())
     print(f"constant velocity: {len(scenes)} scenes, {len(results)} samples, {boxes} boxes -> {args.out}")
 

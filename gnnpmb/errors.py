@@ -13,3 +13,9 @@ class DataError(GnnpmbError):
 
 class UnknownNameError(GnnpmbError):
     """An unknown tracker, class, scene or preset name."""
+
+
+class NotThisDatasetError(DataError):
+    """An input file (detections, tracking results) without entries for samples of the dataset it is used on, or
+    with samples the dataset does not have: made for another split, version or dataset. ``cli.errors`` adds a hint
+    when the built-in demo was used because no dataroot was given."""

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from gnnpmb.data.scene import SceneData
-from gnnpmb.errors import DataError
+from gnnpmb.errors import DataError, NotThisDatasetError
 from gnnpmb.events import EventSink, Extracted, FrameStarted, MeasurementsReceived, NullSink
 from gnnpmb.pipeline import FrameResult, TrackingRun, keyframe_steps
 from gnnpmb.types import Boxes, FrameDetections, TrackEstimate
@@ -130,12 +130,14 @@ def check_coverage(
     results = data["results"]
     missing = [t for t in tokens if t not in results]
     if len(missing) == len(tokens):
-        raise DataError(
+        raise NotThisDatasetError(
             f"{source} has none of the {len(tokens)} samples of {what}; was it made for another scene, split or "
             "dataset version?"
         )
     if missing:
-        raise DataError(f"{source} lacks {len(missing)} of the {len(tokens)} samples of {what} (e.g. {missing[0]})")
+        raise NotThisDatasetError(
+            f"{source} lacks {len(missing)} of the {len(tokens)} samples of {what} (e.g. {missing[0]})"
+        )
     from gnnpmb.eval.submission import check_in_dataset
 
     wanted = set(tokens)

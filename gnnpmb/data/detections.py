@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gnnpmb.data.json_stream import JsonStreamError, NotUtf8Error
-from gnnpmb.errors import DataError
+from gnnpmb.errors import DataError, NotThisDatasetError
 from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES, Boxes
 
@@ -93,6 +93,11 @@ def _box_problem(entry: Any) -> str | None:
     """What is wrong with one box entry, or None."""
     if not isinstance(entry, dict):
         return f"is a {type(entry).__name__}, not an object"
+    if "detection_name" not in entry and "tracking_name" in entry:
+        return (
+            "is a track (tracking_name, no detection_name): this is a tracking results file, not detections; "
+            "open it with --results NAME=FILE.json, score it with gnnpmb eval FILE.json"
+        )
     for name, length in VECTOR_FIELDS:
         if name not in entry:
             return f"has no '{name}' field"
@@ -268,7 +273,7 @@ def load_detection_file(path: Path, sample_tokens: Sequence[str], scene_name: st
     missing = [t for t in sample_tokens if t not in index]
     if missing:
         where = f"the {len(sample_tokens)} " + (f"samples of {scene_name}" if scene_name else "requested samples")
-        raise DataError(
+        raise NotThisDatasetError(
             f"detections file {path.name} has no boxes entry for {len(missing)} of {where} "
             f"(first missing: {missing[0]}); is it for another split or version?"
         )

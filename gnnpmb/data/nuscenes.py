@@ -381,6 +381,13 @@ def _custom_splits(location: DatasetLocation) -> dict[str, list[str]]:
     return data
 
 
+def split_names(location: DatasetLocation) -> list[str]:
+    """Every split name ``split_scenes`` knows for ``location``: the devkit's and the custom ones, sorted."""
+    from nuscenes.utils.splits import create_splits_scenes
+
+    return sorted({**_custom_splits(location), **create_splits_scenes()})
+
+
 def split_scenes(split: str, location: DatasetLocation) -> list[str]:
     """Scene names of a devkit split (``mini_val``, ``val``, ...) or of a custom split in ``splits.json`` that
     exist in the dataset, in the split's order. Like the devkit, a predefined split wins over a custom one

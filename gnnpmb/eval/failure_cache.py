@@ -40,9 +40,10 @@ def report_key(
     tracker: str,
     results: Mapping[str, Sequence[Mapping[str, Any]]],
     keyframes: range | None = None,
+    classes: Sequence[str] | None = None,
 ) -> str:
     """Cache key (hex SHA-256) of the failure report of ``results`` (submission boxes by sample token), evaluated
-    on ``keyframes`` only (None: the whole scene)."""
+    on ``keyframes`` only (None: the whole scene) and ``classes`` only (None: all)."""
     from gnnpmb.provenance import code_version, tables_fingerprint
 
     boxes = results_digest(results)
@@ -57,6 +58,8 @@ def report_key(
     }
     if keyframes is not None:
         blob["keyframes"] = [keyframes.start, keyframes.stop]
+    if classes is not None:
+        blob["classes"] = sorted(classes)
     return hashlib.sha256(json.dumps(blob, sort_keys=True, allow_nan=True).encode()).hexdigest()
 
 
@@ -108,11 +111,12 @@ def cached_report(
     results: Mapping[str, Sequence[Mapping[str, Any]]],
     find: Callable[[], FailureReport],
     keyframes: range | None = None,
+    classes: Sequence[str] | None = None,
 ) -> FailureReport:
-    """The stored report for these inputs (evaluated on ``keyframes``, None: all), else ``find()``'s, stored under
-    ``root/failures``."""
+    """The stored report for these inputs (evaluated on ``keyframes`` and ``classes``, None: all), else ``find()``'s,
+    stored under ``root/failures``."""
     cache = ResultCache(root / FAILURES_FOLDER)
-    key = report_key(location, scene_name, tracker, results, keyframes)
+    key = report_key(location, scene_name, tracker, results, keyframes, classes)
     stored = cache.get(key)
     if stored is not None:
         try:
@@ -132,9 +136,11 @@ def scene_report(
     tracker: str,
     results: Mapping[str, Sequence[Mapping[str, Any]]],
     keyframes: range | None = None,
+    classes: Sequence[str] | None = None,
 ) -> FailureReport:
-    """The failure report of one scene's tracking results (on ``keyframes`` only, None: all): stored, else found by
-    the devkit's evaluation on a version folder holding only that scene (``gnnpmb.data.eval_subset``)."""
+    """The failure report of one scene's tracking results (on ``keyframes`` and ``classes`` only, None: all):
+    stored, else found by the devkit's evaluation on a version folder holding only that scene
+    (``gnnpmb.data.eval_subset``)."""
     from gnnpmb.cache_folder import cache_root
     from gnnpmb.data.eval_subset import eval_location
     from gnnpmb.data.nuscenes import open_nuscenes
@@ -142,9 +148,9 @@ def scene_report(
 
     def find() -> FailureReport:
         nusc = open_nuscenes(eval_location(location, [scene_name]))
-        return find_failures(nusc, scene_name, results, tracker, keyframes=keyframes)
+        return find_failures(nusc, scene_name, results, tracker, keyframes=keyframes, classes=classes)
 
-    return cached_report(cache_root(), location, scene_name, tracker, results, find, keyframes)
+    return cached_report(cache_root(), location, scene_name, tracker, results, find, keyframes, classes)
 
 
 def _drop_oldest(folder: Path, keep: int) -> None:

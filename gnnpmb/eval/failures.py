@@ -645,13 +645,16 @@ def find_failures(
     tracker: str,
     coalescence_radius_m: float = COALESCENCE_RADIUS_M,
     keyframes: range | None = None,
+    classes: Sequence[str] | None = None,
 ) -> FailureReport:
     """Evaluate one scene of a tracking submission with the devkit and list its failures.
 
     results: submission boxes keyed by sample token (``submission.run_results``); samples of the scene without
     an entry count as empty. keyframes: evaluate only these (those a ``--frames`` run tracked), as if the
-    scene held no others; None or the whole scene: all. Failures are sorted by frame, then kind, class and ids;
-    the report keeps the official metrics of the same accumulation (``FailureReport.scores``).
+    scene held no others; None or the whole scene: all. classes: evaluate only these (those a ``--classes`` run
+    tracked: the objects of the others are no one's misses); None: every tracking class. Failures are sorted by
+    frame, then kind, class and ids; the report keeps the official metrics of the same accumulation
+    (``FailureReport.scores``).
     """
     tokens = scene_sample_tokens(nusc, scene_name)
     window = range(len(tokens))
@@ -666,18 +669,20 @@ def find_failures(
             nusc, evaluated, results, split, cfg, f" of {scene_name}"
         )
         scene_token = nusc.get("sample", evaluated[0])["scene_token"]
-        classes: list[ClassEvaluation] = []
+        evaluations: list[ClassEvaluation] = []
         failures: list[Failure] = []
         matches: dict[str, list[tuple[int, str]]] = defaultdict(list)  # track -> (frame, object) it was matched to
         class_data = []
         for class_name in cfg.class_names:
+            if classes is not None and class_name not in classes:
+                continue
             md = class_evaluation(tracks_gt, tracks_pred, class_name, cfg).accumulate()
             class_data.append((class_name, md))
             if np.all(np.isnan(md.mota)):
                 continue  # no ground truth of this class: the devkit does not score it
             best = int(np.nanargmax(md.mota))
             threshold = None if np.isnan(md.confidence[best]) else float(md.confidence[best])
-            classes.append(
+            evaluations.append(
                 ClassEvaluation(
                     class_name,
                     threshold,
@@ -709,7 +714,7 @@ def find_failures(
         scene_name,
         tracker,
         tuple(tokens),
-        tuple(classes),
+        tuple(evaluations),
         tuple(_unannotated(f, annotated) for f in failures),
         coalescence_radius_m,
         track_scores,

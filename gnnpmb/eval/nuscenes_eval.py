@@ -19,13 +19,13 @@ import math
 import shutil
 import tempfile
 import warnings
-from collections.abc import Callable, Collection, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from gnnpmb.atomic import finish, temp_prefix
-from gnnpmb.errors import DataError
+from gnnpmb.errors import DataError, NotThisDatasetError
 from gnnpmb.eval.submission import check_submission, read_submission
 
 if TYPE_CHECKING:
@@ -253,18 +253,35 @@ def evaluate_submission(
             f"holds no annotation of a tracked class in its {len(scene_names)} scenes (as in a test split); the "
             "official evaluation needs ground truth to score against"
         )
-    check_submission(
-        data,
-        results_path.name,
-        split,
-        sample_tokens(location, scene_names),
-        _LazyTokens(lambda: all_sample_tokens(location)),
-    )
+    try:
+        check_submission(
+            data,
+            results_path.name,
+            split,
+            sample_tokens(location, scene_names),
+            _LazyTokens(lambda: all_sample_tokens(location)),
+        )
+    except NotThisDatasetError as exc:
+        raise NotThisDatasetError(f"{exc}{split_hint(location, data.get('results', {}), split)}") from None
     del data
     evaluated = eval_location(location, scene_names)
     return run_tracking_eval(
         results_path, evaluated.dataroot, evaluated.version, split, out_dir or default_eval_dir(results_path)
     )
+
+
+def split_hint(location: DatasetLocation, results: Any, split: str) -> str:
+    """`` It holds the N samples of split X: pass --split X`` when ``results`` (a submission's samples) are exactly
+    those of another split X of the dataset than ``split``; else empty."""
+    from gnnpmb.data.nuscenes import sample_tokens, split_names, split_scenes
+
+    if not isinstance(results, Mapping) or not results:
+        return ""
+    for name in split_names(location):
+        scenes = split_scenes(name, location) if name != split else []
+        if scenes and set(sample_tokens(location, scenes)) == set(results):
+            return f" It holds the {len(results)} samples of split {name}: pass --split {name}"
+    return ""
 
 
 class _LazyTokens(Collection[str]):

@@ -22,7 +22,7 @@ import numpy as np
 
 from gnnpmb.data.detections import LIDAR_ONLY_META, VECTOR_FIELDS, physical_problem, short_repr
 from gnnpmb.data.scene import SceneData
-from gnnpmb.errors import DataError
+from gnnpmb.errors import DataError, NotThisDatasetError
 from gnnpmb.pipeline import TrackingRun
 from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES
@@ -220,6 +220,11 @@ def _box_problem(token: str, box: Any) -> str | None:
     """What is wrong with one submission box, or None (the devkit's TrackingBox checks, and finiteness)."""
     if not isinstance(box, dict):
         return f"is a {type(box).__name__}, not an object"
+    if "tracking_name" not in box and "detection_name" in box:
+        return (
+            "is a detection (detection_name, no tracking_name): this is a detection file, not tracking results; "
+            "pass it as --detections FILE.json (gnnpmb track --detections FILE.json --out results.json tracks it)"
+        )
     for name in _REQUIRED_FIELDS + tuple(n for n, _ in VECTOR_FIELDS):
         if name not in box:
             return f"has no '{name}' field"
@@ -275,7 +280,7 @@ def check_in_dataset(source: str, tokens: Sequence[str], dataset_tokens: Collect
     one of ``dataset_tokens`` (the dataset version's)."""
     unknown = [t for t in tokens if t not in dataset_tokens]
     if unknown:
-        raise DataError(
+        raise NotThisDatasetError(
             f"{source} has {len(unknown)} samples that are not in the dataset (e.g. {unknown[0]}); was it made for "
             "another dataset version?"
         )
@@ -307,13 +312,13 @@ def check_submission(
     missing = [t for t in split_tokens if t not in results]
     extra = [t for t in results if t not in wanted]
     if missing:
-        raise DataError(
+        raise NotThisDatasetError(
             f"{source} lacks {len(missing)} of the {len(split_tokens)} samples of split {split}; "
             "was it made for another split?"
         )
     if extra:
         check_in_dataset(source, extra, dataset_tokens)
-        raise DataError(
+        raise NotThisDatasetError(
             f"{source} has {len(extra)} samples of other splits than {split} (e.g. {extra[0]}); "
             "evaluate it on the split it was made for"
         )

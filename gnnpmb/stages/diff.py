@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from gnnpmb.diff import DiffEntry, DiffResult, metric_deltas, scene_diff
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.stages.evaluation import find_reports
-from gnnpmb.stages.inputs import Inputs
+from gnnpmb.stages.inputs import Inputs, simulated_note
 from gnnpmb.stages.runs import run_all
 
 if TYPE_CHECKING:
@@ -63,6 +63,8 @@ def diff_runs(
         scene_reports.append(reports)
         for run in runs:
             results[run.name].update(run_results(run.tracking))
+    simulated = simulated_note(inputs.location, inputs.source.preset, inputs.source.seed or 0) if scenes else None
+    notices += [simulated] if simulated else []
     one_scene = [scene_reports[0][s.name] for s in specs] if len(scenes) == 1 else []
     shared = [r.scores for r in one_scene if r.scores is not None and r.frames is None]
     if len(shared) == len(specs):

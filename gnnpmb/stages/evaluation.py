@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
+from gnnpmb.classes import TRACKING_CLASSES
 from gnnpmb.errors import DataError
 from gnnpmb.stages.inputs import Inputs
 from gnnpmb.stages.runs import Run
@@ -18,7 +19,7 @@ def find_reports(
     inputs: Inputs, runs: Sequence[Run], on_done: Callable[[], None] = lambda: None
 ) -> tuple[dict[str, FailureReport], list[str]]:
     """Each run's failure report, by name, and notices: a scene without ground truth, or one the devkit cannot
-    evaluate, gives no reports."""
+    evaluate, gives no reports. Only the tracked classes (``--classes``) are evaluated."""
     from gnnpmb.eval.failure_cache import scene_report
     from gnnpmb.eval.submission import run_results
 
@@ -27,10 +28,13 @@ def find_reports(
     if missing is not None:
         return {}, [missing]
     reports = {}
+    classes = None if set(TRACKING_CLASSES) <= set(inputs.classes) else inputs.classes
     for run in runs:
         results = run_results(run.tracking)
         try:
-            reports[run.name] = scene_report(inputs.location, scene.name, run.name, results, inputs.evaluated_keyframes)
+            reports[run.name] = scene_report(
+                inputs.location, scene.name, run.name, results, inputs.evaluated_keyframes, classes
+            )
         except DataError as exc:
             return {}, [f"failure markers skipped: {exc}"]
         on_done()

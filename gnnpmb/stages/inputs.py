@@ -93,6 +93,17 @@ def frame_range_of(bounds: tuple[int | None, int | None], scene: SceneData) -> r
     return range(start, end)
 
 
+def simulated_note(location: DatasetLocation, preset: str | None, seed: int) -> str | None:
+    """The note for detections simulated (``preset``; None: a file was given) on a dataset that is not the built-in
+    demo: a user's own data, tracked on a made-up detector because --detections was left out. None otherwise."""
+    if preset is None or location.synthetic:
+        return None
+    return (
+        f"no --detections: the detections are simulated from the dataset's annotations (--detector {preset}, "
+        f"seed {seed}); pass --detections FILE.json to track your detector's"
+    )
+
+
 def detections_source(
     scene: SceneData, detections: dict[str, Boxes], detections_file: Path | None, detector: str, seed: int
 ) -> DetectionsSource:
@@ -119,6 +130,8 @@ def load_inputs(request: Request) -> Inputs:
     source = detections_source(scene, detections, request.detections_file, request.detector, request.seed)
     frame_detections = preprocess_frames(scene, detections, request.config, request.classes)
     own = _run_inputs(request.runs, scene, location, request.config, detections, frame_detections, request.classes)
+    note = simulated_note(location, None if request.detections_file else request.detector, request.seed)
+    own["notices"] = (note, *own["notices"]) if note else own["notices"]
     freeze_loaded()
     return Inputs(
         scene,

@@ -19,7 +19,7 @@ from gnnpmb.registry import TRACKER_NAMES
 from gnnpmb.stages.evaluation import find_reports
 from gnnpmb.stages.request import parse_classes, parse_frames
 from gnnpmb.stages.runs import Run
-from tests.inprocess import run_main
+from tests.inprocess import run_main, run_script
 from tests.pipeline import prepare, reports_of
 from tests.viz.rrd import at_frame, read_rows
 from viz import paths
@@ -46,7 +46,9 @@ def rows(full_run: tuple[Path, str]) -> dict:
     return read_rows(full_run[0])
 
 
-def test_summary_line_and_where_to_look_next(full_run: tuple[Path, str], demo_dataroot: Path) -> None:
+def test_summary_line_and_where_to_look_next(
+    full_run: tuple[Path, str], demo_dataroot: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out, stdout = full_run
     summary, *hints = stdout.splitlines()
     assert summary.startswith(f"{SCENE}: {N_FRAMES} frames, gnnpmb ")
@@ -62,7 +64,11 @@ def test_summary_line_and_where_to_look_next(full_run: tuple[Path, str], demo_da
     interpolated = sum(f.gt_interpolated for f in report.failures)
     assert (f"({interpolated} at a GT box the evaluation interpolated" in hint) == (interpolated > 0)
     assert f"To open {first} at its frame, add --focus {first} to this command" in hint
-    assert hint.endswith(f"to list them all: gnnpmb failures {SCENE} --tracker gnnpmb (same options).")
+    listing = f"gnnpmb failures {SCENE} --tracker gnnpmb --dataroot {demo_dataroot}"
+    assert hint.endswith(f"to list them all: {listing}")  # the command as it runs, the viewer's options left out
+    listed = run_script(listing.split(), capsys)
+    assert listed.returncode == 0, listed.stderr
+    assert listed.stdout.rstrip().endswith(f"{SCENE}, gnnpmb: {report.totals_text()}")
 
 
 def test_sensors_and_ground_truth_on_every_frame(rows: dict) -> None:

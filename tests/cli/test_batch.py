@@ -267,3 +267,60 @@ def test_a_stop_that_click_turned_into_abort_still_exits_130_with_its_line(capsy
         run_app(app, [])
     assert stop.value.code == 130
     assert capsys.readouterr().err.strip() == "interrupted by Ctrl-C: unfinished outputs were not written"
+
+
+def test_classes_are_the_only_ones_evaluated_in_failures_and_the_viewer(
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--classes car``: the failures are the cars' alone (the other classes, not tracked, are no one's misses),
+    the same in ``gnnpmb failures`` and in ``gnnpmb-viz``'s summary, so the ids one lists the other opens."""
+    from tests.inprocess import run_script
+
+    common = ["scene-0103", "--classes", "car", "--frames", "0:10", "--dataroot", str(demo_dataroot)]
+    listed = run_script(["gnnpmb", "failures", *common, "--json", str(tmp_path / "f.json")], capsys)
+    assert listed.returncode == 0, listed.stderr
+    report = json.loads((tmp_path / "f.json").read_text())
+    assert [c["class_name"] for c in report["classes"]] == ["car"]
+    assert {f["class_name"] for f in report["failures"]} <= {"car"}
+    (car,) = report["classes"]
+    assert report["totals"]["miss"] == car["fn"]
+    (totals,) = re.findall(
+        r"scene-0103, gnnpmb in keyframes 0:10 \(only those were tracked and evaluated\): (.*)", listed.stdout
+    )
+    shown = run_script(["gnnpmb-viz", *common, "--save", str(tmp_path / "x.rrd"), "--no-progress"], capsys)
+    assert shown.returncode == 0, shown.stderr
+    assert f"gnnpmb failures in keyframes 0:10 (only those were tracked and evaluated): {totals}" in shown.stdout
+
+
+@pytest.mark.parametrize("command", ["eval {r} --split staged", "diff mine={r} greedy --split staged"])
+def test_a_results_file_of_another_split_names_that_split(
+    command: str, tracked: tuple[Path, str], demo_dataroot: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A submission of mini_val scored or diffed on another split: the error line names the split it holds."""
+    argv = [*command.format(r=tracked[0]).split(), "--dataroot", str(demo_dataroot)]
+    code, out, err = run(argv, capsys)
+    assert code == 2 and out == ""
+    assert err.startswith("error: results.json ") and len(err.splitlines()) == 1, err
+    assert err.rstrip().endswith(f"It holds the {N_SAMPLES} samples of split mini_val: pass --split mini_val")
+
+
+def test_a_failed_track_prints_its_error_line_alone(
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With the progress bar on (the default) and stderr no terminal (a pipe, a CI log), a track that fails
+    prints its one ``error:`` line and nothing else: no empty line left by the bar."""
+    detections = tmp_path / "det.json"
+    detections.write_text(json.dumps({"meta": {}, "results": {"0" * 32: []}}))
+    argv = [
+        "track",
+        "--dataroot",
+        str(demo_dataroot),
+        "--detections",
+        str(detections),
+        "--out",
+        str(tmp_path / "r.json"),
+    ]
+    code, out, err = run(argv, capsys)
+    assert (code, out) == (2, "")
+    assert err.startswith("error: detections file det.json has no boxes entry") and err.count("\n") == 1, repr(err)
+    assert not (tmp_path / "r.json").exists()

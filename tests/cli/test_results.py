@@ -123,3 +123,30 @@ def test_a_recording_of_a_results_file_and_a_tracker_with_its_own_parameters_rep
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
         viz_main(["reproduce", str(rec)])
     assert "cv: identical (6 frames)" in out.getvalue() and "gnnpmb-paper: identical (6 frames)" in out.getvalue()
+
+
+def test_the_example_tracker_runs_on_ones_own_detection_file(demo_dataroot: Path, tmp_path: Path) -> None:
+    """``examples/cv_tracker.py`` (docs/debugging.md's "a constant-velocity tracker of your own") on a detection file
+    of one's own: it tracks that file's boxes; a bad dataroot is one ``error:`` line, exit 2, no file written."""
+    tables = demo_dataroot / "v1.0-mini"
+    scene = next(s for s in json.loads((tables / "scene.json").read_text()) if s["name"] == SCENE)
+    samples = {s["token"]: s for s in json.loads((tables / "sample.json").read_text())}
+    first = samples[scene["first_sample_token"]]
+    box = {"translation": [600.0, 1600.0, 1.0], "size": [2.0, 4.5, 1.6], "rotation": [1.0, 0.0, 0.0, 0.0]}
+    box |= {"velocity": [0.0, 0.0], "detection_name": "car", "detection_score": 0.9}
+    detections = tmp_path / "det.json"
+    detections.write_text(json.dumps({"meta": {}, "results": {t: [] for t in samples} | {first["token"]: [box]}}))
+    out = tmp_path / "cv.json"
+    cv = [sys.executable, "-m", "examples.cv_tracker", "--scene", SCENE, "--out", str(out)]
+    done = subprocess.run(
+        [*cv, "--dataroot", str(demo_dataroot), "--detections", str(detections)], capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    results = json.loads(out.read_text())["results"]
+    assert [b["translation"] for b in results[first["token"]]] == [box["translation"]]
+    assert sum(len(b) for b in results.values()) == 1 + 2  # the car, then coasting for MAX_MISSES frames
+    out.unlink()
+    done = subprocess.run([*cv, "--dataroot", str(tmp_path / "nope")], capture_output=True, text=True)
+    assert done.returncode == 2
+    assert done.stderr.startswith("error: dataroot ") and len(done.stderr.splitlines()) == 1, done.stderr
+    assert not out.exists()

@@ -220,9 +220,41 @@ def _box_case(field: str, value: object, expected: str) -> DataCase:
     )
 
 
+def _swapped_file(path: Path, demo: Path, kind: str) -> None:
+    """A well-formed file of the other kind than the command expects, for the demo's mini_val samples: a detection
+    file (``kind`` "detection") or a tracking submission ("tracking")."""
+    meta = {"use_camera": False, "use_lidar": True, "use_radar": False, "use_map": False, "use_external": False}
+    box = {"translation": [600.0, 1600.0, 1.0], "size": [2.0, 4.5, 1.6], "rotation": [1.0, 0.0, 0.0, 0.0]}
+    box |= {"velocity": [0.0, 0.0]}
+    if kind == "detection":
+        box |= {"detection_name": "car", "detection_score": 0.9}
+    else:
+        box |= {"tracking_name": "car", "tracking_score": 0.9, "tracking_id": "1"}
+    results = {t: [box | {"sample_token": t}] for t in _split_tokens(demo)}
+    path.write_text(json.dumps({"meta": meta, "results": results}))
+
+
 CASES_WITH_DATA: tuple[DataCase, ...] = (
     # the other field checks are unit tests (tests/gnnpmb/data/test_detections.py)
     _box_case("size", [2.0, -4.5, 1.6], "field 'size' must be positive"),
+    DataCase(
+        "eval a detection file",
+        lambda path, demo: _swapped_file(path, demo, "detection"),
+        "gnnpmb eval {w}/input.json --split mini_val --out {w}/ev",
+        "this is a detection file, not tracking results; pass it as --detections FILE.json",
+    ),
+    DataCase(
+        "results run of a detection file",
+        lambda path, demo: _swapped_file(path, demo, "detection"),
+        "gnnpmb failures scene-0103 --results mine={w}/input.json",
+        "this is a detection file, not tracking results",
+    ),
+    DataCase(
+        "tracking results as detections",
+        lambda path, demo: _swapped_file(path, demo, "tracking"),
+        f"{VIZ} scene-0103 --detections {{w}}/input.json {SAVE} --no-progress",
+        "this is a tracking results file, not detections; open it with --results NAME=FILE.json",
+    ),
     # duplicate ids: tests/gnnpmb/eval/test_submission.py
     DataCase(
         "eval empty submission",
@@ -423,3 +455,55 @@ def test_ctrl_c_while_saving_leaves_no_partial_file(demo_dataroot: Path, tmp_pat
     assert proc.returncode == 130, err
     assert err == "interrupted by Ctrl-C: unfinished outputs were not written\n"
     assert _snapshot(work) == before
+
+
+def _other_dataset_files(work: Path) -> None:
+    """A detection file and a tracking submission of a dataset that is not the demo (sample tokens it lacks)."""
+    box = {"translation": [1.0, 2.0, 1.0], "size": [2.0, 4.5, 1.6], "rotation": [1.0, 0.0, 0.0, 0.0]}
+    box |= {"velocity": [0.0, 0.0], "sample_token": "0" * 32}
+    det = box | {"detection_name": "car", "detection_score": 0.9}
+    track = box | {"tracking_name": "car", "tracking_score": 0.9, "tracking_id": "1"}
+    meta = {"use_camera": False, "use_lidar": True, "use_radar": False, "use_map": False, "use_external": False}
+    (work / "own_det.json").write_text(json.dumps({"meta": meta, "results": {"0" * 32: [det]}}))
+    (work / "own_results.json").write_text(json.dumps({"meta": meta, "results": {"0" * 32: [track]}}))
+
+
+NO_DATAROOT = "no --dataroot or $NUSCENES_DATAROOT was given, so this is the built-in demo dataset"
+
+
+@pytest.mark.parametrize(
+    ("command", "expected"),
+    [
+        (f"{VIZ} scene-0103 --detections {{w}}/own_det.json {SAVE} --no-progress", "has no boxes entry for 40"),
+        ("gnnpmb failures scene-0103 --detections {w}/own_det.json", "has no boxes entry for 40"),
+        ("gnnpmb failures scene-0103 --results mine={w}/own_results.json", "has none of the 40 samples"),
+        ("gnnpmb eval {w}/own_results.json --split mini_val --out {w}/ev", "lacks 80 of the 80 samples"),
+    ],
+    ids=["viz detections", "failures detections", "failures results", "eval"],
+)
+def test_own_files_without_a_dataroot_say_the_demo_was_used(
+    command: str,
+    expected: str,
+    demo_dataroot: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A new user's first mistake: their own detection or results file, and no --dataroot. The demo is used, so
+    the file fits none of its samples; the error line says why and how to point at their data."""
+    import gnnpmb.data.nuscenes
+
+    work = _work_folder(tmp_path / "w")
+    _other_dataset_files(work)
+    before = _snapshot(work)
+    monkeypatch.setattr(gnnpmb.data.nuscenes, "ensure_demo_dataset", lambda *a, **k: demo_dataroot)
+    env = {k: v for k, v in _env(demo_dataroot).items() if k != "NUSCENES_DATAROOT"}
+    proc = run_script_with(command.format(w=work).split(), env, work, monkeypatch, capsys)
+    assert _check(command, proc, expected) == []
+    assert NO_DATAROOT in proc.stderr
+    assert "pass --dataroot DIR" in proc.stderr
+    assert _snapshot(work) == before
+    with_root = f"{command} --dataroot {demo_dataroot}".format(w=work).split()
+    proc = run_script_with(with_root, env, work, monkeypatch, capsys)
+    assert _check(command, proc, expected) == []
+    assert NO_DATAROOT not in proc.stderr

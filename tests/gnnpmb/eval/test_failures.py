@@ -193,6 +193,16 @@ def test_staged_cascading_identity_theft(nusc, scene: SceneData, gt: dict) -> No
     assert "ghost took GT" in thefts[0].describe() and "cascade step 2" in thefts[1].describe()
 
 
+def test_only_the_tracked_classes_are_evaluated(nusc, gt: dict) -> None:
+    """A run of one class (``--classes car``): the other classes' objects are no one's misses."""
+    cars = {token: [b for b in boxes if b["tracking_name"] == "car"] for token, boxes in gt.items()}
+    report = find_failures(nusc, SCENE, cars, "cars", classes=("car",))
+    assert report.failures == ()
+    assert [c.class_name for c in report.classes] == ["car"]
+    every = find_failures(nusc, SCENE, cars, "cars")
+    assert {f.class_name for f in every.failures} == {c.class_name for c in every.classes} - {"car"}
+
+
 def test_failures_of_a_tracker_run_add_up_to_the_devkits_counts(nusc, scene: SceneData) -> None:
     run = run_tracker(scene, get_detections(scene, None, "pointpillars", 0), "gnnpmb", TrackerConfig())
     report = find_failures(nusc, SCENE, run_results(run), "gnnpmb")
