@@ -70,7 +70,14 @@ def calibrate(
     from gnnpmb.atomic import write_text
     from gnnpmb.calibration import calibrate as learn
     from gnnpmb.calibration import calibration_toml
-    from gnnpmb.calibration_check import CHECK_TRACKER, MARGIN_AMOTA, candidate_values, check_jobs, cross_validate
+    from gnnpmb.calibration_check import (
+        CHECK_TRACKER,
+        MARGIN_AMOTA,
+        candidate_values,
+        check_jobs,
+        cross_validate,
+        unchecked_note,
+    )
     from gnnpmb.config import TrackerConfig
     from gnnpmb.data.detections import check_detection_file
     from gnnpmb.data.nuscenes import load_scene, split_scenes
@@ -132,7 +139,9 @@ def calibrate(
             kept = candidate_values(result.chosen[c], learnt[c])
             withheld[c] = [v for v in learnt[c] if v not in kept]
             learnt[c] = kept
-            notes[c] = [f"check: {result.reason(c)}", *notes[c]]
+            unchecked = unchecked_note(kept)
+            check = [f"check of {CHECK_TRACKER}'s values: {result.reason(c)}", *([unchecked] if unchecked else [])]
+            notes[c] = [*check, *notes[c]]
         header += (
             f"\nChecked by a {folds}-fold cross-validation by scenes on the same split with {CHECK_TRACKER}, scored "
             f"with the official evaluation: per class, the defaults unless a candidate beat them by {MARGIN_AMOTA:g} "

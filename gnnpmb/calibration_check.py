@@ -62,6 +62,16 @@ def _checked(item: Learnt) -> bool:
     return item.table.rsplit(".", 1)[-1] not in _UNCHECKED_TABLES
 
 
+def unchecked_note(learnt: Sequence[Learnt]) -> str | None:
+    """The file's line for one class's values the check's tracker does not read, or None when there are none:
+    written as learnt whatever the check chose, which a reader of "the defaults kept" must be told."""
+    tables = sorted({v.table.rsplit(".", 1)[-1] for v in learnt if not _checked(v)})
+    if not tables:
+        return None
+    where = " and ".join(f"[{t}]" for t in tables)
+    return f"{where} written as learnt: read by the PHD/CPHD and JPDA/GNN trackers, which the check does not run"
+
+
 def candidate_values(name: str, learnt: Sequence[Learnt]) -> list[Learnt]:
     """The values of one class's ``learnt`` that candidate ``name`` writes."""
     if name == LEARNT:

@@ -160,7 +160,11 @@ def test_the_file_holds_what_the_printed_check_chose_and_says_what_it_left_out(
         mine = [Learnt(t, k, v, "") for (t, k), v in learnt.items() if t.split(".")[1] == cls]
         expected = {(v.table, v.key) for v in candidate_values(chosen, mine)}
         assert {k for k in written if k[0].split(".")[1] == cls} == expected, cls
-        assert re.search(rf"^# {cls}: check: ", text, re.M), cls
+        assert re.search(rf"^# {cls}: check of gnnpmb's values: ", text, re.M), cls
+        unchecked = sorted({t.rsplit(".", 1)[-1] for (t, _) in written if t.split(".")[1] == cls} & {"phd", "vector"})
+        said = re.search(rf"^# {cls}: (.*) written as learnt: read by the PHD/CPHD and JPDA/GNN trackers", text, re.M)
+        # a class whose gnnpmb values the check left at the defaults still gets the other families' values: said so
+        assert (said.group(1) if said else None) == (" and ".join(f"[{t}]" for t in unchecked) or None), cls
     summary = stdout.strip().splitlines()[-1]
     assert summary.startswith(f"calibrate: {len(written)} per-class values from 2 scenes of mini_val, ")
     assert f", {len(left_out)} left out by the check -> " in summary
