@@ -146,7 +146,8 @@ def run_view(
         else:
             opened = recording(recording_name(inputs, focus), inputs.save, blueprint)
         with opened as stream:
-            sensors_task = bar.add_task(f"{scene.name} sensors", total=len(shown))
+            logged = "boxes and LiDAR" if points_loader is not None else "boxes (no LiDAR files)"
+            sensors_task = bar.add_task(f"{scene.name} {logged}", total=len(shown))
             log_scene(
                 stream,
                 scene,
