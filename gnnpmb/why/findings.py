@@ -189,6 +189,9 @@ class Sighting:
     on_it: tuple[OnObject, ...]
     removed_own: Near | None = None
     radar_points: int = 0
+    in_box: Near | None = None
+    """With no detection of any class within ``NEAR_M``: the nearest one whose centre lies inside the object's box
+    (a long truck seen as two boxes, world6: a sight of part of it, not no sight)."""
 
     @property
     def lidar_points(self) -> int:
@@ -273,6 +276,8 @@ class Origin:
     false_frames: tuple[int, ...] = ()
     victim_held: bool = False
     of_no_object: bool = False
+    part_of: tuple[str, str, float] | None = None
+    """Of no object, but inside this object's box (id, class, m from its centre): see ``Reasoner.part_of``."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -297,6 +302,8 @@ class Deciding:
     lost_would: WouldTake | None = None
     alternative_took: int | None = None
     meas_of_no_object: bool = False
+    meas_part_of: tuple[str, str, float] | None = None
+    """Of no object, but inside this object's box (id, class, m from its centre)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -362,6 +369,9 @@ class FalseOutput:
     threshold: float | None
     object_missed: bool = False
     use: Use | None = None
+    part_of: tuple[str, str, float] | None = None
+    """No object within ``NEAR_M``, but the box's centre lies inside this object's box (id, class, m from its
+    centre): the track was on part of it."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -593,12 +593,28 @@ def _detector_gaps(f: Finding) -> list[str]:
             seen = [by[x] for x in b.frames if x in by]
             out.append(
                 f"at {frames_text(b.frames)} the detector gave {no_detection(seen)}, though it had {points_text(seen)}"
+                f"{_in_box_text(seen)}"
             )
         elif b.rule is Rule.OTHER_CLASS:
             seen = [by[x].seen for x in b.frames if x in by and by[x].seen is not None]
             what = ", ".join(f"{n.class_name} {meas_name(n.meas)} {n.distance_m:.2f} m away" for n in seen)
             out.append(f"at {frames_text(b.frames)} the detector saw it only as another class ({what})")
     return out
+
+
+def _in_box_text(seen: Sequence[Sighting]) -> str:
+    """``, but at frame 13 truck m20 lay inside its box, 3.2 m from its centre (the detector saw part of it)``: the
+    detections a "no detection within 2 m" hides (audit truth50, world6: a 16 m truck seen as two boxes)."""
+    inside = [s for s in seen if s.in_box is not None]
+    if not inside:
+        return ""
+    what = ", ".join(
+        f"{'at frame ' + str(s.frame) + ' ' if len(seen) > 1 else ''}{s.in_box.class_name} {meas_name(s.in_box.meas)} "
+        f"{s.in_box.distance_m:.1f} m"
+        for s in inside[:3]
+    )
+    more = f" and at {len(inside) - 3} more frames" if len(inside) > 3 else ""
+    return f", but inside its box, farther from its centre, lay {what}{more} (the detector saw part of it)"
 
 
 def _hidden(f: Finding) -> list[str]:
@@ -866,7 +882,7 @@ def _lost_object(f: Finding) -> list[str]:
         lead = "then" if d.frame >= f.frame else "the deciding choice was earlier"
         parts.append(f"{lead}, {choice_text(d.frame, d.choice, d.went, d.born, d.alternative_took)}")
         if d.meas_of_no_object:  # truth49 world5 scene-0553 gnn: m24 was the false bus, nowhere said
-            parts.append(f"{meas_name(d.choice.meas.ref)} at frame {d.frame} was {_of_no_object()}")
+            parts.append(f"{meas_name(d.choice.meas.ref)} at frame {d.frame} was {_of_no_object(d.meas_part_of)}")
         parts += _where_from(f)
     elif f.taker is not None and f.taker.frame >= 0:
         o = f.taker
@@ -875,7 +891,7 @@ def _lost_object(f: Finding) -> list[str]:
         elif o.meas >= 0:
             # audit truth49 (world5 scene-0553, a false bus beside a bus's path): the thief's first detection was
             # of no object; the story needs it said where it started, not only its later false frames
-            false = f", {_of_no_object()}" if o.of_no_object else ""
+            false = f", {_of_no_object(o.part_of)}" if o.of_no_object else ""
             parts.append(f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}{false}")
         elif f.switch is not None:
             parts.append(f"track {o.track_id} had existed since frame {o.frame} in a hypothesis other than the best")
@@ -1085,6 +1101,12 @@ def _false_track(f: Finding) -> list[str]:
         parts.append(
             f"no {f.class_name} GT lies within {NEAR_M:.0f} m, but GT {cls} {short_id(gt_id)} does ({d:.1f} m): {what}"
         )
+    elif o.part_of is not None:  # audit truth50 (world6): a truck's trailer box is no "box where no object was"
+        what = "the detection" if o.on is not None else "the box"
+        parts.append(
+            f"no object of a tracked class lies within {NEAR_M:.0f} m, but {what} lies on part of "
+            f"{_part_text(o.part_of)}"
+        )
     elif o.on is not None:
         parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of no tracked object")
     elif Rule.TRACK_INTERPOLATED in tests:
@@ -1216,6 +1238,13 @@ def _miss(f: Finding) -> list[str]:
         parts.append(
             f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and "
             f"{no_detection([s])}{carried}"
+        )
+    elif s.undetected and s.nearest_any is None and s.in_box is not None:  # audit truth50: a split truck
+        n = s.in_box
+        parts.append(
+            f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
+            f"({inside}), only {n.class_name} {meas_name(n.meas)} (score {n.score:.2f}) inside its box, "
+            f"{n.distance_m:.1f} m from its centre: the detector saw part of it"
         )
     elif s.undetected and s.nearest_any is None:
         parts.append(
@@ -1367,10 +1396,20 @@ def _others(f: Finding) -> list[str]:
     return out
 
 
-def _of_no_object() -> str:
+def _of_no_object(part: tuple[str, str, float] | None = None) -> str:
     """What a detection with no annotated object of a tracked class within ``NEAR_M`` was (audit truth49: a false
-    bus's detections)."""
+    bus's detections), or, inside an object's box (``part``), a sight of part of it (audit truth50: a truck's
+    trailer box)."""
+    if part is not None:
+        return f"a detection of part of {_part_text(part)}"
     return f"a detection of no object (none of a tracked class within {NEAR_M:.0f} m)"
+
+
+def _part_text(part: tuple[str, str, float]) -> str:
+    """``truck GT ecf44b (inside its box, 3.5 m from its centre, beyond the evaluation's 2 m)``."""
+    gt_id, cls, d = part
+    where = f"inside its box, {d:.1f} m from its centre, beyond the evaluation's {NEAR_M:.0f} m"
+    return f"{cls} GT {short_id(gt_id)} ({where})"
 
 
 def _beside(o: OnObject, frame: int) -> bool:
