@@ -1730,3 +1730,54 @@ def test_a_deciding_choice_led_by_the_wrong_word_and_a_detection_of_no_object_sa
     started = "track 11 had been started at frame 3 by m1"
     assert kinds(f"{started}, a detection of no object (none of a tracked class within 2 m)", born) == []
     assert kinds(started, born) == ["misleading"]
+
+
+def test_a_box_inside_a_long_objects_box_said_to_be_of_no_object_is_caught() -> None:
+    # audit truth50, world6 scene-0916 / scene-0796: a 16 m truck with trailer detected as a cab box 4.75 m ahead of
+    # its centre and a trailer box 3.25 m behind it; "a detection of no object", "where no tracked object was" and
+    # "the detector missed it" said of boxes inside the truck's own box
+    from gnnpmb.events import Born
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    truck = "c" * 32
+    objects = [{truck: Annotation("truck", (0.0, 0.0), 200, 0, (2.6, 16.0, 0.0))} for _ in range(4)]
+    scene = SceneTruth([[Detection("truck", 0.7, (4.75, 0.0)), Detection("truck", 0.6, (-3.25, 0.0))]] * 4, objects)
+    born = _raw_with(Born("truck", np.array([11]), np.array([1]), np.zeros((1, 4)), np.ones(1)))
+    at = Context("truck", 3, truck)
+
+    def kinds(text: str, ctx: Context = at, ev: EvalFacts | None = None) -> list[str]:
+        return [c.kind for c in check_text(text, ctx, born, ev or _eval(), scene=scene).found]
+
+    started = "track 11 had been started at frame 3 by m1"
+    assert kinds(f"{started}, a detection of no object (none of a tracked class within 2 m)") == ["misleading"]
+    part = "a detection of part of truck GT cccccc (inside its box, 3.2 m from its centre, beyond the evaluation's 2 m)"
+    assert kinds(f"{started}, {part}") == []
+    assert kinds(f"{started}, {part.replace('cccccc', 'aaaaaa')}") == ["detector"]  # not inside GT A's box
+    missed = (
+        "at frame 3 the detector gave no detection of a tracked class within 2 m of truck GT cccccc (200 LiDAR and "
+        "radar points in its box)"
+    )
+    assert kinds(f"{missed}: the detector missed it") == ["misleading"]
+    assert (
+        kinds(f"{missed}, only truck m1 (score 0.60) inside its box, 3.2 m from its centre: the detector saw part")
+        == []
+    )
+    gap = (
+        "at frame 3 the detector gave no detection of a tracked class within 2 m, though it had 200 LiDAR and radar "
+        "points"
+    )
+    assert kinds(gap) == ["misleading"]
+    assert (
+        kinds(f"{gap}, but inside its box, farther from its centre, lay truck m1 3.2 m (the detector saw part of it)")
+        == []
+    )
+    # a false track's box on the trailer
+    ev = _eval()
+    ev.boxes[3] = [("12", "truck", (-3.0, 0.0))]
+    false = Context("truck", 3, None, kind="false_track", track=12)
+    nothing = "no object of a tracked class lies within 2 m: the tracker output a box where no tracked object was"
+    assert kinds(nothing, false, ev) == ["misleading"]
+    on_part = (
+        "no object of a tracked class lies within 2 m, but the box lies on part of truck GT cccccc (inside its box"
+    )
+    assert kinds(on_part, false, ev) == []

@@ -265,6 +265,7 @@ def check_text(
             near = [k[:6] for k, a in here.items() if math.hypot(a.xy_m[0] - where[0], a.xy_m[1] - where[1]) < 2.0]
             if near:
                 bad("detector", m[0], f"annotated objects within 2 m of track {ctx.track}'s box: {near}")
+            _part_of(text[m.end() :], where, ctx.frame, m[0], scene, out, bad)
     for phrase in VIEWER_ONLY:
         if phrase in text:
             out.checked["misleading"] += 1
@@ -372,7 +373,7 @@ LEAD = re.compile(r"(then|the deciding choice was earlier), frame (\d+): (?:clos
 run up to the failure's frame), "earlier" as before the failure's frame."""
 NO_OBJECT = re.compile(
     r"(?:track \d+ had been started at frame (\d+) by m(\d+)|\bm(\d+) at frame (\d+) was)"
-    r"(, a detection of no object| a detection of no object)?"
+    r"(,? a detection of (no object|part of \w+ GT (\w+)))?"
 )
 """A thief's starting detection, or a deciding detection said of no object: of no object exactly when no annotation
 of a tracked class lies within 2 m of it (audit truth49, world5: a false bus that took a real bus's ID)."""
@@ -396,13 +397,16 @@ def _check_lead_and_no_object(text: str, frame: int, scene: SceneTruth | None, o
         said[(x, meas)] = said.get((x, meas), False) or m[5] is not None
         between = text.startswith(" instead of", m.end())  # a track between the two (``_where_from``): not the thief
         if (m[1] is not None and not between) or m[5] is not None:
-            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad)
+            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad, m[7])
     for x, meas, m in deciding:
         if (x, meas) not in said:
             _no_object(x, meas, False, m[0], scene, out, bad)
 
 
-def _no_object(x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, out: Tally, bad) -> None:
+def _no_object(
+    x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, out: Tally, bad, part: str | None = None
+) -> None:
+    """``said``: "a detection of no object" or of ``part`` of an object (its short id) was said of ``meas``."""
     if x >= len(scene.detections) or meas >= len(scene.detections[x]):
         return
     out.checked["detector"] += 1
@@ -412,6 +416,22 @@ def _no_object(x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, 
         bad("detector", sentence, f"m{meas} at frame {x} lies {near:.2f} m from an annotated object")
     elif not said and near >= NEAR_M:
         bad("misleading", sentence, f"m{meas} at frame {x} lies {near:.2f} m from every annotated object: unsaid")
+    elif said:
+        tail = f"part of GT {part}" if part is not None else ""
+        _part_of(tail, xy, x, sentence, scene, out, bad)
+
+
+def _part_of(tail: str, xy, frame: int, sentence: str, scene: SceneTruth, out: Tally, bad) -> None:
+    """A point said to lie within 2 m of no object, ``tail`` the text after it: misleading where it lies inside an
+    annotated object's box and ``tail`` does not start by saying so; wrong where it names an object whose box does
+    not contain it."""
+    inside = scene.inside(frame, tuple(xy))
+    said = re.match(r"(?:, but (?:the detection|the box) lies on |, a detection of )?part of (\w+ )?GT (\w+)", tail)
+    out.checked["misleading"] += 1
+    if said is None and inside:
+        bad("misleading", sentence, f"inside the box of {[k[:6] for k in inside]} at frame {frame}: unsaid")
+    elif said is not None and not any(k.startswith(said[2]) for k in inside):
+        bad("detector", sentence, f"not inside GT {said[2]}'s box at frame {frame} (inside {[k[:6] for k in inside]})")
 
 
 def _patterns() -> list[re.Pattern]:
