@@ -492,6 +492,19 @@ class _Context:
             return None
         return part_of(self.scene.keyframes[frame].gt, fr.detections.boxes.translation_m[meas, :2])
 
+    def own_detections(self, frame: int, gt_id: str) -> tuple[int, ...]:
+        """The kept detections of the class within ``NEAR_M`` of object ``gt_id`` at ``frame`` that lie nearer it
+        than any other annotated object (a detector without NMS gives one object two: audit truth50, world6)."""
+        xy, fr = self.gt_xy(gt_id, frame), self.frames.get(frame)
+        if xy is None or fr is None or not len(fr.detections.boxes.score):
+            return ()
+        boxes = fr.detections.boxes
+        d = np.hypot(*(boxes.translation_m[:, :2] - np.asarray(xy)[:2]).T)
+        ok = (d < NEAR_M) & fr.detections.kept & (boxes.class_name == self.class_name)
+        idx = np.flatnonzero(ok)
+        other = self.nearer_object(frame, boxes.translation_m[idx, :2], d[idx])
+        return tuple(int(m) for m, o in zip(idx.tolist(), other, strict=True) if o is None)
+
     def in_box(self, frame: int, gt_id: str) -> Near | None:
         """The nearest detection of ``frame`` whose centre lies inside object ``gt_id``'s box (None: none)."""
         gt, fr = self.scene.keyframes[frame].gt, self.frames.get(frame)
@@ -664,6 +677,7 @@ class _Context:
         mine = np.flatnonzero(gt.class_name == self.class_name) if len(gt) else np.zeros(0, int)
         nearest_own = nearest_any = None
         matched = None
+        twins: tuple[int, ...] = ()
         if mine.size and d[mine].min() < NEAR_M:
             k = int(mine[np.argmin(d[mine])])
             gt_id = str(gt.instance_id[k])
@@ -684,6 +698,9 @@ class _Context:
             elif g.status is GtStatus.INTERPOLATED and np.hypot(*(np.asarray(g.evaluated_xy_m) - xy)) >= NEAR_M:
                 blame.append(Blame(Rule.INTERPOLATED, (self.f,)))
             else:
+                twins = self.own_detections(self.f, nearest_own[0])
+                if len(twins) >= 2:  # the detector's first, as its other tests (whose doing, in order)
+                    blame.append(Blame(Rule.TWO_DETECTIONS, (self.f,)))
                 blame.append(Blame(Rule.TWO_TRACKS, (self.f,)))
         elif e is None:
             pass  # no box of the tracker's here
@@ -706,6 +723,7 @@ class _Context:
             nearest_own is not None and self.missed_at(nearest_own[0], self.f),
             step.use if (step := self.facts.steps(t, self.class_name).get(self.f)) is not None else None,
             part_of(gt, xy) if nearest_any is None else None,
+            twins if len(twins) >= 2 else (),
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
 

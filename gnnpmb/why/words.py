@@ -1093,6 +1093,10 @@ def _false_track(f: Finding) -> list[str]:
         else:
             other = f" (track {o.matched_instead})" if o.matched_instead is not None else ""
             parts.append(f"{on} and the evaluation matched it to another track{other}: two tracks on one object")
+            if o.twins:  # audit truth50 (world6, a detector without NMS): not the tracker's doing alone
+                n = "two" if len(o.twins) == 2 else str(len(o.twins))
+                what = ", ".join(meas_name(m) for m in o.twins)
+                parts.append(f"the detector gave it {n} {f.class_name} detections within {NEAR_M:.0f} m ({what})")
     elif o.nearest_any is not None:
         gt_id, cls, d = o.nearest_any
         what = "the detector gave it the wrong class" if o.on is not None else "the track coasted onto it"

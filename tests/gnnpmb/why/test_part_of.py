@@ -97,3 +97,34 @@ def test_the_why_says_a_split_objects_boxes_were_on_part_of_it() -> None:
         "saw part of it"
     ) in line
     assert "the detector missed it" not in line
+
+
+def test_a_second_track_on_an_object_the_detector_gave_two_boxes_of_is_not_the_trackers_doing_alone() -> None:
+    # audit truth50, world6 scene-0655 centerpoint gnn false_track:15 (a detector without NMS: a second pedestrian
+    # box 0.3-0.8 m from the first): "two tracks on one object", the tracker's doing, with the detector's two boxes
+    # of it unsaid
+    from gnnpmb.why.findings import Party
+
+    ctx = truck_split()
+    ctx.gt_xy = lambda gt_id, frame: np.zeros(2) if gt_id == TRUCK else None
+    boxes = ctx.frames[14].detections.boxes
+    boxes.translation_m = np.array([[0.2, 0.0, 1.9], [-0.4, 0.3, 1.9], [1.5, 0.0, 1.9]])
+    ctx.frames[14].detections.kept = np.array([True, True, False])  # m2 dropped by preprocessing: not seen
+    assert ctx.own_detections(14, TRUCK) == (0, 1)
+    out = FalseOutput(72, None, (-0.4, 0.3), None, (TRUCK, 0.5, None), None, 41, None, None, twins=(0, 1))
+    blame = (Blame(Rule.TWO_DETECTIONS, (14,)), Blame(Rule.TWO_TRACKS, (14,)))
+    f = finding(
+        FailureKind.FALSE_TRACK,
+        class_name="truck",
+        gt_id=None,
+        track_ids=(72,),
+        frame=14,
+        false_output=out,
+        blame=blame,
+    )
+    (line, *_) = why_lines(f)
+    assert (
+        "truck GT ecf44b lies 0.5 m away and the evaluation matched it to another track (track 41): two tracks on one "
+        "object; the detector gave it two truck detections within 2 m (m0, m1)"
+    ) in line
+    assert Rule.TWO_DETECTIONS.party is Party.DETECTOR and line.startswith("**Why** (gnnpmb, the detector's and")
