@@ -1781,3 +1781,25 @@ def test_a_box_inside_a_long_objects_box_said_to_be_of_no_object_is_caught() -> 
         "no object of a tracked class lies within 2 m, but the box lies on part of truck GT cccccc (inside its box"
     )
     assert kinds(on_part, false, ev) == []
+
+
+def test_two_tracks_on_one_object_the_detector_gave_two_boxes_of_must_say_so() -> None:
+    # audit truth50, world6 scene-0655 (a detector without NMS): "two tracks on one object", the tracker's doing,
+    # where the detector gave the pedestrian two boxes 0.5 m apart
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    objects = [{GT_A: Annotation(C, (0.0, 0.0), 9), GT_B: Annotation(C, (30.0, 0.0), 9)}] * 4
+    scene = SceneTruth([[Detection(C, 0.9, (0.3, 0.0)), Detection(C, 0.5, (-0.3, 0.2))]] * 4, objects)
+    ev = _eval()
+    ev.boxes[3] = [("11", C, (-0.3, 0.2))]
+    false = Context(C, 3, None, kind="false_track", track=11)
+    two = "car GT aaaaaa lies 0.4 m away and the evaluation matched it to another track: two tracks on one object"
+
+    def kinds(text: str, sc: SceneTruth = scene) -> list[str]:
+        return [c.kind for c in check_text(text, false, None, ev, scene=sc).found]
+
+    assert kinds(two) == ["misleading"]
+    assert kinds(f"{two}; the detector gave it two car detections within 2 m (m0, m1)") == []
+    assert kinds(f"{two}; the detector gave it two car detections within 2 m (m0, m2)") == ["detector"]
+    one = SceneTruth([[Detection(C, 0.9, (0.3, 0.0)), Detection(C, 0.5, (29.0, 0.0))]] * 4, objects)
+    assert kinds(two, one) == []  # one box of it: the tracker's doing
