@@ -261,6 +261,9 @@ class LostTrack:
     finite_elsewhere: tuple[tuple[int, int], ...] = ()
     matched_until: int | None = None
     matched_away: tuple[MatchedAway, ...] = ()
+    used_of_no_object: tuple[tuple[int, int], ...] = ()
+    """(frame, detection) pairs its updates in the window used that lay within ``NEAR_M`` of no annotated object
+    and inside none's box (audit truth50: world5's false bus pulled the real bus's JPDA / CPHD track)."""
 
     def step(self, frame: int) -> TrackStep | None:
         return next((s for s in self.steps if s.frame == frame), None)

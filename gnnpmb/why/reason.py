@@ -392,7 +392,15 @@ class _Context:
         finite = self.finite_elsewhere(track_id, steps)
         matched = self.matched_until(gt_id)
         away = matched_away(evaluated, gt_id, matched, self.f)
-        return LostTrack(track_id, held, in_window, off, evaluated, self.threshold, elsewhere, finite, matched, away)
+        nothing = tuple(
+            (s.frame, m)
+            for s in in_window
+            for m in s.used
+            if self.of_no_object(s.frame, m) and self.meas_part_of(s.frame, m) is None
+        )
+        return LostTrack(
+            track_id, held, in_window, off, evaluated, self.threshold, elsewhere, finite, matched, away, nothing
+        )
 
     def matched_until(self, gt_id: str) -> int | None:
         """The last frame before the failure at which the evaluation matched object ``gt_id`` to a track: it scored

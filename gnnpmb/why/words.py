@@ -778,6 +778,10 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     used = [s for s in deciding if s.used]
     if used and mode is not UseMode.ASSIGNED:
         parts.append("; ".join(f"at frame {s.frame} it {use_text(s)}" for s in used))
+        said = {(s.frame, m) for s in used for m, _ in s.use.shares[:2]}
+        nothing = [p for p in lost.used_of_no_object if p in said]
+        if nothing:  # audit truth50 (world5): a soft update from the false bus read as a sight of the bus
+            parts.append(_used_of_no_object(nothing))
     not_output = [x for x in f.deciding if lost.step(x) is None or lost.step(x).output is None]
     ended = next((s for s in steps if s.ended is not None), None)
     if not_output:
@@ -884,6 +888,14 @@ def _lost_object(f: Finding) -> list[str]:
         if d.meas_of_no_object:  # truth49 world5 scene-0553 gnn: m24 was the false bus, nowhere said
             parts.append(f"{meas_name(d.choice.meas.ref)} at frame {d.frame} was {_of_no_object(d.meas_part_of)}")
         parts += _where_from(f)
+        o = f.taker  # audit truth50 (world5 scene-0553 gnn id_switch:1): the thief's false start went unsaid here
+        started_here = d.born and d.went == (o.track_id if o is not None else None)
+        theft = f.kind is FailureKind.IDENTITY_THEFT  # a theft says its thief was a false track
+        if o is not None and o.frame >= 0 and o.meas >= 0 and o.of_no_object and not (started_here or theft):
+            parts.append(
+                f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}, "
+                f"{_of_no_object(o.part_of)}"
+            )
     elif f.taker is not None and f.taker.frame >= 0:
         o = f.taker
         if f.output_only:
@@ -1407,6 +1419,17 @@ def _of_no_object(part: tuple[str, str, float] | None = None) -> str:
     if part is not None:
         return f"a detection of part of {_part_text(part)}"
     return f"a detection of no object (none of a tracked class within {NEAR_M:.0f} m)"
+
+
+def _used_of_no_object(pairs: Sequence[tuple[int, int]]) -> str:
+    """``m24 (frames 15, 16) and m29 (frame 17) were detections of no object (none of a tracked class within 2 m)``."""
+    by: dict[int, list[int]] = {}
+    for frame, m in sorted(pairs):
+        by.setdefault(m, []).append(frame)
+    items = [f"{meas_name(m)} ({frames_text(frames)})" for m, frames in sorted(by.items(), key=lambda kv: kv[1][0])]
+    joined = items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+    what = "was a detection" if len(items) == 1 else "were detections"
+    return f"{joined} {what} of no object (none of a tracked class within {NEAR_M:.0f} m)"
 
 
 def _part_text(part: tuple[str, str, float]) -> str:
