@@ -1803,3 +1803,30 @@ def test_two_tracks_on_one_object_the_detector_gave_two_boxes_of_must_say_so() -
     assert kinds(f"{two}; the detector gave it two car detections within 2 m (m0, m2)") == ["detector"]
     one = SceneTruth([[Detection(C, 0.9, (0.3, 0.0)), Detection(C, 0.5, (29.0, 0.0))]] * 4, objects)
     assert kinds(two, one) == []  # one box of it: the tracker's doing
+
+
+def test_a_soft_update_or_a_thiefs_start_from_a_detection_of_no_object_left_unsaid_is_caught() -> None:
+    # audit truth50 on world5 scene-0553 (a false bus beside a bus): cphd's "at frame 15 it took 32 % of its weight
+    # from m24" and gnn's deciding choice "frame 15: m24 → track 48", track 48 started by the false bus, unsaid
+    from gnnpmb.events import Born
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    objects = [{GT_A: Annotation(C, (0.0, 0.0), 9)}] * 4
+    scene = SceneTruth([[Detection(C, 0.9, (0.3, 0.0)), Detection(C, 0.7, (5.0, 0.0))]] * 4, objects)
+    at = Context(C, 3, GT_A)
+
+    def kinds(text: str, raw=None) -> list[str]:
+        return [c.kind for c in check_text(text, at, raw or _raw_with(), _eval(), scene=scene).found]
+
+    soft = "at frame 2 it took 32 % of its weight from m1"
+    assert "misleading" in kinds(soft)
+    said = f"{soft}; m1 (frame 2) was a detection of no object (none of a tracked class within 2 m)"
+    assert "misleading" not in kinds(said) and "detector" not in kinds(said)
+    assert "detector" in kinds(f"{soft}; m0 (frame 2) was a detection of no object")  # m0: 0.3 m from GT A
+    assert "misleading" not in kinds("at frame 2 it took 90 % of its weight from m0")  # the object's own
+    born = _raw_with(Born(C, np.array([11]), np.array([1]), np.zeros((1, 4)), np.ones(1)))
+    born.by[(1, C)] = born.by.pop((3, C))  # track 11 born at frame 1 from m1
+    choice = "the deciding choice was earlier, frame 2: m0 → track 11 (cost 1.00) over track 7 (2.00), margin 1.00"
+    assert "misleading" in kinds(choice, born)
+    started = f"{choice}; track 11 had been started at frame 1 by m1, a detection of no object (none within 2 m)"
+    assert "misleading" not in kinds(started, born)

@@ -361,7 +361,9 @@ def check_text(
         _check_choice(m, c, raw, out, bad)
     for m in UNDERCUT.finditer(text):
         _check_undercut(m, c, raw, out, bad)
-    _check_lead_and_no_object(text, ctx.frame, scene, out, bad)
+    _check_lead_and_no_object(text, ctx.frame, scene, out, bad, raw, c)
+    if scene is not None:
+        _check_used_no_object(text, scene, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
     lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
     lost.check_used_away(text, c, ctx.lost, ctx.gt_id, scene, raw, out, bad)
@@ -383,9 +385,13 @@ NO_OBJECT = re.compile(
 of a tracked class lies within 2 m of it (audit truth49, world5: a false bus that took a real bus's ID)."""
 
 
-def _check_lead_and_no_object(text: str, frame: int, scene: SceneTruth | None, out: Tally, bad) -> None:
+def _check_lead_and_no_object(
+    text: str, frame: int, scene: SceneTruth | None, out: Tally, bad, raw: RawEvents | None = None, c: str = ""
+) -> None:
     """The deciding choice's lead word against the failure's frame; "a detection of no object" (said, or left
-    unsaid of a thief's start or a deciding detection) against the annotations within ``NEAR_M``."""
+    unsaid of a thief's start or a deciding detection) against the annotations within ``NEAR_M``; the track a
+    deciding choice gave the detection to, started by a detection of no object (``raw``'s ``Born``), must say so or
+    be said to have been a false track (audit truth50, world5 gnn id_switch:1)."""
     deciding = []
     for m in LEAD.finditer(text):
         x = int(m[2])
@@ -405,6 +411,54 @@ def _check_lead_and_no_object(text: str, frame: int, scene: SceneTruth | None, o
     for x, meas, m in deciding:
         if (x, meas) not in said:
             _no_object(x, meas, False, m[0], scene, out, bad)
+        chosen = re.match(r" → \**track (\d+)", text[m.end() :])
+        born = raw.birth(c, int(chosen[1])) if raw is not None and chosen is not None else None
+        if born is None or born[0] >= x or not _of_nothing(scene, *born):
+            continue
+        t = chosen[1]
+        out.checked["misleading"] += 1
+        if (
+            f"track {t} had been started at frame {born[0]}" not in text
+            and f"track {t} had been a false track" not in text
+        ):
+            bad("misleading", m[0], f"track {t} was started at frame {born[0]} by m{born[1]}, of no object: unsaid")
+
+
+def _of_nothing(scene: SceneTruth, x: int, meas: int) -> bool:
+    """Detection ``meas`` of frame ``x`` lies ``NEAR_M`` or more from every annotated object and inside none's box."""
+    if x >= len(scene.detections) or meas >= len(scene.detections[x]):
+        return False
+    xy = scene.detections[x][meas].xy_m
+    far = all(math.dist(a.xy_m, xy) >= NEAR_M for a in scene.objects[x].values())
+    return far and not scene.inside(x, xy)
+
+
+USED_NOTHING = re.compile(
+    r"((?:m\d+ \(frames? [\d–, ]*\d\)(?:, | and )?)+) (?:was a detection|were detections) of no object"
+)
+"""The detections a lost track's soft updates used that were of no object (audit truth50, world5)."""
+SOFT_USE = re.compile(
+    r"at frame (\d+) it (?:used (m\d+(?: \([^)]*\))?(?:, m\d+(?: \([^)]*\))?)?)|took \d+ % of its weight from (m\d+))"
+)
+
+
+def _check_used_no_object(text: str, scene: SceneTruth, out: Tally, bad) -> None:
+    """Each detection said of no object among a soft update's, against the annotations; each a soft update used
+    that was of no object (``_of_nothing``) and not said so: misleading (the false bus's detection read as a sight
+    of the bus)."""
+    said = set()
+    for m in USED_NOTHING.finditer(text):
+        for item in re.finditer(r"m(\d+) \((frames? [\d–, ]*\d)\)", m[1]):
+            for x in frames_of(item[2]):
+                said.add((x, int(item[1])))
+                _no_object(x, int(item[1]), True, m[0], scene, out, bad)
+    for m in SOFT_USE.finditer(text):
+        x = int(m[1])
+        for meas in (int(k) for k in re.findall(r"m(\d+)", m[2] or m[3])):
+            if _of_nothing(scene, x, meas):
+                out.checked["misleading"] += 1
+                if (x, meas) not in said:
+                    bad("misleading", m[0], f"m{meas} at frame {x} is a detection of no object: unsaid")
 
 
 def _no_object(
