@@ -1422,14 +1422,15 @@ def _of_no_object(part: tuple[str, str, float] | None = None) -> str:
 
 
 def _used_of_no_object(pairs: Sequence[tuple[int, int]]) -> str:
-    """``m24 (frames 15, 16) and m29 (frame 17) were detections of no object (none of a tracked class within 2 m)``."""
+    """``of these, m24 (frames 15, 16) and m29 (frame 17) were detections of no object (none of a tracked class within
+    2 m)``: the detections the soft updates told just before used."""
     by: dict[int, list[int]] = {}
     for frame, m in sorted(pairs):
         by.setdefault(m, []).append(frame)
     items = [f"{meas_name(m)} ({frames_text(frames)})" for m, frames in sorted(by.items(), key=lambda kv: kv[1][0])]
     joined = items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
     what = "was a detection" if len(items) == 1 else "were detections"
-    return f"{joined} {what} of no object (none of a tracked class within {NEAR_M:.0f} m)"
+    return f"of these, {joined} {what} of no object (none of a tracked class within {NEAR_M:.0f} m)"
 
 
 def _part_text(part: tuple[str, str, float]) -> str:

@@ -28,12 +28,13 @@ def test_soft_updates_from_detections_of_no_object_say_so() -> None:
     (line, *_) = why_lines(f)
     assert "at frame 15 it took 32 % of its weight from m24; at frame 16 it took 33 % of its weight from m24" in line
     assert (
-        "m24 (frames 15, 16) and m29 (frame 17) were detections of no object (none of a tracked class within 2 m)"
+        "of these, m24 (frames 15, 16) and m29 (frame 17) were detections of no object (none of a tracked class "
+        "within 2 m)"
     ) in line
     assert "m3 (" not in line  # m3 lay on an object: nothing said
     one = LostTrack(34, 13, steps, None, None, None, used_of_no_object=((17, 29),))
     (line, *_) = why_lines(finding(FailureKind.ID_SWITCH, one, mode=UseMode.WEIGHTS.value, deciding=(17,), frame=20))
-    assert "m29 (frame 17) was a detection of no object (none of a tracked class within 2 m)" in line
+    assert "of these, m29 (frame 17) was a detection of no object (none of a tracked class within 2 m)" in line
 
 
 def test_a_deciding_choice_still_says_the_thief_started_on_a_detection_of_no_object() -> None:
