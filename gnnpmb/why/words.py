@@ -603,18 +603,20 @@ def _detector_gaps(f: Finding) -> list[str]:
 
 
 def _in_box_text(seen: Sequence[Sighting]) -> str:
-    """``, but at frame 13 truck m20 lay inside its box, 3.2 m from its centre (the detector saw part of it)``: the
-    detections a "no detection within 2 m" hides (audit truth50, world6: a 16 m truck seen as two boxes)."""
+    """``, but a detection lay inside its box, farther from its centre (truck m20 3.2 m at frame 13): the detector
+    saw part of it``: the detections a "no detection within 2 m" hides (audit truth50, world6: a 16 m truck seen as
+    two boxes)."""
     inside = [s for s in seen if s.in_box is not None]
     if not inside:
         return ""
     what = ", ".join(
-        f"{'at frame ' + str(s.frame) + ' ' if len(seen) > 1 else ''}{s.in_box.class_name} {meas_name(s.in_box.meas)} "
-        f"{s.in_box.distance_m:.1f} m"
+        f"{s.in_box.class_name} {meas_name(s.in_box.meas)} {s.in_box.distance_m:.1f} m"
+        + (f" at frame {s.frame}" if len(seen) > 1 else "")
         for s in inside[:3]
     )
     more = f" and at {len(inside) - 3} more frames" if len(inside) > 3 else ""
-    return f", but inside its box, farther from its centre, lay {what}{more} (the detector saw part of it)"
+    lay = "a detection lay" if len(inside) == 1 else "detections lay"
+    return f", but {lay} inside its box, farther from its centre ({what}{more}): the detector saw part of it"
 
 
 def _hidden(f: Finding) -> list[str]:
@@ -1259,7 +1261,7 @@ def _miss(f: Finding) -> list[str]:
         n = s.in_box
         parts.append(
             f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
-            f"({inside}), only {n.class_name} {meas_name(n.meas)} (score {n.score:.2f}) inside its box, "
+            f"({inside}), but {n.class_name} {meas_name(n.meas)} (score {n.score:.2f}) lay inside its box, "
             f"{n.distance_m:.1f} m from its centre: the detector saw part of it"
         )
     elif s.undetected and s.nearest_any is None:

@@ -1759,7 +1759,7 @@ def test_a_box_inside_a_long_objects_box_said_to_be_of_no_object_is_caught() -> 
     )
     assert kinds(f"{missed}: the detector missed it") == ["misleading"]
     assert (
-        kinds(f"{missed}, only truck m1 (score 0.60) inside its box, 3.2 m from its centre: the detector saw part")
+        kinds(f"{missed}, but truck m1 (score 0.60) lay inside its box, 3.2 m from its centre: the detector saw part")
         == []
     )
     gap = (
@@ -1768,7 +1768,10 @@ def test_a_box_inside_a_long_objects_box_said_to_be_of_no_object_is_caught() -> 
     )
     assert kinds(gap) == ["misleading"]
     assert (
-        kinds(f"{gap}, but inside its box, farther from its centre, lay truck m1 3.2 m (the detector saw part of it)")
+        kinds(
+            f"{gap}, but a detection lay inside its box, farther from its centre (truck m1 3.2 m): the detector saw "
+            "part of it"
+        )
         == []
     )
     # a false track's box on the trailer

@@ -84,6 +84,11 @@ def _close(printed: str, value: float) -> bool:
     return abs(float(printed) - value) <= 0.5 * 10.0**-decimals + 1e-9
 
 
+def _says_in_box(after: str) -> bool:
+    """Whether the clause goes on (``after``: the text that follows it) to name detections inside the box."""
+    return after.startswith(", but") and "lay inside its box" in after.split(";")[0]
+
+
 def _check_in_box(said: bool, frames: list[int], short: str, sentence: str, scene: SceneTruth, out, bad) -> None:
     """ "No detection within 2 m" of an object a detection lay inside the box of (a 16 m truck seen as two boxes,
     each 3-5 m from its centre: audit truth50, world6): misleading unless the sentence goes on to say so; said of
@@ -171,7 +176,7 @@ def check_detector(
         elif not m[2] and scene.untracked_near(x, ann.xy_m):
             bad("detector", m[0], f"the file has {scene.untracked_near(x, ann.xy_m)} within {NEAR_M} m (untracked)")
         else:
-            _check_in_box(text[m.end() :].startswith(", only "), [x], m[4], m[0], scene, out, bad)
+            _check_in_box(_says_in_box(text[m.end() :]), [x], m[4], m[0], scene, out, bad)
     for m in WRONG_CLASS.finditer(text):
         x, ann = int(m[1]), gt_xy(int(m[1]), m[3])
         out.checked["detector"] += 1
@@ -192,8 +197,7 @@ def check_detector(
         if any(seen.values()):
             bad("detector", m[0], f"detections within {NEAR_M} m by frame: {seen}")
         elif not wrong_points(m[0], list(anns.values()), m[3], m[4]) and gt_id is not None:
-            said = text[m.end() :].startswith(", but inside its box")
-            _check_in_box(said, list(anns), gt_id[:6], m[0], scene, out, bad)
+            _check_in_box(_says_in_box(text[m.end() :]), list(anns), gt_id[:6], m[0], scene, out, bad)
     for m in HIDDEN.finditer(text):
         out.checked["detector"] += 1
         wrong = {}

@@ -93,7 +93,7 @@ def test_the_why_says_a_split_objects_boxes_were_on_part_of_it() -> None:
     (line, *_) = why_lines(miss)
     assert (
         "at frame 14 the detector gave no detection of a tracked class within 2 m of truck GT ecf44b (200 LiDAR and "
-        "radar points in its box), only truck m1 (score 0.60) inside its box, 3.2 m from its centre: the detector "
+        "radar points in its box), but truck m1 (score 0.60) lay inside its box, 3.2 m from its centre: the detector "
         "saw part of it"
     ) in line
     assert "the detector missed it" not in line
