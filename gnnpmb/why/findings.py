@@ -13,7 +13,9 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   ``NEAR_M`` of the object while it had LiDAR or radar points, or only detections that lie nearer another annotated
   object (``NO_DETECTION``: they are that object's, ``Near.on_other``), only detections of its own of another
   class (``OTHER_CLASS``), or the false
-  track was output on a detection that lies within ``NEAR_M`` of no object (``DETECTION_OF_NOTHING``);
+  track was output on a detection that lies within ``NEAR_M`` of no object (``DETECTION_OF_NOTHING``), or a false
+  track was a second one on an object the detector gave two or more kept detections of its class within ``NEAR_M``,
+  each nearer it than any other annotated object (``TWO_DETECTIONS``: a detector without NMS, audit truth50);
 * **the tracker's**: a detection of the object's class was within ``NEAR_M`` and the update of the track that had
   the object did not use it (``DETECTION_UNUSED``, naming where it went, or that preprocessing dropped it), or the
   track that had the object (or took its detection) was not output (``NOT_OUTPUT``: over a gap in the
@@ -78,6 +80,7 @@ class Rule(enum.Enum):
     OFF_OBJECT = "off the object"
     NOT_COUNTED = "not counted"
     TWO_TRACKS = "two tracks"
+    TWO_DETECTIONS = "two detections"
     COASTED = "coasted"
     COVERED_TWO = "covered two"
     UNSEEN = "unseen"
@@ -101,6 +104,7 @@ _PARTY = {
     Rule.OFF_OBJECT: Party.TRACKER,
     Rule.NOT_COUNTED: Party.TRACKER,
     Rule.TWO_TRACKS: Party.TRACKER,
+    Rule.TWO_DETECTIONS: Party.DETECTOR,
     Rule.COASTED: Party.TRACKER,
     Rule.COVERED_TWO: Party.TRACKER,
     Rule.UNSEEN: Party.TRACKER,
@@ -189,6 +193,9 @@ class Sighting:
     on_it: tuple[OnObject, ...]
     removed_own: Near | None = None
     radar_points: int = 0
+    in_box: Near | None = None
+    """With no detection of any class within ``NEAR_M``: the nearest one whose centre lies inside the object's box
+    (a long truck seen as two boxes, world6: a sight of part of it, not no sight)."""
 
     @property
     def lidar_points(self) -> int:
@@ -254,6 +261,9 @@ class LostTrack:
     finite_elsewhere: tuple[tuple[int, int], ...] = ()
     matched_until: int | None = None
     matched_away: tuple[MatchedAway, ...] = ()
+    used_of_no_object: tuple[tuple[int, int], ...] = ()
+    """(frame, detection) pairs its updates in the window used that lay within ``NEAR_M`` of no annotated object
+    and inside none's box (audit truth50: world5's false bus pulled the real bus's JPDA / CPHD track)."""
 
     def step(self, frame: int) -> TrackStep | None:
         return next((s for s in self.steps if s.frame == frame), None)
@@ -273,6 +283,8 @@ class Origin:
     false_frames: tuple[int, ...] = ()
     victim_held: bool = False
     of_no_object: bool = False
+    part_of: tuple[str, str, float] | None = None
+    """Of no object, but inside this object's box (id, class, m from its centre): see ``Reasoner.part_of``."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -297,6 +309,8 @@ class Deciding:
     lost_would: WouldTake | None = None
     alternative_took: int | None = None
     meas_of_no_object: bool = False
+    meas_part_of: tuple[str, str, float] | None = None
+    """Of no object, but inside this object's box (id, class, m from its centre)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -362,6 +376,12 @@ class FalseOutput:
     threshold: float | None
     object_missed: bool = False
     use: Use | None = None
+    part_of: tuple[str, str, float] | None = None
+    """No object within ``NEAR_M``, but the box's centre lies inside this object's box (id, class, m from its
+    centre): the track was on part of it."""
+    twins: tuple[int, ...] = ()
+    """The kept detections of its class the detector gave the object within ``NEAR_M`` when two or more
+    (``Rule.TWO_DETECTIONS``)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -593,12 +593,30 @@ def _detector_gaps(f: Finding) -> list[str]:
             seen = [by[x] for x in b.frames if x in by]
             out.append(
                 f"at {frames_text(b.frames)} the detector gave {no_detection(seen)}, though it had {points_text(seen)}"
+                f"{_in_box_text(seen)}"
             )
         elif b.rule is Rule.OTHER_CLASS:
             seen = [by[x].seen for x in b.frames if x in by and by[x].seen is not None]
             what = ", ".join(f"{n.class_name} {meas_name(n.meas)} {n.distance_m:.2f} m away" for n in seen)
             out.append(f"at {frames_text(b.frames)} the detector saw it only as another class ({what})")
     return out
+
+
+def _in_box_text(seen: Sequence[Sighting]) -> str:
+    """``, but a detection lay inside its box, farther from its centre (truck m20 3.2 m at frame 13): the detector
+    saw part of it``: the detections a "no detection within 2 m" hides (audit truth50, world6: a 16 m truck seen as
+    two boxes)."""
+    inside = [s for s in seen if s.in_box is not None]
+    if not inside:
+        return ""
+    what = ", ".join(
+        f"{s.in_box.class_name} {meas_name(s.in_box.meas)} {s.in_box.distance_m:.1f} m"
+        + (f" at frame {s.frame}" if len(seen) > 1 else "")
+        for s in inside[:3]
+    )
+    more = f" and at {len(inside) - 3} more frames" if len(inside) > 3 else ""
+    lay = "a detection lay" if len(inside) == 1 else "detections lay"
+    return f", but {lay} inside its box, farther from its centre ({what}{more}): the detector saw part of it"
 
 
 def _hidden(f: Finding) -> list[str]:
@@ -762,6 +780,10 @@ def _lost_story(f: Finding, lost: LostTrack) -> str:
     used = [s for s in deciding if s.used]
     if used and mode is not UseMode.ASSIGNED:
         parts.append("; ".join(f"at frame {s.frame} it {use_text(s)}" for s in used))
+        said = {(s.frame, m) for s in used for m, _ in s.use.shares[:2]}
+        nothing = [p for p in lost.used_of_no_object if p in said]
+        if nothing:  # audit truth50 (world5): a soft update from the false bus read as a sight of the bus
+            parts.append(_used_of_no_object(nothing))
     not_output = [x for x in f.deciding if lost.step(x) is None or lost.step(x).output is None]
     ended = next((s for s in steps if s.ended is not None), None)
     if not_output:
@@ -866,8 +888,16 @@ def _lost_object(f: Finding) -> list[str]:
         lead = "then" if d.frame >= f.frame else "the deciding choice was earlier"
         parts.append(f"{lead}, {choice_text(d.frame, d.choice, d.went, d.born, d.alternative_took)}")
         if d.meas_of_no_object:  # truth49 world5 scene-0553 gnn: m24 was the false bus, nowhere said
-            parts.append(f"{meas_name(d.choice.meas.ref)} at frame {d.frame} was {_of_no_object()}")
+            parts.append(f"{meas_name(d.choice.meas.ref)} at frame {d.frame} was {_of_no_object(d.meas_part_of)}")
         parts += _where_from(f)
+        o = f.taker  # audit truth50 (world5 scene-0553 gnn id_switch:1): the thief's false start went unsaid here
+        started_here = d.born and d.went == (o.track_id if o is not None else None)
+        theft = f.kind is FailureKind.IDENTITY_THEFT  # a theft says its thief was a false track
+        if o is not None and o.frame >= 0 and o.meas >= 0 and o.of_no_object and not (started_here or theft):
+            parts.append(
+                f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}, "
+                f"{_of_no_object(o.part_of)}"
+            )
     elif f.taker is not None and f.taker.frame >= 0:
         o = f.taker
         if f.output_only:
@@ -875,7 +905,7 @@ def _lost_object(f: Finding) -> list[str]:
         elif o.meas >= 0:
             # audit truth49 (world5 scene-0553, a false bus beside a bus's path): the thief's first detection was
             # of no object; the story needs it said where it started, not only its later false frames
-            false = f", {_of_no_object()}" if o.of_no_object else ""
+            false = f", {_of_no_object(o.part_of)}" if o.of_no_object else ""
             parts.append(f"track {o.track_id} had been started at frame {o.frame} by {meas_name(o.meas)}{false}")
         elif f.switch is not None:
             parts.append(f"track {o.track_id} had existed since frame {o.frame} in a hypothesis other than the best")
@@ -1077,6 +1107,10 @@ def _false_track(f: Finding) -> list[str]:
         else:
             other = f" (track {o.matched_instead})" if o.matched_instead is not None else ""
             parts.append(f"{on} and the evaluation matched it to another track{other}: two tracks on one object")
+            if o.twins:  # audit truth50 (world6, a detector without NMS): not the tracker's doing alone
+                n = "two" if len(o.twins) == 2 else str(len(o.twins))
+                what = ", ".join(meas_name(m) for m in o.twins)
+                parts.append(f"the detector gave it {n} {f.class_name} detections within {NEAR_M:.0f} m ({what})")
     elif o.nearest_any is not None:
         gt_id, cls, d = o.nearest_any
         what = "the detector gave it the wrong class" if o.on is not None else "the track coasted onto it"
@@ -1084,6 +1118,12 @@ def _false_track(f: Finding) -> list[str]:
             what = "the tracker output a box there without a detection of its class under it"
         parts.append(
             f"no {f.class_name} GT lies within {NEAR_M:.0f} m, but GT {cls} {short_id(gt_id)} does ({d:.1f} m): {what}"
+        )
+    elif o.part_of is not None:  # audit truth50 (world6): a truck's trailer box is no "box where no object was"
+        what = "the detection" if o.on is not None else "the box"
+        parts.append(
+            f"no object of a tracked class lies within {NEAR_M:.0f} m, but {what} lies on part of "
+            f"{_part_text(o.part_of)}"
         )
     elif o.on is not None:
         parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of no tracked object")
@@ -1216,6 +1256,13 @@ def _miss(f: Finding) -> list[str]:
         parts.append(
             f"at frame {f.frame} {name} had no LiDAR or radar points (no detector could see it) and "
             f"{no_detection([s])}{carried}"
+        )
+    elif s.undetected and s.nearest_any is None and s.in_box is not None:  # audit truth50: a split truck
+        n = s.in_box
+        parts.append(
+            f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
+            f"({inside}), but {n.class_name} {meas_name(n.meas)} (score {n.score:.2f}) lay inside its box, "
+            f"{n.distance_m:.1f} m from its centre: the detector saw part of it"
         )
     elif s.undetected and s.nearest_any is None:
         parts.append(
@@ -1367,10 +1414,32 @@ def _others(f: Finding) -> list[str]:
     return out
 
 
-def _of_no_object() -> str:
+def _of_no_object(part: tuple[str, str, float] | None = None) -> str:
     """What a detection with no annotated object of a tracked class within ``NEAR_M`` was (audit truth49: a false
-    bus's detections)."""
+    bus's detections), or, inside an object's box (``part``), a sight of part of it (audit truth50: a truck's
+    trailer box)."""
+    if part is not None:
+        return f"a detection of part of {_part_text(part)}"
     return f"a detection of no object (none of a tracked class within {NEAR_M:.0f} m)"
+
+
+def _used_of_no_object(pairs: Sequence[tuple[int, int]]) -> str:
+    """``of these, m24 (frames 15, 16) and m29 (frame 17) were detections of no object (none of a tracked class within
+    2 m)``: the detections the soft updates told just before used."""
+    by: dict[int, list[int]] = {}
+    for frame, m in sorted(pairs):
+        by.setdefault(m, []).append(frame)
+    items = [f"{meas_name(m)} ({frames_text(frames)})" for m, frames in sorted(by.items(), key=lambda kv: kv[1][0])]
+    joined = items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+    what = "was a detection" if len(items) == 1 else "were detections"
+    return f"of these, {joined} {what} of no object (none of a tracked class within {NEAR_M:.0f} m)"
+
+
+def _part_text(part: tuple[str, str, float]) -> str:
+    """``truck GT ecf44b (inside its box, 3.5 m from its centre, beyond the evaluation's 2 m)``."""
+    gt_id, cls, d = part
+    where = f"inside its box, {d:.1f} m from its centre, beyond the evaluation's {NEAR_M:.0f} m"
+    return f"{cls} GT {short_id(gt_id)} ({where})"
 
 
 def _beside(o: OnObject, frame: int) -> bool:

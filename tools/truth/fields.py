@@ -575,6 +575,13 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             on = _boxes_on(src, x, c, xy)
             if not any(x not in src.kept_frames(int(t)) for t in on):
                 return "no track box on it was dropped"
+        elif name == "TWO_DETECTIONS":  # a second track on an object the detector gave two boxes of its class
+            gt_id = f.false_output.nearest_own[0] if f.false_output and f.false_output.nearest_own else f.gt_id
+            at = src.gt_xy(x, gt_id) if gt_id is not None else None
+            near = _own_near(src, x, at) if at is not None else []
+            own = [j for j in near if src.scene.detections[x][j].class_name == c]
+            if len(own) < 2:
+                return f"fewer than two {c} detections of the object's own within reach at frame {x}: {own}"
         elif name == "TWO_TRACKS" and f.lost is not None:
             on = _boxes_on(src, x, c, xy)
             if str(f.lost.track_id) not in on or len(on) < 2:

@@ -37,6 +37,17 @@ class Annotation:
     xy_m: tuple[float, float]
     points: int
     radar: int = 0
+    footprint: tuple[float, ...] = ()
+    """Width, length (m) and heading (rad) of its box on the ground (empty: not read)."""
+
+    def contains(self, xy_m: tuple[float, float]) -> bool:
+        """Whether the ground point ``xy_m`` lies inside the box's footprint."""
+        if not self.footprint:
+            return False
+        w, length, yaw = self.footprint
+        dx, dy = xy_m[0] - self.xy_m[0], xy_m[1] - self.xy_m[1]
+        along, across = dx * math.cos(yaw) + dy * math.sin(yaw), -dx * math.sin(yaw) + dy * math.cos(yaw)
+        return abs(along) <= length / 2 and abs(across) <= w / 2
 
 
 POINTS = r"([\d,]+(?:–[\d,]+)?) LiDAR and (?:([\d,]+(?:–[\d,]+)?) )?radar points"
@@ -109,7 +120,10 @@ class SceneTruth:
                 if name is not None:
                     points = int(a["num_lidar_pts"]) + int(a["num_radar_pts"])
                     xy = tuple(map(float, a["translation"][:2]))
-                    here[a["instance_token"]] = Annotation(name, xy, points, int(a["num_radar_pts"]))
+                    qw, qx, qy, qz = a["rotation"]
+                    yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+                    foot = (float(a["size"][0]), float(a["size"][1]), yaw)
+                    here[a["instance_token"]] = Annotation(name, xy, points, int(a["num_radar_pts"]), foot)
             objects.append(here)
             token = sample["next"]
         return cls(detections, objects, ego, untracked)
@@ -143,6 +157,24 @@ class SceneTruth:
         if best is None or math.dist(best[1].xy_m, d) >= math.dist(xy_m, d) - 1e-6:
             return None
         return best[0], math.dist(best[1].xy_m, d)
+
+    def inside(self, frame: int, xy_m: tuple[float, float]) -> list[str]:
+        """The objects of ``frame`` whose box contains the ground point ``xy_m`` (audit truth50, world6: a truck's
+        trailer box 3 m from its centre is part of it, not "of no object")."""
+        return [k for k, a in self.objects[frame].items() if a.contains(xy_m)] if frame < len(self.objects) else []
+
+    def in_box(self, frame: int, gt_id: str) -> list[int]:
+        """Detections of ``frame`` whose centre lies inside object ``gt_id``'s box and within ``NEAR_M`` of no
+        other annotated object."""
+        a = self.objects[frame].get(gt_id) if frame < len(self.objects) else None
+        if a is None:
+            return []
+        others = [o.xy_m for k, o in self.objects[frame].items() if k != gt_id]
+        return [
+            m
+            for m, d in enumerate(self.detections[frame])
+            if a.contains(d.xy_m) and all(math.dist(o, d.xy_m) >= NEAR_M for o in others)
+        ]
 
     def near(self, frame: int, xy_m: tuple[float, float], class_name: str | None = None) -> list[int]:
         """Detections of ``frame`` within ``NEAR_M`` of ``xy_m`` (of ``class_name`` only, if given)."""

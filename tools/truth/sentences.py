@@ -265,6 +265,11 @@ def check_text(
             near = [k[:6] for k, a in here.items() if math.hypot(a.xy_m[0] - where[0], a.xy_m[1] - where[1]) < 2.0]
             if near:
                 bad("detector", m[0], f"annotated objects within 2 m of track {ctx.track}'s box: {near}")
+            _part_of(text[m.end() :], where, ctx.frame, m[0], scene, out, bad)
+    if scene is not None:
+        _check_twins(
+            text, ctx.frame, scene, (raw.received(ctx.frame, c) or None) if raw is not None else None, out, bad
+        )
     for phrase in VIEWER_ONLY:
         if phrase in text:
             out.checked["misleading"] += 1
@@ -356,7 +361,9 @@ def check_text(
         _check_choice(m, c, raw, out, bad)
     for m in UNDERCUT.finditer(text):
         _check_undercut(m, c, raw, out, bad)
-    _check_lead_and_no_object(text, ctx.frame, scene, out, bad)
+    _check_lead_and_no_object(text, ctx.frame, scene, out, bad, raw, c)
+    if scene is not None:
+        _check_used_no_object(text, scene, out, bad)
     shares.check_shares(text, c, ctx.lost, raw, out, bad)
     lost.check_lost(text, c, ctx.lost, raw, ev, out, bad)
     lost.check_used_away(text, c, ctx.lost, ctx.gt_id, scene, raw, out, bad)
@@ -372,15 +379,19 @@ LEAD = re.compile(r"(then|the deciding choice was earlier), frame (\d+): (?:clos
 run up to the failure's frame), "earlier" as before the failure's frame."""
 NO_OBJECT = re.compile(
     r"(?:track \d+ had been started at frame (\d+) by m(\d+)|\bm(\d+) at frame (\d+) was)"
-    r"(, a detection of no object| a detection of no object)?"
+    r"(,? a detection of (no object|part of \w+ GT (\w+)))?"
 )
 """A thief's starting detection, or a deciding detection said of no object: of no object exactly when no annotation
 of a tracked class lies within 2 m of it (audit truth49, world5: a false bus that took a real bus's ID)."""
 
 
-def _check_lead_and_no_object(text: str, frame: int, scene: SceneTruth | None, out: Tally, bad) -> None:
+def _check_lead_and_no_object(
+    text: str, frame: int, scene: SceneTruth | None, out: Tally, bad, raw: RawEvents | None = None, c: str = ""
+) -> None:
     """The deciding choice's lead word against the failure's frame; "a detection of no object" (said, or left
-    unsaid of a thief's start or a deciding detection) against the annotations within ``NEAR_M``."""
+    unsaid of a thief's start or a deciding detection) against the annotations within ``NEAR_M``; the track a
+    deciding choice gave the detection to, started by a detection of no object (``raw``'s ``Born``), must say so or
+    be said to have been a false track (audit truth50, world5 gnn id_switch:1)."""
     deciding = []
     for m in LEAD.finditer(text):
         x = int(m[2])
@@ -396,13 +407,64 @@ def _check_lead_and_no_object(text: str, frame: int, scene: SceneTruth | None, o
         said[(x, meas)] = said.get((x, meas), False) or m[5] is not None
         between = text.startswith(" instead of", m.end())  # a track between the two (``_where_from``): not the thief
         if (m[1] is not None and not between) or m[5] is not None:
-            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad)
+            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad, m[7])
     for x, meas, m in deciding:
         if (x, meas) not in said:
             _no_object(x, meas, False, m[0], scene, out, bad)
+        chosen = re.match(r" → \**track (\d+)", text[m.end() :])
+        born = raw.birth(c, int(chosen[1])) if raw is not None and chosen is not None else None
+        if born is None or born[0] >= x or not _of_nothing(scene, *born):
+            continue
+        t = chosen[1]
+        out.checked["misleading"] += 1
+        if (
+            f"track {t} had been started at frame {born[0]}" not in text
+            and f"track {t} had been a false track" not in text
+        ):
+            bad("misleading", m[0], f"track {t} was started at frame {born[0]} by m{born[1]}, of no object: unsaid")
 
 
-def _no_object(x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, out: Tally, bad) -> None:
+def _of_nothing(scene: SceneTruth, x: int, meas: int) -> bool:
+    """Detection ``meas`` of frame ``x`` lies ``NEAR_M`` or more from every annotated object and inside none's box."""
+    if x >= len(scene.detections) or meas >= len(scene.detections[x]):
+        return False
+    xy = scene.detections[x][meas].xy_m
+    far = all(math.dist(a.xy_m, xy) >= NEAR_M for a in scene.objects[x].values())
+    return far and not scene.inside(x, xy)
+
+
+USED_NOTHING = re.compile(
+    r"((?:m\d+ \(frames? [\d–, ]*\d\)(?:, | and )?)+) (?:was a detection|were detections) of no object"
+)
+"""The detections a lost track's soft updates used that were of no object (audit truth50, world5)."""
+SOFT_USE = re.compile(
+    r"at frame (\d+) it (?:used (m\d+(?: \([^)]*\))?(?:, m\d+(?: \([^)]*\))?)?)|took \d+ % of its weight from (m\d+))"
+)
+
+
+def _check_used_no_object(text: str, scene: SceneTruth, out: Tally, bad) -> None:
+    """Each detection said of no object among a soft update's, against the annotations; each a soft update used
+    that was of no object (``_of_nothing``) and not said so: misleading (the false bus's detection read as a sight
+    of the bus)."""
+    said = set()
+    for m in USED_NOTHING.finditer(text):
+        for item in re.finditer(r"m(\d+) \((frames? [\d–, ]*\d)\)", m[1]):
+            for x in frames_of(item[2]):
+                said.add((x, int(item[1])))
+                _no_object(x, int(item[1]), True, m[0], scene, out, bad)
+    for m in SOFT_USE.finditer(text):
+        x = int(m[1])
+        for meas in (int(k) for k in re.findall(r"m(\d+)", m[2] or m[3])):
+            if _of_nothing(scene, x, meas):
+                out.checked["misleading"] += 1
+                if (x, meas) not in said:
+                    bad("misleading", m[0], f"m{meas} at frame {x} is a detection of no object: unsaid")
+
+
+def _no_object(
+    x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, out: Tally, bad, part: str | None = None
+) -> None:
+    """``said``: "a detection of no object" or of ``part`` of an object (its short id) was said of ``meas``."""
     if x >= len(scene.detections) or meas >= len(scene.detections[x]):
         return
     out.checked["detector"] += 1
@@ -412,6 +474,48 @@ def _no_object(x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, 
         bad("detector", sentence, f"m{meas} at frame {x} lies {near:.2f} m from an annotated object")
     elif not said and near >= NEAR_M:
         bad("misleading", sentence, f"m{meas} at frame {x} lies {near:.2f} m from every annotated object: unsaid")
+    elif said:
+        tail = f"part of GT {part}" if part is not None else ""
+        _part_of(tail, xy, x, sentence, scene, out, bad)
+
+
+def _part_of(tail: str, xy, frame: int, sentence: str, scene: SceneTruth, out: Tally, bad) -> None:
+    """A point said to lie within 2 m of no object, ``tail`` the text after it: misleading where it lies inside an
+    annotated object's box and ``tail`` does not start by saying so; wrong where it names an object whose box does
+    not contain it."""
+    inside = scene.inside(frame, tuple(xy))
+    said = re.match(r"(?:, but (?:the detection|the box) lies on |, a detection of )?part of (\w+ )?GT (\w+)", tail)
+    out.checked["misleading"] += 1
+    if said is None and inside:
+        bad("misleading", sentence, f"inside the box of {[k[:6] for k in inside]} at frame {frame}: unsaid")
+    elif said is not None and not any(k.startswith(said[2]) for k in inside):
+        bad("detector", sentence, f"not inside GT {said[2]}'s box at frame {frame} (inside {[k[:6] for k in inside]})")
+
+
+TWO_ON_ONE = re.compile(
+    r"(\w+) GT (\w+) lies [\d.]+ m away and the evaluation matched it to another track(?: \(track \d+\))?: two "
+    r"tracks on one object(?:; the detector gave it (?:two|\d+) \w+ detections within 2 m \(((?:m\d+(?:, )?)+)\))?"
+)
+"""A false track beside the object's matched one, and the detections of its class the detector gave the object."""
+
+
+def _check_twins(text: str, frame: int, scene: SceneTruth, received: set[int] | None, out: Tally, bad) -> None:
+    """ "Two tracks on one object": where the detector gave the object two or more detections of its class within
+    2 m that the tracker received (``received``; None: any), each nearer it than any other annotated object (a
+    detector without NMS, audit truth50 world6), unsaid is misleading (the tracker's doing alone); said, the
+    named detections must be exactly those."""
+    for m in TWO_ON_ONE.finditer(text):
+        hit = scene.object_of(frame, m[2])
+        if hit is None:
+            continue
+        out.checked["misleading"] += 1
+        own = [j for j in scene.near(frame, hit[1].xy_m, m[1]) if scene.owner(frame, j, hit[1].xy_m) is None]
+        own = [j for j in own if received is None or j in received]
+        said = [int(x) for x in re.findall(r"m(\d+)", m[3] or "")]
+        if len(own) >= 2 and not said:
+            bad("misleading", m[0], f"the detector gave GT {m[2]} {len(own)} {m[1]} detections of its own: unsaid")
+        elif said and sorted(said) != sorted(own):
+            bad("detector", m[0], f"its own {m[1]} detections within 2 m at frame {frame}: {own}")
 
 
 def _patterns() -> list[re.Pattern]:
