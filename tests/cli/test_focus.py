@@ -400,11 +400,16 @@ def test_a_false_track_says_what_it_was_output_on_and_why_it_counted(
         # The evaluation counted the track: the score it averaged over the frames it kept reaches the threshold.
         assert out.evaluated.averaged_score == report.track_scores[failure.track_ids[0]]
         assert out.evaluated.averaged_score >= report.threshold_of(failure.class_name)
-        (blame,) = finding.blame
-        if out.nearest_own is not None:
-            assert blame.rule in (Rule.NO_EVAL_BOX, Rule.INTERPOLATED, Rule.TWO_TRACKS)
+        rules = [b.rule for b in finding.blame]
+        if out.nearest_own is not None:  # two tracks on one object may be the detector's doing too: two boxes of it
+            assert rules in (
+                [Rule.NO_EVAL_BOX],
+                [Rule.INTERPOLATED],
+                [Rule.TWO_TRACKS],
+                [Rule.TWO_DETECTIONS, Rule.TWO_TRACKS],
+            )
         else:
-            assert blame.rule in (Rule.OTHER_CLASS, Rule.DETECTION_OF_NOTHING, Rule.COASTED)
+            assert len(rules) == 1 and rules[0] in (Rule.OTHER_CLASS, Rule.DETECTION_OF_NOTHING, Rule.COASTED)
         checked += 1
     assert checked
     pick = next(i for i, f in zip(report.ids(), report.failures, strict=True) if f.kind is FailureKind.FALSE_TRACK)
