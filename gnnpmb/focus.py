@@ -22,6 +22,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from gnnpmb.data.boxes3d import containing_box
 from gnnpmb.data.scene import SceneData
 from gnnpmb.errors import GnnpmbError
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport, short_id
@@ -289,16 +290,21 @@ class _Tracked:
 
 def _gt_under_false_track(failure: Failure, scene: SceneData) -> tuple[str, ...]:
     """For a false track: the ground-truth object (any class) nearest its box within ``NEAR_M`` at the failure
-    frame, which the evaluation did not match to it (out of its range, no points, another class); () if none or
+    frame, which the evaluation did not match to it (out of its range, no points, another class), else the one
+    whose box holds its centre (part of a long object, as the Why says: ``why.reason.part_of``); () if none or
     another kind of failure."""
     if failure.kind is not FailureKind.FALSE_TRACK or not failure.boxes:
         return ()
     gt = scene.keyframes[failure.frame_index].gt
     if not len(gt):
         return ()
-    d = np.hypot(*(gt.translation_m[:, :2] - np.asarray(failure.boxes[0].translation_m[:2])).T)
+    xy = np.asarray(failure.boxes[0].translation_m[:2])
+    d = np.hypot(*(gt.translation_m[:, :2] - xy).T)
     k = int(np.argmin(d))
-    return (str(gt.instance_id[k]),) if d[k] <= NEAR_M else ()
+    if d[k] <= NEAR_M:
+        return (str(gt.instance_id[k]),)
+    hit = containing_box(gt, xy)
+    return () if hit is None else (str(gt.instance_id[hit[0]]),)
 
 
 def _tracks_near(estimates: Sequence[TrackEstimate], class_name: str, centers_xy: np.ndarray) -> set[int]:

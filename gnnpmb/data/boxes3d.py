@@ -20,8 +20,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from gnnpmb.types import Boxes
 
 _INSIDE_TOL = 1e-9
 """Slack of the point-in-polygon test (a cross product, m^2), so that shared corners count as inside."""
@@ -38,6 +42,28 @@ def yaw_from_quat_wxyz(quat_wxyz: np.ndarray) -> np.ndarray:
     w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     norm2 = w * w + x * x + y * y + z * z
     return np.arctan2(2.0 * (w * z + x * y), norm2 - 2.0 * (y * y + z * z))
+
+
+def in_footprint(boxes: Boxes, k: int, xy_m: np.ndarray) -> np.ndarray:
+    """Which of the points ``xy_m`` (N, 2) lie inside box ``k``'s ground-plane footprint (its w x l rectangle turned
+    by its yaw), (N,) bool."""
+    yaw = float(yaw_from_quat_wxyz(boxes.quat_wxyz[k]))
+    d = np.asarray(xy_m, dtype=float).reshape(-1, 2) - boxes.translation_m[k, :2]
+    along = d[:, 0] * np.cos(yaw) + d[:, 1] * np.sin(yaw)
+    across = -d[:, 0] * np.sin(yaw) + d[:, 1] * np.cos(yaw)
+    return (np.abs(along) <= 0.5 * boxes.size_wlh_m[k, 1]) & (np.abs(across) <= 0.5 * boxes.size_wlh_m[k, 0])
+
+
+def containing_box(boxes: Boxes, xy_m: np.ndarray) -> tuple[int, float] | None:
+    """The box whose footprint contains the point ``xy_m`` (2,) (the nearest centre of those) and the point's
+    distance to its centre (m); None: inside none."""
+    xy = np.asarray(xy_m, dtype=float)[:2]
+    hits = [k for k in range(len(boxes)) if in_footprint(boxes, k, xy)[0]]
+    if not hits:
+        return None
+    dist_m = {k: float(np.hypot(*(boxes.translation_m[k, :2] - xy))) for k in hits}
+    k = min(hits, key=dist_m.__getitem__)
+    return k, dist_m[k]
 
 
 def quat_wxyz_from_yaw(yaw_rad: np.ndarray) -> np.ndarray:

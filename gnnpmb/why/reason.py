@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gnnpmb.data.boxes3d import yaw_from_quat_wxyz
+from gnnpmb.data.boxes3d import containing_box, in_footprint
 from gnnpmb.data.scene import SceneData
 from gnnpmb.eval.evaluated import GtFrame, GtStatus, TrackEval
 from gnnpmb.eval.failures import Failure, FailureKind, FailureReport
@@ -522,7 +522,7 @@ class _Context:
         boxes = fr.detections.boxes
         xy = boxes.translation_m[:, :2]
         others = np.hypot(*(gt.translation_m[None, :, :2] - xy[:, None, :]).transpose(2, 0, 1)).min(axis=1)
-        inside = _inside(gt, int(k[0]), xy) & (others >= NEAR_M)  # not another object's detection
+        inside = in_footprint(gt, int(k[0]), xy) & (others >= NEAR_M)  # not another object's detection
         if not inside.any():
             return None
         d = np.hypot(*(boxes.translation_m[:, :2] - gt.translation_m[k[0], :2]).T)
@@ -961,26 +961,16 @@ def _same_place(f: Failure, gt_id: str | None, xy: np.ndarray | None, class_name
     return any(np.hypot(*(np.asarray(b.translation_m[:2]) - xy)) < NEAR_M for b in f.boxes)
 
 
-def _inside(gt: Boxes, k: int, xy_m: np.ndarray) -> np.ndarray:
-    """Which of the points ``xy_m`` (N, 2) lie inside annotated box ``k``'s ground-plane footprint (N,)."""
-    yaw = float(yaw_from_quat_wxyz(gt.quat_wxyz[k]))
-    d = np.asarray(xy_m, dtype=float).reshape(-1, 2) - gt.translation_m[k, :2]
-    along = d[:, 0] * math.cos(yaw) + d[:, 1] * math.sin(yaw)
-    across = -d[:, 0] * math.sin(yaw) + d[:, 1] * math.cos(yaw)
-    return (np.abs(along) <= 0.5 * gt.size_wlh_m[k, 1]) & (np.abs(across) <= 0.5 * gt.size_wlh_m[k, 0])
-
-
 def part_of(gt: Boxes, xy_m: np.ndarray) -> tuple[str, str, float] | None:
     """The annotated object whose ground-plane box contains the point ``xy_m`` (the nearest centre of those): id,
     class and the point's distance to its centre; None: inside none. With no centre within ``NEAR_M`` such a
     point is on part of a long object, not on no object (audit truth50, world6: a 16 m truck seen as a cab box
     and a trailer box, each 3-5 m from its centre, was called "a detection of no object")."""
-    xy = np.asarray(xy_m, dtype=float)[:2]
-    hits = [k for k in range(len(gt)) if _inside(gt, k, xy)[0]]
-    if not hits:
+    hit = containing_box(gt, xy_m)
+    if hit is None:
         return None
-    k = min(hits, key=lambda i: float(np.hypot(*(gt.translation_m[i, :2] - xy))))
-    return str(gt.instance_id[k]), str(gt.class_name[k]), float(np.hypot(*(gt.translation_m[k, :2] - xy)))
+    k, dist_m = hit
+    return str(gt.instance_id[k]), str(gt.class_name[k]), dist_m
 
 
 def _entry(matrix: CostMatrix | None, meas: int, track: int) -> float | None:
