@@ -64,7 +64,14 @@ def _metrics(folder: Path) -> dict:
     return {"summary": summary, "details": details}
 
 
-@pytest.mark.parametrize(("split", "scenes"), [("mini_val", SCENES), ("one", ("scene-0916",))])
+@pytest.mark.parametrize(
+    ("split", "scenes"),
+    [
+        # two scenes of ten: the same subset path as one scene of ten, at 10 s of CPU (run by hand, -m exhaustive)
+        pytest.param("mini_val", SCENES, marks=pytest.mark.exhaustive),
+        ("one", ("scene-0916",)),
+    ],
+)
 def test_split_metrics_equal_a_full_load(dataroot: Path, results: dict, tmp_path: Path, split: str, scenes) -> None:
     location = check_dataroot(dataroot, None)
     path = tmp_path / "results.json"
