@@ -477,28 +477,35 @@ class _Context:
             and not self.false_at(self.report, x, int(victim))
             for x in false
         )
-        no_object = self.of_no_object(born[0], born[1])
-        part = self.meas_part_of(born[0], born[1]) if no_object else None
+        no_object, part = self.no_object_part(born[0], born[1])
         return Origin(track_id, born[0], born[1], false, held, no_object, part)
+
+    def _meas_xy(self, frame: int, meas: int) -> np.ndarray | None:
+        """(2,) the centre of detection ``meas`` of ``frame``; None when there is no such detection or frame."""
+        fr = self.frames.get(frame)
+        if meas < 0 or fr is None or meas >= len(fr.detections.boxes.score):
+            return None
+        return fr.detections.boxes.translation_m[meas, :2]
 
     def of_no_object(self, frame: int, meas: int) -> bool:
         """Whether detection ``meas`` of ``frame`` lay farther than ``NEAR_M`` from every annotated object of a
         tracked class (False when unknown: no such detection or frame)."""
-        fr = self.frames.get(frame)
-        if meas < 0 or fr is None or meas >= len(fr.detections.boxes.score):
+        xy = self._meas_xy(frame, meas)
+        if xy is None:
             return False
         gt = self.scene.keyframes[frame].gt
-        if not len(gt):
-            return True
-        xy = fr.detections.boxes.translation_m[meas, :2]
-        return bool(np.hypot(*(gt.translation_m[:, :2] - xy).T).min() >= NEAR_M)
+        return not len(gt) or bool(np.hypot(*(gt.translation_m[:, :2] - xy).T).min() >= NEAR_M)
 
     def meas_part_of(self, frame: int, meas: int) -> tuple[str, str, float] | None:
         """``part_of`` for detection ``meas`` of ``frame`` (None when unknown)."""
-        fr = self.frames.get(frame)
-        if meas < 0 or fr is None or meas >= len(fr.detections.boxes.score):
-            return None
-        return part_of(self.scene.keyframes[frame].gt, fr.detections.boxes.translation_m[meas, :2])
+        xy = self._meas_xy(frame, meas)
+        return None if xy is None else part_of(self.scene.keyframes[frame].gt, xy)
+
+    def no_object_part(self, frame: int, meas: int) -> tuple[bool, tuple[str, str, float] | None]:
+        """(``of_no_object``, and for such a detection ``meas_part_of``): whether it lay near no annotated object,
+        and the long object it lay on part of, if any."""
+        no_object = self.of_no_object(frame, meas)
+        return no_object, self.meas_part_of(frame, meas) if no_object else None
 
     def own_detections(self, frame: int, gt_id: str) -> tuple[int, ...]:
         """The kept detections of the class within ``NEAR_M`` of object ``gt_id`` at ``frame`` that lie nearer it
@@ -624,8 +631,7 @@ class _Context:
         if matrix is not None and assignment is not None and c.alternative is not None:
             would = would_take(matrix, assignment, int(c.meas.ref), int(c.alternative.ref))
         took = self.took(f, int(c.alternative.ref))
-        no_object = self.of_no_object(f, int(c.meas.ref))
-        part = self.meas_part_of(f, int(c.meas.ref)) if no_object else None
+        no_object, part = self.no_object_part(f, int(c.meas.ref))
         return Deciding(f, c, went, is_born, lost, in_gate, would, lost_would, took, no_object, part)
 
     def switch(self, tracks: set[int], deciding: tuple[int, ...]) -> HypothesisSwitch | None:

@@ -60,6 +60,19 @@ def test_a_detection_inside_a_long_objects_box_is_part_of_it_not_of_no_object() 
     assert part_of(ctx.scene.keyframes[14].gt, np.array([0.0, 7.9])) is None  # beside it once turned by 0.5 rad
 
 
+def _false_truck(out: FalseOutput, blame: tuple[Blame, ...]) -> object:
+    """False truck track 72 at frame 14 with output ``out`` and ``blame``."""
+    return finding(
+        FailureKind.FALSE_TRACK,
+        class_name="truck",
+        gt_id=None,
+        track_ids=(72,),
+        frame=14,
+        false_output=out,
+        blame=blame,
+    )
+
+
 def test_the_why_says_a_split_objects_boxes_were_on_part_of_it() -> None:
     ctx = truck_split()
     part = ctx.meas_part_of(14, 1)
@@ -75,15 +88,7 @@ def test_the_why_says_a_split_objects_boxes_were_on_part_of_it() -> None:
     assert "of no object" not in line
     # a false track coasting on the trailer: not "a box where no tracked object was"
     out = FalseOutput(72, None, (-3.0, -1.6), None, None, None, None, None, None, part_of=part)
-    coast = finding(
-        FailureKind.FALSE_TRACK,
-        class_name="truck",
-        gt_id=None,
-        track_ids=(72,),
-        frame=14,
-        false_output=out,
-        blame=(Blame(Rule.COASTED, (14,)),),
-    )
+    coast = _false_truck(out, (Blame(Rule.COASTED, (14,)),))
     (line, *_) = why_lines(coast)
     assert "no object of a tracked class lies within 2 m, but the box lies on part of truck GT ecf44b" in line
     assert "where no tracked object was" not in line
@@ -113,15 +118,7 @@ def test_a_second_track_on_an_object_the_detector_gave_two_boxes_of_is_not_the_t
     assert ctx.own_detections(14, TRUCK) == (0, 1)
     out = FalseOutput(72, None, (-0.4, 0.3), None, (TRUCK, 0.5, None), None, 41, None, None, twins=(0, 1))
     blame = (Blame(Rule.TWO_DETECTIONS, (14,)), Blame(Rule.TWO_TRACKS, (14,)))
-    f = finding(
-        FailureKind.FALSE_TRACK,
-        class_name="truck",
-        gt_id=None,
-        track_ids=(72,),
-        frame=14,
-        false_output=out,
-        blame=blame,
-    )
+    f = _false_truck(out, blame)
     (line, *_) = why_lines(f)
     assert (
         "truck GT ecf44b lies 0.5 m away and the evaluation matched it to another track (track 41): two tracks on one "
