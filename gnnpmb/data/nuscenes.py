@@ -381,21 +381,46 @@ def _custom_splits(location: DatasetLocation) -> dict[str, list[str]]:
     return data
 
 
+SPLIT_VERSION_SUFFIX = {
+    "train": "trainval",
+    "val": "trainval",
+    "train_detect": "trainval",
+    "train_track": "trainval",
+    "mini_train": "mini",
+    "mini_val": "mini",
+    "test": "test",
+}
+"""The devkit's predefined splits and the end of the dataset version each is evaluated on (its ``TrackingEval``
+checks it); a custom split (``splits.json``) goes with any version."""
+
+
+def split_fits_version(split: str, version: str) -> bool:
+    """Whether the devkit evaluates ``split`` on dataset ``version`` (``SPLIT_VERSION_SUFFIX``)."""
+    suffix = SPLIT_VERSION_SUFFIX.get(split)
+    return suffix is None or version.endswith(suffix)
+
+
 def split_names(location: DatasetLocation) -> list[str]:
-    """Every split name ``split_scenes`` knows for ``location``: the devkit's and the custom ones, sorted."""
+    """The split names usable on ``location``, sorted: the devkit's splits of its version and the custom ones."""
     from nuscenes.utils.splits import create_splits_scenes
 
-    return sorted({**_custom_splits(location), **create_splits_scenes()})
+    names = {**_custom_splits(location), **create_splits_scenes()}
+    return sorted(n for n in names if split_fits_version(n, location.version))
 
 
 def split_scenes(split: str, location: DatasetLocation) -> list[str]:
     """Scene names of a devkit split (``mini_val``, ``val``, ...) or of a custom split in ``splits.json`` that
     exist in the dataset, in the split's order. Like the devkit, a predefined split wins over a custom one
     of the same name."""
+    import difflib
+
     from nuscenes.utils.splits import create_splits_scenes
 
     splits = {**_custom_splits(location), **create_splits_scenes()}
     if split not in splits:
-        raise UnknownNameError(f"unknown split '{split}'; known: {', '.join(sorted(splits))}")
+        usable = split_names(location)
+        close = difflib.get_close_matches(split, usable, n=1)
+        guess = f" (did you mean {close[0]}?)" if close else ""
+        raise UnknownNameError(f"unknown split '{split}'{guess}; the splits of {location.version}: {', '.join(usable)}")
     present = {r["name"] for r in _read_scene_table(location.dataroot, location.version)}
     return [name for name in splits[split] if name in present]

@@ -58,16 +58,6 @@ COUNT_METRICS = frozenset({"mt", "ml", "tp", "fp", "fn", "ids", "frag"})
 
 DEVKIT_FILES = ("metrics_summary.json", "metrics_details.json")
 
-_SPLIT_VERSION_SUFFIX = {
-    "train": "trainval",
-    "val": "trainval",
-    "train_detect": "trainval",
-    "train_track": "trainval",
-    "mini_train": "mini",
-    "mini_val": "mini",
-    "test": "test",
-}
-
 
 @contextlib.contextmanager
 def quiet_devkit() -> Iterator[None]:
@@ -140,8 +130,10 @@ def resolve_split(dataroot: Path | None, version: str | None, split: str | None)
 def check_split_version(split: str, version: str) -> None:
     """The devkit evaluates mini splits only on a ``*mini`` version, train/val on ``*trainval``, test on
     ``*test``; custom splits (``splits.json``) on any version."""
-    suffix = _SPLIT_VERSION_SUFFIX.get(split)
-    if suffix is not None and not version.endswith(suffix):
+    from gnnpmb.data.nuscenes import SPLIT_VERSION_SUFFIX, split_fits_version
+
+    if not split_fits_version(split, version):
+        suffix = SPLIT_VERSION_SUFFIX[split]
         raise DataError(
             f"split {split} cannot be evaluated on dataset version {version}; use a version ending in "
             f"'{suffix}' (e.g. v1.0-{suffix}) or a split of {version}"

@@ -197,8 +197,12 @@ def test_split_scenes(location: DatasetLocation, tables_only: Path) -> None:
     assert split_scenes("mini_val", location) == ["scene-0103", "scene-0916"]
     assert split_scenes("mini_train", location) == []
     assert split_scenes("staged", location) == ["scene-9001"]  # the demo's custom split
-    with pytest.raises(UnknownNameError, match=r"^unknown split 'minival'; known: mini_train, mini_val, staged, test"):
+    # only the splits the devkit evaluates on this version are offered (not val, train, test on a mini version)
+    splits = r"the splits of v1\.0-mini: mini_train, mini_val, staged$"
+    with pytest.raises(UnknownNameError, match=rf"^unknown split 'minival' \(did you mean mini_val\?\); {splits}"):
         split_scenes("minival", location)
+    with pytest.raises(UnknownNameError, match=rf"^unknown split 'nowhere'; {splits}"):
+        split_scenes("nowhere", location)
 
     (tables_only / DEMO_VERSION / "splits.json").write_text(json.dumps({"hard": ["scene-0916", "scene-9999"]}))
     custom = check_dataroot(tables_only, None)
