@@ -2,7 +2,8 @@
 
 Built once from the version's table files (streamed row by row, ``gnnpmb.data.json_stream``) into
 ``<cache root>/index/dataset-<key>/`` and rebuilt whenever a table file changes (path, size or modification
-time) or the index is damaged (``gnnpmb.data.index_store``). Per scene, one record batch in each of:
+time), this module's code changes (``index_store.code_identity``) or the index is damaged
+(``gnnpmb.data.index_store``). Per scene, one record batch in each of:
 
 * ``samples.arrow`` — the keyframes in time order (the ``next`` chain), each with its LIDAR_TOP keyframe
   ``sample_data`` row, that row's ego pose and calibrated sensor (the devkit's ``sample['data']['LIDAR_TOP']``);
@@ -32,6 +33,7 @@ import pyarrow.compute as pc
 from gnnpmb.data.index_store import (
     Store,
     build_progress,
+    code_identity,
     open_or_build,
     source_identity,
     write_batches,
@@ -158,11 +160,12 @@ def table_paths(dataroot: Path, version: str) -> list[Path]:
 def open_dataset_index(cache: Path, dataroot: Path, version: str) -> DatasetIndex:
     """The index of ``dataroot``/``version``, built now if missing, stale or damaged (``DataError`` when a table
     cannot be read)."""
-    sources = source_identity(table_paths(dataroot, version))
+    files = source_identity(table_paths(dataroot, version))
+    sources = [*files, code_identity(__name__)]
     folder = index_folder(cache, dataroot, version)
 
     def build(tmp: Path) -> None:
-        total = sum(max(source[1], 0) for source in sources)
+        total = sum(max(source[1], 0) for source in files)
         note = f"indexing {dataroot / version} ({total / 1e6:.0f} MB of tables) into {cache}, once per version"
         with build_progress(note, total) as advance:
             _build(tmp, dataroot, version, sources, advance)

@@ -6,7 +6,8 @@ bar), each sample converted and checked exactly as before (``gnnpmb.data.detecti
 stored under ``<cache root>/index/detections-<key>/``: ``boxes.arrow`` (one batch per sample, in file order),
 ``samples.json`` (token -> batch, or the sample's first problem) and the file's SHA-256 (the provenance's
 detections hash, computed while reading). The index is rebuilt when the file changes (path, size, modification
-time) or the index is damaged (``gnnpmb.data.index_store``).
+time), when the code that converts a sample changes (``index_store.code_identity``: the boxes and the problems'
+texts are derived by it), or when the index is damaged (``gnnpmb.data.index_store``).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import pyarrow as pa
 from gnnpmb.data.index_store import (
     Store,
     build_progress,
+    code_identity,
     file_crcs,
     open_or_build,
     source_identity,
@@ -94,10 +96,11 @@ def open_detection_index(
     """The index of the detection file ``path`` (absolute), built now if missing, stale or damaged. ``convert``
     turns one sample's entries into boxes or a problem; ``describe`` turns a read error into the user's one
     line."""
-    sources = source_identity([path])
+    files = source_identity([path])
+    sources = [*files, code_identity(convert.__module__, __name__)]
 
     def build(tmp: Path) -> None:
-        size = max(sources[0][1], 0)
+        size = max(files[0][1], 0)
         note = f"indexing {path.name} ({size / 1e6:.0f} MB) into {cache}, once per detection file"
         with build_progress(note, size) as advance:
             _build(tmp, path, sources, convert, describe, advance)

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import hashlib
+import importlib
 import json
 import os
 import re
@@ -60,6 +62,16 @@ def source_identity(paths: Sequence[Path]) -> list[list[Any]]:
     """The identity of each source file (``file_identity.file_identity``: path, size, modification and change
     times, inode and a digest of its first and last blocks), checked at every open."""
     return [file_identity(path) for path in paths]
+
+
+def code_identity(*modules: str) -> list[Any]:
+    """``["code", digest]`` of the source files of ``modules`` (dotted names), for an index's sources: an index
+    derived by other code (a fixed conversion, a reworded problem stored in it) is rebuilt on its next open, so
+    a cached index never serves what the running code would not derive. Costs one read of each file."""
+    digest = hashlib.sha256()
+    for name in modules:
+        digest.update(Path(str(importlib.import_module(name).__file__)).read_bytes())
+    return ["code", digest.hexdigest()[:16]]
 
 
 def batch_crc(batch: pa.RecordBatch) -> int:

@@ -25,7 +25,14 @@ import numpy as np
 import pyarrow as pa
 
 from gnnpmb.data.dataset_index import _Tables
-from gnnpmb.data.index_store import open_or_build, source_identity, write_batches, write_json_file, write_manifest
+from gnnpmb.data.index_store import (
+    code_identity,
+    open_or_build,
+    source_identity,
+    write_batches,
+    write_json_file,
+    write_manifest,
+)
 from gnnpmb.data.scene import Pose, SceneData
 
 FORMAT = 1
@@ -184,7 +191,7 @@ def load_scene_sensors(scene: SceneData, frames: range | None = None) -> SceneSe
     from gnnpmb.cache_folder import cache_root
 
     dataroot, version = Path(scene.dataroot), scene.version
-    sources = source_identity([dataroot / version / f"{t}.json" for t in TABLES])
+    sources = [*source_identity([dataroot / version / f"{t}.json" for t in TABLES]), code_identity(__name__)]
     store = open_or_build(
         _index_folder(cache_root(), dataroot, version),
         FORMAT,

@@ -70,6 +70,27 @@ def test_indexed_once_and_again_when_rewritten(det_file, tmp_path, monkeypatch):
     assert list(fresh["s0"].class_name) == ["bicycle"] and len(builds) == 2
 
 
+def test_an_index_built_by_other_code_is_rebuilt(tmp_path, monkeypatch):
+    """A problem's text (and every box) is derived into the index when it is built: an index left by an older
+    version of the conversion code must not serve that version's wording or boxes."""
+    from gnnpmb.data import detection_index, detections
+
+    monkeypatch.setenv("GNNPMB_CACHE_DIR", str(tmp_path / "cache"))
+    bad = box("s0")
+    bad.pop("size")
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(submission({"s0": [bad], "s1": [box("s1")]})))
+    with monkeypatch.context() as old_code:
+        old_code.setattr(detection_index, "code_identity", lambda *modules: ["code", "an older version"])
+        old_code.setattr(detections, "convert_sample", lambda token, entries: "the older wording")
+        with pytest.raises(DataError, match="the older wording"):
+            load_detection_file(path, ["s0"])
+    detections._opened.clear()  # a new process running the current code
+    with pytest.raises(DataError, match="box 0 of sample s0 has no 'size' field"):
+        load_detection_file(path, ["s0"])
+    assert len(load_detection_file(path, ["s1"])["s1"]) == 1
+
+
 def test_damaged_index_is_rebuilt(det_file, tmp_path, monkeypatch):
     from gnnpmb.data import detections
 
