@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import hashlib
 import io
 import os
 import shutil
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 import pytest
@@ -78,6 +79,29 @@ def demo_recording(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory
 
     folder = made_once(tmp_path_factory, "demo-recording", make)
     return folder / "rrd" / "x.rrd", (folder / "stdout.txt").read_text()
+
+
+@pytest.fixture(scope="session")
+def viz_recording(
+    demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Callable[[Sequence[str]], tuple[Path, str]]:
+    """``viz_recording(args)``: ``gnnpmb-viz ARGS --dataroot DEMO --save focus.rrd --no-progress`` run in-process
+    on the demo, each command line once per test session (shared by the xdist workers and the modules that make
+    the same recording): the recording and what the command printed on stdout; read-only."""
+    from cli.app import main
+
+    def run(args: Sequence[str]) -> tuple[Path, str]:
+        def make(folder: Path) -> None:
+            stdout = io.StringIO()
+            with contextlib.redirect_stdout(stdout):
+                main([*args, "--dataroot", str(demo_dataroot), "--save", str(folder / "focus.rrd"), "--no-progress"])
+            (folder / "stdout.txt").write_text(stdout.getvalue())
+
+        key = hashlib.sha256("\0".join(args).encode()).hexdigest()[:16]
+        folder = made_once(tmp_path_factory, f"viz-{key}", make)
+        return folder / "focus.rrd", (folder / "stdout.txt").read_text()
+
+    return run
 
 
 @pytest.fixture(scope="session")
