@@ -29,6 +29,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
+from gnnpmb.classes import TRACKING_NAME_OF_CATEGORY
 from gnnpmb.data.index_store import (
     Store,
     build_progress,
@@ -383,14 +384,12 @@ def _annotations(
 ) -> tuple[list[pa.RecordBatch], dict[str, int]]:
     """Per scene, its annotations (by keyframe, then table order) with category, tracking class and velocity;
     and the scene of every annotated instance."""
-    from nuscenes.eval.tracking.utils import category_to_tracking_name
-
     category_name = {c["token"]: c["name"] for c in categories}
     try:
         instance_category = {i["token"]: category_name[i["category_token"]] for i in instances}
     except KeyError as exc:
         raise tables.field_error("instance", exc) from None
-    tracking = {name: category_to_tracking_name(name) for name in set(category_name.values())}
+    tracking = {name: TRACKING_NAME_OF_CATEGORY.get(name) for name in set(category_name.values())}
     chunks: list[pa.Table] = []
     rows: list[dict] = []
     meta = [array("q") for _ in range(4)]  # scene, keyframe, table position, sample timestamp
