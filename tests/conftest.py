@@ -134,6 +134,18 @@ def swept_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return made_once(tmp_path_factory, "swept", make) / "data"
 
 
+@pytest.fixture(scope="session")
+def two_scene_dataroot(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The demo's two mini_val scenes cut to their first 6 keyframes each (split mini_val holds both; LiDAR files
+    linked), made once per session (shared by the xdist workers); read-only."""
+    from tests.gnnpmb.study.conftest import TINY_FRAMES, cut_dataset
+
+    def make(folder: Path) -> None:
+        cut_dataset(demo_dataroot, folder / "nuscenes", ["scene-0103", "scene-0916"], TINY_FRAMES)
+
+    return made_once(tmp_path_factory, "two-scenes", make) / "nuscenes"
+
+
 MODULE_CPU_S = Path(__file__).with_name("module_cpu_s.json")
 """CPU seconds of each test module in a suite run (``python -m tests.cpu_log DIR --write``): what the workers'
 order is planned by on a fresh clone, where pytest has no durations of its own yet."""
