@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import hashlib
 import io
 import os
 import shutil
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 import pytest
@@ -81,6 +82,29 @@ def demo_recording(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory
 
 
 @pytest.fixture(scope="session")
+def viz_recording(
+    demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Callable[[Sequence[str]], tuple[Path, str]]:
+    """``viz_recording(args)``: ``gnnpmb-viz ARGS --dataroot DEMO --save focus.rrd --no-progress`` run in-process
+    on the demo, each command line once per test session (shared by the xdist workers and the modules that make
+    the same recording): the recording and what the command printed on stdout; read-only."""
+    from cli.app import main
+
+    def run(args: Sequence[str]) -> tuple[Path, str]:
+        def make(folder: Path) -> None:
+            stdout = io.StringIO()
+            with contextlib.redirect_stdout(stdout):
+                main([*args, "--dataroot", str(demo_dataroot), "--save", str(folder / "focus.rrd"), "--no-progress"])
+            (folder / "stdout.txt").write_text(stdout.getvalue())
+
+        key = hashlib.sha256("\0".join(args).encode()).hexdigest()[:16]
+        folder = made_once(tmp_path_factory, f"viz-{key}", make)
+        return folder / "focus.rrd", (folder / "stdout.txt").read_text()
+
+    return run
+
+
+@pytest.fixture(scope="session")
 def cv_results(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Another tracker's results on the demo's ``mini_val`` scenes (a tracking submission written by
     ``examples/cv_tracker.py``, a constant-velocity tracker outside the registry, on the centerpoint preset), made
@@ -108,6 +132,18 @@ def swept_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
             demo.generate_demo_dataset(folder / "data", scenes=("scene-0103",), sweeps=True)
 
     return made_once(tmp_path_factory, "swept", make) / "data"
+
+
+@pytest.fixture(scope="session")
+def two_scene_dataroot(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The demo's two mini_val scenes cut to their first 6 keyframes each (split mini_val holds both; LiDAR files
+    linked), made once per session (shared by the xdist workers); read-only."""
+    from tests.gnnpmb.study.conftest import TINY_FRAMES, cut_dataset
+
+    def make(folder: Path) -> None:
+        cut_dataset(demo_dataroot, folder / "nuscenes", ["scene-0103", "scene-0916"], TINY_FRAMES)
+
+    return made_once(tmp_path_factory, "two-scenes", make) / "nuscenes"
 
 
 MODULE_CPU_S = Path(__file__).with_name("module_cpu_s.json")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import io
 import os
 import subprocess
 import traceback
@@ -57,6 +58,26 @@ def run_script(argv: Sequence[str], capsys: pytest.CaptureFixture[str]) -> subpr
             out, err = capsys.readouterr()
             code, err = 1, err + traceback.format_exc()
     return subprocess.CompletedProcess(list(argv), code, out, err)
+
+
+def run_script_captured(argv: Sequence[str]) -> subprocess.CompletedProcess[str]:
+    """``run_script`` where no ``capsys`` is at hand (a module fixture): what the command writes to
+    ``sys.stdout`` and ``sys.stderr`` is captured by redirecting them."""
+
+    class Captured:
+        def __init__(self) -> None:
+            self.out, self.err = io.StringIO(), io.StringIO()
+
+        def readouterr(self) -> tuple[str, str]:
+            out, err = self.out.getvalue(), self.err.getvalue()
+            for stream in (self.out, self.err):
+                stream.seek(0)
+                stream.truncate()
+            return out, err
+
+    captured = Captured()
+    with contextlib.redirect_stdout(captured.out), contextlib.redirect_stderr(captured.err):
+        return run_script(argv, captured)  # type: ignore[arg-type]
 
 
 def run_script_with(

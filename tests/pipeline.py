@@ -32,3 +32,17 @@ def evidence_of_all(inputs: Inputs) -> tuple[dict, list[str], list[Run]]:
 POSITION_ONLY = Path(__file__).resolve().parents[1] / "gnnpmb" / "params" / "position_only.toml"
 """The PMB family's model set before issue 32: the tests that open a GNN-PMB ID switch on the demo pin it (the
 defaults make none on scene-0103)."""
+
+PMBM_ALL = "pmbm-all"
+PMBM_NO_NSCAN = f"{PMBM_ALL}=pmbm:{POSITION_ONLY.with_name('pmbm_no_nscan.toml')}"
+"""A PMBM run without N-scan pruning (``gnnpmb/params/pmbm_no_nscan.toml``, the README's example): it parts
+from GNN-PMB at the first ID switch; the default PMBM (N-scan 1) loses the bicycle too."""
+
+
+def focus_comparison_args(focus: str) -> list[str]:
+    """``gnnpmb-viz``'s arguments (but ``--dataroot`` and ``--save``) for the focus recording on ``focus`` of GNN-PMB
+    beside PMBM without N-scan pruning on scene-0103 (pointpillars, ``POSITION_ONLY``), without camera views:
+    ``tests/cli/test_focus.py`` reads it and ``tests/viz/test_browser.py`` opens it in Chromium, one recording
+    for both (``viz_recording``, ``tests/conftest.py``)."""
+    argv = ["scene-0103", "--detector", "pointpillars", "--params", str(POSITION_ONLY), "--focus", focus]
+    return [*argv, "--no-cameras", "--tracker", "gnnpmb", "--tracker", PMBM_NO_NSCAN]

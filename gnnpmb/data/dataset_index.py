@@ -2,8 +2,8 @@
 
 Built once from the version's table files (streamed row by row, ``gnnpmb.data.json_stream``) into
 ``<cache root>/index/dataset-<key>/`` and rebuilt whenever a table file changes (path, size or modification
-time), this module's code changes (``index_store.code_identity``) or the index is damaged
-(``gnnpmb.data.index_store``). Per scene, one record batch in each of:
+time), the code that derives it changes (this module and the category table, ``index_store.code_identity``)
+or the index is damaged (``gnnpmb.data.index_store``). Per scene, one record batch in each of:
 
 * ``samples.arrow`` — the keyframes in time order (the ``next`` chain), each with its LIDAR_TOP keyframe
   ``sample_data`` row, that row's ego pose and calibrated sensor (the devkit's ``sample['data']['LIDAR_TOP']``);
@@ -30,6 +30,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
+from gnnpmb.classes import TRACKING_NAME_OF_CATEGORY
 from gnnpmb.data.index_store import (
     Store,
     build_progress,
@@ -161,7 +162,7 @@ def open_dataset_index(cache: Path, dataroot: Path, version: str) -> DatasetInde
     """The index of ``dataroot``/``version``, built now if missing, stale or damaged (``DataError`` when a table
     cannot be read)."""
     files = source_identity(table_paths(dataroot, version))
-    sources = [*files, code_identity(__name__)]
+    sources = [*files, code_identity(__name__, "gnnpmb.classes")]
     folder = index_folder(cache, dataroot, version)
 
     def build(tmp: Path) -> None:
@@ -386,14 +387,12 @@ def _annotations(
 ) -> tuple[list[pa.RecordBatch], dict[str, int]]:
     """Per scene, its annotations (by keyframe, then table order) with category, tracking class and velocity;
     and the scene of every annotated instance."""
-    from nuscenes.eval.tracking.utils import category_to_tracking_name
-
     category_name = {c["token"]: c["name"] for c in categories}
     try:
         instance_category = {i["token"]: category_name[i["category_token"]] for i in instances}
     except KeyError as exc:
         raise tables.field_error("instance", exc) from None
-    tracking = {name: category_to_tracking_name(name) for name in set(category_name.values())}
+    tracking = {name: TRACKING_NAME_OF_CATEGORY.get(name) for name in set(category_name.values())}
     chunks: list[pa.Table] = []
     rows: list[dict] = []
     meta = [array("q") for _ in range(4)]  # scene, keyframe, table position, sample timestamp

@@ -9,6 +9,7 @@ The devkit is imported lazily: importing this module stays cheap.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -400,11 +401,57 @@ def split_fits_version(split: str, version: str) -> bool:
     return suffix is None or version.endswith(suffix)
 
 
+_DEVKIT_SPLIT_LISTS = ("train_detect", "train_track", "val", "test", "mini_train", "mini_val")
+"""The scene lists the devkit's ``nuscenes/utils/splits.py`` writes out (its ``train`` is their union)."""
+
+
+@functools.cache
+def _devkit_split_lists() -> dict[str, tuple[str, ...]] | None:
+    """The devkit's predefined splits read from the source of ``nuscenes/utils/splits.py`` (its lists of scene
+    names are literals), in ``create_splits_scenes``' order; None when that file is not as expected."""
+    import ast
+    import importlib.util
+
+    spec = importlib.util.find_spec("nuscenes")  # finds the package without importing it
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    path = Path(next(iter(spec.submodule_search_locations))) / "utils" / "splits.py"
+    try:
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, SyntaxError, ValueError):
+        return None
+    lists: dict[str, list] = {}
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name):
+            try:
+                lists[node.targets[0].id] = ast.literal_eval(node.value)
+            except ValueError:
+                continue  # not a literal: ``train`` is computed
+    if not all(isinstance(lists.get(n), list) for n in _DEVKIT_SPLIT_LISTS):
+        return None
+    train = sorted(set(lists["train_detect"] + lists["train_track"]))
+    splits = {"train": train, "val": lists["val"], "test": lists["test"]}
+    splits |= {name: lists[name] for name in ("mini_train", "mini_val", "train_detect", "train_track")}
+    return {name: tuple(scenes) for name, scenes in splits.items()}
+
+
+def devkit_splits() -> dict[str, list[str]]:
+    """The devkit's predefined splits, what ``nuscenes.utils.splits.create_splits_scenes()`` gives (a new dict of
+    new lists), without importing the devkit when it is not loaded yet: that module imports the devkit's package,
+    which loads scikit-learn and matplotlib, 2 s of CPU of a ``gnnpmb track`` that never evaluates."""
+    import sys
+
+    lists = None if "nuscenes.utils.splits" in sys.modules else _devkit_split_lists()
+    if lists is None:
+        from nuscenes.utils.splits import create_splits_scenes
+
+        return create_splits_scenes()
+    return {name: list(scenes) for name, scenes in lists.items()}
+
+
 def split_names(location: DatasetLocation) -> list[str]:
     """The split names usable on ``location``, sorted: the devkit's splits of its version and the custom ones."""
-    from nuscenes.utils.splits import create_splits_scenes
-
-    names = {**_custom_splits(location), **create_splits_scenes()}
+    names = {**_custom_splits(location), **devkit_splits()}
     return sorted(n for n in names if split_fits_version(n, location.version))
 
 
@@ -414,9 +461,7 @@ def split_scenes(split: str, location: DatasetLocation) -> list[str]:
     of the same name."""
     import difflib
 
-    from nuscenes.utils.splits import create_splits_scenes
-
-    splits = {**_custom_splits(location), **create_splits_scenes()}
+    splits = {**_custom_splits(location), **devkit_splits()}
     if split not in splits:
         usable = split_names(location)
         close = difflib.get_close_matches(split, usable, n=1)

@@ -1,12 +1,11 @@
-"""``gnnpmb calibrate`` as a user runs it: a real process on the demo's two annotated scenes writes one parameter
+"""``gnnpmb calibrate`` as a user runs it (in-process as the console script runs it, ``tests.inprocess``; the
+script's own process start is checked in ``test_batch.py``): on the demo's two annotated scenes it writes one parameter
 file that every tracker reads, with a comment on every learnt value; bad input is one ``error:`` line. Its check
 by cross-validation is tested on smaller data in ``tests/gnnpmb/study/test_calibrate_check.py``."""
 
 from __future__ import annotations
 
 import re
-import subprocess
-import sys
 import tomllib
 from pathlib import Path
 
@@ -14,16 +13,15 @@ import pytest
 
 from gnnpmb.config import load_config
 from gnnpmb.types import TRACKING_CLASSES
-
-SCRIPT = Path(sys.executable).parent / "gnnpmb"
+from tests.inprocess import run_script, run_script_captured
 
 
 @pytest.fixture(scope="module")
 def calibrated(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
     out = tmp_path_factory.mktemp("calibrate") / "params.toml"
-    argv = [str(SCRIPT), "calibrate", "--dataroot", str(demo_dataroot), "--split", "mini_val", "--out", str(out)]
+    argv = ["gnnpmb", "calibrate", "--dataroot", str(demo_dataroot), "--split", "mini_val", "--out", str(out)]
     argv.append("--no-check")  # everything learnt is written (the check: tests/gnnpmb/study/test_calibrate_check.py)
-    done = subprocess.run(argv, capture_output=True, text=True, timeout=300)
+    done = run_script_captured(argv)
     assert done.returncode == 0, done.stderr
     return out, done.stdout
 
@@ -78,10 +76,12 @@ def test_each_class_says_how_many_objects_its_values_rest_on(calibrated: tuple[P
         assert line in text.splitlines(), (cls, [x for x in text.splitlines() if x.startswith(f"# {cls}: learnt")])
 
 
-def test_a_wrong_output_suffix_is_one_error_line(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_a_wrong_output_suffix_is_one_error_line(
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "params.json"
-    argv = [str(SCRIPT), "calibrate", "--dataroot", str(demo_dataroot), "--split", "mini_val", "--out", str(out)]
-    done = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    argv = ["gnnpmb", "calibrate", "--dataroot", str(demo_dataroot), "--split", "mini_val", "--out", str(out)]
+    done = run_script(argv, capsys)
     assert done.returncode == 2
     assert done.stderr.startswith("error: --out") and done.stderr.count("\n") == 1
     assert not out.exists()

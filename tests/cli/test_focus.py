@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import contextlib
 import functools
-import io
 import re
 from pathlib import Path
 
@@ -12,14 +10,13 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from cli.app import main
 from gnnpmb.eval.failures import FailureKind, short_id
 from gnnpmb.stages.findings import explain_all
 from gnnpmb.why.facts import Ending
 from gnnpmb.why.findings import Party, Rule
 from gnnpmb.why.words import column_name, whose_text, why_lines
 from tests.inprocess import run_script_with
-from tests.pipeline import POSITION_ONLY, evidence_of_all, prepare
+from tests.pipeline import PMBM_ALL, PMBM_NO_NSCAN, POSITION_ONLY, evidence_of_all, focus_comparison_args, prepare
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
@@ -30,10 +27,7 @@ from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_
 
 SCENE = "scene-0103"
 ARGS = ["--detector", "pointpillars", "--params", str(POSITION_ONLY)]
-PMBM_ALL = "pmbm-all"
-PMBM = f"{PMBM_ALL}=pmbm:{POSITION_ONLY.with_name('pmbm_no_nscan.toml')}"
-"""A PMBM run without N-scan pruning (``gnnpmb/params/pmbm_no_nscan.toml``, the README's example): it parts
-from GNN-PMB at the first ID switch; the default PMBM (N-scan 1) loses the bicycle too."""
+PMBM = PMBM_NO_NSCAN
 
 
 @functools.cache
@@ -54,24 +48,16 @@ def gnnpmb_report(demo_dataroot: Path):
 
 
 @pytest.fixture(scope="module")
-def record(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory):
+def record(viz_recording):
     """``record(focus, trackers)``: ``gnnpmb-viz SCENE --focus FOCUS --save focus.rrd`` in-process, each command
-    line run once in the module (tests that look at the same recording share it; read-only): the recording and
-    what the command printed."""
-    made: dict[tuple[str, tuple[str, ...]], tuple[Path, str]] = {}
+    line run once in the session (tests that look at the same recording share it; read-only): the recording and
+    what the command printed. GNN-PMB beside PMBM without N-scan pruning is the recording the browser check opens
+    too (``focus_comparison_args``: without camera views)."""
 
     def run(focus: str, trackers: tuple[str, ...] = ("gnnpmb",)) -> tuple[Path, str]:
-        if (focus, trackers) not in made:
-            out = tmp_path_factory.mktemp("focus") / "focus.rrd"
-            stdout = io.StringIO()
-            argv = [SCENE, "--dataroot", str(demo_dataroot), *ARGS, "--focus", focus, "--save", str(out)]
-            argv.append("--no-progress")
-            for t in trackers:
-                argv += ["--tracker", t]
-            with contextlib.redirect_stdout(stdout):
-                main(argv)
-            made[focus, trackers] = (out, stdout.getvalue())
-        return made[focus, trackers]
+        if trackers == ("gnnpmb", PMBM):
+            return viz_recording(focus_comparison_args(focus))
+        return viz_recording([SCENE, *ARGS, "--focus", focus, *[a for t in trackers for a in ("--tracker", t)]])
 
     return run
 

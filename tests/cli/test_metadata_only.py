@@ -1,13 +1,12 @@
-"""A dataroot with the nuScenes tables and none (or some) of the LiDAR files, through ``gnnpmb-viz`` (in a real
-process when no file is there; the others in-process, ``tests.inprocess.run_script``, a process start less each):
-the recording holds boxes, tracks and failures, the terminal says once which LiDAR files are missing
-(``gnnpmb.data.sensor_files``), and the keyframes without a file show no points rather than the last sweep."""
+"""A dataroot with the nuScenes tables and none (or some) of the LiDAR files, through ``gnnpmb-viz`` (in-process as
+the console script runs it, ``tests.inprocess.run_script``, a process start less each; the script's own process
+start is checked in ``tests/cli/test_app.py``): the recording holds boxes, tracks and failures, the terminal says
+once which LiDAR files are missing (``gnnpmb.data.sensor_files``), and the keyframes without a file show no points
+rather than the last sweep."""
 
 from __future__ import annotations
 
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -16,7 +15,6 @@ from tests.inprocess import run_script
 from tests.viz.rrd import read_rows
 from viz import paths
 
-BIN = Path(sys.executable).parent
 SCENE = "scene-0103"
 FRAMES = range(0, 6)
 
@@ -44,19 +42,16 @@ def _argv(dataroot: Path, out: Path, progress: bool = False) -> list[str]:
     return argv if progress else [*argv, "--no-progress"]
 
 
-def _view(dataroot: Path, out: Path, progress: bool = False) -> subprocess.CompletedProcess[str]:
-    argv = _argv(dataroot, out, progress)
-    return subprocess.run([str(BIN / argv[0]), *argv[1:]], capture_output=True, text=True, timeout=600, check=False)
-
-
 def _points_per_frame(rows: dict) -> dict[int, int]:
     return {r["frame"]: r["Points3D:positions.len"] for r in rows.get(paths.LIDAR, []) if not r["static"]}
 
 
-def test_tables_without_lidar_files_still_draw_tracks_and_failures(demo_dataroot: Path, tmp_path: Path) -> None:
+def test_tables_without_lidar_files_still_draw_tracks_and_failures(
+    demo_dataroot: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     root = _copy_tables(demo_dataroot, tmp_path / "meta")
     out = tmp_path / "meta.rrd"
-    done = _view(root, out, progress=True)
+    done = run_script(_argv(root, out, progress=True), capsys)
     assert done.returncode == 0, done.stderr
     notes = [line for line in done.stderr.splitlines() if line.startswith("note:") and "LiDAR" in line]
     assert len(notes) == 1 and notes[0].startswith(f"note: {SCENE}: no LiDAR files in this dataroot")

@@ -5,21 +5,24 @@ the detections were left out."""
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import pytest
 
+from tests.gnnpmb.study.conftest import cut_dataset
 from tests.inprocess import run_script
 
+SCENES, FRAMES = ("scene-0103", "scene-0916"), 6
 SIMULATED = "note: no --detections: the detections are simulated from the dataset's annotations (--detector"
 
 
 @pytest.fixture(scope="module")
 def own_dataroot(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The demo's tables, scenes described as a user's own (not the demo's marker), no sensor files."""
-    root = tmp_path_factory.mktemp("own") / "nuscenes"
-    shutil.copytree(demo_dataroot / "v1.0-mini", root / "v1.0-mini")
+    """The demo's tables, scenes described as a user's own (not the demo's marker), no sensor files; both scenes cut
+    to their first ``FRAMES`` keyframes (what is said does not depend on the length, the commands' work does)."""
+    root = cut_dataset(demo_dataroot, tmp_path_factory.mktemp("own") / "nuscenes", SCENES, FRAMES)
+    for link in ("samples", "maps"):  # the sensor files and maps stay behind
+        (root / link).unlink(missing_ok=True)
     scenes = root / "v1.0-mini" / "scene.json"
     rows = json.loads(scenes.read_text())
     scenes.write_text(json.dumps([r | {"description": f"own drive {i}"} for i, r in enumerate(rows)]))

@@ -1,5 +1,5 @@
 """Another tracker's results file in the debugger (``--results NAME=FILE.json``): its failures listed and explained
-in real processes, a focus recording read back, and its one-line errors."""
+by ``gnnpmb failures``, a focus recording read back, and its one-line errors."""
 
 from __future__ import annotations
 
@@ -13,34 +13,29 @@ from pathlib import Path
 import pytest
 
 from cli.app import main as viz_main
-from tests.inprocess import run_script
+from tests.inprocess import run_script, run_script_captured
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import paths
 from viz.blueprint import focus_doc
 
 SCENE = "scene-0103"
-BIN = Path(sys.executable).parent
 CvFailures = tuple[subprocess.CompletedProcess[str], dict]
 
 
 @pytest.fixture(scope="module")
 def cv_failures(demo_dataroot: Path, cv_results: Path, tmp_path_factory: pytest.TempPathFactory) -> CvFailures:
-    """``gnnpmb failures SCENE --results cv=FILE --tracker gnnpmb --why --json F`` in a real process, run once for
-    the module: the finished process and the JSON it wrote (read-only)."""
+    """``gnnpmb failures SCENE --results cv=FILE --tracker gnnpmb --why --json F`` in-process as the console script
+    runs it (``tests.inprocess``; the script's own process start is checked in ``test_batch.py``), run once for the
+    module: the finished command and the JSON it wrote (read-only)."""
     report = tmp_path_factory.mktemp("cv_failures") / "cv_failures.json"
-    argv = [str(BIN / "gnnpmb"), "failures", SCENE, "--results", f"cv={cv_results}", "--tracker", "gnnpmb"]
-    proc = subprocess.run(
-        [*argv, "--dataroot", str(demo_dataroot), "--why", "--json", str(report)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    argv = ["gnnpmb", "failures", SCENE, "--results", f"cv={cv_results}", "--tracker", "gnnpmb"]
+    proc = run_script_captured([*argv, "--dataroot", str(demo_dataroot), "--why", "--json", str(report)])
     assert proc.returncode == 0, proc.stderr
     return proc, json.loads(report.read_text())
 
 
-def test_failures_of_a_results_file_in_a_real_process(cv_failures: CvFailures) -> None:
+def test_failures_of_a_results_file(cv_failures: CvFailures) -> None:
     proc, data = cv_failures
     assert "note: cv.json: " in proc.stderr and "samples outside scene-0103 left out" in proc.stderr
     out = proc.stdout

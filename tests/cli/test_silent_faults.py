@@ -461,8 +461,10 @@ def test_a_full_disk_is_one_line_naming_the_place(
 # --- case 13: reproduce says when the code differs --------------------------------------------------------------------
 
 
-def test_reproduce_names_a_change_of_code(demo_dataroot: Path, tmp_path: Path) -> None:
-    """The recording is made by a copy of the package that differs by one comment (same version number)."""
+def test_reproduce_names_a_change_of_code(demo_dataroot: Path, tmp_path: Path, run_in: _InProcess) -> None:
+    """The recording is made by a copy of the package that differs by one comment (same version number), in a real
+    process (its ``PYTHONPATH`` is the change); ``reproduce`` runs this checkout's code, in-process as a new process
+    of the console script would (a process start less)."""
     import gnnpmb
 
     copy = tmp_path / "code"
@@ -473,7 +475,7 @@ def test_reproduce_names_a_change_of_code(demo_dataroot: Path, tmp_path: Path) -
     record = [VIZ, "scene-0103", "--tracker", "gnn", "--frames", "0:3", "--no-failures", "--no-progress"]
     proc = _run([*record, "--save", "run.rrd"], env | {"PYTHONPATH": str(copy)}, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
-    proc = _run([VIZ, "reproduce", "run.rrd"], env, cwd=tmp_path)
+    proc = run_in([VIZ, "reproduce", "run.rrd"], env, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     assert "note: recorded with other gnnpmb code (source digest" in proc.stderr
     assert "gnn: identical" in proc.stdout

@@ -103,7 +103,8 @@ def test_cli_reads_a_damaged_index_and_refuses_a_garbled_table(
 
     def failures() -> tuple[int, str, str]:
         loader._INDEXES.clear()
-        argv = ["failures", SCENE, "--dataroot", str(dataroot), "--detector", "pointpillars"]
+        # six keyframes: the index is read whole whatever the window; the whole scene only adds evaluation
+        argv = ["failures", SCENE, "--dataroot", str(dataroot), "--detector", "pointpillars", "--frames", "0:6"]
         return run_main(functools.partial(run_app, app), argv, capsys)
 
     code, first, _ = failures()
@@ -117,3 +118,26 @@ def test_cli_reads_a_damaged_index_and_refuses_a_garbled_table(
     lines = err.strip().splitlines()
     assert code == 2 and len(lines) == 1 and lines[0].startswith("error: ")
     assert "v1.0-mini/sample.json cannot be read" in lines[0] and "line" in lines[0]
+
+
+def test_an_index_is_built_without_the_devkit_and_names_classes_as_the_devkit_does(
+    dataroot: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The devkit's package loads scikit-learn and matplotlib (a second of CPU in each process that indexes a
+    dataset): the index's tracking classes come from ``TRACKING_NAME_OF_CATEGORY``, the devkit's own mapping."""
+    import sys
+
+    from nuscenes.eval.tracking.utils import category_to_tracking_name
+
+    from gnnpmb.classes import TRACKING_NAME_OF_CATEGORY
+
+    categories = json.loads((dataroot / "v1.0-mini" / "category.json").read_text())
+    names = {c["name"] for c in categories} | set(TRACKING_NAME_OF_CATEGORY) | {"animal", "vehicle.emergency.police"}
+    assert {n: TRACKING_NAME_OF_CATEGORY.get(n) for n in names} == {n: category_to_tracking_name(n) for n in names}
+    with monkeypatch.context() as patch:
+        for name in [m for m in sys.modules if m == "nuscenes" or m.startswith("nuscenes.")]:
+            patch.delitem(sys.modules, name)
+        patch.setitem(sys.modules, "nuscenes", None)  # importing the devkit fails
+        scene = load_scene(check_dataroot(dataroot, None), SCENE)
+    classes = {c for k in scene.keyframes for c in k.gt.class_name}
+    assert {"car", "pedestrian"} <= classes <= set(TRACKING_NAME_OF_CATEGORY.values())

@@ -1,4 +1,5 @@
-"""Tiny data for study tests (one demo scene cut to a few keyframes) and one Ray session per module."""
+"""Tiny data for study tests (one demo scene cut to a few keyframes; both cut: ``two_scene_dataroot`` in
+``tests/conftest.py``) and one Ray session per module."""
 
 from __future__ import annotations
 
@@ -76,13 +77,6 @@ def cut_dataset(src: Path, dst: Path, scene_names: Sequence[str], n_frames: int)
 def tiny_dataroot(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The demo's scene-0103 cut to 6 keyframes: split mini_val holds just this scene."""
     return cut_dataset(demo_dataroot, tmp_path_factory.mktemp("tiny") / "nuscenes", [TINY_SCENE], TINY_FRAMES)
-
-
-@pytest.fixture(scope="session")
-def two_scene_dataroot(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The demo's two mini_val scenes cut to 6 keyframes each: split mini_val holds both."""
-    cut = tmp_path_factory.mktemp("two_scenes") / "nuscenes"
-    return cut_dataset(demo_dataroot, cut, ["scene-0103", "scene-0916"], TINY_FRAMES)
 
 
 @pytest.fixture(scope="module")

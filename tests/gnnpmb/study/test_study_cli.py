@@ -23,6 +23,7 @@ from cli.errors import run_app
 from gnnpmb.config import load_config
 from gnnpmb.study.results import TIME_COLUMNS
 from gnnpmb.study.tune import DEFAULT_CLASS_SPACE
+from tests.gnnpmb.study.conftest import TINY_FRAMES
 from tests.inprocess import run_main
 
 SWEEP = ["--param", "pmb.extraction_threshold=0.5,0.9", "--no-progress", "--detector", "pointpillars"]
@@ -218,11 +219,13 @@ def test_tune_refuses_a_bad_space_before_any_work(
 def test_sweep_and_track_on_two_ray_workers_equal_one_worker(
     ray_local: None,
     tiny_dataroot: Path,
-    demo_dataroot: Path,
+    two_scene_dataroot: Path,
     one_worker_sweep: OneWorkerSweep,
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
+    """The sweep's rows and ``track``'s submission are the same with two Ray workers as with one; ``track`` on the
+    demo's two scenes cut to 6 keyframes each (one scene per worker; the whole demo only adds tracking work)."""
     assert one_worker_sweep.code == 0, one_worker_sweep.stderr
     out = tmp_path / "sweep2"
     argv = ["sweep", "--dataroot", str(tiny_dataroot), "--out", str(out), "--workers", "2", *SWEEP]
@@ -233,9 +236,10 @@ def test_sweep_and_track_on_two_ray_workers_equal_one_worker(
     submissions = {}
     for workers in ("1", "2"):
         out = tmp_path / f"track{workers}.json"
-        argv = ["track", "--dataroot", str(demo_dataroot), "--out", str(out), "--workers", workers, "--no-progress"]
+        argv = ["track", "--dataroot", str(two_scene_dataroot), "--out", str(out), "--workers", workers]
+        argv.append("--no-progress")
         code, _, stderr = run(argv, capsys)
         assert code == 0, stderr
         submissions[workers] = out.read_bytes()
     assert submissions["1"] == submissions["2"]
-    assert len(json.loads(submissions["2"])["results"]) == 80  # both demo scenes, one per worker
+    assert len(json.loads(submissions["2"])["results"]) == 2 * TINY_FRAMES  # both scenes, one per worker
