@@ -824,9 +824,10 @@ class _Context:
             out.append(Blame(Rule.TRACK_DROPPED, f))
         if any(not o.counted for o in s.on_it if o not in dropped):
             out.append(Blame(Rule.NOT_COUNTED, f))
-        # matched to another object while this one was in reach; not where the detector gave this one, visible, no
-        # detection of its own (two objects one box, or none): then no track could have covered both
-        if not (s.undetected and s.points > 0) and covering(s, self.reach_of(s.evaluated, self.object_of())):
+        # matched to another object while this one was in reach; not where the tracker received no detection of
+        # this one's class of its own while it was visible (two objects given one box, or none, or one of another
+        # class): then no track of the class could have covered both
+        if not (s.nearest_own is None and s.points > 0) and covering(s, self.reach_of(s.evaluated, self.object_of())):
             out.append(Blame(Rule.COVERED_TWO, f))
         own = s.nearest_own
         if own is None and s.seen is not None and s.seen.class_name == self.class_name:
