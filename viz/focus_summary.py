@@ -291,10 +291,15 @@ def _gt_markdown(focus: FocusTarget, view: TrackerView, gt_id: str, seen: tuple[
             sent = destination_name(s.went, mode)
         elif s.nearest_any is not None:
             n = s.nearest_any
-            why = "another class" if n.class_name != focus.class_name else "dropped by preprocessing"
+            notes = []
+            if n.class_name != focus.class_name:
+                notes.append("another class")
+            elif not n.kept:
+                notes.append("dropped by preprocessing")
             if n.on_other is not None:  # nearer another object: that one's detection, not a sight of this one
-                why += f"; {n.on_other[2]:.1f} m from {n.on_other[1]} GT {short_id(n.on_other[0])}"
-            nearest = f"none; m{n.meas} {n.class_name} at {n.distance_m:.1f} m (score {n.score:.2f}, {why})"
+                notes.append(f"{n.on_other[2]:.1f} m from {n.on_other[1]} GT {short_id(n.on_other[0])}")
+            why = "".join(f", {note}" for note in notes[:1]) + "".join(f"; {note}" for note in notes[1:])
+            nearest = f"none; m{n.meas} {n.class_name} at {n.distance_m:.1f} m (score {n.score:.2f}{why})"
             sent = "—"
         else:
             nearest, sent = "none", "—"

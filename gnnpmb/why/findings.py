@@ -189,6 +189,7 @@ class Sighting:
     evaluated: GtFrame | None
     nearest_any: Near | None
     nearest_own: Near | None
+    """The nearest kept detection of its class within ``NEAR_M`` that is its own (``Near.of_it``)."""
     went: Destination | None
     on_it: tuple[OnObject, ...]
     removed_own: Near | None = None
@@ -196,6 +197,9 @@ class Sighting:
     in_box: Near | None = None
     """With no detection of any class within ``NEAR_M``: the nearest one whose centre lies inside the object's box
     (a long truck seen as two boxes, world6: a sight of part of it, not no sight)."""
+    neighbours_own: Near | None = None
+    """The nearest kept detection of its class within ``NEAR_M`` that lies nearer another annotated object: that
+    one's, not this one's (``nearest_own`` never is such a detection; two pedestrians given one box)."""
 
     @property
     def lidar_points(self) -> int:

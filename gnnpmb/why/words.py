@@ -567,21 +567,27 @@ def _presence(f: Finding) -> str:
         return ""
     detected = [s.frame for s in seen if s.nearest_own is not None]
     removed = [s.frame for s in seen if s.nearest_own is None and s.removed_own is not None]
+    neighbours = [
+        s.frame for s in seen if s.nearest_own is None and s.removed_own is None and s.neighbours_own is not None
+    ]
     at = frames_text(detected) if detected else "no frame"
     only = " only" if 0 < len(detected) < len(seen) else ""
     kept = "the tracker kept " if removed else ""
+    own = " of its own" if neighbours else ""
     also = (
         f", and at {frames_text(removed)} only one its preprocessing removed (score threshold or NMS)"
         if removed
         else ""
     )
+    if neighbours:
+        also += f", and at {frames_text(neighbours)} only one nearer another annotated object"
     # the frames it was annotated at: one span, or where it left view and came back, each run apart
     span = ", ".join(f"{r[0]}–{r[-1]}" if len(r) > 1 else f"{r[0]}" for r in consecutive_runs([s.frame for s in seen]))
     if len(seen) == 1:
         span = f"{seen[0].frame}–{seen[0].frame}"
     return (
         f"in the {len(seen)} recorded frames up to {f.frame} ({span}), GT "
-        f"{short_id(f.gt_id)} had a {f.class_name} detection {kept}within {NEAR_M:.0f} m at {at}{only}{also}"
+        f"{short_id(f.gt_id)} had a {f.class_name} detection{own} {kept}within {NEAR_M:.0f} m at {at}{only}{also}"
     )
 
 
@@ -1276,9 +1282,9 @@ def _miss(f: Finding) -> list[str]:
     elif s.nearest_own is None and s.seen.class_name != f.class_name:
         n = s.seen
         parts.append(
-            f"at frame {f.frame} the detector gave no {f.class_name} detection within {NEAR_M:.0f} m of {name} "
-            f"({inside}), but a {n.class_name} detection, {meas_name(n.meas)} (score {n.score:.2f}), "
-            f"{n.distance_m:.1f} m away: the detector gave it the wrong class"
+            f"at frame {f.frame} the detector gave no {f.class_name} detection{_of_its_own(s)} within "
+            f"{NEAR_M:.0f} m of {name} ({inside}), but a {n.class_name} detection, {meas_name(n.meas)} "
+            f"(score {n.score:.2f}), {n.distance_m:.1f} m away: the detector gave it the wrong class"
         )
     elif s.nearest_own is None:
         n = s.seen
@@ -1310,6 +1316,11 @@ def _miss(f: Finding) -> list[str]:
             f"it lies {g.ego_distance_m:.1f} m from the ego vehicle, {side} the evaluation's {g.range_m:g} m range"
         )
     return parts
+
+
+def _of_its_own(s: Sighting) -> str:
+    """`` of its own`` where a detection of its class lay within reach, nearer another annotated object."""
+    return " of its own" if s.neighbours_own is not None else ""
 
 
 def _coalescence(f: Finding) -> list[str]:

@@ -60,6 +60,21 @@ def test_the_object_table_says_whose_a_detection_of_another_class_beside_it_is()
     assert "| 3 | 90 | none; m14 car at 1.8 m (score 0.66, another class; 0.1 m from car GT 26e63e) |" in text
 
 
+def test_the_object_table_gives_a_neighbours_box_of_its_class_as_that_ones_not_as_dropped() -> None:
+    # dev set scene-0916 centerpoint coalescence:1, frame 27: two pedestrians 0.78 m apart, one kept box m9, 0.3 m
+    # from GT 9d0a73; for GT 4afe77 the row must not call it its own, nor "dropped by preprocessing"
+    g = GtFrame(27, GtStatus.SCORED, (0.0, 0.0), (0.0, 0.0), None, 4, 20.0, 40.0)
+    theirs = Near(9, "pedestrian", 0.42, 0.9, True, ("9d0a73" + "0" * 26, "pedestrian", 0.3))
+    seen = (Sighting(27, 4, g, theirs, None, None, (), neighbours_own=theirs),)
+    view = SimpleNamespace(
+        facts=SimpleNamespace(mode=lambda c, frames: UseMode.ASSIGNED),
+        evidence=SimpleNamespace(report=SimpleNamespace(threshold_of=lambda c: 0.541)),
+    )
+    focus = FocusTarget("t", 27, (0.0, 0.0), "pedestrian", {"gnnpmb": (108,)}, ())
+    text = "\n".join(_gt_markdown(focus, view, "4afe77" + "0" * 26, seen))
+    assert "| 27 | 4 | none; m9 pedestrian at 0.9 m (score 0.42, 0.3 m from pedestrian GT 9d0a73) |" in text
+
+
 def test_a_track_average_is_printed_on_the_same_side_of_the_printed_threshold_as_the_evaluation_put_it() -> None:
     # dev set scene-1100 centerpoint prob3dmot fragmentation:1: "1 (0.58; track average 0.61)" of a track the
     # evaluation counted, under the heading "... is >= 0.613 (its best-MOTA threshold)"

@@ -27,7 +27,8 @@ NO_DETECTION = re.compile(
     r"its box\)"
 )
 WRONG_CLASS = re.compile(
-    rf"at frame (\d+) the detector gave no (\w+) detection within 2 m of \w+ GT (\w+) \({POINTS} in its box\), but "
+    rf"at frame (\d+) the detector gave no (\w+) detection(?: of its own)? within 2 m of \w+ GT (\w+) \({POINTS} in "
+    rf"its box\), but "
     rf"a (\w+) detection, m(\d+) \(score ({_F})\), ({_F}) m away"
 )
 NONE_ANY = re.compile(
@@ -63,8 +64,9 @@ INTERPOLATED_AT = re.compile(
 )
 PRESENCE = re.compile(
     rf"in the (\d+) recorded frames up to (\d+) \(([\d–, ]+)\), GT (\w+) had an? (\w+) detection "
-    rf"(?:the tracker kept )?within 2 m at ({_FRAMES}|no frame)(?: only)?"
-    rf"(?:,? and at ({_FRAMES}) only one? (?:that )?(?:its )?preprocessing removed)?"
+    rf"(?:of its own )?(?:the tracker kept )?within 2 m at ({_FRAMES}|no frame)(?: only)?"
+    rf"(?:,? and at ({_FRAMES}) only one? (?:that )?(?:its )?preprocessing removed[^,]*)?"
+    rf"(?:, and at ({_FRAMES}) only one nearer another annotated object)?"
 )
 
 
@@ -180,9 +182,11 @@ def check_detector(
     for m in WRONG_CLASS.finditer(text):
         x, ann = int(m[1]), gt_xy(int(m[1]), m[3])
         out.checked["detector"] += 1
-        if ann is None or scene.near(x, ann.xy_m, m[2]):
-            own = scene.near(x, ann.xy_m, m[2]) if ann else None
-            bad("detector", m[0], f"{m[2]} detections within reach: {own}; points {ann.points if ann else None}")
+        near = scene.near(x, ann.xy_m, m[2]) if ann else []
+        mine = [j for j in near if scene.owner(x, j, ann.xy_m) is None] if ann else []  # a neighbour's is not its own
+        if ann is None or mine or (bool(near) != (" of its own " in m[0])):  # "of its own" iff a neighbour's lay near
+            points = ann.points if ann else None
+            bad("detector", m[0], f"{m[2]} detections within reach: {near}, its own {mine}; points {points}")
         elif wrong_points(m[0], [ann], m[4], m[5]):
             continue
         elif (o := scene.owner(x, int(m[7]), ann.xy_m)) is not None:
@@ -238,7 +242,8 @@ def check_detector(
                     dist = ((d.xy_m[0] - a.xy_m[0]) ** 2 + (d.xy_m[1] - a.xy_m[1]) ** 2) ** 0.5
                     ok = ok or (
                         _close(item[3], dist)
-                        and not scene.near(x, a.xy_m, class_name)
+                        # none of its class that is its own (one nearer another object is that one's)
+                        and all(scene.owner(x, j, a.xy_m) is not None for j in scene.near(x, a.xy_m, class_name))
                         and scene.owner(x, int(item[2]), a.xy_m) is None  # this object's, not another's
                     )
             if not ok:
@@ -295,21 +300,27 @@ def _check_presence(m: re.Match, gt_id, class_name: str, scene: SceneTruth, raw:
     first, last, cls = said_frames[0], said_frames[-1], m[5]
     stated = set(frames_of(m[6])) if m[6] != "no frame" else set()
     stated_removed = set(frames_of(m[7])) if m[7] else set()
+    stated_neighbours = set(frames_of(m[8])) if m[8] else set()
     out.checked["misleading"] += 1
     annotated = [x for x in range(first, last + 1) if x < len(scene.objects) and (gt_id or "") in scene.objects[x]]
     if said_frames != annotated or int(m[1]) != len(annotated):
         # the recorded frames are the annotated ones: a span over frames without an annotation hides that it left
         bad("misleading", m[0], f"the object was annotated at frames {annotated} of {first}–{last}")
-    any_near, kept_near = set(), set()
+    any_near, kept_near, neighbours_only = set(), set(), set()
     for x in range(first, last + 1):
         a = scene.objects[x].get(gt_id or "") if x < len(scene.objects) else None
         if a is None:
             continue
         near = scene.near(x, a.xy_m, cls)
-        if near:
+        mine = [j for j in near if scene.owner(x, j, a.xy_m) is None]  # one nearer another object is that one's
+        if near and not mine:
+            neighbours_only.add(x)
+        if mine:
             any_near.add(x)
-        if raw is not None and set(near) & raw.received(x, cls):
+        if raw is not None and set(mine) & raw.received(x, cls):
             kept_near.add(x)
+    if not stated_neighbours <= neighbours_only:
+        bad("detector", m[0], f"only a neighbour's {cls} detection lay within {NEAR_M} m at {sorted(neighbours_only)}")
     out.checked["detector"] += 1
     if raw is None:
         if stated | stated_removed != any_near:
