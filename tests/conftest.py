@@ -153,6 +153,29 @@ UNMEASURED_TEST_CPU_S = 0.3
 """A module not in ``MODULE_CPU_S`` (new) counts this many CPU seconds per test."""
 
 
+_OWN_CACHE: list[Path] = []
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """The test session's own gnnpmb cache folder (``$GNNPMB_CACHE_DIR``), made by the first process (the xdist
+    controller; its workers and the console scripts the tests start inherit it) and removed at its end: what the
+    suite checks never depends on indexes, failure reports or a demo that an earlier run or another session left in
+    the user's cache folder, and it writes nothing there. A ``GNNPMB_CACHE_DIR`` already set is kept."""
+    import tempfile
+
+    from gnnpmb.cache_folder import CACHE_ENV
+
+    if not os.environ.get(CACHE_ENV):
+        folder = Path(tempfile.mkdtemp(prefix="gnnpmb-test-cache-"))
+        os.environ[CACHE_ENV] = str(folder)
+        _OWN_CACHE.append(folder)
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    for folder in _OWN_CACHE:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Modules in the order the workers should take them (``scripts/test.sh`` runs ``--dist loadscope
     --no-loadscope-reorder``: a worker that runs out of work takes the next module): first those opening the web
