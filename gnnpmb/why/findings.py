@@ -382,6 +382,9 @@ class FalseOutput:
     twins: tuple[int, ...] = ()
     """The kept detections of its class the detector gave the object within ``NEAR_M`` when two or more
     (``Rule.TWO_DETECTIONS``)."""
+    coasted_from: tuple[int, int] | None = None
+    """A predicted box on an object of another class: the frame and detection of the track's last box, when that
+    detection was the object's own (the detector gave it the track's class there; ``Rule.OTHER_CLASS``)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -507,6 +507,24 @@ class _Context:
         no_object = self.of_no_object(frame, meas)
         return no_object, self.meas_part_of(frame, meas) if no_object else None
 
+    def coasted_from(self, track_id: int, gt_id: str) -> tuple[int, int] | None:
+        """(frame, detection) of the last box before the failure that track ``track_id`` was output on, when that
+        detection lay within ``NEAR_M`` of object ``gt_id`` and nearer it than any other annotated object: a track
+        of another class that coasted on with the object it was fed by, not onto it (audit truth51, world7: a car
+        detected as a truck at every other frame left a truck track on it); None otherwise."""
+        for x in sorted((x for x in self.frames if x < self.f), reverse=True):
+            e = self.estimate(track_id, x)
+            if e is None or e.meas_index < 0:
+                continue
+            xy, at = self._meas_xy(x, e.meas_index), self.gt_xy(gt_id, x)
+            if xy is None or at is None:
+                return None
+            d = float(np.hypot(*(xy - at)))
+            if d >= NEAR_M or self.nearer_object(x, xy[None, :], np.array([d]))[0] is not None:
+                return None
+            return x, int(e.meas_index)
+        return None
+
     def own_detections(self, frame: int, gt_id: str) -> tuple[int, ...]:
         """The kept detections of the class within ``NEAR_M`` of object ``gt_id`` at ``frame`` that lie nearer it
         than any other annotated object (a detector without NMS gives one object two: audit truth50, world6)."""
@@ -692,6 +710,7 @@ class _Context:
         nearest_own = nearest_any = None
         matched = None
         twins: tuple[int, ...] = ()
+        came: tuple[int, int] | None = None
         if mine.size and d[mine].min() < NEAR_M:
             k = int(mine[np.argmin(d[mine])])
             gt_id = str(gt.instance_id[k])
@@ -719,6 +738,9 @@ class _Context:
         elif e is None:
             pass  # no box of the tracker's here
         elif on is None:
+            came = self.coasted_from(t, nearest_any[0]) if nearest_any is not None else None
+            if came is not None:  # audit truth51 (world7): the track was on the object, fed by its wrong-class boxes
+                blame.append(Blame(Rule.OTHER_CLASS, (came[0],)))
             blame.append(Blame(Rule.COASTED, (self.f,)))
         elif nearest_any is not None:
             blame.append(Blame(Rule.OTHER_CLASS, (self.f,)))
@@ -738,6 +760,7 @@ class _Context:
             step.use if (step := self.facts.steps(t, self.class_name).get(self.f)) is not None else None,
             part_of(gt, xy) if nearest_any is None else None,
             twins if len(twins) >= 2 else (),
+            came,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
 

@@ -1114,6 +1114,12 @@ def _false_track(f: Finding) -> list[str]:
     elif o.nearest_any is not None:
         gt_id, cls, d = o.nearest_any
         what = "the detector gave it the wrong class" if o.on is not None else "the track coasted onto it"
+        if o.on is None and o.coasted_from is not None:  # audit truth51 (world7): not onto it, on with it
+            x, m = o.coasted_from
+            what = (
+                f"the track coasted on with it from {meas_name(m)} at frame {x}, a {f.class_name} detection of it: "
+                "the detector gave it the wrong class"
+            )
         if f.output_only and o.on is None:
             what = "the tracker output a box there without a detection of its class under it"
         parts.append(
