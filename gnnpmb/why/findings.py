@@ -59,6 +59,9 @@ EVALUATED_OFFSET_M = 0.5
 """An interpolated box this far or farther from the annotation makes a failure the evaluation's doing."""
 FRAMES_BEFORE = 8
 """A finding looks back this many keyframes before its failure (and a focus recording starts there)."""
+OFF_NEAR_M = 6.5
+"""How far from an object with no detection within ``NEAR_M`` a detection of its class, nearer it than any other
+annotated object, is named beside the miss: it may be the object's box placed that far off (audit truth51)."""
 
 
 class Party(enum.Enum):
@@ -196,6 +199,10 @@ class Sighting:
     in_box: Near | None = None
     """With no detection of any class within ``NEAR_M``: the nearest one whose centre lies inside the object's box
     (a long truck seen as two boxes, world6: a sight of part of it, not no sight)."""
+    off: Near | None = None
+    """With no detection of any class within ``NEAR_M`` nor inside its box: the nearest detection of its class
+    within ``OFF_NEAR_M`` that lies nearer it than any other annotated object (world7: a car's box placed 3-6 m
+    off for one frame was told as "the detector missed it")."""
 
     @property
     def lidar_points(self) -> int:

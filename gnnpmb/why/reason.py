@@ -30,6 +30,7 @@ from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
     FRAMES_BEFORE,
     NEAR_M,
+    OFF_NEAR_M,
     Blame,
     Deciding,
     EvaluatedReach,
@@ -203,6 +204,7 @@ class _Context:
             own = self.near(f, xy, own=True)
             went = self.facts.destination(f, self.class_name, own.meas) if own is not None else None
             any_near = self.near(f, xy, own=False)
+            box = self.in_box(f, gt_id) if any_near is None else None
             out.append(
                 Sighting(
                     f,
@@ -214,7 +216,8 @@ class _Context:
                     self.on_object(self.report, self.frames[f], xy),
                     self.near(f, xy, own=True, kept_only=False),
                     self.radar_points(gt_id, f),
-                    self.in_box(f, gt_id) if any_near is None else None,
+                    box,
+                    self.off_near(f, gt_id) if any_near is None and box is None else None,
                 )
             )
         return tuple(out)
@@ -537,6 +540,22 @@ class _Context:
         idx = np.flatnonzero(ok)
         other = self.nearer_object(frame, boxes.translation_m[idx, :2], d[idx])
         return tuple(int(m) for m, o in zip(idx.tolist(), other, strict=True) if o is None)
+
+    def off_near(self, frame: int, gt_id: str) -> Near | None:
+        """The nearest detection of the class within ``OFF_NEAR_M`` of object ``gt_id`` at ``frame`` (kept or not)
+        that lies nearer it than any other annotated object (None: none)."""
+        xy, fr = self.gt_xy(gt_id, frame), self.frames.get(frame)
+        if xy is None or fr is None or not len(fr.detections.boxes.score):
+            return None
+        boxes = fr.detections.boxes
+        d = np.hypot(*(boxes.translation_m[:, :2] - xy).T)
+        idx = np.flatnonzero((d < OFF_NEAR_M) & (boxes.class_name == self.class_name))
+        other = self.nearer_object(frame, boxes.translation_m[idx, :2], d[idx])
+        mine = [int(m) for m, o in zip(idx.tolist(), other, strict=True) if o is None]
+        if not mine:
+            return None
+        m = min(mine, key=lambda m: d[m])
+        return Near(m, str(boxes.class_name[m]), float(boxes.score[m]), float(d[m]), bool(fr.detections.kept[m]))
 
     def in_box(self, frame: int, gt_id: str) -> Near | None:
         """The nearest detection of ``frame`` whose centre lies inside object ``gt_id``'s box (None: none)."""

@@ -1270,6 +1270,14 @@ def _miss(f: Finding) -> list[str]:
             f"({inside}), but {n.class_name} {meas_name(n.meas)} (score {n.score:.2f}) lay inside its box, "
             f"{n.distance_m:.1f} m from its centre: the detector saw part of it"
         )
+    elif s.undetected and s.nearest_any is None and s.off is not None:  # audit truth51 (world7): a box 3-6 m off
+        n = s.off
+        parts.append(
+            f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
+            f"({inside}); the nearest {n.class_name} detection, {meas_name(n.meas)} (score {n.score:.2f}), lay "
+            f"{n.distance_m:.1f} m away, nearer it than any other annotated object: the detector missed it or placed "
+            "its box that far off"
+        )
     elif s.undetected and s.nearest_any is None:
         parts.append(
             f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
