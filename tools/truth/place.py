@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import re
 
+from tools.truth.output import placed
 from tools.truth.scene import NEAR_M, POINTS, points_problem
 
 AWAY = re.compile(r"(\w+) GT (\w{6}) lies (\d+\.\d) m away")
@@ -133,6 +134,48 @@ def check_place(text: str, c: str, x: int, place, scene, out, bad) -> None:
             bad("detector", m[0], f"{m[1]} annotations within 2 m: {own}")
         elif hit is None or hit[1].class_name != m[2] or f"{_d(hit[1].xy_m, place):.1f}" != m[4]:
             bad("detector", m[0], f"GT {m[3]} is {hit[1] if hit else 'not annotated here'}")
+
+
+COASTED = re.compile(
+    r"at frame (\d+) track (\d+) \((\w+)\) was output on no detection this frame \(a predicted box\); no \w+ GT lies "
+    r"within 2 m, but GT (\w+) (\w{6}) does \((\d+\.\d) m\): the track coasted (onto it|on with it from m(\d+) at "
+    r"frame (\d+), a \w+ detection of it: the detector gave it the wrong class)"
+)
+
+
+def _fed_by(x: int, track: str, short: str, scene, ev) -> tuple[int, int] | None:
+    """(frame, detection) of the last box before ``x`` of ``track`` that repeats a detection's box, when that
+    detection lies within 2 m of object ``short`` and nearer it than any other annotated object; None otherwise
+    (or where the track's last output box repeats none: a box filter's)."""
+    for y in range(x - 1, -1, -1):
+        if not any(b[0] == track for b in ev.boxes.get(y, [])):
+            continue
+        p = placed(y, track, scene, ev)
+        if p is None or not p[1]:
+            return None
+        hit = scene.object_of(y, short)
+        d = scene.detections[y][p[0]].xy_m
+        if hit is None or _d(hit[1].xy_m, d) >= NEAR_M or scene.owner(y, p[0], hit[1].xy_m) is not None:
+            return None
+        return y, p[0]
+    return None
+
+
+def check_coasted(text: str, scene, ev, out, bad) -> None:
+    """A false track's predicted box on an object of another class: "the track coasted onto it" where the track's
+    last box sat on a detection of that object is misleading (audit truth51, world7: a car seen as a truck at
+    every other frame; the truck track had been on it all along); "coasted on with it from mK at frame y" must
+    name that box's detection and frame."""
+    if scene is None:
+        return
+    for m in COASTED.finditer(text):
+        out.checked["misleading"] += 1
+        fed = _fed_by(int(m[1]), m[2], m[5], scene, ev)
+        if m[7] == "onto it":
+            if fed is not None:
+                bad("misleading", m[0], f"its last box (frame {fed[0]}) sat on m{fed[1]}, a detection of GT {m[5]}")
+        elif fed is None or fed != (int(m[9]), int(m[8])):
+            bad("detector", m[0], f"its last box's detection of the object: {fed}")
 
 
 def _right_way(scene, ev, gt_id: str, x: int) -> tuple[float, float] | None:
