@@ -137,7 +137,8 @@ class Near:
     kept it (score threshold, NMS); on_other: the annotated object (id, class, BEV distance m) the detection lies
     nearer than this one, when it does: then it is that object's detection, not a sight of this one (dev set
     scene-1094 centerpoint ab3dmot: a car detection 1.8 m from a bicycle and 0.1 m from a car was said to be the
-    bicycle seen as a car)."""
+    bicycle seen as a car). A detection of another class within ``NEAR_M`` of an object of its own class is that
+    object's too (audit truth51, world7: a rider's bicycle box, on the spot of the pedestrian annotated with it)."""
 
     meas: int
     class_name: str

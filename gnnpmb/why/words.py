@@ -633,8 +633,9 @@ def _hidden(f: Finding) -> list[str]:
 
 def no_detection(sightings: Sequence[Sighting]) -> str:
     """``no detection of a tracked class within 2 m``, or where detections lay that near but each nearer another
-    annotated object (``Near.on_other``): ``no detection of its own within 2 m (at frame 3 car m4, 1.8 m away,
-    lay 0.1 m from car GT 26e63e)``: that object's detection, not a sight of this one."""
+    annotated object, or within 2 m of one of the detection's own class (``Near.on_other``): ``no detection of its
+    own within 2 m (at frame 3 car m4, 1.8 m away, lay 0.1 m from car GT 26e63e)``: that object's detection, not a
+    sight of this one."""
     others = [s for s in sightings if s.nearest_any is not None and s.nearest_any.on_other is not None]
     if not others:
         return f"no detection of a tracked class within {NEAR_M:.0f} m"
