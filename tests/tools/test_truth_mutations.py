@@ -1891,3 +1891,30 @@ def test_a_wrong_class_track_said_to_have_coasted_onto_the_object_it_was_fed_by_
     assert kinds(f"{head}{fed.replace('frame 2', 'frame 1')}") == ["detector"]
     ev.geometry[(2, "77")] = (2.0, 5.0, 1.6, 1.0, 0.0, 0.0, 0.0, 0.8)  # its box at 2 repeats no detection's box
     assert kinds(f"{head}onto it") == []
+
+
+def test_a_riders_bicycle_box_said_to_be_the_pedestrian_seen_as_the_wrong_class_is_caught() -> None:
+    # audit truth51, world7 scene-0916 centerpoint ab3dmot miss:74: a rider annotated as a bicycle and a pedestrian
+    # on one spot; the bicycle's own box was said to be the pedestrian seen as the wrong class
+    from tools.truth.scene import Annotation, Detection
+
+    ped, bike = "4776dc" + "0" * 26, "a402d8" + "0" * 26
+    objects = [{ped: Annotation("pedestrian", (0.0, 0.0), 40), bike: Annotation("bicycle", (0.0, 0.0), 30)}] * 4
+    scene = SceneTruth([[Detection("bicycle", 0.67, (0.3, 0.4))]] * 4, objects)
+
+    def kinds(text: str) -> list[str]:
+        return [c.kind for c in check_text(text, Context("pedestrian", 3, ped), None, _eval(), scene=scene).found]
+
+    no_ped = (
+        "at frame 3 the detector gave no pedestrian detection within 2 m of pedestrian GT 4776dc (40 LiDAR and radar "
+        "points in its box)"
+    )
+    assert kinds(
+        f"{no_ped}, but a bicycle detection, m0 (score 0.67), 0.5 m away: the detector gave it the wrong class"
+    ) == ["detector"]
+    own = (
+        "at frame 3 the detector gave pedestrian GT 4776dc (40 LiDAR and radar points in its box) no detection of its "
+        "own within 2 m (bicycle m0, 0.5 m away, lay 0.5 m from bicycle GT a402d8)"
+    )
+    assert kinds(own) == []
+    assert kinds("at frame 3 the detector saw it only as another class (bicycle m0 0.50 m away)") == ["detector"]

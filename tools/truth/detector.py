@@ -223,8 +223,8 @@ def check_detector(
             bad("detector", m[0], f"{m[2]} detections within reach: {own}; points {ann.points if ann else None}")
         elif wrong_points(m[0], [ann], m[4], m[5]):
             continue
-        elif (o := scene.owner(x, int(m[7]), ann.xy_m)) is not None:
-            bad("detector", m[0], f"m{m[7]} lies nearer GT {o[0][:6]} ({o[1]:.2f} m): that object's detection")
+        elif (o := scene.claimant(x, int(m[7]), ann.xy_m, m[2])) is not None:
+            bad("detector", m[0], f"m{m[7]} is GT {o[0][:6]}'s ({o[1]:.2f} m): that object's detection")
         score_distance(m[0], x, int(m[7]), m[8], m[9], ann, m[6])
     for m in NONE_ANY.finditer(text):
         out.checked["detector"] += 1
@@ -252,7 +252,9 @@ def check_detector(
         owners = {}
         for x in frames:
             a = gt_xy(x, short)
-            owners[x] = {j: scene.owner(x, j, a.xy_m) for j in scene.near(x, a.xy_m)} if a is not None else None
+            owners[x] = (
+                {j: scene.claimant(x, j, a.xy_m, class_name) for j in scene.near(x, a.xy_m)} if a is not None else None
+            )
         if any(o is None or None in o.values() for o in owners.values()):
             bad("detector", m[0], f"within 2 m by frame, each detection's nearer object (None: the object's): {owners}")
             continue
@@ -277,7 +279,7 @@ def check_detector(
                     ok = ok or (
                         _close(item[3], dist)
                         and not scene.near(x, a.xy_m, class_name)
-                        and scene.owner(x, int(item[2]), a.xy_m) is None  # this object's, not another's
+                        and scene.claimant(x, int(item[2]), a.xy_m, class_name) is None  # this object's
                     )
             if not ok:
                 bad("detector", item[0], f"no frame of {frames} has it so with no {class_name} detection in reach")
