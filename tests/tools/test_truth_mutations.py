@@ -1889,8 +1889,11 @@ def test_a_wrong_class_track_said_to_have_coasted_onto_the_object_it_was_fed_by_
     fed = "on with it from m0 at frame 2, a truck detection of it: the detector gave it the wrong class"
     assert kinds(f"{head}{fed}") == []
     assert kinds(f"{head}{fed.replace('frame 2', 'frame 1')}") == ["detector"]
-    ev.geometry[(2, "77")] = (2.0, 5.0, 1.6, 1.0, 0.0, 0.0, 0.0, 0.8)  # its box at 2 repeats no detection's box
-    assert kinds(f"{head}onto it") == []
+    ev.boxes[1] = [("77", "truck", (5.4, 0.0))]  # a predicted box at 2 is passed over: its box at 1 sat on m0
+    ev.geometry[(1, "77")], ev.geometry[(2, "77")] = box, (2.0, 5.0, 1.6, 1.0, 0.0, 0.0, 0.0, 0.8)
+    scene.detections[1] = [Detection("truck", 0.9, (5.4, 0.0), box)]
+    assert kinds(f"{head}onto it") == ["misleading"]
+    assert kinds(f"{head}{fed.replace('frame 2', 'frame 1')}") == []
 
 
 def test_a_riders_bicycle_box_said_to_be_the_pedestrian_seen_as_the_wrong_class_is_caught() -> None:

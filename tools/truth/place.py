@@ -144,15 +144,13 @@ COASTED = re.compile(
 
 
 def _fed_by(x: int, track: str, short: str, scene, ev) -> tuple[int, int] | None:
-    """(frame, detection) of the last box before ``x`` of ``track`` that repeats a detection's box, when that
-    detection lies within 2 m of object ``short`` and nearer it than any other annotated object; None otherwise
-    (or where the track's last output box repeats none: a box filter's)."""
+    """(frame, detection) of the last box before ``x`` of ``track`` that repeats a detection's box (predicted
+    boxes passed over), when that detection lies within 2 m of object ``short`` and nearer it than any other
+    annotated object; None otherwise (or where no box of it repeats one: a box filter's)."""
     for y in range(x - 1, -1, -1):
-        if not any(b[0] == track for b in ev.boxes.get(y, [])):
-            continue
-        p = placed(y, track, scene, ev)
+        p = placed(y, track, scene, ev) if any(b[0] == track for b in ev.boxes.get(y, [])) else None
         if p is None or not p[1]:
-            return None
+            continue
         hit = scene.object_of(y, short)
         d = scene.detections[y][p[0]].xy_m
         if hit is None or _d(hit[1].xy_m, d) >= NEAR_M or scene.owner(y, p[0], hit[1].xy_m) is not None:
@@ -174,7 +172,7 @@ def check_coasted(text: str, scene, ev, out, bad) -> None:
         if m[7] == "onto it":
             if fed is not None:
                 bad("misleading", m[0], f"its last box (frame {fed[0]}) sat on m{fed[1]}, a detection of GT {m[5]}")
-        elif fed is None or fed != (int(m[9]), int(m[8])):
+        elif fed is not None and fed != (int(m[9]), int(m[8])):  # None: a box filter's boxes repeat none
             bad("detector", m[0], f"its last box's detection of the object: {fed}")
 
 
