@@ -1858,6 +1858,9 @@ def test_a_miss_beside_a_box_of_its_class_placed_off_it_said_to_be_missed_is_cau
         "detector missed it or placed its box that far off"
     )
     assert kinds(f"{missed}{off}") == []
+    from tools.truth.sentences import coverage
+
+    assert not coverage(f"Why (gnnpmb, the detector's doing): {missed}{off}")[1]  # the clause is read
     assert kinds(f"{missed}{off.replace('m0 (score 0.55)', 'm1 (score 0.60)')}") == ["detector"]  # m1 is dddddd's
     assert kinds(f"{missed}{off.replace('5.0 m', '4.0 m')}") == ["detector"]
 

@@ -109,7 +109,7 @@ OFF_NEAR_M = 6.5
 """A miss with a detection of its class this near (beyond ``NEAR_M``), nearer it than any other annotated object,
 must name it (audit truth51, world7: a car's box moved 3-6 m for one frame was told as "the detector missed it")."""
 OFF = re.compile(
-    rf"^; the nearest (\w+) detection, m(\d+) \(score ({_F})\), lay ({_F}) m away, nearer it than any other annotated "
+    rf"the nearest (\w+) detection, m(\d+) \(score ({_F})\), lay ({_F}) m away, nearer it than any other annotated "
     r"object: the detector missed it or placed its box that far off"
 )
 
@@ -128,7 +128,7 @@ def _check_off(after: str, x: int, c: str, short: str, sentence: str, scene: Sce
         if scene.detections[x][k].class_name == c and scene.owner(x, k, hit[1].xy_m) is None
     ]
     best = min(off, key=lambda k: d[k]) if off else None
-    said = OFF.match(after)
+    said = OFF.match(after, 2) if after.startswith("; ") else None
     out.checked["misleading"] += 1
     if said is None:
         if best is not None:
