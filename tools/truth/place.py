@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import re
 
+from gnnpmb.events import Assignment, AxisKind
 from tools.truth.output import placed
 from tools.truth.scene import NEAR_M, POINTS, points_problem
 
@@ -143,23 +144,46 @@ COASTED = re.compile(
 )
 
 
-def _fed_by(x: int, track: str, short: str, scene, ev) -> tuple[int, int] | None:
-    """(frame, detection) of the last box before ``x`` of ``track`` that repeats a detection's box (predicted
-    boxes passed over), when that detection lies within 2 m of object ``short`` and nearer it than any other
-    annotated object; None otherwise (or where no box of it repeats one: a box filter's)."""
+def _fed_last(x: int, track: str, c: str, scene, ev, raw) -> tuple[int, int] | None:
+    """(frame, detection) of the last detection before ``x`` that track ``track`` (class ``c``) was output on: the
+    later of its box repeating a detection's box (a PHD's soft update has no pair) and the raw events' last
+    assignment pair or birth naming it (a box filter's box repeats no detection's); None: none."""
+    seen = None
     for y in range(x - 1, -1, -1):
         p = placed(y, track, scene, ev) if any(b[0] == track for b in ev.boxes.get(y, [])) else None
-        if p is None or not p[1]:
-            continue
-        hit = scene.object_of(y, short)
-        d = scene.detections[y][p[0]].xy_m
-        if hit is None or _d(hit[1].xy_m, d) >= NEAR_M or scene.owner(y, p[0], hit[1].xy_m) is not None:
-            return None
-        return y, p[0]
-    return None
+        if p is not None and p[1]:
+            seen = (y, p[0])
+            break
+    if raw is None:
+        return seen
+    for y in range(x - 1, seen[0] if seen is not None else -1, -1):
+        pairs = [
+            int(r.ref)
+            for a in raw.of_kind(y, c, Assignment)
+            for r, col in a.pairs
+            if r.kind is AxisKind.MEASUREMENT and col.kind is AxisKind.TRACK and str(col.ref) == track
+        ]
+        born = [m for m, t in raw.born(y, c).items() if str(t) == track]
+        if pairs or born:
+            return y, (pairs or born)[-1]
+    return seen
 
 
-def check_coasted(text: str, scene, ev, out, bad) -> None:
+def _fed_by(x: int, track: str, c: str, short: str, scene, ev, raw) -> tuple[int, int] | None:
+    """``_fed_last``, when that detection lies within 2 m of object ``short`` and nearer it than any other annotated
+    object; None otherwise."""
+    fed = _fed_last(x, track, c, scene, ev, raw)
+    if fed is None:
+        return None
+    y, m = fed
+    hit = scene.object_of(y, short)
+    d = scene.detections[y][m].xy_m
+    if hit is None or _d(hit[1].xy_m, d) >= NEAR_M or scene.owner(y, m, hit[1].xy_m) is not None:
+        return None
+    return fed
+
+
+def check_coasted(text: str, scene, ev, out, bad, raw=None) -> None:
     """A false track's predicted box on an object of another class: "the track coasted onto it" where the track's
     last box sat on a detection of that object is misleading (audit truth51, world7: a car seen as a truck at
     every other frame; the truck track had been on it all along); "coasted on with it from mK at frame y" must
@@ -168,7 +192,7 @@ def check_coasted(text: str, scene, ev, out, bad) -> None:
         return
     for m in COASTED.finditer(text):
         out.checked["misleading"] += 1
-        fed = _fed_by(int(m[1]), m[2], m[5], scene, ev)
+        fed = _fed_by(int(m[1]), m[2], m[3], m[5], scene, ev, raw)
         if m[7] == "onto it":
             if fed is not None:
                 bad("misleading", m[0], f"its last box (frame {fed[0]}) sat on m{fed[1]}, a detection of GT {m[5]}")
