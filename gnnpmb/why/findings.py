@@ -59,6 +59,9 @@ EVALUATED_OFFSET_M = 0.5
 """An interpolated box this far or farther from the annotation makes a failure the evaluation's doing."""
 FRAMES_BEFORE = 8
 """A finding looks back this many keyframes before its failure (and a focus recording starts there)."""
+OFF_NEAR_M = 6.5
+"""How far from an object with no detection within ``NEAR_M`` a detection of its class, nearer it than any other
+annotated object, is named beside the miss: it may be the object's box placed that far off (audit truth51)."""
 
 
 class Party(enum.Enum):
@@ -134,7 +137,8 @@ class Near:
     kept it (score threshold, NMS); on_other: the annotated object (id, class, BEV distance m) the detection lies
     nearer than this one, when it does: then it is that object's detection, not a sight of this one (dev set
     scene-1094 centerpoint ab3dmot: a car detection 1.8 m from a bicycle and 0.1 m from a car was said to be the
-    bicycle seen as a car)."""
+    bicycle seen as a car). A detection of another class within ``NEAR_M`` of an object of its own class is that
+    object's too (audit truth51, world7: a rider's bicycle box, on the spot of the pedestrian annotated with it)."""
 
     meas: int
     class_name: str
@@ -197,6 +201,10 @@ class Sighting:
     in_box: Near | None = None
     """With no detection of any class within ``NEAR_M``: the nearest one whose centre lies inside the object's box
     (a long truck seen as two boxes, world6: a sight of part of it, not no sight)."""
+    off: Near | None = None
+    """With no detection of any class within ``NEAR_M`` nor inside its box: the nearest detection of its class
+    within ``OFF_NEAR_M`` that lies nearer it than any other annotated object (world7: a car's box placed 3-6 m
+    off for one frame was told as "the detector missed it")."""
     neighbours_own: Near | None = None
     """The nearest kept detection of its class within ``NEAR_M`` that lies nearer another annotated object: that
     one's, not this one's (``nearest_own`` never is such a detection; two pedestrians given one box)."""
@@ -386,6 +394,9 @@ class FalseOutput:
     twins: tuple[int, ...] = ()
     """The kept detections of its class the detector gave the object within ``NEAR_M`` when two or more
     (``Rule.TWO_DETECTIONS``)."""
+    coasted_from: tuple[int, int] | None = None
+    """A predicted box on an object of another class: the frame and detection of the track's last box, when that
+    detection was the object's own (the detector gave it the track's class there; ``Rule.OTHER_CLASS``)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -30,6 +30,7 @@ from gnnpmb.why.findings import (
     EVALUATED_OFFSET_M,
     FRAMES_BEFORE,
     NEAR_M,
+    OFF_NEAR_M,
     Blame,
     Deciding,
     EvaluatedReach,
@@ -166,9 +167,27 @@ class _Context:
             if not keep:
                 return None
             idx, other = idx[keep], [other[i] for i in keep]
+        else:  # audit truth51 (world7, a rider): a box of another class on an object of that class is its
+            other = [o if o is not None else self.of_its_class(frame, int(m)) for m, o in zip(idx, other, strict=True)]
         k = min(range(idx.size), key=lambda i: (other[i] is not None, d[idx[i]]))
         m = int(idx[k])
         return Near(m, str(boxes.class_name[m]), float(boxes.score[m]), float(d[m]), bool(kept[m]), other[k])
+
+    def of_its_class(self, frame: int, meas: int) -> tuple[str, str, float] | None:
+        """The nearest annotated object of detection ``meas``'s class within ``NEAR_M`` of it, when that class is
+        not the failure's: the detection is that object's (the evaluation would match it there), not a sight of
+        another class's object (world7: a rider annotated as a bicycle and a pedestrian on one spot; the bicycle's
+        box was said to be the pedestrian seen as the wrong class)."""
+        boxes, gt = self.frames[frame].detections.boxes, self.scene.keyframes[frame].gt
+        c = str(boxes.class_name[meas])
+        if c == self.class_name or not len(gt):
+            return None
+        d = np.hypot(*(gt.translation_m[:, :2] - boxes.translation_m[meas, :2]).T)
+        mine = np.flatnonzero((gt.class_name == c) & (d < NEAR_M))
+        if not mine.size:
+            return None
+        g = int(mine[np.argmin(d[mine])])
+        return str(gt.instance_id[g]), c, float(d[g])
 
     def nearer_object(self, frame: int, xy_m: np.ndarray, own_m: np.ndarray) -> list[tuple[str, str, float] | None]:
         """For each of N detections at ``xy_m`` (N, 2), ``own_m`` (N,) from the object: the annotated object of a
@@ -214,6 +233,7 @@ class _Context:
             own = self.near(f, xy, own=True)
             went = self.facts.destination(f, self.class_name, own.meas) if own is not None else None
             any_near = self.near(f, xy, own=False)
+            box = self.in_box(f, gt_id) if any_near is None else None
             out.append(
                 Sighting(
                     f,
@@ -225,8 +245,9 @@ class _Context:
                     self.on_object(self.report, self.frames[f], xy),
                     self.near(f, xy, own=True, kept_only=False),
                     self.radar_points(gt_id, f),
-                    self.in_box(f, gt_id) if any_near is None else None,
-                    self.near(f, xy, own=True, neighbours=True),
+                    box,
+                    self.off_near(f, gt_id) if any_near is None and box is None else None,
+                    neighbours_own=self.near(f, xy, own=True, neighbours=True),
                 )
             )
         return tuple(out)
@@ -519,6 +540,24 @@ class _Context:
         no_object = self.of_no_object(frame, meas)
         return no_object, self.meas_part_of(frame, meas) if no_object else None
 
+    def coasted_from(self, track_id: int, gt_id: str) -> tuple[int, int] | None:
+        """(frame, detection) of the last box before the failure that track ``track_id`` was output on, when that
+        detection lay within ``NEAR_M`` of object ``gt_id`` and nearer it than any other annotated object: a track
+        of another class that coasted on with the object it was fed by, not onto it (audit truth51, world7: a car
+        detected as a truck at every other frame left a truck track on it); None otherwise."""
+        for x in sorted((x for x in self.frames if x < self.f), reverse=True):
+            e = self.estimate(track_id, x)
+            if e is None or e.meas_index < 0:
+                continue
+            xy, at = self._meas_xy(x, e.meas_index), self.gt_xy(gt_id, x)
+            if xy is None or at is None:
+                return None
+            d = float(np.hypot(*(xy - at)))
+            if d >= NEAR_M or self.nearer_object(x, xy[None, :], np.array([d]))[0] is not None:
+                return None
+            return x, int(e.meas_index)
+        return None
+
     def own_detections(self, frame: int, gt_id: str) -> tuple[int, ...]:
         """The kept detections of the class within ``NEAR_M`` of object ``gt_id`` at ``frame`` that lie nearer it
         than any other annotated object (a detector without NMS gives one object two: audit truth50, world6)."""
@@ -531,6 +570,22 @@ class _Context:
         idx = np.flatnonzero(ok)
         other = self.nearer_object(frame, boxes.translation_m[idx, :2], d[idx])
         return tuple(int(m) for m, o in zip(idx.tolist(), other, strict=True) if o is None)
+
+    def off_near(self, frame: int, gt_id: str) -> Near | None:
+        """The nearest detection of the class within ``OFF_NEAR_M`` of object ``gt_id`` at ``frame`` (kept or not)
+        that lies nearer it than any other annotated object (None: none)."""
+        xy, fr = self.gt_xy(gt_id, frame), self.frames.get(frame)
+        if xy is None or fr is None or not len(fr.detections.boxes.score):
+            return None
+        boxes = fr.detections.boxes
+        d = np.hypot(*(boxes.translation_m[:, :2] - xy).T)
+        idx = np.flatnonzero((d < OFF_NEAR_M) & (boxes.class_name == self.class_name))
+        other = self.nearer_object(frame, boxes.translation_m[idx, :2], d[idx])
+        mine = [int(m) for m, o in zip(idx.tolist(), other, strict=True) if o is None]
+        if not mine:
+            return None
+        m = min(mine, key=lambda m: d[m])
+        return Near(m, str(boxes.class_name[m]), float(boxes.score[m]), float(d[m]), bool(fr.detections.kept[m]))
 
     def in_box(self, frame: int, gt_id: str) -> Near | None:
         """The nearest detection of ``frame`` whose centre lies inside object ``gt_id``'s box (None: none)."""
@@ -704,6 +759,7 @@ class _Context:
         nearest_own = nearest_any = None
         matched = None
         twins: tuple[int, ...] = ()
+        came: tuple[int, int] | None = None
         if mine.size and d[mine].min() < NEAR_M:
             k = int(mine[np.argmin(d[mine])])
             gt_id = str(gt.instance_id[k])
@@ -731,6 +787,9 @@ class _Context:
         elif e is None:
             pass  # no box of the tracker's here
         elif on is None:
+            came = self.coasted_from(t, nearest_any[0]) if nearest_any is not None else None
+            if came is not None:  # audit truth51 (world7): the track was on the object, fed by its wrong-class boxes
+                blame.append(Blame(Rule.OTHER_CLASS, (came[0],)))
             blame.append(Blame(Rule.COASTED, (self.f,)))
         elif nearest_any is not None:
             blame.append(Blame(Rule.OTHER_CLASS, (self.f,)))
@@ -750,6 +809,7 @@ class _Context:
             step.use if (step := self.facts.steps(t, self.class_name).get(self.f)) is not None else None,
             part_of(gt, xy) if nearest_any is None else None,
             twins if len(twins) >= 2 else (),
+            came,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
 

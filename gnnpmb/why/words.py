@@ -639,8 +639,9 @@ def _hidden(f: Finding) -> list[str]:
 
 def no_detection(sightings: Sequence[Sighting]) -> str:
     """``no detection of a tracked class within 2 m``, or where detections lay that near but each nearer another
-    annotated object (``Near.on_other``): ``no detection of its own within 2 m (at frame 3 car m4, 1.8 m away,
-    lay 0.1 m from car GT 26e63e)``: that object's detection, not a sight of this one."""
+    annotated object, or within 2 m of one of the detection's own class (``Near.on_other``): ``no detection of its
+    own within 2 m (at frame 3 car m4, 1.8 m away, lay 0.1 m from car GT 26e63e)``: that object's detection, not a
+    sight of this one."""
     others = [s for s in sightings if s.nearest_any is not None and s.nearest_any.on_other is not None]
     if not others:
         return f"no detection of a tracked class within {NEAR_M:.0f} m"
@@ -1120,6 +1121,12 @@ def _false_track(f: Finding) -> list[str]:
     elif o.nearest_any is not None:
         gt_id, cls, d = o.nearest_any
         what = "the detector gave it the wrong class" if o.on is not None else "the track coasted onto it"
+        if o.on is None and o.coasted_from is not None:  # audit truth51 (world7): not onto it, on with it
+            x, m = o.coasted_from
+            what = (
+                f"the track coasted on with it from {meas_name(m)} at frame {x}, a {f.class_name} detection of it: "
+                "the detector gave it the wrong class"
+            )
         if f.output_only and o.on is None:
             what = "the tracker output a box there without a detection of its class under it"
         parts.append(
@@ -1269,6 +1276,14 @@ def _miss(f: Finding) -> list[str]:
             f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
             f"({inside}), but {n.class_name} {meas_name(n.meas)} (score {n.score:.2f}) lay inside its box, "
             f"{n.distance_m:.1f} m from its centre: the detector saw part of it"
+        )
+    elif s.undetected and s.nearest_any is None and s.off is not None:  # audit truth51 (world7): a box 3-6 m off
+        n = s.off
+        parts.append(
+            f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
+            f"({inside}); the nearest {n.class_name} detection, {meas_name(n.meas)} (score {n.score:.2f}), lay "
+            f"{n.distance_m:.1f} m away, nearer it than any other annotated object: the detector missed it or placed "
+            "its box that far off"
         )
     elif s.undetected and s.nearest_any is None:
         parts.append(

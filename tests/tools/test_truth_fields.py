@@ -101,3 +101,20 @@ def test_the_track_another_runs_evaluation_matched_the_object_to_is_read_from_it
     assert not any("other matched" in p for p in _problems(f, src))
     wrong = dataclasses.replace(other, matched=-5 if other.matched is not None else 10_000)
     assert any("other matched" in p for p in _problems(dataclasses.replace(f, others=(wrong,)), src))
+
+
+def test_a_riders_bicycle_box_beside_the_pedestrian_is_the_bicycles_in_the_fields() -> None:
+    # audit truth51, world7 scene-0916 megvii jpda miss:110: a rider annotated as a bicycle and a pedestrian on one
+    # spot; the pedestrian box at 0.3 m from the bicycle's annotation is the pedestrian's, not a wrong-class sight
+    from types import SimpleNamespace
+
+    from tools.truth.devkit import EvalFacts
+    from tools.truth.fields import Sources, check_claim
+    from tools.truth.scene import Annotation, Detection, SceneTruth
+
+    ped, bike = "4776dc" + "0" * 26, "a402d8" + "0" * 26
+    objects = [{ped: Annotation("pedestrian", (0.0, 0.0), 40), bike: Annotation("bicycle", (0.0, 0.0), 30)}] * 2
+    src = Sources(SceneTruth([[Detection("pedestrian", 0.48, (0.0, 0.29))]] * 2, objects), None, EvalFacts())
+    f = SimpleNamespace(class_name="bicycle")
+    assert check_claim("detection near", 1, (bike, 0, "pedestrian", 0.48, 0.29, ped), f, src) == ""
+    assert check_claim("detection near", 1, (bike, 0, "pedestrian", 0.48, 0.29, None), f, src) != ""

@@ -281,7 +281,7 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
             if what == "no detection near":
                 return "" if not near else f"detections within {NEAR_M} m: {near}"
             if what == "detection near":
-                m, owner = v[1], {j: src.scene.owner(x, j, tuple(xy)) for j in near}
+                m, owner = v[1], {j: src.scene.claimant(x, j, tuple(xy), c) for j in near}
                 owner = {j: o[0] if o is not None else None for j, o in owner.items()}
                 own = [j for j in near if owner[j] is None]  # the detections nearer this object than any other
                 if not near or min(own or near, key=lambda j: d[j]) != m:
@@ -292,7 +292,7 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
                 return "" if ok else "class, score or distance differ"
             # of its class and its own: one that lies nearer another annotated object is that one's (a neighbour's
             # box, dev set scene-0916 centerpoint frame 27: two pedestrians 0.78 m apart, one box)
-            own = [j for j in _own_near(src, x, xy) if dets[j].class_name == c]
+            own = [j for j in _own_near(src, x, xy, c) if dets[j].class_name == c]
             if src.raw is not None:  # kept: the tracker received it after its preprocessing
                 got = src.raw.received(x, c)
                 own = [j for j in own if j in got]
@@ -526,13 +526,13 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
             if xy is not None or not any(y < x for y in have) or not any(y > x for y in have):
                 return f"the object is annotated at frame {x}, or not on both sides of it"
         elif name in ("NO_DETECTION", "UNSEEN"):  # none of its own: each one within reach lies nearer another object
-            if xy is None or _own_near(src, x, xy):
+            if xy is None or _own_near(src, x, xy, c):
                 return f"a detection of the object lies within reach at frame {x}"
             hidden = src.points(x, f.gt_id) == 0
             if hidden != (name == "UNSEEN"):
                 return f"the object {'had no' if hidden else 'had'} points at frame {x}"
         elif name == "OTHER_CLASS" and f.false_output is None:  # the object's own detections: another class only
-            mine = _own_near(src, x, xy) if xy is not None else []
+            mine = _own_near(src, x, xy, c) if xy is not None else []
             if not mine or any(src.scene.detections[x][j].class_name == c for j in mine):
                 return f"no detection of the object's own of another class only at frame {x}"
         elif name == "NOT_OUTPUT" and f.lost is not None:
@@ -580,7 +580,7 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
         elif name == "TWO_DETECTIONS":  # a second track on an object the detector gave two boxes of its class
             gt_id = f.false_output.nearest_own[0] if f.false_output and f.false_output.nearest_own else f.gt_id
             at = src.gt_xy(x, gt_id) if gt_id is not None else None
-            near = _own_near(src, x, at) if at is not None else []
+            near = _own_near(src, x, at, c) if at is not None else []
             own = [j for j in near if src.scene.detections[x][j].class_name == c]
             if len(own) < 2:
                 return f"fewer than two {c} detections of the object's own within reach at frame {x}: {own}"
@@ -609,16 +609,17 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
         gaps = [
             x
             for x in f.deciding
-            if (xy := src.gt_xy(x, f.gt_id)) is not None and not _own_near(src, x, xy) and src.points(x, f.gt_id) > 0
+            if (xy := src.gt_xy(x, f.gt_id)) is not None and not _own_near(src, x, xy, c) and src.points(x, f.gt_id) > 0
         ]
         if tuple(gaps) != tuple(frames):
             return f"frames without a detection of the object's own: {gaps}"
     return ""
 
 
-def _own_near(src: Sources, x: int, xy: np.ndarray) -> list[int]:
-    """The detections within reach of the object at ``xy`` that lie nearer it than any other annotated object."""
-    return [j for j in src.near(x, xy)[1] if src.scene.owner(x, j, (float(xy[0]), float(xy[1]))) is None]
+def _own_near(src: Sources, x: int, xy: np.ndarray, c: str) -> list[int]:
+    """The detections within reach of the object (of class ``c``) at ``xy`` that are its own: nearer it than any
+    other annotated object and, of another class, within reach of no object of theirs (``SceneTruth.claimant``)."""
+    return [j for j in src.near(x, xy)[1] if src.scene.claimant(x, j, (float(xy[0]), float(xy[1])), c) is None]
 
 
 def _interpolated_decided(src: Sources, x: int, c: str, gt_id: str, least_m: float) -> bool:

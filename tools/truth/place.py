@@ -32,6 +32,8 @@ from __future__ import annotations
 import math
 import re
 
+from gnnpmb.events import Assignment, AxisKind
+from tools.truth.output import placed
 from tools.truth.scene import NEAR_M, POINTS, points_problem
 
 AWAY = re.compile(r"(\w+) GT (\w{6}) lies (\d+\.\d) m away")
@@ -133,6 +135,69 @@ def check_place(text: str, c: str, x: int, place, scene, out, bad) -> None:
             bad("detector", m[0], f"{m[1]} annotations within 2 m: {own}")
         elif hit is None or hit[1].class_name != m[2] or f"{_d(hit[1].xy_m, place):.1f}" != m[4]:
             bad("detector", m[0], f"GT {m[3]} is {hit[1] if hit else 'not annotated here'}")
+
+
+COASTED = re.compile(
+    r"at frame (\d+) track (\d+) \((\w+)\) was output on no detection this frame \(a predicted box\); no \w+ GT lies "
+    r"within 2 m, but GT (\w+) (\w{6}) does \((\d+\.\d) m\): the track coasted (onto it|on with it from m(\d+) at "
+    r"frame (\d+), a \w+ detection of it: the detector gave it the wrong class)"
+)
+
+
+def _fed_last(x: int, track: str, c: str, scene, ev, raw) -> tuple[int, int] | None:
+    """(frame, detection) of the last detection before ``x`` that track ``track`` (class ``c``) was output on: the
+    later of its box repeating a detection's box (a PHD's soft update has no pair) and the raw events' last
+    assignment pair or birth naming it (a box filter's box repeats no detection's); None: none."""
+    seen = None
+    for y in range(x - 1, -1, -1):
+        p = placed(y, track, scene, ev) if any(b[0] == track for b in ev.boxes.get(y, [])) else None
+        if p is not None and p[1]:
+            seen = (y, p[0])
+            break
+    if raw is None:
+        return seen
+    for y in range(x - 1, seen[0] if seen is not None else -1, -1):
+        pairs = [
+            int(r.ref)
+            for a in raw.of_kind(y, c, Assignment)
+            for r, col in a.pairs
+            if r.kind is AxisKind.MEASUREMENT and col.kind is AxisKind.TRACK and str(col.ref) == track
+        ]
+        born = [m for m, t in raw.born(y, c).items() if str(t) == track]
+        if pairs or born:
+            return y, (pairs or born)[-1]
+    return seen
+
+
+def _fed_by(x: int, track: str, c: str, short: str, scene, ev, raw) -> tuple[int, int] | None:
+    """``_fed_last``, when that detection lies within 2 m of object ``short`` and nearer it than any other annotated
+    object; None otherwise."""
+    fed = _fed_last(x, track, c, scene, ev, raw)
+    if fed is None:
+        return None
+    y, m = fed
+    hit = scene.object_of(y, short)
+    d = scene.detections[y][m].xy_m
+    if hit is None or _d(hit[1].xy_m, d) >= NEAR_M or scene.owner(y, m, hit[1].xy_m) is not None:
+        return None
+    return fed
+
+
+def check_coasted(text: str, scene, ev, out, bad, raw=None) -> None:
+    """A false track's predicted box on an object of another class: "the track coasted onto it" where the track's
+    last box sat on a detection of that object is misleading (audit truth51, world7: a car seen as a truck at
+    every other frame; the truck track had been on it all along); "coasted on with it from mK at frame y" must
+    name that box's detection and frame."""
+    if scene is None:
+        return
+    for m in COASTED.finditer(text):
+        out.checked["misleading"] += 1
+        fed = _fed_by(int(m[1]), m[2], m[3], m[5], scene, ev, raw)
+        if m[7] == "onto it":
+            if fed is not None:
+                bad("misleading", m[0], f"its last box (frame {fed[0]}) sat on m{fed[1]}, a detection of GT {m[5]}")
+        elif fed is not None and fed != (int(m[9]), int(m[8])):  # None: a box filter's boxes repeat none
+            bad("detector", m[0], f"its last box's detection of the object: {fed}")
 
 
 def _right_way(scene, ev, gt_id: str, x: int) -> tuple[float, float] | None:

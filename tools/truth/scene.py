@@ -158,6 +158,18 @@ class SceneTruth:
             return None
         return best[0], math.dist(best[1].xy_m, d)
 
+    def claimant(self, frame: int, m: int, xy_m: tuple[float, float], class_name: str) -> tuple[str, float] | None:
+        """``owner``, or else, for a detection of a class other than ``class_name`` (the object at ``xy_m``'s), the
+        nearest annotation of the detection's own class within ``NEAR_M`` of it: that object's box, which the devkit
+        would match there (audit truth51, world7: a rider annotated as a bicycle and a pedestrian on one spot)."""
+        hit = self.owner(frame, m, xy_m)
+        d = self.detections[frame][m]
+        if hit is not None or d.class_name == class_name:
+            return hit
+        mine = [(math.dist(a.xy_m, d.xy_m), k) for k, a in self.objects[frame].items() if a.class_name == d.class_name]
+        near = min((x for x in mine if x[0] < NEAR_M), default=None)
+        return None if near is None else (near[1], near[0])
+
     def inside(self, frame: int, xy_m: tuple[float, float]) -> list[str]:
         """The objects of ``frame`` whose box contains the ground point ``xy_m`` (audit truth50, world6: a truck's
         trailer box 3 m from its centre is part of it, not "of no object")."""

@@ -247,6 +247,7 @@ def check_text(
     otherruns.check_own_unscored(text, ctx.kind, c, ev, out, bad)
     if ctx.gt_id is None:
         place.check_place(text, c, ctx.frame, where, scene, out, bad)
+        place.check_coasted(text, scene, ev, out, bad, raw)
     place.check_swapped(text, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     place.check_reach_1141(text, ctx.frame, _place(replace(ctx, gt_id=None), ev, scene), scene, ev, out, bad)
     place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)

@@ -83,7 +83,8 @@ def test_a_detection_that_lies_on_another_object_is_not_a_sight_of_this_one() ->
     assert s.seen is None and s.undetected
     ctx.failure, ctx.f = SimpleNamespace(kind=FailureKind.MISS, gt_ids=("d40890" + "0" * 26,)), 3
     assert rules(ctx.blame_uncovered(s)) == [Rule.NO_DETECTION]
-    # seen from the car, the same detection is its own
+    # seen from the car (a car's finding), the same detection is its own
+    ctx.class_name = "car"
     assert ctx.near(3, np.array([1.9, 0.0]), own=False).of_it
 
 
