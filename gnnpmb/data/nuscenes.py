@@ -459,10 +459,10 @@ def split_scenes(split: str, location: DatasetLocation) -> list[str]:
     """Scene names of a devkit split (``mini_val``, ``val``, ...) or of a custom split in ``splits.json`` that
     exist in the dataset, in the split's order. Like the devkit, a predefined split wins over a custom one
     of the same name."""
-    import difflib
-
     splits = {**_custom_splits(location), **devkit_splits()}
     if split not in splits:
+        import difflib
+
         usable = split_names(location)
         close = difflib.get_close_matches(split, usable, n=1)
         guess = f" (did you mean {close[0]}?)" if close else ""

@@ -5,8 +5,6 @@ named beside the miss."""
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 
 from gnnpmb.eval.failures import FailureKind
@@ -14,7 +12,7 @@ from gnnpmb.why.findings import Sighting
 from gnnpmb.why.reason import _Context
 from gnnpmb.why.words import why_lines
 from tests.gnnpmb.why.test_finding_words import finding
-from tests.gnnpmb.why.test_reason_rules import Table
+from tests.gnnpmb.why.test_reason_rules import Table, one_frame_context
 
 CAR = "63bd3c" + "0" * 26
 OTHER = "b38260" + "0" * 26
@@ -33,11 +31,7 @@ def two_cars() -> _Context:
         class_name=np.array(["car", "car", "car"]),
         score=np.array([0.55, 0.6, 0.7]),
     )
-    ctx = _Context.__new__(_Context)
-    ctx.scene = SimpleNamespace(keyframes={18: SimpleNamespace(gt=gt)})
-    ctx.frames = {18: SimpleNamespace(detections=SimpleNamespace(boxes=boxes, kept=np.ones(3, bool)))}
-    ctx.class_name = "car"
-    return ctx
+    return one_frame_context(18, gt, boxes, "car")
 
 
 def test_a_miss_names_a_box_of_its_class_placed_off_it_nearer_it_than_any_other_object() -> None:

@@ -5,8 +5,6 @@ missed it" of boxes that lay inside the truck's own box. They are now said to be
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
 
@@ -15,7 +13,7 @@ from gnnpmb.why.findings import Blame, FalseOutput, Origin, Rule, Sighting
 from gnnpmb.why.reason import _Context, part_of
 from gnnpmb.why.words import why_lines
 from tests.gnnpmb.why.test_finding_words import finding
-from tests.gnnpmb.why.test_reason_rules import Table
+from tests.gnnpmb.why.test_reason_rules import Table, one_frame_context
 
 TRUCK = "ecf44b" + "0" * 26
 CAR = "26e63e" + "0" * 26
@@ -40,11 +38,7 @@ def truck_split() -> _Context:
         class_name=np.array(["truck", "truck", "truck"]),
         score=np.array([0.7, 0.6, 0.5]),
     )
-    ctx = _Context.__new__(_Context)
-    ctx.scene = SimpleNamespace(keyframes={14: SimpleNamespace(gt=gt)})
-    ctx.frames = {14: SimpleNamespace(detections=SimpleNamespace(boxes=boxes, kept=np.ones(3, bool)))}
-    ctx.class_name = "truck"
-    return ctx
+    return one_frame_context(14, gt, boxes, "truck")
 
 
 def test_a_detection_inside_a_long_objects_box_is_part_of_it_not_of_no_object() -> None:

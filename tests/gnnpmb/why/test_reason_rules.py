@@ -53,6 +53,16 @@ class Table(SimpleNamespace):
         return len(self.class_name)
 
 
+def one_frame_context(frame: int, gt: Table, boxes: Table, class_name: str) -> _Context:
+    """A finding's context of ``class_name`` that knows one keyframe: its annotations ``gt`` and its detections
+    ``boxes``, all kept by preprocessing."""
+    ctx = _Context.__new__(_Context)
+    ctx.scene = SimpleNamespace(keyframes={frame: SimpleNamespace(gt=gt)})
+    ctx.frames = {frame: SimpleNamespace(detections=SimpleNamespace(boxes=boxes, kept=np.ones(len(boxes), bool)))}
+    ctx.class_name = class_name
+    return ctx
+
+
 def detections_beside_two_objects() -> _Context:
     """Frame 3: bicycle GT d40890 at (0, 0) and car GT 26e63e at (1.9, 0); the detector gave a car box at (1.8, 0)
     (1.8 m from the bicycle, 0.1 m from the car) and nothing else (dev set scene-1094 centerpoint ab3dmot miss at
@@ -64,11 +74,7 @@ def detections_beside_two_objects() -> _Context:
         translation_m=np.array([[0.0, 0.0, 0.0], [1.9, 0.0, 0.0]]),
     )
     boxes = Table(translation_m=np.array([[1.8, 0.0, 0.0]]), class_name=np.array(["car"]), score=np.array([0.84]))
-    ctx = _Context.__new__(_Context)
-    ctx.scene = SimpleNamespace(keyframes={3: SimpleNamespace(gt=gt)})
-    ctx.frames = {3: SimpleNamespace(detections=SimpleNamespace(boxes=boxes, kept=np.array([True])))}
-    ctx.class_name = "bicycle"
-    return ctx
+    return one_frame_context(3, gt, boxes, "bicycle")
 
 
 def test_a_detection_that_lies_on_another_object_is_not_a_sight_of_this_one() -> None:
@@ -103,11 +109,7 @@ def one_box_for_two_pedestrians() -> _Context:
         class_name=np.array(["pedestrian", "car"]),
         score=np.array([0.42, 0.3]),
     )
-    ctx = _Context.__new__(_Context)
-    ctx.scene = SimpleNamespace(keyframes={27: SimpleNamespace(gt=gt)})
-    ctx.frames = {27: SimpleNamespace(detections=SimpleNamespace(boxes=boxes, kept=np.array([True, True])))}
-    ctx.class_name = "pedestrian"
-    return ctx
+    return one_frame_context(27, gt, boxes, "pedestrian")
 
 
 def test_a_detection_of_its_class_nearer_a_neighbour_is_the_neighbours_not_this_objects() -> None:

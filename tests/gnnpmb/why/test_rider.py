@@ -5,15 +5,13 @@ another class on an object of that class is now that object's, not a sight of th
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 
 from gnnpmb.eval.failures import FailureKind
 from gnnpmb.why.reason import _Context
 from gnnpmb.why.words import why_lines
 from tests.gnnpmb.why.test_finding_words import finding
-from tests.gnnpmb.why.test_reason_rules import Table
+from tests.gnnpmb.why.test_reason_rules import Table, one_frame_context
 
 PED = "4776dc" + "0" * 26
 BIKE = "a402d8" + "0" * 26
@@ -30,11 +28,7 @@ def rider(bike_annotated: bool = True) -> _Context:
         translation_m=np.zeros((n, 3)),
     )
     boxes = Table(translation_m=np.array([[0.3, 0.4, 0.8]]), class_name=np.array(["bicycle"]), score=np.array([0.67]))
-    ctx = _Context.__new__(_Context)
-    ctx.scene = SimpleNamespace(keyframes={13: SimpleNamespace(gt=gt)})
-    ctx.frames = {13: SimpleNamespace(detections=SimpleNamespace(boxes=boxes, kept=np.ones(1, bool)))}
-    ctx.class_name = "pedestrian"
-    return ctx
+    return one_frame_context(13, gt, boxes, "pedestrian")
 
 
 def test_a_box_of_another_class_on_an_object_of_that_class_is_that_objects_not_a_wrong_class_sight() -> None:
