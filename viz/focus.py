@@ -6,7 +6,8 @@
   slightly enlarged in their class colours;
 * ``world/trackers/<tracker>/focus``: that tracker's involved tracks, enlarged, in their colours (their own
   boxes carry the id labels);
-* ``world/trackers/<tracker>/focus/callouts``: the labels of the involved objects (``GT 8bccf2``,
+* ``world/trackers/<tracker>/focus/callouts``: the labels of the involved objects and, at the failure's frame,
+  of every other object the Why names (``GT 8bccf2``,
   ``m10 0.83 → track 26``, ``26 predicted r=0.04``, ``31 predicted r=0.02, missed``) in a column beside them with
   leader lines (``viz.callouts``), so labels of objects on one spot do not cover each other; each assignment is
   said once, on the detection;
@@ -19,6 +20,7 @@
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Collection, Mapping
 
 import numpy as np
@@ -33,7 +35,7 @@ from gnnpmb.pipeline import FrameResult
 from gnnpmb.types import Boxes
 from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode, Went
 from gnnpmb.why.findings import Finding
-from gnnpmb.why.words import existence_text, share_text, went_text
+from gnnpmb.why.words import existence_text, plain, share_text, went_text, why_lines
 from viz import compare, paths
 from viz.blueprint import (
     focus_doc,
@@ -108,6 +110,7 @@ def log_focus(
         _log_involved_story(stream, clock, scene, focus, tracker, logger)
     frames = {t: {f.keyframe.index: f for f in v.evidence.run.frames} for t, v in views.items()}
     gt_ids = set(focus.gt_ids)
+    named_gt = named_objects(finding, scene.keyframes[focus.frame_index].gt, gt_ids) if shown else []
     failure_report = reports.get(focus.failure_tracker or "")
     evaluated = evaluated_offsets(focus, failure_report)
     unannotated = unannotated_evaluated(focus, failure_report)
@@ -117,7 +120,8 @@ def log_focus(
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
         gt = keyframe.gt
-        rows = np.flatnonzero(np.isin(gt.instance_id.astype(str), list(gt_ids))) if len(gt) else np.zeros(0, int)
+        labelled = list(gt_ids) + (named_gt if i == focus.frame_index else [])
+        rows = np.flatnonzero(np.isin(gt.instance_id.astype(str), labelled)) if len(gt) else np.zeros(0, int)
         centers = [gt.translation_m[rows]]
         sizes = [size_wlh_to_xyz(gt.size_wlh_m[rows])]
         quats = [quat_wxyz_to_xyzw(gt.quat_wxyz[rows])]
@@ -127,7 +131,8 @@ def log_focus(
             Callout(tuple(gt.translation_m[r]), label, CLASS_COLORS.get(str(gt.class_name[r]), GREY))
             for r, label in zip(rows.tolist(), labels, strict=True)
         ]
-        z_m = float(gt.translation_m[rows[0], 2]) if rows.size else scene.ground_z_m
+        involved = rows[np.isin(gt.instance_id[rows].astype(str), list(gt_ids))]
+        z_m = float(gt.translation_m[(involved if involved.size else rows)[0], 2]) if rows.size else scene.ground_z_m
         gt_corners = footprint_corners_xy(RerunBoxes(centers[0], sizes[0], quats[0]), SCALE, MARGIN_M)
         depth_m = max(eye_height_m - z_m, 1.0)  # the eye sits at eye_height_m in the global frame
         height_m, view_x_m, view_y_m = _callout_room(focus, depth_m, len(loggers), sight is not None)
@@ -242,6 +247,18 @@ def log_focus(
         )
         if evaluated:
             log_evaluated(stream, focus, scene, evaluated if i == focus.frame_index else {})
+
+
+def named_objects(finding: Finding | None, gt: Boxes, involved: Collection[str]) -> list[str]:
+    """The ids of the annotations of ``gt`` (one keyframe's) that the finding's Why names ("... lay 0.3 m from
+    pedestrian GT 9d0a73") but that are not ``involved``: the view labels every object the text points to, at
+    the failure's frame (dev set scene-0916 centerpoint miss:20: the neighbour whose box the sentence named had
+    no label, so a reader could not find it). No finding: none."""
+    if finding is None or not len(gt):
+        return []
+    text = " ".join(plain(line) for line in why_lines(finding))
+    ids = [str(t) for t in gt.instance_id]
+    return [t for t in ids if t not in involved and re.search(rf"\bGT {re.escape(short_id(t))}\b", text)]
 
 
 def _callout_room(

@@ -440,3 +440,32 @@ def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(de
     assert f"its track logic deleted it at frame {e.frame} ({hits})" in why
     o = finding.taker
     assert f"track {o.track_id} had been started at frame {o.frame} by m{o.meas}" in why
+
+
+def test_every_object_the_why_names_is_labelled_at_the_failure_frame(
+    demo_dataroot: Path, record, gnnpmb_report
+) -> None:
+    """A Why that points at another object ("no detection of its own within 2 m (truck m7, 1.2 m away, lay 1.0 m
+    from truck GT 9da03c)") labels that object in the view at the failure's frame, as it labels the failure's own
+    (dev set scene-0916 centerpoint miss:20: the neighbour the sentence named had no label, so a reader could not
+    find it); at the other frames only the failure's objects are labelled."""
+    report = gnnpmb_report
+    scene = evidence_of(demo_dataroot, ("gnnpmb",))[0].scene
+    findings = findings_of(demo_dataroot, ("gnnpmb",))["gnnpmb"]
+
+    def others(fid: str) -> set[str]:
+        failure = report.by_id(fid)
+        text = " ".join(why_lines(findings[fid]))
+        here = {short_id(str(t)) for t in scene.keyframes[failure.frame_index].gt.instance_id}
+        return set(re.findall(r"\bGT ([0-9a-f]{6})\b", text)) & here - {short_id(g) for g in failure.gt_ids}
+
+    pick = next(i for i in report.ids() if report.by_id(i).gt_ids and others(i))
+    failure = report.by_id(pick)
+    out, _ = record(pick)
+    rows = read_rows(out)
+    labels = {r["frame"]: set(r["Points3D:labels"] or []) for r in rows[paths.focus_callouts("gnnpmb")]}
+    named = {f"GT {g}" for g in others(pick)}
+    assert named <= labels[failure.frame_index], (pick, labels[failure.frame_index])
+    assert all(not named & seen for frame, seen in labels.items() if frame != failure.frame_index)
+    boxes = next(r for r in rows[focus_world()] if r.get("frame") == failure.frame_index)
+    assert named <= set(boxes["Boxes3D:labels"])
