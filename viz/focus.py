@@ -111,6 +111,7 @@ def log_focus(
     frames = {t: {f.keyframe.index: f for f in v.evidence.run.frames} for t, v in views.items()}
     gt_ids = set(focus.gt_ids)
     named_gt = named_objects(finding, scene.keyframes[focus.frame_index].gt, gt_ids) if shown else []
+    named_meas = named_detections(finding, focus.frame_index)
     failure_report = reports.get(focus.failure_tracker or "")
     evaluated = evaluated_offsets(focus, failure_report)
     unannotated = unannotated_evaluated(focus, failure_report)
@@ -199,6 +200,8 @@ def log_focus(
             given |= {m for s in steps.values() if s is not None for m in s.used}
             # and, for a track that used none, the detection nearest it (by NIS) in its gate: where that one went
             given |= {s.gated[0][0] for s in steps.values() if s is not None and not s.used and s.gated}
+            if i == focus.frame_index:
+                given |= named_meas
             meas |= given
             detections = frame.detections.boxes
             use = facts.use(i, focus.class_name)
@@ -259,6 +262,21 @@ def named_objects(finding: Finding | None, gt: Boxes, involved: Collection[str])
     text = " ".join(plain(line) for line in why_lines(finding))
     ids = [str(t) for t in gt.instance_id]
     return [t for t in ids if t not in involved and re.search(rf"\bGT {re.escape(short_id(t))}\b", text)]
+
+
+def named_detections(finding: Finding | None, frame: int) -> set[int]:
+    """The detections (source indices) near the failure's object at ``frame`` that the finding's Why names
+    ("... but a truck detection, m0 (score 0.97), 0.3 m away: the detector gave it the wrong class"): the view
+    labels them at that frame (dev set scene-0916 centerpoint miss:2: the truck box the sentence named had no
+    label). Only a detection the finding's sighting holds at ``frame`` counts, so a name of another frame's
+    detection never labels this frame's box of the same index."""
+    s = finding.sighting(frame) if finding is not None else None
+    if s is None:
+        return set()
+    near = (s.nearest_any, s.nearest_own, s.neighbours_own, s.off, s.in_box, s.removed_own)
+    text = " ".join(plain(line) for line in why_lines(finding))
+    said = {int(m) for m in re.findall(r"\bm(\d+)\b", text)}
+    return {n.meas for n in near if n is not None and n.meas in said}
 
 
 def _callout_room(

@@ -442,7 +442,7 @@ def test_an_id_switch_without_a_close_call_says_where_the_new_track_came_from(de
     assert f"track {o.track_id} had been started at frame {o.frame} by m{o.meas}" in why
 
 
-def test_every_object_the_why_names_is_labelled_at_the_failure_frame(
+def test_every_object_and_detection_the_why_names_is_labelled_at_the_failure_frame(
     demo_dataroot: Path, record, gnnpmb_report
 ) -> None:
     """A Why that points at another object ("no detection of its own within 2 m (truck m7, 1.2 m away, lay 1.0 m
@@ -469,3 +469,11 @@ def test_every_object_the_why_names_is_labelled_at_the_failure_frame(
     assert all(not named & seen for frame, seen in labels.items() if frame != failure.frame_index)
     boxes = next(r for r in rows[focus_world()] if r.get("frame") == failure.frame_index)
     assert named <= set(boxes["Boxes3D:labels"])
+    # The detections it names near the object at that frame too ("truck m7, 1.2 m away"), by their own labels.
+    s = findings[pick].sighting(failure.frame_index)
+    near = {n.meas for n in (s.nearest_any, s.nearest_own, s.neighbours_own, s.off, s.in_box) if n is not None}
+    said = near & {int(m) for m in re.findall(r"\bm(\d+)\b", " ".join(why_lines(findings[pick])))}
+    assert said, pick
+    for m in said:
+        assert any(x.startswith(f"m{m} ") for x in labels[failure.frame_index]), (m, labels[failure.frame_index])
+        assert any(x.startswith(f"m{m} ") for x in boxes["Boxes3D:labels"])
