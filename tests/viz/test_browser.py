@@ -144,6 +144,11 @@ def test_viewer_state_is_decoded_from_its_protobuf_bytes() -> None:
     assert expected.met_by(state)
     assert not Expected("Recording:gnnpmb-viz:abc", frozenset({"gnnpmb 3D"}), {"frame": 39}).met_by(state)
     assert not Expected("Recording:gnnpmb-viz:abc", frozenset({"pmbm 3D"}), {}).met_by(state)
+    # proto3 writes no field whose value is 0: a timeline loaded up to frame 0 has an empty range message
+    at_zero = field(1, field(1, b"focus")) + field(2, 1) + field(3, b"")
+    state = read_viewer_state(field(3, field(1, b"Recording:gnnpmb-viz:abc") + field(2, at_zero)) + views)
+    assert state.timeline_max == {"focus": 0}
+    assert Expected("Recording:gnnpmb-viz:abc", frozenset({"gnnpmb 3D"}), {"focus": 0}).met_by(state)
     with pytest.raises(ValueError):
         protobuf_fields(b"\x0a\x05ab")  # a 5-byte field with 2 bytes left
 
