@@ -26,6 +26,7 @@ import rerun.blueprint as rrb
 from gnnpmb.data.sensors import CAMERA_ORDER
 from gnnpmb.events import Panel
 from gnnpmb.runs import Capabilities, tracker_capabilities
+from gnnpmb.why.findings import FRAMES_BEFORE
 from viz import compare, paths
 from viz.callouts import COMPARED_CAMERA_HEIGHTS_PX, FOCUS_VIEW_WIDTH_PX
 from viz.cameras import with_cameras
@@ -234,13 +235,20 @@ def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visib
     return placed.view_args() if placed is not None else {"plot_legend": rrb.PlotLegend(visible=visible)}
 
 
-_FOCUS_AXIS = rrb.TimeAxis(
-    view_range=rr.TimeRange(
-        start=rr.TimeRangeBoundary.infinite(), end=rr.TimeRangeBoundary.cursor_relative(FOCUS_PAST_FRAMES)
+def _focus_axis(focus: FocusTarget) -> rrb.TimeAxis:
+    """A focus recording's plots run past the failure frame, where they open: a track started at that frame (one
+    point) sat on the plot's edge, half cut (dev set scene-0916 megvii phd id_switch:1, track 24). They start
+    ``FRAMES_BEFORE`` frames before it, where the recording starts, and never before the scene's first frame; near
+    that frame they run as much further past it, so the axis is always that many frames wide: at a failure at
+    frame 0 the data's own range was one frame wide, and the x axis read "#0 #0 #0 ..." (dev set scene-0916
+    centerpoint miss:2)."""
+    before = min(focus.frame_index, FRAMES_BEFORE)
+    return rrb.TimeAxis(
+        view_range=rr.TimeRange(
+            start=rr.TimeRangeBoundary.absolute(seq=focus.frame_index - before),
+            end=rr.TimeRangeBoundary.cursor_relative(seq=FOCUS_PAST_FRAMES + FRAMES_BEFORE - before),
+        )
     )
-)
-"""A focus recording's plots run past the failure frame, where they open: a track started at that frame (one
-point) sat on the plot's edge, half cut (dev set scene-0916 megvii phd id_switch:1, track 24)."""
 
 
 def track_series_views(
@@ -267,7 +275,7 @@ def track_series_views(
             origin=root,
             contents=_series_contents(root, near, tracker, focused=focus is not None),
             name=f"{tracker} {what}{at}",
-            axis_x=_FOCUS_AXIS if focus is not None else None,
+            axis_x=_focus_axis(focus) if focus is not None else None,
             **_legend_args(root, legends, few or focus is not None),
         )
         for root, what in (

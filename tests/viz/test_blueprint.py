@@ -192,3 +192,23 @@ def test_in_a_focus_a_run_with_no_involved_track_plots_no_track(tmp_path: Path) 
         [f"+ {paths.existence_root('gnnpmb')}/car/1", f"+ {paths.existence_root('gnnpmb')}/car/threshold"],
         [f"+ {paths.existence_root('pmbm')}/car/threshold"],
     ]
+
+
+@pytest.mark.parametrize(
+    ("frame", "start", "end"),
+    [(0, 0, 9), (3, 0, 6), (20, 12, 1)],  # (frame, absolute start, end relative to the time cursor)
+)
+def test_a_focus_plot_opens_nine_frames_wide_and_never_before_the_first_frame(frame: int, start: int, end: int) -> None:
+    """A failure at frame 0 opened plots one frame wide whose x axis read "#0 #0 #0 ..." (dev set scene-0916
+    centerpoint miss:2); later ones start where the recording does, 8 frames before, and end one frame past the
+    time cursor, so a track started at the failure frame is not cut by the plot's edge."""
+    from gnnpmb.focus import FocusTarget
+    from viz.blueprint import track_series_views
+
+    focus = FocusTarget("t", frame, (0.0, 0.0), "car", {"gnnpmb": (1,)}, ())
+    for view in track_series_views("gnnpmb", focus):
+        axis = view.properties["TimeAxis"].view_range.as_arrow_array()
+        absolute, cursor_relative = 2, 1  # the union's type codes (Rerun's TimeRangeBoundary)
+        assert axis.field("start").type_codes.to_pylist() == [absolute]
+        assert axis.field("end").type_codes.to_pylist() == [cursor_relative]
+        assert (axis.field("start").to_pylist(), axis.field("end").to_pylist()) == ([start], [end])
