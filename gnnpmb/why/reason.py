@@ -558,6 +558,27 @@ class _Context:
             return x, int(e.meas_index)
         return None
 
+    def drifted_off(self, track_id: int, xy_m: np.ndarray) -> tuple[str, float, int, GtFrame | None] | None:
+        """``FalseOutput.drifted_from`` of track ``track_id``'s box at ``xy_m`` (BEV, m) at the failure frame: the
+        object of its class nearest the track's latest earlier box that lay within ``NEAR_M`` of one, when that
+        object is annotated at the failure frame between ``NEAR_M`` and ``OFF_NEAR_M`` from ``xy_m``."""
+        for x in sorted((x for x in self.frames if x < self.f), reverse=True):
+            e = self.estimate(track_id, x)
+            gt = self.scene.keyframes[x].gt
+            if e is None or not len(gt):
+                continue
+            mine = np.flatnonzero(gt.class_name == self.class_name)
+            d = np.hypot(*(gt.translation_m[mine, :2] - np.asarray(e.translation_m[:2])).T)
+            if not mine.size or d.min() >= NEAR_M:
+                continue
+            gt_id = str(gt.instance_id[mine[np.argmin(d)]])
+            at = self.gt_xy(gt_id, self.f)
+            if at is None:
+                return None
+            now = float(np.hypot(*(at - xy_m)))
+            return (gt_id, now, x, self.report.gt_frame(gt_id, self.f)) if now < OFF_NEAR_M else None
+        return None
+
     def own_detections(self, frame: int, gt_id: str) -> tuple[int, ...]:
         """The kept detections of the class within ``NEAR_M`` of object ``gt_id`` at ``frame`` that lie nearer it
         than any other annotated object (a detector without NMS gives one object two: audit truth50, world6)."""
@@ -760,6 +781,7 @@ class _Context:
         matched = None
         twins: tuple[int, ...] = ()
         came: tuple[int, int] | None = None
+        drifted = None
         if mine.size and d[mine].min() < NEAR_M:
             k = int(mine[np.argmin(d[mine])])
             gt_id = str(gt.instance_id[k])
@@ -791,6 +813,7 @@ class _Context:
             if came is not None:  # audit truth51 (world7): the track was on the object, fed by its wrong-class boxes
                 blame.append(Blame(Rule.OTHER_CLASS, (came[0],)))
             blame.append(Blame(Rule.COASTED, (self.f,)))
+            drifted = self.drifted_off(t, xy) if nearest_any is None else None
         elif nearest_any is not None:
             blame.append(Blame(Rule.OTHER_CLASS, (self.f,)))
         else:
@@ -810,6 +833,7 @@ class _Context:
             part_of(gt, xy) if nearest_any is None else None,
             twins if len(twins) >= 2 else (),
             came,
+            drifted,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
 

@@ -1142,6 +1142,15 @@ def _false_track(f: Finding) -> list[str]:
         parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of no tracked object")
     elif Rule.TRACK_INTERPOLATED in tests:
         parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m of it")
+    elif o.drifted_from is not None:  # dev set scene-0916 false_track:14: it ran past an object it had been on
+        gt_id, d, x, g = o.drifted_from
+        unseen = ""
+        if g is None or g.status in (GtStatus.NO_BOX, GtStatus.BEYOND_RANGE):
+            unseen = f"; the evaluation has no box for that one here ({_no_box_reason(g)})"
+        parts.append(
+            f"no object of a tracked class lies within {NEAR_M:.0f} m: the track's predicted box lies {d:.1f} m from "
+            f"{f.class_name} GT {short_id(gt_id)}, which it was last within {NEAR_M:.0f} m of at frame {x}{unseen}"
+        )
     else:
         parts.append(
             f"no object of a tracked class lies within {NEAR_M:.0f} m: the tracker output a box where no tracked "

@@ -1929,3 +1929,27 @@ def test_a_riders_bicycle_box_said_to_be_the_pedestrian_seen_as_the_wrong_class_
     )
     assert kinds(own) == []
     assert kinds("at frame 3 the detector saw it only as another class (bicycle m0 0.50 m away)") == ["detector"]
+
+
+def test_a_false_box_that_ran_off_its_object_must_say_so_and_say_it_right() -> None:
+    """Dev set scene-0916 centerpoint gnnpmb false_track:14: track 11 on a car with no sensor points at frames 1-2
+    (0.5 m from it), 2.1 m from it at frame 3 (the failure), where the evaluation has no box of it. "A box where no
+    tracked object was" leaves that unsaid; the drift told with the wrong distance, object or frame is false."""
+    from tools.truth.scene import Annotation
+
+    ev = _eval()
+    for x, at in ((1, 0.5), (2, 0.5), (3, 2.1)):
+        ev.boxes[x] = [("11", C, (at, 0.0))]
+    scene = SceneTruth([[]] * 4, [{GT_A: Annotation(C, (0.0, 0.0), 0)}] * 4)
+    at = Context(C, 3, None, kind="false_track", track=11)
+    head = "no object of a tracked class lies within 2 m"
+    unsaid = f"{head}: the tracker output a box where no tracked object was"
+    assert [c.kind for c in check_text(unsaid, at, None, ev, scene=scene).found] == ["misleading"]
+    said = f"{head}: the track's predicted box lies 2.1 m from car GT aaaaaa, which it was last within 2 m of at "
+    said += "frame 2"
+    no_box = "; the evaluation has no box for that one here (it had no LiDAR or radar points, so its box was dropped)"
+    assert check_text(said + no_box, at, None, ev, scene=scene).found == []
+    for false in (said.replace("2.1 m", "3.1 m"), said.replace("frame 2", "frame 1")):
+        assert [c.kind for c in check_text(false, at, None, ev, scene=scene).found] == ["detector"], false
+    ev.evaluated_gt[(3, GT_A)] = (0.0, 0.0)  # the devkit scored a box of it after all
+    assert [c.kind for c in check_text(said + no_box, at, None, ev, scene=scene).found] == ["evaluation"]
