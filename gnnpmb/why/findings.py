@@ -398,10 +398,11 @@ class FalseOutput:
     """A predicted box on an object of another class: the frame and detection of the track's last box, when that
     detection was the object's own (the detector gave it the track's class there; ``Rule.OTHER_CLASS``)."""
     drifted_from: tuple[str, float, int, GtFrame | None] | None = None
-    """A predicted box with no object within ``NEAR_M``: the object of its class the track's box was last output
-    within ``NEAR_M`` of (id, its distance now in m, that frame, how the evaluation saw it now), when it is
-    annotated here, less than ``OFF_NEAR_M`` away (dev set scene-0916 centerpoint false_track:14: a track that
-    followed a bicycle with no sensor points ran 2.1 m past it, told as "a box where no tracked object was")."""
+    """A box on no detection (predicted, or interpolated by the evaluation) with no object within ``NEAR_M``: the
+    object of its class the track's box was last output within ``NEAR_M`` of (id, its distance now in m, that
+    frame, how the evaluation saw it now), when it is annotated here, less than ``OFF_NEAR_M`` away (dev set
+    scene-0916 centerpoint false_track:14: a track that followed a bicycle with no sensor points ran 2.1 m past
+    it, told as "a box where no tracked object was")."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -813,11 +813,12 @@ class _Context:
             if came is not None:  # audit truth51 (world7): the track was on the object, fed by its wrong-class boxes
                 blame.append(Blame(Rule.OTHER_CLASS, (came[0],)))
             blame.append(Blame(Rule.COASTED, (self.f,)))
-            drifted = self.drifted_off(t, xy) if nearest_any is None else None
         elif nearest_any is not None:
             blame.append(Blame(Rule.OTHER_CLASS, (self.f,)))
         else:
             blame.append(Blame(Rule.DETECTION_OF_NOTHING, (self.f,)))
+        if nearest_any is None and on is None and (interpolated or e is not None):  # a box on no detection
+            drifted = self.drifted_off(t, xy)
         output = FalseOutput(
             t,
             on,

@@ -1141,16 +1141,9 @@ def _false_track(f: Finding) -> list[str]:
     elif o.on is not None:
         parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of no tracked object")
     elif Rule.TRACK_INTERPOLATED in tests:
-        parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m of it")
+        parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m of it{_drifted_text(f, o, 'box')}")
     elif o.drifted_from is not None:  # dev set scene-0916 false_track:14: it ran past an object it had been on
-        gt_id, d, x, g = o.drifted_from
-        unseen = ""
-        if g is None or g.status in (GtStatus.NO_BOX, GtStatus.BEYOND_RANGE):
-            unseen = f"; the evaluation has no box for that one here ({_no_box_reason(g)})"
-        parts.append(
-            f"no object of a tracked class lies within {NEAR_M:.0f} m: the track's predicted box lies {d:.1f} m from "
-            f"{f.class_name} GT {short_id(gt_id)}, which it was last within {NEAR_M:.0f} m of at frame {x}{unseen}"
-        )
+        parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m{_drifted_text(f, o, 'predicted box')}")
     else:
         parts.append(
             f"no object of a tracked class lies within {NEAR_M:.0f} m: the tracker output a box where no tracked "
@@ -1163,6 +1156,24 @@ def _false_track(f: Finding) -> list[str]:
             f"{o.threshold:.3f}"
         )
     return parts
+
+
+def _drifted_text(f: Finding, o: FalseOutput, box: str) -> str:
+    """``: the track's predicted box lies 2.1 m from bicycle GT 9348e3, which it was last within 2 m of at frame
+    27; the evaluation has no box for that one here (it had no LiDAR ...)``: the object a false box on no detection
+    ran off (``FalseOutput.drifted_from``; "" without one)."""
+    if o.drifted_from is None:
+        return ""
+    gt_id, d, x, g = o.drifted_from
+    unseen = ""
+    if g is None or g.status is GtStatus.NO_BOX:
+        unseen = f"; the evaluation has no box for that one here ({_no_box_reason(g)})"
+    elif g.status is GtStatus.BEYOND_RANGE:
+        unseen = f"; that one is beyond the evaluation's {g.range_m:g} m range here, so it has no box for it"
+    return (
+        f": the track's {box} lies {d:.1f} m from {f.class_name} GT {short_id(gt_id)}, which it was last within "
+        f"{NEAR_M:.0f} m of at frame {x}{unseen}"
+    )
 
 
 def box_on_text(on: BoxOn, class_name: str) -> str:

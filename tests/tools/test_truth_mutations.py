@@ -1951,5 +1951,12 @@ def test_a_false_box_that_ran_off_its_object_must_say_so_and_say_it_right() -> N
     assert check_text(said + no_box, at, None, ev, scene=scene).found == []
     for false in (said.replace("2.1 m", "3.1 m"), said.replace("frame 2", "frame 1")):
         assert [c.kind for c in check_text(false, at, None, ev, scene=scene).found] == ["detector"], false
+    # a box the evaluation interpolated for the track between its own boxes: the same, after "... within 2 m of it"
+    interpolated = f"{head} of it"
+    assert [c.kind for c in check_text(interpolated, at, None, ev, scene=scene).found] == ["misleading"]
+    told = f"{interpolated}: the track's box lies 2.1 m from car GT aaaaaa, which it was last within 2 m of at frame 2"
+    assert check_text(told, at, None, ev, scene=scene).found == []
+    # a box on a detection of nothing, or on part of another object, is told by those words, not by a drift
+    assert check_text(f"{head}: a detection of no tracked object", at, None, ev, scene=scene).found == []
     ev.evaluated_gt[(3, GT_A)] = (0.0, 0.0)  # the devkit scored a box of it after all
     assert [c.kind for c in check_text(said + no_box, at, None, ev, scene=scene).found] == ["evaluation"]

@@ -495,8 +495,9 @@ def _part_of(tail: str, xy, frame: int, sentence: str, scene: SceneTruth, out: T
 
 
 DRIFTED = re.compile(
-    r": the track's predicted box lies ([\d.]+) m from (\w+) GT (\w+), which it was last within 2 m of at frame (\d+)"
-    r"(; the evaluation has no box for that one here \((it had no LiDAR or radar points)?[^()]*\))?"
+    r"(?: of it)?: the track's (?:predicted )?box lies ([\d.]+) m from (\w+) GT (\w+), which it was last within 2 m "
+    r"of at frame (\d+)(; the evaluation has no box for that one here \((it had no LiDAR or radar points)?[^()]*\)|"
+    r"; that one is beyond the evaluation's \d+ m range here, so it has no box for it)?"
 )
 """A false track's box that ran off the object of its class it had been on (``FalseOutput.drifted_from``)."""
 DRIFT_LOOKBACK = 8
@@ -531,7 +532,9 @@ def _check_drifted(tail: str, ctx: Context, xy, scene: SceneTruth, ev: EvalFacts
     said = DRIFTED.match(tail)
     out.checked["misleading"] += 1
     if said is None:
-        if now is not None and math.dist(now.xy_m, xy) < DRIFT_NEAR_M:
+        # a box on no detection: the predicted one's words, or an interpolated one's (" of it" and the clause's end)
+        on_nothing = tail.startswith(": the tracker output a box where") or re.match(r" of it(;|$)", tail)
+        if on_nothing and now is not None and math.dist(now.xy_m, xy) < DRIFT_NEAR_M:
             bad(
                 "misleading",
                 tail[:80],
@@ -544,7 +547,7 @@ def _check_drifted(tail: str, ctx: Context, xy, scene: SceneTruth, ev: EvalFacts
         bad("detector", said[0], f"the track's box was last within 2 m of an object of its class at {last}")
     elif abs(math.dist(now.xy_m, xy) - d) > 0.05 + 1e-9:
         bad("detector", said[0], f"the box lies {math.dist(now.xy_m, xy):.2f} m from GT {gt}")
-    elif said[5] is not None and (ctx.frame, last[1]) in ev.evaluated_gt:
+    elif said[5] is not None and (ctx.frame, last[1]) in ev.evaluated_gt:  # "no box" of a box the devkit scored
         bad("evaluation", said[0], f"the devkit scored a box of GT {gt} at frame {ctx.frame}")
     elif said[6] is not None and now.points > 0:
         bad("detector", said[0], f"GT {gt} has {now.points} LiDAR and radar points at frame {ctx.frame}")
