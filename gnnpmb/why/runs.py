@@ -164,14 +164,6 @@ class Run:
     def first(self) -> Said:
         return self.members[0]
 
-    def varying(self) -> tuple[tuple[bool, ...], ...]:
-        """Per sentence (``Said.cuts`` order), per value: whether it differs between members."""
-        per_member = [m.cuts() for m in self.members]
-        return tuple(
-            tuple(len({c[k].values[i] for c in per_member}) > 1 for i in range(len(first.slots)))
-            for k, first in enumerate(per_member[0])
-        )
-
 
 def group(findings: Sequence[Said]) -> list[Run]:
     """``findings`` (in printed order) as runs, each placed where its first member was."""
@@ -240,8 +232,9 @@ def run_lines(run: Run) -> list[str]:
     frames = [m.frame for m in run.members]
     when = f"frame {frames[0]}" if len(frames) == 1 else f"frames {frames[0]}-{frames[-1]}"
     head = f"{ids_text([m.failure_id for m in run.members])} ({when}, {first.class_name}): {first.whose}"
-    cuts = first.cuts()
-    varying = run.varying()
+    per_member = [m.cuts() for m in run.members]
+    cuts = per_member[0]
+    varying = [[len({c[k].values[i] for c in per_member}) > 1 for i in range(len(x.slots))] for k, x in enumerate(cuts)]
     names = _slot_names(cuts, varying)
     shown = [tuple(names[(k, i)] if varying[k][i] else v for i, v in enumerate(c.values)) for k, c in enumerate(cuts)]
     texts = [c.text(s) for c, s in zip(cuts, shown, strict=True)]
@@ -257,7 +250,10 @@ def run_lines(run: Run) -> list[str]:
         (k, i) for k, row in enumerate(varying) for i, v in enumerate(row) if v and cuts[k].slots[i] is not Slot.FRAME
     ]
     if columns:
-        rows = [f"{m.frame}: " + ", ".join(m.cuts()[k].values[i] for k, i in columns) for m in run.members]
+        rows = [
+            f"{m.frame}: " + ", ".join(c[k].values[i] for k, i in columns)
+            for m, c in zip(run.members, per_member, strict=True)
+        ]
         lines.append(f"per frame (frame: {', '.join(names[c] for c in columns)}): " + "; ".join(rows))
     return lines
 
