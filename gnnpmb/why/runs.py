@@ -26,6 +26,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from gnnpmb.why.findings import Finding
+from gnnpmb.why.words import plain, whose_text, why_lines
 
 
 class Slot(enum.Enum):
@@ -116,8 +117,6 @@ class Said:
 
 def said(f: Finding) -> Said:
     """``f`` as ``words`` writes it (``whose_text``, ``why_lines`` made plain), its comparisons split off."""
-    from gnnpmb.why.words import plain, whose_text, why_lines
-
     lines = [plain(line) for line in why_lines(f) if line]
     why, rest = (lines[0], tuple(lines[1:])) if lines else ("", ())
     others = tuple(o.tracker for o in f.others)
