@@ -50,6 +50,14 @@ def register(app: typer.Typer) -> None:
                 "--why", help="Explain each failure: whose doing, why and because (with --json: the typed findings)."
             ),
         ] = False,
+        each: Annotated[
+            bool,
+            typer.Option(
+                "--each",
+                help="With --why: every finding's sentences in full, one finding after another (by default a run of "
+                "findings of one object or track that say the same but for per-frame values is printed once).",
+            ),
+        ] = False,
         frames: Annotated[
             str | None,
             typer.Option(
@@ -72,6 +80,8 @@ def register(app: typer.Typer) -> None:
         --results) each is listed in turn; --why explains each failure beside the others."""
         from gnnpmb.runs import parse_runs, run_inputs
 
+        if each and not why:
+            raise GnnpmbError("--each prints the findings of --why in full: add --why")
         runs = parse_runs(tracker or [], results or [], default=DEFAULT_TRACKER)
         inputs = (*source.input_files, *run_inputs(runs))
         json_target = check_output_file(json_out, "--json", inputs=inputs) if json_out is not None else None
@@ -93,7 +103,7 @@ def register(app: typer.Typer) -> None:
         for name, report in reports.items():
             print_report(report, console)
             if why:
-                print_findings(findings[name], console)
+                print_findings(findings[name], console, each=each)
         if json_out is not None:
             typer.echo(f"report -> {json_out}")
 
@@ -159,15 +169,27 @@ def _report_json(reports: dict, findings: dict, track_names: dict) -> dict:
     return data
 
 
-def print_findings(findings: list, console: "Console") -> None:
-    """Each failure's finding: its id and whose doing, then its Why and Because lines (``why.words``)."""
-    from gnnpmb.why.words import plain, whose_text, why_lines
+def print_findings(findings: list, console: "Console", *, each: bool = False) -> None:
+    """Each failure's finding: its id and whose doing, then its Why and Because lines (``why.words``); findings
+    of one subject at consecutive frames that say the same but for per-frame values are printed once
+    (``why.runs``), and a comparison the subject's previous finding gave word for word is not repeated. each:
+    every finding in full, on its own."""
+    from gnnpmb.why.runs import Run, group, run_lines, said
 
-    for f in findings:
-        console.print(f"{f.failure_id} (frame {f.frame}, {f.class_name}): {whose_text(f)}", highlight=False)
-        for line in why_lines(f):
-            if line:
-                console.print(f"  {plain(line)}", highlight=False, soft_wrap=True)
+    everything = [said(f) for f in findings]
+    runs = [Run((s,), (None,) * len(s.comparisons)) for s in everything] if each else group(everything)
+    for run in runs:
+        head, *lines = run_lines(run)
+        console.print(head, highlight=False, soft_wrap=True)
+        for line in lines:
+            console.print(f"  {line}", highlight=False, soft_wrap=True)
+    if len(runs) < len(findings) or any(a is not None for r in runs for a in r.as_for):
+        console.print(
+            "(findings alike but for the <values> given per frame are printed once; 'T: as for ID': run T fared as "
+            "finding ID says; every finding is in --json, and each id opens with gnnpmb-viz SCENE --focus ID)",
+            highlight=False,
+            soft_wrap=True,
+        )
 
 
 def print_report(report: "FailureReport", console: "Console") -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -13,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from cli.app import main as viz_main
+from tests.cli.test_failures_runs import shown_ids
 from tests.inprocess import run_script, run_script_captured
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
@@ -45,7 +47,9 @@ def test_failures_of_a_results_file(cv_failures: CvFailures) -> None:
     findings = data["findings"]
     assert findings and all(f["mode"] == "output only" for f in findings)
     why = [line for line in out.splitlines() if line.startswith("  Why (cv, ")]
-    assert len(why) == len(findings)
+    cv = out[out.index(f"{SCENE}, cv: ") : out.index(f"{SCENE}, gnnpmb: ")]
+    assert len(why) == len(re.findall(r"^[a-z_]+:[\d, \-]+ \(frames? ", cv, flags=re.M))  # a Why per entry
+    assert sorted(shown_ids(cv)) == sorted(f["failure_id"] for f in findings)  # every finding named once
     text = "\n".join(why)
     # Nothing about its update: no gates, existences, costs or births, only where its boxes were.
     for word in ("gate", "existence", "cost", "NIS", "started by", "was given", "(p "):

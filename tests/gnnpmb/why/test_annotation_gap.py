@@ -92,7 +92,7 @@ def gap_run(tmp_path_factory: pytest.TempPathFactory) -> GapRun:
     tmp = tmp_path_factory.mktemp("gap")
     root, detections = _with_gap(tmp / "gap")
     args = [SCENE, "--dataroot", str(root), "--detections", str(detections), "-t", "pmbm"]
-    argv = ["failures", *args, "--why", "--json", str(tmp / "r.json")]
+    argv = ["failures", *args, "--why", "--each", "--json", str(tmp / "r.json")]  # every finding in full
     stdout, stderr = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr), pytest.MonkeyPatch.context() as patch:
         for name in FRESH_PROCESS_STATE:  # as run_script: what an earlier command in this process would have left
