@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numpy as np
 
@@ -50,6 +51,7 @@ from gnnpmb.why.findings import (
     Sighting,
     covering,
 )
+from gnnpmb.why.untracked import untracked_by_token, untracked_on
 
 _ON_IT_RULES = (Rule.TRACK_DROPPED, Rule.NOT_COUNTED, Rule.COVERED_TWO)
 """The tests about tracks output on an object the evaluation still missed (``_Context.blame_uncovered``)."""
@@ -102,6 +104,9 @@ def explain_failure(
 class _Context:
     """The failure, its sources and the frames looked at, with the lookups every part of a finding shares."""
 
+    untracked: Mapping[str, Boxes] = MappingProxyType({})
+    """Per sample token, the annotations of categories the evaluation does not track (``gnnpmb.why.untracked``)."""
+
     def __init__(
         self,
         evidence: Evidence,
@@ -119,6 +124,7 @@ class _Context:
         self.class_name = class_name
         self.window = range(max(min(self.frames), first_frame), frame + 1)
         self.threshold = self.report.threshold_of(self.class_name)
+        self.untracked: Mapping[str, Boxes] = untracked_by_token(scene)
 
     # The object.
     def gt_xy(self, gt_id: str, frame: int) -> np.ndarray | None:
@@ -532,7 +538,13 @@ class _Context:
     def meas_part_of(self, frame: int, meas: int) -> tuple[str, str, float] | None:
         """``part_of`` for detection ``meas`` of ``frame`` (None when unknown)."""
         xy = self._meas_xy(frame, meas)
-        return None if xy is None else part_of(self.scene.keyframes[frame].gt, xy)
+        return None if xy is None else self.part_at(frame, xy)
+
+    def part_at(self, frame: int, xy: np.ndarray) -> tuple[str, str, float] | None:
+        """``part_of`` at ``frame``, else the annotation of an untracked category the point lies on (its class is
+        the category; audit truth52, world8: car boxes on an ambulance were "detections of no tracked object")."""
+        kf = self.scene.keyframes[frame]
+        return part_of(kf.gt, xy) or untracked_on(self.untracked.get(getattr(kf, "sample_token", "")), xy)
 
     def no_object_part(self, frame: int, meas: int) -> tuple[bool, tuple[str, str, float] | None]:
         """(``of_no_object``, and for such a detection ``meas_part_of``): whether it lay near no annotated object,
@@ -807,7 +819,7 @@ class _Context:
             self.threshold,
             nearest_own is not None and self.missed_at(nearest_own[0], self.f),
             step.use if (step := self.facts.steps(t, self.class_name).get(self.f)) is not None else None,
-            part_of(gt, xy) if nearest_any is None else None,
+            self.part_at(self.f, xy) if nearest_any is None else None,
             twins if len(twins) >= 2 else (),
             came,
         )

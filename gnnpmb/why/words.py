@@ -31,6 +31,7 @@ from gnnpmb.why.findings import (
     Sighting,
     covering,
 )
+from gnnpmb.why.untracked import is_untracked, untracked_text
 
 SHOW_MIN_EXISTENCE = 0.5
 """Extracted tracks are drawn (and called shown) from this existence on: the submission may hold far less likely
@@ -1134,8 +1135,9 @@ def _false_track(f: Finding) -> list[str]:
         )
     elif o.part_of is not None:  # audit truth50 (world6): a truck's trailer box is no "box where no object was"
         what = "the detection" if o.on is not None else "the box"
+        on_what = "" if is_untracked(o.part_of) else "part of "  # audit truth52 (world8): a car box on an ambulance
         parts.append(
-            f"no object of a tracked class lies within {NEAR_M:.0f} m, but {what} lies on part of "
+            f"no object of a tracked class lies within {NEAR_M:.0f} m, but {what} lies on {on_what}"
             f"{_part_text(o.part_of)}"
         )
     elif o.on is not None:
@@ -1445,7 +1447,7 @@ def _of_no_object(part: tuple[str, str, float] | None = None) -> str:
     bus's detections), or, inside an object's box (``part``), a sight of part of it (audit truth50: a truck's
     trailer box)."""
     if part is not None:
-        return f"a detection of part of {_part_text(part)}"
+        return f"a detection of {'' if is_untracked(part) else 'part of '}{_part_text(part)}"
     return f"a detection of no object (none of a tracked class within {NEAR_M:.0f} m)"
 
 
@@ -1463,6 +1465,8 @@ def _used_of_no_object(pairs: Sequence[tuple[int, int]]) -> str:
 
 def _part_text(part: tuple[str, str, float]) -> str:
     """``truck GT ecf44b (inside its box, 3.5 m from its centre, beyond the evaluation's 2 m)``."""
+    if is_untracked(part):
+        return untracked_text(part)
     gt_id, cls, d = part
     where = f"inside its box, {d:.1f} m from its centre, beyond the evaluation's {NEAR_M:.0f} m"
     return f"{cls} GT {short_id(gt_id)} ({where})"

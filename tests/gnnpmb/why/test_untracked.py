@@ -1,0 +1,100 @@
+"""Boxes on objects of categories the evaluation does not track (audit truth52, world8: an ambulance, a police car,
+a stroller, a wheelchair, an excavator and barriers, annotated, with car / pedestrian / truck boxes on them). The
+devkit leaves those annotations out, so the boxes' false tracks were "a detection of no tracked object": true, but
+the user looks for a ghost where an annotated ambulance stands. The Why now names the annotation."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from gnnpmb.eval.failures import FailureKind
+from gnnpmb.types import Boxes
+from gnnpmb.why.findings import Blame, FalseOutput, Origin, Rule
+from gnnpmb.why.reason import _Context
+from gnnpmb.why.untracked import untracked_by_token, untracked_on
+from gnnpmb.why.words import why_lines
+from tests.gnnpmb.why.test_finding_words import finding
+from tests.gnnpmb.why.test_reason_rules import Table, one_frame_context
+
+AMBULANCE = "7b72e3" + "0" * 26
+CAR = "26e63e" + "0" * 26
+
+
+def ambulance_scene() -> _Context:
+    """Frame 7 (world8 scene-0103): car GT 26e63e at (20, 0); ambulance 7b72e3 (vehicle.emergency.ambulance, 6 m
+    long) at (0, 0); detections: m0 a car box 0.2 m from the ambulance, m1 a car box 2.6 m ahead of its centre
+    (inside its box), m2 a car box 8 m to its side (on nothing)."""
+    gt = Table(
+        instance_id=np.array([CAR]),
+        class_name=np.array(["car"]),
+        translation_m=np.array([[20.0, 0.0, 0.8]]),
+        size_wlh_m=np.array([[1.9, 4.6, 1.6]]),
+        quat_wxyz=np.array([[1.0, 0, 0, 0]]),
+    )
+    boxes = Table(
+        translation_m=np.array([[0.2, 0.0, 1.0], [2.6, 0.0, 1.0], [0.0, 8.0, 1.0]]),
+        class_name=np.array(["car", "car", "car"]),
+        score=np.array([0.61, 0.5, 0.4]),
+    )
+    ctx = one_frame_context(7, gt, boxes, "car")
+    ctx.scene.keyframes[7].sample_token = "s7"
+    ctx.untracked = {
+        "s7": Boxes(
+            translation_m=np.array([[0.0, 0.0, 1.0]]),
+            size_wlh_m=np.array([[2.2, 6.0, 2.4]]),
+            quat_wxyz=np.array([[1.0, 0, 0, 0]]),
+            velocity_mps=np.zeros((1, 2)),
+            score=np.ones(1),
+            class_name=np.array(["vehicle.emergency.ambulance"], dtype=object),
+            instance_id=np.array([AMBULANCE], dtype=object),
+        )
+    }
+    return ctx
+
+
+def test_a_box_on_an_untracked_objects_annotation_is_found() -> None:
+    ctx = ambulance_scene()
+    assert ctx.of_no_object(7, 0)  # the evaluation's view: no tracked object within 2 m
+    on = ctx.meas_part_of(7, 0)
+    assert on[:2] == (AMBULANCE, "vehicle.emergency.ambulance") and on[2] == pytest.approx(0.2)
+    inside = ctx.meas_part_of(7, 1)  # 2.6 m from its centre, but inside its 6 m box
+    assert inside[:2] == (AMBULANCE, "vehicle.emergency.ambulance") and inside[2] == pytest.approx(2.6)
+    assert ctx.meas_part_of(7, 2) is None
+    assert untracked_on(None, np.zeros(2)) is None
+
+
+def test_the_why_names_the_untracked_object_a_false_track_lay_on() -> None:
+    ctx = ambulance_scene()
+    part = ctx.meas_part_of(7, 0)
+    near = ctx.near(7, np.array([0.2, 0.0]), own=False)
+    out = FalseOutput(42, near, (0.2, 0.0), None, None, None, None, None, None, part_of=part)
+    f = finding(
+        FailureKind.FALSE_TRACK,
+        class_name="car",
+        gt_id=None,
+        track_ids=(42,),
+        frame=7,
+        false_output=out,
+        blame=(Blame(Rule.DETECTION_OF_NOTHING, (7,)),),
+    )
+    (line, *_) = why_lines(f)
+    assert (
+        "no object of a tracked class lies within 2 m, but the detection lies on vehicle.emergency.ambulance 7b72e3 "
+        "(0.2 m away), a category the evaluation does not track"
+    ) in line
+    assert "a detection of no tracked object" not in line and "part of" not in line
+    # a thief started by a box on it: not "a detection of no object"
+    theft = finding(
+        FailureKind.ID_SWITCH, class_name="car", frame=12, taker=Origin(42, 7, 0, of_no_object=True, part_of=part)
+    )
+    (line, *_) = why_lines(theft)
+    assert "track 42 had been started at frame 7 by m0, a detection of vehicle.emergency.ambulance 7b72e3" in line
+    assert "of no object" not in line
+
+
+def test_a_scene_built_in_memory_has_no_untracked_annotations() -> None:
+    assert untracked_by_token(SimpleNamespace(keyframes=())) == {}
+    assert untracked_by_token(SimpleNamespace(dataroot="/nonexistent", version="v1.0-mini", name="scene-0001")) == {}
