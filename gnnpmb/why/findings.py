@@ -208,6 +208,10 @@ class Sighting:
     neighbours_own: Near | None = None
     """The nearest kept detection of its class within ``NEAR_M`` that lies nearer another annotated object: that
     one's, not this one's (``nearest_own`` never is such a detection; two pedestrians given one box)."""
+    untracked_name: tuple[str, float, float] | None = None
+    """With no detection of a tracked class within ``NEAR_M`` nor inside its box: the nearest box of a detection
+    name the evaluation does not track (``construction_vehicle``, ``traffic_cone``, ``barrier``) within ``NEAR_M``:
+    name, score, m (audit truth52, world8: a car detected only as a construction vehicle was "missed")."""
 
     @property
     def lidar_points(self) -> int:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
@@ -51,7 +52,7 @@ from gnnpmb.why.findings import (
     Sighting,
     covering,
 )
-from gnnpmb.why.untracked import untracked_by_token, untracked_on
+from gnnpmb.why.untracked import untracked_by_token, untracked_detections, untracked_name_near, untracked_on
 
 _ON_IT_RULES = (Rule.TRACK_DROPPED, Rule.NOT_COUNTED, Rule.COVERED_TWO)
 """The tests about tracks output on an object the evaluation still missed (``_Context.blame_uncovered``)."""
@@ -75,6 +76,8 @@ class Evidence:
     facts: TrackerFacts
     run: TrackingRun
     boxes_on: Mapping[tuple[int, int], BoxOn] = field(default_factory=dict)
+    detections_path: Path | None = None
+    """The detection file the run read (None: simulated): its boxes of untracked names are read from it."""
 
     @property
     def tracker(self) -> str:
@@ -254,6 +257,7 @@ class _Context:
                     box,
                     self.off_near(f, gt_id) if any_near is None and box is None else None,
                     neighbours_own=self.near(f, xy, own=True, neighbours=True),
+                    untracked_name=self.untracked_name(f, xy) if any_near is None and box is None else None,
                 )
             )
         return tuple(out)
@@ -539,6 +543,16 @@ class _Context:
         """``part_of`` for detection ``meas`` of ``frame`` (None when unknown)."""
         xy = self._meas_xy(frame, meas)
         return None if xy is None else self.part_at(frame, xy)
+
+    def untracked_name(self, frame: int, xy: np.ndarray) -> tuple[str, float, float] | None:
+        """The nearest box of an untracked detection name within ``NEAR_M`` of ``xy`` at ``frame`` in the run's
+        detection file (``gnnpmb.why.untracked``; None: none, or no file)."""
+        path = getattr(self.evidence, "detections_path", None)
+        if path is None:
+            return None
+        tokens = tuple(str(k.sample_token) for k in self.scene.keyframes)
+        token = str(self.scene.keyframes[frame].sample_token)
+        return untracked_name_near(untracked_detections(path, tokens), token, xy)
 
     def part_at(self, frame: int, xy: np.ndarray) -> tuple[str, str, float] | None:
         """``part_of`` at ``frame``, else the annotation of an untracked category the point lies on (its class is

@@ -1,14 +1,17 @@
-"""Annotated objects of categories the evaluation does not track (audit truth52, world8).
+"""Annotated objects of categories the evaluation does not track, and detections of names it does not track
+(audit truth52, world8).
 
 The devkit maps ``vehicle.emergency.*``, ``vehicle.construction``, ``human.pedestrian.stroller``, ``wheelchair``,
 ``personal_mobility``, ``movable_object.*``, ``animal`` and ``static_object.bicycle_rack`` to no tracking class, so
 a scene's ground truth (``Keyframe.gt``) leaves them out. A car box on an ambulance is then a false track "of no
 tracked object", which is true, but the user looks for a ghost where an annotated ambulance stands. These are the
-annotations the explainer names in such a clause.
+annotations the explainer names in such a clause. Likewise a car detected only as ``construction_vehicle`` (a
+name the loader drops) was said to be missed by the detector: it was seen, with a class no tracker takes.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from functools import lru_cache
 from pathlib import Path
 
@@ -87,4 +90,54 @@ def _read(dataroot: Path, version: str, name: str, synthetic: bool) -> dict[str,
             class_name=category[sel],
             instance_id=inst[sel],
         )
+    return out
+
+
+UNTRACKED_NAMES = ("barrier", "construction_vehicle", "traffic_cone")
+"""The nuScenes detection names the tracking evaluation has no class for (the loader drops their boxes)."""
+MAX_READ_BYTES = 100_000_000
+"""Detection files larger than this are not read again for their untracked boxes (a full-split file is 300-700
+MB; its miss clauses stay as they were)."""
+
+
+def untracked_name_near(
+    boxes: Mapping[str, tuple[tuple[str, float, float, float], ...]], token: str, xy_m: np.ndarray
+) -> tuple[str, float, float] | None:
+    """The nearest box of an untracked detection name within ``NEAR_M`` of ``xy_m`` in sample ``token``: (name,
+    score, distance m); None: none."""
+    best = None
+    for name, score, x, y in boxes.get(token, ()):
+        d = float(np.hypot(x - float(xy_m[0]), y - float(xy_m[1])))
+        if d < NEAR_M and (best is None or d < best[2]):
+            best = (name, score, d)
+    return best
+
+
+def untracked_detections(
+    path: Path | None, tokens: tuple[str, ...]
+) -> Mapping[str, tuple[tuple[str, float, float, float], ...]]:
+    """Per sample token of ``tokens``, the boxes of untracked detection names in the detection file ``path``
+    (name, score, x, y); empty without a file, or for one larger than ``MAX_READ_BYTES``."""
+    if path is None or not Path(path).is_file() or Path(path).stat().st_size > MAX_READ_BYTES:
+        return {}
+    p = Path(path)
+    return _untracked_detections(p, p.stat().st_mtime_ns, tokens)
+
+
+@lru_cache(maxsize=4)
+def _untracked_detections(
+    path: Path, _mtime_ns: int, tokens: tuple[str, ...]
+) -> dict[str, tuple[tuple[str, float, float, float], ...]]:
+    from gnnpmb.data.json_stream import iter_object
+
+    wanted, out = set(tokens), {}
+    with path.open("rb") as f:
+        for token, entries in iter_object(f, member="results"):
+            if token not in wanted or not isinstance(entries, list):
+                continue
+            out[token] = tuple(
+                (str(b["detection_name"]), float(b["detection_score"]), *map(float, b["translation"][:2]))
+                for b in entries
+                if isinstance(b, dict) and b.get("detection_name") in UNTRACKED_NAMES
+            )
     return out

@@ -1279,6 +1279,13 @@ def _miss(f: Finding) -> list[str]:
             f"({inside}), but {n.class_name} {meas_name(n.meas)} (score {n.score:.2f}) lay inside its box, "
             f"{n.distance_m:.1f} m from its centre: the detector saw part of it"
         )
+    elif s.undetected and s.nearest_any is None and s.untracked_name is not None:  # audit truth52 (world8)
+        u_name, u_score, u_m = s.untracked_name
+        parts.append(
+            f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
+            f"({inside}), but a {u_name} box (score {u_score:.2f}) {u_m:.1f} m away: the detector gave it a class "
+            "no tracker takes"
+        )
     elif s.undetected and s.nearest_any is None and s.off is not None:  # audit truth51 (world7): a box 3-6 m off
         n = s.off
         parts.append(

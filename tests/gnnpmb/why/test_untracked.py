@@ -98,3 +98,37 @@ def test_the_why_names_the_untracked_object_a_false_track_lay_on() -> None:
 def test_a_scene_built_in_memory_has_no_untracked_annotations() -> None:
     assert untracked_by_token(SimpleNamespace(keyframes=())) == {}
     assert untracked_by_token(SimpleNamespace(dataroot="/nonexistent", version="v1.0-mini", name="scene-0001")) == {}
+
+
+def test_a_car_seen_only_as_a_construction_vehicle_is_not_said_to_be_missed(tmp_path) -> None:
+    # world8 scene-0916: car 812dba detected only as 'construction_vehicle' at keyframes 28-32. The loader drops
+    # that name, so the Why said "no detection of a tracked class within 2 m ...: the detector missed it".
+    from gnnpmb.why.findings import Sighting
+    from gnnpmb.why.untracked import untracked_detections, untracked_name_near
+
+    path = tmp_path / "dets.json"
+    box = {"translation": [10.3, 0.0, 1.0], "size": [2, 5, 2], "rotation": [1, 0, 0, 0], "velocity": [0, 0]}
+    results = {
+        "s28": [
+            dict(box, detection_name="construction_vehicle", detection_score=0.45, attribute_name=""),
+            dict(box, translation=[30.0, 0.0, 1.0], detection_name="traffic_cone", detection_score=0.9),
+            dict(box, translation=[10.0, 0.5, 1.0], detection_name="car", detection_score=0.2),
+        ],
+        "other": [dict(box, detection_name="barrier", detection_score=0.5)],
+    }
+    path.write_text(__import__("json").dumps({"meta": {}, "results": results}))
+    boxes = untracked_detections(path, ("s28",))
+    assert set(boxes) == {"s28"} and len(boxes["s28"]) == 2  # the car box is tracked; 'other' is not this scene's
+    near = untracked_name_near(boxes, "s28", np.array([10.0, 0.0]))
+    assert near[:2] == ("construction_vehicle", 0.45) and near[2] == pytest.approx(0.3)
+    assert untracked_name_near(boxes, "s28", np.array([0.0, 0.0])) is None
+    assert untracked_detections(None, ("s28",)) == {}
+    s = Sighting(28, 120, None, None, None, None, (), untracked_name=near)
+    miss = finding(FailureKind.MISS, class_name="car", gt_id="812dba" + "0" * 26, frame=28, sightings=(s,))
+    (line, *_) = why_lines(miss)
+    assert (
+        "at frame 28 the detector gave no detection of a tracked class within 2 m of car GT 812dba (120 LiDAR and "
+        "radar points in its box), but a construction_vehicle box (score 0.45) 0.3 m away: the detector gave it a "
+        "class no tracker takes"
+    ) in line
+    assert "the detector missed it" not in line
