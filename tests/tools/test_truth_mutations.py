@@ -1929,3 +1929,39 @@ def test_a_riders_bicycle_box_said_to_be_the_pedestrian_seen_as_the_wrong_class_
     )
     assert kinds(own) == []
     assert kinds("at frame 3 the detector saw it only as another class (bicycle m0 0.50 m away)") == ["detector"]
+
+
+def test_a_box_on_an_untracked_category_or_an_untracked_detection_name_left_unsaid_is_caught() -> None:
+    # audit truth52, world8 scene-0103 centerpoint gnnpmb false_track:7: a car track on an annotated ambulance was
+    # "a detection of no tracked object"; scene-0916: car 812dba seen only as a construction_vehicle was "missed"
+    from tools.truth.scene import Annotation, Detection
+
+    car, amb = "812dba" + "0" * 26, "7b72e3" + "0" * 26
+    objects = [{car: Annotation("car", (0.0, 0.0), 120)}] * 4
+    others = [{amb: Annotation("vehicle.emergency.ambulance", (20.0, 0.0), 80, 0, (2.2, 6.0, 0.0))}] * 4
+    dets = [[Detection("car", 0.61, (20.2, 0.0))]] * 4
+    untracked = [[Detection("construction_vehicle", 0.45, (0.3, 0.0))]] * 4
+    scene = SceneTruth(dets, objects, None, untracked, others)
+    ev = _eval()
+    ev.boxes[3] = [("42", "car", (20.2, 0.0))]
+    false = Context("car", 3, None, kind="false_track", track=42)
+
+    def kinds(text: str, ctx: Context | None = None) -> list[str]:
+        return [c.kind for c in check_text(text, ctx or Context("car", 3, car), None, ev, scene=scene).found]
+
+    nothing = "no object of a tracked class lies within 2 m: a detection of no tracked object"
+    assert kinds(nothing, false) == ["misleading"]
+    named = (
+        "no object of a tracked class lies within 2 m, but the detection lies on vehicle.emergency.ambulance 7b72e3 "
+        "(0.2 m away), a category the evaluation does not track"
+    )
+    assert kinds(named, false) == []
+    assert kinds(named.replace("7b72e3", "7b72e4"), false) == ["detector"]
+    missed = (
+        "at frame 3 the detector gave no detection of a tracked class within 2 m of car GT 812dba (120 LiDAR and radar "
+        "points in its box)"
+    )
+    assert kinds(f"{missed}: the detector missed it") == ["misleading"]
+    said = ", but a construction_vehicle box (score 0.45) 0.3 m away: the detector gave it a class no tracker takes"
+    assert kinds(f"{missed}{said}") == []
+    assert kinds(f"{missed}{said.replace('0.45', '0.55')}") == ["misleading"]

@@ -107,6 +107,30 @@ def _check_in_box(said: bool, frames: list[int], short: str, sentence: str, scen
         bad("detector", sentence, "no detection lies inside its box")
 
 
+UNTRACKED_NAMED = re.compile(
+    rf", but an? (\w+) box \(score ({_F})\) ({_F}) m away: the detector gave it a class no tracker takes"
+)
+"""A miss whose only box within 2 m has a name no tracker takes (audit truth52, world8: a car seen only as a
+construction vehicle was "missed")."""
+
+
+def _untracked_unsaid(after: str, x: int, short: str, xy_m, scene: SceneTruth, out) -> bool:
+    """Whether the file's boxes of an untracked name within 2 m of object ``short`` at frame ``x`` go unnamed in
+    ``after`` (the text after "no detection of a tracked class within 2 m of ..."), where no detection lies inside
+    its box (told first)."""
+    near, hit = scene.untracked_near(x, xy_m), scene.object_of(x, short)
+    if (
+        not near
+        or hit is None
+        or scene.in_box(x, hit[0])
+        or not after.startswith((": the detector missed it", ", but"))
+    ):
+        return False
+    out.checked["misleading"] += 1
+    said = UNTRACKED_NAMED.match(after)
+    return said is None or f"{said[1]} {said[2]}" not in near
+
+
 OFF_NEAR_M = 6.5
 """A miss with a detection of its class this near (beyond ``NEAR_M``), nearer it than any other annotated object,
 must name it (audit truth51, world7: a car's box moved 3-6 m for one frame was told as "the detector missed it")."""
@@ -214,6 +238,8 @@ def check_detector(
             continue
         elif not m[2] and scene.untracked_near(x, ann.xy_m):
             bad("detector", m[0], f"the file has {scene.untracked_near(x, ann.xy_m)} within {NEAR_M} m (untracked)")
+        elif _untracked_unsaid(text[m.end() :], x, m[4], ann.xy_m, scene, out):
+            bad("misleading", m[0], f"the file has {scene.untracked_near(x, ann.xy_m)} within {NEAR_M} m: unsaid")
         else:
             _check_in_box(_says_in_box(text[m.end() :]), [x], m[4], m[0], scene, out, bad)
             _check_off(text[m.end() :], x, m[3], m[4], m[0], scene, out, bad)

@@ -491,6 +491,15 @@ def _part_of(tail: str, xy, frame: int, sentence: str, scene: SceneTruth, out: T
         bad("misleading", sentence, f"inside the box of {[k[:6] for k in inside]} at frame {frame}: unsaid")
     elif said is not None and not any(k.startswith(said[2]) for k in inside):
         bad("detector", sentence, f"not inside GT {said[2]}'s box at frame {frame} (inside {[k[:6] for k in inside]})")
+    if inside:
+        return
+    on = scene.untracked_on(frame, tuple(xy))  # audit truth52 (world8): a car box on an ambulance
+    named = re.match(r"(?:, but (?:the detection|the box) lies on |, a detection of )?(\w+(?:\.\w+)+ \w{6}) \(", tail)
+    out.checked["misleading"] += 1
+    if named is None and on:
+        bad("misleading", sentence, f"on {on} at frame {frame} (a category the evaluation does not track): unsaid")
+    elif named is not None and named[1] not in on:
+        bad("detector", sentence, f"not on {named[1]} at frame {frame} (on {on})")
 
 
 TWO_ON_ONE = re.compile(
