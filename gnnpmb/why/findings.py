@@ -401,6 +401,9 @@ class FalseOutput:
     coasted_from: tuple[int, int] | None = None
     """A predicted box on an object of another class: the frame and detection of the track's last box, when that
     detection was the object's own (the detector gave it the track's class there; ``Rule.OTHER_CLASS``)."""
+    beside_untracked: tuple[str, str, float] | None = None
+    """Near an object of its class: the annotation of an untracked category (id, category, m) the box lies nearer
+    than that object (a stroller beside its pusher: the track was on the stroller; audit truth52, world8)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -595,7 +595,19 @@ class _Context:
         ok = (d < NEAR_M) & fr.detections.kept & (boxes.class_name == self.class_name)
         idx = np.flatnonzero(ok)
         other = self.nearer_object(frame, boxes.translation_m[idx, :2], d[idx])
-        return tuple(int(m) for m, o in zip(idx.tolist(), other, strict=True) if o is None)
+        return tuple(
+            int(m)
+            for m, o in zip(idx.tolist(), other, strict=True)
+            if o is None and self.untracked_nearer(frame, boxes.translation_m[m, :2], float(d[m])) is None
+        )
+
+    def untracked_nearer(self, frame: int, xy: np.ndarray, own_m: float) -> tuple[str, str, float] | None:
+        """The annotation of an untracked category nearest ``xy`` at ``frame`` when it lies nearer than ``own_m``
+        (id, category, m), else None: a pedestrian box on a stroller beside its pusher is the stroller's (audit
+        truth52, world8: "the detector gave it two pedestrian detections" counted it as the pusher's)."""
+        kf = self.scene.keyframes[frame]
+        hit = untracked_on(self.untracked.get(getattr(kf, "sample_token", "")), xy)
+        return hit if hit is not None and hit[2] < own_m - 1e-6 else None
 
     def off_near(self, frame: int, gt_id: str) -> Near | None:
         """The nearest detection of the class within ``OFF_NEAR_M`` of object ``gt_id`` at ``frame`` (kept or not)
@@ -836,6 +848,7 @@ class _Context:
             self.part_at(self.f, xy) if nearest_any is None else None,
             twins if len(twins) >= 2 else (),
             came,
+            self.untracked_nearer(self.f, xy, nearest_own[1]) if nearest_own is not None else None,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
 

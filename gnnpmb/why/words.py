@@ -1115,6 +1115,8 @@ def _false_track(f: Finding) -> list[str]:
         else:
             other = f" (track {o.matched_instead})" if o.matched_instead is not None else ""
             parts.append(f"{on} and the evaluation matched it to another track{other}: two tracks on one object")
+            if o.beside_untracked is not None:  # audit truth52 (world8): a pedestrian box on a stroller
+                parts.append(f"the track's box lay nearer {untracked_text(o.beside_untracked)}")
             if o.twins:  # audit truth50 (world6, a detector without NMS): not the tracker's doing alone
                 n = "two" if len(o.twins) == 2 else str(len(o.twins))
                 what = ", ".join(meas_name(m) for m in o.twins)

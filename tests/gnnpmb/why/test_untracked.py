@@ -132,3 +132,58 @@ def test_a_car_seen_only_as_a_construction_vehicle_is_not_said_to_be_missed(tmp_
         "class no tracker takes"
     ) in line
     assert "the detector missed it" not in line
+
+
+MUM = "57377a" + "0" * 26
+STROLLER = "5b2c3d" + "0" * 26
+
+
+def test_a_pedestrian_box_on_a_stroller_is_not_a_second_box_of_its_pusher() -> None:
+    # world8 scene-0103 megvii gnn false_track:16: a stroller (not tracked) 0.8 m beside the adult pushing it; its
+    # pedestrian box was counted as the adult's second: "the detector gave it two pedestrian detections (m17, m18)"
+    gt = Table(
+        instance_id=np.array([MUM]),
+        class_name=np.array(["pedestrian"]),
+        translation_m=np.array([[0.0, 0.0, 0.9]]),
+        size_wlh_m=np.array([[0.62, 0.68, 1.75]]),
+        quat_wxyz=np.array([[1.0, 0, 0, 0]]),
+    )
+    boxes = Table(
+        translation_m=np.array([[0.1, 0.0, 0.9], [0.75, 0.1, 0.6]]),
+        class_name=np.array(["pedestrian", "pedestrian"]),
+        score=np.array([0.64, 0.6]),
+    )
+    ctx = one_frame_context(17, gt, boxes, "pedestrian")
+    ctx.scene.keyframes[17].sample_token = "s17"
+    ctx.gt_xy = lambda gt_id, frame: np.zeros(2) if gt_id == MUM else None
+    ctx.untracked = {
+        "s17": Boxes(
+            translation_m=np.array([[0.8, 0.0, 0.6]]),
+            size_wlh_m=np.array([[0.6, 1.0, 1.1]]),
+            quat_wxyz=np.array([[1.0, 0, 0, 0]]),
+            velocity_mps=np.zeros((1, 2)),
+            score=np.ones(1),
+            class_name=np.array(["human.pedestrian.stroller"], dtype=object),
+            instance_id=np.array([STROLLER], dtype=object),
+        )
+    }
+    assert ctx.own_detections(17, MUM) == (0,)  # m1 lies 0.1 m from the stroller, 0.76 m from the adult
+    beside = ctx.untracked_nearer(17, np.array([0.75, 0.1]), 0.76)
+    assert beside[:2] == (STROLLER, "human.pedestrian.stroller")
+    assert ctx.untracked_nearer(17, np.array([0.1, 0.0]), 0.1) is None
+    out = FalseOutput(121, None, (0.75, 0.1), None, (MUM, 0.76, None), None, 79, None, None, beside_untracked=beside)
+    f = finding(
+        FailureKind.FALSE_TRACK,
+        class_name="pedestrian",
+        gt_id=None,
+        track_ids=(121,),
+        frame=17,
+        false_output=out,
+        blame=(Blame(Rule.TWO_TRACKS, (17,)),),
+    )
+    (line, *_) = why_lines(f)
+    assert (
+        "two tracks on one object; the track's box lay nearer human.pedestrian.stroller 5b2c3d (0.1 m away), a "
+        "category the evaluation does not track"
+    ) in line
+    assert "two pedestrian detections" not in line
