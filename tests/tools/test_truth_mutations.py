@@ -1965,3 +1965,26 @@ def test_a_box_on_an_untracked_category_or_an_untracked_detection_name_left_unsa
     said = ", but a construction_vehicle box (score 0.45) 0.3 m away: the detector gave it a class no tracker takes"
     assert kinds(f"{missed}{said}") == []
     assert kinds(f"{missed}{said.replace('0.45', '0.55')}") == ["misleading"]
+
+
+def test_a_strollers_pedestrian_box_counted_as_its_pushers_second_is_caught() -> None:
+    # audit truth52, world8 scene-0103 megvii gnn false_track:16: "the detector gave it two pedestrian detections
+    # within 2 m (m17, m18)" of an adult, where m18 lay on the (untracked) stroller it pushed
+    from tools.truth.scene import Annotation, Detection
+
+    mum, stroller = "57377a" + "0" * 26, "5b2c3d" + "0" * 26
+    objects = [{mum: Annotation("pedestrian", (0.0, 0.0), 40)}] * 4
+    others = [{stroller: Annotation("human.pedestrian.stroller", (0.8, 0.0), 25)}] * 4
+    dets = [[Detection("pedestrian", 0.64, (0.1, 0.0)), Detection("pedestrian", 0.6, (0.75, 0.1))]] * 4
+    scene = SceneTruth(dets, objects, None, None, others)
+    ev = _eval()
+    ev.boxes[3] = [("121", "pedestrian", (0.75, 0.1))]
+    false = Context("pedestrian", 3, None, kind="false_track", track=121)
+    two = (
+        "pedestrian GT 57377a lies 0.8 m away and the evaluation matched it to another track: two tracks on one object"
+    )
+    found = check_text(
+        f"{two}; the detector gave it two pedestrian detections within 2 m (m0, m1)", false, None, ev, scene=scene
+    ).found
+    assert [c.kind for c in found] == ["detector"]
+    assert check_text(two, false, None, ev, scene=scene).found == []

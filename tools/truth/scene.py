@@ -162,6 +162,16 @@ class SceneTruth:
             f"{a.class_name} {k[:6]}" for k, a in here.items() if math.dist(a.xy_m, xy_m) < NEAR_M or a.contains(xy_m)
         ]
 
+    def untracked_owner(self, frame: int, m: int, xy_m: tuple[float, float]) -> str | None:
+        """The annotation of an untracked category ("category id") detection ``m`` at ``frame`` lies nearer than
+        the object at ``xy_m``, else None (a stroller's box beside its pusher is the stroller's; audit truth52)."""
+        here = self.others[frame] if self.others is not None and frame < len(self.others) else {}
+        d = self.detections[frame][m].xy_m
+        best = min(here.items(), key=lambda kv: math.dist(kv[1].xy_m, d), default=None)
+        if best is None or math.dist(best[1].xy_m, d) >= math.dist(xy_m, d) - 1e-6:
+            return None
+        return f"{best[1].class_name} {best[0][:6]}"
+
     def owner(self, frame: int, m: int, xy_m: tuple[float, float]) -> tuple[str, float] | None:
         """The annotated object (id, distance m) nearest detection ``m`` at ``frame`` when it lies nearer the
         detection than the object at ``xy_m`` does, else None (the detection is that object's)."""
