@@ -551,8 +551,13 @@ class _Context:
         if path is None:
             return None
         tokens = tuple(str(k.sample_token) for k in self.scene.keyframes)
-        token = str(self.scene.keyframes[frame].sample_token)
-        return untracked_name_near(untracked_detections(path, tokens), token, xy)
+        kf = self.scene.keyframes[frame]
+        centres = [kf.gt.translation_m[:, :2]] if len(kf.gt) else []
+        if (others := self.untracked.get(str(kf.sample_token))) is not None and len(others):
+            centres.append(others.translation_m[:, :2])
+        around = np.concatenate(centres) if centres else np.zeros((0, 2))
+        around = around[np.hypot(*(around - xy).T) > 1e-6]  # the object itself
+        return untracked_name_near(untracked_detections(path, tokens), str(kf.sample_token), xy, around)
 
     def part_at(self, frame: int, xy: np.ndarray) -> tuple[str, str, float] | None:
         """``part_of`` at ``frame``, else the annotation of an untracked category the point lies on (its class is

@@ -101,15 +101,23 @@ MB; its miss clauses stay as they were)."""
 
 
 def untracked_name_near(
-    boxes: Mapping[str, tuple[tuple[str, float, float, float], ...]], token: str, xy_m: np.ndarray
+    boxes: Mapping[str, tuple[tuple[str, float, float, float], ...]],
+    token: str,
+    xy_m: np.ndarray,
+    annotated: np.ndarray | None = None,
 ) -> tuple[str, float, float] | None:
-    """The nearest box of an untracked detection name within ``NEAR_M`` of ``xy_m`` in sample ``token``: (name,
-    score, distance m); None: none."""
+    """The nearest box of an untracked detection name within ``NEAR_M`` of ``xy_m`` in sample ``token`` that lies
+    nearer it than any other annotated object (``annotated``: (N, 2) centres of the frame's other annotations,
+    tracked or not; a barrier box on an annotated barrier beside a worker is the barrier's, dev set scene-0103):
+    (name, score, distance m); None: none."""
     best = None
     for name, score, x, y in boxes.get(token, ()):
         d = float(np.hypot(x - float(xy_m[0]), y - float(xy_m[1])))
-        if d < NEAR_M and (best is None or d < best[2]):
-            best = (name, score, d)
+        if d >= NEAR_M or (best is not None and d >= best[2]):
+            continue
+        if annotated is not None and len(annotated) and np.hypot(*(annotated - (x, y)).T).min() < d - 1e-6:
+            continue
+        best = (name, score, d)
     return best
 
 

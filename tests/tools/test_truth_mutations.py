@@ -1964,7 +1964,11 @@ def test_a_box_on_an_untracked_category_or_an_untracked_detection_name_left_unsa
     assert kinds(f"{missed}: the detector missed it") == ["misleading"]
     said = ", but a construction_vehicle box (score 0.45) 0.3 m away: the detector gave it a class no tracker takes"
     assert kinds(f"{missed}{said}") == []
-    assert kinds(f"{missed}{said.replace('0.45', '0.55')}") == ["misleading"]
+    assert kinds(f"{missed}{said.replace('0.45', '0.55')}") == ["detector"]
+    # the box lies on an annotated barrier (dev set scene-0103: a barrier box beside a construction worker)
+    scene.others = [{**others[0], "e499f1" + "0" * 26: Annotation("movable_object.barrier", (0.4, 0.0), 9)}] * 4
+    assert kinds(f"{missed}: the detector missed it") == []
+    assert kinds(f"{missed}{said}") == ["detector"]
 
 
 def test_a_strollers_pedestrian_box_counted_as_its_pushers_second_is_caught() -> None:

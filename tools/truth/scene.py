@@ -154,6 +154,22 @@ class SceneTruth:
         boxes = self.untracked[frame] if self.untracked is not None and frame < len(self.untracked) else []
         return [f"{d.class_name} {d.score:.2f}" for d in boxes if math.dist(d.xy_m, xy_m) < NEAR_M]
 
+    def untracked_own(self, frame: int, gt_id: str) -> list[str]:
+        """``untracked_near`` object ``gt_id`` at ``frame`` that lie nearer it than any other annotation, tracked or
+        not (a barrier box on an annotated barrier beside a worker is the barrier's; audit truth52)."""
+        a = self.objects[frame].get(gt_id) if frame < len(self.objects) else None
+        boxes = self.untracked[frame] if self.untracked is not None and frame < len(self.untracked) else []
+        if a is None:
+            return []
+        others = [o.xy_m for k, o in self.objects[frame].items() if k != gt_id]
+        others += [o.xy_m for o in (self.others[frame].values() if self.others and frame < len(self.others) else [])]
+        return [
+            f"{d.class_name} {d.score:.2f}"
+            for d in boxes
+            if math.dist(d.xy_m, a.xy_m) < NEAR_M
+            and all(math.dist(o, d.xy_m) >= math.dist(a.xy_m, d.xy_m) - 1e-6 for o in others)
+        ]
+
     def untracked_on(self, frame: int, xy_m: tuple[float, float]) -> list[str]:
         """The annotations of untracked categories within ``NEAR_M`` of ``xy_m`` at ``frame``, or whose box contains
         it: "category id" (the id's first 6 characters)."""

@@ -122,6 +122,12 @@ def test_a_car_seen_only_as_a_construction_vehicle_is_not_said_to_be_missed(tmp_
     near = untracked_name_near(boxes, "s28", np.array([10.0, 0.0]))
     assert near[:2] == ("construction_vehicle", 0.45) and near[2] == pytest.approx(0.3)
     assert untracked_name_near(boxes, "s28", np.array([0.0, 0.0])) is None
+    # dev set scene-0103 centerpoint: a barrier box 1.9 m from a construction worker lay 0.2 m from an annotated
+    # barrier: the barrier's box, not the worker seen as a barrier
+    assert untracked_name_near(boxes, "s28", np.array([10.0, 0.0]), np.array([[10.4, 0.1], [50.0, 0.0]])) is None
+    assert (
+        untracked_name_near(boxes, "s28", np.array([10.0, 0.0]), np.array([[12.0, 0.0]]))[0] == "construction_vehicle"
+    )
     assert untracked_detections(None, ("s28",)) == {}
     s = Sighting(28, 120, None, None, None, None, (), untracked_name=near)
     miss = finding(FailureKind.MISS, class_name="car", gt_id="812dba" + "0" * 26, frame=28, sightings=(s,))
@@ -187,3 +193,32 @@ def test_a_pedestrian_box_on_a_stroller_is_not_a_second_box_of_its_pusher() -> N
         "category the evaluation does not track"
     ) in line
     assert "two pedestrian detections" not in line
+
+
+def test_a_barrier_box_on_an_annotated_barrier_beside_a_worker_is_the_barriers(tmp_path) -> None:
+    # dev set scene-0103 centerpoint jpda miss:69: a barrier box 1.9 m from construction worker 824b75 lay 0.2 m
+    # from annotated barrier e499f1; only a box nearer the worker than any other annotation is the worker's
+    import json
+
+    worker = "824b75" + "0" * 26
+    gt = Table(instance_id=np.array([worker]), class_name=np.array(["pedestrian"]), translation_m=np.zeros((1, 3)))
+    path = tmp_path / "dets.json"
+    box = {"translation": [1.9, 0.0, 1.0], "size": [2, 0.5, 1], "rotation": [1, 0, 0, 0], "velocity": [0, 0]}
+    path.write_text(json.dumps({"results": {"s0": [dict(box, detection_name="barrier", detection_score=0.5)]}}))
+    ctx = one_frame_context(0, gt, Table(translation_m=np.zeros((0, 3)), class_name=np.array([])), "pedestrian")
+    ctx.scene = SimpleNamespace(keyframes=[SimpleNamespace(gt=gt, sample_token="s0")])
+    ctx.evidence = SimpleNamespace(detections_path=path)
+    near = ctx.untracked_name(0, np.zeros(2))
+    assert near is not None and near[:2] == ("barrier", 0.5)  # no annotation beside it: the worker's box
+    ctx.untracked = {
+        "s0": Boxes(
+            translation_m=np.array([[2.1, 0.0, 0.5]]),
+            size_wlh_m=np.array([[0.5, 2.5, 1.0]]),
+            quat_wxyz=np.array([[1.0, 0, 0, 0]]),
+            velocity_mps=np.zeros((1, 2)),
+            score=np.ones(1),
+            class_name=np.array(["movable_object.barrier"], dtype=object),
+            instance_id=np.array(["e499f1" + "0" * 26], dtype=object),
+        )
+    }
+    assert ctx.untracked_name(0, np.zeros(2)) is None
