@@ -1992,3 +1992,26 @@ def test_a_strollers_pedestrian_box_counted_as_its_pushers_second_is_caught() ->
     ).found
     assert [c.kind for c in found] == ["detector"]
     assert check_text(two, false, None, ev, scene=scene).found == []
+
+
+def test_a_thiefs_start_on_an_untracked_object_is_told_as_that_objects_box() -> None:
+    # audit truth52, world8: a track started by a car box on an ambulance is "a detection of
+    # vehicle.emergency.ambulance 7b72e3 (...)", not "a detection of no object"
+    from gnnpmb.events import Born
+    from tools.truth.scene import Annotation, Detection
+
+    car, amb = "26e63e" + "0" * 26, "7b72e3" + "0" * 26
+    objects = [{car: Annotation("car", (0.0, 0.0), 60)}] * 4
+    others = [{amb: Annotation("vehicle.emergency.ambulance", (20.0, 0.0), 80, 0, (2.2, 6.0, 0.0))}] * 4
+    scene = SceneTruth([[Detection("car", 0.61, (20.2, 0.0))]] * 4, objects, None, None, others)
+    ctx = Context("car", 3, car, kind="id_switch")
+
+    def kinds(text: str) -> list[str]:
+        raw = _raw_with(Born("car", np.array([42]), np.array([0]), np.zeros((1, 4)), np.ones(1)))
+        return [c.kind for c in check_text(text, ctx, raw, _eval(), scene=scene).found]
+
+    start = "track 42 had been started at frame 3 by m0"
+    named = ", a detection of vehicle.emergency.ambulance 7b72e3 (0.2 m away), a category the evaluation does not track"
+    assert kinds(f"{start}{named}") == []
+    assert kinds(f"{start}, a detection of no object (none of a tracked class within 2 m)") == ["misleading"]
+    assert kinds(f"{start}{named.replace('7b72e3', '7b72e4')}") == ["detector"]

@@ -380,7 +380,7 @@ LEAD = re.compile(r"(then|the deciding choice was earlier), frame (\d+): (?:clos
 run up to the failure's frame), "earlier" as before the failure's frame."""
 NO_OBJECT = re.compile(
     r"(?:track \d+ had been started at frame (\d+) by m(\d+)|\bm(\d+) at frame (\d+) was)"
-    r"(,? a detection of (no object|part of \w+ GT (\w+)))?"
+    r"(,? a detection of (no object|part of \w+ GT (\w+)|(\w+(?:\.\w+)+ \w{6}) \())?"
 )
 """A thief's starting detection, or a deciding detection said of no object: of no object exactly when no annotation
 of a tracked class lies within 2 m of it (audit truth49, world5: a false bus that took a real bus's ID)."""
@@ -408,7 +408,7 @@ def _check_lead_and_no_object(
         said[(x, meas)] = said.get((x, meas), False) or m[5] is not None
         between = text.startswith(" instead of", m.end())  # a track between the two (``_where_from``): not the thief
         if (m[1] is not None and not between) or m[5] is not None:
-            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad, m[7])
+            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad, m[7], m[8])
     for x, meas, m in deciding:
         if (x, meas) not in said:
             _no_object(x, meas, False, m[0], scene, out, bad)
@@ -426,12 +426,13 @@ def _check_lead_and_no_object(
 
 
 def _of_nothing(scene: SceneTruth, x: int, meas: int) -> bool:
-    """Detection ``meas`` of frame ``x`` lies ``NEAR_M`` or more from every annotated object and inside none's box."""
+    """Detection ``meas`` of frame ``x`` lies ``NEAR_M`` or more from every annotated object and inside none's box
+    (an annotation of an untracked category counts: a box on an ambulance is the ambulance's)."""
     if x >= len(scene.detections) or meas >= len(scene.detections[x]):
         return False
     xy = scene.detections[x][meas].xy_m
     far = all(math.dist(a.xy_m, xy) >= NEAR_M for a in scene.objects[x].values())
-    return far and not scene.inside(x, xy)
+    return far and not scene.inside(x, xy) and not scene.untracked_on(x, xy)  # truth52: an ambulance's box
 
 
 USED_NOTHING = re.compile(
@@ -463,9 +464,18 @@ def _check_used_no_object(text: str, scene: SceneTruth, out: Tally, bad) -> None
 
 
 def _no_object(
-    x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, out: Tally, bad, part: str | None = None
+    x: int,
+    meas: int,
+    said: bool,
+    sentence: str,
+    scene: SceneTruth,
+    out: Tally,
+    bad,
+    part: str | None = None,
+    untracked: str | None = None,
 ) -> None:
-    """``said``: "a detection of no object" or of ``part`` of an object (its short id) was said of ``meas``."""
+    """``said``: "a detection of no object", of ``part`` of an object (its short id) or of an ``untracked``
+    category's annotation ("category id") was said of ``meas``."""
     if x >= len(scene.detections) or meas >= len(scene.detections[x]):
         return
     out.checked["detector"] += 1
@@ -476,7 +486,7 @@ def _no_object(
     elif not said and near >= NEAR_M:
         bad("misleading", sentence, f"m{meas} at frame {x} lies {near:.2f} m from every annotated object: unsaid")
     elif said:
-        tail = f"part of GT {part}" if part is not None else ""
+        tail = f"part of GT {part}" if part is not None else f"{untracked} (" if untracked is not None else ""
         _part_of(tail, xy, x, sentence, scene, out, bad)
 
 
