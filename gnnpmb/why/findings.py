@@ -289,8 +289,8 @@ class LostTrack:
 class Origin:
     """Where the track that took the object came from: born at ``frame`` from detection ``meas`` (frame -1: before
     the window), and the frames it was a false track before the failure (identity theft); victim_held: at each of those
-    frames the evaluation matched the object (no miss of it) and the victim was no false track, so the victim held
-    it; of_no_object: no annotated object of a tracked class lay within ``NEAR_M`` of that detection at ``frame``
+    frames the evaluation matched the object to the victim (no miss of it, the victim no false track), so the victim
+    held it; of_no_object: no annotated object of a tracked class lay within ``NEAR_M`` of that detection at ``frame``
     (a false detection started the track)."""
 
     track_id: int

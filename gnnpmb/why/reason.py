@@ -512,16 +512,25 @@ class _Context:
             false = ()
         gt_id = self.failure.gt_ids[0] if self.failure.gt_ids else None
         victim = self.failure.track_ids[1] if len(self.failure.track_ids) > 1 else None
-        held = bool(false) and all(
-            gt_id is not None
-            and victim is not None
-            and not self.missed_at(gt_id, x)
-            and self.evaluated_at(gt_id, x)
-            and not self.false_at(self.report, x, int(victim))
-            for x in false
-        )
+        held = self.victim_held(gt_id, victim, false)
         no_object, part = self.no_object_part(born[0], born[1])
         return Origin(track_id, born[0], born[1], false, held, no_object, part)
+
+    def victim_held(self, gt_id: str | None, victim: str | None, frames: tuple[int, ...]) -> bool:
+        """Whether at each of ``frames`` (a thief's false frames) the evaluation matched object ``gt_id`` to track
+        ``victim``: it scored and did not miss the object, and the victim's match there was the object (audit
+        truth52, world8 scene-0655 cphd identity_theft:1: the object was track 27's at frame 16 and the victim's,
+        track 55's, only from frame 17, yet "the evaluation still gave GT 1defa4 to track 55" at frames 16-18)."""
+        if not frames or gt_id is None or victim is None:
+            return False
+        ev = self.report.track_evals.get(str(victim))
+        return ev is not None and all(
+            not self.missed_at(gt_id, x)
+            and self.evaluated_at(gt_id, x)
+            and not self.false_at(self.report, x, int(victim))
+            and ev.matched_at(x) == gt_id
+            for x in frames
+        )
 
     def _meas_xy(self, frame: int, meas: int) -> np.ndarray | None:
         """(2,) the centre of detection ``meas`` of ``frame``; None when there is no such detection or frame."""
