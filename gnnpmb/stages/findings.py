@@ -5,6 +5,7 @@ a selection of one failure (``gnnpmb.focus``); where a full recording opens; and
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gnnpmb.errors import GnnpmbError
@@ -27,7 +28,8 @@ def evidence_of(inputs: Inputs, report: FailureReport, run: Run) -> Evidence:
     if run.facts is None:
         raise ValueError(f"run {run.name} was not recorded: its failures cannot be explained")
     foreign = inputs.foreign.get(run.name)
-    return Evidence(report, run.facts, run.tracking, foreign.boxes_on if foreign is not None else {})
+    path = Path(inputs.source.path) if inputs.source.kind == "file" and inputs.source.path else None
+    return Evidence(report, run.facts, run.tracking, foreign.boxes_on if foreign is not None else {}, path)
 
 
 def all_evidence(inputs: Inputs, runs: Sequence[Run], reports: Mapping[str, FailureReport]) -> dict[str, Evidence]:

@@ -208,6 +208,10 @@ class Sighting:
     neighbours_own: Near | None = None
     """The nearest kept detection of its class within ``NEAR_M`` that lies nearer another annotated object: that
     one's, not this one's (``nearest_own`` never is such a detection; two pedestrians given one box)."""
+    untracked_name: tuple[str, float, float] | None = None
+    """With no detection of a tracked class within ``NEAR_M`` nor inside its box: the nearest box of a detection
+    name the evaluation does not track (``construction_vehicle``, ``traffic_cone``, ``barrier``) within ``NEAR_M``:
+    name, score, m (audit truth52, world8: a car detected only as a construction vehicle was "missed")."""
 
     @property
     def lidar_points(self) -> int:
@@ -285,8 +289,8 @@ class LostTrack:
 class Origin:
     """Where the track that took the object came from: born at ``frame`` from detection ``meas`` (frame -1: before
     the window), and the frames it was a false track before the failure (identity theft); victim_held: at each of those
-    frames the evaluation matched the object (no miss of it) and the victim was no false track, so the victim held
-    it; of_no_object: no annotated object of a tracked class lay within ``NEAR_M`` of that detection at ``frame``
+    frames the evaluation matched the object to the victim (no miss of it, the victim no false track), so the victim
+    held it; of_no_object: no annotated object of a tracked class lay within ``NEAR_M`` of that detection at ``frame``
     (a false detection started the track)."""
 
     track_id: int
@@ -403,6 +407,9 @@ class FalseOutput:
     frame, how the evaluation saw it now), when it is annotated here, less than ``OFF_NEAR_M`` away (dev set
     scene-0916 centerpoint false_track:14: a track that followed a bicycle with no sensor points ran 2.1 m past
     it, told as "a box where no tracked object was")."""
+    beside_untracked: tuple[str, str, float] | None = None
+    """Near an object of its class: the annotation of an untracked category (id, category, m) the box lies nearer
+    than that object (a stroller beside its pusher: the track was on the stroller; audit truth52, world8)."""
 
 
 @dataclass(frozen=True, slots=True)

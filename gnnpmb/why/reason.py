@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
 
 import numpy as np
 
@@ -50,6 +52,7 @@ from gnnpmb.why.findings import (
     Sighting,
     covering,
 )
+from gnnpmb.why.untracked import untracked_by_token, untracked_detections, untracked_name_near, untracked_on
 
 _ON_IT_RULES = (Rule.TRACK_DROPPED, Rule.NOT_COUNTED, Rule.COVERED_TWO)
 """The tests about tracks output on an object the evaluation still missed (``_Context.blame_uncovered``)."""
@@ -73,6 +76,8 @@ class Evidence:
     facts: TrackerFacts
     run: TrackingRun
     boxes_on: Mapping[tuple[int, int], BoxOn] = field(default_factory=dict)
+    detections_path: Path | None = None
+    """The detection file the run read (None: simulated): its boxes of untracked names are read from it."""
 
     @property
     def tracker(self) -> str:
@@ -102,6 +107,9 @@ def explain_failure(
 class _Context:
     """The failure, its sources and the frames looked at, with the lookups every part of a finding shares."""
 
+    untracked: Mapping[str, Boxes] = MappingProxyType({})
+    """Per sample token, the annotations of categories the evaluation does not track (``gnnpmb.why.untracked``)."""
+
     def __init__(
         self,
         evidence: Evidence,
@@ -119,6 +127,7 @@ class _Context:
         self.class_name = class_name
         self.window = range(max(min(self.frames), first_frame), frame + 1)
         self.threshold = self.report.threshold_of(self.class_name)
+        self.untracked: Mapping[str, Boxes] = untracked_by_token(scene)
 
     # The object.
     def gt_xy(self, gt_id: str, frame: int) -> np.ndarray | None:
@@ -248,6 +257,7 @@ class _Context:
                     box,
                     self.off_near(f, gt_id) if any_near is None and box is None else None,
                     neighbours_own=self.near(f, xy, own=True, neighbours=True),
+                    untracked_name=self.untracked_name(f, xy) if any_near is None and box is None else None,
                 )
             )
         return tuple(out)
@@ -502,16 +512,25 @@ class _Context:
             false = ()
         gt_id = self.failure.gt_ids[0] if self.failure.gt_ids else None
         victim = self.failure.track_ids[1] if len(self.failure.track_ids) > 1 else None
-        held = bool(false) and all(
-            gt_id is not None
-            and victim is not None
-            and not self.missed_at(gt_id, x)
-            and self.evaluated_at(gt_id, x)
-            and not self.false_at(self.report, x, int(victim))
-            for x in false
-        )
+        held = self.victim_held(gt_id, victim, false)
         no_object, part = self.no_object_part(born[0], born[1])
         return Origin(track_id, born[0], born[1], false, held, no_object, part)
+
+    def victim_held(self, gt_id: str | None, victim: str | None, frames: tuple[int, ...]) -> bool:
+        """Whether at each of ``frames`` (a thief's false frames) the evaluation matched object ``gt_id`` to track
+        ``victim``: it scored and did not miss the object, and the victim's match there was the object (audit
+        truth52, world8 scene-0655 cphd identity_theft:1: the object was track 27's at frame 16 and the victim's,
+        track 55's, only from frame 17, yet "the evaluation still gave GT 1defa4 to track 55" at frames 16-18)."""
+        if not frames or gt_id is None or victim is None:
+            return False
+        ev = self.report.track_evals.get(str(victim))
+        return ev is not None and all(
+            not self.missed_at(gt_id, x)
+            and self.evaluated_at(gt_id, x)
+            and not self.false_at(self.report, x, int(victim))
+            and ev.matched_at(x) == gt_id
+            for x in frames
+        )
 
     def _meas_xy(self, frame: int, meas: int) -> np.ndarray | None:
         """(2,) the centre of detection ``meas`` of ``frame``; None when there is no such detection or frame."""
@@ -532,7 +551,28 @@ class _Context:
     def meas_part_of(self, frame: int, meas: int) -> tuple[str, str, float] | None:
         """``part_of`` for detection ``meas`` of ``frame`` (None when unknown)."""
         xy = self._meas_xy(frame, meas)
-        return None if xy is None else part_of(self.scene.keyframes[frame].gt, xy)
+        return None if xy is None else self.part_at(frame, xy)
+
+    def untracked_name(self, frame: int, xy: np.ndarray) -> tuple[str, float, float] | None:
+        """The nearest box of an untracked detection name within ``NEAR_M`` of ``xy`` at ``frame`` in the run's
+        detection file (``gnnpmb.why.untracked``; None: none, or no file)."""
+        path = getattr(self.evidence, "detections_path", None)
+        if path is None:
+            return None
+        tokens = tuple(str(k.sample_token) for k in self.scene.keyframes)
+        kf = self.scene.keyframes[frame]
+        centres = [kf.gt.translation_m[:, :2]] if len(kf.gt) else []
+        if (others := self.untracked.get(str(kf.sample_token))) is not None and len(others):
+            centres.append(others.translation_m[:, :2])
+        around = np.concatenate(centres) if centres else np.zeros((0, 2))
+        around = around[np.hypot(*(around - xy).T) > 1e-6]  # the object itself
+        return untracked_name_near(untracked_detections(path, tokens), str(kf.sample_token), xy, around)
+
+    def part_at(self, frame: int, xy: np.ndarray) -> tuple[str, str, float] | None:
+        """``part_of`` at ``frame``, else the annotation of an untracked category the point lies on (its class is
+        the category; audit truth52, world8: car boxes on an ambulance were "detections of no tracked object")."""
+        kf = self.scene.keyframes[frame]
+        return part_of(kf.gt, xy) or untracked_on(self.untracked.get(getattr(kf, "sample_token", "")), xy)
 
     def no_object_part(self, frame: int, meas: int) -> tuple[bool, tuple[str, str, float] | None]:
         """(``of_no_object``, and for such a detection ``meas_part_of``): whether it lay near no annotated object,
@@ -590,7 +630,19 @@ class _Context:
         ok = (d < NEAR_M) & fr.detections.kept & (boxes.class_name == self.class_name)
         idx = np.flatnonzero(ok)
         other = self.nearer_object(frame, boxes.translation_m[idx, :2], d[idx])
-        return tuple(int(m) for m, o in zip(idx.tolist(), other, strict=True) if o is None)
+        return tuple(
+            int(m)
+            for m, o in zip(idx.tolist(), other, strict=True)
+            if o is None and self.untracked_nearer(frame, boxes.translation_m[m, :2], float(d[m])) is None
+        )
+
+    def untracked_nearer(self, frame: int, xy: np.ndarray, own_m: float) -> tuple[str, str, float] | None:
+        """The annotation of an untracked category nearest ``xy`` at ``frame`` when it lies nearer than ``own_m``
+        (id, category, m), else None: a pedestrian box on a stroller beside its pusher is the stroller's (audit
+        truth52, world8: "the detector gave it two pedestrian detections" counted it as the pusher's)."""
+        kf = self.scene.keyframes[frame]
+        hit = untracked_on(self.untracked.get(getattr(kf, "sample_token", "")), xy)
+        return hit if hit is not None and hit[2] < own_m - 1e-6 else None
 
     def off_near(self, frame: int, gt_id: str) -> Near | None:
         """The nearest detection of the class within ``OFF_NEAR_M`` of object ``gt_id`` at ``frame`` (kept or not)
@@ -831,10 +883,11 @@ class _Context:
             self.threshold,
             nearest_own is not None and self.missed_at(nearest_own[0], self.f),
             step.use if (step := self.facts.steps(t, self.class_name).get(self.f)) is not None else None,
-            part_of(gt, xy) if nearest_any is None else None,
+            self.part_at(self.f, xy) if nearest_any is None else None,
             twins if len(twins) >= 2 else (),
             came,
             drifted,
+            self.untracked_nearer(self.f, xy, nearest_own[1]) if nearest_own is not None else None,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
 

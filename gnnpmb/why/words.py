@@ -31,6 +31,7 @@ from gnnpmb.why.findings import (
     Sighting,
     covering,
 )
+from gnnpmb.why.untracked import is_untracked, untracked_text
 
 SHOW_MIN_EXISTENCE = 0.5
 """Extracted tracks are drawn (and called shown) from this existence on: the submission may hold far less likely
@@ -1114,6 +1115,8 @@ def _false_track(f: Finding) -> list[str]:
         else:
             other = f" (track {o.matched_instead})" if o.matched_instead is not None else ""
             parts.append(f"{on} and the evaluation matched it to another track{other}: two tracks on one object")
+            if o.beside_untracked is not None:  # audit truth52 (world8): a pedestrian box on a stroller
+                parts.append(f"the track's box lay nearer {untracked_text(o.beside_untracked)}")
             if o.twins:  # audit truth50 (world6, a detector without NMS): not the tracker's doing alone
                 n = "two" if len(o.twins) == 2 else str(len(o.twins))
                 what = ", ".join(meas_name(m) for m in o.twins)
@@ -1134,8 +1137,9 @@ def _false_track(f: Finding) -> list[str]:
         )
     elif o.part_of is not None:  # audit truth50 (world6): a truck's trailer box is no "box where no object was"
         what = "the detection" if o.on is not None else "the box"
+        on_what = "" if is_untracked(o.part_of) else "part of "  # audit truth52 (world8): a car box on an ambulance
         parts.append(
-            f"no object of a tracked class lies within {NEAR_M:.0f} m, but {what} lies on part of "
+            f"no object of a tracked class lies within {NEAR_M:.0f} m, but {what} lies on {on_what}"
             f"{_part_text(o.part_of)}"
         )
     elif o.on is not None:
@@ -1296,6 +1300,13 @@ def _miss(f: Finding) -> list[str]:
             f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
             f"({inside}), but {n.class_name} {meas_name(n.meas)} (score {n.score:.2f}) lay inside its box, "
             f"{n.distance_m:.1f} m from its centre: the detector saw part of it"
+        )
+    elif s.undetected and s.nearest_any is None and s.untracked_name is not None:  # audit truth52 (world8)
+        u_name, u_score, u_m = s.untracked_name
+        parts.append(
+            f"at frame {f.frame} the detector gave no detection of a tracked class within {NEAR_M:.0f} m of {name} "
+            f"({inside}), but a {u_name} box (score {u_score:.2f}) {u_m:.1f} m away: the detector gave it a class "
+            "no tracker takes"
         )
     elif s.undetected and s.nearest_any is None and s.off is not None:  # audit truth51 (world7): a box 3-6 m off
         n = s.off
@@ -1465,7 +1476,7 @@ def _of_no_object(part: tuple[str, str, float] | None = None) -> str:
     bus's detections), or, inside an object's box (``part``), a sight of part of it (audit truth50: a truck's
     trailer box)."""
     if part is not None:
-        return f"a detection of part of {_part_text(part)}"
+        return f"a detection of {'' if is_untracked(part) else 'part of '}{_part_text(part)}"
     return f"a detection of no object (none of a tracked class within {NEAR_M:.0f} m)"
 
 
@@ -1483,6 +1494,8 @@ def _used_of_no_object(pairs: Sequence[tuple[int, int]]) -> str:
 
 def _part_text(part: tuple[str, str, float]) -> str:
     """``truck GT ecf44b (inside its box, 3.5 m from its centre, beyond the evaluation's 2 m)``."""
+    if is_untracked(part):
+        return untracked_text(part)
     gt_id, cls, d = part
     where = f"inside its box, {d:.1f} m from its centre, beyond the evaluation's {NEAR_M:.0f} m"
     return f"{cls} GT {short_id(gt_id)} ({where})"

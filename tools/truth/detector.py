@@ -107,6 +107,32 @@ def _check_in_box(said: bool, frames: list[int], short: str, sentence: str, scen
         bad("detector", sentence, "no detection lies inside its box")
 
 
+UNTRACKED_NAMED = re.compile(
+    rf", but an? (\w+) box \(score ({_F})\) ({_F}) m away: the detector gave it a class no tracker takes"
+)
+"""A miss whose only box within 2 m has a name no tracker takes (audit truth52, world8: a car seen only as a
+construction vehicle was "missed")."""
+
+
+def _untracked_unsaid(after: str, x: int, short: str, scene: SceneTruth, out) -> tuple[str, str] | None:
+    """(kind, truth) where the file's boxes of an untracked name that are object ``short``'s at frame ``x`` (within
+    2 m, nearer it than any other annotation) go unnamed in ``after`` (the text after "no detection of a tracked
+    class within 2 m of ..."), or where the box it names is none of them; None: the text holds. A detection inside
+    its box is told first."""
+    hit = scene.object_of(x, short)
+    if hit is None or scene.in_box(x, hit[0]) or not after.startswith((": the detector missed it", ", but")):
+        return None
+    own, said = scene.untracked_own(x, hit[0]), UNTRACKED_NAMED.match(after)
+    if not own and said is None:
+        return None
+    out.checked["misleading"] += 1
+    if said is None:
+        return "misleading", f"the file's untracked boxes of it, unsaid: {own}"
+    if f"{said[1]} {said[2]}" not in own:
+        return "detector", f"{said[1]} {said[2]} is not its own untracked box (its own: {own})"
+    return None
+
+
 OFF_NEAR_M = 6.5
 """A miss with a detection of its class this near (beyond ``NEAR_M``), nearer it than any other annotated object,
 must name it (audit truth51, world7: a car's box moved 3-6 m for one frame was told as "the detector missed it")."""
@@ -214,6 +240,8 @@ def check_detector(
             continue
         elif not m[2] and scene.untracked_near(x, ann.xy_m):
             bad("detector", m[0], f"the file has {scene.untracked_near(x, ann.xy_m)} within {NEAR_M} m (untracked)")
+        elif (problem := _untracked_unsaid(text[m.end() :], x, m[4], scene, out)) is not None:
+            bad(problem[0], m[0], problem[1])
         else:
             _check_in_box(_says_in_box(text[m.end() :]), [x], m[4], m[0], scene, out, bad)
             _check_off(text[m.end() :], x, m[3], m[4], m[0], scene, out, bad)

@@ -91,6 +91,9 @@ class SceneTruth:
     untracked: list[list[Detection]] | None = None
     """Per keyframe, the file's boxes of a class no tracker follows (barrier, traffic cone): no ``mN`` names them,
     but "no detection within 2 m" said with no class is false beside one."""
+    others: list[dict[str, Annotation]] | None = None
+    """Per keyframe, the annotations of categories the devkit does not track (ambulance, stroller, barrier ...),
+    their class the category: a box on one is no "detection of no tracked object" left unnamed (audit truth52)."""
 
     @classmethod
     def read(cls, nusc, scene_name: str, detection_file: Path) -> SceneTruth:
@@ -98,7 +101,7 @@ class SceneTruth:
 
         results = json.loads(Path(detection_file).read_text(encoding="utf-8"))["results"]
         scene = next(s for s in nusc.scene if s["name"] == scene_name)
-        detections, objects, ego, untracked, token = [], [], [], [], scene["first_sample_token"]
+        detections, objects, ego, untracked, others, token = [], [], [], [], [], scene["first_sample_token"]
         while token:
             sample = nusc.get("sample", token)
             pose = nusc.get("ego_pose", nusc.get("sample_data", sample["data"]["LIDAR_TOP"])["ego_pose_token"])
@@ -115,18 +118,20 @@ class SceneTruth:
             detections.append([d for d in boxes if d.class_name in TRACKING])
             untracked.append([d for d in boxes if d.class_name not in TRACKING])
             here: dict[str, Annotation] = {}
+            elsewhere: dict[str, Annotation] = {}
             for a in (nusc.get("sample_annotation", t) for t in sample["anns"]):
                 name = category_to_tracking_name(a["category_name"])
-                if name is not None:
-                    points = int(a["num_lidar_pts"]) + int(a["num_radar_pts"])
-                    xy = tuple(map(float, a["translation"][:2]))
-                    qw, qx, qy, qz = a["rotation"]
-                    yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
-                    foot = (float(a["size"][0]), float(a["size"][1]), yaw)
-                    here[a["instance_token"]] = Annotation(name, xy, points, int(a["num_radar_pts"]), foot)
+                points = int(a["num_lidar_pts"]) + int(a["num_radar_pts"])
+                xy = tuple(map(float, a["translation"][:2]))
+                qw, qx, qy, qz = a["rotation"]
+                yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+                foot = (float(a["size"][0]), float(a["size"][1]), yaw)
+                into, label = (here, name) if name is not None else (elsewhere, a["category_name"])
+                into[a["instance_token"]] = Annotation(label, xy, points, int(a["num_radar_pts"]), foot)
             objects.append(here)
+            others.append(elsewhere)
             token = sample["next"]
-        return cls(detections, objects, ego, untracked)
+        return cls(detections, objects, ego, untracked, others)
 
     def object_of(self, frame: int, short_id: str) -> tuple[str, Annotation] | None:
         """The annotation at ``frame`` whose instance token starts with ``short_id`` (as the text prints it)."""
@@ -148,6 +153,40 @@ class SceneTruth:
         """The file's boxes of an untracked class within ``NEAR_M`` of ``xy_m`` at ``frame``: "class score"."""
         boxes = self.untracked[frame] if self.untracked is not None and frame < len(self.untracked) else []
         return [f"{d.class_name} {d.score:.2f}" for d in boxes if math.dist(d.xy_m, xy_m) < NEAR_M]
+
+    def untracked_own(self, frame: int, gt_id: str) -> list[str]:
+        """``untracked_near`` object ``gt_id`` at ``frame`` that lie nearer it than any other annotation, tracked or
+        not (a barrier box on an annotated barrier beside a worker is the barrier's; audit truth52)."""
+        a = self.objects[frame].get(gt_id) if frame < len(self.objects) else None
+        boxes = self.untracked[frame] if self.untracked is not None and frame < len(self.untracked) else []
+        if a is None:
+            return []
+        others = [o.xy_m for k, o in self.objects[frame].items() if k != gt_id]
+        others += [o.xy_m for o in (self.others[frame].values() if self.others and frame < len(self.others) else [])]
+        return [
+            f"{d.class_name} {d.score:.2f}"
+            for d in boxes
+            if math.dist(d.xy_m, a.xy_m) < NEAR_M
+            and all(math.dist(o, d.xy_m) >= math.dist(a.xy_m, d.xy_m) - 1e-6 for o in others)
+        ]
+
+    def untracked_on(self, frame: int, xy_m: tuple[float, float]) -> list[str]:
+        """The annotations of untracked categories within ``NEAR_M`` of ``xy_m`` at ``frame``, or whose box contains
+        it: "category id" (the id's first 6 characters)."""
+        here = self.others[frame] if self.others is not None and frame < len(self.others) else {}
+        return [
+            f"{a.class_name} {k[:6]}" for k, a in here.items() if math.dist(a.xy_m, xy_m) < NEAR_M or a.contains(xy_m)
+        ]
+
+    def untracked_owner(self, frame: int, m: int, xy_m: tuple[float, float]) -> str | None:
+        """The annotation of an untracked category ("category id") detection ``m`` at ``frame`` lies nearer than
+        the object at ``xy_m``, else None (a stroller's box beside its pusher is the stroller's; audit truth52)."""
+        here = self.others[frame] if self.others is not None and frame < len(self.others) else {}
+        d = self.detections[frame][m].xy_m
+        best = min(here.items(), key=lambda kv: math.dist(kv[1].xy_m, d), default=None)
+        if best is None or math.dist(best[1].xy_m, d) >= math.dist(xy_m, d) - 1e-6:
+            return None
+        return f"{best[1].class_name} {best[0][:6]}"
 
     def owner(self, frame: int, m: int, xy_m: tuple[float, float]) -> tuple[str, float] | None:
         """The annotated object (id, distance m) nearest detection ``m`` at ``frame`` when it lies nearer the

@@ -381,7 +381,7 @@ LEAD = re.compile(r"(then|the deciding choice was earlier), frame (\d+): (?:clos
 run up to the failure's frame), "earlier" as before the failure's frame."""
 NO_OBJECT = re.compile(
     r"(?:track \d+ had been started at frame (\d+) by m(\d+)|\bm(\d+) at frame (\d+) was)"
-    r"(,? a detection of (no object|part of \w+ GT (\w+)))?"
+    r"(,? a detection of (no object|part of \w+ GT (\w+)|(\w+(?:\.\w+)+ \w{6}) \())?"
 )
 """A thief's starting detection, or a deciding detection said of no object: of no object exactly when no annotation
 of a tracked class lies within 2 m of it (audit truth49, world5: a false bus that took a real bus's ID)."""
@@ -409,7 +409,7 @@ def _check_lead_and_no_object(
         said[(x, meas)] = said.get((x, meas), False) or m[5] is not None
         between = text.startswith(" instead of", m.end())  # a track between the two (``_where_from``): not the thief
         if (m[1] is not None and not between) or m[5] is not None:
-            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad, m[7])
+            _no_object(x, meas, m[5] is not None, m[0], scene, out, bad, m[7], m[8])
     for x, meas, m in deciding:
         if (x, meas) not in said:
             _no_object(x, meas, False, m[0], scene, out, bad)
@@ -427,12 +427,13 @@ def _check_lead_and_no_object(
 
 
 def _of_nothing(scene: SceneTruth, x: int, meas: int) -> bool:
-    """Detection ``meas`` of frame ``x`` lies ``NEAR_M`` or more from every annotated object and inside none's box."""
+    """Detection ``meas`` of frame ``x`` lies ``NEAR_M`` or more from every annotated object and inside none's box
+    (an annotation of an untracked category counts: a box on an ambulance is the ambulance's)."""
     if x >= len(scene.detections) or meas >= len(scene.detections[x]):
         return False
     xy = scene.detections[x][meas].xy_m
     far = all(math.dist(a.xy_m, xy) >= NEAR_M for a in scene.objects[x].values())
-    return far and not scene.inside(x, xy)
+    return far and not scene.inside(x, xy) and not scene.untracked_on(x, xy)  # truth52: an ambulance's box
 
 
 USED_NOTHING = re.compile(
@@ -464,9 +465,18 @@ def _check_used_no_object(text: str, scene: SceneTruth, out: Tally, bad) -> None
 
 
 def _no_object(
-    x: int, meas: int, said: bool, sentence: str, scene: SceneTruth, out: Tally, bad, part: str | None = None
+    x: int,
+    meas: int,
+    said: bool,
+    sentence: str,
+    scene: SceneTruth,
+    out: Tally,
+    bad,
+    part: str | None = None,
+    untracked: str | None = None,
 ) -> None:
-    """``said``: "a detection of no object" or of ``part`` of an object (its short id) was said of ``meas``."""
+    """``said``: "a detection of no object", of ``part`` of an object (its short id) or of an ``untracked``
+    category's annotation ("category id") was said of ``meas``."""
     if x >= len(scene.detections) or meas >= len(scene.detections[x]):
         return
     out.checked["detector"] += 1
@@ -477,7 +487,7 @@ def _no_object(
     elif not said and near >= NEAR_M:
         bad("misleading", sentence, f"m{meas} at frame {x} lies {near:.2f} m from every annotated object: unsaid")
     elif said:
-        tail = f"part of GT {part}" if part is not None else ""
+        tail = f"part of GT {part}" if part is not None else f"{untracked} (" if untracked is not None else ""
         _part_of(tail, xy, x, sentence, scene, out, bad)
 
 
@@ -492,6 +502,15 @@ def _part_of(tail: str, xy, frame: int, sentence: str, scene: SceneTruth, out: T
         bad("misleading", sentence, f"inside the box of {[k[:6] for k in inside]} at frame {frame}: unsaid")
     elif said is not None and not any(k.startswith(said[2]) for k in inside):
         bad("detector", sentence, f"not inside GT {said[2]}'s box at frame {frame} (inside {[k[:6] for k in inside]})")
+    if inside:
+        return
+    on = scene.untracked_on(frame, tuple(xy))  # audit truth52 (world8): a car box on an ambulance
+    named = re.match(r"(?:, but (?:the detection|the box) lies on |, a detection of )?(\w+(?:\.\w+)+ \w{6}) \(", tail)
+    out.checked["misleading"] += 1
+    if named is None and on:
+        bad("misleading", sentence, f"on {on} at frame {frame} (a category the evaluation does not track): unsaid")
+    elif named is not None and named[1] not in on:
+        bad("detector", sentence, f"not on {named[1]} at frame {frame} (on {on})")
 
 
 DRIFTED = re.compile(
@@ -572,6 +591,7 @@ def _check_twins(text: str, frame: int, scene: SceneTruth, received: set[int] | 
         out.checked["misleading"] += 1
         own = [j for j in scene.near(frame, hit[1].xy_m, m[1]) if scene.owner(frame, j, hit[1].xy_m) is None]
         own = [j for j in own if received is None or j in received]
+        own = [j for j in own if scene.untracked_owner(frame, j, hit[1].xy_m) is None]  # truth52: a stroller's
         said = [int(x) for x in re.findall(r"m(\d+)", m[3] or "")]
         if len(own) >= 2 and not said:
             bad("misleading", m[0], f"the detector gave GT {m[2]} {len(own)} {m[1]} detections of its own: unsaid")
