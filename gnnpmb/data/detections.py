@@ -45,6 +45,9 @@ DETECTION_CLASSES: tuple[str, ...] = (
     "truck",
 )
 """The ten nuScenes detection classes; all but barrier, traffic_cone and construction_vehicle are tracked."""
+UNTRACKED_NAMES: tuple[str, ...] = tuple(c for c in DETECTION_CLASSES if c not in TRACKING_CLASSES)
+"""The detection names the tracking evaluation has no class for: their boxes are kept aside for the explanations
+(a car seen only as a construction_vehicle was seen, with a class no tracker takes)."""
 
 VECTOR_FIELDS: tuple[tuple[str, int], ...] = (
     ("translation", 3),
@@ -202,6 +205,15 @@ def convert_sample(token: str, entries: Any) -> Boxes | str:
     )
 
 
+def untracked_boxes(entries: list[Any]) -> list[tuple[str, float, float, float]]:
+    """(name, score, x m, y m) of a sample's boxes of ``UNTRACKED_NAMES`` (entries ``convert_sample`` checked)."""
+    return [
+        (str(e["detection_name"]), float(e["detection_score"]), float(e["translation"][0]), float(e["translation"][1]))
+        for e in entries
+        if e["detection_name"] in UNTRACKED_NAMES
+    ]
+
+
 def _read_error(path: Path, exc: Exception) -> DataError:
     """The one line for a detection file that cannot be read as a submission."""
     if isinstance(exc, JsonStreamError):
@@ -244,7 +256,9 @@ def _index(path: Path) -> DetectionIndex:
     key = (str(resolved), st.st_ino, st.st_mtime_ns, st.st_ctime_ns, st.st_size)
     if key not in _opened:
         _opened.clear()
-        _opened[key] = open_detection_index(cache_root(), resolved, convert_sample, lambda exc: _read_error(path, exc))
+        _opened[key] = open_detection_index(
+            cache_root(), resolved, convert_sample, untracked_boxes, lambda exc: _read_error(path, exc)
+        )
     return _opened[key]
 
 
@@ -286,6 +300,20 @@ def load_detection_file(path: Path, sample_tokens: Sequence[str], scene_name: st
         _opened.clear()
         shutil.rmtree(index.store.folder, ignore_errors=True)
         return load_detection_file(path, sample_tokens, scene_name)
+
+
+def untracked_detection_boxes(path: Path, sample_tokens: Sequence[str]) -> dict[str, tuple]:
+    """Per sample token of ``sample_tokens`` with any, its boxes of ``UNTRACKED_NAMES`` in the detection file
+    ``path`` (name, score, x m, y m), from the file's index (read once per file, whatever its size)."""
+    from gnnpmb.data.index_store import IndexDamaged
+
+    index = _index(Path(path))
+    try:
+        return {t: boxes for t in sample_tokens if (boxes := index.untracked(t))}
+    except IndexDamaged:
+        _opened.clear()
+        shutil.rmtree(index.store.folder, ignore_errors=True)
+        return untracked_detection_boxes(path, sample_tokens)
 
 
 def write_detection_file(path: Path, submission: dict[str, Any]) -> None:

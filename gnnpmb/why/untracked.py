@@ -93,13 +93,6 @@ def _read(dataroot: Path, version: str, name: str, synthetic: bool) -> dict[str,
     return out
 
 
-UNTRACKED_NAMES = ("barrier", "construction_vehicle", "traffic_cone")
-"""The nuScenes detection names the tracking evaluation has no class for (the loader drops their boxes)."""
-MAX_READ_BYTES = 100_000_000
-"""Detection files larger than this are not read again for their untracked boxes (a full-split file is 300-700
-MB; its miss clauses stay as they were)."""
-
-
 def untracked_name_near(
     boxes: Mapping[str, tuple[tuple[str, float, float, float], ...]],
     token: str,
@@ -125,8 +118,8 @@ def untracked_detections(
     path: Path | None, tokens: tuple[str, ...]
 ) -> Mapping[str, tuple[tuple[str, float, float, float], ...]]:
     """Per sample token of ``tokens``, the boxes of untracked detection names in the detection file ``path``
-    (name, score, x, y); empty without a file, or for one larger than ``MAX_READ_BYTES``."""
-    if path is None or not Path(path).is_file() or Path(path).stat().st_size > MAX_READ_BYTES:
+    (name, score, x, y), from the file's index (``gnnpmb.data.detection_index``); empty without a file."""
+    if path is None or not Path(path).is_file():
         return {}
     p = Path(path)
     return _untracked_detections(p, p.stat().st_mtime_ns, tokens)
@@ -136,16 +129,6 @@ def untracked_detections(
 def _untracked_detections(
     path: Path, _mtime_ns: int, tokens: tuple[str, ...]
 ) -> dict[str, tuple[tuple[str, float, float, float], ...]]:
-    from gnnpmb.data.json_stream import iter_object
+    from gnnpmb.data.detections import untracked_detection_boxes
 
-    wanted, out = set(tokens), {}
-    with path.open("rb") as f:
-        for token, entries in iter_object(f, member="results"):
-            if token not in wanted or not isinstance(entries, list):
-                continue
-            out[token] = tuple(
-                (str(b["detection_name"]), float(b["detection_score"]), *map(float, b["translation"][:2]))
-                for b in entries
-                if isinstance(b, dict) and b.get("detection_name") in UNTRACKED_NAMES
-            )
-    return out
+    return untracked_detection_boxes(path, tokens)

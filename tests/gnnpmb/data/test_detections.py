@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from gnnpmb.data.detections import load_detection_file, write_detection_file
+from gnnpmb.data.detections import load_detection_file, untracked_detection_boxes, write_detection_file
 from gnnpmb.errors import DataError
 
 
@@ -52,6 +52,24 @@ def test_loads_requested_samples_and_tracking_classes(det_file):
     assert list(s0.instance_id) == ["", ""]
     assert len(out["s1"]) == 0 and out["s1"].translation_m.shape == (0, 3)
     assert list(out["s2"].class_name) == ["truck"]
+
+
+def test_the_index_keeps_the_boxes_of_untracked_names_aside(det_file, tmp_path, monkeypatch):
+    """The tracking loader drops barrier, traffic_cone and construction_vehicle boxes; the explanations name them
+    (a car seen only as a construction_vehicle was seen). They come from the index, read once per file whatever its
+    size (the explainer re-read files of at most 100 MB and said nothing of larger ones: full-split files are
+    300-700 MB)."""
+    monkeypatch.setenv("GNNPMB_CACHE_DIR", str(tmp_path / "cache"))
+    got = untracked_detection_boxes(det_file, ["s2", "s0", "s1"])
+    assert got == {
+        "s0": (("barrier", 0.9, 1.0, 2.0),),
+        "s2": (("traffic_cone", 0.8, 1.0, 2.0), ("construction_vehicle", 0.8, 1.0, 2.0)),
+    }
+    (side,) = (tmp_path / "cache" / "index").glob("detections-*/untracked.arrow")
+    raw = bytearray(side.read_bytes())
+    raw[300] ^= 0xFF  # damaged after it was built: rebuilt, the same boxes
+    side.write_bytes(bytes(raw))
+    assert untracked_detection_boxes(det_file, ["s0", "s2"]) == got
 
 
 def test_indexed_once_and_again_when_rewritten(det_file, tmp_path, monkeypatch):
