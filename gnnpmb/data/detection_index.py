@@ -168,11 +168,8 @@ def _build(
                 batch_of[token] = written
                 written += 1
                 if rows := untracked(entries):
-                    side.write_batch(
-                        pa.RecordBatch.from_pylist(
-                            [dict(zip(UNTRACKED_SCHEMA.names, r, strict=True)) for r in rows], schema=UNTRACKED_SCHEMA
-                        )
-                    )
+                    columns = [list(c) for c in zip(*rows, strict=True)]
+                    side.write_batch(pa.RecordBatch.from_arrays(columns, schema=UNTRACKED_SCHEMA))
                     untracked_of[token] = written_untracked
                     written_untracked += 1
     except (JsonStreamError, NotUtf8Error, KeyError, TypeError, OSError) as exc:
