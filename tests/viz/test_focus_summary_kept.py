@@ -84,3 +84,16 @@ def test_a_track_average_is_printed_on_the_same_side_of_the_printed_threshold_as
     assert beside_threshold(0.61304, 0.61296) == "0.613"  # both print 0.613: ">= 0.613" holds
     assert beside_threshold(0.61294, 0.61296) == "0.6129"  # not counted: 0.613 would read as >= 0.613
     assert beside_threshold(0.5, 0.613) == "0.500"
+
+
+def test_a_phd_labels_table_heads_its_weight_as_a_weight_when_the_window_gave_no_track_a_share() -> None:
+    # world8 scene-0655 centerpoint cphd miss:5 (audit truth52): no update in the window gave a track a share, so
+    # the window read as an assignment and the CPHD label's weight was headed "r before update" (an existence)
+    from viz.focus_summary import _weighs
+
+    weights = SimpleNamespace(mode=UseMode.WEIGHTS)
+    facts = SimpleNamespace(mode=lambda c, frames: UseMode.ASSIGNED, use=lambda f, c: weights if f == 12 else None)
+    assert _weighs(facts, "car", range(10, 14), [SimpleNamespace(frame=12)])
+    assert not _weighs(facts, "car", range(10, 14), [SimpleNamespace(frame=11)])
+    assigned = SimpleNamespace(mode=lambda c, frames: UseMode.ASSIGNED, use=lambda f, c: None)
+    assert not _weighs(assigned, "car", range(10, 14), [SimpleNamespace(frame=12)])
