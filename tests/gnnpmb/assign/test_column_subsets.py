@@ -29,7 +29,7 @@ def test_rank_of_a_column_subset_equals_rank_of_the_cut_matrix(
     rng = np.random.default_rng(5)
     checked = 0
     cache: murty.BlockCache | None = {} if shared_cache else None
-    for trial in range(150):
+    for trial in range(100):
         # a PMB-like block: K track columns, then one private (new-track) column per row, always present
         n_rows, n_tracks = int(rng.integers(1, 5)), int(rng.integers(1, 7))
         integer = trial % 2 == 0  # small integers: many equal costs
@@ -45,7 +45,7 @@ def test_rank_of_a_column_subset_equals_rank_of_the_cut_matrix(
             want = all_solutions(murty.rank(cost[:, present], max_increase=max_increase))
             assert all_solutions(subsets.rank(present)) == want
             checked += len(want) > 1
-    assert checked > 100
+    assert checked > 60
 
 
 def test_block_cache_ranks_a_repeated_block_once(monkeypatch):

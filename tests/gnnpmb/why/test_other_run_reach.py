@@ -22,6 +22,7 @@ pytestmark = pytest.mark.skipif(not (DEVSET / "v1.0-mini").is_dir(), reason=f"no
 def test_another_runs_track_out_of_reach_of_the_scored_box_is_said_so(capsys: pytest.CaptureFixture[str]) -> None:
     detections = DEVSET / "detections" / "megvii_mini_train.json"
     argv = ["gnnpmb", "failures", "scene-0061", "--dataroot", str(DEVSET), "--detections", str(detections)]
+    argv += ["--frames", "0:16"]  # the coalescence is at frame 13; its interpolated box needs the frames after it
     proc = run_script([*argv, "-t", "immortal", "-t", "pmbm", "--why"], capsys)
     assert proc.returncode == 0, proc.stderr
     said = (
