@@ -18,7 +18,7 @@ def _estimate(track_id: int, x: float) -> TrackEstimate:
 
 
 class _Gt(SimpleNamespace):
-    """A keyframe's annotations as ``gnnpmb.focus`` reads them: centres, instance ids and a length."""
+    """A keyframe's annotations as ``gnnpmb.focus`` reads them: centres, classes, instance ids and a length."""
 
     def __len__(self) -> int:
         return len(self.instance_id)
@@ -28,7 +28,8 @@ def _scene(gt_x: float | None, frames: int = 3) -> SimpleNamespace:
     ids = np.array([GT] if gt_x is not None else [], dtype=object)
     xyz = np.array([[gt_x, 0.0, 0.0]]) if gt_x is not None else np.zeros((0, 3))
     keyframe = SimpleNamespace(
-        gt=_Gt(translation_m=xyz, instance_id=ids), ego_pose=SimpleNamespace(translation_m=np.zeros(3))
+        gt=_Gt(translation_m=xyz, class_name=np.array(["car"] * len(ids), dtype=object), instance_id=ids),
+        ego_pose=SimpleNamespace(translation_m=np.zeros(3)),
     )
     return SimpleNamespace(name="s", keyframes=[keyframe] * frames)
 

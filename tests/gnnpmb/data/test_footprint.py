@@ -51,3 +51,25 @@ def test_a_false_track_on_a_trailer_opens_on_the_truck() -> None:
 
     assert _gt_under_false_track(false_track(0.3, -4.75), scene) == ("truck1",)
     assert _gt_under_false_track(false_track(10.0, 3.0), scene) == ()
+
+
+def test_a_false_track_opens_on_the_object_of_its_class_its_why_names() -> None:
+    """World7 scene-0796 pointpillars gnn false_track:16: a car box 1.87 m from car GT d97fc4 and 1.79 m from a
+    bicycle. The Why names the car (its nearest of the class) and another run's track on it; the focus opened on
+    the bicycle, so that track was not highlighted."""
+    gt = Boxes(
+        translation_m=np.array([[0.0, 0.0, 1.0], [1.87, 0.0, 1.0], [-1.79, 0.0, 1.0]]),
+        size_wlh_m=np.tile([1.0, 1.0, 1.0], (3, 1)),
+        quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (3, 1)),
+        velocity_mps=np.zeros((3, 2)),
+        score=np.ones(3),
+        class_name=np.array(["truck", "car", "bicycle"]),
+        instance_id=np.array(["far", "d97fc4", "0f89de"]),
+    )
+    gt.translation_m[0, 0] = 30.0
+    scene = SimpleNamespace(keyframes=[SimpleNamespace(gt=gt)])
+    box = FailureBox("false track", "237", (0.0, 0.0, 1.0), (2.0, 4.5, 1.6), (1.0, 0.0, 0.0, 0.0))
+    car = Failure(FailureKind.FALSE_TRACK, 0, "s0", "car", (), ("237",), (box,))
+    assert _gt_under_false_track(car, scene) == ("d97fc4",)
+    truck = Failure(FailureKind.FALSE_TRACK, 0, "s0", "truck", (), ("237",), (box,))
+    assert _gt_under_false_track(truck, scene) == ("0f89de",)  # none of its class within 2 m: the nearest of any
