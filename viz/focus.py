@@ -110,8 +110,9 @@ def log_focus(
         _log_involved_story(stream, clock, scene, focus, tracker, logger)
     frames = {t: {f.keyframe.index: f for f in v.evidence.run.frames} for t, v in views.items()}
     gt_ids = set(focus.gt_ids)
-    named_gt = named_objects(finding, scene.keyframes[focus.frame_index].gt, gt_ids) if shown else []
-    named_meas = named_detections(finding, focus.frame_index)
+    why = " ".join(plain(line) for line in why_lines(finding)) if finding is not None else ""
+    named_gt = named_objects(why, scene.keyframes[focus.frame_index].gt, gt_ids)
+    named_meas = named_detections(finding, why, focus.frame_index)
     failure_report = reports.get(focus.failure_tracker or "")
     evaluated = evaluated_offsets(focus, failure_report)
     unannotated = unannotated_evaluated(focus, failure_report)
@@ -252,20 +253,19 @@ def log_focus(
             log_evaluated(stream, focus, scene, evaluated if i == focus.frame_index else {})
 
 
-def named_objects(finding: Finding | None, gt: Boxes, involved: Collection[str]) -> list[str]:
-    """The ids of the annotations of ``gt`` (one keyframe's) that the finding's Why names ("... lay 0.3 m from
-    pedestrian GT 9d0a73") but that are not ``involved``: the view labels every object the text points to, at
-    the failure's frame (dev set scene-0916 centerpoint miss:20: the neighbour whose box the sentence named had
-    no label, so a reader could not find it). No finding: none."""
-    if finding is None or not len(gt):
+def named_objects(text: str, gt: Boxes, involved: Collection[str]) -> list[str]:
+    """The ids of the annotations of ``gt`` (one keyframe's) that a finding's Why ``text`` names ("... lay 0.3 m
+    from pedestrian GT 9d0a73") but that are not ``involved``: the view labels every object the text points to,
+    at the failure's frame (dev set scene-0916 centerpoint miss:20: the neighbour whose box the sentence named
+    had no label, so a reader could not find it)."""
+    if not text or not len(gt):
         return []
-    text = " ".join(plain(line) for line in why_lines(finding))
     ids = [str(t) for t in gt.instance_id]
     return [t for t in ids if t not in involved and re.search(rf"\bGT {re.escape(short_id(t))}\b", text)]
 
 
-def named_detections(finding: Finding | None, frame: int) -> set[int]:
-    """The detections (source indices) near the failure's object at ``frame`` that the finding's Why names
+def named_detections(finding: Finding | None, text: str, frame: int) -> set[int]:
+    """The detections (source indices) near the failure's object at ``frame`` that the finding's Why ``text`` names
     ("... but a truck detection, m0 (score 0.97), 0.3 m away: the detector gave it the wrong class"): the view
     labels them at that frame (dev set scene-0916 centerpoint miss:2: the truck box the sentence named had no
     label). Only a detection the finding's sighting holds at ``frame`` counts, so a name of another frame's
@@ -274,7 +274,6 @@ def named_detections(finding: Finding | None, frame: int) -> set[int]:
     if s is None:
         return set()
     near = (s.nearest_any, s.nearest_own, s.neighbours_own, s.off, s.in_box, s.removed_own)
-    text = " ".join(plain(line) for line in why_lines(finding))
     said = {int(m) for m in re.findall(r"\bm(\d+)\b", text)}
     return {n.meas for n in near if n is not None and n.meas in said}
 
