@@ -104,13 +104,29 @@ class GtFrame:
 
 
 @dataclass(frozen=True, slots=True)
+class DroppedBox:
+    """A submitted box the devkit's filter dropped: its frame, the devkit's distance of it to the ego vehicle
+    (``add_center_dist``), its class's range and why (``Dropped.BEYOND_RANGE``: at or beyond the range, which the
+    filter keeps strictly inside; else ``Dropped.BIKE_RACK``: submitted boxes are not filtered on points)."""
+
+    frame: int
+    ego_distance_m: float
+    range_m: float
+
+    @property
+    def reason(self) -> Dropped:
+        return Dropped.BEYOND_RANGE if self.ego_distance_m >= self.range_m else Dropped.BIKE_RACK
+
+
+@dataclass(frozen=True, slots=True)
 class TrackEval:
     """One submitted track, as evaluated: submitted (frames it has a box in the submission), kept (those the
     class-range and bike-rack filters kept), interpolated (frames the evaluation filled in between its kept
     boxes); submitted_mean: its score averaged over every submitted box; averaged_score: over the kept ones, the
     score the devkit compares with the class's threshold (None: no box kept, the track is not evaluated); matches:
     (frame, object) for each frame at which the devkit's accumulator matched the track to an object (a MATCH or
-    SWITCH event at the class's best-MOTA threshold), in frame order."""
+    SWITCH event at the class's best-MOTA threshold), in frame order; dropped: its submitted boxes the class-range
+    or bike-rack filter dropped, in frame order."""
 
     submitted: tuple[int, ...]
     kept: tuple[int, ...]
@@ -118,6 +134,11 @@ class TrackEval:
     submitted_mean: float
     averaged_score: float | None
     matches: tuple[tuple[int, str], ...] = ()
+    dropped: tuple[DroppedBox, ...] = ()
+
+    def dropped_at(self, frame: int) -> DroppedBox | None:
+        """Its box at ``frame`` that the devkit's filter dropped (None: kept, or none submitted there)."""
+        return next((d for d in self.dropped if d.frame == frame), None)
 
     def matched_at(self, frame: int) -> str | None:
         """The object the evaluation matched the track to at ``frame`` (None: none, e.g. a false track there)."""
@@ -135,12 +156,14 @@ class TrackEval:
             "submitted_mean": self.submitted_mean,
             "averaged_score": self.averaged_score,
             "matches": frames,
+            "dropped": [[d.frame, d.ego_distance_m, d.range_m] for d in self.dropped],
         }
 
     @staticmethod
     def from_json(data: Mapping[str, Any]) -> TrackEval:
-        """The track ``to_json`` wrote; one written before ``matches`` existed raises KeyError (a cached report of
-        an older version is evaluated again, not read as if the evaluation had matched the track nowhere)."""
+        """The track ``to_json`` wrote; one written before ``matches`` or ``dropped`` existed raises KeyError (a cached
+        report of an older version is evaluated again, not read as if the evaluation had matched or dropped
+        nothing)."""
         averaged = data["averaged_score"]
         matches = sorted((int(x), str(g)) for g, frames in data["matches"].items() for x in frames)
         return TrackEval(
@@ -150,6 +173,7 @@ class TrackEval:
             float(data["submitted_mean"]),
             None if averaged is None else float(averaged),
             tuple(matches),
+            tuple(DroppedBox(int(f), float(ego), float(reach)) for f, ego, reach in data["dropped"]),
         )
 
 
@@ -239,15 +263,18 @@ def _add_interpolation_ends(
 
 def track_evals(
     results: Mapping[str, Sequence[Mapping[str, Any]]],
+    raw: EvalBoxes,
     kept: EvalBoxes,
     tracks: Mapping[int, Sequence[TrackingBox]],
     averaged: Mapping[str, float],
     frame_of_timestamp: Mapping[int, int],
     token_of_frame: Sequence[str],
     matches: Mapping[str, Sequence[tuple[int, str]]],
+    class_range: Mapping[str, float],
 ) -> dict[str, TrackEval]:
     """Tracking id -> ``TrackEval`` for every track of the scene's submission ``results`` (boxes by sample token),
-    from the boxes the devkit kept, the tracks it built (a frame where it has a box of the track that is not one
+    from the boxes with the devkit's ego distances (``raw``, before its filter), those it kept (``class_range``:
+    the filter's range per class), the tracks it built (a frame where it has a box of the track that is not one
     it kept is one it interpolated), the scores it averaged (``averaged``: id -> the score its tracks carry) and
     its accumulator's matches (``matches``: id -> (frame, object) pairs)."""
     submitted: dict[str, list[tuple[int, float]]] = {}
@@ -262,6 +289,15 @@ def track_evals(
             continue
         for b in kept[token]:
             kept_frames.setdefault(str(b.tracking_id), []).append(f)
+    dropped: dict[str, list[DroppedBox]] = {}
+    for token in raw.sample_tokens:
+        f = frame_of_token.get(token)
+        if f is None:
+            continue
+        for b in raw[token]:
+            t = str(b.tracking_id)
+            if f not in kept_frames.get(t, ()):
+                dropped.setdefault(t, []).append(DroppedBox(f, float(b.ego_dist), float(class_range[b.tracking_name])))
     in_tracks: dict[str, set[int]] = {}
     for timestamp, boxes in tracks.items():
         for b in boxes:
@@ -276,5 +312,6 @@ def track_evals(
             submitted_mean=float(np.mean([s for _, s in frames])),
             averaged_score=averaged.get(t),
             matches=tuple(sorted(matches.get(t, ()))),
+            dropped=tuple(sorted(dropped.get(t, ()), key=lambda d: d.frame)),
         )
     return out

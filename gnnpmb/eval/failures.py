@@ -425,10 +425,10 @@ def devkit_tracks(
     split: str,
     cfg: TrackingConfig,
     whose: str = "",
-) -> tuple[EvalBoxes, EvalBoxes, EvalBoxes, dict, dict]:
+) -> tuple[EvalBoxes, EvalBoxes, EvalBoxes, EvalBoxes, dict, dict]:
     """The devkit's loading of ground truth and of ``results`` (submission boxes by sample token) on the samples
     ``tokens``, as ``TrackingEval`` does (call it inside ``quiet_devkit``): the ground truth before and after its
-    filter (``_prepared``), the kept predictions, then both as tracks by scene (``create_tracks``). Results that
+    filter (``_prepared``), the predictions likewise, then both as tracks by scene (``create_tracks``). Results that
     are not submission boxes raise ``DataError`` (``whose``: which results, e.g. " of scene-0103")."""
     from nuscenes.eval.common.data_classes import EvalBoxes
     from nuscenes.eval.common.loaders import load_gt_of_sample_tokens
@@ -441,9 +441,9 @@ def devkit_tracks(
         raise DataError(f"the tracking results{whose} are not valid submission boxes: {exc}") from None
     gt = load_gt_of_sample_tokens(nusc, tokens, TrackingBox, verbose=False)
     raw_gt, prepared_gt, kept_gt = _prepared(nusc, gt, cfg)
-    _, prepared_pred, kept_pred = _prepared(nusc, pred, cfg)
+    raw_pred, prepared_pred, kept_pred = _prepared(nusc, pred, cfg)
     tracks_gt = create_tracks(prepared_gt, nusc, split, gt=True)
-    return raw_gt, kept_gt, kept_pred, tracks_gt, create_tracks(prepared_pred, nusc, split, gt=False)
+    return raw_gt, kept_gt, raw_pred, kept_pred, tracks_gt, create_tracks(prepared_pred, nusc, split, gt=False)
 
 
 def _copy(boxes: EvalBoxes) -> EvalBoxes:
@@ -665,7 +665,7 @@ def find_failures(
     split = _split_with_scene(nusc, scene_name)
     cfg = tracking_config()
     with quiet_devkit():
-        raw_gt, kept_gt, kept_pred, tracks_gt, tracks_pred = devkit_tracks(
+        raw_gt, kept_gt, raw_pred, kept_pred, tracks_gt, tracks_pred = devkit_tracks(
             nusc, evaluated, results, split, cfg, f" of {scene_name}"
         )
         scene_token = nusc.get("sample", evaluated[0])["scene_token"]
@@ -719,7 +719,17 @@ def find_failures(
         coalescence_radius_m,
         track_scores,
         annotated,
-        track_evals(results, kept_pred, tracks_pred[scene_token], track_scores, frame_of_timestamp, tokens, matches),
+        track_evals(
+            results,
+            raw_pred,
+            kept_pred,
+            tracks_pred[scene_token],
+            track_scores,
+            frame_of_timestamp,
+            tokens,
+            matches,
+            cfg.class_range,
+        ),
         None if whole else (window.start, window.stop),
         scores,
     )

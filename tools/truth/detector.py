@@ -58,7 +58,9 @@ NOT_ITS_OWN = re.compile(
 """Detections within 2 m of an object, each nearer another annotated object: ``(at frame 3 car m4, 1.8 m away, lay
 0.1 m from car GT 26e63e; ...)``."""
 ITS_OWN_ITEM = re.compile(rf"(?:at frame (\d+) )?(\w+) m(\d+), ({_F}) m away, lay ({_F}) m from \w+ GT (\w+)")
-EGO = re.compile(rf"it lies ({_F}) m from the ego vehicle, (inside|beyond) the evaluation's ({_F}) m range")
+EGO = re.compile(
+    rf"(?:it|the object) lies ({_F}) m from the ego vehicle, (inside|beyond) the evaluation's ({_F}) m range"
+)
 INTERPOLATED_AT = re.compile(
     rf"the evaluation scored (?:it|GT \w{{6}}) at a box it interpolated, ({_F}) m from the annotation"
 )

@@ -50,6 +50,8 @@ class EvalFacts:
     """track id -> (frames the devkit's filters kept its box, the score ``create_tracks`` averaged over them)."""
     kept_frames: dict[str, tuple[int, ...]] = field(default_factory=dict)
     """track id -> the frames at which the devkit's filters kept its box (those ``averaged`` is over)."""
+    pred_ego_m: dict[tuple[int, str], float] = field(default_factory=dict)
+    """(frame, track id) -> the devkit's distance (``add_center_dist``) of the submission's box to the ego vehicle."""
     kept_gt: set[tuple[int, str]] = field(default_factory=set)
     """(frame, object id) of each annotated box the devkit's filters kept (the ends its interpolation joins)."""
     stamps: dict[int, int] = field(default_factory=dict)
@@ -117,12 +119,15 @@ def eval_facts(nusc, scene_name: str, results: Mapping[str, Sequence[Mapping[str
         pred = EvalBoxes.deserialize({t: list(results.get(t, [])) for t in tokens}, TrackingBox)
         gt = filter_eval_boxes(nusc, add_center_dist(nusc, gt), cfg.class_range, verbose=False)
         kept_gt = [(t, str(b.tracking_id)) for t in tokens for b in gt[t]]  # create_tracks adds its interpolations
-        pred = filter_eval_boxes(nusc, add_center_dist(nusc, pred), cfg.class_range, verbose=False)
+        pred = add_center_dist(nusc, pred)
+        pred_ego = {(t, str(b.tracking_id)): float(b.ego_dist) for t in tokens for b in pred[t]}
+        pred = filter_eval_boxes(nusc, pred, cfg.class_range, verbose=False)
         kept_pred = [str(b.tracking_id) for t in tokens for b in pred[t]]
         kept_at = [(t, str(b.tracking_id)) for t in tokens for b in pred[t]]
         tracks_gt = create_tracks(gt, nusc, split, gt=True)
         tracks_pred = create_tracks(pred, nusc, split, gt=False)
     out = EvalFacts()
+    out.pred_ego_m = {(frame_of_stamp[nusc.get("sample", t)["timestamp"]], k): d for (t, k), d in pred_ego.items()}
     for t, track in kept_at:
         out.kept_frames.setdefault(track, ())
         out.kept_frames[track] += (frame_of_stamp[nusc.get("sample", t)["timestamp"]],)

@@ -765,3 +765,49 @@ def test_a_thief_started_by_a_detection_of_no_object_and_a_deciding_detection_of
         assert (
             "m24 at frame 15 was a detection of no object (none of a tracked class within 2 m)" in line
         ) is no_object
+
+
+def test_a_track_box_the_evaluation_dropped_says_which_filter_at_the_box_own_distance() -> None:
+    # dev set scene-0757 pointpillars pmbm, frame 37: "its box lies beyond the evaluation's range for the class (or in
+    # a bike rack): the evaluation dropped that box; it lies 39.8 m from the ego vehicle, inside the evaluation's 40 m
+    # range": the object was 39.8 m away, the track's box 40.13 m (the devkit's own distance), beyond the range
+    from gnnpmb.eval.evaluated import DroppedBox, GtFrame, GtStatus
+    from gnnpmb.why.findings import OnObject
+
+    g = GtFrame(37, GtStatus.SCORED, (0.0, 0.0), (0.0, 0.0), None, 7, 39.8, 40.0)
+
+    def line_with(dropped: DroppedBox) -> str:
+        evaluated = TrackEval((36, 37), (36,), (), 0.39, 0.39, (), (dropped,))
+        on = OnObject(562, 0.4, 0.39, -1, evaluated, 0.3)
+        seen = Sighting(37, 7, g, None, None, None, (on,))
+        f = finding(FailureKind.MISS, frame=37, sightings=(seen,), blame=(Blame(Rule.TRACK_DROPPED, (37,)),))
+        return why_lines(f)[0]
+
+    line = line_with(DroppedBox(37, 40.13, 40.0))
+    assert (
+        "track 562 was output on it, but its box there lies 40.1 m from the ego vehicle, beyond the evaluation's 40 m "
+        "range: the evaluation dropped that box; the object lies 39.8 m from the ego vehicle, inside the evaluation's "
+        "40 m range" in line
+    )
+    assert "bike rack" not in line
+    assert "its box there lies in a bike rack: the evaluation dropped that box" in line_with(DroppedBox(37, 30.0, 40.0))
+
+
+def test_a_false_track_whose_box_was_dropped_and_interpolated_says_which_filter_dropped_it() -> None:
+    # "its box lay beyond the evaluation's range for the class and was dropped" was said of every dropped box, a
+    # bicycle's in a bike rack too: the devkit's own distance of the box tells the two apart
+    from gnnpmb.eval.evaluated import DroppedBox
+    from gnnpmb.why.findings import FalseOutput
+
+    def line_with(dropped: DroppedBox) -> str:
+        evaluated = TrackEval((35, 36, 38), (35, 38), (36,), 0.5, 0.5, (), (dropped,))
+        o = FalseOutput(77, None, (0.0, 0.0), (35, 38), None, None, None, evaluated, 0.3)
+        blame = (Blame(Rule.TRACK_INTERPOLATED, (36,)), Blame(Rule.TRACK_DROPPED, (36,)))
+        return why_lines(finding(FailureKind.FALSE_TRACK, frame=36, gt_id=None, false_output=o, blame=blame))[0]
+
+    assert (
+        "at frame 36 track 77 (bicycle) was output, but its box lay 40.2 m from the ego vehicle, beyond the "
+        "evaluation's 40 m range and was dropped: the evaluation interpolated it between its boxes at frames 35 and "
+        "38, and that box matched no object" in line_with(DroppedBox(36, 40.21, 40.0))
+    )
+    assert "was output, but its box lay in a bike rack and was dropped" in line_with(DroppedBox(36, 12.0, 40.0))
