@@ -227,6 +227,7 @@ def log_focus(
                 view_x_m,
                 view_y_m,
                 np.concatenate(named),
+                label_z_m=z_m,
             )
         if meas and detections is not None:
             given = sorted(meas)

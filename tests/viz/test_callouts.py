@@ -98,3 +98,29 @@ def test_a_phd_tracks_prediction_callout_names_a_weight_not_an_existence() -> No
     # m1's own label says it went to track 8 ("m1 0.81 → track 8"): the track's label does not say it again
     (once,) = _prediction_callouts({8: step}, 1.0, {8: (0, 0, 255)}, True, said={(1, 8)})
     assert once.text == "8 predicted r=0.79"
+
+
+def test_a_columns_rows_stay_a_row_apart_on_screen_whatever_their_objects_heights(saved_stream) -> None:
+    """The labels lie in one plane: each at its own object's height, a detection's box 0.9 m above the evaluation
+    range's circle, the rows showed unevenly spaced in the bird's-eye camera and two touched (demo scene-0103
+    pointpillars, gnnpmb beside pmbm, ``--focus miss:2``, frame 7). Read back and projected with a camera looking
+    straight down from ``HEIGHT_M`` above the plane the column is sized for, rows are ``LINE_PX`` apart."""
+    from tests.viz.rrd import read_rows
+    from viz.callouts import FOCUS_BEV_HEIGHT_PX, FOV_Y_DEG, Callout, log_callouts
+
+    stream, path = saved_stream
+    plane_z_m, eye = 0.8, np.array([0.0, 20.0])  # the eye sits HEIGHT_M above the plane, left of and below
+    heights = [0.8, 1.7, -0.2, 0.8]  # a GT, a tall detection, the evaluation range's circle, a prediction
+    callouts = [Callout((0.3 * k, 24.0 + 0.2 * k, z), f"label {k}", (0, 0, 0)) for k, z in enumerate(heights)]
+    stream.set_time("frame", sequence=0)
+    log_callouts(stream, "world/callouts", callouts, HEIGHT_M, label_z_m=plane_z_m)
+    stream.disconnect()
+    (chunk,) = [c for c in RrdReader(path).store().stream() if c.entity_path == "/world/callouts"]
+    at = np.array(chunk.to_record_batch().column("Points3D:positions").to_pylist()[-1])
+    np.testing.assert_allclose(at[:, 2], plane_z_m)
+    strips = np.array(read_rows(path)["world/callouts/leaders"][-1]["LineStrips3D:strips"])
+    np.testing.assert_allclose(strips[:, 0, 2], heights, rtol=1e-6)  # each leader starts at its object
+    np.testing.assert_allclose(strips[:, 1, 2], plane_z_m)  # and ends at its label
+    focal_px = 0.5 * FOCUS_BEV_HEIGHT_PX / np.tan(np.radians(0.5 * FOV_Y_DEG))
+    screen_y = focal_px * (at[:, 1] - eye[1]) / (plane_z_m + HEIGHT_M - at[:, 2])
+    np.testing.assert_allclose(np.diff(np.sort(screen_y)), LINE_PX, rtol=1e-6)
