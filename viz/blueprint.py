@@ -28,7 +28,7 @@ from gnnpmb.events import Panel
 from gnnpmb.runs import Capabilities, tracker_capabilities
 from gnnpmb.why.findings import FRAMES_BEFORE
 from viz import compare, paths
-from viz.callouts import COMPARED_CAMERA_HEIGHTS_PX, FOCUS_VIEW_WIDTH_PX
+from viz.callouts import COMPARED_CAMERA_HEIGHTS_PX, FOCUS_ROW_SHARES, FOCUS_VIEW_WIDTH_PX
 from viz.cameras import with_cameras
 from viz.failures import failure_log
 from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M, BEV_UP, EYE_POSITION_M, EYE_TARGET_M
@@ -109,14 +109,23 @@ def _hidden(tracker: str, *, lidar: bool, callouts: bool = False) -> dict[str, r
     return {p: rrb.EntityBehavior(visible=False) for p in hidden}
 
 
+def focus_perspective_eye(
+    focus: FocusTarget,
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """(position, look target), global, of a focus recording's perspective eye: behind, left of and above the
+    focused place, looking at it (z up)."""
+    x, y = focus.center_xy_m
+    return (x - 14.0, y - 14.0, 16.0), (x, y, 0.0)
+
+
 def spatial_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3DView:
     """Perspective 3D view of the scene and this tracker's entities (not the other trackers')."""
     if focus is None:
         origin, eye = paths.EGO, rrb.EyeControls3D(position=EYE_POSITION_M, look_target=EYE_TARGET_M, eye_up=(0, 0, 1))
     else:
-        x, y = focus.center_xy_m
         origin = paths.WORLD
-        eye = rrb.EyeControls3D(position=(x - 14.0, y - 14.0, 16.0), look_target=(x, y, 0.0), eye_up=(0, 0, 1))
+        position, target = focus_perspective_eye(focus)
+        eye = rrb.EyeControls3D(position=position, look_target=target, eye_up=(0, 0, 1))
     return rrb.Spatial3DView(
         origin=origin,
         contents=_contents(tracker),
@@ -413,7 +422,9 @@ def _tracker_views(
     if focus is not None and runs > 1:
         return rrb.Tabs(bev_view(tracker, focus, runs, cameras), spatial_view(tracker, focus), active_tab=0)
     if focus is not None:
-        return rrb.Vertical(bev_view(tracker, focus, runs, cameras), spatial_view(tracker, focus), row_shares=[7, 3])
+        return rrb.Vertical(
+            bev_view(tracker, focus, runs, cameras), spatial_view(tracker, focus), row_shares=list(FOCUS_ROW_SHARES)
+        )
     if strip is not None:
         from viz.opening import SCENE_SHARES, failure_timeline, strip_share, timeline_bounds
 

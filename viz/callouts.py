@@ -37,6 +37,11 @@ were estimated from (0.55 with a camera, 0.8 compared) made a three-run view wit
 the views were thought 6 % wider in metres than they are and their callouts ran past the edge (demo scene-0103,
 pointpillars, cphd beside ab3dmot and pmbm, ``--focus id_switch:1``). Runs compared keep their perspective views
 in tabs behind these (``viz.blueprint``), so their bird's-eye views are the scene's whole height."""
+FOCUS_ROW_SHARES = (7, 3)
+"""One run's focus layout: the bird's-eye view above the perspective view, in these shares of the scene's height
+(``viz.blueprint``); runs compared keep the perspective view in a tab behind the bird's-eye view, as tall."""
+VIEW_TITLE_PX = 24.0
+"""A view's title bar, above its content (``tools.labels.TITLE_PX``)."""
 FOCUS_VIEW_WIDTH_PX = 1920 * 3 / 5
 """Width the runs' bird's-eye views share in a focus recording at 1920 x 1080 (the scene column, ``viz.blueprint``)."""
 M_PER_PX_PER_HEIGHT = 2.0 * math.tan(math.radians(FOV_Y_DEG / 2.0)) / FOCUS_BEV_HEIGHT_PX
@@ -166,6 +171,20 @@ def focus_height_m(eye_height_m: float, compared: bool, camera: bool) -> float:
     ground: the one at which ``FOCUS_BEV_HEIGHT_PX`` tall would show as many metres per pixel as the layout's view
     (``COMPARED_CAMERA_HEIGHTS_PX``) does from ``eye_height_m``."""
     return eye_height_m * FOCUS_BEV_HEIGHT_PX / COMPARED_CAMERA_HEIGHTS_PX[compared, camera]
+
+
+def focus_views_px(runs: int, camera: bool) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(width, height) in pixels at 1920 x 1080 of a focus recording's bird's-eye view and of its perspective view,
+    for ``runs`` side by side with a ``camera`` view below or not: one run's perspective view shares the scene's
+    height with the bird's-eye view (``FOCUS_ROW_SHARES``; 159 px with a camera, as ``tools.labels.layout_px``
+    lays the demo's out), runs compared show it in a tab as big as the bird's-eye view."""
+    width = FOCUS_VIEW_WIDTH_PX / max(runs, 1)
+    bev = COMPARED_CAMERA_HEIGHTS_PX[runs > 1, camera]
+    if runs > 1:
+        return (width, bev), (width, bev)
+    top, below = FOCUS_ROW_SHARES
+    scene = (bev + VIEW_TITLE_PX) * (top + below) / top
+    return (width, bev), (width, scene * below / (top + below) - VIEW_TITLE_PX)
 
 
 def half_widths_m(chars: np.ndarray, m_per_px: float) -> np.ndarray:
