@@ -129,6 +129,7 @@ def log_focus(
     reach_m = range_near_focus(focus, scene)
     eye_height_m = focus_eye_height_m(focus.class_name, len(loggers), sight is not None)
     eyes = focus_eyes(focus, len(loggers), sight is not None)
+    named_gt = named_in_view(named_gt, scene.keyframes[focus.frame_index].gt, eyes[0])
     for i in shown:
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
@@ -334,6 +335,20 @@ def named_objects(text: str, gt: Boxes, involved: Collection[str]) -> list[str]:
         return []
     ids = [str(t) for t in gt.instance_id]
     return [t for t in ids if t not in involved and re.search(rf"\bGT {re.escape(short_id(t))}\b", text)]
+
+
+def named_in_view(named: Sequence[str], gt: Boxes, eye: Eye) -> list[str]:
+    """The ids of ``named`` (annotations of ``gt``, one keyframe's) whose centre the bird's-eye ``eye`` shows. The
+    Why names an object of another frame too ("at frame 15 truck m4 ... lay 0.4 m from truck GT 9da03c"); where it
+    has gone by the failure's frame, out of the view, its label only led a line across the view and out of it (demo
+    scene-0103 ``--tracker gnnpmb:gnnpmb/params/paper.toml --tracker gnnpmb --focus diff:fixed:1``: GT 9da03c 21 m
+    away at frame 24)."""
+    out = []
+    for t, xyz in zip(gt.instance_id.astype(str).tolist(), gt.translation_m, strict=True):
+        at = eye.screen_px(np.asarray(xyz, dtype=np.float64)) if t in named else None
+        if at is not None and abs(at[0]) <= 0.5 * eye.width_px and abs(at[1]) <= 0.5 * eye.height_px:
+            out.append(t)
+    return out
 
 
 def named_detections(finding: Finding | None, text: str, frame: int) -> set[int]:

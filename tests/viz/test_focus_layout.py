@@ -120,3 +120,29 @@ def test_two_involved_tracks_ids_that_would_cover_each_other_go_to_the_callout_c
     bev = {v.name: v for v in read_views(path)}["immortal bird's-eye"]
     texts = sorted(label.text for label in Recording(path).labels(bev, 0))
     assert texts == (["track 164", "track 2"] if apart_m < 1.0 else ["164", "2"])
+
+
+def test_an_object_the_why_names_is_labelled_at_the_failure_frame_only_where_the_view_shows_it() -> None:
+    """The Why names a truck for frame 15 ("lay 0.4 m from truck GT 9da03c"); at the failure's frame 24 it was 21 m
+    away, out of the two-run view, and its label led a line across the view and out (demo scene-0103 ``--tracker
+    gnnpmb:gnnpmb/params/paper.toml --tracker gnnpmb --focus diff:fixed:1``). A named object beside the failure
+    keeps its label."""
+    from gnnpmb.types import Boxes
+    from viz.focus import focus_eyes, named_in_view, named_objects
+
+    focus = FocusTarget("t", 24, (480.0, 1196.0), "bicycle", {"a": (400,), "b": (21,)}, ("bf3d85aaaa",))
+    ids = np.array(["9da03c11aa", "9d0a7322aa", "bf3d85aaaa"])
+    gt = Boxes(
+        translation_m=np.array([[459.0, 1192.0, 1.5], [481.5, 1197.0, 0.8], [479.0, 1196.5, 0.8]]),
+        size_wlh_m=np.ones((3, 3)),
+        quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (3, 1)),
+        velocity_mps=np.zeros((3, 2)),
+        score=np.ones(3),
+        class_name=np.array(["truck", "pedestrian", "bicycle"]),
+        instance_id=ids,
+    )
+    why = "at frame 15 m4 lay 0.4 m from truck GT 9da03c; at frame 24 it lay 0.3 m from pedestrian GT 9d0a73"
+    named = named_objects(why, gt, {"bf3d85aaaa"})
+    assert named == ["9da03c11aa", "9d0a7322aa"]
+    bev = focus_eyes(focus, 2, True)[0]
+    assert named_in_view(named, gt, bev) == ["9d0a7322aa"]
