@@ -244,6 +244,12 @@ def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visib
     return placed.view_args() if placed is not None else {"plot_legend": rrb.PlotLegend(visible=visible)}
 
 
+def focus_axis_frames(focus: FocusTarget) -> tuple[int, int]:
+    """(first, last) frame a focus recording's plots show on opening, at the failure frame (``_focus_axis``)."""
+    before = min(focus.frame_index, FRAMES_BEFORE)
+    return focus.frame_index - before, focus.frame_index + FOCUS_PAST_FRAMES + FRAMES_BEFORE - before
+
+
 def _focus_axis(focus: FocusTarget) -> rrb.TimeAxis:
     """A focus recording's plots run past the failure frame, where they open: a track started at that frame (one
     point) sat on the plot's edge, half cut (dev set scene-0916 megvii phd id_switch:1, track 24). They start
@@ -251,11 +257,11 @@ def _focus_axis(focus: FocusTarget) -> rrb.TimeAxis:
     that frame they run as much further past it, so the axis is always that many frames wide: at a failure at
     frame 0 the data's own range was one frame wide, and the x axis read "#0 #0 #0 ..." (dev set scene-0916
     centerpoint miss:2)."""
-    before = min(focus.frame_index, FRAMES_BEFORE)
+    first, last = focus_axis_frames(focus)
     return rrb.TimeAxis(
         view_range=rr.TimeRange(
-            start=rr.TimeRangeBoundary.absolute(seq=focus.frame_index - before),
-            end=rr.TimeRangeBoundary.cursor_relative(seq=FOCUS_PAST_FRAMES + FRAMES_BEFORE - before),
+            start=rr.TimeRangeBoundary.absolute(seq=first),
+            end=rr.TimeRangeBoundary.cursor_relative(seq=last - focus.frame_index),
         )
     )
 

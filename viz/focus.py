@@ -38,6 +38,7 @@ from gnnpmb.why.findings import Finding
 from gnnpmb.why.words import existence_text, plain, share_text, went_text, why_lines
 from viz import compare, paths
 from viz.blueprint import (
+    focus_axis_frames,
     focus_doc,
     focus_eye_height_m,
     focus_perspective_eye,
@@ -73,7 +74,7 @@ from viz.geometry import (
 )
 from viz.label_room import Eye, keep_clear
 from viz.label_size import CLEARANCE_PX, text_box
-from viz.legend import COMPARISON_PLOT_HEIGHT_PX, FOCUS_PAST_FRAMES, LegendPlacement, existence_range, place_legend
+from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
 from viz.logger import TrackerLogger
 from viz.markers import send_text_lines
 from viz.reading_guide import READING_GUIDE
@@ -462,7 +463,7 @@ def focus_legends(
             if root == paths.existence_root(tracker):
                 tracks = [logger.sent_series[p] for p in series[:-1] if p in logger.sent_series]  # not the threshold
                 fixed = existence_range([v[f <= last] for f, v in tracks])
-            out[root] = place_legend(lines, len(sent), y_range=fixed, past_frames=FOCUS_PAST_FRAMES)
+            out[root] = place_legend(lines, len(sent), y_range=fixed, x_range=focus_axis_frames(focus))
     if comparison is not None:
         frames = np.asarray(comparison.frame_indices)
         upto = frames <= last
