@@ -232,7 +232,15 @@ def log_focus(
                 stream,
                 paths.focus_callouts(tracker),
                 gt_callouts
-                + _detection_callouts(detections, sorted(given), facts, i, focus.class_name, mode)
+                + _detection_callouts(
+                    detections,
+                    sorted(given),
+                    facts,
+                    i,
+                    focus.class_name,
+                    mode,
+                    {e.track_id for e in frame.estimates},
+                )
                 + _prediction_callouts(
                     steps, z_m, palette, facts.has_existence, mode, _said(given, facts, i, focus.class_name, mode)
                 )
@@ -473,14 +481,30 @@ def focus_legends(
 
 
 def _detection_callouts(
-    detections: Boxes, given: list[int], facts: TrackerFacts, frame: int, class_name: str, mode: UseMode
+    detections: Boxes,
+    given: list[int],
+    facts: TrackerFacts,
+    frame: int,
+    class_name: str,
+    mode: UseMode,
+    output: Collection[int] | None = None,
 ) -> list[Callout]:
     """``m<idx> <score> → <where it went>`` at each detection ``given`` (indices into the frame's detections;
-    where it went: ``why.facts.Destination``, in the tracker's terms)."""
+    where it went: ``why.facts.Destination``, in the tracker's terms), ``, not output`` after a track the run did
+    not output at that frame (``output``: the ids it did; None: not known): "m1 0.85 → track 103" pointed at no
+    box, for 103 was a tentative track, first output a frame later (dev set scene-0916 centerpoint, gnn beside
+    ab3dmot ``--focus id_switch:1``, ab3dmot's view)."""
     out = []
     for m in given:
         d = facts.destination(frame, class_name, m)
         went = f" {went_text(d, mode)}" if d is not None else ""
+        if (
+            d is not None
+            and output is not None
+            and d.went in (Went.TRACK, Went.NEW_TRACK)
+            and mode is not UseMode.OUTPUT
+        ):
+            went += ", not output" if d.track_id not in output else ""
         out.append(
             Callout(
                 tuple(detections.translation_m[m]),

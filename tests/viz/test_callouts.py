@@ -124,3 +124,35 @@ def test_a_columns_rows_stay_a_row_apart_on_screen_whatever_their_objects_height
     focal_px = 0.5 * FOCUS_BEV_HEIGHT_PX / np.tan(np.radians(0.5 * FOV_Y_DEG))
     screen_y = focal_px * (at[:, 1] - eye[1]) / (plane_z_m + HEIGHT_M - at[:, 2])
     np.testing.assert_allclose(np.diff(np.sort(screen_y)), LINE_PX, rtol=1e-6)
+
+
+def test_a_detections_label_says_when_the_track_it_went_to_was_not_output() -> None:
+    """ab3dmot gave m1 to its tentative track 103, first output a frame later: "m1 0.85 → track 103" pointed at no
+    box (dev set scene-0916 centerpoint, gnn beside ab3dmot ``--focus id_switch:1``, frame 16). The label says so;
+    a track output there, a new one too, reads as before; a results file's "under ..." is about output already."""
+    from gnnpmb.types import Boxes
+    from gnnpmb.why.facts import Destination, UseMode, Went
+    from viz.focus import _detection_callouts
+
+    went = {
+        1: Destination(1, Went.TRACK, 103),
+        2: Destination(2, Went.NEW_TRACK, 104),
+        3: Destination(3, Went.TRACK, 7),
+    }
+    facts = SimpleNamespace(destination=lambda frame, class_name, m: went.get(m))
+    n = 4
+    detections = Boxes(
+        translation_m=np.zeros((n, 3)),
+        size_wlh_m=np.ones((n, 3)),
+        quat_wxyz=np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)),
+        velocity_mps=np.zeros((n, 2)),
+        score=np.array([0.5, 0.85, 0.4, 0.9]),
+        class_name=np.array(["truck"] * n),
+        instance_id=np.array([""] * n),
+    )
+    texts = [c.text for c in _detection_callouts(detections, [1, 2, 3], facts, 16, "truck", UseMode.ASSIGNED, {7})]
+    assert texts == ["m1 0.85 → track 103, not output", "m2 0.40 → new track 104, not output", "m3 0.90 → track 7"]
+    unknown = [c.text for c in _detection_callouts(detections, [1], facts, 16, "truck", UseMode.ASSIGNED)]
+    assert unknown == ["m1 0.85 → track 103"]
+    results = [c.text for c in _detection_callouts(detections, [1], facts, 16, "truck", UseMode.OUTPUT, {7})]
+    assert results == ["m1 0.85 under track 103's box"]
