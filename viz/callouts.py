@@ -110,6 +110,11 @@ def column_positions(
             # no place holds it: pushed back inside the view, over the objects (a label over a box can be read,
             # one past the view's edge cannot)
             edge = view_x_m[1] - width_m if side > 0 else view_x_m[0] + width_m
+    if view_x_m is not None and width_m <= view_x_m[1] - view_x_m[0]:
+        # objects beside the view (frames before the failure, the object still on its way): the column starts at the
+        # view's edge and its leaders run out to them (demo scene-0103 pointpillars gnnpmb+pmbm fragmentation:1,
+        # frames 8-9: the object 17 m left of the centre, its labels half past the view's left edge)
+        edge = max(edge, view_x_m[0]) if side > 0 else min(edge, view_x_m[1])
     if view_y_m is not None:  # near the view's top or bottom edge (frames before the failure): rows kept inside
         rows_y = _inside(rows_y, view_y_m, (BELOW_ANCHOR_PX + HEIGHT_PX) * m_per_px)
     out = np.empty((n, 2))

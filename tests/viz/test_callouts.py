@@ -156,3 +156,16 @@ def test_a_detections_label_says_when_the_track_it_went_to_was_not_output() -> N
     assert unknown == ["m1 0.85 → track 103"]
     results = [c.text for c in _detection_callouts(detections, [1], facts, 16, "truck", UseMode.OUTPUT, {7})]
     assert results == ["m1 0.85 under track 103's box"]
+
+
+def test_the_column_of_objects_beside_the_view_starts_inside_it() -> None:
+    """Before the failure the object can still be on its way, beside the view: the column placed right of it ran
+    half past the view's left edge (demo scene-0103 pointpillars gnnpmb beside pmbm ``--focus fragmentation:1``,
+    frames 8-9, "26 predicted r=0.95, missed" cut). It starts at the view's edge; its leaders run out to them."""
+    anchors = np.array([[-17.0, 0.0], [-16.8, 0.5]])
+    chars = np.array([9, 26])
+    view_x, view_y = (-11.0, 11.0), (-9.0, 9.0)
+    out = column_positions(anchors, chars, HEIGHT_M, view_x, view_y)
+    halves = half_widths_m(chars, M_PER_PX_PER_HEIGHT * HEIGHT_M)
+    assert np.all(out[:, 0] - halves >= view_x[0] - 1e-9) and np.all(out[:, 0] + halves <= view_x[1])
+    assert np.ptp(out[:, 0] - halves) < 1e-9  # left ends still aligned
