@@ -14,7 +14,8 @@ the 3D-view regions hold many varied, non-background pixels (LiDAR points, colou
 alone are not enough: panels can still be empty while the 3D views look finished. Both servers run in their own process
 groups and are killed (group-wide) on every exit path; the file server stops with the check.
 
-By hand: ``uv run python -m tools.webcheck FILE.rrd --out shot.png [--views 2]``.
+By hand: ``uv run python -m tools.webcheck FILE.rrd --out shot.png [--views N]`` (default: the runs the recording's
+blueprint lays side by side, ``runs_side_by_side``).
 """
 
 from __future__ import annotations
