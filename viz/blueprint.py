@@ -390,12 +390,14 @@ def comparison_panel(
     trackers: Sequence[str],
     legends: Mapping[str, LegendPlacement] | None = None,
     focus: FocusTarget | None = None,
+    focus_class_quiet: bool = False,
 ) -> rrb.Horizontal:
     """Disagreements per frame (and each tracker's failures per frame) as tabs, beside the disagreement log; with
     a focus, the log opens on the disagreements about the focused class (the whole log is the next tab) and the
     plot, which counts every class's, says so: beside an empty log of the focused class it read as a disagreement
     the log did not hold (demo scene-9001 pmbm beside gnnpmb ``--focus coalescence:2``: a car track at frame 19,
-    the log of bicycles empty)."""
+    the log of bicycles empty); when the runs disagree about nothing of the focused class up to the failure
+    (``focus_class_quiet``), the log opens on the whole log instead, which holds what the plot counts."""
     counts = rrb.Tabs(
         rrb.TimeSeriesView(
             origin=compare.counts_root(),
@@ -409,7 +411,7 @@ def comparison_panel(
         about = rrb.TextLogView(
             origin=compare.focus_log_path(), name=f"disagreements ({focus.class_name})", columns=STORY_COLUMNS
         )
-        log = rrb.Tabs(about, log)
+        log = rrb.Tabs(about, log, active_tab=1 if focus_class_quiet else 0)
     return rrb.Horizontal(counts, log, column_shares=[2, 3], name="comparison")
 
 
@@ -460,6 +462,7 @@ def default_blueprint(
     timeline_rows: Mapping[str, int] | None = None,
     cameras: Sequence[str] = (),
     focus_camera: str | None = None,
+    focus_class_quiet: bool = False,
 ) -> rrb.Blueprint:
     """The layout for a recording of ``trackers`` (one or more runs, side by side) over ``classes``; with ``focus``
     the layout opens at and looks at the failure. ``legends``: where the legends of series views go, keyed by
@@ -468,7 +471,8 @@ def default_blueprint(
     were found (``failure_index``) shows each run's failure index and its failures over ``frames`` (in
     ``timeline_rows`` rows per run), and opens at the failure ``opening`` (``viz.opening``): its ``focus`` timeline
     ends there. ``cameras``: the channels to show below the scene views (``viz.cameras.with_cameras``; in a focus
-    recording only ``focus_camera``, the one that sees the focus object, when one does)."""
+    recording only ``focus_camera``, the one that sees the focus object, when one does). ``focus_class_quiet``: the
+    runs disagree about nothing of the focused class up to the failure (``comparison_panel``)."""
     if not trackers:
         raise ValueError("default_blueprint needs at least one tracker")
     strips = frames if focus is None and failure_index and frames is not None else None
@@ -483,7 +487,8 @@ def default_blueprint(
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:
-        left = rrb.Vertical(scene, comparison_panel(trackers, legends, focus), row_shares=list(COMPARED_ROW_SHARES))
+        comparison = comparison_panel(trackers, legends, focus, focus_class_quiet)
+        left = rrb.Vertical(scene, comparison, row_shares=list(COMPARED_ROW_SHARES))
         layout = rrb.Horizontal(left, rrb.Tabs(*panels), column_shares=[3, 2])
     if focus is None and opening is None:
         time_panel = rrb.TimePanel(state="collapsed", timeline="frame", play_state="paused")
