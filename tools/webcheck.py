@@ -14,7 +14,8 @@ the 3D-view regions hold many varied, non-background pixels (LiDAR points, colou
 alone are not enough: panels can still be empty while the 3D views look finished. Both servers run in their own process
 groups and are killed (group-wide) on every exit path; the file server stops with the check.
 
-By hand: ``uv run python -m tools.webcheck FILE.rrd --out shot.png [--views 2]``.
+By hand: ``uv run python -m tools.webcheck FILE.rrd --out shot.png [--views N]`` (default: the runs the recording's
+blueprint lays side by side, ``runs_side_by_side``).
 """
 
 from __future__ import annotations
@@ -448,6 +449,17 @@ class DevTools:
         self._ws.close()
 
 
+def runs_side_by_side(rrd: Path) -> int:
+    """How many runs' bird's-eye views the recording's default blueprint lays side by side (at least 1): the
+    ``view_regions`` to check. A fixed 2 checked the right half of a one-run recording's bird's-eye view as a
+    second view; on the dev set (no LiDAR) that half is often bare ground with a box or two, never "rendered", and
+    the check waited out its whole timeout and said NOT ready (dev set scene-0103 cphd ``--focus
+    identity_theft:1``: 424 s, exit 1, for a view that had rendered in 40 s)."""
+    from tools.labels import read_views
+
+    return max(1, sum(v.name.endswith("bird's-eye") for v in read_views(rrd, kinds=("3D",))))
+
+
 def view_regions(width: int, height: int, n_views: int) -> list[tuple[int, int, int, int]]:
     """(x0, y0, x1, y1) pixel boxes well inside the bird's-eye view of each of the ``n_views`` trackers side by
     side in the default blueprint (``viz.blueprint``): they span the left three fifths of the window, in the
@@ -680,14 +692,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("rrd", type=Path, help="the recording (.rrd)")
     parser.add_argument("--out", type=Path, default=Path("webcheck.png"), help="screenshot to write (PNG)")
-    parser.add_argument("--views", type=int, default=2, help="number of side-by-side 3D views to check")
+    parser.add_argument(
+        "--views",
+        type=int,
+        default=None,
+        help="number of side-by-side 3D views to check (default: the runs the recording's blueprint lays side by side)",
+    )
     parser.add_argument("--timeout", type=float, default=420.0, help="seconds to wait for the scene to render")
     parser.add_argument("--width", type=int, default=DEFAULT_VIEWPORT[0])
     parser.add_argument("--height", type=int, default=DEFAULT_VIEWPORT[1])
     args = parser.parse_args(argv)
     try:
         result = check_recording(
-            args.rrd, args.out, n_views=args.views, viewport=(args.width, args.height), timeout_s=args.timeout
+            args.rrd,
+            args.out,
+            n_views=args.views if args.views is not None else runs_side_by_side(args.rrd),
+            viewport=(args.width, args.height),
+            timeout_s=args.timeout,
         )
     except WebCheckError as exc:
         print(f"error: {exc}", file=sys.stderr)

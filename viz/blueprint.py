@@ -28,7 +28,7 @@ from gnnpmb.events import Panel
 from gnnpmb.runs import Capabilities, tracker_capabilities
 from gnnpmb.why.findings import FRAMES_BEFORE
 from viz import compare, paths
-from viz.callouts import COMPARED_CAMERA_HEIGHTS_PX, FOCUS_VIEW_WIDTH_PX
+from viz.callouts import COMPARED_CAMERA_HEIGHTS_PX, FOCUS_ROW_SHARES, FOCUS_VIEW_WIDTH_PX
 from viz.cameras import with_cameras
 from viz.failures import failure_log
 from viz.label_room import BEV_EYE_POSITION_M, BEV_TARGET_M, BEV_UP, EYE_POSITION_M, EYE_TARGET_M
@@ -109,14 +109,23 @@ def _hidden(tracker: str, *, lidar: bool, callouts: bool = False) -> dict[str, r
     return {p: rrb.EntityBehavior(visible=False) for p in hidden}
 
 
+def focus_perspective_eye(
+    focus: FocusTarget,
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """(position, look target), global, of a focus recording's perspective eye: behind, left of and above the
+    focused place, looking at it (z up)."""
+    x, y = focus.center_xy_m
+    return (x - 14.0, y - 14.0, 16.0), (x, y, 0.0)
+
+
 def spatial_view(tracker: str, focus: FocusTarget | None = None) -> rrb.Spatial3DView:
     """Perspective 3D view of the scene and this tracker's entities (not the other trackers')."""
     if focus is None:
         origin, eye = paths.EGO, rrb.EyeControls3D(position=EYE_POSITION_M, look_target=EYE_TARGET_M, eye_up=(0, 0, 1))
     else:
-        x, y = focus.center_xy_m
         origin = paths.WORLD
-        eye = rrb.EyeControls3D(position=(x - 14.0, y - 14.0, 16.0), look_target=(x, y, 0.0), eye_up=(0, 0, 1))
+        position, target = focus_perspective_eye(focus)
+        eye = rrb.EyeControls3D(position=position, look_target=target, eye_up=(0, 0, 1))
     return rrb.Spatial3DView(
         origin=origin,
         contents=_contents(tracker),
@@ -235,6 +244,12 @@ def _legend_args(root: str, legends: Mapping[str, LegendPlacement] | None, visib
     return placed.view_args() if placed is not None else {"plot_legend": rrb.PlotLegend(visible=visible)}
 
 
+def focus_axis_frames(focus: FocusTarget) -> tuple[int, int]:
+    """(first, last) frame a focus recording's plots show on opening, at the failure frame (``_focus_axis``)."""
+    before = min(focus.frame_index, FRAMES_BEFORE)
+    return focus.frame_index - before, focus.frame_index + FOCUS_PAST_FRAMES + FRAMES_BEFORE - before
+
+
 def _focus_axis(focus: FocusTarget) -> rrb.TimeAxis:
     """A focus recording's plots run past the failure frame, where they open: a track started at that frame (one
     point) sat on the plot's edge, half cut (dev set scene-0916 megvii phd id_switch:1, track 24). They start
@@ -242,11 +257,11 @@ def _focus_axis(focus: FocusTarget) -> rrb.TimeAxis:
     that frame they run as much further past it, so the axis is always that many frames wide: at a failure at
     frame 0 the data's own range was one frame wide, and the x axis read "#0 #0 #0 ..." (dev set scene-0916
     centerpoint miss:2)."""
-    before = min(focus.frame_index, FRAMES_BEFORE)
+    first, last = focus_axis_frames(focus)
     return rrb.TimeAxis(
         view_range=rr.TimeRange(
-            start=rr.TimeRangeBoundary.absolute(seq=focus.frame_index - before),
-            end=rr.TimeRangeBoundary.cursor_relative(seq=FOCUS_PAST_FRAMES + FRAMES_BEFORE - before),
+            start=rr.TimeRangeBoundary.absolute(seq=first),
+            end=rr.TimeRangeBoundary.cursor_relative(seq=last - focus.frame_index),
         )
     )
 
@@ -375,13 +390,18 @@ def comparison_panel(
     trackers: Sequence[str],
     legends: Mapping[str, LegendPlacement] | None = None,
     focus: FocusTarget | None = None,
+    focus_class_quiet: bool = False,
 ) -> rrb.Horizontal:
     """Disagreements per frame (and each tracker's failures per frame) as tabs, beside the disagreement log; with
-    a focus, the log opens on the disagreements about the focused class (the whole log is the next tab)."""
+    a focus, the log opens on the disagreements about the focused class (the whole log is the next tab) and the
+    plot, which counts every class's, says so: beside an empty log of the focused class it read as a disagreement
+    the log did not hold (demo scene-9001 pmbm beside gnnpmb ``--focus coalescence:2``: a car track at frame 19,
+    the log of bicycles empty); when the runs disagree about nothing of the focused class up to the failure
+    (``focus_class_quiet``), the log opens on the whole log instead, which holds what the plot counts."""
     counts = rrb.Tabs(
         rrb.TimeSeriesView(
             origin=compare.counts_root(),
-            name="disagreements per frame",
+            name="disagreements per frame" if focus is None else "disagreements per frame (every class)",
             **_legend_args(compare.counts_root(), legends, True),
         ),
         *[failure_counts_view(t) for t in trackers],
@@ -391,7 +411,7 @@ def comparison_panel(
         about = rrb.TextLogView(
             origin=compare.focus_log_path(), name=f"disagreements ({focus.class_name})", columns=STORY_COLUMNS
         )
-        log = rrb.Tabs(about, log)
+        log = rrb.Tabs(about, log, active_tab=1 if focus_class_quiet else 0)
     return rrb.Horizontal(counts, log, column_shares=[2, 3], name="comparison")
 
 
@@ -413,7 +433,9 @@ def _tracker_views(
     if focus is not None and runs > 1:
         return rrb.Tabs(bev_view(tracker, focus, runs, cameras), spatial_view(tracker, focus), active_tab=0)
     if focus is not None:
-        return rrb.Vertical(bev_view(tracker, focus, runs, cameras), spatial_view(tracker, focus), row_shares=[7, 3])
+        return rrb.Vertical(
+            bev_view(tracker, focus, runs, cameras), spatial_view(tracker, focus), row_shares=list(FOCUS_ROW_SHARES)
+        )
     if strip is not None:
         from viz.opening import SCENE_SHARES, failure_timeline, strip_share, timeline_bounds
 
@@ -440,6 +462,7 @@ def default_blueprint(
     timeline_rows: Mapping[str, int] | None = None,
     cameras: Sequence[str] = (),
     focus_camera: str | None = None,
+    focus_class_quiet: bool = False,
 ) -> rrb.Blueprint:
     """The layout for a recording of ``trackers`` (one or more runs, side by side) over ``classes``; with ``focus``
     the layout opens at and looks at the failure. ``legends``: where the legends of series views go, keyed by
@@ -448,7 +471,8 @@ def default_blueprint(
     were found (``failure_index``) shows each run's failure index and its failures over ``frames`` (in
     ``timeline_rows`` rows per run), and opens at the failure ``opening`` (``viz.opening``): its ``focus`` timeline
     ends there. ``cameras``: the channels to show below the scene views (``viz.cameras.with_cameras``; in a focus
-    recording only ``focus_camera``, the one that sees the focus object, when one does)."""
+    recording only ``focus_camera``, the one that sees the focus object, when one does). ``focus_class_quiet``: the
+    runs disagree about nothing of the focused class up to the failure (``comparison_panel``)."""
     if not trackers:
         raise ValueError("default_blueprint needs at least one tracker")
     strips = frames if focus is None and failure_index and frames is not None else None
@@ -463,7 +487,8 @@ def default_blueprint(
     if len(trackers) == 1:
         layout = rrb.Horizontal(scene, panels[0], column_shares=[3, 2])
     else:
-        left = rrb.Vertical(scene, comparison_panel(trackers, legends, focus), row_shares=list(COMPARED_ROW_SHARES))
+        comparison = comparison_panel(trackers, legends, focus, focus_class_quiet)
+        left = rrb.Vertical(scene, comparison, row_shares=list(COMPARED_ROW_SHARES))
         layout = rrb.Horizontal(left, rrb.Tabs(*panels), column_shares=[3, 2])
     if focus is None and opening is None:
         time_panel = rrb.TimePanel(state="collapsed", timeline="frame", play_state="paused")

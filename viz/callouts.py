@@ -37,6 +37,11 @@ were estimated from (0.55 with a camera, 0.8 compared) made a three-run view wit
 the views were thought 6 % wider in metres than they are and their callouts ran past the edge (demo scene-0103,
 pointpillars, cphd beside ab3dmot and pmbm, ``--focus id_switch:1``). Runs compared keep their perspective views
 in tabs behind these (``viz.blueprint``), so their bird's-eye views are the scene's whole height."""
+FOCUS_ROW_SHARES = (7, 3)
+"""One run's focus layout: the bird's-eye view above the perspective view, in these shares of the scene's height
+(``viz.blueprint``); runs compared keep the perspective view in a tab behind the bird's-eye view, as tall."""
+VIEW_TITLE_PX = 24.0
+"""A view's title bar, above its content (``tools.labels.TITLE_PX``)."""
 FOCUS_VIEW_WIDTH_PX = 1920 * 3 / 5
 """Width the runs' bird's-eye views share in a focus recording at 1920 x 1080 (the scene column, ``viz.blueprint``)."""
 M_PER_PX_PER_HEIGHT = 2.0 * math.tan(math.radians(FOV_Y_DEG / 2.0)) / FOCUS_BEV_HEIGHT_PX
@@ -105,6 +110,11 @@ def column_positions(
             # no place holds it: pushed back inside the view, over the objects (a label over a box can be read,
             # one past the view's edge cannot)
             edge = view_x_m[1] - width_m if side > 0 else view_x_m[0] + width_m
+    if view_x_m is not None and width_m <= view_x_m[1] - view_x_m[0]:
+        # objects beside the view (frames before the failure, the object still on its way): the column starts at the
+        # view's edge and its leaders run out to them (demo scene-0103 pointpillars gnnpmb+pmbm fragmentation:1,
+        # frames 8-9: the object 17 m left of the centre, its labels half past the view's left edge)
+        edge = max(edge, view_x_m[0]) if side > 0 else min(edge, view_x_m[1])
     if view_y_m is not None:  # near the view's top or bottom edge (frames before the failure): rows kept inside
         rows_y = _inside(rows_y, view_y_m, (BELOW_ANCHOR_PX + HEIGHT_PX) * m_per_px)
     out = np.empty((n, 2))
@@ -168,6 +178,20 @@ def focus_height_m(eye_height_m: float, compared: bool, camera: bool) -> float:
     return eye_height_m * FOCUS_BEV_HEIGHT_PX / COMPARED_CAMERA_HEIGHTS_PX[compared, camera]
 
 
+def focus_views_px(runs: int, camera: bool) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(width, height) in pixels at 1920 x 1080 of a focus recording's bird's-eye view and of its perspective view,
+    for ``runs`` side by side with a ``camera`` view below or not: one run's perspective view shares the scene's
+    height with the bird's-eye view (``FOCUS_ROW_SHARES``; 159 px with a camera, as ``tools.labels.layout_px``
+    lays the demo's out), runs compared show it in a tab as big as the bird's-eye view."""
+    width = FOCUS_VIEW_WIDTH_PX / max(runs, 1)
+    bev = COMPARED_CAMERA_HEIGHTS_PX[runs > 1, camera]
+    if runs > 1:
+        return (width, bev), (width, bev)
+    top, below = FOCUS_ROW_SHARES
+    scene = (bev + VIEW_TITLE_PX) * (top + below) / top
+    return (width, bev), (width, scene * below / (top + below) - VIEW_TITLE_PX)
+
+
 def half_widths_m(chars: np.ndarray, m_per_px: float) -> np.ndarray:
     """(N,) half widths in metres of labels of ``chars`` (N,) characters, with their background."""
     return 0.5 * width_px(np.asarray(chars, dtype=np.float64)) * m_per_px
@@ -190,17 +214,23 @@ def log_callouts(
     view_x_m: tuple[float, float] | None = None,
     view_y_m: tuple[float, float] | None = None,
     clear_xy_m: np.ndarray | None = None,
+    label_z_m: float | None = None,
 ) -> None:
     """The callouts as labelled points (``path``; the text in its colour darkened to be read on the label's pale
     background, ``colors.readable_text``: a truck's light cyan was not) and leader lines (``path/leaders``, in the
     colour itself) at the current time; an empty list clears both. ``view_x_m`` / ``view_y_m``: the x / y range
     the bird's-eye view shows; ``clear_xy_m`` (M, 2): the corners of the boxes the column keeps clear of
-    (``column_positions``)."""
+    (``column_positions``). The labels lie in one plane, ``label_z_m`` high (the height the column is sized for;
+    None: the highest anchor's), and each leader runs from its anchor up or down to it: a label at its own anchor's
+    height stood nearer the eye or further from it than its neighbours, so rows of one column showed unevenly
+    spaced and two touched (demo scene-0103 pointpillars, gnnpmb beside pmbm, ``--focus miss:2``: "m1 0.75 → track
+    76" over "evaluation range for car: 50 m", the detection's box 0.9 m above the circle)."""
     anchors = np.array([c.anchor_m for c in callouts], dtype=np.float64).reshape(-1, 3)
     chars = np.array([len(c.text) for c in callouts], dtype=np.int64)
     xy = column_positions(anchors[:, :2], chars, height_m, view_x_m, view_y_m, clear_xy_m)
-    labels_at = np.concatenate([xy, anchors[:, 2:]], axis=1)
-    ends = np.concatenate([leader_ends(anchors[:, :2], xy, chars, height_m), anchors[:, 2:]], axis=1)
+    z = np.full((len(anchors), 1), label_z_m if label_z_m is not None else np.max(anchors[:, 2], initial=0.0))
+    labels_at = np.concatenate([xy, z], axis=1)
+    ends = np.concatenate([leader_ends(anchors[:, :2], xy, chars, height_m), z], axis=1)
     colors = np.array([c.color for c in callouts], dtype=np.uint8).reshape(-1, 3)
     text_colors = np.array([readable_text(c.color) for c in callouts], dtype=np.uint8).reshape(-1, 3)
     stream.log(

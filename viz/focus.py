@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Collection, Mapping
+from collections.abc import Collection, Mapping, Sequence
 
 import numpy as np
 import rerun as rr
@@ -32,18 +32,28 @@ from gnnpmb.eval.failures import FailureReport, short_id
 from gnnpmb.focus import FocusTarget
 from gnnpmb.focus_cameras import FocusSight
 from gnnpmb.pipeline import FrameResult
-from gnnpmb.types import Boxes
+from gnnpmb.types import Boxes, TrackEstimate
 from gnnpmb.why.facts import TrackerFacts, TrackStep, UseMode, Went
 from gnnpmb.why.findings import Finding
 from gnnpmb.why.words import existence_text, plain, share_text, went_text, why_lines
 from viz import compare, paths
 from viz.blueprint import (
+    focus_axis_frames,
     focus_doc,
     focus_eye_height_m,
+    focus_perspective_eye,
     focus_world,
     reading_guide_doc,
 )
-from viz.callouts import FOCUS_VIEW_WIDTH_PX, FOV_Y_DEG, M_PER_PX_PER_HEIGHT, Callout, focus_height_m, log_callouts
+from viz.callouts import (
+    FOCUS_VIEW_WIDTH_PX,
+    FOV_Y_DEG,
+    M_PER_PX_PER_HEIGHT,
+    Callout,
+    focus_height_m,
+    focus_views_px,
+    log_callouts,
+)
 from viz.colors import CLASS_COLORS, GREY, class_ids, faded, pack_rgba
 from viz.evaluated import (
     evaluated_offsets,
@@ -62,8 +72,9 @@ from viz.geometry import (
     rerun_boxes,
     size_wlh_to_xyz,
 )
-from viz.label_size import CLEARANCE_PX
-from viz.legend import COMPARISON_PLOT_HEIGHT_PX, FOCUS_PAST_FRAMES, LegendPlacement, existence_range, place_legend
+from viz.label_room import Eye, keep_clear
+from viz.label_size import CLEARANCE_PX, text_box
+from viz.legend import COMPARISON_PLOT_HEIGHT_PX, LegendPlacement, existence_range, place_legend
 from viz.logger import TrackerLogger
 from viz.markers import send_text_lines
 from viz.reading_guide import READING_GUIDE
@@ -118,6 +129,8 @@ def log_focus(
     unannotated = unannotated_evaluated(focus, failure_report)
     reach_m = range_near_focus(focus, scene)
     eye_height_m = focus_eye_height_m(focus.class_name, len(loggers), sight is not None)
+    eyes = focus_eyes(focus, len(loggers), sight is not None)
+    named_gt = named_in_view(named_gt, scene.keyframes[focus.frame_index].gt, eyes[0])
     for i in shown:
         keyframe = scene.keyframes[i]
         clock.set(stream, i, keyframe.timestamp_us)
@@ -173,6 +186,7 @@ def log_focus(
                 continue
             chosen = [e for e in frame.estimates if e.track_id in ids]
             palette = loggers[tracker].involved_rgb
+            id_callouts = log_track_ids(stream, tracker, chosen, palette, eyes)
             boxes = estimate_boxes(chosen)
             stream.log(
                 tracker_focus(tracker),
@@ -218,15 +232,25 @@ def log_focus(
                 stream,
                 paths.focus_callouts(tracker),
                 gt_callouts
-                + _detection_callouts(detections, sorted(given), facts, i, focus.class_name, mode)
+                + _detection_callouts(
+                    detections,
+                    sorted(given),
+                    facts,
+                    i,
+                    focus.class_name,
+                    mode,
+                    {e.track_id for e in frame.estimates},
+                )
                 + _prediction_callouts(
                     steps, z_m, palette, facts.has_existence, mode, _said(given, facts, i, focus.class_name, mode)
                 )
-                + ghosts,
+                + ghosts
+                + id_callouts,
                 height_m,
                 view_x_m,
                 view_y_m,
                 np.concatenate(named),
+                label_z_m=z_m,
             )
         if meas and detections is not None:
             given = sorted(meas)
@@ -253,6 +277,64 @@ def log_focus(
             log_evaluated(stream, focus, scene, evaluated if i == focus.frame_index else {})
 
 
+def focus_eyes(focus: FocusTarget, runs: int, camera: bool) -> tuple[Eye, Eye]:
+    """The bird's-eye and perspective cameras of a focus recording (``viz.blueprint``), global, at the sizes its
+    layout gives them at 1920 x 1080 (``viz.callouts.focus_views_px``)."""
+    x, y = focus.center_xy_m
+    (bev_w, bev_h), (persp_w, persp_h) = focus_views_px(runs, camera)
+    position, target = focus_perspective_eye(focus)
+    return (
+        Eye((x, y, focus_eye_height_m(focus.class_name, runs, camera)), (x, y, 0.0), (0.0, 1.0, 0.0), bev_h, bev_w),
+        Eye(position, target, (0.0, 0.0, 1.0), persp_h, persp_w),
+    )
+
+
+def log_track_ids(
+    stream: rr.RecordingStream,
+    tracker: str,
+    estimates: Sequence[TrackEstimate],
+    palette: Mapping[int, tuple[int, int, int]],
+    eyes: Sequence[Eye],
+) -> list[Callout]:
+    """Whether each involved track drawn at the current frame (``estimates``) shows its id on its box, said at every
+    frame (a value logged once holds until the next one); returns the callouts (``track 164``, in the track's
+    ``palette`` colour) of the ids ``crowded_ids`` takes off their boxes."""
+    crowded = crowded_ids(estimates, eyes)
+    for e in estimates:
+        shown = rr.Boxes3D.from_fields(show_labels=e.track_id not in crowded)
+        stream.log(paths.track(tracker, e.class_name, e.track_id), shown)
+    return [
+        Callout(tuple(e.translation_m), f"track {e.track_id}", palette[e.track_id])
+        for e in estimates
+        if e.track_id in crowded
+    ]
+
+
+def crowded_ids(estimates: Sequence[TrackEstimate], eyes: Sequence[Eye]) -> set[int]:
+    """The ids of the involved tracks ``estimates`` (one frame's) whose id labels, drawn centred under their box
+    centres, would cover another's or run past a view's edge in one of ``eyes``: their ids go to the callout column
+    (``track 164``), which keeps its labels apart, and off their boxes. Two tracks on one object printed one id over
+    the other: demo scene-0103 pointpillars immortal ``--focus id_switch:1``, "2" under "164" in the perspective
+    view at frames 11-15; dev set scene-0103 cphd ``--focus identity_theft:1``, "23" and "40" in both views at
+    frame 13."""
+    out: set[int] = set()
+    for eye in eyes:
+        boxes = []
+        for e in estimates:
+            at = eye.screen_px(np.asarray(e.translation_m, dtype=np.float64))
+            if at is None:
+                continue
+            box = text_box(str(e.track_id), *at)
+            if eye.cuts(box, at):
+                out.add(e.track_id)
+            boxes.append((e.track_id, box))
+        for k, (a, ra) in enumerate(boxes):
+            for b, rb in boxes[k + 1 :]:
+                if not keep_clear([(0, a, ra), (0, b, rb)]) >= {a, b}:
+                    out |= {a, b}
+    return out
+
+
 def named_objects(text: str, gt: Boxes, involved: Collection[str]) -> list[str]:
     """The ids of the annotations of ``gt`` (one keyframe's) that a finding's Why ``text`` names ("... lay 0.3 m
     from pedestrian GT 9d0a73") but that are not ``involved``: the view labels every object the text points to,
@@ -262,6 +344,20 @@ def named_objects(text: str, gt: Boxes, involved: Collection[str]) -> list[str]:
         return []
     ids = [str(t) for t in gt.instance_id]
     return [t for t in ids if t not in involved and re.search(rf"\bGT {re.escape(short_id(t))}\b", text)]
+
+
+def named_in_view(named: Sequence[str], gt: Boxes, eye: Eye) -> list[str]:
+    """The ids of ``named`` (annotations of ``gt``, one keyframe's) whose centre the bird's-eye ``eye`` shows. The
+    Why names an object of another frame too ("at frame 15 truck m4 ... lay 0.4 m from truck GT 9da03c"); where it
+    has gone by the failure's frame, out of the view, its label only led a line across the view and out of it (demo
+    scene-0103 ``--tracker gnnpmb:gnnpmb/params/paper.toml --tracker gnnpmb --focus diff:fixed:1``: GT 9da03c 21 m
+    away at frame 24)."""
+    out = []
+    for t, xyz in zip(gt.instance_id.astype(str).tolist(), gt.translation_m, strict=True):
+        at = eye.screen_px(np.asarray(xyz, dtype=np.float64)) if t in named else None
+        if at is not None and abs(at[0]) <= 0.5 * eye.width_px and abs(at[1]) <= 0.5 * eye.height_px:
+            out.append(t)
+    return out
 
 
 def named_detections(finding: Finding | None, text: str, frame: int) -> set[int]:
@@ -375,7 +471,7 @@ def focus_legends(
             if root == paths.existence_root(tracker):
                 tracks = [logger.sent_series[p] for p in series[:-1] if p in logger.sent_series]  # not the threshold
                 fixed = existence_range([v[f <= last] for f, v in tracks])
-            out[root] = place_legend(lines, len(sent), y_range=fixed, past_frames=FOCUS_PAST_FRAMES)
+            out[root] = place_legend(lines, len(sent), y_range=fixed, x_range=focus_axis_frames(focus))
     if comparison is not None:
         frames = np.asarray(comparison.frame_indices)
         upto = frames <= last
@@ -385,14 +481,30 @@ def focus_legends(
 
 
 def _detection_callouts(
-    detections: Boxes, given: list[int], facts: TrackerFacts, frame: int, class_name: str, mode: UseMode
+    detections: Boxes,
+    given: list[int],
+    facts: TrackerFacts,
+    frame: int,
+    class_name: str,
+    mode: UseMode,
+    output: Collection[int] | None = None,
 ) -> list[Callout]:
     """``m<idx> <score> → <where it went>`` at each detection ``given`` (indices into the frame's detections;
-    where it went: ``why.facts.Destination``, in the tracker's terms)."""
+    where it went: ``why.facts.Destination``, in the tracker's terms), ``, not output`` after a track the run did
+    not output at that frame (``output``: the ids it did; None: not known): "m1 0.85 → track 103" pointed at no
+    box, for 103 was a tentative track, first output a frame later (dev set scene-0916 centerpoint, gnn beside
+    ab3dmot ``--focus id_switch:1``, ab3dmot's view)."""
     out = []
     for m in given:
         d = facts.destination(frame, class_name, m)
         went = f" {went_text(d, mode)}" if d is not None else ""
+        if (
+            d is not None
+            and output is not None
+            and d.went in (Went.TRACK, Went.NEW_TRACK)
+            and mode is not UseMode.OUTPUT
+        ):
+            went += ", not output" if d.track_id not in output else ""
         out.append(
             Callout(
                 tuple(detections.translation_m[m]),

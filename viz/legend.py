@@ -88,13 +88,17 @@ def place_legend(
     plot_height_px: float = PLOT_HEIGHT_PX,
     y_range: tuple[float, float] | None = None,
     past_frames: int = 0,
+    x_range: tuple[float, float] | None = None,
 ) -> LegendPlacement:
     """The corner for the legend of a plot of ``lines`` ((K,) x, (K,) y each; NaN values are gaps): the first
     of ``CORNER_ORDER`` whose legend box no line passes through. If there is none: with a fixed ``y_range``
     (e.g. a probability's [0, 1]) the corner that covers the fewest line samples (those at the last frame count
     ``LAST_FRAME_WEIGHT`` times); else the top right with a y range whose upper part is left free for it.
     ``n_entries``: legend rows (default: one per line); ``past_frames``: the plot's x axis runs this many frames
-    past the lines' last x (``FOCUS_PAST_FRAMES``)."""
+    past the lines' last x (``FOCUS_PAST_FRAMES``); ``x_range``: the x axis's own range when the view sets one (it
+    then replaces the lines' range and ``past_frames``): a focus near the scene's start shows frames 0-9 for lines
+    of frames 0-3, and a legend placed for 0-4 hid the two lines it named at the top of the plot (demo scene-9001
+    cphd ``--focus identity_theft:1``, tracks 4 and 7)."""
     drawn = [(np.asarray(x, np.float64), np.asarray(y, np.float64)) for x, y in lines]
     drawn = [(x[np.isfinite(y)], y[np.isfinite(y)]) for x, y in drawn]
     drawn = [(x, y) for x, y in drawn if x.size]
@@ -104,6 +108,8 @@ def place_legend(
     x_lo = min(float(x.min()) for x, _ in drawn)
     last = max(float(x.max()) for x, _ in drawn)
     x_hi = last + past_frames
+    if x_range is not None:
+        x_lo, x_hi = x_range
     if y_range is None:
         y_lo = min(float(y.min()) for _, y in drawn)
         y_hi = max(float(y.max()) for _, y in drawn)

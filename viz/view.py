@@ -239,6 +239,10 @@ def run_view(
                 finding = explain_focus(inputs, focus, evidence, first_frame=shown.start)
                 log_focus(stream, focus, scene, tracker_views(evidence, loggers), loggers, clock, shown, finding, sight)
                 legends = focus_legends(focus, loggers, comparison.within(shown) if comparison is not None else None)
+                quiet = comparison is not None and not any(
+                    d.class_name == focus.class_name and d.frame_index <= focus.frame_index
+                    for d in comparison.within(shown).disagreements
+                )
                 stream.send_blueprint(
                     default_blueprint(
                         inputs.trackers,
@@ -248,6 +252,7 @@ def run_view(
                         inputs.caps,
                         cameras=channels,
                         focus_camera=sight.best_channel if sight is not None else None,
+                        focus_class_quiet=quiet,
                     ),
                     make_active=True,
                     make_default=True,

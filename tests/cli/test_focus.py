@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import re
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -20,7 +21,7 @@ from tests.pipeline import PMBM_ALL, PMBM_NO_NSCAN, POSITION_ONLY, evidence_of_a
 from tests.viz.rrd import read_rows
 from tests.viz.test_blueprint import stored_views
 from viz import compare, paths
-from viz.blueprint import FOCUS_TIMELINE, focus_doc, focus_world, reading_guide_doc
+from viz.blueprint import FOCUS_TIMELINE, focus_axis_frames, focus_doc, focus_world, reading_guide_doc
 from viz.evaluated import evaluated_world
 from viz.focus import predicted_ghosts
 from viz.legend import LOW_EXISTENCE, PROBABILITY_RANGE, existence_range, place_legend
@@ -127,7 +128,8 @@ def test_focus_on_a_failure_id_opens_at_its_frame_looking_at_it(demo_dataroot: P
         for points in ([r for r in rows[p] if r.get("focus") is not None] for p in shown)
     ]
     expected = existence_range([v for _, v in lines[:-1]])  # the tracks' values, not the threshold line
-    placed = place_legend(lines, len(shown), y_range=expected)
+    axis = focus_axis_frames(SimpleNamespace(frame_index=failure.frame_index))  # the plot's x axis on opening
+    placed = place_legend(lines, len(shown), y_range=expected, x_range=axis)
     corner, y_range = stored_legends(bp)["gnnpmb existence"]
     assert corner == placed.corner.value
     assert y_range == pytest.approx(expected)

@@ -212,3 +212,32 @@ def test_a_focus_plot_opens_nine_frames_wide_and_never_before_the_first_frame(fr
         assert axis.field("start").type_codes.to_pylist() == [absolute]
         assert axis.field("end").type_codes.to_pylist() == [cursor_relative]
         assert (axis.field("start").to_pylist(), axis.field("end").to_pylist()) == ([start], [end])
+
+
+def test_a_focus_comparisons_plot_says_it_counts_every_class(tmp_path: Path) -> None:
+    """With a focus the disagreement log opens on the focused class, the plot counts every class: its name says so
+    (demo scene-9001 pmbm beside gnnpmb ``--focus coalescence:2``: "1" at the failure frame, a car track, beside an
+    empty log of bicycles)."""
+    from gnnpmb.focus import FocusTarget
+
+    focus = FocusTarget("t", 19, (0.0, 0.0), "bicycle", {"pmbm": (1,), "gnnpmb": (2,)}, ("abc",))
+    out = tmp_path / "bp.rrd"
+    stream = open_recording("bp", out, default_blueprint(["pmbm", "gnnpmb"], ["bicycle", "car"], focus))
+    close_recording(stream, out)
+    stored = stored_views(out)
+    assert stored["disagreements per frame (every class)"] == ("TimeSeries", compare.counts_root())
+    assert stored["disagreements (bicycle)"] == ("TextLog", compare.focus_log_path())
+
+
+def test_a_focus_with_no_disagreement_of_its_class_opens_the_whole_disagreement_log() -> None:
+    """The runs disagreed about a car, not about the focused bicycles: the log of bicycles was an empty panel beside
+    a plot counting 1 (demo scene-9001 pmbm beside gnnpmb ``--focus coalescence:2``). It opens on the whole log,
+    which holds what the plot counts; with a disagreement of the class, on the class's."""
+    from gnnpmb.focus import FocusTarget
+
+    focus = FocusTarget("t", 19, (0.0, 0.0), "bicycle", {"pmbm": (1,), "gnnpmb": (2,)}, ("abc",))
+    for quiet, name in ((True, "disagreements"), (False, "disagreements (bicycle)")):
+        bp = default_blueprint(["pmbm", "gnnpmb"], ["bicycle", "car"], focus, focus_class_quiet=quiet)
+        comparison = bp.root_container.contents[0].contents[1]  # the left column: the scene, the comparison
+        (logs,) = [c for c in comparison.contents if isinstance(c, rrb.Tabs)][1:]
+        assert logs.contents[logs.active_tab].name == name

@@ -262,3 +262,23 @@ def test_a_sparse_birds_eye_view_counts_as_rendered() -> None:
         img[y + 30, x : x + 42] = rng.integers(0, 256, (42, 3))
     stats = region_stats(img, (0, 0, 800, 400))
     assert 0.005 < stats.foreground_fraction < 0.02 and stats.rendered
+
+
+@pytest.mark.parametrize("runs", [1, 2, 3])
+def test_the_check_looks_at_as_many_views_as_the_recording_lays_side_by_side(tmp_path: Path, runs: int) -> None:
+    """``python -m tools.webcheck FILE.rrd`` checked two views whatever the file: on a one-run recording the right
+    half of its bird's-eye view counted as a second view, which on the dev set (no LiDAR) never looked rendered
+    (dev set scene-0103 cphd ``--focus identity_theft:1``: 424 s, NOT ready). It now reads the blueprint's."""
+    import rerun as rr
+
+    from gnnpmb.focus import FocusTarget
+    from tools.webcheck import runs_side_by_side
+    from viz.blueprint import default_blueprint
+
+    trackers = ["gnnpmb", "pmbm", "cphd"][:runs]
+    for focus in (None, FocusTarget("t", 5, (0.0, 0.0), "car", {t: (1,) for t in trackers}, ("abc",))):
+        path = tmp_path / f"bp-{focus is None}.rrd"
+        stream = rr.RecordingStream("webcheck-views-test")
+        stream.save(path, default_blueprint=default_blueprint(trackers, ["car"], focus))
+        stream.disconnect()
+        assert runs_side_by_side(path) == runs

@@ -95,3 +95,25 @@ def test_an_existence_plot_of_tracks_that_all_stay_low_is_zoomed_to_them() -> No
     assert low == pytest.approx((PROBABILITY_RANGE[0] * 0.07, PROBABILITY_RANGE[1] * 0.07))
     assert existence_range([np.zeros(3)]) == pytest.approx((PROBABILITY_RANGE[0] * 0.01, PROBABILITY_RANGE[1] * 0.01))
     assert existence_range([]) == PROBABILITY_RANGE
+
+
+def test_near_the_scenes_start_the_legend_is_placed_for_the_axis_the_view_shows() -> None:
+    """A focus at frame 3 shows frames 0-9 (``viz.blueprint.focus_axis_frames``): placed for the lines' own 0-4,
+    the legend went top left, where in the real plot it hid the two lines it named near 1.0 at frames 1-3 (demo
+    scene-9001 cphd ``--focus identity_theft:1``, tracks 4 and 7); placed for the axis, it avoids them."""
+    from types import SimpleNamespace
+
+    from viz.blueprint import focus_axis_frames
+
+    axis = focus_axis_frames(SimpleNamespace(frame_index=3))
+    assert axis == (0, 9)
+    lines = [
+        (np.array([0.0, 1.0, 2.0, 3.0]), np.array([0.18, 0.33, 0.30, 0.04])),  # track 2's weight
+        (np.array([1.0, 2.0, 3.0]), np.array([0.69, 1.0, 1.0])),  # track 4's, capped at 1
+        (np.array([2.0, 3.0]), np.array([0.73, 1.0])),  # track 7's
+        (np.array([0.0, 1.0, 2.0, 3.0]), np.full(4, 0.5)),  # the threshold line
+    ]
+    placed = place_legend(lines, 4, y_range=PROBABILITY_RANGE, x_range=axis)
+    assert placed.corner == rrb.components.Corner2D.RightTop  # frames 4-9 of the plot hold no line
+    for_data = place_legend(lines, 4, y_range=PROBABILITY_RANGE, past_frames=1)  # as placed before, for 0-4
+    assert for_data.corner == rrb.components.Corner2D.LeftTop  # where lines 4 and 7 run in the real plot

@@ -438,3 +438,40 @@ def test_a_phd_component_lighter_than_another_of_its_label_says_whose_it_is() ->
     ]
     pmb = SimpleNamespace(existence_word="existence")
     assert TrackerLogger._point_labels(pmb, "candidate %d, {}=%.3f", raw)[0] == "candidate 29, r=0.140"
+
+
+def test_a_phd_tracks_association_line_starts_at_its_heaviest_component(
+    saved_stream: tuple[rr.RecordingStream, Path],
+) -> None:
+    """A GM-PHD label predicted as two components (w 0.32 at x 10, w 0.004 at x 14, listed last) used m0: its
+    line starts where its predicted point ("8 predicted w=0.32") stands, at the heaviest component. It started at
+    the last one listed: dev set scene-0103 cphd ``--focus identity_theft:1``, "m0 → 23" ran from a component of
+    weight 0.004, 6 m from 23's predicted point and its focus label."""
+    from gnnpmb.events import UpdateWeights
+
+    stream, path = saved_stream
+    mean = np.array([[10.0, 2.0, 0.0, 0.0], [14.0, 2.0, 0.0, 0.0]])
+    cov = np.tile(np.eye(4), (2, 1, 1))
+    events = [
+        frame(0),
+        received([10.5]),
+        Predicted("car", np.array([8, 8]), mean, cov, np.array([0.32, 0.004])),
+        UpdateWeights(
+            "car",
+            np.array([8]),
+            np.array([0]),
+            np.array([0.324]),
+            np.array([0.1]),
+            np.array([[0.224]]),
+            np.array([0.01]),
+        ),
+        Posterior("car", np.array([8]), mean[:1], cov[:1], np.array([0.3])),
+        Extracted("car", (), 0.5),
+    ]
+    log_all(stream, events, focus_tracks={8}, has_existence=True, existence_word="weight")
+    stream.disconnect()
+    rows = read_rows(path)
+    (line,) = latest_at(rows[paths.associations(T, "car")], 0, "LineStrips3D:strips")
+    labels = latest_at(rows[paths.predicted_focus(T, "car")], 0, "Points3D:labels")
+    assert labels[0] == "8 predicted w=0.32"
+    np.testing.assert_allclose(np.array(line)[0, :2], [10.0, 2.0])  # the heaviest component's mean
