@@ -1211,7 +1211,8 @@ def _no_box_reason(g: GtFrame | None) -> str:
         return "it is not annotated here"
     if g.status is GtStatus.BEYOND_RANGE:
         return (
-            f"it lies {g.ego_distance_m:.2f} m from the ego vehicle, beyond the evaluation's {g.range_m:g} m range, "
+            f"it lies {ego_distance_text(g.ego_distance_m, g.range_m, 2)} m from the ego vehicle, beyond the "
+            f"evaluation's {g.range_m:g} m range, "
             "and it keeps no box of it both before and after this frame"
         )
     why = f"it had {g.dropped.value}" if g.dropped is Dropped.NO_POINTS else f"it was {g.dropped.value}"
@@ -1241,11 +1242,19 @@ def _not_counted_on_it(f: Finding, s: Sighting) -> list[str]:
     ]
 
 
+BIKE_RACK_CLASSES = ("bicycle", "motorcycle")
+"""The classes whose boxes the devkit's ``filter_eval_boxes`` drops inside a bike rack; every other class's box it
+drops only beyond the class range (a prediction has no point count to filter on)."""
+
+
 def _dropped_on_it(f: Finding, s: Sighting) -> list[str]:
-    """The tracks output on the object whose box there the evaluation's range or bike-rack filter dropped."""
+    """The tracks output on the object whose box there the evaluation's range or bike-rack filter dropped; the
+    bike rack is named only for a bicycle or motorcycle (audit truth53, world9: "(or in a bike rack)" of a car or
+    pedestrian track, a filter the devkit never applies to them)."""
+    rack = " (or in a bike rack)" if f.class_name in BIKE_RACK_CLASSES else ""
     return [
-        f"track {o.track_id} was output on it, but its box lies beyond the evaluation's range for the class (or in a "
-        "bike rack): the evaluation dropped that box"
+        f"track {o.track_id} was output on it, but its box lies beyond the evaluation's range for the class{rack}: "
+        "the evaluation dropped that box"
         for o in s.on_it
         if o.evaluated is not None and f.frame not in o.evaluated.kept and f.frame in o.evaluated.submitted
     ]
@@ -1359,9 +1368,21 @@ def _miss(f: Finding) -> list[str]:
     if g is not None and abs(g.ego_distance_m - g.range_m) <= 5.0:
         side = "inside" if g.ego_distance_m < g.range_m else "beyond"
         parts.append(
-            f"it lies {g.ego_distance_m:.1f} m from the ego vehicle, {side} the evaluation's {g.range_m:g} m range"
+            f"it lies {ego_distance_text(g.ego_distance_m, g.range_m)} m from the ego vehicle, {side} the "
+            f"evaluation's {g.range_m:g} m range"
         )
     return parts
+
+
+def ego_distance_text(distance_m: float, range_m: float, decimals: int = 1) -> str:
+    """The distance to one decimal, or to as many as it takes (up to 3) not to print the range itself: ``39.98``
+    beside a 40 m range, not ``40.0`` (audit truth53, world9: "it lies 40.0 m from the ego vehicle, inside the
+    evaluation's 40 m range" beside a track box there "beyond the evaluation's range")."""
+    for nd in range(decimals, max(decimals, 3) + 1):
+        text = f"{distance_m:.{nd}f}"
+        if float(text) != range_m:
+            return text
+    return text
 
 
 def _of_its_own(s: Sighting) -> str:

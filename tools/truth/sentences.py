@@ -272,6 +272,21 @@ def check_text(
         _check_twins(
             text, ctx.frame, scene, (raw.received(ctx.frame, c) or None) if raw is not None else None, out, bad
         )
+    for m in BIKE_RACK.finditer(text):  # audit truth53 (world9): the devkit's bike-rack filter is for two-wheelers
+        out.checked["misleading"] += 1
+        two_wheeler = c in ("bicycle", "motorcycle")
+        if two_wheeler != (m[2] is not None):
+            bad(
+                "misleading",
+                m[0],
+                f"the devkit drops a {c} box {'in a bike rack too' if two_wheeler else 'only beyond the class range'}",
+            )
+        box = next((xy for t, _, xy in ev.boxes.get(ctx.frame, []) if t == m[1]), None)
+        if scene is not None and scene.ego_xy_m is not None and box is not None and not two_wheeler:
+            out.checked["evaluation"] += 1
+            d = math.dist(box, scene.ego_xy_m[ctx.frame])
+            if d < detector.RANGE_M[c]:
+                bad("evaluation", m[0], f"track {m[1]}'s box lies {d:.2f} m from the ego pose, inside the {c} range")
     for phrase in VIEWER_ONLY:
         if phrase in text:
             out.checked["misleading"] += 1
@@ -519,6 +534,11 @@ DRIFTED = re.compile(
     r"; that one is beyond the evaluation's \d+ m range here, so it has no box for it)?"
 )
 """A false track's box that ran off the object of its class it had been on (``FalseOutput.drifted_from``)."""
+BIKE_RACK = re.compile(
+    r"track (\d+) was output on it, but its box lies beyond the evaluation's range for the class( \(or in a bike "
+    r"rack\))?"
+)
+"""A track's box the devkit's filters dropped: beyond the class range, or (a bicycle or motorcycle) in a bike rack."""
 DRIFT_LOOKBACK = 8
 """Frames before a false track's failure in which its box within 2 m of an object of its class counts as having
 been on that object (a finding's window, ``why.findings.FRAMES_BEFORE``)."""

@@ -1,0 +1,44 @@
+"""The evaluation's class range in words (audit truth53, world9: a pedestrian and a bicycle crossing the 40 m range,
+parked cars at 50 m). world9 scene-0103 centerpoint gnnpmb miss at frame 7 said of car GT a46079 "track 15 was
+output on it, but its box lies beyond the evaluation's range for the class (or in a bike rack): ...; it lies 50.0 m
+from the ego vehicle, inside the evaluation's 50 m range": the devkit's bike-rack filter never drops a car's box, and
+"50.0 m, inside the 50 m range" beside a box "beyond" it tells neither side."""
+
+from __future__ import annotations
+
+from gnnpmb.eval.evaluated import GtFrame, GtStatus, TrackEval
+from gnnpmb.eval.failures import FailureKind
+from gnnpmb.why.findings import Blame, OnObject, Rule, Sighting
+from gnnpmb.why.words import why_lines
+from tests.gnnpmb.why.test_finding_words import GT, finding
+
+
+def dropped_miss(class_name: str, ego_m: float, reach_m: float) -> str:
+    """A miss at frame 13 of an object ``ego_m`` from the ego vehicle, with track 15's box on it dropped by the
+    evaluation's filters (output at frame 13, not kept there)."""
+    g = GtFrame(13, GtStatus.SCORED, (0.0, 0.0), (0.0, 0.0), None, 40, ego_m, reach_m)
+    ev = TrackEval((12, 13), (12,), (), 0.6, 0.6)
+    s = Sighting(13, 40, g, None, None, None, (OnObject(15, 0.1, 0.6, -1, ev, 0.3),))
+    f = finding(
+        FailureKind.MISS, class_name=class_name, gt_id=GT, sightings=(s,), blame=(Blame(Rule.TRACK_DROPPED, (13,)),)
+    )
+    return why_lines(f)[0]
+
+
+def test_a_bike_rack_is_named_only_for_the_classes_its_filter_drops() -> None:
+    car = dropped_miss("car", 49.97, 50.0)
+    assert "track 15 was output on it, but its box lies beyond the evaluation's range for the class: the " in car
+    assert "bike rack" not in car
+    bike = dropped_miss("bicycle", 39.0, 40.0)
+    assert "beyond the evaluation's range for the class (or in a bike rack): the evaluation dropped" in bike
+
+
+def test_a_distance_at_the_range_is_printed_with_the_decimals_that_tell_its_side() -> None:
+    assert "it lies 49.97 m from the ego vehicle, inside the evaluation's 50 m range" in dropped_miss("car", 49.97, 50)
+    assert "it lies 40.04 m from the ego vehicle, beyond the evaluation's 40 m range" in dropped_miss(
+        "pedestrian", 40.04, 40
+    )
+    assert "it lies 47.3 m from the ego vehicle" in dropped_miss("car", 47.31, 50)  # one decimal where it tells
+    from gnnpmb.why.words import ego_distance_text
+
+    assert ego_distance_text(39.9996, 40.0) == "40.000"  # at most three: the side is in the words beside it

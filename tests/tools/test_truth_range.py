@@ -1,0 +1,36 @@
+"""The oracle on the evaluation's class range (audit truth53, world9: a pedestrian and a bicycle crossing the 40 m
+range, parked cars at 50 m): the old explainer's "(or in a bike rack)" of a car track's dropped box, and "it lies
+50.0 m from the ego vehicle, inside the evaluation's 50 m range", passed the oracle unflagged."""
+
+from __future__ import annotations
+
+from tools.truth.devkit import EvalFacts
+from tools.truth.scene import Annotation, SceneTruth
+from tools.truth.sentences import Context, check_text
+
+CAR = "a46079" + "0" * 26
+
+
+def _kinds(text: str, class_name: str = "car", ego_m: float = 49.97, box_m: float = 50.02) -> list[str]:
+    """Frame 3: the object ``ego_m`` from the ego (at the origin), track 15's box ``box_m`` from it."""
+    scene = SceneTruth([[]] * 4, [{CAR: Annotation(class_name, (ego_m, 0.0), 60)}] * 4, [(0.0, 0.0)] * 4)
+    ev = EvalFacts(thresholds={class_name: 0.3})
+    ev.boxes[3] = [("15", class_name, (box_m, 0.0))]
+    return [c.kind for c in check_text(text, Context(class_name, 3, CAR, kind="miss"), None, ev, scene=scene).found]
+
+
+def test_a_bike_rack_offered_for_a_class_its_filter_never_drops_is_caught() -> None:
+    # world9 scene-0103 centerpoint gnnpmb miss at frame 7, car GT a46079
+    said = "track 15 was output on it, but its box lies beyond the evaluation's range for the class"
+    assert _kinds(f"{said} (or in a bike rack): the evaluation dropped that box") == ["misleading"]
+    assert _kinds(f"{said}: the evaluation dropped that box") == []
+    assert _kinds(f"{said}: the evaluation dropped that box", box_m=49.5) == ["evaluation"]  # inside: not dropped
+    bike = f"{said} (or in a bike rack): the evaluation dropped that box"
+    assert _kinds(bike, "bicycle", 39.0, 39.5) == []  # a bicycle's box may lie in a rack inside the range
+
+
+def test_a_distance_printed_as_the_range_itself_is_caught() -> None:
+    inside = "it lies {} m from the ego vehicle, inside the evaluation's 50 m range"
+    assert _kinds(inside.format("50.0")) == ["misleading"]
+    assert _kinds(inside.format("49.97")) == []
+    assert _kinds(inside.format("49.9")) == ["detector"]  # 49.97 to one decimal is 50.0, not 49.9
