@@ -1174,6 +1174,11 @@ def _drifted_text(f: Finding, o: FalseOutput, box: str) -> str:
         unseen = f"; the evaluation has no box for that one here ({_no_box_reason(g)})"
     elif g.status is GtStatus.BEYOND_RANGE:
         unseen = f"; that one is beyond the evaluation's {g.range_m:g} m range here, so it has no box for it"
+    if x == f.frame:  # the track's own box here, dropped by the evaluation, lay on it (``drifted_off``)
+        return (
+            f": the box the evaluation interpolated lies {d:.1f} m from {f.class_name} GT {short_id(gt_id)}, though "
+            f"the track's own box here, the one the evaluation dropped, lay within {NEAR_M:.0f} m of it{unseen}"
+        )
     return (
         f": the track's {box} lies {d:.1f} m from {f.class_name} GT {short_id(gt_id)}, which it was last within "
         f"{NEAR_M:.0f} m of at frame {x}{unseen}"

@@ -34,3 +34,27 @@ def test_a_distance_printed_as_the_range_itself_is_caught() -> None:
     assert _kinds(inside.format("50.0")) == ["misleading"]
     assert _kinds(inside.format("49.97")) == []
     assert _kinds(inside.format("49.9")) == ["detector"]  # 49.97 to one decimal is 50.0, not 49.9
+
+
+def test_a_dropped_box_on_the_object_told_as_the_track_running_off_it_is_caught() -> None:
+    # world9 scene-0103 centerpoint gnnpmb false_track at frame 20: track 44's own box lay 0.2 m from pedestrian GT
+    # b37203 and was dropped (beyond the 40 m range); the box the devkit interpolated in its place lay 5.6 m off
+    ped = "b37203" + "0" * 26
+    scene = SceneTruth([[]] * 4, [{ped: Annotation("pedestrian", (0.0, 0.0), 30)}] * 4, [(40.0, 0.0)] * 4)
+    ev = EvalFacts(thresholds={"pedestrian": 0.3})
+    ev.boxes[2] = [("44", "pedestrian", (0.1, 0.0))]
+    ev.boxes[3] = [("44", "pedestrian", (0.2, 0.0))]
+    ev.pred_xy[("pedestrian", 3)] = {"44": (5.6, 0.0)}
+    ev.kept_frames["44"] = (2,)
+    ctx = Context("pedestrian", 3, None, kind="false_track", track=44)
+    nothing = "no object of a tracked class lies within 2 m of it"
+    old = f"{nothing}: the track's box lies 5.6 m from pedestrian GT b37203, which it was last within 2 m of at frame 2"
+    new = (
+        f"{nothing}: the box the evaluation interpolated lies 5.6 m from pedestrian GT b37203, though the track's own "
+        "box here, the one the evaluation dropped, lay within 2 m of it"
+    )
+    assert [c.kind for c in check_text(old, ctx, None, ev, scene=scene).found] == ["detector"]
+    assert check_text(new, ctx, None, ev, scene=scene).found == []
+    ev.kept_frames["44"] = (2, 3)  # kept there: the box the devkit scored is the track's own, and frame 2 is right
+    ev.boxes[3] = [("44", "pedestrian", (5.6, 0.0))]
+    assert check_text(old, ctx, None, ev, scene=scene).found == []
