@@ -1008,6 +1008,15 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
     head += short_id(f.gt_id or "")
     if off.scored_m is not None and off.scored_m < NEAR_M:  # yet within reach of the box the evaluation scored
         return f"{head}{on}, {off.scored_m:.1f} m from the box the evaluation interpolated for it{before}"
+    ev = lost.evaluated
+    if ev is not None and f.frame in ev.submitted and f.frame not in ev.kept and f.frame not in ev.interpolated:
+        # audit truth53 (world9 scene-1094 pointpillars gnnpmb id_switch:1): the devkit had no box of the track here
+        # at all (43.3 m from the ego, beyond the pedestrian range), so no distance decided the match
+        rack = " or in a bike rack" if f.class_name in BIKE_RACK_CLASSES else ""
+        return (
+            f"{head}{on}, but its box lay beyond the evaluation's range for the class{rack}: the evaluation dropped "
+            f"it and had no box of the track to match to the object{before}"
+        )
     return f"{head}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the object{before}"
 
 

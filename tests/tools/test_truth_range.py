@@ -58,3 +58,25 @@ def test_a_dropped_box_on_the_object_told_as_the_track_running_off_it_is_caught(
     ev.kept_frames["44"] = (2, 3)  # kept there: the box the devkit scored is the track's own, and frame 2 is right
     ev.boxes[3] = [("44", "pedestrian", (5.6, 0.0))]
     assert check_text(old, ctx, None, ev, scene=scene).found == []
+
+
+def test_a_dropped_lost_track_said_beyond_the_evaluations_2_m_is_caught() -> None:
+    # world9 scene-1094 pointpillars gnnpmb id_switch:1 (track 91's box at frame 30 43.3 m from the ego)
+    ped = "88761d" + "0" * 26
+    scene = SceneTruth([[]] * 4, [{ped: Annotation("pedestrian", (39.7, 0.0), 12)}] * 4, [(0.0, 0.0)] * 4)
+    ev = EvalFacts(thresholds={"pedestrian": 0.3})
+    ev.boxes[3] = [("91", "pedestrian", (43.3, 0.0))]
+    ev.submitted = {3: {"91"}}
+    ev.kept_frames["91"] = (1, 2)
+    ctx = Context("pedestrian", 3, ped, kind="id_switch")
+    head = "at frame 3 track 91 was output 3.6 m from GT 88761d"
+    old = f"{head}: beyond the evaluation's 2 m, so it no longer matched the object"
+    new = (
+        f"{head}, but its box lay beyond the evaluation's range for the class: the evaluation dropped it and had no "
+        "box of the track to match to the object"
+    )
+    assert [c.kind for c in check_text(old, ctx, None, ev, scene=scene).found] == ["evaluation"]
+    assert check_text(new, ctx, None, ev, scene=scene).found == []
+    ev.kept_frames["91"] = (1, 2, 3)
+    assert [c.kind for c in check_text(new, ctx, None, ev, scene=scene).found] == ["evaluation"]
+    assert check_text(old, ctx, None, ev, scene=scene).found == []

@@ -42,3 +42,24 @@ def test_a_distance_at_the_range_is_printed_with_the_decimals_that_tell_its_side
     from gnnpmb.why.words import ego_distance_text
 
     assert ego_distance_text(39.9996, 40.0) == "40.000"  # at most three: the side is in the words beside it
+
+
+def test_a_lost_track_whose_box_the_evaluation_dropped_is_not_said_to_be_beyond_its_2_m() -> None:
+    # world9 scene-1094 pointpillars gnnpmb id_switch:1: "at frame 30 track 91 was output 3.7 m from GT 88761d:
+    # beyond the evaluation's 2 m, so it no longer matched the object", though its box lay 43.3 m from the ego,
+    # beyond the pedestrian range: the devkit dropped it and had no box of the track there at all
+    from gnnpmb.why.findings import LostTrack, OffObject
+
+    def said(kept: tuple[int, ...], interpolated: tuple[int, ...] = ()) -> str:
+        ev = TrackEval((9, 10, 11, 12), kept, interpolated, 0.6, 0.6)
+        lost = LostTrack(91, 9, (), OffObject(3.7, -1, ()), ev, 0.3)
+        return why_lines(finding(FailureKind.ID_SWITCH, lost, class_name="pedestrian", frame=11))[0]
+
+    dropped = (
+        "at frame 11 track 91 was output 3.7 m from GT bf3d85, but its box lay beyond the evaluation's range for the "
+        "class: the evaluation dropped it and had no box of the track to match to the object"
+    )
+    assert dropped in said((9, 10))
+    beyond = "at frame 11 track 91 was output 3.7 m from GT bf3d85: beyond the evaluation's 2 m, so it no longer"
+    assert beyond in said((9, 10, 11))  # kept: the 2 m decided
+    assert beyond in said((9, 10, 12), (11,))  # interpolated between frames 10 and 12: a box of it was there
