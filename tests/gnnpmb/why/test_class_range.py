@@ -63,3 +63,23 @@ def test_a_lost_track_whose_box_the_evaluation_dropped_is_not_said_to_be_beyond_
     beyond = "at frame 11 track 91 was output 3.7 m from GT bf3d85: beyond the evaluation's 2 m, so it no longer"
     assert beyond in said((9, 10, 11))  # kept: the 2 m decided
     assert beyond in said((9, 10, 12), (11,))  # interpolated between frames 10 and 12: a box of it was there
+
+
+def test_a_box_interpolated_over_frames_beyond_the_range_is_not_noted_as_one_without_points() -> None:
+    # world9 scene-1094 pointpillars gnnpmb: "pedestrian GT 88761d (GT box interpolated by the evaluation: no
+    # points)" at frames 20-29, where it had 12 LiDAR points and lay 41-43 m from the ego, beyond the 40 m range
+    from gnnpmb.eval.evaluated import Dropped
+    from gnnpmb.eval.failures import Failure, FailureBox, _unannotated
+
+    box = FailureBox("missed gt", GT, (41.0, 0.0, 1.0), (0.6, 0.7, 1.8), (1.0, 0.0, 0.0, 0.0), interpolated=True)
+    miss = Failure(FailureKind.MISS, 13, "token", "pedestrian", (GT,), (), (box,))
+
+    def note(dropped: Dropped) -> str:
+        g = GtFrame(13, GtStatus.INTERPOLATED, (41.0, 0.0), (40.0, 0.0), dropped, 12, 41.0, 40.0)
+        marked = _unannotated(miss, {GT: {13: g}})
+        assert Failure.from_json(marked.to_json()) == marked
+        return marked.describe()
+
+    assert note(Dropped.BEYOND_RANGE).endswith("(GT box interpolated by the evaluation: beyond the class range)")
+    assert note(Dropped.NO_POINTS).endswith("(GT box interpolated by the evaluation: no points)")
+    assert _unannotated(miss, {GT: {}}).describe().endswith("(GT box interpolated by the evaluation: not annotated)")
