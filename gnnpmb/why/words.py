@@ -1389,10 +1389,10 @@ def _miss(f: Finding) -> list[str]:
 
 
 def ego_distance_text(distance_m: float, range_m: float, decimals: int = 1) -> str:
-    """The distance to one decimal, or to as many as it takes (up to 3) not to print the range itself: ``39.98``
+    """The distance to one decimal, or to as many as it takes (up to 4) not to print the range itself: ``39.98``
     beside a 40 m range, not ``40.0`` (audit truth53, world9: "it lies 40.0 m from the ego vehicle, inside the
     evaluation's 40 m range" beside a track box there "beyond the evaluation's range")."""
-    for nd in range(decimals, max(decimals, 3) + 1):
+    for nd in range(decimals, max(decimals, 4) + 1):
         text = f"{distance_m:.{nd}f}"
         if float(text) != range_m:
             return text

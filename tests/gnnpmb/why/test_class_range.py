@@ -41,7 +41,8 @@ def test_a_distance_at_the_range_is_printed_with_the_decimals_that_tell_its_side
     assert "it lies 47.3 m from the ego vehicle" in dropped_miss("car", 47.31, 50)  # one decimal where it tells
     from gnnpmb.why.words import ego_distance_text
 
-    assert ego_distance_text(39.9996, 40.0) == "40.000"  # at most three: the side is in the words beside it
+    assert ego_distance_text(39.9997, 40.0) == "39.9997"  # world9 scene-0103 pedestrian b37203 at frame 20
+    assert ego_distance_text(39.99999, 40.0) == "40.0000"  # at most four: the side is in the words beside it
 
 
 def test_a_lost_track_whose_box_the_evaluation_dropped_is_not_said_to_be_beyond_its_2_m() -> None:
