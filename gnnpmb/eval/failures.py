@@ -99,6 +99,10 @@ class FailureBox:
     quat_wxyz: tuple[float, float, float, float]
     interpolated: bool = False
     annotated: bool = True
+    dropped: str | None = None
+    """Why the evaluation dropped an interpolated ground-truth box's annotation (``Dropped``'s value; None: no
+    points, as before it was recorded): beyond the class range too (audit truth53, world9: a pedestrian with 12
+    LiDAR points crossing the 40 m range was noted "no points")."""
 
     @property
     def is_gt(self) -> bool:
@@ -122,17 +126,15 @@ class Failure:
 
     def describe(self) -> str:
         """One readable line naming the ids (and saying when a ground-truth box was interpolated)."""
-        made_up = {b.object_id: b.annotated for b in self.boxes if b.is_gt and b.interpolated}
+        made_up = {b.object_id: _dropped_note(b) for b in self.boxes if b.is_gt and b.interpolated}
         if not made_up:
             return self._what()
-        why = {True: "no points", False: "not annotated"}  # an annotation without points, or none at all
         if len(self.gt_ids) == 1:
-            return self._what() + f" (GT box interpolated by the evaluation: {why[next(iter(made_up.values()))]})"
+            return self._what() + f" (GT box interpolated by the evaluation: {next(iter(made_up.values()))})"
         parts = []  # of several objects, the one(s) it concerns
-        for annotated in (True, False):
-            named = ", ".join(f"GT {short_id(g)}" for g, a in made_up.items() if a is annotated)
-            if named:
-                parts.append(f"{named}: box interpolated by the evaluation, {why[annotated]}")
+        for why in dict.fromkeys(made_up.values()):
+            named = ", ".join(f"GT {short_id(g)}" for g, a in made_up.items() if a == why)
+            parts.append(f"{named}: box interpolated by the evaluation, {why}")
         return self._what() + f" ({'; '.join(parts)})"
 
     @property
@@ -179,6 +181,7 @@ class Failure:
                     "rotation": list(b.quat_wxyz),
                     "interpolated": b.interpolated,
                     "annotated": b.annotated,
+                    "dropped": b.dropped,
                 }
                 for b in self.boxes
             ],
@@ -203,6 +206,7 @@ class Failure:
                     quat_wxyz=tuple(b["rotation"]),
                     interpolated=bool(b.get("interpolated", False)),
                     annotated=bool(b.get("annotated", True)),
+                    dropped=b.get("dropped"),
                 )
                 for b in data["boxes"]
             ),
@@ -360,15 +364,29 @@ class FailureReport:
         )
 
 
+def _dropped_note(b: FailureBox) -> str:
+    """Why an interpolated ground-truth box's annotation was not scored, in a table note's words."""
+    if not b.annotated:
+        return "not annotated"  # none at all: it left view and came back
+    return {"beyond the class range": "beyond the class range", "in a bike rack": "in a bike rack"}.get(
+        b.dropped or "", "no points"
+    )
+
+
 def _unannotated(failure: Failure, annotated: Mapping[str, Mapping[int, Any]]) -> Failure:
     """``failure`` with each interpolated ground-truth box of an object that had no annotation at its keyframe
-    marked so (``annotated``: object -> the frames it was annotated at, ``gt_frames``)."""
-    boxes = tuple(
-        replace(b, annotated=False)
-        if b.is_gt and b.interpolated and failure.frame_index not in annotated.get(b.object_id, {})
-        else b
-        for b in failure.boxes
-    )
+    marked so, and of one that had, why the evaluation dropped that annotation (``annotated``: object -> frame ->
+    ``GtFrame``, ``gt_frames``)."""
+
+    def marked(b: FailureBox) -> FailureBox:
+        if not (b.is_gt and b.interpolated):
+            return b
+        g = annotated.get(b.object_id, {}).get(failure.frame_index)
+        if g is None:
+            return replace(b, annotated=False)
+        return replace(b, dropped=g.dropped.value) if g.dropped is not None else b
+
+    boxes = tuple(marked(b) for b in failure.boxes)
     return failure if boxes == failure.boxes else replace(failure, boxes=boxes)
 
 

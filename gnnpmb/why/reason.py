@@ -598,11 +598,16 @@ class _Context:
             return x, int(e.meas_index)
         return None
 
-    def drifted_off(self, track_id: int, xy_m: np.ndarray) -> tuple[str, float, int, GtFrame | None] | None:
+    def drifted_off(
+        self, track_id: int, xy_m: np.ndarray, dropped: bool = False
+    ) -> tuple[str, float, int, GtFrame | None] | None:
         """``FalseOutput.drifted_from`` of track ``track_id``'s box at ``xy_m`` (BEV, m) at the failure frame: the
         object of its class nearest the track's latest earlier box that lay within ``NEAR_M`` of one, when that
-        object is annotated at the failure frame between ``NEAR_M`` and ``OFF_NEAR_M`` from ``xy_m``."""
-        for x in sorted((x for x in self.frames if x < self.f), reverse=True):
+        object is annotated at the failure frame between ``NEAR_M`` and ``OFF_NEAR_M`` from ``xy_m``. dropped: the
+        box at ``xy_m`` is one the evaluation interpolated in place of the track's own box there, which it dropped
+        (beyond the class range); that own box counts too, at the failure frame (audit truth53, world9: a
+        pedestrian's track on it at 40.0 m was "last within 2 m of it at frame 19")."""
+        for x in sorted((x for x in self.frames if x < self.f or (dropped and x == self.f)), reverse=True):
             e = self.estimate(track_id, x)
             gt = self.scene.keyframes[x].gt
             if e is None or not len(gt):
@@ -870,7 +875,7 @@ class _Context:
         else:
             blame.append(Blame(Rule.DETECTION_OF_NOTHING, (self.f,)))
         if nearest_any is None and on is None and (interpolated or e is not None):  # a box on no detection
-            drifted = self.drifted_off(t, xy)
+            drifted = self.drifted_off(t, xy, dropped=any(b.rule is Rule.TRACK_DROPPED for b in blame))
         output = FalseOutput(
             t,
             on,

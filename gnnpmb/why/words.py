@@ -1005,6 +1005,16 @@ def _off_text(f: Finding, lost: LostTrack) -> str:
     head += short_id(f.gt_id or "")
     if off.scored_m is not None and off.scored_m < NEAR_M:  # yet within reach of the box the evaluation scored
         return f"{head}{on}, {off.scored_m:.1f} m from the box the evaluation interpolated for it{before}"
+    ev = lost.evaluated
+    if ev is not None and f.frame in ev.submitted and f.frame not in ev.kept and f.frame not in ev.interpolated:
+        # audit truth53 (world9 scene-1094 pointpillars gnnpmb id_switch:1): the devkit had no box of the track here
+        # at all (43.3 m from the ego, beyond the pedestrian range), so no distance decided the match
+        dropped = ev.dropped_at(f.frame)
+        if dropped is not None:
+            return (
+                f"{head}{on}, but its box {dropped_lay(dropped)}: the evaluation dropped it and had no box of the "
+                f"track to match to the object{before}"
+            )
     return f"{head}{on}: beyond the evaluation's {NEAR_M:.0f} m, so it no longer matched the object{before}"
 
 
@@ -1074,12 +1084,9 @@ def _false_track(f: Finding) -> list[str]:
     tests = {b.rule for b in f.blame}
     if Rule.TRACK_INTERPOLATED in tests:
         between = f" between its boxes at frames {o.between[0]} and {o.between[1]}" if o.between else ""
-        dropped = None if o.evaluated is None else o.evaluated.dropped_at(f.frame)
-        why = (
-            f"was output, but its box {dropped_where(dropped).replace('lies', 'lay', 1)} and was dropped"
-            if Rule.TRACK_DROPPED in tests and dropped is not None
-            else "was not output"
-        )
+        why = "was not output"
+        if Rule.TRACK_DROPPED in tests:
+            why = "was output, but " + _dropped_its_box(o.evaluated, f.frame)
         head = (
             f"at frame {f.frame} track {o.track_id} ({f.class_name}) {why}: the evaluation interpolated it{between}, "
             "and that box matched no object"
@@ -1172,6 +1179,11 @@ def _drifted_text(f: Finding, o: FalseOutput, box: str) -> str:
         unseen = f"; the evaluation has no box for that one here ({_no_box_reason(g)})"
     elif g.status is GtStatus.BEYOND_RANGE:
         unseen = f"; that one is beyond the evaluation's {g.range_m:g} m range here, so it has no box for it"
+    if x == f.frame:  # the track's own box here, dropped by the evaluation, lay on it (``drifted_off``)
+        return (
+            f": the box the evaluation interpolated lies {d:.1f} m from {f.class_name} GT {short_id(gt_id)}, though "
+            f"the track's own box here, the one the evaluation dropped, lay within {NEAR_M:.0f} m of it{unseen}"
+        )
     return (
         f": the track's {box} lies {d:.1f} m from {f.class_name} GT {short_id(gt_id)}, which it was last within "
         f"{NEAR_M:.0f} m of at frame {x}{unseen}"
@@ -1209,7 +1221,8 @@ def _no_box_reason(g: GtFrame | None) -> str:
         return "it is not annotated here"
     if g.status is GtStatus.BEYOND_RANGE:
         return (
-            f"it lies {g.ego_distance_m:.2f} m from the ego vehicle, beyond the evaluation's {g.range_m:g} m range, "
+            f"it lies {ego_distance_text(g.ego_distance_m, g.range_m, 2)} m from the ego vehicle, beyond the "
+            f"evaluation's {g.range_m:g} m range, "
             "and it keeps no box of it both before and after this frame"
         )
     why = f"it had {g.dropped.value}" if g.dropped is Dropped.NO_POINTS else f"it was {g.dropped.value}"
@@ -1261,10 +1274,22 @@ def dropped_where(dropped: DroppedBox) -> str:
     rack``."""
     if dropped.reason is Dropped.BEYOND_RANGE:
         return (
-            f"lies {dropped.ego_distance_m:.1f} m from the ego vehicle, beyond the evaluation's {dropped.range_m:g} m "
-            "range"
+            f"lies {ego_distance_text(dropped.ego_distance_m, dropped.range_m)} m from the ego vehicle, beyond the "
+            f"evaluation's {dropped.range_m:g} m range"
         )
     return "lies in a bike rack"
+
+
+def _dropped_its_box(ev: TrackEval | None, frame: int) -> str:
+    """``its box lay 40.2 m from the ego vehicle, beyond the evaluation's 40 m range and was dropped`` where the
+    track's evaluation is at hand, else ``the evaluation dropped its box`` (which filter not known here)."""
+    dropped = None if ev is None else ev.dropped_at(frame)
+    return "the evaluation dropped its box" if dropped is None else f"its box {dropped_lay(dropped)} and was dropped"
+
+
+def dropped_lay(dropped: DroppedBox) -> str:
+    """``dropped_where`` in the past tense: ``lay 43.3 m from the ego vehicle, beyond ...``."""
+    return "lay" + dropped_where(dropped).removeprefix("lies")
 
 
 def _out_of_reach_on_it(f: Finding, s: Sighting) -> list[str]:
@@ -1375,10 +1400,21 @@ def _miss(f: Finding) -> list[str]:
     if g is not None and abs(g.ego_distance_m - g.range_m) <= 5.0:
         side = "inside" if g.ego_distance_m < g.range_m else "beyond"
         parts.append(
-            f"the object lies {g.ego_distance_m:.1f} m from the ego vehicle, {side} the evaluation's {g.range_m:g} m "
-            "range"
+            f"the object lies {ego_distance_text(g.ego_distance_m, g.range_m)} m from the ego vehicle, {side} the "
+            f"evaluation's {g.range_m:g} m range"
         )
     return parts
+
+
+def ego_distance_text(distance_m: float, range_m: float, decimals: int = 1) -> str:
+    """The distance to one decimal, or to as many as it takes (up to 4) not to print the range itself: ``39.98``
+    beside a 40 m range, not ``40.0`` (audit truth53, world9: "it lies 40.0 m from the ego vehicle, inside the
+    evaluation's 40 m range" beside a track box there "beyond the evaluation's range")."""
+    for nd in range(decimals, max(decimals, 4) + 1):
+        text = f"{distance_m:.{nd}f}"
+        if float(text) != range_m:
+            return text
+    return text
 
 
 def _of_its_own(s: Sighting) -> str:
@@ -1392,11 +1428,10 @@ def _coalescence(f: Finding) -> list[str]:
     covered = ", ".join(f"GT {short_id(g)}" for g in f.covered)
     tests = {b.rule for b in f.blame}
     if Rule.TRACK_INTERPOLATED in tests:
-        why = (
-            "was output beyond the evaluation's range for the class, so its box was dropped"
-            if Rule.TRACK_DROPPED in tests
-            else "was not output"
-        )
+        ev = next((o.evaluated for o in s.on_it if o.track_id == t), None) if s is not None else None
+        why = "was not output"
+        if Rule.TRACK_DROPPED in tests:
+            why = "was output, but " + _dropped_its_box(ev, f.frame)
         whose = f"track {t} {why}; the box the evaluation interpolated for it in its place"
     else:
         whose = f"track {t}"

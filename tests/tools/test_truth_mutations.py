@@ -123,8 +123,8 @@ PLANTED = {
     "matched: coalescence at a box the evaluation interpolated for the track": (
         "at frame 3 track 7 was not output; the box the evaluation interpolated for it in its place was matched to "
         "GT aaaaaa and also lay within 2 m of GT bbbbbb",
-        "at frame 3 track 7 was output beyond the evaluation's range for the class, so its box was dropped; the box "
-        "the evaluation interpolated for it in its place was matched to GT aaaaaa and also lay within 2 m of GT bbbbbb",
+        "at frame 3 track 7 was output, but the evaluation dropped its box; the box the evaluation interpolated for "
+        "it in its place was matched to GT aaaaaa and also lay within 2 m of GT bbbbbb",
     ),
     "matched: not counted": (
         "track 5 was output on it, but its score averaged over its 3 frames, 0.40, is below the car threshold "

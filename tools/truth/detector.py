@@ -331,6 +331,8 @@ def check_detector(
         r = RANGE_M[class_name]
         if not _close(m[1], d) or float(m[3]) != r or (m[2] == "inside") != (d < r):
             bad("detector", m[0], f"{d:.2f} m from the ego pose; the devkit's {class_name} range is {r:g} m")
+        elif float(m[1]) == r:  # audit truth53 (world9): "40.0 m ..., inside the 40 m range" says neither side
+            bad("misleading", m[0], f"{d:.3f} m from the ego pose, printed as the {r:g} m range itself")
     for m in INTERPOLATED_AT.finditer(text):
         out.checked["matched"] += 1
         box = evaluated.get((frame, gt_id or "")) if evaluated is not None else None

@@ -312,7 +312,9 @@ def check_reach_1141(text: str, x: int, place, scene, ev, out, bad) -> None:
 
 OFF = re.compile(
     r"at frame (\d+) track (\d+) was output (\d+\.\d) m from GT (\w{6})(?:, on m\d+)?(?:: beyond the evaluation's 2 m, "
-    r"so it no longer matched the object|, (\d+\.\d) m from the box the evaluation interpolated for it)"
+    r"so it no longer matched the object|, (\d+\.\d) m from the box the evaluation interpolated for it|"
+    r"(, but its box lay (?:[\d.]+ m from the ego vehicle, beyond the evaluation's \d+ m range|in a bike rack): the "
+    r"evaluation dropped it and had no box of the track to match to the object))"
 )
 
 
@@ -329,9 +331,14 @@ def check_off(text: str, scene, ev, out, bad) -> None:
             continue
         gap, reach = _d(box, hit[1].xy_m), _d(box, scored) if scored is not None else math.inf
         ok = f"{gap:.1f}" == m[3] and gap >= NEAR_M
-        if m[5] is None:
+        kept = ev.kept_frames.get(t, ())  # audit truth53 (world9): the devkit dropped its box and had none there
+        no_box = bool(ev.kept_frames) and x not in kept and not (min(kept, default=x) < x < max(kept, default=x))
+        if no_box != (m[6] is not None):
+            bad("evaluation", m[0], f"the devkit {'had no' if no_box else 'kept or interpolated a'} box of track {t}")
+            continue
+        if m[5] is None and m[6] is None:
             ok = ok and reach >= NEAR_M
-        else:
+        elif m[5] is not None:
             ok = ok and (x, hit[0]) not in ev.kept_gt and f"{reach:.1f}" == m[5] and reach < NEAR_M
         if not ok:
             bad("evaluation", m[0], f"box {gap:.2f} m from the annotation, {reach:.2f} m from the devkit's box")

@@ -176,8 +176,9 @@ COVERED = re.compile(
     r"another"
 )
 COALESCED = re.compile(
-    r"at frame (\d+) track (\d+) (?:(was not output|was output beyond the evaluation's range for the class, so its "
-    r"box was dropped); the box the evaluation interpolated for it in its place )?was matched to "
+    r"at frame (\d+) track (\d+) (?:(was not output|was output, but (?:its box lay (?:[\d.]+ m from the ego vehicle, "
+    r"beyond the evaluation's \d+ m range|in a bike rack) and was dropped|the evaluation dropped its box)); the box "
+    r"the evaluation interpolated for it in its place )?was matched to "
     r"(GT \w+(?:, GT \w+)*) and also lay within"
 )
 MATCHED_INSTEAD = re.compile(r"the evaluation matched it to another track \(track (\d+)\)")
@@ -520,6 +521,14 @@ DRIFTED = re.compile(
     r"; that one is beyond the evaluation's \d+ m range here, so it has no box for it)?"
 )
 """A false track's box that ran off the object of its class it had been on (``FalseOutput.drifted_from``)."""
+DRIFTED_HERE = re.compile(
+    r"(?: of it)?: the box the evaluation interpolated lies ([\d.]+) m from (\w+) GT (\w+), though the track's own "
+    r"box here, the one the evaluation dropped, lay within 2 m of it()"
+    r"(; the evaluation has no box for that one here \((it had no LiDAR or radar points)?[^()]*\)|"
+    r"; that one is beyond the evaluation's \d+ m range here, so it has no box for it)?"
+)
+"""The same, where the evaluation dropped the track's own box on the object at the failure frame (beyond the class
+range) and the box it interpolated in its place lies off it (audit truth53, world9)."""
 DRIFT_LOOKBACK = 8
 """Frames before a false track's failure in which its box within 2 m of an object of its class counts as having
 been on that object (a finding's window, ``why.findings.FRAMES_BEFORE``)."""
@@ -533,9 +542,15 @@ def _track_xy(ev: EvalFacts, frame: int, track: int | None) -> tuple[float, floa
 
 DROPPED = re.compile(
     r"track (\d+) was output on it, but its box (?:there lies ([\d.]+) m from the ego vehicle, beyond the "
-    r"evaluation's ([\d.]+) m range|there lies in a bike rack|(lies beyond the evaluation's range for the class "
-    r"\(or in a bike rack\))): the evaluation dropped that box"
+    r"evaluation's ([\d.]+) m range|there lies in a bike rack|(lies beyond the evaluation's range for the class"
+    r"( \(or in a bike rack\))?)): the evaluation dropped that box"
 )
+LAY_BEYOND = re.compile(
+    r"at frame (\d+) track (\d+)[^;]*? but its box lay ([\d.]+) m from the ego vehicle, beyond the evaluation's "
+    r"(\d+) m range"
+)
+"""A box the devkit dropped beyond the class range, said of a false track, a coalescence or a lost track (the
+devkit's own distance of the track's box there, at or beyond the range)."""
 
 
 def check_dropped(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> None:
@@ -553,12 +568,20 @@ def check_dropped(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad) -> No
             bad("evaluation", m[0], f"the devkit kept track {track}'s box at frame {ctx.frame} (or it has none)")
             continue
         r = detector.RANGE_M[ctx.class_name]
-        if m[4] is not None:
+        if m[5] is not None:  # the old hedge (audit truth53, world9: of a car's box too, a filter never applied to it)
             bad("misleading", m[0], f"its box lies {d:.2f} m from the ego vehicle, the range is {r:g} m: say which")
+        elif m[4] is not None and d < r:
+            bad("evaluation", m[0], f"its box lies {d:.2f} m from the ego vehicle, inside the {r:g} m range")
         elif m[2] is not None and (abs(float(m[2]) - d) > 0.05 + 1e-9 or float(m[3]) != r or d < r):
             bad("evaluation", m[0], f"the devkit's ego distance of the box is {d:.2f} m; the range is {r:g} m")
-        elif m[2] is None and d >= r:
+        elif m[2] is None and m[4] is None and d >= r:
             bad("evaluation", m[0], f"the box lies {d:.2f} m from the ego vehicle, beyond the {r:g} m range")
+    for m in LAY_BEYOND.finditer(text):
+        out.checked["evaluation"] += 1
+        x, track, said = int(m[1]), m[2], float(m[3])
+        d, r = ev.pred_ego_m.get((x, track)), detector.RANGE_M[ctx.class_name]
+        if d is None or x in ev.kept_frames.get(track, ()) or d < r or float(m[4]) != r or abs(said - d) > 0.05 + 1e-9:
+            bad("evaluation", m[0], f"the devkit's ego distance of track {track}'s box at frame {x}: {d}, range {r:g}")
 
 
 def _check_drifted(tail: str, ctx: Context, xy, scene: SceneTruth, ev: EvalFacts, out: Tally, bad) -> None:
@@ -568,7 +591,9 @@ def _check_drifted(tail: str, ctx: Context, xy, scene: SceneTruth, ev: EvalFacts
     object was" of a track that followed a bicycle with no sensor points and ran 2.1 m past it: dev set scene-0916
     centerpoint gnnpmb false_track:14); said, the distance, the object and the frame must be the submission's."""
     last: tuple[int, str] | None = None
-    for y in range(ctx.frame - 1, max(-1, ctx.frame - 1 - DRIFT_LOOKBACK), -1):
+    # the track's own box at the failure frame counts where the devkit dropped it (audit truth53, world9)
+    dropped_here = ctx.frame not in ev.kept_frames.get(str(ctx.track), (ctx.frame,))
+    for y in range(ctx.frame - (0 if dropped_here else 1), max(-1, ctx.frame - 1 - DRIFT_LOOKBACK), -1):
         at = _track_xy(ev, y, ctx.track)
         mine = [
             (math.dist(a.xy_m, at), k)
@@ -579,7 +604,7 @@ def _check_drifted(tail: str, ctx: Context, xy, scene: SceneTruth, ev: EvalFacts
             last = (y, min(mine)[1])
             break
     now = scene.objects[ctx.frame].get(last[1]) if last is not None and ctx.frame < len(scene.objects) else None
-    said = DRIFTED.match(tail)
+    said = DRIFTED.match(tail) or DRIFTED_HERE.match(tail)
     out.checked["misleading"] += 1
     if said is None:
         # a box on no detection: the predicted one's words, or an interpolated one's (" of it" and the clause's end)
@@ -592,7 +617,7 @@ def _check_drifted(tail: str, ctx: Context, xy, scene: SceneTruth, ev: EvalFacts
                 f"{math.dist(now.xy_m, xy):.1f} m from its box now: unsaid",
             )
         return
-    d, cls, gt, frame = float(said[1]), said[2], said[3], int(said[4])
+    d, cls, gt, frame = float(said[1]), said[2], said[3], int(said[4] or ctx.frame)
     if last is None or not last[1].startswith(gt) or last[0] != frame or cls != ctx.class_name or now is None:
         bad("detector", said[0], f"the track's box was last within 2 m of an object of its class at {last}")
     elif abs(math.dist(now.xy_m, xy) - d) > 0.05 + 1e-9:
@@ -709,7 +734,7 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad, scene: 
         if m[3] is not None:  # the box matched is one the devkit interpolated: the track's own was not kept there
             out.checked["matched"] += 1
             output = t in ev.submitted.get(x, set())
-            if x in ev.kept_frames.get(t, ()) or output != m[3].startswith("was output beyond"):
+            if x in ev.kept_frames.get(t, ()) or output != m[3].startswith("was output"):
                 bad("matched", m[0], f"track {t} at frame {x}: submitted {output}, kept by the devkit's filters")
         for g in ctx.covered:
             out.checked["matched"] += 1

@@ -1,0 +1,85 @@
+"""The oracle on the evaluation's class range (audit truth53, world9: a pedestrian and a bicycle crossing the 40 m
+range, parked cars at 50 m): the old explainer's "(or in a bike rack)" of a car track's dropped box, and "it lies
+50.0 m from the ego vehicle, inside the evaluation's 50 m range", passed the oracle unflagged."""
+
+from __future__ import annotations
+
+from tools.truth.devkit import EvalFacts
+from tools.truth.scene import Annotation, SceneTruth
+from tools.truth.sentences import Context, check_text
+
+CAR = "a46079" + "0" * 26
+
+
+def _kinds(text: str, class_name: str = "car", ego_m: float = 49.97, box_m: float = 50.02) -> list[str]:
+    """Frame 3: the object ``ego_m`` from the ego (at the origin), track 15's box ``box_m`` from it."""
+    scene = SceneTruth([[]] * 4, [{CAR: Annotation(class_name, (ego_m, 0.0), 60)}] * 4, [(0.0, 0.0)] * 4)
+    ev = EvalFacts(thresholds={class_name: 0.3})
+    ev.boxes[3] = [("15", class_name, (box_m, 0.0))]
+    ev.pred_ego_m[(3, "15")] = box_m  # the devkit's distance of the box (``add_center_dist``)
+    return [c.kind for c in check_text(text, Context(class_name, 3, CAR, kind="miss"), None, ev, scene=scene).found]
+
+
+def test_a_bike_rack_offered_for_a_class_its_filter_never_drops_is_caught() -> None:
+    # world9 scene-0103 centerpoint gnnpmb miss at frame 7, car GT a46079
+    said = "track 15 was output on it, but its box lies beyond the evaluation's range for the class"
+    assert _kinds(f"{said} (or in a bike rack): the evaluation dropped that box") == ["misleading"]
+    assert _kinds(f"{said}: the evaluation dropped that box") == []
+    assert _kinds(f"{said}: the evaluation dropped that box", box_m=49.5) == ["evaluation"]  # inside: not dropped
+    rack = "track 15 was output on it, but its box there lies in a bike rack: the evaluation dropped that box"
+    assert _kinds(rack, "bicycle", 39.0, 39.5) == []  # a bicycle's box may lie in a rack inside the range
+    assert _kinds(rack, "bicycle", 39.0, 40.5) == ["evaluation"]  # beyond it: the range filter dropped it
+
+
+def test_a_distance_printed_as_the_range_itself_is_caught() -> None:
+    inside = "the object lies {} m from the ego vehicle, inside the evaluation's 50 m range"
+    assert _kinds(inside.format("50.0")) == ["misleading"]
+    assert _kinds(inside.format("49.97")) == []
+    assert _kinds(inside.format("49.9")) == ["detector"]  # 49.97 to one decimal is 50.0, not 49.9
+
+
+def test_a_dropped_box_on_the_object_told_as_the_track_running_off_it_is_caught() -> None:
+    # world9 scene-0103 centerpoint gnnpmb false_track at frame 20: track 44's own box lay 0.2 m from pedestrian GT
+    # b37203 and was dropped (beyond the 40 m range); the box the devkit interpolated in its place lay 5.6 m off
+    ped = "b37203" + "0" * 26
+    scene = SceneTruth([[]] * 4, [{ped: Annotation("pedestrian", (0.0, 0.0), 30)}] * 4, [(40.0, 0.0)] * 4)
+    ev = EvalFacts(thresholds={"pedestrian": 0.3})
+    ev.boxes[2] = [("44", "pedestrian", (0.1, 0.0))]
+    ev.boxes[3] = [("44", "pedestrian", (0.2, 0.0))]
+    ev.pred_xy[("pedestrian", 3)] = {"44": (5.6, 0.0)}
+    ev.kept_frames["44"] = (2,)
+    ctx = Context("pedestrian", 3, None, kind="false_track", track=44)
+    nothing = "no object of a tracked class lies within 2 m of it"
+    old = f"{nothing}: the track's box lies 5.6 m from pedestrian GT b37203, which it was last within 2 m of at frame 2"
+    new = (
+        f"{nothing}: the box the evaluation interpolated lies 5.6 m from pedestrian GT b37203, though the track's own "
+        "box here, the one the evaluation dropped, lay within 2 m of it"
+    )
+    assert [c.kind for c in check_text(old, ctx, None, ev, scene=scene).found] == ["detector"]
+    assert check_text(new, ctx, None, ev, scene=scene).found == []
+    ev.kept_frames["44"] = (2, 3)  # kept there: the box the devkit scored is the track's own, and frame 2 is right
+    ev.boxes[3] = [("44", "pedestrian", (5.6, 0.0))]
+    assert check_text(old, ctx, None, ev, scene=scene).found == []
+
+
+def test_a_dropped_lost_track_said_beyond_the_evaluations_2_m_is_caught() -> None:
+    # world9 scene-1094 pointpillars gnnpmb id_switch:1 (track 91's box at frame 30 43.3 m from the ego)
+    ped = "88761d" + "0" * 26
+    scene = SceneTruth([[]] * 4, [{ped: Annotation("pedestrian", (39.7, 0.0), 12)}] * 4, [(0.0, 0.0)] * 4)
+    ev = EvalFacts(thresholds={"pedestrian": 0.3})
+    ev.boxes[3] = [("91", "pedestrian", (43.3, 0.0))]
+    ev.submitted = {3: {"91"}}
+    ev.kept_frames["91"] = (1, 2)
+    ctx = Context("pedestrian", 3, ped, kind="id_switch")
+    head = "at frame 3 track 91 was output 3.6 m from GT 88761d"
+    old = f"{head}: beyond the evaluation's 2 m, so it no longer matched the object"
+    new = (
+        f"{head}, but its box lay 43.3 m from the ego vehicle, beyond the evaluation's 40 m range: the evaluation "
+        "dropped it and had no box of the track to match to the object"
+    )
+    ev.pred_ego_m[(3, "91")] = 43.3
+    assert [c.kind for c in check_text(old, ctx, None, ev, scene=scene).found] == ["evaluation"]
+    assert check_text(new, ctx, None, ev, scene=scene).found == []
+    ev.kept_frames["91"] = (1, 2, 3)  # kept: neither the drop nor its distance holds
+    assert [c.kind for c in check_text(new, ctx, None, ev, scene=scene).found] == ["evaluation", "evaluation"]
+    assert check_text(old, ctx, None, ev, scene=scene).found == []
