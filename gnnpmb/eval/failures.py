@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gnnpmb.errors import DataError
-from gnnpmb.eval.evaluated import GtFrame, TrackEval, gt_frames, track_evals
+from gnnpmb.eval.evaluated import Dropped, GtFrame, TrackEval, gt_frames, track_evals
 from gnnpmb.eval.nuscenes_eval import class_evaluation, quiet_devkit, scene_sample_tokens, tracking_config
 from gnnpmb.eval.official_scores import OfficialScores, json_number, official_scores
 
@@ -368,9 +368,7 @@ def _dropped_note(b: FailureBox) -> str:
     """Why an interpolated ground-truth box's annotation was not scored, in a table note's words."""
     if not b.annotated:
         return "not annotated"  # none at all: it left view and came back
-    return {"beyond the class range": "beyond the class range", "in a bike rack": "in a bike rack"}.get(
-        b.dropped or "", "no points"
-    )
+    return "no points" if b.dropped in (None, Dropped.NO_POINTS.value) else b.dropped
 
 
 def _unannotated(failure: Failure, annotated: Mapping[str, Mapping[int, Any]]) -> Failure:
