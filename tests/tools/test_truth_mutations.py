@@ -1986,6 +1986,22 @@ def test_a_false_box_that_ran_off_its_object_must_say_so_and_say_it_right() -> N
     assert [c.kind for c in check_text(said + no_box, at, None, ev, scene=scene).found] == ["evaluation"]
 
 
+def test_a_drift_said_from_further_back_than_the_window_is_checked_against_that_frame() -> None:
+    """Dev set scene-1077 pointpillars immortal false_track:33 at frame 35: "last within 2 m of it at frame 26" (track
+    90's box 1.84 m from car a1a72a there, not output at 29-34) was read over 8 frames back only and called false."""
+    from tools.truth.scene import Annotation
+
+    ev = _eval()
+    ev.boxes[2] = [("90", C, (1.8, 0.0))]
+    ev.boxes[12] = [("90", C, (5.1, 0.0))]
+    scene = SceneTruth([[]] * 13, [{GT_A: Annotation(C, (0.0, 0.0), 0)}] * 13)
+    at = Context(C, 12, None, kind="false_track", track=90)
+    said = "no object of a tracked class lies within 2 m: the track's predicted box lies 5.1 m from car GT aaaaaa, "
+    assert check_text(said + "which it was last within 2 m of at frame 2", at, None, ev, scene=scene).found == []
+    wrong = check_text(said + "which it was last within 2 m of at frame 3", at, None, ev, scene=scene).found
+    assert [c.kind for c in wrong] == ["detector"]
+
+
 def test_a_box_on_an_untracked_category_or_an_untracked_detection_name_left_unsaid_is_caught() -> None:
     # audit truth52, world8 scene-0103 centerpoint gnnpmb false_track:7: a car track on an annotated ambulance was
     # "a detection of no tracked object"; scene-0916: car 812dba seen only as a construction_vehicle was "missed"

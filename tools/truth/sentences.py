@@ -590,10 +590,14 @@ def _check_drifted(tail: str, ctx: Context, xy, scene: SceneTruth, ev: EvalFacts
     window, and that object lies less than 6.5 m from the box now, unsaid is misleading ("a box where no tracked
     object was" of a track that followed a bicycle with no sensor points and ran 2.1 m past it: dev set scene-0916
     centerpoint gnnpmb false_track:14); said, the distance, the object and the frame must be the submission's."""
+    said = DRIFTED.match(tail) or DRIFTED_HERE.match(tail)
     last: tuple[int, str] | None = None
-    # the track's own box at the failure frame counts where the devkit dropped it (audit truth53, world9)
+    # the track's own box at the failure frame counts where the devkit dropped it (audit truth53, world9); unsaid is
+    # judged over the window, a said frame against every earlier frame (dev set scene-1077 pointpillars immortal
+    # false_track:33 at frame 35: track 90's box 1.84 m from car a1a72a at frame 26, nine frames back, is true)
     dropped_here = ctx.frame not in ev.kept_frames.get(str(ctx.track), (ctx.frame,))
-    for y in range(ctx.frame - (0 if dropped_here else 1), max(-1, ctx.frame - 1 - DRIFT_LOOKBACK), -1):
+    oldest = -1 if said is not None else max(-1, ctx.frame - 1 - DRIFT_LOOKBACK)
+    for y in range(ctx.frame - (0 if dropped_here else 1), oldest, -1):
         at = _track_xy(ev, y, ctx.track)
         mine = [
             (math.dist(a.xy_m, at), k)
@@ -604,7 +608,6 @@ def _check_drifted(tail: str, ctx: Context, xy, scene: SceneTruth, ev: EvalFacts
             last = (y, min(mine)[1])
             break
     now = scene.objects[ctx.frame].get(last[1]) if last is not None and ctx.frame < len(scene.objects) else None
-    said = DRIFTED.match(tail) or DRIFTED_HERE.match(tail)
     out.checked["misleading"] += 1
     if said is None:
         # a box on no detection: the predicted one's words, or an interpolated one's (" of it" and the clause's end)
