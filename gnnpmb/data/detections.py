@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import json
 import shutil
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
@@ -30,7 +30,9 @@ from gnnpmb.symlinks import refuse_symlink_loop
 from gnnpmb.types import TRACKING_CLASSES, Boxes
 
 if TYPE_CHECKING:
-    from gnnpmb.data.detection_index import DetectionIndex
+    from gnnpmb.data.detection_index import DetectionIndex, UntrackedBox
+
+T = TypeVar("T")
 
 DETECTION_CLASSES: tuple[str, ...] = (
     "barrier",
@@ -205,7 +207,7 @@ def convert_sample(token: str, entries: Any) -> Boxes | str:
     )
 
 
-def untracked_boxes(entries: list[Any]) -> list[tuple[str, float, float, float]]:
+def untracked_boxes(entries: list[Any]) -> list[UntrackedBox]:
     """(name, score, x m, y m) of a sample's boxes of ``UNTRACKED_NAMES`` (entries ``convert_sample`` checked)."""
     return [
         (str(e["detection_name"]), float(e["detection_score"]), float(e["translation"][0]), float(e["translation"][1]))
@@ -280,40 +282,41 @@ def load_detection_file(path: Path, sample_tokens: Sequence[str], scene_name: st
     scene_name only makes error messages clearer. Raises ``DataError`` when the file is missing or malformed,
     a requested sample has a malformed box, or some requested samples have no entry (an empty list is fine).
     """
-    from gnnpmb.data.index_store import IndexDamaged
-
     path = Path(path)
-    index = _index(path)
-    missing = [t for t in sample_tokens if t not in index]
-    if missing:
-        where = f"the {len(sample_tokens)} " + (f"samples of {scene_name}" if scene_name else "requested samples")
-        raise NotThisDatasetError(
-            f"detections file {path.name} has no boxes entry for {len(missing)} of {where} "
-            f"(first missing: {missing[0]}); is it for another split or version?"
-        )
-    for token in sample_tokens:
-        if token in index.problems:
-            raise DataError(f"detections file {path.name}: {index.problems[token]}")
-    try:
+
+    def read(index: DetectionIndex) -> dict[str, Boxes]:
+        missing = [t for t in sample_tokens if t not in index]
+        if missing:
+            where = f"the {len(sample_tokens)} " + (f"samples of {scene_name}" if scene_name else "requested samples")
+            raise NotThisDatasetError(
+                f"detections file {path.name} has no boxes entry for {len(missing)} of {where} "
+                f"(first missing: {missing[0]}); is it for another split or version?"
+            )
+        for token in sample_tokens:
+            if token in index.problems:
+                raise DataError(f"detections file {path.name}: {index.problems[token]}")
         return {token: index.boxes(token) for token in sample_tokens}
-    except IndexDamaged:
-        _opened.clear()
-        shutil.rmtree(index.store.folder, ignore_errors=True)
-        return load_detection_file(path, sample_tokens, scene_name)
+
+    return _from_index(path, read)
 
 
-def untracked_detection_boxes(path: Path, sample_tokens: Sequence[str]) -> dict[str, tuple]:
+def untracked_detection_boxes(path: Path, sample_tokens: Sequence[str]) -> dict[str, tuple[UntrackedBox, ...]]:
     """Per sample token of ``sample_tokens`` with any, its boxes of ``UNTRACKED_NAMES`` in the detection file
     ``path`` (name, score, x m, y m), from the file's index (read once per file, whatever its size)."""
+    return _from_index(Path(path), lambda index: {t: boxes for t in sample_tokens if (boxes := index.untracked(t))})
+
+
+def _from_index(path: Path, read: Callable[[DetectionIndex], T]) -> T:
+    """``read`` of the detection file's index; an index found damaged while reading is deleted and built again."""
     from gnnpmb.data.index_store import IndexDamaged
 
-    index = _index(Path(path))
+    index = _index(path)
     try:
-        return {t: boxes for t in sample_tokens if (boxes := index.untracked(t))}
+        return read(index)
     except IndexDamaged:
         _opened.clear()
         shutil.rmtree(index.store.folder, ignore_errors=True)
-        return untracked_detection_boxes(path, sample_tokens)
+        return _from_index(path, read)
 
 
 def write_detection_file(path: Path, submission: dict[str, Any]) -> None:

@@ -26,7 +26,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from gnnpmb.why.findings import Finding
-from gnnpmb.why.words import plain, whose_text, why_lines
+from gnnpmb.why.words import consecutive_runs, plain, whose_text, why_lines
 
 
 class Slot(enum.Enum):
@@ -213,13 +213,7 @@ def _fixed_comparisons(members: Sequence[Said]) -> tuple[str | None, ...]:
 def ids_text(ids: Sequence[str]) -> str:
     """``miss:12`` / ``miss:12-14`` / ``false_track:2, 5, 8`` (one kind; consecutive numbers as ranges)."""
     kind = ids[0].split(":")[0]
-    numbers = [int(i.split(":")[1]) for i in ids]
-    spans: list[list[int]] = []
-    for n in numbers:
-        if spans and n == spans[-1][-1] + 1:
-            spans[-1].append(n)
-        else:
-            spans.append([n])
+    spans = consecutive_runs(int(i.split(":")[1]) for i in ids)
     return f"{kind}:" + ", ".join(str(s[0]) if len(s) == 1 else f"{s[0]}-{s[-1]}" for s in spans)
 
 
