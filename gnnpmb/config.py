@@ -385,6 +385,12 @@ class PmbmParams(Section):
         at_least(0),
         paper=0,
     )
+    duplicate_birth_existence: float = param(
+        0.0,
+        "a hypothesis other than the best in which a detection starts a Bernoulli inside the gate of one of"
+        " existence >= this that it leaves missed is dropped (0: off)",
+        unit_interval(True, True),
+    )
 
 
 @dataclass(frozen=True, slots=True)

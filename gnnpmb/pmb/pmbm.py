@@ -12,7 +12,9 @@ the same Bernoullis (same multiset of local keys after the core's existence prun
 weights; then the weights are normalised, sorted (ties keep parent, then rank order), children below
 ``hypothesis_prune`` dropped, with ``[pmbm] n_scan`` N > 0 those not descending from the best child's ancestor N
 frames back dropped (N-scan pruning), at most N_h kept and renormalised. With N_h = 1 this is exactly GNN-PMB
-(``gnnpmb.BestAssignment``).
+(``gnnpmb.BestAssignment``). With ``[pmbm] duplicate_birth_existence`` r > 0, before that, a child other than the
+heaviest that starts a Bernoulli on a measurement inside the gate of a Bernoulli of existence >= r which it leaves
+missed is dropped (``_drop_duplicate_births``).
 
 Of a parent's H_h best assignments only those costing at most -log(hypothesis_prune) more than its best are
 enumerated: the parent's best child alone outweighs such a child by more than 1 / hypothesis_prune, so its
@@ -174,6 +176,8 @@ class KBest:
         for h, assignments in enumerate(ranked):
             children.extend(_Child(bases[h] - total, h, col_of_row, total) for col_of_row, total in assignments)
         merged = _merge_identical(children, union, members, ctx)
+        if self.params.duplicate_birth_existence > 0:
+            merged = _drop_duplicate_births(merged, union, members, self.params.duplicate_birth_existence)
         kept, log_w = self._select(merged, self._child_lineages(merged, len(priors)))
         store, rows = posteriors_from_assignments(
             union, [members[c.parent] for c in kept], [c.col_of_row for c in kept], ctx
@@ -579,6 +583,29 @@ def _merge_identical(
                 into.total_cost,
             )
     return merged
+
+
+def _drop_duplicate_births(
+    children: list[_Child], union: LocalHypotheses, members: list[np.ndarray], min_existence: float
+) -> list[_Child]:
+    """The children without those, other than the heaviest, in which a measurement starts a Bernoulli inside the
+    gate of a Bernoulli of predicted existence >= ``min_existence`` that the same child leaves missed: the
+    object's own detection told as a second object beside its missed track (``docs/results.md``, Rounds 8 and
+    18). Order is kept."""
+    n_union = union.n_tracks
+    sure = union.prior.existence >= min_existence  # (U,)
+    heaviest = int(np.argmax([c.log_weight for c in children]))
+    kept: list[_Child] = []
+    for i, child in enumerate(children):
+        born = np.flatnonzero(child.col_of_row >= n_union)  # rows starting a Bernoulli
+        if i != heaviest and len(born):
+            missed = np.zeros(n_union, dtype=bool)
+            missed[members[child.parent]] = True
+            missed[child.col_of_row[child.col_of_row < n_union]] = False
+            if union.inside[np.ix_(missed & sure, born)].any():
+                continue
+        kept.append(child)
+    return kept
 
 
 def _signatures(

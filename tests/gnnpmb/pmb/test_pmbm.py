@@ -100,6 +100,58 @@ def test_two_hypotheses_weights_equal_hand_computed_likelihoods():
     assert missed.existence[1] == pytest.approx((l_new - P.clutter_intensity) / l_new, rel=1e-12)
 
 
+def _duplicate_rule(min_existence: float) -> TrackerConfig:
+    return CFG.replace(pmbm=dataclasses.replace(CFG.pmbm, duplicate_birth_existence=min_existence))
+
+
+def _weights_and_tracks(core: PmbCore) -> list[tuple[float, list[int]]]:
+    return [(h.log_weight, h.bernoullis.track_id.tolist()) for h in core.hypotheses]
+
+
+def test_a_birth_inside_the_gate_of_its_missed_track_is_dropped_unless_it_is_the_heaviest():
+    """Track 1 (r = 1, predicted r = P_S = 0.7) and one detection inside its gate. At x = 2.2 m 'detected' weighs
+    0.749 and 'missed + new track' 0.251 (the hand computation above): with the rule at r >= 0.5 the second,
+    a birth inside the gate of the track it leaves missed, is dropped and 'detected' alone has weight 1. At
+    r >= 0.8 the track is not sure enough and both stay, weighed as without the rule. At x = 2.6 m 'missed +
+    new track' is the heaviest (0.719, d^2 14.3 inside the gate 40), so the rule keeps it and changes nothing."""
+    off = core_with_track(KBest(CFG.pmbm))
+    off.step(make_measurements([(2.2, 0.0)], 0.8), 0.5, NullSink())
+    assert [tracks for _, tracks in _weights_and_tracks(off)] == [[1], [1, 2]]
+    on = core_with_track(KBest(_duplicate_rule(0.5).pmbm), _duplicate_rule(0.5))
+    on.step(make_measurements([(2.2, 0.0)], 0.8), 0.5, NullSink())
+    assert _weights_and_tracks(on) == [(0.0, [1])]
+    assert on.hypotheses[0].bernoullis.mean.tolist() == off.hypotheses[0].bernoullis.mean.tolist()
+    unsure = core_with_track(KBest(_duplicate_rule(0.8).pmbm), _duplicate_rule(0.8))
+    unsure.step(make_measurements([(2.2, 0.0)], 0.8), 0.5, NullSink())
+    assert _weights_and_tracks(unsure) == _weights_and_tracks(off)
+
+    heaviest_off = core_with_track(KBest(CFG.pmbm))
+    heaviest_on = core_with_track(KBest(_duplicate_rule(0.5).pmbm), _duplicate_rule(0.5))
+    for core in (heaviest_off, heaviest_on):
+        core.step(make_measurements([(2.6, 0.0)], 0.8), 0.5, NullSink())
+    assert [tracks for _, tracks in _weights_and_tracks(heaviest_on)] == [[1, 2], [1]]
+    assert math.exp(heaviest_on.hypotheses[0].log_weight) == pytest.approx(0.719, abs=5e-4)
+    assert _weights_and_tracks(heaviest_on) == _weights_and_tracks(heaviest_off)
+
+
+def test_the_duplicate_rule_off_is_todays_pmbm_and_on_keeps_weights_normalised():
+    """At 0 the rule is off: a cluttered sequence gives what the defaults give, bit for bit. On, every frame's
+    hypotheses still sum to 1, fall in weight and number at most N_h."""
+    default = PmbCore("car", CFG, KBest(CFG.pmbm), IdAllocator())
+    off = PmbCore("car", _duplicate_rule(0.0), KBest(_duplicate_rule(0.0).pmbm), IdAllocator())
+    on = PmbCore("car", _duplicate_rule(0.5), KBest(_duplicate_rule(0.5).pmbm), IdAllocator())
+    fewer = 0
+    for meas in cluttered_sequence(seed=4):
+        assert default.step(meas, 0.5, NullSink()) == off.step(meas, 0.5, NullSink())
+        assert _weights_and_tracks(default) == _weights_and_tracks(off)
+        on.step(meas, 0.5, NullSink())
+        log_w = np.array([h.log_weight for h in on.hypotheses])
+        assert logsumexp(log_w) == pytest.approx(0.0, abs=1e-12) and np.all(np.diff(log_w) <= 0)
+        assert 1 <= len(log_w) <= CFG.pmbm.n_hypotheses
+        fewer += len(on.hypotheses) < len(default.hypotheses)
+    assert fewer > 0
+
+
 def test_n_h_one_equals_gnnpmb_on_a_multi_target_sequence():
     config = CFG.replace(pmbm=PmbmParams(n_hypotheses=1))
     a = PmbCore("car", config, KBest(config.pmbm), IdAllocator())
