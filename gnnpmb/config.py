@@ -387,9 +387,10 @@ class PmbmParams(Section):
     )
     duplicate_birth_existence: float = param(
         0.0,
-        "a hypothesis other than the best in which a detection starts a Bernoulli inside the gate of one of"
-        " existence >= this that it leaves missed is dropped (0: off)",
+        "a hypothesis other than the heaviest in which a detection starts a Bernoulli inside the gate of a"
+        " Bernoulli of predicted existence >= this that it leaves missed is dropped (0: off)",
         unit_interval(True, True),
+        paper=0.0,
     )
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ from scipy.special import logsumexp
 from gnnpmb.assign import murty
 from gnnpmb.assign.clusters import Cluster
 from gnnpmb.assign.murty import k_best
-from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig
+from gnnpmb.config import ConfigError, PmbmParams, PmbParams, TrackerConfig, load_config
 from gnnpmb.detection_fields import DetectionFields
 from gnnpmb.events import Assignment, CostMatrix, GlobalHypotheses, ListSink, NullSink, Pruned, PruneReason
 from gnnpmb.pmb.bernoulli import Bernoullis
@@ -110,13 +111,16 @@ def _weights_and_tracks(core: PmbCore) -> list[tuple[float, list[int]]]:
 
 def test_a_birth_inside_the_gate_of_its_missed_track_is_dropped_unless_it_is_the_heaviest():
     """Track 1 (r = 1, predicted r = P_S = 0.7) and one detection inside its gate. At x = 2.2 m 'detected' weighs
-    0.749 and 'missed + new track' 0.251 (the hand computation above): with the rule at r >= 0.5 the second,
+    0.749 and 'missed + new track' 0.251 (the hand computation above): with the rule at r >= 0.5 (the record
+    ``gnnpmb/params/pmbm_duplicate_birth.toml``) the second,
     a birth inside the gate of the track it leaves missed, is dropped and 'detected' alone has weight 1. At
     r >= 0.8 the track is not sure enough and both stay, weighed as without the rule. At x = 2.6 m 'missed +
     new track' is the heaviest (0.719, d^2 14.3 inside the gate 40), so the rule keeps it and changes nothing."""
     off = core_with_track(KBest(CFG.pmbm))
     off.step(make_measurements([(2.2, 0.0)], 0.8), 0.5, NullSink())
     assert [tracks for _, tracks in _weights_and_tracks(off)] == [[1], [1, 2]]
+    record = load_config(Path(__file__).resolve().parents[3] / "gnnpmb" / "params" / "pmbm_duplicate_birth.toml")
+    assert record.pmbm.duplicate_birth_existence == 0.5  # Round 19's record (docs/results.md)
     on = core_with_track(KBest(_duplicate_rule(0.5).pmbm), _duplicate_rule(0.5))
     on.step(make_measurements([(2.2, 0.0)], 0.8), 0.5, NullSink())
     assert _weights_and_tracks(on) == [(0.0, [1])]
