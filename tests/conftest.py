@@ -42,17 +42,43 @@ def made_once(tmp_path_factory: pytest.TempPathFactory, name: str, make: Callabl
 
 
 @pytest.fixture(scope="session")
-def demo_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def demo_dataroot(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     """Dataroot of the synthetic nuScenes-format demo (``v1.0-mini``, scenes scene-0103 and scene-0916).
 
-    Generated with the default seed into a session temp dir; treat it as read-only.
+    Generated with the default seed into a session temp dir; treat it as read-only: its tables must keep their
+    identity (``file_identity``: size, times, inode, bytes) to the end of the session, which is checked then. The
+    session's dataset index and failure reports of the demo key on it; a test that writes, touches, chmods or
+    hard-links a table (``linkable_demo``) would make every later test index and evaluate the demo again.
     """
     from gnnpmb.data.demo import DEMO_SEED, generate_demo_dataset
+    from gnnpmb.data.file_identity import file_identity
 
     def make(folder: Path) -> None:
         generate_demo_dataset(folder / "nuscenes", seed=DEMO_SEED)
 
-    return made_once(tmp_path_factory, "demo", make) / "nuscenes"
+    root = made_once(tmp_path_factory, "demo", make) / "nuscenes"
+    tables = sorted((root / "v1.0-mini").iterdir())
+    before = [file_identity(path) for path in tables]
+    yield root
+    changed = [path.name for path, was in zip(tables, before, strict=True) if file_identity(path) != was]
+    assert not changed, f"the shared demo's tables changed during the session (written, touched or linked): {changed}"
+
+
+@pytest.fixture(scope="session")
+def linkable_demo(demo_dataroot: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A dataroot with its own copy of the demo's tables (``v1.0-mini``; sensor files and maps linked to the demo's),
+    made once per session, for tests that hard-link a table file. A hard link moves the file's change time, which
+    the dataset index and the failure reports key on (``gnnpmb.data.file_identity``): linking the shared demo's
+    tables would make every later test of the session index and evaluate the demo again. Read-only but for
+    links."""
+
+    def make(folder: Path) -> None:
+        (folder / "nuscenes").mkdir()
+        shutil.copytree(demo_dataroot / "v1.0-mini", folder / "nuscenes" / "v1.0-mini")
+        for name in ("samples", "maps"):
+            (folder / "nuscenes" / name).symlink_to(demo_dataroot / name)
+
+    return made_once(tmp_path_factory, "linkable-demo", make) / "nuscenes"
 
 
 @pytest.fixture(scope="session")

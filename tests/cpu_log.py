@@ -9,7 +9,8 @@ Load it as a plugin with a folder to write to, then sum, and (``--write``) refre
 
 Each test's line is the CPU time of its worker process and of the child processes it waited for (the console
 scripts run in real processes; not Chromium's renderer and GPU processes, which Chromium does not reap before it
-is killed), from the start of its setup to the end of its teardown: a module fixture counts in its first test.
+is killed), from the start of its setup to the end of its teardown: a module fixture counts in its first test;
+then that of the children alone (what starting real processes costs: each imports the stack again).
 """
 
 from __future__ import annotations
@@ -26,35 +27,40 @@ from pathlib import Path
 import pytest
 
 
-def _cpu_s() -> float:
+def _cpu_s() -> tuple[float, float]:
+    """CPU seconds of this process and of the child processes it waited for, and of those children alone."""
     own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+    child_s = children.ru_utime + children.ru_stime
+    return own.ru_utime + own.ru_stime + child_s, child_s
 
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
     folder = os.environ.get("CPULOG_DIR")
-    cpu_s, wall_s = _cpu_s(), time.monotonic()
+    (cpu_s, child_s), wall_s = _cpu_s(), time.monotonic()
     yield
     if folder:
         Path(folder).mkdir(parents=True, exist_ok=True)
+        cpu_after, child_after = _cpu_s()
+        cells = [f"{cpu_after - cpu_s:.3f}", f"{time.monotonic() - wall_s:.3f}", f"{child_after - child_s:.3f}"]
         with open(Path(folder) / f"{os.getpid()}.tsv", "a") as f:
-            f.write(f"{item.nodeid}\t{_cpu_s() - cpu_s:.3f}\t{time.monotonic() - wall_s:.3f}\n")
+            f.write("\t".join([item.nodeid, *cells]) + "\n")
 
 
-def _rows(folder: Path) -> list[tuple[str, float, float]]:
+def _rows(folder: Path) -> list[tuple[str, float, float, float]]:
+    """(test, CPU s, wall s, CPU s of its child processes) per line; logs without the last column count 0 there."""
     rows = []
     for path in sorted(folder.glob("*.tsv")):
         for line in path.read_text().splitlines():
-            nodeid, cpu_s, wall_s = line.split("\t")
-            rows.append((nodeid, float(cpu_s), float(wall_s)))
+            nodeid, cpu_s, wall_s, *child = line.split("\t")
+            rows.append((nodeid, float(cpu_s), float(wall_s), float(child[0]) if child else 0.0))
     return rows
 
 
 def module_cpu_s(folder: Path) -> dict[str, float]:
     """CPU seconds per test module (its tests summed, module fixtures included), costliest first."""
     modules: collections.Counter[str] = collections.Counter()
-    for nodeid, cpu_s, _ in _rows(folder):
+    for nodeid, cpu_s, _, _ in _rows(folder):
         modules[nodeid.split("::")[0]] += cpu_s
     return {name: round(cpu_s, 1) for name, cpu_s in modules.most_common()}
 
@@ -62,19 +68,21 @@ def module_cpu_s(folder: Path) -> dict[str, float]:
 def summary(folder: Path, most: int = 30) -> str:
     """The number of tests, their CPU and wall seconds summed, and the ``most`` costliest modules and tests."""
     rows = _rows(folder)
-    modules: dict[str, list[float]] = collections.defaultdict(lambda: [0.0, 0.0, 0])
-    for nodeid, cpu_s, wall_s in rows:
+    modules: dict[str, list[float]] = collections.defaultdict(lambda: [0.0, 0.0, 0.0, 0])
+    for nodeid, cpu_s, wall_s, child_s in rows:
         module = modules[nodeid.split("::")[0]]
         module[0] += cpu_s
         module[1] += wall_s
-        module[2] += 1
-    lines = [f"{len(rows)} tests: {sum(r[1] for r in rows):.1f} s CPU, {sum(r[2] for r in rows):.1f} s wall summed"]
-    lines.append("modules by CPU (s CPU, s wall, tests):")
-    for name, (cpu_s, wall_s, n) in sorted(modules.items(), key=lambda kv: -kv[1][0])[:most]:
-        lines.append(f"{cpu_s:8.1f} {wall_s:8.1f} {int(n):5d}  {name}")
-    lines.append("tests by CPU (s CPU, s wall):")
-    for nodeid, cpu_s, wall_s in sorted(rows, key=lambda r: -r[1])[:most]:
-        lines.append(f"{cpu_s:8.1f} {wall_s:8.1f}  {nodeid}")
+        module[2] += child_s
+        module[3] += 1
+    total = f"{sum(r[1] for r in rows):.1f} s CPU ({sum(r[3] for r in rows):.1f} in child processes)"
+    lines = [f"{len(rows)} tests: {total}, {sum(r[2] for r in rows):.1f} s wall summed"]
+    lines.append("modules by CPU (s CPU, s wall, s CPU of child processes, tests):")
+    for name, (cpu_s, wall_s, child_s, n) in sorted(modules.items(), key=lambda kv: -kv[1][0])[:most]:
+        lines.append(f"{cpu_s:8.1f} {wall_s:8.1f} {child_s:8.1f} {int(n):5d}  {name}")
+    lines.append("tests by CPU (s CPU, s wall, s CPU of child processes):")
+    for nodeid, cpu_s, wall_s, child_s in sorted(rows, key=lambda r: -r[1])[:most]:
+        lines.append(f"{cpu_s:8.1f} {wall_s:8.1f} {child_s:8.1f}  {nodeid}")
     return "\n".join(lines)
 
 

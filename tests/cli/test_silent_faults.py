@@ -185,34 +185,37 @@ EARLY_REAL_PROCESS = ("1 out is a table, hard link", "8 loop save")
 @pytest.mark.parametrize("case", EARLY_CASES, ids=lambda c: c[0])
 def test_outputs_onto_the_dataset_loops_and_long_names_are_one_line_before_any_work(
     case: tuple[str, str, str],
-    demo_dataroot: Path,
+    linkable_demo: Path,
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """In-process (``tests.inprocess.run_script``); the dataset's tables are unchanged after each."""
+    """In-process (``tests.inprocess.run_script``); the dataset's tables are unchanged after each. The dataset is
+    ``linkable_demo`` (its own tables): the hard link of a table must not touch the shared demo's."""
     name, command, expected = case
-    dataset_before = _tree(demo_dataroot / "v1.0-mini")
-    work = _early_work(case, tmp_path, demo_dataroot)
+    demo = linkable_demo
+    dataset_before = _tree(demo / "v1.0-mini")
+    work = _early_work(case, tmp_path, demo)
     before = _snapshot(work)
-    proc = run_script_with(command.format(demo=demo_dataroot).split(), _env(demo_dataroot), work, monkeypatch, capsys)
+    proc = run_script_with(command.format(demo=demo).split(), _env(demo), work, monkeypatch, capsys)
     assert _check(name, proc, expected) == []
     assert _snapshot(work) == before
-    assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
+    assert _tree(demo / "v1.0-mini") == dataset_before
 
 
-def test_early_refusals_in_real_processes(demo_dataroot: Path, tmp_path: Path) -> None:
-    dataset_before = _tree(demo_dataroot / "v1.0-mini")
-    env = _env(demo_dataroot)
+def test_early_refusals_in_real_processes(linkable_demo: Path, tmp_path: Path) -> None:
+    demo = linkable_demo
+    dataset_before = _tree(demo / "v1.0-mini")
+    env = _env(demo)
     cases = [c for c in EARLY_CASES if c[0] in EARLY_REAL_PROCESS]
     assert len(cases) == len(EARLY_REAL_PROCESS)
 
     def one(case: tuple[str, str, str]) -> tuple[str, Path, list[str], str]:
-        work = _early_work(case, tmp_path, demo_dataroot)
-        return case[0], work, case[1].format(demo=demo_dataroot).split(), case[2]
+        work = _early_work(case, tmp_path, demo)
+        return case[0], work, case[1].format(demo=demo).split(), case[2]
 
     assert _problems_in_real_processes(cases, one, env) == []
-    assert _tree(demo_dataroot / "v1.0-mini") == dataset_before
+    assert _tree(demo / "v1.0-mini") == dataset_before
 
 
 def test_a_255_byte_output_name_is_written(demo_dataroot: Path, tmp_path: Path, run_in: _InProcess) -> None:

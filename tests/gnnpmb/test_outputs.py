@@ -39,15 +39,15 @@ def test_a_name_beyond_the_limit_is_refused_before_it_is_touched(tmp_path: Path)
 
 
 def test_a_hard_link_of_a_table_is_refused_once_the_dataset_is_known(
-    demo_dataroot: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    linkable_demo: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(outputs, "_CHECKED", [])
     monkeypatch.setattr(outputs, "_DATASETS", [])
     link = tmp_path / "copy.json"
-    os.link(demo_dataroot / "v1.0-mini" / "sample.json", link)
+    os.link(linkable_demo / "v1.0-mini" / "sample.json", link)
     check_output_file(link, "--out")  # the dataset is not known yet: its place says nothing
     with pytest.raises(OutputPathError, match="is a hard link of the nuScenes file .*sample.json"):
-        outputs.check_dataset_inputs(demo_dataroot, "v1.0-mini")
+        outputs.check_dataset_inputs(linkable_demo, "v1.0-mini")
     with pytest.raises(OutputPathError, match="a hard link of the nuScenes table or sensor file"):
         check_output_file(link, "--json")
 

@@ -3,6 +3,7 @@ matrix: the same assignments with the same float costs in the same order, ties i
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 
@@ -113,16 +114,10 @@ def test_enumerated_with_a_root_defers_listing_and_agrees_with_its_listing():
         assert all_solutions(lazy) == all_solutions(eager)
 
 
-@pytest.mark.parametrize(("joint_limit", "shared_limit"), [(256, 4096), (0, 4096), (0, 0)])
-@pytest.mark.parametrize("max_increase", [math.inf, 1.5])
-def test_ranks_of_several_column_subsets_equal_each_rank(max_increase, joint_limit, shared_limit, monkeypatch):
-    """``ColumnSubsets.ranks`` (small subsets listed side by side, or from one listing of the block, or each on
-    its own) gives what ``rank`` gives for each subset, solution for solution, ties included, None where it is
-    infeasible."""
-    monkeypatch.setattr(murty, "JOINT_LISTING_LIMIT", joint_limit)
-    monkeypatch.setattr(murty, "SHARED_LISTING_LIMIT", shared_limit)
+def _several_subsets_trials() -> list[tuple[np.ndarray, np.ndarray]]:
+    """200 PMB-like blocks (cost (R, C)) each with 1 to 5 column subsets (patterns (P, C) bool), seeded."""
     rng = np.random.default_rng(11)
-    together = infeasible = 0
+    trials = []
     for trial in range(200):
         n_rows, n_tracks = int(rng.integers(1, 6)), int(rng.integers(1, 8))
         integer = trial % 2 == 0
@@ -134,29 +129,55 @@ def test_ranks_of_several_column_subsets_equal_each_rank(max_increase, joint_lim
         private[rng.random((n_rows, n_rows)) < 0.1] = np.inf  # now and then a row with no private column
         cost = np.hstack([tracks, private])
         patterns = rng.random((int(rng.integers(1, 6)), cost.shape[1])) < 0.7
-        subsets = murty.ColumnSubsets(cost, max_increase)
-        got = subsets.ranks(patterns)
-        for present, ranking in zip(patterns, got, strict=True):
+        trials.append((cost, patterns))
+    return trials
+
+
+@functools.cache
+def _each_rank_of_several_subsets(max_increase: float) -> list[list[list[tuple[list[int], float]] | None]]:
+    """Per trial of ``_several_subsets_trials``, per subset: ``ColumnSubsets.rank``'s solutions, None where it is
+    infeasible. ``rank`` of one subset reads neither listing limit, so the cases below, which set only those,
+    share it (computed once per worker; the module's tests run on one)."""
+    out = []
+    for cost, patterns in _several_subsets_trials():
+        wants = []
+        for present in patterns:
             try:
-                want = all_solutions(murty.ColumnSubsets(cost, max_increase).rank(present))
+                wants.append(all_solutions(murty.ColumnSubsets(cost, max_increase).rank(present)))
             except murty.InfeasibleAssignment:
-                want = None
+                wants.append(None)
+        out.append(wants)
+    return out
+
+
+@pytest.mark.parametrize(("joint_limit", "shared_limit"), [(256, 4096), (0, 4096), (0, 0)])
+@pytest.mark.parametrize("max_increase", [math.inf, 1.5])
+def test_ranks_of_several_column_subsets_equal_each_rank(max_increase, joint_limit, shared_limit, monkeypatch):
+    """``ColumnSubsets.ranks`` (small subsets listed side by side, or from one listing of the block, or each on
+    its own) gives what ``rank`` gives for each subset, solution for solution, ties included, None where it is
+    infeasible."""
+    monkeypatch.setattr(murty, "JOINT_LISTING_LIMIT", joint_limit)
+    monkeypatch.setattr(murty, "SHARED_LISTING_LIMIT", shared_limit)
+    together = infeasible = 0
+    trials = _several_subsets_trials()
+    for (cost, patterns), wants in zip(trials, _each_rank_of_several_subsets(max_increase), strict=True):
+        got = murty.ColumnSubsets(cost, max_increase).ranks(patterns)
+        for ranking, want in zip(got, wants, strict=True):
             assert (None if ranking is None else all_solutions(ranking)) == want
             infeasible += want is None
-        together += n_rows >= 2 and len(patterns) >= 2
+        together += cost.shape[0] >= 2 and len(patterns) >= 2
     assert together > 50 and infeasible > 10
 
 
-@pytest.mark.parametrize("joint_limit", [4, 256])
-@pytest.mark.parametrize("max_increase", [math.inf, 1.5])
-def test_subset_rankings_of_several_blocks_equal_each_rank(max_increase, joint_limit, monkeypatch):
-    """``subset_rankings`` over blocks of different shapes (worked on together per row count, padded to the
-    widest) gives what ``ColumnSubsets.rank`` gives for each, solution for solution, ties included, None where
-    it is infeasible; with a small enumeration limit some sub-problems are ranked one by one."""
-    monkeypatch.setattr(murty, "ENUMERATION_LIMIT", 16)
-    monkeypatch.setattr(murty, "JOINT_LISTING_LIMIT", joint_limit)  # 4: many listed on their own
+SEVERAL_BLOCKS_ENUMERATION_LIMIT = 16
+"""``ENUMERATION_LIMIT`` in ``test_subset_rankings_of_several_blocks_equal_each_rank``: some sub-problems are ranked
+one by one."""
+
+
+def _several_blocks_trials() -> list[tuple[list[np.ndarray], list[np.ndarray]]]:
+    """60 seeded trials of 1 to 8 blocks of different shapes (costs), each with one column subset (patterns)."""
     rng = np.random.default_rng(13)
-    kinds = {"single": 0, "listed": 0, "ranked": 0, "infeasible": 0}
+    trials = []
     for trial in range(60):
         costs, patterns = [], []
         for _ in range(int(rng.integers(1, 9))):
@@ -170,12 +191,41 @@ def test_subset_rankings_of_several_blocks_equal_each_rank(max_increase, joint_l
             private[rng.random((n_rows, n_rows)) < 0.1] = np.inf
             costs.append(np.hstack([tracks, private]))
             patterns.append(np.concatenate([rng.random(n_tracks) < 0.7, np.ones(n_rows, dtype=bool)]))
-        got = murty.subset_rankings(costs, patterns, max_increase)
-        for cost, present, ranking in zip(costs, patterns, got, strict=True):
+        trials.append((costs, patterns))
+    return trials
+
+
+@functools.cache
+def _each_rank_of_several_blocks(max_increase: float) -> list[list[list[tuple[list[int], float]] | None]]:
+    """Per trial of ``_several_blocks_trials``, per block: ``ColumnSubsets.rank``'s solutions of its subset (with
+    ``ENUMERATION_LIMIT`` at ``SEVERAL_BLOCKS_ENUMERATION_LIMIT``), None where it is infeasible. ``rank`` of one
+    subset does not read ``JOINT_LISTING_LIMIT``, so the cases below, which set it, share it (once per worker)."""
+    assert murty.ENUMERATION_LIMIT == SEVERAL_BLOCKS_ENUMERATION_LIMIT
+    out = []
+    for costs, patterns in _several_blocks_trials():
+        wants = []
+        for cost, present in zip(costs, patterns, strict=True):
             try:
-                want = all_solutions(murty.ColumnSubsets(cost, max_increase).rank(present))
+                wants.append(all_solutions(murty.ColumnSubsets(cost, max_increase).rank(present)))
             except murty.InfeasibleAssignment:
-                want = None
+                wants.append(None)
+        out.append(wants)
+    return out
+
+
+@pytest.mark.parametrize("joint_limit", [4, 256])
+@pytest.mark.parametrize("max_increase", [math.inf, 1.5])
+def test_subset_rankings_of_several_blocks_equal_each_rank(max_increase, joint_limit, monkeypatch):
+    """``subset_rankings`` over blocks of different shapes (worked on together per row count, padded to the
+    widest) gives what ``ColumnSubsets.rank`` gives for each, solution for solution, ties included, None where
+    it is infeasible; with a small enumeration limit some sub-problems are ranked one by one."""
+    monkeypatch.setattr(murty, "ENUMERATION_LIMIT", SEVERAL_BLOCKS_ENUMERATION_LIMIT)
+    monkeypatch.setattr(murty, "JOINT_LISTING_LIMIT", joint_limit)  # 4: many listed on their own
+    kinds = {"single": 0, "listed": 0, "ranked": 0, "infeasible": 0}
+    trials = _several_blocks_trials()
+    for (costs, patterns), wants in zip(trials, _each_rank_of_several_blocks(max_increase), strict=True):
+        got = murty.subset_rankings(costs, patterns, max_increase)
+        for ranking, want in zip(got, wants, strict=True):
             assert (None if ranking is None else all_solutions(ranking)) == want
             if want is None:
                 kinds["infeasible"] += 1

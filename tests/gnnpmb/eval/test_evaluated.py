@@ -10,7 +10,8 @@ import pytest
 
 from gnnpmb.data.nuscenes import open_nuscenes
 from gnnpmb.eval.evaluated import Dropped, GtStatus
-from gnnpmb.eval.failures import _split_with_scene, find_failures
+from gnnpmb.eval.failure_cache import scene_report
+from gnnpmb.eval.failures import _split_with_scene
 from gnnpmb.eval.nuscenes_eval import quiet_devkit, scene_sample_tokens, tracking_config
 from gnnpmb.eval.submission import run_results
 from gnnpmb.pipeline import run_tracker
@@ -21,7 +22,9 @@ SCENE = "scene-0103"
 
 @pytest.fixture(scope="module")
 def evaluated(demo_dataroot: Path):
-    """The report of gnnpmb on the scene, the submission, and the devkit's prepared tracks computed apart."""
+    """The report of gnnpmb on the scene, the submission, and the devkit's prepared tracks computed apart. The report
+    is the one ``gnnpmb-viz`` and ``gnnpmb failures`` use (``scene_report``): read from the session's cache when an
+    earlier test evaluated the same run (the README's demo command does), else found now."""
     from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes, load_gt_of_sample_tokens
     from nuscenes.eval.tracking.data_classes import TrackingBox
     from nuscenes.eval.tracking.loaders import create_tracks
@@ -30,7 +33,7 @@ def evaluated(demo_dataroot: Path):
     nusc = open_nuscenes(request.location)
     run = run_tracker(request.scene, request.frame_detections, "gnnpmb", request.config)
     results = run_results(run)
-    report = find_failures(nusc, SCENE, results, "gnnpmb")
+    report = scene_report(request.location, SCENE, "gnnpmb", results)
     tokens = scene_sample_tokens(nusc, SCENE)
     frame_of = {nusc.get("sample", t)["timestamp"]: i for i, t in enumerate(tokens)}
     cfg = tracking_config()
