@@ -410,6 +410,10 @@ class FalseOutput:
     beside_untracked: tuple[str, str, float] | None = None
     """Near an object of its class: the annotation of an untracked category (id, category, m) the box lies nearer
     than that object (a stroller beside its pusher: the track was on the stroller; audit truth52, world8)."""
+    kept_around: tuple[int | None, int | None] | None = None
+    """The nearest object of its class has no box the evaluation scored here (``Rule.NO_EVAL_BOX``): the last frame
+    before and the first after this one at which the evaluation kept its box (None: none on that side), the ends an
+    interpolation would join (audit truth54, dev set: "no box of it both before and after" of one it kept after)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -893,8 +893,17 @@ class _Context:
             came,
             drifted,
             self.untracked_nearer(self.f, xy, nearest_own[1]) if nearest_own is not None else None,
+            self.kept_around(nearest_own[0]) if any(b.rule is Rule.NO_EVAL_BOX for b in blame) else None,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
+
+    def kept_around(self, gt_id: str) -> tuple[int | None, int | None]:
+        """The last frame before this one and the first after it at which the evaluation kept the object's
+        annotated box (None: none on that side): the ends its interpolation would join."""
+        kept = sorted(x for x, g in self.report.gt_frames.get(gt_id, {}).items() if g.dropped is None)
+        before = [x for x in kept if x < self.f]
+        after = [x for x in kept if x > self.f]
+        return (before[-1] if before else None, after[0] if after else None)
 
     @staticmethod
     def false_at(report: FailureReport, frame: int, track_id: int) -> bool:

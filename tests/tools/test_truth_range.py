@@ -83,3 +83,29 @@ def test_a_dropped_lost_track_said_beyond_the_evaluations_2_m_is_caught() -> Non
     ev.kept_frames["91"] = (1, 2, 3)  # kept: neither the drop nor its distance holds
     assert [c.kind for c in check_text(new, ctx, None, ev, scene=scene).found] == ["evaluation", "evaluation"]
     assert check_text(old, ctx, None, ev, scene=scene).found == []
+
+
+def test_no_box_of_an_object_on_one_side_only_told_as_on_neither_is_caught() -> None:
+    # audit truth54, dev set scene-0103 centerpoint gnnpmb false_track:12 (motorcycle GT 31c6f6 at frame 31, 40.15 m
+    # from the ego): the devkit kept its boxes from frame 32 on, none before
+    moto = "31c6f6" + "0" * 26
+    scene = SceneTruth([[]] * 4, [{moto: Annotation("motorcycle", (40.15, 0.0), 20)}] * 4, [(0.0, 0.0)] * 4)
+    ev = EvalFacts(thresholds={"motorcycle": 0.3})
+    ev.kept_gt = {(3, moto)}
+    ev.evaluated_gt = {(3, moto): (40.15, 0.0)}
+    ctx = Context("motorcycle", 2, moto, kind="false_track", track=30)
+    head = (
+        "motorcycle GT 31c6f6 lies 0.2 m away, but the evaluation has no box for it here (it lies 40.15 m from the "
+        "ego vehicle, beyond the evaluation's 40 m range, and "
+    )
+
+    def kinds(why: str) -> list[str]:
+        return [c.kind for c in check_text(f"{head}{why}): a track on it is false", ctx, None, ev, scene=scene).found]
+
+    assert kinds("it keeps no box of it both before and after this frame") == ["misleading"]
+    assert kinds("it keeps none of its boxes before frame 3 to interpolate one from") == []
+    assert kinds("it keeps none of its boxes after frame 1 to interpolate one from") == ["misleading"]
+    assert kinds("it keeps none of its boxes at any frame") == ["misleading"]
+    ev.kept_gt = {(1, moto), (3, moto)}  # kept on both sides: the devkit interpolated a box here
+    ev.evaluated_gt[(2, moto)] = (40.1, 0.0)
+    assert kinds("it keeps none of its boxes before frame 3 to interpolate one from") == ["evaluation"]

@@ -391,6 +391,10 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
             if (xy is None) != (v[2] is None) or (xy is not None and math.dist(xy, v[2]) > ATOL):
                 return "evaluated box differs"
             return ""
+        case "kept around":
+            kept = sorted(y for y, k in src.ev.kept_gt if k == v[0])
+            got = (max((y for y in kept if y < x), default=None), min((y for y in kept if y > x), default=None))
+            return "" if got == (v[1], v[2]) else f"the devkit kept its box last before / first after at {got}"
         case "false at":
             false = {y for y in v[1] if str(v[0]) in src.ev.track_to_gt.get((c, y), {})}
             false = {y for y in false if src.ev.matched_gt(c, y, str(v[0])) is None}
