@@ -410,6 +410,11 @@ class FalseOutput:
     beside_untracked: tuple[str, str, float] | None = None
     """Near an object of its class: the annotation of an untracked category (id, category, m) the box lies nearer
     than that object (a stroller beside its pusher: the track was on the stroller; audit truth52, world8)."""
+    detection_near: tuple[str, str, float, float] | None = None
+    """No object within ``NEAR_M`` of the box, which sat on a detection: the object of a tracked class that
+    detection lay within ``NEAR_M`` of (id, class, the detection's distance m, the box's distance m; audit truth54,
+    dev set scene-0103 pointpillars jpda false_track:19: "a detection of no tracked object" of a bicycle detection
+    1.98 m from a bicycle, the track's box 2.0 m or more from it)."""
     kept_around: tuple[int | None, int | None] | None = None
     """The nearest object of its class has no box the evaluation scored here (``Rule.NO_EVAL_BOX``): the last frame
     before and the first after this one at which the evaluation kept its box (None: none on that side), the ends an

@@ -893,9 +893,23 @@ class _Context:
             came,
             drifted,
             self.untracked_nearer(self.f, xy, nearest_own[1]) if nearest_own is not None else None,
+            self.detection_near(on, xy) if nearest_any is None and on is not None else None,
             self.kept_around(nearest_own[0]) if any(b.rule is Rule.NO_EVAL_BOX for b in blame) else None,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
+
+    def detection_near(self, on: Near, xy: np.ndarray) -> tuple[str, str, float, float] | None:
+        """The nearest annotated object of a tracked class within ``NEAR_M`` of detection ``on`` at this frame (id,
+        class, the detection's distance, the box's at ``xy``), when the box itself lies farther than that."""
+        fr, gt = self.frames.get(self.f), self.scene.keyframes[self.f].gt
+        if fr is None or not len(gt):
+            return None
+        d = np.hypot(*(gt.translation_m[:, :2] - fr.detections.boxes.translation_m[on.meas, :2]).T)
+        k = int(np.argmin(d))
+        if d[k] >= NEAR_M:
+            return None
+        box = float(np.hypot(*(gt.translation_m[k, :2] - xy)))
+        return (str(gt.instance_id[k]), str(gt.class_name[k]), float(d[k]), box)
 
     def kept_around(self, gt_id: str) -> tuple[int | None, int | None]:
         """The last frame before this one and the first after it at which the evaluation kept the object's

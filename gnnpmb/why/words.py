@@ -1148,6 +1148,13 @@ def _false_track(f: Finding) -> list[str]:
             f"no object of a tracked class lies within {NEAR_M:.0f} m, but {what} lies on {on_what}"
             f"{_part_text(o.part_of)}"
         )
+    elif o.on is not None and o.detection_near is not None:
+        gt_id, cls, d, box = o.detection_near
+        parts.append(
+            f"no object of a tracked class lies within {NEAR_M:.0f} m of the box, but {meas_name(o.on.meas)} lay "
+            f"{ego_distance_text(d, NEAR_M, 2)} m from {cls} GT {short_id(gt_id)} (the box "
+            f"{ego_distance_text(box, NEAR_M, 2)} m): a detection of that object, placed off it"
+        )
     elif o.on is not None:
         parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of no tracked object")
     elif Rule.TRACK_INTERPOLATED in tests:

@@ -5,7 +5,7 @@ range, parked cars at 50 m): the old explainer's "(or in a bike rack)" of a car 
 from __future__ import annotations
 
 from tools.truth.devkit import EvalFacts
-from tools.truth.scene import Annotation, SceneTruth
+from tools.truth.scene import Annotation, Detection, SceneTruth
 from tools.truth.sentences import Context, check_text
 
 CAR = "a46079" + "0" * 26
@@ -109,3 +109,26 @@ def test_no_box_of_an_object_on_one_side_only_told_as_on_neither_is_caught() -> 
     ev.kept_gt = {(1, moto), (3, moto)}  # kept on both sides: the devkit interpolated a box here
     ev.evaluated_gt[(2, moto)] = (40.1, 0.0)
     assert kinds("it keeps none of its boxes before frame 3 to interpolate one from") == ["evaluation"]
+
+
+def test_a_detection_within_2_m_of_an_object_called_a_detection_of_no_tracked_object_is_caught() -> None:
+    # audit truth54, dev set scene-0103 pointpillars jpda false_track:19 (frame 20): bicycle detection m14 lay 1.98 m
+    # from bicycle GT 133f97, track 228's box on it 2.03 m
+    bike = "133f97" + "0" * 26
+    dets = [[Detection("bicycle", 0.31, (1.98, 0.0))]] * 4
+    scene = SceneTruth(dets, [{bike: Annotation("bicycle", (0.0, 0.0), 15)}] * 4, [(0.0, 0.0)] * 4)
+    ev = EvalFacts(thresholds={"bicycle": 0.3})
+    ev.boxes[3] = [("228", "bicycle", (2.03, 0.0))]
+    ev.submitted = {3: {"228"}}
+    ctx = Context("bicycle", 3, None, kind="false_track", track=228)
+    head = (
+        "at frame 3 track 228 (bicycle) was output on detection m0 (bicycle, score 0.31); no object of a tracked class "
+    )
+
+    def kinds(tail: str) -> list[str]:
+        return [c.kind for c in check_text(head + tail, ctx, None, ev, scene=scene).found]
+
+    assert kinds("lies within 2 m: a detection of no tracked object") == ["detector"]
+    said = "lies within 2 m of the box, but m0 lay 1.98 m from bicycle GT 133f97 (the box 2.03 m): a detection of "
+    assert kinds(said + "that object, placed off it") == []
+    assert kinds(said.replace("1.98", "1.90") + "that object, placed off it") == ["detector"]

@@ -21,6 +21,10 @@ against the annotation files and the devkit's own boxes.
   object": T's submitted box lies D m (2 m or more) from H's annotation and 2 m or more from the box the devkit
   scored H at; "…, on mN, E m from the box the evaluation interpolated for it": the devkit did not keep H's
   annotation there and scored a box E m (under 2 m) from T's;
+* a false box on detection mN "…: a detection of no tracked object": no annotation of a tracked class lies within
+  2 m of mN either; "…within 2 m of the box, but mN lay D m from C GT H (the box E m)": mN lies D m from H, of
+  class C, and the box E m (audit truth54, dev set scene-0103 pointpillars jpda false_track:19: a bicycle detection
+  1.98 m from a bicycle called a detection of no tracked object);
 * a false track's "C GT H lies D m away, but the evaluation has no box for it here (WHY)": the devkit neither kept
   H's annotation at the frame nor interpolated one; "it had no LiDAR or radar points" only of a box with none; "it
   keeps none of its boxes after frame L" / "before frame R" / "at any frame": L and R are the nearest frames before
@@ -110,6 +114,34 @@ def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, 
         near = [t for t, cls, xy in ev.boxes.get(x, []) if cls == c and math.dist(xy, a.xy_m) < NEAR_M]
         if near:
             bad("output", NOT_CARRIED, f"tracks {near} were output within 2 m of it at frame {x}")
+
+
+OF_NOTHING = re.compile(
+    r"at frame (\d+) track (\d+) \(\w+\) was output on detection m(\d+) \([^()]*\); no object of a tracked class "
+    r"lies within 2 m(?:: a detection of no tracked object| of the box, but m\d+ lay ([\d.]+) m from (\w+) GT (\w{6}) "
+    r"\(the box ([\d.]+) m\))"
+)
+
+
+def check_of_nothing(text: str, scene, ev, out, bad) -> None:
+    """A false box on a detection with no object within 2 m of the box (module docstring)."""
+    for m in OF_NOTHING.finditer(text):
+        x, t, j = int(m[1]), m[2], int(m[3])
+        if scene is None or x >= len(scene.detections) or j >= len(scene.detections[x]):
+            continue
+        out.checked["detector"] += 1
+        d = scene.detections[x][j].xy_m
+        near = sorted((_d(a.xy_m, d), k, a.class_name) for k, a in scene.objects[x].items())
+        if m[4] is None:
+            if near and near[0][0] < NEAR_M:
+                bad("detector", m[0], f"m{j} lies {near[0][0]:.3f} m from {near[0][2]} GT {near[0][1][:6]}")
+            continue
+        hit = scene.object_of(x, m[6])
+        box = next((xy for tt, _, xy in ev.boxes.get(x, []) if tt == t), None)
+        if hit is None or box is None or hit[1].class_name != m[5] or not near or near[0][1] != hit[0]:
+            bad("detector", m[0], f"the annotations nearest m{j}: {near[:2]}")
+        elif abs(_d(hit[1].xy_m, d) - float(m[4])) > 0.006 or abs(_d(hit[1].xy_m, box) - float(m[7])) > 0.006:
+            bad("detector", m[0], f"m{j} {_d(hit[1].xy_m, d):.3f} m, the box {_d(hit[1].xy_m, box):.3f} m from it")
 
 
 NO_BOX = re.compile(

@@ -264,6 +264,7 @@ def check_text(
     place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
     place.check_out_of_reach(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
     place.check_no_box(text, ctx.frame, scene, ev, out, bad)
+    place.check_of_nothing(text, scene, ev, out, bad)
     place.check_off(text, scene, ev, out, bad)
     place.check_none_of_its_own(text, ctx.frame, scene, out, bad)
     check_dropped(text, ctx, ev, out, bad)
