@@ -20,11 +20,12 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   the object did not use it (``DETECTION_UNUSED``, naming where it went, or that preprocessing dropped it), or the
   track that had the object (or took its detection) was not output (``NOT_OUTPUT``: over a gap in the
   detections, the tracker could have carried it), or it was output
-  ``NEAR_M`` or more from the object (``OFF_OBJECT``), or a track on the object was output but not counted
-  (``NOT_COUNTED``), or two tracks were output on one object (``TWO_TRACKS``), or a track was output without a
-  detection on no object (``COASTED``), or one track was matched to an object while covering another
-  (``COVERED_TWO``), or the object had no LiDAR or radar points, so no detector could see it, and no track carried
-  it (``UNSEEN``);
+  ``NEAR_M`` or more from the object (``OFF_OBJECT``; a false track: on a detection within ``NEAR_M`` of an object,
+  its box ``NEAR_M`` or more from every object, ``FalseOutput.detection_near``), or a track on the object was
+  output but not counted (``NOT_COUNTED``), or two tracks were output on one object (``TWO_TRACKS``), or a track
+  was output without a detection on no object (``COASTED``), or one track was matched to an object while covering
+  another (``COVERED_TWO``), or the object had no LiDAR or radar points, so no detector could see it, and no track
+  carried it (``UNSEEN``);
 * **the evaluation's**: the box the object was scored against is an interpolation ``EVALUATED_OFFSET_M`` or more
   from the annotation (for a miss ``NEAR_M`` or more: a nearer box would still match a track on the object), or one
   that put a counted track output within ``NEAR_M`` of the annotation out of the

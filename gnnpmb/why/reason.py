@@ -872,6 +872,8 @@ class _Context:
             blame.append(Blame(Rule.COASTED, (self.f,)))
         elif nearest_any is not None:
             blame.append(Blame(Rule.OTHER_CLASS, (self.f,)))
+        elif on is not None and self.detection_near(on, xy) is not None:  # its detection was the object's (truth54)
+            blame.append(Blame(Rule.OFF_OBJECT, (self.f,)))
         else:
             blame.append(Blame(Rule.DETECTION_OF_NOTHING, (self.f,)))
         if nearest_any is None and on is None and (interpolated or e is not None):  # a box on no detection

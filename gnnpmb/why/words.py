@@ -1141,19 +1141,19 @@ def _false_track(f: Finding) -> list[str]:
         parts.append(
             f"no {f.class_name} GT lies within {NEAR_M:.0f} m, but GT {cls} {short_id(gt_id)} does ({d:.1f} m): {what}"
         )
+    elif o.on is not None and o.detection_near is not None:
+        gt_id, cls, d, box = o.detection_near
+        parts.append(
+            f"no object of a tracked class lies within {NEAR_M:.0f} m of the box, but {meas_name(o.on.meas)} lay "
+            f"{ego_distance_text(d, NEAR_M, 2)} m from {cls} GT {short_id(gt_id)}: the track's box lay "
+            f"{ego_distance_text(box, NEAR_M, 2)} m from that object, beyond the evaluation's {NEAR_M:.0f} m"
+        )
     elif o.part_of is not None:  # audit truth50 (world6): a truck's trailer box is no "box where no object was"
         what = "the detection" if o.on is not None else "the box"
         on_what = "" if is_untracked(o.part_of) else "part of "  # audit truth52 (world8): a car box on an ambulance
         parts.append(
             f"no object of a tracked class lies within {NEAR_M:.0f} m, but {what} lies on {on_what}"
             f"{_part_text(o.part_of)}"
-        )
-    elif o.on is not None and o.detection_near is not None:
-        gt_id, cls, d, box = o.detection_near
-        parts.append(
-            f"no object of a tracked class lies within {NEAR_M:.0f} m of the box, but {meas_name(o.on.meas)} lay "
-            f"{ego_distance_text(d, NEAR_M, 2)} m from {cls} GT {short_id(gt_id)} (the box "
-            f"{ego_distance_text(box, NEAR_M, 2)} m): a detection of that object, placed off it"
         )
     elif o.on is not None:
         parts.append(f"no object of a tracked class lies within {NEAR_M:.0f} m: a detection of no tracked object")

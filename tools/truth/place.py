@@ -22,9 +22,9 @@ against the annotation files and the devkit's own boxes.
   scored H at; "…, on mN, E m from the box the evaluation interpolated for it": the devkit did not keep H's
   annotation there and scored a box E m (under 2 m) from T's;
 * a false box on detection mN "…: a detection of no tracked object": no annotation of a tracked class lies within
-  2 m of mN either; "…within 2 m of the box, but mN lay D m from C GT H (the box E m)": mN lies D m from H, of
-  class C, and the box E m (audit truth54, dev set scene-0103 pointpillars jpda false_track:19: a bicycle detection
-  1.98 m from a bicycle called a detection of no tracked object);
+  2 m of mN either; "…within 2 m of the box, but mN lay D m from C GT H: the track's box lay E m from that
+  object": mN lies D m from H, of class C, and the box E m (audit truth54, dev set scene-0103 pointpillars jpda
+  false_track:19: a bicycle detection 1.98 m from a bicycle called a detection of no tracked object);
 * a false track's "C GT H lies D m away, but the evaluation has no box for it here (WHY)": the devkit neither kept
   H's annotation at the frame nor interpolated one; "it had no LiDAR or radar points" only of a box with none; "it
   keeps none of its boxes after frame L" / "before frame R" / "at any frame": L and R are the nearest frames before
@@ -117,9 +117,9 @@ def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, 
 
 
 OF_NOTHING = re.compile(
-    r"at frame (\d+) track (\d+) \(\w+\) was output on detection m(\d+) \([^()]*\); no object of a tracked class "
-    r"lies within 2 m(?:: a detection of no tracked object| of the box, but m\d+ lay ([\d.]+) m from (\w+) GT (\w{6}) "
-    r"\(the box ([\d.]+) m\))"
+    r"at frame (\d+) track (\d+) \(\w+\) was output (?:on|[\d.]+ m from) detection m(\d+) \([^()]*\)[^;]*; no object "
+    r"of a tracked class lies within 2 m(?:: a detection of no tracked object| of the box, but m\d+ lay ([\d.]+) m "
+    r"from (\w+) GT (\w{6}): the track's box lay ([\d.]+) m from that object)"
 )
 
 
