@@ -135,7 +135,7 @@ def test_a_detection_within_2_m_of_an_object_called_a_detection_of_no_tracked_ob
 
 
 def test_a_false_box_blamed_on_a_detection_of_nothing_that_lay_near_an_object_is_caught() -> None:
-    # audit truth54, dev set scene-0916 pointpillars jpda false_track:23 (frame 28): truck detection m1 lay 0.25 m
+    # audit truth54, dev set scene-0103 pointpillars jpda false_track:23 (frame 28): truck detection m1 lay 0.25 m
     # from truck GT bcd4a2 and track 170's box 2.21 m, blamed on the detector ("a detection of no tracked object")
     from types import SimpleNamespace
 

@@ -1,6 +1,6 @@
 """A false box on a detection that lay within 2 m of an object, the box itself beyond 2 m (audit truth54, dev set
 scene-0103 pointpillars jpda false_track:19, frame 20: bicycle detection m14 lay 1.98 m from bicycle GT 133f97,
-told as "a detection of no tracked object"; scene-0916 pointpillars jpda false_track:23, frame 28: truck
+told as "a detection of no tracked object"; scene-0103 pointpillars jpda false_track:23, frame 28: truck
 detection m1 0.25 m from truck GT bcd4a2, the track's box 2.21 m from it, blamed on the detector)."""
 
 from __future__ import annotations
