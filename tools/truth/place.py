@@ -119,7 +119,7 @@ def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, 
 OF_NOTHING = re.compile(
     r"at frame (\d+) track (\d+) \(\w+\) was output (?:on|[\d.]+ m from) detection m(\d+) \([^()]*\)[^;]*; no object "
     r"of a tracked class lies within 2 m(?:: a detection of no tracked object| of the box, but m\d+ lay ([\d.]+) m "
-    r"from (\w+) GT (\w{6}): the track's box lay ([\d.]+) m from that object)"
+    r"from (\w+) GT (\w{6}): the track's box lay ([\d.]+) m from that object, beyond the evaluation's 2 m)"
 )
 
 
