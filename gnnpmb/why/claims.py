@@ -43,6 +43,8 @@ CLAIM_KINDS = (
     "parent",  # (class, parent): the best hypothesis descends from this prior hypothesis
     "averaged score",  # (track, value, kept frames): the devkit's averaged score over the frames it kept
     "evaluated",  # (gt, status, evaluated xy or None)
+    "kept around",  # (gt, before, after): the last frame before this one and the first after it at which the
+    # evaluation kept the object's annotated box (None: none on that side)
     "false at",  # (track, frames): the evaluation counted it a false track at these frames
     "other failed",  # (tracker, kind, gt, place xy, failed): at the object (or, without one, the place)
     "other matched",  # (tracker, gt, track): that run's evaluation matched the object to this track (None: none)
@@ -169,6 +171,8 @@ def claims(f: Finding) -> list[Claim]:
                 add("output near", f.frame, o.track_id, gt_id, d)
             if g is not None:
                 add("evaluated", f.frame, gt_id, g.status, g.evaluated_xy_m)
+            if o.kept_around is not None:
+                add("kept around", f.frame, gt_id, *o.kept_around)
     for other in f.others:
         add("other failed", f.frame, other.tracker, f.kind.value, f.gt_id, other.place_xy_m, other.failed_same)
         if f.gt_id is not None:

@@ -20,11 +20,12 @@ The tests of ``Blame`` (``Rule``) are stated once, here:
   the object did not use it (``DETECTION_UNUSED``, naming where it went, or that preprocessing dropped it), or the
   track that had the object (or took its detection) was not output (``NOT_OUTPUT``: over a gap in the
   detections, the tracker could have carried it), or it was output
-  ``NEAR_M`` or more from the object (``OFF_OBJECT``), or a track on the object was output but not counted
-  (``NOT_COUNTED``), or two tracks were output on one object (``TWO_TRACKS``), or a track was output without a
-  detection on no object (``COASTED``), or one track was matched to an object while covering another
-  (``COVERED_TWO``), or the object had no LiDAR or radar points, so no detector could see it, and no track carried
-  it (``UNSEEN``);
+  ``NEAR_M`` or more from the object (``OFF_OBJECT``; a false track: on a detection within ``NEAR_M`` of an object,
+  its box ``NEAR_M`` or more from every object, ``FalseOutput.detection_near``), or a track on the object was
+  output but not counted (``NOT_COUNTED``), or two tracks were output on one object (``TWO_TRACKS``), or a track
+  was output without a detection on no object (``COASTED``), or one track was matched to an object while covering
+  another (``COVERED_TWO``), or the object had no LiDAR or radar points, so no detector could see it, and no track
+  carried it (``UNSEEN``);
 * **the evaluation's**: the box the object was scored against is an interpolation ``EVALUATED_OFFSET_M`` or more
   from the annotation (for a miss ``NEAR_M`` or more: a nearer box would still match a track on the object), or one
   that put a counted track output within ``NEAR_M`` of the annotation out of the
@@ -410,6 +411,15 @@ class FalseOutput:
     beside_untracked: tuple[str, str, float] | None = None
     """Near an object of its class: the annotation of an untracked category (id, category, m) the box lies nearer
     than that object (a stroller beside its pusher: the track was on the stroller; audit truth52, world8)."""
+    detection_near: tuple[str, str, float, float] | None = None
+    """No object within ``NEAR_M`` of the box, which sat on a detection: the object of a tracked class that
+    detection lay within ``NEAR_M`` of (id, class, the detection's distance m, the box's distance m; audit truth54,
+    dev set scene-0103 pointpillars jpda false_track:19: "a detection of no tracked object" of a bicycle detection
+    1.98 m from a bicycle, the track's box 2.0 m or more from it)."""
+    kept_around: tuple[int | None, int | None] | None = None
+    """The nearest object of its class has no box the evaluation scored here (``Rule.NO_EVAL_BOX``): the last frame
+    before and the first after this one at which the evaluation kept its box (None: none on that side), the ends an
+    interpolation would join (audit truth54, dev set: "no box of it both before and after" of one it kept after)."""
 
 
 @dataclass(frozen=True, slots=True)

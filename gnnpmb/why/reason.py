@@ -872,6 +872,8 @@ class _Context:
             blame.append(Blame(Rule.COASTED, (self.f,)))
         elif nearest_any is not None:
             blame.append(Blame(Rule.OTHER_CLASS, (self.f,)))
+        elif on is not None and self.detection_near(on, xy) is not None:  # its detection was the object's (truth54)
+            blame.append(Blame(Rule.OFF_OBJECT, (self.f,)))
         else:
             blame.append(Blame(Rule.DETECTION_OF_NOTHING, (self.f,)))
         if nearest_any is None and on is None and (interpolated or e is not None):  # a box on no detection
@@ -893,8 +895,31 @@ class _Context:
             came,
             drifted,
             self.untracked_nearer(self.f, xy, nearest_own[1]) if nearest_own is not None else None,
+            self.detection_near(on, xy) if nearest_any is None and on is not None else None,
+            self.kept_around(nearest_own[0]) if any(b.rule is Rule.NO_EVAL_BOX for b in blame) else None,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
+
+    def detection_near(self, on: Near, xy: np.ndarray) -> tuple[str, str, float, float] | None:
+        """The nearest annotated object of a tracked class within ``NEAR_M`` of detection ``on`` at this frame (id,
+        class, the detection's distance, the box's at ``xy``), when the box itself lies farther than that."""
+        fr, gt = self.frames.get(self.f), self.scene.keyframes[self.f].gt
+        if fr is None or not len(gt):
+            return None
+        d = np.hypot(*(gt.translation_m[:, :2] - fr.detections.boxes.translation_m[on.meas, :2]).T)
+        k = int(np.argmin(d))
+        if d[k] >= NEAR_M:
+            return None
+        box = float(np.hypot(*(gt.translation_m[k, :2] - xy)))
+        return (str(gt.instance_id[k]), str(gt.class_name[k]), float(d[k]), box)
+
+    def kept_around(self, gt_id: str) -> tuple[int | None, int | None]:
+        """The last frame before this one and the first after it at which the evaluation kept the object's
+        annotated box (None: none on that side): the ends its interpolation would join."""
+        kept = sorted(x for x, g in self.report.gt_frames.get(gt_id, {}).items() if g.dropped is None)
+        before = [x for x in kept if x < self.f]
+        after = [x for x in kept if x > self.f]
+        return (before[-1] if before else None, after[0] if after else None)
 
     @staticmethod
     def false_at(report: FailureReport, frame: int, track_id: int) -> bool:

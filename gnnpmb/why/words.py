@@ -1108,7 +1108,8 @@ def _false_track(f: Finding) -> list[str]:
         on = f"{f.class_name} GT {short_id(gt_id)} lies {d:.1f} m away"
         if Rule.NO_EVAL_BOX in tests:
             parts.append(
-                f"{on}, but the evaluation has no box for it here ({_no_box_reason(g)}): a track on it is false"
+                f"{on}, but the evaluation has no box for it here ({_no_box_reason(g, o.kept_around)}): a track on "
+                "it is false"
             )
         elif Rule.INTERPOLATED in tests:
             parts.append(
@@ -1139,6 +1140,13 @@ def _false_track(f: Finding) -> list[str]:
             what = "the tracker output a box there without a detection of its class under it"
         parts.append(
             f"no {f.class_name} GT lies within {NEAR_M:.0f} m, but GT {cls} {short_id(gt_id)} does ({d:.1f} m): {what}"
+        )
+    elif o.on is not None and o.detection_near is not None:
+        gt_id, cls, d, box = o.detection_near
+        parts.append(
+            f"no object of a tracked class lies within {NEAR_M:.0f} m of the box, but {meas_name(o.on.meas)} lay "
+            f"{ego_distance_text(d, NEAR_M, 2)} m from {cls} GT {short_id(gt_id)}: the track's box lay "
+            f"{ego_distance_text(box, NEAR_M, 2)} m from that object, beyond the evaluation's {NEAR_M:.0f} m"
         )
     elif o.part_of is not None:  # audit truth50 (world6): a truck's trailer box is no "box where no object was"
         what = "the detection" if o.on is not None else "the box"
@@ -1216,17 +1224,29 @@ def _output_on_text(f: Finding, frame: int, track_id: int, on: Near | None) -> s
     )
 
 
-def _no_box_reason(g: GtFrame | None) -> str:
+def _no_box_reason(g: GtFrame | None, kept: tuple[int | None, int | None] | None = None) -> str:
     if g is None:
         return "it is not annotated here"
     if g.status is GtStatus.BEYOND_RANGE:
         return (
             f"it lies {ego_distance_text(g.ego_distance_m, g.range_m, 2)} m from the ego vehicle, beyond the "
-            f"evaluation's {g.range_m:g} m range, "
-            "and it keeps no box of it both before and after this frame"
+            f"evaluation's {g.range_m:g} m range, and {_kept_sides_text(kept)}"
         )
     why = f"it had {g.dropped.value}" if g.dropped is Dropped.NO_POINTS else f"it was {g.dropped.value}"
     return f"{why}, so its box was dropped, and no box could be interpolated"
+
+
+def _kept_sides_text(kept: tuple[int | None, int | None] | None) -> str:
+    """Why the evaluation could not interpolate the object's box here: the side on which it kept none of its boxes
+    (``FalseOutput.kept_around``)."""
+    if kept is None:
+        return "no box could be interpolated"
+    before, after = kept
+    if before is not None and after is None:
+        return f"it keeps none of its boxes after frame {before} to interpolate one from"
+    if after is not None and before is None:
+        return f"it keeps none of its boxes before frame {after} to interpolate one from"
+    return "it keeps none of its boxes at any frame" if before is None else "no box could be interpolated"
 
 
 def _covering(f: Finding, s: Sighting) -> str:
@@ -1422,6 +1442,23 @@ def _of_its_own(s: Sighting) -> str:
     return " of its own" if s.neighbours_own is not None else ""
 
 
+def _also_near(f: Finding, s: Sighting | None, t: int) -> str:
+    """``, though counted track 72 lay 0.9 m from it too (matched to GT daa05e)``: the other counted tracks output
+    within ``NEAR_M`` of a coalescence's object that the evaluation matched to another object at the frame (audit
+    truth54, dev set scene-0061 centerpoint jpda: three pedestrians, two tracks; "no counted track covered" it, said
+    with a counted track 0.9 m from it)."""
+    if s is None:
+        return ""
+    near = [
+        (o, g)
+        for o in sorted(s.on_it, key=lambda o: o.distance_m)
+        if o.track_id != t and o.counted and o.evaluated is not None
+        if (g := o.evaluated.matched_at(f.frame)) is not None and g != f.gt_id
+    ]
+    said = [f"track {o.track_id} lay {o.distance_m:.1f} m from it (matched to GT {short_id(g)})" for o, g in near]
+    return f", though counted {' and '.join(said)}" if said else ""
+
+
 def _coalescence(f: Finding) -> list[str]:
     s = f.sighting(f.frame)
     t = f.track_ids[0]
@@ -1437,7 +1474,7 @@ def _coalescence(f: Finding) -> list[str]:
         whose = f"track {t}"
     parts = [
         f"at frame {f.frame} {whose} was matched to {covered} and also lay within {NEAR_M:.0f} m of "
-        f"GT {short_id(f.gt_id or '')}, which no counted track covered"
+        f"GT {short_id(f.gt_id or '')}, which the evaluation matched to no track{_also_near(f, s, t)}"
     ]
     if s is None:
         return parts

@@ -391,6 +391,10 @@ def check_claim(what: str, x: int, v: tuple, f, src: Sources) -> str:  # noqa: C
             if (xy is None) != (v[2] is None) or (xy is not None and math.dist(xy, v[2]) > ATOL):
                 return "evaluated box differs"
             return ""
+        case "kept around":
+            kept = sorted(y for y, k in src.ev.kept_gt if k == v[0])
+            got = (max((y for y in kept if y < x), default=None), min((y for y in kept if y > x), default=None))
+            return "" if got == (v[1], v[2]) else f"the devkit kept its box last before / first after at {got}"
         case "false at":
             false = {y for y in v[1] if str(v[0]) in src.ev.track_to_gt.get((c, y), {})}
             false = {y for y in false if src.ev.matched_gt(c, y, str(v[0])) is None}
@@ -538,6 +542,23 @@ def check_blame(rule, frames: tuple[int, ...], f, src: Sources) -> str:  # noqa:
         elif name == "NOT_OUTPUT" and f.lost is not None:
             if src.box(x, f.lost.track_id) is not None:
                 return f"track {f.lost.track_id} was output at frame {x}"
+        elif name == "OFF_OBJECT" and f.lost is None:  # a false box on a detection of an object (audit truth54)
+            on = f.false_output.on if f.false_output is not None else None
+            box = src.box(x, false_track) if false_track is not None else None
+            if on is None or box is None or on.meas >= len(src.scene.detections[x]):
+                return "no box on a detection"
+            det = src.scene.detections[x][on.meas].xy_m
+            objs = src.scene.objects[x].values()
+            if not any(math.dist(a.xy_m, det) < NEAR_M for a in objs):
+                return "its detection lies within reach of no object"
+            if any(math.dist(a.xy_m, box[1]) < NEAR_M for a in objs):
+                return "the track's box lies within reach of an object"
+        elif name == "DETECTION_OF_NOTHING":  # the detection itself lies within reach of no object (audit truth54)
+            on = f.false_output.on if f.false_output is not None else None
+            if on is not None and on.meas < len(src.scene.detections[x]):
+                det = src.scene.detections[x][on.meas].xy_m
+                if any(math.dist(a.xy_m, det) < NEAR_M for a in src.scene.objects[x].values()):
+                    return "its detection lies within reach of an object"
         elif name == "OFF_OBJECT":
             box = src.box(x, f.lost.track_id)
             if box is None or xy is None or math.hypot(box[1][0] - xy[0], box[1][1] - xy[1]) < NEAR_M:

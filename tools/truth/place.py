@@ -21,6 +21,15 @@ against the annotation files and the devkit's own boxes.
   object": T's submitted box lies D m (2 m or more) from H's annotation and 2 m or more from the box the devkit
   scored H at; "…, on mN, E m from the box the evaluation interpolated for it": the devkit did not keep H's
   annotation there and scored a box E m (under 2 m) from T's;
+* a false box on detection mN "…: a detection of no tracked object": no annotation of a tracked class lies within
+  2 m of mN either; "…within 2 m of the box, but mN lay D m from C GT H: the track's box lay E m from that
+  object": mN lies D m from H, of class C, and the box E m (audit truth54, dev set scene-0103 pointpillars jpda
+  false_track:19: a bicycle detection 1.98 m from a bicycle called a detection of no tracked object);
+* a false track's "C GT H lies D m away, but the evaluation has no box for it here (WHY)": the devkit neither kept
+  H's annotation at the frame nor interpolated one; "it had no LiDAR or radar points" only of a box with none; "it
+  keeps none of its boxes after frame L" / "before frame R" / "at any frame": L and R are the nearest frames before
+  and after at which it kept H's box, and there is none on the other side (audit truth54, dev set: "no box of it
+  both before and after this frame" of an object whose boxes it kept from the next frame on, misleading);
 * a false track's "C GT H lies D m away, but the evaluation has it interpolated O m from the annotation, out of the
   track's reach" cites nuscenes-devkit issue #1141 as "(see …)" only where the box interpolated the right way lies
   within 2 m of the false box, says "weighted the right way (…) it would still lie E m from the track" only where it
@@ -105,6 +114,65 @@ def check_out_of_reach(text: str, c: str, x: int, gt_id: str | None, scene, ev, 
         near = [t for t, cls, xy in ev.boxes.get(x, []) if cls == c and math.dist(xy, a.xy_m) < NEAR_M]
         if near:
             bad("output", NOT_CARRIED, f"tracks {near} were output within 2 m of it at frame {x}")
+
+
+OF_NOTHING = re.compile(
+    r"at frame (\d+) track (\d+) \(\w+\) was output (?:on|[\d.]+ m from) detection m(\d+) \([^()]*\)[^;]*; no object "
+    r"of a tracked class lies within 2 m(?:: a detection of no tracked object| of the box, but m\d+ lay ([\d.]+) m "
+    r"from (\w+) GT (\w{6}): the track's box lay ([\d.]+) m from that object, beyond the evaluation's 2 m)"
+)
+
+
+def check_of_nothing(text: str, scene, ev, out, bad) -> None:
+    """A false box on a detection with no object within 2 m of the box (module docstring)."""
+    for m in OF_NOTHING.finditer(text):
+        x, t, j = int(m[1]), m[2], int(m[3])
+        if scene is None or x >= len(scene.detections) or j >= len(scene.detections[x]):
+            continue
+        out.checked["detector"] += 1
+        d = scene.detections[x][j].xy_m
+        near = sorted((_d(a.xy_m, d), k, a.class_name) for k, a in scene.objects[x].items())
+        if m[4] is None:
+            if near and near[0][0] < NEAR_M:
+                bad("detector", m[0], f"m{j} lies {near[0][0]:.3f} m from {near[0][2]} GT {near[0][1][:6]}")
+            continue
+        hit = scene.object_of(x, m[6])
+        box = next((xy for tt, _, xy in ev.boxes.get(x, []) if tt == t), None)
+        if hit is None or box is None or hit[1].class_name != m[5] or not near or near[0][1] != hit[0]:
+            bad("detector", m[0], f"the annotations nearest m{j}: {near[:2]}")
+        elif abs(_d(hit[1].xy_m, d) - float(m[4])) > 0.006 or abs(_d(hit[1].xy_m, box) - float(m[7])) > 0.006:
+            bad("detector", m[0], f"m{j} {_d(hit[1].xy_m, d):.3f} m, the box {_d(hit[1].xy_m, box):.3f} m from it")
+
+
+NO_BOX = re.compile(
+    r"\w+ GT (\w{6}) lies \d+\.\d m away, but the evaluation has no box for it here \((it had no LiDAR or radar "
+    r"points)?[^()]*?(?:, and (?:(it keeps no box of it both before and after this frame)|it keeps none of its "
+    r"boxes (?:after frame (\d+)|before frame (\d+)|at any frame)[^()]*))?\): a track on it is false"
+)
+
+
+def check_no_box(text: str, x: int, scene, ev, out, bad) -> None:
+    """A false track's "…, but the evaluation has no box for it here (WHY)" (module docstring) at frame ``x``."""
+    for m in NO_BOX.finditer(text):
+        hit = scene.object_of(x, m[1]) if scene is not None else None
+        if hit is None:
+            continue
+        out.checked["evaluation"] += 1
+        gt_id, a = hit
+        if (x, gt_id) in ev.kept_gt or (x, gt_id) in ev.evaluated_gt:
+            bad("evaluation", m[0], f"the devkit scored a box of GT {m[1]} at frame {x}")
+            continue
+        if m[2] is not None and a.points > 0:
+            bad("evaluation", m[0], f"GT {m[1]} has {a.points} LiDAR and radar points at frame {x}")
+        if m[3] is None and m[4] is None and m[5] is None and "at any frame" not in m[0]:
+            continue
+        kept = sorted(y for y, k in ev.kept_gt if k == gt_id)
+        before = max((y for y in kept if y < x), default=None)
+        after = min((y for y in kept if y > x), default=None)
+        out.checked["misleading"] += 1
+        said = (int(m[4]) if m[4] else None, int(m[5]) if m[5] else None)
+        if m[3] is not None or said != (before, after):
+            bad("misleading", m[0], f"the devkit kept its box last before frame {x} at {before}, first after {after}")
 
 
 NONE_OF_ITS_OWN = re.compile(rf"the detector gave GT (\w{{6}}) no detection of its own within 2 m \({POINTS}\)")

@@ -181,6 +181,16 @@ COALESCED = re.compile(
     r"the evaluation interpolated for it in its place )?was matched to "
     r"(GT \w+(?:, GT \w+)*) and also lay within"
 )
+ALSO_NEAR = re.compile(
+    r"at frame (\d+) track (\d+) .{0,200}?and also lay within 2 m of GT (\w{6}), (?:which no counted track "
+    r"covered|which the evaluation matched to no track((?:,| and) (?:though counted )?track \d+ lay [\d.]+ m from it "
+    r"\(matched to GT \w{6}\))*)"
+)
+"""A coalescence's second object: matched to no track; every other counted track the submission has within 2 m of
+its annotation that the devkit matched to another object named, with that object (audit truth54, dev set
+scene-0061 centerpoint jpda: "which no counted track covered" said of a pedestrian with counted track 72 0.9 m
+from it, matched to a third pedestrian)."""
+ALSO_ITEM = re.compile(r"track (\d+) lay ([\d.]+) m from it \(matched to GT (\w{6})\)")
 MATCHED_INSTEAD = re.compile(r"the evaluation matched it to another track \(track (\d+)\)")
 NOT_COUNTED = re.compile(
     r"track (\d+) was output on it(?: \(score [\d.]+\))?, but [^:]*?: the evaluation did not count it"
@@ -253,6 +263,8 @@ def check_text(
     place.check_reach_1141(text, ctx.frame, _place(replace(ctx, gt_id=None), ev, scene), scene, ev, out, bad)
     place.check_interpolated(text, ctx.frame, ctx.gt_id, ev, out, bad)
     place.check_out_of_reach(text, c, ctx.frame, ctx.gt_id, scene, ev, out, bad)
+    place.check_no_box(text, ctx.frame, scene, ev, out, bad)
+    place.check_of_nothing(text, scene, ev, out, bad)
     place.check_off(text, scene, ev, out, bad)
     place.check_none_of_its_own(text, ctx.frame, scene, out, bad)
     check_dropped(text, ctx, ev, out, bad)
@@ -744,6 +756,8 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad, scene: 
             got = ev.matched_track(c, x, g)
             if got != t:
                 bad("matched", m[0], f"the devkit matched GT {g[:6]} at frame {x} to {got}")
+    if scene is not None:
+        _check_also_near(text, c, ev, scene, out, bad)
     for m in MATCHED_INSTEAD.finditer(text):
         out.checked["matched"] += 1
         got = ev.matched_track(c, ctx.frame, ctx.gt_id or "")
@@ -753,6 +767,35 @@ def _check_eval(text: str, ctx: Context, ev: EvalFacts, out: Tally, bad, scene: 
         out.checked["matched"] += 1
         if m[1] in ev.counted.get(c, set()):
             bad("matched", m[0], f"track {m[1]} passes the {c} threshold {ev.thresholds.get(c)}")
+
+
+def _check_also_near(text: str, c: str, ev: EvalFacts, scene: SceneTruth, out: Tally, bad) -> None:
+    """``ALSO_NEAR``: the object matched to no track at the frame, the named tracks and no other left unsaid."""
+    for m in ALSO_NEAR.finditer(text):
+        x, t = int(m[1]), m[2]
+        hit = scene.object_of(x, m[3])
+        if hit is None:
+            continue
+        gt_id, a = hit
+        out.checked["matched"] += 1
+        if ev.matched_track(c, x, gt_id) is not None:
+            bad("matched", m[0], f"the devkit matched GT {m[3]} at frame {x} to track {ev.matched_track(c, x, gt_id)}")
+        near = {
+            k: math.dist(xy, a.xy_m)
+            for k, cls, xy in ev.boxes.get(x, [])
+            if cls == c and k != t and k in ev.counted.get(c, set()) and math.dist(xy, a.xy_m) < NEAR_M
+        }
+        near = {k: d for k, d in near.items() if (g := ev.matched_gt(c, x, k)) is not None and g != gt_id}
+        said = {i[1]: i for i in ALSO_ITEM.finditer(m[4] or "")}
+        for k, i in said.items():
+            out.checked["matched"] += 1
+            g = ev.matched_gt(c, x, k)
+            if k not in near or f"{near[k]:.1f}" != i[2] or g is None or not g.startswith(i[3]):
+                bad("matched", i[0], f"counted tracks within 2 m matched elsewhere: {near}; track {k} matched to {g}")
+        out.checked["misleading"] += 1
+        if set(near) - set(said):
+            unsaid = {k: f"{d:.2f} m, matched to {(ev.matched_gt(c, x, k) or '')[:6]}" for k, d in near.items()}
+            bad("misleading", m[0], f"counted tracks within 2 m of GT {m[3]} left unsaid: {unsaid}")
 
 
 def _place(ctx: Context, ev: EvalFacts, scene: SceneTruth | None) -> tuple[float, float] | None:
