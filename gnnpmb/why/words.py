@@ -1243,10 +1243,10 @@ def _kept_sides_text(kept: tuple[int | None, int | None] | None) -> str:
         return "no box could be interpolated"
     before, after = kept
     if before is not None and after is None:
-        return f"it keeps none of its boxes after frame {before} to interpolate one from"
+        return f"the evaluation keeps none of its boxes after frame {before} to interpolate one from"
     if after is not None and before is None:
-        return f"it keeps none of its boxes before frame {after} to interpolate one from"
-    return "it keeps none of its boxes at any frame" if before is None else "no box could be interpolated"
+        return f"the evaluation keeps none of its boxes before frame {after} to interpolate one from"
+    return "the evaluation keeps none of its boxes at any frame" if before is None else "no box could be interpolated"
 
 
 def _covering(f: Finding, s: Sighting) -> str:

@@ -103,12 +103,12 @@ def test_no_box_of_an_object_on_one_side_only_told_as_on_neither_is_caught() -> 
         return [c.kind for c in check_text(f"{head}{why}): a track on it is false", ctx, None, ev, scene=scene).found]
 
     assert kinds("it keeps no box of it both before and after this frame") == ["misleading"]
-    assert kinds("it keeps none of its boxes before frame 3 to interpolate one from") == []
-    assert kinds("it keeps none of its boxes after frame 1 to interpolate one from") == ["misleading"]
-    assert kinds("it keeps none of its boxes at any frame") == ["misleading"]
+    assert kinds("the evaluation keeps none of its boxes before frame 3 to interpolate one from") == []
+    assert kinds("the evaluation keeps none of its boxes after frame 1 to interpolate one from") == ["misleading"]
+    assert kinds("the evaluation keeps none of its boxes at any frame") == ["misleading"]
     ev.kept_gt = {(1, moto), (3, moto)}  # kept on both sides: the devkit interpolated a box here
     ev.evaluated_gt[(2, moto)] = (40.1, 0.0)
-    assert kinds("it keeps none of its boxes before frame 3 to interpolate one from") == ["evaluation"]
+    assert kinds("the evaluation keeps none of its boxes before frame 3 to interpolate one from") == ["evaluation"]
 
 
 def test_a_detection_within_2_m_of_an_object_called_a_detection_of_no_tracked_object_is_caught() -> None:

@@ -26,10 +26,11 @@ against the annotation files and the devkit's own boxes.
   object": mN lies D m from H, of class C, and the box E m (audit truth54, dev set scene-0103 pointpillars jpda
   false_track:19: a bicycle detection 1.98 m from a bicycle called a detection of no tracked object);
 * a false track's "C GT H lies D m away, but the evaluation has no box for it here (WHY)": the devkit neither kept
-  H's annotation at the frame nor interpolated one; "it had no LiDAR or radar points" only of a box with none; "it
-  keeps none of its boxes after frame L" / "before frame R" / "at any frame": L and R are the nearest frames before
-  and after at which it kept H's box, and there is none on the other side (audit truth54, dev set: "no box of it
-  both before and after this frame" of an object whose boxes it kept from the next frame on, misleading);
+  H's annotation at the frame nor interpolated one; "it had no LiDAR or radar points" only of a box with none;
+  "the evaluation keeps none of its boxes after frame L" / "before frame R" / "at any frame": L and R are the
+  nearest frames before and after at which it kept H's box, and there is none on the other side (audit truth54,
+  dev set: "no box of it both before and after this frame" of an object whose boxes it kept from the next frame
+  on, misleading);
 * a false track's "C GT H lies D m away, but the evaluation has it interpolated O m from the annotation, out of the
   track's reach" cites nuscenes-devkit issue #1141 as "(see …)" only where the box interpolated the right way lies
   within 2 m of the false box, says "weighted the right way (…) it would still lie E m from the track" only where it
@@ -146,8 +147,8 @@ def check_of_nothing(text: str, scene, ev, out, bad) -> None:
 
 NO_BOX = re.compile(
     r"\w+ GT (\w{6}) lies \d+\.\d m away, but the evaluation has no box for it here \((it had no LiDAR or radar "
-    r"points)?[^()]*?(?:, and (?:(it keeps no box of it both before and after this frame)|it keeps none of its "
-    r"boxes (?:after frame (\d+)|before frame (\d+)|at any frame)[^()]*))?\): a track on it is false"
+    r"points)?[^()]*?(?:, and (?:(it keeps no box of it both before and after this frame)|the evaluation keeps none "
+    r"of its boxes (?:after frame (\d+)|before frame (\d+)|at any frame)[^()]*))?\): a track on it is false"
 )
 
 

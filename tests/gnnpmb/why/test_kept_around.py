@@ -29,9 +29,9 @@ def _text(kept: tuple[int | None, int | None]) -> str:
 @pytest.mark.parametrize(
     ("kept", "said"),
     [
-        ((None, 14), "it keeps none of its boxes before frame 14 to interpolate one from"),
-        ((8, None), "it keeps none of its boxes after frame 8 to interpolate one from"),
-        ((None, None), "it keeps none of its boxes at any frame"),
+        ((None, 14), "the evaluation keeps none of its boxes before frame 14 to interpolate one from"),
+        ((8, None), "the evaluation keeps none of its boxes after frame 8 to interpolate one from"),
+        ((None, None), "the evaluation keeps none of its boxes at any frame"),
     ],
 )
 def test_the_side_the_evaluation_kept_no_box_on_is_named(kept, said) -> None:
