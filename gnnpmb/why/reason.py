@@ -10,7 +10,7 @@ checks (``claims``) read the same data.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -817,8 +817,8 @@ class _Context:
             box = next(b for b in self.failure.boxes if b.role == "false track")
             xy = np.asarray(box.translation_m[:2])
             kept = ev.kept if ev is not None else ()
-            before, after = [x for x in kept if x < self.f], [x for x in kept if x > self.f]
-            between = (before[-1], after[0]) if before and after else None
+            before, after = around(kept, self.f)
+            between = (before, after) if before is not None and after is not None else None
             e = None  # the box scored is not the tracker's
         fr = self.frames.get(self.f)
         on = None
@@ -847,6 +847,7 @@ class _Context:
         if d.size and d.min() < NEAR_M:
             k = int(np.argmin(d))
             nearest_any = (str(gt.instance_id[k]), str(gt.class_name[k]), float(d[k]))
+        near_detection = self.detection_near(on, xy) if nearest_any is None and on is not None else None
         blame: list[Blame] = []
         if interpolated:
             blame.append(Blame(Rule.TRACK_INTERPOLATED, (self.f,)))
@@ -872,7 +873,7 @@ class _Context:
             blame.append(Blame(Rule.COASTED, (self.f,)))
         elif nearest_any is not None:
             blame.append(Blame(Rule.OTHER_CLASS, (self.f,)))
-        elif on is not None and self.detection_near(on, xy) is not None:  # its detection was the object's (truth54)
+        elif near_detection is not None:  # its detection was the object's (truth54)
             blame.append(Blame(Rule.OFF_OBJECT, (self.f,)))
         else:
             blame.append(Blame(Rule.DETECTION_OF_NOTHING, (self.f,)))
@@ -895,7 +896,7 @@ class _Context:
             came,
             drifted,
             self.untracked_nearer(self.f, xy, nearest_own[1]) if nearest_own is not None else None,
-            self.detection_near(on, xy) if nearest_any is None and on is not None else None,
+            near_detection,
             self.kept_around(nearest_own[0]) if any(b.rule is Rule.NO_EVAL_BOX for b in blame) else None,
         )
         return {"deciding": (self.f,), "blame": tuple(blame), "false_output": output}
@@ -916,10 +917,7 @@ class _Context:
     def kept_around(self, gt_id: str) -> tuple[int | None, int | None]:
         """The last frame before this one and the first after it at which the evaluation kept the object's
         annotated box (None: none on that side): the ends its interpolation would join."""
-        kept = sorted(x for x, g in self.report.gt_frames.get(gt_id, {}).items() if g.dropped is None)
-        before = [x for x in kept if x < self.f]
-        after = [x for x in kept if x > self.f]
-        return (before[-1] if before else None, after[0] if after else None)
+        return around((x for x, g in self.report.gt_frames.get(gt_id, {}).items() if g.dropped is None), self.f)
 
     @staticmethod
     def false_at(report: FailureReport, frame: int, track_id: int) -> bool:
@@ -1111,6 +1109,15 @@ def matched_away(evaluated: TrackEval | None, gt_id: str, since: int | None, fra
         if since < x <= frame and g != gt_id:
             frames.setdefault(g, []).append(x)
     return tuple(MatchedAway(g, tuple(xs)) for g, xs in frames.items())
+
+
+def around(frames: Iterable[int], frame: int) -> tuple[int | None, int | None]:
+    """The last of ``frames`` before ``frame`` and the first after it (None: none on that side)."""
+    ordered = sorted(frames)
+    return (
+        next((x for x in reversed(ordered) if x < frame), None),
+        next((x for x in ordered if x > frame), None),
+    )
 
 
 def object_frames(

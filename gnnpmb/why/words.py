@@ -1443,7 +1443,7 @@ def _of_its_own(s: Sighting) -> str:
 
 
 def _also_near(f: Finding, s: Sighting | None, t: int) -> str:
-    """``, though counted track 72 lay 0.9 m from it too (matched to GT daa05e)``: the other counted tracks output
+    """``, though counted track 72 lay 0.9 m from it (matched to GT daa05e)``: the other counted tracks output
     within ``NEAR_M`` of a coalescence's object that the evaluation matched to another object at the frame (audit
     truth54, dev set scene-0061 centerpoint jpda: three pedestrians, two tracks; "no counted track covered" it, said
     with a counted track 0.9 m from it)."""
